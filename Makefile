@@ -1,0 +1,79 @@
+# rt - a data-oriented CPU renderer.
+#
+#   make              build ./rt (installs missing Debian packages first)
+#   make test         build and run the test suite
+#   make asan         the test suite under AddressSanitizer + UBSan
+#   make tsan         the threaded tests under ThreadSanitizer
+#   make profile      ./rt-profile: optimised, with symbols and frame pointers (for perf)
+#   make scenes       render every scene in scenes/ into docs/images/
+#   make clean
+#
+# Variables: WERROR=1 turns warnings into errors (CI sets it); SHARED=dir
+# points the tests at the shared assets (default ../shared).
+
+CC      ?= cc
+OPT     ?= -O2 -march=native
+WARN    := -Wall -Wextra -Wpedantic -Wshadow
+ifeq ($(WERROR),1)
+WARN    += -Werror
+endif
+CFLAGS  ?=
+CFLAGS  += -std=c11 $(WARN) $(OPT) -Iinclude -D_POSIX_C_SOURCE=200809L -MMD -MP
+LDLIBS  := -lstb -lpthread -lm
+BUILD   ?= build
+SHARED  ?= ../shared
+RT      ?= rt
+
+LIB_SRC  := $(filter-out src/main.c,$(wildcard src/*.c))
+LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
+TEST_SRC := $(wildcard tests/test_*.c)
+TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
+DEPS_OK  := $(BUILD)/.deps-ok
+
+.PHONY: all test asan tsan profile scenes clean deps
+all: $(RT)
+
+deps: $(DEPS_OK)
+$(DEPS_OK): tools/install-deps.sh
+	@mkdir -p $(BUILD)
+	@CC="$(CC)" sh tools/install-deps.sh
+	@touch $@
+
+$(BUILD)/obj/%.o: src/%.c | $(DEPS_OK)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -c -o $@ $<
+
+$(BUILD)/librt.a: $(LIB_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
+$(RT): $(BUILD)/obj/main.o $(BUILD)/librt.a
+	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
+
+$(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Itests -o $@ $< $(BUILD)/librt.a $(LDLIBS) -lcmocka
+
+test: $(RT) $(TEST_BIN)
+	@RT_SHARED=$(SHARED) RT_BIN=./$(RT) sh tests/run.sh $(TEST_BIN)
+
+# Sanitizer builds live in their own directories so they never mix objects.
+asan:
+	$(MAKE) --no-print-directory BUILD=build-asan RT=build-asan/rt \
+		OPT="-O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all" test
+
+tsan:
+	$(MAKE) --no-print-directory BUILD=build-tsan RT=build-tsan/rt OPT="-O1 -g -fsanitize=thread" test
+
+profile:
+	$(MAKE) --no-print-directory BUILD=build-profile RT=rt-profile OPT="-O2 -march=native -g -fno-omit-frame-pointer"
+
+SCENES := $(wildcard scenes/*.txt)
+scenes: $(RT)
+	@mkdir -p docs/images
+	@for s in $(SCENES); do n=$$(basename $$s .txt); echo "rendering $$s"; ./rt -q -o docs/images/$$n.png $$s || exit 1; done
+
+clean:
+	rm -rf build build-asan build-tsan build-profile rt rt-profile
+
+-include $(LIB_OBJ:.o=.d) $(BUILD)/obj/main.d

@@ -1,0 +1,35 @@
+/* rt/gltf.h - glTF 2.0 (.gltf, .glb) into the scene's tables.
+ *
+ * Our own loader on the jsmn tokenizer, built the way cgltf is built: the
+ * JSON is tokenized once, mapped to flat arrays of records (buffers,
+ * bufferViews, accessors, meshes, nodes, materials, ...) with index cross
+ * references, validated, then flattened into the scene: every triangle
+ * primitive of the chosen scene with each node's world transform applied.
+ *
+ *   rt_gltf_options opt = {0};          // zero = defaults: default scene
+ *   if (rt_gltf_load(&scene, "helmet.glb", &opt, &stats, &err) != RT_OK) ...
+ */
+#ifndef RT_GLTF_H
+#define RT_GLTF_H
+
+#include <stdbool.h>
+
+#include "rt/error.h"
+#include "rt/scene.h"
+
+typedef struct rt_gltf_options {
+    int scene_index;       /* which glTF scene, when use_scene_index; otherwise the file's default */
+    bool use_scene_index;
+    rt_mat4 transform;     /* applied on top of the node transforms */
+    bool use_transform;    /* false = identity */
+} rt_gltf_options;
+
+typedef struct rt_gltf_stats {
+    size_t triangles, meshes, primitives, materials, textures, images, cameras, lights, nodes;
+    rt_box bounds;         /* world bounds of the loaded triangles */
+} rt_gltf_stats;
+
+rt_result rt_gltf_load(rt_scene *s, const char *path, const rt_gltf_options *options, rt_gltf_stats *stats,
+                       rt_error *err);
+
+#endif

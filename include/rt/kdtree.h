@@ -1,0 +1,78 @@
+/* rt/kdtree.h - a flattened SAH kd-tree over every primitive of a scene.
+ *
+ * The tree is built once from a scene (triangles, spheres and quads in the
+ * scene's primitive id space, see scene.h) and then only read, from any
+ * number of threads at once.
+ *
+ *   rt_kdtree tree;
+ *   rt_error err;
+ *   if (rt_kdtree_build(&tree, &scene, NULL, &err) != RT_OK) ...
+ *   rt_hit hit;
+ *   if (rt_kdtree_intersect(&tree, &ray, &hit)) ... hit.t, hit.prim, hit.u, hit.v
+ *   bool blocked = rt_kdtree_occluded(&tree, &shadow_ray);
+ *   rt_kdtree_free(&tree);
+ *
+ * Layout: nodes of 8 bytes in one array (the below child is the next node),
+ * leaf primitive ids in a second array, triangles copied into
+ * structure-of-arrays buffers (v0, e1, e2) for the leaf loops. Build and
+ * traversal are described, with their sources, at the top of kdtree.c.
+ *
+ * The tree keeps a pointer to the scene (for spheres and quads): the scene
+ * must outlive it and must not gain primitives after the build.
+ */
+#ifndef RT_KDTREE_H
+#define RT_KDTREE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rt/error.h"
+#include "rt/intersect.h"
+#include "rt/scene.h"
+
+/* Build parameters; a zero field means "the default". */
+typedef struct rt_kdtree_params {
+    float traversal_cost; /* SAH cost of one traversal step */
+    float intersect_cost; /* SAH cost of one primitive test */
+    float empty_bonus;    /* fraction (0..1) by which a split with an empty side is cheaper */
+    int max_depth;        /* 0 = 8 + 1.3 log2(N) (pbrt's rule) */
+    int threads;          /* build threads; 0 = one */
+} rt_kdtree_params;
+
+typedef struct rt_kdtree_stats {
+    size_t nodes, leaves, empty_leaves;
+    size_t prim_refs;     /* primitive ids stored in leaves (with duplicates) */
+    size_t max_leaf_prims;
+    int depth;
+    double build_ms;
+    size_t bytes;         /* nodes + leaf ids + triangle buffers */
+} rt_kdtree_stats;
+
+typedef struct rt_kdtree_node {
+    uint32_t a; /* interior: split position (float bits); leaf: first index into prim_ids (or the single prim) */
+    uint32_t b; /* low 2 bits: axis 0..2, or 3 = leaf; the rest: above-child index, or leaf prim count */
+} rt_kdtree_node;
+
+typedef struct rt_kdtree {
+    rt_kdtree_node *nodes;
+    size_t node_count;
+    uint32_t *prim_ids;
+    size_t prim_id_count;
+    /* triangle buffers, indexed by triangle id */
+    float *v0x, *v0y, *v0z, *e1x, *e1y, *e1z, *e2x, *e2y, *e2z;
+    size_t triangle_count, sphere_count, quad_count;
+    const rt_scene *scene;
+    rt_box bounds;
+    int max_depth;
+    rt_kdtree_stats stats;
+} rt_kdtree;
+
+rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err);
+void rt_kdtree_free(rt_kdtree *tree);
+
+/* Closest hit with t in (ray->tmin, ray->tmax). */
+bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit);
+/* Any hit with t in (ray->tmin, ray->tmax): for shadow rays. */
+bool rt_kdtree_occluded(const rt_kdtree *tree, const rt_ray *ray);
+
+#endif

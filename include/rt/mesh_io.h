@@ -1,0 +1,39 @@
+/* rt/mesh_io.h - triangle meshes from OBJ (+MTL), PLY and OFF files.
+ *
+ * rt_mesh_load() picks the reader by the file's extension and appends the
+ * mesh to the scene's tables with `transform` applied (positions by the
+ * matrix, normals by its inverse transpose, winding flipped when it
+ * mirrors). Materials come from the file where the format has them (OBJ's
+ * MTL; PLY vertex colours); `material` is used for faces without one, or
+ * for all faces when `override_material` is set.
+ *
+ *   rt_mat4 m = rt_mat4_translate(rt_v3(0, 1, 0));
+ *   if (rt_mesh_load(&scene, "bunny.ply", &m, mat, false, &err) != RT_OK) ...
+ *
+ * Errors name the file and the line (text formats) or byte offset (binary
+ * PLY). Nothing asserts on input.
+ */
+#ifndef RT_MESH_IO_H
+#define RT_MESH_IO_H
+
+#include <stdbool.h>
+
+#include "rt/error.h"
+#include "rt/scene.h"
+
+typedef struct rt_mesh_load_stats {
+    size_t triangles, vertices, materials, skipped_faces;
+} rt_mesh_load_stats;
+
+rt_result rt_mesh_load(rt_scene *s, const char *path, const rt_mat4 *transform, uint32_t material,
+                       bool override_material, rt_mesh_load_stats *stats, rt_error *err);
+
+/* The format readers, also callable directly. */
+rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, uint32_t material,
+                      bool override_material, rt_mesh_load_stats *stats, rt_error *err);
+rt_result rt_ply_load(rt_scene *s, const char *path, const rt_mat4 *transform, uint32_t material,
+                      bool override_material, rt_mesh_load_stats *stats, rt_error *err);
+rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, uint32_t material,
+                      bool override_material, rt_mesh_load_stats *stats, rt_error *err);
+
+#endif

@@ -1,0 +1,66 @@
+/* test_util.h - shared helpers for the cmocka tests.
+ *
+ * Tests include <cmocka.h> through this header. Paths: the repository root is
+ * the working directory (make test runs there); shared assets are found at
+ * $RT_SHARED (default ../shared), and tests that need them skip with a clear
+ * message when they are absent.
+ */
+#ifndef RT_TEST_UTIL_H
+#define RT_TEST_UTIL_H
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <cmocka.h>
+
+/* Path of a file under the shared directory, in a static buffer (one at a time). */
+static inline const char *test_shared_path(const char *rel)
+{
+    static char buf[4096];
+    const char *root = getenv("RT_SHARED");
+    snprintf(buf, sizeof buf, "%s/%s", root && *root ? root : "../shared", rel);
+    return buf;
+}
+
+/* True when the shared assets exist; otherwise prints why the test is skipped. */
+static inline int test_have_shared(void)
+{
+    struct stat st;
+    const char *p = test_shared_path("assets/MANIFEST.md");
+    if (stat(p, &st) == 0)
+        return 1;
+    fprintf(stderr, "note: shared assets not found at %s (set RT_SHARED); skipping\n", p);
+    return 0;
+}
+
+/* Writes `text` to a fresh temporary file and returns its path (static buffer per call site's copy). */
+static inline void test_write_file(const char *path, const void *data, size_t size)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    if (size)
+        assert_int_equal(fwrite(data, 1, size, f), size);
+    fclose(f);
+}
+
+/* A small deterministic PRNG for test data (xorshift64*). */
+typedef struct test_rng { uint64_t s; } test_rng;
+static inline uint64_t test_rng_next(test_rng *r)
+{
+    r->s ^= r->s >> 12;
+    r->s ^= r->s << 25;
+    r->s ^= r->s >> 27;
+    return r->s * 2685821657736338717ull;
+}
+static inline float test_rng_float(test_rng *r) /* [0, 1) */
+{
+    return (float)(test_rng_next(r) >> 40) * (1.0f / 16777216.0f);
+}
+
+#endif
