@@ -76,7 +76,8 @@ void *rt_realloc_array(void *p, size_t count, size_t size)
 {
     if (size && count > SIZE_MAX / size)
         return NULL;
-    return realloc(p, count * size ? count * size : 1);
+    size_t bytes = count * size;
+    return realloc(p, bytes ? bytes : 1);
 }
 
 int rt_grow(void **p, size_t *cap, size_t need, size_t size)
