@@ -1,0 +1,439 @@
+/* main.c - the `rt` command: parse flags, load a scene or model, build the
+ * kd-tree, render on all cores, write the image.
+ *
+ * Exit status: 0 on success, 2 for bad input (flags, scene files, models,
+ * images, an unwritable output), 130 when interrupted (the finished tiles
+ * are still written). Every failure says what and where on stderr, and never
+ * leaves a partial file over an existing image.
+ */
+#include <errno.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "rt/gltf.h"
+#include "rt/image.h"
+#include "rt/kdtree.h"
+#include "rt/mesh_io.h"
+#include "rt/render.h"
+#include "rt/scene.h"
+#include "rt/scene_parse.h"
+
+#define RT_VERSION "0.1.0"
+
+static atomic_int interrupted;
+
+static void on_signal(int sig)
+{
+    if (atomic_exchange(&interrupted, 1)) {
+        /* second Ctrl-C: leave at once */
+        signal(sig, SIG_DFL);
+        raise(sig);
+    }
+}
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off]\n"
+            "\n"
+            "Renders a scene to an image. With no input, renders the built-in Cornell box to out.png.\n"
+            "\n"
+            "options:\n"
+            "  -o FILE            output image: .png (8-bit sRGB), .pfm (linear float), .hdr (Radiance)\n"
+            "                     default: the scene's `output`, else INPUT-NAME.png in this directory\n"
+            "  -t N               render threads (default: all %d cores)\n"
+            "  -s N               samples per pixel (overrides the scene)\n"
+            "  -r WxH             resolution, e.g. -r 1280x720 (overrides the scene)\n"
+            "  -q                 quiet: no progress bar, no warnings\n"
+            "  -v                 verbose: scene statistics, kd-tree build, render time, rays per second\n"
+            "  --integrator NAME  direct, whitted or path (overrides the scene)\n"
+            "  --camera N         use camera N of the loaded glTF models\n"
+            "  --seed N           random seed (default: the scene's, else 0)\n"
+            "  --tile N           tile size in pixels (default 32)\n"
+            "  --preview SECONDS  live view: rewrite the output with the finished tiles every SECONDS\n"
+            "  --info FILE        print what a scene or model contains (key: value lines) and exit\n"
+            "  -h, --help         this text\n"
+            "  --version          print the version\n"
+            "\n"
+            "Scene format: docs/scene-format.md. Exit status: 0 ok, 2 bad input, 130 interrupted.\n",
+            rt_cpu_count());
+}
+
+static int fail_usage(const char *fmt, const char *arg)
+{
+    fprintf(stderr, "rt: ");
+    fprintf(stderr, fmt, arg);
+    fprintf(stderr, "\nrt: see 'rt --help'\n");
+    return 2;
+}
+
+/* Strict integer parsing for flags: the whole string, in range. */
+static bool parse_int(const char *s, long lo, long hi, long *out)
+{
+    if (!s || !*s)
+        return false;
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || *end || v < lo || v > hi)
+        return false;
+    *out = v;
+    return true;
+}
+
+static bool parse_double(const char *s, double lo, double hi, double *out)
+{
+    if (!s || !*s)
+        return false;
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || *end || !(v >= lo && v <= hi))
+        return false;
+    *out = v;
+    return true;
+}
+
+static bool has_ext(const char *path, const char *ext)
+{
+    const char *dot = strrchr(path, '.');
+    const char *slash = strrchr(path, '/');
+    return dot && (!slash || dot > slash) && strcasecmp(dot, ext) == 0;
+}
+
+typedef enum input_kind { INPUT_SCENE, INPUT_GLTF, INPUT_MESH } input_kind;
+
+static input_kind input_kind_of(const char *path)
+{
+    if (has_ext(path, ".gltf") || has_ext(path, ".glb"))
+        return INPUT_GLTF;
+    if (has_ext(path, ".obj") || has_ext(path, ".ply") || has_ext(path, ".off"))
+        return INPUT_MESH;
+    return INPUT_SCENE;
+}
+
+/* Lighting for a bare model: a soft sky and a key light from above. */
+static void add_default_lighting(rt_scene *s)
+{
+    s->settings.background = rt_v3(0.55f, 0.6f, 0.7f);
+    if (s->light_count == 0) {
+        rt_light sun;
+        memset(&sun, 0, sizeof sun);
+        sun.kind = RT_LIGHT_DIRECTIONAL;
+        sun.color = rt_v3(1.0f, 0.96f, 0.9f);
+        sun.intensity = 2.5f;
+        sun.direction = rt_normalize(rt_v3(-0.4f, -1.0f, -0.6f));
+        sun.quad = RT_NONE;
+        rt_scene_add_light(s, &sun);
+    }
+}
+
+static rt_result load_input(rt_scene *s, const char *path, double *load_ms, rt_error *err)
+{
+    double t0 = now_ms();
+    rt_result r;
+    if (!path) {
+        r = rt_scene_parse_string(s, rt_default_scene_text, strlen(rt_default_scene_text), "<built-in scene>", NULL,
+                                  err);
+    } else {
+        switch (input_kind_of(path)) {
+        case INPUT_GLTF: {
+            rt_gltf_options opt;
+            memset(&opt, 0, sizeof opt);
+            rt_gltf_stats gs;
+            r = rt_gltf_load(s, path, &opt, &gs, err);
+            if (r == RT_OK) {
+                add_default_lighting(s);
+                if (s->camera_count) {
+                    s->camera = s->cameras[0];
+                    s->camera_set = true;
+                }
+            }
+            break;
+        }
+        case INPUT_MESH: {
+            rt_material m;
+            rt_material_default(&m, "default");
+            uint32_t mi = rt_scene_add_material(s, &m);
+            rt_mat4 id = rt_mat4_identity();
+            rt_mesh_load_stats ms;
+            r = mi == RT_NONE ? rt_fail(err, RT_ERR_NOMEM, "out of memory")
+                              : rt_mesh_load(s, path, &id, mi, false, &ms, err);
+            if (r == RT_OK)
+                add_default_lighting(s);
+            break;
+        }
+        case INPUT_SCENE:
+        default:
+            r = rt_scene_parse_file(s, path, err);
+            break;
+        }
+    }
+    *load_ms = now_ms() - t0;
+    return r;
+}
+
+/* Output name: -o, else the scene's `output`, else the input's base name
+ * with .png, in the current directory. */
+static void default_output(const rt_scene *s, const char *input, char *out, size_t size)
+{
+    if (s->settings.output[0]) {
+        snprintf(out, size, "%s", s->settings.output);
+        return;
+    }
+    if (!input) {
+        snprintf(out, size, "out.png");
+        return;
+    }
+    const char *base = strrchr(input, '/');
+    base = base ? base + 1 : input;
+    const char *dot = strrchr(base, '.');
+    int len = dot && dot != base ? (int)(dot - base) : (int)strlen(base);
+    snprintf(out, size, "%.*s.png", len, base);
+}
+
+static int print_info(const char *path)
+{
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_error err = {0};
+    double ms;
+    rt_result r = load_input(&s, path, &ms, &err);
+    if (r != RT_OK) {
+        fprintf(stderr, "rt: %s\n", err.message);
+        rt_scene_free(&s);
+        return 2;
+    }
+    rt_box b = rt_scene_bounds(&s);
+    printf("file: %s\n", path);
+    printf("triangles: %zu\n", s.triangles.count);
+    printf("vertices: %zu\n", s.vertices.count);
+    printf("spheres: %zu\n", s.spheres.count);
+    printf("quads: %zu\n", s.quads.count);
+    if (rt_box_is_empty(b))
+        printf("bounds: none\n");
+    else
+        printf("bounds: %.9g %.9g %.9g %.9g %.9g %.9g\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+    printf("materials: %zu\n", s.material_count);
+    printf("textures: %zu\n", s.texture_count);
+    printf("images: %zu\n", s.image_count);
+    for (size_t i = 0; i < s.image_count; i++)
+        printf("image.%zu: %dx%d %s\n", i, s.images[i].width, s.images[i].height, s.images[i].name);
+    printf("cameras: %zu\n", s.camera_count);
+    printf("lights: %zu\n", s.light_count);
+    printf("load_ms: %.3f\n", ms);
+    rt_scene_free(&s);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *input = NULL, *output = NULL, *integrator = NULL, *preview = NULL;
+    long threads = 0, samples = 0, width = 0, height = 0, camera = -1, seed = -1, tile = 0;
+    double preview_seconds = 0.0;
+    rt_log_level level = RT_LOG_NORMAL;
+
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *next = i + 1 < argc ? argv[i + 1] : NULL;
+#define NEED_ARG()                                                                                                     \
+    do {                                                                                                               \
+        if (!next)                                                                                                     \
+            return fail_usage("option %s needs a value", a);                                                         \
+        i++;                                                                                                           \
+    } while (0)
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            usage(stdout);
+            return 0;
+        } else if (strcmp(a, "--version") == 0) {
+            printf("rt %s\n", RT_VERSION);
+            return 0;
+        } else if (strcmp(a, "-o") == 0) {
+            NEED_ARG();
+            output = next;
+        } else if (strcmp(a, "-t") == 0) {
+            NEED_ARG();
+            if (!parse_int(next, 1, 1024, &threads))
+                return fail_usage("-t wants a thread count from 1 to 1024, got '%s'", next);
+        } else if (strcmp(a, "-s") == 0) {
+            NEED_ARG();
+            if (!parse_int(next, 1, 1 << 20, &samples))
+                return fail_usage("-s wants samples per pixel from 1 to 1048576, got '%s'", next);
+        } else if (strcmp(a, "-r") == 0) {
+            NEED_ARG();
+            char *x = strchr(next, 'x');
+            char wbuf[32];
+            if (!x || (size_t)(x - next) >= sizeof wbuf)
+                return fail_usage("-r wants WIDTHxHEIGHT, e.g. 640x480, got '%s'", next);
+            memcpy(wbuf, next, (size_t)(x - next));
+            wbuf[x - next] = 0;
+            if (!parse_int(wbuf, 1, 32768, &width) || !parse_int(x + 1, 1, 32768, &height))
+                return fail_usage("-r wants WIDTHxHEIGHT with sides from 1 to 32768, got '%s'", next);
+        } else if (strcmp(a, "-q") == 0) {
+            level = RT_LOG_QUIET;
+        } else if (strcmp(a, "-v") == 0) {
+            level = RT_LOG_VERBOSE;
+        } else if (strcmp(a, "--integrator") == 0) {
+            NEED_ARG();
+            if (strcmp(next, "direct") && strcmp(next, "whitted") && strcmp(next, "path"))
+                return fail_usage("--integrator wants direct, whitted or path, got '%s'", next);
+            integrator = next;
+        } else if (strcmp(a, "--camera") == 0) {
+            NEED_ARG();
+            if (!parse_int(next, 0, INT_MAX, &camera))
+                return fail_usage("--camera wants a camera index (0, 1, ...), got '%s'", next);
+        } else if (strcmp(a, "--seed") == 0) {
+            NEED_ARG();
+            if (!parse_int(next, 0, UINT32_MAX > LONG_MAX ? LONG_MAX : (long)UINT32_MAX, &seed))
+                return fail_usage("--seed wants a non-negative integer, got '%s'", next);
+        } else if (strcmp(a, "--tile") == 0) {
+            NEED_ARG();
+            if (!parse_int(next, 1, 4096, &tile))
+                return fail_usage("--tile wants a tile size from 1 to 4096, got '%s'", next);
+        } else if (strcmp(a, "--preview") == 0) {
+            NEED_ARG();
+            if (!parse_double(next, 0.1, 3600.0, &preview_seconds))
+                return fail_usage("--preview wants seconds between updates (0.1 to 3600), got '%s'", next);
+            preview = "";
+        } else if (strcmp(a, "--info") == 0) {
+            NEED_ARG();
+            rt_log_set_level(level);
+            return print_info(next);
+        } else if (a[0] == '-' && a[1] != 0) {
+            return fail_usage("unknown option '%s'", a);
+        } else {
+            if (input)
+                return fail_usage("only one input file, please (got a second: '%s')", a);
+            input = a;
+        }
+#undef NEED_ARG
+    }
+    rt_log_set_level(level);
+
+    rt_scene scene;
+    rt_scene_init(&scene);
+    rt_error err = {0};
+    double load_ms = 0;
+    if (load_input(&scene, input, &load_ms, &err) != RT_OK) {
+        fprintf(stderr, "rt: %s\n", err.message);
+        rt_scene_free(&scene);
+        return 2;
+    }
+    rt_settings *set = &scene.settings;
+    if (samples) set->samples = (int)samples;
+    if (width) set->width = (int)width, set->height = (int)height;
+    if (seed >= 0) set->seed = (uint32_t)seed;
+    if (integrator)
+        set->integrator = strcmp(integrator, "whitted") == 0 ? RT_INTEGRATOR_WHITTED
+                          : strcmp(integrator, "path") == 0  ? RT_INTEGRATOR_PATH
+                                                             : RT_INTEGRATOR_DIRECT;
+    if (camera >= 0) {
+        if ((size_t)camera >= scene.camera_count) {
+            fprintf(stderr, "rt: --camera %ld: the loaded models have %zu camera%s\n", camera, scene.camera_count,
+                    scene.camera_count == 1 ? "" : "s");
+            rt_scene_free(&scene);
+            return 2;
+        }
+        scene.camera = scene.cameras[camera];
+        scene.camera_set = true;
+    }
+    if (!scene.camera_set)
+        rt_scene_frame_camera(&scene);
+
+    char outbuf[1024];
+    if (!output) {
+        default_output(&scene, input, outbuf, sizeof outbuf);
+        output = outbuf;
+    }
+    if (rt_output_check(output, &err) != RT_OK) {
+        fprintf(stderr, "rt: %s\n", err.message);
+        rt_scene_free(&scene);
+        return 2;
+    }
+
+    rt_info("scene: %s (loaded in %.1f ms)", input ? input : "<built-in>", load_ms);
+    rt_info("  triangles %zu, spheres %zu, quads %zu, vertices %zu", scene.triangles.count, scene.spheres.count,
+            scene.quads.count, scene.vertices.count);
+    rt_info("  materials %zu, textures %zu, images %zu, lights %zu", scene.material_count, scene.texture_count,
+            scene.image_count, scene.light_count);
+    rt_info("  %dx%d, %d samples per pixel, integrator %s", set->width, set->height, set->samples,
+            set->integrator == RT_INTEGRATOR_WHITTED ? "whitted"
+            : set->integrator == RT_INTEGRATOR_PATH  ? "path"
+                                                     : "direct");
+
+    rt_kdtree tree;
+    if (rt_kdtree_build(&tree, &scene, NULL, &err) != RT_OK) {
+        fprintf(stderr, "rt: %s\n", err.message);
+        rt_scene_free(&scene);
+        return 2;
+    }
+    rt_info("kd-tree: built in %.1f ms: %zu nodes, %zu leaves (%zu empty), %zu references, depth %d, %.1f MiB",
+            tree.stats.build_ms, tree.stats.nodes, tree.stats.leaves, tree.stats.empty_leaves, tree.stats.prim_refs,
+            tree.stats.depth, (double)tree.stats.bytes / (1024.0 * 1024.0));
+
+    rt_framebuffer fb;
+    if (rt_framebuffer_init(&fb, set->width, set->height, &err) != RT_OK) {
+        fprintf(stderr, "rt: %s\n", err.message);
+        rt_kdtree_free(&tree);
+        rt_scene_free(&scene);
+        return 2;
+    }
+
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+
+    rt_render_options ro;
+    memset(&ro, 0, sizeof ro);
+    ro.threads = (int)threads;
+    ro.tile_size = (int)tile;
+    ro.progress = level >= RT_LOG_NORMAL;
+    ro.cancel = &interrupted;
+    ro.preview_path = preview ? output : NULL;
+    ro.preview_seconds = preview_seconds;
+    rt_render_stats rs;
+    rt_result r = rt_render(&scene, &tree, &ro, &fb, &rs, &err);
+    int status = 0;
+    if (r == RT_ERR_INTERRUPTED) {
+        fprintf(stderr, "rt: %s; writing the finished tiles to %s\n", err.message, output);
+        status = 130;
+    } else if (r != RT_OK) {
+        fprintf(stderr, "rt: %s\n", err.message);
+        status = 2;
+    }
+    if (status != 2) {
+        if (rt_framebuffer_write(&fb, output, set->exposure, &err) != RT_OK) {
+            fprintf(stderr, "rt: %s\n", err.message);
+            status = 2;
+        } else if (level >= RT_LOG_NORMAL) {
+            fprintf(stderr, "rt: wrote %s (%dx%d, %d spp, %.2f s)\n", output, fb.width, fb.height, set->samples,
+                    rs.seconds);
+        }
+    }
+    rt_info("render: %.3f s on %d threads, %llu camera rays, %llu rays, %.2f Mrays/s", rs.seconds, rs.threads,
+            (unsigned long long)rs.camera_rays, (unsigned long long)rs.rays,
+            rs.seconds > 0 ? 1e-6 * (double)rs.rays / rs.seconds : 0.0);
+    if (rs.bad_samples)
+        rt_warn("%llu NaN/Inf samples were dropped", (unsigned long long)rs.bad_samples);
+    rt_framebuffer_free(&fb);
+    rt_kdtree_free(&tree);
+    rt_scene_free(&scene);
+    return status;
+}
