@@ -1,0 +1,908 @@
+/* mesh_obj.c - Wavefront OBJ meshes with MTL materials.
+ *
+ * Reference: the Wavefront OBJ and MTL specifications (Alias|Wavefront,
+ * "Advanced Visualizer" manual, appendices B1 and B2), plus what real
+ * exporters write (Blender, MeshLab, 3ds Max, the Cornell box files).
+ *
+ * Algorithm: one pass over the file held in memory, line by line.
+ *   v/vt/vn append to raw attribute arrays (v may carry an "x y z r g b"
+ *   vertex colour, as MeshLab writes). A face corner "v", "v/vt", "v//vn" or
+ *   "v/vt/vn" (1-based, negative = relative to the end so far) becomes one
+ *   output vertex per distinct (v, vt, vn) triple: each position keeps a
+ *   short chain of the output vertices made from it, so the lookup costs a
+ *   step or two and no hashing. Polygons are triangulated as a fan from their
+ *   first corner; quads pick the diagonal that keeps both halves facing the
+ *   same way, so concave quads come out right (larger concave polygons do
+ *   not: fan only). Triangles that repeat a position are dropped and counted
+ *   in stats.skipped_faces.
+ *   usemtl names are resolved after the whole file (and every mtllib) is read,
+ *   so statement order does not matter; faces before any usemtl, and faces
+ *   whose name is unknown (warning), use the caller's material.
+ *   Each MTL material becomes an rt_material "<objfile>:<name>" starting
+ *   from rt_material_default(): Kd colour, Ks luminance as specular, Ns
+ *   shininess, Ni ior, d (or 1 - Tr) alpha, Ke emission, Tf transmission
+ *   colour, Pr/Pm roughness/metallic; illum 3/5 = mirror (reflectivity from
+ *   Ks, 1 when Ks is absent), illum 4/6/7 = refracting glass; map_Kd (sRGB
+ *   base colour) and map_Bump/bump/norm (normal map, -bm scale). Ka above 1
+ *   with no Ke is taken as emission (old Embree-style Cornell files mark the
+ *   light that way). Other texture options are skipped with a warning.
+ *   Unknown statements are warned about once per keyword per file.
+ *   `s` (smoothing groups), `o` and `g` are accepted and otherwise ignored:
+ *   smooth shading comes from the file's vertex normals.
+ * Errors: "path:line:col: ..." for malformed numbers, indices out of range,
+ * faces with fewer than 3 corners. A missing MTL or texture is a warning.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mesh_internal.h"
+#include "rt/mesh_io.h"
+#include "rt/texture.h"
+
+#define OBJ_NAME_MAX 128
+#define OBJ_PATH_MAX 4096
+
+typedef struct obj_mtl {
+    char name[OBJ_NAME_MAX];
+    rt_vec3 kd, ks, ke, ka, tf;
+    float ns, ni, alpha, pr, pm, bump_scale;
+    int illum;
+    bool has_kd, has_ks, has_ke, has_ka, has_tf, has_ns, has_ni, has_alpha, has_pr, has_pm;
+    char map_kd[OBJ_PATH_MAX];
+    char map_bump[OBJ_PATH_MAX];
+    char where[OBJ_PATH_MAX + 32]; /* "file.mtl:12", for texture warnings */
+} obj_mtl;
+
+typedef struct obj_slot { /* a name used by usemtl */
+    char name[OBJ_NAME_MAX];
+    long line;
+    uint32_t material; /* scene index once resolved */
+} obj_slot;
+
+typedef struct obj_parser {
+    const char *path;
+    char dir[OBJ_PATH_MAX];
+    rt_error *err;
+    /* raw attributes */
+    rt_vec3 *v; rt_vec3 *vc; size_t nv, vcap;
+    rt_vec2 *vt; size_t nvt, vtcap;
+    rt_vec3 *vn; size_t nvn, vncap;
+    uint32_t *first; /* per position: first output vertex made from it */
+    /* output vertices: (v, vt, vn) triples, chained per position */
+    uint32_t *ov, *ot, *on, *onext; size_t nout, outcap;
+    bool any_t, any_n;
+    /* face scratch */
+    uint32_t *corner_out, *corner_v; size_t ccap;
+    /* materials */
+    obj_mtl *mtls; size_t nmtl, mtlcap;
+    obj_slot *slots; size_t nslot, slotcap; /* slot 0 = the caller's material */
+    uint32_t cur_slot;
+    bool override_material;
+    rt_warn_once warned;
+    rt_mesh_buf buf;
+} obj_parser;
+
+/* ----------------------------------------------------------- lines */
+
+typedef struct line_ctx {
+    const char *file; /* for messages */
+    long line;
+    const char *start; /* of the line, for columns */
+} line_ctx;
+
+static int col_of(const line_ctx *lc, const char *at) { return (int)(at - lc->start) + 1; }
+
+static const char *skip_space(const char *p, const char *end)
+{
+    while (p < end && rt_mesh_is_space(*p))
+        p++;
+    return p;
+}
+
+static const char *token_end(const char *p, const char *end)
+{
+    while (p < end && !rt_mesh_is_space(*p))
+        p++;
+    return p;
+}
+
+static bool kw_is(const char *k, size_t klen, const char *want)
+{
+    size_t n = strlen(want);
+    return klen == n && memcmp(k, want, n) == 0;
+}
+
+/* The rest of a line, trimmed, as a bounded C string. false if it does not fit. */
+static bool rest_string(const char *p, const char *end, char *out, size_t size)
+{
+    p = skip_space(p, end);
+    while (end > p && rt_mesh_is_space(end[-1]))
+        end--;
+    size_t n = (size_t)(end - p);
+    if (n >= size)
+        return false;
+    memcpy(out, p, n);
+    out[n] = 0;
+    /* embedded NUL bytes would cut the string short; that only shortens it */
+    return true;
+}
+
+/* Parses up to max floats from [p, end); returns how many, or -1 after filling err. */
+static int parse_floats(const line_ctx *lc, const char *p, const char *end, float *out, int max, rt_error *err)
+{
+    int n = 0;
+    for (;;) {
+        p = skip_space(p, end);
+        if (p >= end)
+            return n;
+        const char *te = token_end(p, end);
+        if (n == max) {
+            rt_fail(err, RT_ERR_PARSE, "%s:%ld:%d: unexpected '%.*s' (at most %d numbers here)", lc->file, lc->line,
+                    col_of(lc, p), (int)(te - p > 40 ? 40 : te - p), p, max);
+            return -1;
+        }
+        bool nonfinite;
+        const char *q = rt_mesh_parse_float(p, te, &out[n], &nonfinite);
+        if (!q || q != te) {
+            rt_fail(err, RT_ERR_PARSE, "%s:%ld:%d: %s '%.*s'", lc->file, lc->line, col_of(lc, p),
+                    nonfinite ? "number is not finite:" : "malformed number", (int)(te - p > 40 ? 40 : te - p), p);
+            return -1;
+        }
+        n++;
+        p = te;
+    }
+}
+
+static void warn_unknown(rt_warn_once *w, const line_ctx *lc, const char *k, size_t klen)
+{
+    if (rt_warn_once_first(w, k, klen))
+        rt_warn("%s:%ld: ignoring unsupported statement '%.*s' (warned once per file)", lc->file, lc->line,
+                (int)(klen > 40 ? 40 : klen), k);
+}
+
+/* Calls fn(ctx, lc, p, eol) for each non-blank, non-comment line; stops on failure. */
+typedef rt_result (*line_fn)(void *ctx, line_ctx *lc, const char *p, const char *eol);
+
+static rt_result for_each_line(const char *file, const char *data, size_t size, line_fn fn, void *ctx)
+{
+    const char *p = data, *end = data + size;
+    line_ctx lc = {file, 0, data};
+    while (p < end) {
+        lc.line++;
+        const char *eol = memchr(p, '\n', (size_t)(end - p));
+        if (!eol)
+            eol = end;
+        const char *next = eol < end ? eol + 1 : end;
+        lc.start = p;
+        const char *q = skip_space(p, eol);
+        if (q < eol && *q != '#') {
+            rt_result r = fn(ctx, &lc, q, eol);
+            if (r != RT_OK)
+                return r;
+        }
+        p = next;
+    }
+    return RT_OK;
+}
+
+/* Cuts a line at a comment: '#' anywhere for numeric statements. */
+static const char *cut_comment(const char *p, const char *eol)
+{
+    const char *h = memchr(p, '#', (size_t)(eol - p));
+    return h ? h : eol;
+}
+
+/* For names and file names: only a '#' after whitespace starts a comment. */
+static const char *cut_comment_ws(const char *p, const char *eol)
+{
+    for (const char *q = p; q < eol; q++)
+        if (*q == '#' && (q == p || rt_mesh_is_space(q[-1])))
+            return q;
+    return eol;
+}
+
+/* ------------------------------------------------------------- MTL */
+
+typedef struct mtl_ctx {
+    obj_parser *op;
+    const char *mtl_path;
+    char mtl_dir[OBJ_PATH_MAX];
+    obj_mtl *cur;
+    rt_warn_once warned;
+} mtl_ctx;
+
+static rt_result mtl_color(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl, const char *p, const char *eol,
+                           rt_vec3 *out, bool *has)
+{
+    const char *q = skip_space(p, eol);
+    const char *te = token_end(q, eol);
+    if (kw_is(q, (size_t)(te - q), "spectral") || kw_is(q, (size_t)(te - q), "xyz")) {
+        warn_unknown(&mc->warned, lc, q, (size_t)(te - q));
+        return RT_OK;
+    }
+    float f[3];
+    int n = parse_floats(lc, p, cut_comment(p, eol), f, 3, mc->op->err);
+    if (n < 0)
+        return mc->op->err->code;
+    if (n != 1 && n != 3)
+        return rt_fail(mc->op->err, RT_ERR_PARSE, "%s:%ld: '%.*s' needs 1 or 3 numbers, got %d", lc->file, lc->line,
+                       (int)kl, kw, n);
+    *out = n == 1 ? rt_v3s(f[0]) : rt_v3(f[0], f[1], f[2]);
+    *has = true;
+    return RT_OK;
+}
+
+static rt_result mtl_scalar(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl, const char *p, const char *eol,
+                            float *out)
+{
+    float f[1];
+    int n = parse_floats(lc, p, cut_comment(p, eol), f, 1, mc->op->err);
+    if (n < 0)
+        return mc->op->err->code;
+    if (n != 1)
+        return rt_fail(mc->op->err, RT_ERR_PARSE, "%s:%ld: '%.*s' needs a number", lc->file, lc->line, (int)kl, kw);
+    *out = f[0];
+    return RT_OK;
+}
+
+/* A texture statement: options, then a file name (the rest of the line). */
+static rt_result mtl_map(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl, const char *p, const char *eol,
+                         char *path_out, float *bump_scale)
+{
+    eol = cut_comment_ws(p, eol);
+    for (;;) {
+        p = skip_space(p, eol);
+        if (p >= eol || *p != '-')
+            break;
+        const char *te = token_end(p, eol);
+        size_t ol = (size_t)(te - p);
+        int min_args = 1, max_args = 1;
+        if (kw_is(p, ol, "-o") || kw_is(p, ol, "-s") || kw_is(p, ol, "-t"))
+            max_args = 3;
+        else if (kw_is(p, ol, "-mm"))
+            min_args = max_args = 2;
+        else if (!(kw_is(p, ol, "-bm") || kw_is(p, ol, "-blendu") || kw_is(p, ol, "-blendv") ||
+                   kw_is(p, ol, "-boost") || kw_is(p, ol, "-cc") || kw_is(p, ol, "-clamp") ||
+                   kw_is(p, ol, "-imfchan") || kw_is(p, ol, "-texres") || kw_is(p, ol, "-type")))
+            min_args = max_args = 0; /* unknown option: skip the option word alone */
+        bool is_bm = kw_is(p, ol, "-bm");
+        const char *opt = p;
+        p = te;
+        for (int a = 0; a < max_args; a++) {
+            const char *q = skip_space(p, eol);
+            const char *qe = token_end(q, eol);
+            if (q >= eol)
+                break;
+            float f;
+            bool nonfinite;
+            const char *r = rt_mesh_parse_float(q, qe, &f, &nonfinite);
+            bool numeric = r && r == qe;
+            if (a >= min_args && !numeric)
+                break; /* optional numeric arguments end at the first non-number */
+            if (is_bm) {
+                if (!numeric)
+                    return rt_fail(mc->op->err, RT_ERR_PARSE, "%s:%ld:%d: -bm needs a number", lc->file, lc->line,
+                                   col_of(lc, q));
+                *bump_scale = f;
+            }
+            p = qe;
+        }
+        if (!is_bm && rt_warn_once_first(&mc->warned, opt, ol))
+            rt_warn("%s:%ld: ignoring texture option '%.*s' (warned once per file)", lc->file, lc->line, (int)ol, opt);
+    }
+    char rel[OBJ_PATH_MAX];
+    if (!rest_string(p, eol, rel, sizeof rel))
+        return rt_fail(mc->op->err, RT_ERR_LIMIT, "%s:%ld: texture file name too long", lc->file, lc->line);
+    if (!rel[0]) {
+        rt_warn("%s:%ld: '%.*s' without a file name; ignored", lc->file, lc->line, (int)kl, kw);
+        return RT_OK;
+    }
+    if (!rt_mesh_join(mc->mtl_dir, rel, path_out, OBJ_PATH_MAX))
+        return rt_fail(mc->op->err, RT_ERR_LIMIT, "%s:%ld: texture path too long", lc->file, lc->line);
+    return RT_OK;
+}
+
+static rt_result mtl_line(void *ctx, line_ctx *lc, const char *p, const char *eol)
+{
+    mtl_ctx *mc = ctx;
+    obj_parser *op = mc->op;
+    const char *ke = token_end(p, eol);
+    const char *kw = p;
+    size_t kl = (size_t)(ke - p);
+    p = ke;
+    if (kw_is(kw, kl, "newmtl")) {
+        if (!rt_grow((void **)&op->mtls, &op->mtlcap, op->nmtl + 1, sizeof *op->mtls))
+            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for materials", lc->file);
+        obj_mtl *m = &op->mtls[op->nmtl++];
+        memset(m, 0, sizeof *m);
+        m->bump_scale = 1.0f;
+        m->alpha = 1.0f;
+        m->illum = -1;
+        if (!rest_string(p, cut_comment_ws(p, eol), m->name, sizeof m->name))
+            return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: material name longer than %d bytes", lc->file, lc->line,
+                           OBJ_NAME_MAX - 1);
+        if (!m->name[0])
+            return rt_fail(op->err, RT_ERR_PARSE, "%s:%ld: newmtl without a name", lc->file, lc->line);
+        snprintf(m->where, sizeof m->where, "%s:%ld", lc->file, lc->line);
+        mc->cur = m;
+        return RT_OK;
+    }
+    obj_mtl *m = mc->cur;
+    if (!m) {
+        if (rt_warn_once_first(&mc->warned, "(before newmtl)", 15))
+            rt_warn("%s:%ld: statement before any newmtl; ignored (warned once per file)", lc->file, lc->line);
+        return RT_OK;
+    }
+    if (kw_is(kw, kl, "Kd"))
+        return mtl_color(mc, lc, kw, kl, p, eol, &m->kd, &m->has_kd);
+    if (kw_is(kw, kl, "Ks"))
+        return mtl_color(mc, lc, kw, kl, p, eol, &m->ks, &m->has_ks);
+    if (kw_is(kw, kl, "Ke"))
+        return mtl_color(mc, lc, kw, kl, p, eol, &m->ke, &m->has_ke);
+    if (kw_is(kw, kl, "Ka"))
+        return mtl_color(mc, lc, kw, kl, p, eol, &m->ka, &m->has_ka);
+    if (kw_is(kw, kl, "Tf"))
+        return mtl_color(mc, lc, kw, kl, p, eol, &m->tf, &m->has_tf);
+    rt_result r;
+    if (kw_is(kw, kl, "Ns")) {
+        m->has_ns = true;
+        return mtl_scalar(mc, lc, kw, kl, p, eol, &m->ns);
+    }
+    if (kw_is(kw, kl, "Ni")) {
+        m->has_ni = true;
+        return mtl_scalar(mc, lc, kw, kl, p, eol, &m->ni);
+    }
+    if (kw_is(kw, kl, "Pr")) {
+        m->has_pr = true;
+        return mtl_scalar(mc, lc, kw, kl, p, eol, &m->pr);
+    }
+    if (kw_is(kw, kl, "Pm")) {
+        m->has_pm = true;
+        return mtl_scalar(mc, lc, kw, kl, p, eol, &m->pm);
+    }
+    if (kw_is(kw, kl, "d")) {
+        /* "d -halo f" is an old variant: take the factor */
+        const char *q = skip_space(p, eol);
+        if (kw_is(q, (size_t)(token_end(q, eol) - q), "-halo"))
+            p = token_end(q, eol);
+        m->has_alpha = true;
+        return mtl_scalar(mc, lc, kw, kl, p, eol, &m->alpha);
+    }
+    if (kw_is(kw, kl, "Tr")) {
+        float tr;
+        if ((r = mtl_scalar(mc, lc, kw, kl, p, eol, &tr)) != RT_OK)
+            return r;
+        m->has_alpha = true;
+        m->alpha = 1.0f - tr;
+        return RT_OK;
+    }
+    if (kw_is(kw, kl, "illum")) {
+        float f;
+        if ((r = mtl_scalar(mc, lc, kw, kl, p, eol, &f)) != RT_OK)
+            return r;
+        if (!(f >= 0.0f && f <= 10.0f) || f != (float)(int)f)
+            return rt_fail(op->err, RT_ERR_PARSE, "%s:%ld: illum must be an integer 0..10", lc->file, lc->line);
+        m->illum = (int)f;
+        return RT_OK;
+    }
+    if (kw_is(kw, kl, "map_Kd"))
+        return mtl_map(mc, lc, kw, kl, p, eol, m->map_kd, &m->bump_scale);
+    if (kw_is(kw, kl, "map_Bump") || kw_is(kw, kl, "map_bump") || kw_is(kw, kl, "bump") || kw_is(kw, kl, "norm") ||
+        kw_is(kw, kl, "map_Norm"))
+        return mtl_map(mc, lc, kw, kl, p, eol, m->map_bump, &m->bump_scale);
+    warn_unknown(&mc->warned, lc, kw, kl);
+    return RT_OK;
+}
+
+/* Loads one MTL file into op->mtls. A missing file is a warning. */
+static rt_result load_mtl(obj_parser *op, const char *mtl_path, const line_ctx *at)
+{
+    char *data;
+    size_t size;
+    rt_error e = {0};
+    if (rt_mesh_read_file(mtl_path, &data, &size, &e) != RT_OK) {
+        if (e.code == RT_ERR_NOMEM)
+            return rt_fail(op->err, e.code, "%s", e.message);
+        rt_warn("%s:%ld: %s; its materials fall back to the default", at->file, at->line, e.message);
+        return RT_OK;
+    }
+    mtl_ctx mc;
+    memset(&mc, 0, sizeof mc);
+    mc.op = op;
+    mc.mtl_path = mtl_path;
+    rt_mesh_dirname(mtl_path, mc.mtl_dir, sizeof mc.mtl_dir);
+    rt_result r = for_each_line(mtl_path, data, size, mtl_line, &mc);
+    free(data);
+    return r;
+}
+
+/* -------------------------------------------------------------- OBJ */
+
+static bool grow_raw(void **p, size_t *cap, size_t need, size_t elem)
+{
+    return rt_grow(p, cap, need, elem) != 0;
+}
+
+static rt_result obj_vertex(obj_parser *op, line_ctx *lc, const char *p, const char *eol)
+{
+    float f[7];
+    int n = parse_floats(lc, p, cut_comment(p, eol), f, 7, op->err);
+    if (n < 0)
+        return op->err->code;
+    if (n < 3)
+        return rt_fail(op->err, RT_ERR_PARSE, "%s:%ld: 'v' needs 3 coordinates, got %d", lc->file, lc->line, n);
+    if (op->nv >= (size_t)RT_NONE - 1)
+        return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: too many vertices", lc->file, lc->line);
+    if (op->nv >= op->vcap) {
+        /* grow v, first and vc together; vcap only moves once all have */
+        size_t c = op->vcap ? op->vcap * 2 : 1024;
+        void *a;
+        if (!(a = rt_realloc_array(op->v, c, sizeof *op->v)))
+            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for vertices", lc->file);
+        op->v = a;
+        if (!(a = rt_realloc_array(op->first, c, sizeof *op->first)))
+            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for vertices", lc->file);
+        op->first = a;
+        if (op->vc) {
+            if (!(a = rt_realloc_array(op->vc, c, sizeof *op->vc)))
+                return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for vertices", lc->file);
+            op->vc = a;
+        }
+        op->vcap = c;
+    }
+    size_t i = op->nv++;
+    op->v[i] = rt_v3(f[0], f[1], f[2]);
+    op->first[i] = RT_NONE;
+    if (n >= 6) {
+        if (!op->vc) {
+            if (!(op->vc = rt_alloc(op->vcap, sizeof *op->vc)))
+                return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for vertex colours", lc->file);
+            for (size_t k = 0; k < i; k++)
+                op->vc[k] = rt_v3s(1.0f);
+        }
+        int c = n == 7 ? 4 : 3; /* x y z w r g b */
+        op->vc[i] = rt_v3(f[c], f[c + 1], f[c + 2]);
+    } else if (op->vc) {
+        op->vc[i] = rt_v3s(1.0f);
+    }
+    return RT_OK;
+}
+
+/* Resolves a 1-based or negative OBJ index against count; RT_NONE + err when out of range. */
+static uint32_t resolve_index(obj_parser *op, const line_ctx *lc, const char *at, int64_t idx, size_t count,
+                              const char *what)
+{
+    int64_t r = idx > 0 ? idx - 1 : (int64_t)count + idx;
+    if (idx == 0 || r < 0 || (uint64_t)r >= count) {
+        rt_fail(op->err, RT_ERR_INVALID, "%s:%ld:%d: %s index %lld out of range (%zu defined so far)", lc->file,
+                lc->line, col_of(lc, at), what, (long long)idx, count);
+        return RT_NONE;
+    }
+    return (uint32_t)r;
+}
+
+/* The output vertex for a (v, vt, vn) triple, made on first use. */
+static uint32_t output_vertex(obj_parser *op, uint32_t v, uint32_t t, uint32_t n)
+{
+    for (uint32_t o = op->first[v]; o != RT_NONE; o = op->onext[o])
+        if (op->ot[o] == t && op->on[o] == n)
+            return o;
+    if (op->nout >= (size_t)RT_NONE - 1)
+        return RT_NONE;
+    if (op->nout >= op->outcap) {
+        size_t c = op->outcap ? op->outcap * 2 : 1024;
+        uint32_t *a = rt_realloc_array(op->ov, c, 4);
+        if (!a) return RT_NONE;
+        op->ov = a;
+        if (!(a = rt_realloc_array(op->ot, c, 4))) return RT_NONE;
+        op->ot = a;
+        if (!(a = rt_realloc_array(op->on, c, 4))) return RT_NONE;
+        op->on = a;
+        if (!(a = rt_realloc_array(op->onext, c, 4))) return RT_NONE;
+        op->onext = a;
+        op->outcap = c;
+    }
+    uint32_t o = (uint32_t)op->nout++;
+    op->ov[o] = v;
+    op->ot[o] = t;
+    op->on[o] = n;
+    op->onext[o] = op->first[v];
+    op->first[v] = o;
+    if (t != RT_NONE) op->any_t = true;
+    if (n != RT_NONE) op->any_n = true;
+    return o;
+}
+
+static rt_result obj_face(obj_parser *op, line_ctx *lc, const char *p, const char *eol)
+{
+    eol = cut_comment(p, eol);
+    size_t nc = 0;
+    bool all_t = true, all_n = true;
+    for (;;) {
+        p = skip_space(p, eol);
+        if (p >= eol)
+            break;
+        const char *te = token_end(p, eol);
+        const char *tok = p;
+        int64_t iv, it = 0, in = 0;
+        const char *q = rt_mesh_parse_int(p, te, &iv);
+        if (!q)
+            return rt_fail(op->err, RT_ERR_PARSE, "%s:%ld:%d: malformed face corner '%.*s'", lc->file, lc->line,
+                           col_of(lc, tok), (int)(te - tok > 40 ? 40 : te - tok), tok);
+        bool has_t = false, has_n = false;
+        if (q < te && *q == '/') {
+            q++;
+            if (q < te && *q != '/') {
+                if (!(q = rt_mesh_parse_int(q, te, &it)))
+                    goto bad_corner;
+                has_t = true;
+            }
+            if (q < te && *q == '/') {
+                q++;
+                if (q < te) {
+                    if (!(q = rt_mesh_parse_int(q, te, &in)))
+                        goto bad_corner;
+                    has_n = true;
+                }
+            }
+        }
+        if (q != te)
+            goto bad_corner;
+        uint32_t v = resolve_index(op, lc, tok, iv, op->nv, "vertex");
+        if (v == RT_NONE)
+            return op->err->code;
+        uint32_t t = RT_NONE, n = RT_NONE;
+        if (has_t && (t = resolve_index(op, lc, tok, it, op->nvt, "texture coordinate")) == RT_NONE)
+            return op->err->code;
+        if (has_n && (n = resolve_index(op, lc, tok, in, op->nvn, "normal")) == RT_NONE)
+            return op->err->code;
+        all_t = all_t && has_t;
+        all_n = all_n && has_n;
+        uint32_t o = output_vertex(op, v, t, n);
+        if (o == RT_NONE)
+            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for face vertices", lc->file);
+        if (nc >= op->ccap) {
+            size_t c = op->ccap;
+            if (!grow_raw((void **)&op->corner_out, &c, nc + 1, 4))
+                return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for a face", lc->file);
+            size_t c2 = op->ccap;
+            if (!grow_raw((void **)&op->corner_v, &c2, c, 4))
+                return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for a face", lc->file);
+            op->ccap = c;
+        }
+        op->corner_out[nc] = o;
+        op->corner_v[nc] = v;
+        nc++;
+        p = te;
+        continue;
+    bad_corner:
+        return rt_fail(op->err, RT_ERR_PARSE, "%s:%ld:%d: malformed face corner '%.*s' (expected v, v/vt, v//vn or v/vt/vn)",
+                       lc->file, lc->line, col_of(lc, tok), (int)(te - tok > 40 ? 40 : te - tok), tok);
+    }
+    if (nc < 3)
+        return rt_fail(op->err, RT_ERR_INVALID, "%s:%ld: face has %zu vertices; at least 3 are needed", lc->file,
+                       lc->line, nc);
+    uint8_t flags = (uint8_t)((all_t ? RT_TRI_UV : 0) | (all_n ? RT_TRI_SMOOTH : 0));
+    const uint32_t *cv = op->corner_v, *co = op->corner_out;
+    size_t base = 0;
+    if (nc == 4) {
+        /* concave quad: the 0-2 diagonal makes halves facing opposite ways; use 1-3 */
+        rt_vec3 p0 = op->v[cv[0]], p1 = op->v[cv[1]], p2 = op->v[cv[2]], p3 = op->v[cv[3]];
+        rt_vec3 n1 = rt_cross(rt_sub(p1, p0), rt_sub(p2, p0));
+        rt_vec3 n2 = rt_cross(rt_sub(p2, p0), rt_sub(p3, p0));
+        if (rt_dot(n1, n2) < 0.0f)
+            base = 1;
+    }
+    if (!rt_mesh_buf_reserve_triangles(&op->buf, op->buf.nt + nc - 2))
+        return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for triangles", lc->file);
+    for (size_t k = 1; k + 1 < nc; k++) {
+        size_t a = base, b = (base + k) % nc, c = (base + k + 1) % nc;
+        if (cv[a] == cv[b] || cv[b] == cv[c] || cv[a] == cv[c]) {
+            op->buf.skipped++;
+            continue;
+        }
+        rt_mesh_buf_add_triangle(&op->buf, co[a], co[b], co[c], op->cur_slot, flags);
+    }
+    return RT_OK;
+}
+
+static rt_result obj_usemtl(obj_parser *op, line_ctx *lc, const char *p, const char *eol)
+{
+    if (op->override_material)
+        return RT_OK;
+    char name[OBJ_NAME_MAX];
+    if (!rest_string(p, cut_comment_ws(p, eol), name, sizeof name))
+        return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: material name longer than %d bytes", lc->file, lc->line,
+                       OBJ_NAME_MAX - 1);
+    if (!name[0]) {
+        rt_warn("%s:%ld: usemtl without a name; using the default material", lc->file, lc->line);
+        op->cur_slot = 0;
+        return RT_OK;
+    }
+    for (size_t i = 1; i < op->nslot; i++)
+        if (strcmp(op->slots[i].name, name) == 0) {
+            op->cur_slot = (uint32_t)i;
+            return RT_OK;
+        }
+    if (!rt_grow((void **)&op->slots, &op->slotcap, op->nslot + 1, sizeof *op->slots))
+        return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory", lc->file);
+    obj_slot *sl = &op->slots[op->nslot];
+    memcpy(sl->name, name, sizeof name);
+    sl->line = lc->line;
+    sl->material = RT_NONE;
+    op->cur_slot = (uint32_t)op->nslot++;
+    return RT_OK;
+}
+
+static rt_result obj_mtllib(obj_parser *op, line_ctx *lc, const char *p, const char *eol)
+{
+    if (op->override_material)
+        return RT_OK;
+    eol = cut_comment_ws(p, eol);
+    char rel[OBJ_PATH_MAX], full[OBJ_PATH_MAX];
+    if (!rest_string(p, eol, rel, sizeof rel) || !rt_mesh_join(op->dir, rel, full, sizeof full))
+        return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: mtllib path too long", lc->file, lc->line);
+    if (!rel[0]) {
+        rt_warn("%s:%ld: mtllib without a file name", lc->file, lc->line);
+        return RT_OK;
+    }
+    /* "mtllib a.mtl b.mtl" lists several files; a single name may contain spaces */
+    FILE *f = fopen(full, "rb");
+    if (f || !strpbrk(rel, " \t")) {
+        if (f)
+            fclose(f);
+        return load_mtl(op, full, lc);
+    }
+    for (;;) {
+        p = skip_space(p, eol);
+        if (p >= eol)
+            return RT_OK;
+        const char *te = token_end(p, eol);
+        size_t n = (size_t)(te - p);
+        if (n >= sizeof rel)
+            return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: mtllib path too long", lc->file, lc->line);
+        memcpy(rel, p, n);
+        rel[n] = 0;
+        if (!rt_mesh_join(op->dir, rel, full, sizeof full))
+            return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: mtllib path too long", lc->file, lc->line);
+        rt_result r = load_mtl(op, full, lc);
+        if (r != RT_OK)
+            return r;
+        p = te;
+    }
+}
+
+static rt_result obj_line(void *ctx, line_ctx *lc, const char *p, const char *eol)
+{
+    obj_parser *op = ctx;
+    const char *ke = token_end(p, eol);
+    const char *kw = p;
+    size_t kl = (size_t)(ke - p);
+    p = ke;
+    if (kl == 1 && kw[0] == 'v')
+        return obj_vertex(op, lc, p, eol);
+    if (kl == 1 && kw[0] == 'f')
+        return obj_face(op, lc, p, eol);
+    if (kl == 2 && kw[0] == 'v' && kw[1] == 't') {
+        float f[3];
+        int n = parse_floats(lc, p, cut_comment(p, eol), f, 3, op->err);
+        if (n < 0)
+            return op->err->code;
+        if (n < 1)
+            return rt_fail(op->err, RT_ERR_PARSE, "%s:%ld: 'vt' needs at least 1 coordinate", lc->file, lc->line);
+        if (op->nvt >= (size_t)RT_NONE - 1 || !grow_raw((void **)&op->vt, &op->vtcap, op->nvt + 1, sizeof *op->vt))
+            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for texture coordinates", lc->file);
+        op->vt[op->nvt++] = rt_v2(f[0], 1.0f - (n > 1 ? f[1] : 0.0f));
+        return RT_OK;
+    }
+    if (kl == 2 && kw[0] == 'v' && kw[1] == 'n') {
+        float f[3];
+        int n = parse_floats(lc, p, cut_comment(p, eol), f, 3, op->err);
+        if (n < 0)
+            return op->err->code;
+        if (n != 3)
+            return rt_fail(op->err, RT_ERR_PARSE, "%s:%ld: 'vn' needs 3 numbers, got %d", lc->file, lc->line, n);
+        if (op->nvn >= (size_t)RT_NONE - 1 || !grow_raw((void **)&op->vn, &op->vncap, op->nvn + 1, sizeof *op->vn))
+            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for normals", lc->file);
+        op->vn[op->nvn++] = rt_v3(f[0], f[1], f[2]);
+        return RT_OK;
+    }
+    if (kw_is(kw, kl, "usemtl"))
+        return obj_usemtl(op, lc, p, eol);
+    if (kw_is(kw, kl, "mtllib"))
+        return obj_mtllib(op, lc, p, eol);
+    if (kw_is(kw, kl, "o") || kw_is(kw, kl, "g") || kw_is(kw, kl, "s"))
+        return RT_OK;
+    warn_unknown(&op->warned, lc, kw, kl);
+    return RT_OK;
+}
+
+/* ------------------------------------------------------- materials */
+
+static uint32_t load_texture(rt_scene *s, const char *path, const char *where, const char *what)
+{
+    rt_error e = {0};
+    uint32_t img;
+    if (rt_image_load_file(s, path, &img, &e) != RT_OK) {
+        rt_warn("%s: %s: %s; ignoring the texture", where, what, e.message);
+        return RT_NONE;
+    }
+    rt_texture tex = rt_texture_image(img);
+    return rt_scene_add_texture(s, &tex);
+}
+
+static void make_material(rt_scene *s, const obj_mtl *om, const char *objname, rt_material *m)
+{
+    /* "<objfile>:<name>", cut to fit the 64-byte name field */
+    char name[sizeof m->name];
+    size_t on = strlen(objname), nn = strlen(om->name), cap = sizeof name - 1;
+    if (on > cap / 2 && on + 1 + nn > cap)
+        on = cap - 1 - (nn < cap / 2 ? nn : cap / 2);
+    size_t k = 0;
+    memcpy(name, objname, on);
+    k = on;
+    name[k++] = ':';
+    if (nn > cap - k)
+        nn = cap - k;
+    memcpy(name + k, om->name, nn);
+    name[k + nn] = 0;
+    rt_material_default(m, name);
+    if (om->has_kd)
+        m->color = om->kd;
+    if (om->has_ks)
+        m->specular = rt_clampf(rt_luminance(om->ks), 0.0f, 1.0f);
+    if (om->has_ns)
+        m->shininess = om->ns > 0.0f ? om->ns : 0.0f;
+    if (om->has_ni && om->ni > 0.0f)
+        m->ior = om->ni;
+    if (om->has_alpha) {
+        m->alpha = rt_clampf(om->alpha, 0.0f, 1.0f);
+        if (m->alpha < 1.0f)
+            m->alpha_mode = RT_ALPHA_BLEND;
+    }
+    if (om->has_ke)
+        m->emission = om->ke;
+    else if (om->has_ka && rt_max3(om->ka) > 1.0f)
+        m->emission = om->ka;
+    if (om->has_pr)
+        m->roughness = rt_clampf(om->pr, 0.0f, 1.0f);
+    if (om->has_pm)
+        m->metallic = rt_clampf(om->pm, 0.0f, 1.0f);
+    if (om->illum == 3 || om->illum == 5)
+        m->reflectivity = om->has_ks ? rt_clampf(rt_max3(om->ks), 0.0f, 1.0f) : 1.0f;
+    if (om->illum == 4 || om->illum == 6 || om->illum == 7) {
+        /* glass: transparency comes from refraction, not from d */
+        m->transmission = 1.0f;
+        if (om->has_tf)
+            m->transmission_color = om->tf;
+        m->alpha = 1.0f;
+        m->alpha_mode = RT_ALPHA_OPAQUE;
+    }
+    if (om->map_kd[0])
+        m->base_color_tex.texture = load_texture(s, om->map_kd, om->where, "map_Kd");
+    if (om->map_bump[0]) {
+        m->normal_tex.texture = load_texture(s, om->map_bump, om->where, "normal map");
+        m->normal_scale = om->bump_scale;
+    }
+}
+
+/* Adds the MTL materials to the scene and resolves every usemtl slot. */
+static rt_result resolve_materials(obj_parser *op, rt_scene *s, uint32_t material)
+{
+    const char *objname = rt_mesh_basename(op->path);
+    uint32_t *ids = op->nmtl ? rt_alloc(op->nmtl, sizeof *ids) : NULL;
+    if (op->nmtl && !ids)
+        return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for materials", op->path);
+    for (size_t i = 0; i < op->nmtl; i++) {
+        rt_material m;
+        make_material(s, &op->mtls[i], objname, &m);
+        if ((ids[i] = rt_scene_add_material(s, &m)) == RT_NONE) {
+            free(ids);
+            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for materials", op->path);
+        }
+    }
+    op->slots[0].material = material;
+    for (size_t k = 1; k < op->nslot; k++) {
+        obj_slot *sl = &op->slots[k];
+        sl->material = material;
+        size_t i = op->nmtl;
+        while (i-- > 0) /* the last definition of a name wins */
+            if (strcmp(op->mtls[i].name, sl->name) == 0)
+                break;
+        if (i < op->nmtl)
+            sl->material = ids[i];
+        else
+            rt_warn("%s:%ld: usemtl '%s': no such material in the MTL files; using the default material", op->path,
+                    sl->line, sl->name);
+    }
+    free(ids);
+    return RT_OK;
+}
+
+/* ------------------------------------------------------------ load */
+
+static void obj_free(obj_parser *op)
+{
+    free(op->v); free(op->vc); free(op->vt); free(op->vn); free(op->first);
+    free(op->ov); free(op->ot); free(op->on); free(op->onext);
+    free(op->corner_out); free(op->corner_v);
+    free(op->mtls); free(op->slots);
+    rt_mesh_buf_free(&op->buf);
+}
+
+rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, uint32_t material,
+                      bool override_material, rt_mesh_load_stats *stats, rt_error *err)
+{
+    rt_error local_err;
+    if (!err)
+        err = &local_err;
+    if (stats)
+        memset(stats, 0, sizeof *stats);
+    char *data;
+    size_t size;
+    rt_result r = rt_mesh_read_file(path, &data, &size, err);
+    if (r != RT_OK)
+        return r;
+    obj_parser *op = calloc(1, sizeof *op);
+    if (!op) {
+        free(data);
+        return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
+    }
+    op->path = path;
+    op->err = err;
+    op->override_material = override_material;
+    rt_mesh_dirname(path, op->dir, sizeof op->dir);
+    size_t mat0 = s->material_count, tex0 = s->texture_count;
+    if (!rt_grow((void **)&op->slots, &op->slotcap, 1, sizeof *op->slots)) {
+        r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
+        goto done;
+    }
+    op->nslot = 1;
+    memset(&op->slots[0], 0, sizeof op->slots[0]);
+
+    r = for_each_line(path, data, size, obj_line, op);
+    if (r != RT_OK)
+        goto done;
+
+    if (!override_material && (r = resolve_materials(op, s, material)) != RT_OK)
+        goto done;
+
+    /* output vertices from the (v, vt, vn) triples */
+    rt_mesh_buf *b = &op->buf;
+    unsigned attrs = (op->any_n ? RT_MESH_NRM : 0) | (op->any_t ? RT_MESH_UV : 0) | (op->vc ? RT_MESH_COL : 0);
+    if (!rt_mesh_buf_enable(b, attrs) || !rt_mesh_buf_reserve_vertices(b, op->nout)) {
+        r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for %zu vertices", path, op->nout);
+        goto done;
+    }
+    for (size_t o = 0; o < op->nout; o++) {
+        b->pos[o] = op->v[op->ov[o]];
+        if (b->nrm)
+            b->nrm[o] = op->on[o] != RT_NONE ? op->vn[op->on[o]] : rt_v3s(0);
+        if (b->uv)
+            b->uv[o] = op->ot[o] != RT_NONE ? op->vt[op->ot[o]] : rt_v2(0, 0);
+        if (b->col) {
+            rt_vec3 c = op->vc[op->ov[o]];
+            b->col[o] = rt_v4(c.x, c.y, c.z, 1.0f);
+        }
+    }
+    b->nv = op->nout;
+    for (size_t t = 0; t < b->nt; t++) {
+        b->mat[t] = override_material ? material : op->slots[b->mat[t]].material;
+        if (op->vc)
+            b->flags[t] |= RT_TRI_COLOR;
+    }
+    r = rt_mesh_commit(s, b, transform, path, stats, err);
+    if (r == RT_OK && stats)
+        stats->materials = s->material_count - mat0;
+done:
+    if (r != RT_OK) {
+        /* materials and textures are plain records: dropping them restores the scene
+         * (decoded images stay cached in the scene, which owns them) */
+        s->material_count = mat0;
+        s->texture_count = tex0;
+    }
+    obj_free(op);
+    free(data);
+    return r;
+}
