@@ -1,0 +1,226 @@
+/* test_render.c - end-to-end renders checked against analytic values, the
+ * thread-count independence of the image, and image output. */
+#include "test_util.h"
+
+#include <math.h>
+#include <unistd.h>
+
+#include "rt/camera.h"
+#include "rt/image.h"
+#include "rt/kdtree.h"
+#include "rt/render.h"
+#include "rt/scene.h"
+
+static uint32_t add_lambert(rt_scene *s, const char *name, rt_vec3 albedo)
+{
+    rt_material m;
+    rt_material_default(&m, name);
+    m.color = albedo;
+    return rt_scene_add_material(s, &m);
+}
+
+static void render_scene(rt_scene *s, int threads, int tile, rt_framebuffer *fb)
+{
+    rt_error err = {0};
+    rt_kdtree tree;
+    assert_int_equal(rt_kdtree_build(&tree, s, NULL, &err), RT_OK);
+    assert_int_equal(rt_framebuffer_init(fb, s->settings.width, s->settings.height, &err), RT_OK);
+    rt_render_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.threads = threads;
+    opt.tile_size = tile;
+    rt_render_stats st;
+    assert_int_equal(rt_render(s, &tree, &opt, fb, &st, &err), RT_OK);
+    assert_int_equal(st.bad_samples, 0);
+    rt_kdtree_free(&tree);
+}
+
+/* A Lambertian plane under a point light: L = albedo / pi * I * cos / r^2,
+ * checked at every pixel centre (1 sample per pixel = the centre). */
+static void test_lambert_plane_point_light(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    const float albedo = 0.6f, I = 10.0f;
+    const rt_vec3 light = rt_v3(0.3f, 2.0f, -0.2f);
+    uint32_t m = add_lambert(&s, "plane", rt_v3s(albedo));
+    rt_scene_add_quad(&s, rt_v3(-10, 0, -10), rt_v3(0, 0, 20), rt_v3(20, 0, 0), m);
+    rt_light l;
+    memset(&l, 0, sizeof l);
+    l.kind = RT_LIGHT_POINT;
+    l.color = rt_v3s(1);
+    l.intensity = I;
+    l.position = light;
+    l.quad = RT_NONE;
+    rt_scene_add_light(&s, &l);
+    s.settings.width = 40;
+    s.settings.height = 30;
+    s.settings.samples = 1;
+    s.camera.position = rt_v3(0, 3, 1);
+    s.camera.look_at = rt_v3(0, 0, 0);
+    s.camera.up = rt_v3(0, 1, 0);
+    s.camera.vfov_deg = 50;
+    s.camera_set = true;
+    rt_framebuffer fb;
+    render_scene(&s, 2, 8, &fb);
+
+    rt_camera_frame cf;
+    rt_camera_frame_init(&cf, &s.camera, fb.width, fb.height);
+    double max_rel = 0;
+    for (int y = 0; y < fb.height; y++)
+        for (int x = 0; x < fb.width; x++) {
+            rt_ray r = rt_camera_ray(&cf, x + 0.5f, y + 0.5f, rt_v2(0.5f, 0.5f));
+            double t = -(double)r.org.y / r.dir.y;
+            rt_vec3 p = rt_madd(r.org, r.dir, (float)t);
+            rt_vec3 d = rt_sub(light, p);
+            double r2 = rt_dot(d, d), cosv = d.y / sqrt(r2);
+            double expect = albedo / 3.14159265358979323846 * I * cosv / r2;
+            const float *px = fb.rgb + 3 * ((size_t)y * fb.width + x);
+            for (int c = 0; c < 3; c++) {
+                double rel = fabs(px[c] - expect) / expect;
+                if (rel > max_rel)
+                    max_rel = rel;
+            }
+        }
+    assert_true(max_rel < 1e-4);
+    rt_framebuffer_free(&fb);
+    rt_scene_free(&s);
+}
+
+/* A small scene with an area light, spheres, quads and triangles. */
+static void build_busy_scene(rt_scene *s)
+{
+    rt_scene_init(s);
+    uint32_t white = add_lambert(s, "white", rt_v3(0.7f, 0.7f, 0.7f));
+    uint32_t red = add_lambert(s, "red", rt_v3(0.7f, 0.1f, 0.1f));
+    rt_material em;
+    rt_material_default(&em, "lamp");
+    em.color = rt_v3s(0);
+    em.emission = rt_v3(5, 5, 5);
+    em.double_sided = false;
+    uint32_t lamp = rt_scene_add_material(s, &em);
+    rt_scene_add_quad(s, rt_v3(-2, 0, -2), rt_v3(0, 0, 4), rt_v3(4, 0, 0), white);
+    rt_scene_add_sphere(s, rt_v3(0, 0.5f, 0), 0.5f, red);
+    rt_scene_add_sphere(s, rt_v3(0.9f, 0.3f, 0.4f), 0.3f, white);
+    uint32_t v = rt_scene_add_vertices(s, 3);
+    s->vertices.position[v] = rt_v3(-1.5f, 0, -1);
+    s->vertices.position[v + 1] = rt_v3(-0.5f, 0, -1.2f);
+    s->vertices.position[v + 2] = rt_v3(-1, 1.2f, -1.1f);
+    rt_scene_add_triangle(s, v, v + 1, v + 2, red, 0);
+    rt_vec3 c = rt_v3(-0.5f, 2.5f, -0.5f), eu = rt_v3(1, 0, 0), ev = rt_v3(0, 0, 1);
+    uint32_t q = rt_scene_add_quad(s, c, eu, ev, lamp); /* cross(x, z) = -y: faces down */
+    rt_light l;
+    memset(&l, 0, sizeof l);
+    l.kind = RT_LIGHT_AREA;
+    l.color = rt_v3s(1);
+    l.intensity = 5;
+    l.position = c;
+    l.edge_u = eu;
+    l.edge_v = ev;
+    l.quad = q;
+    rt_scene_add_light(s, &l);
+    s->settings.width = 37;
+    s->settings.height = 23;
+    s->settings.samples = 5;
+    s->settings.shadow_samples = 4;
+    s->camera.position = rt_v3(0, 1.5f, 4);
+    s->camera.look_at = rt_v3(0, 0.5f, 0);
+    s->camera.up = rt_v3(0, 1, 0);
+    s->camera.vfov_deg = 45;
+    s->camera_set = true;
+}
+
+static void test_same_image_any_thread_count(void **state)
+{
+    (void)state;
+    rt_scene s;
+    build_busy_scene(&s);
+    rt_framebuffer a, b, c;
+    render_scene(&s, 1, 32, &a);
+    render_scene(&s, 2, 32, &b);
+    render_scene(&s, 7, 5, &c); /* more threads than useful, odd tiles */
+    size_t n = (size_t)a.width * a.height * 3 * sizeof(float);
+    assert_memory_equal(a.rgb, b.rgb, n);
+    assert_memory_equal(a.rgb, c.rgb, n);
+    /* and the image is not trivially black */
+    double sum = 0;
+    for (size_t i = 0; i < (size_t)a.width * a.height * 3; i++)
+        sum += a.rgb[i];
+    assert_true(sum > 1.0);
+    rt_framebuffer_free(&a);
+    rt_framebuffer_free(&b);
+    rt_framebuffer_free(&c);
+    rt_scene_free(&s);
+}
+
+/* The area light's visible quad shows its radiance from below and nothing from above. */
+static void test_area_light_visible_one_sided(void **state)
+{
+    (void)state;
+    rt_scene s;
+    build_busy_scene(&s);
+    s.settings.width = 1;
+    s.settings.height = 1;
+    s.settings.samples = 1;
+    s.camera.position = rt_v3(0, 1.0f, 0.0f);
+    s.camera.look_at = rt_v3(0, 3, 0.0f);
+    s.camera.up = rt_v3(0, 0, 1);
+    s.camera.vfov_deg = 1;
+    rt_framebuffer fb;
+    render_scene(&s, 1, 32, &fb);
+    assert_float_equal(fb.rgb[0], 5.0f, 1e-5);
+    rt_framebuffer_free(&fb);
+    s.camera.position = rt_v3(0, 4.0f, 0.0f);
+    s.camera.look_at = rt_v3(0, 0, 0.0f);
+    render_scene(&s, 1, 32, &fb);
+    assert_float_equal(fb.rgb[0], 0.0f, 1e-6); /* back of the emitter, lit from nowhere */
+    rt_framebuffer_free(&fb);
+    rt_scene_free(&s);
+}
+
+static void test_pfm_roundtrip_and_atomic_write(void **state)
+{
+    (void)state;
+    rt_error err = {0};
+    rt_framebuffer fb, back;
+    assert_int_equal(rt_framebuffer_init(&fb, 5, 3, &err), RT_OK);
+    for (int i = 0; i < 45; i++)
+        fb.rgb[i] = (float)i * 0.25f - 1.0f;
+    char dir[] = "/tmp/rt-test-XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[256];
+    snprintf(path, sizeof path, "%s/a.pfm", dir);
+    assert_int_equal(rt_framebuffer_write(&fb, path, 1.0f, &err), RT_OK);
+    assert_int_equal(rt_pfm_read(path, &back, &err), RT_OK);
+    assert_int_equal(back.width, 5);
+    assert_int_equal(back.height, 3);
+    assert_memory_equal(fb.rgb, back.rgb, 45 * sizeof(float));
+    rt_framebuffer_free(&back);
+    /* PNG and HDR write too */
+    snprintf(path, sizeof path, "%s/a.png", dir);
+    assert_int_equal(rt_framebuffer_write(&fb, path, 1.0f, &err), RT_OK);
+    snprintf(path, sizeof path, "%s/a.hdr", dir);
+    assert_int_equal(rt_framebuffer_write(&fb, path, 1.0f, &err), RT_OK);
+    /* unknown format and unwritable directory are refused up front */
+    snprintf(path, sizeof path, "%s/a.jpg", dir);
+    assert_int_equal(rt_output_check(path, &err), RT_ERR_INVALID);
+    assert_non_null(strstr(err.message, "unknown output format"));
+    assert_int_equal(rt_output_check("/nonexistent-dir/x.png", &err), RT_ERR_IO);
+    assert_non_null(strstr(err.message, "/nonexistent-dir/x.png"));
+    rt_framebuffer_free(&fb);
+    char cmd[300];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_lambert_plane_point_light),
+        cmocka_unit_test(test_same_image_any_thread_count),
+        cmocka_unit_test(test_area_light_visible_one_sided),
+        cmocka_unit_test(test_pfm_roundtrip_and_atomic_write),
+    };
+    return cmocka_run_group_tests_name("render", tests, NULL, NULL);
+}
