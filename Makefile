@@ -30,7 +30,7 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 DEPS_OK  := $(BUILD)/.deps-ok
 
-.PHONY: all test asan tsan profile scenes clean deps
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -68,12 +68,23 @@ tsan:
 profile:
 	$(MAKE) --no-print-directory BUILD=build-profile RT=rt-profile OPT="-O2 -march=native -g -fno-omit-frame-pointer"
 
+bench/rtbench: bench/rtbench.c $(BUILD)/librt.a | $(DEPS_OK)
+	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/librt.a $(LDLIBS)
+
+# Ray throughput on the shared benchmark rays (../shared/bench), checked against Embree's hits.
+bench: bench/rtbench
+	@SHARED=$(SHARED) sh bench/run.sh
+
+# rt and Embree side by side on the same rays, as ratios (installs Embree 3 on first use).
+bench-compare: bench/rtbench
+	@SHARED=$(SHARED) sh bench/compare.sh
+
 SCENES := $(wildcard scenes/*.txt)
 scenes: $(RT)
 	@mkdir -p docs/images
 	@for s in $(SCENES); do n=$$(basename $$s .txt); echo "rendering $$s"; ./rt -q -o docs/images/$$n.png $$s || exit 1; done
 
 clean:
-	rm -rf build build-asan build-tsan build-profile rt rt-profile
+	rm -rf build build-asan build-tsan build-profile rt rt-profile bench/rtbench
 
 -include $(LIB_OBJ:.o=.d) $(BUILD)/obj/main.d

@@ -1,0 +1,177 @@
+/* rtbench - ray throughput of rt's kd-tree on the shared benchmark rays,
+ * checked against Embree's reference hits.
+ *
+ *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
+ *
+ * Loads the glTF (every triangle of the default scene in world space, as
+ * ../shared/bench/FORMAT.md defines), builds the kd-tree, traces every ray
+ * for the closest hit K times and prints `key: value` lines: triangles,
+ * load_ms, build_ms, nodes, leaves, bytes_per_triangle, mrays_per_s (median
+ * of K runs), hits, mismatches. Exits 1 when more than 0.01% of the rays
+ * disagree with the reference: speed bought with wrong answers does not
+ * count. Exit 2 on bad arguments or files.
+ */
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "rt/gltf.h"
+#include "rt/kdtree.h"
+#include "rt/rayset.h"
+#include "rt/scene.h"
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+typedef struct job {
+    const rt_kdtree *tree;
+    const rt_rayset *rays;
+    float *t_out;
+    atomic_size_t next;
+} job;
+
+enum { CHUNK = 1024 };
+
+static void *trace_worker(void *arg)
+{
+    job *j = arg;
+    for (;;) {
+        size_t start = atomic_fetch_add(&j->next, CHUNK);
+        if (start >= j->rays->count)
+            break;
+        size_t end = start + CHUNK < j->rays->count ? start + CHUNK : j->rays->count;
+        for (size_t i = start; i < end; i++) {
+            rt_hit h;
+            j->t_out[i] = rt_kdtree_intersect(j->tree, &j->rays->rays[i], &h) ? h.t : INFINITY;
+        }
+    }
+    return NULL;
+}
+
+static double trace_all(const rt_kdtree *tree, const rt_rayset *rays, float *t_out, int threads)
+{
+    job j = {tree, rays, t_out, 0};
+    atomic_init(&j.next, 0);
+    pthread_t th[256];
+    double t0 = now_s();
+    int started = 0;
+    for (int i = 1; i < threads; i++)
+        if (pthread_create(&th[started], NULL, trace_worker, &j) == 0)
+            started++;
+    trace_worker(&j);
+    for (int i = 0; i < started; i++)
+        pthread_join(th[i], NULL);
+    return now_s() - t0;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static int usage(void)
+{
+    fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]\n");
+    return 2;
+}
+
+int main(int argc, char **argv)
+{
+    const char *model = NULL, *rays_path = NULL, *hits_path = NULL;
+    int threads = 1, runs = 5;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--ref") == 0 && i + 1 < argc)
+            hits_path = argv[++i];
+        else if (strcmp(argv[i], "-t") == 0 && i + 1 < argc)
+            threads = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--runs") == 0 && i + 1 < argc)
+            runs = atoi(argv[++i]);
+        else if (argv[i][0] == '-')
+            return usage();
+        else if (!model)
+            model = argv[i];
+        else if (!rays_path)
+            rays_path = argv[i];
+        else
+            return usage();
+    }
+    if (!model || !rays_path || threads < 1 || threads > 256 || runs < 1 || runs > 1000)
+        return usage();
+    rt_log_set_level(RT_LOG_QUIET);
+
+    rt_error err = {0};
+    rt_scene scene;
+    rt_scene_init(&scene);
+    rt_gltf_options opt;
+    memset(&opt, 0, sizeof opt);
+    rt_gltf_stats gs;
+    double t0 = now_s();
+    if (rt_gltf_load(&scene, model, &opt, &gs, &err) != RT_OK) {
+        fprintf(stderr, "rtbench: %s\n", err.message);
+        return 2;
+    }
+    double load_ms = 1e3 * (now_s() - t0);
+    rt_rayset rs;
+    if (rt_rayset_load(&rs, rays_path, hits_path, &err) != RT_OK) {
+        fprintf(stderr, "rtbench: %s\n", err.message);
+        return 2;
+    }
+    rt_kdtree tree;
+    if (rt_kdtree_build(&tree, &scene, NULL, &err) != RT_OK) {
+        fprintf(stderr, "rtbench: %s\n", err.message);
+        return 2;
+    }
+    float *t_out = malloc((rs.count ? rs.count : 1) * sizeof(float));
+    double *times = malloc((size_t)runs * sizeof(double));
+    if (!t_out || !times) {
+        fprintf(stderr, "rtbench: out of memory\n");
+        return 2;
+    }
+    for (int r = 0; r < runs; r++)
+        times[r] = trace_all(&tree, &rs, t_out, threads);
+    qsort(times, (size_t)runs, sizeof(double), cmp_double);
+    double median = runs % 2 ? times[runs / 2] : 0.5 * (times[runs / 2 - 1] + times[runs / 2]);
+
+    size_t hits = 0, mismatches = 0;
+    float diag = rt_box_diagonal(tree.bounds);
+    for (size_t i = 0; i < rs.count; i++) {
+        if (t_out[i] < INFINITY)
+            hits++;
+        if (rs.ref_t && !rt_rayset_agrees(t_out[i], rs.ref_t[i], diag))
+            mismatches++;
+    }
+    printf("model: %s\n", model);
+    printf("rays_file: %s\n", rays_path);
+    printf("triangles: %zu\n", scene.triangles.count);
+    printf("load_ms: %.1f\n", load_ms);
+    printf("build_ms: %.1f\n", tree.stats.build_ms);
+    printf("nodes: %zu\n", tree.stats.nodes);
+    printf("leaves: %zu\n", tree.stats.leaves);
+    printf("bytes_per_triangle: %.1f\n",
+           scene.triangles.count ? (double)tree.stats.bytes / (double)scene.triangles.count : 0.0);
+    printf("threads: %d\n", threads);
+    printf("rays: %zu\n", rs.count);
+    printf("mrays_per_s: %.3f\n", median > 0 ? 1e-6 * (double)rs.count / median : 0.0);
+    printf("hits: %zu\n", hits);
+    if (rs.ref_t)
+        printf("mismatches: %zu\n", mismatches);
+    int status = 0;
+    if (rs.ref_t && (double)mismatches > 1e-4 * (double)rs.count) {
+        fprintf(stderr, "rtbench: %zu of %zu rays disagree with %s (over 0.01%%)\n", mismatches, rs.count, hits_path);
+        status = 1;
+    }
+    free(t_out);
+    free(times);
+    rt_kdtree_free(&tree);
+    rt_rayset_free(&rs);
+    rt_scene_free(&scene);
+    return status;
+}
