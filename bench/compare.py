@@ -1,0 +1,66 @@
+#!/usr/bin/env python3
+"""make bench-compare: rt's kd-tree and Embree 3 on the same rays, back to back.
+
+For every model in $SHARED/bench/MANIFEST.md, runs Embree (the shared
+bench/embree/embree-figures script: rtcIntersect1, high-quality BVH) and then
+bench/rtbench on the primary and diffuse ray sets with 1 and 2 threads, and
+prints throughput ratios rt/Embree, build time ratios against Embree's
+high-quality build, and rt's bytes per triangle. The machines are shared and
+noisy, so only ratios from one run mean much.
+Environment: SHARED (default ../shared), RUNS (default 5).
+"""
+import json, os, re, subprocess, sys
+
+shared = os.environ.get("SHARED", "../shared")
+runs = os.environ.get("RUNS", "5")
+embree_dir = os.path.join(shared, "bench", "embree")
+build = os.environ.get("BUILD_EMBREE", "/tmp/rt-embree")
+manifest = open(os.path.join(shared, "bench", "MANIFEST.md")).read()
+models = re.findall(r"^\| (\w+) \| `([^`]+)` \|", manifest, re.M)
+if not models:
+    sys.exit("bench-compare: no models in the manifest")
+
+if subprocess.call(["sh", "-c", "echo '#include <embree3/rtcore.h>' | cc -E -x c - >/dev/null 2>&1"]) != 0:
+    print("bench-compare: installing Embree 3 and the converter's Python packages (make -C %s deps)" % embree_dir,
+          file=sys.stderr)
+    subprocess.check_call(["make", "-C", embree_dir, "deps"])
+
+def rtbench(glb, model, kind, threads):
+    out = subprocess.run(["./bench/rtbench", os.path.join(shared, glb),
+                          os.path.join(shared, "bench", model, "%s.%s.rays" % (model, kind)),
+                          "--ref", os.path.join(shared, "bench", model, "%s.%s.hits" % (model, kind)),
+                          "-t", str(threads), "--runs", runs], capture_output=True, text=True)
+    d = dict(line.split(": ", 1) for line in out.stdout.splitlines() if ": " in line)
+    d["status"] = out.returncode
+    return d
+
+print("%-28s %-8s %3s %10s %10s %7s %11s" % ("model", "kind", "thr", "rt Mray/s", "Embree", "ratio", "mismatches"))
+summary = []
+for model, glb in models:
+    emb = subprocess.run([os.path.join(embree_dir, "embree-figures"), model, runs], capture_output=True, text=True,
+                         env=dict(os.environ, BUILD=build))
+    if emb.returncode != 0:
+        print(emb.stderr, file=sys.stderr)
+        sys.exit("bench-compare: embree-figures failed for " + model)
+    figures = {}
+    for line in emb.stdout.splitlines():
+        kind, _, js = line.partition(": ")
+        figures[kind] = json.loads(js)["results"]
+    build_js = json.loads(subprocess.run([os.path.join(build, "anchor"), "build", os.path.join(build, model + ".tri"),
+                                          "--reps", "3"], capture_output=True, text=True, check=True).stdout)
+    emb_build = build_js["build_ms"]["high_1T"]["median"]
+    rt_build = bytes_tri = None
+    for kind in ("primary", "diffuse"):
+        for t in (1, 2):
+            r = rtbench(glb, model, kind, t)
+            e = figures[kind]["single_%dT" % t]["mrays_s"]
+            mr = float(r.get("mrays_per_s", 0))
+            print("%-28s %-8s %3d %10.2f %10.2f %7.2f %11s" % (model, kind, t, mr, e, mr / e if e else 0,
+                                                               r.get("mismatches", "?")))
+            rt_build = float(r.get("build_ms", 0))
+            bytes_tri = r.get("bytes_per_triangle")
+    summary.append((model, rt_build, emb_build, bytes_tri))
+print()
+print("%-28s %12s %16s %7s %10s" % ("model", "rt build ms", "Embree high ms", "ratio", "bytes/tri"))
+for model, rb, eb, bt in summary:
+    print("%-28s %12.1f %16.1f %7.2f %10s" % (model, rb, eb, rb / eb if eb else 0, bt))
