@@ -702,9 +702,11 @@ static rt_result st_camera(parser *p, const tok *kw)
         case K_UP: r = get_vec3(p, "the camera up vector", &c.up); break;
         case K_FOV:
             r = get_float_above(p, "the camera field of view", 0.0f, &c.vfov_deg);
-            if (r == RT_OK && !(c.vfov_deg < 180.0f))
+            if (r == RT_OK && !(c.vfov_deg < 180.0f)) {
+                char b[80];
                 r = perr(p, RT_ERR_INVALID, prev(p), "the camera field of view must be below 180 degrees, got %s",
-                         prev(p)->s);
+                         show(prev(p), b, sizeof b));
+            }
             break;
         case K_APERTURE: r = get_float_in(p, "the camera aperture", 0.0f, FLT_MAX, &c.aperture); break;
         default: r = get_float_in(p, "the camera focus distance", 0.0f, FLT_MAX, &c.focus_distance); break;
@@ -1246,7 +1248,7 @@ static rt_result st_light(parser *p, const tok *kw)
         if ((r = get_float_in(p, "the spot light outer cone angle", 0.0f, 90.0f, &outer)) != RT_OK)
             return r;
         if (!(outer > 0.0f))
-            return perr(p, RT_ERR_INVALID, prev(p), "the spot light outer cone angle must be > 0, got %s",
+            return perr(p, RT_ERR_INVALID, prev(p), "the spot light outer cone angle must be > 0, got '%s'",
                         prev(p)->s);
         if (inner > outer)
             return perr(p, RT_ERR_INVALID, inner_tok,

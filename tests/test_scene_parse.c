@@ -1,0 +1,880 @@
+/* test_scene_parse.c - the scene text format (src/scene_parse.c).
+ *
+ * Every error kind is checked for its exact "file:line:col" and a message
+ * substring; the built-in default scene and every file in scenes/ parse with
+ * the expected table counts; values land in the right fields; comments,
+ * continuations, quotes and CRLF work; a mesh's translate/rotate/scale give
+ * the composed transform; and a few thousand mutated scenes parse or fail
+ * without crashing or leaking (run under `make asan`).
+ */
+#include "test_util.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+
+#include "rt/scene_parse.h"
+
+#define TMP_DIR "tests/tmp/scene_parse"
+
+static void make_tmp_dir(void)
+{
+    mkdir("tests/tmp", 0777);
+    mkdir(TMP_DIR, 0777);
+}
+
+/* Parses text as "t.txt" (relative paths resolve against TMP_DIR). */
+static rt_result parse(rt_scene *s, const char *text, rt_error *err)
+{
+    rt_scene_init(s);
+    memset(err, 0, sizeof *err);
+    return rt_scene_parse_string(s, text, strlen(text), "t.txt", TMP_DIR, err);
+}
+
+/* Parses text that must fail with `code`, a message starting with
+ * "t.txt:LINE:COL: " and containing `part`. */
+#define expect_error(text, code, where, part) expect_error_at(text, code, where, part, __LINE__)
+static void expect_error_at(const char *text, rt_result code, const char *where, const char *part, int line)
+{
+    rt_scene s;
+    rt_error err;
+    rt_result r = parse(&s, text, &err);
+    char prefix[64];
+    snprintf(prefix, sizeof prefix, "t.txt:%s: ", where);
+    if (r != code || strncmp(err.message, prefix, strlen(prefix)) != 0 || !strstr(err.message, part)) {
+        print_error("test line %d: for %s\n  expected code %d, '%s...%s'\n  got      code %d, '%s'\n", line, text,
+                    code, prefix, part, r, err.message);
+        rt_scene_free(&s);
+        fail();
+    }
+    rt_scene_free(&s);
+}
+
+static void expect_ok(const char *text, rt_scene *s)
+{
+    rt_error err;
+    rt_result r = parse(s, text, &err);
+    if (r != RT_OK) {
+        print_error("unexpected error %d: %s\n", r, err.message);
+        rt_scene_free(s);
+        fail();
+    }
+}
+
+static void assert_vec3(rt_vec3 v, float x, float y, float z)
+{
+    assert_float_equal(v.x, x, 1e-5);
+    assert_float_equal(v.y, y, 1e-5);
+    assert_float_equal(v.z, z, 1e-5);
+}
+
+/* ------------------------------------------------------------ scenes */
+
+static void check_cornell(const rt_scene *s)
+{
+    assert_int_equal(s->material_count, 4); /* white, red, green, the area light's */
+    assert_int_equal(s->quads.count, 11);   /* 5 walls, 5 box faces, the light */
+    assert_int_equal(s->spheres.count, 1);
+    assert_int_equal(s->triangles.count, 0);
+    assert_int_equal(s->light_count, 1);
+    assert_true(s->camera_set);
+    assert_int_equal(s->settings.width, 512);
+    assert_int_equal(s->settings.height, 512);
+    assert_int_equal(s->settings.integrator, RT_INTEGRATOR_DIRECT);
+    const rt_light *l = &s->lights[0];
+    assert_int_equal(l->kind, RT_LIGHT_AREA);
+    assert_int_equal(l->quad, 10);
+    /* the light faces down, into the box */
+    rt_vec3 n = rt_cross(l->edge_u, l->edge_v);
+    assert_true(n.y < 0 && n.x == 0 && n.z == 0);
+    /* every wall faces into the box: its normal points at the box centre */
+    rt_vec3 centre = rt_v3(0, 1, 0);
+    for (size_t i = 0; i < 5; i++) {
+        const rt_quads *q = &s->quads;
+        rt_vec3 p = rt_v3(q->px[i], q->py[i], q->pz[i]);
+        rt_vec3 qn = rt_cross(rt_v3(q->ux[i], q->uy[i], q->uz[i]), rt_v3(q->vx[i], q->vy[i], q->vz[i]));
+        assert_true(rt_dot(qn, rt_sub(centre, p)) > 0);
+    }
+    /* red is on the left (-x) as seen by the camera, green on the right */
+    uint32_t red = rt_scene_find_material(s, "red"), green = rt_scene_find_material(s, "green");
+    assert_int_equal(s->quads.material[3], red);
+    assert_int_equal(s->quads.material[4], green);
+    assert_true(s->quads.px[3] < 0 && s->quads.px[4] > 0);
+    rt_vec3 fwd = rt_sub(s->camera.look_at, s->camera.position);
+    rt_vec3 right = rt_cross(fwd, s->camera.up);
+    assert_true(right.x > 0);
+}
+
+static void test_default_scene(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_error err;
+    rt_scene_init(&s);
+    rt_result r = rt_scene_parse_string(&s, rt_default_scene_text, strlen(rt_default_scene_text), "<default>", NULL,
+                                        &err);
+    if (r != RT_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(r, RT_OK);
+    check_cornell(&s);
+    assert_string_equal(s.settings.output, ""); /* the driver writes out.png */
+    rt_scene_free(&s);
+}
+
+/* scenes/cornell.txt is the default scene plus its output name. */
+static void test_cornell_file_matches_default(void **state)
+{
+    (void)state;
+    rt_scene a, b;
+    rt_error err;
+    rt_scene_init(&a);
+    rt_scene_init(&b);
+    assert_int_equal(rt_scene_parse_string(&a, rt_default_scene_text, strlen(rt_default_scene_text), "<default>",
+                                           NULL, &err),
+                     RT_OK);
+    rt_result r = rt_scene_parse_file(&b, "scenes/cornell.txt", &err);
+    if (r != RT_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(r, RT_OK);
+    check_cornell(&b);
+    assert_string_equal(b.settings.output, "cornell.png");
+    assert_int_equal(a.quads.count, b.quads.count);
+    for (size_t i = 0; i < a.quads.count; i++) {
+        assert_float_equal(a.quads.px[i], b.quads.px[i], 0);
+        assert_float_equal(a.quads.uz[i], b.quads.uz[i], 0);
+        assert_float_equal(a.quads.vy[i], b.quads.vy[i], 0);
+        assert_int_equal(a.quads.material[i], b.quads.material[i]);
+    }
+    assert_float_equal(a.spheres.radius[0], b.spheres.radius[0], 0);
+    assert_memory_equal(&a.camera, &b.camera, sizeof a.camera);
+    assert_memory_equal(&a.lights[0], &b.lights[0], sizeof a.lights[0]);
+    for (size_t i = 0; i < a.material_count; i++)
+        assert_memory_equal(&a.materials[i], &b.materials[i], sizeof a.materials[i]);
+    memset(b.settings.output, 0, sizeof b.settings.output);
+    assert_memory_equal(&a.settings, &b.settings, sizeof a.settings);
+    rt_scene_free(&a);
+    rt_scene_free(&b);
+}
+
+/* Every scene file shipped in scenes/ parses. Scenes that load meshes or
+ * models are skipped while those loaders are placeholders. */
+static void test_all_scene_files(void **state)
+{
+    (void)state;
+    DIR *d = opendir("scenes");
+    assert_non_null(d);
+    struct dirent *e;
+    int parsed = 0;
+    while ((e = readdir(d)) != NULL) {
+        size_t n = strlen(e->d_name);
+        if (n < 5 || strcmp(e->d_name + n - 4, ".txt") != 0)
+            continue;
+        char path[512];
+        snprintf(path, sizeof path, "scenes/%s", e->d_name);
+        rt_scene s;
+        rt_error err;
+        rt_scene_init(&s);
+        rt_result r = rt_scene_parse_file(&s, path, &err);
+        if (r == RT_ERR_UNSUPPORTED) {
+            fprintf(stderr, "note: %s needs a loader that is not built yet: %s\n", path, err.message);
+        } else {
+            if (r != RT_OK)
+                print_error("%s\n", err.message);
+            assert_int_equal(r, RT_OK);
+            assert_true(rt_scene_prim_count(&s) > 0);
+            assert_true(s.light_count > 0 || s.settings.environment_texture != RT_NONE ||
+                        rt_max3(s.settings.background) > 0);
+            assert_true(s.camera_set);
+            assert_true(s.settings.output[0] != '\0');
+            parsed++;
+        }
+        rt_scene_free(&s);
+    }
+    closedir(d);
+    assert_true(parsed >= 2);
+}
+
+static void test_spheres_scene(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_error err;
+    rt_scene_init(&s);
+    rt_result r = rt_scene_parse_file(&s, "scenes/spheres.txt", &err);
+    if (r != RT_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(r, RT_OK);
+    assert_int_equal(s.spheres.count, 5);
+    assert_int_equal(s.quads.count, 1);
+    assert_int_equal(s.light_count, 2);
+    assert_int_equal(s.lights[0].kind, RT_LIGHT_POINT);
+    assert_int_equal(s.lights[1].kind, RT_LIGHT_DIRECTIONAL);
+    assert_int_equal(s.texture_count, 1);
+    assert_int_equal(s.textures[0].kind, RT_TEX_CHECKER);
+    uint32_t floor = rt_scene_find_material(&s, "floor");
+    assert_int_not_equal(floor, RT_NONE);
+    assert_int_equal(s.materials[floor].base_color_tex.texture, 0);
+    rt_scene_free(&s);
+}
+
+/* ------------------------------------------------------------ values */
+
+static void test_settings_values(void **state)
+{
+    (void)state;
+    rt_scene s;
+    expect_ok("resolution 640 480\n"
+              "samples 64\n"
+              "integrator whitted\n"
+              "max_bounce 7\n"
+              "diffuse_bounces 2\n"
+              "diffuse_rays 32\n"
+              "shadow_samples 9\n"
+              "seed 4294967295\n"
+              "background 0.1 0.2 0.3\n"
+              "exposure 1.5\n"
+              "clamp 10\n"
+              "ray_offset 0.001\n"
+              "output \"my render.png\"\n",
+              &s);
+    const rt_settings *st = &s.settings;
+    assert_int_equal(st->width, 640);
+    assert_int_equal(st->height, 480);
+    assert_int_equal(st->samples, 64);
+    assert_int_equal(st->integrator, RT_INTEGRATOR_WHITTED);
+    assert_int_equal(st->max_bounce, 7);
+    assert_int_equal(st->diffuse_bounces, 2);
+    assert_int_equal(st->diffuse_rays, 32);
+    assert_int_equal(st->shadow_samples, 9);
+    assert_int_equal(st->seed, 4294967295u);
+    assert_vec3(st->background, 0.1f, 0.2f, 0.3f);
+    assert_float_equal(st->exposure, 1.5, 0);
+    assert_float_equal(st->clamp, 10, 0);
+    assert_float_equal(st->ray_offset, 0.001, 1e-9);
+    assert_string_equal(st->output, "my render.png");
+    assert_int_equal(st->environment_texture, RT_NONE);
+    assert_false(s.camera_set);
+    rt_scene_free(&s);
+
+    /* defaults stay when nothing is said */
+    expect_ok("# nothing but a comment\n", &s);
+    rt_settings def;
+    rt_settings_default(&def);
+    assert_memory_equal(&s.settings, &def, sizeof def);
+    rt_scene_free(&s);
+
+    expect_ok("integrator path\n", &s);
+    assert_int_equal(s.settings.integrator, RT_INTEGRATOR_PATH);
+    rt_scene_free(&s);
+}
+
+static void test_camera_values(void **state)
+{
+    (void)state;
+    rt_scene s;
+    expect_ok("camera fov 30 look_at 1 2 3 position 4 5 6 up 0 0 1 aperture 0.1 focus 7.5\n", &s);
+    assert_true(s.camera_set);
+    assert_vec3(s.camera.position, 4, 5, 6);
+    assert_vec3(s.camera.look_at, 1, 2, 3);
+    assert_vec3(s.camera.up, 0, 0, 1);
+    assert_float_equal(s.camera.vfov_deg, 30, 0);
+    assert_float_equal(s.camera.aperture, 0.1, 1e-7);
+    assert_float_equal(s.camera.focus_distance, 7.5, 0);
+    rt_scene_free(&s);
+
+    /* up, fov, aperture and focus have defaults */
+    expect_ok("camera position 0 0 5 look_at 0 0 0\n", &s);
+    assert_vec3(s.camera.up, 0, 1, 0);
+    assert_float_equal(s.camera.vfov_deg, 40, 0);
+    assert_float_equal(s.camera.aperture, 0, 0);
+    assert_float_equal(s.camera.focus_distance, 0, 0);
+    rt_scene_free(&s);
+}
+
+static void test_material_values(void **state)
+{
+    (void)state;
+    rt_scene s;
+    expect_ok("texture wood checker 1 0 0 0 0 1 scale 4\n"
+              "texture flat constant 0.5 0.5 1\n"
+              "material m color 0.1 0.2 0.3 alpha 0.5 ambient 0.25 diffuse 0.6 specular 0.7 shininess 50 \\\n"
+              "  reflect 0.3 transmission 0.9 transmission_color 0.9 0.8 0.7 ior 1.33 metallic 1 roughness 0.2 \\\n"
+              "  emission 1 2 3 emission_strength 4 normal_map flat normal_scale 0.5 texture wood \\\n"
+              "  double_sided false unlit true occlusion_strength 0.75 alpha_mode mask alpha_cutoff 0.25 \\\n"
+              "  thickness 0.1 attenuation_color 0.5 0.6 0.7 attenuation_distance 2 \\\n"
+              "  metallic_roughness_map wood occlusion_map flat emission_map wood transmission_map flat \\\n"
+              "  uv_scale 2 3 uv_offset 0.5 0.25\n"
+              "material plain\n"
+              "material glass reflectivity 0.1 base_color 1 1 1 attenuation_distance inf alpha_mode blend\n",
+              &s);
+    assert_int_equal(s.material_count, 3);
+    assert_int_equal(s.texture_count, 2);
+    const rt_material *m = &s.materials[0];
+    assert_string_equal(m->name, "m");
+    assert_vec3(m->color, 0.1f, 0.2f, 0.3f);
+    assert_float_equal(m->alpha, 0.5, 0);
+    assert_float_equal(m->ambient, 0.25, 0);
+    assert_float_equal(m->diffuse, 0.6, 1e-7);
+    assert_float_equal(m->specular, 0.7, 1e-7);
+    assert_float_equal(m->shininess, 50, 0);
+    assert_float_equal(m->reflectivity, 0.3, 1e-7);
+    assert_float_equal(m->transmission, 0.9, 1e-7);
+    assert_vec3(m->transmission_color, 0.9f, 0.8f, 0.7f);
+    assert_float_equal(m->ior, 1.33, 1e-6);
+    assert_float_equal(m->metallic, 1, 0);
+    assert_float_equal(m->roughness, 0.2, 1e-7);
+    assert_vec3(m->emission, 1, 2, 3);
+    assert_float_equal(m->emission_strength, 4, 0);
+    assert_int_equal(m->normal_tex.texture, 1);
+    assert_float_equal(m->normal_scale, 0.5, 0);
+    assert_int_equal(m->base_color_tex.texture, 0);
+    assert_false(m->double_sided);
+    assert_true(m->unlit);
+    assert_float_equal(m->occlusion_strength, 0.75, 0);
+    assert_int_equal(m->alpha_mode, RT_ALPHA_MASK);
+    assert_float_equal(m->alpha_cutoff, 0.25, 0);
+    assert_float_equal(m->thickness, 0.1, 1e-7);
+    assert_vec3(m->attenuation_color, 0.5f, 0.6f, 0.7f);
+    assert_float_equal(m->attenuation_distance, 2, 0);
+    assert_int_equal(m->metal_rough_tex.texture, 0);
+    assert_int_equal(m->occlusion_tex.texture, 1);
+    assert_int_equal(m->emissive_tex.texture, 0);
+    assert_int_equal(m->transmission_tex.texture, 1);
+    const float uvt[6] = {2, 0, 0.5f, 0, 3, 0.25f};
+    for (int i = 0; i < 6; i++) {
+        assert_float_equal(m->base_color_tex.uv_transform[i], uvt[i], 0);
+        assert_float_equal(m->transmission_tex.uv_transform[i], uvt[i], 0);
+    }
+    /* textures */
+    assert_int_equal(s.textures[0].kind, RT_TEX_CHECKER);
+    assert_float_equal(s.textures[0].checker_scale, 4, 0);
+    assert_float_equal(s.textures[0].color_a.x, 1, 0);
+    assert_float_equal(s.textures[0].color_b.z, 1, 0);
+    assert_int_equal(s.textures[1].kind, RT_TEX_CONSTANT);
+    assert_float_equal(s.textures[1].color_a.z, 1, 0);
+    /* a material with nothing said has rt_material_default()'s values */
+    rt_material def;
+    rt_material_default(&def, "plain");
+    assert_memory_equal(&s.materials[1], &def, sizeof def);
+    /* aliases and inf */
+    const rt_material *g = &s.materials[2];
+    assert_float_equal(g->reflectivity, 0.1, 1e-7);
+    assert_vec3(g->color, 1, 1, 1);
+    assert_true(isinf(g->attenuation_distance));
+    assert_int_equal(g->alpha_mode, RT_ALPHA_BLEND);
+    rt_scene_free(&s);
+}
+
+static void test_primitive_values(void **state)
+{
+    (void)state;
+    rt_scene s;
+    expect_ok("material a\nmaterial b color 1 0 0\n"
+              "sphere 1 2 3 0.5 b\n"
+              "quad 0 0 0  1 0 0  0 2 0  a\n"
+              "triangle 0 0 0  1 0 0  0 1 0  b\n",
+              &s);
+    assert_int_equal(s.spheres.count, 1);
+    assert_float_equal(s.spheres.cx[0], 1, 0);
+    assert_float_equal(s.spheres.cy[0], 2, 0);
+    assert_float_equal(s.spheres.cz[0], 3, 0);
+    assert_float_equal(s.spheres.radius[0], 0.5, 0);
+    assert_int_equal(s.spheres.material[0], 1);
+    assert_int_equal(s.quads.count, 1);
+    assert_float_equal(s.quads.ux[0], 1, 0);
+    assert_float_equal(s.quads.vy[0], 2, 0);
+    assert_int_equal(s.quads.material[0], 0);
+    assert_int_equal(s.triangles.count, 1);
+    assert_int_equal(s.vertices.count, 3);
+    assert_int_equal(s.triangles.material[0], 1);
+    assert_int_equal(s.triangles.flags[0], RT_TRI_UV);
+    assert_vec3(rt_tri_vertex(&s, 0, 1), 1, 0, 0);
+    assert_vec3(rt_tri_vertex(&s, 0, 2), 0, 1, 0);
+    assert_float_equal(s.vertices.uv0[1].x, 1, 0);
+    assert_float_equal(s.vertices.uv0[2].y, 1, 0);
+    assert_vec3(s.vertices.normal[0], 0, 0, 1);
+    rt_scene_free(&s);
+}
+
+static void test_light_values(void **state)
+{
+    (void)state;
+    rt_scene s;
+    expect_ok("light point 1 2 3  1 0.5 0.25  100\n"
+              "light directional 0 -2 0  1 1 1  3\n"
+              "light spot 0 5 0  0 -1 0  1 1 1  50  20 30 range 10\n"
+              "light area 0 2 0  1 0 0  0 0 1  1 0.5 0  8\n",
+              &s);
+    assert_int_equal(s.light_count, 4);
+    const rt_light *l = s.lights;
+    assert_int_equal(l[0].kind, RT_LIGHT_POINT);
+    assert_vec3(l[0].position, 1, 2, 3);
+    assert_vec3(l[0].color, 1, 0.5f, 0.25f);
+    assert_float_equal(l[0].intensity, 100, 0);
+    assert_int_equal(l[0].quad, RT_NONE);
+    assert_int_equal(l[1].kind, RT_LIGHT_DIRECTIONAL);
+    assert_vec3(l[1].direction, 0, -1, 0); /* normalised */
+    assert_float_equal(l[1].intensity, 3, 0);
+    assert_int_equal(l[2].kind, RT_LIGHT_SPOT);
+    assert_vec3(l[2].direction, 0, -1, 0);
+    assert_float_equal(l[2].inner_cone, 20 * RT_PI / 180, 1e-6);
+    assert_float_equal(l[2].outer_cone, 30 * RT_PI / 180, 1e-6);
+    assert_float_equal(l[2].range, 10, 0);
+    /* the area light made a visible quad with an emissive material */
+    assert_int_equal(l[3].kind, RT_LIGHT_AREA);
+    assert_float_equal(l[3].intensity, 8, 0);
+    assert_int_equal(l[3].quad, 0);
+    assert_int_equal(s.quads.count, 1);
+    assert_float_equal(s.quads.py[0], 2, 0);
+    assert_float_equal(s.quads.vz[0], 1, 0);
+    const rt_material *m = &s.materials[s.quads.material[0]];
+    assert_string_equal(m->name, "__area_light_3");
+    assert_vec3(m->emission, 8, 4, 0);
+    assert_vec3(m->color, 0, 0, 0);
+    assert_false(m->double_sided);
+    rt_scene_free(&s);
+}
+
+/* ------------------------------------------------------------ lexing */
+
+static void test_comments_and_continuations(void **state)
+{
+    (void)state;
+    rt_scene s;
+    expect_ok("# a comment line\n"
+              "   # an indented one\n"
+              "\n"
+              "material m#comment right after a token\n"
+              "sphere 1 2 \\\n"
+              "   3 \\  # a comment after the backslash\n"
+              "   4 m   # the end of the first sphere\n"
+              "sphere 0 0 0 \\\n"
+              "\\\n"
+              "1 m\n"
+              "samples 8\\\n"
+              "\t\t# the statement ends here, so the samples line is complete\n"
+              "sphere\t5 5 5 1 m",
+              &s); /* no final newline */
+    assert_int_equal(s.spheres.count, 3);
+    assert_float_equal(s.spheres.cz[0], 3, 0);
+    assert_float_equal(s.spheres.radius[0], 4, 0);
+    assert_float_equal(s.spheres.radius[1], 1, 0);
+    assert_int_equal(s.settings.samples, 8);
+    assert_float_equal(s.spheres.cx[2], 5, 0);
+    rt_scene_free(&s);
+
+    /* CRLF line endings and quoted names */
+    expect_ok("material \"a b\" color 1 1 1\r\nsphere 0 0 0 1 \"a b\"\r\n", &s);
+    assert_int_equal(s.spheres.count, 1);
+    assert_string_equal(s.materials[0].name, "a b");
+    rt_scene_free(&s);
+
+    /* empty input */
+    expect_ok("", &s);
+    assert_int_equal(rt_scene_prim_count(&s), 0);
+    rt_scene_free(&s);
+}
+
+/* ------------------------------------------------------------ errors */
+
+static void test_errors_syntax(void **state)
+{
+    (void)state;
+    expect_error("bogus 1 2\n", RT_ERR_PARSE, "1:1", "unknown keyword 'bogus'");
+    expect_error("# c\n\n  sampels 4\n", RT_ERR_PARSE, "3:3", "did you mean 'samples'?");
+    expect_error("material m\nsphere 0 0 0 abc m\n", RT_ERR_PARSE, "2:14",
+                 "expected a number for the sphere radius, got 'abc'");
+    expect_error("material m\nsphere 0 0 0\n", RT_ERR_PARSE, "2:13",
+                 "expected a number for the sphere radius, got end of line");
+    expect_error("material m\nsphere 0 0 0 1.0x m\n", RT_ERR_PARSE, "2:14", "got '1.0x'");
+    expect_error("material m\nsphere 0 0 nan 1 m\n", RT_ERR_PARSE, "2:12",
+                 "expected a number for the sphere centre (z), got 'nan'");
+    expect_error("material m\nsphere inf 0 0 1 m\n", RT_ERR_PARSE, "2:8", "got 'inf'");
+    expect_error("material m\nsphere 0x10 0 0 1 m\n", RT_ERR_PARSE, "2:8", "got '0x10'");
+    expect_error("material m\nsphere 1e39 0 0 1 m\n", RT_ERR_PARSE, "2:8", "got '1e39'"); /* over float range */
+    expect_error("material m\nsphere . 0 0 1 m\n", RT_ERR_PARSE, "2:8", "got '.'");
+    expect_error("material m\nsphere 1e 0 0 1 m\n", RT_ERR_PARSE, "2:8", "got '1e'");
+    expect_error("material m\nsphere 0 0 0 1 m extra\n", RT_ERR_PARSE, "2:18",
+                 "unexpected 'extra' after the end of the sphere statement");
+    expect_error("samples 4.5\n", RT_ERR_PARSE, "1:9", "expected an integer for samples per pixel, got '4.5'");
+    expect_error("samples\n", RT_ERR_PARSE, "1:8", "expected an integer for samples per pixel, got end of line");
+    expect_error("resolution 640\n", RT_ERR_PARSE, "1:15", "expected an integer for the image height, got end of line");
+    expect_error("integrator fancy\n", RT_ERR_PARSE, "1:12",
+                 "expected an integrator (direct|whitted|path), got 'fancy'");
+    expect_error("material m\nsphere 0 0 0 1 m\nsphere 1 2 \\\n  3 x m\n", RT_ERR_PARSE, "4:5",
+                 "expected a number for the sphere radius, got 'x'");
+    expect_error("material \"unterminated\n", RT_ERR_PARSE, "1:10", "unterminated quoted string");
+    expect_error("material \"a\"b\n", RT_ERR_PARSE, "1:13", "expected a blank after the closing quote");
+    expect_error("samples 4\x01\n", RT_ERR_PARSE, "1:10", "unexpected control character 0x01");
+    expect_error("samples 4\n\x7f", RT_ERR_PARSE, "2:1", "unexpected control character 0x7f");
+    {
+        const char text[] = "samples 4\n  \0 x\n";
+        rt_scene s;
+        rt_error err;
+        rt_scene_init(&s);
+        assert_int_equal(rt_scene_parse_string(&s, text, sizeof text - 1, "t.txt", NULL, &err), RT_ERR_PARSE);
+        assert_non_null(strstr(err.message, "t.txt:2:3: unexpected control character 0x00"));
+        rt_scene_free(&s);
+    }
+    expect_error("camera position 0 0 5 look_at 0 0 0 zoom 3\n", RT_ERR_PARSE, "1:37",
+                 "expected a camera key (position|look_at|up|fov|aperture|focus), got 'zoom'");
+    expect_error("light laser 0 0 0\n", RT_ERR_PARSE, "1:7",
+                 "expected a light kind (point|directional|spot|area), got 'laser'");
+    expect_error("light point 0 0 0 1 1 1\n", RT_ERR_PARSE, "1:24",
+                 "expected a number for the point light intensity, got end of line");
+    expect_error("material m shiny 3\n", RT_ERR_PARSE, "1:12", "expected a material key");
+    expect_error("material m double_sided maybe\n", RT_ERR_PARSE, "1:25",
+                 "expected material double_sided (true|false), got 'maybe'");
+    expect_error("texture t image\n", RT_ERR_PARSE, "1:16", "expected an image file, got end of line");
+    expect_error("texture t marble\n", RT_ERR_PARSE, "1:11",
+                 "expected a texture kind (image|checker|constant), got 'marble'");
+    expect_error("texture t checker 1 1 1 0 0 0 scale\n", RT_ERR_PARSE, "1:36",
+                 "expected a number for the checker scale, got end of line");
+    expect_error("texture t checker 1 1 1 0 0 0 size 2\n", RT_ERR_PARSE, "1:31",
+                 "unexpected 'size' after the end of the texture statement");
+    expect_error("material m\nmesh a.obj m spin 3\n", RT_ERR_PARSE, "2:14",
+                 "expected a mesh option (translate, rotate, scale, material_override), got 'spin'");
+    expect_error("material m\nmesh a.obj scale 1 2\n", RT_ERR_PARSE, "2:21",
+                 "expected a number for the mesh scale (z), got end of line");
+    expect_error("model a.gltf rotate 1 2\n", RT_ERR_PARSE, "1:24",
+                 "expected a number for the model rotation in degrees (z), got end of line");
+    expect_error("model a.gltf twist\n", RT_ERR_PARSE, "1:14", "expected a model option");
+    expect_error("mesh\n", RT_ERR_PARSE, "1:5", "expected a mesh file (.obj, .ply or .off), got end of line");
+    /* a very long bad token is shortened in the message */
+    char big[2048];
+    memset(big, 'x', sizeof big);
+    memcpy(big, "samples ", 8);
+    big[sizeof big - 2] = '\n';
+    big[sizeof big - 1] = '\0';
+    expect_error(big, RT_ERR_PARSE, "1:9", "got 'xxxx");
+}
+
+static void test_errors_values(void **state)
+{
+    (void)state;
+    expect_error("material m\nsphere 0 0 0 -1 m\n", RT_ERR_INVALID, "2:14", "the sphere radius must be > 0, got '-1'");
+    expect_error("material m\nsphere 0 0 0 0 m\n", RT_ERR_INVALID, "2:14", "the sphere radius must be > 0");
+    expect_error("resolution 0 100\n", RT_ERR_INVALID, "1:12", "the image width must be between 1 and 32768, got '0'");
+    expect_error("resolution 100 32769\n", RT_ERR_INVALID, "1:16", "the image height must be between 1 and 32768");
+    expect_error("resolution 99999999999999999999999 1\n", RT_ERR_INVALID, "1:12", "between 1 and 32768");
+    expect_error("samples 0\n", RT_ERR_INVALID, "1:9", "samples per pixel must be between 1 and 1048576, got '0'");
+    expect_error("samples 1048577\n", RT_ERR_INVALID, "1:9", "between 1 and 1048576");
+    expect_error("samples -3\n", RT_ERR_INVALID, "1:9", "between 1 and 1048576, got '-3'");
+    expect_error("max_bounce -1\n", RT_ERR_INVALID, "1:12", "max_bounce must be between 0 and 256");
+    expect_error("diffuse_rays 0\n", RT_ERR_INVALID, "1:14", "diffuse_rays must be between 1 and 65536");
+    expect_error("shadow_samples 0\n", RT_ERR_INVALID, "1:16", "shadow_samples must be between 1");
+    expect_error("diffuse_bounces 65\n", RT_ERR_INVALID, "1:17", "diffuse_bounces must be between 0 and 64");
+    expect_error("seed 4294967296\n", RT_ERR_INVALID, "1:6", "the seed must be between 0 and 4294967295");
+    expect_error("exposure 0\n", RT_ERR_INVALID, "1:10", "the exposure must be > 0");
+    expect_error("clamp -1\n", RT_ERR_INVALID, "1:7", "the clamp must be >= 0");
+    expect_error("ray_offset -0.1\n", RT_ERR_INVALID, "1:12", "the ray offset must be >= 0");
+    expect_error("background 0 -1 0\n", RT_ERR_INVALID, "1:14", "the background colour (green) must be >= 0");
+    expect_error("material m alpha 1.5\n", RT_ERR_INVALID, "1:18", "material alpha must be between 0 and 1, got '1.5'");
+    expect_error("material m color 1 1 -1\n", RT_ERR_INVALID, "1:22", "material color (blue) must be >= 0");
+    expect_error("material m ior 0\n", RT_ERR_INVALID, "1:16", "material ior must be between 0.01 and 100");
+    expect_error("material m roughness 2\n", RT_ERR_INVALID, "1:22", "material roughness must be between 0 and 1");
+    expect_error("material m attenuation_distance 0\n", RT_ERR_INVALID, "1:33",
+                 "material attenuation_distance must be > 0");
+    expect_error("material m color 1 1 1 alpha 1 color 0 0 0\n", RT_ERR_INVALID, "1:32",
+                 "material key 'color' is given twice (first at column 12)");
+    expect_error("material m reflect 0.5 reflectivity 0.5\n", RT_ERR_INVALID, "1:24", "'reflect' is given twice");
+    expect_error("camera position 0 0 0 look_at 0 0 0\n", RT_ERR_INVALID, "1:23",
+                 "the camera look_at point equals its position");
+    expect_error("camera position 0 5 0 look_at 0 0 0\n", RT_ERR_INVALID, "1:1",
+                 "the camera up vector is parallel to the view direction");
+    expect_error("camera position 0 0 5 look_at 0 0 0 up 0 0 0\n", RT_ERR_INVALID, "1:37", "the camera up vector is zero");
+    expect_error("camera position 0 0 5 look_at 0 0 0 fov 180\n", RT_ERR_INVALID, "1:41",
+                 "field of view must be below 180 degrees");
+    expect_error("camera position 0 0 5 look_at 0 0 0 fov 0\n", RT_ERR_INVALID, "1:41",
+                 "the camera field of view must be > 0");
+    expect_error("camera position 0 0 5 fov 3\n", RT_ERR_PARSE, "1:28", "expected 'look_at X Y Z'");
+    expect_error("camera look_at 0 0 5 fov 3\n", RT_ERR_PARSE, "1:27", "expected 'position X Y Z'");
+    expect_error("camera position 0 0 5 look_at 0 0 0 position 1 1 1\n", RT_ERR_INVALID, "1:37",
+                 "camera key 'position' is given twice (first at column 8)");
+    expect_error("camera position 0 0 5 look_at 0 0 0\n\ncamera position 0 0 5 look_at 0 0 1\n", RT_ERR_INVALID,
+                 "3:1", "the camera is already set on line 1");
+    expect_error("camera gltf -1\n", RT_ERR_INVALID, "1:13", "the glTF camera index must be between 0");
+    expect_error("# no models\ncamera gltf 0\n", RT_ERR_INVALID, "2:13", "camera gltf 0: the loaded models have 0 cameras");
+    expect_error("material m\nquad 0 0 0  1 0 0  2 0 0  m\n", RT_ERR_INVALID, "2:1", "degenerate quad");
+    expect_error("material m\ntriangle 0 0 0  1 1 1  2 2 2  m\n", RT_ERR_INVALID, "2:1", "degenerate triangle");
+    expect_error("light directional 0 0 0  1 1 1  1\n", RT_ERR_INVALID, "1:19", "the directional light direction is zero");
+    expect_error("light point 0 0 0  1 1 1  -5\n", RT_ERR_INVALID, "1:27", "the point light intensity must be >= 0");
+    expect_error("light spot 0 0 0  0 -1 0  1 1 1  1  40 30\n", RT_ERR_INVALID, "1:37",
+                 "inner cone angle (40) must not exceed the outer one (30)");
+    expect_error("light spot 0 0 0  0 -1 0  1 1 1  1  10 95\n", RT_ERR_INVALID, "1:40",
+                 "the spot light outer cone angle must be between 0 and 90");
+    expect_error("light area 0 0 0  1 0 0  2 0 0  1 1 1  1\n", RT_ERR_INVALID, "1:1", "degenerate area light");
+    expect_error("material m\nmesh a.obj scale 0\n", RT_ERR_INVALID, "2:12", "the mesh scale must not be zero");
+    expect_error("material m\nmesh a.obj m scale 1 scale 2\n", RT_ERR_INVALID, "2:22", "'scale' is given twice");
+    expect_error("mesh a.obj material_override\n", RT_ERR_INVALID, "1:12", "'material_override' needs a material");
+    expect_error("output \"\"\n", RT_ERR_INVALID, "1:8", "expected an output file name, got an empty string");
+    char longname[700];
+    memset(longname, 'a', sizeof longname);
+    memcpy(longname, "output ", 7);
+    longname[sizeof longname - 1] = '\0';
+    expect_error(longname, RT_ERR_LIMIT, "1:8", "output file name is too long");
+}
+
+static void test_errors_names(void **state)
+{
+    (void)state;
+    expect_error("sphere 0 0 0 1 steel\n", RT_ERR_INVALID, "1:16", "undefined material 'steel' for the sphere");
+    expect_error("material m\nquad 0 0 0 1 0 0 0 1 0 n\n", RT_ERR_INVALID, "2:24", "undefined material 'n' for the quad");
+    expect_error("material m\nsphere 0 0 0 1\n", RT_ERR_PARSE, "2:15",
+                 "expected a material name for the sphere, got end of line");
+    expect_error("# first\nmaterial red color 1 0 0\nmaterial blue\nmaterial red color 0.9 0 0\n", RT_ERR_INVALID,
+                 "4:10", "material 'red' is already defined on line 2");
+    expect_error("texture t constant 1 1 1\n\ntexture t constant 0 0 0\n", RT_ERR_INVALID, "3:9",
+                 "texture 't' is already defined on line 1");
+    expect_error("material m texture wood\n", RT_ERR_INVALID, "1:20", "undefined texture 'wood' for material texture");
+    expect_error("material m normal_map bumps\n", RT_ERR_INVALID, "1:23", "undefined texture 'bumps'");
+    expect_error("material __area_light_0\n", RT_ERR_INVALID, "1:10", "names starting with '__' are reserved");
+    expect_error("sphere 0 0 0 1 __area_light_0\n", RT_ERR_INVALID, "1:16", "undefined material '__area_light_0'");
+    expect_error("material scale\n", RT_ERR_INVALID, "1:10", "'scale' is a keyword and cannot be a material name");
+    expect_error("material aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa\n", RT_ERR_INVALID, "1:10",
+                 "is too long (at most 63 characters)");
+    expect_error("material \"\"\n", RT_ERR_INVALID, "1:10", "a material name must not be empty");
+    expect_error("material\n", RT_ERR_PARSE, "1:9", "expected a material name, got end of line");
+    /* a material must be defined before it is used */
+    expect_error("sphere 0 0 0 1 late\nmaterial late\n", RT_ERR_INVALID, "1:16", "undefined material 'late'");
+}
+
+/* ------------------------------------------------------------ files */
+
+/* A 2x2 binary PPM that stb_image reads. */
+static void write_ppm(const char *path)
+{
+    const unsigned char ppm[] = {'P', '6', '\n', '2', ' ', '2', '\n', '2', '5', '5', '\n',
+                                 255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255};
+    test_write_file(path, ppm, sizeof ppm);
+}
+
+static void test_textures_from_files(void **state)
+{
+    (void)state;
+    make_tmp_dir();
+    write_ppm(TMP_DIR "/tex.ppm");
+    rt_scene s;
+    expect_ok("texture t image tex.ppm wrap mirror filter nearest\n"
+              "texture u image tex.ppm\n"
+              "material a texture t\n"
+              "material b texture tex.ppm normal_map u\n"
+              "environment tex.ppm strength 2.5\n",
+              &s);
+    assert_int_equal(s.image_count, 1); /* one file, decoded once */
+    assert_int_equal(s.images[0].width, 2);
+    assert_int_equal(s.texture_count, 4); /* t, u, b's file texture, the environment */
+    assert_int_equal(s.textures[0].kind, RT_TEX_IMAGE);
+    assert_int_equal(s.textures[0].wrap_s, RT_WRAP_MIRROR);
+    assert_int_equal(s.textures[0].wrap_t, RT_WRAP_MIRROR);
+    assert_int_equal(s.textures[0].filter, RT_FILTER_NEAREST);
+    assert_int_equal(s.textures[1].wrap_s, RT_WRAP_REPEAT);
+    assert_int_equal(s.textures[1].filter, RT_FILTER_BILINEAR);
+    assert_int_equal(s.materials[0].base_color_tex.texture, 0);
+    assert_int_equal(s.materials[1].base_color_tex.texture, 2);
+    assert_int_equal(s.textures[2].kind, RT_TEX_IMAGE);
+    assert_int_equal(s.textures[2].image, 0);
+    assert_int_equal(s.materials[1].normal_tex.texture, 1);
+    assert_int_equal(s.settings.environment_texture, 3);
+    assert_float_equal(s.settings.environment_strength, 2.5, 0);
+    rt_scene_free(&s);
+
+    /* loader errors keep their message, prefixed with the scene location */
+    rt_error err;
+    rt_scene_init(&s);
+    const char *text = "material m texture missing.png\n";
+    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", TMP_DIR, &err), RT_ERR_IO);
+    assert_true(strncmp(err.message, "t.txt:1:20: ", 12) == 0);
+    assert_non_null(strstr(err.message, TMP_DIR "/missing.png"));
+    rt_scene_free(&s);
+    expect_error("texture t image nothing.jpg\n", RT_ERR_IO, "1:17", TMP_DIR "/nothing.jpg");
+    expect_error("environment sky.hdr\n", RT_ERR_IO, "1:13", TMP_DIR "/sky.hdr");
+    expect_error("texture t image tex.ppm wrap sideways\n", RT_ERR_PARSE, "1:30",
+                 "expected a wrap mode (repeat|clamp|mirror), got 'sideways'");
+    expect_error("texture t image tex.ppm filter cubic\n", RT_ERR_PARSE, "1:32", "expected a filter (bilinear|nearest)");
+    expect_error("texture t image tex.ppm wrap clamp wrap clamp\n", RT_ERR_INVALID, "1:36", "'wrap' is given twice");
+    /* the glTF loader's error, whatever its code, comes with the scene location */
+    rt_scene_init(&s);
+    text = "model missing.gltf\n";
+    assert_int_not_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", TMP_DIR, &err), RT_OK);
+    assert_true(strncmp(err.message, "t.txt:1:7: ", 11) == 0);
+    assert_non_null(strstr(err.message, "missing.gltf"));
+    rt_scene_free(&s);
+}
+
+/* Relative paths resolve against the scene file's directory. */
+static void test_paths_relative_to_scene_file(void **state)
+{
+    (void)state;
+    make_tmp_dir();
+    mkdir(TMP_DIR "/sub", 0777);
+    write_ppm(TMP_DIR "/sub/tex.ppm");
+    const char *scene = "material m texture tex.ppm\nsphere 0 0 0 1 m\n";
+    test_write_file(TMP_DIR "/sub/scene.txt", scene, strlen(scene));
+    rt_scene s;
+    rt_error err;
+    rt_scene_init(&s);
+    rt_result r = rt_scene_parse_file(&s, TMP_DIR "/sub/scene.txt", &err);
+    if (r != RT_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(r, RT_OK);
+    assert_int_equal(s.image_count, 1);
+    assert_string_equal(s.images[0].name, TMP_DIR "/sub/tex.ppm");
+    rt_scene_free(&s);
+
+    /* errors in a file name the file */
+    const char *bad = "material m\n\nsphere 0 0 0 r m\n";
+    test_write_file(TMP_DIR "/sub/bad.txt", bad, strlen(bad));
+    rt_scene_init(&s);
+    assert_int_equal(rt_scene_parse_file(&s, TMP_DIR "/sub/bad.txt", &err), RT_ERR_PARSE);
+    assert_string_equal(err.message, TMP_DIR "/sub/bad.txt:3:14: expected a number for the sphere radius, got 'r'");
+    rt_scene_free(&s);
+
+    rt_scene_init(&s);
+    assert_int_equal(rt_scene_parse_file(&s, TMP_DIR "/no/such/scene.txt", &err), RT_ERR_IO);
+    assert_non_null(strstr(err.message, TMP_DIR "/no/such/scene.txt: cannot open"));
+    rt_scene_free(&s);
+}
+
+/* mesh ... translate rotate scale: positions go through T * Rz * Ry * Rx * S. */
+static void test_mesh_transform(void **state)
+{
+    (void)state;
+    make_tmp_dir();
+    const char *off = "OFF\n3 1 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n";
+    test_write_file(TMP_DIR "/tri.off", off, strlen(off));
+    rt_scene s;
+    rt_error err;
+    const char *text = "material m color 1 0 0\n"
+                       "mesh tri.off m translate 10 20 30 rotate 90 0 90 scale 2 3 4 material_override\n";
+    rt_result r = parse(&s, text, &err);
+    if (r == RT_ERR_UNSUPPORTED) {
+        fprintf(stderr, "note: the mesh loader is not built yet (%s); skipping the transform check\n", err.message);
+        assert_true(strncmp(err.message, "t.txt:2:6: ", 11) == 0);
+        rt_scene_free(&s);
+        skip();
+    }
+    if (r != RT_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(r, RT_OK);
+    assert_int_equal(s.triangles.count, 1);
+    assert_int_equal(s.triangles.material[0], 0);
+    /* by hand: scale (2,3,4); Rx 90: (x,y,z) -> (x,-z,y); Rz 90: (x,y,z) -> (-y,x,z); then translate.
+     * (1,0,0) -> (2,0,0) -> (2,0,0) -> (0,2,0) -> (10,22,30)
+     * (0,1,0) -> (0,3,0) -> (0,0,3) -> (0,0,3) -> (10,20,33)
+     * (0,0,1) -> (0,0,4) -> (0,-4,0) -> (4,0,0) -> (14,20,30) */
+    rt_vec3 want[3] = {{10, 22, 30}, {10, 20, 33}, {14, 20, 30}};
+    for (int k = 0; k < 3; k++) {
+        rt_vec3 p = rt_tri_vertex(&s, 0, k);
+        int found = 0;
+        for (int j = 0; j < 3; j++)
+            found |= rt_length(rt_sub(p, want[j])) < 1e-4f;
+        assert_true(found);
+    }
+    rt_scene_free(&s);
+
+    /* a uniform scale and a mesh without a material (gets a default one) */
+    r = parse(&s, "mesh tri.off scale 2\n", &err);
+    if (r != RT_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(r, RT_OK);
+    assert_int_equal(s.triangles.count, 1);
+    rt_box b = rt_scene_bounds(&s);
+    assert_vec3(b.hi, 2, 2, 2);
+    rt_scene_free(&s);
+
+    expect_error("mesh nothing.obj\n", RT_ERR_IO, "1:6", TMP_DIR "/nothing.obj");
+}
+
+/* ------------------------------------------------------------ robustness */
+
+/* Mutated scenes (byte flips, insertions, deletions, truncations, spliced
+ * tokens) must parse or fail cleanly; under ASan/UBSan this also checks
+ * memory safety and leaks. Every failure names the file. */
+static void test_mutations_do_not_crash(void **state)
+{
+    (void)state;
+    static const char *const pieces[] = {" ", "\n", "\\\n", "#", "\"", "0", "-1", "1e9", "nan", "1.5.2", "x",
+                                         "material", "sphere", "light area", "camera gltf 0", "texture", "\t",
+                                         "mesh", "quad", "99999999999999999999", "scale", "\r\n", "\x01"};
+    const char *base = rt_default_scene_text;
+    size_t base_len = strlen(base);
+    test_rng rng = {0x5eed5eedu};
+    char *buf = malloc(base_len + 1024);
+    assert_non_null(buf);
+    int failures = 0;
+    rt_log_level level = rt_log_get_level();
+    rt_log_set_level(RT_LOG_QUIET); /* mutations repeat settings: no warnings */
+    for (int iter = 0; iter < 3000; iter++) {
+        size_t len = base_len;
+        memcpy(buf, base, len);
+        int edits = 1 + (int)(test_rng_next(&rng) % 6);
+        for (int e = 0; e < edits; e++) {
+            size_t at = len ? (size_t)(test_rng_next(&rng) % len) : 0;
+            switch (test_rng_next(&rng) % 4) {
+            case 0: /* flip a byte */
+                if (len)
+                    buf[at] = (char)(test_rng_next(&rng) & 0xff);
+                break;
+            case 1: { /* insert a piece */
+                const char *p = pieces[test_rng_next(&rng) % (sizeof pieces / sizeof *pieces)];
+                size_t n = strlen(p);
+                if (len + n < base_len + 1000) {
+                    memmove(buf + at + n, buf + at, len - at);
+                    memcpy(buf + at, p, n);
+                    len += n;
+                }
+                break;
+            }
+            case 2: { /* delete a run */
+                size_t n = (size_t)(test_rng_next(&rng) % 16);
+                if (at + n > len)
+                    n = len - at;
+                memmove(buf + at, buf + at + n, len - at - n);
+                len -= n;
+                break;
+            }
+            default: /* truncate */
+                len = at;
+                break;
+            }
+        }
+        rt_scene s;
+        rt_error err;
+        memset(&err, 0, sizeof err);
+        rt_scene_init(&s);
+        rt_result r = rt_scene_parse_string(&s, buf, len, "m.txt", TMP_DIR, &err);
+        if (r != RT_OK) {
+            failures++;
+            assert_true(strncmp(err.message, "m.txt:", 6) == 0);
+        }
+        rt_scene_free(&s);
+    }
+    free(buf);
+    rt_log_set_level(level);
+    assert_true(failures > 100); /* the mutations did reach the error paths */
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_default_scene),
+        cmocka_unit_test(test_cornell_file_matches_default),
+        cmocka_unit_test(test_all_scene_files),
+        cmocka_unit_test(test_spheres_scene),
+        cmocka_unit_test(test_settings_values),
+        cmocka_unit_test(test_camera_values),
+        cmocka_unit_test(test_material_values),
+        cmocka_unit_test(test_primitive_values),
+        cmocka_unit_test(test_light_values),
+        cmocka_unit_test(test_comments_and_continuations),
+        cmocka_unit_test(test_errors_syntax),
+        cmocka_unit_test(test_errors_values),
+        cmocka_unit_test(test_errors_names),
+        cmocka_unit_test(test_textures_from_files),
+        cmocka_unit_test(test_paths_relative_to_scene_file),
+        cmocka_unit_test(test_mesh_transform),
+        cmocka_unit_test(test_mutations_do_not_crash),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
