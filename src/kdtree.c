@@ -1,73 +1,920 @@
-/* kdtree.c - PLACEHOLDER: brute force over all primitives until the SAH
- * kd-tree lands. Same interface, so the renderer can be written against it. */
+/* kdtree.c - SAH kd-tree: O(N log N) build with perfect splits, and
+ * front-to-back traversal that returns bit-exact closest hits.
+ *
+ * Build: Wald and Havran, "On building fast kd-Trees for Ray Tracing, and on
+ * doing that in O(N log N)", IEEE Symposium on Interactive Ray Tracing 2006
+ * (section 4: event sorting). Each node holds, per axis, a list of events
+ * sorted once at the root by (position, type), type END < PLANAR < START:
+ * a primitive whose (clipped) bounds on axis k are [a, b] has START at a and
+ * END at b, or one PLANAR event when a == b. One linear sweep per axis gives
+ * for every candidate plane p the counts N_L (left of p), N_P (in p) and
+ * N_R (right of p), and the plane cost
+ *
+ *   C(p) = lambda(p) * (K_T + K_I * (P_L * N_L' + P_R * N_R'))
+ *   P_L  = SA(V_L) / SA(V),  P_R = SA(V_R) / SA(V)   (surface area heuristic,
+ *          MacDonald and Booth 1990: probability that a ray through V
+ *          crosses the child)
+ *
+ * with the planar primitives put on the cheaper side (N_L' = N_L + N_P or
+ * N_R' = N_R + N_P), and lambda(p) = 1 - empty_bonus when one side is empty
+ * (the empty-space bonus), else 1. Only planes strictly inside V count
+ * (so no zero-volume cells are cut off again and again). The node becomes a
+ * leaf when the best C(p) is not below the leaf cost K_I * N, or at the depth
+ * limit (default 8 + 1.3 log2 N, as pbrt). Defaults: K_T = 15, K_I = 20,
+ * empty_bonus = 0.2 (the paper's values).
+ * Splitting classifies each primitive as left, right or both in one pass over
+ * the chosen axis' events; the event lists of left-only and right-only
+ * primitives are filtered into the children keeping their order, and only the
+ * straddling primitives get new events: each is clipped against the child
+ * box (Sutherland-Hodgman in double precision, bounds rounded outwards:
+ * "perfect splits", Havran's thesis 2000, section 4.5), the few new events
+ * sorted and merged in. Hence O(N log N) overall. The root lists are sorted
+ * by an LSD radix sort on 64-bit event keys (position bits, type, primitive).
+ *
+ * Layout: 8-byte nodes in depth-first order (below child = next node, above
+ * child index in the node; see kdtree.h), leaf ids in one array, triangles as
+ * v0, e1 = v1 - v0, e2 = v2 - v0 (computed exactly as the reference tests do,
+ * so t is bit-identical to testing the scene's triangle directly).
+ *
+ * Traversal: the recursive ray segment algorithm (Havran's thesis, "TA_B^rec",
+ * and pbrt's KdTreeAccel) with a fixed stack: enter the child on the ray's
+ * side first, push the other with its t interval, stop once the closest hit
+ * lies before the next cell's entry. Every primitive test uses the ray's own
+ * (tmin, closest-so-far) interval, so t is what brute force would compute.
+ * Exactness against rounding: cells are widened by a tiny distance mp
+ * (2^-15 of the scene's and the origin's largest coordinate) on every plane,
+ * so a hit whose computed t lies a few ulps outside the cell of its primitive
+ * (edges shared on a split plane, grazing hits) is still found before the
+ * traversal stops. Rays parallel to a split plane (direction component 0,
+ * 1/0 = inf) are handled without the 0 * inf = NaN of the slab formula.
+ */
 #include "rt/kdtree.h"
 
+#include <float.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+
+/* ------------------------------------------------------------- events */
+
+enum { EV_END = 0, EV_PLANAR = 1, EV_START = 2 };
+enum { SIDE_BOTH = 0, SIDE_LEFT = 1, SIDE_RIGHT = 2 };
+#define PRIM_BITS 30
+#define PRIM_MASK ((1u << PRIM_BITS) - 1u)
+#define KD_STACK 64
+#define KD_MAX_DEPTH 60
+#define LEAF_TAG 3u
+
+/* Event = ordered position bits << 32 | type << 30 | primitive: sorting the
+ * integers sorts by (position, type). */
+static inline uint32_t f2o(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, 4);
+    return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+}
+static inline float o2f(uint32_t o)
+{
+    uint32_t u = (o & 0x80000000u) ? (o & 0x7fffffffu) : ~o;
+    float f;
+    memcpy(&f, &u, 4);
+    return f;
+}
+static inline uint64_t ev_make(float pos, unsigned type, uint32_t prim)
+{
+    pos += 0.0f; /* -0 -> +0: one plane, one key */
+    return ((uint64_t)f2o(pos) << 32) | ((uint64_t)type << PRIM_BITS) | prim;
+}
+static inline uint32_t ev_key(uint64_t e) { return (uint32_t)(e >> 32); }
+static inline unsigned ev_type(uint64_t e) { return (unsigned)(e >> PRIM_BITS) & 3u; }
+static inline uint32_t ev_prim(uint64_t e) { return (uint32_t)e & PRIM_MASK; }
+
+/* Sorts events by (position, type); tmp has room for n. */
+static void ev_sort(uint64_t *a, size_t n, uint64_t *tmp)
+{
+    if (n < 64) {
+        for (size_t i = 1; i < n; i++) {
+            uint64_t x = a[i];
+            size_t j = i;
+            while (j > 0 && (a[j - 1] >> PRIM_BITS) > (x >> PRIM_BITS)) {
+                a[j] = a[j - 1];
+                j--;
+            }
+            a[j] = x;
+        }
+        return;
+    }
+    static const int shift[3] = {30, 41, 52}, bits[3] = {11, 11, 12};
+    uint64_t *src = a, *dst = tmp;
+    size_t count[4096];
+    for (int pass = 0; pass < 3; pass++) {
+        size_t radix = (size_t)1 << bits[pass], mask = radix - 1;
+        memset(count, 0, radix * sizeof count[0]);
+        for (size_t i = 0; i < n; i++)
+            count[(src[i] >> shift[pass]) & mask]++;
+        if (count[(src[0] >> shift[pass]) & mask] == n)
+            continue; /* every key shares this digit */
+        size_t sum = 0;
+        for (size_t r = 0; r < radix; r++) {
+            size_t c = count[r];
+            count[r] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++)
+            dst[count[(src[i] >> shift[pass]) & mask]++] = src[i];
+        uint64_t *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != a)
+        memcpy(a, src, n * sizeof *a);
+}
+
+/* ------------------------------------------------------------ clipping */
+
+static inline float round_down(double x)
+{
+    float f = (float)x;
+    if ((double)f > x)
+        f = nextafterf(f, -INFINITY);
+    return f;
+}
+static inline float round_up(double x)
+{
+    float f = (float)x;
+    if ((double)f < x)
+        f = nextafterf(f, INFINITY);
+    return f;
+}
+
+#define POLY_MAX 40
+
+/* Sutherland-Hodgman: keeps the part of polygon `in` with sign * (x_k - c) >= 0. */
+static int clip_plane(double (*in)[3], int n, double (*out)[3], int k, double c, double sign)
+{
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        const double *a = in[i], *b = in[i + 1 == n ? 0 : i + 1];
+        double da = sign * (a[k] - c), db = sign * (b[k] - c);
+        if (da >= 0.0) {
+            if (m >= POLY_MAX)
+                return -1;
+            memcpy(out[m++], a, sizeof(double[3]));
+        }
+        if ((da >= 0.0) != (db >= 0.0)) {
+            if (m >= POLY_MAX)
+                return -1;
+            double t = da / (da - db);
+            for (int j = 0; j < 3; j++)
+                out[m][j] = a[j] + (b[j] - a[j]) * t;
+            out[m][k] = c;
+            m++;
+        }
+    }
+    return m;
+}
+
+/* ------------------------------------------------------------- build */
+
+typedef struct kd_build {
+    const rt_scene *s;
+    uint32_t T, S, Q;
+    double kt, ki, lambda;
+    int max_depth;
+    uint8_t *side;   /* per primitive, during one split */
+    uint32_t *strad; /* straddling primitives of the current split */
+    size_t strad_cap;
+    rt_kdtree_node *nodes;
+    size_t node_count, node_cap;
+    uint32_t *ids;
+    size_t id_count, id_cap;
+    rt_kdtree_stats st;
+    bool oom;
+} kd_build;
+
+static inline float *box_lo(rt_box *b) { return &b->lo.x; }
+static inline float *box_hi(rt_box *b) { return &b->hi.x; }
+
+/* Bounds of the part of primitive `prim` inside `box` (tight for triangles
+ * and quads, box-intersected for spheres); false when nothing is inside. */
+static bool prim_clip_bounds(const kd_build *c, uint32_t prim, rt_box box, rt_box *out)
+{
+    const rt_scene *s = c->s;
+    double poly[2][POLY_MAX][3];
+    double lo[3], hi[3];
+    int n = 0;
+    const float *bl = &box.lo.x, *bh = &box.hi.x;
+    if (prim < c->T) {
+        for (int v = 0; v < 3; v++) {
+            rt_vec3 p = rt_tri_vertex(s, prim, v);
+            poly[0][v][0] = p.x, poly[0][v][1] = p.y, poly[0][v][2] = p.z;
+        }
+        n = 3;
+    } else if (prim < c->T + c->S) {
+        uint32_t i = prim - c->T;
+        const rt_spheres *sp = &s->spheres;
+        double cc[3] = {sp->cx[i], sp->cy[i], sp->cz[i]}, r = fabs((double)sp->radius[i]);
+        for (int k = 0; k < 3; k++) {
+            lo[k] = cc[k] - r;
+            hi[k] = cc[k] + r;
+        }
+    } else {
+        uint32_t i = prim - c->T - c->S;
+        const rt_quads *q = &s->quads;
+        double p[3] = {q->px[i], q->py[i], q->pz[i]}, u[3] = {q->ux[i], q->uy[i], q->uz[i]},
+               v[3] = {q->vx[i], q->vy[i], q->vz[i]};
+        for (int k = 0; k < 3; k++) {
+            poly[0][0][k] = p[k];
+            poly[0][1][k] = p[k] + u[k];
+            poly[0][2][k] = p[k] + u[k] + v[k];
+            poly[0][3][k] = p[k] + v[k];
+        }
+        n = 4;
+    }
+    if (n > 0) {
+        int cur = 0;
+        for (int k = 0; k < 3 && n > 0; k++) {
+            n = clip_plane(poly[cur], n, poly[cur ^ 1], k, bl[k], 1.0);
+            cur ^= 1;
+            if (n > 0) {
+                n = clip_plane(poly[cur], n, poly[cur ^ 1], k, bh[k], -1.0);
+                cur ^= 1;
+            }
+        }
+        if (n < 0) { /* cannot happen for a convex polygon; stay conservative */
+            for (int k = 0; k < 3; k++)
+                lo[k] = -INFINITY, hi[k] = INFINITY;
+        } else if (n == 0) {
+            return false;
+        } else {
+            for (int k = 0; k < 3; k++)
+                lo[k] = hi[k] = poly[cur][0][k];
+            for (int j = 1; j < n; j++)
+                for (int k = 0; k < 3; k++) {
+                    lo[k] = fmin(lo[k], poly[cur][j][k]);
+                    hi[k] = fmax(hi[k], poly[cur][j][k]);
+                }
+        }
+    }
+    float *ol = &out->lo.x, *oh = &out->hi.x;
+    for (int k = 0; k < 3; k++) {
+        ol[k] = fmaxf(round_down(lo[k]), bl[k]);
+        oh[k] = fminf(round_up(hi[k]), bh[k]);
+        if (!(ol[k] <= oh[k]))
+            return false;
+    }
+    return true;
+}
+
+/* Appends the events of one box to the three per-axis lists. */
+static inline void emit_events(rt_box b, uint32_t prim, uint64_t *list[3], size_t n[3])
+{
+    const float *lo = &b.lo.x, *hi = &b.hi.x;
+    for (int k = 0; k < 3; k++) {
+        if (lo[k] == hi[k]) {
+            list[k][n[k]++] = ev_make(lo[k], EV_PLANAR, prim);
+        } else {
+            list[k][n[k]++] = ev_make(lo[k], EV_START, prim);
+            list[k][n[k]++] = ev_make(hi[k], EV_END, prim);
+        }
+    }
+}
+
+static uint32_t push_node(kd_build *c)
+{
+    if (!rt_grow((void **)&c->nodes, &c->node_cap, c->node_count + 1, sizeof *c->nodes)) {
+        c->oom = true;
+        return 0;
+    }
+    c->nodes[c->node_count].a = 0;
+    c->nodes[c->node_count].b = LEAF_TAG;
+    return (uint32_t)c->node_count++;
+}
+
+static void make_leaf(kd_build *c, uint32_t node, const uint64_t *ev0, size_t n0, size_t nprims, int depth)
+{
+    rt_kdtree_node *nd = &c->nodes[node];
+    c->st.leaves++;
+    if (depth > c->st.depth)
+        c->st.depth = depth;
+    if (nprims > c->st.max_leaf_prims)
+        c->st.max_leaf_prims = nprims;
+    c->st.prim_refs += nprims;
+    if (nprims == 0) {
+        c->st.empty_leaves++;
+        nd->a = 0;
+        nd->b = LEAF_TAG;
+        return;
+    }
+    if (nprims == 1) {
+        for (size_t i = 0; i < n0; i++)
+            if (ev_type(ev0[i]) != EV_END) {
+                nd->a = ev_prim(ev0[i]);
+                break;
+            }
+        nd->b = LEAF_TAG | (1u << 2);
+        return;
+    }
+    if (!rt_grow((void **)&c->ids, &c->id_cap, c->id_count + nprims, sizeof *c->ids)) {
+        c->oom = true;
+        return;
+    }
+    uint32_t *dst = c->ids + c->id_count;
+    size_t m = 0;
+    for (size_t i = 0; i < n0 && m < nprims; i++)
+        if (ev_type(ev0[i]) != EV_END) {
+            uint32_t p = ev_prim(ev0[i]);
+            size_t j = m++; /* insertion sort: ascending ids, triangles first */
+            while (j > 0 && dst[j - 1] > p) {
+                dst[j] = dst[j - 1];
+                j--;
+            }
+            dst[j] = p;
+        }
+    nd->a = (uint32_t)c->id_count;
+    nd->b = LEAF_TAG | ((uint32_t)m << 2);
+    c->id_count += m;
+}
+
+/* Merges sorted `add` (na) into the sorted prefix dst[0..nd) of dst, which
+ * has room for nd + na, from the back. */
+static void merge_back(uint64_t *dst, size_t nd, const uint64_t *add, size_t na)
+{
+    size_t i = nd, j = na, k = nd + na;
+    while (j > 0) {
+        if (i > 0 && (dst[i - 1] >> PRIM_BITS) > (add[j - 1] >> PRIM_BITS))
+            dst[--k] = dst[--i];
+        else
+            dst[--k] = add[--j];
+    }
+}
+
+/* Builds the subtree of box V from its event lists (one block `ev`, lists of
+ * cnt[0], cnt[1], cnt[2] events, owned and freed here) over nprims prims. */
+static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t nprims, int depth)
+{
+    uint32_t node = push_node(c);
+    if (c->oom) {
+        free(ev);
+        return;
+    }
+    uint64_t *list[3] = {ev, ev + cnt[0], ev + cnt[0] + cnt[1]};
+    const float *vlo = &V.lo.x, *vhi = &V.hi.x;
+    double ext[3] = {(double)vhi[0] - vlo[0], (double)vhi[1] - vlo[1], (double)vhi[2] - vlo[2]};
+    double area = 2.0 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[2] * ext[0]);
+    double leaf_cost = c->ki * (double)nprims;
+    double best = INFINITY;
+    int best_k = -1, best_side = SIDE_LEFT;
+    uint32_t best_key = 0;
+
+    if (nprims > 1 && depth < c->max_depth && area > 0.0 && isfinite(area)) {
+        double inv_area = 1.0 / area;
+        for (int k = 0; k < 3; k++) {
+            if (!(vlo[k] < vhi[k]))
+                continue;
+            double a = ext[(k + 1) % 3], b = ext[(k + 2) % 3], ab = a * b, apb = a + b;
+            const uint64_t *E = list[k];
+            size_t n = cnt[k], nl = 0, nr = nprims;
+            for (size_t i = 0; i < n;) {
+                uint32_t key = ev_key(E[i]);
+                size_t pe = 0, pp = 0, ps = 0;
+                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_END)
+                    pe++, i++;
+                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_PLANAR)
+                    pp++, i++;
+                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_START)
+                    ps++, i++;
+                nr -= pp + pe;
+                float p = o2f(key);
+                if (p > vlo[k] && p < vhi[k]) {
+                    double dl = (double)p - vlo[k], dr = (double)vhi[k] - p;
+                    double pl = 2.0 * (ab + dl * apb) * inv_area, pr = 2.0 * (ab + dr * apb) * inv_area;
+                    double l1 = (double)(nl + pp), r1 = (double)nr;       /* planar left */
+                    double l2 = (double)nl, r2 = (double)(nr + pp);       /* planar right */
+                    double c1 = c->kt + c->ki * (pl * l1 + pr * r1);
+                    double c2 = c->kt + c->ki * (pl * l2 + pr * r2);
+                    if (l1 == 0.0 || r1 == 0.0)
+                        c1 *= c->lambda;
+                    if (l2 == 0.0 || r2 == 0.0)
+                        c2 *= c->lambda;
+                    if (c1 < best) {
+                        best = c1, best_k = k, best_key = key, best_side = SIDE_LEFT;
+                    }
+                    if (c2 < best) {
+                        best = c2, best_k = k, best_key = key, best_side = SIDE_RIGHT;
+                    }
+                }
+                nl += ps + pp;
+            }
+        }
+    }
+    if (best_k < 0 || !(best < leaf_cost)) {
+        make_leaf(c, node, list[0], cnt[0], nprims, depth);
+        free(ev);
+        return;
+    }
+
+    /* classify */
+    int k = best_k;
+    uint8_t *side = c->side;
+    const uint64_t *E = list[k];
+    size_t n = cnt[k], ns = 0;
+    for (size_t i = 0; i < n; i++)
+        side[ev_prim(E[i])] = SIDE_BOTH;
+    for (size_t i = 0; i < n; i++) {
+        uint64_t e = E[i];
+        uint32_t key = ev_key(e);
+        unsigned t = ev_type(e);
+        if (t == EV_END && key <= best_key)
+            side[ev_prim(e)] = SIDE_LEFT;
+        else if (t == EV_START && key >= best_key)
+            side[ev_prim(e)] = SIDE_RIGHT;
+        else if (t == EV_PLANAR) {
+            if (key < best_key || (key == best_key && best_side == SIDE_LEFT))
+                side[ev_prim(e)] = SIDE_LEFT;
+            else
+                side[ev_prim(e)] = SIDE_RIGHT;
+        }
+    }
+    for (size_t i = 0; i < n; i++)
+        if (ev_type(E[i]) == EV_START && side[ev_prim(E[i])] == SIDE_BOTH) {
+            if (!rt_grow((void **)&c->strad, &c->strad_cap, ns + 1, sizeof *c->strad)) {
+                c->oom = true;
+                free(ev);
+                return;
+            }
+            c->strad[ns++] = ev_prim(E[i]);
+        }
+
+    float split = o2f(best_key);
+    rt_box VL = V, VR = V;
+    box_hi(&VL)[k] = split;
+    box_lo(&VR)[k] = split;
+
+    /* new events of the straddling primitives, clipped to each child */
+    uint64_t *nbuf = NULL;
+    uint64_t *nl_list[3], *nr_list[3];
+    size_t nl_cnt[3] = {0, 0, 0}, nr_cnt[3] = {0, 0, 0};
+    size_t npl = 0, npr = 0; /* straddlers kept on each side */
+    if (ns > 0) {
+        nbuf = malloc(ns * 14 * sizeof *nbuf); /* 6 lists of 2 ns + sort scratch 2 ns */
+        if (!nbuf) {
+            c->oom = true;
+            free(ev);
+            return;
+        }
+        for (int d = 0; d < 3; d++) {
+            nl_list[d] = nbuf + (size_t)d * 2 * ns;
+            nr_list[d] = nbuf + (size_t)(3 + d) * 2 * ns;
+        }
+        for (size_t i = 0; i < ns; i++) {
+            uint32_t p = c->strad[i];
+            rt_box b;
+            if (prim_clip_bounds(c, p, VL, &b)) {
+                emit_events(b, p, nl_list, nl_cnt);
+                npl++;
+            }
+            if (prim_clip_bounds(c, p, VR, &b)) {
+                emit_events(b, p, nr_list, nr_cnt);
+                npr++;
+            }
+        }
+        uint64_t *scratch = nbuf + 12 * ns;
+        for (int d = 0; d < 3; d++) {
+            ev_sort(nl_list[d], nl_cnt[d], scratch);
+            ev_sort(nr_list[d], nr_cnt[d], scratch);
+        }
+    }
+
+    /* filter the parent lists into the children's blocks */
+    size_t kl[3] = {0, 0, 0}, kr[3] = {0, 0, 0};
+    size_t left_prims = npl, right_prims = npr;
+    for (int d = 0; d < 3; d++)
+        for (size_t i = 0; i < cnt[d]; i++) {
+            uint8_t sd = side[ev_prim(list[d][i])];
+            kl[d] += sd == SIDE_LEFT;
+            kr[d] += sd == SIDE_RIGHT;
+            if (d == k && ev_type(list[d][i]) != EV_END) {
+                left_prims += sd == SIDE_LEFT;
+                right_prims += sd == SIDE_RIGHT;
+            }
+        }
+    size_t lc[3], rc[3], ltot = 0, rtot = 0;
+    for (int d = 0; d < 3; d++) {
+        lc[d] = kl[d] + nl_cnt[d];
+        rc[d] = kr[d] + nr_cnt[d];
+        ltot += lc[d];
+        rtot += rc[d];
+    }
+    uint64_t *lev = malloc((ltot ? ltot : 1) * sizeof *lev);
+    uint64_t *rev = malloc((rtot ? rtot : 1) * sizeof *rev);
+    if (!lev || !rev) {
+        free(lev);
+        free(rev);
+        free(nbuf);
+        free(ev);
+        c->oom = true;
+        return;
+    }
+    uint64_t *lp = lev, *rp = rev;
+    for (int d = 0; d < 3; d++) {
+        size_t a = 0, b = 0;
+        for (size_t i = 0; i < cnt[d]; i++) {
+            uint64_t e = list[d][i];
+            uint8_t sd = side[ev_prim(e)];
+            if (sd == SIDE_LEFT)
+                lp[a++] = e;
+            else if (sd == SIDE_RIGHT)
+                rp[b++] = e;
+        }
+        if (ns > 0) {
+            merge_back(lp, a, nl_list[d], nl_cnt[d]);
+            merge_back(rp, b, nr_list[d], nr_cnt[d]);
+        }
+        lp += lc[d];
+        rp += rc[d];
+    }
+    free(nbuf);
+    free(ev);
+
+    build_rec(c, VL, lev, lc, left_prims, depth + 1);
+    if (c->oom) {
+        free(rev);
+        return;
+    }
+    uint32_t above = (uint32_t)c->node_count;
+    build_rec(c, VR, rev, rc, right_prims, depth + 1);
+    if (c->oom)
+        return;
+    uint32_t bits;
+    memcpy(&bits, &split, 4);
+    c->nodes[node].a = bits;
+    c->nodes[node].b = (uint32_t)k | (above << 2);
+}
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static bool finite_box(rt_box b) { return rt_finite3(b.lo) && rt_finite3(b.hi); }
 
 rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
 {
-    (void)params; (void)err;
+    double t0 = now_ms();
     memset(tree, 0, sizeof *tree);
     tree->scene = scene;
-    tree->triangle_count = scene->triangles.count;
-    tree->sphere_count = scene->spheres.count;
-    tree->quad_count = scene->quads.count;
-    tree->bounds = rt_scene_bounds(scene);
+    tree->bounds = rt_box_empty();
+    size_t T = scene->triangles.count, S = scene->spheres.count, Q = scene->quads.count, N = T + S + Q;
+    if (N >= (size_t)PRIM_MASK)
+        return rt_fail(err, RT_ERR_LIMIT, "kdtree: %zu primitives, at most %u supported", N, PRIM_MASK - 1u);
+    tree->triangle_count = T;
+    tree->sphere_count = S;
+    tree->quad_count = Q;
+
+    kd_build c;
+    memset(&c, 0, sizeof c);
+    c.s = scene;
+    c.T = (uint32_t)T;
+    c.S = (uint32_t)S;
+    c.Q = (uint32_t)Q;
+    c.kt = params && params->traversal_cost > 0.0f ? params->traversal_cost : 15.0;
+    c.ki = params && params->intersect_cost > 0.0f ? params->intersect_cost : 20.0;
+    double eb = params && params->empty_bonus > 0.0f ? params->empty_bonus : 0.2;
+    if (eb > 1.0)
+        eb = 1.0;
+    c.lambda = 1.0 - eb;
+
+    uint64_t *ev = NULL, *tmp = NULL;
+    if (T > 0) {
+        tree->tri = malloc(T * 9 * sizeof *tree->tri);
+        if (!tree->tri)
+            goto oom;
+    }
+    ev = malloc((N ? 6 * N : 1) * sizeof *ev);
+    c.side = malloc(N ? N : 1);
+    if (!ev || !c.side)
+        goto oom;
+
+    /* valid primitives and their bounds: first a count, then the events */
+    size_t nvalid = 0;
+    rt_box *pb = malloc((N ? N : 1) * sizeof *pb);
+    if (!pb)
+        goto oom;
+    size_t nverts = scene->vertices.count;
+    for (size_t i = 0; i < N; i++) {
+        rt_box b = rt_box_empty();
+        bool ok = true;
+        if (i < T) {
+            const uint32_t *ix = scene->triangles.index + 3 * i;
+            float *dst = tree->tri + 9 * i;
+            memset(dst, 0, 9 * sizeof *dst);
+            if (ix[0] >= nverts || ix[1] >= nverts || ix[2] >= nverts) {
+                ok = false;
+            } else {
+                rt_vec3 a = scene->vertices.position[ix[0]], bb = scene->vertices.position[ix[1]],
+                        cc = scene->vertices.position[ix[2]];
+                rt_vec3 e1 = rt_sub(bb, a), e2 = rt_sub(cc, a);
+                ok = rt_finite3(a) && rt_finite3(bb) && rt_finite3(cc) && rt_finite3(e1) && rt_finite3(e2) &&
+                     (e1.x != 0.0f || e1.y != 0.0f || e1.z != 0.0f) && (e2.x != 0.0f || e2.y != 0.0f || e2.z != 0.0f);
+                if (ok) {
+                    dst[0] = a.x, dst[1] = a.y, dst[2] = a.z;
+                    dst[3] = e1.x, dst[4] = e1.y, dst[5] = e1.z;
+                    dst[6] = e2.x, dst[7] = e2.y, dst[8] = e2.z;
+                    b = rt_box_point(rt_box_point(rt_box_point(b, a), bb), cc);
+                }
+            }
+        } else if (i < T + S) {
+            size_t j = i - T;
+            const rt_spheres *sp = &scene->spheres;
+            ok = isfinite(sp->cx[j]) && isfinite(sp->cy[j]) && isfinite(sp->cz[j]) && isfinite(sp->radius[j]);
+            if (ok) {
+                double r = fabs((double)sp->radius[j]);
+                b.lo = rt_v3(round_down(sp->cx[j] - r), round_down(sp->cy[j] - r), round_down(sp->cz[j] - r));
+                b.hi = rt_v3(round_up(sp->cx[j] + r), round_up(sp->cy[j] + r), round_up(sp->cz[j] + r));
+            }
+        } else {
+            size_t j = i - T - S;
+            const rt_quads *q = &scene->quads;
+            rt_vec3 p = rt_v3(q->px[j], q->py[j], q->pz[j]), u = rt_v3(q->ux[j], q->uy[j], q->uz[j]),
+                    v = rt_v3(q->vx[j], q->vy[j], q->vz[j]);
+            rt_vec3 nrm = rt_cross(u, v);
+            ok = rt_finite3(p) && rt_finite3(u) && rt_finite3(v) && rt_dot(nrm, nrm) > 0.0f;
+            if (ok) {
+                double lo[3], hi[3];
+                const float *pp = &p.x, *uu = &u.x, *vv = &v.x;
+                for (int k = 0; k < 3; k++) {
+                    double c0 = pp[k], c1 = c0 + uu[k], c2 = c0 + vv[k], c3 = c1 + vv[k];
+                    lo[k] = fmin(fmin(c0, c1), fmin(c2, c3));
+                    hi[k] = fmax(fmax(c0, c1), fmax(c2, c3));
+                }
+                b.lo = rt_v3(round_down(lo[0]), round_down(lo[1]), round_down(lo[2]));
+                b.hi = rt_v3(round_up(hi[0]), round_up(hi[1]), round_up(hi[2]));
+            }
+        }
+        if (ok && !finite_box(b))
+            ok = false;
+        pb[i] = b;
+        if (ok) {
+            nvalid++;
+            tree->bounds = rt_box_union(tree->bounds, b);
+        } else {
+            pb[i] = rt_box_empty();
+        }
+    }
+    if (nvalid < N)
+        rt_info("kdtree: %zu of %zu primitives can never be hit (non-finite or degenerate) and are left out", N - nvalid,
+                N);
+
+    size_t cnt[3] = {0, 0, 0};
+    uint64_t *list[3] = {ev, ev + 2 * nvalid, ev + 4 * nvalid};
+    for (size_t i = 0; i < N; i++)
+        if (!rt_box_is_empty(pb[i]))
+            emit_events(pb[i], (uint32_t)i, list, cnt);
+    free(pb);
+    tmp = malloc((nvalid ? 2 * nvalid : 1) * sizeof *tmp);
+    if (!tmp)
+        goto oom;
+    for (int k = 0; k < 3; k++)
+        ev_sort(list[k], cnt[k], tmp);
+    free(tmp);
+    tmp = NULL;
+    /* compact the three lists into one block */
+    memmove(ev + cnt[0], list[1], cnt[1] * sizeof *ev);
+    memmove(ev + cnt[0] + cnt[1], list[2], cnt[2] * sizeof *ev);
+
+    if (nvalid > 0) {
+        const float *lo = &tree->bounds.lo.x, *hi = &tree->bounds.hi.x;
+        for (int k = 0; k < 3; k++)
+            tree->scale = fmaxf(tree->scale, fmaxf(fabsf(lo[k]), fabsf(hi[k])));
+    }
+    int md = params && params->max_depth > 0 ? params->max_depth
+                                             : (int)(8.0 + 1.3 * log2((double)(nvalid > 1 ? nvalid : 1)) + 0.5);
+    if (md > KD_MAX_DEPTH)
+        md = KD_MAX_DEPTH;
+    c.max_depth = md;
+    tree->max_depth = md;
+
+    build_rec(&c, tree->bounds, ev, cnt, nvalid, 0);
+    ev = NULL;
+    if (c.oom)
+        goto oom;
+    free(c.side);
+    free(c.strad);
+    tree->nodes = c.nodes;
+    tree->node_count = c.node_count;
+    tree->prim_ids = c.ids;
+    tree->prim_id_count = c.id_count;
+    c.st.nodes = c.node_count;
+    c.st.bytes = c.node_count * sizeof *c.nodes + c.id_count * sizeof *c.ids + T * 9 * sizeof(float);
+    c.st.build_ms = now_ms() - t0;
+    tree->stats = c.st;
     return RT_OK;
+
+oom:
+    free(ev);
+    free(tmp);
+    free(c.side);
+    free(c.strad);
+    free(c.nodes);
+    free(c.ids);
+    free(tree->tri);
+    memset(tree, 0, sizeof *tree);
+    return rt_fail(err, RT_ERR_NOMEM, "kdtree: out of memory building the tree over %zu primitives", N);
 }
 
-void rt_kdtree_free(rt_kdtree *tree) { memset(tree, 0, sizeof *tree); }
-
-static bool prim_hit(const rt_kdtree *tree, uint32_t id, const rt_ray *r, float tmax, rt_hit *h)
+void rt_kdtree_free(rt_kdtree *tree)
 {
-    const rt_scene *s = tree->scene;
-    uint32_t i;
-    float t, u = 0, v = 0;
-    switch (rt_prim_kind_of(s, id, &i)) {
-    case RT_PRIM_TRIANGLE: {
-        rt_vec3 a = rt_tri_vertex(s, i, 0), b = rt_tri_vertex(s, i, 1), c = rt_tri_vertex(s, i, 2);
-        if (!rt_intersect_triangle(r->org, r->dir, a, rt_sub(b, a), rt_sub(c, a), r->tmin, tmax, &t, &u, &v))
-            return false;
-        break;
+    if (!tree)
+        return;
+    free(tree->nodes);
+    free(tree->prim_ids);
+    free(tree->tri);
+    memset(tree, 0, sizeof *tree);
+}
+
+/* ---------------------------------------------------------- traversal */
+
+typedef struct kd_ray {
+    float o[3], d[3], inv[3];
+    float mp; /* widening of every cell, in scene units */
+    float tn, tf;
+} kd_ray;
+
+/* Clips the ray to the (widened) root box; false when it misses. */
+static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r)
+{
+    if (!tree->nodes || !(ray->tmin < ray->tmax) || rt_box_is_empty(tree->bounds))
+        return false;
+    if (!rt_finite3(ray->org) || !rt_finite3(ray->dir))
+        return false;
+    r->o[0] = ray->org.x, r->o[1] = ray->org.y, r->o[2] = ray->org.z;
+    r->d[0] = ray->dir.x, r->d[1] = ray->dir.y, r->d[2] = ray->dir.z;
+    float omax = fmaxf(fabsf(r->o[0]), fmaxf(fabsf(r->o[1]), fabsf(r->o[2])));
+    if (r->d[0] == 0.0f && r->d[1] == 0.0f && r->d[2] == 0.0f)
+        return false;
+    r->mp = (tree->scale + omax) * 0x1p-15f;
+    float tn = ray->tmin, tf = ray->tmax;
+    const float *lo = &tree->bounds.lo.x, *hi = &tree->bounds.hi.x;
+    for (int k = 0; k < 3; k++) {
+        r->inv[k] = 1.0f / r->d[k];
+        if (!(fabsf(r->inv[k]) < INFINITY)) {
+            if (r->o[k] < lo[k] - r->mp || r->o[k] > hi[k] + r->mp)
+                return false;
+            continue;
+        }
+        float ma = r->mp * fabsf(r->inv[k]);
+        float t0 = (lo[k] - r->o[k]) * r->inv[k], t1 = (hi[k] - r->o[k]) * r->inv[k];
+        if (t0 > t1) {
+            float t = t0; t0 = t1; t1 = t;
+        }
+        t0 -= ma;
+        t1 += ma;
+        if (t0 > tn)
+            tn = t0;
+        if (t1 < tf)
+            tf = t1;
     }
-    case RT_PRIM_SPHERE:
-        if (!rt_intersect_sphere(r->org, r->dir, rt_v3(s->spheres.cx[i], s->spheres.cy[i], s->spheres.cz[i]),
-                                 s->spheres.radius[i], r->tmin, tmax, &t))
-            return false;
-        break;
-    default: {
-        const rt_quads *q = &s->quads;
-        if (!rt_intersect_quad(r->org, r->dir, rt_v3(q->px[i], q->py[i], q->pz[i]), rt_v3(q->ux[i], q->uy[i], q->uz[i]),
-                               rt_v3(q->vx[i], q->vy[i], q->vz[i]), r->tmin, tmax, &t, &u, &v))
-            return false;
-    }
-    }
-    h->t = t; h->u = u; h->v = v; h->prim = id;
+    if (!(tn <= tf))
+        return false;
+    r->tn = tn;
+    r->tf = tf;
     return true;
+}
+
+/* Tests one primitive with the reference functions on (tmin, *best). */
+static inline bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit)
+{
+    float t, u, v;
+    if (id < tree->triangle_count) {
+        const float *p = tree->tri + 9 * (size_t)id;
+        if (!rt_intersect_triangle(ray->org, ray->dir, rt_v3(p[0], p[1], p[2]), rt_v3(p[3], p[4], p[5]),
+                                   rt_v3(p[6], p[7], p[8]), ray->tmin, *best, &t, &u, &v))
+            return false;
+    } else if (id < tree->triangle_count + tree->sphere_count) {
+        const rt_spheres *s = &tree->scene->spheres;
+        size_t i = id - tree->triangle_count;
+        if (!rt_intersect_sphere(ray->org, ray->dir, rt_v3(s->cx[i], s->cy[i], s->cz[i]), s->radius[i], ray->tmin,
+                                 *best, &t))
+            return false;
+        u = v = 0.0f;
+    } else {
+        const rt_quads *q = &tree->scene->quads;
+        size_t i = id - tree->triangle_count - tree->sphere_count;
+        if (!rt_intersect_quad(ray->org, ray->dir, rt_v3(q->px[i], q->py[i], q->pz[i]),
+                               rt_v3(q->ux[i], q->uy[i], q->uz[i]), rt_v3(q->vx[i], q->vy[i], q->vz[i]), ray->tmin,
+                               *best, &t, &u, &v))
+            return false;
+    }
+    *best = t;
+    hit->t = t;
+    hit->u = u;
+    hit->v = v;
+    hit->prim = id;
+    return true;
+}
+
+typedef struct kd_entry {
+    uint32_t node;
+    float tn, tf;
+} kd_entry;
+
+/* The shared traversal; any = stop at the first hit (occlusion). */
+static inline bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, bool any)
+{
+    kd_ray r;
+    if (!ray_setup(tree, ray, &r))
+        return false;
+    const rt_kdtree_node *nodes = tree->nodes;
+    const uint32_t *ids = tree->prim_ids;
+    kd_entry stack[KD_STACK];
+    int sp = 0;
+    uint32_t node = 0;
+    float tn = r.tn, tf = r.tf, best = ray->tmax;
+    bool found = false;
+    for (;;) {
+        rt_kdtree_node nd = nodes[node];
+        uint32_t axis = nd.b & 3u;
+        if (axis != LEAF_TAG) {
+            float split;
+            memcpy(&split, &nd.a, 4);
+            uint32_t below = node + 1, above = nd.b >> 2;
+            float o = r.o[axis], inv = r.inv[axis];
+            if (!(fabsf(inv) < INFINITY)) { /* parallel to the plane */
+                float dist = o - split;
+                if (dist < -r.mp) {
+                    node = below;
+                } else if (dist > r.mp) {
+                    node = above;
+                } else {
+                    if (sp < KD_STACK) {
+                        stack[sp].node = above, stack[sp].tn = tn, stack[sp].tf = tf;
+                        sp++;
+                    }
+                    node = below;
+                }
+                continue;
+            }
+            float ts = (split - o) * inv, ma = r.mp * fabsf(inv);
+            uint32_t first = inv > 0.0f ? below : above, second = inv > 0.0f ? above : below;
+            bool v1 = tn <= ts + ma, v2 = ts - ma <= tf;
+            if (v1 && v2) {
+                if (sp < KD_STACK) {
+                    stack[sp].node = second, stack[sp].tn = fmaxf(tn, ts - ma), stack[sp].tf = tf;
+                    sp++;
+                }
+                node = first;
+                tf = fminf(tf, ts + ma);
+            } else if (v1) {
+                node = first;
+            } else {
+                node = second;
+            }
+            continue;
+        }
+        uint32_t n = nd.b >> 2;
+        if (n == 1) {
+            if (test_prim(tree, nd.a, ray, &best, hit)) {
+                found = true;
+                if (any)
+                    return true;
+            }
+        } else {
+            const uint32_t *p = ids + nd.a;
+            for (uint32_t i = 0; i < n; i++)
+                if (test_prim(tree, p[i], ray, &best, hit)) {
+                    found = true;
+                    if (any)
+                        return true;
+                }
+        }
+        for (;;) {
+            if (sp == 0)
+                return found;
+            sp--;
+            if (stack[sp].tn <= best)
+                break;
+        }
+        node = stack[sp].node;
+        tn = stack[sp].tn;
+        tf = stack[sp].tf;
+    }
 }
 
 bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit)
 {
-    size_t n = tree->triangle_count + tree->sphere_count + tree->quad_count;
-    float tmax = ray->tmax;
-    bool any = false;
-    for (size_t i = 0; i < n; i++)
-        if (prim_hit(tree, (uint32_t)i, ray, tmax, hit)) {
-            tmax = hit->t;
-            any = true;
-        }
-    if (!any)
-        hit->prim = RT_NONE;
-    return any;
+    hit->prim = RT_NONE;
+    if (traverse(tree, ray, hit, false))
+        return true;
+    hit->prim = RT_NONE;
+    return false;
 }
 
 bool rt_kdtree_occluded(const rt_kdtree *tree, const rt_ray *ray)
 {
     rt_hit h;
-    size_t n = tree->triangle_count + tree->sphere_count + tree->quad_count;
-    for (size_t i = 0; i < n; i++)
-        if (prim_hit(tree, (uint32_t)i, ray, ray->tmax, &h))
-            return true;
-    return false;
+    return traverse(tree, ray, &h, true);
 }

@@ -10,8 +10,10 @@
  *
  * Triangle: Moeller and Trumbore (1997), "Fast, Minimum Storage Ray/Triangle
  * Intersection", with precomputed edges e1 = v1 - v0, e2 = v2 - v0; (u, v)
- * are the barycentrics of v1 and v2. Degenerate triangles (zero area) never
- * hit.
+ * are the barycentrics of v1 and v2. Degenerate triangles (zero area, or
+ * collinear edges up to rounding) never hit, and neither does a ray within
+ * about 1e-5 rad of a triangle's or quad's plane: there the determinant is
+ * rounding noise and the computed hit could lie anywhere on the ray.
  * Sphere: the numerically robust quadratic of Haines et al., "Precision
  * Improvements for Ray/Sphere Intersection", Ray Tracing Gems ch. 7.
  * Quad (parallelogram p + s*u + t*v): plane hit, then (s, t) by projection.
@@ -56,6 +58,14 @@ static inline bool rt_intersect_triangle(rt_vec3 org, rt_vec3 dir, rt_vec3 v0, r
         return false;
     float t = rt_dot(e2, q) * inv;
     if (!(t > tmin && t < tmax))
+        return false;
+    /* A (near-)degenerate triangle, or a ray within ~1e-5 rad of its plane:
+     * det is then rounding noise and u, v, t are garbage (a collinear
+     * triangle with non-zero edges would "hit" anywhere). Checked on hits
+     * only, so it costs nothing in the common miss path. */
+    float a1 = fabsf(e1.x) + fabsf(e1.y) + fabsf(e1.z), a2 = fabsf(e2.x) + fabsf(e2.y) + fabsf(e2.z);
+    float ad = fabsf(dir.x) + fabsf(dir.y) + fabsf(dir.z);
+    if (!(fabsf(det) / a1 / a2 > 0x1p-16f * ad))
         return false;
     *t_out = t;
     *u_out = u;
@@ -109,6 +119,11 @@ static inline bool rt_intersect_quad(rt_vec3 org, rt_vec3 dir, rt_vec3 p, rt_vec
         return false;
     float r = rt_dot(n, rt_cross(eu, w)) / nn;
     if (r < 0.0f || r > 1.0f)
+        return false;
+    /* as for triangles: edges (nearly) parallel, or a grazing ray, make the
+     * numbers above rounding noise; such hits do not count */
+    float nd = fabsf(n.x) + fabsf(n.y) + fabsf(n.z), ad = fabsf(dir.x) + fabsf(dir.y) + fabsf(dir.z);
+    if (!(nn / rt_dot(eu, eu) / rt_dot(ev, ev) > 0x1p-32f) || !(fabsf(denom) / nd > 0x1p-16f * ad))
         return false;
     *t_out = t;
     *s_out = s;

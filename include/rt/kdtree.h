@@ -13,9 +13,17 @@
  *   rt_kdtree_free(&tree);
  *
  * Layout: nodes of 8 bytes in one array (the below child is the next node),
- * leaf primitive ids in a second array, triangles copied into
- * structure-of-arrays buffers (v0, e1, e2) for the leaf loops. Build and
- * traversal are described, with their sources, at the top of kdtree.c.
+ * leaf primitive ids in a second array (a one-primitive leaf stores its id
+ * in the node), triangles copied into one buffer of 9 floats each (v0, e1,
+ * e2: one cache line per test) for the leaf loops. Build and traversal are
+ * described, with their sources, at the top of kdtree.c.
+ *
+ * Results are exactly those of testing every primitive with the functions
+ * of intersect.h (same t bits; either id when two primitives tie). Rays with
+ * a non-finite origin or direction, a zero direction, or tmin >= tmax (or
+ * NaN) hit nothing. Primitives that can never be hit (non-finite
+ * coordinates, a zero edge, a zero-area quad, a non-finite sphere) are left
+ * out of the tree.
  *
  * The tree keeps a pointer to the scene (for spheres and quads): the scene
  * must outlive it and must not gain primitives after the build.
@@ -58,9 +66,10 @@ typedef struct rt_kdtree {
     size_t node_count;
     uint32_t *prim_ids;
     size_t prim_id_count;
-    /* triangle buffers, indexed by triangle id */
-    float *v0x, *v0y, *v0z, *e1x, *e1y, *e1z, *e2x, *e2y, *e2z;
-    size_t triangle_count, sphere_count, quad_count;
+    /* triangles, indexed by triangle id: v0.xyz, e1.xyz, e2.xyz (9 floats) */
+    float *tri;
+    size_t triangle_count, sphere_count, quad_count; /* at build time */
+    float scale; /* largest absolute coordinate of bounds (traversal epsilon) */
     const rt_scene *scene;
     rt_box bounds;
     int max_depth;

@@ -1,0 +1,634 @@
+/* test_kdtree.c - the kd-tree against brute force.
+ *
+ * Every scene here is checked the same way: thousands of rays are traced
+ * through the tree and through a brute-force loop over every primitive with
+ * the same functions of intersect.h; the closest hits must have the same t
+ * bits and the same primitive (or one that ties at exactly that t), and
+ * occluded() must agree with a brute-force any-hit. The scenes are random
+ * soups and the layouts that break kd-trees: everything in one plane, 1000
+ * copies of a triangle, huge and tiny triangles together, integer boxes whose
+ * faces lie on split planes, spheres and quads, non-finite and degenerate
+ * input, empty and single-primitive scenes.
+ */
+#include "test_util.h"
+
+#include "rt/kdtree.h"
+
+/* ------------------------------------------------------------ helpers */
+
+static uint32_t add_tri(rt_scene *s, rt_vec3 a, rt_vec3 b, rt_vec3 c)
+{
+    uint32_t v = rt_scene_add_vertices(s, 3);
+    assert_int_not_equal(v, RT_NONE);
+    s->vertices.position[v] = a;
+    s->vertices.position[v + 1] = b;
+    s->vertices.position[v + 2] = c;
+    uint32_t t = rt_scene_add_triangle(s, v, v + 1, v + 2, 0, 0);
+    assert_int_not_equal(t, RT_NONE);
+    return t;
+}
+
+static void add_quad_tris(rt_scene *s, rt_vec3 p, rt_vec3 u, rt_vec3 v)
+{
+    add_tri(s, p, rt_add(p, u), rt_add(rt_add(p, u), v));
+    add_tri(s, p, rt_add(rt_add(p, u), v), rt_add(p, v));
+}
+
+/* An axis-aligned box of 12 triangles. */
+static void add_box_tris(rt_scene *s, rt_vec3 lo, rt_vec3 hi)
+{
+    rt_vec3 d = rt_sub(hi, lo);
+    rt_vec3 ex = rt_v3(d.x, 0, 0), ey = rt_v3(0, d.y, 0), ez = rt_v3(0, 0, d.z);
+    add_quad_tris(s, lo, ey, ex);
+    add_quad_tris(s, rt_add(lo, ez), ex, ey);
+    add_quad_tris(s, lo, ex, ez);
+    add_quad_tris(s, rt_add(lo, ey), ez, ex);
+    add_quad_tris(s, lo, ez, ey);
+    add_quad_tris(s, rt_add(lo, ex), ey, ez);
+}
+
+static float rnd(test_rng *r, float lo, float hi) { return lo + (hi - lo) * test_rng_float(r); }
+static rt_vec3 rnd3(test_rng *r, float lo, float hi) { return rt_v3(rnd(r, lo, hi), rnd(r, lo, hi), rnd(r, lo, hi)); }
+
+static void random_soup(rt_scene *s, test_rng *r, size_t n, float size)
+{
+    for (size_t i = 0; i < n; i++) {
+        rt_vec3 c = rnd3(r, 0.0f, 1.0f);
+        float sz = size * rnd(r, 0.2f, 1.0f);
+        add_tri(s, rt_add(c, rnd3(r, -sz, sz)), rt_add(c, rnd3(r, -sz, sz)), rt_add(c, rnd3(r, -sz, sz)));
+    }
+}
+
+/* One primitive with the reference functions, exactly as kdtree.h promises. */
+static bool ref_prim(const rt_scene *s, uint32_t id, const rt_ray *r, float tmax, rt_hit *h)
+{
+    size_t T = s->triangles.count, S = s->spheres.count;
+    float t, u = 0.0f, v = 0.0f;
+    if (id < T) {
+        rt_vec3 a = rt_tri_vertex(s, id, 0), b = rt_tri_vertex(s, id, 1), c = rt_tri_vertex(s, id, 2);
+        if (!rt_intersect_triangle(r->org, r->dir, a, rt_sub(b, a), rt_sub(c, a), r->tmin, tmax, &t, &u, &v))
+            return false;
+    } else if (id < T + S) {
+        size_t i = id - T;
+        const rt_spheres *sp = &s->spheres;
+        if (!rt_intersect_sphere(r->org, r->dir, rt_v3(sp->cx[i], sp->cy[i], sp->cz[i]), sp->radius[i], r->tmin, tmax,
+                                 &t))
+            return false;
+    } else {
+        size_t i = id - T - S;
+        const rt_quads *q = &s->quads;
+        if (!rt_intersect_quad(r->org, r->dir, rt_v3(q->px[i], q->py[i], q->pz[i]), rt_v3(q->ux[i], q->uy[i], q->uz[i]),
+                               rt_v3(q->vx[i], q->vy[i], q->vz[i]), r->tmin, tmax, &t, &u, &v))
+            return false;
+    }
+    h->t = t;
+    h->u = u;
+    h->v = v;
+    h->prim = id;
+    return true;
+}
+
+static bool ref_closest(const rt_scene *s, const rt_ray *r, rt_hit *h)
+{
+    size_t n = rt_scene_prim_count(s);
+    float tmax = r->tmax;
+    bool any = false;
+    h->prim = RT_NONE;
+    for (size_t i = 0; i < n; i++)
+        if (ref_prim(s, (uint32_t)i, r, tmax, h)) {
+            tmax = h->t;
+            any = true;
+        }
+    return any;
+}
+
+static bool ref_any(const rt_scene *s, const rt_ray *r)
+{
+    rt_hit h;
+    size_t n = rt_scene_prim_count(s);
+    for (size_t i = 0; i < n; i++)
+        if (ref_prim(s, (uint32_t)i, r, r->tmax, &h))
+            return true;
+    return false;
+}
+
+typedef struct check_stats {
+    size_t rays, hits, ties;
+} check_stats;
+
+/* The tree's answer for one ray against brute force. */
+static void check_ray(const rt_scene *s, const rt_kdtree *tree, const rt_ray *r, check_stats *cs)
+{
+    rt_hit a, b;
+    memset(&a, 0x55, sizeof a);
+    bool ha = rt_kdtree_intersect(tree, r, &a);
+    bool hb = ref_closest(s, r, &b);
+    if (ha != hb) {
+        fprintf(stderr, "mismatch: kd %d (t %.9g prim %u) brute %d (t %.9g prim %u)\n", ha, (double)a.t, a.prim, hb,
+                (double)b.t, b.prim);
+        fprintf(stderr, "ray org (%.9g %.9g %.9g) dir (%.9g %.9g %.9g) tmin %.9g tmax %.9g\n", (double)r->org.x,
+                (double)r->org.y, (double)r->org.z, (double)r->dir.x, (double)r->dir.y, (double)r->dir.z,
+                (double)r->tmin, (double)r->tmax);
+    }
+    assert_int_equal(ha, hb);
+    cs->rays++;
+    if (!ha) {
+        assert_int_equal(a.prim, RT_NONE);
+    } else {
+        cs->hits++;
+        if (a.t != b.t)
+            fprintf(stderr, "t mismatch: kd %.9g (prim %u) brute %.9g (prim %u)\n", (double)a.t, a.prim, (double)b.t,
+                    b.prim);
+        assert_true(a.t == b.t);
+        if (a.prim == b.prim) {
+            assert_true(a.u == b.u);
+            assert_true(a.v == b.v);
+        } else {
+            /* a tie: the tree's primitive must hit at exactly this t */
+            rt_hit c;
+            assert_true(ref_prim(s, a.prim, r, r->tmax, &c));
+            assert_true(c.t == a.t);
+            assert_true(c.u == a.u && c.v == a.v);
+            cs->ties++;
+        }
+    }
+    assert_int_equal(rt_kdtree_occluded(tree, r), ref_any(s, r));
+}
+
+/* Every primitive that can be hit appears in some leaf; stats add up. */
+static void check_tree(const rt_scene *s, const rt_kdtree *tree)
+{
+    const rt_kdtree_stats *st = &tree->stats;
+    size_t n = rt_scene_prim_count(s);
+    assert_true(st->nodes > 0);
+    assert_int_equal(st->nodes, tree->node_count);
+    assert_true(st->leaves > 0 && st->leaves <= st->nodes);
+    assert_int_equal(st->nodes, 2 * st->leaves - 1);
+    assert_true(st->empty_leaves <= st->leaves);
+    assert_true(st->depth <= tree->max_depth);
+    assert_true(st->bytes >= st->nodes * 8);
+    uint8_t *seen = calloc(n ? n : 1, 1);
+    assert_non_null(seen);
+    size_t refs = 0, maxleaf = 0, leaves = 0;
+    for (size_t i = 0; i < tree->node_count; i++) {
+        const rt_kdtree_node *nd = &tree->nodes[i];
+        if ((nd->b & 3u) != 3u) {
+            assert_true((nd->b >> 2) > i + 1 && (nd->b >> 2) < tree->node_count);
+            continue;
+        }
+        leaves++;
+        size_t c = nd->b >> 2;
+        refs += c;
+        if (c > maxleaf)
+            maxleaf = c;
+        if (c == 1) {
+            assert_true(nd->a < n);
+            seen[nd->a] = 1;
+        } else {
+            assert_true(nd->a + c <= tree->prim_id_count);
+            for (size_t j = 0; j < c; j++) {
+                assert_true(tree->prim_ids[nd->a + j] < n);
+                seen[tree->prim_ids[nd->a + j]] = 1;
+            }
+        }
+    }
+    assert_int_equal(leaves, st->leaves);
+    assert_int_equal(refs, st->prim_refs);
+    assert_int_equal(maxleaf, st->max_leaf_prims);
+    /* a primitive left out of the tree must be one that never hits: its box is empty or non-finite */
+    for (size_t i = 0; i < n; i++) {
+        if (seen[i])
+            continue;
+        rt_box b = rt_scene_prim_bounds(s, (uint32_t)i);
+        bool finite = rt_finite3(b.lo) && rt_finite3(b.hi);
+        if (finite && i < s->triangles.count) {
+            rt_vec3 a = rt_tri_vertex(s, i, 0);
+            rt_vec3 e1 = rt_sub(rt_tri_vertex(s, i, 1), a), e2 = rt_sub(rt_tri_vertex(s, i, 2), a);
+            finite = rt_finite3(e1) && rt_finite3(e2) && rt_length2(e1) > 0.0f && rt_length2(e2) > 0.0f;
+        } else if (finite && i >= s->triangles.count + s->spheres.count) {
+            size_t q = i - s->triangles.count - s->spheres.count;
+            rt_vec3 nq = rt_cross(rt_v3(s->quads.ux[q], s->quads.uy[q], s->quads.uz[q]),
+                                 rt_v3(s->quads.vx[q], s->quads.vy[q], s->quads.vz[q]));
+            finite = rt_dot(nq, nq) > 0.0f;
+        }
+        if (finite)
+            fprintf(stderr, "primitive %zu is in no leaf\n", i);
+        assert_false(finite);
+    }
+    free(seen);
+}
+
+/* A random ray: origin in [lo, hi]^3, direction random with some zero and
+ * axis-aligned components, and a mix of tmin/tmax. */
+static rt_ray random_ray(test_rng *r, float lo, float hi)
+{
+    rt_vec3 o = rnd3(r, lo, hi);
+    rt_vec3 d = rnd3(r, -1.0f, 1.0f);
+    uint64_t k = test_rng_next(r);
+    switch (k % 8) {
+    case 0: d.x = 0.0f; break;
+    case 1: d.y = 0.0f, d.z = 0.0f; break;
+    case 2: d = rt_scale(d, 1000.0f); break;
+    case 3: d = rt_scale(d, 0.001f); break;
+    default: break;
+    }
+    if ((k >> 8) % 4 == 0) /* aim at the middle of the scene */
+        d = rt_sub(rt_v3s(0.5f * (lo + hi)), o);
+    float tmin = (k >> 12) % 3 == 0 ? 0.0f : rnd(r, 0.0f, 0.01f);
+    float tmax = (k >> 16) % 3 == 0 ? rnd(r, 0.1f, 2.0f) : INFINITY;
+    if ((k >> 20) % 7 == 0)
+        d = rt_neg(d);
+    return rt_ray_make(o, d, tmin, tmax);
+}
+
+static void report(const char *name, const check_stats *cs)
+{
+    if (getenv("RT_TEST_VERBOSE"))
+        fprintf(stderr, "%s: %zu rays, %zu hits, %zu ties\n", name, cs->rays, cs->hits, cs->ties);
+}
+
+static void check_random_rays(const rt_scene *s, const rt_kdtree *tree, uint64_t seed, size_t n, float lo, float hi,
+                              check_stats *cs)
+{
+    test_rng r = {seed};
+    for (size_t i = 0; i < n; i++) {
+        rt_ray ray = random_ray(&r, lo, hi);
+        check_ray(s, tree, &ray, cs);
+    }
+}
+
+static void build_ok(rt_kdtree *tree, const rt_scene *s)
+{
+    rt_error err = {0};
+    rt_result res = rt_kdtree_build(tree, s, NULL, &err);
+    if (res != RT_OK)
+        fprintf(stderr, "build failed: %s\n", err.message);
+    assert_int_equal(res, RT_OK);
+    check_tree(s, tree);
+}
+
+/* -------------------------------------------------------------- tests */
+
+static void test_empty_scene(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_kdtree tree;
+    build_ok(&tree, &s);
+    rt_hit h;
+    h.prim = 7;
+    rt_ray r = rt_ray_make(rt_v3(0, 0, -1), rt_v3(0, 0, 1), 0.0f, INFINITY);
+    assert_false(rt_kdtree_intersect(&tree, &r, &h));
+    assert_int_equal(h.prim, RT_NONE);
+    assert_false(rt_kdtree_occluded(&tree, &r));
+    assert_int_equal(tree.stats.prim_refs, 0);
+    rt_kdtree_free(&tree);
+    rt_kdtree_free(&tree); /* twice is harmless */
+    rt_scene_free(&s);
+}
+
+static void test_single_triangle(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    add_tri(&s, rt_v3(0, 0, 0), rt_v3(1, 0, 0), rt_v3(0, 1, 0));
+    rt_kdtree tree;
+    build_ok(&tree, &s);
+    assert_int_equal(tree.stats.nodes, 1);
+    assert_int_equal(tree.stats.prim_refs, 1);
+    rt_hit h;
+    rt_ray r = rt_ray_make(rt_v3(0.25f, 0.25f, -2), rt_v3(0, 0, 1), 0.0f, INFINITY);
+    assert_true(rt_kdtree_intersect(&tree, &r, &h));
+    assert_true(h.t == 2.0f);
+    assert_int_equal(h.prim, 0);
+    assert_true(h.u == 0.25f && h.v == 0.25f);
+    r.tmax = 2.0f; /* open interval: t = tmax is a miss */
+    assert_false(rt_kdtree_intersect(&tree, &r, &h));
+    assert_false(rt_kdtree_occluded(&tree, &r));
+    /* the flat root box (z extent 0) with rays in its plane and parallel to it */
+    r = rt_ray_make(rt_v3(-1, 0.25f, 0), rt_v3(1, 0, 0), 0.0f, INFINITY);
+    assert_false(rt_kdtree_intersect(&tree, &r, &h));
+    check_stats cs = {0, 0, 0};
+    check_random_rays(&s, &tree, 11, 2000, -0.5f, 1.5f, &cs);
+    report(__func__, &cs);
+    assert_true(cs.hits > 50);
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
+static void test_random_soups(void **state)
+{
+    (void)state;
+    static const size_t sizes[] = {300, 1000, 3000};
+    static const float tri_size[] = {0.25f, 0.12f, 0.07f};
+    for (int i = 0; i < 3; i++) {
+        rt_scene s;
+        rt_scene_init(&s);
+        test_rng r = {1234u + (uint64_t)i};
+        random_soup(&s, &r, sizes[i], tri_size[i]);
+        rt_kdtree tree;
+        build_ok(&tree, &s);
+        assert_true(tree.stats.leaves > 10);
+        assert_true(tree.stats.depth > 3);
+        check_stats cs = {0, 0, 0};
+        check_random_rays(&s, &tree, 99 + (uint64_t)i, 3000, -0.2f, 1.2f, &cs);
+        report(__func__, &cs);
+        assert_true(cs.hits > 500);
+        rt_kdtree_free(&tree);
+        rt_scene_free(&s);
+    }
+}
+
+static void test_params(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    test_rng r = {77};
+    random_soup(&s, &r, 1000, 0.05f);
+    rt_kdtree_params p[3] = {
+        {1.0f, 80.0f, 0.5f, 0, 0}, /* pbrt's costs: deep trees */
+        {1.0f, 1.0f, 0.0f, 0, 0},
+        {10.0f, 1.0f, 0.0f, 3, 0}, /* shallow */
+    };
+    for (int i = 0; i < 3; i++) {
+        rt_kdtree tree;
+        rt_error err = {0};
+        assert_int_equal(rt_kdtree_build(&tree, &s, &p[i], &err), RT_OK);
+        check_tree(&s, &tree);
+        if (i == 2)
+            assert_true(tree.stats.depth <= 3);
+        check_stats cs = {0, 0, 0};
+        check_random_rays(&s, &tree, 5 + (uint64_t)i, 1000, -0.2f, 1.2f, &cs);
+        rt_kdtree_free(&tree);
+    }
+    rt_scene_free(&s);
+}
+
+static void test_one_plane(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    test_rng r = {5};
+    for (int i = 0; i < 1500; i++) {
+        rt_vec3 c = rt_v3(rnd(&r, 0, 1), rnd(&r, 0, 1), 0.5f);
+        rt_vec3 a = rt_add(c, rt_v3(rnd(&r, -0.05f, 0.05f), rnd(&r, -0.05f, 0.05f), 0.0f));
+        rt_vec3 b = rt_add(c, rt_v3(rnd(&r, -0.05f, 0.05f), rnd(&r, -0.05f, 0.05f), 0.0f));
+        rt_vec3 d = rt_add(c, rt_v3(rnd(&r, -0.05f, 0.05f), rnd(&r, -0.05f, 0.05f), 0.0f));
+        add_tri(&s, a, b, d);
+    }
+    rt_kdtree tree;
+    build_ok(&tree, &s);
+    assert_true(tree.stats.leaves > 10);
+    check_stats cs = {0, 0, 0};
+    check_random_rays(&s, &tree, 3, 2000, -0.2f, 1.2f, &cs);
+    /* rays in the plane (parallel to it: never hit, must not crash) and through it */
+    for (int i = 0; i < 1000; i++) {
+        rt_ray ray = rt_ray_make(rt_v3(rnd(&r, -0.5f, 1.5f), rnd(&r, -0.5f, 1.5f), 0.5f),
+                                 rt_v3(rnd(&r, -1, 1), rnd(&r, -1, 1), 0.0f), 0.0f, INFINITY);
+        check_ray(&s, &tree, &ray, &cs);
+        ray = rt_ray_make(rt_v3(rnd(&r, 0, 1), rnd(&r, 0, 1), i % 2 ? 2.0f : -1.0f), rt_v3(0, 0, i % 2 ? -1.0f : 1.0f),
+                          0.0f, INFINITY);
+        check_ray(&s, &tree, &ray, &cs);
+    }
+    report(__func__, &cs);
+    assert_true(cs.hits > 500);
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
+static void test_identical_triangles(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    for (int i = 0; i < 1000; i++)
+        add_tri(&s, rt_v3(0, 0, 0), rt_v3(1, 0, 0.5f), rt_v3(0, 1, 0.25f));
+    test_rng r = {8};
+    random_soup(&s, &r, 100, 0.1f);
+    rt_kdtree tree;
+    build_ok(&tree, &s);
+    /* termination: the copies cannot be separated, so no deep tree of them */
+    assert_true(tree.stats.max_leaf_prims >= 1000);
+    assert_true(tree.stats.prim_refs < 20000);
+    check_stats cs = {0, 0, 0};
+    check_random_rays(&s, &tree, 4, 1000, -0.2f, 1.2f, &cs);
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
+static void test_huge_and_tiny(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    test_rng r = {9};
+    random_soup(&s, &r, 1000, 1e-4f);
+    add_tri(&s, rt_v3(-100, -100, 0.3f), rt_v3(100, -100, 0.6f), rt_v3(0, 100, 0.5f));
+    add_tri(&s, rt_v3(-50, 0.5f, -50), rt_v3(50, 0.4f, -50), rt_v3(0, 0.6f, 60));
+    for (int i = 0; i < 200; i++) {
+        rt_vec3 c = rnd3(&r, 0, 1);
+        add_tri(&s, c, rt_add(c, rt_v3(1e-6f, 0, 0)), rt_add(c, rt_v3(0, 1e-6f, 1e-7f)));
+    }
+    rt_kdtree tree;
+    build_ok(&tree, &s);
+    check_stats cs = {0, 0, 0};
+    check_random_rays(&s, &tree, 6, 3000, -0.2f, 1.2f, &cs);
+    /* rays aimed at tiny triangles */
+    for (size_t i = 0; i < 1000; i++) {
+        uint32_t t = (uint32_t)(i % s.triangles.count);
+        rt_vec3 a = rt_tri_vertex(&s, t, 0), b = rt_tri_vertex(&s, t, 1), c = rt_tri_vertex(&s, t, 2);
+        rt_vec3 target = rt_scale(rt_add(rt_add(a, b), c), 1.0f / 3.0f);
+        rt_vec3 o = rnd3(&r, -1, 2);
+        rt_ray ray = rt_ray_make(o, rt_sub(target, o), 0.0f, INFINITY);
+        check_ray(&s, &tree, &ray, &cs);
+    }
+    report(__func__, &cs);
+    assert_true(cs.hits > 1000);
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
+static void test_integer_boxes(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    /* a 4x4x4 lattice of unit cubes with gaps, and touching cubes sharing faces */
+    for (int x = 0; x < 4; x++)
+        for (int y = 0; y < 4; y++)
+            for (int z = 0; z < 4; z++)
+                if ((x + y + z) % 2 == 0)
+                    add_box_tris(&s, rt_v3((float)(2 * x), (float)(2 * y), (float)(2 * z)),
+                                 rt_v3((float)(2 * x + 1), (float)(2 * y + 1), (float)(2 * z + 1)));
+    for (int x = 0; x < 4; x++)
+        add_box_tris(&s, rt_v3((float)x, 9, 0), rt_v3((float)(x + 1), 10, 1));
+    rt_kdtree tree;
+    build_ok(&tree, &s);
+    check_stats cs = {0, 0, 0};
+    test_rng r = {10};
+    /* axis-aligned and diagonal rays from integer and half-integer points:
+     * they run along faces and edges and hit exactly on split planes */
+    static const rt_vec3 dirs[] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, {0, -1, 0}, {0, 0, -1},
+                                   {1, 1, 0}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}, {-1, 1, -1}, {2, 1, 0}};
+    for (int i = 0; i < 6000; i++) {
+        float h = (i % 3 == 0) ? 0.5f : 0.0f;
+        rt_vec3 o = rt_v3((float)(test_rng_next(&r) % 12) - 2.0f + h, (float)(test_rng_next(&r) % 13) - 2.0f,
+                          (float)(test_rng_next(&r) % 12) - 2.0f + (i % 5 == 0 ? 0.5f : 0.0f));
+        rt_vec3 d = dirs[test_rng_next(&r) % (sizeof dirs / sizeof dirs[0])];
+        if (i % 2)
+            d = rt_neg(d);
+        rt_ray ray = rt_ray_make(o, d, i % 4 == 0 ? 0.0f : 1e-3f, INFINITY);
+        check_ray(&s, &tree, &ray, &cs);
+    }
+    check_random_rays(&s, &tree, 12, 2000, -2.0f, 10.0f, &cs);
+    report(__func__, &cs);
+    assert_true(cs.hits > 1500);
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
+static void test_spheres_and_quads(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    test_rng r = {13};
+    random_soup(&s, &r, 500, 0.05f);
+    for (int i = 0; i < 100; i++)
+        rt_scene_add_sphere(&s, rnd3(&r, 0, 1), rnd(&r, 0.001f, 0.08f), 0);
+    rt_scene_add_sphere(&s, rt_v3(0.5f, 0.5f, 0.5f), 0.0f, 0); /* zero radius */
+    rt_scene_add_sphere(&s, rt_v3(0.5f, 0.5f, 0.5f), 2.0f, 0);  /* encloses everything: hit from inside */
+    for (int i = 0; i < 100; i++)
+        rt_scene_add_quad(&s, rnd3(&r, 0, 1), rnd3(&r, -0.1f, 0.1f), rnd3(&r, -0.1f, 0.1f), 0);
+    rt_scene_add_quad(&s, rt_v3(0, 0, 0.5f), rt_v3(1, 0, 0), rt_v3(0, 1, 0), 0); /* axis-aligned */
+    rt_scene_add_quad(&s, rt_v3(0, 0, 0), rt_v3(1, 0, 0), rt_v3(2, 0, 0), 0);    /* degenerate: never hits */
+    rt_kdtree tree;
+    build_ok(&tree, &s);
+    check_stats cs = {0, 0, 0};
+    check_random_rays(&s, &tree, 14, 3000, -0.2f, 1.2f, &cs);
+    check_random_rays(&s, &tree, 15, 500, -3.0f, 4.0f, &cs);
+    report(__func__, &cs);
+    assert_true(cs.hits > 2000);
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
+static void test_bad_input(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    test_rng r = {16};
+    random_soup(&s, &r, 300, 0.1f);
+    float nan = NAN, inf = INFINITY;
+    add_tri(&s, rt_v3(nan, 0, 0), rt_v3(1, 0, 0), rt_v3(0, 1, 0));
+    add_tri(&s, rt_v3(0, 0, 0), rt_v3(inf, 0, 0), rt_v3(0, 1, 0));
+    add_tri(&s, rt_v3(0, 0, 0), rt_v3(-inf, 0, 0), rt_v3(0, inf, 0));
+    add_tri(&s, rt_v3(0.5f, 0.5f, 0.5f), rt_v3(0.5f, 0.5f, 0.5f), rt_v3(0.5f, 0.5f, 0.5f)); /* a point */
+    add_tri(&s, rt_v3(0, 0, 0), rt_v3(0.5f, 0.5f, 0.5f), rt_v3(1, 1, 1));                   /* collinear */
+    add_tri(&s, rt_v3(0.1f, 0.2f, 0.3f), rt_v3(0.7f, 0.2f, 0.3f), rt_v3(0.1f, 0.2f, 0.3f)); /* zero edge */
+    add_tri(&s, rt_v3(-3e38f, 0, 0), rt_v3(3e38f, 0, 0), rt_v3(0, 1, 0));                   /* edge overflows */
+    rt_scene_add_sphere(&s, rt_v3(nan, 0, 0), 1.0f, 0);
+    rt_scene_add_sphere(&s, rt_v3(0, 0, 0), inf, 0);
+    rt_scene_add_quad(&s, rt_v3(0, 0, inf), rt_v3(1, 0, 0), rt_v3(0, 1, 0), 0);
+    rt_kdtree tree;
+    build_ok(&tree, &s);
+    assert_true(rt_finite3(tree.bounds.lo) && rt_finite3(tree.bounds.hi));
+    check_stats cs = {0, 0, 0};
+    check_random_rays(&s, &tree, 17, 2000, -0.2f, 1.2f, &cs);
+    /* bad rays hit nothing and do not crash */
+    rt_hit h;
+    rt_ray bad[] = {
+        rt_ray_make(rt_v3(nan, 0.5f, -1), rt_v3(0, 0, 1), 0, inf),
+        rt_ray_make(rt_v3(0.5f, 0.5f, -1), rt_v3(0, 0, nan), 0, inf),
+        rt_ray_make(rt_v3(0.5f, 0.5f, -1), rt_v3(0, 0, 0), 0, inf),
+        rt_ray_make(rt_v3(0.5f, 0.5f, -1), rt_v3(0, 0, 1), nan, inf),
+        rt_ray_make(rt_v3(0.5f, 0.5f, -1), rt_v3(0, 0, 1), 0, nan),
+        rt_ray_make(rt_v3(0.5f, 0.5f, -1), rt_v3(0, 0, 1), 5, 1),
+        rt_ray_make(rt_v3(inf, 0.5f, -1), rt_v3(0, 0, 1), 0, inf),
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        assert_false(rt_kdtree_intersect(&tree, &bad[i], &h));
+        assert_int_equal(h.prim, RT_NONE);
+        assert_false(rt_kdtree_occluded(&tree, &bad[i]));
+    }
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+
+    /* nothing valid at all */
+    rt_scene_init(&s);
+    add_tri(&s, rt_v3(nan, 0, 0), rt_v3(1, 0, 0), rt_v3(0, 1, 0));
+    build_ok(&tree, &s);
+    rt_ray ray = rt_ray_make(rt_v3(0.2f, 0.2f, -1), rt_v3(0, 0, 1), 0, inf);
+    assert_false(rt_kdtree_intersect(&tree, &ray, &h));
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
+static void test_inside_and_far(void **state)
+{
+    (void)state;
+    /* rays starting inside the root box, and scenes far from the origin */
+    static const float offsets[] = {0.0f, 1000.0f, -1e5f};
+    for (int i = 0; i < 3; i++) {
+        rt_scene s;
+        rt_scene_init(&s);
+        test_rng r = {18 + (uint64_t)i};
+        random_soup(&s, &r, 800, 0.15f);
+        rt_vec3 off = rt_v3s(offsets[i]);
+        for (size_t v = 0; v < s.vertices.count; v++)
+            s.vertices.position[v] = rt_add(s.vertices.position[v], off);
+        rt_kdtree tree;
+        build_ok(&tree, &s);
+        check_stats cs = {0, 0, 0};
+        check_random_rays(&s, &tree, 19, 1500, offsets[i] + 0.2f, offsets[i] + 0.8f, &cs);
+        check_random_rays(&s, &tree, 20, 500, offsets[i] - 3.0f, offsets[i] + 4.0f, &cs);
+        report(__func__, &cs);
+        assert_true(cs.hits > 700);
+        rt_kdtree_free(&tree);
+        rt_scene_free(&s);
+    }
+}
+
+static void test_threads_safe_reads(void **state)
+{
+    (void)state;
+    /* two trees over one scene are independent; a tree is only read by queries */
+    rt_scene s;
+    rt_scene_init(&s);
+    test_rng r = {21};
+    random_soup(&s, &r, 500, 0.05f);
+    rt_kdtree a, b;
+    build_ok(&a, &s);
+    build_ok(&b, &s);
+    assert_int_equal(a.stats.nodes, b.stats.nodes);
+    assert_memory_equal(a.nodes, b.nodes, a.node_count * sizeof *a.nodes);
+    rt_kdtree_free(&a);
+    check_stats cs = {0, 0, 0};
+    check_random_rays(&s, &b, 22, 500, -0.2f, 1.2f, &cs);
+    rt_kdtree_free(&b);
+    rt_scene_free(&s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_empty_scene),
+        cmocka_unit_test(test_single_triangle),
+        cmocka_unit_test(test_random_soups),
+        cmocka_unit_test(test_params),
+        cmocka_unit_test(test_one_plane),
+        cmocka_unit_test(test_identical_triangles),
+        cmocka_unit_test(test_huge_and_tiny),
+        cmocka_unit_test(test_integer_boxes),
+        cmocka_unit_test(test_spheres_and_quads),
+        cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_inside_and_far),
+        cmocka_unit_test(test_threads_safe_reads),
+    };
+    return cmocka_run_group_tests_name("kdtree", tests, NULL, NULL);
+}
