@@ -22,6 +22,39 @@
 
 #include "rt/texture.h"
 
+/* The whitted integrator's ambient radiance: the scene's ambient_light when
+ * given, else the mean radiance of the environment over the sphere (for an
+ * image, a 64 x 32 grid of lookups at cell centres weighted by sin(theta),
+ * the solid angle of each latitude band). */
+static rt_vec3 ambient_radiance(const rt_scene *scene)
+{
+    const rt_settings *st = &scene->settings;
+    if (st->ambient_light_set)
+        return st->ambient_light;
+    if (st->environment_texture == RT_NONE)
+        return rt_scale(st->background, st->environment_strength);
+    enum { NU = 64, NV = 32 };
+    double sum[3] = {0, 0, 0}, wsum = 0;
+    for (int j = 0; j < NV; j++) {
+        float v = ((float)j + 0.5f) / (float)NV;
+        float w = sinf(v * RT_PI);
+        for (int i = 0; i < NU; i++) {
+            float u = ((float)i + 0.5f) / (float)NU;
+            rt_vec4 c = rt_texture_sample(scene, st->environment_texture, rt_v2(u, v), false);
+            if (!(isfinite(c.x) && isfinite(c.y) && isfinite(c.z)))
+                continue;
+            sum[0] += (double)(w * c.x);
+            sum[1] += (double)(w * c.y);
+            sum[2] += (double)(w * c.z);
+            wsum += (double)w;
+        }
+    }
+    if (!(wsum > 0.0))
+        return rt_v3s(0);
+    rt_vec3 mean = rt_v3((float)(sum[0] / wsum), (float)(sum[1] / wsum), (float)(sum[2] / wsum));
+    return rt_scale(mean, st->environment_strength);
+}
+
 void rt_trace_ctx_init(rt_trace_ctx *ctx, const rt_scene *scene, const rt_kdtree *tree)
 {
     memset(ctx, 0, sizeof *ctx);
@@ -39,6 +72,7 @@ void rt_trace_ctx_init(rt_trace_ctx *ctx, const rt_scene *scene, const rt_kdtree
         if (m->transmission > 0.0f || m->alpha_mode != RT_ALPHA_OPAQUE)
             ctx->shadows_need_shading = true;
     }
+    ctx->ambient = ambient_radiance(scene);
 }
 
 bool rt_trace(const rt_trace_ctx *ctx, const rt_ray *ray, rt_hit *hit)
@@ -87,6 +121,24 @@ static rt_vec3 orthonormal_tangent(rt_vec3 n, rt_vec3 t)
     return rt_scale(o, 1.0f / sqrtf(l2));
 }
 
+/* One tangent-space normal-map component from a texel value c in [0, 1].
+ * Float and procedural textures use glTF's n = 2c - 1. 8-bit images use the
+ * signed-normalised reading centred on code 128 (128 -> 0, 255 -> +1,
+ * 0 -> -1, linear on each side; differs from 2c - 1 by at most 1/255), so
+ * the conventional flat colour (128, 128, 255) is exactly (0, 0, 1). Values
+ * within 1e-4 of 0 (float rounding in bilinear weights) are 0. */
+static inline float normal_map_component(float c, bool unorm8)
+{
+    float x;
+    if (unorm8) {
+        float code = c * 255.0f;
+        x = code >= 128.0f ? (code - 128.0f) * (1.0f / 127.0f) : (code - 128.0f) * (1.0f / 128.0f);
+    } else {
+        x = 2.0f * c - 1.0f;
+    }
+    return fabsf(x) < 1e-4f ? 0.0f : x;
+}
+
 static rt_vec2 slot_uv(const rt_surface *sf, const rt_texture_slot *slot)
 {
     return rt_texture_slot_uv(slot, slot->texcoord == 1 ? sf->uv1 : sf->uv0);
@@ -110,6 +162,14 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
         float bu = hit->u, bv = hit->v, bw = 1.0f - bu - bv;
         sf->p = rt_add(rt_add(rt_scale(a, bw), rt_scale(b, bu)), rt_scale(c, bv));
         ng = rt_normalize(rt_cross(e1, e2));
+        if (flags & RT_TRI_SMOOTH) {
+            /* vertex normals define the outside: turn a triangle wound the
+             * other way to agree with them (decided per triangle, so the
+             * side never changes across its face) */
+            rt_vec3 nsum = rt_add(rt_add(vx->normal[idx[0]], vx->normal[idx[1]]), vx->normal[idx[2]]);
+            if (rt_dot(nsum, ng) < 0.0f)
+                ng = rt_neg(ng);
+        }
         n = ng;
         if (flags & RT_TRI_SMOOTH) {
             rt_vec3 ni = rt_add(rt_add(rt_scale(vx->normal[idx[0]], bw), rt_scale(vx->normal[idx[1]], bu)),
@@ -184,12 +244,17 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
     /* normal map, in the frame of the front face */
     if (s->material_count) {
         const rt_material *m = &s->materials[sf->material];
-        if (m->normal_tex.texture != RT_NONE) {
+        if (m->normal_tex.texture != RT_NONE && m->normal_tex.texture < s->texture_count) {
+            const rt_texture *tx = &s->textures[m->normal_tex.texture];
+            bool unorm8 = tx->kind == RT_TEX_IMAGE && tx->image < s->image_count && s->images[tx->image].rgba8;
             rt_vec4 c = rt_texture_sample(s, m->normal_tex.texture, slot_uv(sf, &m->normal_tex), false);
-            float x = (2.0f * c.x - 1.0f) * m->normal_scale, y = (2.0f * c.y - 1.0f) * m->normal_scale;
-            float z = 2.0f * c.z - 1.0f;
+            float x = normal_map_component(c.x, unorm8) * m->normal_scale;
+            float y = normal_map_component(c.y, unorm8) * m->normal_scale;
+            float z = normal_map_component(c.z, unorm8);
             rt_vec3 nm = rt_add(rt_add(rt_scale(tt, x), rt_scale(bb, y)), rt_scale(n, z));
-            if (rt_length2(nm) > 1e-20f && rt_finite3(nm)) {
+            /* a flat texel (x = y = 0) leaves the surface exactly as unmapped */
+            bool flat = x == 0.0f && y == 0.0f && z > 0.0f;
+            if (!flat && rt_length2(nm) > 1e-20f && rt_finite3(nm)) {
                 n = rt_normalize(nm);
                 tt = orthonormal_tangent(n, tt);
                 bb = rt_scale(rt_cross(n, tt), w);

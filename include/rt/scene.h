@@ -68,6 +68,12 @@ typedef struct rt_settings {
     rt_vec3 background;   /* radiance of rays that leave the scene */
     uint32_t environment_texture; /* lat-long image, RT_NONE for constant background */
     float environment_strength;
+    /* whitted: ambient radiance that materials' `ambient` coefficient
+     * reflects. Unset (the default): the background's radiance, i.e. the
+     * constant environment (background * environment_strength) or the mean
+     * of the environment image (see docs/shading.md). */
+    rt_vec3 ambient_light;
+    bool ambient_light_set;
     /* The scene's own output name (`output` line); the driver may override. */
     char output[512];
 } rt_settings;

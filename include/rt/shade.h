@@ -32,6 +32,7 @@ typedef struct rt_trace_ctx {
     const rt_kdtree *tree;
     float scale;              /* largest absolute scene coordinate: sizes ray offsets */
     bool shadows_need_shading; /* some material is transmissive or alpha-tested */
+    rt_vec3 ambient;          /* whitted ambient radiance (settings.ambient_light or the environment's mean) */
     uint64_t *ray_count;      /* per-thread counter of rays traced */
 } rt_trace_ctx;
 
