@@ -66,7 +66,7 @@ typedef struct name_table {
 enum {
     SET_RESOLUTION, SET_SAMPLES, SET_INTEGRATOR, SET_MAX_BOUNCE, SET_DIFFUSE_BOUNCES, SET_DIFFUSE_RAYS,
     SET_SHADOW_SAMPLES, SET_SEED, SET_BACKGROUND, SET_EXPOSURE, SET_CLAMP, SET_RAY_OFFSET, SET_ENVIRONMENT,
-    SET_OUTPUT, SET_COUNT
+    SET_OUTPUT, SET_AMBIENT_LIGHT, SET_COUNT
 };
 
 typedef struct parser {
@@ -578,6 +578,19 @@ static rt_result st_background(parser *p, const tok *kw)
         return r;
     note_setting(p, SET_BACKGROUND, kw);
     p->s->settings.background = c;
+    return RT_OK;
+}
+
+/* whitted's ambient radiance (docs/shading.md); unset = the background's */
+static rt_result st_ambient_light(parser *p, const tok *kw)
+{
+    rt_vec3 c;
+    rt_result r;
+    if ((r = get_color(p, "the ambient light colour", &c)) != RT_OK || (r = expect_end(p, "ambient_light")) != RT_OK)
+        return r;
+    note_setting(p, SET_AMBIENT_LIGHT, kw);
+    p->s->settings.ambient_light = c;
+    p->s->settings.ambient_light_set = true;
     return RT_OK;
 }
 
@@ -1321,6 +1334,7 @@ static const keyword keywords[] = {
     {"shadow_samples", st_int_setting},
     {"seed", st_seed},
     {"background", st_background},
+    {"ambient_light", st_ambient_light},
     {"exposure", st_exposure},
     {"clamp", st_clamp},
     {"ray_offset", st_ray_offset},
