@@ -7,7 +7,9 @@
  *          BRDF (albedo / pi), shadows through transmissive and alpha-tested
  *          surfaces, and one cosine-sampled ray towards a non-black
  *          environment. The foundation's integrator: exact for its scenes.
- * whitted  Phong, mirrors, refraction with Fresnel, diffuse bounces (whitted.c).
+ * whitted  Phong, mirrors, refraction with exact Fresnel through nested
+ *          media, shadows through glass, diffuse bounces (whitted.c,
+ *          rt/whitted.h; the model is specified in docs/shading.md).
  * path     physically based path tracing of glTF materials (path.c).
  *
  * An integrator that is not built yet falls back to `direct`.
