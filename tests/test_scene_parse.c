@@ -232,6 +232,7 @@ static void test_settings_values(void **state)
               "shadow_samples 9\n"
               "seed 4294967295\n"
               "background 0.1 0.2 0.3\n"
+              "ambient_light 0.05 0.04 0.03\n"
               "exposure 1.5\n"
               "clamp 10\n"
               "ray_offset 0.001\n"
@@ -248,6 +249,8 @@ static void test_settings_values(void **state)
     assert_int_equal(st->shadow_samples, 9);
     assert_int_equal(st->seed, 4294967295u);
     assert_vec3(st->background, 0.1f, 0.2f, 0.3f);
+    assert_true(st->ambient_light_set);
+    assert_vec3(st->ambient_light, 0.05f, 0.04f, 0.03f);
     assert_float_equal(st->exposure, 1.5, 0);
     assert_float_equal(st->clamp, 10, 0);
     assert_float_equal(st->ray_offset, 0.001, 1e-9);
@@ -569,6 +572,9 @@ static void test_errors_values(void **state)
     expect_error("clamp -1\n", RT_ERR_INVALID, "1:7", "the clamp must be >= 0");
     expect_error("ray_offset -0.1\n", RT_ERR_INVALID, "1:12", "the ray offset must be >= 0");
     expect_error("background 0 -1 0\n", RT_ERR_INVALID, "1:14", "the background colour (green) must be >= 0");
+    expect_error("ambient_light 0 0 -1\n", RT_ERR_INVALID, "1:19", "the ambient light colour (blue) must be >= 0");
+    expect_error("ambient_light 0 0\n", RT_ERR_PARSE, "1:18",
+                 "expected a number for the ambient light colour (blue), got end of line");
     expect_error("material m alpha 1.5\n", RT_ERR_INVALID, "1:18", "material alpha must be between 0 and 1, got '1.5'");
     expect_error("material m color 1 1 -1\n", RT_ERR_INVALID, "1:22", "material color (blue) must be >= 0");
     expect_error("material m ior 0\n", RT_ERR_INVALID, "1:16", "material ior must be between 0.01 and 100");
