@@ -332,6 +332,7 @@ static bool parse_header(ply_reader *r, ply_file *pf)
                 return fail_at(r, "header has no format line");
             r->pos = next;
             r->format = body_format;
+            r->line++; /* ascii bodies start on the next line */
             return true;
         }
         if (word_eq(w[0], wl[0], "comment") || word_eq(w[0], wl[0], "obj_info"))
