@@ -466,11 +466,18 @@ rt_result rt_mesh_commit(rt_scene *s, rt_mesh_buf *b, const rt_mat4 *transform, 
 
     if (s->triangles.count + b->nt >= RT_NONE)
         return rt_fail(err, RT_ERR_LIMIT, "%s: the scene would have over 2^32 triangles", path);
+    if (b->nt == 0) {
+        /* a point cloud, or every face skipped: nothing to add */
+        rt_warn("%s: no triangles in the file", path);
+        if (stats)
+            stats->skipped_faces += b->skipped;
+        return RT_OK;
+    }
     if (!rt_scene_reserve_triangles(s, b->nt))
         return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for %zu triangles", path, b->nt);
     if (b->col && !rt_scene_enable_attr(s, RT_ATTR_COLOR))
         return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for vertex colours", path);
-    uint32_t first = b->nv ? rt_scene_add_vertices(s, b->nv) : (uint32_t)s->vertices.count;
+    uint32_t first = rt_scene_add_vertices(s, b->nv);
     if (first == RT_NONE)
         return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for %zu vertices (or over 2^32)", path, b->nv);
     rt_vertices *v = &s->vertices;

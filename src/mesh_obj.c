@@ -903,6 +903,7 @@ done:
         s->texture_count = tex0;
     }
     obj_free(op);
+    free(op);
     free(data);
     return r;
 }

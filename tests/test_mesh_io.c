@@ -820,12 +820,24 @@ static double now_ms(void)
     return (double)t.tv_sec * 1e3 + (double)t.tv_nsec * 1e-6;
 }
 
-static void check_box(rt_box b, const float lo[3], const float hi[3], float rel)
+/* The manifest gives 4 significant digits: allow half a unit in the 4th digit of
+ * each figure, plus 1e-4 of the box's extent. */
+static void check_coord(float got, float want, float extent)
 {
-    float scale = fmaxf(fmaxf(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
-    float tol = rel * scale;
-    assert_vec3(b.lo, lo[0], lo[1], lo[2], tol);
-    assert_vec3(b.hi, hi[0], hi[1], hi[2], tol);
+    float half_digit = want == 0.0f ? 0.0f : 0.5f * powf(10.0f, floorf(log10f(fabsf(want))) - 3.0f);
+    float tol = 1e-4f * extent + half_digit;
+    if (fabsf(got - want) > tol)
+        fprintf(stderr, "AABB coordinate %.7g, manifest %.4g (tolerance %.2g)\n", got, want, tol);
+    assert_true(fabsf(got - want) <= tol);
+}
+
+static void check_box(rt_box b, const float lo[3], const float hi[3])
+{
+    float extent = fmaxf(fmaxf(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
+    for (int k = 0; k < 3; k++) {
+        check_coord((&b.lo.x)[k], lo[k], extent);
+        check_coord((&b.hi.x)[k], hi[k], extent);
+    }
 }
 
 static void test_shared_meshes(void **state)
@@ -854,8 +866,7 @@ static void test_shared_meshes(void **state)
         fprintf(stderr, "note: %s: %zu triangles, %zu vertices in %.1f ms\n", cases[i].path, l.st.triangles,
                 l.st.vertices, t1 - t0);
         assert_int_equal(l.s.triangles.count, cases[i].tris);
-        /* 4 significant digits in the manifest: 1e-3 of the extent covers the rounding */
-        check_box(rt_scene_bounds(&l.s), cases[i].lo, cases[i].hi, 1e-3f);
+        check_box(rt_scene_bounds(&l.s), cases[i].lo, cases[i].hi);
         if (i == 2) {
             /* the McGuire box: 8 materials; the light emits Ke 17 12 4; the short box's faces come
                before its usemtl and so are the left wall's red (a quirk of the file, kept) */
@@ -877,8 +888,6 @@ static void test_shared_meshes(void **state)
         }
         rt_scene_free(&l.s);
     }
-    /* igea's AABB to 1e-4 relative against the exact extremes quoted in the manifest (4 digits: 0.03456 is
-       rounded, so compare at the manifest's precision) */
 }
 
 /* ----------------------------------------------------------------- main */
