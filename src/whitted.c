@@ -226,8 +226,11 @@ static rt_vec3 shade(const wctx *w, const rt_surface *sf, const rt_medium_stack 
     rt_vec4 b4 = rt_surface_base_color(ctx, sf);
     rt_vec3 base = rt_v3(b4.x, b4.y, b4.z);
     rt_vec3 L = rt_v3s(0);
+    /* after a diffuse bounce, a sampled light's own quad is not seen: its
+     * light is already counted by direct sampling (and a mirror or glass
+     * chain to it would be a caustic, which this model leaves out) */
     if (!(diffuse_ray && is_light_quad(s, sf->prim)))
-        L = rt_surface_emission(ctx, sf); /* a light's own quad is counted by light sampling */
+        L = rt_surface_emission(ctx, sf);
     if (m->unlit)
         return rt_add(L, base);
 
@@ -302,7 +305,7 @@ static rt_vec3 shade(const wctx *w, const rt_surface *sf, const rt_medium_stack 
     }
     if (w_refl > 0.0f && weight * w_refl >= MIN_WEIGHT) {
         rt_ray r = rt_ray_make(rt_surface_spawn(ctx, sf, rdir), rdir, 0.0f, INFINITY);
-        L = rt_add(L, rt_scale(trace(w, r, med, depth + 1, level, weight * w_refl, false), w_refl));
+        L = rt_add(L, rt_scale(trace(w, r, med, depth + 1, level, weight * w_refl, diffuse_ray), w_refl));
     }
     float wt = rt_max3(w_trans);
     if (wt > 0.0f && weight * wt >= MIN_WEIGHT) {
