@@ -217,6 +217,112 @@ static void test_spheres_scene(void **state)
     rt_scene_free(&s);
 }
 
+/* textures.txt loads an image twice (one decode), an OBJ and a glTF model. */
+static void test_textures_scene(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_error err;
+    rt_scene_init(&s);
+    rt_result r = rt_scene_parse_file(&s, "scenes/textures.txt", &err);
+    if (r == RT_ERR_UNSUPPORTED) {
+        fprintf(stderr, "note: %s\n", err.message);
+        rt_scene_free(&s);
+        skip();
+    }
+    if (r != RT_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(r, RT_OK);
+    assert_int_equal(s.image_count, 2);     /* uvgrid.png once, bumps.png */
+    assert_int_equal(s.camera_count, 1);    /* box.gltf's camera, not selected */
+    assert_vec3(s.camera.position, 0, 2.4f, 6);
+    assert_int_equal(s.light_count, 2);
+    assert_int_equal(s.quads.count, 3);     /* floor, wall, the area light */
+    /* torus 24 x 12 quads = 576 triangles, the glTF cube 12, one triangle */
+    assert_int_equal(s.triangles.count, 576 + 12 + 1);
+    uint32_t brass = rt_scene_find_material(&s, "brass");
+    assert_int_not_equal(brass, RT_NONE);
+    assert_int_not_equal(s.materials[brass].normal_tex.texture, RT_NONE);
+    rt_scene_free(&s);
+}
+
+/* The complete example in docs/scene-format.md parses as written. */
+static void test_docs_example(void **state)
+{
+    (void)state;
+    FILE *f = fopen("docs/scene-format.md", "rb");
+    assert_non_null(f);
+    static char doc[1 << 17];
+    size_t n = fread(doc, 1, sizeof doc - 1, f);
+    fclose(f);
+    doc[n] = '\0';
+    const char *sec = strstr(doc, "## 9. A complete example");
+    assert_non_null(sec);
+    const char *start = strstr(sec, "```\n");
+    assert_non_null(start);
+    start += 4;
+    const char *end = strstr(start, "```");
+    assert_non_null(end);
+    rt_scene s;
+    rt_error err;
+    rt_scene_init(&s);
+    rt_result r = rt_scene_parse_string(&s, start, (size_t)(end - start), "docs/scene-format.md#example", "scenes",
+                                        &err);
+    if (r == RT_ERR_UNSUPPORTED) {
+        fprintf(stderr, "note: %s\n", err.message);
+        rt_scene_free(&s);
+        skip();
+    }
+    if (r != RT_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(r, RT_OK);
+    assert_int_equal(s.light_count, 4);
+    assert_int_equal(s.spheres.count, 2);
+    assert_int_equal(s.settings.integrator, RT_INTEGRATOR_WHITTED);
+    assert_string_equal(s.settings.output, "example.png");
+    assert_true(s.triangles.count > 500);
+    rt_scene_free(&s);
+}
+
+/* `camera gltf N` takes a camera from the models, wherever the model line is. */
+static void test_camera_gltf(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_error err;
+    rt_scene_init(&s);
+    const char *text = "camera gltf 0\nmodel ../assets/box.gltf\n";
+    rt_result r = rt_scene_parse_string(&s, text, strlen(text), "t.txt", "scenes", &err);
+    if (r == RT_ERR_UNSUPPORTED) {
+        fprintf(stderr, "note: %s\n", err.message);
+        rt_scene_free(&s);
+        skip();
+    }
+    if (r != RT_OK)
+        print_error("%s\n", err.message);
+    assert_int_equal(r, RT_OK);
+    assert_int_equal(s.camera_count, 1);
+    assert_true(s.camera_set);
+    assert_memory_equal(&s.camera, &s.cameras[0], sizeof s.camera);
+    assert_vec3(s.camera.position, 1.2f, 1.4f, 3.2f); /* the node's translation (tools/gen_assets.py) */
+    rt_scene_free(&s);
+
+    rt_scene_init(&s);
+    text = "model ../assets/box.gltf\ncamera gltf 1\n";
+    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", "scenes", &err), RT_ERR_INVALID);
+    assert_string_equal(err.message, "t.txt:2:13: camera gltf 1: the loaded models have 1 camera");
+    rt_scene_free(&s);
+
+    /* a model's transform moves its triangles: the unit cube, scaled 2 and moved up 5 */
+    rt_scene_init(&s);
+    text = "model ../assets/box.gltf translate 0 5 0 scale 2\n";
+    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", "scenes", &err), RT_OK);
+    rt_box b = rt_scene_bounds(&s);
+    assert_float_equal(b.lo.y, 4, 1e-4);
+    assert_float_equal(b.hi.y, 6, 1e-4);
+    rt_scene_free(&s);
+}
+
 /* ------------------------------------------------------------ values */
 
 static void test_settings_values(void **state)
@@ -868,6 +974,9 @@ int main(void)
         cmocka_unit_test(test_cornell_file_matches_default),
         cmocka_unit_test(test_all_scene_files),
         cmocka_unit_test(test_spheres_scene),
+        cmocka_unit_test(test_textures_scene),
+        cmocka_unit_test(test_docs_example),
+        cmocka_unit_test(test_camera_gltf),
         cmocka_unit_test(test_settings_values),
         cmocka_unit_test(test_camera_values),
         cmocka_unit_test(test_material_values),
