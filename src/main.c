@@ -24,6 +24,7 @@
 #include "rt/render.h"
 #include "rt/scene.h"
 #include "rt/scene_parse.h"
+#include "rt/tangents.h"
 
 #define RT_VERSION "0.1.0"
 
@@ -183,6 +184,8 @@ static rt_result load_input(rt_scene *s, const char *path, double *load_ms, rt_e
             break;
         }
     }
+    if (r == RT_OK) /* normal-mapped meshes without tangents get per-vertex ones */
+        r = rt_scene_generate_tangents(s, err);
     *load_ms = now_ms() - t0;
     return r;
 }
