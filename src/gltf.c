@@ -752,14 +752,7 @@ static rt_result parse_nodes(gl_doc *d, int t)
             if (KEY(k, "mesh")) TRY(get_index(d, where, "mesh", v, &n->mesh));
             else if (KEY(k, "camera")) TRY(get_index(d, where, "camera", v, &n->camera));
             else if (KEY(k, "skin")) TRY(get_index(d, where, "skin", v, &n->skin));
-            else if (KEY(k, "children")) {
-                FOR_ITEMS(d, v, ci, ce) {
-                    uint32_t c;
-                    TRY(get_index(d, where, "children", ce, &c));
-                    d->children[d->children_count++] = c;
-                    n->child_count++;
-                }
-            } else if (KEY(k, "matrix")) {
+            else if (KEY(k, "matrix")) {
                 TRY(get_floats(d, where, "matrix", v, matrix, 16));
                 have_matrix = true;
             } else if (KEY(k, "translation")) {
@@ -779,6 +772,16 @@ static rt_result parse_nodes(gl_doc *d, int t)
                     if (li >= 0)
                         TRY(get_index(d, where, "extensions.KHR_lights_punctual.light", li, &n->light));
                 }
+            }
+        }
+        /* the same token the counting pass saw, even if "children" is repeated */
+        int ch = rt_json_get(&d->j, e, "children");
+        if (ch >= 0) {
+            FOR_ITEMS(d, ch, ci, ce) {
+                uint32_t c;
+                TRY(get_index(d, where, "children", ce, &c));
+                d->children[d->children_count++] = c;
+                n->child_count++;
             }
         }
         if (have_matrix) {
@@ -1348,19 +1351,31 @@ static rt_result validate(gl_doc *d)
             return fail_at(d, d->nodes[i].tok, RT_ERR_LIMIT,
                            "nodes[%zu] is more than %d levels deep (or in a cycle)", i, GL_MAX_DEPTH);
     }
+    /* scene roots: in range, parentless, listed once (mark[n] = scene + 1) */
+    uint32_t *mark = rt_alloc(d->node_count, sizeof(uint32_t));
+    if (!mark)
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
     for (size_t i = 0; i < d->scene_count; i++) {
         const gl_scene *sc = &d->scenes[i];
         for (uint32_t k = 0; k < sc->count; k++) {
             uint32_t n = d->scene_nodes[sc->first + k];
-            CHECK_INDEX(n, d->node_count, sc->tok, "scenes[%zu].nodes", i);
-            if (d->nodes[n].parent != RT_NONE)
-                return fail_at(d, sc->tok, RT_ERR_INVALID, "scenes[%zu]: node %u is not a root (its parent is node %u)",
-                               i, n, d->nodes[n].parent);
-            for (uint32_t q = 0; q < k; q++)
-                if (d->scene_nodes[sc->first + q] == n)
-                    return fail_at(d, sc->tok, RT_ERR_INVALID, "scenes[%zu]: node %u is listed twice", i, n);
+            rt_result r = RT_OK;
+            if (n >= d->node_count)
+                r = fail_at(d, sc->tok, RT_ERR_INVALID, "scenes[%zu].nodes %u is out of range (%zu in the file)", i,
+                            n, d->node_count);
+            else if (d->nodes[n].parent != RT_NONE)
+                r = fail_at(d, sc->tok, RT_ERR_INVALID, "scenes[%zu]: node %u is not a root (its parent is node %u)",
+                            i, n, d->nodes[n].parent);
+            else if (mark[n] == i + 1)
+                r = fail_at(d, sc->tok, RT_ERR_INVALID, "scenes[%zu]: node %u is listed twice", i, n);
+            if (r != RT_OK) {
+                free(mark);
+                return r;
+            }
+            mark[n] = (uint32_t)i + 1;
         }
     }
+    free(mark);
     CHECK_INDEX(d->default_scene, d->scene_count, -1, "scene");
     for (size_t i = 0; i < d->material_count; i++) {
         const rt_material *m = &d->materials[i].m;
@@ -2013,10 +2028,16 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
         }
     }
     st->triangles = s->triangles.count - tri_first;
+    /* bounds of the vertices triangles use (positions are finite: plain
+     * compares, no fminf calls, which cost more than the rest of the load) */
     rt_box b = rt_box_empty();
-    for (size_t t = tri_first; t < s->triangles.count; t++)
-        for (int c = 0; c < 3; c++)
-            b = rt_box_point(b, s->vertices.position[s->triangles.index[3 * t + (size_t)c]]);
+    const uint32_t *ix = s->triangles.index;
+    for (size_t k = 3 * tri_first; k < 3 * s->triangles.count; k++) {
+        rt_vec3 q = s->vertices.position[ix[k]];
+        b.lo.x = q.x < b.lo.x ? q.x : b.lo.x; b.hi.x = q.x > b.hi.x ? q.x : b.hi.x;
+        b.lo.y = q.y < b.lo.y ? q.y : b.lo.y; b.hi.y = q.y > b.hi.y ? q.y : b.hi.y;
+        b.lo.z = q.z < b.lo.z ? q.z : b.lo.z; b.hi.z = q.z > b.hi.z ? q.z : b.hi.z;
+    }
     st->bounds = b;
 
     /* cameras and lights */

@@ -24,11 +24,20 @@ typedef struct rt_gltf_options {
     bool use_transform;    /* false = identity */
 } rt_gltf_options;
 
+/* What one load added. meshes/primitives count instances (a mesh used by
+ * two nodes counts twice; only triangle primitives); nodes = nodes of the
+ * chosen scene; images = glTF images decoded for this file; cameras =
+ * perspective cameras appended to scene->cameras (the first one of this file
+ * is scene->cameras[camera_count - cameras]). */
 typedef struct rt_gltf_stats {
     size_t triangles, meshes, primitives, materials, textures, images, cameras, lights, nodes;
-    rt_box bounds;         /* world bounds of the loaded triangles */
+    rt_box bounds;         /* world bounds of the vertices the loaded triangles use */
 } rt_gltf_stats;
 
+/* Appends the chosen scene of the glTF at path to s. options and stats may be
+ * NULL. On failure s's tables are restored to their sizes before the call and
+ * err names the file, the byte offset when there is one, and the problem.
+ * Supported features, limits and the material mapping: docs/gltf.md. */
 rt_result rt_gltf_load(rt_scene *s, const char *path, const rt_gltf_options *options, rt_gltf_stats *stats,
                        rt_error *err);
 
