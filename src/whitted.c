@@ -39,6 +39,7 @@
 #include "rt/integrator.h"
 
 #define MIN_WEIGHT (1.0f / 1024.0f)
+#define MAX_NESTING 1024 /* recursion guard: max_bounce <= 256 plus index-matched crossings */
 
 /* ------------------------------------------------------------ optics */
 
@@ -131,9 +132,10 @@ typedef struct wctx {
     const rt_trace_ctx *ctx;
     rt_rng *rng;
     int max_bounce, diffuse_levels, diffuse_rays, shadow_samples;
+    int nesting; /* current recursion depth of trace(), capped at MAX_NESTING */
 } wctx;
 
-static rt_vec3 trace(const wctx *w, rt_ray r, const rt_medium_stack *med, int depth, int level, float weight,
+static rt_vec3 trace(wctx *w, rt_ray r, const rt_medium_stack *med, int depth, int level, float weight,
                      bool diffuse_ray);
 
 /* True when quad primitive `prim` is the visible emitter of a sampled area light. */
@@ -149,7 +151,7 @@ static bool is_light_quad(const rt_scene *s, uint32_t prim)
 }
 
 /* Sum over lights of E * (n.l) into *D and E * (r.v)^shininess into *S. */
-static void direct_phong(const wctx *w, const rt_surface *sf, int area_samples, float shininess, bool want_spec,
+static void direct_phong(wctx *w, const rt_surface *sf, int area_samples, float shininess, bool want_spec,
                          rt_vec3 *D, rt_vec3 *S)
 {
     const rt_trace_ctx *ctx = w->ctx;
@@ -193,7 +195,7 @@ static void direct_phong(const wctx *w, const rt_surface *sf, int area_samples, 
 }
 
 /* Mean radiance of diffuse_rays cosine-distributed rays about sf->n. */
-static rt_vec3 gather_diffuse(const wctx *w, const rt_surface *sf, const rt_medium_stack *med, int depth, int level,
+static rt_vec3 gather_diffuse(wctx *w, const rt_surface *sf, const rt_medium_stack *med, int depth, int level,
                               float weight)
 {
     int n = w->diffuse_rays;
@@ -212,7 +214,7 @@ static rt_vec3 gather_diffuse(const wctx *w, const rt_surface *sf, const rt_medi
 }
 
 /* Radiance leaving a (not cut-away) surface towards sf->wo. */
-static rt_vec3 shade(const wctx *w, const rt_surface *sf, const rt_medium_stack *med, int depth, int level,
+static rt_vec3 shade(wctx *w, const rt_surface *sf, const rt_medium_stack *med, int depth, int level,
                      float weight, bool diffuse_ray)
 {
     const rt_trace_ctx *ctx = w->ctx;
@@ -260,7 +262,8 @@ static rt_vec3 shade(const wctx *w, const rt_surface *sf, const rt_medium_stack 
     }
 
     /* mirror and dielectric */
-    if ((R <= 0.0f && T <= 0.0f) || depth >= w->max_bounce)
+    bool can_bounce = depth < w->max_bounce;
+    if ((R <= 0.0f && T <= 0.0f) || (!can_bounce && T <= 0.0f))
         return L;
     rt_vec3 d = rt_neg(sf->wo);
     rt_vec3 ns = sf->n;
@@ -272,6 +275,7 @@ static rt_vec3 shade(const wctx *w, const rt_surface *sf, const rt_medium_stack 
         geometric = true;
     }
     float w_refl = R, F = 0.0f;
+    bool matched = false; /* equal indices on both sides: no interface, no bounce */
     rt_vec3 w_trans = rt_v3s(0), tdir = d;
     rt_medium_stack inner = *med;
     if (T > 0.0f) {
@@ -285,6 +289,7 @@ static rt_vec3 shade(const wctx *w, const rt_surface *sf, const rt_medium_stack 
             medium_remove(&inner, sf->material);
             n2 = rt_medium_ior(s, &inner);
         }
+        matched = n1 == n2;
         float cos_i = rt_clampf(rt_dot(sf->wo, ns), 0.0f, 1.0f);
         rt_fresnel fr = rt_fresnel_dielectric(cos_i, n1, n2);
         bool ok = !fr.tir && rt_refract(d, ns, n1, n2, &tdir);
@@ -303,30 +308,36 @@ static rt_vec3 shade(const wctx *w, const rt_surface *sf, const rt_medium_stack 
         if (ok)
             w_trans = rt_scale(m->transmission_color, (1.0f - R) * T * (1.0f - F));
     }
-    if (w_refl > 0.0f && weight * w_refl >= MIN_WEIGHT) {
+    if (can_bounce && w_refl > 0.0f && weight * w_refl >= MIN_WEIGHT) {
         rt_ray r = rt_ray_make(rt_surface_spawn(ctx, sf, rdir), rdir, 0.0f, INFINITY);
         L = rt_add(L, rt_scale(trace(w, r, med, depth + 1, level, weight * w_refl, diffuse_ray), w_refl));
     }
     float wt = rt_max3(w_trans);
-    if (wt > 0.0f && weight * wt >= MIN_WEIGHT) {
+    if ((can_bounce || matched) && wt > 0.0f && weight * wt >= MIN_WEIGHT) {
         rt_ray r = rt_ray_make(rt_surface_spawn(ctx, sf, tdir), tdir, 0.0f, INFINITY);
-        L = rt_add(L, rt_mul(trace(w, r, &inner, depth + 1, level, weight * wt, diffuse_ray), w_trans));
+        int next = matched ? depth : depth + 1;
+        L = rt_add(L, rt_mul(trace(w, r, &inner, next, level, weight * wt, diffuse_ray), w_trans));
     }
     return L;
 }
 
 /* Radiance arriving along r: the nearest surface, stepping through
  * alpha-cut surfaces and mixing alpha-blended ones with what lies behind. */
-static rt_vec3 trace(const wctx *w, rt_ray r, const rt_medium_stack *med, int depth, int level, float weight,
+static rt_vec3 trace(wctx *w, rt_ray r, const rt_medium_stack *med, int depth, int level, float weight,
                      bool diffuse_ray)
 {
     const rt_trace_ctx *ctx = w->ctx;
     rt_vec3 result = rt_v3s(0);
     float cov_weight = 1.0f;
+    if (w->nesting >= MAX_NESTING)
+        return result;
+    w->nesting++;
     for (int layer = 0; layer < 32; layer++) {
         rt_hit hit;
-        if (!rt_trace(ctx, &r, &hit))
-            return rt_add(result, rt_scale(rt_environment(ctx, r.dir), cov_weight));
+        if (!rt_trace(ctx, &r, &hit)) {
+            result = rt_add(result, rt_scale(rt_environment(ctx, r.dir), cov_weight));
+            break;
+        }
         rt_surface sf;
         rt_surface_at(ctx, &r, &hit, &sf);
         float coverage;
@@ -341,6 +352,7 @@ static rt_vec3 trace(const wctx *w, rt_ray r, const rt_medium_stack *med, int de
         cov_weight *= 1.0f - coverage;
         r.tmin = hit.t;
     }
+    w->nesting--;
     /* never hand back a non-finite or negative value */
     if (!rt_finite3(result))
         return rt_v3s(0);
@@ -357,6 +369,7 @@ rt_vec3 rt_radiance_whitted_in(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rn
     w.diffuse_levels = st->diffuse_bounces > 0 ? st->diffuse_bounces : 0;
     w.diffuse_rays = st->diffuse_rays > 0 ? st->diffuse_rays : 1;
     w.shadow_samples = st->shadow_samples > 0 ? st->shadow_samples : 1;
+    w.nesting = 0;
     rt_medium_stack med;
     memset(&med, 0, sizeof med);
     if (start)
