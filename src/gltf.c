@@ -868,8 +868,13 @@ static rt_result parse_texinfo(gl_doc *d, const char *where, const char *key, in
                 else if (KEY(k2, "rotation")) TRY(get_float(d, wx, "rotation", v2, &rot));
                 else if (KEY(k2, "texCoord")) TRY(get_int(d, wx, "texCoord", v2, &texcoord));
             }
-            /* matrix = T(offset) * R(rotation) * S(scale), with
-             * R = [cos sin; -sin cos] as the extension defines it */
+            /* matrix = T(offset) * R(rotation) * S(scale) with R, row-major,
+             * = [cos sin; -sin cos]: u' = u cos + v sin, v' = -u sin + v cos.
+             * This is the direction Babylon.js, three.js, Cesium, Blender and
+             * the TextureTransformTest sample agree on ("counter-clockwise" in
+             * glTF's v-down UV space); the README's GLSL listing, read as
+             * GLSL's column-major, rotates the other way (KhronosGroup/glTF
+             * issue 1563). */
             float c = cosf(rot), s = sinf(rot);
             slot->uv_transform[0] = c * scale[0];
             slot->uv_transform[1] = s * scale[1];
@@ -1336,20 +1341,58 @@ static rt_result validate(gl_doc *d)
             d->nodes[ch].parent = (uint32_t)i;
         }
     }
-    /* Each node has at most one parent now: walk up from every node; a chain
-     * longer than the limit is a cycle or an absurd depth. */
-    for (size_t i = 0; i < d->node_count; i++) {
-        uint32_t n = (uint32_t)i;
-        size_t depth = 0;
-        while (d->nodes[n].parent != RT_NONE && depth <= GL_MAX_DEPTH) {
-            n = d->nodes[n].parent;
-            depth++;
-            if (n == i)
-                return fail_at(d, d->nodes[i].tok, RT_ERR_INVALID, "nodes[%zu] is its own ancestor (a cycle)", i);
+    /* Each node has at most one parent now. Depths by walking up to a root
+     * or a node of known depth, memoised, so the whole pass is linear; a
+     * walk that meets its own path is a cycle. */
+    {
+        const uint32_t unknown = UINT32_MAX, on_path = UINT32_MAX - 1;
+        uint32_t *depth = rt_alloc(d->node_count, sizeof(uint32_t));
+        uint32_t *path = rt_alloc(GL_MAX_DEPTH + 2, sizeof(uint32_t));
+        if (!depth || !path) {
+            free(depth);
+            free(path);
+            return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
         }
-        if (depth > GL_MAX_DEPTH)
-            return fail_at(d, d->nodes[i].tok, RT_ERR_LIMIT,
-                           "nodes[%zu] is more than %d levels deep (or in a cycle)", i, GL_MAX_DEPTH);
+        for (size_t i = 0; i < d->node_count; i++)
+            depth[i] = unknown;
+        rt_result r = RT_OK;
+        for (size_t i = 0; i < d->node_count && r == RT_OK; i++) {
+            size_t len = 0;
+            uint32_t n = (uint32_t)i;
+            while (depth[n] == unknown) {
+                if (len > GL_MAX_DEPTH) {
+                    r = fail_at(d, d->nodes[i].tok, RT_ERR_LIMIT, "nodes[%zu] is more than %d levels deep", i,
+                                GL_MAX_DEPTH);
+                    break;
+                }
+                depth[n] = on_path;
+                path[len++] = n;
+                uint32_t p = d->nodes[n].parent;
+                if (p == RT_NONE) {
+                    n = RT_NONE;
+                    break;
+                }
+                if (depth[p] == on_path) {
+                    r = fail_at(d, d->nodes[p].tok, RT_ERR_INVALID, "nodes[%u] is its own ancestor (a cycle)", p);
+                    break;
+                }
+                n = p;
+            }
+            if (r != RT_OK)
+                break;
+            uint32_t base = n == RT_NONE ? 0 : depth[n] + 1;
+            for (size_t k = len; k-- > 0; base++) {
+                if (base > GL_MAX_DEPTH) {
+                    r = fail_at(d, d->nodes[i].tok, RT_ERR_LIMIT, "nodes[%zu] is more than %d levels deep", i,
+                                GL_MAX_DEPTH);
+                    break;
+                }
+                depth[path[k]] = base;
+            }
+        }
+        free(depth);
+        free(path);
+        TRY(r);
     }
     /* scene roots: in range, parentless, listed once (mark[n] = scene + 1) */
     uint32_t *mark = rt_alloc(d->node_count, sizeof(uint32_t));

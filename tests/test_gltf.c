@@ -847,6 +847,27 @@ static void test_broken_data(void **state)
     write_gltf("cycle.gltf", pos, sizeof pos,
                "\"nodes\":[{\"children\":[1]},{\"children\":[2]},{\"children\":[0]}]");
     expect_fail("cycle.gltf", RT_ERR_INVALID, "cycle");
+    /* a chain of 1025 nodes is fine (depth 1024), 1026 is over the limit */
+    for (int len = 1025; len <= 1026; len++) {
+        size_t cap = (size_t)len * 24 + 64;
+        char *nodes = malloc(cap);
+        size_t o = (size_t)snprintf(nodes, cap, "\"nodes\":[");
+        for (int i = 0; i < len; i++)
+            o += (size_t)snprintf(nodes + o, cap - o, i + 1 < len ? "{\"children\":[%d]}," : "{\"mesh\":0}", i + 1);
+        snprintf(nodes + o, cap - o, "],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]");
+        write_gltf("deep.gltf", pos, sizeof pos, nodes);
+        free(nodes);
+        if (len == 1025) {
+            assert_int_equal(load(tmp_path("deep.gltf"), &s, &st, &err), RT_OK);
+            assert_int_equal(st.triangles, 1);
+            assert_int_equal(st.nodes, 1025);
+            rt_scene_free(&s);
+        } else {
+            expect_fail("deep.gltf", RT_ERR_LIMIT, "more than 1024 levels deep");
+        }
+    }
     write_gltf("range.gltf", pos, sizeof pos,
                "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
                "\"accessors\":[{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]");
