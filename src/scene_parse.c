@@ -92,16 +92,59 @@ typedef struct parser {
 
 /* ------------------------------------------------------------ errors */
 
-/* Writes 'token' for messages, shortened when long. */
+/* Length of the valid UTF-8 sequence at s (1..4), or 0 when it is not one. */
+static int utf8_len(const unsigned char *s)
+{
+    unsigned c = s[0], min;
+    int n;
+    if (c < 0x80)
+        return 1;
+    if ((c & 0xe0) == 0xc0)
+        n = 2, min = 0x80;
+    else if ((c & 0xf0) == 0xe0)
+        n = 3, min = 0x800;
+    else if ((c & 0xf8) == 0xf0)
+        n = 4, min = 0x10000;
+    else
+        return 0;
+    unsigned cp = c & (0x7fu >> n);
+    for (int i = 1; i < n; i++) {
+        if ((s[i] & 0xc0) != 0x80) /* also stops at the NUL */
+            return 0;
+        cp = (cp << 6) | (s[i] & 0x3fu);
+    }
+    if (cp < min || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff))
+        return 0;
+    return n;
+}
+
+/* Writes 'token' for messages: shortened when long, bytes that are not
+ * UTF-8 written as \xNN so messages stay printable. size >= 16. */
 static const char *show(const tok *t, char *buf, size_t size)
 {
-    size_t n = strlen(t->s);
-    if (n + 3 <= size) {
-        snprintf(buf, size, "'%s'", t->s);
-    } else {
-        int keep = (int)(size > 8 ? size - 8 : 0);
-        snprintf(buf, size, "'%.*s...'", keep, t->s);
+    const unsigned char *s = (const unsigned char *)t->s;
+    size_t o = 0, limit = size - 6; /* room for "...'" and the NUL */
+    buf[o++] = '\'';
+    while (*s) {
+        int n = utf8_len(s);
+        size_t need = n ? (size_t)n : 4;
+        if (o + need > limit) {
+            memcpy(buf + o, "...", 3);
+            o += 3;
+            break;
+        }
+        if (n) {
+            memcpy(buf + o, s, (size_t)n);
+            o += (size_t)n;
+            s += n;
+        } else {
+            snprintf(buf + o, 5, "\\x%02x", *s);
+            o += 4;
+            s++;
+        }
     }
+    buf[o++] = '\'';
+    buf[o] = '\0';
     return buf;
 }
 
@@ -199,17 +242,21 @@ static bool decimal_syntax(const char *s, bool allow_fraction)
     return *c == '\0';
 }
 
-static bool parse_float(const char *s, float *out)
+typedef enum num_status { NUM_BAD = 0, NUM_OK, NUM_RANGE } num_status;
+
+static num_status parse_float(const char *s, float *out)
 {
     if (!decimal_syntax(s, true))
-        return false;
+        return NUM_BAD;
     errno = 0;
     char *end = NULL;
     double d = strtod(s, &end);
-    if (!end || *end != '\0' || !isfinite(d) || fabs(d) > (double)FLT_MAX)
-        return false;
+    if (!end || *end != '\0')
+        return NUM_BAD;
+    if (!isfinite(d) || fabs(d) > (double)FLT_MAX)
+        return NUM_RANGE;
     *out = (float)d;
-    return true;
+    return NUM_OK;
 }
 
 static rt_result get_float(parser *p, const char *what, float *out)
@@ -218,7 +265,10 @@ static rt_result get_float(parser *p, const char *what, float *out)
     char b[80];
     if (!t)
         return perr(p, RT_ERR_PARSE, NULL, "expected a number for %s, got end of line", what);
-    if (t->quoted || !parse_float(t->s, out))
+    num_status st = t->quoted ? NUM_BAD : parse_float(t->s, out);
+    if (st == NUM_RANGE)
+        return perr(p, RT_ERR_INVALID, t, "%s is out of range (beyond +-3.4e38), got %s", what, show(t, b, sizeof b));
+    if (st != NUM_OK)
         return perr(p, RT_ERR_PARSE, t, "expected a number for %s, got %s", what, show(t, b, sizeof b));
     p->pos++;
     return RT_OK;
@@ -822,6 +872,8 @@ static rt_result st_texture(parser *p, const tok *kw)
 
 /* ------------------------------------------------------------ materials */
 
+static int edit_distance(const char *a, const char *b);
+
 typedef enum mat_kind { MK_FLOAT, MK_COLOR, MK_BOOL, MK_TEXTURE, MK_ALPHA_MODE, MK_DISTANCE, MK_UV } mat_kind;
 
 typedef struct mat_key {
@@ -889,12 +941,23 @@ static rt_result st_material(parser *p, const tok *kw)
         while (k < MAT_KEY_COUNT && strcmp(key->s, mat_keys[k].key) != 0 &&
                !(mat_keys[k].alias && strcmp(key->s, mat_keys[k].alias) == 0))
             k++;
-        if (k == MAT_KEY_COUNT || key->quoted)
+        if (k == MAT_KEY_COUNT || key->quoted) {
+            const char *best = NULL;
+            int best_d = 3;
+            for (size_t i = 0; i < MAT_KEY_COUNT; i++) {
+                int d = edit_distance(key->s, mat_keys[i].key);
+                if (d < best_d)
+                    best_d = d, best = mat_keys[i].key;
+            }
+            if (best)
+                return perr(p, RT_ERR_PARSE, key, "expected a material key, got %s (did you mean '%s'?)",
+                            show(key, b, sizeof b), best);
             return perr(p, RT_ERR_PARSE, key,
                         "expected a material key (color, alpha, ambient, diffuse, specular, shininess, reflect, "
                         "transmission, ior, metallic, roughness, emission, texture, normal_map, ... see "
                         "docs/scene-format.md), got %s",
                         show(key, b, sizeof b));
+        }
         if (seen[k])
             return perr(p, RT_ERR_INVALID, key, "material key '%s' is given twice (first at column %d)",
                         mat_keys[k].key, seen[k]->col);
@@ -1067,7 +1130,7 @@ static rt_result get_xform_option(parser *p, xform *x, const char *stmt, bool *t
         /* `scale X Y Z` when a number follows */
         float tmp;
         const tok *t = peek(p);
-        if (t && !t->quoted && parse_float(t->s, &tmp)) {
+        if (t && !t->quoted && parse_float(t->s, &tmp) != NUM_BAD) {
             snprintf(what, sizeof what, "the %s scale (y)", stmt);
             if ((r = get_float(p, what, &x->scale.y)) != RT_OK)
                 return r;

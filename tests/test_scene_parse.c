@@ -600,7 +600,16 @@ static void test_errors_syntax(void **state)
                  "expected a number for the sphere centre (z), got 'nan'");
     expect_error("material m\nsphere inf 0 0 1 m\n", RT_ERR_PARSE, "2:8", "got 'inf'");
     expect_error("material m\nsphere 0x10 0 0 1 m\n", RT_ERR_PARSE, "2:8", "got '0x10'");
-    expect_error("material m\nsphere 1e39 0 0 1 m\n", RT_ERR_PARSE, "2:8", "got '1e39'"); /* over float range */
+    expect_error("material m\nsphere 1e39 0 0 1 m\n", RT_ERR_INVALID, "2:8",
+                 "the sphere centre (x) is out of range (beyond +-3.4e38), got '1e39'");
+    expect_error("material m\nsphere 0 0 0 1 m scale 1e309\n", RT_ERR_PARSE, "2:18", "unexpected 'scale'");
+    expect_error("mesh a.obj scale 2 1e309 1\n", RT_ERR_INVALID, "1:20", "the mesh scale (y) is out of range");
+    /* bytes that are not UTF-8 are escaped in messages; UTF-8 is kept */
+    expect_error("sampl\xe9s 3\n", RT_ERR_PARSE, "1:1", "unknown keyword 'sampl\\xe9s' (did you mean 'samples'?)");
+    expect_error("material m color 1 1 1\nsphere 0 0 0 1 \xc3\xa9t\xc3\xa9\n", RT_ERR_INVALID, "2:16",
+                 "undefined material '\xc3\xa9t\xc3\xa9'");
+    expect_error("material m colour 1 1 1\n", RT_ERR_PARSE, "1:12",
+                 "expected a material key, got 'colour' (did you mean 'color'?)");
     expect_error("material m\nsphere . 0 0 1 m\n", RT_ERR_PARSE, "2:8", "got '.'");
     expect_error("material m\nsphere 1e 0 0 1 m\n", RT_ERR_PARSE, "2:8", "got '1e'");
     expect_error("material m\nsphere 0 0 0 1 m extra\n", RT_ERR_PARSE, "2:18",
