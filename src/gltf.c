@@ -1220,13 +1220,13 @@ static rt_result parse_document(gl_doc *d)
 
 /* ---------------------------------------------------------- validation */
 
-#define CHECK_INDEX(idx, count, tok, ...)                                                                   \
+#define CHECK_INDEX(idx, count, tok, table, ...)                                                            \
     do {                                                                                                    \
         if ((idx) != RT_NONE && (size_t)(idx) >= (count)) {                                                 \
             char what_[160];                                                                                \
             snprintf(what_, sizeof what_, __VA_ARGS__);                                                     \
-            return fail_at(d, tok, RT_ERR_INVALID, "%s %u is out of range (%zu in the file)", what_,        \
-                           (unsigned)(idx), (size_t)(count));                                               \
+            return fail_at(d, tok, RT_ERR_INVALID, "%s %u is out of range (the file has %zu %s)", what_,    \
+                           (unsigned)(idx), (size_t)(count), table);                                        \
         }                                                                                                   \
     } while (0)
 
@@ -1245,7 +1245,7 @@ static rt_result validate(gl_doc *d)
 {
     for (size_t i = 0; i < d->view_count; i++) {
         const gl_view *v = &d->views[i];
-        CHECK_INDEX(v->buffer, d->buffer_count, v->tok, "bufferViews[%zu].buffer", i);
+        CHECK_INDEX(v->buffer, d->buffer_count, v->tok, "buffers", "bufferViews[%zu].buffer", i);
         size_t blen = d->buffers[v->buffer].byte_length;
         if (!span_fits(v->offset, 1, 0, v->length, blen))
             return fail_at(d, v->tok, RT_ERR_INVALID,
@@ -1256,7 +1256,7 @@ static rt_result validate(gl_doc *d)
         gl_accessor *a = &d->accessors[i];
         size_t es = elem_size(a);
         if (a->view != RT_NONE) {
-            CHECK_INDEX(a->view, d->view_count, a->tok, "accessors[%zu].bufferView", i);
+            CHECK_INDEX(a->view, d->view_count, a->tok, "bufferViews", "accessors[%zu].bufferView", i);
             const gl_view *v = &d->views[a->view];
             size_t stride = v->stride ? v->stride : es;
             if (stride < es)
@@ -1273,8 +1273,10 @@ static rt_result validate(gl_doc *d)
                            i, a->count, GL_MAX_VERTICES);
         }
         if (a->sparse_count) {
-            CHECK_INDEX(a->sp_idx_view, d->view_count, a->tok, "accessors[%zu].sparse.indices.bufferView", i);
-            CHECK_INDEX(a->sp_val_view, d->view_count, a->tok, "accessors[%zu].sparse.values.bufferView", i);
+            CHECK_INDEX(a->sp_idx_view, d->view_count, a->tok, "bufferViews",
+                        "accessors[%zu].sparse.indices.bufferView", i);
+            CHECK_INDEX(a->sp_val_view, d->view_count, a->tok, "bufferViews",
+                        "accessors[%zu].sparse.values.bufferView", i);
             size_t ics = comp_size(a->sp_idx_ctype);
             if (!span_fits(a->sp_idx_offset, a->sparse_count, ics, ics, d->views[a->sp_idx_view].length))
                 return fail_at(d, a->tok, RT_ERR_INVALID, "accessors[%zu].sparse.indices run past bufferView %u", i,
@@ -1287,8 +1289,10 @@ static rt_result validate(gl_doc *d)
     for (size_t m = 0; m < d->mesh_count; m++) {
         for (uint32_t p = 0; p < d->meshes[m].count; p++) {
             const gl_prim *pr = &d->prims[d->meshes[m].first + p];
-            CHECK_INDEX(pr->material, d->material_count, pr->tok, "meshes[%zu].primitives[%u].material", m, p);
-            CHECK_INDEX(pr->indices, d->accessor_count, pr->tok, "meshes[%zu].primitives[%u].indices", m, p);
+            CHECK_INDEX(pr->material, d->material_count, pr->tok, "materials",
+                        "meshes[%zu].primitives[%u].material", m, p);
+            CHECK_INDEX(pr->indices, d->accessor_count, pr->tok, "accessors",
+                        "meshes[%zu].primitives[%u].indices", m, p);
             if (pr->indices != RT_NONE) {
                 const gl_accessor *a = &d->accessors[pr->indices];
                 if (a->ncomp != 1 || a->normalized ||
@@ -1301,7 +1305,8 @@ static rt_result validate(gl_doc *d)
             size_t count = 0;
             for (int k = 0; k < ATTR_COUNT; k++) {
                 uint32_t ai = pr->attr[k];
-                CHECK_INDEX(ai, d->accessor_count, pr->tok, "meshes[%zu].primitives[%u].attributes.%s", m, p,
+                CHECK_INDEX(ai, d->accessor_count, pr->tok, "accessors",
+                            "meshes[%zu].primitives[%u].attributes.%s", m, p,
                             attr_names[k]);
                 if (ai == RT_NONE)
                     continue;
@@ -1328,13 +1333,13 @@ static rt_result validate(gl_doc *d)
     }
     for (size_t i = 0; i < d->node_count; i++) {
         gl_node *n = &d->nodes[i];
-        CHECK_INDEX(n->mesh, d->mesh_count, n->tok, "nodes[%zu].mesh", i);
-        CHECK_INDEX(n->camera, d->camera_count, n->tok, "nodes[%zu].camera", i);
-        CHECK_INDEX(n->skin, d->skin_count, n->tok, "nodes[%zu].skin", i);
-        CHECK_INDEX(n->light, d->light_count, n->tok, "nodes[%zu].KHR_lights_punctual.light", i);
+        CHECK_INDEX(n->mesh, d->mesh_count, n->tok, "meshes", "nodes[%zu].mesh", i);
+        CHECK_INDEX(n->camera, d->camera_count, n->tok, "cameras", "nodes[%zu].camera", i);
+        CHECK_INDEX(n->skin, d->skin_count, n->tok, "skins", "nodes[%zu].skin", i);
+        CHECK_INDEX(n->light, d->light_count, n->tok, "lights", "nodes[%zu].KHR_lights_punctual.light", i);
         for (uint32_t c = 0; c < n->child_count; c++) {
             uint32_t ch = d->children[n->first_child + c];
-            CHECK_INDEX(ch, d->node_count, n->tok, "nodes[%zu].children", i);
+            CHECK_INDEX(ch, d->node_count, n->tok, "nodes", "nodes[%zu].children", i);
             if (d->nodes[ch].parent != RT_NONE)
                 return fail_at(d, n->tok, RT_ERR_INVALID, "nodes[%zu]: child %u already has parent node %u", i, ch,
                                d->nodes[ch].parent);
@@ -1404,7 +1409,7 @@ static rt_result validate(gl_doc *d)
             uint32_t n = d->scene_nodes[sc->first + k];
             rt_result r = RT_OK;
             if (n >= d->node_count)
-                r = fail_at(d, sc->tok, RT_ERR_INVALID, "scenes[%zu].nodes %u is out of range (%zu in the file)", i,
+                r = fail_at(d, sc->tok, RT_ERR_INVALID, "scenes[%zu].nodes %u is out of range (the file has %zu nodes)", i,
                             n, d->node_count);
             else if (d->nodes[n].parent != RT_NONE)
                 r = fail_at(d, sc->tok, RT_ERR_INVALID, "scenes[%zu]: node %u is not a root (its parent is node %u)",
@@ -1419,20 +1424,22 @@ static rt_result validate(gl_doc *d)
         }
     }
     free(mark);
-    CHECK_INDEX(d->default_scene, d->scene_count, -1, "scene");
+    CHECK_INDEX(d->default_scene, d->scene_count, -1, "scenes", "scene");
     for (size_t i = 0; i < d->material_count; i++) {
         const rt_material *m = &d->materials[i].m;
         const rt_texture_slot *slots[] = {&m->base_color_tex, &m->metal_rough_tex, &m->normal_tex,
                                           &m->occlusion_tex,  &m->emissive_tex,    &m->transmission_tex};
         for (size_t k = 0; k < sizeof slots / sizeof slots[0]; k++)
-            CHECK_INDEX(slots[k]->texture, d->texture_count, d->materials[i].tok, "materials[%zu]: texture", i);
+            CHECK_INDEX(slots[k]->texture, d->texture_count, d->materials[i].tok, "textures",
+                        "materials[%zu]: texture", i);
     }
     for (size_t i = 0; i < d->texture_count; i++) {
-        CHECK_INDEX(d->textures[i].source, d->image_count, d->textures[i].tok, "textures[%zu].source", i);
-        CHECK_INDEX(d->textures[i].sampler, d->sampler_count, d->textures[i].tok, "textures[%zu].sampler", i);
+        CHECK_INDEX(d->textures[i].source, d->image_count, d->textures[i].tok, "images", "textures[%zu].source", i);
+        CHECK_INDEX(d->textures[i].sampler, d->sampler_count, d->textures[i].tok, "samplers",
+                    "textures[%zu].sampler", i);
     }
     for (size_t i = 0; i < d->image_count; i++)
-        CHECK_INDEX(d->images[i].view, d->view_count, d->images[i].tok, "images[%zu].bufferView", i);
+        CHECK_INDEX(d->images[i].view, d->view_count, d->images[i].tok, "bufferViews", "images[%zu].bufferView", i);
     return RT_OK;
 }
 
