@@ -57,9 +57,13 @@ typedef struct name_entry {
     int line;       /* where it was defined */
 } name_entry;
 
+/* Names defined in this file, with an open-addressing hash index (FNV-1a,
+ * linear probing) so scenes with many materials stay linear time. */
 typedef struct name_table {
     name_entry *items;
     size_t count, cap;
+    uint32_t *slots; /* item index + 1, 0 = empty; power-of-two size */
+    size_t nslots;
 } name_table;
 
 /* Settings that can be given once; a second line warns. */
@@ -397,24 +401,66 @@ static rt_result expect_end(parser *p, const char *stmt)
 
 /* ------------------------------------------------------------ names and paths */
 
+static uint32_t name_hash(const char *s)
+{
+    uint32_t h = 2166136261u;
+    for (; *s; s++)
+        h = (h ^ (unsigned char)*s) * 16777619u;
+    return h;
+}
+
 static name_entry *name_find(name_table *t, const char *name)
 {
-    for (size_t i = 0; i < t->count; i++)
-        if (strcmp(t->items[i].name, name) == 0)
-            return &t->items[i];
-    return NULL;
+    if (!t->nslots)
+        return NULL;
+    size_t mask = t->nslots - 1;
+    for (size_t i = name_hash(name) & mask;; i = (i + 1) & mask) {
+        uint32_t k = t->slots[i];
+        if (k == 0)
+            return NULL;
+        if (strcmp(t->items[k - 1].name, name) == 0)
+            return &t->items[k - 1];
+    }
+}
+
+static void name_slot_insert(name_table *t, uint32_t item)
+{
+    size_t mask = t->nslots - 1;
+    size_t i = name_hash(t->items[item].name) & mask;
+    while (t->slots[i])
+        i = (i + 1) & mask;
+    t->slots[i] = item + 1;
 }
 
 static bool name_add(name_table *t, const char *name, uint32_t index, int line)
 {
-    if (!rt_grow((void **)&t->items, &t->cap, t->count + 1, sizeof *t->items))
+    if (t->count >= UINT32_MAX / 4 || !rt_grow((void **)&t->items, &t->cap, t->count + 1, sizeof *t->items))
         return false;
-    name_entry *e = &t->items[t->count++];
+    if ((t->count + 1) * 2 > t->nslots) { /* keep the load under 1/2 */
+        size_t n = t->nslots ? t->nslots * 2 : 64;
+        uint32_t *slots = rt_alloc(n, sizeof *slots);
+        if (!slots)
+            return false;
+        free(t->slots);
+        t->slots = slots;
+        t->nslots = n;
+        for (size_t i = 0; i < t->count; i++)
+            name_slot_insert(t, (uint32_t)i);
+    }
+    name_entry *e = &t->items[t->count];
     memset(e, 0, sizeof *e);
     snprintf(e->name, sizeof e->name, "%s", name);
     e->index = index;
     e->line = line;
+    name_slot_insert(t, (uint32_t)t->count);
+    t->count++;
     return true;
+}
+
+static void name_table_free(name_table *t)
+{
+    free(t->items);
+    free(t->slots);
 }
 
 /* Words that follow a name in `mesh`/`model` and so cannot be names. */
@@ -1628,8 +1674,8 @@ rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const
     if (r == RT_OK)
         r = finish(&p);
     free(p.toks);
-    free(p.materials.items);
-    free(p.textures.items);
+    name_table_free(&p.materials);
+    name_table_free(&p.textures);
     free(buf);
     return r;
 }

@@ -760,6 +760,31 @@ static void test_errors_names(void **state)
     expect_error("sphere 0 0 0 1 late\nmaterial late\n", RT_ERR_INVALID, "1:16", "undefined material 'late'");
 }
 
+/* Many names: the hash index grows and still finds every name and duplicate. */
+static void test_many_names(void **state)
+{
+    (void)state;
+    enum { N = 3000 };
+    size_t cap = (size_t)N * 64 + 256, len = 0;
+    char *text = malloc(cap);
+    assert_non_null(text);
+    for (int i = 0; i < N; i++)
+        len += (size_t)snprintf(text + len, cap - len, "material m%d color 0 0 %d\n", i, i % 2);
+    for (int i = N - 1; i >= 0; i -= 7)
+        len += (size_t)snprintf(text + len, cap - len, "sphere 0 0 0 1 m%d\n", i);
+    rt_scene s;
+    expect_ok(text, &s);
+    assert_int_equal(s.material_count, N);
+    for (size_t k = 0; k < s.spheres.count; k++)
+        assert_int_equal(s.spheres.material[k], N - 1 - 7 * (int)k);
+    rt_scene_free(&s);
+    len += (size_t)snprintf(text + len, cap - len, "material m1234\n");
+    char where[32];
+    snprintf(where, sizeof where, "%d:10", N + (N + 6) / 7 + 1);
+    expect_error(text, RT_ERR_INVALID, where, "material 'm1234' is already defined on line 1235");
+    free(text);
+}
+
 /* ------------------------------------------------------------ files */
 
 /* A 2x2 binary PPM that stb_image reads. */
@@ -995,6 +1020,7 @@ int main(void)
         cmocka_unit_test(test_errors_syntax),
         cmocka_unit_test(test_errors_values),
         cmocka_unit_test(test_errors_names),
+        cmocka_unit_test(test_many_names),
         cmocka_unit_test(test_textures_from_files),
         cmocka_unit_test(test_paths_relative_to_scene_file),
         cmocka_unit_test(test_mesh_transform),
