@@ -140,8 +140,9 @@ typedef struct gl_doc {
     const char *path;
     char *dir;            /* directory of the .gltf with a trailing '/', or "" */
     rt_error *err;
-    uint8_t *file;
+    const uint8_t *bytes; /* the whole .gltf/.glb */
     size_t file_size;
+    uint8_t *file;        /* owned copy when read from disk */
     const char *json_text;
     size_t json_len, json_base;
     const uint8_t *bin;   /* GLB BIN chunk */
@@ -365,7 +366,7 @@ static uint32_t rd32(const uint8_t *p) { return (uint32_t)p[0] | (uint32_t)p[1] 
 /* Splits a GLB into its JSON and BIN chunks (spec 4.4). */
 static rt_result split_glb(gl_doc *d)
 {
-    const uint8_t *f = d->file;
+    const uint8_t *f = d->bytes;
     size_t size = d->file_size;
     if (size < 12)
         return rt_fail(d->err, RT_ERR_INVALID, "%s: byte 0: file is %zu bytes, too short for the 12-byte GLB header",
@@ -2162,14 +2163,11 @@ static rt_result load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_glt
         return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
     memcpy(d->dir, d->path, dl);
     d->dir[dl] = '\0';
-    {
-        FILE *f = fopen(d->path, "rb");
-        if (!f)
-            return rt_fail(d->err, RT_ERR_IO, "%s: cannot open: %s", d->path, strerror(errno));
-        fclose(f);
+    if (!d->bytes) {
+        TRY(read_file(d, d->path, "", &d->file, &d->file_size));
+        d->bytes = d->file;
     }
-    TRY(read_file(d, d->path, "", &d->file, &d->file_size));
-    if (d->file_size >= 4 && memcmp(d->file, "glTF", 4) == 0) {
+    if (d->file_size >= 4 && memcmp(d->bytes, "glTF", 4) == 0) {
         d->glb = true;
         TRY(split_glb(d));
     } else {
@@ -2177,7 +2175,7 @@ static rt_result load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_glt
         if (ext && strcmp(ext, ".glb") == 0)
             return rt_fail(d->err, RT_ERR_INVALID, "%s: byte 0: bad magic (expected \"glTF\" for a .glb file)",
                            d->path);
-        d->json_text = (const char *)d->file;
+        d->json_text = (const char *)d->bytes;
         d->json_len = d->file_size;
         if (d->json_len >= 3 && memcmp(d->json_text, "\xEF\xBB\xBF", 3) == 0) { /* UTF-8 byte order mark */
             d->json_text += 3;
@@ -2191,14 +2189,16 @@ static rt_result load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_glt
     return flatten(d, s, opt, st);
 }
 
-rt_result rt_gltf_load(rt_scene *s, const char *path, const rt_gltf_options *options, rt_gltf_stats *stats,
-                       rt_error *err)
+static rt_result load_doc(rt_scene *s, const char *path, const void *data, size_t size,
+                          const rt_gltf_options *options, rt_gltf_stats *stats, rt_error *err)
 {
     rt_error local_err;
     gl_doc d;
     memset(&d, 0, sizeof d);
     d.path = path;
     d.err = err ? err : &local_err;
+    d.bytes = data;
+    d.file_size = size;
     rt_gltf_stats st;
     memset(&st, 0, sizeof st);
     st.bounds = rt_box_empty();
@@ -2224,4 +2224,21 @@ rt_result rt_gltf_load(rt_scene *s, const char *path, const rt_gltf_options *opt
     if (stats)
         *stats = st;
     return RT_OK;
+}
+
+rt_result rt_gltf_load(rt_scene *s, const char *path, const rt_gltf_options *options, rt_gltf_stats *stats,
+                       rt_error *err)
+{
+    if (!path)
+        return rt_fail(err, RT_ERR_IO, "rt_gltf_load: no path");
+    return load_doc(s, path, NULL, 0, options, stats, err);
+}
+
+rt_result rt_gltf_load_memory(rt_scene *s, const void *data, size_t size, const char *name,
+                              const rt_gltf_options *options, rt_gltf_stats *stats, rt_error *err)
+{
+    static const uint8_t empty[1] = {0};
+    if (!data && size)
+        return rt_fail(err, RT_ERR_INVALID, "%s: no data", name ? name : "<memory>");
+    return load_doc(s, name ? name : "<memory>", size ? data : empty, size, options, stats, err);
 }

@@ -41,4 +41,11 @@ typedef struct rt_gltf_stats {
 rt_result rt_gltf_load(rt_scene *s, const char *path, const rt_gltf_options *options, rt_gltf_stats *stats,
                        rt_error *err);
 
+/* The same from a .gltf or .glb already in memory (size bytes at data, not
+ * copied, not kept). `name` stands for the file in messages, and relative
+ * URIs (external .bin and images) resolve against its directory. Handy for
+ * fuzzing and for assets packed in other files. */
+rt_result rt_gltf_load_memory(rt_scene *s, const void *data, size_t size, const char *name,
+                              const rt_gltf_options *options, rt_gltf_stats *stats, rt_error *err);
+
 #endif
