@@ -20,8 +20,11 @@
  * (the empty-space bonus), else 1. Only planes strictly inside V count
  * (so no zero-volume cells are cut off again and again). The node becomes a
  * leaf when the best C(p) is not below the leaf cost K_I * N, or at the depth
- * limit (default 8 + 1.3 log2 N, as pbrt). Defaults: K_T = 15, K_I = 20,
- * empty_bonus = 0.2 (the paper's values).
+ * limit (default 8 + 1.3 log2 N, as pbrt). Defaults: K_T = 3, K_I = 1,
+ * empty_bonus = 0.2 (the paper's lambda = 0.8). The paper's K_T = 15,
+ * K_I = 20 gave no faster traversal here on the shared benchmark rays but
+ * 7 nodes and 5 references per triangle (115 bytes/triangle); K_T / K_I = 3
+ * keeps the tree + triangles under 64 bytes a triangle.
  * Splitting classifies each primitive as left, right or both in one pass over
  * the chosen axis' events; the event lists of left-only and right-only
  * primitives are filtered into the children keeping their order, and only the
@@ -30,6 +33,9 @@
  * "perfect splits", Havran's thesis 2000, section 4.5), the few new events
  * sorted and merged in. Hence O(N log N) overall. The root lists are sorted
  * by an LSD radix sort on 64-bit event keys (position bits, type, primitive).
+ * With params->threads > 1 the subtrees below depth 5 are built as
+ * independent tasks by a pool of threads and spliced into place afterwards:
+ * the tree is bit-identical for any thread count.
  *
  * Layout: 8-byte nodes in depth-first order (below child = next node, above
  * child index in the node; see kdtree.h), leaf ids in one array, triangles as
@@ -50,11 +56,13 @@
  */
 #include "rt/kdtree.h"
 
-#include <float.h>
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 /* ------------------------------------------------------------- events */
 
@@ -177,6 +185,11 @@ static int clip_plane(double (*in)[3], int n, double (*out)[3], int k, double c,
 
 /* ------------------------------------------------------------- build */
 
+/* The subtree builds below a fixed depth are independent tasks, run on
+ * `threads` workers and stitched together in depth-first order afterwards,
+ * so the tree is identical for any number of threads. */
+typedef struct kd_task kd_task;
+
 typedef struct kd_build {
     const rt_scene *s;
     uint32_t T, S, Q;
@@ -191,10 +204,26 @@ typedef struct kd_build {
     size_t id_count, id_cap;
     rt_kdtree_stats st;
     bool oom;
+    /* top-level builder only: subtrees at task_depth become tasks */
+    int task_depth;
+    size_t task_min_prims;
+    kd_task *tasks;
+    size_t task_count, task_cap;
 } kd_build;
+
+struct kd_task {
+    rt_box V;
+    uint64_t *ev;
+    size_t cnt[3], nprims;
+    int depth;
+    kd_build out; /* the subtree's nodes, ids and stats */
+};
+
+#define TASK_MARK (LEAF_TAG | (0x3fffffffu << 2)) /* placeholder leaf: a = task index */
 
 static inline float *box_lo(rt_box *b) { return &b->lo.x; }
 static inline float *box_hi(rt_box *b) { return &b->hi.x; }
+
 
 /* Bounds of the part of primitive `prim` inside `box` (tight for triangles
  * and quads, box-intersected for spheres); false when nothing is inside. */
@@ -320,6 +349,7 @@ static void make_leaf(kd_build *c, uint32_t node, const uint64_t *ev0, size_t n0
         c->oom = true;
         return;
     }
+    nd = &c->nodes[node];
     uint32_t *dst = c->ids + c->id_count;
     size_t m = 0;
     for (size_t i = 0; i < n0 && m < nprims; i++)
@@ -350,6 +380,83 @@ static void merge_back(uint64_t *dst, size_t nd, const uint64_t *add, size_t na)
     }
 }
 
+/* Best SAH plane of a node (section 4.2 of Wald and Havran): one sweep per
+ * axis over its sorted events. Returns the cost, INFINITY when no plane. */
+static double find_plane(const kd_build *c, rt_box V, uint64_t *const list[3], const size_t cnt[3], size_t nprims,
+                         int *best_k, uint32_t *best_key, int *best_side)
+{
+    const float *vlo = &V.lo.x, *vhi = &V.hi.x;
+    double ext[3] = {(double)vhi[0] - vlo[0], (double)vhi[1] - vlo[1], (double)vhi[2] - vlo[2]};
+    double area = 2.0 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[2] * ext[0]);
+    double best = INFINITY;
+    if (!(area > 0.0) || !isfinite(area))
+        return best;
+    /* cost = kt + ki * (PL * nl + PR * nr) = kt + (2 ki / area) * ((ab + dl (a+b)) nl + (ab + dr (a+b)) nr) */
+    double scale = 2.0 * c->ki / area, kt = c->kt, lambda = c->lambda;
+    for (int k = 0; k < 3; k++) {
+        if (!(vlo[k] < vhi[k]))
+            continue;
+        double a = ext[(k + 1) % 3], b = ext[(k + 2) % 3], ab = a * b, apb = a + b;
+        uint32_t lo_key = f2o(vlo[k] + 0.0f), hi_key = f2o(vhi[k] + 0.0f);
+        const uint64_t *E = list[k];
+        size_t n = cnt[k], nl = 0, nr = nprims;
+        for (size_t i = 0; i < n;) {
+            uint32_t key = ev_key(E[i]);
+            size_t pe = 0, pp = 0, ps = 0;
+            while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_END)
+                pe++, i++;
+            while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_PLANAR)
+                pp++, i++;
+            while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_START)
+                ps++, i++;
+            nr -= pp + pe;
+            if (key > lo_key && key < hi_key) {
+                double p = (double)o2f(key);
+                double wl = ab + (p - vlo[k]) * apb, wr = ab + (vhi[k] - p) * apb;
+                double l1 = (double)(nl + pp), r1 = (double)nr; /* planar ones left */
+                double c1 = kt + scale * (wl * l1 + wr * r1);
+                if (l1 == 0.0 || r1 == 0.0)
+                    c1 *= lambda;
+                if (c1 < best) {
+                    best = c1, *best_k = k, *best_key = key, *best_side = SIDE_LEFT;
+                }
+                if (pp > 0) { /* planar ones right */
+                    double l2 = (double)nl, r2 = (double)(nr + pp);
+                    double c2 = kt + scale * (wl * l2 + wr * r2);
+                    if (l2 == 0.0 || r2 == 0.0)
+                        c2 *= lambda;
+                    if (c2 < best) {
+                        best = c2, *best_k = k, *best_key = key, *best_side = SIDE_RIGHT;
+                    }
+                }
+            }
+            nl += ps + pp;
+        }
+    }
+    return best;
+}
+
+static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t nprims, int depth);
+
+/* Records the subtree as a task; its node here is a placeholder. */
+static void make_task(kd_build *c, uint32_t node, rt_box V, uint64_t *ev, size_t cnt[3], size_t nprims, int depth)
+{
+    if (!rt_grow((void **)&c->tasks, &c->task_cap, c->task_count + 1, sizeof *c->tasks)) {
+        c->oom = true;
+        free(ev);
+        return;
+    }
+    kd_task *t = &c->tasks[c->task_count];
+    memset(t, 0, sizeof *t);
+    t->V = V;
+    t->ev = ev;
+    memcpy(t->cnt, cnt, sizeof t->cnt);
+    t->nprims = nprims;
+    t->depth = depth;
+    c->nodes[node].a = (uint32_t)c->task_count++;
+    c->nodes[node].b = TASK_MARK;
+}
+
 /* Builds the subtree of box V from its event lists (one block `ev`, lists of
  * cnt[0], cnt[1], cnt[2] events, owned and freed here) over nprims prims. */
 static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t nprims, int depth)
@@ -359,93 +466,47 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
         free(ev);
         return;
     }
-    uint64_t *list[3] = {ev, ev + cnt[0], ev + cnt[0] + cnt[1]};
-    const float *vlo = &V.lo.x, *vhi = &V.hi.x;
-    double ext[3] = {(double)vhi[0] - vlo[0], (double)vhi[1] - vlo[1], (double)vhi[2] - vlo[2]};
-    double area = 2.0 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[2] * ext[0]);
-    double leaf_cost = c->ki * (double)nprims;
-    double best = INFINITY;
-    int best_k = -1, best_side = SIDE_LEFT;
-    uint32_t best_key = 0;
-
-    if (nprims > 1 && depth < c->max_depth && area > 0.0 && isfinite(area)) {
-        double inv_area = 1.0 / area;
-        for (int k = 0; k < 3; k++) {
-            if (!(vlo[k] < vhi[k]))
-                continue;
-            double a = ext[(k + 1) % 3], b = ext[(k + 2) % 3], ab = a * b, apb = a + b;
-            const uint64_t *E = list[k];
-            size_t n = cnt[k], nl = 0, nr = nprims;
-            for (size_t i = 0; i < n;) {
-                uint32_t key = ev_key(E[i]);
-                size_t pe = 0, pp = 0, ps = 0;
-                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_END)
-                    pe++, i++;
-                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_PLANAR)
-                    pp++, i++;
-                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_START)
-                    ps++, i++;
-                nr -= pp + pe;
-                float p = o2f(key);
-                if (p > vlo[k] && p < vhi[k]) {
-                    double dl = (double)p - vlo[k], dr = (double)vhi[k] - p;
-                    double pl = 2.0 * (ab + dl * apb) * inv_area, pr = 2.0 * (ab + dr * apb) * inv_area;
-                    double l1 = (double)(nl + pp), r1 = (double)nr;       /* planar left */
-                    double l2 = (double)nl, r2 = (double)(nr + pp);       /* planar right */
-                    double c1 = c->kt + c->ki * (pl * l1 + pr * r1);
-                    double c2 = c->kt + c->ki * (pl * l2 + pr * r2);
-                    if (l1 == 0.0 || r1 == 0.0)
-                        c1 *= c->lambda;
-                    if (l2 == 0.0 || r2 == 0.0)
-                        c2 *= c->lambda;
-                    if (c1 < best) {
-                        best = c1, best_k = k, best_key = key, best_side = SIDE_LEFT;
-                    }
-                    if (c2 < best) {
-                        best = c2, best_k = k, best_key = key, best_side = SIDE_RIGHT;
-                    }
-                }
-                nl += ps + pp;
-            }
-        }
+    if (c->task_depth > 0 && depth == c->task_depth && nprims >= c->task_min_prims) {
+        make_task(c, node, V, ev, cnt, nprims, depth);
+        return;
     }
-    if (best_k < 0 || !(best < leaf_cost)) {
+    uint64_t *list[3] = {ev, ev + cnt[0], ev + cnt[0] + cnt[1]};
+    int k = -1, best_side = SIDE_LEFT;
+    uint32_t best_key = 0;
+    double best = INFINITY;
+    if (nprims > 1 && depth < c->max_depth)
+        best = find_plane(c, V, list, cnt, nprims, &k, &best_key, &best_side);
+    if (k < 0 || !(best < c->ki * (double)nprims)) {
         make_leaf(c, node, list[0], cnt[0], nprims, depth);
         free(ev);
         return;
     }
 
-    /* classify */
-    int k = best_k;
+    /* classify in one pass over axis k (events of a primitive come in the
+     * order START, END): left, right, or both (a straddler) */
     uint8_t *side = c->side;
     const uint64_t *E = list[k];
     size_t n = cnt[k], ns = 0;
-    for (size_t i = 0; i < n; i++)
-        side[ev_prim(E[i])] = SIDE_BOTH;
+    if (!rt_grow((void **)&c->strad, &c->strad_cap, nprims, sizeof *c->strad)) {
+        c->oom = true;
+        free(ev);
+        return;
+    }
     for (size_t i = 0; i < n; i++) {
         uint64_t e = E[i];
-        uint32_t key = ev_key(e);
+        uint32_t key = ev_key(e), p = ev_prim(e);
         unsigned t = ev_type(e);
-        if (t == EV_END && key <= best_key)
-            side[ev_prim(e)] = SIDE_LEFT;
-        else if (t == EV_START && key >= best_key)
-            side[ev_prim(e)] = SIDE_RIGHT;
-        else if (t == EV_PLANAR) {
-            if (key < best_key || (key == best_key && best_side == SIDE_LEFT))
-                side[ev_prim(e)] = SIDE_LEFT;
-            else
-                side[ev_prim(e)] = SIDE_RIGHT;
+        if (t == EV_START) {
+            side[p] = key >= best_key ? SIDE_RIGHT : SIDE_BOTH;
+        } else if (t == EV_END) {
+            if (key <= best_key)
+                side[p] = SIDE_LEFT;
+            else if (side[p] == SIDE_BOTH)
+                c->strad[ns++] = p;
+        } else {
+            side[p] = key < best_key || (key == best_key && best_side == SIDE_LEFT) ? SIDE_LEFT : SIDE_RIGHT;
         }
     }
-    for (size_t i = 0; i < n; i++)
-        if (ev_type(E[i]) == EV_START && side[ev_prim(E[i])] == SIDE_BOTH) {
-            if (!rt_grow((void **)&c->strad, &c->strad_cap, ns + 1, sizeof *c->strad)) {
-                c->oom = true;
-                free(ev);
-                return;
-            }
-            c->strad[ns++] = ev_prim(E[i]);
-        }
 
     float split = o2f(best_key);
     rt_box VL = V, VR = V;
@@ -454,7 +515,7 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
 
     /* new events of the straddling primitives, clipped to each child */
     uint64_t *nbuf = NULL;
-    uint64_t *nl_list[3], *nr_list[3];
+    uint64_t *nl_list[3] = {NULL, NULL, NULL}, *nr_list[3] = {NULL, NULL, NULL};
     size_t nl_cnt[3] = {0, 0, 0}, nr_cnt[3] = {0, 0, 0};
     size_t npl = 0, npr = 0; /* straddlers kept on each side */
     if (ns > 0) {
@@ -487,28 +548,12 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
         }
     }
 
-    /* filter the parent lists into the children's blocks */
-    size_t kl[3] = {0, 0, 0}, kr[3] = {0, 0, 0};
-    size_t left_prims = npl, right_prims = npr;
-    for (int d = 0; d < 3; d++)
-        for (size_t i = 0; i < cnt[d]; i++) {
-            uint8_t sd = side[ev_prim(list[d][i])];
-            kl[d] += sd == SIDE_LEFT;
-            kr[d] += sd == SIDE_RIGHT;
-            if (d == k && ev_type(list[d][i]) != EV_END) {
-                left_prims += sd == SIDE_LEFT;
-                right_prims += sd == SIDE_RIGHT;
-            }
-        }
-    size_t lc[3], rc[3], ltot = 0, rtot = 0;
-    for (int d = 0; d < 3; d++) {
-        lc[d] = kl[d] + nl_cnt[d];
-        rc[d] = kr[d] + nr_cnt[d];
-        ltot += lc[d];
-        rtot += rc[d];
-    }
-    uint64_t *lev = malloc((ltot ? ltot : 1) * sizeof *lev);
-    uint64_t *rev = malloc((rtot ? rtot : 1) * sizeof *rev);
+    /* filter the parent lists into the children's blocks, merging the new
+     * events in; sized for the worst case, shrunk afterwards */
+    size_t total = cnt[0] + cnt[1] + cnt[2];
+    size_t lcap = total + nl_cnt[0] + nl_cnt[1] + nl_cnt[2], rcap = total + nr_cnt[0] + nr_cnt[1] + nr_cnt[2];
+    uint64_t *lev = malloc((lcap ? lcap : 1) * sizeof *lev);
+    uint64_t *rev = malloc((rcap ? rcap : 1) * sizeof *rev);
     if (!lev || !rev) {
         free(lev);
         free(rev);
@@ -517,26 +562,43 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
         c->oom = true;
         return;
     }
-    uint64_t *lp = lev, *rp = rev;
+    size_t lc[3], rc[3], lo = 0, ro = 0;
+    size_t left_prims = npl, right_prims = npr;
     for (int d = 0; d < 3; d++) {
-        size_t a = 0, b = 0;
-        for (size_t i = 0; i < cnt[d]; i++) {
-            uint64_t e = list[d][i];
+        uint64_t *lp = lev + lo, *rp = rev + ro;
+        const uint64_t *src = list[d];
+        size_t a = 0, b = 0, m = cnt[d];
+        for (size_t i = 0; i < m; i++) {
+            uint64_t e = src[i];
             uint8_t sd = side[ev_prim(e)];
-            if (sd == SIDE_LEFT)
-                lp[a++] = e;
-            else if (sd == SIDE_RIGHT)
-                rp[b++] = e;
+            lp[a] = e; /* branch-free: write both, advance one */
+            rp[b] = e;
+            a += sd == SIDE_LEFT;
+            b += sd == SIDE_RIGHT;
+        }
+        if (d == k) {
+            for (size_t i = 0; i < a; i++)
+                left_prims += ev_type(lp[i]) != EV_END;
+            for (size_t i = 0; i < b; i++)
+                right_prims += ev_type(rp[i]) != EV_END;
         }
         if (ns > 0) {
             merge_back(lp, a, nl_list[d], nl_cnt[d]);
             merge_back(rp, b, nr_list[d], nr_cnt[d]);
         }
-        lp += lc[d];
-        rp += rc[d];
+        lc[d] = a + nl_cnt[d];
+        rc[d] = b + nr_cnt[d];
+        lo += lc[d];
+        ro += rc[d];
     }
     free(nbuf);
     free(ev);
+    /* give back what the worst case did not need (shrinking cannot fail for good) */
+    uint64_t *t;
+    if (lo < lcap && (t = realloc(lev, (lo ? lo : 1) * sizeof *lev)) != NULL)
+        lev = t;
+    if (ro < rcap && (t = realloc(rev, (ro ? ro : 1) * sizeof *rev)) != NULL)
+        rev = t;
 
     build_rec(c, VL, lev, lc, left_prims, depth + 1);
     if (c->oom) {
@@ -551,6 +613,157 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
     memcpy(&bits, &split, 4);
     c->nodes[node].a = bits;
     c->nodes[node].b = (uint32_t)k | (above << 2);
+}
+
+/* ---------------------------------------------------- parallel tasks */
+
+typedef struct kd_pool {
+    kd_build *top;
+    size_t *order; /* task indices, largest first */
+    atomic_size_t next;
+    size_t nprims_total;
+} kd_pool;
+
+static void *task_worker(void *arg)
+{
+    kd_pool *pool = arg;
+    kd_build *top = pool->top;
+    uint8_t *side = malloc(pool->nprims_total ? pool->nprims_total : 1);
+    uint32_t *strad = NULL;
+    size_t strad_cap = 0;
+    for (;;) {
+        size_t i = atomic_fetch_add(&pool->next, 1);
+        if (i >= top->task_count)
+            break;
+        kd_task *t = &top->tasks[pool->order[i]];
+        kd_build *c = &t->out;
+        c->s = top->s;
+        c->T = top->T, c->S = top->S, c->Q = top->Q;
+        c->kt = top->kt, c->ki = top->ki, c->lambda = top->lambda;
+        c->max_depth = top->max_depth;
+        if (!side) {
+            c->oom = true;
+            free(t->ev);
+            t->ev = NULL;
+            continue;
+        }
+        c->side = side;
+        c->strad = strad;
+        c->strad_cap = strad_cap;
+        build_rec(c, t->V, t->ev, t->cnt, t->nprims, t->depth);
+        t->ev = NULL;
+        strad = c->strad;
+        strad_cap = c->strad_cap;
+        c->side = NULL;
+        c->strad = NULL;
+    }
+    free(side);
+    free(strad);
+    return NULL;
+}
+
+
+/* Runs every task on `threads` workers (the calling thread is one). */
+static bool run_tasks(kd_build *top, int threads, size_t nprims_total)
+{
+    if (top->task_count == 0)
+        return true;
+    size_t *order = malloc(top->task_count * sizeof *order);
+    if (!order)
+        return false;
+    for (size_t i = 0; i < top->task_count; i++)
+        order[i] = i;
+    /* largest first: a simple longest-processing-time schedule */
+    for (size_t i = 1; i < top->task_count; i++) {
+        size_t x = order[i], j = i;
+        while (j > 0 && top->tasks[order[j - 1]].nprims < top->tasks[x].nprims) {
+            order[j] = order[j - 1];
+            j--;
+        }
+        order[j] = x;
+    }
+    kd_pool pool;
+    pool.top = top;
+    pool.order = order;
+    pool.nprims_total = nprims_total;
+    atomic_init(&pool.next, 0);
+    pthread_t th[64];
+    int started = 0;
+    for (int i = 1; i < threads && i < 64; i++)
+        if (pthread_create(&th[started], NULL, task_worker, &pool) == 0)
+            started++;
+    task_worker(&pool);
+    for (int i = 0; i < started; i++)
+        pthread_join(th[i], NULL);
+    free(order);
+    bool ok = true;
+    for (size_t i = 0; i < top->task_count; i++)
+        if (top->tasks[i].out.oom)
+            ok = false;
+    return ok;
+}
+
+/* Copies the top tree into (nodes, ids) in depth-first order, splicing each
+ * task's subtree in place of its placeholder. Returns the next top node. */
+static size_t stitch(const kd_build *top, size_t i, rt_kdtree_node *nodes, size_t *nn, uint32_t *ids, size_t *ni)
+{
+    rt_kdtree_node nd = top->nodes[i];
+    if (nd.b == TASK_MARK) {
+        const kd_build *o = &top->tasks[nd.a].out;
+        size_t base = *nn, idbase = *ni;
+        for (size_t j = 0; j < o->node_count; j++) {
+            rt_kdtree_node x = o->nodes[j];
+            if ((x.b & 3u) != LEAF_TAG)
+                x.b += (uint32_t)base << 2;
+            else if ((x.b >> 2) > 1)
+                x.a += (uint32_t)idbase;
+            nodes[base + j] = x;
+        }
+        if (o->id_count)
+            memcpy(ids + idbase, o->ids, o->id_count * sizeof *ids);
+        *nn += o->node_count;
+        *ni += o->id_count;
+        return i + 1;
+    }
+    if ((nd.b & 3u) == LEAF_TAG) {
+        if ((nd.b >> 2) > 1) {
+            memcpy(ids + *ni, top->ids + nd.a, (nd.b >> 2) * sizeof *ids);
+            nd.a = (uint32_t)*ni;
+            *ni += nd.b >> 2;
+        }
+        nodes[(*nn)++] = nd;
+        return i + 1;
+    }
+    size_t me = (*nn)++;
+    stitch(top, i + 1, nodes, nn, ids, ni);
+    uint32_t above = (uint32_t)*nn;
+    size_t next = stitch(top, nd.b >> 2, nodes, nn, ids, ni);
+    nodes[me].a = nd.a;
+    nodes[me].b = (nd.b & 3u) | (above << 2);
+    return next;
+}
+
+static void add_stats(rt_kdtree_stats *a, const rt_kdtree_stats *b)
+{
+    a->leaves += b->leaves;
+    a->empty_leaves += b->empty_leaves;
+    a->prim_refs += b->prim_refs;
+    if (b->max_leaf_prims > a->max_leaf_prims)
+        a->max_leaf_prims = b->max_leaf_prims;
+    if (b->depth > a->depth)
+        a->depth = b->depth;
+}
+
+static void free_tasks(kd_build *c)
+{
+    for (size_t i = 0; i < c->task_count; i++) {
+        free(c->tasks[i].ev);
+        free(c->tasks[i].out.nodes);
+        free(c->tasks[i].out.ids);
+    }
+    free(c->tasks);
+    c->tasks = NULL;
+    c->task_count = c->task_cap = 0;
 }
 
 static double now_ms(void)
@@ -581,8 +794,8 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     c.T = (uint32_t)T;
     c.S = (uint32_t)S;
     c.Q = (uint32_t)Q;
-    c.kt = params && params->traversal_cost > 0.0f ? params->traversal_cost : 15.0;
-    c.ki = params && params->intersect_cost > 0.0f ? params->intersect_cost : 20.0;
+    c.kt = params && params->traversal_cost > 0.0f ? params->traversal_cost : 3.0;
+    c.ki = params && params->intersect_cost > 0.0f ? params->intersect_cost : 1.0;
     double eb = params && params->empty_bonus > 0.0f ? params->empty_bonus : 0.2;
     if (eb > 1.0)
         eb = 1.0;
@@ -698,10 +911,43 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     c.max_depth = md;
     tree->max_depth = md;
 
+    int threads = params && params->threads > 0 ? params->threads : 1;
+    if (threads > 64)
+        threads = 64;
+    if (threads > 1 && nvalid >= 20000) {
+        c.task_depth = 5; /* up to 32 subtrees */
+        c.task_min_prims = 2048;
+    }
     build_rec(&c, tree->bounds, ev, cnt, nvalid, 0);
     ev = NULL;
     if (c.oom)
         goto oom;
+    if (c.task_count > 0) {
+        if (!run_tasks(&c, threads, N))
+            goto oom;
+        size_t nn = c.node_count - c.task_count, ni = c.id_count;
+        for (size_t i = 0; i < c.task_count; i++) {
+            nn += c.tasks[i].out.node_count;
+            ni += c.tasks[i].out.id_count;
+            add_stats(&c.st, &c.tasks[i].out.st);
+        }
+        rt_kdtree_node *nodes = malloc(nn * sizeof *nodes);
+        uint32_t *ids = malloc((ni ? ni : 1) * sizeof *ids);
+        if (!nodes || !ids) {
+            free(nodes);
+            free(ids);
+            goto oom;
+        }
+        size_t on = 0, oi = 0;
+        stitch(&c, 0, nodes, &on, ids, &oi);
+        free_tasks(&c);
+        free(c.nodes);
+        free(c.ids);
+        c.nodes = nodes;
+        c.ids = ids;
+        c.node_count = on;
+        c.id_count = oi;
+    }
     free(c.side);
     free(c.strad);
     tree->nodes = c.nodes;
@@ -715,6 +961,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     return RT_OK;
 
 oom:
+    free_tasks(&c);
     free(ev);
     free(tmp);
     free(c.side);
@@ -739,7 +986,7 @@ void rt_kdtree_free(rt_kdtree *tree)
 /* ---------------------------------------------------------- traversal */
 
 typedef struct kd_ray {
-    float o[3], d[3], inv[3];
+    float o[3], d[3], inv[3], ma[3];
     float mp; /* widening of every cell, in scene units */
     float tn, tf;
 } kd_ray;
@@ -766,7 +1013,7 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
                 return false;
             continue;
         }
-        float ma = r->mp * fabsf(r->inv[k]);
+        float ma = r->ma[k] = r->mp * fabsf(r->inv[k]);
         float t0 = (lo[k] - r->o[k]) * r->inv[k], t1 = (hi[k] - r->o[k]) * r->inv[k];
         if (t0 > t1) {
             float t = t0; t0 = t1; t1 = t;
@@ -785,8 +1032,16 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
     return true;
 }
 
+#if defined(__GNUC__)
+#define KD_INLINE static inline __attribute__((always_inline))
+#define KD_FLATTEN __attribute__((flatten)) /* inline the intersect.h tests into the loops */
+#else
+#define KD_INLINE static inline
+#define KD_FLATTEN
+#endif
+
 /* Tests one primitive with the reference functions on (tmin, *best). */
-static inline bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit)
+KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit)
 {
     float t, u, v;
     if (id < tree->triangle_count) {
@@ -823,7 +1078,7 @@ typedef struct kd_entry {
 } kd_entry;
 
 /* The shared traversal; any = stop at the first hit (occlusion). */
-static inline bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, bool any)
+KD_INLINE bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, bool any)
 {
     kd_ray r;
     if (!ray_setup(tree, ray, &r))
@@ -858,16 +1113,18 @@ static inline bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hi
                 }
                 continue;
             }
-            float ts = (split - o) * inv, ma = r.mp * fabsf(inv);
+            float ts = (split - o) * inv, ma = r.ma[axis];
             uint32_t first = inv > 0.0f ? below : above, second = inv > 0.0f ? above : below;
             bool v1 = tn <= ts + ma, v2 = ts - ma <= tf;
             if (v1 && v2) {
                 if (sp < KD_STACK) {
-                    stack[sp].node = second, stack[sp].tn = fmaxf(tn, ts - ma), stack[sp].tf = tf;
+                    float lo = ts - ma, hi = ts + ma;
+                    stack[sp].node = second, stack[sp].tn = lo > tn ? lo : tn, stack[sp].tf = tf;
                     sp++;
+                    if (hi < tf)
+                        tf = hi;
                 }
                 node = first;
-                tf = fminf(tf, ts + ma);
             } else if (v1) {
                 node = first;
             } else {
@@ -904,7 +1161,7 @@ static inline bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hi
     }
 }
 
-bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit)
+KD_FLATTEN bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit)
 {
     hit->prim = RT_NONE;
     if (traverse(tree, ray, hit, false))
@@ -913,7 +1170,7 @@ bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit)
     return false;
 }
 
-bool rt_kdtree_occluded(const rt_kdtree *tree, const rt_ray *ray)
+KD_FLATTEN bool rt_kdtree_occluded(const rt_kdtree *tree, const rt_ray *ray)
 {
     rt_hit h;
     return traverse(tree, ray, &h, true);

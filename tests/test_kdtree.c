@@ -614,6 +614,38 @@ static void test_threads_safe_reads(void **state)
     rt_scene_free(&s);
 }
 
+static void test_parallel_build_identical(void **state)
+{
+    (void)state;
+    /* subtrees built as parallel tasks must give exactly the serial tree */
+    rt_scene s;
+    rt_scene_init(&s);
+    test_rng r = {23};
+    random_soup(&s, &r, 30000, 0.03f);
+    rt_kdtree_params p1 = {0}, p3 = {0};
+    p1.threads = 1;
+    p3.threads = 3;
+    rt_kdtree a, b;
+    rt_error err = {0};
+    assert_int_equal(rt_kdtree_build(&a, &s, &p1, &err), RT_OK);
+    assert_int_equal(rt_kdtree_build(&b, &s, &p3, &err), RT_OK);
+    check_tree(&s, &b);
+    assert_int_equal(a.node_count, b.node_count);
+    assert_int_equal(a.prim_id_count, b.prim_id_count);
+    assert_memory_equal(a.nodes, b.nodes, a.node_count * sizeof *a.nodes);
+    assert_memory_equal(a.prim_ids, b.prim_ids, a.prim_id_count * sizeof *a.prim_ids);
+    assert_int_equal(a.stats.leaves, b.stats.leaves);
+    assert_int_equal(a.stats.empty_leaves, b.stats.empty_leaves);
+    assert_int_equal(a.stats.prim_refs, b.stats.prim_refs);
+    assert_int_equal(a.stats.depth, b.stats.depth);
+    check_stats cs = {0, 0, 0};
+    check_random_rays(&s, &b, 24, 300, -0.2f, 1.2f, &cs);
+    report(__func__, &cs);
+    rt_kdtree_free(&a);
+    rt_kdtree_free(&b);
+    rt_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -629,6 +661,7 @@ int main(void)
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_inside_and_far),
         cmocka_unit_test(test_threads_safe_reads),
+        cmocka_unit_test(test_parallel_build_identical),
     };
     return cmocka_run_group_tests_name("kdtree", tests, NULL, NULL);
 }
