@@ -1312,17 +1312,29 @@ static rt_result validate(gl_doc *d)
                 if (ai == RT_NONE)
                     continue;
                 const gl_accessor *a = &d->accessors[ai];
-                bool ok = a->cols == 1;
+                /* types and component types of the spec's attribute table,
+                 * widened by KHR_mesh_quantization (accepted whether or not
+                 * the file declares it) */
+                bool ok = a->cols == 1, ct = false;
+                bool f = a->ctype == GL_FLOAT, n = a->normalized;
+                bool s8s16 = a->ctype == GL_BYTE || a->ctype == GL_SHORT;
+                bool u8u16 = a->ctype == GL_UNSIGNED_BYTE || a->ctype == GL_UNSIGNED_SHORT;
                 switch (k) {
-                case ATTR_POSITION: case ATTR_NORMAL: ok = ok && a->ncomp == 3; break;
-                case ATTR_TANGENT: ok = ok && a->ncomp == 4; break;
-                case ATTR_TEXCOORD_0: case ATTR_TEXCOORD_1: ok = ok && a->ncomp == 2; break;
-                case ATTR_COLOR_0: ok = ok && (a->ncomp == 3 || a->ncomp == 4); break;
+                case ATTR_POSITION: ok = ok && a->ncomp == 3; ct = f || s8s16 || u8u16; break;
+                case ATTR_NORMAL: ok = ok && a->ncomp == 3; ct = f || (s8s16 && n); break;
+                case ATTR_TANGENT: ok = ok && a->ncomp == 4; ct = f || (s8s16 && n); break;
+                case ATTR_TEXCOORD_0: case ATTR_TEXCOORD_1: ok = ok && a->ncomp == 2; ct = f || s8s16 || u8u16; break;
+                case ATTR_COLOR_0: ok = ok && (a->ncomp == 3 || a->ncomp == 4); ct = f || (u8u16 && n); break;
                 }
                 if (!ok)
                     return fail_at(d, pr->tok, RT_ERR_INVALID,
                                    "meshes[%zu].primitives[%u].attributes.%s: accessor %u has the wrong type", m, p,
                                    attr_names[k], ai);
+                if (!ct)
+                    return fail_at(d, pr->tok, RT_ERR_INVALID,
+                                   "meshes[%zu].primitives[%u].attributes.%s: accessor %u has componentType %d%s, "
+                                   "which this attribute does not allow",
+                                   m, p, attr_names[k], ai, a->ctype, n ? " (normalized)" : "");
                 if (count && a->count != count)
                     return fail_at(d, pr->tok, RT_ERR_INVALID,
                                    "meshes[%zu].primitives[%u].attributes.%s: accessor %u has %zu elements, the "

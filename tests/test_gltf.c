@@ -856,6 +856,14 @@ static void test_broken_data(void **state)
     write_gltf("cycle.gltf", pos, sizeof pos,
                "\"nodes\":[{\"children\":[1]},{\"children\":[2]},{\"children\":[0]}]");
     expect_fail("cycle.gltf", RT_ERR_INVALID, "cycle");
+    /* COLOR_0 as plain (not normalized) bytes breaks the attribute table */
+    write_gltf("color.gltf", pos, sizeof pos,
+               "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+               "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+               "{\"bufferView\":0,\"componentType\":5121,\"count\":3,\"type\":\"VEC4\"}],"
+               "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"COLOR_0\":1}}]}],"
+               "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]");
+    expect_fail("color.gltf", RT_ERR_INVALID, "attributes.COLOR_0: accessor 1 has componentType 5121");
     /* a chain of 1025 nodes is fine (depth 1024), 1026 is over the limit */
     for (int len = 1025; len <= 1026; len++) {
         size_t cap = (size_t)len * 24 + 64;
