@@ -370,7 +370,7 @@ static rt_result get_choice(parser *p, const char *what, const char *const *word
     char b[80];
     if (!t)
         return perr(p, RT_ERR_PARSE, NULL, "expected %s (%s), got end of line", what, choices);
-    for (int i = 0; i < n; i++) {
+    for (int i = 0; i < n && !t->quoted; i++) {
         if (strcmp(t->s, words[i]) == 0) {
             p->pos++;
             *out = i;
@@ -1554,7 +1554,7 @@ static rt_result run(parser *p, char *buf, size_t len)
                     size_t start = ++i;
                     while (i < len && buf[i] != '"' && buf[i] != '\n') {
                         unsigned char q = (unsigned char)buf[i];
-                        if (q < 0x20 && q != '\t') {
+                        if ((q < 0x20 && q != '\t') || q == 0x7f) {
                             tok at = {"", line, (int)(i - ls) + 1, 0, false};
                             return perr(p, RT_ERR_PARSE, &at, "unexpected control character 0x%02x", q);
                         }
@@ -1669,7 +1669,9 @@ rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const
     p.dir = dir;
     p.err = err;
     p.default_material = RT_NONE;
-    rt_result r = run(&p, buf, len);
+    /* a UTF-8 byte order mark is not part of the first statement */
+    size_t skip = len >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0 ? 3 : 0;
+    rt_result r = run(&p, buf + skip, len - skip);
     p.ntok = 0;
     if (r == RT_OK)
         r = finish(&p);

@@ -578,6 +578,11 @@ static void test_comments_and_continuations(void **state)
     assert_string_equal(s.materials[0].name, "a b");
     rt_scene_free(&s);
 
+    /* a UTF-8 byte order mark is skipped */
+    expect_ok("\xef\xbb\xbfsamples 3\n", &s);
+    assert_int_equal(s.settings.samples, 3);
+    rt_scene_free(&s);
+
     /* empty input */
     expect_ok("", &s);
     assert_int_equal(rt_scene_prim_count(&s), 0);
@@ -623,6 +628,8 @@ static void test_errors_syntax(void **state)
                  "expected a number for the sphere radius, got 'x'");
     expect_error("material \"unterminated\n", RT_ERR_PARSE, "1:10", "unterminated quoted string");
     expect_error("material \"a\"b\n", RT_ERR_PARSE, "1:13", "expected a blank after the closing quote");
+    expect_error("samples \"4\"\n", RT_ERR_PARSE, "1:9", "expected an integer for samples per pixel, got '4'");
+    expect_error("integrator \"path\"\n", RT_ERR_PARSE, "1:12", "expected an integrator (direct|whitted|path)");
     expect_error("samples 4\x01\n", RT_ERR_PARSE, "1:10", "unexpected control character 0x01");
     expect_error("samples 4\n\x7f", RT_ERR_PARSE, "2:1", "unexpected control character 0x7f");
     {
