@@ -55,6 +55,8 @@
 
 #define GL_MAX_DEPTH 1024                    /* node hierarchy levels */
 #define GL_MAX_VERTICES ((size_t)1 << 25)    /* per load: 32M vertices */
+#define GL_MAX_ZEROS ((size_t)1 << 22)       /* elements of accessors without a bufferView, per accessor and
+                                                per load (instances included): such data costs no file bytes */
 #define GL_MAX_TRIANGLES ((size_t)1 << 25)   /* per load: 32M triangles */
 #define GL_MAX_FILE ((size_t)0x7fffffff)     /* .gltf, .glb, .bin: 2 GiB */
 
@@ -1269,9 +1271,9 @@ static rt_result validate(gl_doc *d)
                                "accessors[%zu]: byteOffset %zu + %zu elements of %zu bytes (stride %zu) run past "
                                "bufferView %u (%zu bytes)",
                                i, a->offset, a->count, es, stride, a->view, v->length);
-        } else if (a->count > GL_MAX_VERTICES) {
+        } else if (a->count > GL_MAX_ZEROS) {
             return fail_at(d, a->tok, RT_ERR_LIMIT, "accessors[%zu]: count %zu without a bufferView is over the limit %zu",
-                           i, a->count, GL_MAX_VERTICES);
+                           i, a->count, GL_MAX_ZEROS);
         }
         if (a->sparse_count) {
             CHECK_INDEX(a->sp_idx_view, d->view_count, a->tok, "bufferViews",
@@ -1987,7 +1989,7 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
     st->nodes = d->visit_count;
 
     /* Count what the scene will hold, then reserve it all at once. */
-    size_t verts = 0, tris = 0;
+    size_t verts = 0, tris = 0, zeros = 0;
     unsigned attrs = 0;
     bool need_default = false, warned_modes = false, warned_skin = false, warned_pos = false;
     for (size_t v = 0; v < d->visit_count; v++) {
@@ -2017,7 +2019,13 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
                 warned_pos = true;
                 continue;
             }
-            verts += d->accessors[p->attr[ATTR_POSITION]].count;
+            const gl_accessor *pa = &d->accessors[p->attr[ATTR_POSITION]];
+            verts += pa->count;
+            if (pa->view == RT_NONE && (zeros += pa->count) > GL_MAX_ZEROS)
+                return rt_fail(d->err, RT_ERR_LIMIT,
+                               "%s: over %zu vertices come from accessors without a bufferView (instancing "
+                               "included); over the loader's limit",
+                               d->path, GL_MAX_ZEROS);
             tris += prim_triangles(d, p);
             if (verts > GL_MAX_VERTICES || tris > GL_MAX_TRIANGLES)
                 return rt_fail(d->err, RT_ERR_LIMIT,

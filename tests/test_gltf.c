@@ -895,6 +895,12 @@ static void test_broken_data(void **state)
                "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
                "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]");
     expect_fail("zeros.gltf", RT_ERR_LIMIT, "over the limit");
+    /* ... nor can instancing a zero accessor under the per-accessor cap */
+    write_gltf("zeros2.gltf", pos, sizeof pos,
+               "\"accessors\":[{\"componentType\":5126,\"count\":3000000,\"type\":\"VEC3\"}],"
+               "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+               "\"nodes\":[{\"mesh\":0},{\"mesh\":0}],\"scenes\":[{\"nodes\":[0,1]}]");
+    expect_fail("zeros2.gltf", RT_ERR_LIMIT, "without a bufferView (instancing included)");
     /* a failed load leaves an existing scene untouched */
     rt_scene_init(&s);
     uint32_t m = rt_scene_add_material(&s, &(rt_material){.name = "keep"});
