@@ -1,7 +1,7 @@
 /* test_texture.c - texture lookups against values worked out by hand:
  * wrap modes at and beyond the edges, nearest texel selection, bilinear
  * weights, sRGB decoding, float images, procedural textures, UV
- * transforms, and the loader: PNG and HDR files decode to what was
+ * transforms, and the loader: PNG, JPEG and HDR files decode to what was
  * written, the same file is loaded once for every material that uses it,
  * and bad files fail cleanly. */
 #include "test_util.h"
@@ -13,6 +13,8 @@
 #include "rt/scene.h"
 #include "rt/scene_parse.h"
 #include "rt/texture.h"
+
+#include <stb/stb_image_write.h> /* the implementation is in -lstb */
 
 /* A w x h RGBA8 image whose texel (x, y) has R = 10 + 40 x, G = 10 + 60 y,
  * B = 7, A = 200, as a texture with the given sampling. */
@@ -276,6 +278,29 @@ static void test_loader_and_cache(void **state)
     assert_non_null(s.images[h].rgbaf);
     assert_true(fabsf(s.images[h].rgbaf[0] - 37.0f * 0.2158605f) < 0.01f * 37.0f * 0.2158605f);
     assert_true(fabsf(s.images[h].rgbaf[4 * 3] - 37.0f * 0.5f) < 0.01f * 37.0f * 0.5f);
+    /* JPEG (written by stb_image_write, quality 95): four flat quadrants
+     * come back within a few codes of what was written */
+    char jpg[512];
+    snprintf(jpg, sizeof jpg, "%s/quad.jpg", dir);
+    static const uint8_t quad_rgb[4][3] = {{200, 40, 30}, {30, 180, 60}, {20, 40, 220}, {128, 128, 128}};
+    uint8_t pix[32 * 32 * 3];
+    for (int y = 0; y < 32; y++)
+        for (int x = 0; x < 32; x++)
+            memcpy(pix + 3 * (y * 32 + x), quad_rgb[(y / 16) * 2 + x / 16], 3);
+    assert_true(stbi_write_jpg(jpg, 32, 32, 3, pix, 95) != 0);
+    uint32_t j = RT_NONE;
+    assert_int_equal(rt_image_load_file(&s, jpg, &j, &err), RT_OK);
+    assert_non_null(s.images[j].rgba8);
+    rt_texture tj = rt_texture_image(j);
+    uint32_t tji = rt_scene_add_texture(&s, &tj);
+    for (int q = 0; q < 4; q++) {
+        rt_vec2 uv = rt_v2((q % 2) * 0.5f + 0.25f, (q / 2) * 0.5f + 0.25f);
+        rt_vec4 c = rt_texture_sample(&s, tji, uv, false);
+        assert_true(fabsf(c.x * 255.0f - quad_rgb[q][0]) < 6.0f);
+        assert_true(fabsf(c.y * 255.0f - quad_rgb[q][1]) < 6.0f);
+        assert_true(fabsf(c.z * 255.0f - quad_rgb[q][2]) < 6.0f);
+    }
+    unlink(jpg);
     /* failures: a missing file and garbage name the file and leave the scene as it was */
     test_write_file(bad, "not an image at all", 19);
     size_t before = s.image_count;
