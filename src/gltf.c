@@ -234,8 +234,9 @@ static rt_result expect_array(gl_doc *d, int t, const char *where, const char *k
     for (int k##_n = 0, k = (obj) + 1, v = (obj) + 2; k##_n < (d)->j.tok[obj].size && v < (d)->j.count; \
          k##_n++, k = rt_json_skip(&(d)->j, v), v = k + 1)
 /* Iterates the elements of an array. */
-#define FOR_ITEMS(d, arr, idx, e)                                                                  \
-    for (int idx = 0, e = (arr) + 1; idx < (d)->j.tok[arr].size && e < (d)->j.count; idx++, e = rt_json_skip(&(d)->j, e))
+#define FOR_ITEMS(d, arr, idx, e)                                                       \
+    for (int idx = 0, e = (arr) + 1; idx < (d)->j.tok[arr].size && e < (d)->j.count; \
+         idx++, e = rt_json_skip(&(d)->j, e))
 
 #define KEY(k, s) rt_json_key_is(&d->j, (k), (s))
 
@@ -363,7 +364,10 @@ static rt_result read_file(gl_doc *d, const char *path, const char *what, uint8_
     return RT_OK;
 }
 
-static uint32_t rd32(const uint8_t *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
+static uint32_t rd32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
 
 /* Splits a GLB into its JSON and BIN chunks (spec 4.4). */
 static rt_result split_glb(gl_doc *d)
@@ -390,17 +394,19 @@ static rt_result split_glb(gl_doc *d)
     int chunk = 0;
     while (off < length) {
         if (length - off < 8)
-            return rt_fail(d->err, RT_ERR_INVALID, "%s: byte %zu: chunk header runs past the end of the file (%u bytes)",
-                           d->path, off, length);
+            return rt_fail(d->err, RT_ERR_INVALID,
+                           "%s: byte %zu: chunk header runs past the end of the file (%u bytes)", d->path, off, length);
         uint32_t clen = rd32(f + off), ctype = rd32(f + off + 4);
         if (clen > length - off - 8)
-            return rt_fail(d->err, RT_ERR_INVALID, "%s: byte %zu: chunk length %u runs past the end of the file (%u bytes)",
-                           d->path, off, clen, length);
+            return rt_fail(d->err, RT_ERR_INVALID,
+                           "%s: byte %zu: chunk length %u runs past the end of the file (%u bytes)", d->path, off, clen,
+                           length);
         const uint8_t *data = f + off + 8;
         if (chunk == 0) {
             if (ctype != 0x4E4F534Au)
-                return rt_fail(d->err, RT_ERR_INVALID, "%s: byte %zu: the first chunk must be JSON (type 0x4E4F534A), got 0x%08X",
-                               d->path, off + 4, ctype);
+                return rt_fail(d->err, RT_ERR_INVALID,
+                               "%s: byte %zu: the first chunk must be JSON (type 0x4E4F534A), got 0x%08X", d->path,
+                               off + 4, ctype);
             d->json_text = (const char *)data;
             d->json_len = clen;
             d->json_base = off + 8;
@@ -971,7 +977,9 @@ static rt_result parse_materials(gl_doc *d, int t)
                 if (strcmp(mode, "OPAQUE") == 0) m->alpha_mode = RT_ALPHA_OPAQUE;
                 else if (strcmp(mode, "MASK") == 0) m->alpha_mode = RT_ALPHA_MASK;
                 else if (strcmp(mode, "BLEND") == 0) m->alpha_mode = RT_ALPHA_BLEND;
-                else return fail_at(d, v, RT_ERR_INVALID, "%s.alphaMode \"%s\" is not OPAQUE, MASK or BLEND", where, mode);
+                else
+                    return fail_at(d, v, RT_ERR_INVALID, "%s.alphaMode \"%s\" is not OPAQUE, MASK or BLEND", where,
+                                   mode);
             } else if (KEY(k, "alphaCutoff")) {
                 TRY(get_float(d, where, "alphaCutoff", v, &m->alpha_cutoff));
             } else if (KEY(k, "doubleSided")) {
@@ -1272,8 +1280,9 @@ static rt_result validate(gl_doc *d)
                                "bufferView %u (%zu bytes)",
                                i, a->offset, a->count, es, stride, a->view, v->length);
         } else if (a->count > GL_MAX_ZEROS) {
-            return fail_at(d, a->tok, RT_ERR_LIMIT, "accessors[%zu]: count %zu without a bufferView is over the limit %zu",
-                           i, a->count, GL_MAX_ZEROS);
+            return fail_at(d, a->tok, RT_ERR_LIMIT,
+                           "accessors[%zu]: count %zu without a bufferView is over the limit %zu", i, a->count,
+                           GL_MAX_ZEROS);
         }
         if (a->sparse_count) {
             CHECK_INDEX(a->sp_idx_view, d->view_count, a->tok, "bufferViews",
@@ -1424,8 +1433,8 @@ static rt_result validate(gl_doc *d)
             uint32_t n = d->scene_nodes[sc->first + k];
             rt_result r = RT_OK;
             if (n >= d->node_count)
-                r = fail_at(d, sc->tok, RT_ERR_INVALID, "scenes[%zu].nodes %u is out of range (the file has %zu nodes)", i,
-                            n, d->node_count);
+                r = fail_at(d, sc->tok, RT_ERR_INVALID,
+                            "scenes[%zu].nodes %u is out of range (the file has %zu nodes)", i, n, d->node_count);
             else if (d->nodes[n].parent != RT_NONE)
                 r = fail_at(d, sc->tok, RT_ERR_INVALID, "scenes[%zu]: node %u is not a root (its parent is node %u)",
                             i, n, d->nodes[n].parent);
