@@ -70,6 +70,7 @@ typedef struct rt_kdtree {
     float *tri;
     size_t triangle_count, sphere_count, quad_count; /* at build time */
     float scale; /* largest absolute coordinate of bounds (traversal epsilon) */
+    bool simd_ok; /* triangle offsets fit the 32-bit lanes of the 8-wide leaf test */
     const rt_scene *scene;
     rt_box bounds;
     int max_depth;
