@@ -2,7 +2,8 @@
  * Fresnel (energy conservation per polarisation, normal incidence,
  * Brewster's angle, total internal reflection), Snell's law, a ray through
  * a glass slab, a mirror facing a coloured wall, the vanishing shadow of a
- * fully transparent sphere, nested media and finiteness. */
+ * fully transparent sphere, nested media, diffuse bounces in a furnace
+ * and finiteness. */
 #include "test_util.h"
 
 #include <math.h>
@@ -493,6 +494,41 @@ static void test_finite(void **state)
     rt_scene_free(&s);
 }
 
+/* Diffuse bounces inside a closed, glowing sphere (a furnace): every
+ * diffuse ray hits the wall, so whatever the random directions, a hit at
+ * level k sees L_k = Le + kd rho L_(k+1), and the last level (k = N) uses
+ * the ambient term: L_N = Le + ka rho A. */
+static void test_diffuse_bounces_furnace(void **state)
+{
+    (void)state;
+    const float rho = 0.5f, Le = 1.0f, A = 0.2f, ka = 0.7f, kd = 0.9f;
+    for (int levels = 0; levels <= 3; levels++) {
+        rt_scene s;
+        rt_scene_init(&s);
+        s.settings.diffuse_bounces = levels;
+        s.settings.diffuse_rays = 3;
+        s.settings.ambient_light = rt_v3s(A);
+        s.settings.ambient_light_set = true;
+        rt_material wall = plain("wall");
+        wall.color = rt_v3s(rho);
+        wall.diffuse = kd;
+        wall.ambient = ka;
+        wall.emission = rt_v3s(Le);
+        rt_scene_add_sphere(&s, rt_v3(0.5f, -0.2f, 0.1f), 2.0f, rt_scene_add_material(&s, &wall));
+        built b;
+        build(&b, &s);
+        double L = Le + ka * rho * A;
+        for (int k = levels - 1; k >= 0; k--)
+            L = Le + kd * rho * L;
+        for (int i = 0; i < 5; i++) {
+            rt_vec3 got = radiance(&b, rt_v3(0.3f, 0.1f * i, 0), rt_v3(0.2f * i - 0.4f, 1, 0.3f));
+            assert_true(fabs(got.x - L) < 1e-5 * L);
+        }
+        rt_kdtree_free(&b.tree);
+        rt_scene_free(&s);
+    }
+}
+
 /* kd = 1, ka = ks = 0: whitted equals the direct integrator's Lambert. */
 static void test_matches_direct(void **state)
 {
@@ -536,6 +572,7 @@ int main(void)
         cmocka_unit_test(test_transparent_sphere_no_shadow),
         cmocka_unit_test(test_nested_media),
         cmocka_unit_test(test_finite),
+        cmocka_unit_test(test_diffuse_bounces_furnace),
         cmocka_unit_test(test_matches_direct),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
