@@ -36,7 +36,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "mesh_internal.h"
 
@@ -80,18 +82,25 @@ rt_result rt_mesh_read_file(const char *path, char **data, size_t *size, rt_erro
 {
     *data = NULL;
     *size = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f)
+    /* open without blocking (a FIFO would otherwise wait for a writer), then insist on a regular file */
+    int fd = open(path, O_RDONLY | O_NONBLOCK);
+    if (fd < 0)
         return rt_fail(err, RT_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
     struct stat st;
-    if (fstat(fileno(f), &st) != 0) {
+    if (fstat(fd, &st) != 0) {
         int e = errno;
-        fclose(f);
+        close(fd);
         return rt_fail(err, RT_ERR_IO, "%s: cannot stat: %s", path, strerror(e));
     }
     if (!S_ISREG(st.st_mode)) {
-        fclose(f);
+        close(fd);
         return rt_fail(err, RT_ERR_IO, "%s: not a regular file", path);
+    }
+    FILE *f = fdopen(fd, "rb");
+    if (!f) {
+        int e = errno;
+        close(fd);
+        return rt_fail(err, RT_ERR_IO, "%s: cannot open: %s", path, strerror(e));
     }
     if (st.st_size < 0 || (unsigned long long)st.st_size >= (unsigned long long)(SIZE_MAX / 2)) {
         fclose(f);

@@ -35,6 +35,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "mesh_internal.h"
 #include "rt/mesh_io.h"
@@ -648,12 +649,9 @@ static rt_result obj_mtllib(obj_parser *op, line_ctx *lc, const char *p, const c
         return RT_OK;
     }
     /* "mtllib a.mtl b.mtl" lists several files; a single name may contain spaces */
-    FILE *f = fopen(full, "rb");
-    if (f || !strpbrk(rel, " \t")) {
-        if (f)
-            fclose(f);
+    struct stat st;
+    if (stat(full, &st) == 0 || !strpbrk(rel, " \t"))
         return load_mtl(op, full, lc);
-    }
     for (;;) {
         p = skip_space(p, eol);
         if (p >= eol)

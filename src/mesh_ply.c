@@ -106,25 +106,37 @@ static ply_type parse_type(const char *t, size_t n)
 
 static bool is_float_type(ply_type t) { return t == PT_F32 || t == PT_F64; }
 
-static uint64_t load_bytes(const unsigned char *p, int n, bool big)
+/* Loads an n-byte unsigned integer stored little- or big-endian (the shift
+ * forms compile to plain loads and byte swaps). */
+static inline uint64_t load_bytes(const unsigned char *p, int n, bool big)
 {
-    uint64_t v = 0;
-    if (big)
-        for (int i = 0; i < n; i++)
-            v = (v << 8) | p[i];
-    else
-        for (int i = n; i-- > 0;)
-            v = (v << 8) | p[i];
-    return v;
+    switch (n) {
+    case 1: return p[0];
+    case 2: return big ? (uint64_t)p[0] << 8 | p[1] : (uint64_t)p[1] << 8 | p[0];
+    case 4:
+        return big ? (uint64_t)((uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3])
+                   : (uint64_t)((uint32_t)p[3] << 24 | (uint32_t)p[2] << 16 | (uint32_t)p[1] << 8 | p[0]);
+    default: {
+        uint64_t v = 0;
+        if (big)
+            for (int i = 0; i < n; i++)
+                v = (v << 8) | p[i];
+        else
+            for (int i = n; i-- > 0;)
+                v = (v << 8) | p[i];
+        return v;
+    }
+    }
 }
 
 /* Binary: one value of type t as int64 (integers) or double (floats). */
-static bool bin_value(ply_reader *r, ply_type t, int64_t *iv, double *dv)
+static inline bool bin_value(ply_reader *r, ply_type t, int64_t *iv, double *dv)
 {
     int n = type_size[t];
     if (r->size - r->pos < (size_t)n)
         return fail_at(r, "unexpected end of file (file is %zu bytes)", r->size);
     uint64_t u = load_bytes(r->data + r->pos, n, r->format == PF_BE);
+    r->pos += (size_t)n;
     switch (t) {
     case PT_I8: *iv = (int8_t)(uint8_t)u; break;
     case PT_U8: *iv = (int64_t)u; break;
@@ -137,14 +149,12 @@ static bool bin_value(ply_reader *r, ply_type t, int64_t *iv, double *dv)
         float f;
         memcpy(&f, &w, 4);
         *dv = f;
-        break;
+        return true;
     }
-    case PT_F64: memcpy(dv, &u, 8); break;
-    default: return fail_at(r, "internal: bad type");
+    case PT_F64: memcpy(dv, &u, 8); return true;
+    default: r->pos -= (size_t)n; return fail_at(r, "internal: bad type");
     }
-    if (!is_float_type(t))
-        *dv = (double)*iv;
-    r->pos += (size_t)n;
+    *dv = (double)*iv;
     return true;
 }
 
