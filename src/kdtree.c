@@ -1097,6 +1097,7 @@ KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, 
  * closest valid lane wins; on a tie, the first, like the scalar loop. */
 KD_INLINE bool tri8(const float *tri, const uint32_t *ids, uint32_t n, const rt_ray *ray, float *best, rt_hit *hit)
 {
+    RT_NO_FP_CONTRACT
     __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)n), lane);
     __m256i id = _mm256_maskload_epi32((const int *)ids, live);

@@ -34,6 +34,9 @@ typedef struct rt_hit {
     uint32_t prim; /* primitive id (see scene.h), RT_NONE for a miss */
 } rt_hit;
 
+/* The tests below must round the same wherever they are compiled (the
+ * kd-tree's 8-wide leaf test reproduces them bit for bit): no fused
+ * multiply-adds, see RT_NO_FP_CONTRACT in vec.h. */
 static inline rt_ray rt_ray_make(rt_vec3 org, rt_vec3 dir, float tmin, float tmax)
 {
     rt_ray r = {org, dir, tmin, tmax};
@@ -43,6 +46,7 @@ static inline rt_ray rt_ray_make(rt_vec3 org, rt_vec3 dir, float tmin, float tma
 static inline bool rt_intersect_triangle(rt_vec3 org, rt_vec3 dir, rt_vec3 v0, rt_vec3 e1, rt_vec3 e2, float tmin,
                                          float tmax, float *t_out, float *u_out, float *v_out)
 {
+    RT_NO_FP_CONTRACT
     rt_vec3 p = rt_cross(dir, e2);
     float det = rt_dot(e1, p);
     if (det == 0.0f || !isfinite(det))
@@ -76,6 +80,7 @@ static inline bool rt_intersect_triangle(rt_vec3 org, rt_vec3 dir, rt_vec3 v0, r
 static inline bool rt_intersect_sphere(rt_vec3 org, rt_vec3 dir, rt_vec3 center, float radius, float tmin, float tmax,
                                        float *t_out)
 {
+    RT_NO_FP_CONTRACT
     rt_vec3 f = rt_sub(org, center);
     float a = rt_dot(dir, dir);
     if (!(a > 0.0f))
@@ -105,6 +110,7 @@ static inline bool rt_intersect_sphere(rt_vec3 org, rt_vec3 dir, rt_vec3 center,
 static inline bool rt_intersect_quad(rt_vec3 org, rt_vec3 dir, rt_vec3 p, rt_vec3 eu, rt_vec3 ev, float tmin,
                                      float tmax, float *t_out, float *s_out, float *r_out)
 {
+    RT_NO_FP_CONTRACT
     rt_vec3 n = rt_cross(eu, ev);
     float nn = rt_dot(n, n);
     float denom = rt_dot(n, dir);

@@ -18,6 +18,16 @@
 #define RT_PI 3.14159265358979323846f
 #define RT_INV_PI 0.31830988618379067154f
 
+/* No fused multiply-adds in the functions marked with this: their results
+ * must be the same bits wherever they are inlined (the kd-tree reproduces
+ * the intersection tests lane by lane in SIMD). GCC contracts nothing under
+ * -std=c11; clang contracts within expressions unless told. */
+#if defined(__clang__)
+#define RT_NO_FP_CONTRACT _Pragma("clang fp contract(off)")
+#else
+#define RT_NO_FP_CONTRACT
+#endif
+
 typedef struct rt_vec2 { float x, y; } rt_vec2;
 typedef struct rt_vec3 { float x, y, z; } rt_vec3;
 typedef struct rt_vec4 { float x, y, z, w; } rt_vec4;
@@ -34,11 +44,20 @@ static inline rt_vec3 rt_div(rt_vec3 a, rt_vec3 b) { return rt_v3(a.x / b.x, a.y
 static inline rt_vec3 rt_scale(rt_vec3 a, float s) { return rt_v3(a.x * s, a.y * s, a.z * s); }
 static inline rt_vec3 rt_neg(rt_vec3 a) { return rt_v3(-a.x, -a.y, -a.z); }
 /* a + b * s, the ray-point form */
-static inline rt_vec3 rt_madd(rt_vec3 a, rt_vec3 b, float s) { return rt_v3(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s); }
+static inline rt_vec3 rt_madd(rt_vec3 a, rt_vec3 b, float s)
+{
+    RT_NO_FP_CONTRACT
+    return rt_v3(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s);
+}
 
-static inline float rt_dot(rt_vec3 a, rt_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline float rt_dot(rt_vec3 a, rt_vec3 b)
+{
+    RT_NO_FP_CONTRACT
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 static inline rt_vec3 rt_cross(rt_vec3 a, rt_vec3 b)
 {
+    RT_NO_FP_CONTRACT
     return rt_v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
 static inline float rt_length2(rt_vec3 a) { return rt_dot(a, a); }
