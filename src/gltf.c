@@ -311,6 +311,8 @@ static rt_result get_string(gl_doc *d, const char *where, const char *key, int t
 static rt_result alloc_table(gl_doc *d, int t, const char *key, size_t elem, void **out, size_t *count)
 {
     TRY(expect_array(d, t, "glTF", key));
+    if (*out)
+        return fail_at(d, t, RT_ERR_INVALID, "%s appears twice", key);
     size_t n = (size_t)jsize(d, t);
     void *p = rt_alloc(n, elem);
     if (!p)
