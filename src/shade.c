@@ -390,6 +390,19 @@ bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, r
     }
 }
 
+/* The material of a primitive, as rt_surface_at() resolves it. */
+static uint32_t prim_material(const rt_scene *s, uint32_t prim)
+{
+    uint32_t i, m;
+    switch (rt_prim_kind_of(s, prim, &i)) {
+    case RT_PRIM_TRIANGLE: m = s->triangles.material[i]; break;
+    case RT_PRIM_SPHERE: m = s->spheres.material[i]; break;
+    case RT_PRIM_QUAD:
+    default: m = s->quads.material[i]; break;
+    }
+    return m < s->material_count ? m : 0;
+}
+
 rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
 {
     rt_vec3 o = rt_surface_spawn(ctx, sf, wi);
@@ -406,9 +419,18 @@ rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, r
         rt_hit h;
         if (!rt_kdtree_intersect(ctx->tree, &r, &h))
             return tr;
+        const rt_material *m = &ctx->scene->materials[prim_material(ctx->scene, h.prim)];
+        if (m->alpha_mode == RT_ALPHA_OPAQUE) { /* no surface record needed */
+            if (!(m->transmission > 0.0f))
+                return rt_v3s(0);
+            tr = rt_mul(tr, rt_scale(m->transmission_color, m->transmission));
+            if (rt_max3(tr) <= 0.0f)
+                return rt_v3s(0);
+            r.tmin = h.t;
+            continue;
+        }
         rt_surface s2;
         rt_surface_at(ctx, &r, &h, &s2);
-        const rt_material *m = &ctx->scene->materials[s2.material];
         float coverage;
         if (!rt_surface_cut_away(ctx, &s2, &coverage)) {
             if (m->transmission > 0.0f) {
