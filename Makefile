@@ -30,7 +30,7 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 DEPS_OK  := $(BUILD)/.deps-ok
 
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare fuzz
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -53,6 +53,11 @@ $(RT): $(BUILD)/obj/main.o $(BUILD)/librt.a
 $(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests -o $@ $< $(BUILD)/librt.a $(LDLIBS) -lcmocka
+
+# the corpus replay test links the fuzz harness too
+$(BUILD)/tests/test_corpus: tests/test_corpus.c tests/fuzz/harness.c tests/fuzz/harness.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Itests -o $@ tests/test_corpus.c tests/fuzz/harness.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 test: $(RT) $(TEST_BIN)
 	@RT_SHARED=$(SHARED) RT_BIN=./$(RT) sh tests/run.sh $(TEST_BIN)
@@ -85,6 +90,10 @@ scenes: $(RT)
 	@for s in $(SCENES); do n=$$(basename $$s .txt); echo "rendering $$s"; ./rt -q -o docs/images/$$n.png $$s || exit 1; done
 
 clean:
-	rm -rf build build-asan build-tsan build-profile rt rt-profile bench/rtbench
+	rm -rf build build-asan build-tsan build-profile build-fuzz rt rt-profile bench/rtbench
 
 -include $(LIB_OBJ:.o=.d) $(BUILD)/obj/main.d
+
+# libFuzzer over every parser (installs clang on first use); FUZZ_SECONDS per target (default 60).
+fuzz:
+	@SHARED=$(SHARED) sh tools/fuzz.sh

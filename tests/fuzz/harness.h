@@ -1,0 +1,25 @@
+/* harness.h - the fuzz targets as plain functions, shared by the libFuzzer
+ * binaries (make fuzz) and the corpus regression test (make test).
+ *
+ *   rt_fuzz_run("gltf", data, size);   // feeds one input to one target
+ *
+ * Targets: scene (scene text), gltf (a .gltf JSON alone), glb (a .glb
+ * container), gltf_bin (a .gltf plus its .bin: u32 little-endian JSON
+ * length, the JSON, then the buffer, which the JSON must name
+ * "buffer.bin"), obj (u32 OBJ length, the OBJ, then an MTL named
+ * "m.mtl"), ply, off, image (any image bytes through our size checks).
+ */
+#ifndef RT_FUZZ_HARNESS_H
+#define RT_FUZZ_HARNESS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Runs one input through a target; returns -1 for an unknown target, else 0
+ * (bad input is expected: only crashes, leaks and hangs are bugs). */
+int rt_fuzz_run(const char *target, const uint8_t *data, size_t size);
+
+/* The target names, NULL-terminated. */
+extern const char *const rt_fuzz_targets[];
+
+#endif

@@ -1,0 +1,63 @@
+#!/bin/sh
+# make fuzz: builds one libFuzzer binary per target (tests/fuzz/harness.h)
+# with clang -fsanitize=fuzzer,address,undefined, seeds each from
+# ../shared/assets, scenes/ and tests/corpus/, and runs it for FUZZ_SECONDS
+# (default 60). Prints executions per second and totals per target; exits 1
+# if any target crashed (the input is saved under build-fuzz/crashes/TARGET/:
+# fix the bug, then keep the input in tests/corpus/TARGET/ so make test
+# replays it).
+# Environment: FUZZ_SECONDS, FUZZ_TARGETS (space-separated subset), SHARED.
+set -eu
+SECONDS_EACH=${FUZZ_SECONDS:-60}
+SHARED=${SHARED:-../shared}
+TARGETS=${FUZZ_TARGETS:-"scene gltf glb gltf_bin obj ply off image"}
+B=build-fuzz
+
+if ! command -v clang >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
+    echo "fuzz: installing clang and its libFuzzer runtime (clang, libclang-rt-14-dev)" >&2
+    SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO=sudo
+    $SUDO apt-get install -y -q clang libclang-rt-14-dev >&2 || { $SUDO apt-get update -q >&2 && $SUDO apt-get install -y -q clang libclang-rt-14-dev >&2; }
+fi
+
+SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined"
+CFLAGS="-std=c11 -g -O1 -fno-omit-frame-pointer -Iinclude -Itests -D_POSIX_C_SOURCE=200809L $SAN"
+mkdir -p $B/obj
+# the library, instrumented for coverage
+for src in src/*.c; do
+    [ "$src" = src/main.c ] && continue
+    obj=$B/obj/$(basename "$src" .c).o
+    if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find include -newer "$obj" 2>/dev/null | head -n 1)" ]; then
+        clang $CFLAGS -fsanitize=fuzzer-no-link -c -o "$obj" "$src"
+    fi
+done
+clang $CFLAGS -fsanitize=fuzzer-no-link -c -o $B/harness.o tests/fuzz/harness.c
+
+# seed corpora
+python3 tools/fuzz_seeds.py "$SHARED" $B/seeds
+
+status=0
+printf '%-10s %12s %14s %8s\n' target execs/s total_execs crashes
+for t in $TARGETS; do
+    clang $CFLAGS -fsanitize=fuzzer -DRT_FUZZ_TARGET="\"$t\"" -o $B/fuzz_$t tests/fuzz/fuzz_main.c $B/harness.o $B/obj/*.o \
+        -lstb -lpthread -lm
+    mkdir -p $B/corpus/$t $B/crashes/$t
+    dict=""
+    case $t in
+        gltf|glb|gltf_bin) dict="-dict=tests/fuzz/gltf.dict" ;;
+        scene) dict="-dict=tests/fuzz/scene.dict" ;;
+    esac
+    seeds="$B/seeds/$t"
+    [ -d tests/corpus/$t ] && seeds="$seeds tests/corpus/$t"
+    log=$B/fuzz_$t.log
+    if ! ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 ./$B/fuzz_$t $dict -max_total_time="$SECONDS_EACH" \
+        -rss_limit_mb=4096 -malloc_limit_mb=2048 -timeout=20 -print_final_stats=1 \
+        -artifact_prefix=$B/crashes/$t/ $B/corpus/$t $seeds >"$log" 2>&1; then
+        status=1
+    fi
+    execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
+    rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log")
+    crashes=$(find $B/crashes/$t -type f | wc -l)
+    printf '%-10s %12s %14s %8s\n' "$t" "${rate:-?}" "${execs:-?}" "$crashes"
+    [ "$crashes" -eq 0 ] || { status=1; grep -m 3 -E 'ERROR|SUMMARY' "$log" >&2 || true; }
+done
+exit $status
