@@ -482,6 +482,22 @@ rt_result rt_mesh_commit(rt_scene *s, rt_mesh_buf *b, const rt_mat4 *transform, 
             stats->skipped_faces += b->skipped;
         return RT_OK;
     }
+    /* a material index the scene does not have (RT_NONE from a caller with no default)
+     * becomes a default material, added once */
+    uint32_t fallback = RT_NONE;
+    for (size_t t = 0; t < b->nt; t++) {
+        if (b->mat[t] < s->material_count)
+            continue;
+        if (fallback == RT_NONE) {
+            rt_material dm;
+            char name[sizeof dm.name];
+            snprintf(name, sizeof name, "%.50s:default", rt_mesh_basename(path));
+            rt_material_default(&dm, name);
+            if ((fallback = rt_scene_add_material(s, &dm)) == RT_NONE)
+                return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for a material", path);
+        }
+        b->mat[t] = fallback;
+    }
     if (!rt_scene_reserve_triangles(s, b->nt))
         return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for %zu triangles", path, b->nt);
     if (b->col && !rt_scene_enable_attr(s, RT_ATTR_COLOR))

@@ -344,6 +344,15 @@ static void test_dispatch(void **state)
     load_ok(&l, tpath("upper.OBJ"), NULL);
     assert_int_equal(l.s.triangles.count, 1);
     rt_scene_free(&l.s);
+    /* no caller material: a default one is made, once */
+    rt_scene_init(&l.s);
+    assert_int_equal(rt_mesh_load(&l.s, tpath("upper.OBJ"), NULL, RT_NONE, false, &l.st, &l.err), RT_OK);
+    assert_int_equal(rt_mesh_load(&l.s, tpath("upper.OBJ"), NULL, RT_NONE, true, NULL, &l.err), RT_OK);
+    assert_int_equal(l.s.material_count, 2);
+    assert_string_equal(l.s.materials[0].name, "upper.OBJ:default");
+    assert_int_equal(l.s.triangles.material[0], 0);
+    assert_int_equal(l.s.triangles.material[1], 1);
+    rt_scene_free(&l.s);
     write_text("mesh.stl", "solid\n");
     load_fail(tpath("mesh.stl"), RT_ERR_UNSUPPORTED, "unknown mesh format '.stl'");
     load_fail(tpath("noext"), RT_ERR_UNSUPPORTED, "no file extension");

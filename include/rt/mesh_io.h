@@ -12,6 +12,21 @@
  *
  * Errors name the file and the line (text formats) or byte offset (binary
  * PLY). Nothing asserts on input.
+ *
+ * Conventions (details at the top of src/mesh_io.c and each reader):
+ *   - All or nothing: on failure no vertex or triangle of the file is in the
+ *     scene (nor are its MTL materials).
+ *   - Non-finite numbers (nan, inf, overflow) in vertex data are errors.
+ *   - UVs are stored with v flipped (v' = 1 - v): OBJ/PLY/OFF put v = 0 at
+ *     the bottom of the image, rt (like glTF) at the top.
+ *   - Polygons are triangulated as fans (quads choose the diagonal that keeps
+ *     concave quads right); triangles that repeat a vertex are dropped and
+ *     counted in skipped_faces.
+ *   - OBJ: each MTL material becomes a scene material "<objfile>:<name>"
+ *     (stats.materials counts them); faces before any usemtl, or naming an
+ *     unknown material, use `material`; a missing MTL or texture is a warning.
+ *   - A `material` the scene does not have (RT_NONE) gets a default material
+ *     "<file>:default" added (once per load).
  */
 #ifndef RT_MESH_IO_H
 #define RT_MESH_IO_H
