@@ -529,6 +529,114 @@ static void test_diffuse_bounces_furnace(void **state)
     }
 }
 
+/* A square area light over a floor: unoccluded, the floor shows
+ * kd rho / pi * E with E the light's irradiance (brute-force integral
+ * here); a half-plane occluder whose edge lies over the point hides half
+ * the light (soft shadow); a full occluder hides all of it. */
+static float area_light_floor(int occluder) /* 0 none, 1 half, 2 full */
+{
+    rt_scene s;
+    rt_scene_init(&s);
+    s.settings.shadow_samples = 64;
+    rt_material fl = plain("floor");
+    fl.color = rt_v3s(0.5f);
+    fl.diffuse = 1.0f;
+    uint32_t mf = rt_scene_add_material(&s, &fl);
+    rt_scene_add_quad(&s, rt_v3(-5, 0, -5), rt_v3(0, 0, 10), rt_v3(10, 0, 0), mf);
+    rt_material bl = plain("blocker");
+    uint32_t mb = rt_scene_add_material(&s, &bl);
+    if (occluder == 1) /* x >= 0 at height 1, above the shaded point (0, 0, 0) */
+        rt_scene_add_quad(&s, rt_v3(0, 1, -5), rt_v3(0, 0, 10), rt_v3(5, 0, 0), mb);
+    else if (occluder == 2)
+        rt_scene_add_quad(&s, rt_v3(-5, 1, -5), rt_v3(0, 0, 10), rt_v3(10, 0, 0), mb);
+    rt_light l;
+    memset(&l, 0, sizeof l);
+    l.kind = RT_LIGHT_AREA;
+    l.color = rt_v3s(1);
+    l.intensity = 5.0f;
+    l.position = rt_v3(-0.5f, 2, -0.5f); /* 1 x 1 at height 2, facing down */
+    l.edge_u = rt_v3(1, 0, 0);
+    l.edge_v = rt_v3(0, 0, 1);
+    l.quad = RT_NONE;
+    rt_scene_add_light(&s, &l);
+    built b;
+    build(&b, &s);
+    float sum = 0;
+    for (int i = 0; i < 8; i++) /* several rng streams: average out the jitter */
+        sum += rt_luminance(radiance(&b, rt_v3(0, 0.5f, 0.5f), rt_v3(0, -0.5f, -0.5f + 1e-4f * i)));
+    rt_kdtree_free(&b.tree);
+    rt_scene_free(&s);
+    return sum / 8;
+}
+
+static void test_area_light_soft_shadow(void **state)
+{
+    (void)state;
+    /* E at (0, 0, 0) from the 1 x 1 square at height 2: L cos cos_l / d^2 dA */
+    double E = 0;
+    const int n = 400;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            double x = -0.5 + (i + 0.5) / n, z = -0.5 + (j + 0.5) / n, h = 2;
+            double d2 = x * x + z * z + h * h;
+            E += 5.0 * (h * h / d2) / d2 / ((double)n * n);
+        }
+    float open = area_light_floor(0), half = area_light_floor(1), full = area_light_floor(2);
+    double expect = 0.5 / 3.14159265358979323846 * E;
+    assert_true(fabs(open - expect) < 0.01 * expect);
+    assert_true(fabs(half / open - 0.5) < 0.03);
+    assert_true(full == 0.0f);
+}
+
+/* Without ambient_light, the ambient radiance is the background's (times
+ * the environment strength), or the mean of an environment image. */
+static void test_ambient_default(void **state)
+{
+    (void)state;
+    for (int use_image = 0; use_image < 2; use_image++) {
+        rt_scene s;
+        rt_scene_init(&s);
+        s.settings.background = rt_v3(0.2f, 0.4f, 0.6f);
+        s.settings.environment_strength = 1.5f;
+        rt_vec3 expect_a = rt_scale(s.settings.background, 1.5f);
+        if (use_image) { /* rows 0.1 / 0.3 (north / south halves): mean 0.2 */
+            rt_image img;
+            memset(&img, 0, sizeof img);
+            img.width = 4;
+            img.height = 2;
+            img.rgbaf = malloc(8 * 4 * sizeof(float));
+            assert_non_null(img.rgbaf);
+            for (int i = 0; i < 8; i++)
+                for (int c = 0; c < 4; c++)
+                    img.rgbaf[4 * i + c] = i < 4 ? 0.1f : 0.3f;
+            snprintf(img.name, sizeof img.name, "env");
+            rt_texture t = rt_texture_image(rt_scene_add_image(&s, &img));
+            t.filter = RT_FILTER_NEAREST;
+            s.settings.environment_texture = rt_scene_add_texture(&s, &t);
+            expect_a = rt_v3s(0.2f * 1.5f);
+        }
+        rt_material fl = plain("floor");
+        fl.color = rt_v3(1.0f, 0.5f, 0.25f);
+        fl.ambient = 0.5f;
+        rt_scene_add_quad(&s, rt_v3(-5, 0, -5), rt_v3(0, 0, 10), rt_v3(10, 0, 0), rt_scene_add_material(&s, &fl));
+        built b;
+        build(&b, &s);
+        rt_vec3 L = radiance(&b, rt_v3(0, 1, 0), rt_v3(0.1f, -1, 0.2f));
+        assert_true(fabsf(L.x - 0.5f * 1.0f * expect_a.x) < 1e-3f * expect_a.x);
+        assert_true(fabsf(L.y - 0.5f * 0.5f * expect_a.y) < 1e-3f * expect_a.y);
+        assert_true(fabsf(L.z - 0.5f * 0.25f * expect_a.z) < 1e-3f * expect_a.z);
+        rt_kdtree_free(&b.tree);
+        /* an explicit ambient_light wins */
+        s.settings.ambient_light = rt_v3s(2.0f);
+        s.settings.ambient_light_set = true;
+        build(&b, &s);
+        L = radiance(&b, rt_v3(0, 1, 0), rt_v3(0.1f, -1, 0.2f));
+        assert_true(fabsf(L.x - 1.0f) < 1e-6f && fabsf(L.z - 0.25f) < 1e-6f);
+        rt_kdtree_free(&b.tree);
+        rt_scene_free(&s);
+    }
+}
+
 /* kd = 1, ka = ks = 0: whitted equals the direct integrator's Lambert. */
 static void test_matches_direct(void **state)
 {
@@ -573,6 +681,8 @@ int main(void)
         cmocka_unit_test(test_nested_media),
         cmocka_unit_test(test_finite),
         cmocka_unit_test(test_diffuse_bounces_furnace),
+        cmocka_unit_test(test_area_light_soft_shadow),
+        cmocka_unit_test(test_ambient_default),
         cmocka_unit_test(test_matches_direct),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
