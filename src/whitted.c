@@ -231,8 +231,9 @@ static rt_vec3 shade(wctx *w, const rt_surface *sf, const rt_medium_stack *med, 
     /* after a diffuse bounce, a sampled light's own quad is not seen: its
      * light is already counted by direct sampling (and a mirror or glass
      * chain to it would be a caustic, which this model leaves out) */
-    if (!(diffuse_ray && is_light_quad(s, sf->prim)))
-        L = rt_surface_emission(ctx, sf);
+    L = rt_surface_emission(ctx, sf);
+    if (diffuse_ray && rt_max3(L) > 0.0f && is_light_quad(s, sf->prim))
+        L = rt_v3s(0);
     if (m->unlit)
         return rt_add(L, base);
 
