@@ -227,11 +227,10 @@ static rt_vec3 shade(wctx *w, const rt_surface *sf, const rt_medium_stack *med, 
     }
     rt_vec4 b4 = rt_surface_base_color(ctx, sf);
     rt_vec3 base = rt_v3(b4.x, b4.y, b4.z);
-    rt_vec3 L = rt_v3s(0);
     /* after a diffuse bounce, a sampled light's own quad is not seen: its
      * light is already counted by direct sampling (and a mirror or glass
      * chain to it would be a caustic, which this model leaves out) */
-    L = rt_surface_emission(ctx, sf);
+    rt_vec3 L = rt_surface_emission(ctx, sf);
     if (diffuse_ray && rt_max3(L) > 0.0f && is_light_quad(s, sf->prim))
         L = rt_v3s(0);
     if (m->unlit)
