@@ -62,6 +62,16 @@ rt_result rt_mesh_read_file(const char *path, char **data, size_t *size, rt_erro
 const char *rt_mesh_parse_float(const char *p, const char *end, float *out, bool *nonfinite);
 const char *rt_mesh_parse_int(const char *p, const char *end, int64_t *out);
 
+/* Triangulates a polygon of n corners whose positions are pos[vidx[k]]
+ * (pos may be NULL when the positions are not known yet: plain fan). Writes
+ * 3 * (n - 2) corner numbers (0..n-1) into out and returns n - 2 (0 when
+ * n < 3). Convex polygons are fans from corner 0; quads take the diagonal
+ * that keeps both halves facing the same way; non-convex polygons of up to
+ * RT_MESH_EARCLIP_MAX corners are ear-clipped in the plane of their Newell
+ * normal, with a work bound that falls back to a fan. */
+#define RT_MESH_EARCLIP_MAX 128
+size_t rt_mesh_triangulate(const rt_vec3 *pos, const uint32_t *vidx, size_t n, uint32_t *out);
+
 /* Directory part of a path including the trailing '/' ("" for none), into out. */
 void rt_mesh_dirname(const char *path, char *out, size_t size);
 /* Base name (after the last '/'). */

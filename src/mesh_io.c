@@ -309,6 +309,110 @@ const char *rt_mesh_parse_float(const char *p, const char *end, float *out, bool
     return p;
 }
 
+/* ------------------------------------------------------ triangulation */
+
+/* Ear clipping: repeatedly cut off a convex corner whose triangle holds no
+ * other corner (Meisters, "Polygons have ears", Amer. Math. Monthly 82, 1975;
+ * Eberly, "Triangulation by Ear Clipping", Geometric Tools 2002). Works in
+ * 2D after dropping the largest axis of the Newell normal. false = convex
+ * (the caller's fan is then exact) or nothing sensible to do. */
+static bool ear_clip(const rt_vec3 *pos, const uint32_t *vidx, size_t n, uint32_t *out)
+{
+    rt_vec3 nn = rt_v3s(0);
+    for (size_t i = 0; i < n; i++) {
+        rt_vec3 a = pos[vidx[i]], b = pos[vidx[(i + 1) % n]];
+        nn.x += (a.y - b.y) * (a.z + b.z);
+        nn.y += (a.z - b.z) * (a.x + b.x);
+        nn.z += (a.x - b.x) * (a.y + b.y);
+    }
+    int axis = fabsf(nn.x) > fabsf(nn.y) ? (fabsf(nn.x) > fabsf(nn.z) ? 0 : 2) : (fabsf(nn.y) > fabsf(nn.z) ? 1 : 2);
+    float along = rt_axis(nn, axis);
+    if (!(fabsf(along) > 0.0f) || !isfinite(along))
+        return false;
+    int ua = (axis + 1) % 3, va = (axis + 2) % 3;
+    float flip = along < 0.0f ? -1.0f : 1.0f; /* make the polygon counter-clockwise in (u, v) */
+    float px[RT_MESH_EARCLIP_MAX], py[RT_MESH_EARCLIP_MAX];
+    for (size_t i = 0; i < n; i++) {
+        px[i] = flip * rt_axis(pos[vidx[i]], ua);
+        py[i] = rt_axis(pos[vidx[i]], va);
+    }
+#define CROSS2(a, b, c) ((px[b] - px[a]) * (py[c] - py[a]) - (py[b] - py[a]) * (px[c] - px[a]))
+    bool convex = true;
+    for (size_t i = 0; i < n && convex; i++)
+        convex = CROSS2(i, (i + 1) % n, (i + 2) % n) >= 0.0f;
+    if (convex)
+        return false;
+    uint8_t ring[RT_MESH_EARCLIP_MAX];
+    for (size_t i = 0; i < n; i++)
+        ring[i] = (uint8_t)i;
+    size_t m = n, nt = 0, i = 0, since_ear = 0;
+    size_t budget = 8 * n * n; /* inner-loop steps before giving up on ears */
+    while (m > 3) {
+        size_t ia = (i + m - 1) % m, ic = (i + 1) % m;
+        int a = ring[ia], b = ring[i], c = ring[ic];
+        bool ear = CROSS2(a, b, c) > 0.0f;
+        for (size_t j = 0; ear && j < m; j++) {
+            int q = ring[j];
+            if (q == a || q == b || q == c)
+                continue;
+            if ((px[q] == px[a] && py[q] == py[a]) || (px[q] == px[b] && py[q] == py[b]) ||
+                (px[q] == px[c] && py[q] == py[c]))
+                continue; /* a repeated corner (a bridged hole) does not block */
+            if (CROSS2(a, b, q) >= 0.0f && CROSS2(b, c, q) >= 0.0f && CROSS2(c, a, q) >= 0.0f)
+                ear = false;
+        }
+        if (budget < m)
+            break;
+        budget -= m;
+        if (ear) {
+            out[3 * nt] = (uint32_t)a;
+            out[3 * nt + 1] = (uint32_t)b;
+            out[3 * nt + 2] = (uint32_t)c;
+            nt++;
+            memmove(ring + i, ring + i + 1, m - i - 1);
+            m--;
+            if (i >= m)
+                i = 0;
+            since_ear = 0;
+            continue;
+        }
+        i = (i + 1) % m;
+        if (++since_ear > m)
+            break; /* no ear left (self-intersecting or degenerate): fan the rest */
+    }
+#undef CROSS2
+    for (size_t k = 1; k + 1 < m; k++) {
+        out[3 * nt] = ring[0];
+        out[3 * nt + 1] = ring[k];
+        out[3 * nt + 2] = ring[k + 1];
+        nt++;
+    }
+    return true;
+}
+
+size_t rt_mesh_triangulate(const rt_vec3 *pos, const uint32_t *vidx, size_t n, uint32_t *out)
+{
+    if (n < 3)
+        return 0;
+    if (pos && n == 4) {
+        /* concave quad: if the 0-2 diagonal gives halves facing opposite ways, use 1-3 */
+        rt_vec3 p0 = pos[vidx[0]], p1 = pos[vidx[1]], p2 = pos[vidx[2]], p3 = pos[vidx[3]];
+        rt_vec3 n1 = rt_cross(rt_sub(p1, p0), rt_sub(p2, p0));
+        rt_vec3 n2 = rt_cross(rt_sub(p2, p0), rt_sub(p3, p0));
+        static const uint32_t d02[6] = {0, 1, 2, 0, 2, 3}, d13[6] = {1, 2, 3, 1, 3, 0};
+        memcpy(out, rt_dot(n1, n2) < 0.0f ? d13 : d02, sizeof d02);
+        return 2;
+    }
+    if (pos && n >= 5 && n <= RT_MESH_EARCLIP_MAX && ear_clip(pos, vidx, n, out))
+        return n - 2;
+    for (size_t k = 1; k + 1 < n; k++) {
+        out[3 * (k - 1)] = 0;
+        out[3 * (k - 1) + 1] = (uint32_t)k;
+        out[3 * (k - 1) + 2] = (uint32_t)(k + 1);
+    }
+    return n - 2;
+}
+
 /* --------------------------------------------------------- mesh buffer */
 
 void rt_mesh_buf_free(rt_mesh_buf *b)

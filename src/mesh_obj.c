@@ -10,11 +10,10 @@
  *   "v/vt/vn" (1-based, negative = relative to the end so far) becomes one
  *   output vertex per distinct (v, vt, vn) triple: each position keeps a
  *   short chain of the output vertices made from it, so the lookup costs a
- *   step or two and no hashing. Polygons are triangulated as a fan from their
- *   first corner; quads pick the diagonal that keeps both halves facing the
- *   same way, so concave quads come out right (larger concave polygons do
- *   not: fan only). Triangles that repeat a position are dropped and counted
- *   in stats.skipped_faces.
+ *   step or two and no hashing. Polygons are triangulated by
+ *   rt_mesh_triangulate (mesh_io.c): fans for convex ones, the right diagonal
+ *   for concave quads, ear clipping for other concave polygons. Triangles
+ *   that repeat a position are dropped and counted in stats.skipped_faces.
  *   usemtl names are resolved after the whole file (and every mtllib) is read,
  *   so statement order does not matter; faces before any usemtl, and faces
  *   whose name is unknown (warning), use the caller's material.
@@ -75,6 +74,7 @@ typedef struct obj_parser {
     bool any_t, any_n;
     /* face scratch */
     uint32_t *corner_out, *corner_v; size_t ccap;
+    uint32_t *tri_out; size_t tcap; /* triangulation of the current face */
     /* materials */
     obj_mtl *mtls; size_t nmtl, mtlcap;
     obj_slot *slots; size_t nslot, slotcap; /* slot 0 = the caller's material */
@@ -585,20 +585,18 @@ static rt_result obj_face(obj_parser *op, line_ctx *lc, const char *p, const cha
         return rt_fail(op->err, RT_ERR_INVALID, "%s:%ld: face has %zu vertices; at least 3 are needed", lc->file,
                        lc->line, nc);
     uint8_t flags = (uint8_t)((all_t ? RT_TRI_UV : 0) | (all_n ? RT_TRI_SMOOTH : 0));
-    const uint32_t *cv = op->corner_v, *co = op->corner_out;
-    size_t base = 0;
-    if (nc == 4) {
-        /* concave quad: the 0-2 diagonal makes halves facing opposite ways; use 1-3 */
-        rt_vec3 p0 = op->v[cv[0]], p1 = op->v[cv[1]], p2 = op->v[cv[2]], p3 = op->v[cv[3]];
-        rt_vec3 n1 = rt_cross(rt_sub(p1, p0), rt_sub(p2, p0));
-        rt_vec3 n2 = rt_cross(rt_sub(p2, p0), rt_sub(p3, p0));
-        if (rt_dot(n1, n2) < 0.0f)
-            base = 1;
+    if (op->tcap < 3 * (nc - 2)) {
+        size_t c = op->tcap;
+        if (!grow_raw((void **)&op->tri_out, &c, 3 * (nc - 2), sizeof *op->tri_out))
+            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for a face", lc->file);
+        op->tcap = c;
     }
-    if (!rt_mesh_buf_reserve_triangles(&op->buf, op->buf.nt + nc - 2))
+    size_t nt = rt_mesh_triangulate(op->v, op->corner_v, nc, op->tri_out);
+    if (!rt_mesh_buf_reserve_triangles(&op->buf, op->buf.nt + nt))
         return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for triangles", lc->file);
-    for (size_t k = 1; k + 1 < nc; k++) {
-        size_t a = base, b = (base + k) % nc, c = (base + k + 1) % nc;
+    const uint32_t *cv = op->corner_v, *co = op->corner_out, *tri = op->tri_out;
+    for (size_t k = 0; k < nt; k++) {
+        uint32_t a = tri[3 * k], b = tri[3 * k + 1], c = tri[3 * k + 2];
         if (cv[a] == cv[b] || cv[b] == cv[c] || cv[a] == cv[c]) {
             op->buf.skipped++;
             continue;
@@ -824,7 +822,7 @@ static void obj_free(obj_parser *op)
 {
     free(op->v); free(op->vc); free(op->vt); free(op->vn); free(op->first);
     free(op->ov); free(op->ot); free(op->on); free(op->onext);
-    free(op->corner_out); free(op->corner_v);
+    free(op->corner_out); free(op->corner_v); free(op->tri_out);
     free(op->mtls); free(op->slots);
     rt_mesh_buf_free(&op->buf);
 }

@@ -14,7 +14,8 @@
  * bytes, a face line 8). Vertex colours (C) become vertex colours (values
  * above 1 are taken as 0..255), normals (N) smooth shading, texture
  * coordinates (ST) UVs with v flipped (see mesh_io.c). Faces are
- * triangulated as a fan; per-face colours are ignored; faces with fewer than
+ * triangulated by rt_mesh_triangulate (fans, concave quads, ear clipping);
+ * per-face colours are ignored; faces with fewer than
  * 3 vertices and triangles that repeat a vertex are skipped and counted.
  * 4OFF, nOFF and binary OFF are refused. Errors name "path:line:col".
  */
@@ -105,8 +106,8 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         return r;
     rt_mesh_buf b;
     memset(&b, 0, sizeof b);
-    uint32_t *face = NULL;
-    size_t fcap = 0;
+    uint32_t *face = NULL, *tri = NULL;
+    size_t fcap = 0, tcap = 0;
     off_lines L = {path, data, data + size, 0, data, data};
 
     /* header keyword */
@@ -273,12 +274,18 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
             }
             continue;
         }
-        for (int64_t j = 1; j + 1 < n; j++) {
-            if (face[0] == face[j] || face[j] == face[j + 1] || face[0] == face[j + 1]) {
+        if (3 * ((size_t)n - 2) > tcap && !rt_grow((void **)&tri, &tcap, 3 * ((size_t)n - 2), sizeof *tri)) {
+            r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
+            goto done;
+        }
+        size_t nt = rt_mesh_triangulate(b.pos, face, (size_t)n, tri);
+        for (size_t j = 0; j < nt; j++) {
+            uint32_t ca = face[tri[3 * j]], cb = face[tri[3 * j + 1]], cc = face[tri[3 * j + 2]];
+            if (ca == cb || cb == cc || ca == cc) {
                 b.skipped++;
                 continue;
             }
-            if (!rt_mesh_buf_add_triangle(&b, face[0], face[j], face[j + 1], material, flags)) {
+            if (!rt_mesh_buf_add_triangle(&b, ca, cb, cc, material, flags)) {
                 r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for triangles", path);
                 goto done;
             }
@@ -288,6 +295,7 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
 done:
     rt_mesh_buf_free(&b);
     free(face);
+    free(tri);
     free(data);
     return r;
 }

@@ -18,8 +18,10 @@
  *              blue [alpha] (integers divided by their type's maximum, so
  *              uchar / 255; floats as they are) -> vertex colours.
  *   face:      list vertex_indices (or vertex_index) of any length,
- *              triangulated as a fan; lists shorter than 3 are skipped with a
- *              warning and counted.
+ *              triangulated by rt_mesh_triangulate (fan, concave quads and
+ *              ear clipping; a plain fan if the faces come before the
+ *              vertices); lists shorter than 3 are skipped with a warning
+ *              and counted.
  *   tristrips: list vertex_indices; -1 ends a strip and starts the next;
  *              the winding alternates within each strip (even triangles
  *              (a, b, c), odd ones (b, a, c)); triangles that repeat an index
@@ -438,8 +440,10 @@ typedef struct ply_load {
     uint64_t nverts; /* declared size of the vertex element */
     uint32_t material;
     uint8_t tri_flags;
-    uint32_t *scratch;
+    uint32_t *scratch; /* one face's vertex indices */
     size_t scap;
+    uint32_t *tri; /* its triangulation */
+    size_t tcap;
     rt_warn_once warned;
 } ply_load;
 
@@ -608,13 +612,25 @@ static bool read_faces(ply_load *L, const ply_elem *el, uint64_t e)
                             r->path, (unsigned long long)i, (long long)n);
                 continue;
             }
+            if (3 * ((size_t)n - 2) > L->tcap) {
+                size_t cap = L->tcap;
+                if (!rt_grow((void **)&L->tri, &cap, 3 * ((size_t)n - 2), sizeof *L->tri)) {
+                    rt_fail(r->err, RT_ERR_NOMEM, "%s: out of memory for a face of %lld", r->path, (long long)n);
+                    return false;
+                }
+                L->tcap = cap;
+            }
+            /* positions are known when the vertex element came first */
+            const rt_vec3 *pos = b->nv == L->nverts ? b->pos : NULL;
             const uint32_t *s = L->scratch;
-            for (int64_t j = 1; j + 1 < n; j++) {
-                if (s[0] == s[j] || s[j] == s[j + 1] || s[0] == s[j + 1]) {
+            size_t nt = rt_mesh_triangulate(pos, s, (size_t)n, L->tri);
+            for (size_t j = 0; j < nt; j++) {
+                uint32_t ca = s[L->tri[3 * j]], cb = s[L->tri[3 * j + 1]], cc = s[L->tri[3 * j + 2]];
+                if (ca == cb || cb == cc || ca == cc) {
                     b->skipped++;
                     continue;
                 }
-                if (!rt_mesh_buf_add_triangle(b, s[0], s[j], s[j + 1], L->material, L->tri_flags)) {
+                if (!rt_mesh_buf_add_triangle(b, ca, cb, cc, L->material, L->tri_flags)) {
                     rt_fail(r->err, RT_ERR_NOMEM, "%s: out of memory for triangles", r->path);
                     return false;
                 }
@@ -736,6 +752,7 @@ rt_result rt_ply_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
     free(L.pf.elems);
     free(L.pf.props);
     free(L.scratch);
+    free(L.tri);
     free(data);
     return res;
 }

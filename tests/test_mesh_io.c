@@ -158,6 +158,65 @@ static void test_obj_concave_quad(void **state)
     rt_scene_free(&l.s);
 }
 
+/* Random star-shaped (hence simple, mostly concave) polygons in random planes:
+ * a correct triangulation has n - 2 triangles, all facing the polygon's way,
+ * whose areas add up to the polygon's. A fan gets this wrong for most of them. */
+static void test_triangulate_concave(void **state)
+{
+    (void)state;
+    test_rng rng = {77};
+    rt_vec3 pos[64];
+    uint32_t vidx[64], tri[3 * 62];
+    for (int iter = 0; iter < 2000; iter++) {
+        size_t n = 5 + (size_t)(test_rng_next(&rng) % 60);
+        rt_mat4 rot = rt_mat4_mul(rt_mat4_rotate_axis(0, 360.0f * test_rng_float(&rng)),
+                                  rt_mat4_rotate_axis(1, 360.0f * test_rng_float(&rng)));
+        bool reverse = test_rng_next(&rng) & 1;
+        double area2d = 0;
+        float px[64], py[64];
+        for (size_t i = 0; i < n; i++) {
+            float ang = 2.0f * RT_PI * ((float)i + 0.1f + 0.8f * test_rng_float(&rng)) / (float)n;
+            float rad = 0.3f + 0.7f * test_rng_float(&rng);
+            size_t k = reverse ? n - 1 - i : i;
+            px[k] = rad * cosf(ang);
+            py[k] = rad * sinf(ang);
+        }
+        for (size_t i = 0; i < n; i++) {
+            area2d += 0.5 * ((double)px[i] * py[(i + 1) % n] - (double)px[(i + 1) % n] * py[i]);
+            pos[i] = rt_mat4_point(&rot, rt_v3(px[i], py[i], 0.0f));
+            vidx[i] = (uint32_t)i;
+        }
+        rt_vec3 normal = rt_mat4_vector(&rot, rt_v3(0, 0, area2d > 0 ? 1.0f : -1.0f));
+        size_t nt = rt_mesh_triangulate(pos, vidx, n, tri);
+        assert_int_equal(nt, n - 2);
+        double sum = 0;
+        for (size_t t = 0; t < nt; t++) {
+            for (int c = 0; c < 3; c++)
+                assert_true(tri[3 * t + (size_t)c] < n);
+            rt_vec3 a = pos[tri[3 * t]], b = pos[tri[3 * t + 1]], c = pos[tri[3 * t + 2]];
+            rt_vec3 cr = rt_cross(rt_sub(b, a), rt_sub(c, a));
+            assert_true(rt_dot(cr, normal) >= -1e-6f); /* same way as the polygon */
+            sum += 0.5 * rt_length(cr);
+        }
+        if (fabs(sum - fabs(area2d)) > 1e-4 * fabs(area2d))
+            fprintf(stderr, "n=%zu: triangles cover %g, polygon %g\n", n, sum, fabs(area2d));
+        assert_true(fabs(sum - fabs(area2d)) <= 1e-4 * fabs(area2d));
+    }
+    /* an L-shaped hexagon through the OBJ reader */
+    write_text("ell.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nf 3 4 5 6 1 2\n");
+    loaded l;
+    load_ok(&l, tpath("ell.obj"), NULL);
+    assert_int_equal(l.s.triangles.count, 4);
+    float area = 0;
+    for (size_t t = 0; t < 4; t++) {
+        rt_vec3 cr = rt_cross(rt_sub(tri_v(&l.s, t, 1), tri_v(&l.s, t, 0)), rt_sub(tri_v(&l.s, t, 2), tri_v(&l.s, t, 0)));
+        assert_true(cr.z >= 0);
+        area += 0.5f * rt_length(cr);
+    }
+    assert_float_equal(area, 3.0f, 1e-6);
+    rt_scene_free(&l.s);
+}
+
 static void test_obj_negative_indices_and_forms(void **state)
 {
     (void)state;
@@ -911,6 +970,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_obj_polygons),
         cmocka_unit_test(test_obj_concave_quad),
+        cmocka_unit_test(test_triangulate_concave),
         cmocka_unit_test(test_obj_negative_indices_and_forms),
         cmocka_unit_test(test_obj_mtl),
         cmocka_unit_test(test_obj_warnings),
