@@ -79,6 +79,8 @@ enum { SIDE_BOTH = 0, SIDE_LEFT = 1, SIDE_RIGHT = 2 };
 #define KD_STACK 64
 #define KD_MAX_DEPTH 60
 #define LEAF_TAG 3u
+#define KD_MAX_NODES ((size_t)1 << 29) /* stitching adds task nodes: stay well below 2^30 */
+#define KD_MAX_IDS ((size_t)UINT32_MAX)
 
 /* Event = ordered position bits << 32 | type << 30 | primitive: sorting the
  * integers sorts by (position, type). */
@@ -209,7 +211,7 @@ typedef struct kd_build {
     uint32_t *ids;
     size_t id_count, id_cap;
     rt_kdtree_stats st;
-    bool oom;
+    bool oom, limit; /* limit: the tree outgrew the node format (reported as RT_ERR_LIMIT) */
     /* top-level builder only: subtrees at task_depth become tasks */
     int task_depth;
     size_t task_min_prims;
@@ -318,6 +320,10 @@ static inline void emit_events(rt_box b, uint32_t prim, uint64_t *list[3], size_
 
 static uint32_t push_node(kd_build *c)
 {
+    if (c->node_count >= KD_MAX_NODES) { /* 30 bits of child index */
+        c->oom = c->limit = true;
+        return 0;
+    }
     if (!rt_grow((void **)&c->nodes, &c->node_cap, c->node_count + 1, sizeof *c->nodes)) {
         c->oom = true;
         return 0;
@@ -349,6 +355,10 @@ static void make_leaf(kd_build *c, uint32_t node, const uint64_t *ev0, size_t n0
                 break;
             }
         nd->b = LEAF_TAG | (1u << 2);
+        return;
+    }
+    if (c->id_count + nprims > KD_MAX_IDS) {
+        c->oom = c->limit = true;
         return;
     }
     if (!rt_grow((void **)&c->ids, &c->id_cap, c->id_count + nprims, sizeof *c->ids)) {
@@ -704,8 +714,10 @@ static bool run_tasks(kd_build *top, int threads, size_t nprims_total)
     free(order);
     bool ok = true;
     for (size_t i = 0; i < top->task_count; i++)
-        if (top->tasks[i].out.oom)
+        if (top->tasks[i].out.oom) {
             ok = false;
+            top->limit |= top->tasks[i].out.limit;
+        }
     return ok;
 }
 
@@ -918,7 +930,9 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     c.max_depth = md;
     tree->max_depth = md;
 
-    int threads = params && params->threads > 0 ? params->threads : 1;
+    int threads = params && params->threads > 0 ? params->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    if (threads < 1)
+        threads = 1;
     if (threads > 64)
         threads = 64;
     if (threads > 1 && nvalid >= 20000) {
@@ -937,6 +951,10 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
             nn += c.tasks[i].out.node_count;
             ni += c.tasks[i].out.id_count;
             add_stats(&c.st, &c.tasks[i].out.st);
+        }
+        if (nn >= ((size_t)1 << 30) || ni > KD_MAX_IDS) {
+            c.limit = true;
+            goto oom;
         }
         rt_kdtree_node *nodes = malloc(nn * sizeof *nodes);
         uint32_t *ids = malloc((ni ? ni : 1) * sizeof *ids);
@@ -977,6 +995,9 @@ oom:
     free(c.ids);
     free(tree->tri);
     memset(tree, 0, sizeof *tree);
+    if (c.limit)
+        return rt_fail(err, RT_ERR_LIMIT, "kdtree: %zu primitives make more nodes or references than the node format holds",
+                       N);
     return rt_fail(err, RT_ERR_NOMEM, "kdtree: out of memory building the tree over %zu primitives", N);
 }
 

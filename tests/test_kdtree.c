@@ -12,6 +12,8 @@
  */
 #include "test_util.h"
 
+#include <pthread.h>
+
 #include "rt/kdtree.h"
 
 /* ------------------------------------------------------------ helpers */
@@ -594,9 +596,71 @@ static void test_inside_and_far(void **state)
     }
 }
 
+typedef struct trace_job {
+    const rt_kdtree *tree;
+    const rt_ray *rays;
+    size_t n;
+    rt_hit *out;
+    bool *occ;
+} trace_job;
+
+static void *trace_thread(void *arg)
+{
+    trace_job *j = arg;
+    for (size_t i = 0; i < j->n; i++) {
+        rt_kdtree_intersect(j->tree, &j->rays[i], &j->out[i]);
+        j->occ[i] = rt_kdtree_occluded(j->tree, &j->rays[i]);
+    }
+    return NULL;
+}
+
 static void test_threads_safe_reads(void **state)
 {
     (void)state;
+    /* four threads query one tree at once (ThreadSanitizer watches) and get
+     * what one thread gets */
+    {
+        rt_scene s;
+        rt_scene_init(&s);
+        test_rng r = {25};
+        random_soup(&s, &r, 2000, 0.1f);
+        rt_kdtree tree;
+        build_ok(&tree, &s);
+        enum { NR = 2000, NT = 4 };
+        rt_ray *rays = malloc(NR * sizeof *rays);
+        rt_hit *ref = malloc(NR * sizeof *ref), *out = malloc(NT * NR * sizeof *out);
+        bool *occ_ref = malloc(NR), *occ = malloc(NT * NR);
+        assert_true(rays && ref && out && occ_ref && occ);
+        for (size_t i = 0; i < NR; i++) {
+            rays[i] = random_ray(&r, -0.2f, 1.2f);
+            if (!rt_kdtree_intersect(&tree, &rays[i], &ref[i]))
+                ref[i].t = INFINITY;
+            occ_ref[i] = rt_kdtree_occluded(&tree, &rays[i]);
+        }
+        pthread_t th[NT];
+        trace_job jobs[NT];
+        for (int k = 0; k < NT; k++) {
+            jobs[k] = (trace_job){&tree, rays, NR, out + (size_t)k * NR, occ + (size_t)k * NR};
+            assert_int_equal(pthread_create(&th[k], NULL, trace_thread, &jobs[k]), 0);
+        }
+        for (int k = 0; k < NT; k++)
+            pthread_join(th[k], NULL);
+        for (int k = 0; k < NT; k++)
+            for (size_t i = 0; i < NR; i++) {
+                const rt_hit *h = &out[(size_t)k * NR + i];
+                assert_int_equal(h->prim, ref[i].prim);
+                if (h->prim != RT_NONE)
+                    assert_true(h->t == ref[i].t && h->u == ref[i].u && h->v == ref[i].v);
+                assert_int_equal(occ[(size_t)k * NR + i], occ_ref[i]);
+            }
+        free(rays);
+        free(ref);
+        free(out);
+        free(occ_ref);
+        free(occ);
+        rt_kdtree_free(&tree);
+        rt_scene_free(&s);
+    }
     /* two trees over one scene are independent; a tree is only read by queries */
     rt_scene s;
     rt_scene_init(&s);

@@ -44,7 +44,7 @@ typedef struct rt_kdtree_params {
     float intersect_cost; /* SAH cost of one primitive test */
     float empty_bonus;    /* fraction (0..1) by which a split with an empty side is cheaper */
     int max_depth;        /* 0 = 8 + 1.3 log2(N) (pbrt's rule) */
-    int threads;          /* build threads; 0 = one */
+    int threads;          /* build threads; 0 = one per online CPU (same tree for any count) */
 } rt_kdtree_params;
 
 typedef struct rt_kdtree_stats {
