@@ -224,17 +224,25 @@ static inline bool read_value(ply_reader *r, ply_type t, int64_t *iv, double *dv
     return r->format == PF_ASCII ? ascii_value(r, t, iv, dv) : bin_value(r, t, iv, dv);
 }
 
-static bool read_count(ply_reader *r, ply_type ct, int64_t *n)
+/* A list's length, checked against the bytes left before anything loops over
+ * or allocates for it: binary items take their size, ascii ones at least two
+ * characters (the last may end the file). */
+static bool read_count(ply_reader *r, ply_type ct, ply_type item, int64_t *n)
 {
     double d;
+    size_t at = r->pos;
     if (!read_value(r, ct, n, &d))
         return false;
-    if (*n < 0)
+    if (*n < 0) {
+        r->pos = at;
         return fail_at(r, "negative list length %lld", (long long)*n);
-    /* every item takes at least one byte: a cheap bound before any loop */
+    }
     size_t left = r->size - r->pos;
-    if ((uint64_t)*n > left)
+    size_t fit = r->format == PF_ASCII ? (left + 1) / 2 : left / (size_t)type_size[item];
+    if ((uint64_t)*n > fit) {
+        r->pos = at;
         return fail_at(r, "list of %lld entries runs past the end of the file", (long long)*n);
+    }
     return true;
 }
 
@@ -246,13 +254,10 @@ static bool skip_prop(ply_reader *r, const ply_prop *p)
     if (p->count_type == PT_NONE)
         return read_value(r, p->type, &iv, &dv);
     int64_t n;
-    if (!read_count(r, p->count_type, &n))
+    if (!read_count(r, p->count_type, p->type, &n))
         return false;
     if (r->format != PF_ASCII) {
-        size_t bytes = (size_t)n * (size_t)type_size[p->type];
-        if ((uint64_t)n > (r->size - r->pos) / (size_t)type_size[p->type])
-            return fail_at(r, "list of %lld entries runs past the end of the file", (long long)n);
-        r->pos += bytes;
+        r->pos += (size_t)n * (size_t)type_size[p->type]; /* read_count checked it fits */
         return true;
     }
     for (int64_t i = 0; i < n; i++)
@@ -546,7 +551,7 @@ static bool read_faces(ply_load *L, const ply_elem *el, uint64_t e)
             }
             used = true;
             int64_t n;
-            if (!read_count(r, p->count_type, &n))
+            if (!read_count(r, p->count_type, p->type, &n))
                 return false;
             if (strips) {
                 int have = 0, parity = 0;
