@@ -78,6 +78,7 @@ enum { SIDE_BOTH = 0, SIDE_LEFT = 1, SIDE_RIGHT = 2 };
 #define PRIM_MASK ((1u << PRIM_BITS) - 1u)
 #define KD_STACK 64
 #define KD_MAX_DEPTH 60
+_Static_assert(KD_MAX_DEPTH < KD_STACK, "one stack entry per level at most");
 #define LEAF_TAG 3u
 #define KD_MAX_NODES ((size_t)1 << 29) /* stitching adds task nodes: stay well below 2^30 */
 #define KD_MAX_IDS ((size_t)UINT32_MAX)
@@ -1248,32 +1249,24 @@ KD_INLINE bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, b
                 } else if (dist > r.mp) {
                     node = above;
                 } else {
-                    if (sp < KD_STACK) {
-                        stack[sp].node = above, stack[sp].tn = tn, stack[sp].tf = tf;
-                        sp++;
-                    }
+                    stack[sp].node = above, stack[sp].tn = tn, stack[sp].tf = tf;
+                    sp++;
                     node = below;
                 }
                 continue;
             }
             float ts = (split - o) * inv, ma = r.ma[axis];
-            uint32_t first = inv > 0.0f ? below : above, second = inv > 0.0f ? above : below;
-            bool v1 = tn <= ts + ma, v2 = ts - ma <= tf;
-            if (v1 && v2) {
-                if (sp < KD_STACK) {
-                    float lo = ts - ma, hi = ts + ma;
-                    KD_PREFETCH(&nodes[second]);
-                    stack[sp].node = second, stack[sp].tn = lo > tn ? lo : tn, stack[sp].tf = tf;
-                    sp++;
-                    if (hi < tf)
-                        tf = hi;
-                }
-                node = first;
-            } else if (v1) {
-                node = first;
-            } else {
-                node = second;
-            }
+            uint32_t first = inv > 0.0f ? below : above, second = below + above - first;
+            float lo = ts - ma, hi = ts + ma;
+            bool v1 = tn <= hi, v2 = lo <= tf, both = v1 & v2;
+            /* branch-free: the far child is always written and kept only
+             * when both children are crossed (at most one push per level,
+             * depth <= KD_MAX_DEPTH < KD_STACK) */
+            KD_PREFETCH(&nodes[second]);
+            stack[sp].node = second, stack[sp].tn = lo > tn ? lo : tn, stack[sp].tf = tf;
+            sp += both;
+            tf = both && hi < tf ? hi : tf;
+            node = v1 ? first : second;
             continue;
         }
         uint32_t n = nd.b >> 2;
