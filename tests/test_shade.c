@@ -2,11 +2,14 @@
  * tangent frames (from UVs on the fly, from rt_scene_generate_tangents,
  * mirrored UVs) and normal mapping: a flat map changes nothing, bit for
  * bit; a tilted map tilts the normal by the right angle towards the right
- * world-space direction on a rotated mesh, a sphere and a quad. */
+ * world-space direction on a rotated mesh, a sphere and a quad; and the
+ * Khronos NormalTangentTest / NormalTangentMirrorTest models (shared
+ * assets) show every normal-mapped dome as a dome. */
 #include "test_util.h"
 
 #include <math.h>
 
+#include "rt/gltf.h"
 #include "rt/image.h"
 #include "rt/kdtree.h"
 #include "rt/render.h"
@@ -399,6 +402,116 @@ static void test_generate_tangents(void **state)
     rt_scene_free(&s);
 }
 
+/* Khronos' NormalTangentTest (no tangents: rt generates them) and
+ * NormalTangentMirrorTest (supplied tangents, mirrored U and V layouts):
+ * plates facing +z, each with a hemispherical dome, either real geometry or
+ * a normal map. Seen along -z on a grid, the shading normal's xy part d is
+ * non-zero on each dome; each dome is a connected region of |d| > 0.05, and
+ * on a dome d points away from its centre: sum d.x (x - cx) > 0 and
+ * sum d.y (y - cy) > 0. A flipped green channel or an ignored handedness
+ * turns one of them negative. */
+static void check_domes(const char *rel, size_t expect_domes)
+{
+    if (!test_have_shared())
+        return;
+    const char *path = test_shared_path(rel);
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_error err = {0};
+    rt_gltf_stats gs;
+    if (rt_gltf_load(&s, path, NULL, &gs, &err) != RT_OK) {
+        fprintf(stderr, "note: %s: %s; skipping\n", path, err.message);
+        rt_scene_free(&s);
+        return;
+    }
+    assert_int_equal(rt_scene_generate_tangents(&s, &err), RT_OK);
+    rt_kdtree tree;
+    assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
+    rt_trace_ctx ctx;
+    rt_trace_ctx_init(&ctx, &s, &tree);
+    rt_box b = rt_scene_bounds(&s);
+    enum { W = 640, H = 512 };
+    float *dx = calloc((size_t)W * H, sizeof *dx), *dy = calloc((size_t)W * H, sizeof *dy);
+    int *label = calloc((size_t)W * H, sizeof *label), *stack = malloc((size_t)W * H * sizeof *stack);
+    assert_true(dx && dy && label && stack);
+    float sx = (b.hi.x - b.lo.x) / W, sy = (b.hi.y - b.lo.y) / H;
+    for (int j = 0; j < H; j++)
+        for (int i = 0; i < W; i++) {
+            rt_vec3 o = rt_v3(b.lo.x + (i + 0.5f) * sx, b.hi.y - (j + 0.5f) * sy, b.hi.z + 1.0f);
+            rt_ray r = rt_ray_make(o, rt_v3(0, 0, -1), 0.0f, INFINITY);
+            rt_hit h;
+            if (!rt_trace(&ctx, &r, &h))
+                continue;
+            rt_surface sf;
+            rt_surface_at(&ctx, &r, &h, &sf);
+            if (!sf.front)
+                continue;
+            dx[j * W + i] = sf.n.x;
+            dy[j * W + i] = sf.n.y;
+        }
+    size_t domes = 0;
+    int next = 0;
+    for (int start = 0; start < W * H; start++) {
+        if (label[start] || dx[start] * dx[start] + dy[start] * dy[start] < 0.05f * 0.05f)
+            continue;
+        /* flood fill one region (4-connected) */
+        int n = 0, top = 0;
+        label[start] = ++next;
+        stack[top++] = start;
+        double cx = 0, cy = 0;
+        int *members = malloc((size_t)W * H * sizeof *members);
+        assert_non_null(members);
+        while (top) {
+            int p = stack[--top], x = p % W, y = p / W;
+            members[n++] = p;
+            cx += x;
+            cy += y;
+            const int nb[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+            for (int k = 0; k < 4; k++) {
+                int qx = x + nb[k][0], qy = y + nb[k][1];
+                if (qx < 0 || qy < 0 || qx >= W || qy >= H)
+                    continue;
+                int q = qy * W + qx;
+                if (!label[q] && dx[q] * dx[q] + dy[q] * dy[q] >= 0.05f * 0.05f) {
+                    label[q] = next;
+                    stack[top++] = q;
+                }
+            }
+        }
+        if (n >= 300) { /* a dome, not a label's edge or a corner arrow */
+            cx /= n;
+            cy /= n;
+            double ax = 0, ay = 0;
+            for (int k = 0; k < n; k++) {
+                int x = members[k] % W, y = members[k] / W;
+                ax += dx[members[k]] * (x - cx);
+                ay += dy[members[k]] * (cy - y); /* image rows grow downwards, world y upwards */
+            }
+            if (!(ax > 0 && ay > 0))
+                fprintf(stderr, "%s: region at pixel (%.0f, %.0f), %d px: x %.1f y %.1f\n", rel, cx, cy, n, ax, ay);
+            assert_true(ax > 0 && ay > 0);
+            domes++;
+        }
+        free(members);
+    }
+    assert_true(domes >= expect_domes);
+    free(dx);
+    free(dy);
+    free(label);
+    free(stack);
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
+static void test_khronos_normal_tangent_models(void **state)
+{
+    (void)state;
+    /* 3 blocks x 5 rows x (geometry, normal map) */
+    check_domes("assets/gltf/NormalTangentTest/glTF-Binary/NormalTangentTest.glb", 30);
+    /* 2 blocks x 5 rows x (geometry, normal map, V mirror, U mirror) */
+    check_domes("assets/gltf/NormalTangentMirrorTest/glTF-Binary/NormalTangentMirrorTest.glb", 40);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -408,6 +521,7 @@ int main(void)
         cmocka_unit_test(test_flat_normal_map_is_exact),
         cmocka_unit_test(test_normal_map_8bit_extremes),
         cmocka_unit_test(test_generate_tangents),
+        cmocka_unit_test(test_khronos_normal_tangent_models),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
