@@ -35,9 +35,10 @@
  * "perfect splits", Havran's thesis 2000, section 4.5), the few new events
  * sorted and merged in. Hence O(N log N) overall. The root lists are sorted
  * by an LSD radix sort on 64-bit event keys (position bits, type, primitive).
- * With params->threads > 1 the subtrees below depth 5 are built as
- * independent tasks by a pool of threads and spliced into place afterwards:
- * the tree is bit-identical for any thread count.
+ * With more than one build thread (params->threads; default one per online
+ * CPU) the subtrees below depth 5 are built as independent tasks by a pool
+ * of threads and spliced into place afterwards: the tree is bit-identical
+ * for any thread count.
  *
  * Layout: 8-byte nodes in depth-first order (below child = next node, above
  * child index in the node; see kdtree.h), leaf ids in one array, triangles as
