@@ -26,8 +26,11 @@
  *   with no Ke is taken as emission (old Embree-style Cornell files mark the
  *   light that way). Other texture options are skipped with a warning.
  *   Unknown statements are warned about once per keyword per file.
- *   `s` (smoothing groups), `o` and `g` are accepted and otherwise ignored:
- *   smooth shading comes from the file's vertex normals.
+ *   Smoothing groups (`s N`): faces without vn in a group other than 0/off
+ *   get generated vertex normals, the area-weighted sum of the face normals
+ *   of that group around each position (vertices are split per group), and
+ *   smooth shading. Faces with vn use them. `o` and `g` are accepted and
+ *   otherwise ignored.
  * Errors: "path:line:col: ..." for malformed numbers, indices out of range,
  * faces with fewer than 3 corners. A missing MTL or texture is a warning.
  */
@@ -70,10 +73,11 @@ typedef struct obj_parser {
     rt_vec3 *vn; size_t nvn, vncap;
     uint32_t *first; /* per position: first output vertex made from it */
     /* output vertices: (v, vt, vn) triples, chained per position */
-    uint32_t *ov, *ot, *on, *onext; size_t nout, outcap;
-    bool any_t, any_n;
+    uint32_t *ov, *ot, *on, *osg, *onext; size_t nout, outcap;
+    bool any_t, any_n, any_sg;
+    uint32_t cur_sg; /* current smoothing group, 0 = off */
     /* face scratch */
-    uint32_t *corner_out, *corner_v; size_t ccap;
+    uint32_t *corner_out, *corner_v, *corner_t, *corner_n; size_t ccap;
     uint32_t *tri_out; size_t tcap; /* triangulation of the current face */
     /* materials */
     obj_mtl *mtls; size_t nmtl, mtlcap;
@@ -483,35 +487,37 @@ static uint32_t resolve_index(obj_parser *op, const line_ctx *lc, const char *at
     return (uint32_t)r;
 }
 
-/* The output vertex for a (v, vt, vn) triple, made on first use. */
-static uint32_t output_vertex(obj_parser *op, uint32_t v, uint32_t t, uint32_t n)
+/* The output vertex for a (v, vt, vn, smoothing group) key, made on first
+ * use. sg is 0 except for faces without normals in a smoothing group, whose
+ * normals are generated. */
+static uint32_t output_vertex(obj_parser *op, uint32_t v, uint32_t t, uint32_t n, uint32_t sg)
 {
     for (uint32_t o = op->first[v]; o != RT_NONE; o = op->onext[o])
-        if (op->ot[o] == t && op->on[o] == n)
+        if (op->ot[o] == t && op->on[o] == n && op->osg[o] == sg)
             return o;
     if (op->nout >= (size_t)RT_NONE - 1)
         return RT_NONE;
     if (op->nout >= op->outcap) {
         size_t c = op->outcap ? op->outcap * 2 : 1024;
-        uint32_t *a = rt_realloc_array(op->ov, c, 4);
-        if (!a) return RT_NONE;
-        op->ov = a;
-        if (!(a = rt_realloc_array(op->ot, c, 4))) return RT_NONE;
-        op->ot = a;
-        if (!(a = rt_realloc_array(op->on, c, 4))) return RT_NONE;
-        op->on = a;
-        if (!(a = rt_realloc_array(op->onext, c, 4))) return RT_NONE;
-        op->onext = a;
+        uint32_t **arrays[] = {&op->ov, &op->ot, &op->on, &op->osg, &op->onext};
+        for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++) {
+            uint32_t *a = rt_realloc_array(*arrays[i], c, sizeof **arrays[i]);
+            if (!a)
+                return RT_NONE; /* outcap unchanged: the grown arrays are merely larger */
+            *arrays[i] = a;
+        }
         op->outcap = c;
     }
     uint32_t o = (uint32_t)op->nout++;
     op->ov[o] = v;
     op->ot[o] = t;
     op->on[o] = n;
+    op->osg[o] = sg;
     op->onext[o] = op->first[v];
     op->first[v] = o;
     if (t != RT_NONE) op->any_t = true;
     if (n != RT_NONE) op->any_n = true;
+    if (sg) op->any_sg = true;
     return o;
 }
 
@@ -519,7 +525,7 @@ static rt_result obj_face(obj_parser *op, line_ctx *lc, const char *p, const cha
 {
     eol = cut_comment(p, eol);
     size_t nc = 0;
-    bool all_t = true, all_n = true;
+    bool all_t = true, all_n = true, any_n = false;
     for (;;) {
         p = skip_space(p, eol);
         if (p >= eol)
@@ -560,20 +566,21 @@ static rt_result obj_face(obj_parser *op, line_ctx *lc, const char *p, const cha
             return op->err->code;
         all_t = all_t && has_t;
         all_n = all_n && has_n;
-        uint32_t o = output_vertex(op, v, t, n);
-        if (o == RT_NONE)
-            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for face vertices", lc->file);
+        any_n = any_n || has_n;
         if (nc >= op->ccap) {
-            size_t c = op->ccap;
-            if (!grow_raw((void **)&op->corner_out, &c, nc + 1, 4))
-                return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for a face", lc->file);
-            size_t c2 = op->ccap;
-            if (!grow_raw((void **)&op->corner_v, &c2, c, 4))
-                return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for a face", lc->file);
+            size_t c = op->ccap ? op->ccap * 2 : 64;
+            uint32_t **arrays[] = {&op->corner_out, &op->corner_v, &op->corner_t, &op->corner_n};
+            for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++) {
+                uint32_t *a = rt_realloc_array(*arrays[i], c, sizeof **arrays[i]);
+                if (!a)
+                    return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for a face", lc->file);
+                *arrays[i] = a;
+            }
             op->ccap = c;
         }
-        op->corner_out[nc] = o;
         op->corner_v[nc] = v;
+        op->corner_t[nc] = t;
+        op->corner_n[nc] = n;
         nc++;
         p = te;
         continue;
@@ -584,7 +591,15 @@ static rt_result obj_face(obj_parser *op, line_ctx *lc, const char *p, const cha
     if (nc < 3)
         return rt_fail(op->err, RT_ERR_INVALID, "%s:%ld: face has %zu vertices; at least 3 are needed", lc->file,
                        lc->line, nc);
-    uint8_t flags = (uint8_t)((all_t ? RT_TRI_UV : 0) | (all_n ? RT_TRI_SMOOTH : 0));
+    /* a face without normals in a smoothing group gets generated ones */
+    uint32_t sg = any_n ? 0 : op->cur_sg;
+    for (size_t k = 0; k < nc; k++) {
+        uint32_t o = output_vertex(op, op->corner_v[k], op->corner_t[k], op->corner_n[k], sg);
+        if (o == RT_NONE)
+            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for face vertices", lc->file);
+        op->corner_out[k] = o;
+    }
+    uint8_t flags = (uint8_t)((all_t ? RT_TRI_UV : 0) | (all_n || sg ? RT_TRI_SMOOTH : 0));
     if (op->tcap < 3 * (nc - 2)) {
         size_t c = op->tcap;
         if (!grow_raw((void **)&op->tri_out, &c, 3 * (nc - 2), sizeof *op->tri_out))
@@ -708,7 +723,23 @@ static rt_result obj_line(void *ctx, line_ctx *lc, const char *p, const char *eo
         return obj_usemtl(op, lc, p, eol);
     if (kw_is(kw, kl, "mtllib"))
         return obj_mtllib(op, lc, p, eol);
-    if (kw_is(kw, kl, "o") || kw_is(kw, kl, "g") || kw_is(kw, kl, "s"))
+    if (kw_is(kw, kl, "s")) {
+        /* "s off", "s 0" or "s <group>" */
+        const char *le = cut_comment(p, eol);
+        const char *q = skip_space(p, le), *qe = token_end(q, le);
+        int64_t g = 0;
+        if (kw_is(q, (size_t)(qe - q), "off") || q >= qe)
+            g = 0;
+        else if (rt_mesh_parse_int(q, qe, &g) != qe || g < 0 || g >= (int64_t)RT_NONE) {
+            if (rt_warn_once_first(&op->warned, "s", 1))
+                rt_warn("%s:%ld:%d: smoothing group '%.*s' is not 'off' or a number; taken as off (warned once)",
+                        lc->file, lc->line, col_of(lc, q), (int)(qe - q > 40 ? 40 : qe - q), q);
+            g = 0;
+        }
+        op->cur_sg = (uint32_t)g;
+        return RT_OK;
+    }
+    if (kw_is(kw, kl, "o") || kw_is(kw, kl, "g"))
         return RT_OK;
     warn_unknown(&op->warned, lc, kw, kl);
     return RT_OK;
@@ -822,7 +853,8 @@ static void obj_free(obj_parser *op)
 {
     free(op->v); free(op->vc); free(op->vt); free(op->vn); free(op->first);
     free(op->ov); free(op->ot); free(op->on); free(op->onext);
-    free(op->corner_out); free(op->corner_v); free(op->tri_out);
+    free(op->corner_out); free(op->corner_v); free(op->corner_t); free(op->corner_n); free(op->tri_out);
+    free(op->osg);
     free(op->mtls); free(op->slots);
     rt_mesh_buf_free(&op->buf);
 }
@@ -866,7 +898,8 @@ rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
 
     /* output vertices from the (v, vt, vn) triples */
     rt_mesh_buf *b = &op->buf;
-    unsigned attrs = (op->any_n ? RT_MESH_NRM : 0) | (op->any_t ? RT_MESH_UV : 0) | (op->vc ? RT_MESH_COL : 0);
+    unsigned attrs = (op->any_n || op->any_sg ? RT_MESH_NRM : 0) | (op->any_t ? RT_MESH_UV : 0) |
+                     (op->vc ? RT_MESH_COL : 0);
     if (!rt_mesh_buf_enable(b, attrs) || !rt_mesh_buf_reserve_vertices(b, op->nout)) {
         r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for %zu vertices", path, op->nout);
         goto done;
@@ -883,6 +916,19 @@ rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         }
     }
     b->nv = op->nout;
+    if (op->any_sg) {
+        /* smoothing groups: area-weighted sums of the face normals around each
+         * (position, group) vertex; triangles of one face share the group */
+        for (size_t t = 0; t < b->nt; t++) {
+            const uint32_t *ix = b->idx + 3 * t;
+            if (!op->osg[ix[0]])
+                continue;
+            rt_vec3 p0 = b->pos[ix[0]], p1 = b->pos[ix[1]], p2 = b->pos[ix[2]];
+            rt_vec3 fn = rt_cross(rt_sub(p1, p0), rt_sub(p2, p0));
+            for (int k = 0; k < 3; k++)
+                b->nrm[ix[k]] = rt_add(b->nrm[ix[k]], fn);
+        }
+    }
     for (size_t t = 0; t < b->nt; t++) {
         b->mat[t] = override_material ? material : op->slots[b->mat[t]].material;
         if (op->vc)

@@ -256,6 +256,41 @@ static void test_obj_negative_indices_and_forms(void **state)
     rt_scene_free(&l.s);
 }
 
+static void test_obj_smoothing_groups(void **state)
+{
+    (void)state;
+    /* a roof: two faces over the edge A-B, facing (0,-1,1) and (0,1,1) */
+    const char *verts = "v 0 0 0\nv 1 0 0\nv 0 1 1\nv 0 -1 1\n";
+    char text[256];
+    snprintf(text, sizeof text, "%ss 1\nf 1 2 3\nf 2 1 4\n", verts);
+    write_text("sg1.obj", text);
+    loaded l;
+    load_ok(&l, tpath("sg1.obj"), NULL);
+    const rt_scene *s = &l.s;
+    assert_int_equal(s->vertices.count, 4);
+    assert_int_equal(s->triangles.flags[0], RT_TRI_SMOOTH);
+    assert_int_equal(s->triangles.flags[1], RT_TRI_SMOOTH);
+    float h = sqrtf(0.5f);
+    assert_vec3(s->vertices.normal[s->triangles.index[0]], 0, 0, 1, 1e-6f);  /* A: the average */
+    assert_vec3(s->vertices.normal[s->triangles.index[2]], 0, -h, h, 1e-6f); /* C: its face's */
+    rt_scene_free(&l.s);
+
+    snprintf(text, sizeof text, "%ss 1\nf 1 2 3\ns 2\nf 2 1 4\n", verts);
+    write_text("sg2.obj", text);
+    load_ok(&l, tpath("sg2.obj"), NULL);
+    assert_int_equal(l.s.vertices.count, 6); /* A and B split between the groups */
+    assert_vec3(l.s.vertices.normal[l.s.triangles.index[0]], 0, -h, h, 1e-6f);
+    assert_vec3(l.s.vertices.normal[l.s.triangles.index[4]], 0, h, h, 1e-6f);
+    rt_scene_free(&l.s);
+
+    snprintf(text, sizeof text, "%ss 1\ns off\nf 1 2 3\nf 2 1 4\n", verts);
+    write_text("sg3.obj", text);
+    load_ok(&l, tpath("sg3.obj"), NULL);
+    assert_int_equal(l.s.vertices.count, 4);
+    assert_int_equal(l.s.triangles.flags[0], 0);
+    rt_scene_free(&l.s);
+}
+
 static void test_obj_mtl(void **state)
 {
     (void)state;
@@ -972,6 +1007,7 @@ int main(void)
         cmocka_unit_test(test_obj_concave_quad),
         cmocka_unit_test(test_triangulate_concave),
         cmocka_unit_test(test_obj_negative_indices_and_forms),
+        cmocka_unit_test(test_obj_smoothing_groups),
         cmocka_unit_test(test_obj_mtl),
         cmocka_unit_test(test_obj_warnings),
         cmocka_unit_test(test_obj_errors),
