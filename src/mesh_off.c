@@ -194,8 +194,8 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
             p = te;
         }
         int ncol = col ? n - need : 0;
-        if (n < need || (col && ncol != 3 && ncol != 4)) {
-            r = rt_fail(err, RT_ERR_PARSE, "%s:%ld: vertex %llu has %d numbers, expected %d%s", path, L.line,
+        if ((!col && n != need) || (col && ncol != 3 && ncol != 4)) {
+            r = rt_fail(err, RT_ERR_PARSE, "%s:%ld: vertex %llu has %d numbers, expected %d%s (one vertex a line)", path, L.line,
                         (unsigned long long)i, n, need, col ? " plus 3 or 4 colour components" : "");
             goto done;
         }

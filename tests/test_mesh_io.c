@@ -790,6 +790,8 @@ static void test_off(void **state)
     load_fail(tpath("e3.off"), RT_ERR_INVALID, "do not fit");
     write_text("e4.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n");
     load_fail(tpath("e4.off"), RT_ERR_PARSE, "file ends after 0 of 1 faces");
+    write_text("e6.off", "OFF\n3 1 0\n0 0 0 1 0 0 0 1 0\n3 0 1 2\n");
+    load_fail(tpath("e6.off"), RT_ERR_PARSE, "e6.off:3: vertex 0 has 9 numbers, expected 3");
     write_text("e5.off", "PLY\n");
     load_fail(tpath("e5.off"), RT_ERR_PARSE, "not an OFF file");
 }
