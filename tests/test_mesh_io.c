@@ -854,9 +854,10 @@ static void test_float_parser(void **state)
     }
     bool nf;
     float f;
-    assert_null(rt_mesh_parse_float("abc", "abc" + 3, &f, &nf));
-    assert_null(rt_mesh_parse_float(".", "." + 1, &f, &nf));
-    assert_null(rt_mesh_parse_float("-inf", "-inf" + 4, &f, &nf));
+    static const char abc[] = "abc", dot[] = ".", minf[] = "-inf";
+    assert_null(rt_mesh_parse_float(abc, abc + 3, &f, &nf));
+    assert_null(rt_mesh_parse_float(dot, dot + 1, &f, &nf));
+    assert_null(rt_mesh_parse_float(minf, minf + 4, &f, &nf));
     assert_true(nf);
     const char *t = "1.5e";
     assert_ptr_equal(rt_mesh_parse_float(t, t + 4, &f, &nf), t + 3); /* a bare 'e' is left to the caller */
