@@ -127,9 +127,11 @@ static input_kind input_kind_of(const char *path)
     return INPUT_SCENE;
 }
 
-/* Lighting for a bare model: a soft sky and a key light from above. */
+/* Lighting and sampling for a bare model: a soft sky, a key light from
+ * above, and enough samples for clean edges. */
 static void add_default_lighting(rt_scene *s)
 {
+    s->settings.samples = 16;
     s->settings.background = rt_v3(0.55f, 0.6f, 0.7f);
     if (s->light_count == 0) {
         rt_light sun;

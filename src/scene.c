@@ -9,7 +9,7 @@ void rt_settings_default(rt_settings *s)
     memset(s, 0, sizeof *s);
     s->width = 512;
     s->height = 512;
-    s->samples = 16;
+    s->samples = 1; /* the old renderer's default; scenes ask for more */
     s->integrator = RT_INTEGRATOR_DIRECT;
     s->max_bounce = 1;
     s->diffuse_bounces = 0;
@@ -155,8 +155,6 @@ static bool soa_grow(void **arrays[], const size_t sizes[], int n, size_t *cap, 
         c *= 2;
     }
     for (int i = 0; i < n; i++) {
-        if (!arrays[i])
-            continue;
         void *q = rt_realloc_array(*arrays[i], c, sizes[i]);
         if (!q)
             return false; /* arrays already grown keep their new size; cap stays: still consistent */
@@ -199,10 +197,6 @@ uint32_t rt_scene_add_quad(rt_scene *s, rt_vec3 p, rt_vec3 u, rt_vec3 v, uint32_
 
 static bool vertices_reserve(rt_vertices *v, size_t need)
 {
-    void **arrays[] = {(void **)&v->position, (void **)&v->normal, (void **)&v->uv0,
-                       (void **)&v->uv1, (void **)&v->tangent, (void **)&v->color};
-    const size_t sizes[] = {sizeof(rt_vec3), sizeof(rt_vec3), sizeof(rt_vec2),
-                            sizeof(rt_vec2), sizeof(rt_vec4), sizeof(rt_vec4)};
     if (!v->position) {
         /* first use: the always-present arrays must exist before growing */
         v->position = rt_alloc(1, sizeof(rt_vec3));
@@ -212,7 +206,17 @@ static bool vertices_reserve(rt_vertices *v, size_t need)
             return false;
         v->cap = 1;
     }
-    return soa_grow(arrays, sizes, 6, &v->cap, need);
+    /* the optional arrays (uv1, tangent, color) grow only once enabled */
+    void **arrays[6];
+    size_t sizes[6];
+    int n = 0;
+    arrays[n] = (void **)&v->position, sizes[n++] = sizeof(rt_vec3);
+    arrays[n] = (void **)&v->normal, sizes[n++] = sizeof(rt_vec3);
+    arrays[n] = (void **)&v->uv0, sizes[n++] = sizeof(rt_vec2);
+    if (v->uv1) arrays[n] = (void **)&v->uv1, sizes[n++] = sizeof(rt_vec2);
+    if (v->tangent) arrays[n] = (void **)&v->tangent, sizes[n++] = sizeof(rt_vec4);
+    if (v->color) arrays[n] = (void **)&v->color, sizes[n++] = sizeof(rt_vec4);
+    return soa_grow(arrays, sizes, n, &v->cap, need);
 }
 
 uint32_t rt_scene_add_vertices(rt_scene *s, size_t n)
