@@ -438,6 +438,12 @@ static bool parse_header(ply_reader *r, ply_file *pf)
 
 /* -------------------------------------------------------------- body */
 
+/* An element's properties (NULL when it has none: no arithmetic on NULL). */
+static const ply_prop *elem_props(const ply_file *pf, const ply_elem *el)
+{
+    return el->nprops ? pf->props + el->first_prop : NULL;
+}
+
 typedef struct ply_load {
     ply_reader r;
     ply_file pf;
@@ -458,7 +464,7 @@ static bool read_vertices(ply_load *L, const ply_elem *el)
 {
     ply_reader *r = &L->r;
     rt_mesh_buf *b = L->b;
-    const ply_prop *props = L->pf.props + el->first_prop;
+    const ply_prop *props = elem_props(&L->pf, el);
     unsigned have = 0;
     for (size_t k = 0; k < el->nprops; k++)
         if (props[k].count_type == PT_NONE && props[k].role != R_SKIP)
@@ -534,7 +540,7 @@ static bool read_faces(ply_load *L, const ply_elem *el, uint64_t e)
 {
     ply_reader *r = &L->r;
     rt_mesh_buf *b = L->b;
-    const ply_prop *props = L->pf.props + el->first_prop;
+    const ply_prop *props = elem_props(&L->pf, el);
     if (!rt_mesh_buf_reserve_triangles(b, b->nt + (size_t)el->count)) {
         rt_fail(r->err, RT_ERR_NOMEM, "%s: out of memory for %llu faces", r->path, (unsigned long long)el->count);
         return false;
@@ -651,7 +657,7 @@ static bool read_faces(ply_load *L, const ply_elem *el, uint64_t e)
 static bool skip_element(ply_load *L, const ply_elem *el)
 {
     ply_reader *r = &L->r;
-    const ply_prop *props = L->pf.props + el->first_prop;
+    const ply_prop *props = elem_props(&L->pf, el);
     bool lists = false;
     size_t row = 0;
     for (size_t k = 0; k < el->nprops; k++) {
@@ -681,7 +687,7 @@ static bool check_counts(ply_load *L)
     for (size_t e = 0; e < L->pf.nelem; e++) {
         const ply_elem *el = &L->pf.elems[e];
         uint64_t per = 0;
-        const ply_prop *props = L->pf.props + el->first_prop;
+        const ply_prop *props = elem_props(&L->pf, el);
         for (size_t k = 0; k < el->nprops; k++)
             per += r->format == PF_ASCII ? 2u
                    : (uint64_t)type_size[props[k].count_type != PT_NONE ? props[k].count_type : props[k].type];
