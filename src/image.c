@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <stb/stb_image_write.h>
@@ -158,6 +159,18 @@ rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float
         unlink(tmp);
         return rt_fail(err, RT_ERR_IO, "%s: write failed: %s", path, strerror(saved ? saved : EIO));
     }
+    /* mkstemp made the file 0600: give it the mode a plain fopen would
+     * (0666 less the umask), or keep the mode of the image it replaces */
+    struct stat st;
+    mode_t mode;
+    if (stat(path, &st) == 0) {
+        mode = st.st_mode & 07777;
+    } else {
+        mode_t mask = umask(0);
+        umask(mask);
+        mode = 0666 & ~mask;
+    }
+    chmod(tmp, mode);
     if (rename(tmp, path) != 0) {
         saved = errno;
         unlink(tmp);
