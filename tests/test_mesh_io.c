@@ -654,6 +654,56 @@ static void test_ply_encodings(void **state)
     }
 }
 
+/* Every scalar type name and alias, in both byte orders. */
+static void test_ply_types(void **state)
+{
+    (void)state;
+    for (int f = 1; f < 3; f++) {
+        ply_out o;
+        o.n = 0;
+        o.format = f;
+        put_text(&o, f == 1 ? "ply\nformat binary_little_endian 1.0\n" : "ply\nformat binary_big_endian 1.0\n");
+        put_text(&o, "element vertex 3\nproperty char x\nproperty int16 y\nproperty float64 z\n"
+                     "property ushort red\nproperty uint8 green\nproperty int blue\nproperty uint32 junk\n"
+                     "property short j2\nproperty int8 j3\nproperty uint j4\nproperty float32 j5\n"
+                     "element face 1\nproperty list ushort uint16 vertex_index\nend_header\n");
+        static const long xs[3] = {-128, 127, 0}, ys[3] = {-32768, 0, 32767};
+        static const double zs[3] = {0.1, -2.5e10, 1e-300};
+        for (int v = 0; v < 3; v++) {
+            put_i(&o, xs[v], 1);
+            put_i(&o, ys[v], 2);
+            double z = zs[v];
+            put_raw(&o, &z, 8, f == 2);
+            put_i(&o, 65535 * v / 2, 2);
+            put_i(&o, 255, 1);
+            put_i(&o, 2147483647, 4);
+            put_i(&o, 7, 4);
+            put_i(&o, -3, 2);
+            put_i(&o, -1, 1);
+            put_i(&o, 9, 4);
+            put_f(&o, 1.5f);
+        }
+        put_i(&o, 3, 2);
+        put_i(&o, 2, 2);
+        put_i(&o, 1, 2);
+        put_i(&o, 0, 2);
+        test_write_file(tpath("types.ply"), o.buf, o.n);
+        loaded l;
+        load_ok(&l, tpath("types.ply"), NULL);
+        const rt_scene *s = &l.s;
+        for (int v = 0; v < 3; v++) {
+            assert_vec3(s->vertices.position[v], (float)xs[v], (float)ys[v], (float)zs[v], 0);
+            assert_float_equal(s->vertices.color[v].x, (float)((double)(65535 * v / 2) / 65535.0), 1e-7);
+            assert_float_equal(s->vertices.color[v].y, 1.0f, 0);
+            assert_float_equal(s->vertices.color[v].z, 1.0f, 0);
+        }
+        assert_int_equal(s->triangles.count, 1);
+        assert_int_equal(s->triangles.index[0], 2);
+        assert_int_equal(s->triangles.index[2], 0);
+        rt_scene_free(&l.s);
+    }
+}
+
 static void test_ply_strips_normals_uv(void **state)
 {
     (void)state;
@@ -1017,6 +1067,7 @@ int main(void)
         cmocka_unit_test(test_dispatch),
         cmocka_unit_test(test_transform),
         cmocka_unit_test(test_ply_encodings),
+        cmocka_unit_test(test_ply_types),
         cmocka_unit_test(test_ply_strips_normals_uv),
         cmocka_unit_test(test_ply_errors),
         cmocka_unit_test(test_ply_faces_first_and_crlf),
