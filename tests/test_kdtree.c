@@ -183,15 +183,14 @@ static void check_tree(const rt_scene *s, const rt_kdtree *tree)
         refs += c;
         if (c > maxleaf)
             maxleaf = c;
-        if (c == 1) {
-            assert_true(nd->a < n);
-            seen[nd->a] = 1;
-        } else {
+        const uint32_t *ids = c == 1 ? &nd->a : tree->prim_ids + nd->a;
+        if (c > 1)
             assert_true(nd->a + c <= tree->prim_id_count);
-            for (size_t j = 0; j < c; j++) {
-                assert_true(tree->prim_ids[nd->a + j] < n);
-                seen[tree->prim_ids[nd->a + j]] = 1;
-            }
+        for (size_t j = 0; j < c; j++) {
+            assert_true(ids[j] < n);
+            if (j > 0) /* ascending: triangles first, as the leaf loop expects */
+                assert_true(ids[j - 1] < ids[j]);
+            seen[ids[j]] = 1;
         }
     }
     assert_int_equal(leaves, st->leaves);
