@@ -128,7 +128,7 @@ static input_kind input_kind_of(const char *path)
 }
 
 /* Lighting and sampling for a bare model: a soft sky, a key light from
- * above, and enough samples for clean edges. */
+ * above when the model brings no lights, and enough samples for clean edges. */
 static void add_default_lighting(rt_scene *s)
 {
     s->settings.samples = 16;
@@ -145,50 +145,58 @@ static void add_default_lighting(rt_scene *s)
     }
 }
 
-static rt_result load_input(rt_scene *s, const char *path, double *load_ms, rt_error *err)
+/* What loading one input found, for --info. */
+typedef struct input_info {
+    input_kind kind;
+    double load_ms;
+    size_t meshes, primitives, nodes; /* glTF only */
+} input_info;
+
+/* Loads the input (NULL = the built-in scene). for_render adds what a bare
+ * model needs to be rendered (lights, samples, its first camera) and the
+ * tangents normal maps need; --info leaves the model as it is. */
+static rt_result load_input(rt_scene *s, const char *path, bool for_render, input_info *info, rt_error *err)
 {
     double t0 = now_ms();
     rt_result r;
+    memset(info, 0, sizeof *info);
+    info->kind = path ? input_kind_of(path) : INPUT_SCENE;
     if (!path) {
         r = rt_scene_parse_string(s, rt_default_scene_text, strlen(rt_default_scene_text), "<built-in scene>", NULL,
                                   err);
-    } else {
-        switch (input_kind_of(path)) {
-        case INPUT_GLTF: {
-            rt_gltf_options opt;
-            memset(&opt, 0, sizeof opt);
-            rt_gltf_stats gs;
-            r = rt_gltf_load(s, path, &opt, &gs, err);
-            if (r == RT_OK) {
-                add_default_lighting(s);
-                if (s->camera_count) {
-                    s->camera = s->cameras[0];
-                    s->camera_set = true;
-                }
+    } else if (info->kind == INPUT_GLTF) {
+        rt_gltf_options opt;
+        memset(&opt, 0, sizeof opt);
+        rt_gltf_stats gs;
+        memset(&gs, 0, sizeof gs);
+        r = rt_gltf_load(s, path, &opt, &gs, err);
+        info->meshes = gs.meshes;
+        info->primitives = gs.primitives;
+        info->nodes = gs.nodes;
+        if (r == RT_OK && for_render) {
+            add_default_lighting(s);
+            if (s->camera_count) {
+                s->camera = s->cameras[0];
+                s->camera_set = true;
             }
-            break;
         }
-        case INPUT_MESH: {
-            rt_material m;
-            rt_material_default(&m, "default");
-            uint32_t mi = rt_scene_add_material(s, &m);
-            rt_mat4 id = rt_mat4_identity();
-            rt_mesh_load_stats ms;
-            r = mi == RT_NONE ? rt_fail(err, RT_ERR_NOMEM, "out of memory")
-                              : rt_mesh_load(s, path, &id, mi, false, &ms, err);
-            if (r == RT_OK)
-                add_default_lighting(s);
-            break;
-        }
-        case INPUT_SCENE:
-        default:
-            r = rt_scene_parse_file(s, path, err);
-            break;
-        }
+    } else if (info->kind == INPUT_MESH) {
+        rt_material m;
+        rt_material_default(&m, "default");
+        uint32_t mi = rt_scene_add_material(s, &m);
+        rt_mat4 id = rt_mat4_identity();
+        rt_mesh_load_stats ms;
+        r = mi == RT_NONE ? rt_fail(err, RT_ERR_NOMEM, "out of memory")
+                          : rt_mesh_load(s, path, &id, mi, false, &ms, err);
+        info->meshes = info->primitives = r == RT_OK ? 1 : 0;
+        if (r == RT_OK && for_render)
+            add_default_lighting(s);
+    } else {
+        r = rt_scene_parse_file(s, path, err);
     }
-    if (r == RT_OK) /* normal-mapped meshes without tangents get per-vertex ones */
+    if (r == RT_OK && for_render) /* normal-mapped meshes without tangents get per-vertex ones */
         r = rt_scene_generate_tangents(s, err);
-    *load_ms = now_ms() - t0;
+    info->load_ms = now_ms() - t0;
     return r;
 }
 
@@ -211,13 +219,14 @@ static void default_output(const rt_scene *s, const char *input, char *out, size
     snprintf(out, size, "%.*s.png", len, base);
 }
 
+/* --info: one `key: value` line per figure, for people and scripts. */
 static int print_info(const char *path)
 {
     rt_scene s;
     rt_scene_init(&s);
     rt_error err = {0};
-    double ms;
-    rt_result r = load_input(&s, path, &ms, &err);
+    input_info info;
+    rt_result r = load_input(&s, path, false, &info, &err);
     if (r != RT_OK) {
         fprintf(stderr, "rt: %s\n", err.message);
         rt_scene_free(&s);
@@ -225,6 +234,7 @@ static int print_info(const char *path)
     }
     rt_box b = rt_scene_bounds(&s);
     printf("file: %s\n", path);
+    printf("format: %s\n", info.kind == INPUT_GLTF ? "gltf" : info.kind == INPUT_MESH ? "mesh" : "scene");
     printf("triangles: %zu\n", s.triangles.count);
     printf("vertices: %zu\n", s.vertices.count);
     printf("spheres: %zu\n", s.spheres.count);
@@ -233,6 +243,12 @@ static int print_info(const char *path)
         printf("bounds: none\n");
     else
         printf("bounds: %.9g %.9g %.9g %.9g %.9g %.9g\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+    if (info.kind != INPUT_SCENE) {
+        printf("meshes: %zu\n", info.meshes);
+        printf("primitives: %zu\n", info.primitives);
+    }
+    if (info.kind == INPUT_GLTF)
+        printf("nodes: %zu\n", info.nodes);
     printf("materials: %zu\n", s.material_count);
     printf("textures: %zu\n", s.texture_count);
     printf("images: %zu\n", s.image_count);
@@ -240,7 +256,7 @@ static int print_info(const char *path)
         printf("image.%zu: %dx%d %s\n", i, s.images[i].width, s.images[i].height, s.images[i].name);
     printf("cameras: %zu\n", s.camera_count);
     printf("lights: %zu\n", s.light_count);
-    printf("load_ms: %.3f\n", ms);
+    printf("load_ms: %.3f\n", info.load_ms);
     rt_scene_free(&s);
     return 0;
 }
@@ -332,8 +348,8 @@ int main(int argc, char **argv)
     rt_scene scene;
     rt_scene_init(&scene);
     rt_error err = {0};
-    double load_ms = 0;
-    if (load_input(&scene, input, &load_ms, &err) != RT_OK) {
+    input_info info;
+    if (load_input(&scene, input, true, &info, &err) != RT_OK) {
         fprintf(stderr, "rt: %s\n", err.message);
         rt_scene_free(&scene);
         return 2;
@@ -370,7 +386,7 @@ int main(int argc, char **argv)
         return 2;
     }
 
-    rt_info("scene: %s (loaded in %.1f ms)", input ? input : "<built-in>", load_ms);
+    rt_info("scene: %s (loaded in %.1f ms)", input ? input : "<built-in>", info.load_ms);
     rt_info("  triangles %zu, spheres %zu, quads %zu, vertices %zu", scene.triangles.count, scene.spheres.count,
             scene.quads.count, scene.vertices.count);
     rt_info("  materials %zu, textures %zu, images %zu, lights %zu", scene.material_count, scene.texture_count,

@@ -341,20 +341,39 @@ rt_box rt_scene_bounds(const rt_scene *s)
 void rt_scene_frame_camera(rt_scene *s)
 {
     rt_box b = rt_scene_bounds(s);
-    if (rt_box_is_empty(b))
+    if (rt_box_is_empty(b) || !rt_finite3(b.lo) || !rt_finite3(b.hi))
         b.lo = rt_v3s(-1), b.hi = rt_v3s(1);
     rt_vec3 c = rt_scale(rt_add(b.lo, b.hi), 0.5f);
-    float radius = 0.5f * rt_length(rt_sub(b.hi, b.lo));
-    if (!(radius > 0.0f))
-        radius = 1.0f;
     float fov = 40.0f;
     float aspect = (float)s->settings.width / (float)(s->settings.height > 0 ? s->settings.height : 1);
-    float half = 0.5f * fov * (RT_PI / 180.0f);
-    if (aspect < 1.0f)
-        half = atanf(tanf(half) * aspect); /* fit the narrower horizontal extent */
-    float dist = radius / sinf(half) * 1.05f;
-    /* look from the front, slightly above and to the side, the usual product shot */
+    float tan_v = tanf(0.5f * fov * (RT_PI / 180.0f)), tan_h = tan_v * aspect;
+    /* look from the front (+z), a little above and to the side: the usual product shot */
     rt_vec3 dir = rt_normalize(rt_v3(0.35f, 0.3f, 1.0f));
+    rt_vec3 right = rt_normalize(rt_cross(rt_neg(dir), rt_v3(0, 1, 0)));
+    rt_vec3 up = rt_cross(right, rt_neg(dir));
+    /* the nearest distance at which every vertex (and every corner of the
+     * other primitives' boxes) is in view: tighter than fitting the box */
+    float dist = 0.0f;
+    size_t nv = s->vertices.count, nother = s->spheres.count + s->quads.count;
+    for (size_t i = 0; i < nv + 8 * nother; i++) {
+        rt_vec3 p;
+        if (i < nv) {
+            p = s->vertices.position[i];
+        } else {
+            size_t k = i - nv;
+            rt_box pb = rt_scene_prim_bounds(s, (uint32_t)(s->triangles.count + k / 8));
+            p = rt_v3(k & 1 ? pb.hi.x : pb.lo.x, k & 2 ? pb.hi.y : pb.lo.y, k & 4 ? pb.hi.z : pb.lo.z);
+        }
+        if (!rt_finite3(p))
+            continue;
+        rt_vec3 q = rt_sub(p, c);
+        float z = rt_dot(q, dir);
+        dist = fmaxf(dist, z + fabsf(rt_dot(q, right)) / tan_h);
+        dist = fmaxf(dist, z + fabsf(rt_dot(q, up)) / tan_v);
+    }
+    if (!(dist > 0.0f) || !isfinite(dist))
+        dist = 1.0f;
+    dist *= 1.08f; /* a small margin */
     s->camera.position = rt_madd(c, dir, dist);
     s->camera.look_at = c;
     s->camera.up = rt_v3(0, 1, 0);
