@@ -8,9 +8,9 @@
  *   v/vt/vn append to raw attribute arrays (v may carry an "x y z r g b"
  *   vertex colour, as MeshLab writes). A face corner "v", "v/vt", "v//vn" or
  *   "v/vt/vn" (1-based, negative = relative to the end so far) becomes one
- *   output vertex per distinct (v, vt, vn) triple: each position keeps a
- *   short chain of the output vertices made from it, so the lookup costs a
- *   step or two and no hashing. Polygons are triangulated by
+ *   output vertex per distinct (v, vt, vn) triple, found again through an
+ *   open-addressing hash table (material names likewise), so adversarial
+ *   files stay linear. Polygons are triangulated by
  *   rt_mesh_triangulate (mesh_io.c): fans for convex ones, the right diagonal
  *   for concave quads, ear clipping for other concave polygons. Triangles
  *   that repeat a position are dropped and counted in stats.skipped_faces.
@@ -52,9 +52,9 @@ typedef struct obj_mtl {
     float ns, ni, alpha, pr, pm, bump_scale;
     int illum;
     bool has_kd, has_ks, has_ke, has_ka, has_tf, has_ns, has_ni, has_alpha, has_pr, has_pm;
-    char map_kd[OBJ_PATH_MAX];
-    char map_bump[OBJ_PATH_MAX];
-    char where[OBJ_PATH_MAX + 32]; /* "file.mtl:12", for texture warnings */
+    char *map_kd, *map_bump; /* resolved texture paths (malloc'd) or NULL */
+    uint32_t file;           /* index into obj_parser.mtl_files, for messages */
+    long line;
 } obj_mtl;
 
 typedef struct obj_slot { /* a name used by usemtl */
@@ -62,6 +62,78 @@ typedef struct obj_slot { /* a name used by usemtl */
     long line;
     uint32_t material; /* scene index once resolved */
 } obj_slot;
+
+/* ------------------------------------------------------ hash tables */
+
+static uint64_t mix64(uint64_t x)
+{
+    /* splitmix64's finaliser (Steele, Lea, Flood, "Fast splittable pseudorandom number generators", 2014) */
+    x ^= x >> 30;
+    x *= 0xbf58476d1ce4e5b9ull;
+    x ^= x >> 27;
+    x *= 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+}
+
+static uint64_t hash_str(const char *s)
+{
+    uint64_t h = 1469598103934665603ull; /* FNV-1a */
+    for (; *s; s++)
+        h = (h ^ (unsigned char)*s) * 1099511628211ull;
+    return mix64(h);
+}
+
+/* Names (the first member of records in an array) to record indices, by open
+ * addressing, so that many distinct usemtl/newmtl names stay linear. */
+typedef struct name_map {
+    uint32_t *tab;
+    size_t cap, count;
+} name_map;
+
+static const char *rec_name(const void *base, size_t stride, uint32_t i) { return (const char *)base + i * stride; }
+
+static uint32_t name_map_find(const name_map *m, const char *name, const void *base, size_t stride)
+{
+    if (!m->cap)
+        return RT_NONE;
+    for (size_t h = (size_t)hash_str(name) & (m->cap - 1);; h = (h + 1) & (m->cap - 1)) {
+        uint32_t i = m->tab[h];
+        if (i == RT_NONE || strcmp(rec_name(base, stride, i), name) == 0)
+            return i;
+    }
+}
+
+/* Maps the record's name to index i (replacing an earlier record of that name). */
+static bool name_map_put(name_map *m, uint32_t i, const void *base, size_t stride)
+{
+    if (2 * (m->count + 1) > m->cap) {
+        size_t cap = m->cap ? 2 * m->cap : 64;
+        uint32_t *tab = rt_alloc(cap, sizeof *tab);
+        if (!tab)
+            return false;
+        memset(tab, 0xff, cap * sizeof *tab);
+        for (size_t k = 0; k < m->cap; k++) {
+            uint32_t j = m->tab[k];
+            if (j == RT_NONE)
+                continue;
+            size_t h = (size_t)hash_str(rec_name(base, stride, j)) & (cap - 1);
+            while (tab[h] != RT_NONE)
+                h = (h + 1) & (cap - 1);
+            tab[h] = j;
+        }
+        free(m->tab);
+        m->tab = tab;
+        m->cap = cap;
+    }
+    const char *name = rec_name(base, stride, i);
+    size_t h = (size_t)hash_str(name) & (m->cap - 1);
+    while (m->tab[h] != RT_NONE && strcmp(rec_name(base, stride, m->tab[h]), name) != 0)
+        h = (h + 1) & (m->cap - 1);
+    if (m->tab[h] == RT_NONE)
+        m->count++;
+    m->tab[h] = i;
+    return true;
+}
 
 typedef struct obj_parser {
     const char *path;
@@ -71,9 +143,9 @@ typedef struct obj_parser {
     rt_vec3 *v; rt_vec3 *vc; size_t nv, vcap;
     rt_vec2 *vt; size_t nvt, vtcap;
     rt_vec3 *vn; size_t nvn, vncap;
-    uint32_t *first; /* per position: first output vertex made from it */
     /* output vertices: (v, vt, vn) triples, chained per position */
-    uint32_t *ov, *ot, *on, *osg, *onext; size_t nout, outcap;
+    uint32_t *ov, *ot, *on, *osg; size_t nout, outcap;
+    uint32_t *vhash; size_t vhcap; /* open addressing over output vertices */
     bool any_t, any_n, any_sg;
     uint32_t cur_sg; /* current smoothing group, 0 = off */
     /* face scratch */
@@ -81,7 +153,9 @@ typedef struct obj_parser {
     uint32_t *tri_out; size_t tcap; /* triangulation of the current face */
     /* materials */
     obj_mtl *mtls; size_t nmtl, mtlcap;
+    char **mtl_files; size_t nfiles, filecap; /* MTL paths, for messages */
     obj_slot *slots; size_t nslot, slotcap; /* slot 0 = the caller's material */
+    name_map mtl_names, slot_names;
     uint32_t cur_slot;
     bool override_material;
     rt_warn_once warned;
@@ -211,6 +285,7 @@ static const char *cut_comment_ws(const char *p, const char *eol)
 
 typedef struct mtl_ctx {
     obj_parser *op;
+    uint32_t file; /* index into op->mtl_files */
     const char *mtl_path;
     char mtl_dir[OBJ_PATH_MAX];
     obj_mtl *cur;
@@ -253,7 +328,7 @@ static rt_result mtl_scalar(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl
 
 /* A texture statement: options, then a file name (the rest of the line). */
 static rt_result mtl_map(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl, const char *p, const char *eol,
-                         char *path_out, float *bump_scale)
+                         char **path_out, float *bump_scale)
 {
     eol = cut_comment_ws(p, eol);
     for (;;) {
@@ -303,8 +378,14 @@ static rt_result mtl_map(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl, c
         rt_warn("%s:%ld: '%.*s' without a file name; ignored", lc->file, lc->line, (int)kl, kw);
         return RT_OK;
     }
-    if (!rt_mesh_join(mc->mtl_dir, rel, path_out, OBJ_PATH_MAX))
+    char full[OBJ_PATH_MAX];
+    if (!rt_mesh_join(mc->mtl_dir, rel, full, sizeof full))
         return rt_fail(mc->op->err, RT_ERR_LIMIT, "%s:%ld: texture path too long", lc->file, lc->line);
+    char *copy = strdup(full);
+    if (!copy)
+        return rt_fail(mc->op->err, RT_ERR_NOMEM, "%s: out of memory", lc->file);
+    free(*path_out);
+    *path_out = copy;
     return RT_OK;
 }
 
@@ -317,7 +398,8 @@ static rt_result mtl_line(void *ctx, line_ctx *lc, const char *p, const char *eo
     size_t kl = (size_t)(ke - p);
     p = ke;
     if (kw_is(kw, kl, "newmtl")) {
-        if (!rt_grow((void **)&op->mtls, &op->mtlcap, op->nmtl + 1, sizeof *op->mtls))
+        if (op->nmtl >= (size_t)RT_NONE - 1 ||
+            !rt_grow((void **)&op->mtls, &op->mtlcap, op->nmtl + 1, sizeof *op->mtls))
             return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for materials", lc->file);
         obj_mtl *m = &op->mtls[op->nmtl++];
         memset(m, 0, sizeof *m);
@@ -329,8 +411,11 @@ static rt_result mtl_line(void *ctx, line_ctx *lc, const char *p, const char *eo
                            OBJ_NAME_MAX - 1);
         if (!m->name[0])
             return rt_fail(op->err, RT_ERR_PARSE, "%s:%ld: newmtl without a name", lc->file, lc->line);
-        snprintf(m->where, sizeof m->where, "%s:%ld", lc->file, lc->line);
+        m->file = mc->file;
+        m->line = lc->line;
         mc->cur = m;
+        if (!name_map_put(&op->mtl_names, (uint32_t)(op->nmtl - 1), op->mtls, sizeof *op->mtls))
+            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for materials", lc->file);
         return RT_OK;
     }
     obj_mtl *m = mc->cur;
@@ -392,10 +477,10 @@ static rt_result mtl_line(void *ctx, line_ctx *lc, const char *p, const char *eo
         return RT_OK;
     }
     if (kw_is(kw, kl, "map_Kd"))
-        return mtl_map(mc, lc, kw, kl, p, eol, m->map_kd, &m->bump_scale);
+        return mtl_map(mc, lc, kw, kl, p, eol, &m->map_kd, &m->bump_scale);
     if (kw_is(kw, kl, "map_Bump") || kw_is(kw, kl, "map_bump") || kw_is(kw, kl, "bump") || kw_is(kw, kl, "norm") ||
         kw_is(kw, kl, "map_Norm"))
-        return mtl_map(mc, lc, kw, kl, p, eol, m->map_bump, &m->bump_scale);
+        return mtl_map(mc, lc, kw, kl, p, eol, &m->map_bump, &m->bump_scale);
     warn_unknown(&mc->warned, lc, kw, kl);
     return RT_OK;
 }
@@ -412,9 +497,17 @@ static rt_result load_mtl(obj_parser *op, const char *mtl_path, const line_ctx *
         rt_warn("%s:%ld: %s; its materials fall back to the default", at->file, at->line, e.message);
         return RT_OK;
     }
+    char *copy = strdup(mtl_path);
+    if (!copy || !rt_grow((void **)&op->mtl_files, &op->filecap, op->nfiles + 1, sizeof *op->mtl_files)) {
+        free(copy);
+        free(data);
+        return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory", mtl_path);
+    }
+    op->mtl_files[op->nfiles] = copy;
     mtl_ctx mc;
     memset(&mc, 0, sizeof mc);
     mc.op = op;
+    mc.file = (uint32_t)op->nfiles++;
     mc.mtl_path = mtl_path;
     rt_mesh_dirname(mtl_path, mc.mtl_dir, sizeof mc.mtl_dir);
     rt_result r = for_each_line(mtl_path, data, size, mtl_line, &mc);
@@ -440,15 +533,12 @@ static rt_result obj_vertex(obj_parser *op, line_ctx *lc, const char *p, const c
     if (op->nv >= (size_t)RT_NONE - 1)
         return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: too many vertices", lc->file, lc->line);
     if (op->nv >= op->vcap) {
-        /* grow v, first and vc together; vcap only moves once all have */
+        /* grow v and vc together; vcap only moves once both have */
         size_t c = op->vcap ? op->vcap * 2 : 1024;
         void *a;
         if (!(a = rt_realloc_array(op->v, c, sizeof *op->v)))
             return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for vertices", lc->file);
         op->v = a;
-        if (!(a = rt_realloc_array(op->first, c, sizeof *op->first)))
-            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for vertices", lc->file);
-        op->first = a;
         if (op->vc) {
             if (!(a = rt_realloc_array(op->vc, c, sizeof *op->vc)))
                 return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for vertices", lc->file);
@@ -458,7 +548,6 @@ static rt_result obj_vertex(obj_parser *op, line_ctx *lc, const char *p, const c
     }
     size_t i = op->nv++;
     op->v[i] = rt_v3(f[0], f[1], f[2]);
-    op->first[i] = RT_NONE;
     if (n >= 6) {
         if (!op->vc) {
             if (!(op->vc = rt_alloc(op->vcap, sizeof *op->vc)))
@@ -487,19 +576,45 @@ static uint32_t resolve_index(obj_parser *op, const line_ctx *lc, const char *at
     return (uint32_t)r;
 }
 
+static size_t vertex_hash(uint32_t v, uint32_t t, uint32_t n, uint32_t sg)
+{
+    return (size_t)mix64(((uint64_t)v << 32 | t) ^ mix64((uint64_t)n << 32 | sg));
+}
+
 /* The output vertex for a (v, vt, vn, smoothing group) key, made on first
- * use. sg is 0 except for faces without normals in a smoothing group, whose
- * normals are generated. */
+ * use; an open-addressing table finds it again. sg is 0 except for faces
+ * without normals in a smoothing group, whose normals are generated. */
 static uint32_t output_vertex(obj_parser *op, uint32_t v, uint32_t t, uint32_t n, uint32_t sg)
 {
-    for (uint32_t o = op->first[v]; o != RT_NONE; o = op->onext[o])
-        if (op->ot[o] == t && op->on[o] == n && op->osg[o] == sg)
+    if (2 * (op->nout + 1) > op->vhcap) {
+        size_t cap = op->vhcap ? 2 * op->vhcap : 4096;
+        uint32_t *tab = rt_alloc(cap, sizeof *tab);
+        if (!tab)
+            return RT_NONE;
+        memset(tab, 0xff, cap * sizeof *tab);
+        for (size_t o = 0; o < op->nout; o++) {
+            size_t h = vertex_hash(op->ov[o], op->ot[o], op->on[o], op->osg[o]) & (cap - 1);
+            while (tab[h] != RT_NONE)
+                h = (h + 1) & (cap - 1);
+            tab[h] = (uint32_t)o;
+        }
+        free(op->vhash);
+        op->vhash = tab;
+        op->vhcap = cap;
+    }
+    size_t h = vertex_hash(v, t, n, sg) & (op->vhcap - 1);
+    for (;; h = (h + 1) & (op->vhcap - 1)) {
+        uint32_t o = op->vhash[h];
+        if (o == RT_NONE)
+            break;
+        if (op->ov[o] == v && op->ot[o] == t && op->on[o] == n && op->osg[o] == sg)
             return o;
+    }
     if (op->nout >= (size_t)RT_NONE - 1)
         return RT_NONE;
     if (op->nout >= op->outcap) {
         size_t c = op->outcap ? op->outcap * 2 : 1024;
-        uint32_t **arrays[] = {&op->ov, &op->ot, &op->on, &op->osg, &op->onext};
+        uint32_t **arrays[] = {&op->ov, &op->ot, &op->on, &op->osg};
         for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; i++) {
             uint32_t *a = rt_realloc_array(*arrays[i], c, sizeof **arrays[i]);
             if (!a)
@@ -513,8 +628,7 @@ static uint32_t output_vertex(obj_parser *op, uint32_t v, uint32_t t, uint32_t n
     op->ot[o] = t;
     op->on[o] = n;
     op->osg[o] = sg;
-    op->onext[o] = op->first[v];
-    op->first[v] = o;
+    op->vhash[h] = o;
     if (t != RT_NONE) op->any_t = true;
     if (n != RT_NONE) op->any_n = true;
     if (sg) op->any_sg = true;
@@ -634,18 +748,21 @@ static rt_result obj_usemtl(obj_parser *op, line_ctx *lc, const char *p, const c
         op->cur_slot = 0;
         return RT_OK;
     }
-    for (size_t i = 1; i < op->nslot; i++)
-        if (strcmp(op->slots[i].name, name) == 0) {
-            op->cur_slot = (uint32_t)i;
-            return RT_OK;
-        }
-    if (!rt_grow((void **)&op->slots, &op->slotcap, op->nslot + 1, sizeof *op->slots))
+    uint32_t found = name_map_find(&op->slot_names, name, op->slots, sizeof *op->slots);
+    if (found != RT_NONE) {
+        op->cur_slot = found;
+        return RT_OK;
+    }
+    if (op->nslot >= (size_t)RT_NONE - 1 ||
+        !rt_grow((void **)&op->slots, &op->slotcap, op->nslot + 1, sizeof *op->slots))
         return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory", lc->file);
     obj_slot *sl = &op->slots[op->nslot];
     memcpy(sl->name, name, sizeof name);
     sl->line = lc->line;
     sl->material = RT_NONE;
     op->cur_slot = (uint32_t)op->nslot++;
+    if (!name_map_put(&op->slot_names, op->cur_slot, op->slots, sizeof *op->slots))
+        return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory", lc->file);
     return RT_OK;
 }
 
@@ -759,8 +876,10 @@ static uint32_t load_texture(rt_scene *s, const char *path, const char *where, c
     return rt_scene_add_texture(s, &tex);
 }
 
-static void make_material(rt_scene *s, const obj_mtl *om, const char *objname, rt_material *m)
+static void make_material(rt_scene *s, const obj_mtl *om, const char *objname, const char *mtl_file, rt_material *m)
 {
+    char where[OBJ_PATH_MAX + 32];
+    snprintf(where, sizeof where, "%s:%ld", mtl_file, om->line);
     /* "<objfile>:<name>", cut to fit the 64-byte name field */
     char name[sizeof m->name];
     size_t on = strlen(objname), nn = strlen(om->name), cap = sizeof name - 1;
@@ -806,10 +925,10 @@ static void make_material(rt_scene *s, const obj_mtl *om, const char *objname, r
         m->alpha = 1.0f;
         m->alpha_mode = RT_ALPHA_OPAQUE;
     }
-    if (om->map_kd[0])
-        m->base_color_tex.texture = load_texture(s, om->map_kd, om->where, "map_Kd");
-    if (om->map_bump[0]) {
-        m->normal_tex.texture = load_texture(s, om->map_bump, om->where, "normal map");
+    if (om->map_kd)
+        m->base_color_tex.texture = load_texture(s, om->map_kd, where, "map_Kd");
+    if (om->map_bump) {
+        m->normal_tex.texture = load_texture(s, om->map_bump, where, "normal map");
         m->normal_scale = om->bump_scale;
     }
 }
@@ -823,26 +942,27 @@ static rt_result resolve_materials(obj_parser *op, rt_scene *s, uint32_t materia
         return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for materials", op->path);
     for (size_t i = 0; i < op->nmtl; i++) {
         rt_material m;
-        make_material(s, &op->mtls[i], objname, &m);
+        make_material(s, &op->mtls[i], objname, op->mtl_files[op->mtls[i].file], &m);
         if ((ids[i] = rt_scene_add_material(s, &m)) == RT_NONE) {
             free(ids);
             return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for materials", op->path);
         }
     }
     op->slots[0].material = material;
+    size_t unknown = 0;
     for (size_t k = 1; k < op->nslot; k++) {
         obj_slot *sl = &op->slots[k];
         sl->material = material;
-        size_t i = op->nmtl;
-        while (i-- > 0) /* the last definition of a name wins */
-            if (strcmp(op->mtls[i].name, sl->name) == 0)
-                break;
-        if (i < op->nmtl)
+        /* the last definition of a name wins (name_map_put replaces) */
+        uint32_t i = name_map_find(&op->mtl_names, sl->name, op->mtls, sizeof *op->mtls);
+        if (i != RT_NONE)
             sl->material = ids[i];
-        else
+        else if (++unknown <= 8)
             rt_warn("%s:%ld: usemtl '%s': no such material in the MTL files; using the default material", op->path,
                     sl->line, sl->name);
     }
+    if (unknown > 8)
+        rt_warn("%s: %zu more unknown usemtl names use the default material", op->path, unknown - 8);
     free(ids);
     return RT_OK;
 }
@@ -851,8 +971,16 @@ static rt_result resolve_materials(obj_parser *op, rt_scene *s, uint32_t materia
 
 static void obj_free(obj_parser *op)
 {
-    free(op->v); free(op->vc); free(op->vt); free(op->vn); free(op->first);
-    free(op->ov); free(op->ot); free(op->on); free(op->onext);
+    free(op->v); free(op->vc); free(op->vt); free(op->vn);
+    free(op->ov); free(op->ot); free(op->on); free(op->vhash);
+    for (size_t i = 0; i < op->nmtl; i++) {
+        free(op->mtls[i].map_kd);
+        free(op->mtls[i].map_bump);
+    }
+    for (size_t i = 0; i < op->nfiles; i++)
+        free(op->mtl_files[i]);
+    free(op->mtl_files);
+    free(op->mtl_names.tab); free(op->slot_names.tab);
     free(op->corner_out); free(op->corner_v); free(op->corner_t); free(op->corner_n); free(op->tri_out);
     free(op->osg);
     free(op->mtls); free(op->slots);

@@ -403,6 +403,32 @@ static void test_obj_warnings(void **state)
     rt_scene_free(&l.s);
 }
 
+/* Many distinct material names and many (v, vt) combinations on one position
+ * stay fast (hash tables, not linear searches). */
+static void test_obj_many_names(void **state)
+{
+    (void)state;
+    const int n = 30000;
+    size_t cap = (size_t)n * 64 + 256, len = 0;
+    char *text = malloc(cap);
+    assert_non_null(text);
+    len += (size_t)snprintf(text + len, cap - len, "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    for (int i = 0; i < n; i++)
+        len += (size_t)snprintf(text + len, cap - len, "vt %d 0\nusemtl m%d\nf 1/%d 2/1 3/1\n", i, i, i + 1);
+    test_write_file(tpath("many.obj"), text, len);
+    free(text);
+    loaded l;
+    double t0 = (double)clock() / CLOCKS_PER_SEC;
+    rt_log_set_level(RT_LOG_QUIET); /* 30000 unknown-material warnings */
+    load_ok(&l, tpath("many.obj"), NULL);
+    rt_log_set_level(RT_LOG_NORMAL);
+    double t1 = (double)clock() / CLOCKS_PER_SEC;
+    assert_int_equal(l.s.triangles.count, (size_t)n);
+    assert_int_equal(l.s.vertices.count, (size_t)n + 2);
+    assert_true(t1 - t0 < 2.0);
+    rt_scene_free(&l.s);
+}
+
 static void test_obj_errors(void **state)
 {
     (void)state;
@@ -1063,6 +1089,7 @@ int main(void)
         cmocka_unit_test(test_obj_smoothing_groups),
         cmocka_unit_test(test_obj_mtl),
         cmocka_unit_test(test_obj_warnings),
+        cmocka_unit_test(test_obj_many_names),
         cmocka_unit_test(test_obj_errors),
         cmocka_unit_test(test_dispatch),
         cmocka_unit_test(test_transform),
