@@ -990,7 +990,7 @@ static void obj_free(obj_parser *op)
 rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, uint32_t material,
                       bool override_material, rt_mesh_load_stats *stats, rt_error *err)
 {
-    rt_error local_err;
+    rt_error local_err = {0};
     if (!err)
         err = &local_err;
     if (stats)

@@ -94,7 +94,7 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
                       bool override_material, rt_mesh_load_stats *stats, rt_error *err)
 {
     (void)override_material; /* OFF has no materials */
-    rt_error local_err;
+    rt_error local_err = {0};
     if (!err)
         err = &local_err;
     if (stats)

@@ -704,7 +704,7 @@ rt_result rt_ply_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
                       bool override_material, rt_mesh_load_stats *stats, rt_error *err)
 {
     (void)override_material; /* PLY has no materials: every face uses `material` */
-    rt_error local_err;
+    rt_error local_err = {0};
     if (!err)
         err = &local_err;
     if (stats)
