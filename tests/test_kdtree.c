@@ -613,6 +613,37 @@ static void *trace_thread(void *arg)
     return NULL;
 }
 
+static void test_extreme_scales(void **state)
+{
+    (void)state;
+    /* the same soup at 1e-9 and 1e12 scene units: epsilons are relative
+     * (Moeller-Trumbore multiplies three lengths: scale^3 must stay a float) */
+    static const float scales[] = {1e-9f, 1e12f};
+    for (int i = 0; i < 2; i++) {
+        rt_scene s;
+        rt_scene_init(&s);
+        test_rng r = {26};
+        random_soup(&s, &r, 600, 0.15f);
+        for (size_t v = 0; v < s.vertices.count; v++)
+            s.vertices.position[v] = rt_scale(s.vertices.position[v], scales[i]);
+        rt_kdtree tree;
+        build_ok(&tree, &s);
+        check_stats cs = {0, 0, 0};
+        test_rng rr = {27};
+        for (int k = 0; k < 1500; k++) {
+            rt_ray ray = random_ray(&rr, -0.2f, 1.2f);
+            ray.org = rt_scale(ray.org, scales[i]);
+            ray.tmin = 0.0f;
+            ray.tmax *= scales[i]; /* same direction: t scales with the scene */
+            check_ray(&s, &tree, &ray, &cs);
+        }
+        report(__func__, &cs);
+        assert_true(cs.hits > 300);
+        rt_kdtree_free(&tree);
+        rt_scene_free(&s);
+    }
+}
+
 static void test_threads_safe_reads(void **state)
 {
     (void)state;
@@ -723,6 +754,7 @@ int main(void)
         cmocka_unit_test(test_spheres_and_quads),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_inside_and_far),
+        cmocka_unit_test(test_extreme_scales),
         cmocka_unit_test(test_threads_safe_reads),
         cmocka_unit_test(test_parallel_build_identical),
     };
