@@ -22,7 +22,8 @@
  *              ear clipping; a plain fan if the faces come before the
  *              vertices); lists shorter than 3 are skipped with a warning
  *              and counted.
- *   tristrips: list vertex_indices; -1 ends a strip and starts the next;
+ *   tristrips: list vertex_indices; -1 (or an unsigned type's maximum)
+ *              ends a strip and starts the next;
  *              the winding alternates within each strip (even triangles
  *              (a, b, c), odd ones (b, a, c)); triangles that repeat an index
  *              (the stitching between strips) are dropped silently.
@@ -693,7 +694,8 @@ static bool check_counts(ply_load *L)
                    : (uint64_t)type_size[props[k].count_type != PT_NONE ? props[k].count_type : props[k].type];
         if (per == 0 || el->count == 0)
             continue;
-        if (el->count > (left + 1) / per || (need += el->count * per) > left + 1)
+        uint64_t room = r->format == PF_ASCII ? left + 1 : left; /* the last ascii value may end the file */
+        if (el->count > room / per || (need += el->count * per) > room)
             return fail_at(r, "header claims %llu '%s' elements, more than the %llu bytes after the header can hold",
                            (unsigned long long)el->count, el->name, (unsigned long long)left);
     }
