@@ -418,30 +418,39 @@ static double find_plane(const kd_build *c, rt_box V, uint64_t *const list[3], c
         uint32_t lo_key = f2o(vlo[k] + 0.0f), hi_key = f2o(vhi[k] + 0.0f);
         const uint64_t *E = list[k];
         size_t n = cnt[k], nl = 0, nr = nprims;
+        double lo = vlo[k], hi = vhi[k];
         for (size_t i = 0; i < n;) {
-            uint32_t key = ev_key(E[i]);
-            size_t pe = 0, pp = 0, ps = 0;
-            while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_END)
-                pe++, i++;
-            while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_PLANAR)
-                pp++, i++;
-            while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_START)
-                ps++, i++;
+            uint64_t e = E[i];
+            uint32_t key = ev_key(e);
+            size_t pe, pp, ps;
+            if (i + 1 == n || ev_key(E[i + 1]) != key) { /* the usual lone event */
+                unsigned t = ev_type(e);
+                pe = t == EV_END, pp = t == EV_PLANAR, ps = t == EV_START;
+                i++;
+            } else {
+                pe = pp = ps = 0;
+                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_END)
+                    pe++, i++;
+                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_PLANAR)
+                    pp++, i++;
+                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_START)
+                    ps++, i++;
+            }
             nr -= pp + pe;
             if (key > lo_key && key < hi_key) {
                 double p = (double)o2f(key);
-                double wl = ab + (p - vlo[k]) * apb, wr = ab + (vhi[k] - p) * apb;
-                double l1 = (double)(nl + pp), r1 = (double)nr; /* planar ones left */
-                double c1 = kt + scale * (wl * l1 + wr * r1);
-                if (l1 == 0.0 || r1 == 0.0)
+                double wl = ab + (p - lo) * apb, wr = ab + (hi - p) * apb;
+                size_t nl1 = nl + pp; /* planar ones left */
+                double c1 = kt + scale * (wl * (double)(int64_t)nl1 + wr * (double)(int64_t)nr);
+                if (nl1 == 0 || nr == 0)
                     c1 *= lambda;
                 if (c1 < best) {
                     best = c1, *best_k = k, *best_key = key, *best_side = SIDE_LEFT;
                 }
                 if (pp > 0) { /* planar ones right */
-                    double l2 = (double)nl, r2 = (double)(nr + pp);
-                    double c2 = kt + scale * (wl * l2 + wr * r2);
-                    if (l2 == 0.0 || r2 == 0.0)
+                    size_t nr2 = nr + pp;
+                    double c2 = kt + scale * (wl * (double)(int64_t)nl + wr * (double)(int64_t)nr2);
+                    if (nl == 0 || nr2 == 0)
                         c2 *= lambda;
                     if (c2 < best) {
                         best = c2, *best_k = k, *best_key = key, *best_side = SIDE_RIGHT;
