@@ -192,6 +192,24 @@ static bool kw_is(const char *k, size_t klen, const char *want)
     return klen == n && memcmp(k, want, n) == 0;
 }
 
+/* MTL keywords are matched without case: exporters write map_kd, Map_Kd, KD. */
+static bool kw_is_ci(const char *k, size_t klen, const char *want)
+{
+    size_t n = strlen(want);
+    if (klen != n)
+        return false;
+    for (size_t i = 0; i < n; i++) {
+        char a = k[i], b = want[i];
+        if (a >= 'A' && a <= 'Z')
+            a = (char)(a - 'A' + 'a');
+        if (b >= 'A' && b <= 'Z')
+            b = (char)(b - 'A' + 'a');
+        if (a != b)
+            return false;
+    }
+    return true;
+}
+
 /* The rest of a line, trimmed, as a bounded C string. false if it does not fit. */
 static bool rest_string(const char *p, const char *end, char *out, size_t size)
 {
@@ -397,7 +415,7 @@ static rt_result mtl_line(void *ctx, line_ctx *lc, const char *p, const char *eo
     const char *kw = p;
     size_t kl = (size_t)(ke - p);
     p = ke;
-    if (kw_is(kw, kl, "newmtl")) {
+    if (kw_is_ci(kw, kl, "newmtl")) {
         if (op->nmtl >= (size_t)RT_NONE - 1 ||
             !rt_grow((void **)&op->mtls, &op->mtlcap, op->nmtl + 1, sizeof *op->mtls))
             return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for materials", lc->file);
@@ -424,34 +442,34 @@ static rt_result mtl_line(void *ctx, line_ctx *lc, const char *p, const char *eo
             rt_warn("%s:%ld: statement before any newmtl; ignored (warned once per file)", lc->file, lc->line);
         return RT_OK;
     }
-    if (kw_is(kw, kl, "Kd"))
+    if (kw_is_ci(kw, kl, "Kd"))
         return mtl_color(mc, lc, kw, kl, p, eol, &m->kd, &m->has_kd);
-    if (kw_is(kw, kl, "Ks"))
+    if (kw_is_ci(kw, kl, "Ks"))
         return mtl_color(mc, lc, kw, kl, p, eol, &m->ks, &m->has_ks);
-    if (kw_is(kw, kl, "Ke"))
+    if (kw_is_ci(kw, kl, "Ke"))
         return mtl_color(mc, lc, kw, kl, p, eol, &m->ke, &m->has_ke);
-    if (kw_is(kw, kl, "Ka"))
+    if (kw_is_ci(kw, kl, "Ka"))
         return mtl_color(mc, lc, kw, kl, p, eol, &m->ka, &m->has_ka);
-    if (kw_is(kw, kl, "Tf"))
+    if (kw_is_ci(kw, kl, "Tf"))
         return mtl_color(mc, lc, kw, kl, p, eol, &m->tf, &m->has_tf);
     rt_result r;
-    if (kw_is(kw, kl, "Ns")) {
+    if (kw_is_ci(kw, kl, "Ns")) {
         m->has_ns = true;
         return mtl_scalar(mc, lc, kw, kl, p, eol, &m->ns);
     }
-    if (kw_is(kw, kl, "Ni")) {
+    if (kw_is_ci(kw, kl, "Ni")) {
         m->has_ni = true;
         return mtl_scalar(mc, lc, kw, kl, p, eol, &m->ni);
     }
-    if (kw_is(kw, kl, "Pr")) {
+    if (kw_is_ci(kw, kl, "Pr")) {
         m->has_pr = true;
         return mtl_scalar(mc, lc, kw, kl, p, eol, &m->pr);
     }
-    if (kw_is(kw, kl, "Pm")) {
+    if (kw_is_ci(kw, kl, "Pm")) {
         m->has_pm = true;
         return mtl_scalar(mc, lc, kw, kl, p, eol, &m->pm);
     }
-    if (kw_is(kw, kl, "d")) {
+    if (kw_is_ci(kw, kl, "d")) {
         /* "d -halo f" is an old variant: take the factor */
         const char *q = skip_space(p, eol);
         if (kw_is(q, (size_t)(token_end(q, eol) - q), "-halo"))
@@ -459,7 +477,7 @@ static rt_result mtl_line(void *ctx, line_ctx *lc, const char *p, const char *eo
         m->has_alpha = true;
         return mtl_scalar(mc, lc, kw, kl, p, eol, &m->alpha);
     }
-    if (kw_is(kw, kl, "Tr")) {
+    if (kw_is_ci(kw, kl, "Tr")) {
         float tr;
         if ((r = mtl_scalar(mc, lc, kw, kl, p, eol, &tr)) != RT_OK)
             return r;
@@ -467,7 +485,7 @@ static rt_result mtl_line(void *ctx, line_ctx *lc, const char *p, const char *eo
         m->alpha = 1.0f - tr;
         return RT_OK;
     }
-    if (kw_is(kw, kl, "illum")) {
+    if (kw_is_ci(kw, kl, "illum")) {
         float f;
         if ((r = mtl_scalar(mc, lc, kw, kl, p, eol, &f)) != RT_OK)
             return r;
@@ -476,10 +494,10 @@ static rt_result mtl_line(void *ctx, line_ctx *lc, const char *p, const char *eo
         m->illum = (int)f;
         return RT_OK;
     }
-    if (kw_is(kw, kl, "map_Kd"))
+    if (kw_is_ci(kw, kl, "map_Kd"))
         return mtl_map(mc, lc, kw, kl, p, eol, &m->map_kd, &m->bump_scale);
-    if (kw_is(kw, kl, "map_Bump") || kw_is(kw, kl, "map_bump") || kw_is(kw, kl, "bump") || kw_is(kw, kl, "norm") ||
-        kw_is(kw, kl, "map_Norm"))
+    if (kw_is_ci(kw, kl, "map_Bump") || kw_is_ci(kw, kl, "bump") || kw_is_ci(kw, kl, "norm") ||
+        kw_is_ci(kw, kl, "map_Norm"))
         return mtl_map(mc, lc, kw, kl, p, eol, &m->map_bump, &m->bump_scale);
     warn_unknown(&mc->warned, lc, kw, kl);
     return RT_OK;

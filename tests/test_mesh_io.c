@@ -299,7 +299,7 @@ static void test_obj_mtl(void **state)
     test_write_file(tpath("tex.ppm"), ppm, sizeof ppm - 1);
     write_text("mats.mtl", "# materials\n"
                            "newmtl red\n  Kd 0.8 0.1 0.05  # comment\n  Ks 0.5 0.5 0.5\n  Ns 64\n  Ni 1.33\n  d 0.5\n"
-                           "  Ke 1 2 3\n  map_Kd -s 1 1 1 tex.ppm\n  map_Bump -bm 0.25 tex.ppm\n"
+                           "  ke 1 2 3\n  map_Kd -s 1 1 1 tex.ppm\n  map_bump -bm 0.25 tex.ppm\n" /* keywords without case */
                            "newmtl glass\n  Kd 1 1 1\n  Ni 1.5\n  illum 7\n  Tf 0.9 1 0.9\n  Tr 0.75\n"
                            "newmtl mirror\n  illum 3\n  Ks 0.6 0.7 0.8\n"
                            "newmtl lamp\n  Ka 20 20 20\n"
