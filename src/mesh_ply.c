@@ -161,6 +161,32 @@ static inline bool bin_value(ply_reader *r, ply_type t, int64_t *iv, double *dv)
     return true;
 }
 
+/* Decodes one binary value whose bytes are known to be in the file. */
+static inline double bin_decode(const unsigned char *q, ply_type t, bool big, int64_t *iv)
+{
+    uint64_t u = load_bytes(q, type_size[t], big);
+    switch (t) {
+    case PT_I8: *iv = (int8_t)(uint8_t)u; break;
+    case PT_I16: *iv = (int16_t)(uint16_t)u; break;
+    case PT_I32: *iv = (int32_t)(uint32_t)u; break;
+    case PT_F32: {
+        uint32_t w = (uint32_t)u;
+        float f;
+        memcpy(&f, &w, 4);
+        *iv = 0;
+        return f;
+    }
+    case PT_F64: {
+        double d;
+        memcpy(&d, &u, 8);
+        *iv = 0;
+        return d;
+    }
+    default: *iv = (int64_t)u; break; /* unsigned types */
+    }
+    return (double)*iv;
+}
+
 /* Ascii: the next whitespace-separated token (newlines counted). */
 static bool ascii_token(ply_reader *r, const char **tok, const char **tend)
 {
@@ -461,6 +487,17 @@ typedef struct ply_load {
 
 static const double int_max[] = {1, 127.0, 255.0, 32767.0, 65535.0, 2147483647.0, 4294967295.0, 1, 1};
 
+static void store_vertex(rt_mesh_buf *b, size_t v, const float *val, bool nrm, bool uv, bool col)
+{
+    b->pos[v] = rt_v3(val[R_X], val[R_Y], val[R_Z]);
+    if (nrm)
+        b->nrm[v] = rt_v3(val[R_NX], val[R_NY], val[R_NZ]);
+    if (uv)
+        b->uv[v] = rt_v2(val[R_U], 1.0f - val[R_V]);
+    if (col)
+        b->col[v] = rt_v4(val[R_R], val[R_G], val[R_B], val[R_A]);
+}
+
 static bool read_vertices(ply_load *L, const ply_elem *el)
 {
     ply_reader *r = &L->r;
@@ -483,7 +520,43 @@ static bool read_vertices(ply_load *L, const ply_elem *el)
         return false;
     }
     L->tri_flags = (uint8_t)((nrm ? RT_TRI_SMOOTH : 0) | (uv ? RT_TRI_UV : 0) | (col ? RT_TRI_COLOR : 0));
+    size_t row = 0;
+    bool lists = false;
+    for (size_t k = 0; k < el->nprops; k++) {
+        row += (size_t)type_size[props[k].type];
+        lists = lists || props[k].count_type != PT_NONE;
+    }
+    bool fast = r->format != PF_ASCII && !lists;
+    if (fast && el->count > (r->size - r->pos) / row)
+        return fail_at(r, "%llu vertices of %zu bytes run past the end of the file (%zu bytes left)",
+                       (unsigned long long)el->count, row, r->size - r->pos);
+    bool big = r->format == PF_BE;
     for (uint64_t i = 0; i < el->count; i++) {
+        if (fast) {
+            /* binary rows of scalars: fixed offsets, one bounds check for the element */
+            float val[R_A + 1] = {0};
+            val[R_R] = val[R_G] = val[R_B] = val[R_A] = 1.0f;
+            const unsigned char *q = r->data + r->pos;
+            for (size_t k = 0; k < el->nprops; k++) {
+                const ply_prop *p = &props[k];
+                if (p->role != R_SKIP) {
+                    int64_t iv;
+                    double dv = bin_decode(q, p->type, big, &iv);
+                    if (p->role >= R_R && p->role <= R_A && !is_float_type(p->type))
+                        dv /= int_max[p->type];
+                    float f = (float)dv;
+                    if (!isfinite(f)) {
+                        r->pos = (size_t)(q - r->data);
+                        return fail_at(r, "vertex %llu: property '%s' is not finite", (unsigned long long)i, p->name);
+                    }
+                    val[p->role] = f;
+                }
+                q += type_size[p->type];
+            }
+            r->pos += row;
+            store_vertex(b, (size_t)i, val, nrm, uv, col);
+            continue;
+        }
         float val[R_A + 1] = {0};
         val[R_R] = val[R_G] = val[R_B] = val[R_A] = 1.0f;
         for (size_t k = 0; k < el->nprops; k++) {
@@ -507,14 +580,7 @@ static bool read_vertices(ply_load *L, const ply_elem *el)
             }
             val[p->role] = f;
         }
-        size_t v = (size_t)i;
-        b->pos[v] = rt_v3(val[R_X], val[R_Y], val[R_Z]);
-        if (nrm)
-            b->nrm[v] = rt_v3(val[R_NX], val[R_NY], val[R_NZ]);
-        if (uv)
-            b->uv[v] = rt_v2(val[R_U], 1.0f - val[R_V]);
-        if (col)
-            b->col[v] = rt_v4(val[R_R], val[R_G], val[R_B], val[R_A]);
+        store_vertex(b, (size_t)i, val, nrm, uv, col);
     }
     b->nv = (size_t)el->count;
     return true;
@@ -526,8 +592,13 @@ static bool read_index(ply_load *L, ply_type t, int64_t *out, bool *restart)
     ply_reader *r = &L->r;
     size_t at = r->pos;
     double dv;
-    if (!read_value(r, t, out, &dv))
+    if (r->format != PF_ASCII) {
+        /* list items: read_count has checked that the whole list is in the file */
+        bin_decode(r->data + r->pos, t, r->format == PF_BE, out);
+        r->pos += (size_t)type_size[t];
+    } else if (!ascii_value(r, t, out, &dv)) {
         return false;
+    }
     *restart = *out == -1 || ((t == PT_U16 || t == PT_U32) && *out == (int64_t)int_max[t]);
     if (!*restart && (*out < 0 || (uint64_t)*out >= L->nverts)) {
         r->pos = at;
