@@ -19,9 +19,11 @@
  *   - Non-finite numbers (nan, inf, overflow) in vertex data are errors.
  *   - UVs are stored with v flipped (v' = 1 - v): OBJ/PLY/OFF put v = 0 at
  *     the bottom of the image, rt (like glTF) at the top.
- *   - Polygons are triangulated as fans (quads choose the diagonal that keeps
- *     concave quads right); triangles that repeat a vertex are dropped and
- *     counted in skipped_faces.
+ *   - Polygons: convex ones become fans, concave quads take the right
+ *     diagonal, other concave polygons (up to 128 corners) are ear-clipped;
+ *     triangles that repeat a vertex are dropped and counted in
+ *     skipped_faces. OBJ smoothing groups generate normals for faces
+ *     without vn.
  *   - OBJ: each MTL material becomes a scene material "<objfile>:<name>"
  *     (stats.materials counts them); faces before any usemtl, or naming an
  *     unknown material, use `material`; a missing MTL or texture is a warning.
