@@ -175,7 +175,11 @@ static void check_tree(const rt_scene *s, const rt_kdtree *tree)
     for (size_t i = 0; i < tree->node_count; i++) {
         const rt_kdtree_node *nd = &tree->nodes[i];
         if ((nd->b & 3u) != 3u) {
-            assert_true((nd->b >> 2) > i + 1 && (nd->b >> 2) < tree->node_count);
+            size_t above = nd->b >> 4;
+            assert_true(above > i + 1 && above < tree->node_count);
+            /* the empty-child flags say exactly which children are empty leaves */
+            assert_int_equal((nd->b >> 2) & 1u, tree->nodes[i + 1].b == 3u);
+            assert_int_equal((nd->b >> 3) & 1u, tree->nodes[above].b == 3u);
             continue;
         }
         leaves++;

@@ -58,7 +58,9 @@ typedef struct rt_kdtree_stats {
 
 typedef struct rt_kdtree_node {
     uint32_t a; /* interior: split position (float bits); leaf: first index into prim_ids (or the single prim) */
-    uint32_t b; /* low 2 bits: axis 0..2, or 3 = leaf; the rest: above-child index, or leaf prim count */
+    uint32_t b; /* low 2 bits: axis 0..2, or 3 = leaf. Leaf: b >> 2 = prim count (0 = empty leaf).
+                 * Interior: bit 2 = below child is an empty leaf, bit 3 = above child is,
+                 * b >> 4 = above-child index (the below child is the next node). */
 } rt_kdtree_node;
 
 typedef struct rt_kdtree {
