@@ -160,19 +160,31 @@ static void ev_sort(uint64_t *a, size_t n, uint64_t *tmp)
 
 /* ------------------------------------------------------------ clipping */
 
+/* The float next to finite-or-infinite f towards -inf / +inf (nextafterf
+ * without the library call). */
+static inline float float_down(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, 4);
+    if (f == 0.0f)
+        u = 0x80000001u; /* -smallest subnormal */
+    else
+        u = f > 0.0f ? u - 1 : u + 1;
+    memcpy(&f, &u, 4);
+    return f;
+}
+static inline float float_up(float f) { return -float_down(-f); }
+
+/* x rounded to a float below / above it (outwards, for conservative bounds). */
 static inline float round_down(double x)
 {
     float f = (float)x;
-    if ((double)f > x)
-        f = nextafterf(f, -INFINITY);
-    return f;
+    return (double)f > x ? float_down(f) : f;
 }
 static inline float round_up(double x)
 {
     float f = (float)x;
-    if ((double)f < x)
-        f = nextafterf(f, INFINITY);
-    return f;
+    return (double)f < x ? float_up(f) : f;
 }
 
 #define POLY_MAX 40
@@ -243,7 +255,6 @@ struct kd_task {
 static inline float *box_lo(rt_box *b) { return &b->lo.x; }
 static inline float *box_hi(rt_box *b) { return &b->hi.x; }
 
-
 /* Bounds of the part of primitive `prim` inside `box` (tight for triangles
  * and quads, box-intersected for spheres); false when nothing is inside. */
 static bool prim_clip_bounds(const kd_build *c, uint32_t prim, rt_box box, rt_box *out)
@@ -300,15 +311,17 @@ static bool prim_clip_bounds(const kd_build *c, uint32_t prim, rt_box box, rt_bo
                 lo[k] = hi[k] = poly[cur][0][k];
             for (int j = 1; j < n; j++)
                 for (int k = 0; k < 3; k++) {
-                    lo[k] = fmin(lo[k], poly[cur][j][k]);
-                    hi[k] = fmax(hi[k], poly[cur][j][k]);
+                    double x = poly[cur][j][k];
+                    lo[k] = x < lo[k] ? x : lo[k];
+                    hi[k] = x > hi[k] ? x : hi[k];
                 }
         }
     }
     float *ol = &out->lo.x, *oh = &out->hi.x;
     for (int k = 0; k < 3; k++) {
-        ol[k] = fmaxf(round_down(lo[k]), bl[k]);
-        oh[k] = fminf(round_up(hi[k]), bh[k]);
+        float l = round_down(lo[k]), h = round_up(hi[k]);
+        ol[k] = l > bl[k] ? l : bl[k];
+        oh[k] = h < bh[k] ? h : bh[k];
         if (!(ol[k] <= oh[k]))
             return false;
     }
