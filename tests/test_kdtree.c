@@ -648,6 +648,61 @@ static void test_extreme_scales(void **state)
     }
 }
 
+static float chaos_coord(test_rng *r)
+{
+    static const float special[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, 2.0f, 1e-30f, -1e-30f, 1e30f, -1e30f, 1e-3f, 3.0f};
+    uint64_t k = test_rng_next(r) % 100;
+    if (k < 50)
+        return rnd(r, -2.0f, 2.0f);
+    if (k < 75)
+        return (float)(int)(test_rng_next(r) % 5) - 2.0f; /* integer lattice: shared planes and edges */
+    if (k < 98)
+        return special[test_rng_next(r) % (sizeof special / sizeof special[0])];
+    return k == 98 ? NAN : INFINITY;
+}
+
+static void test_chaos(void **state)
+{
+    (void)state;
+    /* triangles, spheres and quads with coordinates from a mix of lattice
+     * points, tiny and huge values and the odd NaN/inf: the build must not
+     * fail or crash, and every answer must still be brute force's */
+    for (int round = 0; round < 6; round++) {
+        rt_scene s;
+        rt_scene_init(&s);
+        test_rng r = {100 + (uint64_t)round};
+        for (int i = 0; i < 300; i++) {
+            rt_vec3 v[3];
+            for (int j = 0; j < 3; j++)
+                v[j] = rt_v3(chaos_coord(&r), chaos_coord(&r), chaos_coord(&r));
+            add_tri(&s, v[0], v[1], v[2]);
+        }
+        for (int i = 0; i < 20; i++)
+            rt_scene_add_sphere(&s, rt_v3(chaos_coord(&r), chaos_coord(&r), chaos_coord(&r)),
+                                fabsf(chaos_coord(&r)) * 0.3f, 0);
+        for (int i = 0; i < 20; i++)
+            rt_scene_add_quad(&s, rt_v3(chaos_coord(&r), chaos_coord(&r), chaos_coord(&r)),
+                              rt_v3(chaos_coord(&r), chaos_coord(&r), chaos_coord(&r)),
+                              rt_v3(chaos_coord(&r), chaos_coord(&r), chaos_coord(&r)), 0);
+        rt_kdtree tree;
+        build_ok(&tree, &s);
+        check_stats cs = {0, 0, 0};
+        for (int k = 0; k < 800; k++) {
+            rt_ray ray = random_ray(&r, -2.5f, 2.5f);
+            if (k % 4 == 0) /* from lattice points along lattice directions */
+                ray = rt_ray_make(rt_v3((float)(int)(test_rng_next(&r) % 5) - 2.0f, (float)(int)(test_rng_next(&r) % 5) - 2.0f,
+                                        -3.0f),
+                                  rt_v3((float)(int)(test_rng_next(&r) % 3) - 1.0f, (float)(int)(test_rng_next(&r) % 3) - 1.0f,
+                                        1.0f),
+                                  0.0f, INFINITY);
+            check_ray(&s, &tree, &ray, &cs);
+        }
+        report(__func__, &cs);
+        rt_kdtree_free(&tree);
+        rt_scene_free(&s);
+    }
+}
+
 static void test_threads_safe_reads(void **state)
 {
     (void)state;
@@ -759,6 +814,7 @@ int main(void)
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_inside_and_far),
         cmocka_unit_test(test_extreme_scales),
+        cmocka_unit_test(test_chaos),
         cmocka_unit_test(test_threads_safe_reads),
         cmocka_unit_test(test_parallel_build_identical),
     };
