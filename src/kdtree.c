@@ -55,10 +55,12 @@
  * lies before the next cell's entry. Every primitive test uses the ray's own
  * (tmin, closest-so-far) interval, so t is what brute force would compute.
  * Exactness against rounding: cells are widened by a tiny distance mp
- * (2^-15 of the scene's and the origin's largest coordinate) on every plane,
- * so a hit whose computed t lies a few ulps outside the cell of its primitive
- * (edges shared on a split plane, grazing hits) is still found before the
- * traversal stops. Rays parallel to a split plane (direction component 0,
+ * (2^-18 of the scene's and the origin's largest coordinate, 64 times the
+ * float rounding of those coordinates) on every plane, so a hit whose
+ * computed t lies a few ulps outside the cell of its primitive (edges shared
+ * on a split plane, grazing hits) is still found before the traversal stops.
+ * Without it the lattice and chaos tests fail; with 2^-24 they pass; the
+ * widening costs under 1% of the steps on the benchmark scenes. Rays parallel to a split plane (direction component 0,
  * 1/0 = inf) are handled without the 0 * inf = NaN of the slab formula.
  * Interior nodes flag children that are empty leaves (about half of all
  * leaves, and 3 of every 4 leaves a ray meets), so the descent skips them
@@ -1071,7 +1073,7 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
         omax = fabsf(r->o[2]);
     if (r->d[0] == 0.0f && r->d[1] == 0.0f && r->d[2] == 0.0f)
         return false;
-    r->mp = (tree->scale + omax) * 0x1p-15f;
+    r->mp = (tree->scale + omax) * 0x1p-18f;
     float tn = ray->tmin, tf = ray->tmax;
     const float *lo = &tree->bounds.lo.x, *hi = &tree->bounds.hi.x;
     for (int k = 0; k < 3; k++) {
