@@ -64,9 +64,9 @@
  * 1/0 = inf) are handled without the 0 * inf = NaN of the slab formula.
  * Interior nodes flag children that are empty leaves (about half of all
  * leaves, and 3 of every 4 leaves a ray meets), so the descent skips them
- * without loading them: -10 to -15% of the steps, +10-35% rays/s. The
- * descent is branch-free (the far child is always written to the stack and
- * kept only when both children are wanted): incoherent rays mispredict less.
+ * without loading them: -10 to -15% of the steps, +10-35% rays/s. (A
+ * branch-free descent was tried: it helped incoherent rays before the flags
+ * and lost to this plain one after.)
  */
 #include "rt/kdtree.h"
 
@@ -1295,20 +1295,23 @@ KD_INLINE bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, b
             uint32_t first = pos ? below : above, second = below + above - first;
             bool fe = pos ? be : ae, se = pos ? ae : be;
             float lo = ts - ma, hi = ts + ma;
-            /* want a child when the ray crosses it and it is not an empty leaf */
-            bool wf = tn <= hi && !fe, ws = lo <= tf && !se, both = wf & ws;
-            /* branch-free: the far child is always written and kept only
-             * when both children are wanted (at most one push per level,
-             * depth <= KD_MAX_DEPTH < KD_STACK) */
-            KD_PREFETCH(&nodes[second]);
-            stack[sp].node = second, stack[sp].tn = lo > tn ? lo : tn, stack[sp].tf = tf;
-            sp += both;
-            if (!(wf | ws))
+            /* want a child when the ray crosses it and it is not an empty
+             * leaf; at most one push per level (depth <= KD_MAX_DEPTH < KD_STACK) */
+            bool wf = tn <= hi && !fe, ws = lo <= tf && !se;
+            if (wf) {
+                if (ws) {
+                    KD_PREFETCH(&nodes[second]);
+                    stack[sp].node = second, stack[sp].tn = lo > tn ? lo : tn, stack[sp].tf = tf;
+                    sp++;
+                }
+                tf = hi < tf ? hi : tf;
+                node = first;
+            } else if (ws) {
+                tn = lo > tn ? lo : tn;
+                node = second;
+            } else {
                 goto pop;
-            /* the child entered: the near one ends at the plane, the far one starts there */
-            tf = wf && hi < tf ? hi : tf;
-            tn = !wf && lo > tn ? lo : tn;
-            node = wf ? first : second;
+            }
             continue;
         }
         uint32_t n = nd.b >> 2;
