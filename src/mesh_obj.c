@@ -145,7 +145,8 @@ typedef struct obj_parser {
     rt_vec3 *vn; size_t nvn, vncap;
     /* output vertices: (v, vt, vn) triples, chained per position */
     uint32_t *ov, *ot, *on, *osg; size_t nout, outcap;
-    uint32_t *vhash; size_t vhcap; /* open addressing over output vertices */
+    uint32_t *vhash; size_t vhcap, nhashed; /* open addressing over output vertices with vt/vn/group */
+    uint32_t *plain; /* per position: its output vertex for bare "v" corners, or RT_NONE */
     bool any_t, any_n, any_sg;
     uint32_t cur_sg; /* current smoothing group, 0 = off */
     /* face scratch */
@@ -551,12 +552,15 @@ static rt_result obj_vertex(obj_parser *op, line_ctx *lc, const char *p, const c
     if (op->nv >= (size_t)RT_NONE - 1)
         return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: too many vertices", lc->file, lc->line);
     if (op->nv >= op->vcap) {
-        /* grow v and vc together; vcap only moves once both have */
+        /* grow v, plain and vc together; vcap only moves once all have */
         size_t c = op->vcap ? op->vcap * 2 : 1024;
         void *a;
         if (!(a = rt_realloc_array(op->v, c, sizeof *op->v)))
             return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for vertices", lc->file);
         op->v = a;
+        if (!(a = rt_realloc_array(op->plain, c, sizeof *op->plain)))
+            return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for vertices", lc->file);
+        op->plain = a;
         if (op->vc) {
             if (!(a = rt_realloc_array(op->vc, c, sizeof *op->vc)))
                 return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for vertices", lc->file);
@@ -566,6 +570,7 @@ static rt_result obj_vertex(obj_parser *op, line_ctx *lc, const char *p, const c
     }
     size_t i = op->nv++;
     op->v[i] = rt_v3(f[0], f[1], f[2]);
+    op->plain[i] = RT_NONE;
     if (n >= 6) {
         if (!op->vc) {
             if (!(op->vc = rt_alloc(op->vcap, sizeof *op->vc)))
@@ -602,32 +607,8 @@ static size_t vertex_hash(uint32_t v, uint32_t t, uint32_t n, uint32_t sg)
 /* The output vertex for a (v, vt, vn, smoothing group) key, made on first
  * use; an open-addressing table finds it again. sg is 0 except for faces
  * without normals in a smoothing group, whose normals are generated. */
-static uint32_t output_vertex(obj_parser *op, uint32_t v, uint32_t t, uint32_t n, uint32_t sg)
+static uint32_t new_output_vertex(obj_parser *op, uint32_t v, uint32_t t, uint32_t n, uint32_t sg)
 {
-    if (2 * (op->nout + 1) > op->vhcap) {
-        size_t cap = op->vhcap ? 2 * op->vhcap : 4096;
-        uint32_t *tab = rt_alloc(cap, sizeof *tab);
-        if (!tab)
-            return RT_NONE;
-        memset(tab, 0xff, cap * sizeof *tab);
-        for (size_t o = 0; o < op->nout; o++) {
-            size_t h = vertex_hash(op->ov[o], op->ot[o], op->on[o], op->osg[o]) & (cap - 1);
-            while (tab[h] != RT_NONE)
-                h = (h + 1) & (cap - 1);
-            tab[h] = (uint32_t)o;
-        }
-        free(op->vhash);
-        op->vhash = tab;
-        op->vhcap = cap;
-    }
-    size_t h = vertex_hash(v, t, n, sg) & (op->vhcap - 1);
-    for (;; h = (h + 1) & (op->vhcap - 1)) {
-        uint32_t o = op->vhash[h];
-        if (o == RT_NONE)
-            break;
-        if (op->ov[o] == v && op->ot[o] == t && op->on[o] == n && op->osg[o] == sg)
-            return o;
-    }
     if (op->nout >= (size_t)RT_NONE - 1)
         return RT_NONE;
     if (op->nout >= op->outcap) {
@@ -646,10 +627,51 @@ static uint32_t output_vertex(obj_parser *op, uint32_t v, uint32_t t, uint32_t n
     op->ot[o] = t;
     op->on[o] = n;
     op->osg[o] = sg;
-    op->vhash[h] = o;
     if (t != RT_NONE) op->any_t = true;
     if (n != RT_NONE) op->any_n = true;
     if (sg) op->any_sg = true;
+    return o;
+}
+
+static uint32_t output_vertex(obj_parser *op, uint32_t v, uint32_t t, uint32_t n, uint32_t sg)
+{
+    if (t == RT_NONE && n == RT_NONE && sg == 0) {
+        /* a bare "f 1 2 3" corner: one vertex per position, a direct table */
+        if (op->plain[v] == RT_NONE)
+            op->plain[v] = new_output_vertex(op, v, t, n, sg);
+        return op->plain[v];
+    }
+    if (2 * (op->nhashed + 1) > op->vhcap) {
+        size_t cap = op->vhcap ? 2 * op->vhcap : 4096;
+        uint32_t *tab = rt_alloc(cap, sizeof *tab);
+        if (!tab)
+            return RT_NONE;
+        memset(tab, 0xff, cap * sizeof *tab);
+        for (size_t o = 0; o < op->nout; o++) {
+            if (op->ot[o] == RT_NONE && op->on[o] == RT_NONE && op->osg[o] == 0)
+                continue; /* in the direct table */
+            size_t h = vertex_hash(op->ov[o], op->ot[o], op->on[o], op->osg[o]) & (cap - 1);
+            while (tab[h] != RT_NONE)
+                h = (h + 1) & (cap - 1);
+            tab[h] = (uint32_t)o;
+        }
+        free(op->vhash);
+        op->vhash = tab;
+        op->vhcap = cap;
+    }
+    size_t h = vertex_hash(v, t, n, sg) & (op->vhcap - 1);
+    for (;; h = (h + 1) & (op->vhcap - 1)) {
+        uint32_t o = op->vhash[h];
+        if (o == RT_NONE)
+            break;
+        if (op->ov[o] == v && op->ot[o] == t && op->on[o] == n && op->osg[o] == sg)
+            return o;
+    }
+    uint32_t o = new_output_vertex(op, v, t, n, sg);
+    if (o != RT_NONE) {
+        op->vhash[h] = o;
+        op->nhashed++;
+    }
     return o;
 }
 
@@ -990,7 +1012,7 @@ static rt_result resolve_materials(obj_parser *op, rt_scene *s, uint32_t materia
 static void obj_free(obj_parser *op)
 {
     free(op->v); free(op->vc); free(op->vt); free(op->vn);
-    free(op->ov); free(op->ot); free(op->on); free(op->vhash);
+    free(op->ov); free(op->ot); free(op->on); free(op->vhash); free(op->plain);
     for (size_t i = 0; i < op->nmtl; i++) {
         free(op->mtls[i].map_kd);
         free(op->mtls[i].map_bump);
