@@ -3,7 +3,7 @@
  * Built the way cgltf (jkuhlmann/cgltf) is built, in four passes:
  *   1. read   the file; a GLB is split into its JSON and BIN chunks after
  *             checking the 12-byte header and every chunk length against the
- *             file size (glTF 2.0 spec, section 4.4 "Binary glTF Layout").
+ *             file size (glTF 2.0 spec, "GLB File Format Specification").
  *   2. map    the JSON (tokenized once by jsmn, see json.c) into flat tables
  *             of records with a count each: buffers, bufferViews, accessors,
  *             meshes/primitives, nodes, scenes, materials, textures,
@@ -28,12 +28,13 @@
  * bitangent sign w multiplied by sign(det M): with n' ~ M^-T n and
  * t' ~ M t, cross(n', t') points along sign(det M) * M cross(n, t), so a
  * mirroring transform must flip w to keep bitangent = w * cross(n, t).
- * A negative determinant also flips triangle winding (spec 3.7.2.1), so
+ * A negative determinant also flips triangle winding (spec, "Meshes"), so
  * the geometric normal keeps agreeing with the shading normal.
  *
- * Sources: Khronos glTF 2.0 specification (accessor and sparse layout 3.6,
- * normalized integers 3.11, primitive modes 3.7.2.1, materials 3.9,
- * samplers 3.8.4); extension specs KHR_texture_transform,
+ * Sources: Khronos glTF 2.0 specification (sections "Accessors" with
+ * sparse accessors and data alignment, "Animations" for the normalized
+ * integer formulas, "Meshes" for primitive modes and winding, "Materials",
+ * "Samplers", "GLB File Format Specification"); extension specs KHR_texture_transform,
  * KHR_materials_{emissive_strength,transmission,ior,volume,unlit},
  * KHR_lights_punctual, KHR_mesh_quantization. docs/gltf.md lists what is
  * supported and how glTF materials map to rt_material.
@@ -371,7 +372,7 @@ static uint32_t rd32(const uint8_t *p)
     return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
 }
 
-/* Splits a GLB into its JSON and BIN chunks (spec 4.4). */
+/* Splits a GLB into its JSON and BIN chunks (spec: "GLB File Format Specification"). */
 static rt_result split_glb(gl_doc *d)
 {
     const uint8_t *f = d->bytes;
@@ -556,7 +557,7 @@ static size_t comp_size(int ct)
     return 0;
 }
 
-/* Element size with the spec's column padding for matrices (3.6.2.4). */
+/* Element size with the spec's column padding for matrices ("Data Alignment"). */
 static size_t elem_size(const gl_accessor *a)
 {
     size_t cs = comp_size(a->ctype);
