@@ -2142,6 +2142,7 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
                 c.look_at = rt_add(origin, fwd);
                 c.up = rt_normalize(rt_mat4_vector(W, rt_v3(0, 1, 0)));
                 c.vfov_deg = gc->yfov * (180.0f / RT_PI);
+                c.aspect_ratio = isfinite(gc->aspect) && gc->aspect > 0.0f ? gc->aspect : 0.0f;
                 if (rt_scene_add_camera(s, &c) == RT_NONE)
                     return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding cameras", d->path);
                 st->cameras++;

@@ -372,6 +372,11 @@ int main(int argc, char **argv)
         scene.camera = scene.cameras[camera];
         scene.camera_set = true;
     }
+    /* a glTF camera made for another aspect ratio: keep the height, fit the width */
+    if (!width && input && info.kind == INPUT_GLTF && scene.camera.aspect_ratio > 0.0f) {
+        double w = (double)set->height * scene.camera.aspect_ratio + 0.5;
+        set->width = w < 1.0 ? 1 : (w > 32768.0 ? 32768 : (int)w);
+    }
     if (!scene.camera_set)
         rt_scene_frame_camera(&scene);
 

@@ -44,6 +44,7 @@ typedef struct rt_camera {
     float vfov_deg;       /* vertical field of view, degrees */
     float aperture;       /* lens diameter; 0 = pinhole */
     float focus_distance; /* 0 = distance from position to look_at */
+    float aspect_ratio;   /* width / height the camera was made for (glTF); 0 = none, follow the image */
 } rt_camera;
 
 typedef enum rt_integrator {
@@ -58,6 +59,7 @@ typedef struct rt_settings {
     int samples;          /* samples per pixel (stratified when a square) */
     rt_integrator integrator;
     int max_bounce;       /* mirror/refraction recursion depth */
+    int max_depth;        /* path: most scattering events a path may have; 0 = unlimited (Russian roulette ends paths) */
     int diffuse_bounces;  /* levels of indirect diffuse light (whitted) */
     int diffuse_rays;     /* cosine-distributed rays per diffuse level */
     int shadow_samples;   /* samples per area light per shading point */
@@ -119,6 +121,11 @@ typedef struct rt_texture_slot {
 
 typedef enum rt_alpha_mode { RT_ALPHA_OPAQUE = 0, RT_ALPHA_MASK, RT_ALPHA_BLEND } rt_alpha_mode;
 
+/* The path tracer's scattering model (docs/path-tracer.md): the glTF
+ * metallic-roughness BRDF (the default, zero) or a pure Lambertian
+ * albedo / pi with no specular lobe (`bsdf lambert`). */
+typedef enum rt_bsdf_model { RT_BSDF_GLTF = 0, RT_BSDF_LAMBERT } rt_bsdf_model;
+
 /* One material table for every source. The Phong fields drive the whitted
  * integrator; the PBR fields drive the path tracer; colour, textures,
  * reflection and transmission are read by both. rt_material_default() gives
@@ -144,6 +151,7 @@ typedef struct rt_material {
     float alpha_cutoff;
     bool double_sided;
     bool unlit;
+    rt_bsdf_model bsdf;     /* path tracer: glTF metallic-roughness (default) or pure Lambert */
     float thickness;        /* KHR_materials_volume */
     rt_vec3 attenuation_color;
     float attenuation_distance; /* INFINITY = no absorption */
