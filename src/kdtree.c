@@ -36,9 +36,11 @@
  * sorted and merged in. Hence O(N log N) overall. The root lists are sorted
  * by an LSD radix sort on 64-bit event keys (position bits, type, primitive).
  * With more than one build thread (params->threads; default one per online
- * CPU) the subtrees below depth 5 are built as independent tasks by a pool
- * of threads and spliced into place afterwards: the tree is bit-identical
- * for any thread count.
+ * CPU) the top levels fork: a below child's subtree is built by a new
+ * thread into its own arrays while the above child is built here, down to
+ * about 4 concurrent subtrees per thread, and the pieces are spliced into
+ * depth-first order afterwards: the tree is bit-identical for any thread
+ * count.
  *
  * Layout: 8-byte nodes in depth-first order (below child = next node, above
  * child index in the node; see kdtree.h), leaf ids in one array, triangles as
@@ -72,7 +74,6 @@
 
 #include <math.h>
 #include <pthread.h>
-#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -218,10 +219,12 @@ static int clip_plane(double (*in)[3], int n, double (*out)[3], int k, double c,
 
 /* ------------------------------------------------------------- build */
 
-/* The subtree builds below a fixed depth are independent tasks, run on
- * `threads` workers and stitched together in depth-first order afterwards,
- * so the tree is identical for any number of threads. */
-typedef struct kd_task kd_task;
+/* Parallel build: near the root (depth < fork_depth) the below child's
+ * subtree is handed to a new thread, building into its own arrays, while
+ * this thread builds the above child; the parent keeps a placeholder node
+ * that is replaced by the subtree when everything is stitched together in
+ * depth-first order. So the tree is identical for any number of threads. */
+typedef struct kd_fork kd_fork;
 
 typedef struct kd_build {
     const rt_scene *s;
@@ -237,22 +240,22 @@ typedef struct kd_build {
     size_t id_count, id_cap;
     rt_kdtree_stats st;
     bool oom, limit; /* limit: the tree outgrew the node format (reported as RT_ERR_LIMIT) */
-    /* top-level builder only: subtrees at task_depth become tasks */
-    int task_depth;
-    size_t task_min_prims;
-    kd_task *tasks;
-    size_t task_count, task_cap;
+    int fork_depth;       /* fork below children above this depth */
+    size_t fork_min;      /* ... of at least this many primitives */
+    size_t nprims_total;  /* length of a side array */
+    kd_fork **forks;      /* subtrees built by other threads (stable addresses) */
+    size_t fork_count, fork_cap;
 } kd_build;
 
-struct kd_task {
+struct kd_fork {
+    kd_build out; /* the subtree's nodes, ids, stats and its own forks */
     rt_box V;
     uint64_t *ev;
     size_t cnt[3], nprims;
     int depth;
-    kd_build out; /* the subtree's nodes, ids and stats */
 };
 
-#define TASK_MARK (LEAF_TAG | (0x3fffffffu << 2)) /* placeholder leaf: a = task index */
+#define TASK_MARK (LEAF_TAG | (0x3fffffffu << 2)) /* placeholder leaf: a = fork index */
 
 static inline float *box_lo(rt_box *b) { return &b->lo.x; }
 static inline float *box_hi(rt_box *b) { return &b->hi.x; }
@@ -489,24 +492,8 @@ static double find_plane(const kd_build *c, rt_box V, uint64_t *const list[3], c
 
 static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t nprims, int depth);
 
-/* Records the subtree as a task; its node here is a placeholder. */
-static void make_task(kd_build *c, uint32_t node, rt_box V, uint64_t *ev, size_t cnt[3], size_t nprims, int depth)
-{
-    if (!rt_grow((void **)&c->tasks, &c->task_cap, c->task_count + 1, sizeof *c->tasks)) {
-        c->oom = true;
-        free(ev);
-        return;
-    }
-    kd_task *t = &c->tasks[c->task_count];
-    memset(t, 0, sizeof *t);
-    t->V = V;
-    t->ev = ev;
-    memcpy(t->cnt, cnt, sizeof t->cnt);
-    t->nprims = nprims;
-    t->depth = depth;
-    c->nodes[node].a = (uint32_t)c->task_count++;
-    c->nodes[node].b = TASK_MARK;
-}
+static void *fork_worker(void *arg);
+static void free_forks(kd_build *c);
 
 /* Builds the subtree of box V from its event lists (one block `ev`, lists of
  * cnt[0], cnt[1], cnt[2] events, owned and freed here) over nprims prims. */
@@ -515,10 +502,6 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
     uint32_t node = push_node(c);
     if (c->oom) {
         free(ev);
-        return;
-    }
-    if (c->task_depth > 0 && depth == c->task_depth && nprims >= c->task_min_prims) {
-        make_task(c, node, V, ev, cnt, nprims, depth);
         return;
     }
     uint64_t *list[3] = {ev, ev + cnt[0], ev + cnt[0] + cnt[1]};
@@ -651,6 +634,53 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
     if (ro < rcap && (t = realloc(rev, (ro ? ro : 1) * sizeof *rev)) != NULL)
         rev = t;
 
+    kd_fork *f = NULL;
+    if (depth < c->fork_depth && left_prims >= c->fork_min &&
+        rt_grow((void **)&c->forks, &c->fork_cap, c->fork_count + 1, sizeof *c->forks) &&
+        (f = calloc(1, sizeof *f)) != NULL) {
+        uint32_t ph = push_node(c);
+        if (c->oom) {
+            free(f);
+            free(lev);
+            free(rev);
+            return;
+        }
+        c->nodes[ph].a = (uint32_t)c->fork_count;
+        c->nodes[ph].b = TASK_MARK;
+        c->forks[c->fork_count++] = f;
+        kd_build *o = &f->out;
+        o->s = c->s;
+        o->T = c->T, o->S = c->S, o->Q = c->Q;
+        o->kt = c->kt, o->ki = c->ki, o->lambda = c->lambda;
+        o->max_depth = c->max_depth;
+        o->fork_depth = c->fork_depth, o->fork_min = c->fork_min, o->nprims_total = c->nprims_total;
+        f->V = VL;
+        f->ev = lev;
+        memcpy(f->cnt, lc, sizeof f->cnt);
+        f->nprims = left_prims;
+        f->depth = depth + 1;
+        pthread_t th;
+        bool started = pthread_create(&th, NULL, fork_worker, f) == 0;
+        if (!started)
+            fork_worker(f);
+        uint32_t above = (uint32_t)c->node_count;
+        build_rec(c, VR, rev, rc, right_prims, depth + 1);
+        if (started)
+            pthread_join(th, NULL);
+        if (f->out.oom) {
+            c->oom = true;
+            c->limit |= f->out.limit;
+        }
+        if (c->oom)
+            return;
+        uint32_t bits;
+        memcpy(&bits, &split, 4);
+        c->nodes[node].a = bits;
+        bool below_empty = f->out.node_count == 1 && f->out.nodes[0].b == LEAF_TAG;
+        uint32_t flags = (below_empty ? KD_BELOW_EMPTY : 0u) | (c->nodes[above].b == LEAF_TAG ? KD_ABOVE_EMPTY : 0u);
+        c->nodes[node].b = (uint32_t)k | flags | (above << 4);
+        return;
+    }
     build_rec(c, VL, lev, lc, left_prims, depth + 1);
     if (c->oom) {
         free(rev);
@@ -669,121 +699,74 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
     c->nodes[node].b = (uint32_t)k | flags | (above << 4);
 }
 
-/* ---------------------------------------------------- parallel tasks */
+/* ---------------------------------------------------- parallel build */
 
-typedef struct kd_pool {
-    kd_build *top;
-    size_t *order; /* task indices, largest first */
-    atomic_size_t next;
-    size_t nprims_total;
-} kd_pool;
-
-static void *task_worker(void *arg)
+static void *fork_worker(void *arg)
 {
-    kd_pool *pool = arg;
-    kd_build *top = pool->top;
-    uint8_t *side = malloc(pool->nprims_total ? pool->nprims_total : 1);
-    uint32_t *strad = NULL;
-    size_t strad_cap = 0;
-    for (;;) {
-        size_t i = atomic_fetch_add(&pool->next, 1);
-        if (i >= top->task_count)
-            break;
-        kd_task *t = &top->tasks[pool->order[i]];
-        kd_build *c = &t->out;
-        c->s = top->s;
-        c->T = top->T, c->S = top->S, c->Q = top->Q;
-        c->kt = top->kt, c->ki = top->ki, c->lambda = top->lambda;
-        c->max_depth = top->max_depth;
-        if (!side) {
-            c->oom = true;
-            free(t->ev);
-            t->ev = NULL;
-            continue;
-        }
-        c->side = side;
-        c->strad = strad;
-        c->strad_cap = strad_cap;
-        build_rec(c, t->V, t->ev, t->cnt, t->nprims, t->depth);
-        t->ev = NULL;
-        strad = c->strad;
-        strad_cap = c->strad_cap;
-        c->side = NULL;
-        c->strad = NULL;
+    kd_fork *f = arg;
+    kd_build *c = &f->out;
+    c->side = malloc(c->nprims_total ? c->nprims_total : 1);
+    if (!c->side) {
+        c->oom = true;
+        free(f->ev);
+    } else {
+        build_rec(c, f->V, f->ev, f->cnt, f->nprims, f->depth);
     }
-    free(side);
-    free(strad);
+    f->ev = NULL;
+    free(c->side);
+    free(c->strad);
+    c->side = NULL;
+    c->strad = NULL;
+    c->strad_cap = 0;
     return NULL;
 }
 
-
-/* Runs every task on `threads` workers (the calling thread is one). */
-static bool run_tasks(kd_build *top, int threads, size_t nprims_total)
+static void free_forks(kd_build *c)
 {
-    if (top->task_count == 0)
-        return true;
-    size_t *order = malloc(top->task_count * sizeof *order);
-    if (!order)
-        return false;
-    for (size_t i = 0; i < top->task_count; i++)
-        order[i] = i;
-    /* largest first: a simple longest-processing-time schedule */
-    for (size_t i = 1; i < top->task_count; i++) {
-        size_t x = order[i], j = i;
-        while (j > 0 && top->tasks[order[j - 1]].nprims < top->tasks[x].nprims) {
-            order[j] = order[j - 1];
-            j--;
-        }
-        order[j] = x;
+    for (size_t i = 0; i < c->fork_count; i++) {
+        kd_fork *f = c->forks[i];
+        free_forks(&f->out);
+        free(f->ev);
+        free(f->out.nodes);
+        free(f->out.ids);
+        free(f);
     }
-    kd_pool pool;
-    pool.top = top;
-    pool.order = order;
-    pool.nprims_total = nprims_total;
-    atomic_init(&pool.next, 0);
-    pthread_t th[64];
-    int started = 0;
-    for (int i = 1; i < threads && i < 64; i++)
-        if (pthread_create(&th[started], NULL, task_worker, &pool) == 0)
-            started++;
-    task_worker(&pool);
-    for (int i = 0; i < started; i++)
-        pthread_join(th[i], NULL);
-    free(order);
-    bool ok = true;
-    for (size_t i = 0; i < top->task_count; i++)
-        if (top->tasks[i].out.oom) {
-            ok = false;
-            top->limit |= top->tasks[i].out.limit;
-        }
-    return ok;
+    free(c->forks);
+    c->forks = NULL;
+    c->fork_count = c->fork_cap = 0;
 }
 
-/* Copies the top tree into (nodes, ids) in depth-first order, splicing each
- * task's subtree in place of its placeholder. Returns the next top node. */
-static size_t stitch(const kd_build *top, size_t i, rt_kdtree_node *nodes, size_t *nn, uint32_t *ids, size_t *ni)
+/* Sizes and stats of a builder with all its forks. */
+static void sum_forks(const kd_build *c, size_t *nodes, size_t *ids, rt_kdtree_stats *st, bool top)
 {
-    rt_kdtree_node nd = top->nodes[i];
+    *nodes += c->node_count - c->fork_count;
+    *ids += c->id_count;
+    if (!top) {
+        st->leaves += c->st.leaves;
+        st->empty_leaves += c->st.empty_leaves;
+        st->prim_refs += c->st.prim_refs;
+        if (c->st.max_leaf_prims > st->max_leaf_prims)
+            st->max_leaf_prims = c->st.max_leaf_prims;
+        if (c->st.depth > st->depth)
+            st->depth = c->st.depth;
+    }
+    for (size_t i = 0; i < c->fork_count; i++)
+        sum_forks(&c->forks[i]->out, nodes, ids, st, false);
+}
+
+/* Copies the subtree at node i of builder b into (nodes, ids) in
+ * depth-first order, splicing forked subtrees in place of their
+ * placeholders. Returns the index in b after the subtree. */
+static size_t stitch(const kd_build *b, size_t i, rt_kdtree_node *nodes, size_t *nn, uint32_t *ids, size_t *ni)
+{
+    rt_kdtree_node nd = b->nodes[i];
     if (nd.b == TASK_MARK) {
-        const kd_build *o = &top->tasks[nd.a].out;
-        size_t base = *nn, idbase = *ni;
-        for (size_t j = 0; j < o->node_count; j++) {
-            rt_kdtree_node x = o->nodes[j];
-            if ((x.b & 3u) != LEAF_TAG)
-                x.b += (uint32_t)base << 4;
-            else if ((x.b >> 2) > 1)
-                x.a += (uint32_t)idbase;
-            nodes[base + j] = x;
-        }
-        if (o->id_count)
-            memcpy(ids + idbase, o->ids, o->id_count * sizeof *ids);
-        *nn += o->node_count;
-        *ni += o->id_count;
+        stitch(&b->forks[nd.a]->out, 0, nodes, nn, ids, ni);
         return i + 1;
     }
     if ((nd.b & 3u) == LEAF_TAG) {
         if ((nd.b >> 2) > 1) {
-            memcpy(ids + *ni, top->ids + nd.a, (nd.b >> 2) * sizeof *ids);
+            memcpy(ids + *ni, b->ids + nd.a, (nd.b >> 2) * sizeof *ids);
             nd.a = (uint32_t)*ni;
             *ni += nd.b >> 2;
         }
@@ -791,35 +774,12 @@ static size_t stitch(const kd_build *top, size_t i, rt_kdtree_node *nodes, size_
         return i + 1;
     }
     size_t me = (*nn)++;
-    stitch(top, i + 1, nodes, nn, ids, ni);
+    stitch(b, i + 1, nodes, nn, ids, ni);
     uint32_t above = (uint32_t)*nn;
-    size_t next = stitch(top, nd.b >> 4, nodes, nn, ids, ni);
+    size_t next = stitch(b, nd.b >> 4, nodes, nn, ids, ni);
     nodes[me].a = nd.a;
     nodes[me].b = (nd.b & 15u) | (above << 4);
     return next;
-}
-
-static void add_stats(rt_kdtree_stats *a, const rt_kdtree_stats *b)
-{
-    a->leaves += b->leaves;
-    a->empty_leaves += b->empty_leaves;
-    a->prim_refs += b->prim_refs;
-    if (b->max_leaf_prims > a->max_leaf_prims)
-        a->max_leaf_prims = b->max_leaf_prims;
-    if (b->depth > a->depth)
-        a->depth = b->depth;
-}
-
-static void free_tasks(kd_build *c)
-{
-    for (size_t i = 0; i < c->task_count; i++) {
-        free(c->tasks[i].ev);
-        free(c->tasks[i].out.nodes);
-        free(c->tasks[i].out.ids);
-    }
-    free(c->tasks);
-    c->tasks = NULL;
-    c->task_count = c->task_cap = 0;
 }
 
 static double now_ms(void)
@@ -830,6 +790,20 @@ static double now_ms(void)
 }
 
 static bool finite_box(rt_box b) { return rt_finite3(b.lo) && rt_finite3(b.hi); }
+
+typedef struct kd_sort_job {
+    uint64_t *list[2];
+    size_t cnt[2];
+    uint64_t *tmp;
+} kd_sort_job;
+
+static void *sort_worker(void *arg)
+{
+    kd_sort_job *j = arg;
+    ev_sort(j->list[0], j->cnt[0], j->tmp);
+    ev_sort(j->list[1], j->cnt[1], j->tmp);
+    return NULL;
+}
 
 rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
 {
@@ -857,6 +831,11 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     if (eb > 1.0)
         eb = 1.0;
     c.lambda = 1.0 - eb;
+    int threads = params && params->threads > 0 ? params->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    if (threads < 1)
+        threads = 1;
+    if (threads > 64)
+        threads = 64;
 
     uint64_t *ev = NULL, *tmp = NULL;
     if (T > 0) {
@@ -948,8 +927,22 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     tmp = malloc((nvalid ? 2 * nvalid : 1) * sizeof *tmp);
     if (!tmp)
         goto oom;
-    for (int k = 0; k < 3; k++)
-        ev_sort(list[k], cnt[k], tmp);
+    {
+        /* the three axes sort independently: y and z on a helper thread */
+        kd_sort_job job = {{list[1], list[2]}, {cnt[1], cnt[2]}, NULL};
+        pthread_t th;
+        bool started = false;
+        if (threads > 1 && nvalid >= 20000 && (job.tmp = malloc(2 * nvalid * sizeof *job.tmp)) != NULL)
+            started = pthread_create(&th, NULL, sort_worker, &job) == 0;
+        ev_sort(list[0], cnt[0], tmp);
+        if (started) {
+            pthread_join(th, NULL);
+        } else {
+            ev_sort(list[1], cnt[1], tmp);
+            ev_sort(list[2], cnt[2], tmp);
+        }
+        free(job.tmp);
+    }
     free(tmp);
     tmp = NULL;
     /* compact the three lists into one block */
@@ -968,28 +961,22 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     c.max_depth = md;
     tree->max_depth = md;
 
-    int threads = params && params->threads > 0 ? params->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
-    if (threads < 1)
-        threads = 1;
-    if (threads > 64)
-        threads = 64;
     if (threads > 1 && nvalid >= 20000) {
-        c.task_depth = 5; /* up to 32 subtrees */
-        c.task_min_prims = 2048;
+        /* 4 subtrees per thread: the OS evens out uneven halves */
+        int f = 2;
+        while ((1 << (f - 2)) < threads && f < 8)
+            f++;
+        c.fork_depth = f;
+        c.fork_min = 4096;
+        c.nprims_total = N;
     }
     build_rec(&c, tree->bounds, ev, cnt, nvalid, 0);
     ev = NULL;
     if (c.oom)
         goto oom;
-    if (c.task_count > 0) {
-        if (!run_tasks(&c, threads, N))
-            goto oom;
-        size_t nn = c.node_count - c.task_count, ni = c.id_count;
-        for (size_t i = 0; i < c.task_count; i++) {
-            nn += c.tasks[i].out.node_count;
-            ni += c.tasks[i].out.id_count;
-            add_stats(&c.st, &c.tasks[i].out.st);
-        }
+    if (c.fork_count > 0) {
+        size_t nn = 0, ni = 0;
+        sum_forks(&c, &nn, &ni, &c.st, true);
         if (nn >= ((size_t)1 << KD_INDEX_BITS) || ni > KD_MAX_IDS) {
             c.limit = true;
             goto oom;
@@ -1003,7 +990,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
         }
         size_t on = 0, oi = 0;
         stitch(&c, 0, nodes, &on, ids, &oi);
-        free_tasks(&c);
+        free_forks(&c);
         free(c.nodes);
         free(c.ids);
         c.nodes = nodes;
@@ -1024,7 +1011,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     return RT_OK;
 
 oom:
-    free_tasks(&c);
+    free_forks(&c);
     free(ev);
     free(tmp);
     free(c.side);
