@@ -10,6 +10,7 @@
  */
 #include "rt/integrator.h"
 
+#include "rt/path.h"
 #include "rt/whitted.h"
 
 rt_vec3 rt_direct_lambert(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 albedo, rt_rng *rng)
@@ -86,6 +87,8 @@ rt_vec3 rt_radiance(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng)
     switch (ctx->scene->settings.integrator) {
     case RT_INTEGRATOR_WHITTED:
         return rt_radiance_whitted(ctx, ray, rng);
+    case RT_INTEGRATOR_PATH:
+        return rt_radiance_path(ctx, ray, rng);
     case RT_INTEGRATOR_DIRECT:
     default:
         return rt_radiance_direct(ctx, ray, rng);

@@ -10,9 +10,9 @@
  * whitted  Phong, mirrors, refraction with exact Fresnel through nested
  *          media, shadows through glass, diffuse bounces (whitted.c,
  *          rt/whitted.h; the model is specified in docs/shading.md).
- * path     physically based path tracing of glTF materials (path.c).
- *
- * An integrator that is not built yet falls back to `direct`.
+ * path     physically based path tracing of glTF materials with
+ *          next-event estimation and MIS (path.c, rt/path.h,
+ *          docs/path-tracer.md).
  */
 #ifndef RT_INTEGRATOR_H
 #define RT_INTEGRATOR_H

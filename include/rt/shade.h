@@ -34,6 +34,10 @@ typedef struct rt_trace_ctx {
     bool shadows_need_shading; /* some material is transmissive or alpha-tested */
     rt_vec3 ambient;          /* whitted ambient radiance (settings.ambient_light or the environment's mean) */
     uint64_t *ray_count;      /* per-thread counter of rays traced */
+    /* path tracer: the scene's emitter table (rt/path.h), built once before
+     * the workers start and shared read-only; NULL (rt_trace_ctx_init's
+     * value) = emissive primitives are found by BSDF sampling only */
+    const struct rt_light_table *light_table;
 } rt_trace_ctx;
 
 void rt_trace_ctx_init(rt_trace_ctx *ctx, const rt_scene *scene, const rt_kdtree *tree);

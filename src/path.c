@@ -1,0 +1,459 @@
+/* path.c - the `path` integrator: unidirectional path tracing with
+ * next-event estimation and multiple importance sampling.
+ *
+ * Estimator (Kajiya 1986, "The Rendering Equation"; the structure of pbrt
+ * v3's PathIntegrator, Pharr, Jakob, Humphreys, ch. 14.5): from the camera,
+ * at each surface vertex x with throughput beta,
+ *   - emission seen along the ray is added, beta Le, weighted by MIS
+ *     against light sampling when the emitter could have been light-sampled
+ *     from the previous vertex;
+ *   - next-event estimation: every rt_light is sampled once (area lights
+ *     uniformly by area, pdf d^2 / (A cos theta_l); point, spot and
+ *     directional lights are deltas, weight 1), and, with a light table,
+ *     one emissive primitive chosen in proportion to its power (area x mean
+ *     emitted radiance) and a uniform point on it;
+ *   - the BSDF (rt/bsdf.h) samples the next direction, beta *= f cos / pdf.
+ * Light and BSDF samples are combined with the power heuristic (Veach 1997,
+ * "Robust Monte Carlo Methods for Light Transport Simulation", ch. 9,
+ * beta = 2), so a BSDF-sampled ray that hits a light counts with weight
+ * pdf_bsdf^2 / (pdf_bsdf^2 + pdf_light^2) and the light sample with the
+ * complement. Emitters that are not light-sampled (emissive primitives
+ * without a table, the environment) count in full on BSDF hits.
+ *
+ * Russian roulette (Arvo and Kirk 1990) from RT_PATH_RR_START bounces: the
+ * path survives with q = min(max channel of beta, 0.95) and beta /= q, which
+ * keeps the estimator unbiased. settings.max_depth caps the scattering
+ * events of a path (0 = no cap).
+ *
+ * Area lights are pure emitters: their visible quad emits from its front
+ * and reflects nothing. Shadow rays pass alpha cut-outs and blended
+ * surfaces (times 1 - alpha); refractive (transmissive) surfaces block them,
+ * light through glass arrives by BSDF sampling. Alpha blending on camera
+ * and bounce rays is stochastic: the surface is kept with probability alpha.
+ * All random numbers come from the rng handed in, so images do not depend
+ * on the thread count; every contribution is checked finite.
+ */
+#include "rt/path.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "rt/bsdf.h"
+
+/* ------------------------------------------------------------ light table */
+
+static bool emissive_material(const rt_scene *s, uint32_t m, float *power)
+{
+    if (m >= s->material_count)
+        return false;
+    const rt_material *mt = &s->materials[m];
+    rt_vec3 e = rt_scale(mt->emission, mt->emission_strength);
+    float p = (e.x + e.y + e.z) * (1.0f / 3.0f);
+    if (!(p > 0.0f) || !isfinite(p))
+        return false;
+    *power = mt->double_sided ? 2.0f * p : p;
+    return true;
+}
+
+static float prim_area(const rt_scene *s, uint32_t prim)
+{
+    uint32_t i;
+    switch (rt_prim_kind_of(s, prim, &i)) {
+    case RT_PRIM_TRIANGLE: {
+        rt_vec3 a = rt_tri_vertex(s, i, 0), b = rt_tri_vertex(s, i, 1), c = rt_tri_vertex(s, i, 2);
+        return 0.5f * rt_length(rt_cross(rt_sub(b, a), rt_sub(c, a)));
+    }
+    case RT_PRIM_SPHERE: {
+        float r = s->spheres.radius[i];
+        return 4.0f * RT_PI * r * r;
+    }
+    case RT_PRIM_QUAD:
+    default: {
+        const rt_quads *q = &s->quads;
+        rt_vec3 u = rt_v3(q->ux[i], q->uy[i], q->uz[i]), v = rt_v3(q->vx[i], q->vy[i], q->vz[i]);
+        return rt_length(rt_cross(u, v));
+    }
+    }
+}
+
+static uint32_t prim_material_of(const rt_scene *s, uint32_t prim)
+{
+    uint32_t i;
+    switch (rt_prim_kind_of(s, prim, &i)) {
+    case RT_PRIM_TRIANGLE: return s->triangles.material[i];
+    case RT_PRIM_SPHERE: return s->spheres.material[i];
+    case RT_PRIM_QUAD:
+    default: return s->quads.material[i];
+    }
+}
+
+void rt_light_table_free(rt_light_table *t)
+{
+    if (!t)
+        return;
+    free(t->prim);
+    free(t->cdf);
+    free(t->area);
+    free(t->prim_pdf);
+    free(t->quad_light);
+    memset(t, 0, sizeof *t);
+}
+
+rt_result rt_light_table_build(rt_light_table *t, const rt_scene *s, rt_error *err)
+{
+    memset(t, 0, sizeof *t);
+    size_t np = rt_scene_prim_count(s), nq = s->quads.count;
+    t->prim_count = np;
+    t->quad_count = nq;
+    t->prim_pdf = rt_alloc(np ? np : 1, sizeof *t->prim_pdf);
+    t->quad_light = rt_alloc(nq ? nq : 1, sizeof *t->quad_light);
+    if (!t->prim_pdf || !t->quad_light)
+        goto nomem;
+    for (size_t q = 0; q < nq; q++)
+        t->quad_light[q] = RT_NONE;
+    for (size_t l = 0; l < s->light_count; l++)
+        if (s->lights[l].kind == RT_LIGHT_AREA && s->lights[l].quad < nq)
+            t->quad_light[s->lights[l].quad] = (uint32_t)l;
+    size_t quad0 = s->triangles.count + s->spheres.count;
+    size_t n = 0;
+    for (size_t p = 0; p < np; p++) {
+        float pw;
+        if (p >= quad0 && t->quad_light[p - quad0] != RT_NONE)
+            continue;
+        if (emissive_material(s, prim_material_of(s, (uint32_t)p), &pw) && prim_area(s, (uint32_t)p) > 0.0f)
+            n++;
+    }
+    t->count = n;
+    if (n == 0)
+        return RT_OK;
+    t->prim = rt_alloc(n, sizeof *t->prim);
+    t->cdf = rt_alloc(n, sizeof *t->cdf);
+    t->area = rt_alloc(n, sizeof *t->area);
+    double *w = rt_alloc(n, sizeof *w);
+    if (!t->prim || !t->cdf || !t->area || !w) {
+        free(w);
+        goto nomem;
+    }
+    double total = 0.0;
+    size_t k = 0;
+    for (size_t p = 0; p < np && k < n; p++) {
+        float pw, a;
+        if (p >= quad0 && t->quad_light[p - quad0] != RT_NONE)
+            continue;
+        if (!emissive_material(s, prim_material_of(s, (uint32_t)p), &pw) || !((a = prim_area(s, (uint32_t)p)) > 0.0f))
+            continue;
+        t->prim[k] = (uint32_t)p;
+        t->area[k] = a;
+        w[k] = (double)pw * (double)a;
+        if (!isfinite(w[k]))
+            w[k] = 0.0;
+        total += w[k];
+        k++;
+    }
+    t->count = k;
+    if (!(total > 0.0) || !isfinite(total)) { /* nothing usable: behave as without a table */
+        free(w);
+        t->count = 0;
+        return RT_OK;
+    }
+    double acc = 0.0;
+    for (size_t i = 0; i < k; i++) {
+        acc += w[i];
+        t->cdf[i] = (float)(acc / total);
+        t->prim_pdf[t->prim[i]] = (float)(w[i] / total / (double)t->area[i]);
+    }
+    t->cdf[k - 1] = 1.0f;
+    free(w);
+    return RT_OK;
+nomem:
+    rt_light_table_free(t);
+    return rt_fail(err, RT_ERR_NOMEM, "out of memory building the emitter table (%zu primitives)", np);
+}
+
+/* Index of the first cdf entry above u. */
+static size_t table_pick(const rt_light_table *t, float u)
+{
+    size_t lo = 0, hi = t->count - 1;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (t->cdf[mid] > u)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    return lo;
+}
+
+/* --------------------------------------------------------------- helpers */
+
+/* The area light whose visible quad primitive `prim` is, or RT_NONE. */
+static uint32_t light_of_prim(const rt_trace_ctx *ctx, uint32_t prim)
+{
+    const rt_scene *s = ctx->scene;
+    uint32_t q;
+    if (rt_prim_kind_of(s, prim, &q) != RT_PRIM_QUAD)
+        return RT_NONE;
+    const rt_light_table *t = ctx->light_table;
+    if (t && q < t->quad_count)
+        return t->quad_light[q];
+    for (size_t i = 0; i < s->light_count; i++)
+        if (s->lights[i].kind == RT_LIGHT_AREA && s->lights[i].quad == q)
+            return (uint32_t)i;
+    return RT_NONE;
+}
+
+/* Solid-angle pdf of sampling area light l towards direction d (unit) from
+ * a point at distance dist; 0 when seen from behind. */
+static float area_light_pdf(const rt_light *l, rt_vec3 d, float dist)
+{
+    rt_vec3 nl = rt_cross(l->edge_u, l->edge_v);
+    float area = rt_length(nl);
+    if (!(area > 0.0f))
+        return 0.0f;
+    float cos_l = -rt_dot(nl, d) / area;
+    if (!(cos_l > 0.0f))
+        return 0.0f;
+    float p = dist * dist / (area * cos_l);
+    return isfinite(p) ? p : 0.0f;
+}
+
+/* Fraction of light that reaches sf->p from distance dist along wi:
+ * 0 behind opaque or refractive surfaces, through alpha cut-outs, scaled by
+ * 1 - alpha through blended surfaces. */
+static float visibility(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
+{
+    rt_vec3 o = rt_surface_spawn(ctx, sf, wi);
+    float tmax = isfinite(dist) ? dist * (1.0f - 1e-4f) : INFINITY;
+    rt_ray r = rt_ray_make(o, wi, 0.0f, tmax);
+    if (ctx->ray_count)
+        (*ctx->ray_count)++;
+    if (!ctx->shadows_need_shading)
+        return rt_kdtree_occluded(ctx->tree, &r) ? 0.0f : 1.0f;
+    const rt_scene *s = ctx->scene;
+    float v = 1.0f;
+    for (int layer = 0; layer < 64; layer++) {
+        rt_hit h;
+        if (!rt_kdtree_intersect(ctx->tree, &r, &h))
+            return v;
+        uint32_t mi = prim_material_of(s, h.prim);
+        const rt_material *m = mi < s->material_count ? &s->materials[mi] : NULL;
+        if (!m || (m->alpha_mode == RT_ALPHA_OPAQUE))
+            return 0.0f;
+        rt_surface s2;
+        rt_surface_at(ctx, &r, &h, &s2);
+        float coverage;
+        if (!rt_surface_cut_away(ctx, &s2, &coverage)) {
+            if (m->transmission > 0.0f || coverage >= 1.0f)
+                return 0.0f;
+            v *= 1.0f - coverage;
+        }
+        if (!(v > 0.0f))
+            return 0.0f;
+        r.tmin = h.t;
+    }
+    return 0.0f;
+}
+
+static inline rt_vec3 add_finite(rt_vec3 acc, rt_vec3 c)
+{
+    return rt_finite3(c) ? rt_add(acc, rt_vmax(c, rt_v3s(0.0f))) : acc;
+}
+
+/* Light sampled at one vertex: sum over rt_lights plus one table emitter,
+ * each f cos Le / pdf_light times its MIS weight. */
+static rt_vec3 next_event(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo,
+                          rt_rng *rng)
+{
+    const rt_scene *s = ctx->scene;
+    rt_vec3 sum = rt_v3s(0.0f);
+    for (size_t i = 0; i < s->light_count; i++) {
+        const rt_light *l = &s->lights[i];
+        rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
+        rt_light_sample ls;
+        if (!rt_light_sample_at(ctx, l, sf->p, u, &ls))
+            continue;
+        if (!(rt_dot(ls.wi, b->ng) > 0.0f))
+            continue; /* below the geometric surface */
+        rt_vec3 wi = rt_bsdf_to_local(b, ls.wi);
+        float pdf_b;
+        rt_vec3 f = rt_bsdf_eval(b, wo, wi, &pdf_b);
+        if (!(rt_max3(f) > 0.0f))
+            continue;
+        float w = 1.0f;
+        if (l->kind == RT_LIGHT_AREA && l->quad != RT_NONE)
+            w = rt_mis_power(area_light_pdf(l, ls.wi, ls.dist), pdf_b);
+        if (!(w > 0.0f))
+            continue;
+        float vis = visibility(ctx, sf, ls.wi, ls.dist);
+        if (!(vis > 0.0f))
+            continue;
+        sum = add_finite(sum, rt_scale(rt_mul(f, ls.li), wi.z * vis * w));
+    }
+    const rt_light_table *t = ctx->light_table;
+    if (t && t->count) {
+        float ul = rt_rng_float(rng);
+        rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
+        size_t k = table_pick(t, ul);
+        uint32_t prim = t->prim[k], local;
+        rt_hit h;
+        h.prim = prim;
+        rt_vec3 q;
+        switch (rt_prim_kind_of(s, prim, &local)) {
+        case RT_PRIM_TRIANGLE: {
+            float su = sqrtf(u.x);
+            h.u = u.y * su;        /* weight of vertex 1 */
+            h.v = 1.0f - su;       /* weight of vertex 2 */
+            rt_vec3 a = rt_tri_vertex(s, local, 0), bb = rt_tri_vertex(s, local, 1), c = rt_tri_vertex(s, local, 2);
+            q = rt_add(rt_add(rt_scale(a, 1.0f - h.u - h.v), rt_scale(bb, h.u)), rt_scale(c, h.v));
+            break;
+        }
+        case RT_PRIM_SPHERE: {
+            float z = 1.0f - 2.0f * u.x, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * RT_PI * u.y;
+            const rt_spheres *sp = &s->spheres;
+            q = rt_madd(rt_v3(sp->cx[local], sp->cy[local], sp->cz[local]),
+                        rt_v3(r * cosf(phi), r * sinf(phi), z), fabsf(sp->radius[local]));
+            h.u = h.v = 0.0f;
+            break;
+        }
+        case RT_PRIM_QUAD:
+        default: {
+            const rt_quads *qd = &s->quads;
+            h.u = u.x;
+            h.v = u.y;
+            q = rt_add(rt_v3(qd->px[local], qd->py[local], qd->pz[local]),
+                       rt_add(rt_scale(rt_v3(qd->ux[local], qd->uy[local], qd->uz[local]), u.x),
+                              rt_scale(rt_v3(qd->vx[local], qd->vy[local], qd->vz[local]), u.y)));
+            break;
+        }
+        }
+        rt_vec3 d = rt_sub(q, sf->p);
+        float d2 = rt_length2(d);
+        if (d2 > 0.0f && isfinite(d2)) {
+            float dist = sqrtf(d2);
+            rt_vec3 wdir = rt_scale(d, 1.0f / dist);
+            h.t = dist;
+            rt_ray r = rt_ray_make(sf->p, wdir, 0.0f, INFINITY);
+            rt_surface se;
+            rt_surface_at(ctx, &r, &h, &se);
+            float cos_l = fabsf(rt_dot(se.ng, wdir));
+            rt_vec3 Le = rt_surface_emission(ctx, &se);
+            float pdf_l = t->prim_pdf[prim] * d2 / cos_l;
+            if (rt_max3(Le) > 0.0f && cos_l > 0.0f && pdf_l > 0.0f && isfinite(pdf_l) &&
+                rt_dot(wdir, b->ng) > 0.0f) {
+                rt_vec3 wi = rt_bsdf_to_local(b, wdir);
+                float pdf_b;
+                rt_vec3 f = rt_bsdf_eval(b, wo, wi, &pdf_b);
+                float w = rt_mis_power(pdf_l, pdf_b);
+                if (rt_max3(f) > 0.0f && w > 0.0f) {
+                    float vis = visibility(ctx, sf, wdir, dist);
+                    if (vis > 0.0f)
+                        sum = add_finite(sum, rt_scale(rt_mul(f, Le), wi.z * vis * w / pdf_l));
+                }
+            }
+        }
+    }
+    return sum;
+}
+
+/* ------------------------------------------------------------ integrator */
+
+rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng)
+{
+    const rt_scene *s = ctx->scene;
+    int max_depth = s->settings.max_depth > 0 ? s->settings.max_depth : RT_PATH_HARD_LIMIT;
+    if (max_depth > RT_PATH_HARD_LIMIT)
+        max_depth = RT_PATH_HARD_LIMIT;
+    rt_ray r = *ray;
+    float len = rt_length(r.dir);
+    if (!(len > 0.0f) || !isfinite(len))
+        return rt_v3s(0.0f);
+    r.dir = rt_scale(r.dir, 1.0f / len);
+    r.tmin *= len;
+    r.tmax *= len;
+    rt_vec3 L = rt_v3s(0.0f), beta = rt_v3s(1.0f);
+    bool prev_delta = true;     /* the camera "samples" its ray: no MIS */
+    float prev_pdf = 0.0f;      /* BSDF pdf of the ray just traced */
+    rt_vec3 prev_p = r.org;
+    int bounces = 0, layers = 0;
+    for (;;) {
+        rt_hit hit;
+        if (!rt_trace(ctx, &r, &hit)) {
+            L = add_finite(L, rt_mul(beta, rt_environment(ctx, r.dir)));
+            break;
+        }
+        rt_surface sf;
+        rt_surface_at(ctx, &r, &hit, &sf);
+        float coverage;
+        bool cut = rt_surface_cut_away(ctx, &sf, &coverage);
+        if (!cut && coverage < 1.0f && rt_rng_float(rng) >= coverage)
+            cut = true; /* stochastic alpha blending */
+        if (cut) {
+            if (++layers > 256)
+                break;
+            r.tmin = hit.t;
+            continue;
+        }
+        layers = 0;
+        /* emission, MIS-weighted when it could have been light-sampled */
+        rt_vec3 Le = rt_surface_emission(ctx, &sf);
+        uint32_t light = light_of_prim(ctx, sf.prim);
+        if (rt_max3(Le) > 0.0f) {
+            float w = 1.0f;
+            if (!prev_delta) {
+                float d2 = rt_length2(rt_sub(sf.p, prev_p));
+                float pdf_l = 0.0f;
+                if (light != RT_NONE) {
+                    pdf_l = area_light_pdf(&s->lights[light], r.dir, sqrtf(d2));
+                } else if (ctx->light_table && sf.prim < ctx->light_table->prim_count) {
+                    float cos_l = fabsf(rt_dot(sf.ng, r.dir));
+                    float pa = ctx->light_table->prim_pdf[sf.prim];
+                    pdf_l = (pa > 0.0f && cos_l > 0.0f) ? pa * d2 / cos_l : 0.0f;
+                }
+                if (pdf_l > 0.0f && isfinite(pdf_l))
+                    w = rt_mis_power(prev_pdf, pdf_l);
+            }
+            L = add_finite(L, rt_scale(rt_mul(beta, Le), w));
+        }
+        if (light != RT_NONE)
+            break; /* an area light's quad reflects nothing */
+        const rt_material *m = s->material_count ? &s->materials[sf.material] : NULL;
+        if (m && m->unlit) {
+            rt_vec4 c = rt_surface_base_color(ctx, &sf);
+            L = add_finite(L, rt_mul(beta, rt_v3(c.x, c.y, c.z)));
+            break;
+        }
+        if (bounces >= max_depth)
+            break;
+        rt_bsdf b;
+        rt_bsdf_from_surface(ctx, &sf, &b);
+        rt_vec3 wo = rt_bsdf_to_local(&b, sf.wo);
+        if (!(wo.z > 0.0f))
+            break;
+        L = add_finite(L, rt_mul(beta, next_event(ctx, &sf, &b, wo, rng)));
+        /* continue the path by sampling the BSDF */
+        float ulobe = rt_rng_float(rng);
+        rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
+        rt_bsdf_sample bs;
+        if (!rt_bsdf_sample_dir(&b, wo, u, ulobe, &bs))
+            break;
+        rt_vec3 wi = rt_normalize(rt_bsdf_to_world(&b, bs.wi));
+        float side = rt_dot(wi, sf.ng);
+        if (bs.wi.z > 0.0f ? !(side > 0.0f) : !(side < 0.0f))
+            break; /* the shading normal disagrees with the geometry: no light leaks */
+        beta = rt_mul(beta, bs.weight);
+        if (!rt_finite3(beta) || !(rt_max3(beta) > 0.0f))
+            break;
+        prev_delta = bs.delta;
+        prev_pdf = bs.pdf;
+        prev_p = sf.p;
+        bounces++;
+        if (bounces >= RT_PATH_RR_START) {
+            float q = fminf(rt_max3(beta), 0.95f);
+            if (rt_rng_float(rng) >= q)
+                break;
+            beta = rt_scale(beta, 1.0f / q);
+        }
+        r = rt_ray_make(rt_surface_spawn(ctx, &sf, wi), wi, 0.0f, INFINITY);
+    }
+    return rt_finite3(L) ? L : rt_v3s(0.0f);
+}
