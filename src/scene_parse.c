@@ -70,7 +70,7 @@ typedef struct name_table {
 enum {
     SET_RESOLUTION, SET_SAMPLES, SET_INTEGRATOR, SET_MAX_BOUNCE, SET_DIFFUSE_BOUNCES, SET_DIFFUSE_RAYS,
     SET_SHADOW_SAMPLES, SET_SEED, SET_BACKGROUND, SET_EXPOSURE, SET_CLAMP, SET_RAY_OFFSET, SET_ENVIRONMENT,
-    SET_OUTPUT, SET_AMBIENT_LIGHT, SET_COUNT
+    SET_OUTPUT, SET_AMBIENT_LIGHT, SET_MAX_DEPTH, SET_COUNT
 };
 
 typedef struct parser {
@@ -619,6 +619,7 @@ typedef struct int_setting {
 static const int_setting int_settings[] = {
     {"samples", SET_SAMPLES, 1, MAX_SAMPLES, "samples per pixel", offsetof(rt_settings, samples)},
     {"max_bounce", SET_MAX_BOUNCE, 0, 256, "max_bounce", offsetof(rt_settings, max_bounce)},
+    {"max_depth", SET_MAX_DEPTH, 0, 1024, "max_depth", offsetof(rt_settings, max_depth)},
     {"diffuse_bounces", SET_DIFFUSE_BOUNCES, 0, 64, "diffuse_bounces", offsetof(rt_settings, diffuse_bounces)},
     {"diffuse_rays", SET_DIFFUSE_RAYS, 1, 65536, "diffuse_rays", offsetof(rt_settings, diffuse_rays)},
     {"shadow_samples", SET_SHADOW_SAMPLES, 1, 65536, "shadow_samples", offsetof(rt_settings, shadow_samples)},
@@ -920,7 +921,7 @@ static rt_result st_texture(parser *p, const tok *kw)
 
 static int edit_distance(const char *a, const char *b);
 
-typedef enum mat_kind { MK_FLOAT, MK_COLOR, MK_BOOL, MK_TEXTURE, MK_ALPHA_MODE, MK_DISTANCE, MK_UV } mat_kind;
+typedef enum mat_kind { MK_FLOAT, MK_COLOR, MK_BOOL, MK_TEXTURE, MK_ALPHA_MODE, MK_DISTANCE, MK_UV, MK_BSDF } mat_kind;
 
 typedef struct mat_key {
     const char *key;
@@ -952,6 +953,7 @@ static const mat_key mat_keys[] = {
     {"alpha_cutoff", NULL, MK_FLOAT, MOFF(alpha_cutoff), 0, 1},
     {"double_sided", NULL, MK_BOOL, MOFF(double_sided), 0, 0},
     {"unlit", NULL, MK_BOOL, MOFF(unlit), 0, 0},
+    {"bsdf", NULL, MK_BSDF, MOFF(bsdf), 0, 0},
     {"thickness", NULL, MK_FLOAT, MOFF(thickness), 0, FLT_MAX},
     {"attenuation_color", NULL, MK_COLOR, MOFF(attenuation_color), 0, 0},
     {"attenuation_distance", NULL, MK_DISTANCE, MOFF(attenuation_distance), 0, 0},
@@ -1023,6 +1025,15 @@ static rt_result st_material(parser *p, const tok *kw)
             r = get_choice(p, what, modes, 3, "opaque|mask|blend", &i);
             if (r == RT_OK)
                 *(rt_alpha_mode *)field = values[i];
+            break;
+        }
+        case MK_BSDF: {
+            static const char *const models[] = {"gltf", "lambert"};
+            static const rt_bsdf_model values[] = {RT_BSDF_GLTF, RT_BSDF_LAMBERT};
+            int i = 0;
+            r = get_choice(p, what, models, 2, "gltf|lambert", &i);
+            if (r == RT_OK)
+                *(rt_bsdf_model *)field = values[i];
             break;
         }
         case MK_DISTANCE:
@@ -1438,6 +1449,7 @@ static const keyword keywords[] = {
     {"samples", st_int_setting},
     {"integrator", st_integrator},
     {"max_bounce", st_int_setting},
+    {"max_depth", st_int_setting},
     {"diffuse_bounces", st_int_setting},
     {"diffuse_rays", st_int_setting},
     {"shadow_samples", st_int_setting},
