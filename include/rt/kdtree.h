@@ -40,9 +40,9 @@
 
 /* Build parameters; a zero field means "the default". */
 typedef struct rt_kdtree_params {
-    float traversal_cost; /* SAH cost of one traversal step */
-    float intersect_cost; /* SAH cost of one primitive test */
-    float empty_bonus;    /* fraction (0..1) by which a split with an empty side is cheaper */
+    float traversal_cost; /* SAH cost of one traversal step (default 4) */
+    float intersect_cost; /* SAH cost of one primitive test (default 1) */
+    float empty_bonus;    /* fraction (0..1) by which a split with an empty side is cheaper (default 0.2) */
     int max_depth;        /* 0 = 8 + 1.3 log2(N) (pbrt's rule) */
     int threads;          /* build threads; 0 = one per online CPU (same tree for any count) */
 } rt_kdtree_params;
