@@ -1,0 +1,155 @@
+/* test_bench_rays.c - the kd-tree against Embree's answers on the shared
+ * benchmark rays (../shared/bench, FORMAT.md and MANIFEST.md there).
+ *
+ * For every model of the bench manifest: load the glTF as FORMAT.md says
+ * (every triangle of the default scene in world space), build the tree, and
+ * trace every k-th ray of the primary and the diffuse set (about 2,500 rays
+ * per set, k fixed per set so the subset is deterministic). Each traced
+ * distance must agree with Embree's (rt_rayset_agrees: both miss, or
+ * |t - ref| <= 1e-4 ref + 1e-6 diagonal), and the any-hit query must agree
+ * with the closest-hit one on whether the ray hits at all.
+ *
+ * Allowance: at most floor(0.01% of the rays tested) + 2 disagreements per
+ * set. The 0.01% is make bench's bound on the full sets; with a few thousand
+ * rays it rounds to zero, so a small absolute allowance covers the rays that
+ * may legitimately differ between two tracers (FORMAT.md: "a handful of rays
+ * that graze a shared edge or silhouette"): on the full sets there is at
+ * most one such ray per set (a crack between adjacent triangles, ray
+ * 307,200-scale rarity), so 2 in a subset cannot hide a real bug, which
+ * shows up as tens or hundreds of mismatches.
+ *
+ * Cost: all three models, including the 1M-triangle one (its build is about
+ * 1-2 s on two cores). It stays in because it is the model that tests the
+ * epsilons (a 7 mm world) and the deep tree; the whole file runs in a few
+ * seconds. Skips with a message when the shared material is absent.
+ */
+#include "test_util.h"
+
+#include <ctype.h>
+
+#include "rt/gltf.h"
+#include "rt/kdtree.h"
+#include "rt/rayset.h"
+#include "rt/scene.h"
+
+#define RAYS_PER_SET 2500
+
+typedef struct bench_model {
+    char name[128];
+    char glb[512];
+} bench_model;
+
+/* Models from the manifest's table rows: "| Name | `path` | ...". */
+static size_t read_manifest(bench_model *out, size_t cap)
+{
+    FILE *f = fopen(test_shared_path("bench/MANIFEST.md"), "r");
+    if (!f)
+        return 0;
+    char line[2048];
+    size_t n = 0;
+    while (n < cap && fgets(line, sizeof line, f)) {
+        if (strncmp(line, "| ", 2) != 0)
+            continue;
+        const char *p = line + 2, *q = p;
+        while (isalnum((unsigned char)*q) || *q == '_')
+            q++;
+        if (q == p || strncmp(q, " | `", 4) != 0)
+            continue;
+        const char *g = q + 4, *ge = strchr(g, '`');
+        if (!ge || (size_t)(q - p) >= sizeof out[n].name || (size_t)(ge - g) >= sizeof out[n].glb)
+            continue;
+        memcpy(out[n].name, p, (size_t)(q - p));
+        out[n].name[q - p] = '\0';
+        memcpy(out[n].glb, g, (size_t)(ge - g));
+        out[n].glb[ge - g] = '\0';
+        n++;
+    }
+    fclose(f);
+    return n;
+}
+
+static void check_set(const rt_kdtree *tree, const char *model, const char *kind)
+{
+    char rel[512], rays[4096], hits[4096];
+    snprintf(rel, sizeof rel, "bench/%s/%s.%s.rays", model, model, kind);
+    memcpy(rays, test_shared_path(rel), sizeof rays);
+    snprintf(rel, sizeof rel, "bench/%s/%s.%s.hits", model, model, kind);
+    memcpy(hits, test_shared_path(rel), sizeof hits);
+    rt_rayset rs;
+    rt_error err = {0};
+    rt_result res = rt_rayset_load(&rs, rays, hits, &err);
+    if (res != RT_OK)
+        fprintf(stderr, "%s\n", err.message);
+    assert_int_equal(res, RT_OK);
+    assert_non_null(rs.ref_t);
+    assert_true(rs.count > 0);
+    size_t step = rs.count / RAYS_PER_SET;
+    if (step < 1)
+        step = 1;
+    float diag = rt_box_diagonal(tree->bounds);
+    size_t tested = 0, bad = 0, hit_count = 0, ref_hits = 0;
+    for (size_t i = 0; i < rs.count; i += step) {
+        const rt_ray *r = &rs.rays[i];
+        rt_hit h;
+        bool hit = rt_kdtree_intersect(tree, r, &h);
+        float t = hit ? h.t : INFINITY;
+        tested++;
+        hit_count += hit;
+        ref_hits += rs.ref_t[i] < INFINITY;
+        assert_int_equal(rt_kdtree_occluded(tree, r), hit);
+        if (!rt_rayset_agrees(t, rs.ref_t[i], diag)) {
+            bad++;
+            fprintf(stderr, "%s %s ray %zu: rt t %.9g, Embree t %.9g\n", model, kind, i, (double)t,
+                    (double)rs.ref_t[i]);
+        }
+    }
+    size_t allowed = tested / 10000 + 2;
+    if (getenv("RT_TEST_VERBOSE"))
+        fprintf(stderr, "%s %s: %zu rays (every %zu-th), %zu hits (Embree %zu), %zu disagree\n", model, kind, tested,
+                step, hit_count, ref_hits, bad);
+    assert_true(tested >= RAYS_PER_SET);
+    assert_true(bad <= allowed);
+    rt_rayset_free(&rs);
+}
+
+static void test_bench_rays(void **state)
+{
+    (void)state;
+    if (!test_have_shared())
+        return;
+    bench_model models[16];
+    size_t n = read_manifest(models, 16);
+    if (n == 0) {
+        fprintf(stderr, "note: no bench manifest at %s; skipping\n", test_shared_path("bench/MANIFEST.md"));
+        return;
+    }
+    for (size_t m = 0; m < n; m++) {
+        rt_scene scene;
+        rt_scene_init(&scene);
+        rt_gltf_options opt;
+        memset(&opt, 0, sizeof opt);
+        rt_gltf_stats gs;
+        rt_error err = {0};
+        rt_result res = rt_gltf_load(&scene, test_shared_path(models[m].glb), &opt, &gs, &err);
+        if (res != RT_OK)
+            fprintf(stderr, "%s\n", err.message);
+        assert_int_equal(res, RT_OK);
+        rt_kdtree tree;
+        res = rt_kdtree_build(&tree, &scene, NULL, &err);
+        if (res != RT_OK)
+            fprintf(stderr, "%s\n", err.message);
+        assert_int_equal(res, RT_OK);
+        check_set(&tree, models[m].name, "primary");
+        check_set(&tree, models[m].name, "diffuse");
+        rt_kdtree_free(&tree);
+        rt_scene_free(&scene);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bench_rays),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
