@@ -2,10 +2,12 @@
 # make fuzz: builds one libFuzzer binary per target (tests/fuzz/harness.h)
 # with clang -fsanitize=fuzzer,address,undefined, seeds each from
 # ../shared/assets, scenes/ and tests/corpus/, and runs it for FUZZ_SECONDS
-# (default 60). Prints executions per second and totals per target; exits 1
-# if any target crashed (the input is saved under build-fuzz/crashes/TARGET/:
-# fix the bug, then keep the input in tests/corpus/TARGET/ so make test
-# replays it).
+# (default 60). Prints executions per second and totals per target (also
+# kept in build-fuzz/summary.txt); exits 1 if any target crashed, leaked,
+# hung or ran out of memory in this run (the input is saved under
+# build-fuzz/crashes/TARGET/: fix the bug, then keep the input in
+# tests/corpus/TARGET/ so make test replays it). Reproduce one input with
+# ./build-fuzz/fuzz_TARGET FILE.
 # Environment: FUZZ_SECONDS, FUZZ_TARGETS (space-separated subset), SHARED.
 set -eu
 SECONDS_EACH=${FUZZ_SECONDS:-60}
@@ -36,7 +38,8 @@ clang $CFLAGS -fsanitize=fuzzer-no-link -c -o $B/harness.o tests/fuzz/harness.c
 python3 tools/fuzz_seeds.py "$SHARED" $B/seeds
 
 status=0
-printf '%-10s %12s %14s %8s\n' target execs/s total_execs crashes
+summary=$B/summary.txt
+printf '%-10s %12s %14s %8s\n' target execs/s total_execs crashes | tee "$summary"
 for t in $TARGETS; do
     clang $CFLAGS -fsanitize=fuzzer -DRT_FUZZ_TARGET="\"$t\"" -o $B/fuzz_$t tests/fuzz/fuzz_main.c $B/harness.o $B/obj/*.o \
         -lstb -lpthread -lm
@@ -49,6 +52,8 @@ for t in $TARGETS; do
     seeds="$B/seeds/$t"
     [ -d tests/corpus/$t ] && seeds="$seeds tests/corpus/$t"
     log=$B/fuzz_$t.log
+    stamp=$B/crashes/$t/.started
+    : >"$stamp"
     if ! ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 ./$B/fuzz_$t $dict -max_total_time="$SECONDS_EACH" \
         -rss_limit_mb=4096 -malloc_limit_mb=2048 -timeout=20 -print_final_stats=1 \
         -artifact_prefix=$B/crashes/$t/ $B/corpus/$t $seeds >"$log" 2>&1; then
@@ -56,8 +61,9 @@ for t in $TARGETS; do
     fi
     execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
     rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log")
-    crashes=$(find $B/crashes/$t -type f | wc -l)
-    printf '%-10s %12s %14s %8s\n' "$t" "${rate:-?}" "${execs:-?}" "$crashes"
-    [ "$crashes" -eq 0 ] || { status=1; grep -m 3 -E 'ERROR|SUMMARY' "$log" >&2 || true; }
+    # only this run's artifacts count (older ones stay for reference)
+    crashes=$(find $B/crashes/$t -type f ! -name .started -newer "$stamp" | wc -l)
+    printf '%-10s %12s %14s %8s\n' "$t" "${rate:-?}" "${execs:-?}" "$crashes" | tee -a "$summary"
+    [ "$crashes" -eq 0 ] || { status=1; grep -m 3 -E 'ERROR|SUMMARY|runtime error' "$log" >&2 || true; }
 done
 exit $status
