@@ -406,8 +406,13 @@ static uint32_t prim_material(const rt_scene *s, uint32_t prim)
 rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
 {
     rt_vec3 o = rt_surface_spawn(ctx, sf, wi);
-    /* stop just short of the light's own surface (area lights are geometry too) */
-    float tmax = isfinite(dist) ? dist * (1.0f - 1e-4f) : INFINITY;
+    /* stop just short of the light's own surface (area lights are geometry
+     * too), measured from the offset origin: the offset moves it towards
+     * the light by up to ~1e-5 of the scene's scale, more than 1e-4 of a
+     * short distance in a small scene */
+    float tmax = INFINITY;
+    if (isfinite(dist))
+        tmax = rt_dot(rt_sub(rt_madd(sf->p, wi, dist), o), wi) * (1.0f - 1e-4f);
     rt_ray r = rt_ray_make(o, wi, 0.0f, tmax);
     if (ctx->ray_count)
         (*ctx->ray_count)++;
