@@ -223,7 +223,8 @@ static float area_light_pdf(const rt_light *l, rt_vec3 d, float dist)
 static float visibility(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
 {
     rt_vec3 o = rt_surface_spawn(ctx, sf, wi);
-    float tmax = isfinite(dist) ? dist * (1.0f - 1e-4f) : INFINITY;
+    /* stop just short of the emitter, measured from the offset origin */
+    float tmax = isfinite(dist) ? rt_dot(rt_sub(rt_madd(sf->p, wi, dist), o), wi) * (1.0f - 1e-4f) : INFINITY;
     rt_ray r = rt_ray_make(o, wi, 0.0f, tmax);
     if (ctx->ray_count)
         (*ctx->ray_count)++;

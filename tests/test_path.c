@@ -1,0 +1,410 @@
+/* test_path.c - the path integrator against closed forms and against the
+ * shared Mitsuba 3 reference:
+ *   - white furnace: a convex Lambertian object in a uniform environment of
+ *     radiance 1 shows exactly its albedo (every path escapes after one
+ *     bounce), sample by sample; a GGX metal shows its directional albedo
+ *     (a 1D quadrature here), never more than 1;
+ *   - inside a closed emissive Lambertian sphere (emission E, albedo a)
+ *     L = E (1 + a + ... + a^k) = E (1 - a^(k+1)) / (1 - a) with max_depth
+ *     k, and E / (1 - a) unlimited: Russian roulette is unbiased, and with
+ *     the emitter table (light sampling + MIS) the value is the same as
+ *     without (nothing counted twice);
+ *   - a point light over a Lambertian floor: exactly a I cos / (pi r^2);
+ *   - one-sided area lights: the front shows the radiance, the back nothing;
+ *   - an emissive quad made of two triangles lights a floor like the same
+ *     area light, with and without the table;
+ *   - every sample finite on a scene of every material kind, and the image
+ *     identical for 1 and 3 threads;
+ *   - scenes/cornell-reference.txt at 64x64 against the reference image
+ *     box-averaged over 8x8 blocks: image means within 1%, RMSE bounded.
+ */
+#include "test_util.h"
+
+#include <math.h>
+
+#include "rt/bsdf.h"
+#include "rt/camera.h"
+#include "rt/image.h"
+#include "rt/integrator.h"
+#include "rt/kdtree.h"
+#include "rt/path.h"
+#include "rt/render.h"
+#include "rt/scene.h"
+#include "rt/scene_parse.h"
+
+typedef struct fixture {
+    rt_scene s;
+    rt_kdtree tree;
+    rt_trace_ctx ctx;
+    rt_light_table lt;
+} fixture;
+
+static void load(fixture *f, const char *text, bool table)
+{
+    rt_error err;
+    rt_scene_init(&f->s);
+    if (rt_scene_parse_string(&f->s, text, strlen(text), "test", NULL, &err) != RT_OK)
+        fail_msg("parse: %s", err.message);
+    assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
+    rt_trace_ctx_init(&f->ctx, &f->s, &f->tree);
+    memset(&f->lt, 0, sizeof f->lt);
+    if (table) {
+        assert_int_equal(rt_light_table_build(&f->lt, &f->s, &err), RT_OK);
+        f->ctx.light_table = &f->lt;
+    }
+}
+
+static void unload(fixture *f)
+{
+    rt_light_table_free(&f->lt);
+    rt_kdtree_free(&f->tree);
+    rt_scene_free(&f->s);
+}
+
+static rt_vec3 radiance(const fixture *f, rt_vec3 org, rt_vec3 dir, uint32_t i)
+{
+    rt_rng rng = rt_rng_for_sample(17, i, 0);
+    rt_ray r = rt_ray_make(org, rt_normalize(dir), 0.0f, INFINITY);
+    rt_vec3 L = rt_radiance_path(&f->ctx, &r, &rng);
+    assert_true(rt_finite3(L) && L.x >= 0.0f && L.y >= 0.0f && L.z >= 0.0f);
+    return L;
+}
+
+/* ------------------------------------------------------------- furnaces */
+
+static void test_furnace_lambert(void **state)
+{
+    (void)state;
+    const float albedo[][3] = {{1, 1, 1}, {0.5f, 0.8f, 0.2f}};
+    for (int k = 0; k < 2; k++) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 "integrator path\nbackground 1 1 1\n"
+                 "material m color %g %g %g bsdf lambert\nsphere 0 0 0 1 m\n",
+                 (double)albedo[k][0], (double)albedo[k][1], (double)albedo[k][2]);
+        fixture f;
+        load(&f, text, false);
+        test_rng tr = {5};
+        for (uint32_t i = 0; i < 4000; i++) {
+            /* rays from outside at random points of the disk the sphere covers */
+            float x = 1.8f * test_rng_float(&tr) - 0.9f, y = 1.8f * test_rng_float(&tr) - 0.9f;
+            rt_vec3 L = radiance(&f, rt_v3(x, y, 5), rt_v3(0, 0, -1), i);
+            bool hit = x * x + y * y < 0.99f;
+            rt_vec3 want = hit ? rt_v3(albedo[k][0], albedo[k][1], albedo[k][2]) : rt_v3s(1.0f);
+            if (x * x + y * y > 0.97f && x * x + y * y < 1.01f)
+                continue; /* the silhouette */
+            assert_true(fabsf(L.x - want.x) < 1e-5f && fabsf(L.y - want.y) < 1e-5f && fabsf(L.z - want.z) < 1e-5f);
+        }
+        unload(&f);
+    }
+}
+
+/* Directional albedo at normal incidence of a white GGX metal, by the 1D
+ * integral over cos(theta_i) of D(h) G2 / (4 cos_i) cos_i (h = half vector). */
+static double metal_albedo_normal(float alpha)
+{
+    const int n = 200000;
+    double sum = 0.0;
+    for (int i = 0; i < n; i++) {
+        float ci = ((float)i + 0.5f) / (float)n;
+        float s = sqrtf(1.0f - ci * ci);
+        rt_vec3 wi = rt_v3(s, 0.0f, ci), wo = rt_v3(0, 0, 1);
+        rt_vec3 h = rt_normalize(rt_add(wi, wo));
+        sum += (double)rt_ggx_d(h, alpha) * (double)rt_ggx_g2(wo, wi, alpha) / 4.0;
+    }
+    return 2.0 * 3.14159265358979 * sum / n;
+}
+
+static void test_furnace_metal(void **state)
+{
+    (void)state;
+    const float rough[] = {0.3f, 0.5f, 0.8f};
+    for (int k = 0; k < 3; k++) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 "integrator path\nbackground 1 1 1\n"
+                 "material m color 1 1 1 metallic 1 roughness %g\nsphere 0 0 0 1 m\n",
+                 (double)rough[k]);
+        fixture f;
+        load(&f, text, false);
+        double sum = 0.0;
+        const uint32_t n = 40000;
+        for (uint32_t i = 0; i < n; i++) {
+            rt_vec3 L = radiance(&f, rt_v3(0, 0, 5), rt_v3(0, 0, -1), i);
+            /* VNDF sampling of F = 1: each sample weighs G2 / G1 <= 1 */
+            assert_true(L.x <= 1.0f + 1e-5f);
+            sum += L.x;
+        }
+        double mean = sum / n, want = metal_albedo_normal(rough[k] * rough[k]);
+        assert_true(want < 1.0 && want > 0.5);
+        if (fabs(mean - want) > 0.01)
+            fail_msg("roughness %g: furnace %.4f, quadrature %.4f", (double)rough[k], mean, want);
+        unload(&f);
+    }
+}
+
+/* Inside an emissive Lambertian sphere: L = E (1 - a^(k+1)) / (1 - a). */
+static void test_closed_furnace(void **state)
+{
+    (void)state;
+    const int depths[] = {0, 1, 3}; /* 0 = unlimited */
+    for (int t = 0; t < 2; t++) {
+        for (int d = 0; d < 3; d++) {
+            char text[512];
+            snprintf(text, sizeof text,
+                     "integrator path\nmax_depth %d\n"
+                     "material m color 0.6 0.6 0.6 bsdf lambert emission 1 1 1\nsphere 0 0 0 1 m\n",
+                     depths[d]);
+            fixture f;
+            load(&f, text, t == 1);
+            assert_int_equal(f.lt.count, t == 1 ? 1 : 0);
+            double a = 0.6, want = depths[d] ? (1.0 - pow(a, depths[d] + 1)) / (1.0 - a) : 1.0 / (1.0 - a);
+            double sum = 0.0, sum2 = 0.0;
+            const uint32_t n = 40000;
+            test_rng tr = {9};
+            for (uint32_t i = 0; i < n; i++) {
+                rt_vec3 dir = rt_v3(test_rng_float(&tr) - 0.5f, test_rng_float(&tr) - 0.5f, test_rng_float(&tr) - 0.5f);
+                if (rt_length2(dir) < 1e-6f)
+                    dir = rt_v3(0, 0, 1);
+                rt_vec3 L = radiance(&f, rt_v3(0.1f, -0.2f, 0.3f), dir, i);
+                sum += L.x;
+                sum2 += (double)L.x * L.x;
+            }
+            double mean = sum / n, sd = sqrt(fmax(0.0, sum2 / n - mean * mean) / n);
+            if (fabs(mean - want) > 4.0 * sd + 1e-3)
+                fail_msg("table %d max_depth %d: %.4f +- %.4f, want %.4f", t, depths[d], mean, sd, want);
+            unload(&f);
+        }
+    }
+}
+
+/* ------------------------------------------------------------- lights */
+
+static void test_point_light_exact(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f,
+         "integrator path\nmaterial m color 0.5 0.25 1 bsdf lambert\n"
+         "quad -10 0 10  20 0 0  0 0 -20  m\nlight point 1 2 0  1 1 1  10\n",
+         true);
+    for (uint32_t i = 0; i < 200; i++) {
+        float x = -3.0f + 6.0f * (float)i / 200.0f;
+        rt_vec3 p = rt_v3(x, 0, 0.5f);
+        rt_vec3 L = radiance(&f, rt_v3(x, 1, 1.5f), rt_sub(p, rt_v3(x, 1, 1.5f)), i);
+        rt_vec3 d = rt_sub(rt_v3(1, 2, 0), p);
+        float r2 = rt_length2(d), c = d.y / sqrtf(r2);
+        float e = 10.0f * c / r2 * RT_INV_PI;
+        assert_true(fabsf(L.x - 0.5f * e) < 1e-4f * e && fabsf(L.y - 0.25f * e) < 1e-4f * e &&
+                    fabsf(L.z - e) < 1e-4f * e);
+    }
+    unload(&f);
+}
+
+static void test_area_light_one_sided(void **state)
+{
+    (void)state;
+    for (int t = 0; t < 2; t++) {
+        fixture f;
+        load(&f, "integrator path\nlight area -1 2 -1  0 0 2  2 0 0  17 12 4  1\n", t == 1);
+        /* cross((0,0,2), (2,0,0)) = (0,4,0): the front faces +y... */
+        rt_vec3 above = radiance(&f, rt_v3(0.2f, 5, 0.1f), rt_v3(0, -1, 0), 1);
+        rt_vec3 below = radiance(&f, rt_v3(0.2f, 0, 0.1f), rt_v3(0, 1, 0), 2);
+        assert_true(above.x == 17.0f && above.y == 12.0f && above.z == 4.0f);
+        assert_true(below.x == 0.0f && below.y == 0.0f && below.z == 0.0f);
+        unload(&f);
+    }
+}
+
+/* An emitter made of two triangles and the same rectangle as an area
+ * light give the same floor brightness, with or without the table. */
+static void test_emissive_triangles_vs_area_light(void **state)
+{
+    (void)state;
+    const char *tri =
+        "integrator path\nmaterial floor color 0.8 0.8 0.8 bsdf lambert\n"
+        "material lamp color 0 0 0 emission 4 4 4 double_sided false bsdf lambert\n"
+        "quad -10 0 10  20 0 0  0 0 -20  floor\n"
+        "triangle -0.5 1 -0.5  0.5 1 -0.5  0.5 1 0.5  lamp\n"
+        "triangle -0.5 1 -0.5  0.5 1 0.5  -0.5 1 0.5  lamp\n";
+    const char *area =
+        "integrator path\nmaterial floor color 0.8 0.8 0.8 bsdf lambert\n"
+        "quad -10 0 10  20 0 0  0 0 -20  floor\n"
+        "light area -0.5 1 -0.5  1 0 0  0 0 1  4 4 4  1\n";
+    double mean[3], sd[3];
+    for (int v = 0; v < 3; v++) {
+        fixture f;
+        load(&f, v == 2 ? area : tri, v == 1);
+        double sum = 0.0, sum2 = 0.0;
+        const uint32_t n = 20000;
+        for (uint32_t i = 0; i < n; i++) {
+            rt_vec3 L = radiance(&f, rt_v3(0.3f, 0.5f, 2.0f), rt_sub(rt_v3(0.3f, 0, 0.2f), rt_v3(0.3f, 0.5f, 2.0f)), i);
+            sum += L.x;
+            sum2 += (double)L.x * L.x;
+        }
+        mean[v] = sum / n;
+        sd[v] = sqrt(fmax(0.0, sum2 / n - mean[v] * mean[v]) / n);
+        unload(&f);
+    }
+    /* the table and the area light sample the light: far less noise */
+    assert_true(sd[1] < 0.5 * sd[0] && sd[2] < 0.5 * sd[0]);
+    for (int v = 0; v < 2; v++)
+        if (fabs(mean[v] - mean[2]) > 4.0 * sqrt(sd[v] * sd[v] + sd[2] * sd[2]))
+            fail_msg("variant %d: %.5f +- %.5f vs area light %.5f +- %.5f", v, mean[v], sd[v], mean[2], sd[2]);
+    assert_true(mean[2] > 0.05);
+}
+
+/* ------------------------------------------------------ whole images */
+
+static const char *every_material =
+    "integrator path\nresolution 48 32\nsamples 8\nbackground 0.2 0.3 0.4\n"
+    "camera position 0 1.5 6 look_at 0 0.8 0 fov 40\n"
+    "texture checks checker 0.9 0.9 0.9  0.1 0.1 0.1 scale 4\n"
+    "material floor texture checks roughness 0.6\n"
+    "material metal color 0.9 0.6 0.2 metallic 1 roughness 0.05\n"
+    "material rough color 0.9 0.9 0.9 metallic 1 roughness 1\n"
+    "material plastic color 0.2 0.4 0.9 roughness 0.3\n"
+    "material glass color 1 1 1 transmission 1 ior 1.5 roughness 0\n"
+    "material veil color 1 0 0 alpha 0.5 alpha_mode blend\n"
+    "material cut color 0 1 0 alpha 0.2 alpha_mode mask\n"
+    "material lamp color 0 0 0 emission 3 3 2 double_sided false\n"
+    "material flat color 1 1 1 unlit true\n"
+    "quad -5 0 5  10 0 0  0 0 -10  floor\n"
+    "sphere -1.5 0.5 0 0.5 metal\nsphere -0.5 0.5 0 0.5 rough\nsphere 0.5 0.5 0 0.5 plastic\n"
+    "sphere 1.5 0.5 0 0.5 glass\nquad -2 0 1  4 0 0  0 2 0  veil\nquad -2 1.2 1.5  4 0 0  0 0.5 0  cut\n"
+    "triangle -1 2 -1  1 2 -1  0 2.5 -1  lamp\nsphere 0 2.2 -2 0.2 flat\n"
+    "light point 0 3 2  1 1 1  5\nlight spot 2 3 0  0 -1 0  1 1 1  10  10 30\n"
+    "light directional -1 -1 -1  0.5 0.5 0.5  1\nlight area -1 2.9 -1  2 0 0  0 0 2  2 2 2  1\n";
+
+static void render_fixture(fixture *f, int threads, rt_framebuffer *fb, rt_render_stats *st)
+{
+    rt_error err;
+    assert_int_equal(rt_framebuffer_init(fb, f->s.settings.width, f->s.settings.height, &err), RT_OK);
+    rt_render_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.threads = threads;
+    opt.tile_size = 8;
+    assert_int_equal(rt_render(&f->s, &f->tree, &opt, fb, st, &err), RT_OK);
+}
+
+static void test_every_material_finite_and_deterministic(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, every_material, false);
+    rt_framebuffer a, b;
+    rt_render_stats sa, sb;
+    render_fixture(&f, 1, &a, &sa);
+    render_fixture(&f, 3, &b, &sb);
+    assert_true(sa.bad_samples == 0 && sb.bad_samples == 0);
+    size_t n = (size_t)a.width * (size_t)a.height * 3;
+    double sum = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        assert_true(isfinite(a.rgb[i]) && a.rgb[i] >= 0.0f);
+        sum += a.rgb[i];
+    }
+    assert_true(sum > 0.0);
+    assert_memory_equal(a.rgb, b.rgb, n * sizeof(float));
+    rt_framebuffer_free(&a);
+    rt_framebuffer_free(&b);
+    /* the same through the emitter table: every sample finite */
+    rt_light_table lt;
+    rt_error err;
+    assert_int_equal(rt_light_table_build(&lt, &f.s, &err), RT_OK);
+    assert_int_equal(lt.count, 1); /* the lamp triangle (the area light's quad is a light already) */
+    f.ctx.light_table = &lt;
+    rt_camera_frame cf;
+    rt_camera_frame_init(&cf, &f.s.camera, 48, 32);
+    for (uint32_t i = 0; i < 48 * 32 * 4; i++) {
+        uint32_t p = i / 4;
+        rt_rng rng = rt_rng_for_sample(3, p, i % 4);
+        rt_ray r = rt_camera_ray(&cf, (float)(p % 48) + 0.5f, (float)(p / 48) + 0.5f, rt_v2(0.5f, 0.5f));
+        rt_vec3 L = rt_radiance_path(&f.ctx, &r, &rng);
+        assert_true(rt_finite3(L) && L.x >= 0.0f && L.y >= 0.0f && L.z >= 0.0f);
+    }
+    rt_light_table_free(&lt);
+    unload(&f);
+}
+
+/* The shared reference: scenes/cornell-reference.txt at 64x64 (the same
+ * camera, so each pixel covers an 8x8 block of the 512x512 reference) and
+ * 256 samples per pixel, against the reference box-averaged over 8x8
+ * blocks. The reference's own noise (RMSE 0.002 per 512x512 pixel at 8064
+ * spp) averages to ~0.0003 per block, negligible. Our per-block noise: a
+ * sample's standard deviation over this scene is about 0.075 (measured: the
+ * 512x512 render at 64 spp has RMSE 0.0092 = 0.075 / 8), so 256 samples give
+ * ~0.075 / 16 = 0.0047, plus the light's edge, which a 64x64 pixel straddles
+ * with a much larger spread. Bound: 0.008. Image means: the mean over 4096
+ * pixels x 256 samples has a relative noise of ~0.1%, so 1% detects any bias
+ * that matters (a 4-bounce cap alone darkens by 2.5-3.4%, SCENE.md). */
+static void test_cornell_reference(void **state)
+{
+    (void)state;
+    const char *ref_path = test_shared_path("reference/cornell/reference.pfm");
+    FILE *probe = fopen(ref_path, "rb");
+    if (!probe) {
+        fprintf(stderr, "note: %s not found (set RT_SHARED); skipping the reference comparison\n", ref_path);
+        return;
+    }
+    fclose(probe);
+    rt_error err;
+    rt_framebuffer ref;
+    assert_int_equal(rt_pfm_read(ref_path, &ref, &err), RT_OK);
+    assert_int_equal(ref.width, 512);
+    assert_int_equal(ref.height, 512);
+    fixture f;
+    rt_scene_init(&f.s);
+    if (rt_scene_parse_file(&f.s, "scenes/cornell-reference.txt", &err) != RT_OK)
+        fail_msg("%s", err.message);
+    assert_int_equal(f.s.triangles.count, 30);
+    assert_int_equal(f.s.light_count, 1);
+    f.s.settings.width = f.s.settings.height = 64;
+    f.s.settings.samples = 256;
+    assert_int_equal(rt_kdtree_build(&f.tree, &f.s, NULL, &err), RT_OK);
+    memset(&f.lt, 0, sizeof f.lt);
+    rt_framebuffer img;
+    rt_render_stats st;
+    render_fixture(&f, 0, &img, &st);
+    assert_true(st.bad_samples == 0);
+    double se = 0.0, mine[3] = {0, 0, 0}, theirs[3] = {0, 0, 0};
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++)
+            for (int c = 0; c < 3; c++) {
+                double r = 0.0;
+                for (int j = 0; j < 8; j++)
+                    for (int i = 0; i < 8; i++)
+                        r += ref.rgb[3 * ((size_t)(8 * y + j) * 512 + (size_t)(8 * x + i)) + (size_t)c];
+                r /= 64.0;
+                double v = img.rgb[3 * ((size_t)y * 64 + (size_t)x) + (size_t)c];
+                se += (v - r) * (v - r);
+                mine[c] += v / 4096.0;
+                theirs[c] += r / 4096.0;
+            }
+    double rmse = sqrt(se / (64.0 * 64.0 * 3.0));
+    fprintf(stderr, "cornell-reference 64x64 @ 256 spp: RMSE %.5f, means (%.5f %.5f %.5f) vs (%.5f %.5f %.5f)\n", rmse,
+            mine[0], mine[1], mine[2], theirs[0], theirs[1], theirs[2]);
+    /* the reference's published means */
+    assert_true(fabs(theirs[0] - 0.19650) < 2e-5 && fabs(theirs[1] - 0.12749) < 2e-5 && fabs(theirs[2] - 0.03642) < 2e-5);
+    for (int c = 0; c < 3; c++)
+        assert_true(fabs(mine[c] / theirs[c] - 1.0) < 0.01);
+    assert_true(rmse < 0.008);
+    rt_framebuffer_free(&img);
+    rt_framebuffer_free(&ref);
+    rt_kdtree_free(&f.tree);
+    rt_scene_free(&f.s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_furnace_lambert),
+        cmocka_unit_test(test_furnace_metal),
+        cmocka_unit_test(test_closed_furnace),
+        cmocka_unit_test(test_point_light_exact),
+        cmocka_unit_test(test_area_light_one_sided),
+        cmocka_unit_test(test_emissive_triangles_vs_area_light),
+        cmocka_unit_test(test_every_material_finite_and_deterministic),
+        cmocka_unit_test(test_cornell_reference),
+    };
+    return cmocka_run_group_tests_name("path", tests, NULL, NULL);
+}
