@@ -5,6 +5,14 @@
  * images, an unwritable output), 130 when interrupted (the finished tiles
  * are still written). Every failure says what and where on stderr, and never
  * leaves a partial file over an existing image.
+ *
+ * Memory: the process runs under a budget (--max-memory, default 75% of the
+ * physical memory, or of the cgroup's limit when that is lower), enforced
+ * with setrlimit(RLIMIT_DATA), which Linux >= 4.7 applies to the heap and
+ * every private writable mapping. An allocation past it fails, the checked
+ * allocation reports "out of memory", and we say which budget was hit and
+ * how to raise it, instead of swapping or meeting the OOM killer. Sanitizer
+ * builds skip the limit (their shadow memory would trip it).
  */
 #include <errno.h>
 #include <limits.h>
@@ -14,9 +22,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/resource.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "rt/camera.h"
 #include "rt/gltf.h"
 #include "rt/image.h"
 #include "rt/kdtree.h"
@@ -27,6 +37,23 @@
 #include "rt/tangents.h"
 
 #define RT_VERSION "0.1.0"
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define RT_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#define RT_SANITIZED 1
+#endif
+#endif
+#ifndef RT_SANITIZED
+#define RT_SANITIZED 0
+#endif
+
+/* The kd-tree's primitive ids are 30 bits (src/kdtree.c). */
+#define MAX_PRIMITIVES (((size_t)1 << 30) - 2)
+/* whitted: rays a camera sample may spawn through diffuse gathering
+ * (diffuse_rays ^ diffuse_bounces); more is a render that never ends. */
+#define MAX_DIFFUSE_TREE ((double)(1 << 24))
 
 static atomic_int interrupted;
 
@@ -46,8 +73,138 @@ static double now_ms(void)
     return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
 }
 
+/* ------------------------------------------------------------ memory budget */
+
+typedef struct memory_budget {
+    unsigned long long bytes; /* 0 = none */
+    bool from_flag;           /* --max-memory given */
+    bool enforced;            /* setrlimit took it */
+} memory_budget;
+
+/* The cgroup v2 (or v1) memory limit of this process, 0 when none. */
+static unsigned long long cgroup_memory_limit(void)
+{
+    static const char *const files[] = {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"};
+    for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
+        FILE *f = fopen(files[i], "r");
+        if (!f)
+            continue;
+        char buf[64] = {0};
+        bool ok = fgets(buf, sizeof buf, f) != NULL;
+        fclose(f);
+        if (!ok || strncmp(buf, "max", 3) == 0)
+            continue;
+        errno = 0;
+        char *end;
+        unsigned long long v = strtoull(buf, &end, 10);
+        if (!errno && end != buf && v > 0 && v < (1ull << 60))
+            return v;
+    }
+    return 0;
+}
+
+/* 75% of physical memory (or of the cgroup limit, when lower). */
+static unsigned long long default_memory_budget(void)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    unsigned long long phys = pages > 0 && page > 0 ? (unsigned long long)pages * (unsigned long long)page : 0;
+    unsigned long long cg = cgroup_memory_limit();
+    if (cg && (!phys || cg < phys))
+        phys = cg;
+    return phys / 4 * 3;
+}
+
+/* "4G", "512M", "1.5g", "300000K", "123456789" (bytes); "0", "none" or
+ * "unlimited" turn the budget off (*out = 0). */
+static bool parse_size(const char *s, unsigned long long *out)
+{
+    if (!s || !*s)
+        return false;
+    if (strcmp(s, "none") == 0 || strcmp(s, "unlimited") == 0) {
+        *out = 0;
+        return true;
+    }
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || !(v >= 0.0))
+        return false;
+    double mul = 1.0;
+    switch (*end) {
+    case 'k': case 'K': mul = 1024.0; end++; break;
+    case 'm': case 'M': mul = 1024.0 * 1024.0; end++; break;
+    case 'g': case 'G': mul = 1024.0 * 1024.0 * 1024.0; end++; break;
+    case 't': case 'T': mul = 1024.0 * 1024.0 * 1024.0 * 1024.0; end++; break;
+    default: break;
+    }
+    if (*end == 'i' && mul > 1.0) /* KiB, MiB, ... */
+        end++;
+    if ((*end == 'B' || *end == 'b') && end[1] == 0)
+        end++;
+    if (*end)
+        return false;
+    double bytes = v * mul;
+    if (!(bytes < 9.0e18))
+        return false;
+    *out = (unsigned long long)bytes;
+    return true;
+}
+
+static void format_size(unsigned long long bytes, char *buf, size_t size)
+{
+    if (bytes >= (1ull << 30))
+        snprintf(buf, size, "%.1f GiB", (double)bytes / (double)(1ull << 30));
+    else
+        snprintf(buf, size, "%.0f MiB", (double)bytes / (double)(1ull << 20));
+}
+
+/* Caps the data segment (heap and private mappings) at the budget. Below
+ * 64 MiB nothing works at all, so smaller budgets are refused. */
+static void apply_memory_budget(memory_budget *b)
+{
+    b->enforced = false;
+    if (!b->bytes || RT_SANITIZED)
+        return;
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_DATA, &rl) != 0)
+        return;
+    rlim_t want = (rlim_t)b->bytes;
+    if (rl.rlim_max != RLIM_INFINITY && want > rl.rlim_max)
+        want = rl.rlim_max;
+    if (rl.rlim_cur != RLIM_INFINITY && rl.rlim_cur < want) /* someone set a lower limit: keep it */
+        want = rl.rlim_cur;
+    rl.rlim_cur = want;
+    if (setrlimit(RLIMIT_DATA, &rl) == 0) {
+        b->bytes = (unsigned long long)want;
+        b->enforced = true;
+    }
+}
+
+static memory_budget budget;
+
+/* Prints an error; out-of-memory errors also say which budget ran out and
+ * how to raise it. */
+static void report(const rt_error *err)
+{
+    fprintf(stderr, "rt: %s\n", err->message);
+    if (err->code != RT_ERR_NOMEM)
+        return;
+    if (budget.enforced) {
+        char sz[32];
+        format_size(budget.bytes, sz, sizeof sz);
+        fprintf(stderr,
+                "rt: the memory budget of %s (%s) ran out; raise it with --max-memory SIZE (e.g. --max-memory 16G, or "
+                "'none' for no limit)\n",
+                sz, budget.from_flag ? "--max-memory" : "the default, 75% of physical memory");
+    } else {
+        fprintf(stderr, "rt: the machine's memory ran out (no --max-memory budget was in force)\n");
+    }
+}
+
 static void usage(FILE *f)
 {
+    char default_budget_text[32];
+    format_size(default_memory_budget(), default_budget_text, sizeof default_budget_text);
     fprintf(f,
             "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off]\n"
             "\n"
@@ -67,11 +224,14 @@ static void usage(FILE *f)
             "  --tile N           tile size in pixels (default 32)\n"
             "  --preview SECONDS  live view: rewrite the output with the finished tiles every SECONDS\n"
             "  --info FILE        print what a scene or model contains (key: value lines) and exit\n"
+            "  --max-memory SIZE  memory budget, e.g. 4G or 512M; 'none' for no limit\n"
+            "                     (default: 75%% of physical memory, here %s)\n"
             "  -h, --help         this text\n"
             "  --version          print the version\n"
             "\n"
-            "Scene format: docs/scene-format.md. Exit status: 0 ok, 2 bad input, 130 interrupted.\n",
-            rt_cpu_count());
+            "Scene format: docs/scene-format.md; limits and exit codes: docs/robustness.md.\n"
+            "Exit status: 0 ok, 2 bad input (or over a limit), 130 interrupted.\n",
+            rt_cpu_count(), default_budget_text);
 }
 
 static int fail_usage(const char *fmt, const char *arg)
@@ -129,7 +289,7 @@ static input_kind input_kind_of(const char *path)
 
 /* Lighting and sampling for a bare model: a soft sky, a key light from
  * above when the model brings no lights, and enough samples for clean edges. */
-static void add_default_lighting(rt_scene *s)
+static bool add_default_lighting(rt_scene *s)
 {
     s->settings.samples = 16;
     s->settings.background = rt_v3(0.55f, 0.6f, 0.7f);
@@ -141,8 +301,10 @@ static void add_default_lighting(rt_scene *s)
         sun.intensity = 2.5f;
         sun.direction = rt_normalize(rt_v3(-0.4f, -1.0f, -0.6f));
         sun.quad = RT_NONE;
-        rt_scene_add_light(s, &sun);
+        if (rt_scene_add_light(s, &sun) == RT_NONE)
+            return false;
     }
+    return true;
 }
 
 /* What loading one input found, for --info. */
@@ -174,7 +336,8 @@ static rt_result load_input(rt_scene *s, const char *path, bool for_render, inpu
         info->primitives = gs.primitives;
         info->nodes = gs.nodes;
         if (r == RT_OK && for_render) {
-            add_default_lighting(s);
+            if (!add_default_lighting(s))
+                r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", path);
             if (s->camera_count) {
                 s->camera = s->cameras[0];
                 s->camera_set = true;
@@ -186,11 +349,11 @@ static rt_result load_input(rt_scene *s, const char *path, bool for_render, inpu
         uint32_t mi = rt_scene_add_material(s, &m);
         rt_mat4 id = rt_mat4_identity();
         rt_mesh_load_stats ms;
-        r = mi == RT_NONE ? rt_fail(err, RT_ERR_NOMEM, "out of memory")
+        r = mi == RT_NONE ? rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path)
                           : rt_mesh_load(s, path, &id, mi, false, &ms, err);
         info->meshes = info->primitives = r == RT_OK ? 1 : 0;
-        if (r == RT_OK && for_render)
-            add_default_lighting(s);
+        if (r == RT_OK && for_render && !add_default_lighting(s))
+            r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", path);
     } else {
         r = rt_scene_parse_file(s, path, err);
     }
@@ -219,6 +382,46 @@ static void default_output(const rt_scene *s, const char *input, char *out, size
     snprintf(out, size, "%.*s.png", len, base);
 }
 
+/* Caps on what a loaded scene may ask for, checked before any large
+ * allocation of the render: the primitive count the kd-tree can index, a
+ * diffuse-gather tree that would never finish, a usable camera. The image
+ * size and sample count are capped where they are read (flags, parser). */
+static rt_result check_limits(rt_scene *s, const char *input, bool camera_from_input, rt_error *err)
+{
+    const char *name = input ? input : "<built-in scene>";
+    size_t prims = rt_scene_prim_count(s);
+    if (prims > MAX_PRIMITIVES)
+        return rt_fail(err, RT_ERR_LIMIT, "%s: %zu primitives (triangles %zu, spheres %zu, quads %zu), over the limit of %zu",
+                       name, prims, s->triangles.count, s->spheres.count, s->quads.count, MAX_PRIMITIVES);
+    const rt_settings *set = &s->settings;
+    if (set->width < 1 || set->height < 1 || set->width > 32768 || set->height > 32768)
+        return rt_fail(err, RT_ERR_LIMIT, "%s: image size %dx%d is out of range (1..32768 a side)", name, set->width,
+                       set->height);
+    if (set->samples > (1 << 20))
+        return rt_fail(err, RT_ERR_LIMIT, "%s: %d samples per pixel, over the limit of 1048576", name, set->samples);
+    if (set->integrator == RT_INTEGRATOR_WHITTED && set->diffuse_bounces > 0 && set->diffuse_rays > 1) {
+        double rays = 1.0;
+        for (int i = 0; i < set->diffuse_bounces && rays <= MAX_DIFFUSE_TREE; i++)
+            rays *= (double)set->diffuse_rays;
+        if (rays > MAX_DIFFUSE_TREE)
+            return rt_fail(err, RT_ERR_LIMIT,
+                           "%s: diffuse_rays %d with diffuse_bounces %d would trace over %.0f rays per camera sample "
+                           "(diffuse_rays ^ diffuse_bounces); lower one of them",
+                           name, set->diffuse_rays, set->diffuse_bounces, MAX_DIFFUSE_TREE);
+    }
+    rt_camera_frame cf;
+    if (!rt_camera_frame_init(&cf, &s->camera, set->width, set->height)) {
+        if (camera_from_input)
+            return rt_fail(err, RT_ERR_INVALID,
+                           "%s: the camera is degenerate (position equal to look_at, up parallel to the view, a field of "
+                           "view outside 0..180 degrees, or a value that is not finite)",
+                           name);
+        rt_warn("%s: could not frame the model automatically (its bounds are empty or not finite); looking down -z",
+                name);
+    }
+    return RT_OK;
+}
+
 /* --info: one `key: value` line per figure, for people and scripts. */
 static int print_info(const char *path)
 {
@@ -228,7 +431,7 @@ static int print_info(const char *path)
     input_info info;
     rt_result r = load_input(&s, path, false, &info, &err);
     if (r != RT_OK) {
-        fprintf(stderr, "rt: %s\n", err.message);
+        report(&err);
         rt_scene_free(&s);
         return 2;
     }
@@ -263,7 +466,8 @@ static int print_info(const char *path)
 
 int main(int argc, char **argv)
 {
-    const char *input = NULL, *output = NULL, *integrator = NULL, *preview = NULL;
+    const char *input = NULL, *output = NULL, *integrator = NULL, *preview = NULL, *info_path = NULL;
+    budget.bytes = default_memory_budget();
     long threads = 0, samples = 0, width = 0, height = 0, camera = -1, seed = -1, tile = 0;
     double preview_seconds = 0.0;
     rt_log_level level = RT_LOG_NORMAL;
@@ -332,8 +536,14 @@ int main(int argc, char **argv)
             preview = "";
         } else if (strcmp(a, "--info") == 0) {
             NEED_ARG();
-            rt_log_set_level(level);
-            return print_info(next);
+            info_path = next;
+        } else if (strcmp(a, "--max-memory") == 0) {
+            NEED_ARG();
+            if (!parse_size(next, &budget.bytes))
+                return fail_usage("--max-memory wants a size such as 4G, 512M or 'none', got '%s'", next);
+            if (budget.bytes && budget.bytes < (64ull << 20))
+                return fail_usage("--max-memory: '%s' is below the 64M rt needs to start", next);
+            budget.from_flag = true;
         } else if (a[0] == '-' && a[1] != 0) {
             return fail_usage("unknown option '%s'", a);
         } else {
@@ -344,13 +554,23 @@ int main(int argc, char **argv)
 #undef NEED_ARG
     }
     rt_log_set_level(level);
+    apply_memory_budget(&budget);
+    if (budget.enforced) {
+        char sz[32];
+        format_size(budget.bytes, sz, sizeof sz);
+        rt_info("memory budget: %s%s", sz, budget.from_flag ? " (--max-memory)" : " (75%% of physical memory)");
+    } else {
+        rt_info("memory budget: none%s", RT_SANITIZED && budget.bytes ? " (not enforced in sanitizer builds)" : "");
+    }
+    if (info_path)
+        return print_info(info_path);
 
     rt_scene scene;
     rt_scene_init(&scene);
     rt_error err = {0};
     input_info info;
     if (load_input(&scene, input, true, &info, &err) != RT_OK) {
-        fprintf(stderr, "rt: %s\n", err.message);
+        report(&err);
         rt_scene_free(&scene);
         return 2;
     }
@@ -377,16 +597,22 @@ int main(int argc, char **argv)
         double w = (double)set->height * scene.camera.aspect_ratio + 0.5;
         set->width = w < 1.0 ? 1 : (w > 32768.0 ? 32768 : (int)w);
     }
+    bool camera_from_input = scene.camera_set;
     if (!scene.camera_set)
         rt_scene_frame_camera(&scene);
+    if (check_limits(&scene, input, camera_from_input, &err) != RT_OK) {
+        report(&err);
+        rt_scene_free(&scene);
+        return 2;
+    }
 
     char outbuf[1024];
     if (!output) {
         default_output(&scene, input, outbuf, sizeof outbuf);
         output = outbuf;
     }
-    if (rt_output_check(output, &err) != RT_OK) {
-        fprintf(stderr, "rt: %s\n", err.message);
+    if (rt_output_check(output, &err) != RT_OK || rt_output_check_size(output, set->width, set->height, &err) != RT_OK) {
+        report(&err);
         rt_scene_free(&scene);
         return 2;
     }
@@ -403,7 +629,7 @@ int main(int argc, char **argv)
 
     rt_kdtree tree;
     if (rt_kdtree_build(&tree, &scene, NULL, &err) != RT_OK) {
-        fprintf(stderr, "rt: %s\n", err.message);
+        report(&err);
         rt_scene_free(&scene);
         return 2;
     }
@@ -413,7 +639,7 @@ int main(int argc, char **argv)
 
     rt_framebuffer fb;
     if (rt_framebuffer_init(&fb, set->width, set->height, &err) != RT_OK) {
-        fprintf(stderr, "rt: %s\n", err.message);
+        report(&err);
         rt_kdtree_free(&tree);
         rt_scene_free(&scene);
         return 2;
@@ -441,12 +667,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "rt: %s; writing the finished tiles to %s\n", err.message, output);
         status = 130;
     } else if (r != RT_OK) {
-        fprintf(stderr, "rt: %s\n", err.message);
+        report(&err);
         status = 2;
     }
     if (status != 2) {
         if (rt_framebuffer_write(&fb, output, set->exposure, &err) != RT_OK) {
-            fprintf(stderr, "rt: %s\n", err.message);
+            report(&err);
             status = 2;
         } else if (level >= RT_LOG_NORMAL) {
             fprintf(stderr, "rt: wrote %s (%dx%d, %d spp, %.2f s)\n", output, fb.width, fb.height, set->samples,
