@@ -90,6 +90,23 @@ rt_result rt_output_check(const char *path, rt_error *err)
     return RT_OK;
 }
 
+/* stb_image_write builds a PNG in memory with int sizes: the filtered rows
+ * ((3w + 1) h bytes) and their zlib stream must stay well below 2 GiB. */
+#define MAX_PNG_RAW_BYTES ((uint64_t)1 << 30)
+
+rt_result rt_output_check_size(const char *path, int width, int height, rt_error *err)
+{
+    rt_image_format fmt;
+    rt_result r = rt_output_format(path, &fmt, err);
+    if (r != RT_OK)
+        return r;
+    if (fmt == RT_FORMAT_PNG && ((uint64_t)width * 3 + 1) * (uint64_t)(height > 0 ? height : 0) > MAX_PNG_RAW_BYTES)
+        return rt_fail(err, RT_ERR_LIMIT,
+                       "%s: a %dx%d PNG is over the PNG writer's limit of 1 GiB of pixel data; write .pfm or .hdr", path,
+                       width, height);
+    return RT_OK;
+}
+
 static void write_to_file(void *context, void *data, int size)
 {
     FILE *f = context;
@@ -138,6 +155,8 @@ rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float
     rt_image_format fmt;
     rt_result r = rt_output_format(path, &fmt, err);
     if (r != RT_OK)
+        return r;
+    if ((r = rt_output_check_size(path, fb->width, fb->height, err)) != RT_OK)
         return r;
     char tmp[4200];
     FILE *f = open_temp_beside(path, tmp, sizeof tmp);

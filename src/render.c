@@ -51,7 +51,10 @@ typedef struct worker {
     uint64_t rays, camera_rays, bad_samples;
 } worker;
 
-static void render_tile(render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
+/* Renders one tile; false when cancelled part-way (the tile then stays
+ * unfinished and is cleared to black). The cancel flag is read once a
+ * pixel, so Ctrl-C is answered within a pixel's samples, not a tile's. */
+static bool render_tile(render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
 {
     const rt_settings *st = &job->scene->settings;
     int tx = tile % job->tiles_x, ty = tile / job->tiles_x;
@@ -62,6 +65,8 @@ static void render_tile(render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
     uint32_t spp = st->samples > 0 ? (uint32_t)st->samples : 1;
     for (int y = y0; y < y1; y++) {
         for (int x = x0; x < x1; x++) {
+            if (job->cancel && atomic_load_explicit(job->cancel, memory_order_relaxed))
+                return false;
             uint64_t pixel = (uint64_t)y * (uint64_t)job->fb->width + (uint64_t)x;
             uint32_t pattern = (uint32_t)rt_mix64(pixel ^ ((uint64_t)st->seed << 40));
             rt_vec3 sum = rt_v3s(0);
@@ -93,6 +98,7 @@ static void render_tile(render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
             px[2] = sum.z;
         }
     }
+    return true;
 }
 
 static void *worker_main(void *arg)
@@ -108,7 +114,8 @@ static void *worker_main(void *arg)
         int tile = atomic_fetch_add(&job->next_tile, 1);
         if (tile >= job->tiles_total)
             break;
-        render_tile(job, w, &ctx, tile);
+        if (!render_tile(job, w, &ctx, tile))
+            break;
         atomic_store(&job->tile_finished[tile], 1);
         atomic_fetch_add(&job->tiles_done, 1);
     }
@@ -181,9 +188,12 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     job.fb = fb;
     job.cancel = opt.cancel;
     rt_camera_frame_init(&job.camera, &scene->camera, fb->width, fb->height);
-    job.tile_size = opt.tile_size > 0 ? opt.tile_size : 32;
-    job.tiles_x = (fb->width + job.tile_size - 1) / job.tile_size;
-    job.tiles_y = (fb->height + job.tile_size - 1) / job.tile_size;
+    job.tile_size = opt.tile_size > 0 ? (opt.tile_size < 65536 ? opt.tile_size : 65536) : 32;
+    job.tiles_x = (int)(((int64_t)fb->width + job.tile_size - 1) / job.tile_size);
+    job.tiles_y = (int)(((int64_t)fb->height + job.tile_size - 1) / job.tile_size);
+    if ((int64_t)job.tiles_x * job.tiles_y > (int64_t)(1 << 26))
+        return rt_fail(err, RT_ERR_LIMIT, "%dx%d image in %d-pixel tiles makes %lld tiles, over the limit of %d; use larger tiles",
+                       fb->width, fb->height, job.tile_size, (long long)job.tiles_x * job.tiles_y, 1 << 26);
     job.tiles_total = job.tiles_x * job.tiles_y;
     atomic_init(&job.next_tile, 0);
     atomic_init(&job.tiles_done, 0);

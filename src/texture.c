@@ -178,6 +178,16 @@ static rt_result png_precheck(const unsigned char *p, size_t size, const char *n
     return RT_OK;
 }
 
+/* stb reports a failed allocation as "outofmem": that is RT_ERR_NOMEM (the
+ * driver then names the memory budget), anything else is a bad image. */
+static rt_result decode_failed(const char *name, rt_error *err)
+{
+    const char *why = stbi_failure_reason();
+    if (why && strcmp(why, "outofmem") == 0)
+        return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory decoding the image", name);
+    return rt_fail(err, RT_ERR_INVALID, "%s: cannot decode image (%s)", name, why ? why : "unknown reason");
+}
+
 static uint32_t find_image(const rt_scene *s, const char *name)
 {
     for (size_t i = 0; i < s->image_count; i++)
@@ -218,11 +228,11 @@ rt_result rt_image_load_memory(rt_scene *s, const void *data, size_t size, const
     if (hdr) {
         img.rgbaf = stbi_loadf_from_memory(bytes, (int)size, &lw, &lh, &lc, 4);
         if (!img.rgbaf)
-            return rt_fail(err, RT_ERR_INVALID, "%s: cannot decode image (%s)", name, stbi_failure_reason());
+            return decode_failed(name, err);
     } else {
         img.rgba8 = stbi_load_from_memory(bytes, (int)size, &lw, &lh, &lc, 4);
         if (!img.rgba8)
-            return rt_fail(err, RT_ERR_INVALID, "%s: cannot decode image (%s)", name, stbi_failure_reason());
+            return decode_failed(name, err);
     }
     if (lw != w || lh != h) {
         free(img.rgba8);

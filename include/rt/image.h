@@ -32,6 +32,9 @@ rt_result rt_output_format(const char *path, rt_image_format *format, rt_error *
 /* Checks before a render that the format is known and the directory is
  * writable (by creating and removing a temporary file there). */
 rt_result rt_output_check(const char *path, rt_error *err);
+/* Checks that the format can hold a width x height image (PNG output is
+ * capped at 1 GiB of pixel data; RT_ERR_LIMIT beyond). */
+rt_result rt_output_check_size(const char *path, int width, int height, rt_error *err);
 /* Writes atomically. exposure scales the values for PNG only. */
 rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float exposure, rt_error *err);
 
