@@ -208,6 +208,15 @@ rt_result rt_image_load_memory(rt_scene *s, const void *data, size_t size, const
         return rt_fail(err, RT_ERR_INVALID, "%s: image data is %s", name, size ? "over 2 GiB" : "empty");
     const stbi_uc *bytes = data;
     int w = 0, h = 0, comp = 0;
+    /* stb refuses PNGs over 2^30 bytes of pixels as "unknown image type":
+     * read the size from the IHDR chunk ourselves to say what is wrong */
+    static const unsigned char png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (size >= 24 && memcmp(bytes, png_sig, 8) == 0 && memcmp(bytes + 12, "IHDR", 4) == 0) {
+        uint32_t pw = be32(bytes + 16), ph = be32(bytes + 20);
+        if (pw > RT_MAX_IMAGE_DIM || ph > RT_MAX_IMAGE_DIM || (uint64_t)pw * ph > RT_MAX_IMAGE_PIXELS)
+            return rt_fail(err, RT_ERR_LIMIT, "%s: image is %ux%u, over the limit of %dx%d and %u pixels", name, pw, ph,
+                           RT_MAX_IMAGE_DIM, RT_MAX_IMAGE_DIM, (unsigned)RT_MAX_IMAGE_PIXELS);
+    }
     if (!stbi_info_from_memory(bytes, (int)size, &w, &h, &comp))
         return rt_fail(err, RT_ERR_INVALID, "%s: not a readable image (%s)", name, stbi_failure_reason());
     if (w <= 0 || h <= 0 || w > RT_MAX_IMAGE_DIM || h > RT_MAX_IMAGE_DIM ||

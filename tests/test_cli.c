@@ -1,0 +1,653 @@
+/* test_cli.c - the `rt` command as a user meets it: run as a subprocess
+ * ($RT_BIN, default ./rt) with bad flags, bad scene files, bad models and
+ * images made here, unwritable outputs and resource limits. Each must exit
+ * with status 2, print a message naming the file (and line or byte) and
+ * what is wrong, leave an existing output image byte-identical and leave no
+ * temporary file behind. Then the good paths that are easy to get wrong:
+ * Ctrl-C / SIGTERM (exit 130, the finished tiles written, the rest black),
+ * a second Ctrl-C (exits at once, the old image kept), a 1x1 image, and the
+ * same bytes from 1, 64 and more-threads-than-tiles renders.
+ */
+#include "test_util.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdbool.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "rt/image.h"
+
+static char dir[256];     /* this run's scratch directory */
+static char out_png[512]; /* the "earlier image" every failing run must leave alone */
+static const char precious[] = "\x89PNG not really, but an earlier image the user wants to keep\n";
+
+static const char *rt_bin(void)
+{
+    const char *b = getenv("RT_BIN");
+    return b && *b ? b : "./rt";
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void sleep_s(double s)
+{
+    struct timespec ts = {(time_t)s, (long)((s - (double)(time_t)s) * 1e9)};
+    while (nanosleep(&ts, &ts) != 0 && errno == EINTR)
+        ;
+}
+
+static const char *path_in(const char *name)
+{
+    static char buf[32][600]; /* the last 32 results stay valid */
+    static int k;
+    k = (k + 1) % 32;
+    snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name);
+    return buf[k];
+}
+
+static void write_text(const char *name, const char *text)
+{
+    test_write_file(path_in(name), text, strlen(text));
+}
+
+static size_t read_all(const char *path, char *buf, size_t cap)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return (size_t)-1;
+    size_t n = fread(buf, 1, cap - 1, f);
+    buf[n] = 0;
+    fclose(f);
+    return n;
+}
+
+static void copy_file(const char *from, const char *to)
+{
+    static char buf[1 << 20];
+    size_t n = read_all(from, buf, sizeof buf);
+    assert_true(n != (size_t)-1);
+    test_write_file(to, buf, n);
+}
+
+typedef struct run_result {
+    int status;   /* exit status, or -1 when killed by a signal */
+    int signal;   /* the signal that killed it, else 0 */
+    double seconds;
+    char err[16384]; /* stderr */
+} run_result;
+
+static pid_t spawn(const char *const *args)
+{
+    const char *argv[64];
+    int n = 0;
+    argv[n++] = rt_bin();
+    for (int i = 0; args[i] && n < 63; i++)
+        argv[n++] = args[i];
+    argv[n] = NULL;
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        int null = open("/dev/null", O_WRONLY);
+        int e = open(path_in("stderr.txt"), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (null < 0 || e < 0)
+            _exit(127);
+        dup2(null, 1);
+        dup2(e, 2);
+        execv(argv[0], (char *const *)argv);
+        _exit(127);
+    }
+    return pid;
+}
+
+static void wait_for(pid_t pid, double t0, double timeout, run_result *r)
+{
+    int st = 0;
+    for (;;) {
+        pid_t w = waitpid(pid, &st, WNOHANG);
+        if (w == pid)
+            break;
+        assert_true(w == 0 || errno == EINTR);
+        if (now_s() - t0 > timeout) {
+            kill(pid, SIGKILL);
+            waitpid(pid, &st, 0);
+            fail_msg("%s did not finish within %.0f s", rt_bin(), timeout);
+        }
+        sleep_s(0.002);
+    }
+    r->seconds = now_s() - t0;
+    r->status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    r->signal = WIFSIGNALED(st) ? WTERMSIG(st) : 0;
+    if (read_all(path_in("stderr.txt"), r->err, sizeof r->err) == (size_t)-1)
+        r->err[0] = 0;
+    if (r->status == 127)
+        fail_msg("could not run %s (build it first, or set RT_BIN)", rt_bin());
+}
+
+static void run_args(run_result *r, const char *const *args)
+{
+    double t0 = now_s();
+    wait_for(spawn(args), t0, 120.0, r);
+}
+
+/* No .rt-tmp-* file may be left in the scratch directory. */
+static void assert_no_temp_files(void)
+{
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    struct dirent *e;
+    while ((e = readdir(d)))
+        if (strncmp(e->d_name, ".rt-tmp-", 8) == 0)
+            fail_msg("temporary file %s/%s left behind", dir, e->d_name);
+    closedir(d);
+}
+
+static void put_precious(const char *path)
+{
+    test_write_file(path, precious, sizeof precious - 1);
+}
+
+static void assert_precious(const char *path)
+{
+    char buf[256];
+    size_t n = read_all(path, buf, sizeof buf);
+    assert_int_equal(n, sizeof precious - 1);
+    assert_memory_equal(buf, precious, n);
+}
+
+static void assert_contains(const char *hay, const char *needle)
+{
+    if (needle && !strstr(hay, needle))
+        fail_msg("expected \"%s\" in rt's message:\n%s", needle, hay);
+}
+
+/* Runs rt with args (NULL-terminated) and expects a clean refusal: exit 2,
+ * a message with both fragments, `protect` (an existing image) untouched. */
+static void expect_refusal_v(const char *protect, const char *msg1, const char *msg2, const char *const *args)
+{
+    put_precious(protect);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_args(r, args);
+    if (r->status != 2) {
+        fprintf(stderr, "args:");
+        for (int i = 0; args[i]; i++)
+            fprintf(stderr, " %s", args[i]);
+        fail_msg("\nexpected exit status 2, got %d (signal %d); stderr:\n%s", r->status, r->signal, r->err);
+    }
+    assert_true(strncmp(r->err, "rt: ", 4) == 0);
+    assert_contains(r->err, msg1);
+    assert_contains(r->err, msg2);
+    assert_null(strstr(r->err, "internal error"));
+    assert_precious(protect);
+    assert_no_temp_files();
+    free(r);
+}
+
+#define REFUSE(protect, m1, m2, ...)                                                                                   \
+    do {                                                                                                               \
+        const char *const args_[] = {__VA_ARGS__, NULL};                                                               \
+        expect_refusal_v(protect, m1, m2, args_);                                                                      \
+    } while (0)
+
+/* --------------------------------------------------------------- setup */
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(dir, sizeof dir, "/tmp/rt-test-cli-XXXXXX");
+    if (!mkdtemp(dir))
+        return -1;
+    snprintf(out_png, sizeof out_png, "%s/out.png", dir);
+    if (access(rt_bin(), X_OK) != 0) {
+        fprintf(stderr, "test_cli: %s is not built (make rt, or set RT_BIN)\n", rt_bin());
+        return -1;
+    }
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    DIR *d = opendir(dir);
+    if (d) {
+        struct dirent *e;
+        while ((e = readdir(d))) {
+            if (e->d_name[0] == '.' && (e->d_name[1] == 0 || (e->d_name[1] == '.' && e->d_name[2] == 0)))
+                continue;
+            char p[600];
+            snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
+            unlink(p);
+        }
+        closedir(d);
+    }
+    rmdir(dir);
+    return 0;
+}
+
+/* True when this rt enforces --max-memory (sanitizer builds do not). */
+static bool budget_enforced(void)
+{
+    write_text("tiny.txt", "resolution 4 4\n");
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *const args[] = {"-v", "--info", path_in("tiny.txt"), NULL};
+    run_args(r, args);
+    assert_int_equal(r->status, 0);
+    assert_contains(r->err, "memory budget: ");
+    bool on = strstr(r->err, "memory budget: none") == NULL;
+    free(r);
+    return on;
+}
+
+/* --------------------------------------------------------------- flags */
+
+static void test_bad_flags(void **state)
+{
+    (void)state;
+    const char *o = out_png;
+    REFUSE(o, "-s wants samples per pixel", "'0'", "-s", "0", "-o", o);
+    REFUSE(o, "-s wants", "2000000", "-s", "2000000", "-o", o);
+    REFUSE(o, "-r wants", "'0x5'", "-r", "0x5", "-o", o);
+    REFUSE(o, "-r wants", "40000x10", "-r", "40000x10", "-o", o);
+    REFUSE(o, "-r wants", "'640'", "-r", "640", "-o", o);
+    REFUSE(o, "-t wants a thread count", "'0'", "-t", "0", "-o", o);
+    REFUSE(o, "-t wants", "'many'", "-t", "many", "-o", o);
+    REFUSE(o, "--tile wants", "'0'", "--tile", "0", "-o", o);
+    REFUSE(o, "--integrator wants", "'magic'", "--integrator", "magic", "-o", o);
+    REFUSE(o, "--max-memory wants a size", "'lots'", "--max-memory", "lots", "-o", o);
+    REFUSE(o, "--max-memory", "below the 64M", "--max-memory", "1M", "-o", o);
+    REFUSE(o, "--preview wants", "'0'", "--preview", "0", "-o", o);
+    REFUSE(o, "unknown option", "'--bogus'", "--bogus", "-o", o);
+    REFUSE(o, "only one input", "b.txt", "a.txt", "b.txt", "-o", o);
+    REFUSE(o, "option -o needs a value", NULL, "-o");
+    REFUSE(o, "--camera 3", "0 cameras", "--camera", "3", "-o", o);
+}
+
+/* ------------------------------------------------------------ scene files */
+
+static void test_bad_scene_files(void **state)
+{
+    (void)state;
+    const char *o = out_png;
+    write_text("kw.txt", "resolution 16 16\nbogus 1 2\n");
+    REFUSE(o, "kw.txt:2:1: ", "unknown keyword 'bogus'", path_in("kw.txt"), "-o", o);
+    write_text("nan.txt", "resolution 16 16\ncamera position 0 1 nan look_at 0 0 0\n");
+    REFUSE(o, "nan.txt:2:21: ", "'nan'", path_in("nan.txt"), "-o", o);
+    write_text("inf.txt", "resolution 16 16\ncamera position 0 1 2 look_at 0 0 0 fov inf\n");
+    REFUSE(o, "inf.txt:2:", "'inf'", path_in("inf.txt"), "-o", o);
+    write_text("cam.txt", "resolution 16 16\ncamera position 0 0 0 look_at 0 0 0\n");
+    REFUSE(o, "cam.txt:2:", "look_at point equals its position", path_in("cam.txt"), "-o", o);
+    write_text("spp.txt", "samples 2000000\n");
+    REFUSE(o, "spp.txt:1:9: ", "between 1 and 1048576", path_in("spp.txt"), "-o", o);
+    write_text("res.txt", "resolution 40000 10\n");
+    REFUSE(o, "res.txt:1:12: ", "between 1 and 32768", path_in("res.txt"), "-o", o);
+    write_text("depth.txt", "max_bounce 1000\n");
+    REFUSE(o, "depth.txt:1:12: ", "max_bounce must be between 0 and 256", path_in("depth.txt"), "-o", o);
+    write_text("tree.txt", "resolution 8 8\nintegrator whitted\ndiffuse_rays 1000\ndiffuse_bounces 5\n");
+    REFUSE(o, "tree.txt: ", "rays per camera sample", path_in("tree.txt"), "-o", o);
+    write_text("badnum.txt", "resolution 16 16x\n");
+    REFUSE(o, "badnum.txt:1:", NULL, path_in("badnum.txt"), "-o", o);
+    REFUSE(o, "missing.txt: cannot open", NULL, path_in("missing.txt"), "-o", o);
+    write_text("mesh.txt", "mesh missing.obj\n");
+    REFUSE(o, "missing.obj", NULL, path_in("mesh.txt"), "-o", o);
+    /* the scene's own output line is protected the same way */
+    char own[700];
+    snprintf(own, sizeof own, "output \"%s\"\nbogus\n", o);
+    write_text("own.txt", own);
+    REFUSE(o, "own.txt:2:1: ", NULL, path_in("own.txt"));
+}
+
+/* --------------------------------------------------------------- models */
+
+static const char *gltf_doc(char *buf, size_t size, int count, int bad_index, const char *nodes)
+{
+    /* three positions (36 bytes) and three u16 indices (6 bytes + 2 padding), base64 */
+    unsigned char bin[44];
+    float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    memcpy(bin, pos, 36);
+    uint16_t idx[4] = {0, 1, (uint16_t)(bad_index ? 7 : 2), 0};
+    memcpy(bin + 36, idx, 8);
+    static const char b64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    char enc[80];
+    int n = 0;
+    for (int i = 0; i < 44; i += 3) {
+        uint32_t v = (uint32_t)bin[i] << 16 | (uint32_t)(i + 1 < 44 ? bin[i + 1] : 0) << 8 | (i + 2 < 44 ? bin[i + 2] : 0);
+        enc[n++] = b64[v >> 18 & 63];
+        enc[n++] = b64[v >> 12 & 63];
+        enc[n++] = i + 1 < 44 ? b64[v >> 6 & 63] : '=';
+        enc[n++] = i + 2 < 44 ? b64[v & 63] : '=';
+    }
+    enc[n] = 0;
+    snprintf(buf, size,
+             "{\"asset\":{\"version\":\"2.0\"},"
+             "\"buffers\":[{\"byteLength\":44,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":36},"
+             "{\"buffer\":0,\"byteOffset\":36,\"byteLength\":6}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%d,\"type\":\"VEC3\","
+             "\"min\":[0,0,0],\"max\":[1,1,0]},"
+             "{\"bufferView\":1,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
+             "\"nodes\":%s,\"scenes\":[{\"nodes\":[0]}],\"scene\":0}",
+             enc, count, nodes);
+    return buf;
+}
+
+static void test_bad_models(void **state)
+{
+    (void)state;
+    const char *o = out_png;
+    static char doc[1 << 21];
+
+    /* the good one renders, so the refusals below are about the one change */
+    write_text("ok.gltf", gltf_doc(doc, sizeof doc, 3, 0, "[{\"mesh\":0}]"));
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *const good[] = {"-q", "-r", "8x8", "-o", path_in("ok.png"), path_in("ok.gltf"), NULL};
+    run_args(r, good);
+    if (r->status != 0)
+        fail_msg("the valid glTF failed: %s", r->err);
+    free(r);
+
+    write_text("acc.gltf", gltf_doc(doc, sizeof doc, 1000, 0, "[{\"mesh\":0}]"));
+    REFUSE(o, "acc.gltf: byte ", "1000 elements", path_in("acc.gltf"), "-o", o);
+    write_text("idx.gltf", gltf_doc(doc, sizeof doc, 3, 1, "[{\"mesh\":0}]"));
+    REFUSE(o, "idx.gltf: byte ", "is 7, past the vertex count 3", path_in("idx.gltf"), "-o", o);
+    write_text("cycle.gltf", gltf_doc(doc, sizeof doc, 3, 0, "[{\"mesh\":0,\"children\":[1]},{\"children\":[0]}]"));
+    REFUSE(o, "cycle.gltf: byte ", "cycle", path_in("cycle.gltf"), "-o", o);
+    /* a chain of 5000 nodes, each the child of the one before */
+    char *nodes = malloc(200000);
+    assert_non_null(nodes);
+    size_t k = 0;
+    nodes[k++] = '[';
+    for (int i = 0; i < 5000; i++)
+        k += (size_t)snprintf(nodes + k, 200000 - k, i < 4999 ? "{\"children\":[%d]}," : "{\"mesh\":0}]", i + 1);
+    write_text("deep.gltf", gltf_doc(doc, sizeof doc, 3, 0, nodes));
+    free(nodes);
+    REFUSE(o, "deep.gltf: byte ", "levels deep", path_in("deep.gltf"), "-o", o);
+    write_text("json.gltf", "{\"asset\":{\"version\":\"2.0\"},\n \"nodes\": [ {\"mesh\": } ]}");
+    REFUSE(o, "json.gltf", NULL, path_in("json.gltf"), "-o", o);
+    copy_file("tests/corpus/glb/huge-length.glb", path_in("huge.glb"));
+    REFUSE(o, "huge.glb: byte 8: ", "runs past the end of the file", path_in("huge.glb"), "-o", o);
+
+    write_text("idx.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+    REFUSE(o, "idx.obj:4:7: ", "vertex index 9 out of range", path_in("idx.obj"), "-o", o);
+    write_text("nan.obj", "v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    REFUSE(o, "nan.obj:1:7: ", "not finite", path_in("nan.obj"), "-o", o);
+    write_text("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 inf 1\nf 1//1 2//1 3//1\n");
+    REFUSE(o, "inf.obj:4:", "not finite", path_in("inf.obj"), "-o", o);
+    write_text("lie.ply", "ply\nformat ascii 1.0\nelement vertex 1000000\nproperty float x\nproperty float y\n"
+                          "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n");
+    REFUSE(o, "lie.ply:", "1000000 'vertex' elements", path_in("lie.ply"), "-o", o);
+    test_write_file(path_in("bin.ply"),
+                    "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nend_header\n\0\0\0\0\0\0",
+                    strlen("ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float "
+                           "y\nproperty float z\nend_header\n") + 6);
+    REFUSE(o, "bin.ply: byte ", "3 'vertex' elements", path_in("bin.ply"), "-o", o);
+    write_text("t.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n");
+    REFUSE(o, "t.off:4: ", "2 of 3 vertices", path_in("t.off"), "-o", o);
+    write_text("idx.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n");
+    REFUSE(o, "idx.off:", NULL, path_in("idx.off"), "-o", o);
+}
+
+/* ---------------------------------------------------------------- images */
+
+static void be32put(unsigned char *p, uint32_t v)
+{
+    p[0] = (unsigned char)(v >> 24);
+    p[1] = (unsigned char)(v >> 16);
+    p[2] = (unsigned char)(v >> 8);
+    p[3] = (unsigned char)v;
+}
+
+static void test_bad_images(void **state)
+{
+    (void)state;
+    const char *o = out_png;
+    /* a PNG header claiming 60000x60000 RGBA (14 GB decoded) on 45 bytes */
+    unsigned char png[45] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R'};
+    be32put(png + 16, 60000);
+    be32put(png + 20, 60000);
+    png[24] = 8;
+    png[25] = 6;
+    memcpy(png + 33, "\0\0\0\0IEND\xae\x42\x60\x82", 12);
+    test_write_file(path_in("huge.png"), png, sizeof png);
+    write_text("tex.txt", "resolution 8 8\nmaterial m color 1 1 1 texture huge.png\nsphere 0 0 0 1 m\n");
+    REFUSE(o, "tex.txt:2:", "huge.png: image is 60000x60000, over the limit", path_in("tex.txt"), "-o", o);
+    /* a normal 256x256 header over a zlib stream that never ends */
+    copy_file("tests/corpus/image/png-zlib-stream-without-end.png", path_in("bomb.png"));
+    write_text("bomb.txt", "resolution 8 8\nmaterial m color 1 1 1 texture bomb.png\nsphere 0 0 0 1 m\n");
+    REFUSE(o, "bomb.png: PNG pixel data does not inflate", NULL, path_in("bomb.txt"), "-o", o);
+    write_text("junk.png", "this is not an image");
+    write_text("env.txt", "resolution 8 8\nenvironment junk.png\n");
+    REFUSE(o, "junk.png", NULL, path_in("env.txt"), "-o", o);
+}
+
+/* ---------------------------------------------------------------- output */
+
+static void test_bad_output(void **state)
+{
+    (void)state;
+    const char *o = out_png;
+    REFUSE(o, "/no-such-dir-for-rt/x.png: cannot write there", NULL, "-r", "8x8", "-o", "/no-such-dir-for-rt/x.png");
+    REFUSE(o, "out.xyz: unknown output format", NULL, "-r", "8x8", "-o", path_in("out.xyz"));
+    REFUSE(o, "out: unknown output format", NULL, "-r", "8x8", "-o", path_in("out"));
+    write_text("file", "a file, not a directory");
+    REFUSE(o, "file/x.png: cannot write there", NULL, "-r", "8x8", "-o", path_in("file/x.png"));
+    /* too big for the PNG writer: refused before rendering, not after */
+    REFUSE(o, "out.png: a 32768x32768 PNG", ".pfm", "-r", "32768x32768", "-o", o);
+    if (geteuid() != 0) { /* root writes anywhere */
+        const char *ro = path_in("ro");
+        assert_int_equal(mkdir(ro, 0755), 0);
+        char prot[700];
+        snprintf(prot, sizeof prot, "%s/old.png", ro);
+        put_precious(prot);
+        assert_int_equal(chmod(ro, 0555), 0);
+        REFUSE(prot, "old.png: cannot write there", NULL, "-r", "8x8", "-o", prot);
+        chmod(ro, 0755);
+        unlink(prot);
+        rmdir(ro);
+    }
+}
+
+/* ---------------------------------------------------------------- limits */
+
+static void test_memory_budget(void **state)
+{
+    (void)state;
+    if (!budget_enforced()) {
+        fprintf(stderr, "note: this rt does not enforce --max-memory (sanitizer build); skipping\n");
+        return;
+    }
+    const char *pfm = path_in("big.pfm");
+    /* 20000x20000 floats are 4.5 GiB: over a 256 MiB budget at the framebuffer */
+    REFUSE(pfm, "out of memory for a 20000x20000 image", "budget of 256 MiB (--max-memory) ran out", "-q", "-r",
+           "20000x20000", "--max-memory", "256M", "-o", pfm);
+    /* the default budget is there and named */
+    REFUSE(pfm, "out of memory for a 32768x32768 image", "--max-memory SIZE", "-q", "-r", "32768x32768",
+           "--max-memory", "1G", "-o", pfm);
+    unlink(pfm);
+}
+
+/* ------------------------------------------------------------- rendering */
+
+static void assert_same_file(const char *a, const char *b)
+{
+    static char x[1 << 20], y[1 << 20];
+    size_t n = read_all(a, x, sizeof x), m = read_all(b, y, sizeof y);
+    assert_true(n != (size_t)-1 && m != (size_t)-1);
+    assert_int_equal(n, m);
+    assert_memory_equal(x, y, n);
+}
+
+static void render_ok(const char *out, const char *const *extra)
+{
+    const char *args[32] = {"-q", "-o", out};
+    int n = 3;
+    for (int i = 0; extra[i]; i++)
+        args[n++] = extra[i];
+    args[n] = NULL;
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_args(r, args);
+    if (r->status != 0)
+        fail_msg("render to %s failed (%d): %s", out, r->status, r->err);
+    free(r);
+}
+
+static void test_threads_same_image(void **state)
+{
+    (void)state;
+    char one[600], many[600], lone[600], px[600], px_png[600];
+    snprintf(one, sizeof one, "%s", path_in("t1.pfm"));
+    snprintf(many, sizeof many, "%s", path_in("t64.pfm"));
+    snprintf(lone, sizeof lone, "%s", path_in("tlone.pfm"));
+    snprintf(px, sizeof px, "%s", path_in("one.pfm"));
+    snprintf(px_png, sizeof px_png, "%s", path_in("one.png"));
+    const char *const a1[] = {"-r", "24x20", "--tile", "4", "-s", "4", "-t", "1", NULL};
+    const char *const a64[] = {"-r", "24x20", "--tile", "4", "-s", "4", "-t", "64", NULL};
+    render_ok(one, a1);
+    render_ok(many, a64); /* 64 threads on however few cores, 30 tiles */
+    assert_same_file(one, many);
+    /* one tile, eight threads: seven find nothing to do */
+    const char *const alone[] = {"-r", "24x20", "--tile", "64", "-s", "4", "-t", "8", NULL};
+    render_ok(lone, alone);
+    assert_same_file(one, lone);
+    /* a 1x1 image */
+    const char *const a11[] = {"-r", "1x1", "-s", "4", "-t", "3", NULL};
+    render_ok(px, a11);
+    rt_framebuffer fb;
+    rt_error err;
+    assert_int_equal(rt_pfm_read(px, &fb, &err), RT_OK);
+    assert_int_equal(fb.width, 1);
+    assert_int_equal(fb.height, 1);
+    for (int c = 0; c < 3; c++)
+        assert_true(fb.rgb[c] >= 0.0f && fb.rgb[c] < 1e6f);
+    rt_framebuffer_free(&fb);
+    const char *const a11p[] = {"-r", "1x1", NULL};
+    render_ok(px_png, a11p);
+    unlink(one), unlink(many), unlink(lone), unlink(px), unlink(px_png);
+}
+
+/* A render interrupted by `sig` after 0.7 s: exit 130, the message, and a
+ * complete image whose tiles are each either finished or black. Every
+ * pixel of the scene is non-zero (a glowing sphere before a lit
+ * background), so a finished tile has no black pixel. */
+static void interrupted_render(int sig)
+{
+    const char *pfm = path_in("int.pfm");
+    put_precious(pfm);
+    write_text("slow.txt", "resolution 64 64\nbackground 0.5 0.6 0.7\n"
+                           "camera position 0 0 4 look_at 0 0 0 up 0 1 0 fov 40\n"
+                           "material glow color 0.5 0.5 0.5 emission 1 0.5 0.25\nsphere 0 0 0 1 glow\n");
+    const char *const args[] = {"-q", "--tile", "8", "-s", "8192", "-t", "2", "-o", pfm, path_in("slow.txt"), NULL};
+    double t0 = now_s();
+    pid_t pid = spawn(args);
+    sleep_s(0.7);
+    kill(pid, sig);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    wait_for(pid, t0, 60.0, r);
+    if (r->status != 130)
+        fail_msg("expected exit 130 after signal %d, got %d (signal %d): %s", sig, r->status, r->signal, r->err);
+    assert_contains(r->err, "render interrupted: ");
+    assert_contains(r->err, "of 64 tiles finished; writing the finished tiles to ");
+    rt_framebuffer fb;
+    rt_error err;
+    assert_int_equal(rt_pfm_read(pfm, &fb, &err), RT_OK);
+    assert_int_equal(fb.width, 64);
+    assert_int_equal(fb.height, 64);
+    int finished = 0, black = 0;
+    for (int ty = 0; ty < 8; ty++)
+        for (int tx = 0; tx < 8; tx++) {
+            int zero = 0;
+            for (int y = ty * 8; y < ty * 8 + 8; y++)
+                for (int x = tx * 8; x < tx * 8 + 8; x++) {
+                    const float *p = fb.rgb + 3 * ((size_t)y * 64 + (size_t)x);
+                    zero += p[0] == 0.0f && p[1] == 0.0f && p[2] == 0.0f;
+                }
+            if (zero == 64)
+                black++;
+            else if (zero == 0)
+                finished++;
+            else
+                fail_msg("tile (%d,%d) is partly black (%d of 64 pixels): a half-rendered tile was written", tx, ty,
+                         zero);
+        }
+    int reported = -1;
+    const char *p = strstr(r->err, "render interrupted: ");
+    assert_int_equal(sscanf(p, "render interrupted: %d of 64", &reported), 1);
+    assert_int_equal(reported, finished);
+    assert_true(black > 0);
+    fprintf(stderr, "note: signal %d after 0.7 s: %d tiles finished, %d black, exit after %.2f s\n", sig, finished,
+            black, r->seconds);
+    rt_framebuffer_free(&fb);
+    assert_no_temp_files();
+    unlink(pfm);
+    free(r);
+}
+
+static void test_sigint_writes_finished_tiles(void **state)
+{
+    (void)state;
+    interrupted_render(SIGINT);
+}
+
+static void test_sigterm_writes_finished_tiles(void **state)
+{
+    (void)state;
+    interrupted_render(SIGTERM);
+}
+
+/* The second Ctrl-C leaves at once: a pixel of 2^20 samples takes seconds,
+ * so the first Ctrl-C is still waiting for it when the second comes. */
+static void test_second_sigint_exits_at_once(void **state)
+{
+    (void)state;
+    const char *png = path_in("keep.png");
+    put_precious(png);
+    const char *const args[] = {"-q", "-r", "2x1", "-s", "1048576", "-t", "1", "-o", png, NULL};
+    double t0 = now_s();
+    pid_t pid = spawn(args);
+    sleep_s(0.4);
+    kill(pid, SIGINT);
+    sleep_s(0.2);
+    double t1 = now_s();
+    kill(pid, SIGINT);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    wait_for(pid, t0, 60.0, r);
+    if (r->signal != SIGINT)
+        fail_msg("expected death by SIGINT, got exit %d (signal %d): %s", r->status, r->signal, r->err);
+    assert_true(now_s() - t1 < 2.0);
+    assert_precious(png);
+    assert_no_temp_files();
+    unlink(png);
+    free(r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bad_flags),
+        cmocka_unit_test(test_bad_scene_files),
+        cmocka_unit_test(test_bad_models),
+        cmocka_unit_test(test_bad_images),
+        cmocka_unit_test(test_bad_output),
+        cmocka_unit_test(test_memory_budget),
+        cmocka_unit_test(test_threads_same_image),
+        cmocka_unit_test(test_sigint_writes_finished_tiles),
+        cmocka_unit_test(test_sigterm_writes_finished_tiles),
+        cmocka_unit_test(test_second_sigint_exits_at_once),
+    };
+    return cmocka_run_group_tests_name("cli", tests, setup, teardown);
+}
