@@ -20,10 +20,14 @@
  *   is one-sample MIS over the lobes with the balance heuristic (Veach 1997,
  *   ch. 9.2.4), so rt_bsdf_eval's pdf is exactly the sampling density.
  *
- * The transmission lobe is a smooth dielectric (a delta in the refracted
- * direction, Snell's law with the material's ior), whatever the roughness;
- * radiance is not rescaled by eta^2 across the interface (it cancels for
- * paths that leave the object again). Every result is finite: grazing
+ * The transmission lobe refracts through a GGX microfacet normal sampled
+ * from the visible normals (Walter et al. 2007's rough dielectric BTDF,
+ * with the same alpha; the macro normal, i.e. a smooth dielectric, at the
+ * smallest alpha), Snell's law with the material's ior. It is sampled
+ * only, never evaluated: transmitted rays are not light-sampled, so an
+ * emitter they hit counts in full (no MIS). Radiance is not rescaled by
+ * eta^2 across the interface (it cancels for paths that leave the object
+ * again). Every result is finite: grazing
  * directions give zero, never a division by zero.
  */
 #include "rt/bsdf.h"
@@ -111,6 +115,21 @@ static inline rt_vec3 schlick(rt_vec3 f0, float c)
     return rt_add(f0, rt_scale(rt_sub(rt_v3s(1.0f), f0), w));
 }
 
+/* Fresnel reflectance at a (micro)facet seen at cosine c from wo. glTF's
+ * Schlick on |wo.h|; for a transmissive surface seen from inside (eta > 1)
+ * Schlick on the refracted side's cosine, 1 beyond the critical angle
+ * (total internal reflection), so reflection and refraction share one F. */
+static inline rt_vec3 fresnel(const rt_bsdf *b, float c)
+{
+    if (b->transmission > 0.0f && b->eta > 1.0f) {
+        float sin2_t = b->eta * b->eta * fmaxf(0.0f, 1.0f - c * c);
+        if (sin2_t >= 1.0f)
+            return rt_v3s(1.0f);
+        c = sqrtf(1.0f - sin2_t);
+    }
+    return schlick(b->f0, c);
+}
+
 static inline float mean3(rt_vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
 
 static void set_frame(rt_bsdf *b, rt_vec3 n, rt_vec3 ng)
@@ -196,9 +215,13 @@ void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p
         *p_diffuse = mean3(b->diffuse) > 0.0f ? 1.0f : 0.0f;
         return;
     }
-    rt_vec3 F = schlick(b->f0, wo.z);
-    float ws = mean3(F);
-    float wd = mean3(rt_mul(rt_sub(rt_v3s(1.0f), F), b->diffuse));
+    /* F at the macro normal estimates each lobe's share; the floors keep
+     * every lobe that can contribute at some microfacet sampleable (inside
+     * glass past the critical angle F is 1 at the normal, yet tilted
+     * facets still transmit) */
+    rt_vec3 F = fresnel(b, wo.z);
+    float ws = fmaxf(mean3(F), 0.02f);
+    float wd = mean3(rt_mul(rt_vmax(rt_sub(rt_v3s(1.0f), F), rt_v3s(0.1f)), b->diffuse));
     float wt = wd * b->transmission;
     wd *= 1.0f - b->transmission;
     float sum = ws + wd + wt;
@@ -225,7 +248,7 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
         return rt_v3s(0.0f);
     h = rt_scale(h, 1.0f / sqrtf(l2));
     float voh = rt_dot(wo, h);
-    rt_vec3 F = schlick(b->f0, voh);
+    rt_vec3 F = fresnel(b, voh);
     float D = rt_ggx_d(h, b->alpha);
     float G = rt_ggx_g2(wo, wi, b->alpha);
     float spec = D * G / (4.0f * wo.z * wi.z);
@@ -259,23 +282,28 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
     if (!(pd + ps + pt > 0.0f))
         return false;
     if (pt > 0.0f && ulobe >= pd + ps) {
-        /* smooth refraction through the interface (normal = z) */
+        /* refraction through a microfacet: the macro normal for the
+         * smoothest surfaces, else a visible normal (Heitz 2018); the
+         * weight f |cos| / pdf of Walter et al.'s BTDF with that sampling
+         * is (1 - F) T c_diff G2 / G1(wo) */
+        bool rough = b->alpha > RT_BSDF_MIN_ALPHA;
+        rt_vec3 h = rough ? rt_ggx_sample_vndf(wo, b->alpha, u) : rt_v3(0.0f, 0.0f, 1.0f);
         float eta = b->eta;
-        float ci = wo.z;
+        float ci = rt_dot(wo, h);
+        if (!(ci > 0.0f))
+            return false;
         float sin2_t = eta * eta * fmaxf(0.0f, 1.0f - ci * ci);
-        rt_vec3 wi;
-        float c;
-        if (sin2_t >= 1.0f) { /* total internal reflection: the transmitted share reflects */
-            wi = rt_v3(-wo.x, -wo.y, wo.z);
-            c = 1.0f;
-        } else {
-            float ct = sqrtf(1.0f - sin2_t);
-            wi = rt_v3(-eta * wo.x, -eta * wo.y, -ct);
-            c = eta > 1.0f ? ct : ci; /* Schlick on the side of the larger angle */
-        }
-        rt_vec3 F = sin2_t >= 1.0f ? rt_v3s(0.0f) : schlick(b->f0, c);
-        rt_vec3 w = rt_scale(rt_mul(rt_sub(rt_v3s(1.0f), F), b->diffuse), b->transmission / pt);
-        s->wi = rt_normalize(wi);
+        if (sin2_t >= 1.0f)
+            return false; /* total internal reflection: F = 1, the reflection lobe carries it */
+        float ct = sqrtf(1.0f - sin2_t);
+        rt_vec3 wi = rt_add(rt_scale(wo, -eta), rt_scale(h, eta * ci - ct));
+        if (!(wi.z < 0.0f))
+            return false; /* the microfacet sends it back out */
+        wi = rt_normalize(wi);
+        rt_vec3 F = fresnel(b, ci);
+        float g = rough ? rt_ggx_g2(wo, wi, b->alpha) / rt_ggx_g1(wo, b->alpha) : 1.0f;
+        rt_vec3 w = rt_scale(rt_mul(rt_sub(rt_v3s(1.0f), F), b->diffuse), g * b->transmission / pt);
+        s->wi = wi;
         s->weight = w;
         s->pdf = 0.0f;
         s->delta = true;

@@ -26,8 +26,9 @@
  *
  * with D the GGX (Trowbridge-Reitz) distribution and V = G2 / (4 |n.wo|
  * |n.wi|), G2 the height-correlated Smith masking-shadowing term. The
- * transmitted share (1 - F) T c_diff leaves through a smooth refraction
- * (a delta lobe, Snell's law with eta). RT_BSDF_LAMBERT is exactly B / pi.
+ * transmitted share (1 - F) T c_diff refracts through a GGX microfacet
+ * (Walter et al. 2007; smooth at roughness 0), sampled only (a "delta"
+ * sample: not light-sampled, no MIS). RT_BSDF_LAMBERT is exactly B / pi.
  *
  * Sampling picks a lobe by its estimated share of the reflected energy at
  * wo, then samples diffuse by the cosine, specular by the distribution of
@@ -58,8 +59,8 @@ typedef struct rt_bsdf {
 typedef struct rt_bsdf_sample {
     rt_vec3 wi;       /* local direction */
     rt_vec3 weight;   /* f |cos| / pdf, or the delta lobe's weight / its probability */
-    float pdf;        /* solid-angle pdf; 0 for a delta lobe */
-    bool delta;       /* specular transmission: not light-sampled, no MIS */
+    float pdf;        /* solid-angle pdf; 0 for a transmission sample */
+    bool delta;       /* transmission: sampled only, never light-sampled, so no MIS */
 } rt_bsdf_sample;
 
 /* GGX building blocks, local frame (z = normal). */
