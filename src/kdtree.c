@@ -805,6 +805,60 @@ static void *sort_worker(void *arg)
     return NULL;
 }
 
+/* Renumbers the triangles in the order the depth-first node array first
+ * references them and stores their data in that order, so the triangles of
+ * a leaf mostly sit next to each other in memory (one or two cache lines
+ * per leaf instead of one per triangle); tree->tri_id maps the tree's
+ * numbers back to the scene's. Leaf lists stay ascending. */
+static bool leaf_order(rt_kdtree *tree, kd_build *c, size_t T)
+{
+    uint32_t *newid = malloc(T * sizeof *newid);
+    uint32_t *old = malloc(T * sizeof *old);
+    float *tri = malloc(T * 9 * sizeof *tri);
+    if (!newid || !old || !tri) {
+        free(newid);
+        free(old);
+        free(tri);
+        return false;
+    }
+    memset(newid, 0xff, T * sizeof *newid);
+    uint32_t next = 0;
+    for (size_t i = 0; i < c->node_count; i++) {
+        rt_kdtree_node *nd = &c->nodes[i];
+        if ((nd->b & 3u) != LEAF_TAG || nd->b == LEAF_TAG)
+            continue;
+        uint32_t n = nd->b >> 2;
+        uint32_t *p = n == 1 ? &nd->a : c->ids + nd->a;
+        for (uint32_t j = 0; j < n && p[j] < T; j++) {
+            if (newid[p[j]] == UINT32_MAX) {
+                old[next] = p[j];
+                newid[p[j]] = next++;
+            }
+            p[j] = newid[p[j]];
+        }
+        for (uint32_t j = 1; j < n && p[j] < T; j++) { /* ascending again (first-seen ones already are) */
+            uint32_t x = p[j], k = j;
+            while (k > 0 && p[k - 1] > x) {
+                p[k] = p[k - 1];
+                k--;
+            }
+            p[k] = x;
+        }
+    }
+    for (size_t i = 0; i < T; i++) /* triangles in no leaf (never hit) go last */
+        if (newid[i] == UINT32_MAX) {
+            old[next] = (uint32_t)i;
+            newid[i] = next++;
+        }
+    for (size_t i = 0; i < T; i++)
+        memcpy(tri + 9 * (size_t)i, tree->tri + 9 * (size_t)old[i], 9 * sizeof *tri);
+    free(newid);
+    free(tree->tri);
+    tree->tri = tri;
+    tree->tri_id = old;
+    return true;
+}
+
 rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
 {
     double t0 = now_ms();
@@ -1000,12 +1054,17 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     }
     free(c.side);
     free(c.strad);
+    c.side = NULL;
+    c.strad = NULL;
+    if (T > 0 && !leaf_order(tree, &c, T))
+        goto oom;
     tree->nodes = c.nodes;
     tree->node_count = c.node_count;
     tree->prim_ids = c.ids;
     tree->prim_id_count = c.id_count;
     c.st.nodes = c.node_count;
-    c.st.bytes = c.node_count * sizeof *c.nodes + c.id_count * sizeof *c.ids + T * 9 * sizeof(float);
+    c.st.bytes = c.node_count * sizeof *c.nodes + c.id_count * sizeof *c.ids + T * 9 * sizeof(float) +
+                 T * sizeof *tree->tri_id;
     c.st.build_ms = now_ms() - t0;
     tree->stats = c.st;
     return RT_OK;
@@ -1019,6 +1078,7 @@ oom:
     free(c.nodes);
     free(c.ids);
     free(tree->tri);
+    free(tree->tri_id);
     memset(tree, 0, sizeof *tree);
     if (c.limit)
         return rt_fail(err, RT_ERR_LIMIT, "kdtree: %zu primitives make more nodes or references than the node format holds",
@@ -1033,6 +1093,7 @@ void rt_kdtree_free(rt_kdtree *tree)
     free(tree->nodes);
     free(tree->prim_ids);
     free(tree->tri);
+    free(tree->tri_id);
     memset(tree, 0, sizeof *tree);
 }
 
@@ -1330,8 +1391,11 @@ KD_INLINE bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, b
 KD_FLATTEN bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit)
 {
     hit->prim = RT_NONE;
-    if (traverse(tree, ray, hit, false))
+    if (traverse(tree, ray, hit, false)) {
+        if (hit->prim < tree->triangle_count)
+            hit->prim = tree->tri_id[hit->prim];
         return true;
+    }
     hit->prim = RT_NONE;
     return false;
 }

@@ -194,7 +194,10 @@ static void check_tree(const rt_scene *s, const rt_kdtree *tree)
             assert_true(ids[j] < n);
             if (j > 0) /* ascending: triangles first, as the leaf loop expects */
                 assert_true(ids[j - 1] < ids[j]);
-            seen[ids[j]] = 1;
+            /* triangles are numbered in leaf order; tri_id gives the scene's id */
+            size_t id = ids[j] < s->triangles.count ? tree->tri_id[ids[j]] : ids[j];
+            assert_true(id < n);
+            seen[id] = 1;
         }
     }
     assert_int_equal(leaves, st->leaves);

@@ -13,10 +13,12 @@
  *   rt_kdtree_free(&tree);
  *
  * Layout: nodes of 8 bytes in one array (the below child is the next node),
- * leaf primitive ids in a second array (a one-primitive leaf stores its id
- * in the node), triangles copied into one buffer of 9 floats each (v0, e1,
- * e2: one cache line per test) for the leaf loops. Build and traversal are
- * described, with their sources, at the top of kdtree.c.
+ * leaf primitive numbers in a second array (a one-primitive leaf stores its
+ * number in the node), triangles copied into one buffer of 9 floats each
+ * (v0, e1, e2) in the order the leaves first use them, so a leaf's triangles
+ * are mostly adjacent; tri_id maps these tree triangle numbers back to the
+ * scene's ids (hits report scene ids). Build and traversal are described,
+ * with their sources, at the top of kdtree.c.
  *
  * Results are exactly those of testing every primitive with the functions
  * of intersect.h (same t bits; either id when two primitives tie). Rays with
@@ -66,10 +68,11 @@ typedef struct rt_kdtree_node {
 typedef struct rt_kdtree {
     rt_kdtree_node *nodes;
     size_t node_count;
-    uint32_t *prim_ids;
+    uint32_t *prim_ids;   /* leaf lists: tree triangle numbers, then scene ids of spheres and quads */
     size_t prim_id_count;
-    /* triangles, indexed by triangle id: v0.xyz, e1.xyz, e2.xyz (9 floats) */
+    /* triangles in leaf order (tree triangle numbers): v0.xyz, e1.xyz, e2.xyz (9 floats) */
     float *tri;
+    uint32_t *tri_id;     /* tree triangle number -> scene triangle id */
     size_t triangle_count, sphere_count, quad_count; /* at build time */
     float scale; /* largest absolute coordinate of bounds (traversal epsilon) */
     bool simd_ok; /* triangle offsets fit the 32-bit lanes of the 8-wide leaf test */
