@@ -397,7 +397,10 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         layers = 0;
         /* emission, MIS-weighted when it could have been light-sampled */
         rt_vec3 Le = rt_surface_emission(ctx, &sf);
-        uint32_t light = light_of_prim(ctx, sf.prim);
+        const rt_material *m = s->material_count ? &s->materials[sf.material] : NULL;
+        /* area lights' quads have emissive materials: look only those up */
+        bool emissive = m && rt_max3(rt_scale(m->emission, m->emission_strength)) > 0.0f;
+        uint32_t light = emissive ? light_of_prim(ctx, sf.prim) : RT_NONE;
         if (rt_max3(Le) > 0.0f) {
             float w = 1.0f;
             if (!prev_delta) {
@@ -417,7 +420,6 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         }
         if (light != RT_NONE)
             break; /* an area light's quad reflects nothing */
-        const rt_material *m = s->material_count ? &s->materials[sf.material] : NULL;
         if (m && m->unlit) {
             rt_vec4 c = rt_surface_base_color(ctx, &sf);
             L = add_finite(L, rt_mul(beta, rt_v3(c.x, c.y, c.z)));
