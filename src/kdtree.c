@@ -1307,11 +1307,9 @@ typedef struct kd_entry {
 } kd_entry;
 
 /* The shared traversal; any = stop at the first hit (occlusion). */
-KD_INLINE bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, bool any)
+KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, bool any, bool par, const kd_ray *rp)
 {
-    kd_ray r;
-    if (!ray_setup(tree, ray, &r))
-        return false;
+    const kd_ray r = *rp;
     const rt_kdtree_node *nodes = tree->nodes;
     const uint32_t *ids = tree->prim_ids;
     kd_entry stack[KD_STACK];
@@ -1328,7 +1326,7 @@ KD_INLINE bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, b
             uint32_t below = node + 1, above = nd.b >> 4;
             bool be = nd.b & KD_BELOW_EMPTY, ae = nd.b & KD_ABOVE_EMPTY;
             float o = r.o[axis], inv = r.inv[axis];
-            if (!(fabsf(inv) < INFINITY)) { /* parallel to the plane */
+            if (par && !(fabsf(inv) < INFINITY)) { /* parallel to the plane */
                 float dist = o - split;
                 bool wb = dist <= r.mp && !be, wa = dist >= -r.mp && !ae;
                 stack[sp].node = above, stack[sp].tn = tn, stack[sp].tf = tf;
@@ -1386,6 +1384,18 @@ KD_INLINE bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, b
         tn = stack[sp].tn;
         tf = stack[sp].tf;
     }
+}
+
+/* Two copies of the loop: rays parallel to some axis (rare: a zero direction
+ * component) need a test at every node that the others skip. */
+KD_INLINE bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, bool any)
+{
+    kd_ray r;
+    if (!ray_setup(tree, ray, &r))
+        return false;
+    if (fabsf(r.inv[0]) < INFINITY && fabsf(r.inv[1]) < INFINITY && fabsf(r.inv[2]) < INFINITY)
+        return traverse_ray(tree, ray, hit, any, false, &r);
+    return traverse_ray(tree, ray, hit, any, true, &r);
 }
 
 KD_FLATTEN bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit)
