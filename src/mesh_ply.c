@@ -234,7 +234,8 @@ static bool ascii_value(ply_reader *r, ply_type t, int64_t *iv, double *dv)
         float f;
         bool nonfinite;
         q = rt_mesh_parse_float(tok, te, &f, &nonfinite);
-        if (!q || q != te || f != (float)(int64_t)f || f > 4294967295.0f || f < -2147483648.0f)
+        /* range first: converting an out-of-range (or NaN) float to an integer is undefined */
+        if (!q || q != te || !(f >= -2147483648.0f && f <= 4294967295.0f) || f != (float)(int64_t)f)
             return fail_at(r, "malformed integer '%.*s'", len, tok);
         *iv = (int64_t)f;
     }
