@@ -25,15 +25,22 @@ if subprocess.call(["sh", "-c", "echo '#include <embree3/rtcore.h>' | cc -E -x c
           file=sys.stderr)
     subprocess.check_call(["make", "-C", embree_dir, "deps"])
 
-def rtbench(glb, model, kind, threads):
+def rtbench(glb, model, kind, threads, extra=()):
     out = subprocess.run(["./bench/rtbench", os.path.join(shared, glb),
                           os.path.join(shared, "bench", model, "%s.%s.rays" % (model, kind)),
                           "--ref", os.path.join(shared, "bench", model, "%s.%s.hits" % (model, kind)),
-                          "-t", str(threads), "--runs", runs], capture_output=True, text=True)
+                          "-t", str(threads), "--runs", runs] + list(extra), capture_output=True, text=True)
     d = dict(line.split(": ", 1) for line in out.stdout.splitlines() if ": " in line)
     d["status"] = out.returncode
     return d
 
+def loadavg():
+    try:
+        return " ".join(open("/proc/loadavg").read().split()[:3])
+    except OSError:
+        return "?"
+
+print("load average at start: " + loadavg())
 print("%-28s %-8s %3s %10s %10s %7s %11s" % ("model", "kind", "thr", "rt Mray/s", "Embree", "ratio", "mismatches"))
 summary = []
 for model, glb in models:
@@ -49,6 +56,7 @@ for model, glb in models:
     build_js = json.loads(subprocess.run([os.path.join(build, "anchor"), "build", os.path.join(build, model + ".tri"),
                                           "--reps", "3"], capture_output=True, text=True, check=True).stdout)
     emb_build = build_js["build_ms"]["high_1T"]["median"]
+    emb_build2 = build_js["build_ms"]["high_2T"]["median"]
     rt_build = bytes_tri = None
     for kind in ("primary", "diffuse"):
         for t in (1, 2):
@@ -59,8 +67,13 @@ for model, glb in models:
                                                                r.get("mismatches", "?")))
             rt_build = float(r.get("build_ms", 0))
             bytes_tri = r.get("bytes_per_triangle")
-    summary.append((model, rt_build, emb_build, bytes_tri))
+    rt_build1 = float(rtbench(glb, model, "diffuse", 1, ["--build-threads", "1", "--runs", "1"]).get("build_ms", 0))
+    summary.append((model, rt_build1, emb_build, rt_build, emb_build2, bytes_tri))
 print()
-print("%-28s %12s %16s %7s %10s" % ("model", "rt build ms", "Embree high ms", "ratio", "bytes/tri"))
-for model, rb, eb, bt in summary:
-    print("%-28s %12.1f %16.1f %7.2f %10s" % (model, rb, eb, rb / eb if eb else 0, bt))
+print("%-28s %10s %10s %6s %10s %10s %6s %10s" % ("model", "rt 1T ms", "Embree 1T", "ratio", "rt 2T ms", "Embree 2T",
+                                                 "ratio", "bytes/tri"))
+for model, rb1, eb1, rb2, eb2, bt in summary:
+    print("%-28s %10.1f %10.1f %6.2f %10.1f %10.1f %6.2f %10s" % (model, rb1, eb1, rb1 / eb1 if eb1 else 0, rb2, eb2,
+                                                                 rb2 / eb2 if eb2 else 0, bt))
+print("(build: rt's kd-tree vs Embree's high-quality BVH build, 1 and 2 threads)")
+print("load average at end: " + loadavg())

@@ -2,14 +2,20 @@
  * checked against Embree's reference hits.
  *
  *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
+ *           [--build-threads N] [--occluded]
  *
  * Loads the glTF (every triangle of the default scene in world space, as
- * ../shared/bench/FORMAT.md defines), builds the kd-tree, traces every ray
- * for the closest hit K times and prints `key: value` lines: triangles,
- * load_ms, build_ms, nodes, leaves, bytes_per_triangle, mrays_per_s (median
- * of K runs), hits, mismatches. Exits 1 when more than 0.01% of the rays
- * disagree with the reference: speed bought with wrong answers does not
- * count. Exit 2 on bad arguments or files.
+ * ../shared/bench/FORMAT.md defines), builds the kd-tree (N build threads,
+ * default one per core), traces every ray for the closest hit K times and
+ * prints `key: value` lines: triangles, load_ms, build_ms, nodes, leaves,
+ * bytes_per_triangle, mrays_per_s (median of K runs, wall clock),
+ * mrays_per_s_best (the fastest run), cpu_mrays_per_s (rays per CPU-second
+ * of the median run, summed over threads: on a shared, loaded machine this
+ * is the steadier figure), hits, mismatches. With --occluded the same rays
+ * go through the any-hit query (shadow rays) instead, and a mismatch is a
+ * ray whose hit/miss differs from the reference. Exits 1 when more than
+ * 0.01% of the rays disagree with the reference: speed bought with wrong
+ * answers does not count. Exit 2 on bad arguments or files.
  */
 #include <pthread.h>
 #include <stdatomic.h>
@@ -30,10 +36,18 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+static double cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 typedef struct job {
     const rt_kdtree *tree;
     const rt_rayset *rays;
     float *t_out;
+    bool occluded;
     atomic_size_t next;
 } job;
 
@@ -47,20 +61,27 @@ static void *trace_worker(void *arg)
         if (start >= j->rays->count)
             break;
         size_t end = start + CHUNK < j->rays->count ? start + CHUNK : j->rays->count;
-        for (size_t i = start; i < end; i++) {
-            rt_hit h;
-            j->t_out[i] = rt_kdtree_intersect(j->tree, &j->rays->rays[i], &h) ? h.t : INFINITY;
+        if (j->occluded) {
+            for (size_t i = start; i < end; i++) /* hit/miss only: 0 for a hit */
+                j->t_out[i] = rt_kdtree_occluded(j->tree, &j->rays->rays[i]) ? 0.0f : INFINITY;
+        } else {
+            for (size_t i = start; i < end; i++) {
+                rt_hit h;
+                j->t_out[i] = rt_kdtree_intersect(j->tree, &j->rays->rays[i], &h) ? h.t : INFINITY;
+            }
         }
     }
     return NULL;
 }
 
-static double trace_all(const rt_kdtree *tree, const rt_rayset *rays, float *t_out, int threads)
+/* Wall seconds of one pass; *cpu gets the CPU seconds of all threads. */
+static double trace_all(const rt_kdtree *tree, const rt_rayset *rays, float *t_out, int threads, bool occluded,
+                        double *cpu)
 {
-    job j = {tree, rays, t_out, 0};
+    job j = {tree, rays, t_out, occluded, 0};
     atomic_init(&j.next, 0);
     pthread_t th[256];
-    double t0 = now_s();
+    double c0 = cpu_s(), t0 = now_s();
     int started = 0;
     for (int i = 1; i < threads; i++)
         if (pthread_create(&th[started], NULL, trace_worker, &j) == 0)
@@ -68,7 +89,9 @@ static double trace_all(const rt_kdtree *tree, const rt_rayset *rays, float *t_o
     trace_worker(&j);
     for (int i = 0; i < started; i++)
         pthread_join(th[i], NULL);
-    return now_s() - t0;
+    double wall = now_s() - t0;
+    *cpu = cpu_s() - c0;
+    return wall;
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -79,14 +102,16 @@ static int cmp_double(const void *a, const void *b)
 
 static int usage(void)
 {
-    fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]\n");
+    fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K] [--build-threads N] "
+                    "[--occluded]\n");
     return 2;
 }
 
 int main(int argc, char **argv)
 {
     const char *model = NULL, *rays_path = NULL, *hits_path = NULL;
-    int threads = 1, runs = 5;
+    int threads = 1, runs = 5, build_threads = 0;
+    bool occluded = false;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--ref") == 0 && i + 1 < argc)
             hits_path = argv[++i];
@@ -94,6 +119,10 @@ int main(int argc, char **argv)
             threads = atoi(argv[++i]);
         else if (strcmp(argv[i], "--runs") == 0 && i + 1 < argc)
             runs = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--build-threads") == 0 && i + 1 < argc)
+            build_threads = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--occluded") == 0)
+            occluded = true;
         else if (argv[i][0] == '-')
             return usage();
         else if (!model)
@@ -103,7 +132,8 @@ int main(int argc, char **argv)
         else
             return usage();
     }
-    if (!model || !rays_path || threads < 1 || threads > 256 || runs < 1 || runs > 1000)
+    if (!model || !rays_path || threads < 1 || threads > 256 || runs < 1 || runs > 1000 || build_threads < 0 ||
+        build_threads > 64)
         return usage();
     rt_log_set_level(RT_LOG_QUIET);
 
@@ -125,27 +155,33 @@ int main(int argc, char **argv)
         return 2;
     }
     rt_kdtree tree;
-    if (rt_kdtree_build(&tree, &scene, NULL, &err) != RT_OK) {
+    rt_kdtree_params params;
+    memset(&params, 0, sizeof params);
+    params.threads = build_threads;
+    if (rt_kdtree_build(&tree, &scene, &params, &err) != RT_OK) {
         fprintf(stderr, "rtbench: %s\n", err.message);
         return 2;
     }
     float *t_out = malloc((rs.count ? rs.count : 1) * sizeof(float));
-    double *times = malloc((size_t)runs * sizeof(double));
-    if (!t_out || !times) {
+    double *times = malloc((size_t)runs * sizeof(double)), *cpus = malloc((size_t)runs * sizeof(double));
+    if (!t_out || !times || !cpus) {
         fprintf(stderr, "rtbench: out of memory\n");
         return 2;
     }
     for (int r = 0; r < runs; r++)
-        times[r] = trace_all(&tree, &rs, t_out, threads);
+        times[r] = trace_all(&tree, &rs, t_out, threads, occluded, &cpus[r]);
     qsort(times, (size_t)runs, sizeof(double), cmp_double);
+    qsort(cpus, (size_t)runs, sizeof(double), cmp_double);
     double median = runs % 2 ? times[runs / 2] : 0.5 * (times[runs / 2 - 1] + times[runs / 2]);
+    double cpu_median = runs % 2 ? cpus[runs / 2] : 0.5 * (cpus[runs / 2 - 1] + cpus[runs / 2]);
 
     size_t hits = 0, mismatches = 0;
     float diag = rt_box_diagonal(tree.bounds);
     for (size_t i = 0; i < rs.count; i++) {
         if (t_out[i] < INFINITY)
             hits++;
-        if (rs.ref_t && !rt_rayset_agrees(t_out[i], rs.ref_t[i], diag))
+        if (rs.ref_t && (occluded ? (t_out[i] < INFINITY) != (rs.ref_t[i] < INFINITY)
+                                  : !rt_rayset_agrees(t_out[i], rs.ref_t[i], diag)))
             mismatches++;
     }
     printf("model: %s\n", model);
@@ -159,7 +195,10 @@ int main(int argc, char **argv)
            scene.triangles.count ? (double)tree.stats.bytes / (double)scene.triangles.count : 0.0);
     printf("threads: %d\n", threads);
     printf("rays: %zu\n", rs.count);
+    printf("query: %s\n", occluded ? "occluded" : "closest");
     printf("mrays_per_s: %.3f\n", median > 0 ? 1e-6 * (double)rs.count / median : 0.0);
+    printf("mrays_per_s_best: %.3f\n", times[0] > 0 ? 1e-6 * (double)rs.count / times[0] : 0.0);
+    printf("cpu_mrays_per_s: %.3f\n", cpu_median > 0 ? 1e-6 * (double)rs.count / cpu_median : 0.0);
     printf("hits: %zu\n", hits);
     if (rs.ref_t)
         printf("mismatches: %zu\n", mismatches);
@@ -170,6 +209,7 @@ int main(int argc, char **argv)
     }
     free(t_out);
     free(times);
+    free(cpus);
     rt_kdtree_free(&tree);
     rt_rayset_free(&rs);
     rt_scene_free(&scene);
