@@ -30,7 +30,7 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 DEPS_OK  := $(BUILD)/.deps-ok
 
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare fuzz
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build fuzz
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -84,13 +84,20 @@ bench: bench/rtbench
 bench-compare: bench/rtbench
 	@SHARED=$(SHARED) sh bench/compare.sh
 
+bench/buildscale: bench/buildscale.c $(BUILD)/librt.a | $(DEPS_OK)
+	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/librt.a $(LDLIBS)
+
+# kd-tree build time from 10k to 2M triangles (the N log N check) and on the shared bench models.
+bench-build: bench/buildscale
+	@./bench/buildscale $$(sed -n 's#^| [A-Za-z0-9_]* | `\([^`]*\)`.*#$(SHARED)/\1#p' $(SHARED)/bench/MANIFEST.md 2>/dev/null)
+
 SCENES := $(wildcard scenes/*.txt)
 scenes: $(RT)
 	@mkdir -p docs/images
 	@for s in $(SCENES); do n=$$(basename $$s .txt); echo "rendering $$s"; ./rt -q -o docs/images/$$n.png $$s || exit 1; done
 
 clean:
-	rm -rf build build-asan build-tsan build-profile build-fuzz rt rt-profile bench/rtbench
+	rm -rf build build-asan build-tsan build-profile build-fuzz rt rt-profile bench/rtbench bench/buildscale
 
 -include $(LIB_OBJ:.o=.d) $(BUILD)/obj/main.d
 

@@ -1,0 +1,141 @@
+/* buildscale - kd-tree build time against triangle count, to check that it
+ * grows as N log N (Wald and Havran 2006; see src/kdtree.c).
+ *
+ *   buildscale [--reps K] [--max N] [MODEL.glb ...]
+ *
+ * Scenes: random triangle soups of 10k to N (default 2M) triangles in the
+ * unit cube, each triangle's size scaled with N^(-1/3) so the density of
+ * the scene, and hence the tree's shape, stays the same; then every glTF
+ * given on the command line. For each: the median of K (default 3) builds
+ * with 1 thread and with 2 threads, and the 1-thread time divided by
+ * N log2 N (in ns), which stays flat when the build is O(N log N).
+ * Prints a Markdown table.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rt/gltf.h"
+#include "rt/kdtree.h"
+#include "rt/scene.h"
+
+/* xorshift64*: a deterministic soup */
+static uint64_t rng_next(uint64_t *s)
+{
+    *s ^= *s >> 12;
+    *s ^= *s << 25;
+    *s ^= *s >> 27;
+    return *s * 2685821657736338717ull;
+}
+static float rng_float(uint64_t *s) { return (float)(rng_next(s) >> 40) * (1.0f / 16777216.0f); }
+
+static int soup(rt_scene *s, size_t n)
+{
+    uint64_t st = 0x9e3779b97f4a7c15ull ^ n;
+    float size = 2.0f * powf((float)n, -1.0f / 3.0f); /* about a cell of a n^(1/3) grid */
+    uint32_t v = rt_scene_add_vertices(s, 3 * n);
+    if (v == RT_NONE)
+        return -1;
+    for (size_t i = 0; i < n; i++) {
+        rt_vec3 c = rt_v3(rng_float(&st), rng_float(&st), rng_float(&st));
+        for (int k = 0; k < 3; k++)
+            s->vertices.position[v + 3 * i + k] =
+                rt_add(c, rt_v3(size * (rng_float(&st) - 0.5f), size * (rng_float(&st) - 0.5f),
+                                size * (rng_float(&st) - 0.5f)));
+        uint32_t a = v + 3 * (uint32_t)i;
+        if (rt_scene_add_triangle(s, a, a + 1, a + 2, 0, 0) == RT_NONE)
+            return -1;
+    }
+    return 0;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Median build time in ms with `threads` build threads; 0 on failure. */
+static double build_ms(const rt_scene *s, int threads, int reps, rt_kdtree_stats *st)
+{
+    double t[64];
+    for (int r = 0; r < reps; r++) {
+        rt_kdtree tree;
+        rt_error err = {0};
+        rt_kdtree_params p;
+        memset(&p, 0, sizeof p);
+        p.threads = threads;
+        if (rt_kdtree_build(&tree, s, &p, &err) != RT_OK) {
+            fprintf(stderr, "buildscale: %s\n", err.message);
+            return 0.0;
+        }
+        t[r] = tree.stats.build_ms;
+        *st = tree.stats;
+        rt_kdtree_free(&tree);
+    }
+    qsort(t, (size_t)reps, sizeof t[0], cmp_double);
+    return t[reps / 2];
+}
+
+static void row(const char *name, const rt_scene *s, int reps)
+{
+    rt_kdtree_stats st;
+    double n = (double)s->triangles.count;
+    double t1 = build_ms(s, 1, reps, &st), t2 = build_ms(s, 2, reps, &st);
+    printf("| %s | %zu | %.1f | %.1f | %.1f | %.0f | %.2f | %.1f |\n", name, s->triangles.count, t1, t2,
+           t2 > 0 ? t1 / t2 : 0.0, 1e6 * t1 / (n * log2(n)), (double)st.prim_refs / n, (double)st.bytes / n);
+    fflush(stdout);
+}
+
+int main(int argc, char **argv)
+{
+    int reps = 3;
+    size_t max = 2000000;
+    int first_model = argc;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--reps") == 0 && i + 1 < argc) {
+            reps = atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--max") == 0 && i + 1 < argc) {
+            max = (size_t)atof(argv[++i]);
+        } else if (argv[i][0] == '-') {
+            fprintf(stderr, "usage: buildscale [--reps K] [--max N] [MODEL.glb ...]\n");
+            return 2;
+        } else {
+            first_model = i;
+            break;
+        }
+    }
+    if (reps < 1 || reps > 64)
+        reps = 3;
+    rt_log_set_level(RT_LOG_QUIET);
+    printf("| scene | triangles | build 1T ms | build 2T ms | 2T speed-up | 1T ns / (N log2 N) | refs / tri | bytes / tri |\n");
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
+    static const size_t sizes[] = {10000, 30000, 100000, 300000, 1000000, 2000000, 4000000};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0] && sizes[k] <= max; k++) {
+        rt_scene s;
+        rt_scene_init(&s);
+        if (soup(&s, sizes[k]) != 0) {
+            fprintf(stderr, "buildscale: out of memory\n");
+            return 1;
+        }
+        row("random soup", &s, reps);
+        rt_scene_free(&s);
+    }
+    for (int i = first_model; i < argc; i++) {
+        rt_scene s;
+        rt_scene_init(&s);
+        rt_gltf_options opt;
+        memset(&opt, 0, sizeof opt);
+        rt_gltf_stats gs;
+        rt_error err = {0};
+        if (rt_gltf_load(&s, argv[i], &opt, &gs, &err) != RT_OK) {
+            fprintf(stderr, "buildscale: %s\n", err.message);
+            return 2;
+        }
+        const char *name = strrchr(argv[i], '/');
+        row(name ? name + 1 : argv[i], &s, reps);
+        rt_scene_free(&s);
+    }
+    return 0;
+}
