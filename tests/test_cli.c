@@ -538,6 +538,42 @@ static void test_threads_same_image(void **state)
     unlink(one), unlink(many), unlink(lone), unlink(px), unlink(px_png);
 }
 
+/* Recursion at its caps: two facing mirrors at max_bounce 256, and 600
+ * index-matched glass spheres in a row (1200 crossings, past whitted's
+ * guard of 1024 nested rays): no stack overflow, a finite image. */
+static void test_deep_recursion(void **state)
+{
+    (void)state;
+    write_text("mirrors.txt", "resolution 16 16\nintegrator whitted\nmax_bounce 256\n"
+                              "camera position 0 0 0.5 look_at 0 0 -1 up 0 1 0 fov 10\n"
+                              "material mirror color 1 1 1 reflectivity 1\n"
+                              "quad -50 -50 -1  100 0 0  0 100 0 mirror\nquad -50 -50 1  0 100 0  100 0 0 mirror\n"
+                              "light point 0 0 0 1 1 1 1\n");
+    static char glass[64 * 1024];
+    int n = snprintf(glass, sizeof glass, "resolution 8 8\nintegrator whitted\nmax_bounce 256\n"
+                                          "camera position 0 0 0 look_at 0 0 -1 up 0 1 0 fov 10\n"
+                                          "material glass color 1 1 1 transmission 1 ior 1.0\n"
+                                          "light point 0 0 0 1 1 1 1\n");
+    for (int i = 1; i <= 600; i++)
+        n += snprintf(glass + n, sizeof glass - (size_t)n, "sphere 0 0 -%d 1 glass\n", 3 * i);
+    write_text("glass.txt", glass);
+    const char *names[2] = {"mirrors", "glass"};
+    for (int k = 0; k < 2; k++) {
+        char scene[600], pfm[600];
+        snprintf(scene, sizeof scene, "%s/%s.txt", dir, names[k]);
+        snprintf(pfm, sizeof pfm, "%s/%s.pfm", dir, names[k]);
+        const char *const args[] = {"-t", "2", scene, NULL};
+        render_ok(pfm, args);
+        rt_framebuffer fb;
+        rt_error err;
+        assert_int_equal(rt_pfm_read(pfm, &fb, &err), RT_OK);
+        for (size_t i = 0; i < 3 * (size_t)fb.width * (size_t)fb.height; i++)
+            assert_true(fb.rgb[i] >= 0.0f && fb.rgb[i] < 1e30f);
+        rt_framebuffer_free(&fb);
+        unlink(pfm);
+    }
+}
+
 /* A render interrupted by `sig` after 0.7 s: exit 130, the message, and a
  * complete image whose tiles are each either finished or black. Every
  * pixel of the scene is non-zero (a glowing sphere before a lit
@@ -645,6 +681,7 @@ int main(void)
         cmocka_unit_test(test_bad_output),
         cmocka_unit_test(test_memory_budget),
         cmocka_unit_test(test_threads_same_image),
+        cmocka_unit_test(test_deep_recursion),
         cmocka_unit_test(test_sigint_writes_finished_tiles),
         cmocka_unit_test(test_sigterm_writes_finished_tiles),
         cmocka_unit_test(test_second_sigint_exits_at_once),
