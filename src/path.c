@@ -11,14 +11,18 @@
  *     uniformly by area, pdf d^2 / (A cos theta_l); point, spot and
  *     directional lights are deltas, weight 1), and, with a light table,
  *     one emissive primitive chosen in proportion to its power (area x mean
- *     emitted radiance) and a uniform point on it;
+ *     emitted radiance) and a uniform point on it, and one direction of the
+ *     environment image drawn in proportion to luminance x sin(theta)
+ *     (piecewise constant over its latitude-longitude cells, pbrt-v3
+ *     14.2.4);
  *   - the BSDF (rt/bsdf.h) samples the next direction, beta *= f cos / pdf.
  * Light and BSDF samples are combined with the power heuristic (Veach 1997,
  * "Robust Monte Carlo Methods for Light Transport Simulation", ch. 9,
  * beta = 2), so a BSDF-sampled ray that hits a light counts with weight
  * pdf_bsdf^2 / (pdf_bsdf^2 + pdf_light^2) and the light sample with the
  * complement. Emitters that are not light-sampled (emissive primitives
- * without a table, the environment) count in full on BSDF hits.
+ * and environment images without a table, a constant background) count in
+ * full on BSDF hits.
  *
  * Russian roulette (Arvo and Kirk 1990) from RT_PATH_RR_START bounces: the
  * path survives with q = min(max channel of beta, 0.95) and beta /= q, which
@@ -96,7 +100,155 @@ void rt_light_table_free(rt_light_table *t)
     free(t->area);
     free(t->prim_pdf);
     free(t->quad_light);
+    free(t->env_row_cdf);
+    free(t->env_col_cdf);
+    free(t->env_cell);
     memset(t, 0, sizeof *t);
+}
+
+/* Latitude-longitude mapping of rt_environment (shade.c):
+ * u = 0.5 + atan2(x, z) / 2pi, v = acos(y) / pi. */
+static rt_vec3 latlong_dir(float u, float v)
+{
+    float theta = v * RT_PI, phi = (u - 0.5f) * 2.0f * RT_PI;
+    float st = sinf(theta);
+    return rt_v3(st * sinf(phi), cosf(theta), st * cosf(phi));
+}
+
+/* The environment's sampling distribution: luminance (the largest over the
+ * cell) x sin(theta) per cell of a grid at the image's resolution (at most
+ * 1024 x 512), piecewise constant in (u, v) (pbrt-v3 14.2.4, "Infinite Area Lights"). false =
+ * out of memory. */
+static bool build_env(rt_light_table *t, const rt_scene *s)
+{
+    const rt_settings *st = &s->settings;
+    uint32_t tex = st->environment_texture;
+    if (tex == RT_NONE || tex >= s->texture_count || !(st->environment_strength > 0.0f))
+        return true;
+    int w = 256, h = 128;
+    const rt_texture *tx = &s->textures[tex];
+    if (tx->kind == RT_TEX_IMAGE && tx->image < s->image_count) {
+        w = s->images[tx->image].width;
+        h = s->images[tx->image].height;
+        w = w < 1 ? 1 : (w > 1024 ? 1024 : w);
+        h = h < 1 ? 1 : (h > 512 ? 512 : h);
+    }
+    size_t n = (size_t)w * (size_t)h;
+    t->env_row_cdf = rt_alloc((size_t)h, sizeof *t->env_row_cdf);
+    t->env_col_cdf = rt_alloc(n, sizeof *t->env_col_cdf);
+    t->env_cell = rt_alloc(n, sizeof *t->env_cell);
+    double *row = rt_alloc((size_t)h, sizeof *row);
+    if (!t->env_row_cdf || !t->env_col_cdf || !t->env_cell || !row) {
+        free(row);
+        return false;
+    }
+    rt_trace_ctx c;
+    memset(&c, 0, sizeof c);
+    c.scene = s;
+    double total = 0.0;
+    for (int j = 0; j < h; j++) {
+        float v = ((float)j + 0.5f) / (float)h;
+        float sin_t = sinf(v * RT_PI);
+        double acc = 0.0;
+        float *cdf = t->env_col_cdf + (size_t)j * (size_t)w, *cell = t->env_cell + (size_t)j * (size_t)w;
+        for (int i = 0; i < w; i++) {
+            /* the largest of 3 x 3 lookups over the cell: bilinear
+             * filtering spreads a bright texel into its neighbours' cells */
+            float lum = 0.0f;
+            for (int b = 0; b < 3; b++)
+                for (int a = 0; a < 3; a++) {
+                    float uu = ((float)i + 0.5f * (float)a) / (float)w;
+                    float vv = ((float)j + 0.5f * (float)b) / (float)h;
+                    rt_vec3 e = rt_environment(&c, latlong_dir(uu, vv));
+                    float l = rt_luminance(rt_vmax(e, rt_v3s(0.0f)));
+                    if (l > lum && isfinite(l))
+                        lum = l;
+                }
+            double wgt = (double)lum * (double)sin_t;
+            if (!(wgt > 0.0) || !isfinite(wgt))
+                wgt = 0.0;
+            acc += wgt;
+            cell[i] = (float)wgt;
+            cdf[i] = (float)acc;
+        }
+        for (int i = 0; i < w; i++)
+            cdf[i] = acc > 0.0 ? (float)(cdf[i] / acc) : (float)(i + 1) / (float)w;
+        cdf[w - 1] = 1.0f;
+        row[j] = acc;
+        total += acc;
+    }
+    if (!(total > 0.0) || !isfinite(total)) { /* a black environment: nothing to sample */
+        free(row);
+        free(t->env_row_cdf);
+        free(t->env_col_cdf);
+        free(t->env_cell);
+        t->env_row_cdf = t->env_col_cdf = t->env_cell = NULL;
+        return true;
+    }
+    double acc = 0.0;
+    for (int j = 0; j < h; j++) {
+        acc += row[j];
+        t->env_row_cdf[j] = (float)(acc / total);
+        for (int i = 0; i < w; i++)
+            t->env_cell[(size_t)j * (size_t)w + (size_t)i] = (float)(t->env_cell[(size_t)j * (size_t)w + (size_t)i] / total);
+    }
+    t->env_row_cdf[h - 1] = 1.0f;
+    t->env_w = w;
+    t->env_h = h;
+    free(row);
+    return true;
+}
+
+/* Index of the first of n cumulative values above u. */
+static size_t cdf_pick(const float *cdf, size_t n, float u)
+{
+    size_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (cdf[mid] > u)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    return lo;
+}
+
+float rt_light_table_env_pdf(const rt_light_table *t, rt_vec3 d)
+{
+    if (!t || t->env_w <= 0)
+        return 0.0f;
+    float sin_t = sqrtf(fmaxf(0.0f, 1.0f - d.y * d.y));
+    if (!(sin_t > 0.0f))
+        return 0.0f;
+    float u = 0.5f + atan2f(d.x, d.z) * (0.5f * RT_INV_PI);
+    float v = acosf(rt_clampf(d.y, -1.0f, 1.0f)) * RT_INV_PI;
+    int i = (int)(u * (float)t->env_w), j = (int)(v * (float)t->env_h);
+    i = i < 0 ? 0 : (i >= t->env_w ? t->env_w - 1 : i);
+    j = j < 0 ? 0 : (j >= t->env_h ? t->env_h - 1 : j);
+    float p = t->env_cell[(size_t)j * (size_t)t->env_w + (size_t)i] * (float)t->env_w * (float)t->env_h /
+              (2.0f * RT_PI * RT_PI * sin_t);
+    return isfinite(p) ? p : 0.0f;
+}
+
+/* A direction from the environment's distribution and its solid-angle
+ * pdf; false when it falls on a pole. */
+static bool env_sample(const rt_light_table *t, rt_vec2 u, rt_vec3 *d, float *pdf)
+{
+    size_t h = (size_t)t->env_h, w = (size_t)t->env_w;
+    size_t j = cdf_pick(t->env_row_cdf, h, u.y);
+    float r0 = j ? t->env_row_cdf[j - 1] : 0.0f, r1 = t->env_row_cdf[j];
+    float fv = r1 > r0 ? rt_clampf((u.y - r0) / (r1 - r0), 0.0f, 0x1.fffffep-1f) : 0.5f;
+    const float *cdf = t->env_col_cdf + j * w;
+    size_t i = cdf_pick(cdf, w, u.x);
+    float c0 = i ? cdf[i - 1] : 0.0f, c1 = cdf[i];
+    float fu = c1 > c0 ? rt_clampf((u.x - c0) / (c1 - c0), 0.0f, 0x1.fffffep-1f) : 0.5f;
+    float uu = ((float)i + fu) / (float)w, vv = ((float)j + fv) / (float)h;
+    float sin_t = sinf(vv * RT_PI);
+    if (!(sin_t > 1e-6f))
+        return false;
+    *d = latlong_dir(uu, vv);
+    *pdf = t->env_cell[j * w + i] * (float)w * (float)h / (2.0f * RT_PI * RT_PI * sin_t);
+    return *pdf > 0.0f && isfinite(*pdf) && rt_finite3(*d);
 }
 
 rt_result rt_light_table_build(rt_light_table *t, const rt_scene *s, rt_error *err)
@@ -123,6 +275,8 @@ rt_result rt_light_table_build(rt_light_table *t, const rt_scene *s, rt_error *e
         if (emissive_material(s, prim_material_of(s, (uint32_t)p), &pw) && prim_area(s, (uint32_t)p) > 0.0f)
             n++;
     }
+    if (!build_env(t, s))
+        goto nomem;
     t->count = n;
     if (n == 0)
         return RT_OK;
@@ -291,6 +445,22 @@ static rt_vec3 next_event(const rt_trace_ctx *ctx, const rt_surface *sf, const r
         sum = add_finite(sum, rt_scale(rt_mul(f, ls.li), wi.z * vis * w));
     }
     const rt_light_table *t = ctx->light_table;
+    if (t && t->env_w > 0) {
+        rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
+        rt_vec3 d;
+        float pdf_l;
+        if (env_sample(t, u, &d, &pdf_l) && rt_dot(d, b->ng) > 0.0f) {
+            rt_vec3 wi = rt_bsdf_to_local(b, d);
+            float pdf_b;
+            rt_vec3 f = rt_bsdf_eval(b, wo, wi, &pdf_b);
+            float w = rt_mis_power(pdf_l, pdf_b);
+            if (rt_max3(f) > 0.0f && w > 0.0f) {
+                float vis = visibility(ctx, sf, d, INFINITY);
+                if (vis > 0.0f)
+                    sum = add_finite(sum, rt_scale(rt_mul(f, rt_environment(ctx, d)), wi.z * vis * w / pdf_l));
+            }
+        }
+    }
     if (t && t->count) {
         float ul = rt_rng_float(rng);
         rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
@@ -379,7 +549,10 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
     for (;;) {
         rt_hit hit;
         if (!rt_trace(ctx, &r, &hit)) {
-            L = add_finite(L, rt_mul(beta, rt_environment(ctx, r.dir)));
+            float w = 1.0f; /* MIS against environment sampling, when the table does it */
+            if (!prev_delta && ctx->light_table && ctx->light_table->env_w > 0)
+                w = rt_mis_power(prev_pdf, rt_light_table_env_pdf(ctx->light_table, r.dir));
+            L = add_finite(L, rt_scale(rt_mul(beta, rt_environment(ctx, r.dir)), w));
             break;
         }
         rt_surface sf;

@@ -31,6 +31,7 @@
 #include "rt/render.h"
 #include "rt/scene.h"
 #include "rt/scene_parse.h"
+#include "rt/texture.h"
 
 typedef struct fixture {
     rt_scene s;
@@ -288,6 +289,115 @@ static void test_emissive_triangles_vs_area_light(void **state)
     assert_true(mean[2] > 0.05);
 }
 
+/* --------------------------------------------------------- environment */
+
+/* Adds a w x h float environment image: sky radiance everywhere, `sun`
+ * in a 2 x 2 texel patch around texel (si, sj). */
+static void add_env(rt_scene *s, int w, int h, float sky, float sun, int si, int sj)
+{
+    rt_image img;
+    memset(&img, 0, sizeof img);
+    img.width = w;
+    img.height = h;
+    img.rgbaf = malloc((size_t)w * (size_t)h * 4 * sizeof(float));
+    assert_non_null(img.rgbaf);
+    for (int j = 0; j < h; j++)
+        for (int i = 0; i < w; i++) {
+            bool in = (i == si || i == si + 1) && (j == sj || j == sj + 1);
+            float *px = img.rgbaf + 4 * ((size_t)j * (size_t)w + (size_t)i);
+            px[0] = px[1] = px[2] = in ? sun : sky;
+            px[3] = 1.0f;
+        }
+    snprintf(img.name, sizeof img.name, "test-env");
+    uint32_t im = rt_scene_add_image(s, &img);
+    assert_true(im != RT_NONE);
+    rt_texture tex = rt_texture_image(im);
+    tex.wrap_t = RT_WRAP_CLAMP;
+    uint32_t t = rt_scene_add_texture(s, &tex);
+    assert_true(t != RT_NONE);
+    s->settings.environment_texture = t;
+    s->settings.environment_strength = 1.0f;
+}
+
+static void load_env(fixture *f, const char *text, float sky, float sun, bool table)
+{
+    rt_error err;
+    rt_scene_init(&f->s);
+    if (rt_scene_parse_string(&f->s, text, strlen(text), "test", NULL, &err) != RT_OK)
+        fail_msg("parse: %s", err.message);
+    add_env(&f->s, 64, 32, sky, sun, 40, 8);
+    assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
+    rt_trace_ctx_init(&f->ctx, &f->s, &f->tree);
+    memset(&f->lt, 0, sizeof f->lt);
+    if (table) {
+        assert_int_equal(rt_light_table_build(&f->lt, &f->s, &err), RT_OK);
+        f->ctx.light_table = &f->lt;
+    }
+}
+
+/* The environment's sampling density integrates to 1 over the sphere. */
+static void test_env_pdf_normalised(void **state)
+{
+    (void)state;
+    fixture f;
+    load_env(&f, "integrator path\n", 0.1f, 1000.0f, true);
+    assert_int_equal(f.lt.env_w, 64);
+    assert_int_equal(f.lt.env_h, 32);
+    /* midpoint rule in (u, v), 16 x 16 points per cell (the cells' edges
+     * fall between points), dw = 2 pi^2 sin(theta) du dv */
+    double sum = 0.0;
+    const int nu = 64 * 16, nv = 32 * 16;
+    for (int j = 0; j < nv; j++) {
+        double v = (j + 0.5) / nv, theta = v * 3.14159265358979;
+        for (int i = 0; i < nu; i++) {
+            double u = (i + 0.5) / nu, phi = (u - 0.5) * 2.0 * 3.14159265358979;
+            rt_vec3 d = rt_v3((float)(sin(theta) * sin(phi)), (float)cos(theta), (float)(sin(theta) * cos(phi)));
+            sum += rt_light_table_env_pdf(&f.lt, d) * sin(theta);
+        }
+    }
+    double integral = sum * 2.0 * 3.14159265358979 * 3.14159265358979 / ((double)nu * nv);
+    if (fabs(integral - 1.0) >= 0.01)
+        fail_msg("integral of the environment pdf: %.4f", integral);
+    unload(&f);
+}
+
+/* A Lambertian floor under a sky with a small bright sun: environment
+ * sampling with MIS gives the same mean as BSDF sampling alone, with far
+ * less noise; under a uniform sky of 1 a Lambertian sphere shows its albedo. */
+static void test_env_sampling(void **state)
+{
+    (void)state;
+    const char *text = "integrator path\nmaterial m color 0.5 0.5 0.5 bsdf lambert\nquad -10 0 10  20 0 0  0 0 -20  m\n";
+    double mean[2], sd[2];
+    for (int t = 0; t < 2; t++) {
+        fixture f;
+        load_env(&f, text, 0.1f, 1000.0f, t == 1);
+        double sum = 0.0, sum2 = 0.0;
+        const uint32_t n = 20000;
+        for (uint32_t i = 0; i < n; i++) {
+            rt_vec3 L = radiance(&f, rt_v3(0, 1, 1), rt_v3(0, -1, -1), i);
+            sum += L.x;
+            sum2 += (double)L.x * L.x;
+        }
+        mean[t] = sum / n;
+        sd[t] = sqrt(fmax(0.0, sum2 / n - mean[t] * mean[t]) / n);
+        unload(&f);
+    }
+    fprintf(stderr, "sun and sky: BSDF only %.4f +- %.4f, with environment sampling %.4f +- %.4f\n", mean[0], sd[0],
+            mean[1], sd[1]);
+    assert_true(sd[1] < 0.3 * sd[0]);
+    assert_true(fabs(mean[0] - mean[1]) < 4.0 * sqrt(sd[0] * sd[0] + sd[1] * sd[1]));
+    /* uniform sky, textured: the furnace again, now through light sampling */
+    fixture f;
+    load_env(&f, "integrator path\nmaterial m color 0.7 0.7 0.7 bsdf lambert\nsphere 0 0 0 1 m\n", 1.0f, 1.0f, true);
+    double sum = 0.0;
+    const uint32_t n = 20000;
+    for (uint32_t i = 0; i < n; i++)
+        sum += radiance(&f, rt_v3(0.3f, 0.2f, 5), rt_v3(0, 0, -1), i).x;
+    assert_true(fabs(sum / n - 0.7) < 0.005);
+    unload(&f);
+}
+
 /* ------------------------------------------------------ whole images */
 
 static const char *every_material =
@@ -497,6 +607,8 @@ int main(void)
         cmocka_unit_test(test_point_light_exact),
         cmocka_unit_test(test_area_light_one_sided),
         cmocka_unit_test(test_emissive_triangles_vs_area_light),
+        cmocka_unit_test(test_env_pdf_normalised),
+        cmocka_unit_test(test_env_sampling),
         cmocka_unit_test(test_every_material_finite_and_deterministic),
         cmocka_unit_test(test_cornell_reference),
         cmocka_unit_test(test_cornell_emissive_triangles),

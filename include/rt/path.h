@@ -8,7 +8,7 @@
  * Lights sampled at every path vertex: every rt_light (point, spot,
  * directional, area) and, when ctx->light_table is set, one emissive
  * primitive (triangle, quad or sphere with an emissive material) chosen by
- * power. The table is per scene and read-only while rendering: build it
+ * power, and the environment image by its luminance. The table is per scene and read-only while rendering: build it
  * once after the scene is loaded, before the render threads start, and
  * point each thread's context at it:
  *
@@ -40,7 +40,17 @@ typedef struct rt_light_table {
     float *prim_pdf;      /* per primitive id: selection probability / area (0 = not in the table) */
     size_t quad_count;
     uint32_t *quad_light; /* per quad: index of the area light it is the visible quad of, or RT_NONE */
+    /* environment image, importance-sampled by luminance x sin(theta) over
+     * an env_w x env_h grid of its latitude-longitude cells (0 = none) */
+    int env_w, env_h;
+    float *env_row_cdf;   /* env_h: cumulative probability of the rows */
+    float *env_col_cdf;   /* env_h x env_w: cumulative probability within each row */
+    float *env_cell;      /* env_h x env_w: probability of each cell */
 } rt_light_table;
+
+/* Solid-angle pdf with which the table samples the environment towards
+ * unit direction d (0 without an environment image). */
+float rt_light_table_env_pdf(const rt_light_table *t, rt_vec3 d);
 
 rt_result rt_light_table_build(rt_light_table *t, const rt_scene *s, rt_error *err);
 void rt_light_table_free(rt_light_table *t);
