@@ -18,6 +18,7 @@
 
 #include "rt/camera.h"
 #include "rt/integrator.h"
+#include "rt/path.h"
 #include "rt/sampling.h"
 
 int rt_cpu_count(void)
@@ -43,6 +44,7 @@ typedef struct render_job {
     atomic_int tiles_done;
     atomic_uchar *tile_finished; /* per tile: 1 once its pixels are final */
     atomic_int *cancel;
+    const rt_light_table *lights; /* path tracer's emitter table, shared read-only */
 } render_job;
 
 typedef struct worker {
@@ -107,6 +109,7 @@ static void *worker_main(void *arg)
     render_job *job = w->job;
     rt_trace_ctx ctx;
     rt_trace_ctx_init(&ctx, job->scene, job->tree);
+    ctx.light_table = job->lights;
     ctx.ray_count = &w->rays;
     for (;;) {
         if (job->cancel && atomic_load(job->cancel))
@@ -209,6 +212,18 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     }
     for (int t = 0; t < job.tiles_total; t++)
         atomic_init(&job.tile_finished[t], 0);
+    /* the path tracer's emitter table: built once, before the workers */
+    rt_light_table lights;
+    memset(&lights, 0, sizeof lights);
+    if (set->integrator == RT_INTEGRATOR_PATH) {
+        rt_result lr = rt_light_table_build(&lights, scene, err);
+        if (lr != RT_OK) {
+            free(job.tile_finished);
+            free(workers);
+            return lr;
+        }
+        job.lights = &lights;
+    }
 
     double t0 = now_seconds();
     int started = 0;
@@ -268,6 +283,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     }
     free(job.tile_finished);
     free(workers);
+    rt_light_table_free(&lights);
     if (stats)
         *stats = st;
     if (st.interrupted)
