@@ -987,6 +987,14 @@ static rt_result parse_materials(gl_doc *d, int t)
                 TRY(get_float(d, where, "alphaCutoff", v, &m->alpha_cutoff));
             } else if (KEY(k, "doubleSided")) {
                 TRY(get_bool(d, where, "doubleSided", v, &m->double_sided));
+            } else if (KEY(k, "extras")) {
+                /* extras are free-form: only an object with "bsdf": "lambertian"
+                 * means something to rt (a pure Lambertian surface, as the
+                 * shared reference scenes use); anything else is ignored */
+                int b = rt_json_get(&d->j, v, "bsdf");
+                char bsdf[16];
+                if (b >= 0 && rt_json_string(&d->j, b, bsdf, sizeof bsdf) >= 0 && strcmp(bsdf, "lambertian") == 0)
+                    m->bsdf = RT_BSDF_LAMBERT;
             } else if (KEY(k, "extensions")) {
                 char wx[96];
                 snprintf(wx, sizeof wx, "%s.extensions", where);
