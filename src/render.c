@@ -233,6 +233,9 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
             break;
         started++;
     }
+    if (started < nthreads) /* out of memory for stacks, or a process limit: fewer threads, same image */
+        rt_warn("could start only %d of %d render threads%s", started, nthreads,
+                started ? "" : "; rendering on the main thread");
     if (started == 0) {
         /* no threads could be started: render on this one */
         workers[0].job = &job;
