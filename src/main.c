@@ -180,22 +180,20 @@ static void apply_memory_budget(memory_budget *b)
     }
 }
 
-static memory_budget budget;
-
 /* Prints an error; out-of-memory errors also say which budget ran out and
  * how to raise it. */
-static void report(const rt_error *err)
+static void report(const rt_error *err, const memory_budget *budget)
 {
     fprintf(stderr, "rt: %s\n", err->message);
     if (err->code != RT_ERR_NOMEM)
         return;
-    if (budget.enforced) {
+    if (budget->enforced) {
         char sz[32];
-        format_size(budget.bytes, sz, sizeof sz);
+        format_size(budget->bytes, sz, sizeof sz);
         fprintf(stderr,
                 "rt: the memory budget of %s (%s) ran out; raise it with --max-memory SIZE (e.g. --max-memory 16G, or "
                 "'none' for no limit)\n",
-                sz, budget.from_flag ? "--max-memory" : "the default, 75% of physical memory");
+                sz, budget->from_flag ? "--max-memory" : "the default, 75% of physical memory");
     } else {
         fprintf(stderr, "rt: the machine's memory ran out (no --max-memory budget was in force)\n");
     }
@@ -423,7 +421,7 @@ static rt_result check_limits(rt_scene *s, const char *input, bool camera_from_i
 }
 
 /* --info: one `key: value` line per figure, for people and scripts. */
-static int print_info(const char *path)
+static int print_info(const char *path, const memory_budget *budget)
 {
     rt_scene s;
     rt_scene_init(&s);
@@ -431,7 +429,7 @@ static int print_info(const char *path)
     input_info info;
     rt_result r = load_input(&s, path, false, &info, &err);
     if (r != RT_OK) {
-        report(&err);
+        report(&err, budget);
         rt_scene_free(&s);
         return 2;
     }
@@ -467,7 +465,7 @@ static int print_info(const char *path)
 int main(int argc, char **argv)
 {
     const char *input = NULL, *output = NULL, *integrator = NULL, *preview = NULL, *info_path = NULL;
-    budget.bytes = default_memory_budget();
+    memory_budget budget = {default_memory_budget(), false, false};
     long threads = 0, samples = 0, width = 0, height = 0, camera = -1, seed = -1, tile = 0;
     double preview_seconds = 0.0;
     rt_log_level level = RT_LOG_NORMAL;
@@ -558,19 +556,19 @@ int main(int argc, char **argv)
     if (budget.enforced) {
         char sz[32];
         format_size(budget.bytes, sz, sizeof sz);
-        rt_info("memory budget: %s%s", sz, budget.from_flag ? " (--max-memory)" : " (75%% of physical memory)");
+        rt_info("memory budget: %s%s", sz, budget.from_flag ? " (--max-memory)" : " (75% of physical memory)");
     } else {
         rt_info("memory budget: none%s", RT_SANITIZED && budget.bytes ? " (not enforced in sanitizer builds)" : "");
     }
     if (info_path)
-        return print_info(info_path);
+        return print_info(info_path, &budget);
 
     rt_scene scene;
     rt_scene_init(&scene);
     rt_error err = {0};
     input_info info;
     if (load_input(&scene, input, true, &info, &err) != RT_OK) {
-        report(&err);
+        report(&err, &budget);
         rt_scene_free(&scene);
         return 2;
     }
@@ -601,7 +599,7 @@ int main(int argc, char **argv)
     if (!scene.camera_set)
         rt_scene_frame_camera(&scene);
     if (check_limits(&scene, input, camera_from_input, &err) != RT_OK) {
-        report(&err);
+        report(&err, &budget);
         rt_scene_free(&scene);
         return 2;
     }
@@ -612,7 +610,7 @@ int main(int argc, char **argv)
         output = outbuf;
     }
     if (rt_output_check(output, &err) != RT_OK || rt_output_check_size(output, set->width, set->height, &err) != RT_OK) {
-        report(&err);
+        report(&err, &budget);
         rt_scene_free(&scene);
         return 2;
     }
@@ -629,7 +627,7 @@ int main(int argc, char **argv)
 
     rt_kdtree tree;
     if (rt_kdtree_build(&tree, &scene, NULL, &err) != RT_OK) {
-        report(&err);
+        report(&err, &budget);
         rt_scene_free(&scene);
         return 2;
     }
@@ -639,7 +637,7 @@ int main(int argc, char **argv)
 
     rt_framebuffer fb;
     if (rt_framebuffer_init(&fb, set->width, set->height, &err) != RT_OK) {
-        report(&err);
+        report(&err, &budget);
         rt_kdtree_free(&tree);
         rt_scene_free(&scene);
         return 2;
@@ -667,12 +665,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "rt: %s; writing the finished tiles to %s\n", err.message, output);
         status = 130;
     } else if (r != RT_OK) {
-        report(&err);
+        report(&err, &budget);
         status = 2;
     }
     if (status != 2) {
         if (rt_framebuffer_write(&fb, output, set->exposure, &err) != RT_OK) {
-            report(&err);
+            report(&err, &budget);
             status = 2;
         } else if (level >= RT_LOG_NORMAL) {
             fprintf(stderr, "rt: wrote %s (%dx%d, %d spp, %.2f s)\n", output, fb.width, fb.height, set->samples,
