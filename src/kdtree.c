@@ -1363,6 +1363,7 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, c
             while (p[i + m - 1] >= T)
                 m--;
             if (tri8(tree->tri, p + i, m, ray, best, hit)) {
+                KD_PREFETCH(&tree->tri_id[hit->prim]); /* wanted at the end of the traversal */
                 found = true;
                 if (any)
                     return true;
