@@ -614,6 +614,10 @@ static bool read_faces(ply_load *L, const ply_elem *el, uint64_t e)
     ply_reader *r = &L->r;
     rt_mesh_buf *b = L->b;
     const ply_prop *props = elem_props(&L->pf, el);
+    /* an element without properties holds no bytes, so check_counts cannot
+     * bound its count: it has no faces to read (and nothing to reserve) */
+    if (el->nprops == 0)
+        return true;
     if (!rt_mesh_buf_reserve_triangles(b, b->nt + (size_t)el->count)) {
         rt_fail(r->err, RT_ERR_NOMEM, "%s: out of memory for %llu faces", r->path, (unsigned long long)el->count);
         return false;
@@ -731,6 +735,8 @@ static bool skip_element(ply_load *L, const ply_elem *el)
 {
     ply_reader *r = &L->r;
     const ply_prop *props = elem_props(&L->pf, el);
+    if (el->nprops == 0) /* no bytes, however large the count: no loop over it */
+        return true;
     bool lists = false;
     size_t row = 0;
     for (size_t k = 0; k < el->nprops; k++) {

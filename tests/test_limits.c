@@ -290,6 +290,20 @@ static rt_result load_mesh_text(const char *name, const char *text, rt_scene *s,
 static void test_mesh_numbers(void **state)
 {
     (void)state;
+    /* a face element without properties holds no bytes: its count (4e9,
+     * which no file size bounds) must not be reserved (found by libFuzzer) */
+    rt_scene z;
+    rt_scene_init(&z);
+    rt_error zerr = {0};
+    assert_int_equal(load_mesh_text("zero.ply",
+                                    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                    "property float z\nelement face 4000000000\nelement junk 4000000000\nend_header\n"
+                                    "0 0 0\n1 0 0\n0 1 0\n",
+                                    &z, &zerr),
+                     RT_OK);
+    assert_int_equal(z.triangles.count, 0);
+    rt_scene_free(&z);
+
     static const char *const bad[][2] = {
         {"a.obj", "v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"},
         {"b.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 inf\nf 1/1 2/1 3/1\n"},
