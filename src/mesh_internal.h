@@ -88,5 +88,19 @@ typedef struct rt_warn_once {
 bool rt_warn_once_first(rt_warn_once *w, const char *key, size_t len);
 
 static inline bool rt_mesh_is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+/* The first non-space character at or after p (end when none). */
+static inline const char *rt_mesh_skip_space(const char *p, const char *end)
+{
+    while (p < end && rt_mesh_is_space(*p))
+        p++;
+    return p;
+}
+/* The end of the token starting at p. */
+static inline const char *rt_mesh_token_end(const char *p, const char *end)
+{
+    while (p < end && !rt_mesh_is_space(*p))
+        p++;
+    return p;
+}
 
 #endif

@@ -173,20 +173,6 @@ typedef struct line_ctx {
 
 static int col_of(const line_ctx *lc, const char *at) { return (int)(at - lc->start) + 1; }
 
-static const char *skip_space(const char *p, const char *end)
-{
-    while (p < end && rt_mesh_is_space(*p))
-        p++;
-    return p;
-}
-
-static const char *token_end(const char *p, const char *end)
-{
-    while (p < end && !rt_mesh_is_space(*p))
-        p++;
-    return p;
-}
-
 static bool kw_is(const char *k, size_t klen, const char *want)
 {
     size_t n = strlen(want);
@@ -214,7 +200,7 @@ static bool kw_is_ci(const char *k, size_t klen, const char *want)
 /* The rest of a line, trimmed, as a bounded C string. false if it does not fit. */
 static bool rest_string(const char *p, const char *end, char *out, size_t size)
 {
-    p = skip_space(p, end);
+    p = rt_mesh_skip_space(p, end);
     while (end > p && rt_mesh_is_space(end[-1]))
         end--;
     size_t n = (size_t)(end - p);
@@ -231,10 +217,10 @@ static int parse_floats(const line_ctx *lc, const char *p, const char *end, floa
 {
     int n = 0;
     for (;;) {
-        p = skip_space(p, end);
+        p = rt_mesh_skip_space(p, end);
         if (p >= end)
             return n;
-        const char *te = token_end(p, end);
+        const char *te = rt_mesh_token_end(p, end);
         if (n == max) {
             rt_fail(err, RT_ERR_PARSE, "%s:%ld:%d: unexpected '%.*s' (at most %d numbers here)", lc->file, lc->line,
                     col_of(lc, p), (int)(te - p > 40 ? 40 : te - p), p, max);
@@ -273,7 +259,7 @@ static rt_result for_each_line(const char *file, const char *data, size_t size, 
             eol = end;
         const char *next = eol < end ? eol + 1 : end;
         lc.start = p;
-        const char *q = skip_space(p, eol);
+        const char *q = rt_mesh_skip_space(p, eol);
         if (q < eol && *q != '#') {
             rt_result r = fn(ctx, &lc, q, eol);
             if (r != RT_OK)
@@ -314,8 +300,8 @@ typedef struct mtl_ctx {
 static rt_result mtl_color(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl, const char *p, const char *eol,
                            rt_vec3 *out, bool *has)
 {
-    const char *q = skip_space(p, eol);
-    const char *te = token_end(q, eol);
+    const char *q = rt_mesh_skip_space(p, eol);
+    const char *te = rt_mesh_token_end(q, eol);
     if (kw_is(q, (size_t)(te - q), "spectral") || kw_is(q, (size_t)(te - q), "xyz")) {
         warn_unknown(&mc->warned, lc, q, (size_t)(te - q));
         return RT_OK;
@@ -351,10 +337,10 @@ static rt_result mtl_map(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl, c
 {
     eol = cut_comment_ws(p, eol);
     for (;;) {
-        p = skip_space(p, eol);
+        p = rt_mesh_skip_space(p, eol);
         if (p >= eol || *p != '-')
             break;
-        const char *te = token_end(p, eol);
+        const char *te = rt_mesh_token_end(p, eol);
         size_t ol = (size_t)(te - p);
         int min_args = 1, max_args = 1;
         if (kw_is(p, ol, "-o") || kw_is(p, ol, "-s") || kw_is(p, ol, "-t"))
@@ -369,8 +355,8 @@ static rt_result mtl_map(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl, c
         const char *opt = p;
         p = te;
         for (int a = 0; a < max_args; a++) {
-            const char *q = skip_space(p, eol);
-            const char *qe = token_end(q, eol);
+            const char *q = rt_mesh_skip_space(p, eol);
+            const char *qe = rt_mesh_token_end(q, eol);
             if (q >= eol)
                 break;
             float f;
@@ -412,7 +398,7 @@ static rt_result mtl_line(void *ctx, line_ctx *lc, const char *p, const char *eo
 {
     mtl_ctx *mc = ctx;
     obj_parser *op = mc->op;
-    const char *ke = token_end(p, eol);
+    const char *ke = rt_mesh_token_end(p, eol);
     const char *kw = p;
     size_t kl = (size_t)(ke - p);
     p = ke;
@@ -472,9 +458,9 @@ static rt_result mtl_line(void *ctx, line_ctx *lc, const char *p, const char *eo
     }
     if (kw_is_ci(kw, kl, "d")) {
         /* "d -halo f" is an old variant: take the factor */
-        const char *q = skip_space(p, eol);
-        if (kw_is(q, (size_t)(token_end(q, eol) - q), "-halo"))
-            p = token_end(q, eol);
+        const char *q = rt_mesh_skip_space(p, eol);
+        if (kw_is(q, (size_t)(rt_mesh_token_end(q, eol) - q), "-halo"))
+            p = rt_mesh_token_end(q, eol);
         m->has_alpha = true;
         return mtl_scalar(mc, lc, kw, kl, p, eol, &m->alpha);
     }
@@ -681,10 +667,10 @@ static rt_result obj_face(obj_parser *op, line_ctx *lc, const char *p, const cha
     size_t nc = 0;
     bool all_t = true, all_n = true, any_n = false;
     for (;;) {
-        p = skip_space(p, eol);
+        p = rt_mesh_skip_space(p, eol);
         if (p >= eol)
             break;
-        const char *te = token_end(p, eol);
+        const char *te = rt_mesh_token_end(p, eol);
         const char *tok = p;
         int64_t iv, it = 0, in = 0;
         const char *q = rt_mesh_parse_int(p, te, &iv);
@@ -823,10 +809,10 @@ static rt_result obj_mtllib(obj_parser *op, line_ctx *lc, const char *p, const c
     if (stat(full, &st) == 0 || !strpbrk(rel, " \t"))
         return load_mtl(op, full, lc);
     for (;;) {
-        p = skip_space(p, eol);
+        p = rt_mesh_skip_space(p, eol);
         if (p >= eol)
             return RT_OK;
-        const char *te = token_end(p, eol);
+        const char *te = rt_mesh_token_end(p, eol);
         size_t n = (size_t)(te - p);
         if (n >= sizeof rel)
             return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: mtllib path too long", lc->file, lc->line);
@@ -844,7 +830,7 @@ static rt_result obj_mtllib(obj_parser *op, line_ctx *lc, const char *p, const c
 static rt_result obj_line(void *ctx, line_ctx *lc, const char *p, const char *eol)
 {
     obj_parser *op = ctx;
-    const char *ke = token_end(p, eol);
+    const char *ke = rt_mesh_token_end(p, eol);
     const char *kw = p;
     size_t kl = (size_t)(ke - p);
     p = ke;
@@ -883,7 +869,7 @@ static rt_result obj_line(void *ctx, line_ctx *lc, const char *p, const char *eo
     if (kw_is(kw, kl, "s")) {
         /* "s off", "s 0" or "s <group>" */
         const char *le = cut_comment(p, eol);
-        const char *q = skip_space(p, le), *qe = token_end(q, le);
+        const char *q = rt_mesh_skip_space(p, le), *qe = rt_mesh_token_end(q, le);
         int64_t g = 0;
         if (kw_is(q, (size_t)(qe - q), "off") || q >= qe)
             g = 0;

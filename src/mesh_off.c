@@ -53,20 +53,6 @@ static bool next_line(off_lines *L)
     return false;
 }
 
-static const char *skip_ws(const char *p, const char *end)
-{
-    while (p < end && rt_mesh_is_space(*p))
-        p++;
-    return p;
-}
-
-static const char *tok_end(const char *p, const char *end)
-{
-    while (p < end && !rt_mesh_is_space(*p))
-        p++;
-    return p;
-}
-
 static rt_result bad_token(const off_lines *L, rt_error *err, const char *tok, const char *te, const char *what)
 {
     return rt_fail(err, RT_ERR_PARSE, "%s:%ld:%d: %s '%.*s'", L->path, L->line, (int)(tok - L->ls) + 1, what,
@@ -77,8 +63,8 @@ static rt_result bad_token(const off_lines *L, rt_error *err, const char *tok, c
 static int read_ints(const off_lines *L, const char *p, int64_t *out, int max, rt_error *err)
 {
     int n = 0;
-    for (p = skip_ws(p, L->le); p < L->le && n < max; p = skip_ws(p, L->le)) {
-        const char *te = tok_end(p, L->le);
+    for (p = rt_mesh_skip_space(p, L->le); p < L->le && n < max; p = rt_mesh_skip_space(p, L->le)) {
+        const char *te = rt_mesh_token_end(p, L->le);
         const char *q = rt_mesh_parse_int(p, te, &out[n]);
         if (!q || q != te) {
             bad_token(L, err, p, te, "expected an integer, got");
@@ -115,7 +101,7 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         r = rt_fail(err, RT_ERR_PARSE, "%s: empty file, expected an OFF header", path);
         goto done;
     }
-    const char *kw = skip_ws(L.ls, L.le), *kwe = tok_end(kw, L.le);
+    const char *kw = rt_mesh_skip_space(L.ls, L.le), *kwe = rt_mesh_token_end(kw, L.le);
     bool st = false, col = false, nrm = false;
     const char *k = kw;
     if (kwe - k >= 2 && k[0] == 'S' && k[1] == 'T') { st = true; k += 2; }
@@ -131,8 +117,8 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         goto done;
     }
     /* counts: on the header line or the next line */
-    const char *cp = skip_ws(kwe, L.le);
-    if (cp < L.le && tok_end(cp, L.le) - cp == 6 && memcmp(cp, "BINARY", 6) == 0) {
+    const char *cp = rt_mesh_skip_space(kwe, L.le);
+    if (cp < L.le && rt_mesh_token_end(cp, L.le) - cp == 6 && memcmp(cp, "BINARY", 6) == 0) {
         r = rt_fail(err, RT_ERR_UNSUPPORTED, "%s:%ld: binary OFF is not supported", path, L.line);
         goto done;
     }
@@ -182,8 +168,8 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         }
         float f[16];
         int n = 0;
-        for (const char *p = skip_ws(L.ls, L.le); p < L.le && n < 16; p = skip_ws(p, L.le)) {
-            const char *te = tok_end(p, L.le);
+        for (const char *p = rt_mesh_skip_space(L.ls, L.le); p < L.le && n < 16; p = rt_mesh_skip_space(p, L.le)) {
+            const char *te = rt_mesh_token_end(p, L.le);
             bool nonfinite;
             const char *q = rt_mesh_parse_float(p, te, &f[n], &nonfinite);
             if (!q || q != te) {
@@ -226,7 +212,7 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
                         (unsigned long long)i, (unsigned long long)nf);
             goto done;
         }
-        const char *p = skip_ws(L.ls, L.le), *te = tok_end(p, L.le);
+        const char *p = rt_mesh_skip_space(L.ls, L.le), *te = rt_mesh_token_end(p, L.le);
         int64_t n;
         const char *q = rt_mesh_parse_int(p, te, &n);
         if (!q || q != te || n < 0) {
@@ -244,8 +230,8 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         }
         p = te;
         for (int64_t j = 0; j < n; j++) {
-            p = skip_ws(p, L.le);
-            te = tok_end(p, L.le);
+            p = rt_mesh_skip_space(p, L.le);
+            te = rt_mesh_token_end(p, L.le);
             int64_t v;
             q = p < L.le ? rt_mesh_parse_int(p, te, &v) : NULL;
             if (p >= L.le) {
