@@ -906,6 +906,156 @@ static bool leaf_order(rt_kdtree *tree, kd_build *c, size_t T)
     return true;
 }
 
+/* ------------------------------------------------------- wide nodes */
+
+/* Packs the binary tree (c->nodes, c->ids) into 64-byte nodes of three
+ * levels each (rt_kdtree_wide in kdtree.h), in depth-first order, and
+ * rewrites the leaf lists with their counts in front. Cell by cell: follow
+ * the cell's three below/above choices down from the top node; a leaf met
+ * above the third level takes the cell whose remaining choices are all
+ * "below" (the missing planes are +inf, so that cell is the leaf's whole
+ * box) and the other cells under it stay empty. */
+typedef struct kd_widen {
+    const rt_kdtree_node *bn;
+    const uint32_t *bids;
+    rt_kdtree_wide *w;
+    size_t wn, wcap;
+    uint32_t *ids;
+    size_t in;
+    bool oom, limit;
+} kd_widen;
+
+#define KD_NO_NODE UINT32_MAX
+
+static uint32_t widen_leaf(kd_widen *x, const rt_kdtree_node *nd)
+{
+    uint32_t n = nd->b >> 2;
+    if (n == 0)
+        return RT_KD_EMPTY;
+    if (n == 1)
+        return RT_KD_ONE | nd->a;
+    if (x->in > RT_KD_PAYLOAD) {
+        x->limit = true;
+        return RT_KD_EMPTY;
+    }
+    uint32_t off = (uint32_t)x->in;
+    x->ids[x->in++] = n;
+    memcpy(x->ids + x->in, x->bids + nd->a, n * sizeof *x->ids);
+    x->in += n;
+    return RT_KD_LEAF | off;
+}
+
+/* The binary child of interior node i on side `above`, or KD_NO_NODE for an
+ * empty leaf. */
+static uint32_t binary_child(const rt_kdtree_node *bn, uint32_t i, unsigned above)
+{
+    uint32_t b = bn[i].b;
+    if (b & (above ? KD_ABOVE_EMPTY : KD_BELOW_EMPTY))
+        return KD_NO_NODE;
+    return above ? b >> 4 : i + 1;
+}
+
+static bool is_leaf(const rt_kdtree_node *bn, uint32_t i) { return (bn[i].b & 3u) == LEAF_TAG; }
+
+static uint32_t widen_rec(kd_widen *x, uint32_t top)
+{
+    const rt_kdtree_node *bn = x->bn;
+    if (top == KD_NO_NODE)
+        return RT_KD_EMPTY;
+    if (is_leaf(bn, top))
+        return widen_leaf(x, &bn[top]);
+    if (x->wn >= (size_t)RT_KD_LEAF) {
+        x->limit = true;
+        return RT_KD_EMPTY;
+    }
+    if (!rt_grow((void **)&x->w, &x->wcap, x->wn + 1, sizeof *x->w)) {
+        x->oom = true;
+        return RT_KD_EMPTY;
+    }
+    size_t me = x->wn++;
+    rt_kdtree_wide w;
+    memset(&w, 0, sizeof w);
+    uint32_t plane[7];
+    plane[0] = top;
+    for (int p = 0; p < 3; p++) {
+        uint32_t i = plane[p];
+        bool inner = i != KD_NO_NODE && !is_leaf(bn, i);
+        plane[2 * p + 1] = inner ? binary_child(bn, i, 0) : KD_NO_NODE;
+        plane[2 * p + 2] = inner ? binary_child(bn, i, 1) : KD_NO_NODE;
+    }
+    for (int p = 0; p < 7; p++) {
+        uint32_t i = plane[p];
+        if (i != KD_NO_NODE && !is_leaf(bn, i)) {
+            memcpy(&w.split[p], &bn[i].a, 4);
+            w.axes |= (bn[i].b & 3u) << (2 * p);
+        } else {
+            w.split[p] = INFINITY; /* axis 0: the whole cell is below */
+        }
+    }
+    for (unsigned cell = 0; cell < 8; cell++) {
+        uint32_t i = top;
+        bool leaf_above = false; /* i is a leaf (or empty) met above level 3 */
+        bool gone = false;       /* the cell is beside such a leaf */
+        for (int level = 0; level < 3 && !gone; level++) {
+            unsigned bit = (cell >> (2 - level)) & 1u;
+            if (leaf_above) {
+                gone = bit != 0;
+                continue;
+            }
+            i = binary_child(bn, i, bit);
+            if (i == KD_NO_NODE) {
+                leaf_above = true;
+                gone = true; /* an empty leaf: every cell under it is empty */
+            } else if (is_leaf(bn, i)) {
+                leaf_above = level < 2;
+            }
+        }
+        w.child[cell] = gone ? RT_KD_EMPTY : widen_rec(x, i);
+        if (x->oom || x->limit)
+            return RT_KD_EMPTY;
+    }
+    x->w[me] = w; /* x->w may have moved */
+    return (uint32_t)me;
+}
+
+static void *alloc_line(size_t size)
+{
+    if (size >= KD_HUGE)
+        return alloc_hot(size);
+    void *p = NULL;
+    return posix_memalign(&p, 64, size ? size : 64) == 0 ? p : NULL;
+}
+
+static bool widen(rt_kdtree *tree, kd_build *c)
+{
+    size_t leaves = 0;
+    for (size_t i = 0; i < c->node_count; i++)
+        leaves += is_leaf(c->nodes, (uint32_t)i) && (c->nodes[i].b >> 2) > 1;
+    kd_widen x;
+    memset(&x, 0, sizeof x);
+    x.bn = c->nodes;
+    x.bids = c->ids;
+    size_t nids = c->id_count + leaves;
+    x.ids = alloc_hot((nids ? nids : 1) * sizeof *x.ids);
+    if (!x.ids)
+        return false;
+    tree->root = c->node_count ? widen_rec(&x, 0) : RT_KD_EMPTY;
+    rt_kdtree_wide *w = NULL;
+    if (!x.oom && !x.limit && (w = alloc_line((x.wn ? x.wn : 1) * sizeof *w)) != NULL && x.wn)
+        memcpy(w, x.w, x.wn * sizeof *w);
+    free(x.w);
+    if (!w) {
+        free(x.ids);
+        c->limit = x.limit;
+        return false;
+    }
+    tree->wide = w;
+    tree->wide_count = x.wn;
+    tree->prim_ids = x.ids;
+    tree->prim_id_count = x.in;
+    return true;
+}
+
 rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
 {
     double t0 = now_ms();
@@ -1105,29 +1255,14 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     c.strad = NULL;
     if (T > 0 && !leaf_order(tree, &c, T))
         goto oom;
-    if (c.node_count * sizeof *c.nodes >= KD_HUGE || c.id_count * sizeof *c.ids >= KD_HUGE) {
-        rt_kdtree_node *hn = alloc_hot(c.node_count * sizeof *hn);
-        uint32_t *hi = alloc_hot(c.id_count * sizeof *hi);
-        if (!hn || !hi) {
-            free(hn);
-            free(hi);
-            goto oom;
-        }
-        memcpy(hn, c.nodes, c.node_count * sizeof *hn);
-        if (c.id_count)
-            memcpy(hi, c.ids, c.id_count * sizeof *hi);
-        free(c.nodes);
-        free(c.ids);
-        c.nodes = hn;
-        c.ids = hi;
-    }
-    tree->nodes = c.nodes;
-    tree->node_count = c.node_count;
-    tree->prim_ids = c.ids;
-    tree->prim_id_count = c.id_count;
+    if (!widen(tree, &c))
+        goto oom;
     c.st.nodes = c.node_count;
-    c.st.bytes = c.node_count * sizeof *c.nodes + c.id_count * sizeof *c.ids + T * 9 * sizeof(float) +
-                 T * sizeof *tree->tri_id;
+    c.st.wide_nodes = tree->wide_count;
+    c.st.bytes = tree->wide_count * sizeof *tree->wide + tree->prim_id_count * sizeof *tree->prim_ids +
+                 T * 9 * sizeof(float) + T * sizeof *tree->tri_id;
+    free(c.nodes);
+    free(c.ids);
     c.st.build_ms = now_ms() - t0;
     tree->stats = c.st;
     return RT_OK;
@@ -1153,7 +1288,7 @@ void rt_kdtree_free(rt_kdtree *tree)
 {
     if (!tree)
         return;
-    free(tree->nodes);
+    free(tree->wide);
     free(tree->prim_ids);
     free(tree->tri);
     free(tree->tri_id);
@@ -1162,40 +1297,50 @@ void rt_kdtree_free(rt_kdtree *tree)
 
 /* ---------------------------------------------------------- traversal */
 
+/* The ray as the wide step reads it: per axis (lanes 0-2 of 8; lanes 3-7
+ * repeat lane 0 and are never selected) origin, 1/direction, cell widening
+ * in t, "direction negative" and "parallel to the axis". */
 typedef struct kd_ray {
-    float o[3], d[3], inv[3], ma[3];
+    _Alignas(32) float o[8];
+    _Alignas(32) float inv[8];
+    _Alignas(32) float ma[8];
+    _Alignas(32) int32_t neg[8]; /* -1: the above side comes first */
+    _Alignas(32) int32_t par[8]; /* -1: parallel (the ray moves less than mp along the axis) */
     float mp; /* widening of every cell, in scene units */
     float tn, tf;
+    bool any_par;
 } kd_ray;
 
-/* Clips the ray to the (widened) root box; false when it misses. */
+/* Clips the ray to the (widened) root box; false when it misses. An axis
+ * is treated as parallel when 1/d is infinite or mp/|d| overflows: then the
+ * ray moves less than mp along it for any finite t, so the side of a plane
+ * is decided by the origin alone (within mp: both sides). */
 static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r)
 {
-    if (!tree->nodes || !(ray->tmin < ray->tmax) || rt_box_is_empty(tree->bounds))
+    if (tree->root == RT_KD_EMPTY || !(ray->tmin < ray->tmax) || rt_box_is_empty(tree->bounds))
         return false;
     if (!rt_finite3(ray->org) || !rt_finite3(ray->dir))
         return false;
-    r->o[0] = ray->org.x, r->o[1] = ray->org.y, r->o[2] = ray->org.z;
-    r->d[0] = ray->dir.x, r->d[1] = ray->dir.y, r->d[2] = ray->dir.z;
-    float omax = fabsf(r->o[0]);
-    if (fabsf(r->o[1]) > omax)
-        omax = fabsf(r->o[1]);
-    if (fabsf(r->o[2]) > omax)
-        omax = fabsf(r->o[2]);
-    if (r->d[0] == 0.0f && r->d[1] == 0.0f && r->d[2] == 0.0f)
+    const float o[3] = {ray->org.x, ray->org.y, ray->org.z}, d[3] = {ray->dir.x, ray->dir.y, ray->dir.z};
+    if (d[0] == 0.0f && d[1] == 0.0f && d[2] == 0.0f)
         return false;
+    float omax = fmaxf(fabsf(o[0]), fmaxf(fabsf(o[1]), fabsf(o[2])));
     r->mp = (tree->scale + omax) * 0x1p-18f;
+    r->any_par = false;
     float tn = ray->tmin, tf = ray->tmax;
     const float *lo = &tree->bounds.lo.x, *hi = &tree->bounds.hi.x;
     for (int k = 0; k < 3; k++) {
-        r->inv[k] = 1.0f / r->d[k];
-        if (!(fabsf(r->inv[k]) < INFINITY)) {
-            if (r->o[k] < lo[k] - r->mp || r->o[k] > hi[k] + r->mp)
+        float inv = 1.0f / d[k], ma = r->mp * fabsf(inv);
+        r->o[k] = o[k];
+        if (!(ma < INFINITY)) {
+            if (o[k] < lo[k] - r->mp || o[k] > hi[k] + r->mp)
                 return false;
+            r->inv[k] = 0.0f, r->ma[k] = 0.0f, r->neg[k] = 0, r->par[k] = -1;
+            r->any_par = true;
             continue;
         }
-        float ma = r->ma[k] = r->mp * fabsf(r->inv[k]);
-        float t0 = (lo[k] - r->o[k]) * r->inv[k], t1 = (hi[k] - r->o[k]) * r->inv[k];
+        r->inv[k] = inv, r->ma[k] = ma, r->neg[k] = inv > 0.0f ? 0 : -1, r->par[k] = 0;
+        float t0 = (lo[k] - o[k]) * inv, t1 = (hi[k] - o[k]) * inv;
         if (t0 > t1) {
             float t = t0; t0 = t1; t1 = t;
         }
@@ -1206,6 +1351,8 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
         if (t1 < tf)
             tf = t1;
     }
+    for (int k = 3; k < 8; k++)
+        r->o[k] = r->o[0], r->inv[k] = r->inv[0], r->ma[k] = r->ma[0], r->neg[k] = r->neg[0], r->par[k] = r->par[0];
     if (!(tn <= tf))
         return false;
     r->tn = tn;
@@ -1255,7 +1402,7 @@ KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, 
     return true;
 }
 
-#if defined(__AVX2__) && defined(__GNUC__)
+#if defined(__AVX2__) && defined(__GNUC__) && !defined(RT_KD_SCALAR) /* RT_KD_SCALAR: the portable code, for tests */
 #include <immintrin.h>
 #define KD_SIMD 1
 #define KD_SIMD_MIN 3 /* leaves with at least this many triangles go 8 at a time */
@@ -1381,99 +1528,366 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, c
     return found;
 }
 
-typedef struct kd_entry {
-    uint32_t node;
-    float tn, tf;
-} kd_entry;
+/* ------------------------------------------------------ the wide step */
 
-/* The shared traversal; any = stop at the first hit (occlusion). */
-KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, bool any, bool par, const kd_ray *rp)
+/* Lane L of the step holds the cell that comes (7 - L)-th front to back:
+ * key k = 7 - L, whose bits k2 k1 k0 say "far side" at levels 0, 1, 2. The
+ * far side of a plane is the above one unless the ray runs towards -axis
+ * (neg). Cell c = 4 b0 + 2 b1 + b2 with b = k ^ neg at each level, planes
+ * 0, 1 + b0, 3 + 2 b0 + b1. The cell's t interval is [tn, tf] cut by
+ * [lo, inf) for each plane it lies beyond and (-inf, hi] for each it lies
+ * before, lo/hi = t(plane) -/+ ma: the binary traversal's intervals, so the
+ * same leaves in the same order. Valid cells (non-empty interval, non-empty
+ * child) are written farthest first, so the nearest ends on top of the
+ * stack. Returns how many. */
+#define KD_WSTACK 192 /* 7 net pushes per wide level, KD_MAX_DEPTH / 3 levels, + 8 for the full-width store */
+_Static_assert(7 * ((KD_MAX_DEPTH + 2) / 3) + 8 <= KD_WSTACK, "wide traversal stack");
+
+KD_INLINE int wide_step_scalar(const rt_kdtree_wide *w, const kd_ray *r, bool par, float tn, float tf, uint32_t *sref,
+                               float *slo, float *shi, unsigned *near_cell, float *near_tn, float *near_tf)
 {
-    const kd_ray r = *rp;
-    const rt_kdtree_node *nodes = tree->nodes;
+    float lo[7], hi[7];
+    int neg[7];
+    for (int p = 0; p < 7; p++) {
+        unsigned k = (w->axes >> (2 * p)) & 3u;
+        if (par && r->par[k]) {
+            float dist = r->o[k] - w->split[p];
+            lo[p] = dist >= -r->mp ? -INFINITY : INFINITY;
+            hi[p] = dist <= r->mp ? INFINITY : -INFINITY;
+            neg[p] = 0;
+        } else {
+            float t = (w->split[p] - r->o[k]) * r->inv[k];
+            lo[p] = t - r->ma[k];
+            hi[p] = t + r->ma[k];
+            neg[p] = r->neg[k];
+        }
+    }
+    int n = -1;
+    for (unsigned key = 0; key < 8; key++) { /* front to back */
+        unsigned f0 = key >> 2 & 1u, f1 = key >> 1 & 1u, f2 = key & 1u;
+        unsigned b0 = f0 ^ (unsigned)(neg[0] & 1), p1 = 1 + b0, b1 = f1 ^ (unsigned)(neg[p1] & 1),
+                 p2 = 3 + 2 * b0 + b1, b2 = f2 ^ (unsigned)(neg[p2] & 1);
+        float l = tn, h = tf;
+        if (f0) l = lo[0] > l ? lo[0] : l; else h = hi[0] < h ? hi[0] : h;
+        if (f1) l = lo[p1] > l ? lo[p1] : l; else h = hi[p1] < h ? hi[p1] : h;
+        if (f2) l = lo[p2] > l ? lo[p2] : l; else h = hi[p2] < h ? hi[p2] : h;
+        unsigned cell = 4 * b0 + 2 * b1 + b2;
+        uint32_t ref = w->child[cell];
+        if (ref == RT_KD_EMPTY || !(l <= h))
+            continue;
+        if (n < 0) {
+            *near_cell = cell, *near_tn = l, *near_tf = h;
+            n = 0;
+        } else {
+            sref[n] = ref, slo[n] = l, shi[n] = h;
+            n++;
+        }
+    }
+    for (int i = 0, j = n - 1; i < j; i++, j--) { /* farthest first */
+        uint32_t tr = sref[i]; sref[i] = sref[j]; sref[j] = tr;
+        float tl = slo[i]; slo[i] = slo[j]; slo[j] = tl;
+        float th = shi[i]; shi[i] = shi[j]; shi[j] = th;
+    }
+    return n;
+}
+
+#ifdef KD_SIMD
+/* Byte i of entry m: the lane of the i-th set bit of m (compaction by a
+ * permute, as AVX2 has no compress instruction). */
+static const uint64_t kd_compress[256] = {
+    0x0000000000000000ull, 0x0000000000000000ull, 0x0000000000000001ull, 0x0000000000000100ull,
+    0x0000000000000002ull, 0x0000000000000200ull, 0x0000000000000201ull, 0x0000000000020100ull,
+    0x0000000000000003ull, 0x0000000000000300ull, 0x0000000000000301ull, 0x0000000000030100ull,
+    0x0000000000000302ull, 0x0000000000030200ull, 0x0000000000030201ull, 0x0000000003020100ull,
+    0x0000000000000004ull, 0x0000000000000400ull, 0x0000000000000401ull, 0x0000000000040100ull,
+    0x0000000000000402ull, 0x0000000000040200ull, 0x0000000000040201ull, 0x0000000004020100ull,
+    0x0000000000000403ull, 0x0000000000040300ull, 0x0000000000040301ull, 0x0000000004030100ull,
+    0x0000000000040302ull, 0x0000000004030200ull, 0x0000000004030201ull, 0x0000000403020100ull,
+    0x0000000000000005ull, 0x0000000000000500ull, 0x0000000000000501ull, 0x0000000000050100ull,
+    0x0000000000000502ull, 0x0000000000050200ull, 0x0000000000050201ull, 0x0000000005020100ull,
+    0x0000000000000503ull, 0x0000000000050300ull, 0x0000000000050301ull, 0x0000000005030100ull,
+    0x0000000000050302ull, 0x0000000005030200ull, 0x0000000005030201ull, 0x0000000503020100ull,
+    0x0000000000000504ull, 0x0000000000050400ull, 0x0000000000050401ull, 0x0000000005040100ull,
+    0x0000000000050402ull, 0x0000000005040200ull, 0x0000000005040201ull, 0x0000000504020100ull,
+    0x0000000000050403ull, 0x0000000005040300ull, 0x0000000005040301ull, 0x0000000504030100ull,
+    0x0000000005040302ull, 0x0000000504030200ull, 0x0000000504030201ull, 0x0000050403020100ull,
+    0x0000000000000006ull, 0x0000000000000600ull, 0x0000000000000601ull, 0x0000000000060100ull,
+    0x0000000000000602ull, 0x0000000000060200ull, 0x0000000000060201ull, 0x0000000006020100ull,
+    0x0000000000000603ull, 0x0000000000060300ull, 0x0000000000060301ull, 0x0000000006030100ull,
+    0x0000000000060302ull, 0x0000000006030200ull, 0x0000000006030201ull, 0x0000000603020100ull,
+    0x0000000000000604ull, 0x0000000000060400ull, 0x0000000000060401ull, 0x0000000006040100ull,
+    0x0000000000060402ull, 0x0000000006040200ull, 0x0000000006040201ull, 0x0000000604020100ull,
+    0x0000000000060403ull, 0x0000000006040300ull, 0x0000000006040301ull, 0x0000000604030100ull,
+    0x0000000006040302ull, 0x0000000604030200ull, 0x0000000604030201ull, 0x0000060403020100ull,
+    0x0000000000000605ull, 0x0000000000060500ull, 0x0000000000060501ull, 0x0000000006050100ull,
+    0x0000000000060502ull, 0x0000000006050200ull, 0x0000000006050201ull, 0x0000000605020100ull,
+    0x0000000000060503ull, 0x0000000006050300ull, 0x0000000006050301ull, 0x0000000605030100ull,
+    0x0000000006050302ull, 0x0000000605030200ull, 0x0000000605030201ull, 0x0000060503020100ull,
+    0x0000000000060504ull, 0x0000000006050400ull, 0x0000000006050401ull, 0x0000000605040100ull,
+    0x0000000006050402ull, 0x0000000605040200ull, 0x0000000605040201ull, 0x0000060504020100ull,
+    0x0000000006050403ull, 0x0000000605040300ull, 0x0000000605040301ull, 0x0000060504030100ull,
+    0x0000000605040302ull, 0x0000060504030200ull, 0x0000060504030201ull, 0x0006050403020100ull,
+    0x0000000000000007ull, 0x0000000000000700ull, 0x0000000000000701ull, 0x0000000000070100ull,
+    0x0000000000000702ull, 0x0000000000070200ull, 0x0000000000070201ull, 0x0000000007020100ull,
+    0x0000000000000703ull, 0x0000000000070300ull, 0x0000000000070301ull, 0x0000000007030100ull,
+    0x0000000000070302ull, 0x0000000007030200ull, 0x0000000007030201ull, 0x0000000703020100ull,
+    0x0000000000000704ull, 0x0000000000070400ull, 0x0000000000070401ull, 0x0000000007040100ull,
+    0x0000000000070402ull, 0x0000000007040200ull, 0x0000000007040201ull, 0x0000000704020100ull,
+    0x0000000000070403ull, 0x0000000007040300ull, 0x0000000007040301ull, 0x0000000704030100ull,
+    0x0000000007040302ull, 0x0000000704030200ull, 0x0000000704030201ull, 0x0000070403020100ull,
+    0x0000000000000705ull, 0x0000000000070500ull, 0x0000000000070501ull, 0x0000000007050100ull,
+    0x0000000000070502ull, 0x0000000007050200ull, 0x0000000007050201ull, 0x0000000705020100ull,
+    0x0000000000070503ull, 0x0000000007050300ull, 0x0000000007050301ull, 0x0000000705030100ull,
+    0x0000000007050302ull, 0x0000000705030200ull, 0x0000000705030201ull, 0x0000070503020100ull,
+    0x0000000000070504ull, 0x0000000007050400ull, 0x0000000007050401ull, 0x0000000705040100ull,
+    0x0000000007050402ull, 0x0000000705040200ull, 0x0000000705040201ull, 0x0000070504020100ull,
+    0x0000000007050403ull, 0x0000000705040300ull, 0x0000000705040301ull, 0x0000070504030100ull,
+    0x0000000705040302ull, 0x0000070504030200ull, 0x0000070504030201ull, 0x0007050403020100ull,
+    0x0000000000000706ull, 0x0000000000070600ull, 0x0000000000070601ull, 0x0000000007060100ull,
+    0x0000000000070602ull, 0x0000000007060200ull, 0x0000000007060201ull, 0x0000000706020100ull,
+    0x0000000000070603ull, 0x0000000007060300ull, 0x0000000007060301ull, 0x0000000706030100ull,
+    0x0000000007060302ull, 0x0000000706030200ull, 0x0000000706030201ull, 0x0000070603020100ull,
+    0x0000000000070604ull, 0x0000000007060400ull, 0x0000000007060401ull, 0x0000000706040100ull,
+    0x0000000007060402ull, 0x0000000706040200ull, 0x0000000706040201ull, 0x0000070604020100ull,
+    0x0000000007060403ull, 0x0000000706040300ull, 0x0000000706040301ull, 0x0000070604030100ull,
+    0x0000000706040302ull, 0x0000070604030200ull, 0x0000070604030201ull, 0x0007060403020100ull,
+    0x0000000000070605ull, 0x0000000007060500ull, 0x0000000007060501ull, 0x0000000706050100ull,
+    0x0000000007060502ull, 0x0000000706050200ull, 0x0000000706050201ull, 0x0000070605020100ull,
+    0x0000000007060503ull, 0x0000000706050300ull, 0x0000000706050301ull, 0x0000070605030100ull,
+    0x0000000706050302ull, 0x0000070605030200ull, 0x0000070605030201ull, 0x0007060503020100ull,
+    0x0000000007060504ull, 0x0000000706050400ull, 0x0000000706050401ull, 0x0000070605040100ull,
+    0x0000000706050402ull, 0x0000070605040200ull, 0x0000070605040201ull, 0x0007060504020100ull,
+    0x0000000706050403ull, 0x0000070605040300ull, 0x0000070605040301ull, 0x0007060504030100ull,
+    0x0000070605040302ull, 0x0007060504030200ull, 0x0007060504030201ull, 0x0706050403020100ull,
+};
+
+/* The front-to-back order of a node's cells depends only on which of its 7
+ * planes the ray crosses towards -axis (7 bits nb): byte L of
+ * kd_cell_of_key[nb] is the cell with key 7 - L, byte c of
+ * kd_key_of_cell[nb] the key of cell c (keys as in wide_step_scalar). */
+static const uint64_t kd_cell_of_key[128] = {
+    0x0001020304050607ull, 0x0405060700010203ull, 0x0203000104050607ull, 0x0405060702030001ull,
+    0x0001020306070405ull, 0x0607040500010203ull, 0x0203000106070405ull, 0x0607040502030001ull,
+    0x0100020304050607ull, 0x0405060701000203ull, 0x0203010004050607ull, 0x0405060702030100ull,
+    0x0100020306070405ull, 0x0607040501000203ull, 0x0203010006070405ull, 0x0607040502030100ull,
+    0x0001030204050607ull, 0x0405060700010302ull, 0x0302000104050607ull, 0x0405060703020001ull,
+    0x0001030206070405ull, 0x0607040500010302ull, 0x0302000106070405ull, 0x0607040503020001ull,
+    0x0100030204050607ull, 0x0405060701000302ull, 0x0302010004050607ull, 0x0405060703020100ull,
+    0x0100030206070405ull, 0x0607040501000302ull, 0x0302010006070405ull, 0x0607040503020100ull,
+    0x0001020305040607ull, 0x0504060700010203ull, 0x0203000105040607ull, 0x0504060702030001ull,
+    0x0001020306070504ull, 0x0607050400010203ull, 0x0203000106070504ull, 0x0607050402030001ull,
+    0x0100020305040607ull, 0x0504060701000203ull, 0x0203010005040607ull, 0x0504060702030100ull,
+    0x0100020306070504ull, 0x0607050401000203ull, 0x0203010006070504ull, 0x0607050402030100ull,
+    0x0001030205040607ull, 0x0504060700010302ull, 0x0302000105040607ull, 0x0504060703020001ull,
+    0x0001030206070504ull, 0x0607050400010302ull, 0x0302000106070504ull, 0x0607050403020001ull,
+    0x0100030205040607ull, 0x0504060701000302ull, 0x0302010005040607ull, 0x0504060703020100ull,
+    0x0100030206070504ull, 0x0607050401000302ull, 0x0302010006070504ull, 0x0607050403020100ull,
+    0x0001020304050706ull, 0x0405070600010203ull, 0x0203000104050706ull, 0x0405070602030001ull,
+    0x0001020307060405ull, 0x0706040500010203ull, 0x0203000107060405ull, 0x0706040502030001ull,
+    0x0100020304050706ull, 0x0405070601000203ull, 0x0203010004050706ull, 0x0405070602030100ull,
+    0x0100020307060405ull, 0x0706040501000203ull, 0x0203010007060405ull, 0x0706040502030100ull,
+    0x0001030204050706ull, 0x0405070600010302ull, 0x0302000104050706ull, 0x0405070603020001ull,
+    0x0001030207060405ull, 0x0706040500010302ull, 0x0302000107060405ull, 0x0706040503020001ull,
+    0x0100030204050706ull, 0x0405070601000302ull, 0x0302010004050706ull, 0x0405070603020100ull,
+    0x0100030207060405ull, 0x0706040501000302ull, 0x0302010007060405ull, 0x0706040503020100ull,
+    0x0001020305040706ull, 0x0504070600010203ull, 0x0203000105040706ull, 0x0504070602030001ull,
+    0x0001020307060504ull, 0x0706050400010203ull, 0x0203000107060504ull, 0x0706050402030001ull,
+    0x0100020305040706ull, 0x0504070601000203ull, 0x0203010005040706ull, 0x0504070602030100ull,
+    0x0100020307060504ull, 0x0706050401000203ull, 0x0203010007060504ull, 0x0706050402030100ull,
+    0x0001030205040706ull, 0x0504070600010302ull, 0x0302000105040706ull, 0x0504070603020001ull,
+    0x0001030207060504ull, 0x0706050400010302ull, 0x0302000107060504ull, 0x0706050403020001ull,
+    0x0100030205040706ull, 0x0504070601000302ull, 0x0302010005040706ull, 0x0504070603020100ull,
+    0x0100030207060504ull, 0x0706050401000302ull, 0x0302010007060504ull, 0x0706050403020100ull,
+};
+static const uint64_t kd_key_of_cell[128] = {
+    0x0706050403020100ull, 0x0302010007060504ull, 0x0706050401000302ull, 0x0302010005040706ull,
+    0x0504070603020100ull, 0x0100030207060504ull, 0x0504070601000302ull, 0x0100030205040706ull,
+    0x0706050403020001ull, 0x0302010007060405ull, 0x0706050401000203ull, 0x0302010005040607ull,
+    0x0504070603020001ull, 0x0100030207060405ull, 0x0504070601000203ull, 0x0100030205040607ull,
+    0x0706050402030100ull, 0x0302010006070504ull, 0x0706050400010302ull, 0x0302010004050706ull,
+    0x0504070602030100ull, 0x0100030206070504ull, 0x0504070600010302ull, 0x0100030204050706ull,
+    0x0706050402030001ull, 0x0302010006070405ull, 0x0706050400010203ull, 0x0302010004050607ull,
+    0x0504070602030001ull, 0x0100030206070405ull, 0x0504070600010203ull, 0x0100030204050607ull,
+    0x0706040503020100ull, 0x0302000107060504ull, 0x0706040501000302ull, 0x0302000105040706ull,
+    0x0504060703020100ull, 0x0100020307060504ull, 0x0504060701000302ull, 0x0100020305040706ull,
+    0x0706040503020001ull, 0x0302000107060405ull, 0x0706040501000203ull, 0x0302000105040607ull,
+    0x0504060703020001ull, 0x0100020307060405ull, 0x0504060701000203ull, 0x0100020305040607ull,
+    0x0706040502030100ull, 0x0302000106070504ull, 0x0706040500010302ull, 0x0302000104050706ull,
+    0x0504060702030100ull, 0x0100020306070504ull, 0x0504060700010302ull, 0x0100020304050706ull,
+    0x0706040502030001ull, 0x0302000106070405ull, 0x0706040500010203ull, 0x0302000104050607ull,
+    0x0504060702030001ull, 0x0100020306070405ull, 0x0504060700010203ull, 0x0100020304050607ull,
+    0x0607050403020100ull, 0x0203010007060504ull, 0x0607050401000302ull, 0x0203010005040706ull,
+    0x0405070603020100ull, 0x0001030207060504ull, 0x0405070601000302ull, 0x0001030205040706ull,
+    0x0607050403020001ull, 0x0203010007060405ull, 0x0607050401000203ull, 0x0203010005040607ull,
+    0x0405070603020001ull, 0x0001030207060405ull, 0x0405070601000203ull, 0x0001030205040607ull,
+    0x0607050402030100ull, 0x0203010006070504ull, 0x0607050400010302ull, 0x0203010004050706ull,
+    0x0405070602030100ull, 0x0001030206070504ull, 0x0405070600010302ull, 0x0001030204050706ull,
+    0x0607050402030001ull, 0x0203010006070405ull, 0x0607050400010203ull, 0x0203010004050607ull,
+    0x0405070602030001ull, 0x0001030206070405ull, 0x0405070600010203ull, 0x0001030204050607ull,
+    0x0607040503020100ull, 0x0203000107060504ull, 0x0607040501000302ull, 0x0203000105040706ull,
+    0x0405060703020100ull, 0x0001020307060504ull, 0x0405060701000302ull, 0x0001020305040706ull,
+    0x0607040503020001ull, 0x0203000107060405ull, 0x0607040501000203ull, 0x0203000105040607ull,
+    0x0405060703020001ull, 0x0001020307060405ull, 0x0405060701000203ull, 0x0001020305040607ull,
+    0x0607040502030100ull, 0x0203000106070504ull, 0x0607040500010302ull, 0x0203000104050706ull,
+    0x0405060702030100ull, 0x0001020306070504ull, 0x0405060700010302ull, 0x0001020304050706ull,
+    0x0607040502030001ull, 0x0203000106070405ull, 0x0607040500010203ull, 0x0203000104050607ull,
+    0x0405060702030001ull, 0x0001020306070405ull, 0x0405060700010203ull, 0x0001020304050607ull,
+};
+
+/* The same as wide_step_scalar, eight cells at once. Lanes are cells here
+ * (lane c = cell c, whose planes 0, 1 + c/4 and 3 + c/2 are the same for
+ * every node), so the caller can read the nearest cell's interval from a
+ * fixed lane once it has branched on the cell: only that branch waits for
+ * the choice of the nearest cell, the data does not. The pushes go in key
+ * order (see wide_step_scalar) through the key -> cell permutation. */
+typedef struct kd_step {
+    __m256 l, h;   /* per cell: its t interval */
+    unsigned cell; /* the nearest valid cell */
+} kd_step;
+
+KD_INLINE int wide_step_avx2(const rt_kdtree_wide *w, const kd_ray *r, bool par, float tn, float tf, uint32_t *sref,
+                             float *slo, float *shi, kd_step *out)
+{
+    const __m256i three = _mm256_set1_epi32(3), zero = _mm256_setzero_si256();
+    const __m256 ninf = _mm256_set1_ps(-INFINITY), pinf = _mm256_set1_ps(INFINITY);
+    __m256 split = _mm256_load_ps((const float *)(const void *)w); /* lane 7: the axes, unused */
+    __m256i axis = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32((int)w->axes),
+                                                      _mm256_setr_epi32(0, 2, 4, 6, 8, 10, 12, 0)),
+                                    three);
+    __m256 o = _mm256_permutevar8x32_ps(_mm256_load_ps(r->o), axis);
+    __m256 inv = _mm256_permutevar8x32_ps(_mm256_load_ps(r->inv), axis);
+    __m256 ma = _mm256_permutevar8x32_ps(_mm256_load_ps(r->ma), axis);
+    __m256i neg = _mm256_permutevar8x32_epi32(_mm256_load_si256((const __m256i *)(const void *)r->neg), axis);
+    __m256 t = _mm256_mul_ps(_mm256_sub_ps(split, o), inv);
+    __m256 lo = _mm256_sub_ps(t, ma), hi = _mm256_add_ps(t, ma);
+    if (par) {
+        __m256 pm = _mm256_castsi256_ps(
+            _mm256_permutevar8x32_epi32(_mm256_load_si256((const __m256i *)(const void *)r->par), axis));
+        __m256 dist = _mm256_sub_ps(o, split), mp = _mm256_set1_ps(r->mp);
+        __m256 plo = _mm256_blendv_ps(pinf, ninf, _mm256_cmp_ps(dist, _mm256_sub_ps(_mm256_setzero_ps(), mp), _CMP_GE_OQ));
+        __m256 phi = _mm256_blendv_ps(ninf, pinf, _mm256_cmp_ps(dist, mp, _CMP_LE_OQ));
+        lo = _mm256_blendv_ps(lo, plo, pm);
+        hi = _mm256_blendv_ps(hi, phi, pm);
+        neg = _mm256_andnot_si256(_mm256_castps_si256(pm), neg);
+    }
+    /* cell order: the planes of cell c (0, 1 + c/4, 3 + c/2), and the key
+     * bits that say on which side of each the cell is for this ray */
+    const __m256i q1 = _mm256_setr_epi32(1, 1, 1, 1, 2, 2, 2, 2), q2 = _mm256_setr_epi32(3, 3, 4, 4, 5, 5, 6, 6);
+    unsigned nb = (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(neg)) & 0x7fu;
+    uint64_t order = kd_cell_of_key[nb];
+    __m256i key = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128((long long)kd_key_of_cell[nb]));
+    /* blendv reads the sign bit: key bit 2, 1, 0 = far side at level 0, 1, 2 */
+    __m256 m0 = _mm256_castsi256_ps(_mm256_slli_epi32(key, 29)), m1 = _mm256_castsi256_ps(_mm256_slli_epi32(key, 30)),
+           m2 = _mm256_castsi256_ps(_mm256_slli_epi32(key, 31));
+    __m256 x = _mm256_max_ps(_mm256_blendv_ps(ninf, _mm256_permutevar8x32_ps(lo, zero), m0),
+                             _mm256_max_ps(_mm256_blendv_ps(ninf, _mm256_permutevar8x32_ps(lo, q1), m1),
+                                           _mm256_blendv_ps(ninf, _mm256_permutevar8x32_ps(lo, q2), m2)));
+    __m256 y = _mm256_min_ps(_mm256_blendv_ps(_mm256_permutevar8x32_ps(hi, zero), pinf, m0),
+                             _mm256_min_ps(_mm256_blendv_ps(_mm256_permutevar8x32_ps(hi, q1), pinf, m1),
+                                           _mm256_blendv_ps(_mm256_permutevar8x32_ps(hi, q2), pinf, m2)));
+    __m256 l = _mm256_max_ps(x, _mm256_set1_ps(tn)), h = _mm256_min_ps(y, _mm256_set1_ps(tf));
+    __m256i ref = _mm256_load_si256((const __m256i *)(const void *)w->child);
+    __m256 ok = _mm256_andnot_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(ref, _mm256_set1_epi32(-1))),
+                                 _mm256_cmp_ps(l, h, _CMP_LE_OQ));
+    /* key order, farthest first: the nearest valid cell is the top bit */
+    __m256i cell = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128((long long)order));
+    unsigned mask = (unsigned)_mm256_movemask_ps(_mm256_permutevar8x32_ps(ok, cell));
+    if (!mask)
+        return -1;
+    unsigned lane = 31u - (unsigned)__builtin_clz(mask), rest = mask ^ (1u << lane);
+    out->l = l, out->h = h, out->cell = (unsigned)(order >> (8 * lane)) & 7u;
+    __m256i idx = _mm256_permutevar8x32_epi32(
+        cell, _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(const void *)&kd_compress[rest])));
+    _mm256_storeu_si256((__m256i *)(void *)sref, _mm256_permutevar8x32_epi32(ref, idx));
+    _mm256_storeu_ps(slo, _mm256_permutevar8x32_ps(l, idx));
+    _mm256_storeu_ps(shi, _mm256_permutevar8x32_ps(h, idx));
+    return __builtin_popcount(rest);
+}
+
+/* The nearest cell's child and interval: a branch per cell (see above). */
+#define KD_NEAR(c)                                                                 \
+    case c:                                                                        \
+        ref = w->child[c];                                                         \
+        tn = _mm_cvtss_f32(_mm_permute_ps(_mm256_extractf128_ps(st.l, (c) / 4), (c) % 4)); \
+        tf = _mm_cvtss_f32(_mm_permute_ps(_mm256_extractf128_ps(st.h, (c) / 4), (c) % 4)); \
+        break;
+#endif
+
+/* The shared traversal; any = stop at the first hit (occlusion). A stack
+ * entry is a child reference with its t interval; the nearest is on top. */
+KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, bool any, bool par, const kd_ray *r)
+{
+    const rt_kdtree_wide *wide = tree->wide;
     const uint32_t *ids = tree->prim_ids;
-    kd_entry stack[KD_STACK];
+    uint32_t sref[KD_WSTACK];
+    float slo[KD_WSTACK], shi[KD_WSTACK];
     int sp = 0;
-    uint32_t node = 0;
-    float tn = r.tn, tf = r.tf, best = ray->tmax;
+    uint32_t ref = tree->root;
+    float tn = r->tn, tf = r->tf, best = ray->tmax;
     bool found = false;
     for (;;) {
-        rt_kdtree_node nd = nodes[node];
-        uint32_t axis = nd.b & 3u;
-        if (axis != LEAF_TAG) {
-            float split;
-            memcpy(&split, &nd.a, 4);
-            uint32_t below = node + 1, above = nd.b >> 4;
-            bool be = nd.b & KD_BELOW_EMPTY, ae = nd.b & KD_ABOVE_EMPTY;
-            float o = r.o[axis], inv = r.inv[axis];
-            if (par && !(fabsf(inv) < INFINITY)) { /* parallel to the plane */
-                float dist = o - split;
-                bool wb = dist <= r.mp && !be, wa = dist >= -r.mp && !ae;
-                stack[sp].node = above, stack[sp].tn = tn, stack[sp].tf = tf;
-                sp += wb & wa;
-                if (!(wb | wa))
-                    goto pop;
-                node = wb ? below : above;
-                continue;
-            }
-            float ts = (split - o) * inv, ma = r.ma[axis];
-            bool pos = inv > 0.0f;
-            uint32_t first = pos ? below : above, second = below + above - first;
-            bool fe = pos ? be : ae, se = pos ? ae : be;
-            float lo = ts - ma, hi = ts + ma;
-            /* want a child when the ray crosses it and it is not an empty
-             * leaf; at most one push per level (depth <= KD_MAX_DEPTH < KD_STACK) */
-            bool wf = tn <= hi && !fe, ws = lo <= tf && !se;
-            if (wf) {
-                if (ws) {
-                    KD_PREFETCH(&nodes[second]);
-                    stack[sp].node = second, stack[sp].tn = lo > tn ? lo : tn, stack[sp].tf = tf;
-                    sp++;
-                }
-                tf = hi < tf ? hi : tf;
-                node = first;
-            } else if (ws) {
-                tn = lo > tn ? lo : tn;
-                node = second;
-            } else {
+        while (ref < RT_KD_LEAF) {
+            const rt_kdtree_wide *w = &wide[ref];
+#ifdef KD_SIMD
+            kd_step st;
+            int n = wide_step_avx2(w, r, par, tn, tf < best ? tf : best, sref + sp, slo + sp, shi + sp, &st);
+            if (n < 0)
                 goto pop;
+            sp += n;
+            /* a branch per cell rather than w->child[cell]: when the branch
+             * is predicted (coherent rays), the next node's address is
+             * known as soon as this node is loaded */
+            switch (st.cell) {
+                KD_NEAR(0) KD_NEAR(1) KD_NEAR(2) KD_NEAR(3) KD_NEAR(4) KD_NEAR(5) KD_NEAR(6)
+            default:
+                KD_NEAR(7)
             }
-            continue;
+#else
+            unsigned cell;
+            int n = wide_step_scalar(w, r, par, tn, tf < best ? tf : best, sref + sp, slo + sp, shi + sp, &cell, &tn,
+                                     &tf);
+            if (n < 0)
+                goto pop;
+            sp += n;
+            ref = w->child[cell];
+#endif
         }
-        uint32_t n = nd.b >> 2;
-        if (n == 1) {
-            if (test_prim(tree, nd.a, ray, &best, hit)) {
+        if (ref >= RT_KD_ONE) {
+            if (test_prim(tree, ref & RT_KD_PAYLOAD, ray, &best, hit)) {
                 found = true;
                 if (any)
                     return true;
             }
-        } else if (test_leaf(tree, ids + nd.a, n, ray, &best, hit, any)) {
-            found = true;
-            if (any)
-                return true;
+        } else {
+            const uint32_t *p = ids + (ref & RT_KD_PAYLOAD);
+            if (test_leaf(tree, p + 1, p[0], ray, &best, hit, any)) {
+                found = true;
+                if (any)
+                    return true;
+            }
         }
     pop:
-        for (;;) {
+        for (;;) { /* next cell that starts before the closest hit */
             if (sp == 0)
                 return found;
             sp--;
-            if (stack[sp].tn <= best)
+            if (slo[sp] <= best)
                 break;
         }
-        node = stack[sp].node;
-        tn = stack[sp].tn;
-        tf = stack[sp].tf;
+        ref = sref[sp];
+        tn = slo[sp];
+        tf = shi[sp];
     }
 }
 
 /* Two copies of the loop: rays parallel to some axis (rare: a zero direction
- * component) need a test at every node that the others skip. */
+ * component) need a case in every step that the others skip. */
 KD_INLINE bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, bool any)
 {
     kd_ray r;
     if (!ray_setup(tree, ray, &r))
         return false;
-    if (fabsf(r.inv[0]) < INFINITY && fabsf(r.inv[1]) < INFINITY && fabsf(r.inv[2]) < INFINITY)
+    if (!r.any_par)
         return traverse_ray(tree, ray, hit, any, false, &r);
     return traverse_ray(tree, ray, hit, any, true, &r);
 }

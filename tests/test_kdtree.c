@@ -158,48 +158,85 @@ static void check_ray(const rt_scene *s, const rt_kdtree *tree, const rt_ray *r,
 }
 
 /* Every primitive that can be hit appears in some leaf; stats add up. */
+/* Walks the wide nodes from the root: each is reached exactly once, its
+ * planes are real (axis 0-2, finite) or +inf padding, and every leaf list is
+ * in range and ascending. */
+typedef struct walk_state {
+    const rt_scene *s;
+    const rt_kdtree *tree;
+    uint8_t *seen, *node_seen;
+    size_t n, refs, maxleaf, leaves;
+} walk_state;
+
+static void walk_ref(walk_state *w, uint32_t ref)
+{
+    const rt_kdtree *tree = w->tree;
+    if (ref == RT_KD_EMPTY)
+        return;
+    if (ref < RT_KD_LEAF) {
+        assert_true(ref < tree->wide_count);
+        assert_false(w->node_seen[ref]);
+        w->node_seen[ref] = 1;
+        const rt_kdtree_wide *nd = &tree->wide[ref];
+        for (int p = 0; p < 7; p++) {
+            unsigned axis = (nd->axes >> (2 * p)) & 3u;
+            assert_true(axis < 3);
+            assert_true(isfinite(nd->split[p]) || (nd->split[p] == INFINITY && axis == 0));
+        }
+        assert_int_equal(nd->axes >> 14, 0);
+        for (int c = 0; c < 8; c++)
+            walk_ref(w, nd->child[c]);
+        return;
+    }
+    const uint32_t *ids;
+    size_t c;
+    uint32_t one = ref & RT_KD_PAYLOAD;
+    if (ref >= RT_KD_ONE) {
+        c = 1;
+        ids = &one;
+    } else {
+        assert_true(one < tree->prim_id_count);
+        c = tree->prim_ids[one];
+        ids = tree->prim_ids + one + 1;
+        assert_true(c > 1 && one + 1 + c <= tree->prim_id_count);
+    }
+    w->leaves++;
+    w->refs += c;
+    if (c > w->maxleaf)
+        w->maxleaf = c;
+    for (size_t j = 0; j < c; j++) {
+        assert_true(ids[j] < w->n);
+        if (j > 0) /* ascending: triangles first, as the leaf loop expects */
+            assert_true(ids[j - 1] < ids[j]);
+        /* triangles are numbered in leaf order; tri_id gives the scene's id */
+        size_t id = ids[j] < w->s->triangles.count ? tree->tri_id[ids[j]] : ids[j];
+        assert_true(id < w->n);
+        w->seen[id] = 1;
+    }
+}
+
 static void check_tree(const rt_scene *s, const rt_kdtree *tree)
 {
     const rt_kdtree_stats *st = &tree->stats;
     size_t n = rt_scene_prim_count(s);
     assert_true(st->nodes > 0);
-    assert_int_equal(st->nodes, tree->node_count);
     assert_true(st->leaves > 0 && st->leaves <= st->nodes);
     assert_int_equal(st->nodes, 2 * st->leaves - 1);
     assert_true(st->empty_leaves <= st->leaves);
     assert_true(st->depth <= tree->max_depth);
-    assert_true(st->bytes >= st->nodes * 8);
-    uint8_t *seen = calloc(n ? n : 1, 1);
-    assert_non_null(seen);
-    size_t refs = 0, maxleaf = 0, leaves = 0;
-    for (size_t i = 0; i < tree->node_count; i++) {
-        const rt_kdtree_node *nd = &tree->nodes[i];
-        if ((nd->b & 3u) != 3u) {
-            size_t above = nd->b >> 4;
-            assert_true(above > i + 1 && above < tree->node_count);
-            /* the empty-child flags say exactly which children are empty leaves */
-            assert_int_equal((nd->b >> 2) & 1u, tree->nodes[i + 1].b == 3u);
-            assert_int_equal((nd->b >> 3) & 1u, tree->nodes[above].b == 3u);
-            continue;
-        }
-        leaves++;
-        size_t c = nd->b >> 2;
-        refs += c;
-        if (c > maxleaf)
-            maxleaf = c;
-        const uint32_t *ids = c == 1 ? &nd->a : tree->prim_ids + nd->a;
-        if (c > 1)
-            assert_true(nd->a + c <= tree->prim_id_count);
-        for (size_t j = 0; j < c; j++) {
-            assert_true(ids[j] < n);
-            if (j > 0) /* ascending: triangles first, as the leaf loop expects */
-                assert_true(ids[j - 1] < ids[j]);
-            /* triangles are numbered in leaf order; tri_id gives the scene's id */
-            size_t id = ids[j] < s->triangles.count ? tree->tri_id[ids[j]] : ids[j];
-            assert_true(id < n);
-            seen[id] = 1;
-        }
-    }
+    assert_int_equal(st->wide_nodes, tree->wide_count);
+    assert_true(tree->wide_count <= st->nodes);
+    assert_true(st->bytes >= tree->wide_count * 64);
+    assert_int_equal((uintptr_t)tree->wide % 64, 0);
+    walk_state w = {s, tree, calloc(n ? n : 1, 1), calloc(tree->wide_count + 1, 1), n, 0, 0, 0};
+    assert_non_null(w.seen);
+    assert_non_null(w.node_seen);
+    walk_ref(&w, tree->root);
+    for (size_t i = 0; i < tree->wide_count; i++)
+        assert_true(w.node_seen[i]);
+    free(w.node_seen);
+    uint8_t *seen = w.seen;
+    size_t refs = w.refs, maxleaf = w.maxleaf, leaves = w.leaves + st->empty_leaves;
     assert_int_equal(leaves, st->leaves);
     assert_int_equal(refs, st->prim_refs);
     assert_int_equal(maxleaf, st->max_leaf_prims);
@@ -762,7 +799,8 @@ static void test_threads_safe_reads(void **state)
     build_ok(&a, &s);
     build_ok(&b, &s);
     assert_int_equal(a.stats.nodes, b.stats.nodes);
-    assert_memory_equal(a.nodes, b.nodes, a.node_count * sizeof *a.nodes);
+    assert_int_equal(a.wide_count, b.wide_count);
+    assert_memory_equal(a.wide, b.wide, a.wide_count * sizeof *a.wide);
     rt_kdtree_free(&a);
     check_stats cs = {0, 0, 0};
     check_random_rays(&s, &b, 22, 500, -0.2f, 1.2f, &cs);
@@ -786,9 +824,11 @@ static void test_parallel_build_identical(void **state)
     assert_int_equal(rt_kdtree_build(&a, &s, &p1, &err), RT_OK);
     assert_int_equal(rt_kdtree_build(&b, &s, &p3, &err), RT_OK);
     check_tree(&s, &b);
-    assert_int_equal(a.node_count, b.node_count);
+    assert_int_equal(a.stats.nodes, b.stats.nodes);
+    assert_int_equal(a.wide_count, b.wide_count);
+    assert_int_equal(a.root, b.root);
     assert_int_equal(a.prim_id_count, b.prim_id_count);
-    assert_memory_equal(a.nodes, b.nodes, a.node_count * sizeof *a.nodes);
+    assert_memory_equal(a.wide, b.wide, a.wide_count * sizeof *a.wide);
     assert_memory_equal(a.prim_ids, b.prim_ids, a.prim_id_count * sizeof *a.prim_ids);
     assert_int_equal(a.stats.leaves, b.stats.leaves);
     assert_int_equal(a.stats.empty_leaves, b.stats.empty_leaves);

@@ -12,13 +12,17 @@
  *   bool blocked = rt_kdtree_occluded(&tree, &shadow_ray);
  *   rt_kdtree_free(&tree);
  *
- * Layout: nodes of 8 bytes in one array (the below child is the next node),
- * leaf primitive numbers in a second array (a one-primitive leaf stores its
- * number in the node), triangles copied into one buffer of 9 floats each
- * (v0, e1, e2) in the order the leaves first use them, so a leaf's triangles
- * are mostly adjacent; tri_id maps these tree triangle numbers back to the
- * scene's ids (hits report scene ids). Build and traversal are described,
- * with their sources, at the top of kdtree.c.
+ * Layout: the build makes 8-byte nodes in one array (the below child is the
+ * next node, see rt_kdtree_node) and leaf primitive lists in a second
+ * array; for tracing, every three levels of that binary tree are then packed
+ * into one 64-byte, cache-line-aligned rt_kdtree_wide (7 split planes, 8
+ * cells), so a ray resolves three levels with one memory access and one
+ * SIMD step instead of three dependent branches. The planes and cells are
+ * exactly the binary tree's. Triangles are copied into one buffer of 9
+ * floats each (v0, e1, e2) in the order the leaves first use them, so a
+ * leaf's triangles are mostly adjacent; tri_id maps these tree triangle
+ * numbers back to the scene's ids (hits report scene ids). Build and
+ * traversal are described, with their sources, at the top of kdtree.c.
  *
  * Results are exactly those of testing every primitive with the functions
  * of intersect.h (same t bits; either id when two primitives tie). Rays with
@@ -50,7 +54,8 @@ typedef struct rt_kdtree_params {
 } rt_kdtree_params;
 
 typedef struct rt_kdtree_stats {
-    size_t nodes, leaves, empty_leaves;
+    size_t nodes, leaves, empty_leaves; /* of the binary tree */
+    size_t wide_nodes;    /* 64-byte nodes of 3 levels each, which the traversal reads */
     size_t prim_refs;     /* primitive ids stored in leaves (with duplicates) */
     size_t max_leaf_prims;
     int depth;
@@ -58,6 +63,7 @@ typedef struct rt_kdtree_stats {
     size_t bytes;         /* nodes + leaf ids + triangle buffers */
 } rt_kdtree_stats;
 
+/* The build's binary node. */
 typedef struct rt_kdtree_node {
     uint32_t a; /* interior: split position (float bits); leaf: first index into prim_ids (or the single prim) */
     uint32_t b; /* low 2 bits: axis 0..2, or 3 = leaf. Leaf: b >> 2 = prim count (0 = empty leaf).
@@ -65,10 +71,28 @@ typedef struct rt_kdtree_node {
                  * b >> 4 = above-child index (the below child is the next node). */
 } rt_kdtree_node;
 
+/* Three levels of the binary tree: planes in breadth-first order (0 the top
+ * node, 1 and 2 its below and above children, 3-6 theirs: plane p's children
+ * are 2p+1 and 2p+2), cells c = 4 b0 + 2 b1 + b2 with b = 0 for the below
+ * side at each level. A plane that does not exist (a leaf above level 3)
+ * is +inf on x, which keeps the whole cell below it. A child reference is
+ * another wide node (< RT_KD_LEAF), RT_KD_EMPTY, RT_KD_ONE | primitive, or
+ * RT_KD_LEAF | offset into prim_ids, where the count precedes the list. */
+typedef struct rt_kdtree_wide {
+    float split[7];
+    uint32_t axes;      /* axis of plane p in bits 2p, 2p+1 */
+    uint32_t child[8];
+} rt_kdtree_wide;
+#define RT_KD_EMPTY 0xffffffffu
+#define RT_KD_LEAF 0x80000000u
+#define RT_KD_ONE 0xc0000000u
+#define RT_KD_PAYLOAD 0x3fffffffu
+
 typedef struct rt_kdtree {
-    rt_kdtree_node *nodes;
-    size_t node_count;
-    uint32_t *prim_ids;   /* leaf lists: tree triangle numbers, then scene ids of spheres and quads */
+    rt_kdtree_wide *wide; /* 64-byte aligned */
+    size_t wide_count;
+    uint32_t root;        /* a child reference: the whole tree */
+    uint32_t *prim_ids;   /* leaf lists (count, then tree triangle numbers, then scene ids of spheres and quads) */
     size_t prim_id_count;
     /* triangles in leaf order (tree triangle numbers): v0.xyz, e1.xyz, e2.xyz (9 floats) */
     float *tri;
