@@ -926,6 +926,7 @@ typedef struct kd_widen {
 } kd_widen;
 
 #define KD_NO_NODE UINT32_MAX
+#define KD_IDS_PAD 8
 
 static uint32_t widen_leaf(kd_widen *x, const rt_kdtree_node *nd)
 {
@@ -939,9 +940,9 @@ static uint32_t widen_leaf(kd_widen *x, const rt_kdtree_node *nd)
         return RT_KD_EMPTY;
     }
     uint32_t off = (uint32_t)x->in;
-    x->ids[x->in++] = n;
     memcpy(x->ids + x->in, x->bids + nd->a, n * sizeof *x->ids);
     x->in += n;
+    x->ids[x->in - 1] |= RT_KD_LAST;
     return RT_KD_LEAF | off;
 }
 
@@ -1028,18 +1029,17 @@ static void *alloc_line(size_t size)
 
 static bool widen(rt_kdtree *tree, kd_build *c)
 {
-    size_t leaves = 0;
-    for (size_t i = 0; i < c->node_count; i++)
-        leaves += is_leaf(c->nodes, (uint32_t)i) && (c->nodes[i].b >> 2) > 1;
     kd_widen x;
     memset(&x, 0, sizeof x);
     x.bn = c->nodes;
     x.bids = c->ids;
-    size_t nids = c->id_count + leaves;
-    x.ids = alloc_hot((nids ? nids : 1) * sizeof *x.ids);
+    /* + KD_IDS_PAD: a leaf's length is found by loading 8 ids at a time */
+    x.ids = alloc_hot((c->id_count + KD_IDS_PAD) * sizeof *x.ids);
     if (!x.ids)
         return false;
     tree->root = c->node_count ? widen_rec(&x, 0) : RT_KD_EMPTY;
+    for (size_t i = 0; i < KD_IDS_PAD; i++)
+        x.ids[x.in + i] = RT_KD_LAST;
     rt_kdtree_wide *w = NULL;
     if (!x.oom && !x.limit && (w = alloc_line((x.wn ? x.wn : 1) * sizeof *w)) != NULL && x.wn)
         memcpy(w, x.w, x.wn * sizeof *w);
@@ -1418,7 +1418,8 @@ KD_INLINE bool tri8(const float *tri, const uint32_t *ids, uint32_t n, const rt_
     __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)n), lane);
     __m256i id = _mm256_maskload_epi32((const int *)ids, live);
-    id = _mm256_blendv_epi8(_mm256_set1_epi32((int)ids[0]), id, live);
+    id = _mm256_and_si256(_mm256_blendv_epi8(_mm256_set1_epi32((int)ids[0]), id, live),
+                          _mm256_set1_epi32((int)RT_KD_PAYLOAD)); /* the last id carries RT_KD_LAST */
     __m256i base = _mm256_mullo_epi32(id, _mm256_set1_epi32(9));
     /* floats 0-7 of each triangle: one unaligned load per lane and an 8x8
      * transpose (cheaper than eight gathers); float 8 by one gather */
@@ -1491,10 +1492,28 @@ KD_INLINE bool tri8(const float *tri, const uint32_t *ids, uint32_t n, const rt_
     hit->t = tl[k];
     hit->u = ul[k];
     hit->v = vl[k];
-    hit->prim = ids[k];
+    hit->prim = ids[k] & RT_KD_PAYLOAD;
     return true;
 }
 #endif
+
+/* The length of a leaf list: up to its id with RT_KD_LAST (the lists are
+ * followed by KD_IDS_PAD such ids, so 8 can always be loaded). */
+KD_INLINE uint32_t leaf_length(const uint32_t *p)
+{
+    uint32_t n = 0;
+#ifdef KD_SIMD
+    for (;; n += 8) {
+        unsigned m = (unsigned)_mm256_movemask_ps(_mm256_loadu_ps((const float *)(const void *)(p + n)));
+        if (m)
+            return n + (uint32_t)__builtin_ctz(m) + 1;
+    }
+#else
+    while (!(p[n] & RT_KD_LAST))
+        n++;
+    return n + 1;
+#endif
+}
 
 /* All primitives of a multi-primitive leaf (ids ascending: triangles first). */
 KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, const rt_ray *ray, float *best,
@@ -1505,9 +1524,9 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, c
 #ifdef KD_SIMD
     if (n >= KD_SIMD_MIN && tree->simd_ok) {
         uint32_t T = (uint32_t)tree->triangle_count;
-        while (i < n && p[i] < T) {
+        while (i < n && (p[i] & RT_KD_PAYLOAD) < T) {
             uint32_t m = n - i < 8 ? n - i : 8;
-            while (p[i + m - 1] >= T)
+            while ((p[i + m - 1] & RT_KD_PAYLOAD) >= T)
                 m--;
             if (tri8(tree->tri, p + i, m, ray, best, hit)) {
                 KD_PREFETCH(&tree->tri_id[hit->prim]); /* wanted at the end of the traversal */
@@ -1520,7 +1539,7 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, c
     }
 #endif
     for (; i < n; i++)
-        if (test_prim(tree, p[i], ray, best, hit)) {
+        if (test_prim(tree, p[i] & RT_KD_PAYLOAD, ray, best, hit)) {
             found = true;
             if (any)
                 return true;
@@ -1860,7 +1879,7 @@ KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hi
             }
         } else {
             const uint32_t *p = ids + (ref & RT_KD_PAYLOAD);
-            if (test_leaf(tree, p + 1, p[0], ray, &best, hit, any)) {
+            if (test_leaf(tree, p, leaf_length(p), ray, &best, hit, any)) {
                 found = true;
                 if (any)
                     return true;

@@ -166,6 +166,7 @@ typedef struct walk_state {
     const rt_kdtree *tree;
     uint8_t *seen, *node_seen;
     size_t n, refs, maxleaf, leaves;
+    uint32_t *leaf_ids;
 } walk_state;
 
 static void walk_ref(walk_state *w, uint32_t ref)
@@ -196,9 +197,15 @@ static void walk_ref(walk_state *w, uint32_t ref)
         ids = &one;
     } else {
         assert_true(one < tree->prim_id_count);
-        c = tree->prim_ids[one];
-        ids = tree->prim_ids + one + 1;
-        assert_true(c > 1 && one + 1 + c <= tree->prim_id_count);
+        c = 1;
+        while (!(tree->prim_ids[one + c - 1] & RT_KD_LAST))
+            c++;
+        assert_true(c > 1 && one + c <= tree->prim_id_count);
+        w->leaf_ids = realloc(w->leaf_ids, c * sizeof *w->leaf_ids);
+        assert_non_null(w->leaf_ids);
+        for (size_t j = 0; j < c; j++)
+            w->leaf_ids[j] = tree->prim_ids[one + j] & RT_KD_PAYLOAD;
+        ids = w->leaf_ids;
     }
     w->leaves++;
     w->refs += c;
@@ -228,13 +235,14 @@ static void check_tree(const rt_scene *s, const rt_kdtree *tree)
     assert_true(tree->wide_count <= st->nodes);
     assert_true(st->bytes >= tree->wide_count * 64);
     assert_int_equal((uintptr_t)tree->wide % 64, 0);
-    walk_state w = {s, tree, calloc(n ? n : 1, 1), calloc(tree->wide_count + 1, 1), n, 0, 0, 0};
+    walk_state w = {s, tree, calloc(n ? n : 1, 1), calloc(tree->wide_count + 1, 1), n, 0, 0, 0, NULL};
     assert_non_null(w.seen);
     assert_non_null(w.node_seen);
     walk_ref(&w, tree->root);
     for (size_t i = 0; i < tree->wide_count; i++)
         assert_true(w.node_seen[i]);
     free(w.node_seen);
+    free(w.leaf_ids);
     uint8_t *seen = w.seen;
     size_t refs = w.refs, maxleaf = w.maxleaf, leaves = w.leaves + st->empty_leaves;
     assert_int_equal(leaves, st->leaves);

@@ -77,7 +77,8 @@ typedef struct rt_kdtree_node {
  * side at each level. A plane that does not exist (a leaf above level 3)
  * is +inf on x, which keeps the whole cell below it. A child reference is
  * another wide node (< RT_KD_LEAF), RT_KD_EMPTY, RT_KD_ONE | primitive, or
- * RT_KD_LEAF | offset into prim_ids, where the count precedes the list. */
+ * RT_KD_LEAF | offset into prim_ids, where the list's last id has RT_KD_LAST
+ * set. */
 typedef struct rt_kdtree_wide {
     float split[7];
     uint32_t axes;      /* axis of plane p in bits 2p, 2p+1 */
@@ -87,12 +88,13 @@ typedef struct rt_kdtree_wide {
 #define RT_KD_LEAF 0x80000000u
 #define RT_KD_ONE 0xc0000000u
 #define RT_KD_PAYLOAD 0x3fffffffu
+#define RT_KD_LAST 0x80000000u
 
 typedef struct rt_kdtree {
     rt_kdtree_wide *wide; /* 64-byte aligned */
     size_t wide_count;
     uint32_t root;        /* a child reference: the whole tree */
-    uint32_t *prim_ids;   /* leaf lists (count, then tree triangle numbers, then scene ids of spheres and quads) */
+    uint32_t *prim_ids;   /* leaf lists: tree triangle numbers, then scene ids of spheres and quads */
     size_t prim_id_count;
     /* triangles in leaf order (tree triangle numbers): v0.xyz, e1.xyz, e2.xyz (9 floats) */
     float *tri;
