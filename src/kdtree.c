@@ -1297,6 +1297,11 @@ void rt_kdtree_free(rt_kdtree *tree)
 
 /* ---------------------------------------------------------- traversal */
 
+#if defined(__AVX2__) && defined(__GNUC__) && !defined(RT_KD_SCALAR) /* RT_KD_SCALAR: the portable code, for tests */
+#include <immintrin.h>
+#define KD_SIMD 1
+#endif
+
 /* The ray as the wide step reads it: per axis (lanes 0-2 of 8; lanes 3-7
  * repeat lane 0 and are never selected) origin, 1/direction, cell widening
  * in t, "direction negative" and "parallel to the axis". */
@@ -1315,6 +1320,55 @@ typedef struct kd_ray {
  * is treated as parallel when 1/d is infinite or mp/|d| overflows: then the
  * ray moves less than mp along it for any finite t, so the side of a plane
  * is decided by the origin alone (within mp: both sides). */
+#ifdef KD_SIMD
+static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r)
+{
+    if (tree->root == RT_KD_EMPTY || !(ray->tmin < ray->tmax) || rt_box_is_empty(tree->bounds))
+        return false;
+    if (!rt_finite3(ray->org) || !rt_finite3(ray->dir))
+        return false;
+    if (ray->dir.x == 0.0f && ray->dir.y == 0.0f && ray->dir.z == 0.0f)
+        return false;
+    float omax = fmaxf(fabsf(ray->org.x), fmaxf(fabsf(ray->org.y), fabsf(ray->org.z)));
+    r->mp = (tree->scale + omax) * 0x1p-18f;
+    /* the same operations as the scalar set-up below, three axes at once
+     * (lane 3 repeats x) */
+    const rt_box *bb = &tree->bounds;
+    __m128 o = _mm_setr_ps(ray->org.x, ray->org.y, ray->org.z, ray->org.x);
+    __m128 d = _mm_setr_ps(ray->dir.x, ray->dir.y, ray->dir.z, ray->dir.x);
+    __m128 lo = _mm_setr_ps(bb->lo.x, bb->lo.y, bb->lo.z, bb->lo.x), hi = _mm_setr_ps(bb->hi.x, bb->hi.y, bb->hi.z, bb->hi.x);
+    __m128 mp = _mm_set1_ps(r->mp), inf = _mm_set1_ps(INFINITY);
+    __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), d);
+    __m128 ma = _mm_mul_ps(mp, _mm_andnot_ps(_mm_set1_ps(-0.0f), inv));
+    __m128 par = _mm_cmp_ps(ma, inf, _CMP_NLT_UQ);
+    __m128 out = _mm_or_ps(_mm_cmp_ps(o, _mm_sub_ps(lo, mp), _CMP_LT_OQ), _mm_cmp_ps(o, _mm_add_ps(hi, mp), _CMP_GT_OQ));
+    if (_mm_movemask_ps(_mm_and_ps(par, out)))
+        return false;
+    __m128 t0 = _mm_mul_ps(_mm_sub_ps(lo, o), inv), t1 = _mm_mul_ps(_mm_sub_ps(hi, o), inv);
+    __m128 a = _mm_sub_ps(_mm_min_ps(t1, t0), ma), b = _mm_add_ps(_mm_max_ps(t0, t1), ma);
+    a = _mm_blendv_ps(a, _mm_set1_ps(-INFINITY), par);
+    b = _mm_blendv_ps(b, inf, par);
+    a = _mm_max_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(1, 0, 3, 2)));
+    a = _mm_max_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(2, 3, 0, 1)));
+    b = _mm_min_ps(b, _mm_shuffle_ps(b, b, _MM_SHUFFLE(1, 0, 3, 2)));
+    b = _mm_min_ps(b, _mm_shuffle_ps(b, b, _MM_SHUFFLE(2, 3, 0, 1)));
+    float tn = fmaxf(ray->tmin, _mm_cvtss_f32(a)), tf = fminf(ray->tmax, _mm_cvtss_f32(b));
+    if (!(tn <= tf))
+        return false;
+    r->tn = tn;
+    r->tf = tf;
+    __m128 neg = _mm_andnot_ps(par, _mm_cmp_ps(inv, _mm_setzero_ps(), _CMP_NGT_UQ));
+    inv = _mm_andnot_ps(par, inv);
+    ma = _mm_andnot_ps(par, ma);
+    _mm256_store_ps(r->o, _mm256_set_m128(o, o));
+    _mm256_store_ps(r->inv, _mm256_set_m128(inv, inv));
+    _mm256_store_ps(r->ma, _mm256_set_m128(ma, ma));
+    _mm256_store_ps((float *)(void *)r->neg, _mm256_set_m128(neg, neg));
+    _mm256_store_ps((float *)(void *)r->par, _mm256_set_m128(par, par));
+    r->any_par = _mm_movemask_ps(par) != 0;
+    return true;
+}
+#else
 static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r)
 {
     if (tree->root == RT_KD_EMPTY || !(ray->tmin < ray->tmax) || rt_box_is_empty(tree->bounds))
@@ -1359,6 +1413,7 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
     r->tf = tf;
     return true;
 }
+#endif
 
 #if defined(__GNUC__)
 #define KD_INLINE static inline __attribute__((always_inline))
@@ -1402,9 +1457,7 @@ KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, 
     return true;
 }
 
-#if defined(__AVX2__) && defined(__GNUC__) && !defined(RT_KD_SCALAR) /* RT_KD_SCALAR: the portable code, for tests */
-#include <immintrin.h>
-#define KD_SIMD 1
+#ifdef KD_SIMD
 #define KD_SIMD_MIN 3 /* leaves with at least this many triangles go 8 at a time */
 
 /* Up to 8 triangles (ids, all triangles) at once: the very operations of
