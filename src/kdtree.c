@@ -42,16 +42,27 @@
  * depth-first order afterwards: the tree is bit-identical for any thread
  * count.
  *
- * Layout: 8-byte nodes in depth-first order (below child = next node, above
- * child index in the node; see kdtree.h), leaf ids in one array, triangles as
- * v0, e1 = v1 - v0, e2 = v2 - v0 (computed exactly as the reference tests do,
- * so t is bit-identical to testing the scene's triangle directly). After the
- * build the triangles are renumbered in the order the depth-first leaves
- * first use them and stored in that order (tri_id maps back to the scene's
- * ids), so a leaf's triangles mostly share cache lines: on the 1M-triangle
- * model +15-30% rays/s (profile: ~40% of the time was the first triangle
- * gather waiting on memory). Arrays over 2 MB go on transparent huge pages
+ * Layout: the build makes 8-byte nodes in depth-first order (below child =
+ * next node, above child index in the node; see kdtree.h) and leaf id lists
+ * in a second array. Triangles are stored as v0, e1 = v1 - v0, e2 = v2 - v0
+ * (computed exactly as the reference tests do, so t is bit-identical to
+ * testing the scene's triangle directly) plus their scene id, 10 floats.
+ * After the build the triangles are renumbered in the order the
+ * depth-first leaves first use them and stored in that order, so a leaf's
+ * triangles mostly share cache lines: on the 1M-triangle model +15-30%
+ * rays/s (profile: ~40% of the time was the first triangle gather waiting
+ * on memory); the scene id in the same record spares the hit a last cache
+ * miss into a separate map. Arrays over 2 MB go on transparent huge pages
  * (madvise): +5-15% there, the TLB no longer misses on every node.
+ *
+ * Wide nodes: for tracing, the binary tree is then packed three levels at a
+ * time into 64-byte, cache-line-aligned nodes (rt_kdtree_wide: 7 planes, 8
+ * cells, a reference per cell to a wide node, a leaf or nothing; missing
+ * planes below a leaf are +inf), in depth-first order. Leaf lists end with
+ * a flag on the last id. The binary node loop cost ~20 cycles a level on
+ * incoherent rays (a load, then a mispredicted choice of child), and on the
+ * 1M-triangle model every other level missed the cache; a wide node costs
+ * one line for three levels and one SIMD step (see "Traversal").
  *
  * Leaves with 3 or more triangles are tested 8 at a time with AVX2 (when
  * compiled for it): the same IEEE operations per lane as the scalar
@@ -61,25 +72,35 @@
  * hottest instructions in the profile (+10-30% rays/s without them).
  *
  * Traversal: the recursive ray segment algorithm (Havran's thesis, "TA_B^rec",
- * and pbrt's KdTreeAccel) with a fixed stack: enter the child on the ray's
- * side first, push the other with its t interval, stop once the closest hit
- * lies before the next cell's entry. Every primitive test uses the ray's own
- * (tmin, closest-so-far) interval, so t is what brute force would compute.
+ * and pbrt's KdTreeAccel) with a fixed stack, three levels per step. In a
+ * wide node, each plane gives t = (split - o) / d, each cell the ray's t
+ * interval through it (the parent interval cut by the near or far side of
+ * its three planes), all 8 at once in AVX2 lanes; the cells' front-to-back
+ * order depends only on the direction signs along the 7 planes' axes, so two
+ * 128-entry tables give it. The nearest valid cell is entered, the others
+ * pushed farthest first (compacted by a permute from a 256-entry table);
+ * a cell is popped only if it starts before the closest hit so far. The
+ * nearest cell is taken through a switch on the cell number, not by indexing
+ * the node with it: when the branch is predicted (coherent rays), the next
+ * node's address is known as soon as this node is loaded (indexing made
+ * primary rays 35% slower). The cells and intervals are exactly the binary
+ * traversal's. Every primitive test uses the ray's own (tmin, closest-so-
+ * far) interval, so t is what brute force would compute.
  * Exactness against rounding: cells are widened by a tiny distance mp
  * (2^-18 of the scene's and the origin's largest coordinate, 64 times the
  * float rounding of those coordinates) on every plane, so a hit whose
  * computed t lies a few ulps outside the cell of its primitive (edges shared
  * on a split plane, grazing hits) is still found before the traversal stops.
  * Without it the lattice and chaos tests fail; with 2^-24 they pass; the
- * widening costs under 1% of the steps on the benchmark scenes. Rays parallel to a split plane (direction component 0,
- * 1/0 = inf) are handled without the 0 * inf = NaN of the slab formula.
- * Interior nodes flag children that are empty leaves (about half of all
- * leaves, and 3 of every 4 leaves a ray meets), so the descent skips them
- * without loading them: -10 to -15% of the steps, +10-35% rays/s. (A
- * branch-free descent was tried: it helped incoherent rays before the flags
- * and lost to this plain one after.) The loop exists twice: rays with a zero
- * direction component need a parallel-ray case at every node, the others
- * skip that test (-8% instructions per ray).
+ * widening costs under 1% of the steps on the benchmark scenes. An axis
+ * along which the ray moves less than mp for any finite t (direction
+ * component 0, or mp / |d| overflows) is "parallel": the side of a plane is
+ * then decided by the origin (both sides within mp), without the 0 * inf =
+ * NaN of the slab formula; such rays (rare) run a copy of the loop with
+ * that case, the others a copy without it. Empty leaves are not stored
+ * (their cells' references are "empty"), so no step is spent on them.
+ * Without AVX2 (or with RT_KD_SCALAR, which the tests build too) the same
+ * step runs as plain loops.
  *
  * Measured and not kept (docs/performance.md has the numbers): leaves whose
  * triangles got consecutive numbers stored as a range without an id list
@@ -89,7 +110,11 @@
  * the per-ray shear set-up and the permuted gathers); K_T 1.5-6, empty bonus
  * 0.2-0.8 and depth limits up to 50 (no gain on both ray kinds); the 8-wide
  * test from 2 or 5 triangles instead of 3; huge pages for the build's event
- * arrays (no faster).
+ * arrays (no faster). With the wide nodes: a SAH leaf cost in steps of 8
+ * primitives (the 8-wide test) with K_T 2-8; packing subtrees of at most 8
+ * primitives into one leaf (-0.4 bytes/triangle, a little slower
+ * everywhere); prefetching the cell on top of the stack (-12% on
+ * DamagedHelmet diffuse); the leaf test out of line.
  */
 #if defined(__linux__) && !defined(_DEFAULT_SOURCE)
 #define _DEFAULT_SOURCE /* madvise */
@@ -855,13 +880,13 @@ static void *sort_worker(void *arg)
 /* Renumbers the triangles in the order the depth-first node array first
  * references them and stores their data in that order, so the triangles of
  * a leaf mostly sit next to each other in memory (one or two cache lines
- * per leaf instead of one per triangle); tree->tri_id maps the tree's
- * numbers back to the scene's. Leaf lists stay ascending. */
+ * per leaf instead of one per triangle); each record ends with the
+ * triangle's scene id. Leaf lists stay ascending. */
 static bool leaf_order(rt_kdtree *tree, kd_build *c, size_t T)
 {
     uint32_t *newid = malloc(T * sizeof *newid);
     uint32_t *old = malloc(T * sizeof *old);
-    float *tri = alloc_hot(T * 9 * sizeof *tri);
+    float *tri = alloc_hot(T * RT_KD_TRI * sizeof *tri);
     if (!newid || !old || !tri) {
         free(newid);
         free(old);
@@ -897,12 +922,14 @@ static bool leaf_order(rt_kdtree *tree, kd_build *c, size_t T)
             old[next] = (uint32_t)i;
             newid[i] = next++;
         }
-    for (size_t i = 0; i < T; i++)
-        memcpy(tri + 9 * (size_t)i, tree->tri + 9 * (size_t)old[i], 9 * sizeof *tri);
+    for (size_t i = 0; i < T; i++) { /* 9 floats, then the scene id (the hit's, in the same cache line) */
+        memcpy(tri + RT_KD_TRI * i, tree->tri + 9 * (size_t)old[i], 9 * sizeof *tri);
+        memcpy(tri + RT_KD_TRI * i + 9, &old[i], sizeof old[i]);
+    }
     free(newid);
+    free(old);
     free(tree->tri);
     tree->tri = tri;
-    tree->tri_id = old;
     return true;
 }
 
@@ -1066,7 +1093,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     if (N >= (size_t)PRIM_MASK)
         return rt_fail(err, RT_ERR_LIMIT, "kdtree: %zu primitives, at most %u supported", N, PRIM_MASK - 1u);
     tree->triangle_count = T;
-    tree->simd_ok = T < (size_t)INT32_MAX / 9;
+    tree->simd_ok = T < (size_t)INT32_MAX / RT_KD_TRI;
     tree->sphere_count = S;
     tree->quad_count = Q;
 
@@ -1260,7 +1287,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     c.st.nodes = c.node_count;
     c.st.wide_nodes = tree->wide_count;
     c.st.bytes = tree->wide_count * sizeof *tree->wide + tree->prim_id_count * sizeof *tree->prim_ids +
-                 T * 9 * sizeof(float) + T * sizeof *tree->tri_id;
+                 T * RT_KD_TRI * sizeof(float);
     free(c.nodes);
     free(c.ids);
     c.st.build_ms = now_ms() - t0;
@@ -1276,7 +1303,6 @@ oom:
     free(c.nodes);
     free(c.ids);
     free(tree->tri);
-    free(tree->tri_id);
     memset(tree, 0, sizeof *tree);
     if (c.limit)
         return rt_fail(err, RT_ERR_LIMIT, "kdtree: %zu primitives make more nodes or references than the node format holds",
@@ -1291,7 +1317,6 @@ void rt_kdtree_free(rt_kdtree *tree)
     free(tree->wide);
     free(tree->prim_ids);
     free(tree->tri);
-    free(tree->tri_id);
     memset(tree, 0, sizeof *tree);
 }
 
@@ -1430,7 +1455,7 @@ KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, 
 {
     float t, u, v;
     if (id < tree->triangle_count) {
-        const float *p = tree->tri + 9 * (size_t)id;
+        const float *p = tree->tri + RT_KD_TRI * (size_t)id;
         if (!rt_intersect_triangle(ray->org, ray->dir, rt_v3(p[0], p[1], p[2]), rt_v3(p[3], p[4], p[5]),
                                    rt_v3(p[6], p[7], p[8]), ray->tmin, *best, &t, &u, &v))
             return false;
@@ -1473,7 +1498,7 @@ KD_INLINE bool tri8(const float *tri, const uint32_t *ids, uint32_t n, const rt_
     __m256i id = _mm256_maskload_epi32((const int *)ids, live);
     id = _mm256_and_si256(_mm256_blendv_epi8(_mm256_set1_epi32((int)ids[0]), id, live),
                           _mm256_set1_epi32((int)RT_KD_PAYLOAD)); /* the last id carries RT_KD_LAST */
-    __m256i base = _mm256_mullo_epi32(id, _mm256_set1_epi32(9));
+    __m256i base = _mm256_mullo_epi32(id, _mm256_set1_epi32(RT_KD_TRI));
     /* floats 0-7 of each triangle: one unaligned load per lane and an 8x8
      * transpose (cheaper than eight gathers); float 8 by one gather */
     uint32_t off[8];
@@ -1582,7 +1607,6 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, c
             while ((p[i + m - 1] & RT_KD_PAYLOAD) >= T)
                 m--;
             if (tri8(tree->tri, p + i, m, ray, best, hit)) {
-                KD_PREFETCH(&tree->tri_id[hit->prim]); /* wanted at the end of the traversal */
                 found = true;
                 if (any)
                     return true;
@@ -1969,7 +1993,7 @@ KD_FLATTEN bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt
     hit->prim = RT_NONE;
     if (traverse(tree, ray, hit, false)) {
         if (hit->prim < tree->triangle_count)
-            hit->prim = tree->tri_id[hit->prim];
+            hit->prim = rt_kdtree_scene_triangle(tree, hit->prim);
         return true;
     }
     hit->prim = RT_NONE;

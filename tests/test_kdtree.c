@@ -215,8 +215,8 @@ static void walk_ref(walk_state *w, uint32_t ref)
         assert_true(ids[j] < w->n);
         if (j > 0) /* ascending: triangles first, as the leaf loop expects */
             assert_true(ids[j - 1] < ids[j]);
-        /* triangles are numbered in leaf order; tri_id gives the scene's id */
-        size_t id = ids[j] < w->s->triangles.count ? tree->tri_id[ids[j]] : ids[j];
+        /* triangles are numbered in leaf order and carry the scene's id */
+        size_t id = ids[j] < w->s->triangles.count ? rt_kdtree_scene_triangle(tree, ids[j]) : ids[j];
         assert_true(id < w->n);
         w->seen[id] = 1;
     }

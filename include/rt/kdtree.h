@@ -20,8 +20,8 @@
  * SIMD step instead of three dependent branches. The planes and cells are
  * exactly the binary tree's. Triangles are copied into one buffer of 9
  * floats each (v0, e1, e2) in the order the leaves first use them, so a
- * leaf's triangles are mostly adjacent; tri_id maps these tree triangle
- * numbers back to the scene's ids (hits report scene ids). Build and
+ * leaf's triangles are mostly adjacent; each carries its scene id (hits
+ * report scene ids). Build and
  * traversal are described, with their sources, at the top of kdtree.c.
  *
  * Results are exactly those of testing every primitive with the functions
@@ -39,6 +39,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "rt/error.h"
 #include "rt/intersect.h"
@@ -89,6 +90,7 @@ typedef struct rt_kdtree_wide {
 #define RT_KD_ONE 0xc0000000u
 #define RT_KD_PAYLOAD 0x3fffffffu
 #define RT_KD_LAST 0x80000000u
+#define RT_KD_TRI 10
 
 typedef struct rt_kdtree {
     rt_kdtree_wide *wide; /* 64-byte aligned */
@@ -96,9 +98,9 @@ typedef struct rt_kdtree {
     uint32_t root;        /* a child reference: the whole tree */
     uint32_t *prim_ids;   /* leaf lists: tree triangle numbers, then scene ids of spheres and quads */
     size_t prim_id_count;
-    /* triangles in leaf order (tree triangle numbers): v0.xyz, e1.xyz, e2.xyz (9 floats) */
+    /* triangles in leaf order (tree triangle numbers), RT_KD_TRI floats each:
+     * v0.xyz, e1.xyz, e2.xyz, then the bits of the scene's triangle id */
     float *tri;
-    uint32_t *tri_id;     /* tree triangle number -> scene triangle id */
     size_t triangle_count, sphere_count, quad_count; /* at build time */
     float scale; /* largest absolute coordinate of bounds (traversal epsilon) */
     bool simd_ok; /* triangle offsets fit the 32-bit lanes of the 8-wide leaf test */
@@ -110,6 +112,14 @@ typedef struct rt_kdtree {
 
 rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err);
 void rt_kdtree_free(rt_kdtree *tree);
+
+/* The scene's id of tree triangle number n. */
+static inline uint32_t rt_kdtree_scene_triangle(const rt_kdtree *tree, uint32_t n)
+{
+    uint32_t id;
+    memcpy(&id, tree->tri + (size_t)RT_KD_TRI * n + 9, sizeof id);
+    return id;
+}
 
 /* Closest hit with t in (ray->tmin, ray->tmax). */
 bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit);
