@@ -167,6 +167,10 @@ _Static_assert(KD_MAX_DEPTH < KD_STACK, "one stack entry per level at most");
 #define KD_INDEX_BITS 28
 #define KD_MAX_NODES ((size_t)1 << (KD_INDEX_BITS - 1)) /* per builder; stitching adds them up */
 #define KD_MAX_IDS ((size_t)UINT32_MAX)
+/* Below this many primitives the build stays on one thread. 4096: with the
+ * second core free, DamagedHelmet (15k triangles) builds in 21-24 ms with 2
+ * threads against 30-36 ms with 1 (20000 before, measured under load). */
+#define KD_FORK_MIN_PRIMS 4096
 
 /* Event = ordered position bits << 32 | type << 30 | primitive: sorting the
  * integers sorts by (position, type). */
@@ -1210,7 +1214,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
         kd_sort_job job = {{list[1], list[2]}, {cnt[1], cnt[2]}, NULL};
         pthread_t th;
         bool started = false;
-        if (threads > 1 && nvalid >= 20000 && (job.tmp = malloc(2 * nvalid * sizeof *job.tmp)) != NULL)
+        if (threads > 1 && nvalid >= KD_FORK_MIN_PRIMS && (job.tmp = malloc(2 * nvalid * sizeof *job.tmp)) != NULL)
             started = pthread_create(&th, NULL, sort_worker, &job) == 0;
         ev_sort(list[0], cnt[0], tmp);
         if (started) {
@@ -1239,7 +1243,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     c.max_depth = md;
     tree->max_depth = md;
 
-    if (threads > 1 && nvalid >= 20000) {
+    if (threads > 1 && nvalid >= KD_FORK_MIN_PRIMS) {
         /* 4 subtrees per thread: the OS evens out uneven halves */
         int f = 2;
         while ((1 << (f - 2)) < threads && f < 8)
