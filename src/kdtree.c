@@ -1630,19 +1630,25 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, c
 
 /* ------------------------------------------------------ the wide step */
 
-/* Lane L of the step holds the cell that comes (7 - L)-th front to back:
- * key k = 7 - L, whose bits k2 k1 k0 say "far side" at levels 0, 1, 2. The
- * far side of a plane is the above one unless the ray runs towards -axis
- * (neg). Cell c = 4 b0 + 2 b1 + b2 with b = k ^ neg at each level, planes
- * 0, 1 + b0, 3 + 2 b0 + b1. The cell's t interval is [tn, tf] cut by
- * [lo, inf) for each plane it lies beyond and (-inf, hi] for each it lies
+/* One step through a wide node w for the ray's interval [tn, tf]: which of
+ * the 8 cells the ray crosses (non-empty t interval, non-empty child), in
+ * front-to-back order. The nearest is returned in *near_cell with its
+ * interval, the others are pushed farthest first (so the next nearest ends
+ * on top of the stack); returns how many were pushed, or -1 when the ray
+ * crosses no non-empty cell.
+ *
+ * Order: a cell's key k = k0 k1 k2 (bit 2 = level 0) says on which side of
+ * its plane at each level it lies, 0 = the side the ray enters first (the
+ * below side unless the ray runs towards -axis: neg). Cell c = 4 b0 + 2 b1
+ * + b2 with b = k ^ neg at each level, its planes 0, 1 + b0, 3 + 2 b0 + b1;
+ * ascending keys are front to back. The cell's t interval is [tn, tf] cut
+ * by [lo, inf) for each plane it lies beyond and (-inf, hi] for each it lies
  * before, lo/hi = t(plane) -/+ ma: the binary traversal's intervals, so the
- * same leaves in the same order. Valid cells (non-empty interval, non-empty
- * child) are written farthest first, so the nearest ends on top of the
- * stack. Returns how many. */
+ * same leaves in the same order. */
 #define KD_WSTACK 192 /* 7 net pushes per wide level, KD_MAX_DEPTH / 3 levels, + 8 for the full-width store */
 _Static_assert(7 * ((KD_MAX_DEPTH + 2) / 3) + 8 <= KD_WSTACK, "wide traversal stack");
 
+#ifndef KD_SIMD /* the portable step (the AVX2 one below does the same, 8 cells at once) */
 KD_INLINE int wide_step_scalar(const rt_kdtree_wide *w, const kd_ray *r, bool par, float tn, float tf, uint32_t *sref,
                                float *slo, float *shi, unsigned *near_cell, float *near_tn, float *near_tf)
 {
@@ -1690,6 +1696,7 @@ KD_INLINE int wide_step_scalar(const rt_kdtree_wide *w, const kd_ray *r, bool pa
     }
     return n;
 }
+#endif
 
 #ifdef KD_SIMD
 /* Byte i of entry m: the lane of the i-th set bit of m (compaction by a
@@ -1943,7 +1950,7 @@ KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hi
                 KD_NEAR(7)
             }
 #else
-            unsigned cell;
+            unsigned cell = 0; /* set whenever the step returns >= 0 */
             int n = wide_step_scalar(w, r, par, tn, tf < best ? tf : best, sref + sp, slo + sp, shi + sp, &cell, &tn,
                                      &tf);
             if (n < 0)
