@@ -420,6 +420,36 @@ static void test_params(void **state)
     rt_scene_free(&s);
 }
 
+static void test_deepest_tree(void **state)
+{
+    (void)state;
+    /* Triangles ever closer to the origin (distances and sizes halving), with
+     * a cost model that splits whenever it can: a tree down to the deepest
+     * level the format allows (60, so 20 levels of wide nodes), traced by
+     * rays through the cluster. Each wide level can push 7 cells, so this
+     * is where the traversal stack is fullest (ASan checks its bound). */
+    rt_scene s;
+    rt_scene_init(&s);
+    for (int k = 0; k < 90; k++)
+        for (int axis = 0; axis < 3; axis++) {
+            float d = ldexpf(1.0f, -k), e = 0.25f * d;
+            rt_vec3 c = rt_v3(axis == 0 ? d : 0.1f * d, axis == 1 ? d : 0.1f * d, axis == 2 ? d : 0.1f * d);
+            add_tri(&s, c, rt_add(c, rt_v3(e, 0, 0)), rt_add(c, rt_v3(0, e, e)));
+        }
+    rt_kdtree_params p = {1.0f, 80.0f, 0.5f, 60, 1};
+    rt_kdtree tree;
+    rt_error err = {0};
+    assert_int_equal(rt_kdtree_build(&tree, &s, &p, &err), RT_OK);
+    check_tree(&s, &tree);
+    assert_true(tree.stats.depth >= 40);
+    check_stats cs = {0, 0, 0};
+    check_random_rays(&s, &tree, 91, 3000, -0.05f, 0.05f, &cs);
+    check_random_rays(&s, &tree, 92, 1000, -1.0f, 1.0f, &cs);
+    report(__func__, &cs);
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
 static void test_one_plane(void **state)
 {
     (void)state;
@@ -857,6 +887,7 @@ int main(void)
         cmocka_unit_test(test_single_triangle),
         cmocka_unit_test(test_random_soups),
         cmocka_unit_test(test_params),
+        cmocka_unit_test(test_deepest_tree),
         cmocka_unit_test(test_one_plane),
         cmocka_unit_test(test_identical_triangles),
         cmocka_unit_test(test_huge_and_tiny),
