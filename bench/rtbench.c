@@ -7,8 +7,9 @@
  * Loads the glTF (every triangle of the default scene in world space, as
  * ../shared/bench/FORMAT.md defines), builds the kd-tree (N build threads,
  * default one per core), traces every ray for the closest hit K times and
- * prints `key: value` lines: triangles, load_ms, build_ms, nodes, leaves,
- * bytes_per_triangle, mrays_per_s (median of K runs, wall clock),
+ * prints `key: value` lines: triangles, load_ms, build_ms, nodes and leaves
+ * (of the binary tree the build makes), wide_nodes (the 64-byte nodes of
+ * three levels that the traversal reads), bytes_per_triangle, mrays_per_s (median of K runs, wall clock),
  * mrays_per_s_best (the fastest run), cpu_mrays_per_s (rays per CPU-second
  * of the median run, summed over threads: on a shared, loaded machine this
  * is the steadier figure), hits, mismatches. With --occluded the same rays
@@ -191,6 +192,7 @@ int main(int argc, char **argv)
     printf("build_ms: %.1f\n", tree.stats.build_ms);
     printf("nodes: %zu\n", tree.stats.nodes);
     printf("leaves: %zu\n", tree.stats.leaves);
+    printf("wide_nodes: %zu\n", tree.stats.wide_nodes);
     printf("bytes_per_triangle: %.1f\n",
            scene.triangles.count ? (double)tree.stats.bytes / (double)scene.triangles.count : 0.0);
     printf("threads: %d\n", threads);
