@@ -631,9 +631,10 @@ int main(int argc, char **argv)
         rt_scene_free(&scene);
         return 2;
     }
-    rt_info("kd-tree: built in %.1f ms: %zu nodes, %zu leaves (%zu empty), %zu references, depth %d, %.1f MiB",
+    rt_info("kd-tree: built in %.1f ms: %zu nodes, %zu leaves (%zu empty), %zu references, depth %d; "
+            "%zu 64-byte nodes of 3 levels, %.1f MiB",
             tree.stats.build_ms, tree.stats.nodes, tree.stats.leaves, tree.stats.empty_leaves, tree.stats.prim_refs,
-            tree.stats.depth, (double)tree.stats.bytes / (1024.0 * 1024.0));
+            tree.stats.depth, tree.stats.wide_nodes, (double)tree.stats.bytes / (1024.0 * 1024.0));
 
     rt_framebuffer fb;
     if (rt_framebuffer_init(&fb, set->width, set->height, &err) != RT_OK) {
