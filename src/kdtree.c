@@ -1700,7 +1700,8 @@ KD_INLINE int wide_step_scalar(const rt_kdtree_wide *w, const kd_ray *r, bool pa
 
 #ifdef KD_SIMD
 /* Byte i of entry m: the lane of the i-th set bit of m (compaction by a
- * permute, as AVX2 has no compress instruction). */
+ * permute, as AVX2 has no compress instruction). This table and the two
+ * below are printed by tools/kd_tables.py. */
 static const uint64_t kd_compress[256] = {
     0x0000000000000000ull, 0x0000000000000000ull, 0x0000000000000001ull, 0x0000000000000100ull,
     0x0000000000000002ull, 0x0000000000000200ull, 0x0000000000000201ull, 0x0000000000020100ull,
