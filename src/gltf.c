@@ -734,23 +734,49 @@ static rt_mat4 mat_from_gltf(const float *c)
     return r;
 }
 
-static rt_result parse_nodes(gl_doc *d, int t)
+/* Items of a table that each hold an optional array of indices under
+ * `member` ("children" of nodes, "nodes" of scenes) share one flat array.
+ * The first pass checks the items and arrays and allocates room for all
+ * their indices; read_index_list then fills it item by item. */
+static rt_result alloc_index_lists(gl_doc *d, int t, const char *table, const char *member, uint32_t **out)
 {
-    TRY(alloc_table(d, t, "nodes", sizeof(gl_node), (void **)&d->nodes, &d->node_count));
     size_t total = 0;
     FOR_ITEMS(d, t, i, e) {
         char where[48];
-        snprintf(where, sizeof where, "nodes[%d]", i);
+        snprintf(where, sizeof where, "%s[%d]", table, i);
         TRY(expect_object(d, e, where));
-        int c = rt_json_get(&d->j, e, "children");
-        if (c >= 0) {
-            TRY(expect_array(d, c, where, "children"));
-            total += (size_t)jsize(d, c);
+        int a = rt_json_get(&d->j, e, member);
+        if (a >= 0) {
+            TRY(expect_array(d, a, where, member));
+            total += (size_t)jsize(d, a);
         }
     }
-    d->children = rt_alloc(total, sizeof(uint32_t));
-    if (!d->children)
-        return fail_at(d, t, RT_ERR_NOMEM, "out of memory for %zu node children", total);
+    *out = rt_alloc(total, sizeof(uint32_t));
+    if (!*out)
+        return fail_at(d, t, RT_ERR_NOMEM, "out of memory for %zu %s of %s", total, member, table);
+    return RT_OK;
+}
+
+/* Appends item e's indices to list (*used so far) and counts them in *n. */
+static rt_result read_index_list(gl_doc *d, int e, const char *where, const char *member, uint32_t *list, size_t *used,
+                                 uint32_t *n)
+{
+    int a = rt_json_get(&d->j, e, member); /* the token the counting pass saw, even if the key is repeated */
+    if (a < 0)
+        return RT_OK;
+    FOR_ITEMS(d, a, i, x) {
+        uint32_t index;
+        TRY(get_index(d, where, member, x, &index));
+        list[(*used)++] = index;
+        (*n)++;
+    }
+    return RT_OK;
+}
+
+static rt_result parse_nodes(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "nodes", sizeof(gl_node), (void **)&d->nodes, &d->node_count));
+    TRY(alloc_index_lists(d, t, "nodes", "children", &d->children));
     FOR_ITEMS(d, t, i, e) {
         char where[48];
         snprintf(where, sizeof where, "nodes[%d]", i);
@@ -786,16 +812,7 @@ static rt_result parse_nodes(gl_doc *d, int t)
                 }
             }
         }
-        /* the same token the counting pass saw, even if "children" is repeated */
-        int ch = rt_json_get(&d->j, e, "children");
-        if (ch >= 0) {
-            FOR_ITEMS(d, ch, ci, ce) {
-                uint32_t c;
-                TRY(get_index(d, where, "children", ce, &c));
-                d->children[d->children_count++] = c;
-                n->child_count++;
-            }
-        }
+        TRY(read_index_list(d, e, where, "children", d->children, &d->children_count, &n->child_count));
         if (have_matrix) {
             if (have_trs)
                 rt_warn("%s: %s has both matrix and TRS; using the matrix", d->path, where);
@@ -820,35 +837,14 @@ static rt_result parse_nodes(gl_doc *d, int t)
 static rt_result parse_scenes(gl_doc *d, int t)
 {
     TRY(alloc_table(d, t, "scenes", sizeof(gl_scene), (void **)&d->scenes, &d->scene_count));
-    size_t total = 0;
-    FOR_ITEMS(d, t, i, e) {
-        char where[48];
-        snprintf(where, sizeof where, "scenes[%d]", i);
-        TRY(expect_object(d, e, where));
-        int n = rt_json_get(&d->j, e, "nodes");
-        if (n >= 0) {
-            TRY(expect_array(d, n, where, "nodes"));
-            total += (size_t)jsize(d, n);
-        }
-    }
-    d->scene_nodes = rt_alloc(total, sizeof(uint32_t));
-    if (!d->scene_nodes)
-        return fail_at(d, t, RT_ERR_NOMEM, "out of memory for %zu scene nodes", total);
+    TRY(alloc_index_lists(d, t, "scenes", "nodes", &d->scene_nodes));
     FOR_ITEMS(d, t, i, e) {
         char where[48];
         snprintf(where, sizeof where, "scenes[%d]", i);
         gl_scene *sc = &d->scenes[i];
         sc->tok = e;
         sc->first = (uint32_t)d->scene_nodes_count;
-        int n = rt_json_get(&d->j, e, "nodes");
-        if (n >= 0) {
-            FOR_ITEMS(d, n, ni, ne) {
-                uint32_t node;
-                TRY(get_index(d, where, "nodes", ne, &node));
-                d->scene_nodes[d->scene_nodes_count++] = node;
-                sc->count++;
-            }
-        }
+        TRY(read_index_list(d, e, where, "nodes", d->scene_nodes, &d->scene_nodes_count, &sc->count));
     }
     return RT_OK;
 }
