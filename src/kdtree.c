@@ -134,13 +134,14 @@
 /* The arrays the traversal reads, when large, go on 2 MB pages where the
  * system allows (Linux transparent huge pages in "madvise" mode): rays
  * through a million-triangle scene touch tens of MB at random, and with
- * 4 KB pages most of those cache misses also miss the TLB. Free with free(). */
+ * 4 KB pages most of those cache misses also miss the TLB. Smaller arrays
+ * are cache-line aligned. Free with free(). */
 #define KD_HUGE ((size_t)2 << 20)
 static void *alloc_hot(size_t size)
 {
+    void *p = NULL;
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
     if (size >= KD_HUGE) {
-        void *p = NULL;
         size_t rounded = (size + KD_HUGE - 1) & ~(KD_HUGE - 1);
         if (posix_memalign(&p, KD_HUGE, rounded) != 0)
             return NULL;
@@ -148,7 +149,8 @@ static void *alloc_hot(size_t size)
         return p;
     }
 #endif
-    return malloc(size ? size : 1);
+    /* cache-line aligned: a wide node must sit in one line */
+    return posix_memalign(&p, 64, size ? size : 64) == 0 ? p : NULL;
 }
 
 /* ------------------------------------------------------------- events */
@@ -1050,14 +1052,6 @@ static uint32_t widen_rec(kd_widen *x, uint32_t top)
     return (uint32_t)me;
 }
 
-static void *alloc_line(size_t size)
-{
-    if (size >= KD_HUGE)
-        return alloc_hot(size);
-    void *p = NULL;
-    return posix_memalign(&p, 64, size ? size : 64) == 0 ? p : NULL;
-}
-
 static bool widen(rt_kdtree *tree, kd_build *c)
 {
     kd_widen x;
@@ -1072,7 +1066,7 @@ static bool widen(rt_kdtree *tree, kd_build *c)
     for (size_t i = 0; i < KD_IDS_PAD; i++)
         x.ids[x.in + i] = RT_KD_LAST;
     rt_kdtree_wide *w = NULL;
-    if (!x.oom && !x.limit && (w = alloc_line((x.wn ? x.wn : 1) * sizeof *w)) != NULL && x.wn)
+    if (!x.oom && !x.limit && (w = alloc_hot(x.wn * sizeof *w)) != NULL && x.wn)
         memcpy(w, x.w, x.wn * sizeof *w);
     free(x.w);
     if (!w) {
@@ -1331,9 +1325,10 @@ void rt_kdtree_free(rt_kdtree *tree)
 #define KD_SIMD 1
 #endif
 
-/* The ray as the wide step reads it: per axis (lanes 0-2 of 8; lanes 3-7
- * repeat lane 0 and are never selected) origin, 1/direction, cell widening
- * in t, "direction negative" and "parallel to the axis". */
+/* The ray as the wide step reads it: per axis (lanes 0-2 of 8, which the
+ * AVX2 step loads whole and permutes by axis; the SSE set-up repeats the
+ * values in lanes 3-7, which are never selected) origin, 1/direction, cell
+ * widening in t, "direction negative" and "parallel to the axis". */
 typedef struct kd_ray {
     _Alignas(32) float o[8];
     _Alignas(32) float inv[8];
@@ -1349,8 +1344,10 @@ typedef struct kd_ray {
  * is treated as parallel when 1/d is infinite or mp/|d| overflows: then the
  * ray moves less than mp along it for any finite t, so the side of a plane
  * is decided by the origin alone (within mp: both sides). */
-#ifdef KD_SIMD
-static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r)
+/* What both set-ups below share: rays that can hit nothing (an empty tree,
+ * an empty interval, a non-finite or zero vector) are turned away, and the
+ * cell widening mp is set. */
+static inline bool ray_accept(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r)
 {
     if (tree->root == RT_KD_EMPTY || !(ray->tmin < ray->tmax) || rt_box_is_empty(tree->bounds))
         return false;
@@ -1360,6 +1357,14 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
         return false;
     float omax = fmaxf(fabsf(ray->org.x), fmaxf(fabsf(ray->org.y), fabsf(ray->org.z)));
     r->mp = (tree->scale + omax) * 0x1p-18f;
+    return true;
+}
+
+#ifdef KD_SIMD
+static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r)
+{
+    if (!ray_accept(tree, ray, r))
+        return false;
     /* the same operations as the scalar set-up below, three axes at once
      * (lane 3 repeats x) */
     const rt_box *bb = &tree->bounds;
@@ -1400,15 +1405,9 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
 #else
 static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r)
 {
-    if (tree->root == RT_KD_EMPTY || !(ray->tmin < ray->tmax) || rt_box_is_empty(tree->bounds))
-        return false;
-    if (!rt_finite3(ray->org) || !rt_finite3(ray->dir))
+    if (!ray_accept(tree, ray, r))
         return false;
     const float o[3] = {ray->org.x, ray->org.y, ray->org.z}, d[3] = {ray->dir.x, ray->dir.y, ray->dir.z};
-    if (d[0] == 0.0f && d[1] == 0.0f && d[2] == 0.0f)
-        return false;
-    float omax = fmaxf(fabsf(o[0]), fmaxf(fabsf(o[1]), fabsf(o[2])));
-    r->mp = (tree->scale + omax) * 0x1p-18f;
     r->any_par = false;
     float tn = ray->tmin, tf = ray->tmax;
     const float *lo = &tree->bounds.lo.x, *hi = &tree->bounds.hi.x;
@@ -1434,8 +1433,6 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
         if (t1 < tf)
             tf = t1;
     }
-    for (int k = 3; k < 8; k++)
-        r->o[k] = r->o[0], r->inv[k] = r->inv[0], r->ma[k] = r->ma[0], r->neg[k] = r->neg[0], r->par[k] = r->par[0];
     if (!(tn <= tf))
         return false;
     r->tn = tn;
@@ -1668,8 +1665,10 @@ KD_INLINE int wide_step_scalar(const rt_kdtree_wide *w, const kd_ray *r, bool pa
             neg[p] = r->neg[k];
         }
     }
-    int n = -1;
-    for (unsigned key = 0; key < 8; key++) { /* front to back */
+    /* back to front: the entries come out farthest first, and the last one
+     * (the nearest) is returned instead of pushed */
+    int n = 0;
+    for (unsigned key = 8; key-- > 0;) {
         unsigned f0 = key >> 2 & 1u, f1 = key >> 1 & 1u, f2 = key & 1u;
         unsigned b0 = f0 ^ (unsigned)(neg[0] & 1), p1 = 1 + b0, b1 = f1 ^ (unsigned)(neg[p1] & 1),
                  p2 = 3 + 2 * b0 + b1, b2 = f2 ^ (unsigned)(neg[p2] & 1);
@@ -1681,20 +1680,11 @@ KD_INLINE int wide_step_scalar(const rt_kdtree_wide *w, const kd_ray *r, bool pa
         uint32_t ref = w->child[cell];
         if (ref == RT_KD_EMPTY || !(l <= h))
             continue;
-        if (n < 0) {
-            *near_cell = cell, *near_tn = l, *near_tf = h;
-            n = 0;
-        } else {
-            sref[n] = ref, slo[n] = l, shi[n] = h;
-            n++;
-        }
+        sref[n] = ref, slo[n] = l, shi[n] = h;
+        n++;
+        *near_cell = cell, *near_tn = l, *near_tf = h;
     }
-    for (int i = 0, j = n - 1; i < j; i++, j--) { /* farthest first */
-        uint32_t tr = sref[i]; sref[i] = sref[j]; sref[j] = tr;
-        float tl = slo[i]; slo[i] = slo[j]; slo[j] = tl;
-        float th = shi[i]; shi[i] = shi[j]; shi[j] = th;
-    }
-    return n;
+    return n - 1; /* -1: none */
 }
 #endif
 
