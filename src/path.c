@@ -414,6 +414,26 @@ static inline rt_vec3 add_finite(rt_vec3 acc, rt_vec3 c)
     return rt_finite3(c) ? rt_add(acc, rt_vmax(c, rt_v3s(0.0f))) : acc;
 }
 
+/* One sample of a light from the light table in direction d (world, above
+ * the geometric surface) with light-sampling density pdf_l, weighted against
+ * BSDF sampling by the power heuristic: f cos vis w / pdf_l times the
+ * radiance, which is *Le or, for Le NULL, the environment in d (looked up
+ * only when the sample counts). */
+static rt_vec3 light_table_term(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo, rt_vec3 d,
+                                const rt_vec3 *Le, float pdf_l, float dist)
+{
+    rt_vec3 wi = rt_bsdf_to_local(b, d);
+    float pdf_b;
+    rt_vec3 f = rt_bsdf_eval(b, wo, wi, &pdf_b);
+    float w = rt_mis_power(pdf_l, pdf_b);
+    if (!(rt_max3(f) > 0.0f && w > 0.0f))
+        return rt_v3s(0.0f);
+    float vis = visibility(ctx, sf, d, dist);
+    if (!(vis > 0.0f))
+        return rt_v3s(0.0f);
+    return rt_scale(rt_mul(f, Le ? *Le : rt_environment(ctx, d)), wi.z * vis * w / pdf_l);
+}
+
 /* Light sampled at one vertex: sum over rt_lights plus one table emitter,
  * each f cos Le / pdf_light times its MIS weight. */
 static rt_vec3 next_event(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo,
@@ -449,17 +469,8 @@ static rt_vec3 next_event(const rt_trace_ctx *ctx, const rt_surface *sf, const r
         rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
         rt_vec3 d;
         float pdf_l;
-        if (env_sample(t, u, &d, &pdf_l) && rt_dot(d, b->ng) > 0.0f) {
-            rt_vec3 wi = rt_bsdf_to_local(b, d);
-            float pdf_b;
-            rt_vec3 f = rt_bsdf_eval(b, wo, wi, &pdf_b);
-            float w = rt_mis_power(pdf_l, pdf_b);
-            if (rt_max3(f) > 0.0f && w > 0.0f) {
-                float vis = visibility(ctx, sf, d, INFINITY);
-                if (vis > 0.0f)
-                    sum = add_finite(sum, rt_scale(rt_mul(f, rt_environment(ctx, d)), wi.z * vis * w / pdf_l));
-            }
-        }
+        if (env_sample(t, u, &d, &pdf_l) && rt_dot(d, b->ng) > 0.0f)
+            sum = add_finite(sum, light_table_term(ctx, sf, b, wo, d, NULL, pdf_l, INFINITY));
     }
     if (t && t->count) {
         float ul = rt_rng_float(rng);
@@ -510,17 +521,8 @@ static rt_vec3 next_event(const rt_trace_ctx *ctx, const rt_surface *sf, const r
             rt_vec3 Le = rt_surface_emission(ctx, &se);
             float pdf_l = t->prim_pdf[prim] * d2 / cos_l;
             if (rt_max3(Le) > 0.0f && cos_l > 0.0f && pdf_l > 0.0f && isfinite(pdf_l) &&
-                rt_dot(wdir, b->ng) > 0.0f) {
-                rt_vec3 wi = rt_bsdf_to_local(b, wdir);
-                float pdf_b;
-                rt_vec3 f = rt_bsdf_eval(b, wo, wi, &pdf_b);
-                float w = rt_mis_power(pdf_l, pdf_b);
-                if (rt_max3(f) > 0.0f && w > 0.0f) {
-                    float vis = visibility(ctx, sf, wdir, dist);
-                    if (vis > 0.0f)
-                        sum = add_finite(sum, rt_scale(rt_mul(f, Le), wi.z * vis * w / pdf_l));
-                }
-            }
+                rt_dot(wdir, b->ng) > 0.0f)
+                sum = add_finite(sum, light_table_term(ctx, sf, b, wo, wdir, &Le, pdf_l, dist));
         }
     }
     return sum;
