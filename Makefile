@@ -24,8 +24,12 @@ BUILD   ?= build
 SHARED  ?= ../shared
 RT      ?= rt
 
-LIB_SRC  := $(filter-out src/main.c,$(wildcard src/*.c))
+# The library, by pipeline stage (docs/architecture.md); the driver is src/driver.
+STAGES   := base io scene accel render
+LIB_SRC  := $(foreach d,$(STAGES),$(wildcard src/$(d)/*.c))
 LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
+DRV_SRC  := $(wildcard src/driver/*.c)
+DRV_OBJ  := $(DRV_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 DEPS_OK  := $(BUILD)/.deps-ok
@@ -47,7 +51,7 @@ $(BUILD)/librt.a: $(LIB_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-$(RT): $(BUILD)/obj/main.o $(BUILD)/librt.a
+$(RT): $(DRV_OBJ) $(BUILD)/librt.a
 	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
 
 $(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
@@ -61,9 +65,9 @@ $(BUILD)/tests/test_corpus: tests/test_corpus.c tests/fuzz/harness.c tests/fuzz/
 
 # the kd-tree's portable path (no AVX2), tested on machines that have AVX2 too
 TEST_BIN += $(BUILD)/tests/test_kdtree_scalar
-$(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c src/kdtree.c $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+$(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c src/accel/kdtree.c $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -DRT_KD_SCALAR -Itests -o $@ tests/test_kdtree.c src/kdtree.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+	$(CC) $(CFLAGS) -DRT_KD_SCALAR -Itests -o $@ tests/test_kdtree.c src/accel/kdtree.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 test: $(RT) $(TEST_BIN)
 	@RT_SHARED=$(SHARED) RT_BIN=./$(RT) sh tests/run.sh $(TEST_BIN)
@@ -105,7 +109,7 @@ scenes: $(RT)
 clean:
 	rm -rf build build-asan build-tsan build-profile build-fuzz rt rt-profile bench/rtbench bench/buildscale
 
--include $(LIB_OBJ:.o=.d) $(BUILD)/obj/main.d
+-include $(LIB_OBJ:.o=.d) $(DRV_OBJ:.o=.d)
 
 # libFuzzer over every parser (installs clang on first use); FUZZ_SECONDS per target (default 60).
 fuzz:

@@ -16,9 +16,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "rt/gltf.h"
-#include "rt/kdtree.h"
-#include "rt/scene.h"
+#include "rt/io/gltf.h"
+#include "rt/accel/kdtree.h"
+#include "rt/scene/scene.h"
 
 /* xorshift64*: a deterministic soup */
 static uint64_t rng_next(uint64_t *s)

@@ -25,10 +25,10 @@
 #include <string.h>
 #include <time.h>
 
-#include "rt/gltf.h"
-#include "rt/kdtree.h"
-#include "rt/rayset.h"
-#include "rt/scene.h"
+#include "rt/io/gltf.h"
+#include "rt/accel/kdtree.h"
+#include "rt/io/rayset.h"
+#include "rt/scene/scene.h"
 
 static double now_s(void)
 {

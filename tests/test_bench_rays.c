@@ -27,10 +27,10 @@
 
 #include <ctype.h>
 
-#include "rt/gltf.h"
-#include "rt/kdtree.h"
-#include "rt/rayset.h"
-#include "rt/scene.h"
+#include "rt/io/gltf.h"
+#include "rt/accel/kdtree.h"
+#include "rt/io/rayset.h"
+#include "rt/scene/scene.h"
 
 #define RAYS_PER_SET 2500
 

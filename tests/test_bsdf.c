@@ -11,8 +11,8 @@
 
 #include <math.h>
 
-#include "rt/bsdf.h"
-#include "rt/sampling.h"
+#include "rt/render/bsdf.h"
+#include "rt/render/sampling.h"
 
 static rt_vec3 dir_from(float cos_t, float phi)
 {

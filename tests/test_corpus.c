@@ -7,7 +7,7 @@
 #include <dirent.h>
 
 #include "fuzz/harness.h"
-#include "rt/error.h"
+#include "rt/base/error.h"
 
 static int run_dir(const char *target)
 {

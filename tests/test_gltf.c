@@ -9,10 +9,10 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "rt/base64.h"
-#include "rt/gltf.h"
-#include "rt/json.h"
-#include "rt/scene.h"
+#include "rt/io/base64.h"
+#include "rt/io/gltf.h"
+#include "rt/io/json.h"
+#include "rt/scene/scene.h"
 
 /* ------------------------------------------------------------ helpers */
 

@@ -7,7 +7,7 @@
  */
 #include "test_util.h"
 
-#include "rt/intersect.h"
+#include "rt/accel/intersect.h"
 
 static bool tri(rt_vec3 o, rt_vec3 d, rt_vec3 a, rt_vec3 b, rt_vec3 c, float tmin, float tmax, float *t, float *u,
                 float *v)

@@ -14,7 +14,7 @@
 
 #include <pthread.h>
 
-#include "rt/kdtree.h"
+#include "rt/accel/kdtree.h"
 
 /* ------------------------------------------------------------ helpers */
 

@@ -19,14 +19,14 @@
 
 #include <stb/stb_image_write.h>
 
-#include "rt/gltf.h"
-#include "rt/image.h"
-#include "rt/kdtree.h"
-#include "rt/mesh_io.h"
-#include "rt/render.h"
-#include "rt/scene.h"
-#include "rt/scene_parse.h"
-#include "rt/texture.h"
+#include "rt/io/gltf.h"
+#include "rt/io/image.h"
+#include "rt/accel/kdtree.h"
+#include "rt/io/mesh_io.h"
+#include "rt/render/render.h"
+#include "rt/scene/scene.h"
+#include "rt/io/scene_parse.h"
+#include "rt/scene/texture.h"
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define SANITIZED 1

@@ -13,9 +13,9 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "../src/mesh_internal.h"
-#include "rt/mesh_io.h"
-#include "rt/texture.h"
+#include "../src/io/mesh_internal.h"
+#include "rt/io/mesh_io.h"
+#include "rt/scene/texture.h"
 
 static char tmpdir[256];
 

@@ -22,16 +22,16 @@
 
 #include <math.h>
 
-#include "rt/bsdf.h"
-#include "rt/camera.h"
-#include "rt/image.h"
-#include "rt/integrator.h"
-#include "rt/kdtree.h"
-#include "rt/path.h"
-#include "rt/render.h"
-#include "rt/scene.h"
-#include "rt/scene_parse.h"
-#include "rt/texture.h"
+#include "rt/render/bsdf.h"
+#include "rt/render/camera.h"
+#include "rt/io/image.h"
+#include "rt/render/integrator.h"
+#include "rt/accel/kdtree.h"
+#include "rt/render/path.h"
+#include "rt/render/render.h"
+#include "rt/scene/scene.h"
+#include "rt/io/scene_parse.h"
+#include "rt/scene/texture.h"
 
 typedef struct fixture {
     rt_scene s;

@@ -5,11 +5,11 @@
 #include <math.h>
 #include <unistd.h>
 
-#include "rt/camera.h"
-#include "rt/image.h"
-#include "rt/kdtree.h"
-#include "rt/render.h"
-#include "rt/scene.h"
+#include "rt/render/camera.h"
+#include "rt/io/image.h"
+#include "rt/accel/kdtree.h"
+#include "rt/render/render.h"
+#include "rt/scene/scene.h"
 
 static uint32_t add_lambert(rt_scene *s, const char *name, rt_vec3 albedo)
 {

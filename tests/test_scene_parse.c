@@ -13,7 +13,7 @@
 #include <errno.h>
 #include <math.h>
 
-#include "rt/scene_parse.h"
+#include "rt/io/scene_parse.h"
 
 #define TMP_DIR "tests/tmp/scene_parse"
 

@@ -9,14 +9,14 @@
 
 #include <math.h>
 
-#include "rt/gltf.h"
-#include "rt/image.h"
-#include "rt/kdtree.h"
-#include "rt/render.h"
-#include "rt/scene.h"
-#include "rt/shade.h"
-#include "rt/tangents.h"
-#include "rt/texture.h"
+#include "rt/io/gltf.h"
+#include "rt/io/image.h"
+#include "rt/accel/kdtree.h"
+#include "rt/render/render.h"
+#include "rt/scene/scene.h"
+#include "rt/render/shade.h"
+#include "rt/scene/tangents.h"
+#include "rt/scene/texture.h"
 
 static bool near3(rt_vec3 a, rt_vec3 b, float eps)
 {

@@ -9,10 +9,10 @@
 #include <math.h>
 #include <unistd.h>
 
-#include "rt/image.h"
-#include "rt/scene.h"
-#include "rt/scene_parse.h"
-#include "rt/texture.h"
+#include "rt/io/image.h"
+#include "rt/scene/scene.h"
+#include "rt/io/scene_parse.h"
+#include "rt/scene/texture.h"
 
 #include <stb/stb_image_write.h> /* the implementation is in -lstb */
 

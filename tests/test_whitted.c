@@ -8,13 +8,13 @@
 
 #include <math.h>
 
-#include "rt/image.h"
-#include "rt/integrator.h"
-#include "rt/kdtree.h"
-#include "rt/render.h"
-#include "rt/scene.h"
-#include "rt/texture.h"
-#include "rt/whitted.h"
+#include "rt/io/image.h"
+#include "rt/render/integrator.h"
+#include "rt/accel/kdtree.h"
+#include "rt/render/render.h"
+#include "rt/scene/scene.h"
+#include "rt/scene/texture.h"
+#include "rt/render/whitted.h"
 
 /* ------------------------------------------------------------ optics */
 

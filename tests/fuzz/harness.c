@@ -7,11 +7,11 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "rt/gltf.h"
-#include "rt/mesh_io.h"
-#include "rt/scene.h"
-#include "rt/scene_parse.h"
-#include "rt/texture.h"
+#include "rt/io/gltf.h"
+#include "rt/io/mesh_io.h"
+#include "rt/scene/scene.h"
+#include "rt/io/scene_parse.h"
+#include "rt/scene/texture.h"
 
 const char *const rt_fuzz_targets[] = {"scene", "gltf", "glb", "gltf_bin", "obj", "ply", "off", "image", NULL};
 

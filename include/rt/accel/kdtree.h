@@ -1,0 +1,129 @@
+/* rt/kdtree.h - a flattened SAH kd-tree over every primitive of a scene.
+ *
+ * The tree is built once from a scene (triangles, spheres and quads in the
+ * scene's primitive id space, see scene.h) and then only read, from any
+ * number of threads at once.
+ *
+ *   rt_kdtree tree;
+ *   rt_error err;
+ *   if (rt_kdtree_build(&tree, &scene, NULL, &err) != RT_OK) ...
+ *   rt_hit hit;
+ *   if (rt_kdtree_intersect(&tree, &ray, &hit)) ... hit.t, hit.prim, hit.u, hit.v
+ *   bool blocked = rt_kdtree_occluded(&tree, &shadow_ray);
+ *   rt_kdtree_free(&tree);
+ *
+ * Layout: the build makes 8-byte nodes in one array (the below child is the
+ * next node, see rt_kdtree_node) and leaf primitive lists in a second
+ * array; for tracing, every three levels of that binary tree are then packed
+ * into one 64-byte, cache-line-aligned rt_kdtree_wide (7 split planes, 8
+ * cells), so a ray resolves three levels with one memory access and one
+ * SIMD step instead of three dependent branches. The planes and cells are
+ * exactly the binary tree's. Triangles are copied into one buffer of 9
+ * floats each (v0, e1, e2) in the order the leaves first use them, so a
+ * leaf's triangles are mostly adjacent; each carries its scene id (hits
+ * report scene ids). Build and
+ * traversal are described, with their sources, at the top of kdtree.c.
+ *
+ * Results are exactly those of testing every primitive with the functions
+ * of intersect.h (same t bits; either id when two primitives tie). Rays with
+ * a non-finite origin or direction, a zero direction, or tmin >= tmax (or
+ * NaN) hit nothing. Primitives that can never be hit (non-finite
+ * coordinates, a zero edge, a zero-area quad, a non-finite sphere) are left
+ * out of the tree.
+ *
+ * The tree keeps a pointer to the scene (for spheres and quads): the scene
+ * must outlive it and must not gain primitives after the build.
+ */
+#ifndef RT_KDTREE_H
+#define RT_KDTREE_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "rt/base/error.h"
+#include "rt/accel/intersect.h"
+#include "rt/scene/scene.h"
+
+/* Build parameters; a zero field means "the default". */
+typedef struct rt_kdtree_params {
+    float traversal_cost; /* SAH cost of one traversal step (default 4) */
+    float intersect_cost; /* SAH cost of one primitive test (default 1) */
+    float empty_bonus;    /* fraction (0..1) by which a split with an empty side is cheaper (default 0.2) */
+    int max_depth;        /* 0 = 8 + 1.3 log2(N) (pbrt's rule) */
+    int threads;          /* build threads; 0 = one per online CPU (same tree for any count) */
+} rt_kdtree_params;
+
+typedef struct rt_kdtree_stats {
+    size_t nodes, leaves, empty_leaves; /* of the binary tree */
+    size_t wide_nodes;    /* 64-byte nodes of 3 levels each, which the traversal reads */
+    size_t prim_refs;     /* primitive ids stored in leaves (with duplicates) */
+    size_t max_leaf_prims;
+    int depth;
+    double build_ms;
+    size_t bytes;         /* nodes + leaf ids + triangle buffers */
+} rt_kdtree_stats;
+
+/* The build's binary node. */
+typedef struct rt_kdtree_node {
+    uint32_t a; /* interior: split position (float bits); leaf: first index into prim_ids (or the single prim) */
+    uint32_t b; /* low 2 bits: axis 0..2, or 3 = leaf. Leaf: b >> 2 = prim count (0 = empty leaf).
+                 * Interior: bit 2 = below child is an empty leaf, bit 3 = above child is,
+                 * b >> 4 = above-child index (the below child is the next node). */
+} rt_kdtree_node;
+
+/* Three levels of the binary tree: planes in breadth-first order (0 the top
+ * node, 1 and 2 its below and above children, 3-6 theirs: plane p's children
+ * are 2p+1 and 2p+2), cells c = 4 b0 + 2 b1 + b2 with b = 0 for the below
+ * side at each level. A plane that does not exist (a leaf above level 3)
+ * is +inf on x, which keeps the whole cell below it. A child reference is
+ * another wide node (< RT_KD_LEAF), RT_KD_EMPTY, RT_KD_ONE | primitive, or
+ * RT_KD_LEAF | offset into prim_ids, where the list's last id has RT_KD_LAST
+ * set. */
+typedef struct rt_kdtree_wide {
+    float split[7];
+    uint32_t axes;      /* axis of plane p in bits 2p, 2p+1 */
+    uint32_t child[8];
+} rt_kdtree_wide;
+#define RT_KD_EMPTY 0xffffffffu
+#define RT_KD_LEAF 0x80000000u
+#define RT_KD_ONE 0xc0000000u
+#define RT_KD_PAYLOAD 0x3fffffffu
+#define RT_KD_LAST 0x80000000u
+#define RT_KD_TRI 10
+
+typedef struct rt_kdtree {
+    rt_kdtree_wide *wide; /* 64-byte aligned */
+    size_t wide_count;
+    uint32_t root;        /* a child reference: the whole tree */
+    uint32_t *prim_ids;   /* leaf lists: tree triangle numbers, then scene ids of spheres and quads */
+    size_t prim_id_count;
+    /* triangles in leaf order (tree triangle numbers), RT_KD_TRI floats each:
+     * v0.xyz, e1.xyz, e2.xyz, then the bits of the scene's triangle id */
+    float *tri;
+    size_t triangle_count, sphere_count, quad_count; /* at build time */
+    float scale; /* largest absolute coordinate of bounds (traversal epsilon) */
+    bool simd_ok; /* triangle offsets fit the 32-bit lanes of the 8-wide leaf test */
+    const rt_scene *scene;
+    rt_box bounds;
+    int max_depth;
+    rt_kdtree_stats stats;
+} rt_kdtree;
+
+rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err);
+void rt_kdtree_free(rt_kdtree *tree);
+
+/* The scene's id of tree triangle number n. */
+static inline uint32_t rt_kdtree_scene_triangle(const rt_kdtree *tree, uint32_t n)
+{
+    uint32_t id;
+    memcpy(&id, tree->tri + (size_t)RT_KD_TRI * n + 9, sizeof id);
+    return id;
+}
+
+/* Closest hit with t in (ray->tmin, ray->tmax). */
+bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit);
+/* Any hit with t in (ray->tmin, ray->tmax): for shadow rays. */
+bool rt_kdtree_occluded(const rt_kdtree *tree, const rt_ray *ray);
+
+#endif

@@ -1,0 +1,51 @@
+/* rt/gltf.h - glTF 2.0 (.gltf, .glb) into the scene's tables.
+ *
+ * Our own loader on the jsmn tokenizer, built the way cgltf is built: the
+ * JSON is tokenized once, mapped to flat arrays of records (buffers,
+ * bufferViews, accessors, meshes, nodes, materials, ...) with index cross
+ * references, validated, then flattened into the scene: every triangle
+ * primitive of the chosen scene with each node's world transform applied.
+ *
+ *   rt_gltf_options opt = {0};          // zero = defaults: default scene
+ *   if (rt_gltf_load(&scene, "helmet.glb", &opt, &stats, &err) != RT_OK) ...
+ */
+#ifndef RT_GLTF_H
+#define RT_GLTF_H
+
+#include <stdbool.h>
+
+#include "rt/base/error.h"
+#include "rt/scene/scene.h"
+
+typedef struct rt_gltf_options {
+    int scene_index;       /* which glTF scene, when use_scene_index; otherwise the file's default */
+    bool use_scene_index;
+    rt_mat4 transform;     /* applied on top of the node transforms */
+    bool use_transform;    /* false = identity */
+} rt_gltf_options;
+
+/* What one load added. meshes/primitives count instances (a mesh used by
+ * two nodes counts twice; only triangle primitives); nodes = nodes of the
+ * chosen scene; images = glTF images decoded for this file; cameras =
+ * perspective cameras appended to scene->cameras (the first one of this file
+ * is scene->cameras[camera_count - cameras]). */
+typedef struct rt_gltf_stats {
+    size_t triangles, meshes, primitives, materials, textures, images, cameras, lights, nodes;
+    rt_box bounds;         /* world bounds of the vertices the loaded triangles use */
+} rt_gltf_stats;
+
+/* Appends the chosen scene of the glTF at path to s. options and stats may be
+ * NULL. On failure s's tables are restored to their sizes before the call and
+ * err names the file, the byte offset when there is one, and the problem.
+ * Supported features, limits and the material mapping: docs/gltf.md. */
+rt_result rt_gltf_load(rt_scene *s, const char *path, const rt_gltf_options *options, rt_gltf_stats *stats,
+                       rt_error *err);
+
+/* The same from a .gltf or .glb already in memory (size bytes at data, not
+ * copied, not kept). `name` stands for the file in messages, and relative
+ * URIs (external .bin and images) resolve against its directory. Handy for
+ * fuzzing and for assets packed in other files. */
+rt_result rt_gltf_load_memory(rt_scene *s, const void *data, size_t size, const char *name,
+                              const rt_gltf_options *options, rt_gltf_stats *stats, rt_error *err);
+
+#endif

@@ -1,0 +1,103 @@
+/* rt/bsdf.h - the path tracer's scattering functions: Lambert and the glTF
+ * metallic-roughness model (GGX microfacets, height-correlated Smith
+ * masking-shadowing, Schlick Fresnel), with a smooth dielectric
+ * transmission lobe for KHR_materials_transmission.
+ *
+ * Everything works in the local shading frame: z is the shading normal on
+ * the side the light leaves towards (wo.z > 0), x and y the tangents.
+ *
+ *   rt_bsdf b;
+ *   rt_bsdf_from_surface(&ctx, &sf, &b);              // material + textures at a hit
+ *   rt_vec3 wo = rt_bsdf_to_local(&b, sf.wo);
+ *   float pdf;
+ *   rt_vec3 f = rt_bsdf_eval(&b, wo, wi, &pdf);       // f (no cosine), pdf of rt_bsdf_sample
+ *   rt_bsdf_sample s;
+ *   if (rt_bsdf_sample_dir(&b, wo, u, ulobe, &s))     // s.weight = f cos / pdf
+ *       ... rt_bsdf_to_world(&b, s.wi) ...
+ *
+ * Model, for base colour B, metallic m, roughness r, alpha = r^2, index of
+ * refraction eta, transmission T (glTF 2.0 spec, appendix B.3.5, with
+ * KHR_materials_ior and KHR_materials_transmission):
+ *
+ *   F0     = lerp(((eta - 1) / (eta + 1))^2, B, m)
+ *   F      = F0 + (1 - F0) (1 - |wo.h|)^5           (Schlick)
+ *   c_diff = lerp(B, 0, m)
+ *   f      = (1 - F)(1 - T) c_diff / pi  +  F D(h) V(wo, wi)
+ *
+ * with D the GGX (Trowbridge-Reitz) distribution and V = G2 / (4 |n.wo|
+ * |n.wi|), G2 the height-correlated Smith masking-shadowing term. The
+ * transmitted share (1 - F) T c_diff refracts through a GGX microfacet
+ * (Walter et al. 2007; smooth at roughness 0), sampled only (a "delta"
+ * sample: not light-sampled, no MIS). RT_BSDF_LAMBERT is exactly B / pi.
+ *
+ * Sampling picks a lobe by its estimated share of the reflected energy at
+ * wo, then samples diffuse by the cosine, specular by the distribution of
+ * visible normals (Heitz 2018, "Sampling the GGX Distribution of Visible
+ * Normals", JCGT 7(4)); the pdf is the mixture of both (one-sample MIS over
+ * the lobes), and rt_bsdf_eval returns the same pdf.
+ */
+#ifndef RT_BSDF_H
+#define RT_BSDF_H
+
+#include <stdbool.h>
+
+#include "rt/render/shade.h"
+
+#define RT_BSDF_MIN_ALPHA 1e-3f /* GGX alpha floor: roughness 0 is a very sharp lobe, never a delta */
+
+typedef struct rt_bsdf {
+    rt_vec3 t, b, n;  /* shading frame, world space; n on the side of wo */
+    rt_vec3 ng;       /* geometric normal on the side of wo */
+    bool lambert;     /* pure Lambert: f = diffuse / pi */
+    rt_vec3 diffuse;  /* c_diff (Lambert: the albedo) */
+    rt_vec3 f0;       /* Schlick normal-incidence reflectance per channel */
+    float alpha;      /* GGX alpha */
+    float transmission; /* T */
+    float eta;        /* index ratio across the surface along a transmitted ray: n_incident / n_transmitted */
+} rt_bsdf;
+
+typedef struct rt_bsdf_sample {
+    rt_vec3 wi;       /* local direction */
+    rt_vec3 weight;   /* f |cos| / pdf, or the delta lobe's weight / its probability */
+    float pdf;        /* solid-angle pdf; 0 for a transmission sample */
+    bool delta;       /* transmission: sampled only, never light-sampled, so no MIS */
+} rt_bsdf_sample;
+
+/* GGX building blocks, local frame (z = normal). */
+float rt_ggx_d(rt_vec3 h, float alpha);              /* D(h), 0 below the surface */
+float rt_ggx_lambda(rt_vec3 w, float alpha);         /* Smith Lambda(w) */
+float rt_ggx_g1(rt_vec3 w, float alpha);             /* 1 / (1 + Lambda) */
+float rt_ggx_g2(rt_vec3 wo, rt_vec3 wi, float alpha); /* height-correlated 1 / (1 + L(wo) + L(wi)) */
+/* A visible normal for wo (wo.z > 0) from u in [0,1)^2 (Heitz 2018). */
+rt_vec3 rt_ggx_sample_vndf(rt_vec3 wo, float alpha, rt_vec2 u);
+/* pdf of reflecting wo into wi by VNDF sampling: G1(wo) D(h) / (4 wo.z). */
+float rt_ggx_reflect_pdf(rt_vec3 wo, rt_vec3 wi, float alpha);
+
+/* Builds the BSDF of a hit: material factors x textures (base colour,
+ * metallic-roughness, transmission), frame from the shading normal (the
+ * geometric one when wo lies below the shading normal). */
+void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b);
+/* The same from plain parameters, frame n (unit) with ng = n; for tests. */
+void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float roughness, float ior,
+                  float transmission, bool lambert);
+
+static inline rt_vec3 rt_bsdf_to_local(const rt_bsdf *b, rt_vec3 w)
+{
+    return rt_v3(rt_dot(w, b->t), rt_dot(w, b->b), rt_dot(w, b->n));
+}
+static inline rt_vec3 rt_bsdf_to_world(const rt_bsdf *b, rt_vec3 w)
+{
+    return rt_add(rt_add(rt_scale(b->t, w.x), rt_scale(b->b, w.y)), rt_scale(b->n, w.z));
+}
+
+/* f(wo, wi) for the non-delta lobes (not times the cosine); *pdf (may be
+ * NULL) receives the pdf rt_bsdf_sample_dir draws wi with. Zero when wo
+ * or wi is below the surface. */
+rt_vec3 rt_bsdf_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float *pdf);
+/* Draws wi from u (2D) and ulobe (lobe choice); false when nothing is
+ * scattered (black material, wo below the surface, a zero pdf). */
+bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s);
+/* Probability that rt_bsdf_sample_dir picks each lobe at wo (for tests). */
+void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit);
+
+#endif

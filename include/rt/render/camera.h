@@ -1,0 +1,33 @@
+/* rt/camera.h - pinhole and thin-lens cameras: film position to ray.
+ *
+ * Film coordinates: x in [0, width) from the left edge, y in [0, height)
+ * from the top edge; the vertical field of view spans the full image height.
+ * For a pinhole camera the direction is exactly
+ *   d = normalize(f + (2x/W - 1) * t * aspect * r + (1 - 2y/H) * t * u)
+ * with f = normalize(look_at - position), r = normalize(cross(f, up)),
+ * u = cross(r, f), t = tan(vfov / 2) (the convention of the shared
+ * benchmark rays and reference scenes).
+ *
+ *   rt_camera_frame cf;
+ *   rt_camera_frame_init(&cf, &scene.camera, width, height);
+ *   rt_ray r = rt_camera_ray(&cf, x + 0.5f, y + 0.5f, lens_sample);
+ */
+#ifndef RT_CAMERA_H
+#define RT_CAMERA_H
+
+#include "rt/accel/intersect.h"
+#include "rt/scene/scene.h"
+
+typedef struct rt_camera_frame {
+    rt_vec3 origin, forward, right, up;
+    float tan_half, aspect;
+    float lens_radius, focus_distance;
+    float inv_width, inv_height;
+} rt_camera_frame;
+
+/* false when the camera is degenerate (look_at == position, up parallel to
+ * the view direction, fov outside (0, 180)). */
+bool rt_camera_frame_init(rt_camera_frame *cf, const rt_camera *cam, int width, int height);
+rt_ray rt_camera_ray(const rt_camera_frame *cf, float film_x, float film_y, rt_vec2 lens_sample);
+
+#endif

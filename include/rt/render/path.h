@@ -1,0 +1,72 @@
+/* rt/path.h - the `path` integrator: unidirectional path tracing of the
+ * glTF material model (rt/bsdf.h) with next-event estimation, multiple
+ * importance sampling and Russian roulette. docs/path-tracer.md has the
+ * estimator, its validation against Mitsuba 3, and the settings.
+ *
+ *   rt_vec3 L = rt_radiance_path(&ctx, &ray, &rng);   // via rt_radiance()
+ *
+ * Lights sampled at every path vertex: every rt_light (point, spot,
+ * directional, area) and, when ctx->light_table is set, one emissive
+ * primitive (triangle, quad or sphere with an emissive material) chosen by
+ * power, and the environment image by its luminance. The table is per scene and read-only while rendering: build it
+ * once after the scene is loaded, before the render threads start, and
+ * point each thread's context at it:
+ *
+ *   rt_light_table lt;
+ *   if (rt_light_table_build(&lt, &scene, &err) != RT_OK) ...
+ *   ... in each worker: rt_trace_ctx_init(&ctx, &scene, &tree); ctx.light_table = &lt;
+ *   rt_light_table_free(&lt);                            // after the render
+ *
+ * Without a table (ctx->light_table == NULL) the image is the same in
+ * expectation: emissive primitives are then found only by BSDF-sampled
+ * rays and counted in full (noisier for small bright emitters).
+ */
+#ifndef RT_PATH_H
+#define RT_PATH_H
+
+#include "rt/base/error.h"
+#include "rt/render/sampling.h"
+#include "rt/render/shade.h"
+
+#define RT_PATH_RR_START 3     /* Russian roulette from this many bounces on */
+#define RT_PATH_HARD_LIMIT 1024 /* bounces when max_depth is 0 (unlimited): a guard, never reached in practice */
+
+typedef struct rt_light_table {
+    size_t count;         /* emissive primitives (area lights' own quads excluded) */
+    uint32_t *prim;       /* their primitive ids */
+    float *cdf;           /* cumulative selection probability, cdf[count - 1] == 1 */
+    float *area;          /* their areas */
+    size_t prim_count;    /* primitive ids covered by prim_pdf */
+    float *prim_pdf;      /* per primitive id: selection probability / area (0 = not in the table) */
+    size_t quad_count;
+    uint32_t *quad_light; /* per quad: index of the area light it is the visible quad of, or RT_NONE */
+    /* environment image, importance-sampled by luminance x sin(theta) over
+     * an env_w x env_h grid of its latitude-longitude cells (0 = none) */
+    int env_w, env_h;
+    float *env_row_cdf;   /* env_h: cumulative probability of the rows */
+    float *env_col_cdf;   /* env_h x env_w: cumulative probability within each row */
+    float *env_cell;      /* env_h x env_w: probability of each cell */
+} rt_light_table;
+
+/* Solid-angle pdf with which the table samples the environment towards
+ * unit direction d (0 without an environment image). */
+float rt_light_table_env_pdf(const rt_light_table *t, rt_vec3 d);
+
+rt_result rt_light_table_build(rt_light_table *t, const rt_scene *s, rt_error *err);
+void rt_light_table_free(rt_light_table *t);
+
+rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng);
+
+/* Power heuristic with exponent 2 (Veach 1997, ch. 9): a^2 / (a^2 + b^2). */
+static inline float rt_mis_power(float a, float b)
+{
+    if (!(a > 0.0f))
+        return 0.0f;
+    if (isinf(a))
+        return 1.0f;
+    float a2 = a * a, b2 = b * b;
+    float w = a2 / (a2 + b2);
+    return isfinite(w) ? w : (a > b ? 1.0f : 0.0f);
+}
+
+#endif

@@ -1,0 +1,309 @@
+/* rt/scene.h - the scene as flat tables: everything a render reads.
+ *
+ * A scene is a set of arrays, each with its count, in the spirit of cgltf and
+ * yocto-gl: no per-object allocations, no pointers between records (records
+ * refer to each other by index). Loaders (scene_parse.c, gltf.c, mesh_obj.c,
+ * mesh_ply.c, mesh_off.c) append to these tables; the kd-tree and the
+ * integrators only read them.
+ *
+ *   Geometry    vertices (SoA-ish attribute arrays), triangles (index triplets,
+ *               material, flags), spheres and quads (structure-of-arrays).
+ *   Appearance  materials (one table for the text format and glTF alike),
+ *               textures (image + sampler), images (decoded pixels, once).
+ *   Light       lights (point, directional, spot, area over a quad) and a
+ *               constant or image environment.
+ *   View        camera and render settings.
+ *
+ * Primitive ids: one id space over all kinds, used by the kd-tree and hits.
+ * Ids [0, T) are triangles, [T, T+S) spheres, [T+S, T+S+Q) quads, where
+ * T, S, Q are the counts at kd-tree build time (see rt_prim_kind()).
+ *
+ *   rt_scene s;
+ *   rt_scene_init(&s);
+ *   uint32_t m = rt_scene_add_material(&s, &mat);
+ *   rt_scene_add_sphere(&s, rt_v3(0, 1, 0), 1.0f, m);
+ *   ...
+ *   rt_scene_free(&s);
+ */
+#ifndef RT_SCENE_H
+#define RT_SCENE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rt/base/error.h"
+#include "rt/base/vec.h"
+
+#define RT_NONE UINT32_MAX /* "no index": no texture, no hit, no material */
+
+/* ---------------------------------------------------------------- view */
+
+typedef struct rt_camera {
+    rt_vec3 position, look_at, up;
+    float vfov_deg;       /* vertical field of view, degrees */
+    float aperture;       /* lens diameter; 0 = pinhole */
+    float focus_distance; /* 0 = distance from position to look_at */
+    float aspect_ratio;   /* width / height the camera was made for (glTF); 0 = none, follow the image */
+} rt_camera;
+
+typedef enum rt_integrator {
+    RT_INTEGRATOR_DIRECT = 0, /* direct light, Lambert: the foundation slice */
+    RT_INTEGRATOR_WHITTED,    /* Phong, mirrors, glass, diffuse bounces */
+    RT_INTEGRATOR_PATH,       /* physically based path tracer */
+} rt_integrator;
+
+/* Render settings. rt_settings_default() gives the documented defaults. */
+typedef struct rt_settings {
+    int width, height;
+    int samples;          /* samples per pixel (stratified when a square) */
+    rt_integrator integrator;
+    int max_bounce;       /* mirror/refraction recursion depth */
+    int max_depth;        /* path: most scattering events a path may have; 0 = unlimited (Russian roulette ends paths) */
+    int diffuse_bounces;  /* levels of indirect diffuse light (whitted) */
+    int diffuse_rays;     /* cosine-distributed rays per diffuse level */
+    int shadow_samples;   /* samples per area light per shading point */
+    float ray_offset;     /* extra user offset, scene units (0 = robust automatic offset only) */
+    float clamp;          /* max sample luminance, 0 = no clamp (fireflies) */
+    float exposure;       /* linear scale before writing 8-bit output */
+    uint32_t seed;
+    rt_vec3 background;   /* radiance of rays that leave the scene */
+    uint32_t environment_texture; /* lat-long image, RT_NONE for constant background */
+    float environment_strength;
+    /* whitted: ambient radiance that materials' `ambient` coefficient
+     * reflects. Unset (the default): the background's radiance, i.e. the
+     * constant environment (background * environment_strength) or the mean
+     * of the environment image (see docs/shading.md). */
+    rt_vec3 ambient_light;
+    bool ambient_light_set;
+    /* The scene's own output name (`output` line); the driver may override. */
+    char output[512];
+} rt_settings;
+
+void rt_settings_default(rt_settings *s);
+
+/* ------------------------------------------------------------ textures */
+
+typedef enum rt_wrap { RT_WRAP_REPEAT = 0, RT_WRAP_CLAMP, RT_WRAP_MIRROR } rt_wrap;
+typedef enum rt_filter { RT_FILTER_BILINEAR = 0, RT_FILTER_NEAREST } rt_filter;
+
+/* Decoded pixels, loaded once per file (or per embedded buffer). Either
+ * rgba8 (LDR, 4 bytes a texel, values as stored: sRGB decode happens on
+ * lookup for colour slots) or rgbaf (HDR, linear float) is set. */
+typedef struct rt_image {
+    int width, height;
+    uint8_t *rgba8;
+    float *rgbaf;
+    char name[256]; /* path or "file.glb#image3", for messages and caching */
+} rt_image;
+
+/* A texture: which image, how it is sampled, or a procedural pattern. */
+typedef enum rt_texture_kind { RT_TEX_IMAGE = 0, RT_TEX_CONSTANT, RT_TEX_CHECKER } rt_texture_kind;
+
+typedef struct rt_texture {
+    rt_texture_kind kind;
+    uint32_t image;          /* RT_TEX_IMAGE: index into images */
+    rt_wrap wrap_s, wrap_t;
+    rt_filter filter;
+    rt_vec4 color_a, color_b; /* constant colour; checker's two colours */
+    float checker_scale;      /* checker squares per UV unit */
+} rt_texture;
+
+/* A material's use of a texture. */
+typedef struct rt_texture_slot {
+    uint32_t texture;    /* RT_NONE = no texture */
+    uint8_t texcoord;    /* UV set 0 or 1 */
+    /* UV transform (KHR_texture_transform): uv' = (m0*u + m1*v + m2, m3*u + m4*v + m5) */
+    float uv_transform[6];
+} rt_texture_slot;
+
+/* ----------------------------------------------------------- materials */
+
+typedef enum rt_alpha_mode { RT_ALPHA_OPAQUE = 0, RT_ALPHA_MASK, RT_ALPHA_BLEND } rt_alpha_mode;
+
+/* The path tracer's scattering model (docs/path-tracer.md): the glTF
+ * metallic-roughness BRDF (the default, zero) or a pure Lambertian
+ * albedo / pi with no specular lobe (`bsdf lambert`). */
+typedef enum rt_bsdf_model { RT_BSDF_GLTF = 0, RT_BSDF_LAMBERT } rt_bsdf_model;
+
+/* One material table for every source. The Phong fields drive the whitted
+ * integrator; the PBR fields drive the path tracer; colour, textures,
+ * reflection and transmission are read by both. rt_material_default() gives
+ * the documented defaults (the old renderer's constants: ambient 0.4,
+ * diffuse 0.8, specular 0.05). */
+typedef struct rt_material {
+    char name[64];
+    rt_vec3 color;          /* diffuse / base colour, linear RGB */
+    float alpha;            /* base colour alpha */
+    /* Phong */
+    float ambient, diffuse, specular, shininess;
+    float reflectivity;     /* mirror reflection weight, 0..1 */
+    float transmission;     /* refraction weight, 0..1 */
+    rt_vec3 transmission_color; /* filter colour for light passing through */
+    float ior;              /* index of refraction of the inside */
+    /* PBR (glTF metallic-roughness and extensions) */
+    float metallic, roughness;
+    rt_vec3 emission;       /* emitted radiance = emission * emission_strength */
+    float emission_strength;
+    float normal_scale;
+    float occlusion_strength;
+    rt_alpha_mode alpha_mode;
+    float alpha_cutoff;
+    bool double_sided;
+    bool unlit;
+    rt_bsdf_model bsdf;     /* path tracer: glTF metallic-roughness (default) or pure Lambert */
+    float thickness;        /* KHR_materials_volume */
+    rt_vec3 attenuation_color;
+    float attenuation_distance; /* INFINITY = no absorption */
+    /* textures */
+    rt_texture_slot base_color_tex; /* sRGB colour */
+    rt_texture_slot metal_rough_tex; /* B = metal, G = roughness */
+    rt_texture_slot normal_tex;      /* tangent-space normal map */
+    rt_texture_slot occlusion_tex;   /* R */
+    rt_texture_slot emissive_tex;    /* sRGB colour */
+    rt_texture_slot transmission_tex; /* R */
+} rt_material;
+
+void rt_material_default(rt_material *m, const char *name);
+void rt_texture_slot_none(rt_texture_slot *slot);
+
+/* -------------------------------------------------------------- lights */
+
+typedef enum rt_light_kind {
+    RT_LIGHT_POINT = 0,
+    RT_LIGHT_DIRECTIONAL,
+    RT_LIGHT_SPOT,
+    RT_LIGHT_AREA, /* one-sided emitter over a parallelogram: corner + edge_u + edge_v */
+} rt_light_kind;
+
+typedef struct rt_light {
+    rt_light_kind kind;
+    rt_vec3 color;       /* linear RGB, multiplied by intensity */
+    float intensity;     /* point/spot: W/sr-like intensity; directional: irradiance; area: radiance */
+    rt_vec3 position;    /* point, spot; area: corner */
+    rt_vec3 direction;   /* directional, spot: the direction light travels */
+    rt_vec3 edge_u, edge_v; /* area: the quad's two edges; emits towards cross(edge_u, edge_v) */
+    float inner_cone, outer_cone; /* spot, radians */
+    float range;         /* 0 = infinite */
+    uint32_t quad;       /* area: the visible quad primitive (index into quads), RT_NONE if none */
+} rt_light;
+
+/* ------------------------------------------------------------ geometry */
+
+/* Per-vertex attributes. position, normal and uv0 always exist for every
+ * vertex; uv1, tangent and color are NULL until some loader enables them
+ * (rt_scene_enable_attr), after which every vertex has one (defaults:
+ * uv (0,0), tangent (0,0,0,0) = none, colour (1,1,1,1)). */
+typedef struct rt_vertices {
+    size_t count, cap;
+    rt_vec3 *position;
+    rt_vec3 *normal;
+    rt_vec2 *uv0;
+    rt_vec2 *uv1;
+    rt_vec4 *tangent; /* xyz tangent, w = bitangent sign (glTF convention) */
+    rt_vec4 *color;
+} rt_vertices;
+
+enum rt_vertex_attr { RT_ATTR_UV1 = 1, RT_ATTR_TANGENT = 2, RT_ATTR_COLOR = 4 };
+
+/* Per-triangle flags: which vertex attributes are meaningful for it. */
+enum rt_triangle_flags {
+    RT_TRI_SMOOTH = 1,  /* interpolate vertex normals (else flat geometric normal) */
+    RT_TRI_TANGENT = 2, /* vertex tangents are valid */
+    RT_TRI_COLOR = 4,   /* vertex colours are valid */
+    RT_TRI_UV = 8,      /* vertex UVs are meaningful (else generated) */
+};
+
+typedef struct rt_triangles {
+    size_t count, cap;
+    uint32_t *index;    /* 3 vertex indices per triangle */
+    uint32_t *material;
+    uint8_t *flags;
+} rt_triangles;
+
+typedef struct rt_spheres {
+    size_t count, cap;
+    float *cx, *cy, *cz, *radius;
+    uint32_t *material;
+} rt_spheres;
+
+/* A parallelogram: corner p, edges u and v; points p + s*u + t*v, s,t in
+ * [0,1]; UV = (s, t); normal = normalize(cross(u, v)). */
+typedef struct rt_quads {
+    size_t count, cap;
+    float *px, *py, *pz;
+    float *ux, *uy, *uz;
+    float *vx, *vy, *vz;
+    uint32_t *material;
+} rt_quads;
+
+/* -------------------------------------------------------------- scene */
+
+typedef struct rt_scene {
+    rt_camera camera;
+    bool camera_set;   /* false: frame the scene bounds automatically */
+    rt_settings settings;
+
+    rt_material *materials; size_t material_count, material_cap;
+    rt_texture *textures;   size_t texture_count, texture_cap;
+    rt_image *images;       size_t image_count, image_cap;
+    rt_light *lights;       size_t light_count, light_cap;
+    rt_camera *cameras;     size_t camera_count, camera_cap; /* from models (glTF cameras) */
+
+    rt_vertices vertices;
+    rt_triangles triangles;
+    rt_spheres spheres;
+    rt_quads quads;
+} rt_scene;
+
+void rt_scene_init(rt_scene *s);
+void rt_scene_free(rt_scene *s);
+
+/* Table appends. Each returns the new record's index, or RT_NONE when out of
+ * memory. */
+uint32_t rt_scene_add_material(rt_scene *s, const rt_material *m);
+uint32_t rt_scene_find_material(const rt_scene *s, const char *name); /* RT_NONE if absent */
+uint32_t rt_scene_add_texture(rt_scene *s, const rt_texture *t);
+uint32_t rt_scene_add_image(rt_scene *s, const rt_image *img); /* takes ownership of the pixels */
+uint32_t rt_scene_add_light(rt_scene *s, const rt_light *l);
+uint32_t rt_scene_add_camera(rt_scene *s, const rt_camera *c);
+uint32_t rt_scene_add_sphere(rt_scene *s, rt_vec3 center, float radius, uint32_t material);
+uint32_t rt_scene_add_quad(rt_scene *s, rt_vec3 corner, rt_vec3 edge_u, rt_vec3 edge_v, uint32_t material);
+
+/* Appends n vertices with default attributes (normal 0, uv 0, colour 1) and
+ * returns the index of the first, or RT_NONE. */
+uint32_t rt_scene_add_vertices(rt_scene *s, size_t n);
+/* Makes the optional attribute arrays exist (RT_ATTR_* bits). false = out of memory. */
+bool rt_scene_enable_attr(rt_scene *s, unsigned attrs);
+/* Appends a triangle over existing vertices; RT_NONE when out of memory. */
+uint32_t rt_scene_add_triangle(rt_scene *s, uint32_t a, uint32_t b, uint32_t c, uint32_t material, uint8_t flags);
+/* Reserves room for n more triangles (avoids repeated growth). */
+bool rt_scene_reserve_triangles(rt_scene *s, size_t n);
+
+/* Primitive id space (see the top of this file). */
+typedef enum rt_prim_kind { RT_PRIM_TRIANGLE = 0, RT_PRIM_SPHERE, RT_PRIM_QUAD } rt_prim_kind;
+static inline size_t rt_scene_prim_count(const rt_scene *s)
+{
+    return s->triangles.count + s->spheres.count + s->quads.count;
+}
+static inline rt_prim_kind rt_prim_kind_of(const rt_scene *s, uint32_t prim, uint32_t *local)
+{
+    size_t t = s->triangles.count, sp = s->spheres.count;
+    if (prim < t) { *local = prim; return RT_PRIM_TRIANGLE; }
+    if (prim < t + sp) { *local = (uint32_t)(prim - t); return RT_PRIM_SPHERE; }
+    *local = (uint32_t)(prim - t - sp);
+    return RT_PRIM_QUAD;
+}
+static inline rt_vec3 rt_tri_vertex(const rt_scene *s, size_t tri, int corner)
+{
+    return s->vertices.position[s->triangles.index[3 * tri + (size_t)corner]];
+}
+/* World bounds of one primitive, and of the whole scene (primitives only). */
+rt_box rt_scene_prim_bounds(const rt_scene *s, uint32_t prim);
+rt_box rt_scene_bounds(const rt_scene *s);
+
+/* Points the camera at the scene's bounds from the front (+z side), for
+ * models without a camera. */
+void rt_scene_frame_camera(rt_scene *s);
+
+#endif

@@ -1,0 +1,48 @@
+/* rt/texture.h - images (decoded once, cached by name) and texture lookups.
+ *
+ * Images are decoded with stb_image (PNG, JPEG, HDR, and the rest of what it
+ * reads) behind our own checks: a header whose size is over the limit is
+ * refused before any pixel memory is allocated. Loading the same file twice
+ * returns the same image index.
+ *
+ *   uint32_t img;
+ *   if (rt_image_load_file(&scene, "wood.png", &img, &err) != RT_OK) ...
+ *   rt_texture tex = rt_texture_image(img);  // repeat, bilinear
+ *   uint32_t t = rt_scene_add_texture(&scene, &tex);
+ *   rt_vec4 c = rt_texture_sample(&scene, t, uv, true);  // sRGB colour -> linear
+ */
+#ifndef RT_TEXTURE_H
+#define RT_TEXTURE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "rt/base/error.h"
+#include "rt/scene/scene.h"
+
+#define RT_MAX_IMAGE_DIM 32768          /* per side */
+#define RT_MAX_IMAGE_PIXELS (1u << 28)  /* 268M texels, 1 GiB as RGBA8 */
+
+/* Loads (or finds in the cache) an image file; path is used as given. */
+rt_result rt_image_load_file(rt_scene *s, const char *path, uint32_t *image, rt_error *err);
+/* Decodes an image held in memory (a glTF bufferView or data: URI); `name`
+ * identifies it for the cache and for messages ("model.glb#image2"). */
+rt_result rt_image_load_memory(rt_scene *s, const void *data, size_t size, const char *name, uint32_t *image,
+                               rt_error *err);
+
+rt_texture rt_texture_image(uint32_t image);       /* repeat, bilinear */
+rt_texture rt_texture_constant(rt_vec4 color);
+rt_texture rt_texture_checker(rt_vec4 a, rt_vec4 b, float squares_per_unit);
+
+/* Samples texture t at uv. srgb: decode the texel from sRGB to linear (colour
+ * slots); data slots (normal, metal-rough, occlusion) pass false. Alpha is
+ * never decoded. */
+rt_vec4 rt_texture_sample(const rt_scene *s, uint32_t t, rt_vec2 uv, bool srgb);
+/* Applies a slot's UV transform. */
+rt_vec2 rt_texture_slot_uv(const rt_texture_slot *slot, rt_vec2 uv);
+
+/* sRGB transfer function and its inverse (IEC 61966-2-1). */
+float rt_srgb_to_linear(float c);
+float rt_linear_to_srgb(float c);
+
+#endif

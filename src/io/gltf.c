@@ -1,0 +1,2281 @@
+/* gltf.c - glTF 2.0 (.gltf, .glb) loader for static scenes.
+ *
+ * Built the way cgltf (jkuhlmann/cgltf) is built, in four passes:
+ *   1. read   the file; a GLB is split into its JSON and BIN chunks after
+ *             checking the 12-byte header and every chunk length against the
+ *             file size (glTF 2.0 spec, "GLB File Format Specification").
+ *   2. map    the JSON (tokenized once by jsmn, see json.c) into flat tables
+ *             of records with a count each: buffers, bufferViews, accessors,
+ *             meshes/primitives, nodes, scenes, materials, textures,
+ *             samplers, images, cameras, KHR_lights_punctual lights. Cross
+ *             references stay indices.
+ *   3. check  every index against its table, every accessor against its
+ *             bufferView and every bufferView against its buffer (with
+ *             overflow-safe arithmetic), the node graph for shared children,
+ *             cycles and depth; only then are buffers read (files relative to
+ *             the .gltf, base64 data: URIs, the GLB BIN chunk) and their real
+ *             sizes checked against byteLength. Nothing is allocated from a
+ *             count that has not been checked against the bytes behind it
+ *             (or, for accessors without a bufferView, against a fixed cap).
+ *   4. flatten the chosen scene: node world matrices (parent * local, TRS =
+ *             T * R * S), every triangle primitive of every mesh instance
+ *             into the scene's vertex and triangle tables (strips and fans
+ *             converted with the spec's vertex orders), materials, textures
+ *             (images decoded once through texture.c), cameras and lights.
+ *
+ * Transforms: positions by the world matrix M; normals by the inverse
+ * transpose (rt_mat4_normal_matrix); tangents by M's upper 3x3, with the
+ * bitangent sign w multiplied by sign(det M): with n' ~ M^-T n and
+ * t' ~ M t, cross(n', t') points along sign(det M) * M cross(n, t), so a
+ * mirroring transform must flip w to keep bitangent = w * cross(n, t).
+ * A negative determinant also flips triangle winding (spec, "Meshes"), so
+ * the geometric normal keeps agreeing with the shading normal.
+ *
+ * Sources: Khronos glTF 2.0 specification (sections "Accessors" with
+ * sparse accessors and data alignment, "Animations" for the normalized
+ * integer formulas, "Meshes" for primitive modes and winding, "Materials",
+ * "Samplers", "GLB File Format Specification"); extension specs KHR_texture_transform,
+ * KHR_materials_{emissive_strength,transmission,ior,volume,unlit},
+ * KHR_lights_punctual, KHR_mesh_quantization. docs/gltf.md lists what is
+ * supported and how glTF materials map to rt_material.
+ */
+#include "rt/io/gltf.h"
+
+#include <errno.h>
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rt/io/base64.h"
+#include "rt/io/json.h"
+#include "rt/scene/texture.h"
+
+#define GL_MAX_DEPTH 1024                    /* node hierarchy levels */
+#define GL_MAX_VERTICES ((size_t)1 << 25)    /* per load: 32M vertices */
+#define GL_MAX_ZEROS ((size_t)1 << 22)       /* elements of accessors without a bufferView, per accessor and
+                                                per load (instances included): such data costs no file bytes */
+#define GL_MAX_TRIANGLES ((size_t)1 << 25)   /* per load: 32M triangles */
+#define GL_MAX_FILE ((size_t)0x7fffffff)     /* .gltf, .glb, .bin: 2 GiB */
+
+enum { GL_BYTE = 5120, GL_UNSIGNED_BYTE = 5121, GL_SHORT = 5122, GL_UNSIGNED_SHORT = 5123,
+       GL_UNSIGNED_INT = 5125, GL_FLOAT = 5126 };
+
+enum { ATTR_POSITION = 0, ATTR_NORMAL, ATTR_TANGENT, ATTR_TEXCOORD_0, ATTR_TEXCOORD_1, ATTR_COLOR_0, ATTR_COUNT };
+static const char *const attr_names[ATTR_COUNT] = {"POSITION", "NORMAL", "TANGENT", "TEXCOORD_0", "TEXCOORD_1",
+                                                   "COLOR_0"};
+
+/* ------------------------------------------------------------- records */
+
+typedef struct gl_buffer {
+    size_t byte_length;
+    int uri;              /* string token, -1 = none (GLB BIN chunk) */
+    const uint8_t *data;  /* after loading: at least byte_length bytes */
+    uint8_t *owned;
+    int tok;
+} gl_buffer;
+
+typedef struct gl_view {
+    uint32_t buffer;
+    size_t offset, length, stride; /* stride 0 = tightly packed */
+    int tok;
+} gl_view;
+
+typedef struct gl_accessor {
+    uint32_t view;       /* RT_NONE = all zeros */
+    size_t offset, count;
+    int ctype;
+    int ncomp, rows, cols; /* VEC3: 3, 3, 1; MAT3: 9, 3, 3 */
+    bool normalized;
+    size_t sparse_count; /* 0 = not sparse */
+    uint32_t sp_idx_view, sp_val_view;
+    size_t sp_idx_offset, sp_val_offset;
+    int sp_idx_ctype;
+    int tok;
+} gl_accessor;
+
+typedef struct gl_prim {
+    int mode;
+    uint32_t indices, material;
+    uint32_t attr[ATTR_COUNT];
+    bool targets;
+    int tok;
+} gl_prim;
+
+typedef struct gl_mesh { uint32_t first, count; int tok; } gl_mesh;
+
+typedef struct gl_node {
+    uint32_t mesh, camera, light, skin;
+    uint32_t first_child, child_count; /* into doc.children */
+    uint32_t parent;
+    rt_mat4 local;
+    int tok;
+} gl_node;
+
+typedef struct gl_scene { uint32_t first, count; int tok; } gl_scene; /* into doc.scene_nodes */
+
+typedef struct gl_texture { uint32_t source, sampler; int tok; } gl_texture;
+typedef struct gl_sampler { int mag, min, wrap_s, wrap_t; int tok; } gl_sampler;
+typedef struct gl_image { int uri; uint32_t view; int tok; } gl_image;
+
+typedef struct gl_camera {
+    bool perspective;
+    float yfov, aspect, znear, zfar;
+    int tok;
+} gl_camera;
+
+typedef struct gl_light {
+    rt_light_kind kind;
+    rt_vec3 color;
+    float intensity, range, inner, outer;
+    int tok;
+} gl_light;
+
+typedef struct gl_material { rt_material m; int tok; } gl_material; /* slot.texture = glTF texture index */
+
+/* One visited node of the chosen scene with its world matrix. */
+typedef struct gl_visit { uint32_t node; rt_mat4 world; } gl_visit;
+
+typedef struct gl_doc {
+    const char *path;
+    char *dir;            /* directory of the .gltf with a trailing '/', or "" */
+    rt_error *err;
+    const uint8_t *bytes; /* the whole .gltf/.glb */
+    size_t file_size;
+    uint8_t *file;        /* owned copy when read from disk */
+    const char *json_text;
+    size_t json_len, json_base;
+    const uint8_t *bin;   /* GLB BIN chunk */
+    size_t bin_size;
+    bool glb;
+    rt_json j;
+
+    gl_buffer *buffers;     size_t buffer_count;
+    gl_view *views;         size_t view_count;
+    gl_accessor *accessors; size_t accessor_count;
+    gl_mesh *meshes;        size_t mesh_count;
+    gl_prim *prims;         size_t prim_count;
+    gl_node *nodes;         size_t node_count;
+    uint32_t *children;     size_t children_count;
+    gl_scene *scenes;       size_t scene_count;
+    uint32_t *scene_nodes;  size_t scene_nodes_count;
+    gl_material *materials; size_t material_count;
+    gl_texture *textures;   size_t texture_count;
+    gl_sampler *samplers;   size_t sampler_count;
+    gl_image *images;       size_t image_count;
+    gl_camera *cameras;     size_t camera_count;
+    gl_light *lights;       size_t light_count;
+    size_t skin_count;
+    uint32_t default_scene; /* RT_NONE = absent */
+
+    /* flattening */
+    gl_visit *visits;       size_t visit_count;
+    uint32_t *visit_of;     /* node -> its visit (valid once visited) */
+    uint32_t *image_map;    /* glTF image -> scene image, RT_NONE = not loaded yet */
+    uint32_t *texture_map;  /* glTF texture -> scene texture */
+    float *scratch[ATTR_COUNT];
+    size_t scratch_cap[ATTR_COUNT];
+    uint32_t *idx_scratch;
+    size_t idx_cap;
+} gl_doc;
+
+/* ------------------------------------------------------------- errors */
+
+static rt_result fail_at(gl_doc *d, int tok, rt_result code, const char *fmt, ...) RT_PRINTF(4, 5);
+static rt_result fail_at(gl_doc *d, int tok, rt_result code, const char *fmt, ...)
+{
+    char msg[900];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (tok >= 0 && tok < d->j.count)
+        return rt_fail(d->err, code, "%s: byte %zu: %s", d->path, d->json_base + (size_t)d->j.tok[tok].start, msg);
+    return rt_fail(d->err, code, "%s: %s", d->path, msg);
+}
+
+#define TRY(x)                      \
+    do {                            \
+        rt_result r_ = (x);         \
+        if (r_ != RT_OK)            \
+            return r_;              \
+    } while (0)
+
+/* ------------------------------------------------------- JSON helpers */
+
+static int jtype(const gl_doc *d, int t) { return t >= 0 && t < d->j.count ? d->j.tok[t].type : 0; }
+static int jsize(const gl_doc *d, int t) { return t >= 0 && t < d->j.count ? d->j.tok[t].size : 0; }
+
+/* Checks that t is an object whose keys are all strings followed by a value. */
+static rt_result expect_object(gl_doc *d, int t, const char *where)
+{
+    if (jtype(d, t) != RT_JSON_OBJECT)
+        return fail_at(d, t, RT_ERR_INVALID, "%s: expected an object", where);
+    int k = t + 1;
+    for (int n = 0; n < d->j.tok[t].size; n++) {
+        if (k + 1 >= d->j.count || d->j.tok[k].type != RT_JSON_STRING || d->j.tok[k].size != 1)
+            return fail_at(d, k < d->j.count ? k : t, RT_ERR_PARSE, "%s: expected \"key\": value", where);
+        k = rt_json_skip(&d->j, k + 1);
+    }
+    return RT_OK;
+}
+
+static rt_result expect_array(gl_doc *d, int t, const char *where, const char *key)
+{
+    if (jtype(d, t) != RT_JSON_ARRAY)
+        return fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected an array", where, key);
+    return RT_OK;
+}
+
+/* Iterates the keys of an object already checked by expect_object. */
+#define FOR_KEYS(d, obj, k, v)                                                                    \
+    for (int k##_n = 0, k = (obj) + 1, v = (obj) + 2; k##_n < (d)->j.tok[obj].size && v < (d)->j.count; \
+         k##_n++, k = rt_json_skip(&(d)->j, v), v = k + 1)
+/* Iterates the elements of an array. */
+#define FOR_ITEMS(d, arr, idx, e)                                                       \
+    for (int idx = 0, e = (arr) + 1; idx < (d)->j.tok[arr].size && e < (d)->j.count; \
+         idx++, e = rt_json_skip(&(d)->j, e))
+
+#define KEY(k, s) rt_json_key_is(&d->j, (k), (s))
+
+static rt_result get_num(gl_doc *d, const char *where, const char *key, int t, double *v)
+{
+    if (!rt_json_number(&d->j, t, v))
+        return fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected a number", where, key);
+    return RT_OK;
+}
+
+static rt_result get_index(gl_doc *d, const char *where, const char *key, int t, uint32_t *out)
+{
+    double v;
+    if (!rt_json_number(&d->j, t, &v) || v < 0 || v != floor(v) || v > 4294967294.0)
+        return fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected an index (a non-negative integer)", where, key);
+    *out = (uint32_t)v;
+    return RT_OK;
+}
+
+static rt_result get_size(gl_doc *d, const char *where, const char *key, int t, size_t *out)
+{
+    double v;
+    if (!rt_json_number(&d->j, t, &v) || v < 0 || v != floor(v) || v > 9007199254740992.0 || v > (double)SIZE_MAX)
+        return fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected a non-negative integer", where, key);
+    *out = (size_t)v;
+    return RT_OK;
+}
+
+static rt_result get_int(gl_doc *d, const char *where, const char *key, int t, int *out)
+{
+    double v;
+    if (!rt_json_number(&d->j, t, &v) || v != floor(v) || v < -2147483647.0 || v > 2147483647.0)
+        return fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected an integer", where, key);
+    *out = (int)v;
+    return RT_OK;
+}
+
+static rt_result get_float(gl_doc *d, const char *where, const char *key, int t, float *out)
+{
+    double v;
+    TRY(get_num(d, where, key, t, &v));
+    if (fabs(v) > FLT_MAX)
+        return fail_at(d, t, RT_ERR_INVALID, "%s.%s: number out of float range", where, key);
+    *out = (float)v;
+    return RT_OK;
+}
+
+static rt_result get_floats(gl_doc *d, const char *where, const char *key, int t, float *out, int n)
+{
+    if (jtype(d, t) != RT_JSON_ARRAY || jsize(d, t) != n)
+        return fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected an array of %d numbers", where, key, n);
+    FOR_ITEMS(d, t, i, e) TRY(get_float(d, where, key, e, &out[i]));
+    return RT_OK;
+}
+
+static rt_result get_bool(gl_doc *d, const char *where, const char *key, int t, bool *out)
+{
+    if (!rt_json_bool(&d->j, t, out))
+        return fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected true or false", where, key);
+    return RT_OK;
+}
+
+static rt_result get_string(gl_doc *d, const char *where, const char *key, int t, char *buf, size_t cap)
+{
+    if (rt_json_string(&d->j, t, buf, cap) < 0)
+        return fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected a string (at most %zu bytes, valid escapes)", where,
+                       key, cap - 1);
+    return RT_OK;
+}
+
+/* Allocates one zeroed record per element of array token t. */
+static rt_result alloc_table(gl_doc *d, int t, const char *key, size_t elem, void **out, size_t *count)
+{
+    TRY(expect_array(d, t, "glTF", key));
+    if (*out)
+        return fail_at(d, t, RT_ERR_INVALID, "%s appears twice", key);
+    size_t n = (size_t)jsize(d, t);
+    void *p = rt_alloc(n, elem);
+    if (!p)
+        return fail_at(d, t, RT_ERR_NOMEM, "out of memory for %zu %s", n, key);
+    *out = p;
+    *count = n;
+    return RT_OK;
+}
+
+/* --------------------------------------------------------- file I/O */
+
+static rt_result read_file(gl_doc *d, const char *path, const char *what, uint8_t **data, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return rt_fail(d->err, RT_ERR_IO, "%s: %scannot open \"%s\": %s", d->path, what, path, strerror(errno));
+    uint8_t *buf = NULL;
+    size_t n = 0, cap = 0;
+    for (;;) {
+        if (n == cap) {
+            size_t want = cap ? cap * 2 : 65536;
+            if (want > GL_MAX_FILE + 1)
+                want = GL_MAX_FILE + 1;
+            if (n >= want) {
+                free(buf);
+                fclose(f);
+                return rt_fail(d->err, RT_ERR_LIMIT, "%s: %s\"%s\" is over the 2 GiB limit", d->path, what, path);
+            }
+            uint8_t *q = realloc(buf, want);
+            if (!q) {
+                free(buf);
+                fclose(f);
+                return rt_fail(d->err, RT_ERR_NOMEM, "%s: %sout of memory reading \"%s\"", d->path, what, path);
+            }
+            buf = q;
+            cap = want;
+        }
+        size_t got = fread(buf + n, 1, cap - n, f);
+        n += got;
+        if (got == 0)
+            break;
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(buf);
+        return rt_fail(d->err, RT_ERR_IO, "%s: %sread error on \"%s\"", d->path, what, path);
+    }
+    *data = buf;
+    *size = n;
+    return RT_OK;
+}
+
+static uint32_t rd32(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+/* Splits a GLB into its JSON and BIN chunks (spec: "GLB File Format Specification"). */
+static rt_result split_glb(gl_doc *d)
+{
+    const uint8_t *f = d->bytes;
+    size_t size = d->file_size;
+    if (size < 12)
+        return rt_fail(d->err, RT_ERR_INVALID, "%s: byte 0: file is %zu bytes, too short for the 12-byte GLB header",
+                       d->path, size);
+    uint32_t version = rd32(f + 4), length = rd32(f + 8);
+    if (version != 2)
+        return rt_fail(d->err, RT_ERR_UNSUPPORTED, "%s: byte 4: GLB version %u (only version 2 is supported)",
+                       d->path, version);
+    if (length > size)
+        return rt_fail(d->err, RT_ERR_INVALID,
+                       "%s: byte 8: header length %u runs past the end of the file (%zu bytes): truncated?", d->path,
+                       length, size);
+    if (length < 20)
+        return rt_fail(d->err, RT_ERR_INVALID, "%s: byte 8: header length %u leaves no room for the JSON chunk",
+                       d->path, length);
+    if (length < size)
+        rt_warn("%s: %zu bytes after the GLB's declared length %u are ignored", d->path, size - length, length);
+    size_t off = 12;
+    int chunk = 0;
+    while (off < length) {
+        if (length - off < 8)
+            return rt_fail(d->err, RT_ERR_INVALID,
+                           "%s: byte %zu: chunk header runs past the end of the file (%u bytes)", d->path, off, length);
+        uint32_t clen = rd32(f + off), ctype = rd32(f + off + 4);
+        if (clen > length - off - 8)
+            return rt_fail(d->err, RT_ERR_INVALID,
+                           "%s: byte %zu: chunk length %u runs past the end of the file (%u bytes)", d->path, off, clen,
+                           length);
+        const uint8_t *data = f + off + 8;
+        if (chunk == 0) {
+            if (ctype != 0x4E4F534Au)
+                return rt_fail(d->err, RT_ERR_INVALID,
+                               "%s: byte %zu: the first chunk must be JSON (type 0x4E4F534A), got 0x%08X", d->path,
+                               off + 4, ctype);
+            d->json_text = (const char *)data;
+            d->json_len = clen;
+            d->json_base = off + 8;
+        } else if (ctype == 0x004E4942u) {
+            if (chunk != 1)
+                return rt_fail(d->err, RT_ERR_INVALID, "%s: byte %zu: the BIN chunk must be the second chunk", d->path,
+                               off + 4);
+            d->bin = data;
+            d->bin_size = clen;
+        } else if (ctype == 0x4E4F534Au) {
+            return rt_fail(d->err, RT_ERR_INVALID, "%s: byte %zu: a second JSON chunk", d->path, off + 4);
+        } /* unknown chunk types are skipped, as the spec says */
+        off += 8 + (size_t)clen;
+        off = (off + 3) & ~(size_t)3; /* chunks are 4-byte aligned */
+        chunk++;
+    }
+    return RT_OK;
+}
+
+/* ----------------------------------------------------------- parsing */
+
+static const struct { const char *name; bool supported; } known_extensions[] = {
+    {"KHR_materials_emissive_strength", true}, {"KHR_texture_transform", true},
+    {"KHR_materials_transmission", true},      {"KHR_materials_ior", true},
+    {"KHR_materials_volume", true},            {"KHR_materials_unlit", true},
+    {"KHR_lights_punctual", true},             {"KHR_mesh_quantization", true},
+    {"KHR_xmp", true},                         {"KHR_xmp_json_ld", true}, /* metadata only */
+};
+
+static bool extension_supported(const gl_doc *d, int t)
+{
+    for (size_t i = 0; i < sizeof known_extensions / sizeof known_extensions[0]; i++)
+        if (rt_json_key_is(&d->j, t, known_extensions[i].name))
+            return known_extensions[i].supported;
+    return false;
+}
+
+static rt_result check_extensions(gl_doc *d)
+{
+    char name[128];
+    int req = rt_json_get(&d->j, 0, "extensionsRequired");
+    if (req >= 0) {
+        TRY(expect_array(d, req, "glTF", "extensionsRequired"));
+        FOR_ITEMS(d, req, i, e) {
+            TRY(get_string(d, "glTF", "extensionsRequired", e, name, sizeof name));
+            if (!extension_supported(d, e))
+                return fail_at(d, e, RT_ERR_UNSUPPORTED, "required extension %s is not supported", name);
+        }
+    }
+    int used = rt_json_get(&d->j, 0, "extensionsUsed");
+    if (used >= 0) {
+        TRY(expect_array(d, used, "glTF", "extensionsUsed"));
+        FOR_ITEMS(d, used, i, e) {
+            TRY(get_string(d, "glTF", "extensionsUsed", e, name, sizeof name));
+            if (!extension_supported(d, e))
+                rt_warn("%s: extension %s is not supported; ignored", d->path, name);
+        }
+    }
+    return RT_OK;
+}
+
+static rt_result parse_asset(gl_doc *d, int t)
+{
+    TRY(expect_object(d, t, "asset"));
+    int v = rt_json_get(&d->j, t, "version");
+    char buf[32];
+    if (v < 0)
+        return fail_at(d, t, RT_ERR_INVALID, "asset.version is missing");
+    TRY(get_string(d, "asset", "version", v, buf, sizeof buf));
+    int minv = rt_json_get(&d->j, t, "minVersion");
+    char mbuf[32];
+    if (minv >= 0) {
+        TRY(get_string(d, "asset", "minVersion", minv, mbuf, sizeof mbuf));
+        if (strcmp(mbuf, "2.0") != 0)
+            return fail_at(d, minv, RT_ERR_UNSUPPORTED, "asset.minVersion %s is not supported (only 2.0)", mbuf);
+    } else if (buf[0] != '2' || buf[1] != '.') {
+        return fail_at(d, v, RT_ERR_UNSUPPORTED, "glTF version %s is not supported (only 2.x)", buf);
+    }
+    return RT_OK;
+}
+
+static rt_result parse_buffers(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "buffers", sizeof(gl_buffer), (void **)&d->buffers, &d->buffer_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "buffers[%d]", i);
+        gl_buffer *b = &d->buffers[i];
+        b->uri = -1;
+        b->tok = e;
+        b->byte_length = SIZE_MAX;
+        TRY(expect_object(d, e, where));
+        FOR_KEYS(d, e, k, v) {
+            if (KEY(k, "uri")) {
+                if (jtype(d, v) != RT_JSON_STRING)
+                    return fail_at(d, v, RT_ERR_INVALID, "%s.uri: expected a string", where);
+                b->uri = v;
+            } else if (KEY(k, "byteLength")) {
+                TRY(get_size(d, where, "byteLength", v, &b->byte_length));
+            }
+        }
+        if (b->byte_length == SIZE_MAX || b->byte_length == 0)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: byteLength is missing or 0", where);
+    }
+    return RT_OK;
+}
+
+static rt_result parse_views(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "bufferViews", sizeof(gl_view), (void **)&d->views, &d->view_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "bufferViews[%d]", i);
+        gl_view *bv = &d->views[i];
+        bv->buffer = RT_NONE;
+        bv->length = SIZE_MAX;
+        bv->tok = e;
+        TRY(expect_object(d, e, where));
+        FOR_KEYS(d, e, k, v) {
+            if (KEY(k, "buffer")) TRY(get_index(d, where, "buffer", v, &bv->buffer));
+            else if (KEY(k, "byteOffset")) TRY(get_size(d, where, "byteOffset", v, &bv->offset));
+            else if (KEY(k, "byteLength")) TRY(get_size(d, where, "byteLength", v, &bv->length));
+            else if (KEY(k, "byteStride")) {
+                TRY(get_size(d, where, "byteStride", v, &bv->stride));
+                if (bv->stride < 4 || bv->stride > 252 || bv->stride % 4)
+                    return fail_at(d, v, RT_ERR_INVALID, "%s.byteStride %zu must be a multiple of 4 in [4, 252]",
+                                   where, bv->stride);
+            }
+        }
+        if (bv->buffer == RT_NONE)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: buffer is missing", where);
+        if (bv->length == SIZE_MAX || bv->length == 0)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: byteLength is missing or 0", where);
+    }
+    return RT_OK;
+}
+
+static size_t comp_size(int ct)
+{
+    switch (ct) {
+    case GL_BYTE: case GL_UNSIGNED_BYTE: return 1;
+    case GL_SHORT: case GL_UNSIGNED_SHORT: return 2;
+    case GL_UNSIGNED_INT: case GL_FLOAT: return 4;
+    }
+    return 0;
+}
+
+/* Element size with the spec's column padding for matrices ("Data Alignment"). */
+static size_t elem_size(const gl_accessor *a)
+{
+    size_t cs = comp_size(a->ctype);
+    if (a->cols > 1) {
+        size_t col = ((size_t)a->rows * cs + 3) & ~(size_t)3;
+        return col * (size_t)a->cols;
+    }
+    return (size_t)a->ncomp * cs;
+}
+
+static rt_result parse_sparse(gl_doc *d, const char *where, int t, gl_accessor *a)
+{
+    char w[80];
+    snprintf(w, sizeof w, "%s.sparse", where);
+    TRY(expect_object(d, t, w));
+    bool have_count = false, have_idx = false, have_val = false;
+    a->sp_idx_view = a->sp_val_view = RT_NONE;
+    FOR_KEYS(d, t, k, v) {
+        if (KEY(k, "count")) {
+            TRY(get_size(d, w, "count", v, &a->sparse_count));
+            have_count = true;
+        } else if (KEY(k, "indices")) {
+            char wi[96];
+            snprintf(wi, sizeof wi, "%s.indices", w);
+            TRY(expect_object(d, v, wi));
+            have_idx = true;
+            a->sp_idx_ctype = 0;
+            FOR_KEYS(d, v, k2, v2) {
+                if (KEY(k2, "bufferView")) TRY(get_index(d, wi, "bufferView", v2, &a->sp_idx_view));
+                else if (KEY(k2, "byteOffset")) TRY(get_size(d, wi, "byteOffset", v2, &a->sp_idx_offset));
+                else if (KEY(k2, "componentType")) TRY(get_int(d, wi, "componentType", v2, &a->sp_idx_ctype));
+            }
+            if (a->sp_idx_ctype != GL_UNSIGNED_BYTE && a->sp_idx_ctype != GL_UNSIGNED_SHORT &&
+                a->sp_idx_ctype != GL_UNSIGNED_INT)
+                return fail_at(d, v, RT_ERR_INVALID, "%s: componentType must be 5121, 5123 or 5125", wi);
+        } else if (KEY(k, "values")) {
+            char wv[96];
+            snprintf(wv, sizeof wv, "%s.values", w);
+            TRY(expect_object(d, v, wv));
+            have_val = true;
+            FOR_KEYS(d, v, k2, v2) {
+                if (KEY(k2, "bufferView")) TRY(get_index(d, wv, "bufferView", v2, &a->sp_val_view));
+                else if (KEY(k2, "byteOffset")) TRY(get_size(d, wv, "byteOffset", v2, &a->sp_val_offset));
+            }
+        }
+    }
+    if (!have_count || !have_idx || !have_val || a->sp_idx_view == RT_NONE || a->sp_val_view == RT_NONE)
+        return fail_at(d, t, RT_ERR_INVALID, "%s: needs count, indices.bufferView and values.bufferView", w);
+    if (a->sparse_count == 0 || a->sparse_count > a->count)
+        return fail_at(d, t, RT_ERR_INVALID, "%s.count %zu must be in [1, accessor count %zu]", w, a->sparse_count,
+                       a->count);
+    return RT_OK;
+}
+
+static rt_result parse_accessors(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "accessors", sizeof(gl_accessor), (void **)&d->accessors, &d->accessor_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "accessors[%d]", i);
+        gl_accessor *a = &d->accessors[i];
+        a->view = RT_NONE;
+        a->count = SIZE_MAX;
+        a->tok = e;
+        TRY(expect_object(d, e, where));
+        int sparse = -1;
+        char type[16] = "";
+        FOR_KEYS(d, e, k, v) {
+            if (KEY(k, "bufferView")) TRY(get_index(d, where, "bufferView", v, &a->view));
+            else if (KEY(k, "byteOffset")) TRY(get_size(d, where, "byteOffset", v, &a->offset));
+            else if (KEY(k, "componentType")) TRY(get_int(d, where, "componentType", v, &a->ctype));
+            else if (KEY(k, "normalized")) TRY(get_bool(d, where, "normalized", v, &a->normalized));
+            else if (KEY(k, "count")) TRY(get_size(d, where, "count", v, &a->count));
+            else if (KEY(k, "type")) TRY(get_string(d, where, "type", v, type, sizeof type));
+            else if (KEY(k, "sparse")) sparse = v;
+        }
+        if (comp_size(a->ctype) == 0)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: componentType %d is not one of 5120 5121 5122 5123 5125 5126",
+                           where, a->ctype);
+        static const struct { const char *n; int comp, rows, cols; } types[] = {
+            {"SCALAR", 1, 1, 1}, {"VEC2", 2, 2, 1}, {"VEC3", 3, 3, 1}, {"VEC4", 4, 4, 1},
+            {"MAT2", 4, 2, 2},   {"MAT3", 9, 3, 3}, {"MAT4", 16, 4, 4}};
+        for (size_t k = 0; k < sizeof types / sizeof types[0]; k++)
+            if (strcmp(type, types[k].n) == 0) {
+                a->ncomp = types[k].comp;
+                a->rows = types[k].rows;
+                a->cols = types[k].cols;
+            }
+        if (a->ncomp == 0)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: type \"%s\" is not SCALAR, VECn or MATn", where, type);
+        if (a->count == SIZE_MAX || a->count == 0)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: count is missing or 0", where);
+        if (a->normalized && (a->ctype == GL_FLOAT || a->ctype == GL_UNSIGNED_INT))
+            return fail_at(d, e, RT_ERR_INVALID, "%s: normalized is not allowed for componentType %d", where, a->ctype);
+        if (sparse >= 0)
+            TRY(parse_sparse(d, where, sparse, a));
+    }
+    return RT_OK;
+}
+
+static rt_result parse_meshes(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "meshes", sizeof(gl_mesh), (void **)&d->meshes, &d->mesh_count));
+    /* count primitives first so they live in one table */
+    size_t total = 0;
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "meshes[%d]", i);
+        TRY(expect_object(d, e, where));
+        int p = rt_json_get(&d->j, e, "primitives");
+        if (p < 0)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: primitives is missing", where);
+        TRY(expect_array(d, p, where, "primitives"));
+        if (jsize(d, p) == 0)
+            return fail_at(d, p, RT_ERR_INVALID, "%s.primitives is empty", where);
+        total += (size_t)jsize(d, p);
+    }
+    d->prims = rt_alloc(total, sizeof(gl_prim));
+    if (!d->prims)
+        return fail_at(d, t, RT_ERR_NOMEM, "out of memory for %zu primitives", total);
+    FOR_ITEMS(d, t, i, e) {
+        gl_mesh *m = &d->meshes[i];
+        m->tok = e;
+        int p = rt_json_get(&d->j, e, "primitives");
+        m->first = (uint32_t)d->prim_count;
+        m->count = (uint32_t)jsize(d, p);
+        FOR_ITEMS(d, p, pi, pe) {
+            char where[64];
+            snprintf(where, sizeof where, "meshes[%d].primitives[%d]", i, pi);
+            gl_prim *pr = &d->prims[d->prim_count++];
+            pr->tok = pe;
+            pr->mode = 4;
+            pr->indices = pr->material = RT_NONE;
+            for (int a = 0; a < ATTR_COUNT; a++)
+                pr->attr[a] = RT_NONE;
+            TRY(expect_object(d, pe, where));
+            bool have_attrs = false;
+            FOR_KEYS(d, pe, k, v) {
+                if (KEY(k, "indices")) TRY(get_index(d, where, "indices", v, &pr->indices));
+                else if (KEY(k, "material")) TRY(get_index(d, where, "material", v, &pr->material));
+                else if (KEY(k, "mode")) {
+                    TRY(get_int(d, where, "mode", v, &pr->mode));
+                    if (pr->mode < 0 || pr->mode > 6)
+                        return fail_at(d, v, RT_ERR_INVALID, "%s.mode %d is not in [0, 6]", where, pr->mode);
+                } else if (KEY(k, "targets")) {
+                    TRY(expect_array(d, v, where, "targets"));
+                    pr->targets = jsize(d, v) > 0;
+                } else if (KEY(k, "attributes")) {
+                    char wa[96];
+                    snprintf(wa, sizeof wa, "%s.attributes", where);
+                    TRY(expect_object(d, v, wa));
+                    have_attrs = true;
+                    FOR_KEYS(d, v, k2, v2) {
+                        for (int a = 0; a < ATTR_COUNT; a++)
+                            if (KEY(k2, attr_names[a]))
+                                TRY(get_index(d, wa, attr_names[a], v2, &pr->attr[a]));
+                    }
+                }
+            }
+            if (!have_attrs)
+                return fail_at(d, pe, RT_ERR_INVALID, "%s: attributes is missing", where);
+        }
+    }
+    return RT_OK;
+}
+
+/* glTF matrices are column-major; rt_mat4 is m[row][col]. */
+static rt_mat4 mat_from_gltf(const float *c)
+{
+    rt_mat4 r;
+    for (int row = 0; row < 4; row++)
+        for (int col = 0; col < 4; col++)
+            r.m[row][col] = c[col * 4 + row];
+    return r;
+}
+
+/* Items of a table that each hold an optional array of indices under
+ * `member` ("children" of nodes, "nodes" of scenes) share one flat array.
+ * The first pass checks the items and arrays and allocates room for all
+ * their indices; read_index_list then fills it item by item. */
+static rt_result alloc_index_lists(gl_doc *d, int t, const char *table, const char *member, uint32_t **out)
+{
+    size_t total = 0;
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "%s[%d]", table, i);
+        TRY(expect_object(d, e, where));
+        int a = rt_json_get(&d->j, e, member);
+        if (a >= 0) {
+            TRY(expect_array(d, a, where, member));
+            total += (size_t)jsize(d, a);
+        }
+    }
+    *out = rt_alloc(total, sizeof(uint32_t));
+    if (!*out)
+        return fail_at(d, t, RT_ERR_NOMEM, "out of memory for %zu %s of %s", total, member, table);
+    return RT_OK;
+}
+
+/* Appends item e's indices to list (*used so far) and counts them in *n. */
+static rt_result read_index_list(gl_doc *d, int e, const char *where, const char *member, uint32_t *list, size_t *used,
+                                 uint32_t *n)
+{
+    int a = rt_json_get(&d->j, e, member); /* the token the counting pass saw, even if the key is repeated */
+    if (a < 0)
+        return RT_OK;
+    FOR_ITEMS(d, a, i, x) {
+        uint32_t index;
+        TRY(get_index(d, where, member, x, &index));
+        list[(*used)++] = index;
+        (*n)++;
+    }
+    return RT_OK;
+}
+
+static rt_result parse_nodes(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "nodes", sizeof(gl_node), (void **)&d->nodes, &d->node_count));
+    TRY(alloc_index_lists(d, t, "nodes", "children", &d->children));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "nodes[%d]", i);
+        gl_node *n = &d->nodes[i];
+        n->tok = e;
+        n->mesh = n->camera = n->light = n->skin = n->parent = RT_NONE;
+        n->first_child = (uint32_t)d->children_count;
+        bool have_matrix = false, have_trs = false;
+        float matrix[16], tr[3] = {0, 0, 0}, rot[4] = {0, 0, 0, 1}, sc[3] = {1, 1, 1};
+        FOR_KEYS(d, e, k, v) {
+            if (KEY(k, "mesh")) TRY(get_index(d, where, "mesh", v, &n->mesh));
+            else if (KEY(k, "camera")) TRY(get_index(d, where, "camera", v, &n->camera));
+            else if (KEY(k, "skin")) TRY(get_index(d, where, "skin", v, &n->skin));
+            else if (KEY(k, "matrix")) {
+                TRY(get_floats(d, where, "matrix", v, matrix, 16));
+                have_matrix = true;
+            } else if (KEY(k, "translation")) {
+                TRY(get_floats(d, where, "translation", v, tr, 3));
+                have_trs = true;
+            } else if (KEY(k, "rotation")) {
+                TRY(get_floats(d, where, "rotation", v, rot, 4));
+                have_trs = true;
+            } else if (KEY(k, "scale")) {
+                TRY(get_floats(d, where, "scale", v, sc, 3));
+                have_trs = true;
+            } else if (KEY(k, "extensions")) {
+                int l = rt_json_get(&d->j, v, "KHR_lights_punctual");
+                if (l >= 0) {
+                    TRY(expect_object(d, l, where));
+                    int li = rt_json_get(&d->j, l, "light");
+                    if (li >= 0)
+                        TRY(get_index(d, where, "extensions.KHR_lights_punctual.light", li, &n->light));
+                }
+            }
+        }
+        TRY(read_index_list(d, e, where, "children", d->children, &d->children_count, &n->child_count));
+        if (have_matrix) {
+            if (have_trs)
+                rt_warn("%s: %s has both matrix and TRS; using the matrix", d->path, where);
+            n->local = mat_from_gltf(matrix);
+        } else {
+            double q2 = (double)rot[0] * rot[0] + (double)rot[1] * rot[1] + (double)rot[2] * rot[2] +
+                        (double)rot[3] * rot[3];
+            rt_vec4 q = rt_v4(0, 0, 0, 1);
+            if (q2 > 1e-12) {
+                float s = (float)(1.0 / sqrt(q2)); /* exporters round; renormalise */
+                q = rt_v4(rot[0] * s, rot[1] * s, rot[2] * s, rot[3] * s);
+            } else {
+                rt_warn("%s: %s.rotation is a zero quaternion; using identity", d->path, where);
+            }
+            n->local = rt_mat4_mul(rt_mat4_translate(rt_v3(tr[0], tr[1], tr[2])),
+                                   rt_mat4_mul(rt_mat4_quat(q), rt_mat4_scale(rt_v3(sc[0], sc[1], sc[2]))));
+        }
+    }
+    return RT_OK;
+}
+
+static rt_result parse_scenes(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "scenes", sizeof(gl_scene), (void **)&d->scenes, &d->scene_count));
+    TRY(alloc_index_lists(d, t, "scenes", "nodes", &d->scene_nodes));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "scenes[%d]", i);
+        gl_scene *sc = &d->scenes[i];
+        sc->tok = e;
+        sc->first = (uint32_t)d->scene_nodes_count;
+        TRY(read_index_list(d, e, where, "nodes", d->scene_nodes, &d->scene_nodes_count, &sc->count));
+    }
+    return RT_OK;
+}
+
+/* A textureInfo: index, texCoord, KHR_texture_transform. */
+static rt_result parse_texinfo(gl_doc *d, const char *where, const char *key, int t, rt_texture_slot *slot,
+                               float *extra, const char *extra_key)
+{
+    char w[128];
+    snprintf(w, sizeof w, "%s.%s", where, key);
+    TRY(expect_object(d, t, w));
+    uint32_t index = RT_NONE;
+    int texcoord = 0;
+    FOR_KEYS(d, t, k, v) {
+        if (KEY(k, "index")) TRY(get_index(d, w, "index", v, &index));
+        else if (KEY(k, "texCoord")) TRY(get_int(d, w, "texCoord", v, &texcoord));
+        else if (extra_key && KEY(k, extra_key)) TRY(get_float(d, w, extra_key, v, extra));
+        else if (KEY(k, "extensions")) {
+            int x = rt_json_get(&d->j, v, "KHR_texture_transform");
+            if (x < 0)
+                continue;
+            char wx[200];
+            snprintf(wx, sizeof wx, "%s.extensions.KHR_texture_transform", w);
+            TRY(expect_object(d, x, wx));
+            float off[2] = {0, 0}, scale[2] = {1, 1}, rot = 0;
+            FOR_KEYS(d, x, k2, v2) {
+                if (KEY(k2, "offset")) TRY(get_floats(d, wx, "offset", v2, off, 2));
+                else if (KEY(k2, "scale")) TRY(get_floats(d, wx, "scale", v2, scale, 2));
+                else if (KEY(k2, "rotation")) TRY(get_float(d, wx, "rotation", v2, &rot));
+                else if (KEY(k2, "texCoord")) TRY(get_int(d, wx, "texCoord", v2, &texcoord));
+            }
+            /* matrix = T(offset) * R(rotation) * S(scale) with R, row-major,
+             * = [cos sin; -sin cos]: u' = u cos + v sin, v' = -u sin + v cos.
+             * This is the direction Babylon.js, three.js, Cesium, Blender and
+             * the TextureTransformTest sample agree on ("counter-clockwise" in
+             * glTF's v-down UV space); the README's GLSL listing, read as
+             * GLSL's column-major, rotates the other way (KhronosGroup/glTF
+             * issue 1563). */
+            float c = cosf(rot), s = sinf(rot);
+            slot->uv_transform[0] = c * scale[0];
+            slot->uv_transform[1] = s * scale[1];
+            slot->uv_transform[2] = off[0];
+            slot->uv_transform[3] = -s * scale[0];
+            slot->uv_transform[4] = c * scale[1];
+            slot->uv_transform[5] = off[1];
+        }
+    }
+    if (index == RT_NONE)
+        return fail_at(d, t, RT_ERR_INVALID, "%s: index is missing", w);
+    if (texcoord < 0)
+        return fail_at(d, t, RT_ERR_INVALID, "%s: texCoord %d is negative", w, texcoord);
+    if (texcoord > 1) {
+        rt_warn("%s: %s uses TEXCOORD_%d; only sets 0 and 1 are loaded, using 0", d->path, w, texcoord);
+        texcoord = 0;
+    }
+    slot->texture = index;
+    slot->texcoord = (uint8_t)texcoord;
+    return RT_OK;
+}
+
+/* Phong fields from the metallic-roughness model, for the whitted
+ * integrator (docs/gltf.md, "Material mapping"). */
+static void derive_phong(rt_material *m)
+{
+    float metal = rt_clampf(m->metallic, 0, 1), rough = rt_clampf(m->roughness, 0, 1);
+    float f0 = 0.04f + (1.0f - 0.04f) * metal;       /* mean normal-incidence reflectance */
+    m->diffuse = 0.8f * (1.0f - metal) + 0.2f * metal; /* metals keep a little colour */
+    m->specular = f0 * (1.0f - 0.5f * rough);
+    float a = rough * rough;                          /* GGX alpha */
+    float a2 = a * a;
+    m->shininess = a2 > 1e-6f ? rt_clampf(2.0f / a2 - 2.0f, 1.0f, 4096.0f) : 4096.0f;
+    float smooth = (1.0f - rough) * (1.0f - rough);
+    m->reflectivity = metal * smooth;
+}
+
+static rt_result parse_materials(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "materials", sizeof(gl_material), (void **)&d->materials, &d->material_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "materials[%d]", i);
+        gl_material *gm = &d->materials[i];
+        rt_material *m = &gm->m;
+        gm->tok = e;
+        char name[64];
+        snprintf(name, sizeof name, "material%d", i);
+        rt_material_default(m, name);
+        m->color = rt_v3s(1);
+        m->metallic = 1;
+        m->roughness = 1;
+        m->double_sided = false;
+        m->transmission_color = rt_v3s(1);
+        TRY(expect_object(d, e, where));
+        FOR_KEYS(d, e, k, v) {
+            if (KEY(k, "name")) {
+                if (rt_json_string(&d->j, v, m->name, sizeof m->name) < 0) /* long names: keep the default */
+                    snprintf(m->name, sizeof m->name, "%s", name);
+            } else if (KEY(k, "pbrMetallicRoughness")) {
+                char wp[80];
+                snprintf(wp, sizeof wp, "%s.pbrMetallicRoughness", where);
+                TRY(expect_object(d, v, wp));
+                FOR_KEYS(d, v, k2, v2) {
+                    if (KEY(k2, "baseColorFactor")) {
+                        float c[4];
+                        TRY(get_floats(d, wp, "baseColorFactor", v2, c, 4));
+                        m->color = rt_v3(c[0], c[1], c[2]);
+                        m->alpha = c[3];
+                    } else if (KEY(k2, "metallicFactor")) TRY(get_float(d, wp, "metallicFactor", v2, &m->metallic));
+                    else if (KEY(k2, "roughnessFactor")) TRY(get_float(d, wp, "roughnessFactor", v2, &m->roughness));
+                    else if (KEY(k2, "baseColorTexture"))
+                        TRY(parse_texinfo(d, wp, "baseColorTexture", v2, &m->base_color_tex, NULL, NULL));
+                    else if (KEY(k2, "metallicRoughnessTexture"))
+                        TRY(parse_texinfo(d, wp, "metallicRoughnessTexture", v2, &m->metal_rough_tex, NULL, NULL));
+                }
+            } else if (KEY(k, "normalTexture")) {
+                TRY(parse_texinfo(d, where, "normalTexture", v, &m->normal_tex, &m->normal_scale, "scale"));
+            } else if (KEY(k, "occlusionTexture")) {
+                TRY(parse_texinfo(d, where, "occlusionTexture", v, &m->occlusion_tex, &m->occlusion_strength,
+                                  "strength"));
+            } else if (KEY(k, "emissiveTexture")) {
+                TRY(parse_texinfo(d, where, "emissiveTexture", v, &m->emissive_tex, NULL, NULL));
+            } else if (KEY(k, "emissiveFactor")) {
+                float c[3];
+                TRY(get_floats(d, where, "emissiveFactor", v, c, 3));
+                m->emission = rt_v3(c[0], c[1], c[2]);
+            } else if (KEY(k, "alphaMode")) {
+                char mode[16];
+                TRY(get_string(d, where, "alphaMode", v, mode, sizeof mode));
+                if (strcmp(mode, "OPAQUE") == 0) m->alpha_mode = RT_ALPHA_OPAQUE;
+                else if (strcmp(mode, "MASK") == 0) m->alpha_mode = RT_ALPHA_MASK;
+                else if (strcmp(mode, "BLEND") == 0) m->alpha_mode = RT_ALPHA_BLEND;
+                else
+                    return fail_at(d, v, RT_ERR_INVALID, "%s.alphaMode \"%s\" is not OPAQUE, MASK or BLEND", where,
+                                   mode);
+            } else if (KEY(k, "alphaCutoff")) {
+                TRY(get_float(d, where, "alphaCutoff", v, &m->alpha_cutoff));
+            } else if (KEY(k, "doubleSided")) {
+                TRY(get_bool(d, where, "doubleSided", v, &m->double_sided));
+            } else if (KEY(k, "extras")) {
+                /* extras are free-form: only an object with "bsdf": "lambertian"
+                 * means something to rt (a pure Lambertian surface, as the
+                 * shared reference scenes use); anything else is ignored */
+                int b = rt_json_get(&d->j, v, "bsdf");
+                char bsdf[16];
+                if (b >= 0 && rt_json_string(&d->j, b, bsdf, sizeof bsdf) >= 0 && strcmp(bsdf, "lambertian") == 0)
+                    m->bsdf = RT_BSDF_LAMBERT;
+            } else if (KEY(k, "extensions")) {
+                char wx[96];
+                snprintf(wx, sizeof wx, "%s.extensions", where);
+                TRY(expect_object(d, v, wx));
+                FOR_KEYS(d, v, k2, v2) {
+                    char we[160];
+                    if (KEY(k2, "KHR_materials_emissive_strength")) {
+                        snprintf(we, sizeof we, "%s.KHR_materials_emissive_strength", wx);
+                        TRY(expect_object(d, v2, we));
+                        int s = rt_json_get(&d->j, v2, "emissiveStrength");
+                        if (s >= 0)
+                            TRY(get_float(d, we, "emissiveStrength", s, &m->emission_strength));
+                    } else if (KEY(k2, "KHR_materials_transmission")) {
+                        snprintf(we, sizeof we, "%s.KHR_materials_transmission", wx);
+                        TRY(expect_object(d, v2, we));
+                        FOR_KEYS(d, v2, k3, v3) {
+                            if (KEY(k3, "transmissionFactor"))
+                                TRY(get_float(d, we, "transmissionFactor", v3, &m->transmission));
+                            else if (KEY(k3, "transmissionTexture"))
+                                TRY(parse_texinfo(d, we, "transmissionTexture", v3, &m->transmission_tex, NULL, NULL));
+                        }
+                    } else if (KEY(k2, "KHR_materials_ior")) {
+                        snprintf(we, sizeof we, "%s.KHR_materials_ior", wx);
+                        TRY(expect_object(d, v2, we));
+                        int s = rt_json_get(&d->j, v2, "ior");
+                        if (s >= 0)
+                            TRY(get_float(d, we, "ior", s, &m->ior));
+                    } else if (KEY(k2, "KHR_materials_volume")) {
+                        snprintf(we, sizeof we, "%s.KHR_materials_volume", wx);
+                        TRY(expect_object(d, v2, we));
+                        FOR_KEYS(d, v2, k3, v3) {
+                            if (KEY(k3, "thicknessFactor")) TRY(get_float(d, we, "thicknessFactor", v3, &m->thickness));
+                            else if (KEY(k3, "attenuationDistance"))
+                                TRY(get_float(d, we, "attenuationDistance", v3, &m->attenuation_distance));
+                            else if (KEY(k3, "attenuationColor")) {
+                                float c[3];
+                                TRY(get_floats(d, we, "attenuationColor", v3, c, 3));
+                                m->attenuation_color = rt_v3(c[0], c[1], c[2]);
+                            }
+                        }
+                        if (!(m->attenuation_distance > 0))
+                            return fail_at(d, v2, RT_ERR_INVALID, "%s.attenuationDistance must be positive", we);
+                    } else if (KEY(k2, "KHR_materials_unlit")) {
+                        m->unlit = true;
+                    }
+                }
+            }
+        }
+        /* transmitted light is tinted by the base colour (KHR_materials_transmission) */
+        m->transmission_color = m->color;
+        derive_phong(m);
+    }
+    return RT_OK;
+}
+
+static rt_result parse_textures(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "textures", sizeof(gl_texture), (void **)&d->textures, &d->texture_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "textures[%d]", i);
+        gl_texture *tx = &d->textures[i];
+        tx->tok = e;
+        tx->source = tx->sampler = RT_NONE;
+        TRY(expect_object(d, e, where));
+        FOR_KEYS(d, e, k, v) {
+            if (KEY(k, "source")) TRY(get_index(d, where, "source", v, &tx->source));
+            else if (KEY(k, "sampler")) TRY(get_index(d, where, "sampler", v, &tx->sampler));
+        }
+    }
+    return RT_OK;
+}
+
+static rt_result parse_samplers(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "samplers", sizeof(gl_sampler), (void **)&d->samplers, &d->sampler_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "samplers[%d]", i);
+        gl_sampler *sm = &d->samplers[i];
+        sm->tok = e;
+        sm->wrap_s = sm->wrap_t = 10497;
+        TRY(expect_object(d, e, where));
+        FOR_KEYS(d, e, k, v) {
+            if (KEY(k, "magFilter")) TRY(get_int(d, where, "magFilter", v, &sm->mag));
+            else if (KEY(k, "minFilter")) TRY(get_int(d, where, "minFilter", v, &sm->min));
+            else if (KEY(k, "wrapS")) TRY(get_int(d, where, "wrapS", v, &sm->wrap_s));
+            else if (KEY(k, "wrapT")) TRY(get_int(d, where, "wrapT", v, &sm->wrap_t));
+        }
+        int w[2] = {sm->wrap_s, sm->wrap_t};
+        for (int k = 0; k < 2; k++)
+            if (w[k] != 33071 && w[k] != 33648 && w[k] != 10497)
+                return fail_at(d, e, RT_ERR_INVALID, "%s: wrap mode %d is not 33071, 33648 or 10497", where, w[k]);
+        if (sm->mag != 0 && sm->mag != 9728 && sm->mag != 9729)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: magFilter %d is not 9728 or 9729", where, sm->mag);
+    }
+    return RT_OK;
+}
+
+static rt_result parse_images(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "images", sizeof(gl_image), (void **)&d->images, &d->image_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "images[%d]", i);
+        gl_image *im = &d->images[i];
+        im->tok = e;
+        im->uri = -1;
+        im->view = RT_NONE;
+        TRY(expect_object(d, e, where));
+        FOR_KEYS(d, e, k, v) {
+            if (KEY(k, "uri")) {
+                if (jtype(d, v) != RT_JSON_STRING)
+                    return fail_at(d, v, RT_ERR_INVALID, "%s.uri: expected a string", where);
+                im->uri = v;
+            } else if (KEY(k, "bufferView")) {
+                TRY(get_index(d, where, "bufferView", v, &im->view));
+            }
+        }
+        if ((im->uri < 0) == (im->view == RT_NONE))
+            return fail_at(d, e, RT_ERR_INVALID, "%s: needs exactly one of uri and bufferView", where);
+    }
+    return RT_OK;
+}
+
+static rt_result parse_cameras(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "cameras", sizeof(gl_camera), (void **)&d->cameras, &d->camera_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "cameras[%d]", i);
+        gl_camera *c = &d->cameras[i];
+        c->tok = e;
+        TRY(expect_object(d, e, where));
+        char type[16] = "";
+        int persp = -1;
+        FOR_KEYS(d, e, k, v) {
+            if (KEY(k, "type")) TRY(get_string(d, where, "type", v, type, sizeof type));
+            else if (KEY(k, "perspective")) persp = v;
+        }
+        if (strcmp(type, "perspective") == 0) {
+            c->perspective = true;
+            if (persp < 0)
+                return fail_at(d, e, RT_ERR_INVALID, "%s: perspective is missing", where);
+            char wp[64];
+            snprintf(wp, sizeof wp, "%s.perspective", where);
+            TRY(expect_object(d, persp, wp));
+            c->yfov = -1;
+            FOR_KEYS(d, persp, k, v) {
+                if (KEY(k, "yfov")) TRY(get_float(d, wp, "yfov", v, &c->yfov));
+                else if (KEY(k, "aspectRatio")) TRY(get_float(d, wp, "aspectRatio", v, &c->aspect));
+                else if (KEY(k, "znear")) TRY(get_float(d, wp, "znear", v, &c->znear));
+                else if (KEY(k, "zfar")) TRY(get_float(d, wp, "zfar", v, &c->zfar));
+            }
+            if (!(c->yfov > 0 && c->yfov < RT_PI))
+                return fail_at(d, persp, RT_ERR_INVALID, "%s.yfov must be in (0, pi)", wp);
+        } else if (strcmp(type, "orthographic") != 0) {
+            return fail_at(d, e, RT_ERR_INVALID, "%s: type \"%s\" is not perspective or orthographic", where, type);
+        }
+    }
+    return RT_OK;
+}
+
+static rt_result parse_lights(gl_doc *d, int ext)
+{
+    TRY(expect_object(d, ext, "extensions"));
+    int l = rt_json_get(&d->j, ext, "KHR_lights_punctual");
+    if (l < 0)
+        return RT_OK;
+    TRY(expect_object(d, l, "extensions.KHR_lights_punctual"));
+    int t = rt_json_get(&d->j, l, "lights");
+    if (t < 0)
+        return RT_OK;
+    TRY(alloc_table(d, t, "lights", sizeof(gl_light), (void **)&d->lights, &d->light_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[64];
+        snprintf(where, sizeof where, "KHR_lights_punctual.lights[%d]", i);
+        gl_light *g = &d->lights[i];
+        g->tok = e;
+        g->color = rt_v3s(1);
+        g->intensity = 1;
+        g->inner = 0;
+        g->outer = RT_PI / 4;
+        TRY(expect_object(d, e, where));
+        char type[16] = "";
+        FOR_KEYS(d, e, k, v) {
+            if (KEY(k, "type")) TRY(get_string(d, where, "type", v, type, sizeof type));
+            else if (KEY(k, "color")) {
+                float c[3];
+                TRY(get_floats(d, where, "color", v, c, 3));
+                g->color = rt_v3(c[0], c[1], c[2]);
+            } else if (KEY(k, "intensity")) TRY(get_float(d, where, "intensity", v, &g->intensity));
+            else if (KEY(k, "range")) TRY(get_float(d, where, "range", v, &g->range));
+            else if (KEY(k, "spot")) {
+                TRY(expect_object(d, v, where));
+                FOR_KEYS(d, v, k2, v2) {
+                    if (KEY(k2, "innerConeAngle")) TRY(get_float(d, where, "spot.innerConeAngle", v2, &g->inner));
+                    else if (KEY(k2, "outerConeAngle")) TRY(get_float(d, where, "spot.outerConeAngle", v2, &g->outer));
+                }
+            }
+        }
+        if (strcmp(type, "point") == 0) g->kind = RT_LIGHT_POINT;
+        else if (strcmp(type, "spot") == 0) g->kind = RT_LIGHT_SPOT;
+        else if (strcmp(type, "directional") == 0) g->kind = RT_LIGHT_DIRECTIONAL;
+        else return fail_at(d, e, RT_ERR_INVALID, "%s: type \"%s\" is not point, spot or directional", where, type);
+        if (g->range < 0)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: range must be positive", where);
+        if (!(g->inner >= 0 && g->inner < g->outer && g->outer <= RT_PI / 2 + 1e-6f))
+            return fail_at(d, e, RT_ERR_INVALID, "%s: spot cones need 0 <= inner < outer <= pi/2", where);
+    }
+    return RT_OK;
+}
+
+static rt_result parse_document(gl_doc *d)
+{
+    TRY(rt_json_parse(&d->j, d->json_text, d->json_len, d->path, d->json_base, d->err));
+    TRY(expect_object(d, 0, "glTF"));
+    TRY(check_extensions(d));
+    bool have_asset = false;
+    d->default_scene = RT_NONE;
+    FOR_KEYS(d, 0, k, v) {
+        if (KEY(k, "asset")) { TRY(parse_asset(d, v)); have_asset = true; }
+        else if (KEY(k, "buffers")) TRY(parse_buffers(d, v));
+        else if (KEY(k, "bufferViews")) TRY(parse_views(d, v));
+        else if (KEY(k, "accessors")) TRY(parse_accessors(d, v));
+        else if (KEY(k, "meshes")) TRY(parse_meshes(d, v));
+        else if (KEY(k, "nodes")) TRY(parse_nodes(d, v));
+        else if (KEY(k, "scenes")) TRY(parse_scenes(d, v));
+        else if (KEY(k, "scene")) TRY(get_index(d, "glTF", "scene", v, &d->default_scene));
+        else if (KEY(k, "materials")) TRY(parse_materials(d, v));
+        else if (KEY(k, "textures")) TRY(parse_textures(d, v));
+        else if (KEY(k, "samplers")) TRY(parse_samplers(d, v));
+        else if (KEY(k, "images")) TRY(parse_images(d, v));
+        else if (KEY(k, "cameras")) TRY(parse_cameras(d, v));
+        else if (KEY(k, "extensions")) TRY(parse_lights(d, v));
+        else if (KEY(k, "skins")) {
+            TRY(expect_array(d, v, "glTF", "skins"));
+            d->skin_count = (size_t)jsize(d, v);
+        }
+    }
+    if (!have_asset)
+        return fail_at(d, 0, RT_ERR_INVALID, "asset is missing (not a glTF file?)");
+    return RT_OK;
+}
+
+/* ---------------------------------------------------------- validation */
+
+#define CHECK_INDEX(idx, count, tok, table, ...)                                                            \
+    do {                                                                                                    \
+        if ((idx) != RT_NONE && (size_t)(idx) >= (count)) {                                                 \
+            char what_[160];                                                                                \
+            snprintf(what_, sizeof what_, __VA_ARGS__);                                                     \
+            return fail_at(d, tok, RT_ERR_INVALID, "%s %u is out of range (the file has %zu %s)", what_,    \
+                           (unsigned)(idx), (size_t)(count), table);                                        \
+        }                                                                                                   \
+    } while (0)
+
+/* Does [offset, offset + count * stride - stride + elem) fit in length? */
+static bool span_fits(size_t offset, size_t count, size_t stride, size_t elem, size_t length)
+{
+    if (offset > length || elem > length - offset)
+        return false;
+    if (count <= 1)
+        return true;
+    size_t room = length - offset - elem;
+    return stride == 0 ? true : (count - 1) <= room / stride;
+}
+
+static rt_result validate(gl_doc *d)
+{
+    for (size_t i = 0; i < d->view_count; i++) {
+        const gl_view *v = &d->views[i];
+        CHECK_INDEX(v->buffer, d->buffer_count, v->tok, "buffers", "bufferViews[%zu].buffer", i);
+        size_t blen = d->buffers[v->buffer].byte_length;
+        if (!span_fits(v->offset, 1, 0, v->length, blen))
+            return fail_at(d, v->tok, RT_ERR_INVALID,
+                           "bufferViews[%zu]: byteOffset %zu + byteLength %zu runs past buffer %u (%zu bytes)", i,
+                           v->offset, v->length, v->buffer, blen);
+    }
+    for (size_t i = 0; i < d->accessor_count; i++) {
+        gl_accessor *a = &d->accessors[i];
+        size_t es = elem_size(a);
+        if (a->view != RT_NONE) {
+            CHECK_INDEX(a->view, d->view_count, a->tok, "bufferViews", "accessors[%zu].bufferView", i);
+            const gl_view *v = &d->views[a->view];
+            size_t stride = v->stride ? v->stride : es;
+            if (stride < es)
+                return fail_at(d, a->tok, RT_ERR_INVALID,
+                               "accessors[%zu]: bufferView %u has byteStride %zu, less than the element size %zu", i,
+                               a->view, v->stride, es);
+            if (!span_fits(a->offset, a->count, stride, es, v->length))
+                return fail_at(d, a->tok, RT_ERR_INVALID,
+                               "accessors[%zu]: byteOffset %zu + %zu elements of %zu bytes (stride %zu) run past "
+                               "bufferView %u (%zu bytes)",
+                               i, a->offset, a->count, es, stride, a->view, v->length);
+        } else if (a->count > GL_MAX_ZEROS) {
+            return fail_at(d, a->tok, RT_ERR_LIMIT,
+                           "accessors[%zu]: count %zu without a bufferView is over the limit %zu", i, a->count,
+                           GL_MAX_ZEROS);
+        }
+        if (a->sparse_count) {
+            CHECK_INDEX(a->sp_idx_view, d->view_count, a->tok, "bufferViews",
+                        "accessors[%zu].sparse.indices.bufferView", i);
+            CHECK_INDEX(a->sp_val_view, d->view_count, a->tok, "bufferViews",
+                        "accessors[%zu].sparse.values.bufferView", i);
+            size_t ics = comp_size(a->sp_idx_ctype);
+            if (!span_fits(a->sp_idx_offset, a->sparse_count, ics, ics, d->views[a->sp_idx_view].length))
+                return fail_at(d, a->tok, RT_ERR_INVALID, "accessors[%zu].sparse.indices run past bufferView %u", i,
+                               a->sp_idx_view);
+            if (!span_fits(a->sp_val_offset, a->sparse_count, es, es, d->views[a->sp_val_view].length))
+                return fail_at(d, a->tok, RT_ERR_INVALID, "accessors[%zu].sparse.values run past bufferView %u", i,
+                               a->sp_val_view);
+        }
+    }
+    for (size_t m = 0; m < d->mesh_count; m++) {
+        for (uint32_t p = 0; p < d->meshes[m].count; p++) {
+            const gl_prim *pr = &d->prims[d->meshes[m].first + p];
+            CHECK_INDEX(pr->material, d->material_count, pr->tok, "materials",
+                        "meshes[%zu].primitives[%u].material", m, p);
+            CHECK_INDEX(pr->indices, d->accessor_count, pr->tok, "accessors",
+                        "meshes[%zu].primitives[%u].indices", m, p);
+            if (pr->indices != RT_NONE) {
+                const gl_accessor *a = &d->accessors[pr->indices];
+                if (a->ncomp != 1 || a->normalized ||
+                    (a->ctype != GL_UNSIGNED_BYTE && a->ctype != GL_UNSIGNED_SHORT && a->ctype != GL_UNSIGNED_INT))
+                    return fail_at(d, pr->tok, RT_ERR_INVALID,
+                                   "meshes[%zu].primitives[%u].indices: accessor %u must be SCALAR of unsigned "
+                                   "byte, short or int",
+                                   m, p, pr->indices);
+            }
+            size_t count = 0;
+            for (int k = 0; k < ATTR_COUNT; k++) {
+                uint32_t ai = pr->attr[k];
+                CHECK_INDEX(ai, d->accessor_count, pr->tok, "accessors",
+                            "meshes[%zu].primitives[%u].attributes.%s", m, p,
+                            attr_names[k]);
+                if (ai == RT_NONE)
+                    continue;
+                const gl_accessor *a = &d->accessors[ai];
+                /* types and component types of the spec's attribute table,
+                 * widened by KHR_mesh_quantization (accepted whether or not
+                 * the file declares it) */
+                bool ok = a->cols == 1, ct = false;
+                bool f = a->ctype == GL_FLOAT, n = a->normalized;
+                bool s8s16 = a->ctype == GL_BYTE || a->ctype == GL_SHORT;
+                bool u8u16 = a->ctype == GL_UNSIGNED_BYTE || a->ctype == GL_UNSIGNED_SHORT;
+                switch (k) {
+                case ATTR_POSITION: ok = ok && a->ncomp == 3; ct = f || s8s16 || u8u16; break;
+                case ATTR_NORMAL: ok = ok && a->ncomp == 3; ct = f || (s8s16 && n); break;
+                case ATTR_TANGENT: ok = ok && a->ncomp == 4; ct = f || (s8s16 && n); break;
+                case ATTR_TEXCOORD_0: case ATTR_TEXCOORD_1: ok = ok && a->ncomp == 2; ct = f || s8s16 || u8u16; break;
+                case ATTR_COLOR_0: ok = ok && (a->ncomp == 3 || a->ncomp == 4); ct = f || (u8u16 && n); break;
+                }
+                if (!ok)
+                    return fail_at(d, pr->tok, RT_ERR_INVALID,
+                                   "meshes[%zu].primitives[%u].attributes.%s: accessor %u has the wrong type", m, p,
+                                   attr_names[k], ai);
+                if (!ct)
+                    return fail_at(d, pr->tok, RT_ERR_INVALID,
+                                   "meshes[%zu].primitives[%u].attributes.%s: accessor %u has componentType %d%s, "
+                                   "which this attribute does not allow",
+                                   m, p, attr_names[k], ai, a->ctype, n ? " (normalized)" : "");
+                if (count && a->count != count)
+                    return fail_at(d, pr->tok, RT_ERR_INVALID,
+                                   "meshes[%zu].primitives[%u].attributes.%s: accessor %u has %zu elements, the "
+                                   "others %zu",
+                                   m, p, attr_names[k], ai, a->count, count);
+                count = a->count;
+            }
+        }
+    }
+    for (size_t i = 0; i < d->node_count; i++) {
+        gl_node *n = &d->nodes[i];
+        CHECK_INDEX(n->mesh, d->mesh_count, n->tok, "meshes", "nodes[%zu].mesh", i);
+        CHECK_INDEX(n->camera, d->camera_count, n->tok, "cameras", "nodes[%zu].camera", i);
+        CHECK_INDEX(n->skin, d->skin_count, n->tok, "skins", "nodes[%zu].skin", i);
+        CHECK_INDEX(n->light, d->light_count, n->tok, "lights", "nodes[%zu].KHR_lights_punctual.light", i);
+        for (uint32_t c = 0; c < n->child_count; c++) {
+            uint32_t ch = d->children[n->first_child + c];
+            CHECK_INDEX(ch, d->node_count, n->tok, "nodes", "nodes[%zu].children", i);
+            if (d->nodes[ch].parent != RT_NONE)
+                return fail_at(d, n->tok, RT_ERR_INVALID, "nodes[%zu]: child %u already has parent node %u", i, ch,
+                               d->nodes[ch].parent);
+            d->nodes[ch].parent = (uint32_t)i;
+        }
+    }
+    /* Each node has at most one parent now. Depths by walking up to a root
+     * or a node of known depth, memoised, so the whole pass is linear; a
+     * walk that meets its own path is a cycle. */
+    {
+        const uint32_t unknown = UINT32_MAX, on_path = UINT32_MAX - 1;
+        uint32_t *depth = rt_alloc(d->node_count, sizeof(uint32_t));
+        uint32_t *path = rt_alloc(GL_MAX_DEPTH + 2, sizeof(uint32_t));
+        if (!depth || !path) {
+            free(depth);
+            free(path);
+            return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
+        }
+        for (size_t i = 0; i < d->node_count; i++)
+            depth[i] = unknown;
+        rt_result r = RT_OK;
+        for (size_t i = 0; i < d->node_count && r == RT_OK; i++) {
+            size_t len = 0;
+            uint32_t n = (uint32_t)i;
+            while (depth[n] == unknown) {
+                if (len > GL_MAX_DEPTH) {
+                    r = fail_at(d, d->nodes[i].tok, RT_ERR_LIMIT, "nodes[%zu] is more than %d levels deep", i,
+                                GL_MAX_DEPTH);
+                    break;
+                }
+                depth[n] = on_path;
+                path[len++] = n;
+                uint32_t p = d->nodes[n].parent;
+                if (p == RT_NONE) {
+                    n = RT_NONE;
+                    break;
+                }
+                if (depth[p] == on_path) {
+                    r = fail_at(d, d->nodes[p].tok, RT_ERR_INVALID, "nodes[%u] is its own ancestor (a cycle)", p);
+                    break;
+                }
+                n = p;
+            }
+            if (r != RT_OK)
+                break;
+            uint32_t base = n == RT_NONE ? 0 : depth[n] + 1;
+            for (size_t k = len; k-- > 0; base++) {
+                if (base > GL_MAX_DEPTH) {
+                    r = fail_at(d, d->nodes[i].tok, RT_ERR_LIMIT, "nodes[%zu] is more than %d levels deep", i,
+                                GL_MAX_DEPTH);
+                    break;
+                }
+                depth[path[k]] = base;
+            }
+        }
+        free(depth);
+        free(path);
+        TRY(r);
+    }
+    /* scene roots: in range, parentless, listed once (mark[n] = scene + 1) */
+    uint32_t *mark = rt_alloc(d->node_count, sizeof(uint32_t));
+    if (!mark)
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
+    for (size_t i = 0; i < d->scene_count; i++) {
+        const gl_scene *sc = &d->scenes[i];
+        for (uint32_t k = 0; k < sc->count; k++) {
+            uint32_t n = d->scene_nodes[sc->first + k];
+            rt_result r = RT_OK;
+            if (n >= d->node_count)
+                r = fail_at(d, sc->tok, RT_ERR_INVALID,
+                            "scenes[%zu].nodes %u is out of range (the file has %zu nodes)", i, n, d->node_count);
+            else if (d->nodes[n].parent != RT_NONE)
+                r = fail_at(d, sc->tok, RT_ERR_INVALID, "scenes[%zu]: node %u is not a root (its parent is node %u)",
+                            i, n, d->nodes[n].parent);
+            else if (mark[n] == i + 1)
+                r = fail_at(d, sc->tok, RT_ERR_INVALID, "scenes[%zu]: node %u is listed twice", i, n);
+            if (r != RT_OK) {
+                free(mark);
+                return r;
+            }
+            mark[n] = (uint32_t)i + 1;
+        }
+    }
+    free(mark);
+    CHECK_INDEX(d->default_scene, d->scene_count, -1, "scenes", "scene");
+    for (size_t i = 0; i < d->material_count; i++) {
+        const rt_material *m = &d->materials[i].m;
+        const rt_texture_slot *slots[] = {&m->base_color_tex, &m->metal_rough_tex, &m->normal_tex,
+                                          &m->occlusion_tex,  &m->emissive_tex,    &m->transmission_tex};
+        for (size_t k = 0; k < sizeof slots / sizeof slots[0]; k++)
+            CHECK_INDEX(slots[k]->texture, d->texture_count, d->materials[i].tok, "textures",
+                        "materials[%zu]: texture", i);
+    }
+    for (size_t i = 0; i < d->texture_count; i++) {
+        CHECK_INDEX(d->textures[i].source, d->image_count, d->textures[i].tok, "images", "textures[%zu].source", i);
+        CHECK_INDEX(d->textures[i].sampler, d->sampler_count, d->textures[i].tok, "samplers",
+                    "textures[%zu].sampler", i);
+    }
+    for (size_t i = 0; i < d->image_count; i++)
+        CHECK_INDEX(d->images[i].view, d->view_count, d->images[i].tok, "bufferViews", "images[%zu].bufferView", i);
+    return RT_OK;
+}
+
+/* ------------------------------------------------------- URIs and data */
+
+static int hexval(char c)
+{
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+}
+
+/* Decodes a data: URI (base64 only) into a fresh buffer. */
+static rt_result decode_data_uri(gl_doc *d, int tok, const char *uri, size_t len, const char *what, uint8_t **out,
+                                 size_t *out_len)
+{
+    const char *comma = memchr(uri, ',', len);
+    if (!comma)
+        return fail_at(d, tok, RT_ERR_INVALID, "%s: data: URI without a ','", what);
+    size_t head = (size_t)(comma - uri);
+    if (head < 12 || memcmp(comma - 7, ";base64", 7) != 0)
+        return fail_at(d, tok, RT_ERR_UNSUPPORTED, "%s: only base64 data: URIs are supported", what);
+    const char *b = comma + 1;
+    size_t blen = len - head - 1;
+    uint8_t *buf = malloc(rt_base64_max_decoded(blen));
+    if (!buf)
+        return fail_at(d, tok, RT_ERR_NOMEM, "%s: out of memory decoding %zu base64 characters", what, blen);
+    size_t n, bad;
+    if (rt_base64_decode(b, blen, buf, &n, &bad) != RT_OK) {
+        free(buf);
+        if (bad >= blen)
+            return fail_at(d, tok, RT_ERR_PARSE, "%s: bad base64 in data: URI (length %zu is not a multiple of 4)",
+                           what, blen);
+        unsigned char c = (unsigned char)b[bad];
+        return fail_at(d, tok, RT_ERR_PARSE, "%s: bad base64 in data: URI: character %zu is '%c' (0x%02X)", what,
+                       head + 1 + bad, c >= 32 && c < 127 ? c : '?', c);
+    }
+    *out = buf;
+    *out_len = n;
+    return RT_OK;
+}
+
+/* Resolves a relative file URI against the .gltf's directory. */
+static rt_result uri_to_path(gl_doc *d, int tok, const char *uri, const char *what, char **out)
+{
+    size_t len = strlen(uri);
+    for (const char *p = uri; *p && *p != '/'; p++)
+        if (*p == ':')
+            return fail_at(d, tok, RT_ERR_UNSUPPORTED, "%s: URI \"%.200s\" has a scheme; only relative paths and "
+                           "data: URIs are supported", what, uri);
+    if (uri[0] == '/' || uri[0] == '\0')
+        return fail_at(d, tok, RT_ERR_INVALID, "%s: URI \"%.200s\" is not a relative path", what, uri);
+    size_t dl = strlen(d->dir);
+    char *path = malloc(dl + len + 1);
+    if (!path)
+        return fail_at(d, tok, RT_ERR_NOMEM, "%s: out of memory", what);
+    memcpy(path, d->dir, dl);
+    size_t o = dl;
+    for (size_t i = 0; i < len; i++) {
+        if (uri[i] == '%') {
+            int h = i + 2 < len ? hexval(uri[i + 1]) : -1, l = i + 2 < len ? hexval(uri[i + 2]) : -1;
+            if (h < 0 || l < 0 || (h == 0 && l == 0)) {
+                free(path);
+                return fail_at(d, tok, RT_ERR_INVALID, "%s: bad percent-encoding in URI \"%.200s\"", what, uri);
+            }
+            path[o++] = (char)(h * 16 + l);
+            i += 2;
+        } else {
+            path[o++] = uri[i];
+        }
+    }
+    path[o] = '\0';
+    *out = path;
+    return RT_OK;
+}
+
+/* The decoded string of token t in a fresh buffer. */
+static rt_result token_string(gl_doc *d, int t, const char *what, char **out)
+{
+    size_t cap = (size_t)(d->j.tok[t].end - d->j.tok[t].start) * 4 + 1; /* \uXXXX never grows */
+    char *s = malloc(cap);
+    if (!s)
+        return fail_at(d, t, RT_ERR_NOMEM, "%s: out of memory", what);
+    if (rt_json_string(&d->j, t, s, cap) < 0) {
+        free(s);
+        return fail_at(d, t, RT_ERR_INVALID, "%s: bad string", what);
+    }
+    *out = s;
+    return RT_OK;
+}
+
+static rt_result load_buffers(gl_doc *d)
+{
+    for (size_t i = 0; i < d->buffer_count; i++) {
+        gl_buffer *b = &d->buffers[i];
+        char what[48];
+        snprintf(what, sizeof what, "buffers[%zu]", i);
+        size_t have = 0;
+        if (b->uri < 0) {
+            if (!d->glb || i != 0 || !d->bin)
+                return fail_at(d, b->tok, RT_ERR_INVALID, "%s has no uri and there is no GLB BIN chunk", what);
+            b->data = d->bin;
+            have = d->bin_size;
+        } else {
+            char *uri;
+            TRY(token_string(d, b->uri, what, &uri));
+            rt_result r;
+            if (strncmp(uri, "data:", 5) == 0) {
+                r = decode_data_uri(d, b->uri, uri, strlen(uri), what, &b->owned, &have);
+            } else {
+                char *path = NULL;
+                r = uri_to_path(d, b->uri, uri, what, &path);
+                if (r == RT_OK) {
+                    char w2[64];
+                    snprintf(w2, sizeof w2, "%s: ", what);
+                    r = read_file(d, path, w2, &b->owned, &have);
+                }
+                free(path);
+            }
+            free(uri);
+            TRY(r);
+            b->data = b->owned;
+        }
+        if (have < b->byte_length)
+            return fail_at(d, b->tok, RT_ERR_INVALID, "%s: byteLength is %zu but only %zu bytes of data exist", what,
+                           b->byte_length, have);
+    }
+    return RT_OK;
+}
+
+/* ---------------------------------------------------------- accessors */
+
+static inline float comp_float(const uint8_t *p, int ct, bool norm)
+{
+    switch (ct) {
+    case GL_FLOAT: { float f; memcpy(&f, p, 4); return f; }
+    case GL_BYTE: { float v = (float)(int8_t)p[0]; return norm ? fmaxf(v / 127.0f, -1.0f) : v; }
+    case GL_UNSIGNED_BYTE: return norm ? p[0] / 255.0f : (float)p[0];
+    case GL_SHORT: { int16_t v; memcpy(&v, p, 2); return norm ? fmaxf(v / 32767.0f, -1.0f) : (float)v; }
+    case GL_UNSIGNED_SHORT: { uint16_t v; memcpy(&v, p, 2); return norm ? v / 65535.0f : (float)v; }
+    case GL_UNSIGNED_INT: { uint32_t v; memcpy(&v, p, 4); return (float)v; }
+    }
+    return 0.0f;
+}
+
+static inline uint32_t comp_uint(const uint8_t *p, int ct)
+{
+    switch (ct) {
+    case GL_UNSIGNED_BYTE: return p[0];
+    case GL_UNSIGNED_SHORT: { uint16_t v; memcpy(&v, p, 2); return v; }
+    case GL_UNSIGNED_INT: { uint32_t v; memcpy(&v, p, 4); return v; }
+    }
+    return 0;
+}
+
+static const uint8_t *view_ptr(const gl_doc *d, uint32_t view, size_t offset)
+{
+    const gl_view *v = &d->views[view];
+    return d->buffers[v->buffer].data + v->offset + offset;
+}
+
+/* Reads the sparse index k, checking order and range. */
+static rt_result sparse_index(gl_doc *d, uint32_t ai, size_t k, size_t *prev, size_t *out)
+{
+    const gl_accessor *a = &d->accessors[ai];
+    size_t cs = comp_size(a->sp_idx_ctype);
+    size_t idx = comp_uint(view_ptr(d, a->sp_idx_view, a->sp_idx_offset) + k * cs, a->sp_idx_ctype);
+    if (idx >= a->count || (k > 0 && idx <= *prev))
+        return fail_at(d, a->tok, RT_ERR_INVALID,
+                       "accessors[%u].sparse.indices: element %zu is %zu (must increase and be below %zu)", ai, k,
+                       idx, a->count);
+    *prev = idx;
+    *out = idx;
+    return RT_OK;
+}
+
+/* Decodes accessor ai into out (count * ncomp floats), sparse applied. */
+static rt_result read_floats(gl_doc *d, uint32_t ai, float *out)
+{
+    const gl_accessor *a = &d->accessors[ai];
+    size_t n = (size_t)a->ncomp, cs = comp_size(a->ctype), es = elem_size(a);
+    if (a->view == RT_NONE) {
+        memset(out, 0, a->count * n * sizeof *out);
+    } else {
+        size_t stride = d->views[a->view].stride ? d->views[a->view].stride : es;
+        const uint8_t *p = view_ptr(d, a->view, a->offset);
+        if (a->ctype == GL_FLOAT) {
+            if (stride == es)
+                memcpy(out, p, a->count * es);
+            else
+                for (size_t i = 0; i < a->count; i++)
+                    memcpy(out + i * n, p + i * stride, es);
+        } else {
+            for (size_t i = 0; i < a->count; i++)
+                for (size_t c = 0; c < n; c++)
+                    out[i * n + c] = comp_float(p + i * stride + c * cs, a->ctype, a->normalized);
+        }
+    }
+    if (a->sparse_count) {
+        const uint8_t *vals = view_ptr(d, a->sp_val_view, a->sp_val_offset);
+        size_t prev = 0, idx;
+        for (size_t k = 0; k < a->sparse_count; k++) {
+            TRY(sparse_index(d, ai, k, &prev, &idx));
+            for (size_t c = 0; c < n; c++)
+                out[idx * n + c] = comp_float(vals + k * es + c * cs, a->ctype, a->normalized);
+        }
+    }
+    return RT_OK;
+}
+
+/* Decodes an index accessor into out (count values), sparse applied. */
+static rt_result read_uints(gl_doc *d, uint32_t ai, uint32_t *out)
+{
+    const gl_accessor *a = &d->accessors[ai];
+    size_t cs = comp_size(a->ctype);
+    if (a->view == RT_NONE) {
+        memset(out, 0, a->count * sizeof *out);
+    } else {
+        size_t stride = d->views[a->view].stride ? d->views[a->view].stride : cs;
+        const uint8_t *p = view_ptr(d, a->view, a->offset);
+        switch (a->ctype) {
+        case GL_UNSIGNED_BYTE:
+            for (size_t i = 0; i < a->count; i++) out[i] = p[i * stride];
+            break;
+        case GL_UNSIGNED_SHORT:
+            for (size_t i = 0; i < a->count; i++) { uint16_t v; memcpy(&v, p + i * stride, 2); out[i] = v; }
+            break;
+        default:
+            if (stride == 4)
+                memcpy(out, p, a->count * 4);
+            else
+                for (size_t i = 0; i < a->count; i++) memcpy(&out[i], p + i * stride, 4);
+        }
+    }
+    if (a->sparse_count) {
+        const uint8_t *vals = view_ptr(d, a->sp_val_view, a->sp_val_offset);
+        size_t prev = 0, idx;
+        for (size_t k = 0; k < a->sparse_count; k++) {
+            TRY(sparse_index(d, ai, k, &prev, &idx));
+            out[idx] = comp_uint(vals + k * cs, a->ctype);
+        }
+    }
+    return RT_OK;
+}
+
+static rt_result scratch(gl_doc *d, int slot, size_t floats, float **out)
+{
+    if (!rt_grow((void **)&d->scratch[slot], &d->scratch_cap[slot], floats ? floats : 1, sizeof(float)))
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu vertex values", d->path, floats);
+    *out = d->scratch[slot];
+    return RT_OK;
+}
+
+/* ------------------------------------------------------------ flatten */
+
+static bool is_triangles(int mode) { return mode == 4 || mode == 5 || mode == 6; }
+
+static size_t prim_triangles(const gl_doc *d, const gl_prim *p)
+{
+    size_t n = p->indices != RT_NONE ? d->accessors[p->indices].count : d->accessors[p->attr[ATTR_POSITION]].count;
+    if (p->mode == 4)
+        return n / 3;
+    return n >= 3 ? n - 2 : 0;
+}
+
+/* The nodes of the chosen scene in depth-first order with world matrices. */
+static rt_result collect_visits(gl_doc *d, const rt_gltf_options *opt)
+{
+    uint32_t scene = d->default_scene;
+    if (opt && opt->use_scene_index) {
+        if (opt->scene_index < 0 || (size_t)opt->scene_index >= d->scene_count)
+            return rt_fail(d->err, RT_ERR_INVALID, "%s: scene %d requested, the file has %zu scenes", d->path,
+                           opt->scene_index, d->scene_count);
+        scene = (uint32_t)opt->scene_index;
+    } else if (scene == RT_NONE && d->scene_count > 0) {
+        scene = 0;
+    }
+    /* roots: the scene's nodes, or every parentless node when there is no scene */
+    size_t root_count = 0;
+    uint32_t *roots = rt_alloc(d->node_count, sizeof(uint32_t));
+    uint32_t *stack = rt_alloc(d->node_count, sizeof(uint32_t));
+    d->visits = rt_alloc(d->node_count, sizeof(gl_visit));
+    d->visit_of = rt_alloc(d->node_count, sizeof(uint32_t));
+    if (!roots || !stack || !d->visits || !d->visit_of) {
+        free(roots);
+        free(stack);
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu nodes", d->path, d->node_count);
+    }
+    if (scene != RT_NONE) {
+        for (uint32_t k = 0; k < d->scenes[scene].count; k++)
+            roots[root_count++] = d->scene_nodes[d->scenes[scene].first + k];
+    } else {
+        for (size_t i = 0; i < d->node_count; i++)
+            if (d->nodes[i].parent == RT_NONE)
+                roots[root_count++] = (uint32_t)i;
+    }
+    rt_mat4 top = opt && opt->use_transform ? opt->transform : rt_mat4_identity();
+    /* Depth-first with an explicit stack; a visit's world matrix is its
+     * parent's (already visited) times its local matrix. The hierarchy is a
+     * forest with unique scene roots (validated), so each node is visited at
+     * most once and the stack never holds more than node_count entries.
+     */
+    for (size_t r = 0; r < root_count; r++) {
+        size_t sp = 0;
+        uint32_t root = roots[r];
+        stack[sp++] = root;
+        while (sp > 0) {
+            uint32_t n = stack[--sp];
+            const gl_node *node = &d->nodes[n];
+            rt_mat4 parent = n == root ? top : d->visits[d->visit_of[node->parent]].world;
+            d->visit_of[n] = (uint32_t)d->visit_count;
+            gl_visit *vis = &d->visits[d->visit_count++];
+            vis->node = n;
+            vis->world = rt_mat4_mul(parent, node->local);
+            for (uint32_t c = node->child_count; c-- > 0;)
+                stack[sp++] = d->children[node->first_child + c];
+        }
+    }
+    free(roots);
+    free(stack);
+    return RT_OK;
+}
+
+static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t mesh, uint32_t pi, const rt_mat4 *M,
+                                uint32_t material, size_t vbase)
+{
+    const gl_prim *p = &d->prims[d->meshes[mesh].first + pi];
+    const gl_accessor *pos = &d->accessors[p->attr[ATTR_POSITION]];
+    size_t vcount = pos->count;
+    rt_vertices *V = &s->vertices;
+    float *f = NULL;
+
+    TRY(scratch(d, ATTR_POSITION, vcount * 3, &f));
+    TRY(read_floats(d, p->attr[ATTR_POSITION], f));
+    for (size_t i = 0; i < vcount; i++) {
+        rt_vec3 q = rt_v3(f[3 * i], f[3 * i + 1], f[3 * i + 2]);
+        if (!rt_finite3(q))
+            return fail_at(d, pos->tok, RT_ERR_INVALID,
+                           "accessors[%u] (POSITION of meshes[%u].primitives[%u]): element %zu is not finite "
+                           "(%g, %g, %g)",
+                           p->attr[ATTR_POSITION], mesh, pi, i, (double)q.x, (double)q.y, (double)q.z);
+        V->position[vbase + i] = rt_mat4_point(M, q);
+    }
+    float det = rt_mat4_det3(M);
+    rt_mat4 N;
+    bool have_n = p->attr[ATTR_NORMAL] != RT_NONE && rt_mat4_normal_matrix(M, &N);
+    uint8_t flags = 0;
+    if (have_n) {
+        TRY(scratch(d, ATTR_NORMAL, vcount * 3, &f));
+        TRY(read_floats(d, p->attr[ATTR_NORMAL], f));
+        for (size_t i = 0; i < vcount; i++) {
+            rt_vec3 n = rt_v3(f[3 * i], f[3 * i + 1], f[3 * i + 2]);
+            V->normal[vbase + i] = rt_finite3(n) ? rt_normalize(rt_mat4_vector(&N, n)) : rt_v3s(0);
+        }
+        flags |= RT_TRI_SMOOTH;
+        if (p->attr[ATTR_TANGENT] != RT_NONE) {
+            TRY(scratch(d, ATTR_TANGENT, vcount * 4, &f));
+            TRY(read_floats(d, p->attr[ATTR_TANGENT], f));
+            float sign = det < 0 ? -1.0f : 1.0f;
+            for (size_t i = 0; i < vcount; i++) {
+                rt_vec3 t = rt_mat4_vector(M, rt_v3(f[4 * i], f[4 * i + 1], f[4 * i + 2]));
+                t = rt_finite3(t) ? rt_normalize(t) : rt_v3s(0);
+                float w = f[4 * i + 3] < 0 ? -sign : sign;
+                V->tangent[vbase + i] = rt_v4(t.x, t.y, t.z, w);
+            }
+            flags |= RT_TRI_TANGENT;
+        }
+    }
+    for (int k = ATTR_TEXCOORD_0; k <= ATTR_TEXCOORD_1; k++) {
+        if (p->attr[k] == RT_NONE)
+            continue;
+        TRY(scratch(d, k, vcount * 2, &f));
+        TRY(read_floats(d, p->attr[k], f));
+        rt_vec2 *uv = k == ATTR_TEXCOORD_0 ? V->uv0 : V->uv1;
+        for (size_t i = 0; i < vcount; i++)
+            uv[vbase + i] = rt_v2(f[2 * i], f[2 * i + 1]);
+        if (k == ATTR_TEXCOORD_0)
+            flags |= RT_TRI_UV;
+    }
+    if (p->attr[ATTR_COLOR_0] != RT_NONE) {
+        const gl_accessor *ca = &d->accessors[p->attr[ATTR_COLOR_0]];
+        size_t nc = (size_t)ca->ncomp;
+        TRY(scratch(d, ATTR_COLOR_0, vcount * nc, &f));
+        TRY(read_floats(d, p->attr[ATTR_COLOR_0], f));
+        for (size_t i = 0; i < vcount; i++)
+            V->color[vbase + i] = rt_v4(f[nc * i], f[nc * i + 1], f[nc * i + 2], nc == 4 ? f[nc * i + 3] : 1.0f);
+        flags |= RT_TRI_COLOR;
+    }
+
+    /* triangles */
+    size_t icount = vcount;
+    const uint32_t *idx = NULL;
+    if (p->indices != RT_NONE) {
+        icount = d->accessors[p->indices].count;
+        if (!rt_grow((void **)&d->idx_scratch, &d->idx_cap, icount, sizeof(uint32_t)))
+            return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu indices", d->path, icount);
+        TRY(read_uints(d, p->indices, d->idx_scratch));
+        idx = d->idx_scratch;
+        for (size_t i = 0; i < icount; i++)
+            if (idx[i] >= vcount)
+                return fail_at(d, d->accessors[p->indices].tok, RT_ERR_INVALID,
+                               "accessors[%u] (indices of meshes[%u].primitives[%u]): element %zu is %u, past the "
+                               "vertex count %zu",
+                               p->indices, mesh, pi, i, idx[i], vcount);
+    }
+    size_t ntri = prim_triangles(d, p);
+    if (p->mode == 4 && icount % 3)
+        rt_warn("%s: meshes[%u].primitives[%u]: %zu indices are not a multiple of 3; the last %zu are ignored",
+                d->path, mesh, pi, icount, icount % 3);
+    rt_triangles *T = &s->triangles;
+    bool flip = det < 0;
+    for (size_t t = 0; t < ntri; t++) {
+        size_t a, b, c;
+        if (p->mode == 4) { a = 3 * t; b = 3 * t + 1; c = 3 * t + 2; }
+        else if (p->mode == 5) { a = t; b = t + 1 + (t % 2); c = t + 2 - (t % 2); }
+        else { a = t + 1; b = t + 2; c = 0; }
+        uint32_t va = (uint32_t)vbase + (idx ? idx[a] : (uint32_t)a);
+        uint32_t vb = (uint32_t)vbase + (idx ? idx[b] : (uint32_t)b);
+        uint32_t vc = (uint32_t)vbase + (idx ? idx[c] : (uint32_t)c);
+        size_t o = T->count++;
+        T->index[3 * o] = va;
+        T->index[3 * o + 1] = flip ? vc : vb;
+        T->index[3 * o + 2] = flip ? vb : vc;
+        T->material[o] = material;
+        T->flags[o] = flags;
+    }
+    return RT_OK;
+}
+
+static rt_result load_image(gl_doc *d, rt_scene *s, uint32_t ii, uint32_t *out)
+{
+    if (d->image_map[ii] != RT_NONE) {
+        *out = d->image_map[ii];
+        return RT_OK;
+    }
+    const gl_image *im = &d->images[ii];
+    char what[48];
+    snprintf(what, sizeof what, "images[%u]", ii);
+    rt_error inner = {0};
+    rt_result r = RT_OK;
+    uint32_t img = RT_NONE;
+    char label[300];
+    if (im->view != RT_NONE) {
+        const gl_view *v = &d->views[im->view];
+        snprintf(label, sizeof label, "bufferView %u", im->view);
+        char name[300];
+        snprintf(name, sizeof name, "%.250s#image%u", d->path, ii);
+        r = rt_image_load_memory(s, d->buffers[v->buffer].data + v->offset, v->length, name, &img, &inner);
+    } else {
+        char *uri;
+        TRY(token_string(d, im->uri, what, &uri));
+        snprintf(label, sizeof label, "\"%.200s%s\"", uri, strlen(uri) > 200 ? "..." : "");
+        if (strncmp(uri, "data:", 5) == 0) {
+            uint8_t *bytes = NULL;
+            size_t n = 0;
+            snprintf(label, sizeof label, "data: URI");
+            r = decode_data_uri(d, im->uri, uri, strlen(uri), what, &bytes, &n);
+            if (r == RT_OK) {
+                char name[300];
+                snprintf(name, sizeof name, "%.250s#image%u", d->path, ii);
+                r = rt_image_load_memory(s, bytes, n, name, &img, &inner);
+            } else {
+                inner = *d->err;
+            }
+            free(bytes);
+        } else {
+            char *path = NULL;
+            r = uri_to_path(d, im->uri, uri, what, &path);
+            if (r == RT_OK)
+                r = rt_image_load_file(s, path, &img, &inner);
+            else
+                inner = *d->err;
+            free(path);
+        }
+        free(uri);
+    }
+    if (r != RT_OK) {
+        if (strncmp(inner.message, d->path, strlen(d->path)) == 0)
+            return rt_fail(d->err, r, "%s", inner.message); /* already names the file and the image */
+        return fail_at(d, im->tok, r, "%s (%s): %s", what, label, inner.message);
+    }
+    d->image_map[ii] = img;
+    *out = img;
+    return RT_OK;
+}
+
+static rt_result load_textures(gl_doc *d, rt_scene *s, rt_gltf_stats *st)
+{
+    d->image_map = rt_alloc(d->image_count, sizeof(uint32_t));
+    d->texture_map = rt_alloc(d->texture_count, sizeof(uint32_t));
+    if (!d->image_map || !d->texture_map)
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
+    for (size_t i = 0; i < d->image_count; i++)
+        d->image_map[i] = RT_NONE;
+    for (size_t i = 0; i < d->texture_count; i++) {
+        const gl_texture *gt = &d->textures[i];
+        d->texture_map[i] = RT_NONE;
+        if (gt->source == RT_NONE) {
+            rt_warn("%s: textures[%zu] has no source rt can read (KTX2/WebP extensions are not supported); "
+                    "left untextured", d->path, i);
+            continue;
+        }
+        bool fresh = d->image_map[gt->source] == RT_NONE;
+        uint32_t img = RT_NONE;
+        TRY(load_image(d, s, gt->source, &img));
+        if (fresh)
+            st->images++;
+        rt_texture tex = rt_texture_image(img);
+        if (gt->sampler != RT_NONE) {
+            const gl_sampler *sm = &d->samplers[gt->sampler];
+            int w[2] = {sm->wrap_s, sm->wrap_t};
+            rt_wrap r[2];
+            for (int k = 0; k < 2; k++)
+                r[k] = w[k] == 33071 ? RT_WRAP_CLAMP : w[k] == 33648 ? RT_WRAP_MIRROR : RT_WRAP_REPEAT;
+            tex.wrap_s = r[0];
+            tex.wrap_t = r[1];
+            tex.filter = sm->mag == 9728 ? RT_FILTER_NEAREST : RT_FILTER_BILINEAR;
+        }
+        uint32_t ti = rt_scene_add_texture(s, &tex);
+        if (ti == RT_NONE)
+            return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding textures", d->path);
+        d->texture_map[i] = ti;
+        st->textures++;
+    }
+    return RT_OK;
+}
+
+static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st)
+{
+    TRY(collect_visits(d, opt));
+    st->nodes = d->visit_count;
+
+    /* Count what the scene will hold, then reserve it all at once. */
+    size_t verts = 0, tris = 0, zeros = 0;
+    unsigned attrs = 0;
+    bool need_default = false, warned_modes = false, warned_skin = false, warned_pos = false;
+    for (size_t v = 0; v < d->visit_count; v++) {
+        const gl_node *n = &d->nodes[d->visits[v].node];
+        if ((n->skin != RT_NONE) && !warned_skin) {
+            rt_warn("%s: skins and morph targets are not applied; meshes are loaded in their rest pose", d->path);
+            warned_skin = true;
+        }
+        if (n->mesh == RT_NONE)
+            continue;
+        const gl_mesh *m = &d->meshes[n->mesh];
+        for (uint32_t k = 0; k < m->count; k++) {
+            const gl_prim *p = &d->prims[m->first + k];
+            if (p->targets && !warned_skin) {
+                rt_warn("%s: skins and morph targets are not applied; meshes are loaded in their rest pose", d->path);
+                warned_skin = true;
+            }
+            if (!is_triangles(p->mode)) {
+                if (!warned_modes)
+                    rt_warn("%s: points and lines primitives (modes 0-3) are skipped", d->path);
+                warned_modes = true;
+                continue;
+            }
+            if (p->attr[ATTR_POSITION] == RT_NONE) {
+                if (!warned_pos)
+                    rt_warn("%s: primitives without POSITION are skipped", d->path);
+                warned_pos = true;
+                continue;
+            }
+            const gl_accessor *pa = &d->accessors[p->attr[ATTR_POSITION]];
+            verts += pa->count;
+            if (pa->view == RT_NONE && (zeros += pa->count) > GL_MAX_ZEROS)
+                return rt_fail(d->err, RT_ERR_LIMIT,
+                               "%s: over %zu vertices come from accessors without a bufferView (instancing "
+                               "included); over the loader's limit",
+                               d->path, GL_MAX_ZEROS);
+            tris += prim_triangles(d, p);
+            if (verts > GL_MAX_VERTICES || tris > GL_MAX_TRIANGLES)
+                return rt_fail(d->err, RT_ERR_LIMIT,
+                               "%s: the scene has over %zu vertices or triangles (instancing included); over the "
+                               "loader's limit",
+                               d->path, GL_MAX_VERTICES);
+            if (p->material == RT_NONE)
+                need_default = true;
+            if (p->attr[ATTR_TEXCOORD_1] != RT_NONE) attrs |= RT_ATTR_UV1;
+            if (p->attr[ATTR_TANGENT] != RT_NONE && p->attr[ATTR_NORMAL] != RT_NONE) attrs |= RT_ATTR_TANGENT;
+            if (p->attr[ATTR_COLOR_0] != RT_NONE) attrs |= RT_ATTR_COLOR;
+            st->primitives++;
+        }
+        st->meshes++;
+    }
+    if (s->vertices.count + verts >= RT_NONE || s->triangles.count + tris >= RT_NONE)
+        return rt_fail(d->err, RT_ERR_LIMIT, "%s: the scene would exceed 2^32 vertices or triangles", d->path);
+
+    TRY(load_textures(d, s, st));
+
+    /* materials: one per glTF material (+ a default for primitives without one) */
+    uint32_t mat_base = (uint32_t)s->material_count;
+    for (size_t i = 0; i < d->material_count; i++) {
+        rt_material m = d->materials[i].m;
+        rt_texture_slot *slots[] = {&m.base_color_tex, &m.metal_rough_tex, &m.normal_tex,
+                                    &m.occlusion_tex,  &m.emissive_tex,    &m.transmission_tex};
+        for (size_t k = 0; k < sizeof slots / sizeof slots[0]; k++)
+            if (slots[k]->texture != RT_NONE)
+                slots[k]->texture = d->texture_map[slots[k]->texture];
+        if (rt_scene_add_material(s, &m) == RT_NONE)
+            return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding materials", d->path);
+        st->materials++;
+    }
+    uint32_t default_mat = RT_NONE;
+    if (need_default) {
+        rt_material m;
+        rt_material_default(&m, "gltf_default");
+        m.color = rt_v3s(1);
+        m.metallic = 1;
+        m.roughness = 1;
+        m.double_sided = false;
+        m.transmission_color = m.color;
+        derive_phong(&m);
+        default_mat = rt_scene_add_material(s, &m);
+        if (default_mat == RT_NONE)
+            return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding materials", d->path);
+        st->materials++;
+    }
+
+    /* geometry */
+    if (attrs && !rt_scene_enable_attr(s, attrs))
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for vertex attributes", d->path);
+    size_t tri_first = s->triangles.count;
+    if (!rt_scene_reserve_triangles(s, tris))
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu triangles", d->path, tris);
+    size_t vbase = s->vertices.count;
+    if (verts && rt_scene_add_vertices(s, verts) == RT_NONE)
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu vertices", d->path, verts);
+    for (size_t v = 0; v < d->visit_count; v++) {
+        const gl_node *n = &d->nodes[d->visits[v].node];
+        if (n->mesh == RT_NONE)
+            continue;
+        const gl_mesh *m = &d->meshes[n->mesh];
+        for (uint32_t k = 0; k < m->count; k++) {
+            const gl_prim *p = &d->prims[m->first + k];
+            if (!is_triangles(p->mode) || p->attr[ATTR_POSITION] == RT_NONE)
+                continue;
+            uint32_t mat = p->material == RT_NONE ? default_mat : mat_base + p->material;
+            TRY(emit_primitive(d, s, n->mesh, k, &d->visits[v].world, mat, vbase));
+            vbase += d->accessors[p->attr[ATTR_POSITION]].count;
+        }
+    }
+    st->triangles = s->triangles.count - tri_first;
+    /* bounds of the vertices triangles use (positions are finite: plain
+     * compares, no fminf calls, which cost more than the rest of the load) */
+    rt_box b = rt_box_empty();
+    const uint32_t *ix = s->triangles.index;
+    for (size_t k = 3 * tri_first; k < 3 * s->triangles.count; k++) {
+        rt_vec3 q = s->vertices.position[ix[k]];
+        b.lo.x = q.x < b.lo.x ? q.x : b.lo.x; b.hi.x = q.x > b.hi.x ? q.x : b.hi.x;
+        b.lo.y = q.y < b.lo.y ? q.y : b.lo.y; b.hi.y = q.y > b.hi.y ? q.y : b.hi.y;
+        b.lo.z = q.z < b.lo.z ? q.z : b.lo.z; b.hi.z = q.z > b.hi.z ? q.z : b.hi.z;
+    }
+    st->bounds = b;
+
+    /* cameras and lights */
+    bool warned_ortho = false;
+    for (size_t v = 0; v < d->visit_count; v++) {
+        const gl_node *n = &d->nodes[d->visits[v].node];
+        const rt_mat4 *W = &d->visits[v].world;
+        rt_vec3 origin = rt_mat4_point(W, rt_v3s(0));
+        rt_vec3 fwd = rt_normalize(rt_mat4_vector(W, rt_v3(0, 0, -1)));
+        if (n->camera != RT_NONE) {
+            const gl_camera *gc = &d->cameras[n->camera];
+            if (!gc->perspective) {
+                if (!warned_ortho)
+                    rt_warn("%s: orthographic cameras are not supported; skipped", d->path);
+                warned_ortho = true;
+            } else {
+                rt_camera c = {0};
+                c.position = origin;
+                c.look_at = rt_add(origin, fwd);
+                c.up = rt_normalize(rt_mat4_vector(W, rt_v3(0, 1, 0)));
+                c.vfov_deg = gc->yfov * (180.0f / RT_PI);
+                c.aspect_ratio = isfinite(gc->aspect) && gc->aspect > 0.0f ? gc->aspect : 0.0f;
+                if (rt_scene_add_camera(s, &c) == RT_NONE)
+                    return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding cameras", d->path);
+                st->cameras++;
+            }
+        }
+        if (n->light != RT_NONE) {
+            const gl_light *gl = &d->lights[n->light];
+            rt_light l;
+            memset(&l, 0, sizeof l);
+            l.kind = gl->kind;
+            l.color = gl->color;
+            l.intensity = gl->intensity;
+            l.position = origin;
+            l.direction = fwd;
+            l.inner_cone = gl->inner;
+            l.outer_cone = gl->outer;
+            l.range = gl->range;
+            l.quad = RT_NONE;
+            if (rt_scene_add_light(s, &l) == RT_NONE)
+                return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding lights", d->path);
+            st->lights++;
+        }
+    }
+    return RT_OK;
+}
+
+/* -------------------------------------------------------------- entry */
+
+static void doc_free(gl_doc *d)
+{
+    for (size_t i = 0; i < d->buffer_count; i++)
+        free(d->buffers[i].owned);
+    free(d->buffers); free(d->views); free(d->accessors); free(d->meshes); free(d->prims);
+    free(d->nodes); free(d->children); free(d->scenes); free(d->scene_nodes); free(d->materials);
+    free(d->textures); free(d->samplers); free(d->images); free(d->cameras); free(d->lights);
+    free(d->visits); free(d->visit_of); free(d->image_map); free(d->texture_map);
+    for (int k = 0; k < ATTR_COUNT; k++)
+        free(d->scratch[k]);
+    free(d->idx_scratch);
+    rt_json_free(&d->j);
+    free(d->file);
+    free(d->dir);
+}
+
+static rt_result load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st)
+{
+    const char *slash = strrchr(d->path, '/');
+    size_t dl = slash ? (size_t)(slash - d->path) + 1 : 0;
+    d->dir = malloc(dl + 1);
+    if (!d->dir)
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
+    memcpy(d->dir, d->path, dl);
+    d->dir[dl] = '\0';
+    if (!d->bytes) {
+        TRY(read_file(d, d->path, "", &d->file, &d->file_size));
+        d->bytes = d->file;
+    }
+    if (d->file_size >= 4 && memcmp(d->bytes, "glTF", 4) == 0) {
+        d->glb = true;
+        TRY(split_glb(d));
+    } else {
+        const char *ext = strrchr(d->path, '.');
+        if (ext && strcmp(ext, ".glb") == 0)
+            return rt_fail(d->err, RT_ERR_INVALID, "%s: byte 0: bad magic (expected \"glTF\" for a .glb file)",
+                           d->path);
+        d->json_text = (const char *)d->bytes;
+        d->json_len = d->file_size;
+        if (d->json_len >= 3 && memcmp(d->json_text, "\xEF\xBB\xBF", 3) == 0) { /* UTF-8 byte order mark */
+            d->json_text += 3;
+            d->json_len -= 3;
+            d->json_base = 3;
+        }
+    }
+    TRY(parse_document(d));
+    TRY(validate(d));
+    TRY(load_buffers(d));
+    return flatten(d, s, opt, st);
+}
+
+static rt_result load_doc(rt_scene *s, const char *path, const void *data, size_t size,
+                          const rt_gltf_options *options, rt_gltf_stats *stats, rt_error *err)
+{
+    rt_error local_err;
+    gl_doc d;
+    memset(&d, 0, sizeof d);
+    d.path = path;
+    d.err = err ? err : &local_err;
+    d.bytes = data;
+    d.file_size = size;
+    rt_gltf_stats st;
+    memset(&st, 0, sizeof st);
+    st.bounds = rt_box_empty();
+    /* remember the table sizes so a failed load leaves the scene as it was */
+    size_t n_mat = s->material_count, n_tex = s->texture_count, n_img = s->image_count, n_light = s->light_count,
+           n_cam = s->camera_count, n_vert = s->vertices.count, n_tri = s->triangles.count;
+    rt_result r = load(&d, s, options, &st);
+    doc_free(&d);
+    if (r != RT_OK) {
+        for (size_t i = n_img; i < s->image_count; i++) {
+            free(s->images[i].rgba8);
+            free(s->images[i].rgbaf);
+        }
+        s->material_count = n_mat;
+        s->texture_count = n_tex;
+        s->image_count = n_img;
+        s->light_count = n_light;
+        s->camera_count = n_cam;
+        s->vertices.count = n_vert;
+        s->triangles.count = n_tri;
+        return r;
+    }
+    if (stats)
+        *stats = st;
+    return RT_OK;
+}
+
+rt_result rt_gltf_load(rt_scene *s, const char *path, const rt_gltf_options *options, rt_gltf_stats *stats,
+                       rt_error *err)
+{
+    if (!path)
+        return rt_fail(err, RT_ERR_IO, "rt_gltf_load: no path");
+    return load_doc(s, path, NULL, 0, options, stats, err);
+}
+
+rt_result rt_gltf_load_memory(rt_scene *s, const void *data, size_t size, const char *name,
+                              const rt_gltf_options *options, rt_gltf_stats *stats, rt_error *err)
+{
+    static const uint8_t empty[1] = {0};
+    if (!data && size)
+        return rt_fail(err, RT_ERR_INVALID, "%s: no data", name ? name : "<memory>");
+    return load_doc(s, name ? name : "<memory>", size ? data : empty, size, options, stats, err);
+}

@@ -1,0 +1,334 @@
+/* bsdf.c - Lambert and the glTF metallic-roughness BSDF for the path
+ * tracer: evaluation, pdf and importance sampling (see rt/bsdf.h).
+ *
+ * Sources:
+ * - The BRDF: glTF 2.0 specification, appendix B "BRDF Implementation"
+ *   (B.3.5, metal-roughness material: c_diff, f0 = lerp(0.04, base,
+ *   metallic), Schlick's F on |V.H|, f = (1 - F) c_diff / pi + F D V), with
+ *   KHR_materials_ior (f0 from the index) and KHR_materials_transmission
+ *   (the dielectric base lobe split between diffuse and a BTDF).
+ * - GGX / Trowbridge-Reitz distribution and its Smith Lambda: Walter,
+ *   Marschner, Li, Torrance 2007, "Microfacet Models for Refraction through
+ *   Rough Surfaces" (EGSR); height-correlated masking-shadowing: Heitz 2014,
+ *   "Understanding the Masking-Shadowing Function in Microfacet-Based
+ *   BRDFs" (JCGT 3(2)), eq. 99: G2 = 1 / (1 + Lambda(wo) + Lambda(wi)).
+ * - Sampling visible normals: Heitz 2018, "Sampling the GGX Distribution
+ *   of Visible Normals" (JCGT 7(4)), listing 1; its pdf D_wo(h) / (4 wo.h)
+ *   = G1(wo) D(h) / (4 wo.z) for reflection.
+ * - Cosine sampling of the diffuse lobe (rt/sampling.h).
+ * - Choosing one lobe by its estimated weight and returning the mixture pdf
+ *   is one-sample MIS over the lobes with the balance heuristic (Veach 1997,
+ *   ch. 9.2.4), so rt_bsdf_eval's pdf is exactly the sampling density.
+ *
+ * The transmission lobe refracts through a GGX microfacet normal sampled
+ * from the visible normals (Walter et al. 2007's rough dielectric BTDF,
+ * with the same alpha; the macro normal, i.e. a smooth dielectric, at the
+ * smallest alpha), Snell's law with the material's ior. It is sampled
+ * only, never evaluated: transmitted rays are not light-sampled, so an
+ * emitter they hit counts in full (no MIS). Radiance is not rescaled by
+ * eta^2 across the interface (it cancels for paths that leave the object
+ * again). Every result is finite: grazing
+ * directions give zero, never a division by zero.
+ */
+#include "rt/render/bsdf.h"
+
+#include "rt/render/sampling.h"
+#include "rt/scene/texture.h"
+
+float rt_ggx_d(rt_vec3 h, float alpha)
+{
+    if (!(h.z > 0.0f))
+        return 0.0f;
+    float a2 = alpha * alpha;
+    float c2 = h.z * h.z;
+    float k = c2 * (a2 - 1.0f) + 1.0f; /* = cos^2 (a^2 - 1) + 1 = a^2 cos^2 + sin^2 */
+    float d = a2 / (RT_PI * k * k);
+    return isfinite(d) ? d : 0.0f;
+}
+
+float rt_ggx_lambda(rt_vec3 w, float alpha)
+{
+    float c2 = w.z * w.z;
+    float s2 = fmaxf(0.0f, w.x * w.x + w.y * w.y);
+    if (!(c2 > 0.0f))
+        return INFINITY;
+    float t2 = alpha * alpha * s2 / c2; /* alpha^2 tan^2 theta */
+    return 0.5f * (sqrtf(1.0f + t2) - 1.0f);
+}
+
+float rt_ggx_g1(rt_vec3 w, float alpha)
+{
+    float l = rt_ggx_lambda(w, alpha);
+    return isfinite(l) ? 1.0f / (1.0f + l) : 0.0f;
+}
+
+float rt_ggx_g2(rt_vec3 wo, rt_vec3 wi, float alpha)
+{
+    float lo = rt_ggx_lambda(wo, alpha), li = rt_ggx_lambda(wi, alpha);
+    if (!isfinite(lo) || !isfinite(li))
+        return 0.0f;
+    return 1.0f / (1.0f + lo + li);
+}
+
+rt_vec3 rt_ggx_sample_vndf(rt_vec3 wo, float alpha, rt_vec2 u)
+{
+    /* stretch the view direction to the hemisphere configuration */
+    rt_vec3 vh = rt_normalize(rt_v3(alpha * wo.x, alpha * wo.y, wo.z));
+    float lensq = vh.x * vh.x + vh.y * vh.y;
+    rt_vec3 t1 = lensq > 1e-14f ? rt_scale(rt_v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(lensq)) : rt_v3(1, 0, 0);
+    rt_vec3 t2 = rt_cross(vh, t1);
+    /* a point on the projected area of the hemisphere */
+    float r = sqrtf(u.x), phi = 2.0f * RT_PI * u.y;
+    float p1 = r * cosf(phi), p2 = r * sinf(phi);
+    float s = 0.5f * (1.0f + vh.z);
+    p2 = (1.0f - s) * sqrtf(fmaxf(0.0f, 1.0f - p1 * p1)) + s * p2;
+    rt_vec3 nh = rt_add(rt_add(rt_scale(t1, p1), rt_scale(t2, p2)),
+                        rt_scale(vh, sqrtf(fmaxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));
+    /* unstretch */
+    rt_vec3 ne = rt_v3(alpha * nh.x, alpha * nh.y, fmaxf(1e-7f, nh.z));
+    return rt_normalize(ne);
+}
+
+float rt_ggx_reflect_pdf(rt_vec3 wo, rt_vec3 wi, float alpha)
+{
+    if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
+        return 0.0f;
+    rt_vec3 h = rt_add(wo, wi);
+    float l2 = rt_length2(h);
+    if (!(l2 > 1e-20f))
+        return 0.0f;
+    h = rt_scale(h, 1.0f / sqrtf(l2));
+    float p = rt_ggx_g1(wo, alpha) * rt_ggx_d(h, alpha) / (4.0f * wo.z);
+    return isfinite(p) ? p : 0.0f;
+}
+
+static inline float schlick_weight(float c)
+{
+    float x = 1.0f - rt_clampf(c, 0.0f, 1.0f);
+    float x2 = x * x;
+    return x2 * x2 * x;
+}
+
+static inline rt_vec3 schlick(rt_vec3 f0, float c)
+{
+    float w = schlick_weight(c);
+    return rt_add(f0, rt_scale(rt_sub(rt_v3s(1.0f), f0), w));
+}
+
+/* Fresnel reflectance at a (micro)facet seen at cosine c from wo. glTF's
+ * Schlick on |wo.h|; for a transmissive surface seen from inside (eta > 1)
+ * Schlick on the refracted side's cosine, 1 beyond the critical angle
+ * (total internal reflection), so reflection and refraction share one F. */
+static inline rt_vec3 fresnel(const rt_bsdf *b, float c)
+{
+    if (b->transmission > 0.0f && b->eta > 1.0f) {
+        float sin2_t = b->eta * b->eta * fmaxf(0.0f, 1.0f - c * c);
+        if (sin2_t >= 1.0f)
+            return rt_v3s(1.0f);
+        c = sqrtf(1.0f - sin2_t);
+    }
+    return schlick(b->f0, c);
+}
+
+static inline float mean3(rt_vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
+
+static void set_frame(rt_bsdf *b, rt_vec3 n, rt_vec3 ng)
+{
+    b->n = n;
+    b->ng = ng;
+    rt_onb(n, &b->t, &b->b);
+}
+
+static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness, float ior, float transmission,
+                       bool lambert)
+{
+    base = rt_vmax(base, rt_v3s(0.0f));
+    if (!rt_finite3(base))
+        base = rt_v3s(0.0f);
+    metallic = isfinite(metallic) ? rt_clampf(metallic, 0.0f, 1.0f) : 0.0f;
+    roughness = isfinite(roughness) ? rt_clampf(roughness, 0.0f, 1.0f) : 1.0f;
+    transmission = isfinite(transmission) ? rt_clampf(transmission, 0.0f, 1.0f) : 0.0f;
+    if (!(ior > 0.0f) || !isfinite(ior))
+        ior = 1.5f;
+    b->lambert = lambert;
+    if (lambert) {
+        b->diffuse = base;
+        b->f0 = rt_v3s(0.0f);
+        b->alpha = 1.0f;
+        b->transmission = 0.0f;
+        b->eta = 1.0f;
+        return;
+    }
+    float r0 = (ior - 1.0f) / (ior + 1.0f);
+    r0 *= r0;
+    b->diffuse = rt_scale(base, 1.0f - metallic);
+    b->f0 = rt_lerp3(rt_v3s(r0), base, metallic);
+    b->alpha = fmaxf(roughness * roughness, RT_BSDF_MIN_ALPHA);
+    b->transmission = transmission;
+    b->eta = 1.0f / ior;
+}
+
+void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float roughness, float ior,
+                  float transmission, bool lambert)
+{
+    set_frame(b, n, n);
+    set_params(b, base, metallic, roughness, ior, transmission, lambert);
+}
+
+void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
+{
+    const rt_scene *s = ctx->scene;
+    rt_material fallback;
+    const rt_material *m = s->material_count ? &s->materials[sf->material] : NULL;
+    if (!m) {
+        rt_material_default(&fallback, "default");
+        m = &fallback;
+    }
+    /* frame: the shading normal, unless wo is not above it (normal maps,
+     * interpolated normals at silhouettes); then the geometric normal */
+    rt_vec3 n = sf->n;
+    if (!(rt_dot(n, sf->wo) > 1e-4f) || !rt_finite3(n))
+        n = sf->ng;
+    set_frame(b, n, sf->ng);
+    rt_vec4 b4 = rt_surface_base_color(ctx, sf);
+    float metallic = m->metallic, roughness = m->roughness, transmission = m->transmission;
+    if (m->bsdf != RT_BSDF_LAMBERT && m->metal_rough_tex.texture != RT_NONE) {
+        rt_vec2 uv = rt_texture_slot_uv(&m->metal_rough_tex, m->metal_rough_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
+        rt_vec4 mr = rt_texture_sample(s, m->metal_rough_tex.texture, uv, false);
+        metallic *= mr.z;
+        roughness *= mr.y;
+    }
+    if (m->bsdf != RT_BSDF_LAMBERT && transmission > 0.0f && m->transmission_tex.texture != RT_NONE) {
+        rt_vec2 uv = rt_texture_slot_uv(&m->transmission_tex,
+                                        m->transmission_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
+        transmission *= rt_texture_sample(s, m->transmission_tex.texture, uv, false).x;
+    }
+    set_params(b, rt_v3(b4.x, b4.y, b4.z), metallic, roughness, m->ior, transmission, m->bsdf == RT_BSDF_LAMBERT);
+    if (!sf->front)
+        b->eta = 1.0f / b->eta; /* leaving the object through its back */
+}
+
+void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit)
+{
+    *p_diffuse = *p_specular = *p_transmit = 0.0f;
+    if (b->lambert) {
+        *p_diffuse = mean3(b->diffuse) > 0.0f ? 1.0f : 0.0f;
+        return;
+    }
+    /* F at the macro normal estimates each lobe's share; the floors keep
+     * every lobe that can contribute at some microfacet sampleable (inside
+     * glass past the critical angle F is 1 at the normal, yet tilted
+     * facets still transmit) */
+    rt_vec3 F = fresnel(b, wo.z);
+    float ws = fmaxf(mean3(F), 0.02f);
+    float wd = mean3(rt_mul(rt_vmax(rt_sub(rt_v3s(1.0f), F), rt_v3s(0.1f)), b->diffuse));
+    float wt = wd * b->transmission;
+    wd *= 1.0f - b->transmission;
+    float sum = ws + wd + wt;
+    if (!(sum > 0.0f) || !isfinite(sum))
+        return;
+    *p_diffuse = wd / sum;
+    *p_specular = ws / sum;
+    *p_transmit = wt / sum;
+}
+
+/* f and pdf of the non-delta lobes, given lobe probabilities. */
+static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, float ps, float *pdf)
+{
+    *pdf = 0.0f;
+    if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
+        return rt_v3s(0.0f);
+    if (b->lambert) {
+        *pdf = pd * wi.z * RT_INV_PI;
+        return rt_scale(b->diffuse, RT_INV_PI);
+    }
+    rt_vec3 h = rt_add(wo, wi);
+    float l2 = rt_length2(h);
+    if (!(l2 > 1e-20f)) /* opposite directions: both grazing */
+        return rt_v3s(0.0f);
+    h = rt_scale(h, 1.0f / sqrtf(l2));
+    float voh = rt_dot(wo, h);
+    rt_vec3 F = fresnel(b, voh);
+    float D = rt_ggx_d(h, b->alpha);
+    float G = rt_ggx_g2(wo, wi, b->alpha);
+    float spec = D * G / (4.0f * wo.z * wi.z);
+    if (!isfinite(spec))
+        spec = 0.0f;
+    rt_vec3 f = rt_scale(rt_mul(rt_sub(rt_v3s(1.0f), F), b->diffuse), (1.0f - b->transmission) * RT_INV_PI);
+    f = rt_add(f, rt_scale(F, spec));
+    float p = pd * wi.z * RT_INV_PI;
+    if (ps > 0.0f) {
+        float pv = rt_ggx_g1(wo, b->alpha) * D / (4.0f * wo.z);
+        if (isfinite(pv))
+            p += ps * pv;
+    }
+    *pdf = p;
+    return f;
+}
+
+rt_vec3 rt_bsdf_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float *pdf)
+{
+    float pd, ps, pt, dummy;
+    rt_bsdf_lobe_probs(b, wo, &pd, &ps, &pt);
+    return eval_lobes(b, wo, wi, pd, ps, pdf ? pdf : &dummy);
+}
+
+bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
+{
+    if (!(wo.z > 0.0f))
+        return false;
+    float pd, ps, pt;
+    rt_bsdf_lobe_probs(b, wo, &pd, &ps, &pt);
+    if (!(pd + ps + pt > 0.0f))
+        return false;
+    if (pt > 0.0f && ulobe >= pd + ps) {
+        /* refraction through a microfacet: the macro normal for the
+         * smoothest surfaces, else a visible normal (Heitz 2018); the
+         * weight f |cos| / pdf of Walter et al.'s BTDF with that sampling
+         * is (1 - F) T c_diff G2 / G1(wo) */
+        bool rough = b->alpha > RT_BSDF_MIN_ALPHA;
+        rt_vec3 h = rough ? rt_ggx_sample_vndf(wo, b->alpha, u) : rt_v3(0.0f, 0.0f, 1.0f);
+        float eta = b->eta;
+        float ci = rt_dot(wo, h);
+        if (!(ci > 0.0f))
+            return false;
+        float sin2_t = eta * eta * fmaxf(0.0f, 1.0f - ci * ci);
+        if (sin2_t >= 1.0f)
+            return false; /* total internal reflection: F = 1, the reflection lobe carries it */
+        float ct = sqrtf(1.0f - sin2_t);
+        rt_vec3 wi = rt_add(rt_scale(wo, -eta), rt_scale(h, eta * ci - ct));
+        if (!(wi.z < 0.0f))
+            return false; /* the microfacet sends it back out */
+        wi = rt_normalize(wi);
+        rt_vec3 F = fresnel(b, ci);
+        float g = rough ? rt_ggx_g2(wo, wi, b->alpha) / rt_ggx_g1(wo, b->alpha) : 1.0f;
+        rt_vec3 w = rt_scale(rt_mul(rt_sub(rt_v3s(1.0f), F), b->diffuse), g * b->transmission / pt);
+        s->wi = wi;
+        s->weight = w;
+        s->pdf = 0.0f;
+        s->delta = true;
+        return rt_finite3(s->wi) && rt_finite3(w);
+    }
+    rt_vec3 wi;
+    if (ulobe < pd || b->lambert || !(ps > 0.0f)) {
+        wi = rt_sample_cosine_hemisphere(u);
+    } else {
+        rt_vec3 h = rt_ggx_sample_vndf(wo, b->alpha, u);
+        wi = rt_sub(rt_scale(h, 2.0f * rt_dot(wo, h)), wo);
+    }
+    if (!(wi.z > 0.0f) || !rt_finite3(wi))
+        return false;
+    wi = rt_normalize(wi);
+    float pdf;
+    rt_vec3 f = eval_lobes(b, wo, wi, pd, ps, &pdf);
+    if (!(pdf > 0.0f) || !isfinite(pdf))
+        return false;
+    rt_vec3 w = rt_scale(f, wi.z / pdf);
+    if (!rt_finite3(w))
+        return false;
+    s->wi = wi;
+    s->weight = w;
+    s->pdf = pdf;
+    s->delta = false;
+    return true;
+}

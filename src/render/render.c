@@ -1,0 +1,296 @@
+/* render.c - the tile queue and its worker threads, the pixel loop, the
+ * progress bar and the live preview.
+ *
+ * Pixel estimate: the box-filtered average of `samples` radiance samples at
+ * correlated multi-jittered positions in the pixel (Kensler 2013), so any
+ * sample count is stratified. A sample that comes back NaN or infinite is
+ * dropped and counted (it shows a bug, not light); the pixel averages the
+ * rest. settings.clamp, when set, caps a sample's luminance.
+ */
+#include "rt/render/render.h"
+
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "rt/render/camera.h"
+#include "rt/render/integrator.h"
+#include "rt/render/path.h"
+#include "rt/render/sampling.h"
+
+int rt_cpu_count(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 ? (n > 1024 ? 1024 : (int)n) : 1;
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+typedef struct render_job {
+    const rt_scene *scene;
+    const rt_kdtree *tree;
+    rt_framebuffer *fb;
+    rt_camera_frame camera;
+    int tile_size, tiles_x, tiles_y, tiles_total;
+    atomic_int next_tile;
+    atomic_int tiles_done;
+    atomic_uchar *tile_finished; /* per tile: 1 once its pixels are final */
+    atomic_int *cancel;
+    const rt_light_table *lights; /* path tracer's emitter table, shared read-only */
+} render_job;
+
+typedef struct worker {
+    pthread_t thread;
+    render_job *job;
+    uint64_t rays, camera_rays, bad_samples;
+} worker;
+
+/* Renders one tile; false when cancelled part-way (the tile then stays
+ * unfinished and is cleared to black). The cancel flag is read once a
+ * pixel, so Ctrl-C is answered within a pixel's samples, not a tile's. */
+static bool render_tile(render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
+{
+    const rt_settings *st = &job->scene->settings;
+    int tx = tile % job->tiles_x, ty = tile / job->tiles_x;
+    int x0 = tx * job->tile_size, y0 = ty * job->tile_size;
+    int x1 = x0 + job->tile_size, y1 = y0 + job->tile_size;
+    if (x1 > job->fb->width) x1 = job->fb->width;
+    if (y1 > job->fb->height) y1 = job->fb->height;
+    uint32_t spp = st->samples > 0 ? (uint32_t)st->samples : 1;
+    for (int y = y0; y < y1; y++) {
+        for (int x = x0; x < x1; x++) {
+            if (job->cancel && atomic_load_explicit(job->cancel, memory_order_relaxed))
+                return false;
+            uint64_t pixel = (uint64_t)y * (uint64_t)job->fb->width + (uint64_t)x;
+            uint32_t pattern = (uint32_t)rt_mix64(pixel ^ ((uint64_t)st->seed << 40));
+            rt_vec3 sum = rt_v3s(0);
+            uint32_t good = 0;
+            for (uint32_t s = 0; s < spp; s++) {
+                rt_vec2 j = spp > 1 ? rt_cmj_sample(s, spp, pattern) : rt_v2(0.5f, 0.5f);
+                rt_vec2 lens = rt_cmj_sample(s, spp, pattern ^ 0x68bc21ebu);
+                rt_ray ray = rt_camera_ray(&job->camera, (float)x + j.x, (float)y + j.y, lens);
+                rt_rng rng = rt_rng_for_sample(st->seed, pixel, s);
+                w->camera_rays++;
+                rt_vec3 L = rt_radiance(ctx, &ray, &rng);
+                if (!rt_finite3(L) || L.x < 0.0f || L.y < 0.0f || L.z < 0.0f) {
+                    w->bad_samples++;
+                    continue;
+                }
+                if (st->clamp > 0.0f) {
+                    float lum = rt_luminance(L);
+                    if (lum > st->clamp)
+                        L = rt_scale(L, st->clamp / lum);
+                }
+                sum = rt_add(sum, L);
+                good++;
+            }
+            if (good)
+                sum = rt_scale(sum, 1.0f / (float)good);
+            float *px = job->fb->rgb + 3 * pixel;
+            px[0] = sum.x;
+            px[1] = sum.y;
+            px[2] = sum.z;
+        }
+    }
+    return true;
+}
+
+static void *worker_main(void *arg)
+{
+    worker *w = arg;
+    render_job *job = w->job;
+    rt_trace_ctx ctx;
+    rt_trace_ctx_init(&ctx, job->scene, job->tree);
+    ctx.light_table = job->lights;
+    ctx.ray_count = &w->rays;
+    for (;;) {
+        if (job->cancel && atomic_load(job->cancel))
+            break;
+        int tile = atomic_fetch_add(&job->next_tile, 1);
+        if (tile >= job->tiles_total)
+            break;
+        if (!render_tile(job, w, &ctx, tile))
+            break;
+        atomic_store(&job->tile_finished[tile], 1);
+        atomic_fetch_add(&job->tiles_done, 1);
+    }
+    return NULL;
+}
+
+static void draw_progress(int done, int total, double elapsed, bool final)
+{
+    const int width = 30;
+    double f = total ? (double)done / total : 1.0;
+    int bar = (int)(f * width + 0.5);
+    char line[128];
+    int n = 0;
+    line[n++] = '[';
+    for (int i = 0; i < width; i++)
+        line[n++] = i < bar ? '#' : ' ';
+    line[n++] = ']';
+    line[n] = 0;
+    double eta = (done > 0 && done < total) ? elapsed * (total - done) / done : 0.0;
+    fprintf(stderr, "\r%s %5.1f%%  %6.1fs elapsed", line, 100.0 * f, elapsed);
+    if (!final && done > 0)
+        fprintf(stderr, "  ETA %6.1fs ", eta);
+    else
+        fprintf(stderr, "              ");
+    if (final)
+        fputc('\n', stderr);
+    fflush(stderr);
+}
+
+/* Live view: a copy of the framebuffer where unfinished tiles are dim grey. */
+static void write_preview(render_job *job, const char *path)
+{
+    rt_framebuffer copy;
+    rt_error err;
+    if (rt_framebuffer_init(&copy, job->fb->width, job->fb->height, &err) != RT_OK)
+        return;
+    for (int t = 0; t < job->tiles_total; t++) {
+        bool fin = atomic_load(&job->tile_finished[t]);
+        int tx = t % job->tiles_x, ty = t / job->tiles_x;
+        for (int y = ty * job->tile_size; y < (ty + 1) * job->tile_size && y < copy.height; y++)
+            for (int x = tx * job->tile_size; x < (tx + 1) * job->tile_size && x < copy.width; x++) {
+                size_t i = 3 * ((size_t)y * (size_t)copy.width + (size_t)x);
+                for (int c = 0; c < 3; c++)
+                    copy.rgb[i + c] = fin ? job->fb->rgb[i + c] : 0.02f;
+            }
+    }
+    if (rt_framebuffer_write(&copy, path, job->scene->settings.exposure, &err) != RT_OK)
+        rt_warn("live preview: %s", err.message);
+    rt_framebuffer_free(&copy);
+}
+
+rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_render_options *options,
+                    rt_framebuffer *fb, rt_render_stats *stats, rt_error *err)
+{
+    rt_render_options opt;
+    memset(&opt, 0, sizeof opt);
+    if (options)
+        opt = *options;
+    rt_render_stats st;
+    memset(&st, 0, sizeof st);
+    const rt_settings *set = &scene->settings;
+    if (fb->width != set->width || fb->height != set->height || !fb->rgb)
+        return rt_fail(err, RT_ERR_INVALID, "framebuffer is %dx%d but the scene asks for %dx%d", fb->width,
+                       fb->height, set->width, set->height);
+
+    render_job job;
+    memset(&job, 0, sizeof job);
+    job.scene = scene;
+    job.tree = tree;
+    job.fb = fb;
+    job.cancel = opt.cancel;
+    rt_camera_frame_init(&job.camera, &scene->camera, fb->width, fb->height);
+    job.tile_size = opt.tile_size > 0 ? (opt.tile_size < 65536 ? opt.tile_size : 65536) : 32;
+    job.tiles_x = (int)(((int64_t)fb->width + job.tile_size - 1) / job.tile_size);
+    job.tiles_y = (int)(((int64_t)fb->height + job.tile_size - 1) / job.tile_size);
+    if ((int64_t)job.tiles_x * job.tiles_y > (int64_t)(1 << 26))
+        return rt_fail(err, RT_ERR_LIMIT, "%dx%d image in %d-pixel tiles makes %lld tiles, over the limit of %d; use larger tiles",
+                       fb->width, fb->height, job.tile_size, (long long)job.tiles_x * job.tiles_y, 1 << 26);
+    job.tiles_total = job.tiles_x * job.tiles_y;
+    atomic_init(&job.next_tile, 0);
+    atomic_init(&job.tiles_done, 0);
+    job.tile_finished = rt_alloc((size_t)job.tiles_total, sizeof *job.tile_finished);
+    int nthreads = opt.threads > 0 ? opt.threads : rt_cpu_count();
+    if (nthreads > 1024)
+        nthreads = 1024;
+    worker *workers = rt_alloc((size_t)nthreads, sizeof *workers);
+    if (!job.tile_finished || !workers) {
+        free(job.tile_finished);
+        free(workers);
+        return rt_fail(err, RT_ERR_NOMEM, "out of memory setting up %d render threads", nthreads);
+    }
+    for (int t = 0; t < job.tiles_total; t++)
+        atomic_init(&job.tile_finished[t], 0);
+    /* the path tracer's emitter table: built once, before the workers */
+    rt_light_table lights;
+    memset(&lights, 0, sizeof lights);
+    if (set->integrator == RT_INTEGRATOR_PATH) {
+        rt_result lr = rt_light_table_build(&lights, scene, err);
+        if (lr != RT_OK) {
+            free(job.tile_finished);
+            free(workers);
+            return lr;
+        }
+        job.lights = &lights;
+    }
+
+    double t0 = now_seconds();
+    int started = 0;
+    for (int i = 0; i < nthreads; i++) {
+        workers[i].job = &job;
+        if (pthread_create(&workers[i].thread, NULL, worker_main, &workers[i]) != 0)
+            break;
+        started++;
+    }
+    if (started < nthreads) /* out of memory for stacks, or a process limit: fewer threads, same image */
+        rt_warn("could start only %d of %d render threads%s", started, nthreads,
+                started ? "" : "; rendering on the main thread");
+    if (started == 0) {
+        /* no threads could be started: render on this one */
+        workers[0].job = &job;
+        worker_main(&workers[0]);
+    }
+    bool show = opt.progress && isatty(2);
+    double preview_every = opt.preview_seconds > 0 ? opt.preview_seconds : 2.0;
+    double last_preview = t0;
+    if (started > 0) {
+        while (atomic_load(&job.tiles_done) < job.tiles_total) {
+            if (job.cancel && atomic_load(job.cancel))
+                break;
+            struct timespec ts = {0, 50 * 1000 * 1000};
+            nanosleep(&ts, NULL);
+            double t = now_seconds();
+            if (show)
+                draw_progress(atomic_load(&job.tiles_done), job.tiles_total, t - t0, false);
+            if (opt.preview_path && t - last_preview >= preview_every) {
+                write_preview(&job, opt.preview_path);
+                last_preview = t;
+            }
+        }
+        for (int i = 0; i < started; i++)
+            pthread_join(workers[i].thread, NULL);
+    }
+    st.seconds = now_seconds() - t0;
+    st.tiles_total = job.tiles_total;
+    st.tiles_done = atomic_load(&job.tiles_done);
+    st.threads = started > 0 ? started : 1;
+    for (int i = 0; i < nthreads; i++) {
+        st.rays += workers[i].rays;
+        st.camera_rays += workers[i].camera_rays;
+        st.bad_samples += workers[i].bad_samples;
+    }
+    if (show)
+        draw_progress(st.tiles_done, job.tiles_total, st.seconds, true);
+    st.interrupted = st.tiles_done < job.tiles_total;
+    if (st.interrupted) {
+        /* clear tiles that were started but not finished: a partial tile is worse than a black one */
+        for (int t = 0; t < job.tiles_total; t++) {
+            if (atomic_load(&job.tile_finished[t]))
+                continue;
+            int tx = t % job.tiles_x, ty = t / job.tiles_x;
+            for (int y = ty * job.tile_size; y < (ty + 1) * job.tile_size && y < fb->height; y++)
+                for (int x = tx * job.tile_size; x < (tx + 1) * job.tile_size && x < fb->width; x++)
+                    memset(fb->rgb + 3 * ((size_t)y * (size_t)fb->width + (size_t)x), 0, 3 * sizeof(float));
+        }
+    }
+    free(job.tile_finished);
+    free(workers);
+    rt_light_table_free(&lights);
+    if (stats)
+        *stats = st;
+    if (st.interrupted)
+        return rt_fail(err, RT_ERR_INTERRUPTED, "render interrupted: %d of %d tiles finished", st.tiles_done,
+                       st.tiles_total);
+    return RT_OK;
+}

@@ -1,0 +1,384 @@
+/* scene.c - the scene tables: defaults, appends, bounds, automatic framing. */
+#include "rt/scene/scene.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void rt_settings_default(rt_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    s->width = 512;
+    s->height = 512;
+    s->samples = 1; /* the old renderer's default; scenes ask for more */
+    s->integrator = RT_INTEGRATOR_DIRECT;
+    s->max_bounce = 1;
+    s->diffuse_bounces = 0;
+    s->diffuse_rays = 128;
+    s->shadow_samples = 16;
+    s->ray_offset = 0.0f;
+    s->clamp = 0.0f;
+    s->exposure = 1.0f;
+    s->seed = 0;
+    s->background = rt_v3s(0.0f);
+    s->environment_texture = RT_NONE;
+    s->environment_strength = 1.0f;
+}
+
+void rt_texture_slot_none(rt_texture_slot *slot)
+{
+    slot->texture = RT_NONE;
+    slot->texcoord = 0;
+    const float id[6] = {1, 0, 0, 0, 1, 0};
+    memcpy(slot->uv_transform, id, sizeof id);
+}
+
+void rt_material_default(rt_material *m, const char *name)
+{
+    memset(m, 0, sizeof *m);
+    if (name) {
+        strncpy(m->name, name, sizeof m->name - 1);
+    }
+    m->color = rt_v3s(0.8f);
+    m->alpha = 1.0f;
+    m->ambient = 0.4f;
+    m->diffuse = 0.8f;
+    m->specular = 0.05f;
+    m->shininess = 32.0f;
+    m->reflectivity = 0.0f;
+    m->transmission = 0.0f;
+    m->transmission_color = rt_v3s(1.0f);
+    m->ior = 1.5f;
+    m->metallic = 0.0f;
+    m->roughness = 1.0f;
+    m->emission = rt_v3s(0.0f);
+    m->emission_strength = 1.0f;
+    m->normal_scale = 1.0f;
+    m->occlusion_strength = 1.0f;
+    m->alpha_mode = RT_ALPHA_OPAQUE;
+    m->alpha_cutoff = 0.5f;
+    m->double_sided = true;
+    m->thickness = 0.0f;
+    m->attenuation_color = rt_v3s(1.0f);
+    m->attenuation_distance = INFINITY;
+    rt_texture_slot_none(&m->base_color_tex);
+    rt_texture_slot_none(&m->metal_rough_tex);
+    rt_texture_slot_none(&m->normal_tex);
+    rt_texture_slot_none(&m->occlusion_tex);
+    rt_texture_slot_none(&m->emissive_tex);
+    rt_texture_slot_none(&m->transmission_tex);
+}
+
+void rt_scene_init(rt_scene *s)
+{
+    memset(s, 0, sizeof *s);
+    rt_settings_default(&s->settings);
+    s->camera.position = rt_v3(0, 0, 5);
+    s->camera.look_at = rt_v3(0, 0, 0);
+    s->camera.up = rt_v3(0, 1, 0);
+    s->camera.vfov_deg = 40.0f;
+}
+
+void rt_scene_free(rt_scene *s)
+{
+    for (size_t i = 0; i < s->image_count; i++) {
+        free(s->images[i].rgba8);
+        free(s->images[i].rgbaf);
+    }
+    free(s->images);
+    free(s->materials);
+    free(s->textures);
+    free(s->lights);
+    free(s->cameras);
+    rt_vertices *v = &s->vertices;
+    free(v->position); free(v->normal); free(v->uv0); free(v->uv1); free(v->tangent); free(v->color);
+    free(s->triangles.index); free(s->triangles.material); free(s->triangles.flags);
+    rt_spheres *sp = &s->spheres;
+    free(sp->cx); free(sp->cy); free(sp->cz); free(sp->radius); free(sp->material);
+    rt_quads *q = &s->quads;
+    free(q->px); free(q->py); free(q->pz); free(q->ux); free(q->uy); free(q->uz);
+    free(q->vx); free(q->vy); free(q->vz); free(q->material);
+    memset(s, 0, sizeof *s);
+}
+
+/* Appends one record to an array-of-structs table. */
+static uint32_t table_push(void **items, size_t *count, size_t *cap, const void *item, size_t size)
+{
+    if (*count >= RT_NONE - 1 || !rt_grow(items, cap, *count + 1, size))
+        return RT_NONE;
+    memcpy((char *)*items + *count * size, item, size);
+    return (uint32_t)(*count)++;
+}
+
+uint32_t rt_scene_add_material(rt_scene *s, const rt_material *m)
+{
+    return table_push((void **)&s->materials, &s->material_count, &s->material_cap, m, sizeof *m);
+}
+
+uint32_t rt_scene_find_material(const rt_scene *s, const char *name)
+{
+    for (size_t i = s->material_count; i-- > 0;)
+        if (strcmp(s->materials[i].name, name) == 0)
+            return (uint32_t)i;
+    return RT_NONE;
+}
+
+uint32_t rt_scene_add_texture(rt_scene *s, const rt_texture *t)
+{
+    return table_push((void **)&s->textures, &s->texture_count, &s->texture_cap, t, sizeof *t);
+}
+
+uint32_t rt_scene_add_image(rt_scene *s, const rt_image *img)
+{
+    return table_push((void **)&s->images, &s->image_count, &s->image_cap, img, sizeof *img);
+}
+
+uint32_t rt_scene_add_light(rt_scene *s, const rt_light *l)
+{
+    return table_push((void **)&s->lights, &s->light_count, &s->light_cap, l, sizeof *l);
+}
+
+uint32_t rt_scene_add_camera(rt_scene *s, const rt_camera *c)
+{
+    return table_push((void **)&s->cameras, &s->camera_count, &s->camera_cap, c, sizeof *c);
+}
+
+/* Grows every array of a structure-of-arrays table together. `arrays` lists
+ * the addresses of the array pointers, `sizes` their element sizes. */
+static bool soa_grow(void **arrays[], const size_t sizes[], int n, size_t *cap, size_t need)
+{
+    if (need <= *cap)
+        return true;
+    size_t c = *cap ? *cap : 64;
+    while (c < need) {
+        if (c > (SIZE_MAX >> 2))
+            return false;
+        c *= 2;
+    }
+    for (int i = 0; i < n; i++) {
+        void *q = rt_realloc_array(*arrays[i], c, sizes[i]);
+        if (!q)
+            return false; /* arrays already grown keep their new size; cap stays: still consistent */
+        *arrays[i] = q;
+    }
+    *cap = c;
+    return true;
+}
+
+uint32_t rt_scene_add_sphere(rt_scene *s, rt_vec3 center, float radius, uint32_t material)
+{
+    rt_spheres *sp = &s->spheres;
+    void **arrays[] = {(void **)&sp->cx, (void **)&sp->cy, (void **)&sp->cz, (void **)&sp->radius,
+                       (void **)&sp->material};
+    const size_t sizes[] = {4, 4, 4, 4, 4};
+    if (sp->count >= RT_NONE - 1 || !soa_grow(arrays, sizes, 5, &sp->cap, sp->count + 1))
+        return RT_NONE;
+    size_t i = sp->count++;
+    sp->cx[i] = center.x; sp->cy[i] = center.y; sp->cz[i] = center.z;
+    sp->radius[i] = radius;
+    sp->material[i] = material;
+    return (uint32_t)i;
+}
+
+uint32_t rt_scene_add_quad(rt_scene *s, rt_vec3 p, rt_vec3 u, rt_vec3 v, uint32_t material)
+{
+    rt_quads *q = &s->quads;
+    void **arrays[] = {(void **)&q->px, (void **)&q->py, (void **)&q->pz, (void **)&q->ux, (void **)&q->uy,
+                       (void **)&q->uz, (void **)&q->vx, (void **)&q->vy, (void **)&q->vz, (void **)&q->material};
+    const size_t sizes[] = {4, 4, 4, 4, 4, 4, 4, 4, 4, 4};
+    if (q->count >= RT_NONE - 1 || !soa_grow(arrays, sizes, 10, &q->cap, q->count + 1))
+        return RT_NONE;
+    size_t i = q->count++;
+    q->px[i] = p.x; q->py[i] = p.y; q->pz[i] = p.z;
+    q->ux[i] = u.x; q->uy[i] = u.y; q->uz[i] = u.z;
+    q->vx[i] = v.x; q->vy[i] = v.y; q->vz[i] = v.z;
+    q->material[i] = material;
+    return (uint32_t)i;
+}
+
+static bool vertices_reserve(rt_vertices *v, size_t need)
+{
+    if (!v->position) {
+        /* first use: the always-present arrays must exist before growing */
+        v->position = rt_alloc(1, sizeof(rt_vec3));
+        v->normal = rt_alloc(1, sizeof(rt_vec3));
+        v->uv0 = rt_alloc(1, sizeof(rt_vec2));
+        if (!v->position || !v->normal || !v->uv0)
+            return false;
+        v->cap = 1;
+    }
+    /* the optional arrays (uv1, tangent, color) grow only once enabled */
+    void **arrays[6];
+    size_t sizes[6];
+    int n = 0;
+    arrays[n] = (void **)&v->position, sizes[n++] = sizeof(rt_vec3);
+    arrays[n] = (void **)&v->normal, sizes[n++] = sizeof(rt_vec3);
+    arrays[n] = (void **)&v->uv0, sizes[n++] = sizeof(rt_vec2);
+    if (v->uv1) arrays[n] = (void **)&v->uv1, sizes[n++] = sizeof(rt_vec2);
+    if (v->tangent) arrays[n] = (void **)&v->tangent, sizes[n++] = sizeof(rt_vec4);
+    if (v->color) arrays[n] = (void **)&v->color, sizes[n++] = sizeof(rt_vec4);
+    return soa_grow(arrays, sizes, n, &v->cap, need);
+}
+
+uint32_t rt_scene_add_vertices(rt_scene *s, size_t n)
+{
+    rt_vertices *v = &s->vertices;
+    if (n >= RT_NONE || v->count >= (size_t)RT_NONE - n || !vertices_reserve(v, v->count + n))
+        return RT_NONE;
+    size_t first = v->count;
+    for (size_t i = first; i < first + n; i++) {
+        v->position[i] = rt_v3s(0);
+        v->normal[i] = rt_v3s(0);
+        v->uv0[i] = rt_v2(0, 0);
+        if (v->uv1) v->uv1[i] = rt_v2(0, 0);
+        if (v->tangent) v->tangent[i] = rt_v4(0, 0, 0, 0);
+        if (v->color) v->color[i] = rt_v4(1, 1, 1, 1);
+    }
+    v->count += n;
+    return (uint32_t)first;
+}
+
+bool rt_scene_enable_attr(rt_scene *s, unsigned attrs)
+{
+    rt_vertices *v = &s->vertices;
+    size_t cap = v->cap ? v->cap : 1;
+    if ((attrs & RT_ATTR_UV1) && !v->uv1) {
+        if (!(v->uv1 = rt_alloc(cap, sizeof(rt_vec2))))
+            return false;
+    }
+    if ((attrs & RT_ATTR_TANGENT) && !v->tangent) {
+        if (!(v->tangent = rt_alloc(cap, sizeof(rt_vec4))))
+            return false;
+    }
+    if ((attrs & RT_ATTR_COLOR) && !v->color) {
+        if (!(v->color = rt_alloc(cap, sizeof(rt_vec4))))
+            return false;
+        for (size_t i = 0; i < cap; i++)
+            v->color[i] = rt_v4(1, 1, 1, 1);
+    }
+    if (!v->cap && !vertices_reserve(v, 1))
+        return false;
+    return true;
+}
+
+bool rt_scene_reserve_triangles(rt_scene *s, size_t n)
+{
+    rt_triangles *t = &s->triangles;
+    if (t->count > SIZE_MAX / 4 - n)
+        return false;
+    size_t need = t->count + n;
+    if (need <= t->cap)
+        return true;
+    size_t c = t->cap ? t->cap : 64;
+    while (c < need)
+        c *= 2;
+    uint32_t *idx = rt_realloc_array(t->index, c, 3 * sizeof(uint32_t));
+    if (!idx) return false;
+    t->index = idx;
+    uint32_t *mat = rt_realloc_array(t->material, c, sizeof(uint32_t));
+    if (!mat) return false;
+    t->material = mat;
+    uint8_t *fl = rt_realloc_array(t->flags, c, 1);
+    if (!fl) return false;
+    t->flags = fl;
+    t->cap = c;
+    return true;
+}
+
+uint32_t rt_scene_add_triangle(rt_scene *s, uint32_t a, uint32_t b, uint32_t c, uint32_t material, uint8_t flags)
+{
+    rt_triangles *t = &s->triangles;
+    if (t->count >= RT_NONE - 1 || !rt_scene_reserve_triangles(s, 1))
+        return RT_NONE;
+    size_t i = t->count++;
+    t->index[3 * i] = a;
+    t->index[3 * i + 1] = b;
+    t->index[3 * i + 2] = c;
+    t->material[i] = material;
+    t->flags[i] = flags;
+    return (uint32_t)i;
+}
+
+rt_box rt_scene_prim_bounds(const rt_scene *s, uint32_t prim)
+{
+    uint32_t i;
+    rt_box b = rt_box_empty();
+    switch (rt_prim_kind_of(s, prim, &i)) {
+    case RT_PRIM_TRIANGLE:
+        for (int k = 0; k < 3; k++)
+            b = rt_box_point(b, rt_tri_vertex(s, i, k));
+        break;
+    case RT_PRIM_SPHERE: {
+        const rt_spheres *sp = &s->spheres;
+        float r = fabsf(sp->radius[i]);
+        b.lo = rt_v3(sp->cx[i] - r, sp->cy[i] - r, sp->cz[i] - r);
+        b.hi = rt_v3(sp->cx[i] + r, sp->cy[i] + r, sp->cz[i] + r);
+        break;
+    }
+    case RT_PRIM_QUAD: {
+        const rt_quads *q = &s->quads;
+        rt_vec3 p = rt_v3(q->px[i], q->py[i], q->pz[i]);
+        rt_vec3 u = rt_v3(q->ux[i], q->uy[i], q->uz[i]);
+        rt_vec3 v = rt_v3(q->vx[i], q->vy[i], q->vz[i]);
+        b = rt_box_point(b, p);
+        b = rt_box_point(b, rt_add(p, u));
+        b = rt_box_point(b, rt_add(p, v));
+        b = rt_box_point(b, rt_add(rt_add(p, u), v));
+        break;
+    }
+    }
+    return b;
+}
+
+rt_box rt_scene_bounds(const rt_scene *s)
+{
+    rt_box b = rt_box_empty();
+    size_t n = rt_scene_prim_count(s);
+    for (size_t i = 0; i < n; i++)
+        b = rt_box_union(b, rt_scene_prim_bounds(s, (uint32_t)i));
+    return b;
+}
+
+void rt_scene_frame_camera(rt_scene *s)
+{
+    rt_box b = rt_scene_bounds(s);
+    if (rt_box_is_empty(b) || !rt_finite3(b.lo) || !rt_finite3(b.hi))
+        b.lo = rt_v3s(-1), b.hi = rt_v3s(1);
+    rt_vec3 c = rt_scale(rt_add(b.lo, b.hi), 0.5f);
+    float fov = 40.0f;
+    float aspect = (float)s->settings.width / (float)(s->settings.height > 0 ? s->settings.height : 1);
+    float tan_v = tanf(0.5f * fov * (RT_PI / 180.0f)), tan_h = tan_v * aspect;
+    /* look from the front (+z), a little above and to the side: the usual product shot */
+    rt_vec3 dir = rt_normalize(rt_v3(0.35f, 0.3f, 1.0f));
+    rt_vec3 right = rt_normalize(rt_cross(rt_neg(dir), rt_v3(0, 1, 0)));
+    rt_vec3 up = rt_cross(right, rt_neg(dir));
+    /* the nearest distance at which every vertex (and every corner of the
+     * other primitives' boxes) is in view: tighter than fitting the box */
+    float dist = 0.0f;
+    size_t nv = s->vertices.count, nother = s->spheres.count + s->quads.count;
+    for (size_t i = 0; i < nv + 8 * nother; i++) {
+        rt_vec3 p;
+        if (i < nv) {
+            p = s->vertices.position[i];
+        } else {
+            size_t k = i - nv;
+            rt_box pb = rt_scene_prim_bounds(s, (uint32_t)(s->triangles.count + k / 8));
+            p = rt_v3(k & 1 ? pb.hi.x : pb.lo.x, k & 2 ? pb.hi.y : pb.lo.y, k & 4 ? pb.hi.z : pb.lo.z);
+        }
+        if (!rt_finite3(p))
+            continue;
+        rt_vec3 q = rt_sub(p, c);
+        float z = rt_dot(q, dir);
+        dist = fmaxf(dist, z + fabsf(rt_dot(q, right)) / tan_h);
+        dist = fmaxf(dist, z + fabsf(rt_dot(q, up)) / tan_v);
+    }
+    if (!(dist > 0.0f) || !isfinite(dist))
+        dist = 1.0f;
+    dist *= 1.08f; /* a small margin */
+    s->camera.position = rt_madd(c, dir, dist);
+    s->camera.look_at = c;
+    s->camera.up = rt_v3(0, 1, 0);
+    s->camera.vfov_deg = fov;
+    s->camera.aperture = 0.0f;
+    s->camera.focus_distance = 0.0f;
+    s->camera_set = true;
+}
