@@ -27,7 +27,7 @@ SHARED  ?= ../shared
 RT      ?= rt
 
 # The library, by pipeline stage (docs/architecture.md); the driver is src/driver.
-STAGES   := base io scene accel render
+STAGES   := base io scene accel render image
 LIB_SRC  := $(foreach d,$(STAGES),$(wildcard src/$(d)/*.c))
 LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 DRV_SRC  := $(wildcard src/driver/*.c)
