@@ -16,7 +16,10 @@ holds, and writes the images as PFM files to --out for `rt compare`.
 
 With two PFM files (linear RGB, as rt writes them) it prints LDR-FLIP of the
 images clamped to [0, 1] and sRGB-encoded, and HDR-FLIP of the linear
-values: the numbers `rt compare CAND.pfm REF.pfm` should print.
+values: the numbers `rt compare CAND.pfm REF.pfm` should print. (Of the
+pairs written to --out, `rt compare NAME-cand-hdr.pfm NAME-ref-hdr.pfm`
+prints the table's HDR-FLIP; the -ldr files hold the sRGB values themselves,
+which rt compare, taking them as linear, would encode once more.)
 """
 import argparse
 import os
