@@ -344,7 +344,7 @@ static rt_result work_init(flip_work *wk, int w, int h, float ppd, rt_error *err
     memset(wk, 0, sizeof *wk);
     if (!(ppd > 0.0f) || !(ppd <= 10000.0f))
         return rt_fail(err, RT_ERR_INVALID, "FLIP: pixels per degree %g is out of range (0..10000]", (double)ppd);
-    if (w <= 0 || h <= 0 || (size_t)w > SIZE_MAX / 64 / (size_t)h)
+    if (w <= 0 || h <= 0 || (size_t)w > SIZE_MAX / 128 / (size_t)h)
         return rt_fail(err, RT_ERR_INVALID, "FLIP: image size %dx%d is out of range", w, h);
     const float pi_sq = FLIP_PI * FLIP_PI;
     wk->w = w;
@@ -355,10 +355,9 @@ static rt_result work_init(flip_work *wk, int w, int h, float ppd, rt_error *err
     size_t ts = 2 * (size_t)wk->f.rs + 1, tf = 2 * (size_t)wk->f.rf + 1;
     size_t rmax = (size_t)(wk->f.rs > wk->f.rf ? wk->f.rs : wk->f.rf);
     size_t wn = (size_t)w;
-    /* 2 x (3 + 4) planes + scratch; 2 x 4 rows; pad; taps */
+    /* 2 x (3 + 4) planes + scratch; 2 x 4 rows; pad; taps (w h < SIZE_MAX / 128
+     * and the radii are at most 1351, so this cannot overflow) */
     size_t total = 15 * wk->n + 8 * wn + (wn + 2 * rmax) + 4 * ts + 3 * tf;
-    if (wk->n > (SIZE_MAX / sizeof(float) - 8 * wn - (wn + 2 * rmax) - 4 * ts - 3 * tf) / 15)
-        return rt_fail(err, RT_ERR_NOMEM, "FLIP: a %dx%d image needs more memory than can be addressed", w, h);
     wk->block = malloc(total * sizeof(float));
     if (!wk->block)
         return rt_fail(err, RT_ERR_NOMEM, "FLIP: out of memory for a %dx%d image", w, h);
@@ -496,7 +495,7 @@ static rt_result check_inputs(const float *cand, const float *ref, int w, int h,
 {
     if (!cand || !ref)
         return rt_fail(err, RT_ERR_INVALID, "FLIP: no image given");
-    if (w <= 0 || h <= 0 || (size_t)w > SIZE_MAX / 64 / (size_t)h)
+    if (w <= 0 || h <= 0 || (size_t)w > SIZE_MAX / 128 / (size_t)h)
         return rt_fail(err, RT_ERR_INVALID, "FLIP: image size %dx%d is out of range", w, h);
     size_t n = 3 * (size_t)w * (size_t)h;
     for (int i = 0; i < 2; i++) {
