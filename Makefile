@@ -27,7 +27,7 @@ SHARED  ?= ../shared
 RT      ?= rt
 
 # The library, by pipeline stage (docs/architecture.md); the driver is src/driver.
-STAGES   := base io scene accel render
+STAGES   := base io scene accel render image
 LIB_SRC  := $(foreach d,$(STAGES),$(wildcard src/$(d)/*.c))
 LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
 DRV_SRC  := $(wildcard src/driver/*.c)
@@ -64,6 +64,11 @@ $(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
 $(BUILD)/tests/test_corpus: tests/test_corpus.c tests/fuzz/harness.c tests/fuzz/harness.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests -o $@ tests/test_corpus.c tests/fuzz/harness.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+
+# rt compare's driver code is tested in-process
+$(BUILD)/tests/test_compare: tests/test_compare.c src/driver/compare.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Itests -o $@ tests/test_compare.c src/driver/compare.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # the kd-tree's portable path (no AVX2), tested on machines that have AVX2 too
 TEST_BIN += $(BUILD)/tests/test_kdtree_scalar

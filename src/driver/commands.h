@@ -1,0 +1,22 @@
+/* commands.h - rt's subcommands besides rendering, each a whole program:
+ * main() hands over argc and argv shifted so that argv[0] is the command's
+ * name, and returns what the command returns as the exit status.
+ *
+ *   if (argc > 1 && strcmp(argv[1], "compare") == 0)
+ *       return rt_cmd_compare(argc - 1, argv + 1);
+ */
+#ifndef RT_DRIVER_COMMANDS_H
+#define RT_DRIVER_COMMANDS_H
+
+#include <stdio.h>
+
+/* rt compare CANDIDATE REFERENCE [--max-rmse X] [--max-flip X] ...
+ * (docs/compare.md): prints the metrics as key: value lines on stdout.
+ * Exit status 0 when every threshold given holds, 1 when one fails, 2 for
+ * bad input (flags, unreadable images, different sizes). */
+int rt_cmd_compare(int argc, char **argv);
+
+/* The same, printing to `out` and `errs` instead of stdout and stderr (tests). */
+int rt_cmd_compare_to(int argc, char **argv, FILE *out, FILE *errs);
+
+#endif
