@@ -462,15 +462,8 @@ static void test_srgb_encode_and_magma(void **state)
 }
 
 /* Sanitizer builds are 10x slower: the time is only printed there. */
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define TEST_SANITIZED 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-#define TEST_SANITIZED 1
-#endif
-#endif
-
-/* A 512x512 LDR-FLIP should take well under a second (it is about 0.1 s). */
+/* A 512x512 LDR-FLIP runs and prints its time (about 0.1 s; speed is
+ * measured by benchmarks, never asserted in tests). */
 static void test_flip_512_time(void **state)
 {
     (void)state;
@@ -494,9 +487,6 @@ static void test_flip_512_time(void **state)
     double sec = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     printf("    512x512 LDR-FLIP: %.3f s (mean %.4f)\n", sec, mean);
     assert_true(mean > 0.0 && mean < 1.0);
-#if !defined(TEST_SANITIZED) && !defined(RT_DEBUG)
-    assert_true(sec < 1.0);
-#endif
     free(c);
     free(r);
 }
