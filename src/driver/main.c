@@ -17,18 +17,19 @@
 #include <strings.h>
 #include <time.h>
 
-#include "args.h"
-#include "memory_budget.h"
-#include "rt/accel/kdtree.h"
+#include "rt/render/camera.h"
 #include "rt/io/gltf.h"
 #include "rt/io/image.h"
+#include "rt/accel/kdtree.h"
 #include "rt/io/mesh_io.h"
-#include "rt/io/scene_parse.h"
-#include "rt/render/camera.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
+#include "rt/io/scene_parse.h"
 #include "rt/scene/settings.h"
 #include "rt/scene/tangents.h"
+
+#include "args.h"
+#include "memory_budget.h"
 
 /* The kd-tree's primitive ids are 30 bits (src/accel/kdtree.c). */
 #define MAX_PRIMITIVES (((size_t)1 << 30) - 2)

@@ -11,9 +11,10 @@
  * range-checked and stored by it, and located here) or in a table of
  * keywords; each handler consumes its arguments through a cursor (get_float,
  * get_int, get_word ...) that produces the uniform "expected X for Y, got 'Z'"
- * messages, then appends records to the scene's flat tables (scene.h). Names (materials, textures) are resolved at once, so
- * a name must be defined before it is used; `camera gltf N` is resolved after
- * the last statement, when every model's cameras are known.
+ * messages, then appends records to the scene's flat tables (scene.h). Names
+ * (materials, textures) are resolved at once, so a name must be defined
+ * before it is used; `camera gltf N` is resolved after the last statement,
+ * when every model's cameras are known.
  *
  * Numbers: decimal only ([+-]digits[.digits][e[+-]digits], number.h),
  * finite, and within float range; the whole token must be used, so `1.0x`,
