@@ -85,7 +85,9 @@ typedef struct run_result {
     char err[16384]; /* stderr */
 } run_result;
 
-static pid_t spawn(const char *const *args)
+/* Runs rt with args; its stdout goes to stdout_path (NULL = /dev/null), its
+ * stderr to stderr.txt in the scratch directory. */
+static pid_t spawn_to(const char *const *args, const char *stdout_path)
 {
     const char *argv[64];
     int n = 0;
@@ -96,7 +98,7 @@ static pid_t spawn(const char *const *args)
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
-        int null = open("/dev/null", O_WRONLY);
+        int null = stdout_path ? open(stdout_path, O_WRONLY | O_CREAT | O_TRUNC, 0644) : open("/dev/null", O_WRONLY);
         int e = open(path_in("stderr.txt"), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         if (null < 0 || e < 0)
             _exit(127);
@@ -106,6 +108,11 @@ static pid_t spawn(const char *const *args)
         _exit(127);
     }
     return pid;
+}
+
+static pid_t spawn(const char *const *args)
+{
+    return spawn_to(args, NULL);
 }
 
 static void wait_for(pid_t pid, double t0, double timeout, run_result *r)
@@ -248,6 +255,30 @@ static bool budget_enforced(void)
     return on;
 }
 
+static void assert_same_file(const char *a, const char *b)
+{
+    static char x[1 << 20], y[1 << 20];
+    size_t n = read_all(a, x, sizeof x), m = read_all(b, y, sizeof y);
+    assert_true(n != (size_t)-1 && m != (size_t)-1);
+    assert_int_equal(n, m);
+    assert_memory_equal(x, y, n);
+}
+
+static void render_ok(const char *out, const char *const *extra)
+{
+    const char *args[32] = {"-q", "-o", out};
+    int n = 3;
+    for (int i = 0; extra[i]; i++)
+        args[n++] = extra[i];
+    args[n] = NULL;
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_args(r, args);
+    if (r->status != 0)
+        fail_msg("render to %s failed (%d): %s", out, r->status, r->err);
+    free(r);
+}
+
 /* --------------------------------------------------------------- flags */
 
 static void test_bad_flags(void **state)
@@ -270,6 +301,135 @@ static void test_bad_flags(void **state)
     REFUSE(o, "only one input", "b.txt", "a.txt", "b.txt", "-o", o);
     REFUSE(o, "option -o needs a value", NULL, "-o");
     REFUSE(o, "--camera 3", "0 cameras", "--camera", "3", "-o", o);
+}
+
+/* The flags as users expect them: long forms, --flag=value, a missing value
+ * named, --set for any scene setting with the scene format's checks. */
+static void test_flag_forms(void **state)
+{
+    (void)state;
+    const char *o = out_png;
+    REFUSE(o, "option -s needs a value", NULL, "-s", "-o", o); /* not "got '-o'" */
+    REFUSE(o, "option --samples needs a value", NULL, "--samples", "--quiet", "-o", o);
+    REFUSE(o, "option --set needs a value", NULL, "-o", o, "--set");
+    REFUSE(o, "option --quiet takes no value", "'--quiet=yes'", "--quiet=yes", "-o", o);
+    REFUSE(o, "--samples wants samples per pixel", "'0'", "--samples=0", "-o", o);
+    REFUSE(o, "--resolution wants", "'0X5'", "--resolution", "0X5", "-o", o);
+    REFUSE(o, "--threads wants a thread count", "'0'", "--threads=0", "-o", o);
+    REFUSE(o, "-t wants", "'-1'", "-t", "-1", "-o", o); /* a negative number is a value, not a flag */
+    REFUSE(o, "--output", "needs a value", "--output");
+    REFUSE(o, "--set samples=0: ", "samples per pixel must be between 1 and 1048576, got '0'", "--set", "samples=0",
+           "-o", o);
+    REFUSE(o, "--set max_bounce=300: ", "max_bounce must be between 0 and 256", "--set=max_bounce=300", "-o", o);
+    REFUSE(o, "--set exposure=0: ", "the exposure must be > 0, got '0'", "--set", "exposure=0", "-o", o);
+    REFUSE(o, "--set background=1,-1,0: ", "the background colour (green) must be >= 0", "--set",
+           "background=1,-1,0", "-o", o);
+    REFUSE(o, "--set resolution=640: ", "expected an integer for the image height, got nothing", "--set",
+           "resolution=640", "-o", o);
+    REFUSE(o, "--set wants KEY=VALUE", "'samples'", "--set", "samples", "-o", o);
+    REFUSE(o, "no setting is called 'sampels'", "samples, integrator", "--set", "sampels=4", "-o", o);
+    /* applied after loading, so file errors come then, named by the flag */
+    char env[700];
+    snprintf(env, sizeof env, "environment=%s", path_in("no-such.hdr"));
+    REFUSE(o, "--set environment=", "no-such.hdr", "--set", env, "-o", o);
+    /* over the scene's own values, then through the same limits */
+    write_text("tree2.txt", "resolution 8 8\nintegrator whitted\ndiffuse_bounces 1\n");
+    REFUSE(o, "tree2.txt: ", "rays per camera sample", path_in("tree2.txt"), "--set", "diffuse_rays=1000", "--set",
+           "diffuse_bounces=5", "-o", o);
+}
+
+static void test_flag_forms_same_image(void **state)
+{
+    (void)state;
+    char ref[600];
+    snprintf(ref, sizeof ref, "%s", path_in("forms-ref.pfm"));
+    const char *const shorts[] = {"-r", "12x10", "-s", "2", "-t", "1", "--seed", "3", "--integrator", "whitted", NULL};
+    render_ok(ref, shorts);
+    const char *const longs[] = {"--resolution=12X10", "--samples", "2", "--threads=1", "--seed=3",
+                                 "--integrator=whitted", "--quiet", NULL};
+    const char *const sets[] = {"--set", "resolution=12,10", "--set", "samples=2", "--set=seed=3", "--set",
+                                "integrator=whitted", "-t", "1", NULL};
+    const char *const later[] = {"-s", "64", "--set", "samples=2", "-r", "99x99", "--set", "resolution=12x10",
+                                 "--seed", "3", "--set", "integrator=path", "--integrator", "whitted", NULL};
+    const char *const *variants[] = {longs, sets, later};
+    for (size_t i = 0; i < sizeof variants / sizeof *variants; i++) {
+        char out[600];
+        snprintf(out, sizeof out, "%s/forms-%zu.pfm", dir, i);
+        render_ok(out, variants[i]);
+        assert_same_file(ref, out);
+        unlink(out);
+    }
+    /* a scene file saying the same, and `--` before the input */
+    write_text("forms.txt", "resolution 99 99\nsamples 64\nseed 3\nintegrator whitted\n");
+    char a[600], b[600];
+    snprintf(a, sizeof a, "%s", path_in("forms-a.pfm"));
+    snprintf(b, sizeof b, "%s", path_in("forms-b.pfm"));
+    const char *const scene_then_flags[] = {"--set", "resolution=12x10", "-s", "2", "--", path_in("forms.txt"), NULL};
+    render_ok(a, scene_then_flags);
+    write_text("forms2.txt", "resolution 12 10\nsamples 2\nseed 3\nintegrator whitted\n");
+    const char *const scene_alone[] = {path_in("forms2.txt"), NULL};
+    render_ok(b, scene_alone);
+    assert_same_file(a, b);
+    unlink(ref), unlink(a), unlink(b);
+}
+
+/* Every flag `rt --help` lists is in README.md's flag table ("Using it"). */
+static void test_help_flags_in_readme(void **state)
+{
+    (void)state;
+    const char *const args[] = {"--help", NULL};
+    const char *help_path = path_in("help.txt");
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    double t0 = now_s();
+    wait_for(spawn_to(args, help_path), t0, 60.0, r);
+    assert_int_equal(r->status, 0);
+    free(r);
+    static char help[1 << 16], readme[1 << 17];
+    assert_true(read_all(help_path, help, sizeof help) != (size_t)-1);
+    assert_true(read_all("README.md", readme, sizeof readme) != (size_t)-1);
+    char *table = strstr(readme, "\n## Using it\n");
+    assert_non_null(table);
+    char *end = strstr(table + 1, "\n## ");
+    if (end)
+        *end = '\0';
+    int flags = 0, missing = 0;
+    for (char *line = strtok(help, "\n"); line; line = strtok(NULL, "\n")) {
+        if (strncmp(line, "  ", 2) != 0)
+            continue;
+        char *c = line;
+        while (*c == ' ')
+            c++;
+        if (*c != '-')
+            continue;
+        /* "-s, --samples N     samples per pixel ...": the names end at two blanks */
+        char names[128];
+        char *gap = strstr(c, "  ");
+        size_t n = gap ? (size_t)(gap - c) : strlen(c);
+        snprintf(names, sizeof names, "%.*s", (int)n, c);
+        for (char *name = names; name && *name;) {
+            char *next = strstr(name, ", ");
+            if (next)
+                *next = '\0', next += 2;
+            size_t len = strcspn(name, " =");
+            char needle[64];
+            snprintf(needle, sizeof needle, "`%.*s", (int)len, name);
+            bool found = false;
+            for (const char *p = strstr(table, needle); p && !found; p = strstr(p + 1, needle)) {
+                char after = p[strlen(needle)];
+                found = after == ' ' || after == '`' || after == '=';
+            }
+            if (!found) {
+                fprintf(stderr, "README.md's flag table has no %s`\n", needle);
+                missing++;
+            }
+            flags++;
+            name = next;
+        }
+    }
+    assert_true(flags >= 20);
+    assert_int_equal(missing, 0);
+    unlink(help_path);
 }
 
 /* ------------------------------------------------------------ scene files */
@@ -482,30 +642,6 @@ static void test_memory_budget(void **state)
 
 /* ------------------------------------------------------------- rendering */
 
-static void assert_same_file(const char *a, const char *b)
-{
-    static char x[1 << 20], y[1 << 20];
-    size_t n = read_all(a, x, sizeof x), m = read_all(b, y, sizeof y);
-    assert_true(n != (size_t)-1 && m != (size_t)-1);
-    assert_int_equal(n, m);
-    assert_memory_equal(x, y, n);
-}
-
-static void render_ok(const char *out, const char *const *extra)
-{
-    const char *args[32] = {"-q", "-o", out};
-    int n = 3;
-    for (int i = 0; extra[i]; i++)
-        args[n++] = extra[i];
-    args[n] = NULL;
-    run_result *r = malloc(sizeof *r);
-    assert_non_null(r);
-    run_args(r, args);
-    if (r->status != 0)
-        fail_msg("render to %s failed (%d): %s", out, r->status, r->err);
-    free(r);
-}
-
 static void test_threads_same_image(void **state)
 {
     (void)state;
@@ -677,6 +813,9 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bad_flags),
+        cmocka_unit_test(test_flag_forms),
+        cmocka_unit_test(test_flag_forms_same_image),
+        cmocka_unit_test(test_help_flags_in_readme),
         cmocka_unit_test(test_bad_scene_files),
         cmocka_unit_test(test_bad_models),
         cmocka_unit_test(test_bad_images),

@@ -14,6 +14,7 @@
 #include <math.h>
 
 #include "rt/io/scene_parse.h"
+#include "rt/scene/settings.h"
 
 #define TMP_DIR "tests/tmp/scene_parse"
 
@@ -371,6 +372,171 @@ static void test_settings_values(void **state)
     expect_ok("integrator path\n", &s);
     assert_int_equal(s.settings.integrator, RT_INTEGRATOR_PATH);
     rt_scene_free(&s);
+}
+
+/* The settings table's defaults are the documented ones (they were written
+ * out in rt_settings_default() before the table). */
+static void test_settings_table_defaults(void **state)
+{
+    (void)state;
+    rt_settings d;
+    memset(&d, 0x5a, sizeof d);
+    rt_settings_default(&d);
+    assert_int_equal(d.width, 512);
+    assert_int_equal(d.height, 512);
+    assert_int_equal(d.samples, 1);
+    assert_int_equal(d.integrator, RT_INTEGRATOR_DIRECT);
+    assert_int_equal(d.max_bounce, 1);
+    assert_int_equal(d.max_depth, 0);
+    assert_int_equal(d.diffuse_bounces, 0);
+    assert_int_equal(d.diffuse_rays, 128);
+    assert_int_equal(d.shadow_samples, 16);
+    assert_true(d.ray_offset == 0.0f && d.clamp == 0.0f && d.exposure == 1.0f);
+    assert_int_equal(d.seed, 0);
+    assert_vec3(d.background, 0, 0, 0);
+    assert_int_equal(d.environment_texture, RT_NONE);
+    assert_true(d.environment_strength == 1.0f);
+    assert_false(d.ambient_light_set);
+    assert_vec3(d.ambient_light, 0, 0, 0);
+    assert_string_equal(d.output, "");
+
+    /* every entry is found by its name, and a default written out parses back to it */
+    for (size_t i = 0; i < rt_settings_count; i++) {
+        const rt_setting *def = &rt_settings_table[i];
+        assert_ptr_equal(rt_setting_find(def->name), def);
+        char dflt[128], text[256];
+        rt_setting_default_text(def, dflt, sizeof dflt);
+        if (def->marks_given || def->type == RT_SETTING_STRING || def->type == RT_SETTING_ENVIRONMENT)
+            continue; /* "unset", "none" */
+        snprintf(text, sizeof text, "%s %s\n", def->name, dflt);
+        rt_scene sc;
+        expect_ok(text, &sc);
+        assert_memory_equal(&sc.settings, &d, sizeof d);
+        rt_scene_free(&sc);
+    }
+    assert_null(rt_setting_find("sampels"));
+    rt_setting_problem pb;
+    assert_int_equal(rt_settings_check(&d, &pb), RT_OK);
+    d.samples = RT_MAX_SAMPLES + 1;
+    assert_int_equal(rt_settings_check(&d, &pb), RT_ERR_INVALID);
+    assert_string_equal(pb.message, "samples per pixel must be between 1 and 1048576, got 1048577");
+    rt_settings_default(&d);
+    d.background.y = -1.0f;
+    assert_int_equal(rt_settings_check(&d, &pb), RT_ERR_INVALID);
+    assert_string_equal(pb.message, "the background colour (green) must be >= 0, got -1");
+}
+
+/* The command-line form of a value (--set, -r): words at blanks or commas,
+ * WxH for a resolution, checked like a scene line, messages complete. */
+static void test_settings_text_form(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_setting_problem pb;
+    const rt_setting *res = rt_setting_find("resolution");
+    static const char *const sizes[] = {"640x480", "640X480", "640 480", "640,480", " 640 , 480 "};
+    for (size_t i = 0; i < sizeof sizes / sizeof *sizes; i++) {
+        s.settings.width = s.settings.height = 1;
+        assert_int_equal(rt_setting_set(&s, res, sizes[i], &pb), RT_OK);
+        assert_int_equal(s.settings.width, 640);
+        assert_int_equal(s.settings.height, 480);
+    }
+    assert_int_equal(rt_setting_set(&s, res, "640", &pb), RT_ERR_PARSE);
+    assert_string_equal(pb.message, "expected an integer for the image height, got nothing");
+    assert_int_equal(rt_setting_set(&s, res, "0x5", &pb), RT_ERR_INVALID);
+    assert_string_equal(pb.message, "the image width must be between 1 and 32768, got '0'");
+    assert_int_equal(rt_setting_set(&s, res, "640x480x2", &pb), RT_ERR_PARSE);
+    assert_string_equal(pb.message, "expected an integer for the image height, got '480x2'");
+    assert_int_equal(rt_setting_set(&s, rt_setting_find("samples"), "4 5", &pb), RT_ERR_PARSE);
+    assert_string_equal(pb.message, "unexpected '5' after the end of the value");
+    assert_int_equal(rt_setting_set(&s, rt_setting_find("samples"), "", &pb), RT_ERR_PARSE);
+    assert_string_equal(pb.message, "expected an integer for samples per pixel, got nothing");
+    assert_int_equal(rt_setting_set(&s, rt_setting_find("integrator"), "magic", &pb), RT_ERR_PARSE);
+    assert_string_equal(pb.message, "expected an integrator (direct|whitted|path), got 'magic'");
+
+    assert_int_equal(rt_setting_set(&s, rt_setting_find("background"), "0.1,0.2 0.3", &pb), RT_OK);
+    assert_vec3(s.settings.background, 0.1f, 0.2f, 0.3f);
+    assert_false(s.settings.ambient_light_set);
+    assert_int_equal(rt_setting_set(&s, rt_setting_find("ambient_light"), "1 2 3", &pb), RT_OK);
+    assert_true(s.settings.ambient_light_set);
+    assert_int_equal(rt_setting_set(&s, rt_setting_find("output"), "a b,c.png", &pb), RT_OK);
+    assert_string_equal(s.settings.output, "a b,c.png");
+    assert_int_equal(rt_setting_set(&s, rt_setting_find("output"), "", &pb), RT_ERR_INVALID);
+    assert_string_equal(pb.message, "expected an output file name, got an empty string");
+    assert_int_equal(rt_setting_set(&s, rt_setting_find("seed"), "4294967295", &pb), RT_OK);
+    assert_int_equal(s.settings.seed, 4294967295u);
+
+    /* a NULL scene only checks */
+    assert_int_equal(rt_setting_set(NULL, rt_setting_find("exposure"), "0", &pb), RT_ERR_INVALID);
+    assert_string_equal(pb.message, "the exposure must be > 0, got '0'");
+    assert_int_equal(rt_setting_set(NULL, rt_setting_find("environment"), "no-such.hdr strength 2", &pb), RT_OK);
+    assert_int_equal(rt_setting_set(NULL, rt_setting_find("environment"), "sky.hdr strength -1", &pb),
+                     RT_ERR_INVALID);
+    assert_string_equal(pb.message, "the environment strength must be >= 0, got '-1'");
+    /* with a scene, the environment image is loaded (relative to the current directory) */
+    assert_int_equal(rt_setting_set(&s, rt_setting_find("environment"), TMP_DIR "/no-such.hdr", &pb), RT_ERR_IO);
+    assert_non_null(strstr(pb.message, "no-such.hdr"));
+    assert_int_equal(s.settings.environment_texture, RT_NONE);
+    rt_scene_free(&s);
+}
+
+/* docs/scene-format.md's settings table lists every setting of the table,
+ * written as `name words`, with the table's default and allowed values. */
+static void test_settings_table_in_docs(void **state)
+{
+    (void)state;
+    FILE *f = fopen("docs/scene-format.md", "rb");
+    assert_non_null(f);
+    static char doc[1 << 17];
+    size_t n = fread(doc, 1, sizeof doc - 1, f);
+    fclose(f);
+    doc[n] = '\0';
+    char *sec = strstr(doc, "\n## 2. Settings\n");
+    assert_non_null(sec);
+    char *end = strstr(sec + 1, "\n## ");
+    if (end)
+        *end = '\0';
+    int missing = 0;
+    for (size_t i = 0; i < rt_settings_count; i++) {
+        const rt_setting *def = &rt_settings_table[i];
+        char head[128], range[128], dflt[128], row[2048];
+        snprintf(head, sizeof head, "\n| `%s %s` |", def->name, def->args);
+        rt_setting_range_text(def, range, sizeof range);
+        rt_setting_default_text(def, dflt, sizeof dflt);
+        const char *r = strstr(sec, head);
+        if (!r) {
+            print_error("docs/scene-format.md section 2 has no row for `%s %s`\n", def->name, def->args);
+            missing++;
+            continue;
+        }
+        /* the row's cells, with \| unescaped: statement, argument, default, allowed, field */
+        size_t k = 0;
+        for (const char *c = r + 1; *c && *c != '\n' && k + 1 < sizeof row; c++) {
+            if (c[0] == '\\' && c[1] == '|')
+                continue;
+            row[k++] = *c == '|' && c[-1] != '\\' ? '\t' : *c;
+        }
+        row[k] = '\0';
+        char *cells[8] = {0};
+        int ncell = 0;
+        for (char *c = strtok(row, "\t"); c && ncell < 8; c = strtok(NULL, "\t"))
+            cells[ncell++] = c;
+        assert_true(ncell >= 4);
+        char quoted[140];
+        snprintf(quoted, sizeof quoted, " `%s`", dflt);
+        char plain[140];
+        snprintf(plain, sizeof plain, " %s", dflt);
+        if (strncmp(cells[2], quoted, strlen(quoted)) != 0 && strncmp(cells[2], plain, strlen(plain)) != 0) {
+            print_error("docs: `%s` default is '%s', the table says '%s'\n", def->name, cells[2], dflt);
+            missing++;
+        }
+        if (!strstr(cells[3], range)) {
+            print_error("docs: `%s` allows '%s', the table says '%s'\n", def->name, cells[3], range);
+            missing++;
+        }
+    }
+    assert_int_equal(missing, 0);
 }
 
 static void test_camera_values(void **state)
@@ -1015,6 +1181,9 @@ int main(void)
         cmocka_unit_test(test_docs_example),
         cmocka_unit_test(test_camera_gltf),
         cmocka_unit_test(test_settings_values),
+        cmocka_unit_test(test_settings_table_defaults),
+        cmocka_unit_test(test_settings_text_form),
+        cmocka_unit_test(test_settings_table_in_docs),
         cmocka_unit_test(test_camera_values),
         cmocka_unit_test(test_material_values),
         cmocka_unit_test(test_primitive_values),

@@ -1,30 +1,21 @@
-/* main.c - the `rt` command: parse flags, load a scene or model, build the
- * kd-tree, render on all cores, write the image.
+/* main.c - the `rt` command: the pipeline, one step a line. Parse the flags
+ * (args.c), load the scene or model, apply the setting flags, frame the
+ * camera and check the limits, build the kd-tree, render on all cores, write
+ * the image.
  *
  * Exit status: 0 on success, 2 for bad input (flags, scene files, models,
  * images, an unwritable output), 130 when interrupted (the finished tiles
  * are still written). Every failure says what and where on stderr, and never
- * leaves a partial file over an existing image.
- *
- * Memory: the process runs under a budget (--max-memory, default 75% of the
- * physical memory, or of the cgroup's limit when that is lower), enforced
- * with setrlimit(RLIMIT_DATA), which Linux >= 4.7 applies to the heap and
- * every private writable mapping. An allocation past it fails, the checked
- * allocation reports "out of memory", and we say which budget was hit and
- * how to raise it, instead of swapping or meeting the OOM killer. Sanitizer
- * builds skip the limit (their shadow memory would trip it).
+ * leaves a partial file over an existing image. The process runs under a
+ * memory budget (memory_budget.c).
  */
-#include <errno.h>
-#include <limits.h>
 #include <signal.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <sys/resource.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "rt/render/camera.h"
 #include "rt/io/gltf.h"
@@ -34,22 +25,13 @@
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
 #include "rt/io/scene_parse.h"
+#include "rt/scene/settings.h"
 #include "rt/scene/tangents.h"
 
-#define RT_VERSION "0.1.0"
+#include "args.h"
+#include "memory_budget.h"
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define RT_SANITIZED 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
-#define RT_SANITIZED 1
-#endif
-#endif
-#ifndef RT_SANITIZED
-#define RT_SANITIZED 0
-#endif
-
-/* The kd-tree's primitive ids are 30 bits (src/kdtree.c). */
+/* The kd-tree's primitive ids are 30 bits (src/accel/kdtree.c). */
 #define MAX_PRIMITIVES (((size_t)1 << 30) - 2)
 /* whitted: rays a camera sample may spawn through diffuse gathering
  * (diffuse_rays ^ diffuse_bounces); more is a render that never ends. */
@@ -73,113 +55,6 @@ static double now_ms(void)
     return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
 }
 
-/* ------------------------------------------------------------ memory budget */
-
-typedef struct memory_budget {
-    unsigned long long bytes; /* 0 = none */
-    bool from_flag;           /* --max-memory given */
-    bool enforced;            /* setrlimit took it */
-} memory_budget;
-
-/* The cgroup v2 (or v1) memory limit of this process, 0 when none. */
-static unsigned long long cgroup_memory_limit(void)
-{
-    static const char *const files[] = {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"};
-    for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
-        FILE *f = fopen(files[i], "r");
-        if (!f)
-            continue;
-        char buf[64] = {0};
-        bool ok = fgets(buf, sizeof buf, f) != NULL;
-        fclose(f);
-        if (!ok || strncmp(buf, "max", 3) == 0)
-            continue;
-        errno = 0;
-        char *end;
-        unsigned long long v = strtoull(buf, &end, 10);
-        if (!errno && end != buf && v > 0 && v < (1ull << 60))
-            return v;
-    }
-    return 0;
-}
-
-/* 75% of physical memory (or of the cgroup limit, when lower). */
-static unsigned long long default_memory_budget(void)
-{
-    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-    unsigned long long phys = pages > 0 && page > 0 ? (unsigned long long)pages * (unsigned long long)page : 0;
-    unsigned long long cg = cgroup_memory_limit();
-    if (cg && (!phys || cg < phys))
-        phys = cg;
-    return phys / 4 * 3;
-}
-
-/* "4G", "512M", "1.5g", "300000K", "123456789" (bytes); "0", "none" or
- * "unlimited" turn the budget off (*out = 0). */
-static bool parse_size(const char *s, unsigned long long *out)
-{
-    if (!s || !*s)
-        return false;
-    if (strcmp(s, "none") == 0 || strcmp(s, "unlimited") == 0) {
-        *out = 0;
-        return true;
-    }
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (errno || end == s || !(v >= 0.0))
-        return false;
-    double mul = 1.0;
-    switch (*end) {
-    case 'k': case 'K': mul = 1024.0; end++; break;
-    case 'm': case 'M': mul = 1024.0 * 1024.0; end++; break;
-    case 'g': case 'G': mul = 1024.0 * 1024.0 * 1024.0; end++; break;
-    case 't': case 'T': mul = 1024.0 * 1024.0 * 1024.0 * 1024.0; end++; break;
-    default: break;
-    }
-    if (*end == 'i' && mul > 1.0) /* KiB, MiB, ... */
-        end++;
-    if ((*end == 'B' || *end == 'b') && end[1] == 0)
-        end++;
-    if (*end)
-        return false;
-    double bytes = v * mul;
-    if (!(bytes < 9.0e18))
-        return false;
-    *out = (unsigned long long)bytes;
-    return true;
-}
-
-static void format_size(unsigned long long bytes, char *buf, size_t size)
-{
-    if (bytes >= (1ull << 30))
-        snprintf(buf, size, "%.1f GiB", (double)bytes / (double)(1ull << 30));
-    else
-        snprintf(buf, size, "%.0f MiB", (double)bytes / (double)(1ull << 20));
-}
-
-/* Caps the data segment (heap and private mappings) at the budget. Below
- * 64 MiB nothing works at all, so smaller budgets are refused. */
-static void apply_memory_budget(memory_budget *b)
-{
-    b->enforced = false;
-    if (!b->bytes || RT_SANITIZED)
-        return;
-    struct rlimit rl;
-    if (getrlimit(RLIMIT_DATA, &rl) != 0)
-        return;
-    rlim_t want = (rlim_t)b->bytes;
-    if (rl.rlim_max != RLIM_INFINITY && want > rl.rlim_max)
-        want = rl.rlim_max;
-    if (rl.rlim_cur != RLIM_INFINITY && rl.rlim_cur < want) /* someone set a lower limit: keep it */
-        want = rl.rlim_cur;
-    rl.rlim_cur = want;
-    if (setrlimit(RLIMIT_DATA, &rl) == 0) {
-        b->bytes = (unsigned long long)want;
-        b->enforced = true;
-    }
-}
-
 /* Prints an error; out-of-memory errors also say which budget ran out and
  * how to raise it. */
 static void report(const rt_error *err, const memory_budget *budget)
@@ -189,7 +64,7 @@ static void report(const rt_error *err, const memory_budget *budget)
         return;
     if (budget->enforced) {
         char sz[32];
-        format_size(budget->bytes, sz, sizeof sz);
+        memory_budget_format(budget->bytes, sz, sizeof sz);
         fprintf(stderr,
                 "rt: the memory budget of %s (%s) ran out; raise it with --max-memory SIZE (e.g. --max-memory 16G, or "
                 "'none' for no limit)\n",
@@ -197,74 +72,6 @@ static void report(const rt_error *err, const memory_budget *budget)
     } else {
         fprintf(stderr, "rt: the machine's memory ran out (no --max-memory budget was in force)\n");
     }
-}
-
-static void usage(FILE *f)
-{
-    char default_budget_text[32];
-    format_size(default_memory_budget(), default_budget_text, sizeof default_budget_text);
-    fprintf(f,
-            "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off]\n"
-            "\n"
-            "Renders a scene to an image. With no input, renders the built-in Cornell box to out.png.\n"
-            "\n"
-            "options:\n"
-            "  -o FILE            output image: .png (8-bit sRGB), .pfm (linear float), .hdr (Radiance)\n"
-            "                     default: the scene's `output`, else INPUT-NAME.png in this directory\n"
-            "  -t N               render threads (default: all %d cores)\n"
-            "  -s N               samples per pixel (overrides the scene)\n"
-            "  -r WxH             resolution, e.g. -r 1280x720 (overrides the scene)\n"
-            "  -q                 quiet: no progress bar, no warnings\n"
-            "  -v                 verbose: scene statistics, kd-tree build, render time, rays per second\n"
-            "  --integrator NAME  direct, whitted or path (overrides the scene)\n"
-            "  --camera N         use camera N of the loaded glTF models\n"
-            "  --seed N           random seed (default: the scene's, else 0)\n"
-            "  --tile N           tile size in pixels (default 32)\n"
-            "  --preview SECONDS  live view: rewrite the output with the finished tiles every SECONDS\n"
-            "  --info FILE        print what a scene or model contains (key: value lines) and exit\n"
-            "  --max-memory SIZE  memory budget, e.g. 4G or 512M; 'none' for no limit\n"
-            "                     (default: 75%% of physical memory, here %s)\n"
-            "  -h, --help         this text\n"
-            "  --version          print the version\n"
-            "\n"
-            "Scene format: docs/scene-format.md; limits and exit codes: docs/robustness.md.\n"
-            "Exit status: 0 ok, 2 bad input (or over a limit), 130 interrupted.\n",
-            rt_cpu_count(), default_budget_text);
-}
-
-static int fail_usage(const char *fmt, const char *arg)
-{
-    fprintf(stderr, "rt: ");
-    fprintf(stderr, fmt, arg);
-    fprintf(stderr, "\nrt: see 'rt --help'\n");
-    return 2;
-}
-
-/* Strict integer parsing for flags: the whole string, in range. */
-static bool parse_int(const char *s, long lo, long hi, long *out)
-{
-    if (!s || !*s)
-        return false;
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || *end || v < lo || v > hi)
-        return false;
-    *out = v;
-    return true;
-}
-
-static bool parse_double(const char *s, double lo, double hi, double *out)
-{
-    if (!s || !*s)
-        return false;
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (errno || *end || !(v >= lo && v <= hi))
-        return false;
-    *out = v;
-    return true;
 }
 
 static bool has_ext(const char *path, const char *ext)
@@ -382,8 +189,9 @@ static void default_output(const rt_scene *s, const char *input, char *out, size
 
 /* Caps on what a loaded scene may ask for, checked before any large
  * allocation of the render: the primitive count the kd-tree can index, a
- * diffuse-gather tree that would never finish, a usable camera. The image
- * size and sample count are capped where they are read (flags, parser). */
+ * diffuse-gather tree that would never finish, a usable camera, and every
+ * setting in the range of the settings table (flags and the parser check
+ * them as they read them; this catches what loaders set). */
 static rt_result check_limits(rt_scene *s, const char *input, bool camera_from_input, rt_error *err)
 {
     const char *name = input ? input : "<built-in scene>";
@@ -392,11 +200,9 @@ static rt_result check_limits(rt_scene *s, const char *input, bool camera_from_i
         return rt_fail(err, RT_ERR_LIMIT, "%s: %zu primitives (triangles %zu, spheres %zu, quads %zu), over the limit of %zu",
                        name, prims, s->triangles.count, s->spheres.count, s->quads.count, MAX_PRIMITIVES);
     const rt_settings *set = &s->settings;
-    if (set->width < 1 || set->height < 1 || set->width > 32768 || set->height > 32768)
-        return rt_fail(err, RT_ERR_LIMIT, "%s: image size %dx%d is out of range (1..32768 a side)", name, set->width,
-                       set->height);
-    if (set->samples > (1 << 20))
-        return rt_fail(err, RT_ERR_LIMIT, "%s: %d samples per pixel, over the limit of 1048576", name, set->samples);
+    rt_setting_problem pb;
+    if (rt_settings_check(set, &pb) != RT_OK)
+        return rt_fail(err, RT_ERR_LIMIT, "%s: %s", name, pb.message);
     if (set->integrator == RT_INTEGRATOR_WHITTED && set->diffuse_bounces > 0 && set->diffuse_rays > 1) {
         double rays = 1.0;
         for (int i = 0; i < set->diffuse_bounces && rays <= MAX_DIFFUSE_TREE; i++)
@@ -462,173 +268,64 @@ static int print_info(const char *path, const memory_budget *budget)
     return 0;
 }
 
-int main(int argc, char **argv)
+/* The loaded scene as the flags want it: setting flags applied, --camera
+ * chosen, a glTF camera fitted to the image, the camera framed when the
+ * input has none, the limits checked, the output path chosen and checked. */
+static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t size, rt_error *err)
 {
-    const char *input = NULL, *output = NULL, *integrator = NULL, *preview = NULL, *info_path = NULL;
-    memory_budget budget = {default_memory_budget(), false, false};
-    long threads = 0, samples = 0, width = 0, height = 0, camera = -1, seed = -1, tile = 0;
-    double preview_seconds = 0.0;
-    rt_log_level level = RT_LOG_NORMAL;
-
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *next = i + 1 < argc ? argv[i + 1] : NULL;
-#define NEED_ARG()                                                                                                     \
-    do {                                                                                                               \
-        if (!next)                                                                                                     \
-            return fail_usage("option %s needs a value", a);                                                         \
-        i++;                                                                                                           \
-    } while (0)
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            usage(stdout);
-            return 0;
-        } else if (strcmp(a, "--version") == 0) {
-            printf("rt %s\n", RT_VERSION);
-            return 0;
-        } else if (strcmp(a, "-o") == 0) {
-            NEED_ARG();
-            output = next;
-        } else if (strcmp(a, "-t") == 0) {
-            NEED_ARG();
-            if (!parse_int(next, 1, 1024, &threads))
-                return fail_usage("-t wants a thread count from 1 to 1024, got '%s'", next);
-        } else if (strcmp(a, "-s") == 0) {
-            NEED_ARG();
-            if (!parse_int(next, 1, 1 << 20, &samples))
-                return fail_usage("-s wants samples per pixel from 1 to 1048576, got '%s'", next);
-        } else if (strcmp(a, "-r") == 0) {
-            NEED_ARG();
-            char *x = strchr(next, 'x');
-            char wbuf[32];
-            if (!x || (size_t)(x - next) >= sizeof wbuf)
-                return fail_usage("-r wants WIDTHxHEIGHT, e.g. 640x480, got '%s'", next);
-            memcpy(wbuf, next, (size_t)(x - next));
-            wbuf[x - next] = 0;
-            if (!parse_int(wbuf, 1, 32768, &width) || !parse_int(x + 1, 1, 32768, &height))
-                return fail_usage("-r wants WIDTHxHEIGHT with sides from 1 to 32768, got '%s'", next);
-        } else if (strcmp(a, "-q") == 0) {
-            level = RT_LOG_QUIET;
-        } else if (strcmp(a, "-v") == 0) {
-            level = RT_LOG_VERBOSE;
-        } else if (strcmp(a, "--integrator") == 0) {
-            NEED_ARG();
-            if (strcmp(next, "direct") && strcmp(next, "whitted") && strcmp(next, "path"))
-                return fail_usage("--integrator wants direct, whitted or path, got '%s'", next);
-            integrator = next;
-        } else if (strcmp(a, "--camera") == 0) {
-            NEED_ARG();
-            if (!parse_int(next, 0, INT_MAX, &camera))
-                return fail_usage("--camera wants a camera index (0, 1, ...), got '%s'", next);
-        } else if (strcmp(a, "--seed") == 0) {
-            NEED_ARG();
-            if (!parse_int(next, 0, UINT32_MAX > LONG_MAX ? LONG_MAX : (long)UINT32_MAX, &seed))
-                return fail_usage("--seed wants a non-negative integer, got '%s'", next);
-        } else if (strcmp(a, "--tile") == 0) {
-            NEED_ARG();
-            if (!parse_int(next, 1, 4096, &tile))
-                return fail_usage("--tile wants a tile size from 1 to 4096, got '%s'", next);
-        } else if (strcmp(a, "--preview") == 0) {
-            NEED_ARG();
-            if (!parse_double(next, 0.1, 3600.0, &preview_seconds))
-                return fail_usage("--preview wants seconds between updates (0.1 to 3600), got '%s'", next);
-            preview = "";
-        } else if (strcmp(a, "--info") == 0) {
-            NEED_ARG();
-            info_path = next;
-        } else if (strcmp(a, "--max-memory") == 0) {
-            NEED_ARG();
-            if (!parse_size(next, &budget.bytes))
-                return fail_usage("--max-memory wants a size such as 4G, 512M or 'none', got '%s'", next);
-            if (budget.bytes && budget.bytes < (64ull << 20))
-                return fail_usage("--max-memory: '%s' is below the 64M rt needs to start", next);
-            budget.from_flag = true;
-        } else if (a[0] == '-' && a[1] != 0) {
-            return fail_usage("unknown option '%s'", a);
-        } else {
-            if (input)
-                return fail_usage("only one input file, please (got a second: '%s')", a);
-            input = a;
-        }
-#undef NEED_ARG
-    }
-    rt_log_set_level(level);
-    apply_memory_budget(&budget);
-    if (budget.enforced) {
-        char sz[32];
-        format_size(budget.bytes, sz, sizeof sz);
-        rt_info("memory budget: %s%s", sz, budget.from_flag ? " (--max-memory)" : " (75% of physical memory)");
-    } else {
-        rt_info("memory budget: none%s", RT_SANITIZED && budget.bytes ? " (not enforced in sanitizer builds)" : "");
-    }
-    if (info_path)
-        return print_info(info_path, &budget);
-
-    rt_scene scene;
-    rt_scene_init(&scene);
-    rt_error err = {0};
     input_info info;
-    if (load_input(&scene, input, true, &info, &err) != RT_OK) {
-        report(&err, &budget);
-        rt_scene_free(&scene);
-        return 2;
-    }
-    rt_settings *set = &scene.settings;
-    if (samples) set->samples = (int)samples;
-    if (width) set->width = (int)width, set->height = (int)height;
-    if (seed >= 0) set->seed = (uint32_t)seed;
-    if (integrator)
-        set->integrator = strcmp(integrator, "whitted") == 0 ? RT_INTEGRATOR_WHITTED
-                          : strcmp(integrator, "path") == 0  ? RT_INTEGRATOR_PATH
-                                                             : RT_INTEGRATOR_DIRECT;
-    if (camera >= 0) {
-        if ((size_t)camera >= scene.camera_count) {
-            fprintf(stderr, "rt: --camera %ld: the loaded models have %zu camera%s\n", camera, scene.camera_count,
-                    scene.camera_count == 1 ? "" : "s");
-            rt_scene_free(&scene);
-            return 2;
-        }
-        scene.camera = scene.cameras[camera];
-        scene.camera_set = true;
+    rt_result r;
+    if ((r = load_input(scene, a->input, true, &info, err)) != RT_OK ||
+        (r = args_apply_settings(a, scene, err)) != RT_OK)
+        return r;
+    rt_settings *set = &scene->settings;
+    if (a->camera >= 0) {
+        if ((size_t)a->camera >= scene->camera_count)
+            return rt_fail(err, RT_ERR_INVALID, "--camera %d: the loaded models have %zu camera%s", a->camera,
+                           scene->camera_count, scene->camera_count == 1 ? "" : "s");
+        scene->camera = scene->cameras[a->camera];
+        scene->camera_set = true;
     }
     /* a glTF camera made for another aspect ratio: keep the height, fit the width */
-    if (!width && input && info.kind == INPUT_GLTF && scene.camera.aspect_ratio > 0.0f) {
-        double w = (double)set->height * scene.camera.aspect_ratio + 0.5;
-        set->width = w < 1.0 ? 1 : (w > 32768.0 ? 32768 : (int)w);
+    if (!args_sets(a, "resolution") && a->input && info.kind == INPUT_GLTF && scene->camera.aspect_ratio > 0.0f) {
+        double w = (double)set->height * scene->camera.aspect_ratio + 0.5;
+        set->width = w < 1.0 ? 1 : (w > (double)RT_MAX_IMAGE_SIDE ? RT_MAX_IMAGE_SIDE : (int)w);
     }
-    bool camera_from_input = scene.camera_set;
-    if (!scene.camera_set)
-        rt_scene_frame_camera(&scene);
-    if (check_limits(&scene, input, camera_from_input, &err) != RT_OK) {
-        report(&err, &budget);
-        rt_scene_free(&scene);
-        return 2;
-    }
+    bool camera_from_input = scene->camera_set;
+    if (!scene->camera_set)
+        rt_scene_frame_camera(scene);
+    if ((r = check_limits(scene, a->input, camera_from_input, err)) != RT_OK)
+        return r;
 
-    char outbuf[1024];
-    if (!output) {
-        default_output(&scene, input, outbuf, sizeof outbuf);
-        output = outbuf;
-    }
-    if (rt_output_check(output, &err) != RT_OK || rt_output_check_size(output, set->width, set->height, &err) != RT_OK) {
-        report(&err, &budget);
-        rt_scene_free(&scene);
-        return 2;
-    }
+    if (a->output)
+        snprintf(output, size, "%s", a->output);
+    else
+        default_output(scene, a->input, output, size);
+    if ((r = rt_output_check(output, err)) != RT_OK ||
+        (r = rt_output_check_size(output, set->width, set->height, err)) != RT_OK)
+        return r;
 
-    rt_info("scene: %s (loaded in %.1f ms)", input ? input : "<built-in>", info.load_ms);
-    rt_info("  triangles %zu, spheres %zu, quads %zu, vertices %zu", scene.triangles.count, scene.spheres.count,
-            scene.quads.count, scene.vertices.count);
-    rt_info("  materials %zu, textures %zu, images %zu, lights %zu", scene.material_count, scene.texture_count,
-            scene.image_count, scene.light_count);
+    rt_info("scene: %s (loaded in %.1f ms)", a->input ? a->input : "<built-in>", info.load_ms);
+    rt_info("  triangles %zu, spheres %zu, quads %zu, vertices %zu", scene->triangles.count, scene->spheres.count,
+            scene->quads.count, scene->vertices.count);
+    rt_info("  materials %zu, textures %zu, images %zu, lights %zu", scene->material_count, scene->texture_count,
+            scene->image_count, scene->light_count);
     rt_info("  %dx%d, %d samples per pixel, integrator %s", set->width, set->height, set->samples,
             set->integrator == RT_INTEGRATOR_WHITTED ? "whitted"
             : set->integrator == RT_INTEGRATOR_PATH  ? "path"
                                                      : "direct");
+    return RT_OK;
+}
 
+/* Builds the kd-tree, renders (Ctrl-C and SIGTERM stop the workers) and
+ * writes the image; returns the exit status. */
+static int render_and_write(const rt_scene *scene, const args *a, const char *output)
+{
+    const rt_settings *set = &scene->settings;
+    rt_error err = {0};
     rt_kdtree tree;
-    if (rt_kdtree_build(&tree, &scene, NULL, &err) != RT_OK) {
-        report(&err, &budget);
-        rt_scene_free(&scene);
+    if (rt_kdtree_build(&tree, scene, NULL, &err) != RT_OK) {
+        report(&err, &a->budget);
         return 2;
     }
     rt_info("kd-tree: built in %.1f ms: %zu nodes, %zu leaves (%zu empty), %zu references, depth %d; "
@@ -638,9 +335,8 @@ int main(int argc, char **argv)
 
     rt_framebuffer fb;
     if (rt_framebuffer_init(&fb, set->width, set->height, &err) != RT_OK) {
-        report(&err, &budget);
+        report(&err, &a->budget);
         rt_kdtree_free(&tree);
-        rt_scene_free(&scene);
         return 2;
     }
 
@@ -653,27 +349,27 @@ int main(int argc, char **argv)
 
     rt_render_options ro;
     memset(&ro, 0, sizeof ro);
-    ro.threads = (int)threads;
-    ro.tile_size = (int)tile;
-    ro.progress = level >= RT_LOG_NORMAL;
+    ro.threads = a->threads;
+    ro.tile_size = a->tile;
+    ro.progress = a->log_level >= RT_LOG_NORMAL;
     ro.cancel = &interrupted;
-    ro.preview_path = preview ? output : NULL;
-    ro.preview_seconds = preview_seconds;
+    ro.preview_path = a->preview_seconds > 0.0 ? output : NULL;
+    ro.preview_seconds = a->preview_seconds;
     rt_render_stats rs;
-    rt_result r = rt_render(&scene, &tree, &ro, &fb, &rs, &err);
+    rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);
     int status = 0;
     if (r == RT_ERR_INTERRUPTED) {
         fprintf(stderr, "rt: %s; writing the finished tiles to %s\n", err.message, output);
         status = 130;
     } else if (r != RT_OK) {
-        report(&err, &budget);
+        report(&err, &a->budget);
         status = 2;
     }
     if (status != 2) {
         if (rt_framebuffer_write(&fb, output, set->exposure, &err) != RT_OK) {
-            report(&err, &budget);
+            report(&err, &a->budget);
             status = 2;
-        } else if (level >= RT_LOG_NORMAL) {
+        } else if (a->log_level >= RT_LOG_NORMAL) {
             fprintf(stderr, "rt: wrote %s (%dx%d, %d spp, %.2f s)\n", output, fb.width, fb.height, set->samples,
                     rs.seconds);
         }
@@ -685,6 +381,30 @@ int main(int argc, char **argv)
         rt_warn("%llu NaN/Inf samples were dropped", (unsigned long long)rs.bad_samples);
     rt_framebuffer_free(&fb);
     rt_kdtree_free(&tree);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    args a;
+    int status = args_parse(&a, argc, argv);
+    if (status != ARGS_OK)
+        return status;
+    rt_log_set_level(a.log_level);
+    memory_budget_apply(&a.budget);
+    if (a.info_path)
+        return print_info(a.info_path, &a.budget);
+
+    rt_scene scene;
+    rt_scene_init(&scene);
+    rt_error err = {0};
+    char output[1024];
+    if (prepare(&scene, &a, output, sizeof output, &err) != RT_OK) {
+        report(&err, &a.budget);
+        rt_scene_free(&scene);
+        return 2;
+    }
+    status = render_and_write(&scene, &a, output);
     rt_scene_free(&scene);
     return status;
 }

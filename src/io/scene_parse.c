@@ -7,16 +7,18 @@
  * paths with spaces). Each token keeps its 1-based line and column so every
  * error can name `file:line:column` of the offending token, the way pbrt's
  * scene parser reports `FileLoc`s. The first token of a statement is looked
- * up in a table of keywords; each handler consumes its arguments through a
- * cursor (get_float, get_int, get_word ...) that produces the uniform
- * "expected X for Y, got 'Z'" messages, then appends records to the scene's
- * flat tables (scene.h). Names (materials, textures) are resolved at once, so
- * a name must be defined before it is used; `camera gltf N` is resolved after
- * the last statement, when every model's cameras are known.
+ * up in the settings table (settings.h: `samples`, `resolution`, ... are read,
+ * range-checked and stored by it, and located here) or in a table of
+ * keywords; each handler consumes its arguments through a cursor (get_float,
+ * get_int, get_word ...) that produces the uniform "expected X for Y, got 'Z'"
+ * messages, then appends records to the scene's flat tables (scene.h). Names
+ * (materials, textures) are resolved at once, so a name must be defined
+ * before it is used; `camera gltf N` is resolved after the last statement,
+ * when every model's cameras are known.
  *
- * Numbers: decimal only ([+-]digits[.digits][e[+-]digits], checked before
- * strtod), finite, and within float range; the whole token must be used, so
- * `1.0x`, `nan`, `inf` and `0x10` are all rejected.
+ * Numbers: decimal only ([+-]digits[.digits][e[+-]digits], number.h),
+ * finite, and within float range; the whole token must be used, so `1.0x`,
+ * `nan`, `inf` and `0x10` are all rejected.
  *
  * On failure the scene may hold what was appended before the bad statement;
  * the caller frees it with rt_scene_free() as usual. The parser's own memory
@@ -33,14 +35,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt/base/number.h"
 #include "rt/io/gltf.h"
 #include "rt/io/mesh_io.h"
+#include "rt/scene/settings.h"
 #include "rt/scene/texture.h"
 
 #define MAX_SCENE_BYTES ((size_t)256 << 20) /* 256 MiB of text keeps line and column in an int */
 #define MAX_PATH_LEN 4096
-#define MAX_RESOLUTION 32768
-#define MAX_SAMPLES (1 << 20)
 
 /* ------------------------------------------------------------ tokens */
 
@@ -66,13 +68,6 @@ typedef struct name_table {
     size_t nslots;
 } name_table;
 
-/* Settings that can be given once; a second line warns. */
-enum {
-    SET_RESOLUTION, SET_SAMPLES, SET_INTEGRATOR, SET_MAX_BOUNCE, SET_DIFFUSE_BOUNCES, SET_DIFFUSE_RAYS,
-    SET_SHADOW_SAMPLES, SET_SEED, SET_BACKGROUND, SET_EXPOSURE, SET_CLAMP, SET_RAY_OFFSET, SET_ENVIRONMENT,
-    SET_OUTPUT, SET_AMBIENT_LIGHT, SET_MAX_DEPTH, SET_COUNT
-};
-
 typedef struct parser {
     rt_scene *s;
     const char *name; /* file name for messages */
@@ -87,7 +82,7 @@ typedef struct parser {
     name_table materials, textures;
     uint32_t default_material; /* made on first use by a mesh without a material */
 
-    int setting_line[SET_COUNT];
+    int setting_line[RT_SETTINGS_MAX]; /* by settings-table index: where it was given, 0 = not yet */
     int camera_line;          /* line of the `camera` statement, 0 = none yet */
     bool camera_gltf;         /* `camera gltf N` given: resolve after parsing */
     long long camera_gltf_index;
@@ -217,62 +212,16 @@ static rt_result get_word(parser *p, const char *what, const tok **out)
     return RT_OK;
 }
 
-/* Decimal number syntax: [+-] digits [. digits] [(e|E) [+-] digits], with at
- * least one digit in the mantissa. */
-static bool decimal_syntax(const char *s, bool allow_fraction)
-{
-    const char *c = s;
-    int digits = 0;
-    if (*c == '+' || *c == '-')
-        c++;
-    while (*c >= '0' && *c <= '9')
-        c++, digits++;
-    if (allow_fraction && *c == '.') {
-        c++;
-        while (*c >= '0' && *c <= '9')
-            c++, digits++;
-    }
-    if (digits == 0)
-        return false;
-    if (allow_fraction && (*c == 'e' || *c == 'E')) {
-        c++;
-        if (*c == '+' || *c == '-')
-            c++;
-        if (!(*c >= '0' && *c <= '9'))
-            return false;
-        while (*c >= '0' && *c <= '9')
-            c++;
-    }
-    return *c == '\0';
-}
-
-typedef enum num_status { NUM_BAD = 0, NUM_OK, NUM_RANGE } num_status;
-
-static num_status parse_float(const char *s, float *out)
-{
-    if (!decimal_syntax(s, true))
-        return NUM_BAD;
-    errno = 0;
-    char *end = NULL;
-    double d = strtod(s, &end);
-    if (!end || *end != '\0')
-        return NUM_BAD;
-    if (!isfinite(d) || fabs(d) > (double)FLT_MAX)
-        return NUM_RANGE;
-    *out = (float)d;
-    return NUM_OK;
-}
-
 static rt_result get_float(parser *p, const char *what, float *out)
 {
     const tok *t = peek(p);
     char b[80];
     if (!t)
         return perr(p, RT_ERR_PARSE, NULL, "expected a number for %s, got end of line", what);
-    num_status st = t->quoted ? NUM_BAD : parse_float(t->s, out);
-    if (st == NUM_RANGE)
+    rt_number_status st = t->quoted ? RT_NUMBER_BAD : rt_parse_float(t->s, out);
+    if (st == RT_NUMBER_RANGE)
         return perr(p, RT_ERR_INVALID, t, "%s is out of range (beyond +-3.4e38), got %s", what, show(t, b, sizeof b));
-    if (st != NUM_OK)
+    if (st != RT_NUMBER_OK)
         return perr(p, RT_ERR_PARSE, t, "expected a number for %s, got %s", what, show(t, b, sizeof b));
     p->pos++;
     return RT_OK;
@@ -317,13 +266,12 @@ static rt_result get_int(parser *p, const char *what, long long lo, long long hi
     char b[80];
     if (!t)
         return perr(p, RT_ERR_PARSE, NULL, "expected an integer for %s, got end of line", what);
-    if (t->quoted || !decimal_syntax(t->s, false))
+    long long v = 0;
+    rt_number_status st = t->quoted ? RT_NUMBER_BAD : rt_parse_int(t->s, &v);
+    if (st == RT_NUMBER_BAD)
         return perr(p, RT_ERR_PARSE, t, "expected an integer for %s, got %s", what, show(t, b, sizeof b));
-    errno = 0;
-    char *end = NULL;
-    long long v = strtoll(t->s, &end, 10);
     p->pos++;
-    if (errno == ERANGE || v < lo || v > hi)
+    if (st == RT_NUMBER_RANGE || v < lo || v > hi)
         return perr(p, RT_ERR_INVALID, t, "%s must be between %lld and %lld, got %s", what, lo, hi,
                     show(t, b, sizeof b));
     *out = v;
@@ -585,188 +533,41 @@ static rt_result get_texture_ref(parser *p, const char *what, uint32_t *out)
 
 /* ------------------------------------------------------------ settings */
 
-static void note_setting(parser *p, int which, const tok *kw)
+/* A setting statement (`samples 64`, `resolution 640 480`, ...): the settings
+ * table reads, checks and stores the words after the keyword; this adds the
+ * location of the word at fault, and warns when a setting is given twice. */
+static rt_result st_setting(parser *p, const rt_setting *def, const tok *kw)
 {
+    const char *words[RT_SETTING_MAX_WORDS];
+    bool quoted[RT_SETTING_MAX_WORDS];
+    size_t first = p->pos, n = 0;
+    for (; n < RT_SETTING_MAX_WORDS && first + n < p->ntok; n++) {
+        words[n] = p->toks[first + n].s;
+        quoted[n] = p->toks[first + n].quoted;
+    }
+    rt_setting_value v;
+    rt_setting_problem pb;
+    rt_result r = rt_setting_read(def, words, quoted, n, &v, &pb);
+    if (r == RT_OK) {
+        p->pos = first + v.words;
+        if ((r = expect_end(p, def->name)) != RT_OK)
+            return r;
+        r = rt_setting_store(p->s, def, &v, p->dir, &pb);
+    }
+    if (r != RT_OK) {
+        const tok *t = pb.word < n ? &p->toks[first + pb.word] : NULL; /* NULL: a word is missing */
+        char b[80];
+        if (pb.got)
+            return perr(p, r, t, "%s, got %s", pb.message, t ? show(t, b, sizeof b) : "end of line");
+        if (t) /* a loader's message may be long: not through perr's buffer */
+            return rt_fail(p->err, r, "%s:%d:%d: %s", p->name, t->line, t->col, pb.message);
+        return perr(p, r, NULL, "%s", pb.message);
+    }
+    size_t which = (size_t)(def - rt_settings_table);
     if (p->setting_line[which])
         rt_warn("%s:%d:%d: '%s' was already set on line %d; the later value wins", p->name, kw->line, kw->col,
                 kw->s, p->setting_line[which]);
     p->setting_line[which] = kw->line;
-}
-
-static rt_result st_resolution(parser *p, const tok *kw)
-{
-    long long w = 0, h = 0;
-    rt_result r;
-    if ((r = get_int(p, "the image width", 1, MAX_RESOLUTION, &w)) != RT_OK ||
-        (r = get_int(p, "the image height", 1, MAX_RESOLUTION, &h)) != RT_OK ||
-        (r = expect_end(p, "resolution")) != RT_OK)
-        return r;
-    note_setting(p, SET_RESOLUTION, kw);
-    p->s->settings.width = (int)w;
-    p->s->settings.height = (int)h;
-    return RT_OK;
-}
-
-/* The integer settings share one handler, driven by this table. */
-typedef struct int_setting {
-    const char *key;
-    int which;
-    long long lo, hi;
-    const char *what;
-    size_t offset; /* of the int in rt_settings; seed is handled apart */
-} int_setting;
-
-static const int_setting int_settings[] = {
-    {"samples", SET_SAMPLES, 1, MAX_SAMPLES, "samples per pixel", offsetof(rt_settings, samples)},
-    {"max_bounce", SET_MAX_BOUNCE, 0, 256, "max_bounce", offsetof(rt_settings, max_bounce)},
-    {"max_depth", SET_MAX_DEPTH, 0, 1024, "max_depth", offsetof(rt_settings, max_depth)},
-    {"diffuse_bounces", SET_DIFFUSE_BOUNCES, 0, 64, "diffuse_bounces", offsetof(rt_settings, diffuse_bounces)},
-    {"diffuse_rays", SET_DIFFUSE_RAYS, 1, 65536, "diffuse_rays", offsetof(rt_settings, diffuse_rays)},
-    {"shadow_samples", SET_SHADOW_SAMPLES, 1, 65536, "shadow_samples", offsetof(rt_settings, shadow_samples)},
-};
-
-static rt_result st_int_setting(parser *p, const tok *kw)
-{
-    for (size_t i = 0; i < sizeof int_settings / sizeof *int_settings; i++) {
-        const int_setting *is = &int_settings[i];
-        if (strcmp(kw->s, is->key) != 0)
-            continue;
-        long long v = 0;
-        rt_result r;
-        if ((r = get_int(p, is->what, is->lo, is->hi, &v)) != RT_OK || (r = expect_end(p, is->key)) != RT_OK)
-            return r;
-        note_setting(p, is->which, kw);
-        *(int *)((char *)&p->s->settings + is->offset) = (int)v;
-        return RT_OK;
-    }
-    return perr(p, RT_ERR_PARSE, kw, "internal: no integer setting '%s'", kw->s);
-}
-
-static rt_result st_seed(parser *p, const tok *kw)
-{
-    long long v = 0;
-    rt_result r;
-    if ((r = get_int(p, "the seed", 0, UINT32_MAX, &v)) != RT_OK || (r = expect_end(p, "seed")) != RT_OK)
-        return r;
-    note_setting(p, SET_SEED, kw);
-    p->s->settings.seed = (uint32_t)v;
-    return RT_OK;
-}
-
-static rt_result st_integrator(parser *p, const tok *kw)
-{
-    static const char *const words[] = {"direct", "whitted", "path"};
-    static const rt_integrator values[] = {RT_INTEGRATOR_DIRECT, RT_INTEGRATOR_WHITTED, RT_INTEGRATOR_PATH};
-    int i = 0;
-    rt_result r;
-    if ((r = get_choice(p, "an integrator", words, 3, "direct|whitted|path", &i)) != RT_OK ||
-        (r = expect_end(p, "integrator")) != RT_OK)
-        return r;
-    note_setting(p, SET_INTEGRATOR, kw);
-    p->s->settings.integrator = values[i];
-    return RT_OK;
-}
-
-static rt_result st_background(parser *p, const tok *kw)
-{
-    rt_vec3 c;
-    rt_result r;
-    if ((r = get_color(p, "the background colour", &c)) != RT_OK || (r = expect_end(p, "background")) != RT_OK)
-        return r;
-    note_setting(p, SET_BACKGROUND, kw);
-    p->s->settings.background = c;
-    return RT_OK;
-}
-
-/* whitted's ambient radiance (docs/shading.md); unset = the background's */
-static rt_result st_ambient_light(parser *p, const tok *kw)
-{
-    rt_vec3 c;
-    rt_result r;
-    if ((r = get_color(p, "the ambient light colour", &c)) != RT_OK || (r = expect_end(p, "ambient_light")) != RT_OK)
-        return r;
-    note_setting(p, SET_AMBIENT_LIGHT, kw);
-    p->s->settings.ambient_light = c;
-    p->s->settings.ambient_light_set = true;
-    return RT_OK;
-}
-
-static rt_result st_exposure(parser *p, const tok *kw)
-{
-    float v = 0;
-    rt_result r;
-    if ((r = get_float_above(p, "the exposure", 0.0f, &v)) != RT_OK || (r = expect_end(p, "exposure")) != RT_OK)
-        return r;
-    note_setting(p, SET_EXPOSURE, kw);
-    p->s->settings.exposure = v;
-    return RT_OK;
-}
-
-static rt_result st_clamp(parser *p, const tok *kw)
-{
-    float v = 0;
-    rt_result r;
-    if ((r = get_float_in(p, "the clamp", 0.0f, FLT_MAX, &v)) != RT_OK || (r = expect_end(p, "clamp")) != RT_OK)
-        return r;
-    note_setting(p, SET_CLAMP, kw);
-    p->s->settings.clamp = v;
-    return RT_OK;
-}
-
-static rt_result st_ray_offset(parser *p, const tok *kw)
-{
-    float v = 0;
-    rt_result r;
-    if ((r = get_float_in(p, "the ray offset", 0.0f, FLT_MAX, &v)) != RT_OK ||
-        (r = expect_end(p, "ray_offset")) != RT_OK)
-        return r;
-    note_setting(p, SET_RAY_OFFSET, kw);
-    p->s->settings.ray_offset = v;
-    return RT_OK;
-}
-
-static rt_result st_environment(parser *p, const tok *kw)
-{
-    const tok *file = NULL;
-    float strength = 1.0f;
-    rt_result r;
-    if ((r = get_word(p, "an environment image file", &file)) != RT_OK)
-        return r;
-    if (peek_is(p, "strength")) {
-        p->pos++;
-        if ((r = get_float_in(p, "the environment strength", 0.0f, FLT_MAX, &strength)) != RT_OK)
-            return r;
-    }
-    if ((r = expect_end(p, "environment")) != RT_OK)
-        return r;
-    rt_texture tex;
-    if ((r = image_texture(p, file, &tex)) != RT_OK)
-        return r;
-    tex.wrap_s = RT_WRAP_REPEAT; /* longitude wraps around */
-    tex.wrap_t = RT_WRAP_CLAMP;  /* latitude stops at the poles */
-    uint32_t id = rt_scene_add_texture(p->s, &tex);
-    if (id == RT_NONE)
-        return nomem(p, file);
-    note_setting(p, SET_ENVIRONMENT, kw);
-    p->s->settings.environment_texture = id;
-    p->s->settings.environment_strength = strength;
-    return RT_OK;
-}
-
-static rt_result st_output(parser *p, const tok *kw)
-{
-    const tok *file = NULL;
-    rt_result r;
-    if ((r = get_word(p, "an output file name", &file)) != RT_OK || (r = expect_end(p, "output")) != RT_OK)
-        return r;
-    size_t n = strlen(file->s);
-    if (n == 0)
-        return perr(p, RT_ERR_INVALID, file, "expected an output file name, got an empty string");
-    if (n >= sizeof p->s->settings.output)
-        return perr(p, RT_ERR_LIMIT, file, "output file name is too long (at most %zu characters)",
-                    sizeof p->s->settings.output - 1);
-    note_setting(p, SET_OUTPUT, kw);
-    memcpy(p->s->settings.output, file->s, n + 1);
     return RT_OK;
 }
 
@@ -1187,7 +988,7 @@ static rt_result get_xform_option(parser *p, xform *x, const char *stmt, bool *t
         /* `scale X Y Z` when a number follows */
         float tmp;
         const tok *t = peek(p);
-        if (t && !t->quoted && parse_float(t->s, &tmp) != NUM_BAD) {
+        if (t && !t->quoted && rt_parse_float(t->s, &tmp) != RT_NUMBER_BAD) {
             snprintf(what, sizeof what, "the %s scale (y)", stmt);
             if ((r = get_float(p, what, &x->scale.y)) != RT_OK)
                 return r;
@@ -1444,23 +1245,8 @@ typedef struct keyword {
     handler fn;
 } keyword;
 
+/* The statements that are not settings (those are in the settings table). */
 static const keyword keywords[] = {
-    {"resolution", st_resolution},
-    {"samples", st_int_setting},
-    {"integrator", st_integrator},
-    {"max_bounce", st_int_setting},
-    {"max_depth", st_int_setting},
-    {"diffuse_bounces", st_int_setting},
-    {"diffuse_rays", st_int_setting},
-    {"shadow_samples", st_int_setting},
-    {"seed", st_seed},
-    {"background", st_background},
-    {"ambient_light", st_ambient_light},
-    {"exposure", st_exposure},
-    {"clamp", st_clamp},
-    {"ray_offset", st_ray_offset},
-    {"environment", st_environment},
-    {"output", st_output},
     {"camera", st_camera},
     {"texture", st_texture},
     {"material", st_material},
@@ -1497,12 +1283,21 @@ static rt_result run_statement(parser *p)
     const tok *kw = &p->toks[0];
     char b[80];
     p->pos = 1;
-    if (!kw->quoted)
+    if (!kw->quoted) {
+        const rt_setting *def = rt_setting_find(kw->s);
+        if (def)
+            return st_setting(p, def, kw);
         for (size_t i = 0; i < sizeof keywords / sizeof *keywords; i++)
             if (strcmp(kw->s, keywords[i].word) == 0)
                 return keywords[i].fn(p, kw);
+    }
     const char *best = NULL;
     int best_d = 3;
+    for (size_t i = 0; i < rt_settings_count; i++) {
+        int d = edit_distance(kw->s, rt_settings_table[i].name);
+        if (d < best_d)
+            best_d = d, best = rt_settings_table[i].name;
+    }
     for (size_t i = 0; i < sizeof keywords / sizeof *keywords; i++) {
         int d = edit_distance(kw->s, keywords[i].word);
         if (d < best_d)

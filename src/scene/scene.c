@@ -1,28 +1,9 @@
-/* scene.c - the scene tables: defaults, appends, bounds, automatic framing. */
+/* scene.c - the scene tables: defaults, appends, bounds, automatic framing.
+ * (rt_settings_default() is in settings.c, driven by the settings table.) */
 #include "rt/scene/scene.h"
 
 #include <stdlib.h>
 #include <string.h>
-
-void rt_settings_default(rt_settings *s)
-{
-    memset(s, 0, sizeof *s);
-    s->width = 512;
-    s->height = 512;
-    s->samples = 1; /* the old renderer's default; scenes ask for more */
-    s->integrator = RT_INTEGRATOR_DIRECT;
-    s->max_bounce = 1;
-    s->diffuse_bounces = 0;
-    s->diffuse_rays = 128;
-    s->shadow_samples = 16;
-    s->ray_offset = 0.0f;
-    s->clamp = 0.0f;
-    s->exposure = 1.0f;
-    s->seed = 0;
-    s->background = rt_v3s(0.0f);
-    s->environment_texture = RT_NONE;
-    s->environment_strength = 1.0f;
-}
 
 void rt_texture_slot_none(rt_texture_slot *slot)
 {

@@ -53,7 +53,8 @@ typedef enum rt_integrator {
     RT_INTEGRATOR_PATH,       /* physically based path tracer */
 } rt_integrator;
 
-/* Render settings. rt_settings_default() gives the documented defaults. */
+/* Render settings. rt_settings_default() gives the documented defaults; the
+ * table of them (names, ranges, defaults, help) is rt/scene/settings.h. */
 typedef struct rt_settings {
     int width, height;
     int samples;          /* samples per pixel (stratified when a square) */

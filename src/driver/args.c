@@ -1,0 +1,385 @@
+/* args.c - the `rt` command line (args.h): one table of flags drives the
+ * parsing and the --help text; the flags that set scene settings take their
+ * ranges, help and defaults from the settings table (settings.h), so the
+ * command line, the scene format and --help cannot disagree.
+ *
+ * Conventions (GNU getopt_long's, without its global state): short and long
+ * forms, `--name=value`, `--` ends the flags. A value that looks like a flag
+ * (`-s -o`) is not taken as a value; a lone `-` or a negative number is.
+ */
+#include "args.h"
+
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "rt/base/number.h"
+#include "rt/render/render.h"
+
+typedef enum flag_kind {
+    FLAG_OUTPUT,
+    FLAG_THREADS,
+    FLAG_SETTING, /* sets the scene setting `setting` */
+    FLAG_SET,     /* --set KEY=VALUE: any scene setting */
+    FLAG_QUIET,
+    FLAG_VERBOSE,
+    FLAG_CAMERA,
+    FLAG_TILE,
+    FLAG_PREVIEW,
+    FLAG_INFO,
+    FLAG_MAX_MEMORY,
+    FLAG_HELP,
+    FLAG_VERSION,
+} flag_kind;
+
+typedef struct flag {
+    const char *short_name; /* "-s", or NULL */
+    const char *long_name;  /* "--samples" */
+    const char *value;      /* what it takes, for --help ("N"); NULL = no value */
+    flag_kind kind;
+    const char *setting;    /* FLAG_SETTING: the name in the settings table */
+    const char *help;       /* lines for --help; FLAG_SETTING: the table's */
+} flag;
+
+/* In --help order. */
+static const flag flags[] = {
+    {"-o", "--output", "FILE", FLAG_OUTPUT, NULL,
+     "output image: .png (8-bit sRGB), .pfm (linear float), .hdr (Radiance)\n"
+     "default: the scene's `output`, else INPUT-NAME.png in this directory"},
+    {"-t", "--threads", "N", FLAG_THREADS, NULL, "render threads"},
+    {"-s", "--samples", "N", FLAG_SETTING, "samples", NULL},
+    {"-r", "--resolution", "WxH", FLAG_SETTING, "resolution", NULL},
+    {"-q", "--quiet", NULL, FLAG_QUIET, NULL, "quiet: no progress bar, no warnings"},
+    {"-v", "--verbose", NULL, FLAG_VERBOSE, NULL, "verbose: scene statistics, kd-tree build, render time, rays per second"},
+    {NULL, "--integrator", "NAME", FLAG_SETTING, "integrator", NULL},
+    {NULL, "--seed", "N", FLAG_SETTING, "seed", NULL},
+    {NULL, "--set", "KEY=VALUE", FLAG_SET, NULL,
+     "set any scene setting listed below, as a scene file would (repeatable)"},
+    {NULL, "--camera", "N", FLAG_CAMERA, NULL, "use camera N of the loaded glTF models"},
+    {NULL, "--tile", "N", FLAG_TILE, NULL, "tile size in pixels (default 32)"},
+    {NULL, "--preview", "SECONDS", FLAG_PREVIEW, NULL,
+     "live view: rewrite the output with the finished tiles every SECONDS"},
+    {NULL, "--info", "FILE", FLAG_INFO, NULL, "print what a scene or model contains (key: value lines) and exit"},
+    {NULL, "--max-memory", "SIZE", FLAG_MAX_MEMORY, NULL, "memory budget, e.g. 4G or 512M; 'none' for no limit"},
+    {"-h", "--help", NULL, FLAG_HELP, NULL, "this text"},
+    {NULL, "--version", NULL, FLAG_VERSION, NULL, "print the version"},
+};
+#define FLAG_COUNT (sizeof flags / sizeof *flags)
+
+/* ------------------------------------------------------------ --help */
+
+#define HELP_COLUMN 26
+#define HELP_WIDTH 100
+
+/* Prints text from column `at` on, wrapped at HELP_WIDTH with continuation
+ * lines starting at `indent`; a '\n' in text starts a new line. */
+static void print_wrapped(FILE *f, const char *text, int at, int indent)
+{
+    int col = at;
+    for (const char *c = text; *c;) {
+        if (*c == '\n' || *c == ' ') {
+            bool forced = *c == '\n';
+            c++;
+            size_t next = strcspn(c, " \n");
+            if (forced || col + 1 + (int)next > HELP_WIDTH) {
+                fprintf(f, "\n%*s", indent, "");
+                col = indent;
+            } else {
+                fputc(' ', f);
+                col++;
+            }
+            continue;
+        }
+        size_t n = strcspn(c, " \n");
+        fprintf(f, "%.*s", (int)n, c);
+        col += (int)n;
+        c += n;
+    }
+    fputc('\n', f);
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off]\n"
+               "\n"
+               "Renders a scene to an image. With no input, renders the built-in Cornell box to out.png.\n"
+               "\n"
+               "options (a value may also follow '=', as in --samples=64; the setting flags -s, -r,\n"
+               "--integrator, --seed and --set override the scene, the later flag winning):\n");
+    for (size_t i = 0; i < FLAG_COUNT; i++) {
+        const flag *fl = &flags[i];
+        char names[64], text[512];
+        snprintf(names, sizeof names, "%s%s%s%s%s", fl->short_name ? fl->short_name : "  ",
+                 fl->short_name ? ", " : "  ", fl->long_name, fl->value ? " " : "", fl->value ? fl->value : "");
+        if (fl->kind == FLAG_SETTING) {
+            const rt_setting *def = rt_setting_find(fl->setting);
+            char range[128], dflt[128];
+            rt_setting_range_text(def, range, sizeof range);
+            rt_setting_default_text(def, dflt, sizeof dflt);
+            snprintf(text, sizeof text, "%s (%s; default %s)", def->help, range, dflt);
+        } else if (fl->kind == FLAG_THREADS) {
+            snprintf(text, sizeof text, "%s (default: all %d cores)", fl->help, rt_cpu_count());
+        } else if (fl->kind == FLAG_MAX_MEMORY) {
+            char budget[32];
+            memory_budget_format(memory_budget_default(), budget, sizeof budget);
+            snprintf(text, sizeof text, "%s\n(default: 75%% of physical memory, here %s)", fl->help, budget);
+        } else {
+            snprintf(text, sizeof text, "%s", fl->help);
+        }
+        fprintf(f, "  %-*s", HELP_COLUMN - 2, names);
+        print_wrapped(f, text, HELP_COLUMN, HELP_COLUMN);
+    }
+    fprintf(f, "\nsettings (a scene file's setting statements; --set KEY=VALUE gives any of them, its words\n"
+               "separated by blanks or commas: --set background=0.1,0.2,0.3 --set resolution=640x480):\n");
+    int width = 0;
+    for (size_t i = 0; i < rt_settings_count; i++) {
+        int w = (int)(strlen(rt_settings_table[i].name) + 1 + strlen(rt_settings_table[i].args));
+        width = w > width ? w : width;
+    }
+    for (size_t i = 0; i < rt_settings_count; i++) {
+        const rt_setting *def = &rt_settings_table[i];
+        char head[128], range[128], dflt[128], text[512];
+        snprintf(head, sizeof head, "%s %s", def->name, def->args);
+        rt_setting_range_text(def, range, sizeof range);
+        rt_setting_default_text(def, dflt, sizeof dflt);
+        snprintf(text, sizeof text, "%s (%s; default %s)", def->help, range, dflt);
+        fprintf(f, "  %-*s  ", width, head);
+        print_wrapped(f, text, width + 4, width + 6);
+    }
+    fprintf(f, "\n"
+               "Scene format: docs/scene-format.md; limits and exit codes: docs/robustness.md.\n"
+               "Exit status: 0 ok, 2 bad input (or over a limit), 130 interrupted.\n");
+}
+
+/* ------------------------------------------------------------ parsing */
+
+static int fail_usage(const char *fmt, ...) RT_PRINTF(1, 2);
+static int fail_usage(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "rt: ");
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "\nrt: see 'rt --help'\n");
+    va_end(ap);
+    return 2;
+}
+
+/* `-o`, `--output`, but not `-`, `-5` or `-.5` (values). */
+static bool looks_like_flag(const char *s)
+{
+    return s[0] == '-' && s[1] != 0 && !(s[1] >= '0' && s[1] <= '9') && s[1] != '.';
+}
+
+/* The flag named by a[0, len). */
+static const flag *find_flag(const char *a, size_t len)
+{
+    for (size_t i = 0; i < FLAG_COUNT; i++) {
+        const flag *fl = &flags[i];
+        if ((fl->short_name && strlen(fl->short_name) == len && strncmp(a, fl->short_name, len) == 0) ||
+            (strlen(fl->long_name) == len && strncmp(a, fl->long_name, len) == 0))
+            return fl;
+    }
+    return NULL;
+}
+
+/* An integer flag value in [lo, hi]. */
+static bool int_value(const char *s, long long lo, long long hi, int *out)
+{
+    long long v = 0;
+    if (rt_parse_int(s, &v) != RT_NUMBER_OK || v < lo || v > hi)
+        return false;
+    *out = (int)v;
+    return true;
+}
+
+/* What a setting flag accepts, for its error message: "samples per pixel
+ * from 1 to 1048576", "WIDTHxHEIGHT with sides from 1 to 32768", "direct,
+ * whitted or path". */
+static void setting_wants(const rt_setting *def, char *buf, size_t size)
+{
+    switch (def->type) {
+    case RT_SETTING_INT:
+    case RT_SETTING_UINT32:
+        snprintf(buf, size, "%s from %lld to %lld", def->help, (long long)def->min, (long long)def->max);
+        return;
+    case RT_SETTING_SIZE:
+        snprintf(buf, size, "WIDTHxHEIGHT with sides from %lld to %lld", (long long)def->min, (long long)def->max);
+        return;
+    case RT_SETTING_ENUM: {
+        size_t o = 0;
+        buf[0] = 0;
+        for (size_t i = 0; def->words[i] && o < size; i++) {
+            const char *sep = i == 0 ? "" : def->words[i + 1] ? ", " : " or ";
+            int n = snprintf(buf + o, size - o, "%s%s", sep, def->words[i]);
+            o += n > 0 ? (size_t)n : 0;
+        }
+        return;
+    }
+    default: {
+        char range[128];
+        rt_setting_range_text(def, range, sizeof range);
+        snprintf(buf, size, "%s (%s)", def->help, range);
+        return;
+    }
+    }
+}
+
+static int add_setting(args *a, const char *name, const char *arg, const rt_setting *def, const char *value)
+{
+    if (a->setting_count >= ARGS_MAX_SETTINGS)
+        return fail_usage("%s: too many setting flags (at most %d)", name, ARGS_MAX_SETTINGS);
+    a->settings[a->setting_count++] = (setting_flag){name, arg, def, value};
+    return ARGS_OK;
+}
+
+/* --set KEY=VALUE */
+static int parse_set(args *a, const char *name, const char *arg)
+{
+    const char *eq = strchr(arg, '=');
+    char key[64];
+    if (!eq || eq == arg || (size_t)(eq - arg) >= sizeof key)
+        return fail_usage("%s wants KEY=VALUE (a scene setting and its value, e.g. samples=64), got '%s'", name, arg);
+    memcpy(key, arg, (size_t)(eq - arg));
+    key[eq - arg] = 0;
+    const rt_setting *def = rt_setting_find(key);
+    if (!def) {
+        char names[1024];
+        size_t o = 0;
+        for (size_t i = 0; i < rt_settings_count && o < sizeof names; i++) {
+            int n = snprintf(names + o, sizeof names - o, "%s%s", i ? ", " : "", rt_settings_table[i].name);
+            o += n > 0 ? (size_t)n : 0;
+        }
+        return fail_usage("%s %s: no setting is called '%s' (the settings: %s)", name, arg, key, names);
+    }
+    rt_setting_problem pb;
+    if (rt_setting_set(NULL, def, eq + 1, &pb) != RT_OK)
+        return fail_usage("%s %s: %s", name, arg, pb.message);
+    return add_setting(a, name, arg, def, eq + 1);
+}
+
+int args_parse(args *a, int argc, char **argv)
+{
+    memset(a, 0, sizeof *a);
+    a->camera = -1;
+    a->log_level = RT_LOG_NORMAL;
+    a->budget.bytes = memory_budget_default();
+    bool flags_ended = false;
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i];
+        if (flags_ended || !looks_like_flag(arg)) {
+            if (a->input)
+                return fail_usage("only one input file, please (got a second: '%s')", arg);
+            a->input = arg;
+            continue;
+        }
+        if (strcmp(arg, "--") == 0) {
+            flags_ended = true;
+            continue;
+        }
+        /* --name=value */
+        const char *eq = strncmp(arg, "--", 2) == 0 ? strchr(arg, '=') : NULL;
+        size_t len = eq ? (size_t)(eq - arg) : strlen(arg);
+        const flag *fl = find_flag(arg, len);
+        if (!fl)
+            return fail_usage("unknown option '%s'", arg);
+        const char *name = eq ? fl->long_name : arg; /* as typed */
+        const char *value = NULL;
+        if (fl->value) {
+            if (eq)
+                value = eq + 1;
+            else if (i + 1 < argc && !looks_like_flag(argv[i + 1]))
+                value = argv[++i];
+            else
+                return fail_usage("option %s needs a value (%s %s)", name, name, fl->value);
+        } else if (eq) {
+            return fail_usage("option %s takes no value, got '%s'", name, arg);
+        }
+        switch (fl->kind) {
+        case FLAG_HELP:
+            usage(stdout);
+            return 0;
+        case FLAG_VERSION:
+            printf("rt %s\n", RT_VERSION);
+            return 0;
+        case FLAG_OUTPUT:
+            a->output = value;
+            break;
+        case FLAG_THREADS:
+            if (!int_value(value, 1, 1024, &a->threads))
+                return fail_usage("%s wants a thread count from 1 to 1024, got '%s'", name, value);
+            break;
+        case FLAG_SETTING: {
+            const rt_setting *def = rt_setting_find(fl->setting);
+            rt_setting_problem pb;
+            if (rt_setting_set(NULL, def, value, &pb) != RT_OK) {
+                char wants[256];
+                setting_wants(def, wants, sizeof wants);
+                return fail_usage("%s wants %s, got '%s'", name, wants, value);
+            }
+            int r = add_setting(a, name, value, def, value);
+            if (r != ARGS_OK)
+                return r;
+            break;
+        }
+        case FLAG_SET: {
+            int r = parse_set(a, name, value);
+            if (r != ARGS_OK)
+                return r;
+            break;
+        }
+        case FLAG_QUIET:
+            a->log_level = RT_LOG_QUIET;
+            break;
+        case FLAG_VERBOSE:
+            a->log_level = RT_LOG_VERBOSE;
+            break;
+        case FLAG_CAMERA:
+            if (!int_value(value, 0, INT32_MAX, &a->camera))
+                return fail_usage("%s wants a camera index (0, 1, ...), got '%s'", name, value);
+            break;
+        case FLAG_TILE:
+            if (!int_value(value, 1, 4096, &a->tile))
+                return fail_usage("%s wants a tile size from 1 to 4096, got '%s'", name, value);
+            break;
+        case FLAG_PREVIEW: {
+            float s = 0.0f;
+            if (rt_parse_float(value, &s) != RT_NUMBER_OK || !(s >= 0.1f && s <= 3600.0f))
+                return fail_usage("%s wants seconds between updates (0.1 to 3600), got '%s'", name, value);
+            a->preview_seconds = (double)s;
+            break;
+        }
+        case FLAG_INFO:
+            a->info_path = value;
+            break;
+        case FLAG_MAX_MEMORY:
+            if (!memory_budget_parse(value, &a->budget.bytes))
+                return fail_usage("%s wants a size such as 4G, 512M or 'none', got '%s'", name, value);
+            if (a->budget.bytes && a->budget.bytes < (64ull << 20))
+                return fail_usage("%s: '%s' is below the 64M rt needs to start", name, value);
+            a->budget.from_flag = true;
+            break;
+        }
+    }
+    return ARGS_OK;
+}
+
+bool args_sets(const args *a, const char *name)
+{
+    for (size_t i = 0; i < a->setting_count; i++)
+        if (strcmp(a->settings[i].setting->name, name) == 0)
+            return true;
+    return false;
+}
+
+rt_result args_apply_settings(const args *a, rt_scene *s, rt_error *err)
+{
+    for (size_t i = 0; i < a->setting_count; i++) {
+        const setting_flag *sf = &a->settings[i];
+        rt_setting_problem pb;
+        if (rt_setting_set(s, sf->setting, sf->value, &pb) != RT_OK)
+            return rt_fail(err, pb.code, "%s %s: %s", sf->flag, sf->arg, pb.message);
+    }
+    return RT_OK;
+}

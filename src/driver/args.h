@@ -1,0 +1,63 @@
+/* args.h - the `rt` command line (driver-private): flags in, one record out.
+ *
+ * Every flag has a short and/or long form (`-s 64`, `--samples 64`,
+ * `--samples=64`); a flag missing its value says so rather than taking the
+ * next flag as its value. The flags that set scene settings (-s, -r, --seed,
+ * --integrator, and --set KEY=VALUE for any setting) go through the settings
+ * table (rt/scene/settings.h): they are checked while parsing, so a bad value
+ * is refused before anything is loaded, and applied after loading, in the
+ * order given, so a later flag wins.
+ *
+ *   args a;
+ *   int status = args_parse(&a, argc, argv);   // prints --help, --version and flag errors itself
+ *   if (status != ARGS_OK)
+ *       return status;                          // 0 after --help or --version, 2 after a bad flag
+ *   ... load the scene ...
+ *   if (args_apply_settings(&a, &scene, &err) != RT_OK) ...   // "--set environment=sky.hdr: ..."
+ */
+#ifndef RT_DRIVER_ARGS_H
+#define RT_DRIVER_ARGS_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "memory_budget.h"
+#include "rt/base/error.h"
+#include "rt/scene/scene.h"
+#include "rt/scene/settings.h"
+
+#define ARGS_OK (-1)
+#define ARGS_MAX_SETTINGS 64 /* setting flags on one command line */
+
+#define RT_VERSION "0.1.0"
+
+/* One setting flag as given: `-s 64`, `--set samples=64`. */
+typedef struct setting_flag {
+    const char *flag;          /* as typed, for messages: "-s", "--samples", "--set" */
+    const char *arg;           /* its argument as typed: "64", "samples=64" */
+    const rt_setting *setting; /* what it sets */
+    const char *value;         /* the setting's value text: "64" */
+} setting_flag;
+
+typedef struct args {
+    const char *input;      /* the scene or model; NULL = the built-in scene */
+    const char *output;     /* -o; NULL = the scene's `output`, else INPUT-NAME.png */
+    const char *info_path;  /* --info FILE: print what it contains and exit */
+    int threads;            /* -t; 0 = all cores */
+    int tile;               /* --tile; 0 = the default */
+    int camera;             /* --camera N; -1 = none */
+    double preview_seconds; /* --preview; 0 = no live view */
+    rt_log_level log_level; /* -q, -v */
+    memory_budget budget;   /* --max-memory, else the default (not applied yet) */
+    setting_flag settings[ARGS_MAX_SETTINGS];
+    size_t setting_count;
+} args;
+
+/* Parses argv into *a. Returns ARGS_OK to go on, else the exit status. */
+int args_parse(args *a, int argc, char **argv);
+/* True when a flag sets the setting called `name` (e.g. "resolution"). */
+bool args_sets(const args *a, const char *name);
+/* Applies the setting flags to the loaded scene, in command-line order. */
+rt_result args_apply_settings(const args *a, rt_scene *s, rt_error *err);
+
+#endif
