@@ -809,6 +809,34 @@ static void test_second_sigint_exits_at_once(void **state)
     free(r);
 }
 
+/* `rt compare` is reached from the command line: an image against itself
+ * (every metric 0, exit 0), against a different one with a threshold that
+ * fails (exit 1), and against a missing file (exit 2, the file named). */
+static void test_compare_command(void **state)
+{
+    (void)state;
+    const char *a = path_in("cmp-a.pfm"), *b = path_in("cmp-b.pfm"), *out = path_in("cmp-out.txt");
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_args(r, (const char *const[]){"-q", "-r", "16x16", "-s", "1", "-o", a, NULL});
+    assert_int_equal(r->status, 0);
+    run_args(r, (const char *const[]){"-q", "-r", "16x16", "-s", "4", "-o", b, NULL});
+    assert_int_equal(r->status, 0);
+    double t0 = now_s();
+    wait_for(spawn_to((const char *const[]){"compare", a, a, NULL}, out), t0, 120.0, r);
+    assert_int_equal(r->status, 0);
+    static char text[8192];
+    assert_true(read_all(out, text, sizeof text) != (size_t)-1);
+    assert_contains(text, "RMSE: 0\n");
+    assert_contains(text, "LDR-FLIP: 0.000000\n");
+    run_args(r, (const char *const[]){"compare", a, b, "--max-rmse", "0", NULL});
+    assert_int_equal(r->status, 1);
+    run_args(r, (const char *const[]){"compare", a, path_in("no-such.pfm"), NULL});
+    assert_int_equal(r->status, 2);
+    assert_contains(r->err, "no-such.pfm");
+    free(r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -826,6 +854,7 @@ int main(void)
         cmocka_unit_test(test_sigint_writes_finished_tiles),
         cmocka_unit_test(test_sigterm_writes_finished_tiles),
         cmocka_unit_test(test_second_sigint_exits_at_once),
+        cmocka_unit_test(test_compare_command),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);
 }

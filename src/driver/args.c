@@ -102,6 +102,7 @@ static void print_wrapped(FILE *f, const char *text, int at, int indent)
 static void usage(FILE *f)
 {
     fprintf(f, "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off]\n"
+               "       rt compare CANDIDATE REFERENCE [--max-rmse X] [--max-flip X] ...  (docs/compare.md)\n"
                "\n"
                "Renders a scene to an image. With no input, renders the built-in Cornell box to out.png.\n"
                "\n"

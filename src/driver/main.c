@@ -29,6 +29,7 @@
 #include "rt/scene/tangents.h"
 
 #include "args.h"
+#include "commands.h"
 #include "memory_budget.h"
 
 /* The kd-tree's primitive ids are 30 bits (src/accel/kdtree.c). */
@@ -386,6 +387,8 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
 
 int main(int argc, char **argv)
 {
+    if (argc > 1 && strcmp(argv[1], "compare") == 0)
+        return rt_cmd_compare(argc - 1, argv + 1);
     args a;
     int status = args_parse(&a, argc, argv);
     if (status != ARGS_OK)
