@@ -21,11 +21,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 #include <sys/resource.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "rt/base/file.h"
 #include "rt/render/camera.h"
 #include "rt/io/gltf.h"
 #include "rt/io/image.h"
@@ -267,20 +267,13 @@ static bool parse_double(const char *s, double lo, double hi, double *out)
     return true;
 }
 
-static bool has_ext(const char *path, const char *ext)
-{
-    const char *dot = strrchr(path, '.');
-    const char *slash = strrchr(path, '/');
-    return dot && (!slash || dot > slash) && strcasecmp(dot, ext) == 0;
-}
-
 typedef enum input_kind { INPUT_SCENE, INPUT_GLTF, INPUT_MESH } input_kind;
 
 static input_kind input_kind_of(const char *path)
 {
-    if (has_ext(path, ".gltf") || has_ext(path, ".glb"))
+    if (rt_path_has_ext(path, ".gltf") || rt_path_has_ext(path, ".glb"))
         return INPUT_GLTF;
-    if (has_ext(path, ".obj") || has_ext(path, ".ply") || has_ext(path, ".off"))
+    if (rt_path_has_ext(path, ".obj") || rt_path_has_ext(path, ".ply") || rt_path_has_ext(path, ".off"))
         return INPUT_MESH;
     return INPUT_SCENE;
 }

@@ -51,9 +51,6 @@ bool rt_mesh_buf_add_triangle(rt_mesh_buf *b, uint32_t a, uint32_t c1, uint32_t 
 rt_result rt_mesh_commit(rt_scene *s, rt_mesh_buf *b, const rt_mat4 *transform, const char *path,
                          rt_mesh_load_stats *stats, rt_error *err);
 
-/* Reads a whole regular file into a fresh NUL-terminated buffer (free it). */
-rt_result rt_mesh_read_file(const char *path, char **data, size_t *size, rt_error *err);
-
 /* Number parsing on [p, end) without locale or allocation. Both return the
  * position after the number, or NULL when no number starts at p. Floats are
  * correctly rounded (a fast exact path, else strtof on a bounded copy).
@@ -71,13 +68,6 @@ const char *rt_mesh_parse_int(const char *p, const char *end, int64_t *out);
  * normal, with a work bound that falls back to a fan. */
 #define RT_MESH_EARCLIP_MAX 128
 size_t rt_mesh_triangulate(const rt_vec3 *pos, const uint32_t *vidx, size_t n, uint32_t *out);
-
-/* Directory part of a path including the trailing '/' ("" for none), into out. */
-void rt_mesh_dirname(const char *path, char *out, size_t size);
-/* Base name (after the last '/'). */
-const char *rt_mesh_basename(const char *path);
-/* dir + rel unless rel is absolute; backslashes in rel become '/'. false if too long. */
-bool rt_mesh_join(const char *dir, const char *rel, char *out, size_t size);
 
 /* Warn once per keyword per file: a small set of keywords already warned about. */
 typedef struct rt_warn_once {

@@ -36,23 +36,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "mesh_internal.h"
+#include "rt/base/file.h"
 
 /* ------------------------------------------------------------ dispatch */
 
 static int ascii_lower(int c) { return (c >= 'A' && c <= 'Z') ? c - 'A' + 'a' : c; }
-
-static bool ext_is(const char *ext, const char *want)
-{
-    for (; *ext && *want; ext++, want++)
-        if (ascii_lower((unsigned char)*ext) != *want)
-            return false;
-    return *ext == 0 && *want == 0;
-}
 
 rt_result rt_mesh_load(rt_scene *s, const char *path, const rt_mat4 *transform, uint32_t material,
                        bool override_material, rt_mesh_load_stats *stats, rt_error *err)
@@ -61,98 +51,17 @@ rt_result rt_mesh_load(rt_scene *s, const char *path, const rt_mat4 *transform, 
         memset(stats, 0, sizeof *stats);
     if (!path)
         return rt_fail(err, RT_ERR_INVALID, "mesh: no path given");
-    const char *base = rt_mesh_basename(path);
-    const char *dot = strrchr(base, '.');
-    const char *ext = dot ? dot + 1 : "";
-    if (ext_is(ext, "obj"))
+    if (rt_path_has_ext(path, ".obj"))
         return rt_obj_load(s, path, transform, material, override_material, stats, err);
-    if (ext_is(ext, "ply"))
+    if (rt_path_has_ext(path, ".ply"))
         return rt_ply_load(s, path, transform, material, override_material, stats, err);
-    if (ext_is(ext, "off"))
+    if (rt_path_has_ext(path, ".off"))
         return rt_off_load(s, path, transform, material, override_material, stats, err);
-    if (!dot)
+    const char *ext = rt_path_ext(path);
+    if (!*ext)
         return rt_fail(err, RT_ERR_UNSUPPORTED, "%s: no file extension; meshes must be .obj, .ply or .off", path);
-    return rt_fail(err, RT_ERR_UNSUPPORTED, "%s: unknown mesh format '.%s' (expected .obj, .ply or .off)", path,
+    return rt_fail(err, RT_ERR_UNSUPPORTED, "%s: unknown mesh format '%s' (expected .obj, .ply or .off)", path,
                    ext);
-}
-
-/* ---------------------------------------------------------------- files */
-
-rt_result rt_mesh_read_file(const char *path, char **data, size_t *size, rt_error *err)
-{
-    *data = NULL;
-    *size = 0;
-    /* open without blocking (a FIFO would otherwise wait for a writer), then insist on a regular file */
-    int fd = open(path, O_RDONLY | O_NONBLOCK);
-    if (fd < 0)
-        return rt_fail(err, RT_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    struct stat st;
-    if (fstat(fd, &st) != 0) {
-        int e = errno;
-        close(fd);
-        return rt_fail(err, RT_ERR_IO, "%s: cannot stat: %s", path, strerror(e));
-    }
-    if (!S_ISREG(st.st_mode)) {
-        close(fd);
-        return rt_fail(err, RT_ERR_IO, "%s: not a regular file", path);
-    }
-    FILE *f = fdopen(fd, "rb");
-    if (!f) {
-        int e = errno;
-        close(fd);
-        return rt_fail(err, RT_ERR_IO, "%s: cannot open: %s", path, strerror(e));
-    }
-    if (st.st_size < 0 || (unsigned long long)st.st_size >= (unsigned long long)(SIZE_MAX / 2)) {
-        fclose(f);
-        return rt_fail(err, RT_ERR_LIMIT, "%s: file too large", path);
-    }
-    size_t n = (size_t)st.st_size;
-    char *buf = malloc(n + 1);
-    if (!buf) {
-        fclose(f);
-        return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory reading %zu bytes", path, n);
-    }
-    size_t got = n ? fread(buf, 1, n, f) : 0;
-    int bad = ferror(f);
-    fclose(f);
-    if (bad || got != n) {
-        free(buf);
-        return rt_fail(err, RT_ERR_IO, "%s: read error (got %zu of %zu bytes)", path, got, n);
-    }
-    buf[n] = 0;
-    *data = buf;
-    *size = n;
-    return RT_OK;
-}
-
-void rt_mesh_dirname(const char *path, char *out, size_t size)
-{
-    if (!size)
-        return;
-    const char *slash = strrchr(path, '/');
-    size_t n = slash ? (size_t)(slash - path) + 1 : 0;
-    if (n >= size)
-        n = 0; /* too long to be useful: resolve against the current directory */
-    memcpy(out, path, n);
-    out[n] = 0;
-}
-
-const char *rt_mesh_basename(const char *path)
-{
-    const char *slash = strrchr(path, '/');
-    return slash ? slash + 1 : path;
-}
-
-bool rt_mesh_join(const char *dir, const char *rel, char *out, size_t size)
-{
-    size_t dl = rel[0] == '/' ? 0 : strlen(dir), rl = strlen(rel);
-    if (dl + rl + 1 > size)
-        return false;
-    memcpy(out, dir, dl);
-    for (size_t i = 0; i < rl; i++)
-        out[dl + i] = rel[i] == '\\' ? '/' : rel[i];
-    out[dl + rl] = 0;
-    return true;
 }
 
 bool rt_warn_once_first(rt_warn_once *w, const char *key, size_t len)
@@ -595,7 +504,7 @@ rt_result rt_mesh_commit(rt_scene *s, rt_mesh_buf *b, const rt_mat4 *transform, 
         if (fallback == RT_NONE) {
             rt_material dm;
             char name[sizeof dm.name];
-            snprintf(name, sizeof name, "%.50s:default", rt_mesh_basename(path));
+            snprintf(name, sizeof name, "%.50s:default", rt_path_basename(path));
             rt_material_default(&dm, name);
             if ((fallback = rt_scene_add_material(s, &dm)) == RT_NONE)
                 return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for a material", path);

@@ -40,6 +40,7 @@
 #include <sys/stat.h>
 
 #include "mesh_internal.h"
+#include "rt/base/file.h"
 #include "rt/io/mesh_io.h"
 #include "rt/scene/texture.h"
 
@@ -286,6 +287,16 @@ static const char *cut_comment_ws(const char *p, const char *eol)
     return eol;
 }
 
+/* dir + rel (rel alone when absolute). Files written on Windows name paths
+ * with '\\': those become '/' in rel first. false when too long. */
+static bool obj_join(const char *dir, char *rel, char *out, size_t size)
+{
+    for (char *c = rel; *c; c++)
+        if (*c == '\\')
+            *c = '/';
+    return rt_path_join(dir, rel, out, size);
+}
+
 /* ------------------------------------------------------------- MTL */
 
 typedef struct mtl_ctx {
@@ -384,7 +395,7 @@ static rt_result mtl_map(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl, c
         return RT_OK;
     }
     char full[OBJ_PATH_MAX];
-    if (!rt_mesh_join(mc->mtl_dir, rel, full, sizeof full))
+    if (!obj_join(mc->mtl_dir, rel, full, sizeof full))
         return rt_fail(mc->op->err, RT_ERR_LIMIT, "%s:%ld: texture path too long", lc->file, lc->line);
     char *copy = strdup(full);
     if (!copy)
@@ -496,7 +507,7 @@ static rt_result load_mtl(obj_parser *op, const char *mtl_path, const line_ctx *
     char *data;
     size_t size;
     rt_error e = {0};
-    if (rt_mesh_read_file(mtl_path, &data, &size, &e) != RT_OK) {
+    if (rt_read_file(mtl_path, 0, &data, &size, &e) != RT_OK) {
         if (e.code == RT_ERR_NOMEM)
             return rt_fail(op->err, e.code, "%s", e.message);
         rt_warn("%s:%ld: %s; its materials fall back to the default", at->file, at->line, e.message);
@@ -514,7 +525,7 @@ static rt_result load_mtl(obj_parser *op, const char *mtl_path, const line_ctx *
     mc.op = op;
     mc.file = (uint32_t)op->nfiles++;
     mc.mtl_path = mtl_path;
-    rt_mesh_dirname(mtl_path, mc.mtl_dir, sizeof mc.mtl_dir);
+    rt_path_dirname(mtl_path, mc.mtl_dir, sizeof mc.mtl_dir);
     rt_result r = for_each_line(mtl_path, data, size, mtl_line, &mc);
     free(data);
     return r;
@@ -798,7 +809,7 @@ static rt_result obj_mtllib(obj_parser *op, line_ctx *lc, const char *p, const c
         return RT_OK;
     eol = cut_comment_ws(p, eol);
     char rel[OBJ_PATH_MAX], full[OBJ_PATH_MAX];
-    if (!rest_string(p, eol, rel, sizeof rel) || !rt_mesh_join(op->dir, rel, full, sizeof full))
+    if (!rest_string(p, eol, rel, sizeof rel) || !obj_join(op->dir, rel, full, sizeof full))
         return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: mtllib path too long", lc->file, lc->line);
     if (!rel[0]) {
         rt_warn("%s:%ld: mtllib without a file name", lc->file, lc->line);
@@ -818,7 +829,7 @@ static rt_result obj_mtllib(obj_parser *op, line_ctx *lc, const char *p, const c
             return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: mtllib path too long", lc->file, lc->line);
         memcpy(rel, p, n);
         rel[n] = 0;
-        if (!rt_mesh_join(op->dir, rel, full, sizeof full))
+        if (!obj_join(op->dir, rel, full, sizeof full))
             return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: mtllib path too long", lc->file, lc->line);
         rt_result r = load_mtl(op, full, lc);
         if (r != RT_OK)
@@ -962,7 +973,7 @@ static void make_material(rt_scene *s, const obj_mtl *om, const char *objname, c
 /* Adds the MTL materials to the scene and resolves every usemtl slot. */
 static rt_result resolve_materials(obj_parser *op, rt_scene *s, uint32_t material)
 {
-    const char *objname = rt_mesh_basename(op->path);
+    const char *objname = rt_path_basename(op->path);
     uint32_t *ids = op->nmtl ? rt_alloc(op->nmtl, sizeof *ids) : NULL;
     if (op->nmtl && !ids)
         return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for materials", op->path);
@@ -1023,7 +1034,7 @@ rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         memset(stats, 0, sizeof *stats);
     char *data;
     size_t size;
-    rt_result r = rt_mesh_read_file(path, &data, &size, err);
+    rt_result r = rt_read_file(path, 0, &data, &size, err);
     if (r != RT_OK)
         return r;
     obj_parser *op = calloc(1, sizeof *op);
@@ -1034,7 +1045,7 @@ rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
     op->path = path;
     op->err = err;
     op->override_material = override_material;
-    rt_mesh_dirname(path, op->dir, sizeof op->dir);
+    rt_path_dirname(path, op->dir, sizeof op->dir);
     size_t mat0 = s->material_count, tex0 = s->texture_count;
     if (!rt_grow((void **)&op->slots, &op->slotcap, 1, sizeof *op->slots)) {
         r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);

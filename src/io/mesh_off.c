@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "mesh_internal.h"
+#include "rt/base/file.h"
 #include "rt/io/mesh_io.h"
 
 typedef struct off_lines {
@@ -87,7 +88,7 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         memset(stats, 0, sizeof *stats);
     char *data;
     size_t size;
-    rt_result r = rt_mesh_read_file(path, &data, &size, err);
+    rt_result r = rt_read_file(path, 0, &data, &size, err);
     if (r != RT_OK)
         return r;
     rt_mesh_buf b;

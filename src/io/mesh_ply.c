@@ -37,6 +37,7 @@
 #include <string.h>
 
 #include "mesh_internal.h"
+#include "rt/base/file.h"
 #include "rt/io/mesh_io.h"
 
 typedef enum ply_type { PT_NONE = 0, PT_I8, PT_U8, PT_I16, PT_U16, PT_I32, PT_U32, PT_F32, PT_F64 } ply_type;
@@ -791,7 +792,7 @@ rt_result rt_ply_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         memset(stats, 0, sizeof *stats);
     char *data;
     size_t size;
-    rt_result res = rt_mesh_read_file(path, &data, &size, err);
+    rt_result res = rt_read_file(path, 0, &data, &size, err);
     if (res != RT_OK)
         return res;
     rt_mesh_buf b;

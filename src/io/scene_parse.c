@@ -33,6 +33,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt/base/file.h"
 #include "rt/io/gltf.h"
 #include "rt/io/mesh_io.h"
 #include "rt/scene/texture.h"
@@ -76,7 +77,7 @@ enum {
 typedef struct parser {
     rt_scene *s;
     const char *name; /* file name for messages */
-    const char *dir;  /* directory relative paths resolve against, NULL = current */
+    const char *dir;  /* directory relative paths resolve against ("" = the current one) */
     rt_error *err;
 
     /* the current statement */
@@ -521,14 +522,9 @@ static rt_result get_material(parser *p, const char *what, uint32_t *out)
 /* Joins the scene's directory and a relative path. */
 static rt_result resolve_path(parser *p, const tok *t, char *out, size_t size)
 {
-    int n;
     if (t->s[0] == '\0')
         return perr(p, RT_ERR_INVALID, t, "expected a file name, got an empty string");
-    if (t->s[0] == '/' || !p->dir || !p->dir[0])
-        n = snprintf(out, size, "%s", t->s);
-    else
-        n = snprintf(out, size, "%s/%s", p->dir, t->s);
-    if (n < 0 || (size_t)n >= size)
+    if (!rt_path_join(p->dir, t->s, out, size))
         return perr(p, RT_ERR_LIMIT, t, "file path is too long (at most %zu characters)", size - 1);
     return RT_OK;
 }
@@ -1668,6 +1664,13 @@ rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const
     if (len > MAX_SCENE_BYTES)
         return rt_fail(err, RT_ERR_LIMIT, "%s: scene text is %zu bytes, over the limit of %zu", name, len,
                        MAX_SCENE_BYTES);
+    /* relative paths in the text resolve against dir, by default the directory of name */
+    char name_dir[MAX_PATH_LEN];
+    if (!dir) {
+        if (!rt_path_dirname(name, name_dir, sizeof name_dir))
+            return rt_fail(err, RT_ERR_LIMIT, "%s: path is too long", name);
+        dir = name_dir;
+    }
     char *buf = malloc(len + 1);
     if (!buf)
         return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", name);
@@ -1698,57 +1701,12 @@ rt_result rt_scene_parse_file(rt_scene *s, const char *path, rt_error *err)
 {
     if (!path)
         return rt_fail(err, RT_ERR_INVALID, "no scene file given");
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return rt_fail(err, RT_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    char *text = NULL;
-    size_t len = 0, cap = 0;
-    rt_result r = RT_OK;
-    for (;;) {
-        if (len == cap) {
-            if (cap >= MAX_SCENE_BYTES + 1) {
-                r = rt_fail(err, RT_ERR_LIMIT, "%s: scene file is over the limit of %zu bytes", path,
-                            MAX_SCENE_BYTES);
-                break;
-            }
-            size_t nc = cap ? cap * 2 : 65536;
-            char *q = realloc(text, nc);
-            if (!q) {
-                r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
-                break;
-            }
-            text = q;
-            cap = nc;
-        }
-        size_t n = fread(text + len, 1, cap - len, f);
-        len += n;
-        if (n == 0) {
-            if (ferror(f))
-                r = rt_fail(err, RT_ERR_IO, "%s: read error", path);
-            break;
-        }
-    }
-    fclose(f);
-    if (r == RT_OK) {
-        /* relative paths in the file resolve against its directory */
-        char dir[MAX_PATH_LEN];
-        const char *slash = strrchr(path, '/');
-        const char *d = NULL;
-        if (slash) {
-            size_t n = (size_t)(slash - path);
-            if (n == 0)
-                n = 1; /* "/scene.txt": the root */
-            if (n < sizeof dir) {
-                memcpy(dir, path, n);
-                dir[n] = '\0';
-                d = dir;
-            } else {
-                r = rt_fail(err, RT_ERR_LIMIT, "%s: path is too long", path);
-            }
-        }
-        if (r == RT_OK)
-            r = rt_scene_parse_string(s, text, len, path, d, err);
-    }
+    char *text;
+    size_t len;
+    rt_result r = rt_read_file(path, MAX_SCENE_BYTES, &text, &len, err);
+    if (r != RT_OK)
+        return r;
+    r = rt_scene_parse_string(s, text, len, path, NULL, err);
     free(text);
     return r;
 }
