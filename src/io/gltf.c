@@ -2201,23 +2201,11 @@ static rt_result load_doc(rt_scene *s, const char *path, const void *data, size_
     rt_gltf_stats st;
     memset(&st, 0, sizeof st);
     st.bounds = rt_box_empty();
-    /* remember the table sizes so a failed load leaves the scene as it was */
-    size_t n_mat = s->material_count, n_tex = s->texture_count, n_img = s->image_count, n_light = s->light_count,
-           n_cam = s->camera_count, n_vert = s->vertices.count, n_tri = s->triangles.count;
+    rt_scene_mark mark = rt_scene_mark_of(s); /* a failed load leaves the scene as it was */
     rt_result r = load(&d, s, options, &st);
     doc_free(&d);
     if (r != RT_OK) {
-        for (size_t i = n_img; i < s->image_count; i++) {
-            free(s->images[i].rgba8);
-            free(s->images[i].rgbaf);
-        }
-        s->material_count = n_mat;
-        s->texture_count = n_tex;
-        s->image_count = n_img;
-        s->light_count = n_light;
-        s->camera_count = n_cam;
-        s->vertices.count = n_vert;
-        s->triangles.count = n_tri;
+        rt_scene_rollback(s, &mark);
         return r;
     }
     if (stats)

@@ -1046,7 +1046,7 @@ rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
     op->err = err;
     op->override_material = override_material;
     rt_path_dirname(path, op->dir, sizeof op->dir);
-    size_t mat0 = s->material_count, tex0 = s->texture_count;
+    rt_scene_mark mark = rt_scene_mark_of(s); /* a failed load leaves the scene as it was */
     if (!rt_grow((void **)&op->slots, &op->slotcap, 1, sizeof *op->slots)) {
         r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
         goto done;
@@ -1101,14 +1101,10 @@ rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
     }
     r = rt_mesh_commit(s, b, transform, path, stats, err);
     if (r == RT_OK && stats)
-        stats->materials = s->material_count - mat0;
+        stats->materials = s->material_count - mark.materials;
 done:
-    if (r != RT_OK) {
-        /* materials and textures are plain records: dropping them restores the scene
-         * (decoded images stay cached in the scene, which owns them) */
-        s->material_count = mat0;
-        s->texture_count = tex0;
-    }
+    if (r != RT_OK)
+        rt_scene_rollback(s, &mark);
     obj_free(op);
     free(op);
     free(data);

@@ -93,6 +93,7 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         return r;
     rt_mesh_buf b;
     memset(&b, 0, sizeof b);
+    rt_scene_mark mark = rt_scene_mark_of(s); /* a failed load leaves the scene as it was */
     uint32_t *face = NULL, *tri = NULL;
     size_t fcap = 0, tcap = 0;
     off_lines L = {path, data, data + size, 0, data, data};
@@ -280,6 +281,8 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
     }
     r = rt_mesh_commit(s, &b, transform, path, stats, err);
 done:
+    if (r != RT_OK)
+        rt_scene_rollback(s, &mark);
     rt_mesh_buf_free(&b);
     free(face);
     free(tri);

@@ -797,6 +797,7 @@ rt_result rt_ply_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         return res;
     rt_mesh_buf b;
     memset(&b, 0, sizeof b);
+    rt_scene_mark mark = rt_scene_mark_of(s); /* a failed load leaves the scene as it was */
     ply_load L;
     memset(&L, 0, sizeof L);
     L.r.path = path;
@@ -840,6 +841,8 @@ rt_result rt_ply_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
     } else {
         res = err->code ? err->code : RT_ERR_PARSE;
     }
+    if (res != RT_OK)
+        rt_scene_rollback(s, &mark);
     rt_mesh_buf_free(&b);
     free(L.pf.elems);
     free(L.pf.props);

@@ -18,9 +18,9 @@
  * strtod), finite, and within float range; the whole token must be used, so
  * `1.0x`, `nan`, `inf` and `0x10` are all rejected.
  *
- * On failure the scene may hold what was appended before the bad statement;
- * the caller frees it with rt_scene_free() as usual. The parser's own memory
- * is released on every path.
+ * On failure the scene is rolled back to where it was before the call
+ * (rt_scene_rollback): no half-parsed scene. The parser's own memory is
+ * released on every path.
  */
 #include "rt/io/scene_parse.h"
 
@@ -1686,10 +1686,13 @@ rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const
     p.default_material = RT_NONE;
     /* a UTF-8 byte order mark is not part of the first statement */
     size_t skip = len >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0 ? 3 : 0;
+    rt_scene_mark mark = rt_scene_mark_of(s); /* a failed parse leaves the scene as it was */
     rt_result r = run(&p, buf + skip, len - skip);
     p.ntok = 0;
     if (r == RT_OK)
         r = finish(&p);
+    if (r != RT_OK)
+        rt_scene_rollback(s, &mark);
     free(p.toks);
     name_table_free(&p.materials);
     name_table_free(&p.textures);

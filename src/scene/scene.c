@@ -1,4 +1,5 @@
-/* scene.c - the scene tables: defaults, appends, bounds, automatic framing. */
+/* scene.c - the scene tables: defaults, appends, marks and rollback, bounds,
+ * automatic framing. */
 #include "rt/scene/scene.h"
 
 #include <stdlib.h>
@@ -296,6 +297,67 @@ uint32_t rt_scene_add_triangle(rt_scene *s, uint32_t a, uint32_t b, uint32_t c, 
     t->material[i] = material;
     t->flags[i] = flags;
     return (uint32_t)i;
+}
+
+rt_scene_mark rt_scene_mark_of(const rt_scene *s)
+{
+    rt_scene_mark m;
+    memset(&m, 0, sizeof m);
+    m.materials = s->material_count;
+    m.textures = s->texture_count;
+    m.images = s->image_count;
+    m.lights = s->light_count;
+    m.cameras = s->camera_count;
+    m.vertices = s->vertices.count;
+    m.triangles = s->triangles.count;
+    m.spheres = s->spheres.count;
+    m.quads = s->quads.count;
+    m.vertex_attrs = (s->vertices.uv1 ? RT_ATTR_UV1 : 0u) | (s->vertices.tangent ? RT_ATTR_TANGENT : 0u) |
+                     (s->vertices.color ? RT_ATTR_COLOR : 0u);
+    m.camera_set = s->camera_set;
+    m.camera = s->camera;
+    m.settings = s->settings;
+    return m;
+}
+
+/* Truncates a count to its mark (a table never grows back). */
+static void truncate_to(size_t *count, size_t mark)
+{
+    if (*count > mark)
+        *count = mark;
+}
+
+void rt_scene_rollback(rt_scene *s, const rt_scene_mark *m)
+{
+    for (size_t i = m->images; i < s->image_count; i++) {
+        free(s->images[i].rgba8);
+        free(s->images[i].rgbaf);
+    }
+    truncate_to(&s->image_count, m->images);
+    truncate_to(&s->material_count, m->materials);
+    truncate_to(&s->texture_count, m->textures);
+    truncate_to(&s->light_count, m->lights);
+    truncate_to(&s->camera_count, m->cameras);
+    truncate_to(&s->vertices.count, m->vertices);
+    truncate_to(&s->triangles.count, m->triangles);
+    truncate_to(&s->spheres.count, m->spheres);
+    truncate_to(&s->quads.count, m->quads);
+    rt_vertices *v = &s->vertices;
+    if (!(m->vertex_attrs & RT_ATTR_UV1)) {
+        free(v->uv1);
+        v->uv1 = NULL;
+    }
+    if (!(m->vertex_attrs & RT_ATTR_TANGENT)) {
+        free(v->tangent);
+        v->tangent = NULL;
+    }
+    if (!(m->vertex_attrs & RT_ATTR_COLOR)) {
+        free(v->color);
+        v->color = NULL;
+    }
+    s->camera_set = m->camera_set;
+    s->camera = m->camera;
+    s->settings = m->settings;
 }
 
 rt_box rt_scene_prim_bounds(const rt_scene *s, uint32_t prim)
