@@ -338,10 +338,9 @@ static rt_result load_input(rt_scene *s, const char *path, bool for_render, inpu
         rt_material m;
         rt_material_default(&m, "default");
         uint32_t mi = rt_scene_add_material(s, &m);
-        rt_mat4 id = rt_mat4_identity();
-        rt_mesh_load_stats ms;
+        rt_mesh_options mo = {.material = mi};
         r = mi == RT_NONE ? rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path)
-                          : rt_mesh_load(s, path, &id, mi, false, &ms, err);
+                          : rt_mesh_load(s, path, &mo, NULL, err);
         info->meshes = info->primitives = r == RT_OK ? 1 : 0;
         if (r == RT_OK && for_render && !add_default_lighting(s))
             r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", path);

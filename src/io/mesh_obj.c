@@ -11,7 +11,7 @@
  *   output vertex per distinct (v, vt, vn) triple, found again through an
  *   open-addressing hash table (material names likewise), so adversarial
  *   files stay linear. Polygons are triangulated by
- *   rt_mesh_triangulate (mesh_io.c): fans for convex ones, the right diagonal
+ *   rt_mesh_triangulate (mesh_buffer.c): fans for convex ones, the right diagonal
  *   for concave quads, ear clipping for other concave polygons. Triangles
  *   that repeat a position are dropped and counted in stats.skipped_faces.
  *   usemtl names are resolved after the whole file (and every mtllib) is read,
@@ -39,9 +39,10 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "mesh_internal.h"
+#include "mesh_buffer.h"
+#include "mesh_readers.h"
+#include "mesh_text.h"
 #include "rt/base/file.h"
-#include "rt/io/mesh_io.h"
 #include "rt/scene/texture.h"
 
 #define OBJ_NAME_MAX 128
@@ -161,7 +162,7 @@ typedef struct obj_parser {
     uint32_t cur_slot;
     bool override_material;
     rt_warn_once warned;
-    rt_mesh_buf buf;
+    rt_mesh_buf *buf; /* the output (the dispatcher's) */
 } obj_parser;
 
 /* ----------------------------------------------------------- lines */
@@ -758,16 +759,16 @@ static rt_result obj_face(obj_parser *op, line_ctx *lc, const char *p, const cha
         op->tcap = c;
     }
     size_t nt = rt_mesh_triangulate(op->v, op->corner_v, nc, op->tri_out);
-    if (!rt_mesh_buf_reserve_triangles(&op->buf, op->buf.nt + nt))
+    if (!rt_mesh_buf_reserve_triangles(op->buf, op->buf->nt + nt))
         return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for triangles", lc->file);
     const uint32_t *cv = op->corner_v, *co = op->corner_out, *tri = op->tri_out;
     for (size_t k = 0; k < nt; k++) {
         uint32_t a = tri[3 * k], b = tri[3 * k + 1], c = tri[3 * k + 2];
         if (cv[a] == cv[b] || cv[b] == cv[c] || cv[a] == cv[c]) {
-            op->buf.skipped++;
+            op->buf->skipped++;
             continue;
         }
-        rt_mesh_buf_add_triangle(&op->buf, co[a], co[b], co[c], op->cur_slot, flags);
+        rt_mesh_buf_add_triangle(op->buf, co[a], co[b], co[c], op->cur_slot, flags);
     }
     return RT_OK;
 }
@@ -1021,32 +1022,22 @@ static void obj_free(obj_parser *op)
     free(op->corner_out); free(op->corner_v); free(op->corner_t); free(op->corner_n); free(op->tri_out);
     free(op->osg);
     free(op->mtls); free(op->slots);
-    rt_mesh_buf_free(&op->buf);
 }
 
-rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, uint32_t material,
-                      bool override_material, rt_mesh_load_stats *stats, rt_error *err)
+rt_result rt_obj_parse(const rt_mesh_input *in, rt_mesh_buf *b)
 {
-    rt_error local_err = {0};
-    if (!err)
-        err = &local_err;
-    if (stats)
-        memset(stats, 0, sizeof *stats);
-    char *data;
-    size_t size;
-    rt_result r = rt_read_file(path, 0, &data, &size, err);
-    if (r != RT_OK)
-        return r;
+    const char *path = in->name;
+    rt_error *err = in->err;
+    rt_scene *s = in->scene;
     obj_parser *op = calloc(1, sizeof *op);
-    if (!op) {
-        free(data);
+    if (!op)
         return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
-    }
+    rt_result r = RT_OK;
     op->path = path;
     op->err = err;
-    op->override_material = override_material;
+    op->buf = b;
+    op->override_material = in->override_material;
     rt_path_dirname(path, op->dir, sizeof op->dir);
-    rt_scene_mark mark = rt_scene_mark_of(s); /* a failed load leaves the scene as it was */
     if (!rt_grow((void **)&op->slots, &op->slotcap, 1, sizeof *op->slots)) {
         r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
         goto done;
@@ -1054,15 +1045,14 @@ rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
     op->nslot = 1;
     memset(&op->slots[0], 0, sizeof op->slots[0]);
 
-    r = for_each_line(path, data, size, obj_line, op);
+    r = for_each_line(path, in->bytes, in->size, obj_line, op);
     if (r != RT_OK)
         goto done;
 
-    if (!override_material && (r = resolve_materials(op, s, material)) != RT_OK)
+    if (!in->override_material && (r = resolve_materials(op, s, in->material)) != RT_OK)
         goto done;
 
     /* output vertices from the (v, vt, vn) triples */
-    rt_mesh_buf *b = &op->buf;
     unsigned attrs = (op->any_n || op->any_sg ? RT_MESH_NRM : 0) | (op->any_t ? RT_MESH_UV : 0) |
                      (op->vc ? RT_MESH_COL : 0);
     if (!rt_mesh_buf_enable(b, attrs) || !rt_mesh_buf_reserve_vertices(b, op->nout)) {
@@ -1095,18 +1085,12 @@ rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         }
     }
     for (size_t t = 0; t < b->nt; t++) {
-        b->mat[t] = override_material ? material : op->slots[b->mat[t]].material;
+        b->mat[t] = in->override_material ? in->material : op->slots[b->mat[t]].material;
         if (op->vc)
             b->flags[t] |= RT_TRI_COLOR;
     }
-    r = rt_mesh_commit(s, b, transform, path, stats, err);
-    if (r == RT_OK && stats)
-        stats->materials = s->material_count - mark.materials;
 done:
-    if (r != RT_OK)
-        rt_scene_rollback(s, &mark);
     obj_free(op);
     free(op);
-    free(data);
     return r;
 }

@@ -1263,7 +1263,8 @@ static rt_result st_mesh(parser *p, const tok *kw)
     rt_mat4 m = xform_matrix(&x);
     rt_error inner = {0};
     rt_mesh_load_stats stats = {0};
-    r = rt_mesh_load(p->s, path, &m, material, override_tok != NULL, &stats, &inner);
+    rt_mesh_options opt = {.transform = &m, .material = material, .override_material = override_tok != NULL};
+    r = rt_mesh_load(p->s, path, &opt, &stats, &inner);
     if (r != RT_OK)
         return loader_err(p, file, r, &inner);
     rt_info("%s:%d: mesh %s: %zu triangles, %zu vertices, %zu materials", p->name, kw->line, path, stats.triangles,

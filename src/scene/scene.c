@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt/base/soa.h"
+
 void rt_settings_default(rt_settings *s)
 {
     memset(s, 0, sizeof *s);
@@ -143,35 +145,13 @@ uint32_t rt_scene_add_camera(rt_scene *s, const rt_camera *c)
     return table_push((void **)&s->cameras, &s->camera_count, &s->camera_cap, c, sizeof *c);
 }
 
-/* Grows every array of a structure-of-arrays table together. `arrays` lists
- * the addresses of the array pointers, `sizes` their element sizes. */
-static bool soa_grow(void **arrays[], const size_t sizes[], int n, size_t *cap, size_t need)
-{
-    if (need <= *cap)
-        return true;
-    size_t c = *cap ? *cap : 64;
-    while (c < need) {
-        if (c > (SIZE_MAX >> 2))
-            return false;
-        c *= 2;
-    }
-    for (int i = 0; i < n; i++) {
-        void *q = rt_realloc_array(*arrays[i], c, sizes[i]);
-        if (!q)
-            return false; /* arrays already grown keep their new size; cap stays: still consistent */
-        *arrays[i] = q;
-    }
-    *cap = c;
-    return true;
-}
-
 uint32_t rt_scene_add_sphere(rt_scene *s, rt_vec3 center, float radius, uint32_t material)
 {
     rt_spheres *sp = &s->spheres;
     void **arrays[] = {(void **)&sp->cx, (void **)&sp->cy, (void **)&sp->cz, (void **)&sp->radius,
                        (void **)&sp->material};
     const size_t sizes[] = {4, 4, 4, 4, 4};
-    if (sp->count >= RT_NONE - 1 || !soa_grow(arrays, sizes, 5, &sp->cap, sp->count + 1))
+    if (sp->count >= RT_NONE - 1 || !rt_soa_reserve(arrays, sizes, 5, &sp->cap, sp->count + 1))
         return RT_NONE;
     size_t i = sp->count++;
     sp->cx[i] = center.x; sp->cy[i] = center.y; sp->cz[i] = center.z;
@@ -186,7 +166,7 @@ uint32_t rt_scene_add_quad(rt_scene *s, rt_vec3 p, rt_vec3 u, rt_vec3 v, uint32_
     void **arrays[] = {(void **)&q->px, (void **)&q->py, (void **)&q->pz, (void **)&q->ux, (void **)&q->uy,
                        (void **)&q->uz, (void **)&q->vx, (void **)&q->vy, (void **)&q->vz, (void **)&q->material};
     const size_t sizes[] = {4, 4, 4, 4, 4, 4, 4, 4, 4, 4};
-    if (q->count >= RT_NONE - 1 || !soa_grow(arrays, sizes, 10, &q->cap, q->count + 1))
+    if (q->count >= RT_NONE - 1 || !rt_soa_reserve(arrays, sizes, 10, &q->cap, q->count + 1))
         return RT_NONE;
     size_t i = q->count++;
     q->px[i] = p.x; q->py[i] = p.y; q->pz[i] = p.z;
@@ -217,7 +197,7 @@ static bool vertices_reserve(rt_vertices *v, size_t need)
     if (v->uv1) arrays[n] = (void **)&v->uv1, sizes[n++] = sizeof(rt_vec2);
     if (v->tangent) arrays[n] = (void **)&v->tangent, sizes[n++] = sizeof(rt_vec4);
     if (v->color) arrays[n] = (void **)&v->color, sizes[n++] = sizeof(rt_vec4);
-    return soa_grow(arrays, sizes, n, &v->cap, need);
+    return rt_soa_reserve(arrays, sizes, n, &v->cap, need);
 }
 
 uint32_t rt_scene_add_vertices(rt_scene *s, size_t n)
@@ -266,23 +246,9 @@ bool rt_scene_reserve_triangles(rt_scene *s, size_t n)
     rt_triangles *t = &s->triangles;
     if (t->count > SIZE_MAX / 4 - n)
         return false;
-    size_t need = t->count + n;
-    if (need <= t->cap)
-        return true;
-    size_t c = t->cap ? t->cap : 64;
-    while (c < need)
-        c *= 2;
-    uint32_t *idx = rt_realloc_array(t->index, c, 3 * sizeof(uint32_t));
-    if (!idx) return false;
-    t->index = idx;
-    uint32_t *mat = rt_realloc_array(t->material, c, sizeof(uint32_t));
-    if (!mat) return false;
-    t->material = mat;
-    uint8_t *fl = rt_realloc_array(t->flags, c, 1);
-    if (!fl) return false;
-    t->flags = fl;
-    t->cap = c;
-    return true;
+    void **arrays[] = {(void **)&t->index, (void **)&t->material, (void **)&t->flags};
+    const size_t sizes[] = {3 * sizeof *t->index, sizeof *t->material, sizeof *t->flags};
+    return rt_soa_reserve(arrays, sizes, 3, &t->cap, t->count + n);
 }
 
 uint32_t rt_scene_add_triangle(rt_scene *s, uint32_t a, uint32_t b, uint32_t c, uint32_t material, uint8_t flags)

@@ -74,10 +74,10 @@ static void load_mesh(const char *name, const uint8_t *data, size_t size)
     rt_material m;
     rt_material_default(&m, "fuzz");
     uint32_t mi = rt_scene_add_material(&s, &m);
-    rt_mat4 id = rt_mat4_identity();
+    rt_mesh_options opt = {.material = mi};
     rt_error err;
     rt_mesh_load_stats st;
-    rt_mesh_load(&s, path, &id, mi, false, &st, &err);
+    rt_mesh_load(&s, path, &opt, &st, &err);
     rt_scene_free(&s);
 }
 
