@@ -5,8 +5,8 @@
  *
  * Scenes: random triangle soups of 10k to N (default 2M) triangles in the
  * unit cube, each triangle's size scaled with N^(-1/3) so the density of
- * the scene, and hence the tree's shape, stays the same; then every glTF
- * given on the command line. For each: the median of K (default 3) builds
+ * the scene, and hence the tree's shape, stays the same; then every model
+ * given on the command line (loaded with rt_load, as `rt` does). For each: the median of K (default 3) builds
  * with 1 thread and with 2 threads, and the 1-thread time divided by
  * N log2 N (in ns), which stays flat when the build is O(N log N).
  * Prints a Markdown table.
@@ -16,7 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "rt/io/gltf.h"
+#include "rt/io/load.h"
 #include "rt/accel/kdtree.h"
 #include "rt/scene/scene.h"
 
@@ -125,11 +125,8 @@ int main(int argc, char **argv)
     for (int i = first_model; i < argc; i++) {
         rt_scene s;
         rt_scene_init(&s);
-        rt_gltf_options opt;
-        memset(&opt, 0, sizeof opt);
-        rt_gltf_stats gs;
         rt_error err = {0};
-        if (rt_gltf_load(&s, argv[i], &opt, &gs, &err) != RT_OK) {
+        if (rt_load(&s, argv[i], NULL, NULL, &err) != RT_OK) {
             fprintf(stderr, "buildscale: %s\n", err.message);
             return 2;
         }

@@ -4,8 +4,9 @@
  *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
  *           [--build-threads N] [--occluded]
  *
- * Loads the glTF (every triangle of the default scene in world space, as
- * ../shared/bench/FORMAT.md defines), builds the kd-tree (N build threads,
+ * Loads the model with rt_load, as `rt` does (a glTF: every triangle of
+ * the default scene in world space, as ../shared/bench/FORMAT.md defines;
+ * any other input rt reads works too), builds the kd-tree (N build threads,
  * default one per core), traces every ray for the closest hit K times and
  * prints `key: value` lines: triangles, load_ms, build_ms, nodes and leaves
  * (of the binary tree the build makes), wide_nodes (the 64-byte nodes of
@@ -25,7 +26,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "rt/io/gltf.h"
+#include "rt/io/load.h"
 #include "rt/accel/kdtree.h"
 #include "rt/io/rayset.h"
 #include "rt/scene/scene.h"
@@ -141,11 +142,8 @@ int main(int argc, char **argv)
     rt_error err = {0};
     rt_scene scene;
     rt_scene_init(&scene);
-    rt_gltf_options opt;
-    memset(&opt, 0, sizeof opt);
-    rt_gltf_stats gs;
     double t0 = now_s();
-    if (rt_gltf_load(&scene, model, &opt, &gs, &err) != RT_OK) {
+    if (rt_load(&scene, model, NULL, NULL, &err) != RT_OK) {
         fprintf(stderr, "rtbench: %s\n", err.message);
         return 2;
     }

@@ -27,7 +27,7 @@
 
 #include <ctype.h>
 
-#include "rt/io/gltf.h"
+#include "rt/io/load.h"
 #include "rt/accel/kdtree.h"
 #include "rt/io/rayset.h"
 #include "rt/scene/scene.h"
@@ -126,11 +126,8 @@ static void test_bench_rays(void **state)
     for (size_t m = 0; m < n; m++) {
         rt_scene scene;
         rt_scene_init(&scene);
-        rt_gltf_options opt;
-        memset(&opt, 0, sizeof opt);
-        rt_gltf_stats gs;
         rt_error err = {0};
-        rt_result res = rt_gltf_load(&scene, test_shared_path(models[m].glb), &opt, &gs, &err);
+        rt_result res = rt_load(&scene, test_shared_path(models[m].glb), NULL, NULL, &err);
         if (res != RT_OK)
             fprintf(stderr, "%s\n", err.message);
         assert_int_equal(res, RT_OK);

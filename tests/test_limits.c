@@ -282,7 +282,8 @@ static rt_result load_mesh_text(const char *name, const char *text, rt_scene *s,
     uint32_t mi = rt_scene_add_material(s, &m);
     rt_mat4 id = rt_mat4_identity();
     rt_mesh_load_stats st;
-    rt_result r = rt_mesh_load(s, path, &id, mi, false, &st, err);
+    rt_mesh_options opt = {.transform = &id, .material = mi};
+    rt_result r = rt_mesh_load(s, path, &opt, &st, err);
     unlink(path);
     return r;
 }

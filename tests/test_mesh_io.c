@@ -13,7 +13,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "../src/io/mesh_internal.h"
+#include "../src/io/mesh_buffer.h"
+#include "../src/io/mesh_text.h"
 #include "rt/io/mesh_io.h"
 #include "rt/scene/texture.h"
 
@@ -45,7 +46,8 @@ static void load(loaded *l, const char *path, const rt_mat4 *m)
     rt_material mat;
     rt_material_default(&mat, "caller");
     l->def = rt_scene_add_material(&l->s, &mat);
-    l->r = rt_mesh_load(&l->s, path, m, l->def, false, &l->st, &l->err);
+    rt_mesh_options opt = {.transform = m, .material = l->def};
+    l->r = rt_mesh_load(&l->s, path, &opt, &l->st, &l->err);
 }
 
 static void load_ok(loaded *l, const char *path, const rt_mat4 *m)
@@ -370,7 +372,8 @@ static void test_obj_mtl(void **state)
     rt_material d;
     rt_material_default(&d, "only");
     uint32_t only = rt_scene_add_material(&l.s, &d);
-    assert_int_equal(rt_mesh_load(&l.s, tpath("mats.obj"), NULL, only, true, &l.st, &l.err), RT_OK);
+    rt_mesh_options only_opt = {.material = only, .override_material = true};
+    assert_int_equal(rt_mesh_load(&l.s, tpath("mats.obj"), &only_opt, &l.st, &l.err), RT_OK);
     assert_int_equal(l.s.material_count, 1);
     for (size_t t = 0; t < l.s.triangles.count; t++)
         assert_int_equal(l.s.triangles.material[t], only);
@@ -466,8 +469,9 @@ static void test_dispatch(void **state)
     rt_scene_free(&l.s);
     /* no caller material: a default one is made, once */
     rt_scene_init(&l.s);
-    assert_int_equal(rt_mesh_load(&l.s, tpath("upper.OBJ"), NULL, RT_NONE, false, &l.st, &l.err), RT_OK);
-    assert_int_equal(rt_mesh_load(&l.s, tpath("upper.OBJ"), NULL, RT_NONE, true, NULL, &l.err), RT_OK);
+    rt_mesh_options none = {.material = RT_NONE}, none_override = {.material = RT_NONE, .override_material = true};
+    assert_int_equal(rt_mesh_load(&l.s, tpath("upper.OBJ"), &none, &l.st, &l.err), RT_OK);
+    assert_int_equal(rt_mesh_load(&l.s, tpath("upper.OBJ"), &none_override, NULL, &l.err), RT_OK);
     assert_int_equal(l.s.material_count, 2);
     assert_string_equal(l.s.materials[0].name, "upper.OBJ:default");
     assert_int_equal(l.s.triangles.material[0], 0);

@@ -14,19 +14,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
-#include <time.h>
 
 #include "rt/render/camera.h"
-#include "rt/io/gltf.h"
-#include "rt/io/image.h"
 #include "rt/accel/kdtree.h"
-#include "rt/io/mesh_io.h"
+#include "rt/io/image.h"
+#include "rt/io/load.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
-#include "rt/io/scene_parse.h"
 #include "rt/scene/settings.h"
-#include "rt/scene/tangents.h"
 
 #include "args.h"
 #include "commands.h"
@@ -49,13 +44,6 @@ static void on_signal(int sig)
     }
 }
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
-}
-
 /* Prints an error; out-of-memory errors also say which budget ran out and
  * how to raise it. */
 static void report(const rt_error *err, const memory_budget *budget)
@@ -75,99 +63,6 @@ static void report(const rt_error *err, const memory_budget *budget)
     }
 }
 
-static bool has_ext(const char *path, const char *ext)
-{
-    const char *dot = strrchr(path, '.');
-    const char *slash = strrchr(path, '/');
-    return dot && (!slash || dot > slash) && strcasecmp(dot, ext) == 0;
-}
-
-typedef enum input_kind { INPUT_SCENE, INPUT_GLTF, INPUT_MESH } input_kind;
-
-static input_kind input_kind_of(const char *path)
-{
-    if (has_ext(path, ".gltf") || has_ext(path, ".glb"))
-        return INPUT_GLTF;
-    if (has_ext(path, ".obj") || has_ext(path, ".ply") || has_ext(path, ".off"))
-        return INPUT_MESH;
-    return INPUT_SCENE;
-}
-
-/* Lighting and sampling for a bare model: a soft sky, a key light from
- * above when the model brings no lights, and enough samples for clean edges. */
-static bool add_default_lighting(rt_scene *s)
-{
-    s->settings.samples = 16;
-    s->settings.background = rt_v3(0.55f, 0.6f, 0.7f);
-    if (s->light_count == 0) {
-        rt_light sun;
-        memset(&sun, 0, sizeof sun);
-        sun.kind = RT_LIGHT_DIRECTIONAL;
-        sun.color = rt_v3(1.0f, 0.96f, 0.9f);
-        sun.intensity = 2.5f;
-        sun.direction = rt_normalize(rt_v3(-0.4f, -1.0f, -0.6f));
-        sun.quad = RT_NONE;
-        if (rt_scene_add_light(s, &sun) == RT_NONE)
-            return false;
-    }
-    return true;
-}
-
-/* What loading one input found, for --info. */
-typedef struct input_info {
-    input_kind kind;
-    double load_ms;
-    size_t meshes, primitives, nodes; /* glTF only */
-} input_info;
-
-/* Loads the input (NULL = the built-in scene). for_render adds what a bare
- * model needs to be rendered (lights, samples, its first camera) and the
- * tangents normal maps need; --info leaves the model as it is. */
-static rt_result load_input(rt_scene *s, const char *path, bool for_render, input_info *info, rt_error *err)
-{
-    double t0 = now_ms();
-    rt_result r;
-    memset(info, 0, sizeof *info);
-    info->kind = path ? input_kind_of(path) : INPUT_SCENE;
-    if (!path) {
-        r = rt_scene_parse_string(s, rt_default_scene_text, strlen(rt_default_scene_text), "<built-in scene>", NULL,
-                                  err);
-    } else if (info->kind == INPUT_GLTF) {
-        rt_gltf_options opt;
-        memset(&opt, 0, sizeof opt);
-        rt_gltf_stats gs;
-        memset(&gs, 0, sizeof gs);
-        r = rt_gltf_load(s, path, &opt, &gs, err);
-        info->meshes = gs.meshes;
-        info->primitives = gs.primitives;
-        info->nodes = gs.nodes;
-        if (r == RT_OK && for_render) {
-            if (!add_default_lighting(s))
-                r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", path);
-            if (s->camera_count) {
-                s->camera = s->cameras[0];
-                s->camera_set = true;
-            }
-        }
-    } else if (info->kind == INPUT_MESH) {
-        rt_material m;
-        rt_material_default(&m, "default");
-        uint32_t mi = rt_scene_add_material(s, &m);
-        rt_mat4 id = rt_mat4_identity();
-        rt_mesh_load_stats ms;
-        r = mi == RT_NONE ? rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path)
-                          : rt_mesh_load(s, path, &id, mi, false, &ms, err);
-        info->meshes = info->primitives = r == RT_OK ? 1 : 0;
-        if (r == RT_OK && for_render && !add_default_lighting(s))
-            r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", path);
-    } else {
-        r = rt_scene_parse_file(s, path, err);
-    }
-    if (r == RT_OK && for_render) /* normal-mapped meshes without tangents get per-vertex ones */
-        r = rt_scene_generate_tangents(s, err);
-    info->load_ms = now_ms() - t0;
-    return r;
-}
 
 /* Output name: -o, else the scene's `output`, else the input's base name
  * with .png, in the current directory. */
@@ -233,8 +128,8 @@ static int print_info(const char *path, const memory_budget *budget)
     rt_scene s;
     rt_scene_init(&s);
     rt_error err = {0};
-    input_info info;
-    rt_result r = load_input(&s, path, false, &info, &err);
+    rt_load_info info;
+    rt_result r = rt_load(&s, path, NULL, &info, &err);
     if (r != RT_OK) {
         report(&err, budget);
         rt_scene_free(&s);
@@ -242,7 +137,7 @@ static int print_info(const char *path, const memory_budget *budget)
     }
     rt_box b = rt_scene_bounds(&s);
     printf("file: %s\n", path);
-    printf("format: %s\n", info.kind == INPUT_GLTF ? "gltf" : info.kind == INPUT_MESH ? "mesh" : "scene");
+    printf("format: %s\n", rt_load_kind_name(info.kind));
     printf("triangles: %zu\n", s.triangles.count);
     printf("vertices: %zu\n", s.vertices.count);
     printf("spheres: %zu\n", s.spheres.count);
@@ -251,11 +146,11 @@ static int print_info(const char *path, const memory_budget *budget)
         printf("bounds: none\n");
     else
         printf("bounds: %.9g %.9g %.9g %.9g %.9g %.9g\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
-    if (info.kind != INPUT_SCENE) {
+    if (info.kind != RT_LOAD_SCENE) {
         printf("meshes: %zu\n", info.meshes);
         printf("primitives: %zu\n", info.primitives);
     }
-    if (info.kind == INPUT_GLTF)
+    if (info.kind == RT_LOAD_GLTF)
         printf("nodes: %zu\n", info.nodes);
     printf("materials: %zu\n", s.material_count);
     printf("textures: %zu\n", s.texture_count);
@@ -274,9 +169,10 @@ static int print_info(const char *path, const memory_budget *budget)
  * input has none, the limits checked, the output path chosen and checked. */
 static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t size, rt_error *err)
 {
-    input_info info;
+    rt_load_info info;
+    rt_load_options lo = {.for_render = true};
     rt_result r;
-    if ((r = load_input(scene, a->input, true, &info, err)) != RT_OK ||
+    if ((r = rt_load(scene, a->input, &lo, &info, err)) != RT_OK ||
         (r = args_apply_settings(a, scene, err)) != RT_OK)
         return r;
     rt_settings *set = &scene->settings;
@@ -288,7 +184,7 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
         scene->camera_set = true;
     }
     /* a glTF camera made for another aspect ratio: keep the height, fit the width */
-    if (!args_sets(a, "resolution") && a->input && info.kind == INPUT_GLTF && scene->camera.aspect_ratio > 0.0f) {
+    if (!args_sets(a, "resolution") && a->input && info.kind == RT_LOAD_GLTF && scene->camera.aspect_ratio > 0.0f) {
         double w = (double)set->height * scene->camera.aspect_ratio + 0.5;
         set->width = w < 1.0 ? 1 : (w > (double)RT_MAX_IMAGE_SIDE ? RT_MAX_IMAGE_SIDE : (int)w);
     }

@@ -41,7 +41,6 @@
  */
 #include "rt/io/gltf.h"
 
-#include <errno.h>
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>
@@ -50,6 +49,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt/base/file.h"
 #include "rt/io/base64.h"
 #include "rt/io/json.h"
 #include "rt/scene/texture.h"
@@ -141,11 +141,10 @@ typedef struct gl_visit { uint32_t node; rt_mat4 world; } gl_visit;
 
 typedef struct gl_doc {
     const char *path;
-    char *dir;            /* directory of the .gltf with a trailing '/', or "" */
+    char *dir;            /* directory of the .gltf with its trailing '/', or "" */
     rt_error *err;
     const uint8_t *bytes; /* the whole .gltf/.glb */
     size_t file_size;
-    uint8_t *file;        /* owned copy when read from disk */
     const char *json_text;
     size_t json_len, json_base;
     const uint8_t *bin;   /* GLB BIN chunk */
@@ -325,45 +324,14 @@ static rt_result alloc_table(gl_doc *d, int t, const char *key, size_t elem, voi
 
 /* --------------------------------------------------------- file I/O */
 
+/* Reads a file the document names (an external buffer). */
 static rt_result read_file(gl_doc *d, const char *path, const char *what, uint8_t **data, size_t *size)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return rt_fail(d->err, RT_ERR_IO, "%s: %scannot open \"%s\": %s", d->path, what, path, strerror(errno));
-    uint8_t *buf = NULL;
-    size_t n = 0, cap = 0;
-    for (;;) {
-        if (n == cap) {
-            size_t want = cap ? cap * 2 : 65536;
-            if (want > GL_MAX_FILE + 1)
-                want = GL_MAX_FILE + 1;
-            if (n >= want) {
-                free(buf);
-                fclose(f);
-                return rt_fail(d->err, RT_ERR_LIMIT, "%s: %s\"%s\" is over the 2 GiB limit", d->path, what, path);
-            }
-            uint8_t *q = realloc(buf, want);
-            if (!q) {
-                free(buf);
-                fclose(f);
-                return rt_fail(d->err, RT_ERR_NOMEM, "%s: %sout of memory reading \"%s\"", d->path, what, path);
-            }
-            buf = q;
-            cap = want;
-        }
-        size_t got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0)
-            break;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        return rt_fail(d->err, RT_ERR_IO, "%s: %sread error on \"%s\"", d->path, what, path);
-    }
-    *data = buf;
-    *size = n;
+    rt_error inner = {0};
+    char *bytes;
+    if (rt_read_file(path, GL_MAX_FILE, &bytes, size, &inner) != RT_OK)
+        return rt_fail(d->err, inner.code, "%s: %s%s", d->path, what, inner.message);
+    *data = (uint8_t *)bytes;
     return RT_OK;
 }
 
@@ -2187,29 +2155,23 @@ static void doc_free(gl_doc *d)
         free(d->scratch[k]);
     free(d->idx_scratch);
     rt_json_free(&d->j);
-    free(d->file);
     free(d->dir);
 }
 
 static rt_result load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st)
 {
-    const char *slash = strrchr(d->path, '/');
-    size_t dl = slash ? (size_t)(slash - d->path) + 1 : 0;
-    d->dir = malloc(dl + 1);
+    size_t dir_size = strlen(d->path) + 1;
+    d->dir = malloc(dir_size);
     if (!d->dir)
         return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
-    memcpy(d->dir, d->path, dl);
-    d->dir[dl] = '\0';
-    if (!d->bytes) {
-        TRY(read_file(d, d->path, "", &d->file, &d->file_size));
-        d->bytes = d->file;
-    }
+    rt_path_dirname(d->path, d->dir, dir_size);
+    if (d->file_size > GL_MAX_FILE)
+        return rt_fail(d->err, RT_ERR_LIMIT, "%s: file is over the limit of %zu bytes", d->path, GL_MAX_FILE);
     if (d->file_size >= 4 && memcmp(d->bytes, "glTF", 4) == 0) {
         d->glb = true;
         TRY(split_glb(d));
     } else {
-        const char *ext = strrchr(d->path, '.');
-        if (ext && strcmp(ext, ".glb") == 0)
+        if (rt_path_has_ext(d->path, ".glb"))
             return rt_fail(d->err, RT_ERR_INVALID, "%s: byte 0: bad magic (expected \"glTF\" for a .glb file)",
                            d->path);
         d->json_text = (const char *)d->bytes;
@@ -2239,23 +2201,11 @@ static rt_result load_doc(rt_scene *s, const char *path, const void *data, size_
     rt_gltf_stats st;
     memset(&st, 0, sizeof st);
     st.bounds = rt_box_empty();
-    /* remember the table sizes so a failed load leaves the scene as it was */
-    size_t n_mat = s->material_count, n_tex = s->texture_count, n_img = s->image_count, n_light = s->light_count,
-           n_cam = s->camera_count, n_vert = s->vertices.count, n_tri = s->triangles.count;
+    rt_scene_mark mark = rt_scene_mark_of(s); /* a failed load leaves the scene as it was */
     rt_result r = load(&d, s, options, &st);
     doc_free(&d);
     if (r != RT_OK) {
-        for (size_t i = n_img; i < s->image_count; i++) {
-            free(s->images[i].rgba8);
-            free(s->images[i].rgbaf);
-        }
-        s->material_count = n_mat;
-        s->texture_count = n_tex;
-        s->image_count = n_img;
-        s->light_count = n_light;
-        s->camera_count = n_cam;
-        s->vertices.count = n_vert;
-        s->triangles.count = n_tri;
+        rt_scene_rollback(s, &mark);
         return r;
     }
     if (stats)
@@ -2268,7 +2218,14 @@ rt_result rt_gltf_load(rt_scene *s, const char *path, const rt_gltf_options *opt
 {
     if (!path)
         return rt_fail(err, RT_ERR_IO, "rt_gltf_load: no path");
-    return load_doc(s, path, NULL, 0, options, stats, err);
+    char *bytes;
+    size_t size;
+    rt_result r = rt_read_file(path, GL_MAX_FILE, &bytes, &size, err);
+    if (r != RT_OK)
+        return r;
+    r = rt_gltf_load_memory(s, bytes, size, path, options, stats, err);
+    free(bytes);
+    return r;
 }
 
 rt_result rt_gltf_load_memory(rt_scene *s, const void *data, size_t size, const char *name,

@@ -11,7 +11,7 @@
  *   output vertex per distinct (v, vt, vn) triple, found again through an
  *   open-addressing hash table (material names likewise), so adversarial
  *   files stay linear. Polygons are triangulated by
- *   rt_mesh_triangulate (mesh_io.c): fans for convex ones, the right diagonal
+ *   rt_mesh_triangulate (mesh_buffer.c): fans for convex ones, the right diagonal
  *   for concave quads, ear clipping for other concave polygons. Triangles
  *   that repeat a position are dropped and counted in stats.skipped_faces.
  *   usemtl names are resolved after the whole file (and every mtllib) is read,
@@ -39,8 +39,10 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "mesh_internal.h"
-#include "rt/io/mesh_io.h"
+#include "mesh_buffer.h"
+#include "mesh_readers.h"
+#include "mesh_text.h"
+#include "rt/base/file.h"
 #include "rt/scene/texture.h"
 
 #define OBJ_NAME_MAX 128
@@ -160,7 +162,7 @@ typedef struct obj_parser {
     uint32_t cur_slot;
     bool override_material;
     rt_warn_once warned;
-    rt_mesh_buf buf;
+    rt_mesh_buf *buf; /* the output (the dispatcher's) */
 } obj_parser;
 
 /* ----------------------------------------------------------- lines */
@@ -286,6 +288,16 @@ static const char *cut_comment_ws(const char *p, const char *eol)
     return eol;
 }
 
+/* dir + rel (rel alone when absolute). Files written on Windows name paths
+ * with '\\': those become '/' in rel first. false when too long. */
+static bool obj_join(const char *dir, char *rel, char *out, size_t size)
+{
+    for (char *c = rel; *c; c++)
+        if (*c == '\\')
+            *c = '/';
+    return rt_path_join(dir, rel, out, size);
+}
+
 /* ------------------------------------------------------------- MTL */
 
 typedef struct mtl_ctx {
@@ -384,7 +396,7 @@ static rt_result mtl_map(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl, c
         return RT_OK;
     }
     char full[OBJ_PATH_MAX];
-    if (!rt_mesh_join(mc->mtl_dir, rel, full, sizeof full))
+    if (!obj_join(mc->mtl_dir, rel, full, sizeof full))
         return rt_fail(mc->op->err, RT_ERR_LIMIT, "%s:%ld: texture path too long", lc->file, lc->line);
     char *copy = strdup(full);
     if (!copy)
@@ -496,7 +508,7 @@ static rt_result load_mtl(obj_parser *op, const char *mtl_path, const line_ctx *
     char *data;
     size_t size;
     rt_error e = {0};
-    if (rt_mesh_read_file(mtl_path, &data, &size, &e) != RT_OK) {
+    if (rt_read_file(mtl_path, 0, &data, &size, &e) != RT_OK) {
         if (e.code == RT_ERR_NOMEM)
             return rt_fail(op->err, e.code, "%s", e.message);
         rt_warn("%s:%ld: %s; its materials fall back to the default", at->file, at->line, e.message);
@@ -514,7 +526,7 @@ static rt_result load_mtl(obj_parser *op, const char *mtl_path, const line_ctx *
     mc.op = op;
     mc.file = (uint32_t)op->nfiles++;
     mc.mtl_path = mtl_path;
-    rt_mesh_dirname(mtl_path, mc.mtl_dir, sizeof mc.mtl_dir);
+    rt_path_dirname(mtl_path, mc.mtl_dir, sizeof mc.mtl_dir);
     rt_result r = for_each_line(mtl_path, data, size, mtl_line, &mc);
     free(data);
     return r;
@@ -747,16 +759,16 @@ static rt_result obj_face(obj_parser *op, line_ctx *lc, const char *p, const cha
         op->tcap = c;
     }
     size_t nt = rt_mesh_triangulate(op->v, op->corner_v, nc, op->tri_out);
-    if (!rt_mesh_buf_reserve_triangles(&op->buf, op->buf.nt + nt))
+    if (!rt_mesh_buf_reserve_triangles(op->buf, op->buf->nt + nt))
         return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for triangles", lc->file);
     const uint32_t *cv = op->corner_v, *co = op->corner_out, *tri = op->tri_out;
     for (size_t k = 0; k < nt; k++) {
         uint32_t a = tri[3 * k], b = tri[3 * k + 1], c = tri[3 * k + 2];
         if (cv[a] == cv[b] || cv[b] == cv[c] || cv[a] == cv[c]) {
-            op->buf.skipped++;
+            op->buf->skipped++;
             continue;
         }
-        rt_mesh_buf_add_triangle(&op->buf, co[a], co[b], co[c], op->cur_slot, flags);
+        rt_mesh_buf_add_triangle(op->buf, co[a], co[b], co[c], op->cur_slot, flags);
     }
     return RT_OK;
 }
@@ -798,7 +810,7 @@ static rt_result obj_mtllib(obj_parser *op, line_ctx *lc, const char *p, const c
         return RT_OK;
     eol = cut_comment_ws(p, eol);
     char rel[OBJ_PATH_MAX], full[OBJ_PATH_MAX];
-    if (!rest_string(p, eol, rel, sizeof rel) || !rt_mesh_join(op->dir, rel, full, sizeof full))
+    if (!rest_string(p, eol, rel, sizeof rel) || !obj_join(op->dir, rel, full, sizeof full))
         return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: mtllib path too long", lc->file, lc->line);
     if (!rel[0]) {
         rt_warn("%s:%ld: mtllib without a file name", lc->file, lc->line);
@@ -818,7 +830,7 @@ static rt_result obj_mtllib(obj_parser *op, line_ctx *lc, const char *p, const c
             return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: mtllib path too long", lc->file, lc->line);
         memcpy(rel, p, n);
         rel[n] = 0;
-        if (!rt_mesh_join(op->dir, rel, full, sizeof full))
+        if (!obj_join(op->dir, rel, full, sizeof full))
             return rt_fail(op->err, RT_ERR_LIMIT, "%s:%ld: mtllib path too long", lc->file, lc->line);
         rt_result r = load_mtl(op, full, lc);
         if (r != RT_OK)
@@ -962,7 +974,7 @@ static void make_material(rt_scene *s, const obj_mtl *om, const char *objname, c
 /* Adds the MTL materials to the scene and resolves every usemtl slot. */
 static rt_result resolve_materials(obj_parser *op, rt_scene *s, uint32_t material)
 {
-    const char *objname = rt_mesh_basename(op->path);
+    const char *objname = rt_path_basename(op->path);
     uint32_t *ids = op->nmtl ? rt_alloc(op->nmtl, sizeof *ids) : NULL;
     if (op->nmtl && !ids)
         return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for materials", op->path);
@@ -1010,32 +1022,22 @@ static void obj_free(obj_parser *op)
     free(op->corner_out); free(op->corner_v); free(op->corner_t); free(op->corner_n); free(op->tri_out);
     free(op->osg);
     free(op->mtls); free(op->slots);
-    rt_mesh_buf_free(&op->buf);
 }
 
-rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, uint32_t material,
-                      bool override_material, rt_mesh_load_stats *stats, rt_error *err)
+rt_result rt_obj_parse(const rt_mesh_input *in, rt_mesh_buf *b)
 {
-    rt_error local_err = {0};
-    if (!err)
-        err = &local_err;
-    if (stats)
-        memset(stats, 0, sizeof *stats);
-    char *data;
-    size_t size;
-    rt_result r = rt_mesh_read_file(path, &data, &size, err);
-    if (r != RT_OK)
-        return r;
+    const char *path = in->name;
+    rt_error *err = in->err;
+    rt_scene *s = in->scene;
     obj_parser *op = calloc(1, sizeof *op);
-    if (!op) {
-        free(data);
+    if (!op)
         return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
-    }
+    rt_result r = RT_OK;
     op->path = path;
     op->err = err;
-    op->override_material = override_material;
-    rt_mesh_dirname(path, op->dir, sizeof op->dir);
-    size_t mat0 = s->material_count, tex0 = s->texture_count;
+    op->buf = b;
+    op->override_material = in->override_material;
+    rt_path_dirname(path, op->dir, sizeof op->dir);
     if (!rt_grow((void **)&op->slots, &op->slotcap, 1, sizeof *op->slots)) {
         r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
         goto done;
@@ -1043,15 +1045,14 @@ rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
     op->nslot = 1;
     memset(&op->slots[0], 0, sizeof op->slots[0]);
 
-    r = for_each_line(path, data, size, obj_line, op);
+    r = for_each_line(path, in->bytes, in->size, obj_line, op);
     if (r != RT_OK)
         goto done;
 
-    if (!override_material && (r = resolve_materials(op, s, material)) != RT_OK)
+    if (!in->override_material && (r = resolve_materials(op, s, in->material)) != RT_OK)
         goto done;
 
     /* output vertices from the (v, vt, vn) triples */
-    rt_mesh_buf *b = &op->buf;
     unsigned attrs = (op->any_n || op->any_sg ? RT_MESH_NRM : 0) | (op->any_t ? RT_MESH_UV : 0) |
                      (op->vc ? RT_MESH_COL : 0);
     if (!rt_mesh_buf_enable(b, attrs) || !rt_mesh_buf_reserve_vertices(b, op->nout)) {
@@ -1084,22 +1085,12 @@ rt_result rt_obj_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         }
     }
     for (size_t t = 0; t < b->nt; t++) {
-        b->mat[t] = override_material ? material : op->slots[b->mat[t]].material;
+        b->mat[t] = in->override_material ? in->material : op->slots[b->mat[t]].material;
         if (op->vc)
             b->flags[t] |= RT_TRI_COLOR;
     }
-    r = rt_mesh_commit(s, b, transform, path, stats, err);
-    if (r == RT_OK && stats)
-        stats->materials = s->material_count - mat0;
 done:
-    if (r != RT_OK) {
-        /* materials and textures are plain records: dropping them restores the scene
-         * (decoded images stay cached in the scene, which owns them) */
-        s->material_count = mat0;
-        s->texture_count = tex0;
-    }
     obj_free(op);
     free(op);
-    free(data);
     return r;
 }

@@ -13,7 +13,7 @@
  * bytes left before anything is allocated (a vertex line takes at least 6
  * bytes, a face line 8). Vertex colours (C) become vertex colours (values
  * above 1 are taken as 0..255), normals (N) smooth shading, texture
- * coordinates (ST) UVs with v flipped (see mesh_io.c). Faces are
+ * coordinates (ST) UVs with v flipped (see mesh_buffer.c). Faces are
  * triangulated by rt_mesh_triangulate (fans, concave quads, ear clipping);
  * per-face colours are ignored; faces with fewer than
  * 3 vertices and triangles that repeat a vertex are skipped and counted.
@@ -23,8 +23,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mesh_internal.h"
-#include "rt/io/mesh_io.h"
+#include "mesh_buffer.h"
+#include "mesh_readers.h"
+#include "mesh_text.h"
 
 typedef struct off_lines {
     const char *path;
@@ -76,25 +77,15 @@ static int read_ints(const off_lines *L, const char *p, int64_t *out, int max, r
     return n;
 }
 
-rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, uint32_t material,
-                      bool override_material, rt_mesh_load_stats *stats, rt_error *err)
+rt_result rt_off_parse(const rt_mesh_input *in, rt_mesh_buf *b)
 {
-    (void)override_material; /* OFF has no materials */
-    rt_error local_err = {0};
-    if (!err)
-        err = &local_err;
-    if (stats)
-        memset(stats, 0, sizeof *stats);
-    char *data;
-    size_t size;
-    rt_result r = rt_mesh_read_file(path, &data, &size, err);
-    if (r != RT_OK)
-        return r;
-    rt_mesh_buf b;
-    memset(&b, 0, sizeof b);
+    /* OFF has no materials: every face takes in->material */
+    const char *path = in->name;
+    rt_error *err = in->err;
+    rt_result r = RT_OK;
     uint32_t *face = NULL, *tri = NULL;
     size_t fcap = 0, tcap = 0;
-    off_lines L = {path, data, data + size, 0, data, data};
+    off_lines L = {path, in->bytes, in->bytes + in->size, 0, in->bytes, in->bytes};
 
     /* header keyword */
     if (!next_line(&L)) {
@@ -151,8 +142,8 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         goto done;
     }
     unsigned attrs = (nrm ? RT_MESH_NRM : 0) | (st ? RT_MESH_UV : 0) | (col ? RT_MESH_COL : 0);
-    if (!rt_mesh_buf_enable(&b, attrs) || !rt_mesh_buf_reserve_vertices(&b, (size_t)nv) ||
-        !rt_mesh_buf_reserve_triangles(&b, (size_t)nf)) {
+    if (!rt_mesh_buf_enable(b, attrs) || !rt_mesh_buf_reserve_vertices(b, (size_t)nv) ||
+        !rt_mesh_buf_reserve_triangles(b, (size_t)nf)) {
         r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
         goto done;
     }
@@ -186,23 +177,23 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
             goto done;
         }
         size_t v = (size_t)i;
-        b.pos[v] = rt_v3(f[0], f[1], f[2]);
+        b->pos[v] = rt_v3(f[0], f[1], f[2]);
         int at = 3;
         if (nrm) {
-            b.nrm[v] = rt_v3(f[3], f[4], f[5]);
+            b->nrm[v] = rt_v3(f[3], f[4], f[5]);
             at = 6;
         }
         if (col) {
             rt_vec4 c = rt_v4(f[at], f[at + 1], f[at + 2], ncol == 4 ? f[at + 3] : 1.0f);
             if (c.x > 1.0f || c.y > 1.0f || c.z > 1.0f || c.w > 1.0f)
                 c = rt_v4(c.x / 255.0f, c.y / 255.0f, c.z / 255.0f, ncol == 4 ? c.w / 255.0f : 1.0f);
-            b.col[v] = c;
+            b->col[v] = c;
             at += ncol;
         }
         if (st)
-            b.uv[v] = rt_v2(f[at], 1.0f - f[at + 1]);
+            b->uv[v] = rt_v2(f[at], 1.0f - f[at + 1]);
     }
-    b.nv = (size_t)nv;
+    b->nv = (size_t)nv;
 
     /* faces */
     bool warned_short = false;
@@ -253,7 +244,7 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
         }
         /* the rest of the line (a face colour) is ignored */
         if (n < 3) {
-            b.skipped++;
+            b->skipped++;
             if (!warned_short) {
                 warned_short = true;
                 rt_warn("%s:%ld: face with %lld vertices skipped (warned once)", path, L.line, (long long)n);
@@ -264,24 +255,21 @@ rt_result rt_off_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
             r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
             goto done;
         }
-        size_t nt = rt_mesh_triangulate(b.pos, face, (size_t)n, tri);
+        size_t nt = rt_mesh_triangulate(b->pos, face, (size_t)n, tri);
         for (size_t j = 0; j < nt; j++) {
             uint32_t ca = face[tri[3 * j]], cb = face[tri[3 * j + 1]], cc = face[tri[3 * j + 2]];
             if (ca == cb || cb == cc || ca == cc) {
-                b.skipped++;
+                b->skipped++;
                 continue;
             }
-            if (!rt_mesh_buf_add_triangle(&b, ca, cb, cc, material, flags)) {
+            if (!rt_mesh_buf_add_triangle(b, ca, cb, cc, in->material, flags)) {
                 r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for triangles", path);
                 goto done;
             }
         }
     }
-    r = rt_mesh_commit(s, &b, transform, path, stats, err);
 done:
-    rt_mesh_buf_free(&b);
     free(face);
     free(tri);
-    free(data);
     return r;
 }

@@ -14,7 +14,7 @@
  * encoding; unknown elements and properties, lists included, are read and
  * dropped.
  *   vertex:    x y z; nx ny nz (smooth shading); u v, s t, texture_u texture_v
- *              or texture_s texture_t (v flipped, see mesh_io.c); red green
+ *              or texture_s texture_t (v flipped, see mesh_buffer.c); red green
  *              blue [alpha] (integers divided by their type's maximum, so
  *              uchar / 255; floats as they are) -> vertex colours.
  *   face:      list vertex_indices (or vertex_index) of any length,
@@ -36,8 +36,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mesh_internal.h"
-#include "rt/io/mesh_io.h"
+#include "mesh_buffer.h"
+#include "mesh_readers.h"
+#include "mesh_text.h"
 
 typedef enum ply_type { PT_NONE = 0, PT_I8, PT_U8, PT_I16, PT_U16, PT_I32, PT_U32, PT_F32, PT_F64 } ply_type;
 static const int type_size[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
@@ -780,30 +781,20 @@ static bool check_counts(ply_load *L)
     return true;
 }
 
-rt_result rt_ply_load(rt_scene *s, const char *path, const rt_mat4 *transform, uint32_t material,
-                      bool override_material, rt_mesh_load_stats *stats, rt_error *err)
+rt_result rt_ply_parse(const rt_mesh_input *in, rt_mesh_buf *b)
 {
-    (void)override_material; /* PLY has no materials: every face uses `material` */
-    rt_error local_err = {0};
-    if (!err)
-        err = &local_err;
-    if (stats)
-        memset(stats, 0, sizeof *stats);
-    char *data;
-    size_t size;
-    rt_result res = rt_mesh_read_file(path, &data, &size, err);
-    if (res != RT_OK)
-        return res;
-    rt_mesh_buf b;
-    memset(&b, 0, sizeof b);
+    /* PLY has no materials: every face takes in->material */
+    const char *path = in->name;
+    rt_error *err = in->err;
+    rt_result res = RT_OK;
     ply_load L;
     memset(&L, 0, sizeof L);
     L.r.path = path;
-    L.r.data = (const unsigned char *)data;
-    L.r.size = size;
+    L.r.data = (const unsigned char *)in->bytes;
+    L.r.size = in->size;
     L.r.err = err;
-    L.b = &b;
-    L.material = material;
+    L.b = b;
+    L.material = in->material;
     bool ok = parse_header(&L.r, &L.pf) && check_counts(&L);
     size_t vert_elem = SIZE_MAX;
     for (size_t e = 0; ok && e < L.pf.nelem; e++) {
@@ -833,17 +824,14 @@ rt_result rt_ply_load(rt_scene *s, const char *path, const rt_mat4 *transform, u
     }
     if (ok) {
         /* flags were set per triangle from the vertex element; if faces came first, set them now */
-        for (size_t t = 0; t < b.nt; t++)
-            b.flags[t] = L.tri_flags;
-        res = rt_mesh_commit(s, &b, transform, path, stats, err);
+        for (size_t t = 0; t < b->nt; t++)
+            b->flags[t] = L.tri_flags;
     } else {
         res = err->code ? err->code : RT_ERR_PARSE;
     }
-    rt_mesh_buf_free(&b);
     free(L.pf.elems);
     free(L.pf.props);
     free(L.scratch);
     free(L.tri);
-    free(data);
     return res;
 }

@@ -20,9 +20,9 @@
  * finite, and within float range; the whole token must be used, so `1.0x`,
  * `nan`, `inf` and `0x10` are all rejected.
  *
- * On failure the scene may hold what was appended before the bad statement;
- * the caller frees it with rt_scene_free() as usual. The parser's own memory
- * is released on every path.
+ * On failure the scene is rolled back to where it was before the call
+ * (rt_scene_rollback): no half-parsed scene. The parser's own memory is
+ * released on every path.
  */
 #include "rt/io/scene_parse.h"
 
@@ -35,6 +35,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt/base/file.h"
 #include "rt/base/number.h"
 #include "rt/io/gltf.h"
 #include "rt/io/mesh_io.h"
@@ -71,7 +72,7 @@ typedef struct name_table {
 typedef struct parser {
     rt_scene *s;
     const char *name; /* file name for messages */
-    const char *dir;  /* directory relative paths resolve against, NULL = current */
+    const char *dir;  /* directory relative paths resolve against ("" = the current one) */
     rt_error *err;
 
     /* the current statement */
@@ -469,14 +470,9 @@ static rt_result get_material(parser *p, const char *what, uint32_t *out)
 /* Joins the scene's directory and a relative path. */
 static rt_result resolve_path(parser *p, const tok *t, char *out, size_t size)
 {
-    int n;
     if (t->s[0] == '\0')
         return perr(p, RT_ERR_INVALID, t, "expected a file name, got an empty string");
-    if (t->s[0] == '/' || !p->dir || !p->dir[0])
-        n = snprintf(out, size, "%s", t->s);
-    else
-        n = snprintf(out, size, "%s/%s", p->dir, t->s);
-    if (n < 0 || (size_t)n >= size)
+    if (!rt_path_join(p->dir, t->s, out, size))
         return perr(p, RT_ERR_LIMIT, t, "file path is too long (at most %zu characters)", size - 1);
     return RT_OK;
 }
@@ -1068,7 +1064,8 @@ static rt_result st_mesh(parser *p, const tok *kw)
     rt_mat4 m = xform_matrix(&x);
     rt_error inner = {0};
     rt_mesh_load_stats stats = {0};
-    r = rt_mesh_load(p->s, path, &m, material, override_tok != NULL, &stats, &inner);
+    rt_mesh_options opt = {.transform = &m, .material = material, .override_material = override_tok != NULL};
+    r = rt_mesh_load(p->s, path, &opt, &stats, &inner);
     if (r != RT_OK)
         return loader_err(p, file, r, &inner);
     rt_info("%s:%d: mesh %s: %zu triangles, %zu vertices, %zu materials", p->name, kw->line, path, stats.triangles,
@@ -1463,6 +1460,13 @@ rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const
     if (len > MAX_SCENE_BYTES)
         return rt_fail(err, RT_ERR_LIMIT, "%s: scene text is %zu bytes, over the limit of %zu", name, len,
                        MAX_SCENE_BYTES);
+    /* relative paths in the text resolve against dir, by default the directory of name */
+    char name_dir[MAX_PATH_LEN];
+    if (!dir) {
+        if (!rt_path_dirname(name, name_dir, sizeof name_dir))
+            return rt_fail(err, RT_ERR_LIMIT, "%s: path is too long", name);
+        dir = name_dir;
+    }
     char *buf = malloc(len + 1);
     if (!buf)
         return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", name);
@@ -1478,10 +1482,13 @@ rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const
     p.default_material = RT_NONE;
     /* a UTF-8 byte order mark is not part of the first statement */
     size_t skip = len >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0 ? 3 : 0;
+    rt_scene_mark mark = rt_scene_mark_of(s); /* a failed parse leaves the scene as it was */
     rt_result r = run(&p, buf + skip, len - skip);
     p.ntok = 0;
     if (r == RT_OK)
         r = finish(&p);
+    if (r != RT_OK)
+        rt_scene_rollback(s, &mark);
     free(p.toks);
     name_table_free(&p.materials);
     name_table_free(&p.textures);
@@ -1493,57 +1500,12 @@ rt_result rt_scene_parse_file(rt_scene *s, const char *path, rt_error *err)
 {
     if (!path)
         return rt_fail(err, RT_ERR_INVALID, "no scene file given");
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return rt_fail(err, RT_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    char *text = NULL;
-    size_t len = 0, cap = 0;
-    rt_result r = RT_OK;
-    for (;;) {
-        if (len == cap) {
-            if (cap >= MAX_SCENE_BYTES + 1) {
-                r = rt_fail(err, RT_ERR_LIMIT, "%s: scene file is over the limit of %zu bytes", path,
-                            MAX_SCENE_BYTES);
-                break;
-            }
-            size_t nc = cap ? cap * 2 : 65536;
-            char *q = realloc(text, nc);
-            if (!q) {
-                r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
-                break;
-            }
-            text = q;
-            cap = nc;
-        }
-        size_t n = fread(text + len, 1, cap - len, f);
-        len += n;
-        if (n == 0) {
-            if (ferror(f))
-                r = rt_fail(err, RT_ERR_IO, "%s: read error", path);
-            break;
-        }
-    }
-    fclose(f);
-    if (r == RT_OK) {
-        /* relative paths in the file resolve against its directory */
-        char dir[MAX_PATH_LEN];
-        const char *slash = strrchr(path, '/');
-        const char *d = NULL;
-        if (slash) {
-            size_t n = (size_t)(slash - path);
-            if (n == 0)
-                n = 1; /* "/scene.txt": the root */
-            if (n < sizeof dir) {
-                memcpy(dir, path, n);
-                dir[n] = '\0';
-                d = dir;
-            } else {
-                r = rt_fail(err, RT_ERR_LIMIT, "%s: path is too long", path);
-            }
-        }
-        if (r == RT_OK)
-            r = rt_scene_parse_string(s, text, len, path, d, err);
-    }
+    char *text;
+    size_t len;
+    rt_result r = rt_read_file(path, MAX_SCENE_BYTES, &text, &len, err);
+    if (r != RT_OK)
+        return r;
+    r = rt_scene_parse_string(s, text, len, path, NULL, err);
     free(text);
     return r;
 }

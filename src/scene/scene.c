@@ -1,9 +1,12 @@
-/* scene.c - the scene tables: defaults, appends, bounds, automatic framing.
- * (rt_settings_default() is in settings.c, driven by the settings table.) */
+/* scene.c - the scene tables: defaults, appends, marks and rollback, bounds,
+ * automatic framing. (rt_settings_default() is in settings.c, driven by the
+ * settings table.) */
 #include "rt/scene/scene.h"
 
 #include <stdlib.h>
 #include <string.h>
+
+#include "rt/base/soa.h"
 
 void rt_texture_slot_none(rt_texture_slot *slot)
 {
@@ -123,35 +126,13 @@ uint32_t rt_scene_add_camera(rt_scene *s, const rt_camera *c)
     return table_push((void **)&s->cameras, &s->camera_count, &s->camera_cap, c, sizeof *c);
 }
 
-/* Grows every array of a structure-of-arrays table together. `arrays` lists
- * the addresses of the array pointers, `sizes` their element sizes. */
-static bool soa_grow(void **arrays[], const size_t sizes[], int n, size_t *cap, size_t need)
-{
-    if (need <= *cap)
-        return true;
-    size_t c = *cap ? *cap : 64;
-    while (c < need) {
-        if (c > (SIZE_MAX >> 2))
-            return false;
-        c *= 2;
-    }
-    for (int i = 0; i < n; i++) {
-        void *q = rt_realloc_array(*arrays[i], c, sizes[i]);
-        if (!q)
-            return false; /* arrays already grown keep their new size; cap stays: still consistent */
-        *arrays[i] = q;
-    }
-    *cap = c;
-    return true;
-}
-
 uint32_t rt_scene_add_sphere(rt_scene *s, rt_vec3 center, float radius, uint32_t material)
 {
     rt_spheres *sp = &s->spheres;
     void **arrays[] = {(void **)&sp->cx, (void **)&sp->cy, (void **)&sp->cz, (void **)&sp->radius,
                        (void **)&sp->material};
     const size_t sizes[] = {4, 4, 4, 4, 4};
-    if (sp->count >= RT_NONE - 1 || !soa_grow(arrays, sizes, 5, &sp->cap, sp->count + 1))
+    if (sp->count >= RT_NONE - 1 || !rt_soa_reserve(arrays, sizes, 5, &sp->cap, sp->count + 1))
         return RT_NONE;
     size_t i = sp->count++;
     sp->cx[i] = center.x; sp->cy[i] = center.y; sp->cz[i] = center.z;
@@ -166,7 +147,7 @@ uint32_t rt_scene_add_quad(rt_scene *s, rt_vec3 p, rt_vec3 u, rt_vec3 v, uint32_
     void **arrays[] = {(void **)&q->px, (void **)&q->py, (void **)&q->pz, (void **)&q->ux, (void **)&q->uy,
                        (void **)&q->uz, (void **)&q->vx, (void **)&q->vy, (void **)&q->vz, (void **)&q->material};
     const size_t sizes[] = {4, 4, 4, 4, 4, 4, 4, 4, 4, 4};
-    if (q->count >= RT_NONE - 1 || !soa_grow(arrays, sizes, 10, &q->cap, q->count + 1))
+    if (q->count >= RT_NONE - 1 || !rt_soa_reserve(arrays, sizes, 10, &q->cap, q->count + 1))
         return RT_NONE;
     size_t i = q->count++;
     q->px[i] = p.x; q->py[i] = p.y; q->pz[i] = p.z;
@@ -197,7 +178,7 @@ static bool vertices_reserve(rt_vertices *v, size_t need)
     if (v->uv1) arrays[n] = (void **)&v->uv1, sizes[n++] = sizeof(rt_vec2);
     if (v->tangent) arrays[n] = (void **)&v->tangent, sizes[n++] = sizeof(rt_vec4);
     if (v->color) arrays[n] = (void **)&v->color, sizes[n++] = sizeof(rt_vec4);
-    return soa_grow(arrays, sizes, n, &v->cap, need);
+    return rt_soa_reserve(arrays, sizes, n, &v->cap, need);
 }
 
 uint32_t rt_scene_add_vertices(rt_scene *s, size_t n)
@@ -246,23 +227,9 @@ bool rt_scene_reserve_triangles(rt_scene *s, size_t n)
     rt_triangles *t = &s->triangles;
     if (t->count > SIZE_MAX / 4 - n)
         return false;
-    size_t need = t->count + n;
-    if (need <= t->cap)
-        return true;
-    size_t c = t->cap ? t->cap : 64;
-    while (c < need)
-        c *= 2;
-    uint32_t *idx = rt_realloc_array(t->index, c, 3 * sizeof(uint32_t));
-    if (!idx) return false;
-    t->index = idx;
-    uint32_t *mat = rt_realloc_array(t->material, c, sizeof(uint32_t));
-    if (!mat) return false;
-    t->material = mat;
-    uint8_t *fl = rt_realloc_array(t->flags, c, 1);
-    if (!fl) return false;
-    t->flags = fl;
-    t->cap = c;
-    return true;
+    void **arrays[] = {(void **)&t->index, (void **)&t->material, (void **)&t->flags};
+    const size_t sizes[] = {3 * sizeof *t->index, sizeof *t->material, sizeof *t->flags};
+    return rt_soa_reserve(arrays, sizes, 3, &t->cap, t->count + n);
 }
 
 uint32_t rt_scene_add_triangle(rt_scene *s, uint32_t a, uint32_t b, uint32_t c, uint32_t material, uint8_t flags)
@@ -277,6 +244,67 @@ uint32_t rt_scene_add_triangle(rt_scene *s, uint32_t a, uint32_t b, uint32_t c, 
     t->material[i] = material;
     t->flags[i] = flags;
     return (uint32_t)i;
+}
+
+rt_scene_mark rt_scene_mark_of(const rt_scene *s)
+{
+    rt_scene_mark m;
+    memset(&m, 0, sizeof m);
+    m.materials = s->material_count;
+    m.textures = s->texture_count;
+    m.images = s->image_count;
+    m.lights = s->light_count;
+    m.cameras = s->camera_count;
+    m.vertices = s->vertices.count;
+    m.triangles = s->triangles.count;
+    m.spheres = s->spheres.count;
+    m.quads = s->quads.count;
+    m.vertex_attrs = (s->vertices.uv1 ? RT_ATTR_UV1 : 0u) | (s->vertices.tangent ? RT_ATTR_TANGENT : 0u) |
+                     (s->vertices.color ? RT_ATTR_COLOR : 0u);
+    m.camera_set = s->camera_set;
+    m.camera = s->camera;
+    m.settings = s->settings;
+    return m;
+}
+
+/* Truncates a count to its mark (a table never grows back). */
+static void truncate_to(size_t *count, size_t mark)
+{
+    if (*count > mark)
+        *count = mark;
+}
+
+void rt_scene_rollback(rt_scene *s, const rt_scene_mark *m)
+{
+    for (size_t i = m->images; i < s->image_count; i++) {
+        free(s->images[i].rgba8);
+        free(s->images[i].rgbaf);
+    }
+    truncate_to(&s->image_count, m->images);
+    truncate_to(&s->material_count, m->materials);
+    truncate_to(&s->texture_count, m->textures);
+    truncate_to(&s->light_count, m->lights);
+    truncate_to(&s->camera_count, m->cameras);
+    truncate_to(&s->vertices.count, m->vertices);
+    truncate_to(&s->triangles.count, m->triangles);
+    truncate_to(&s->spheres.count, m->spheres);
+    truncate_to(&s->quads.count, m->quads);
+    rt_vertices *v = &s->vertices;
+    if (!(m->vertex_attrs & RT_ATTR_UV1)) {
+        free(v->uv1);
+        v->uv1 = NULL;
+    }
+    if (!(m->vertex_attrs & RT_ATTR_TANGENT)) {
+        free(v->tangent);
+        v->tangent = NULL;
+    }
+    if (!(m->vertex_attrs & RT_ATTR_COLOR)) {
+        free(v->color);
+        v->color = NULL;
+    }
+    s->camera_set = m->camera_set;
+    s->camera = m->camera;
+    s->settings = m->settings;
 }
 
 rt_box rt_scene_prim_bounds(const rt_scene *s, uint32_t prim)

@@ -11,13 +11,14 @@
  */
 #include "rt/scene/texture.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <stb/stb_image.h>
+
+#include "rt/base/file.h"
 
 /* sRGB 8-bit code -> linear value, from the IEC 61966-2-1 formula. */
 static const float srgb_table[256] = {
@@ -267,34 +268,12 @@ rt_result rt_image_load_file(rt_scene *s, const char *path, uint32_t *image, rt_
         *image = cached;
         return RT_OK;
     }
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return rt_fail(err, RT_ERR_IO, "%s: cannot open image: %s", path, strerror(errno));
-    unsigned char *buf = NULL;
-    size_t len = 0, cap = 0;
-    for (;;) {
-        if (!rt_grow((void **)&buf, &cap, len + 65536, 1)) {
-            free(buf);
-            fclose(f);
-            return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory reading the image", path);
-        }
-        size_t n = fread(buf + len, 1, cap - len, f);
-        len += n;
-        if (n == 0)
-            break;
-        if (len > (size_t)INT32_MAX) {
-            free(buf);
-            fclose(f);
-            return rt_fail(err, RT_ERR_LIMIT, "%s: image file is over 2 GiB", path);
-        }
-    }
-    int bad = ferror(f);
-    fclose(f);
-    if (bad) {
-        free(buf);
-        return rt_fail(err, RT_ERR_IO, "%s: read error", path);
-    }
-    rt_result r = rt_image_load_memory(s, buf, len, path, image, err);
+    char *buf;
+    size_t len;
+    rt_result r = rt_read_file(path, (size_t)INT32_MAX, &buf, &len, err);
+    if (r != RT_OK)
+        return r;
+    r = rt_image_load_memory(s, buf, len, path, image, err);
     free(buf);
     return r;
 }

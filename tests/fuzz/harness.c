@@ -1,5 +1,7 @@
-/* harness.c - see harness.h. Inputs that loaders read by path are written
- * to a private temporary directory (one per process) first. */
+/* harness.c - see harness.h. Every input but an image goes through
+ * rt_load_memory, the dispatch `rt` uses, named as a file in a private
+ * temporary directory (one per process), where the files an input refers
+ * to (a glTF's buffer.bin, an OBJ's m.mtl) are written first. */
 #include "harness.h"
 
 #include <stdio.h>
@@ -7,10 +9,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "rt/io/gltf.h"
-#include "rt/io/mesh_io.h"
+#include "rt/io/load.h"
 #include "rt/scene/scene.h"
-#include "rt/io/scene_parse.h"
 #include "rt/scene/texture.h"
 
 const char *const rt_fuzz_targets[] = {"scene", "gltf", "glb", "gltf_bin", "obj", "ply", "off", "image", NULL};
@@ -19,7 +19,7 @@ static char dir[64];
 
 static void remove_temp_dir(void)
 {
-    static const char *const files[] = {"buffer.bin", "m.mtl", "fuzz.obj", "fuzz.ply", "fuzz.off", NULL};
+    static const char *const files[] = {"buffer.bin", "m.mtl", NULL};
     char path[256];
     for (int i = 0; files[i]; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, files[i]);
@@ -65,57 +65,46 @@ static void split(const uint8_t *data, size_t size, size_t *first)
     *first = n < size - 4 ? n : size - 4;
 }
 
-static void load_mesh(const char *name, const uint8_t *data, size_t size)
+/* Loads one input the way rt does (rt_load_memory: by content, then by the
+ * extension of name), as a file of that name in the temporary directory. */
+static void load(const char *name, const uint8_t *data, size_t size)
 {
     char path[256];
-    write_temp(name, data, size, path, sizeof path);
+    snprintf(path, sizeof path, "%s/%s", temp_dir(), name);
     rt_scene s;
     rt_scene_init(&s);
-    rt_material m;
-    rt_material_default(&m, "fuzz");
-    uint32_t mi = rt_scene_add_material(&s, &m);
-    rt_mat4 id = rt_mat4_identity();
     rt_error err;
-    rt_mesh_load_stats st;
-    rt_mesh_load(&s, path, &id, mi, false, &st, &err);
+    rt_load_memory(&s, data, size, path, NULL, NULL, &err);
     rt_scene_free(&s);
 }
 
 int rt_fuzz_run(const char *target, const uint8_t *data, size_t size)
 {
-    rt_scene s;
-    rt_error err;
     char path[256];
     if (strcmp(target, "scene") == 0) {
-        rt_scene_init(&s);
-        rt_scene_parse_string(&s, (const char *)data, size, "fuzz.txt", temp_dir(), &err);
-        rt_scene_free(&s);
-    } else if (strcmp(target, "gltf") == 0 || strcmp(target, "glb") == 0) {
-        rt_scene_init(&s);
-        snprintf(path, sizeof path, "%s/fuzz.%s", temp_dir(), target);
-        rt_gltf_load_memory(&s, data, size, path, NULL, NULL, &err);
-        rt_scene_free(&s);
+        load("fuzz.txt", data, size);
+    } else if (strcmp(target, "gltf") == 0) {
+        load("fuzz.gltf", data, size);
+    } else if (strcmp(target, "glb") == 0) {
+        load("fuzz.glb", data, size);
     } else if (strcmp(target, "gltf_bin") == 0) {
         size_t n;
         split(data, size, &n);
-        char bin[256];
-        write_temp("buffer.bin", data + 4 + n, size >= 4 ? size - 4 - n : 0, bin, sizeof bin);
-        rt_scene_init(&s);
-        snprintf(path, sizeof path, "%s/fuzz.gltf", temp_dir());
-        rt_gltf_load_memory(&s, size >= 4 ? data + 4 : data, n, path, NULL, NULL, &err);
-        rt_scene_free(&s);
+        write_temp("buffer.bin", data + 4 + n, size >= 4 ? size - 4 - n : 0, path, sizeof path);
+        load("fuzz.gltf", size >= 4 ? data + 4 : data, n);
     } else if (strcmp(target, "obj") == 0) {
         size_t n;
         split(data, size, &n);
-        char mtl[256];
-        write_temp("m.mtl", data + 4 + n, size >= 4 ? size - 4 - n : 0, mtl, sizeof mtl);
-        load_mesh("fuzz.obj", size >= 4 ? data + 4 : data, n);
+        write_temp("m.mtl", data + 4 + n, size >= 4 ? size - 4 - n : 0, path, sizeof path);
+        load("fuzz.obj", size >= 4 ? data + 4 : data, n);
     } else if (strcmp(target, "ply") == 0) {
-        load_mesh("fuzz.ply", data, size);
+        load("fuzz.ply", data, size);
     } else if (strcmp(target, "off") == 0) {
-        load_mesh("fuzz.off", data, size);
+        load("fuzz.off", data, size);
     } else if (strcmp(target, "image") == 0) {
+        rt_scene s;
         rt_scene_init(&s);
+        rt_error err;
         uint32_t img;
         rt_image_load_memory(&s, data, size, "fuzz.img", &img, &err);
         rt_scene_free(&s);

@@ -8,6 +8,9 @@
  * length, the JSON, then the buffer, which the JSON must name
  * "buffer.bin"), obj (u32 OBJ length, the OBJ, then an MTL named
  * "m.mtl"), ply, off, image (any image bytes through our size checks).
+ * Every target but image loads through rt_load_memory, as `rt` loads a file
+ * of that kind (fuzz.txt, fuzz.gltf, fuzz.obj, ...): the content picks the
+ * reader before the name does.
  */
 #ifndef RT_FUZZ_HARNESS_H
 #define RT_FUZZ_HARNESS_H

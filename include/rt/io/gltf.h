@@ -34,10 +34,11 @@ typedef struct rt_gltf_stats {
     rt_box bounds;         /* world bounds of the vertices the loaded triangles use */
 } rt_gltf_stats;
 
-/* Appends the chosen scene of the glTF at path to s. options and stats may be
- * NULL. On failure s's tables are restored to their sizes before the call and
- * err names the file, the byte offset when there is one, and the problem.
- * Supported features, limits and the material mapping: docs/gltf.md. */
+/* Appends the chosen scene of the glTF at path (read with rt_read_file) to
+ * s. options and stats may be NULL. On failure s is left exactly as it was
+ * (rt_scene_rollback) and err names the file, the byte offset when there is
+ * one, and the problem. Supported features, limits and the material
+ * mapping: docs/gltf.md. */
 rt_result rt_gltf_load(rt_scene *s, const char *path, const rt_gltf_options *options, rt_gltf_stats *stats,
                        rt_error *err);
 

@@ -21,8 +21,9 @@
 /* Parses a scene file; relative paths in it (meshes, textures, models) are
  * relative to the file's directory. */
 rt_result rt_scene_parse_file(rt_scene *s, const char *path, rt_error *err);
-/* Parses scene text held in memory; `name` is used in messages and `dir`
- * is the directory relative paths resolve against (NULL = current). */
+/* Parses scene text held in memory (the reader rt_load uses); `name` is
+ * used in messages, and relative paths resolve against `dir`, or against
+ * the directory of `name` when dir is NULL ("" = the current directory). */
 rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const char *name, const char *dir,
                                 rt_error *err);
 

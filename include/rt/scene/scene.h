@@ -281,6 +281,32 @@ uint32_t rt_scene_add_triangle(rt_scene *s, uint32_t a, uint32_t b, uint32_t c, 
 /* Reserves room for n more triangles (avoids repeated growth). */
 bool rt_scene_reserve_triangles(rt_scene *s, size_t n);
 
+/* Undoing a load that failed half way: every loader marks the scene before
+ * it appends anything and rolls back to the mark on any error, so that a
+ * failed load leaves the scene exactly as it was.
+ *
+ *   rt_scene_mark mark = rt_scene_mark_of(s);
+ *   if ((r = append_things(s, ...)) != RT_OK)
+ *       rt_scene_rollback(s, &mark);
+ *
+ * The mark holds every table's count, which optional vertex attribute
+ * arrays existed, and the camera and settings (which the scene format sets).
+ * Rolling back truncates every table to its count (images beyond it free
+ * their pixels), frees the attribute arrays enabled since, and restores the
+ * camera and settings. Marks nest: a loader inside another rolls back its
+ * own part. */
+typedef struct rt_scene_mark {
+    size_t materials, textures, images, lights, cameras;
+    size_t vertices, triangles, spheres, quads;
+    unsigned vertex_attrs; /* RT_ATTR_* arrays that existed */
+    bool camera_set;
+    rt_camera camera;
+    rt_settings settings;
+} rt_scene_mark;
+
+rt_scene_mark rt_scene_mark_of(const rt_scene *s);
+void rt_scene_rollback(rt_scene *s, const rt_scene_mark *mark);
+
 /* Primitive id space (see the top of this file). */
 typedef enum rt_prim_kind { RT_PRIM_TRIANGLE = 0, RT_PRIM_SPHERE, RT_PRIM_QUAD } rt_prim_kind;
 static inline size_t rt_scene_prim_count(const rt_scene *s)

@@ -1,0 +1,182 @@
+/* load.c - rt_load: one input (scene text, glTF, OBJ/PLY/OFF) into the
+ * scene, through the reader its content or extension names (rt/io/load.h).
+ *
+ * Content before extension, so that a file named for the wrong format still
+ * loads: the GLB magic and JSON's opening brace are glTF (glTF 2.0
+ * specification, "GLB File Format Specification" and "JSON Schema"), PLY and
+ * OFF headers are meshes (rt_mesh_format_of); only then do .gltf/.glb and
+ * .obj/.ply/.off decide, and anything else is the scene text format, which
+ * has no magic (docs/scene-format.md).
+ *
+ * The whole load is one undo unit: the scene is marked first and rolled
+ * back on any error, including the default material a mesh gets, the
+ * default light and the tangents that for_render adds.
+ */
+#include "rt/io/load.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "rt/base/file.h"
+#include "rt/io/gltf.h"
+#include "rt/io/mesh_io.h"
+#include "rt/io/scene_parse.h"
+#include "rt/scene/tangents.h"
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+}
+
+/* JSON text may start with a UTF-8 byte order mark and white space. */
+static bool starts_like_json(const unsigned char *p, size_t size)
+{
+    size_t i = size >= 3 && memcmp(p, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
+    while (i < size && (p[i] == ' ' || p[i] == '\t' || p[i] == '\r' || p[i] == '\n'))
+        i++;
+    return i < size && p[i] == '{';
+}
+
+rt_load_kind rt_load_kind_of(const void *bytes, size_t size, const char *name)
+{
+    const unsigned char *p = bytes;
+    if (p && ((size >= 4 && memcmp(p, "glTF", 4) == 0) || starts_like_json(p, size)))
+        return RT_LOAD_GLTF;
+    if (p && rt_mesh_format_of(p, size, NULL) != RT_MESH_UNKNOWN)
+        return RT_LOAD_MESH;
+    if (name && (rt_path_has_ext(name, ".gltf") || rt_path_has_ext(name, ".glb")))
+        return RT_LOAD_GLTF;
+    if (name && rt_mesh_format_of(NULL, 0, name) != RT_MESH_UNKNOWN)
+        return RT_LOAD_MESH;
+    return RT_LOAD_SCENE;
+}
+
+const char *rt_load_kind_name(rt_load_kind kind)
+{
+    switch (kind) {
+    case RT_LOAD_SCENE: return "scene";
+    case RT_LOAD_GLTF: return "gltf";
+    case RT_LOAD_MESH: return "mesh";
+    }
+    return "unknown";
+}
+
+/* Lighting and sampling for a bare model: a soft sky, a key light from
+ * above when the model brings no lights, and enough samples for clean edges. */
+static bool add_default_lighting(rt_scene *s)
+{
+    s->settings.samples = 16;
+    s->settings.background = rt_v3(0.55f, 0.6f, 0.7f);
+    if (s->light_count == 0) {
+        rt_light sun;
+        memset(&sun, 0, sizeof sun);
+        sun.kind = RT_LIGHT_DIRECTIONAL;
+        sun.color = rt_v3(1.0f, 0.96f, 0.9f);
+        sun.intensity = 2.5f;
+        sun.direction = rt_normalize(rt_v3(-0.4f, -1.0f, -0.6f));
+        sun.quad = RT_NONE;
+        if (rt_scene_add_light(s, &sun) == RT_NONE)
+            return false;
+    }
+    return true;
+}
+
+/* The reader for kind, then what for_render adds to that kind. */
+static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const char *name, rt_load_kind kind,
+                           bool for_render, rt_load_info *info, rt_error *err)
+{
+    rt_result r;
+    switch (kind) {
+    case RT_LOAD_GLTF: {
+        rt_gltf_stats gs;
+        memset(&gs, 0, sizeof gs);
+        r = rt_gltf_load_memory(s, bytes, size, name, NULL, &gs, err);
+        info->meshes = gs.meshes;
+        info->primitives = gs.primitives;
+        info->nodes = gs.nodes;
+        if (r == RT_OK && for_render) {
+            if (!add_default_lighting(s))
+                r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", name);
+            if (s->camera_count) {
+                s->camera = s->cameras[0];
+                s->camera_set = true;
+            }
+        }
+        return r;
+    }
+    case RT_LOAD_MESH: {
+        rt_material m;
+        rt_material_default(&m, "default");
+        rt_mesh_options mo = {.material = rt_scene_add_material(s, &m)};
+        r = mo.material == RT_NONE ? rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", name)
+                                   : rt_mesh_load_memory(s, bytes, size, name, &mo, NULL, err);
+        info->meshes = info->primitives = r == RT_OK ? 1 : 0;
+        if (r == RT_OK && for_render && !add_default_lighting(s))
+            r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", name);
+        return r;
+    }
+    case RT_LOAD_SCENE:
+        break;
+    }
+    return rt_scene_parse_string(s, bytes, size, name, NULL, err);
+}
+
+/* Marks the scene, loads, adds tangents for rendering, and rolls back on
+ * any error. t0 is when the load began (reading included). */
+static rt_result load_marked(rt_scene *s, const void *bytes, size_t size, const char *name, rt_load_kind kind,
+                             const rt_load_options *options, rt_load_info *info, double t0, rt_error *err)
+{
+    bool for_render = options && options->for_render;
+    rt_scene_mark mark = rt_scene_mark_of(s);
+    rt_result r = load_kind(s, bytes, size, name, kind, for_render, info, err);
+    if (r == RT_OK && for_render) /* normal-mapped meshes without tangents get per-vertex ones */
+        r = rt_scene_generate_tangents(s, err);
+    if (r != RT_OK)
+        rt_scene_rollback(s, &mark);
+    info->load_ms = now_ms() - t0;
+    return r;
+}
+
+rt_result rt_load_memory(rt_scene *s, const void *bytes, size_t size, const char *name,
+                         const rt_load_options *options, rt_load_info *info, rt_error *err)
+{
+    double t0 = now_ms();
+    rt_load_info local_info;
+    if (!info)
+        info = &local_info;
+    memset(info, 0, sizeof *info);
+    if (!name)
+        name = "<memory>";
+    if (!bytes && size)
+        return rt_fail(err, RT_ERR_INVALID, "%s: no data", name);
+    info->kind = rt_load_kind_of(bytes, size, name);
+    return load_marked(s, size ? bytes : "", size, name, info->kind, options, info, t0, err);
+}
+
+rt_result rt_load(rt_scene *s, const char *path, const rt_load_options *options, rt_load_info *info,
+                  rt_error *err)
+{
+    double t0 = now_ms();
+    rt_load_info local_info;
+    if (!info)
+        info = &local_info;
+    memset(info, 0, sizeof *info);
+    if (!path)
+        return load_marked(s, rt_default_scene_text, strlen(rt_default_scene_text), "<built-in scene>",
+                           RT_LOAD_SCENE, options, info, t0, err);
+    char *bytes;
+    size_t size;
+    rt_result r = rt_read_file(path, 0, &bytes, &size, err);
+    if (r != RT_OK) {
+        info->kind = rt_load_kind_of(NULL, 0, path);
+        info->load_ms = now_ms() - t0;
+        return r;
+    }
+    info->kind = rt_load_kind_of(bytes, size, path);
+    r = load_marked(s, bytes, size, path, info->kind, options, info, t0, err);
+    free(bytes);
+    return r;
+}
