@@ -63,11 +63,13 @@ $(BUILD)/tests/test_corpus: tests/test_corpus.c tests/fuzz/harness.c tests/fuzz/
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests -o $@ tests/test_corpus.c tests/fuzz/harness.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
-# the kd-tree's portable path (no AVX2), tested on machines that have AVX2 too
+# the kd-tree's portable path (no AVX2), tested on machines that have AVX2 too:
+# the traversal compiled again with RT_KD_SCALAR; its two functions take the
+# place of the library's (build and packing come from librt.a unchanged)
 TEST_BIN += $(BUILD)/tests/test_kdtree_scalar
-$(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c src/accel/kdtree_build.c $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+$(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c src/accel/kdtree_trace.c src/accel/kdtree_internal.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -DRT_KD_SCALAR -Itests -o $@ tests/test_kdtree.c src/accel/kdtree_build.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+	$(CC) $(CFLAGS) -DRT_KD_SCALAR -Itests -o $@ tests/test_kdtree.c src/accel/kdtree_trace.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 test: $(RT) $(TEST_BIN)
 	@RT_SHARED=$(SHARED) RT_BIN=./$(RT) sh tests/run.sh $(TEST_BIN)
