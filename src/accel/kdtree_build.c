@@ -382,15 +382,9 @@ static void make_leaf(kd_build *c, uint32_t node, const uint64_t *ev0, size_t n0
     uint32_t *dst = c->ids + c->id_count;
     size_t m = 0;
     for (size_t i = 0; i < n0 && m < nprims; i++)
-        if (ev_type(ev0[i]) != EV_END) {
-            uint32_t p = ev_prim(ev0[i]);
-            size_t j = m++; /* insertion sort: ascending ids, triangles first */
-            while (j > 0 && dst[j - 1] > p) {
-                dst[j] = dst[j - 1];
-                j--;
-            }
-            dst[j] = p;
-        }
+        if (ev_type(ev0[i]) != EV_END)
+            dst[m++] = ev_prim(ev0[i]);
+    kd_sort_ids(dst, m);
     nd->a = (uint32_t)c->id_count;
     nd->b = KD_LEAF_TAG | ((uint32_t)m << 2);
     c->id_count += m;
@@ -407,6 +401,15 @@ static void merge_back(uint64_t *dst, size_t nd, const uint64_t *add, size_t na)
         else
             dst[--k] = add[--j];
     }
+}
+
+/* The cost C(p) of a plane with nl primitives on its left and nr on its
+ * right (wl, wr: the children's surface areas, scaled as in find_plane),
+ * with the empty-space bonus when a side is empty. */
+static inline double plane_cost(double kt, double scale, double lambda, double wl, double wr, size_t nl, size_t nr)
+{
+    double c = kt + scale * (wl * (double)(int64_t)nl + wr * (double)(int64_t)nr);
+    return nl == 0 || nr == 0 ? c * lambda : c;
 }
 
 /* Best SAH plane of a node (section 4.2 of Wald and Havran): one sweep per
@@ -451,18 +454,12 @@ static double find_plane(const kd_build *c, rt_box V, uint64_t *const list[3], c
             if (key > lo_key && key < hi_key) {
                 double p = (double)o2f(key);
                 double wl = ab + (p - lo) * apb, wr = ab + (hi - p) * apb;
-                size_t nl1 = nl + pp; /* planar ones left */
-                double c1 = kt + scale * (wl * (double)(int64_t)nl1 + wr * (double)(int64_t)nr);
-                if (nl1 == 0 || nr == 0)
-                    c1 *= lambda;
+                double c1 = plane_cost(kt, scale, lambda, wl, wr, nl + pp, nr); /* planar ones left */
                 if (c1 < best) {
                     best = c1, *best_k = k, *best_key = key, *best_side = SIDE_LEFT;
                 }
                 if (pp > 0) { /* planar ones right */
-                    size_t nr2 = nr + pp;
-                    double c2 = kt + scale * (wl * (double)(int64_t)nl + wr * (double)(int64_t)nr2);
-                    if (nl == 0 || nr2 == 0)
-                        c2 *= lambda;
+                    double c2 = plane_cost(kt, scale, lambda, wl, wr, nl, nr + pp);
                     if (c2 < best) {
                         best = c2, *best_k = k, *best_key = key, *best_side = SIDE_RIGHT;
                     }

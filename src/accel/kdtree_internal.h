@@ -46,6 +46,22 @@ typedef struct rt_kdtree_node {
  * ids at a time. */
 #define KD_IDS_PAD 8
 
+/* Sorts a leaf's ids ascending (insertion sort: leaves are short). Leaf
+ * lists are kept so: triangles, the lowest ids, come first, and the
+ * traversal's 8-wide leaf test takes them as one run. */
+static inline void kd_sort_ids(uint32_t *p, size_t n)
+{
+    for (size_t i = 1; i < n; i++) {
+        uint32_t x = p[i];
+        size_t j = i;
+        while (j > 0 && p[j - 1] > x) {
+            p[j] = p[j - 1];
+            j--;
+        }
+        p[j] = x;
+    }
+}
+
 /* The build's result: nodes in depth-first order, and the id lists their
  * leaves of two or more primitives point into (ascending ids: triangles,
  * then the scene ids of spheres and quads). */

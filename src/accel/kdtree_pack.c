@@ -99,14 +99,7 @@ bool rt_kd_order_triangles(rt_kdtree *tree, rt_kd_binary *bin)
             }
             p[j] = newid[p[j]];
         }
-        for (uint32_t j = 1; j < n && p[j] < T; j++) { /* ascending again (first-seen ones already are) */
-            uint32_t x = p[j], k = j;
-            while (k > 0 && p[k - 1] > x) {
-                p[k] = p[k - 1];
-                k--;
-            }
-            p[k] = x;
-        }
+        kd_sort_ids(p, n); /* ascending again (spheres and quads keep their ids, above every triangle's) */
     }
     for (size_t i = 0; i < T; i++) /* triangles in no leaf (never hit) go last */
         if (newid[i] == UINT32_MAX) {
