@@ -834,7 +834,12 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     if (!ev || !c.side)
         goto oom;
 
-    /* valid primitives and their bounds: first a count, then the events */
+    /* valid primitives and their bounds: first a count, then the events.
+     * Spheres and quads are bounded as the splits will clip them, here
+     * against all of space; a triangle's box is its vertices' (the same
+     * numbers, without the clipping passes that a million triangles would
+     * pay for nothing). */
+    const rt_box everywhere = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
     size_t nvalid = 0;
     rt_box *pb = malloc((N ? N : 1) * sizeof *pb);
     if (!pb)
@@ -865,30 +870,16 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
         } else if (i < T + S) {
             size_t j = i - T;
             const rt_spheres *sp = &scene->spheres;
-            ok = isfinite(sp->cx[j]) && isfinite(sp->cy[j]) && isfinite(sp->cz[j]) && isfinite(sp->radius[j]);
-            if (ok) {
-                double r = fabs((double)sp->radius[j]);
-                b.lo = rt_v3(round_down(sp->cx[j] - r), round_down(sp->cy[j] - r), round_down(sp->cz[j] - r));
-                b.hi = rt_v3(round_up(sp->cx[j] + r), round_up(sp->cy[j] + r), round_up(sp->cz[j] + r));
-            }
+            ok = isfinite(sp->cx[j]) && isfinite(sp->cy[j]) && isfinite(sp->cz[j]) && isfinite(sp->radius[j]) &&
+                 prim_clip_bounds(&c, (uint32_t)i, everywhere, &b);
         } else {
             size_t j = i - T - S;
             const rt_quads *q = &scene->quads;
             rt_vec3 p = rt_v3(q->px[j], q->py[j], q->pz[j]), u = rt_v3(q->ux[j], q->uy[j], q->uz[j]),
                     v = rt_v3(q->vx[j], q->vy[j], q->vz[j]);
             rt_vec3 nrm = rt_cross(u, v);
-            ok = rt_finite3(p) && rt_finite3(u) && rt_finite3(v) && rt_dot(nrm, nrm) > 0.0f;
-            if (ok) {
-                double lo[3], hi[3];
-                const float *pp = &p.x, *uu = &u.x, *vv = &v.x;
-                for (int k = 0; k < 3; k++) {
-                    double c0 = pp[k], c1 = c0 + uu[k], c2 = c0 + vv[k], c3 = c1 + vv[k];
-                    lo[k] = fmin(fmin(c0, c1), fmin(c2, c3));
-                    hi[k] = fmax(fmax(c0, c1), fmax(c2, c3));
-                }
-                b.lo = rt_v3(round_down(lo[0]), round_down(lo[1]), round_down(lo[2]));
-                b.hi = rt_v3(round_up(hi[0]), round_up(hi[1]), round_up(hi[2]));
-            }
+            ok = rt_finite3(p) && rt_finite3(u) && rt_finite3(v) && rt_dot(nrm, nrm) > 0.0f &&
+                 prim_clip_bounds(&c, (uint32_t)i, everywhere, &b);
         }
         if (ok && !finite_box(b))
             ok = false;
