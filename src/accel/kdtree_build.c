@@ -471,6 +471,18 @@ static double find_plane(const kd_build *c, rt_box V, uint64_t *const list[3], c
     return best;
 }
 
+/* Fills in interior node `node` once both children are built: split
+ * position, axis, above child, and flags for children that are empty leaves
+ * (the traversal skips them unread). */
+static void set_interior(kd_build *c, uint32_t node, int k, float split, bool below_empty, uint32_t above)
+{
+    uint32_t bits;
+    memcpy(&bits, &split, 4);
+    c->nodes[node].a = bits;
+    uint32_t flags = (below_empty ? KD_BELOW_EMPTY : 0u) | (c->nodes[above].b == KD_LEAF_TAG ? KD_ABOVE_EMPTY : 0u);
+    c->nodes[node].b = (uint32_t)k | flags | (above << 4);
+}
+
 static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t nprims, int depth);
 
 static void *fork_worker(void *arg);
@@ -654,12 +666,8 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
         }
         if (c->oom)
             return;
-        uint32_t bits;
-        memcpy(&bits, &split, 4);
-        c->nodes[node].a = bits;
         bool below_empty = f->out.node_count == 1 && f->out.nodes[0].b == KD_LEAF_TAG;
-        uint32_t flags = (below_empty ? KD_BELOW_EMPTY : 0u) | (c->nodes[above].b == KD_LEAF_TAG ? KD_ABOVE_EMPTY : 0u);
-        c->nodes[node].b = (uint32_t)k | flags | (above << 4);
+        set_interior(c, node, k, split, below_empty, above);
         return;
     }
     build_rec(c, VL, lev, lc, left_prims, depth + 1);
@@ -671,13 +679,7 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
     build_rec(c, VR, rev, rc, right_prims, depth + 1);
     if (c->oom)
         return;
-    uint32_t bits;
-    memcpy(&bits, &split, 4);
-    c->nodes[node].a = bits;
-    /* flag children that are empty leaves: traversal skips them unread */
-    uint32_t flags = (c->nodes[node + 1].b == KD_LEAF_TAG ? KD_BELOW_EMPTY : 0u) |
-                     (c->nodes[above].b == KD_LEAF_TAG ? KD_ABOVE_EMPTY : 0u);
-    c->nodes[node].b = (uint32_t)k | flags | (above << 4);
+    set_interior(c, node, k, split, c->nodes[node + 1].b == KD_LEAF_TAG, above);
 }
 
 /* ---------------------------------------------------- parallel build */
