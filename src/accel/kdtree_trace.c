@@ -57,6 +57,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "rt/accel/intersect.h"
+
 #if defined(__AVX2__) && defined(__GNUC__) && !defined(RT_KD_SCALAR) /* RT_KD_SCALAR: the portable code, for tests */
 #include <immintrin.h>
 #define KD_SIMD 1

@@ -1,4 +1,4 @@
-/* rt/kdtree.h - a flattened SAH kd-tree over every primitive of a scene.
+/* rt/accel/kdtree.h - a flattened SAH kd-tree over every primitive of a scene.
  *
  * The tree is built once from a scene (triangles, spheres and quads in the
  * scene's primitive id space, see scene.h) and then only read, from any
@@ -42,7 +42,7 @@
 #include <string.h>
 
 #include "rt/base/error.h"
-#include "rt/accel/intersect.h"
+#include "rt/accel/ray.h"
 #include "rt/scene/scene.h"
 
 /* Build parameters; a zero field means "the default". */
