@@ -14,7 +14,7 @@
  *   kdtree_trace.c  rt_kdtree_intersect and rt_kdtree_occluded over those
  *                   arrays (the AVX2 step and the portable one).
  *
- * Only the build and packing see rt_kdtree_node; the traversal reads
+ * Only the build and packing use rt_kdtree_node; the traversal reads
  * nothing but rt_kdtree and this file's KD_MAX_DEPTH and KD_IDS_PAD.
  */
 #ifndef RT_KDTREE_INTERNAL_H
