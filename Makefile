@@ -72,9 +72,11 @@ $(BUILD)/tests/test_compare: tests/test_compare.c src/driver/compare.c src/drive
 
 # the kd-tree's portable path (no AVX2), tested on machines that have AVX2 too
 TEST_BIN += $(BUILD)/tests/test_kdtree_scalar
-$(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c src/accel/kdtree.c $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+# (only the traversal is compiled again, with RT_KD_SCALAR; its two functions
+# take the place of the library's, and the build and packing come from librt.a)
+$(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c src/accel/kdtree_trace.c src/accel/kdtree_internal.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -DRT_KD_SCALAR -Itests -o $@ tests/test_kdtree.c src/accel/kdtree.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+	$(CC) $(CFLAGS) -DRT_KD_SCALAR -Itests -o $@ tests/test_kdtree.c src/accel/kdtree_trace.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 test: $(RT) $(TEST_BIN)
 	@RT_SHARED=$(SHARED) RT_BIN=./$(RT) sh tests/run.sh $(TEST_BIN)

@@ -1,5 +1,5 @@
 /* buildscale - kd-tree build time against triangle count, to check that it
- * grows as N log N (Wald and Havran 2006; see src/kdtree.c).
+ * grows as N log N (Wald and Havran 2006; see src/accel/kdtree_build.c).
  *
  *   buildscale [--reps K] [--max N] [MODEL.glb ...]
  *

@@ -14,6 +14,7 @@
 
 #include <pthread.h>
 
+#include "rt/accel/intersect.h"
 #include "rt/accel/kdtree.h"
 
 /* ------------------------------------------------------------ helpers */

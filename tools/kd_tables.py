@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Prints the three constant tables of the wide kd-tree step in src/kdtree.c.
+"""Prints the three constant tables of the wide kd-tree step in
+src/accel/kdtree_trace.c.
 
 kd_compress[m]: byte i = the lane of the i-th set bit of the 8-bit mask m
 (compaction by a permute). kd_cell_of_key[nb] / kd_key_of_cell[nb]: the
@@ -10,7 +11,7 @@ the cell is c = 4 b0 + 2 b1 + b2 with b = k ^ neg(plane) at each level and
 planes 0, 1 + b0, 3 + 2 b0 + b1. Byte L of kd_cell_of_key[nb] is the cell
 with key 7 - L (farthest first); byte c of kd_key_of_cell[nb] is c's key.
 
-    python3 tools/kd_tables.py   # compare with the tables in src/kdtree.c
+    python3 tools/kd_tables.py   # compare with the tables in src/accel/kdtree_trace.c
 """
 
 

@@ -1,4 +1,5 @@
-/* rt/intersect.h - rays, hits, and the ray-primitive tests.
+/* rt/accel/intersect.h - the ray-primitive tests (rays and hits are in
+ * ray.h, which this includes).
  *
  * All tests are two-sided and return the nearest hit with t in the open
  * interval (tmin, tmax). They are `static inline` because the kd-tree's leaf
@@ -21,28 +22,12 @@
 #ifndef RT_INTERSECT_H
 #define RT_INTERSECT_H
 
+#include "rt/accel/ray.h"
 #include "rt/base/vec.h"
-
-typedef struct rt_ray {
-    rt_vec3 org, dir; /* dir need not be unit length; t is in units of |dir| */
-    float tmin, tmax;
-} rt_ray;
-
-typedef struct rt_hit {
-    float t;
-    float u, v;    /* triangle barycentrics of v1, v2; quad (s, t); sphere unused */
-    uint32_t prim; /* primitive id (see scene.h), RT_NONE for a miss */
-} rt_hit;
 
 /* The tests below must round the same wherever they are compiled (the
  * kd-tree's 8-wide leaf test reproduces them bit for bit): no fused
  * multiply-adds, see RT_NO_FP_CONTRACT in vec.h. */
-static inline rt_ray rt_ray_make(rt_vec3 org, rt_vec3 dir, float tmin, float tmax)
-{
-    rt_ray r = {org, dir, tmin, tmax};
-    return r;
-}
-
 static inline bool rt_intersect_triangle(rt_vec3 org, rt_vec3 dir, rt_vec3 v0, rt_vec3 e1, rt_vec3 e2, float tmin,
                                          float tmax, float *t_out, float *u_out, float *v_out)
 {
@@ -135,33 +120,6 @@ static inline bool rt_intersect_quad(rt_vec3 org, rt_vec3 dir, rt_vec3 p, rt_vec
     *s_out = s;
     *r_out = r;
     return true;
-}
-
-/* Robust origin for a secondary ray leaving a surface at p with geometric
- * normal n (unit, pointing to the side the ray leaves on): Waechter and
- * Binder, "A Fast and Robust Method for Avoiding Self-Intersection", Ray
- * Tracing Gems ch. 6. Away from the origin p moves a fixed number of float
- * ulps along n, so the step grows with |p|; near the origin, where ulps
- * vanish, it moves a fixed distance. `scale` is the scene's size (largest
- * absolute coordinate; 1 for the paper's constants): both the "near the
- * origin" region and the fixed step scale with it, because the error of a
- * computed hit point is relative to the coordinates of the geometry hit, not
- * to p. So a 6 cm model and a 400 m one both render without acne or leaks. */
-static inline float rt__nudge_float(float x, int ulps)
-{
-    union { float f; int32_t i; } u;
-    u.f = x;
-    u.i += x < 0.0f ? -ulps : ulps;
-    return u.f;
-}
-static inline rt_vec3 rt_offset_ray_origin(rt_vec3 p, rt_vec3 n, float scale)
-{
-    const float origin = scale * (1.0f / 32.0f), float_scale = scale * (1.0f / 65536.0f), int_scale = 256.0f;
-    rt_vec3 q;
-    q.x = fabsf(p.x) < origin ? p.x + float_scale * n.x : rt__nudge_float(p.x, (int)(int_scale * n.x));
-    q.y = fabsf(p.y) < origin ? p.y + float_scale * n.y : rt__nudge_float(p.y, (int)(int_scale * n.y));
-    q.z = fabsf(p.z) < origin ? p.z + float_scale * n.z : rt__nudge_float(p.z, (int)(int_scale * n.z));
-    return q;
 }
 
 #endif

@@ -1,4 +1,4 @@
-/* rt/kdtree.h - a flattened SAH kd-tree over every primitive of a scene.
+/* rt/accel/kdtree.h - a flattened SAH kd-tree over every primitive of a scene.
  *
  * The tree is built once from a scene (triangles, spheres and quads in the
  * scene's primitive id space, see scene.h) and then only read, from any
@@ -13,16 +13,16 @@
  *   rt_kdtree_free(&tree);
  *
  * Layout: the build makes 8-byte nodes in one array (the below child is the
- * next node, see rt_kdtree_node) and leaf primitive lists in a second
- * array; for tracing, every three levels of that binary tree are then packed
- * into one 64-byte, cache-line-aligned rt_kdtree_wide (7 split planes, 8
- * cells), so a ray resolves three levels with one memory access and one
- * SIMD step instead of three dependent branches. The planes and cells are
- * exactly the binary tree's. Triangles are copied into one buffer of 9
- * floats each (v0, e1, e2) in the order the leaves first use them, so a
- * leaf's triangles are mostly adjacent; each carries its scene id (hits
- * report scene ids). Build and
- * traversal are described, with their sources, at the top of kdtree.c.
+ * next node) and leaf primitive lists in a second array; for tracing,
+ * every three levels of that binary tree are then packed into one 64-byte,
+ * cache-line-aligned rt_kdtree_wide (7 split planes, 8 cells), so a ray
+ * resolves three levels with one memory access and one SIMD step instead of
+ * three dependent branches. The planes and cells are exactly the binary
+ * tree's. Triangles are copied into one buffer of 9 floats each (v0, e1,
+ * e2) in the order the leaves first use them, so a leaf's triangles are
+ * mostly adjacent; each carries its scene id (hits report scene ids). The
+ * build, this packing and the traversal are described, with their sources,
+ * at the top of src/accel/kdtree_build.c, kdtree_pack.c and kdtree_trace.c.
  *
  * Results are exactly those of testing every primitive with the functions
  * of intersect.h (same t bits; either id when two primitives tie). Rays with
@@ -42,7 +42,7 @@
 #include <string.h>
 
 #include "rt/base/error.h"
-#include "rt/accel/intersect.h"
+#include "rt/accel/ray.h"
 #include "rt/scene/scene.h"
 
 /* Build parameters; a zero field means "the default". */
@@ -63,14 +63,6 @@ typedef struct rt_kdtree_stats {
     double build_ms;
     size_t bytes;         /* nodes + leaf ids + triangle buffers */
 } rt_kdtree_stats;
-
-/* The build's binary node. */
-typedef struct rt_kdtree_node {
-    uint32_t a; /* interior: split position (float bits); leaf: first index into prim_ids (or the single prim) */
-    uint32_t b; /* low 2 bits: axis 0..2, or 3 = leaf. Leaf: b >> 2 = prim count (0 = empty leaf).
-                 * Interior: bit 2 = below child is an empty leaf, bit 3 = above child is,
-                 * b >> 4 = above-child index (the below child is the next node). */
-} rt_kdtree_node;
 
 /* Three levels of the binary tree: planes in breadth-first order (0 the top
  * node, 1 and 2 its below and above children, 3-6 theirs: plane p's children

@@ -1,0 +1,1023 @@
+/* kdtree_build.c - the SAH kd-tree's build: O(N log N) with perfect splits,
+ * on one or more threads, into a binary tree that kdtree_pack.c then packs
+ * for the traversal (kdtree_trace.c). rt_kdtree_build and rt_kdtree_free.
+ *
+ * Build: Wald and Havran, "On building fast kd-Trees for Ray Tracing, and on
+ * doing that in O(N log N)", IEEE Symposium on Interactive Ray Tracing 2006
+ * (section 4: event sorting). Each node holds, per axis, a list of events
+ * sorted once at the root by (position, type), type END < PLANAR < START:
+ * a primitive whose (clipped) bounds on axis k are [a, b] has START at a and
+ * END at b, or one PLANAR event when a == b. One linear sweep per axis gives
+ * for every candidate plane p the counts N_L (left of p), N_P (in p) and
+ * N_R (right of p), and the plane cost
+ *
+ *   C(p) = lambda(p) * (K_T + K_I * (P_L * N_L' + P_R * N_R'))
+ *   P_L  = SA(V_L) / SA(V),  P_R = SA(V_R) / SA(V)   (surface area heuristic,
+ *          MacDonald and Booth 1990: probability that a ray through V
+ *          crosses the child)
+ *
+ * with the planar primitives put on the cheaper side (N_L' = N_L + N_P or
+ * N_R' = N_R + N_P), and lambda(p) = 1 - empty_bonus when one side is empty
+ * (the empty-space bonus), else 1. Only planes strictly inside V count
+ * (so no zero-volume cells are cut off again and again). The node becomes a
+ * leaf when the best C(p) is not below the leaf cost K_I * N, or at the depth
+ * limit (default 8 + 1.3 log2 N, as pbrt). Defaults: K_T = 4, K_I = 1,
+ * empty_bonus = 0.2 (the paper's lambda = 0.8). Measured on the shared
+ * benchmark rays (DamagedHelmet, ReciprocatingSaw, MetalRoughSpheres), the
+ * paper's K_T = 15, K_I = 20 traced no faster but made 7 nodes and 5
+ * references per triangle (115 bytes/triangle); K_T / K_I from 2 to 5 all
+ * trace at the same speed within noise, and 4 gives 50-56 bytes a triangle
+ * (tree + triangles) and the faster build.
+ * Splitting classifies each primitive as left, right or both in one pass over
+ * the chosen axis' events; the event lists of left-only and right-only
+ * primitives are filtered into the children keeping their order, and only the
+ * straddling primitives get new events: each is clipped against the child
+ * box (Sutherland-Hodgman in double precision, bounds rounded outwards:
+ * "perfect splits", Havran's thesis 2000, section 4.5), the few new events
+ * sorted and merged in. Hence O(N log N) overall. The root lists are sorted
+ * by an LSD radix sort on 64-bit event keys (position bits, type, primitive).
+ * With more than one build thread (params->threads; default one per online
+ * CPU) the top levels fork: a below child's subtree is built by a new
+ * thread into its own arrays while the above child is built here, down to
+ * about 4 concurrent subtrees per thread, and the pieces are spliced into
+ * depth-first order afterwards: the tree is bit-identical for any thread
+ * count.
+ *
+ * Output (kdtree_internal.h): 8-byte nodes in depth-first order (below
+ * child = next node, above child index in the node) and leaf id lists in a
+ * second array, ascending, triangles first. The triangles' records for the
+ * traversal (v0, e1 = v1 - v0, e2 = v2 - v0, computed exactly as the
+ * reference tests of intersect.h do, so t is bit-identical to testing the
+ * scene's triangle directly) are made here with the primitives' bounds;
+ * kdtree_pack.c puts them in leaf order and packs the nodes.
+ *
+ * Measured and not kept (docs/performance.md has the numbers): K_T 1.5-6,
+ * empty bonus 0.2-0.8 and depth limits up to 50 (no gain on both ray
+ * kinds); huge pages for the build's event arrays (no faster); with the
+ * wide nodes, a SAH leaf cost in steps of 8 primitives (the 8-wide leaf
+ * test) with K_T 2-8.
+ */
+#include "kdtree_internal.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+/* ------------------------------------------------------------- events */
+
+enum { EV_END = 0, EV_PLANAR = 1, EV_START = 2 };
+enum { SIDE_BOTH = 0, SIDE_LEFT = 1, SIDE_RIGHT = 2 };
+#define PRIM_BITS 30
+#define PRIM_MASK ((1u << PRIM_BITS) - 1u)
+#define KD_INDEX_BITS 28 /* of the above-child index in a binary node */
+#define KD_MAX_NODES ((size_t)1 << (KD_INDEX_BITS - 1)) /* per builder; stitching adds them up */
+#define KD_MAX_IDS ((size_t)UINT32_MAX)
+/* Below this many primitives the build stays on one thread. 4096: with the
+ * second core free, DamagedHelmet (15k triangles) builds in 21-24 ms with 2
+ * threads against 30-36 ms with 1 (20000 before, measured under load). */
+#define KD_FORK_MIN_PRIMS 4096
+
+/* Event = ordered position bits << 32 | type << 30 | primitive: sorting the
+ * integers sorts by (position, type). */
+static inline uint32_t f2o(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, 4);
+    return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+}
+static inline float o2f(uint32_t o)
+{
+    uint32_t u = (o & 0x80000000u) ? (o & 0x7fffffffu) : ~o;
+    float f;
+    memcpy(&f, &u, 4);
+    return f;
+}
+static inline uint64_t ev_make(float pos, unsigned type, uint32_t prim)
+{
+    pos += 0.0f; /* -0 -> +0: one plane, one key */
+    return ((uint64_t)f2o(pos) << 32) | ((uint64_t)type << PRIM_BITS) | prim;
+}
+static inline uint32_t ev_key(uint64_t e) { return (uint32_t)(e >> 32); }
+static inline unsigned ev_type(uint64_t e) { return (unsigned)(e >> PRIM_BITS) & 3u; }
+static inline uint32_t ev_prim(uint64_t e) { return (uint32_t)e & PRIM_MASK; }
+
+/* Sorts events by (position, type); tmp has room for n. */
+static void ev_sort(uint64_t *a, size_t n, uint64_t *tmp)
+{
+    if (n < 64) {
+        for (size_t i = 1; i < n; i++) {
+            uint64_t x = a[i];
+            size_t j = i;
+            while (j > 0 && (a[j - 1] >> PRIM_BITS) > (x >> PRIM_BITS)) {
+                a[j] = a[j - 1];
+                j--;
+            }
+            a[j] = x;
+        }
+        return;
+    }
+    static const int shift[3] = {30, 41, 52}, bits[3] = {11, 11, 12};
+    uint64_t *src = a, *dst = tmp;
+    size_t count[4096];
+    for (int pass = 0; pass < 3; pass++) {
+        size_t radix = (size_t)1 << bits[pass], mask = radix - 1;
+        memset(count, 0, radix * sizeof count[0]);
+        for (size_t i = 0; i < n; i++)
+            count[(src[i] >> shift[pass]) & mask]++;
+        if (count[(src[0] >> shift[pass]) & mask] == n)
+            continue; /* every key shares this digit */
+        size_t sum = 0;
+        for (size_t r = 0; r < radix; r++) {
+            size_t c = count[r];
+            count[r] = sum;
+            sum += c;
+        }
+        for (size_t i = 0; i < n; i++)
+            dst[count[(src[i] >> shift[pass]) & mask]++] = src[i];
+        uint64_t *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != a)
+        memcpy(a, src, n * sizeof *a);
+}
+
+/* ------------------------------------------------------------ clipping */
+
+/* The float next to finite-or-infinite f towards -inf / +inf (nextafterf
+ * without the library call). */
+static inline float float_down(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, 4);
+    if (f == 0.0f)
+        u = 0x80000001u; /* -smallest subnormal */
+    else
+        u = f > 0.0f ? u - 1 : u + 1;
+    memcpy(&f, &u, 4);
+    return f;
+}
+static inline float float_up(float f) { return -float_down(-f); }
+
+/* x rounded to a float below / above it (outwards, for conservative bounds). */
+static inline float round_down(double x)
+{
+    float f = (float)x;
+    return (double)f > x ? float_down(f) : f;
+}
+static inline float round_up(double x)
+{
+    float f = (float)x;
+    return (double)f < x ? float_up(f) : f;
+}
+
+#define POLY_MAX 40
+
+/* Sutherland-Hodgman: keeps the part of polygon `in` with sign * (x_k - c) >= 0. */
+static int clip_plane(double (*in)[3], int n, double (*out)[3], int k, double c, double sign)
+{
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        const double *a = in[i], *b = in[i + 1 == n ? 0 : i + 1];
+        double da = sign * (a[k] - c), db = sign * (b[k] - c);
+        if (da >= 0.0) {
+            if (m >= POLY_MAX)
+                return -1;
+            memcpy(out[m++], a, sizeof(double[3]));
+        }
+        if ((da >= 0.0) != (db >= 0.0)) {
+            if (m >= POLY_MAX)
+                return -1;
+            double t = da / (da - db);
+            for (int j = 0; j < 3; j++)
+                out[m][j] = a[j] + (b[j] - a[j]) * t;
+            out[m][k] = c;
+            m++;
+        }
+    }
+    return m;
+}
+
+/* ------------------------------------------------------------- build */
+
+/* Parallel build: near the root (depth < fork_depth) the below child's
+ * subtree is handed to a new thread, building into its own arrays, while
+ * this thread builds the above child; the parent keeps a placeholder node
+ * that is replaced by the subtree when everything is stitched together in
+ * depth-first order. So the tree is identical for any number of threads. */
+typedef struct kd_fork kd_fork;
+
+typedef struct kd_build {
+    const rt_scene *s;
+    uint32_t T, S, Q;
+    double kt, ki, lambda;
+    int max_depth;
+    uint8_t *side;   /* per primitive, during one split */
+    uint32_t *strad; /* straddling primitives of the current split */
+    size_t strad_cap;
+    rt_kdtree_node *nodes;
+    size_t node_count, node_cap;
+    uint32_t *ids;
+    size_t id_count, id_cap;
+    rt_kdtree_stats st;
+    bool oom, limit; /* limit: the tree outgrew the node format (reported as RT_ERR_LIMIT) */
+    int fork_depth;       /* fork below children above this depth */
+    size_t fork_min;      /* ... of at least this many primitives */
+    size_t nprims_total;  /* length of a side array */
+    kd_fork **forks;      /* subtrees built by other threads (stable addresses) */
+    size_t fork_count, fork_cap;
+} kd_build;
+
+struct kd_fork {
+    kd_build out; /* the subtree's nodes, ids, stats and its own forks */
+    rt_box V;
+    uint64_t *ev;
+    size_t cnt[3], nprims;
+    int depth;
+};
+
+#define TASK_MARK (KD_LEAF_TAG | (0x3fffffffu << 2)) /* placeholder leaf: a = fork index */
+
+static inline float *box_lo(rt_box *b) { return &b->lo.x; }
+static inline float *box_hi(rt_box *b) { return &b->hi.x; }
+
+/* Bounds of the part of primitive `prim` inside `box` (tight for triangles
+ * and quads, box-intersected for spheres); false when nothing is inside. */
+static bool prim_clip_bounds(const kd_build *c, uint32_t prim, rt_box box, rt_box *out)
+{
+    const rt_scene *s = c->s;
+    double poly[2][POLY_MAX][3];
+    double lo[3], hi[3];
+    int n = 0;
+    const float *bl = &box.lo.x, *bh = &box.hi.x;
+    if (prim < c->T) {
+        for (int v = 0; v < 3; v++) {
+            rt_vec3 p = rt_tri_vertex(s, prim, v);
+            poly[0][v][0] = p.x, poly[0][v][1] = p.y, poly[0][v][2] = p.z;
+        }
+        n = 3;
+    } else if (prim < c->T + c->S) {
+        uint32_t i = prim - c->T;
+        const rt_spheres *sp = &s->spheres;
+        double cc[3] = {sp->cx[i], sp->cy[i], sp->cz[i]}, r = fabs((double)sp->radius[i]);
+        for (int k = 0; k < 3; k++) {
+            lo[k] = cc[k] - r;
+            hi[k] = cc[k] + r;
+        }
+    } else {
+        uint32_t i = prim - c->T - c->S;
+        const rt_quads *q = &s->quads;
+        double p[3] = {q->px[i], q->py[i], q->pz[i]}, u[3] = {q->ux[i], q->uy[i], q->uz[i]},
+               v[3] = {q->vx[i], q->vy[i], q->vz[i]};
+        for (int k = 0; k < 3; k++) {
+            poly[0][0][k] = p[k];
+            poly[0][1][k] = p[k] + u[k];
+            poly[0][2][k] = p[k] + u[k] + v[k];
+            poly[0][3][k] = p[k] + v[k];
+        }
+        n = 4;
+    }
+    if (n > 0) {
+        int cur = 0;
+        for (int k = 0; k < 3 && n > 0; k++) {
+            n = clip_plane(poly[cur], n, poly[cur ^ 1], k, bl[k], 1.0);
+            cur ^= 1;
+            if (n > 0) {
+                n = clip_plane(poly[cur], n, poly[cur ^ 1], k, bh[k], -1.0);
+                cur ^= 1;
+            }
+        }
+        if (n < 0) { /* cannot happen for a convex polygon; stay conservative */
+            for (int k = 0; k < 3; k++)
+                lo[k] = -INFINITY, hi[k] = INFINITY;
+        } else if (n == 0) {
+            return false;
+        } else {
+            for (int k = 0; k < 3; k++)
+                lo[k] = hi[k] = poly[cur][0][k];
+            for (int j = 1; j < n; j++)
+                for (int k = 0; k < 3; k++) {
+                    double x = poly[cur][j][k];
+                    lo[k] = x < lo[k] ? x : lo[k];
+                    hi[k] = x > hi[k] ? x : hi[k];
+                }
+        }
+    }
+    float *ol = &out->lo.x, *oh = &out->hi.x;
+    for (int k = 0; k < 3; k++) {
+        float l = round_down(lo[k]), h = round_up(hi[k]);
+        ol[k] = l > bl[k] ? l : bl[k];
+        oh[k] = h < bh[k] ? h : bh[k];
+        if (!(ol[k] <= oh[k]))
+            return false;
+    }
+    return true;
+}
+
+/* Appends the events of one box to the three per-axis lists. */
+static inline void emit_events(rt_box b, uint32_t prim, uint64_t *list[3], size_t n[3])
+{
+    const float *lo = &b.lo.x, *hi = &b.hi.x;
+    for (int k = 0; k < 3; k++) {
+        if (lo[k] == hi[k]) {
+            list[k][n[k]++] = ev_make(lo[k], EV_PLANAR, prim);
+        } else {
+            list[k][n[k]++] = ev_make(lo[k], EV_START, prim);
+            list[k][n[k]++] = ev_make(hi[k], EV_END, prim);
+        }
+    }
+}
+
+static uint32_t push_node(kd_build *c)
+{
+    if (c->node_count >= KD_MAX_NODES) { /* 28 bits of child index */
+        c->oom = c->limit = true;
+        return 0;
+    }
+    if (!rt_grow((void **)&c->nodes, &c->node_cap, c->node_count + 1, sizeof *c->nodes)) {
+        c->oom = true;
+        return 0;
+    }
+    c->nodes[c->node_count].a = 0;
+    c->nodes[c->node_count].b = KD_LEAF_TAG;
+    return (uint32_t)c->node_count++;
+}
+
+static void make_leaf(kd_build *c, uint32_t node, const uint64_t *ev0, size_t n0, size_t nprims, int depth)
+{
+    rt_kdtree_node *nd = &c->nodes[node];
+    c->st.leaves++;
+    if (depth > c->st.depth)
+        c->st.depth = depth;
+    if (nprims > c->st.max_leaf_prims)
+        c->st.max_leaf_prims = nprims;
+    c->st.prim_refs += nprims;
+    if (nprims == 0) {
+        c->st.empty_leaves++;
+        nd->a = 0;
+        nd->b = KD_LEAF_TAG;
+        return;
+    }
+    if (nprims == 1) {
+        for (size_t i = 0; i < n0; i++)
+            if (ev_type(ev0[i]) != EV_END) {
+                nd->a = ev_prim(ev0[i]);
+                break;
+            }
+        nd->b = KD_LEAF_TAG | (1u << 2);
+        return;
+    }
+    if (c->id_count + nprims > KD_MAX_IDS) {
+        c->oom = c->limit = true;
+        return;
+    }
+    if (!rt_grow((void **)&c->ids, &c->id_cap, c->id_count + nprims, sizeof *c->ids)) {
+        c->oom = true;
+        return;
+    }
+    nd = &c->nodes[node];
+    uint32_t *dst = c->ids + c->id_count;
+    size_t m = 0;
+    for (size_t i = 0; i < n0 && m < nprims; i++)
+        if (ev_type(ev0[i]) != EV_END)
+            dst[m++] = ev_prim(ev0[i]);
+    kd_sort_ids(dst, m);
+    nd->a = (uint32_t)c->id_count;
+    nd->b = KD_LEAF_TAG | ((uint32_t)m << 2);
+    c->id_count += m;
+}
+
+/* Merges sorted `add` (na) into the sorted prefix dst[0..nd) of dst, which
+ * has room for nd + na, from the back. */
+static void merge_back(uint64_t *dst, size_t nd, const uint64_t *add, size_t na)
+{
+    size_t i = nd, j = na, k = nd + na;
+    while (j > 0) {
+        if (i > 0 && (dst[i - 1] >> PRIM_BITS) > (add[j - 1] >> PRIM_BITS))
+            dst[--k] = dst[--i];
+        else
+            dst[--k] = add[--j];
+    }
+}
+
+/* The cost C(p) of a plane with nl primitives on its left and nr on its
+ * right (wl, wr: the children's surface areas, scaled as in find_plane),
+ * with the empty-space bonus when a side is empty. */
+static inline double plane_cost(double kt, double scale, double lambda, double wl, double wr, size_t nl, size_t nr)
+{
+    double c = kt + scale * (wl * (double)(int64_t)nl + wr * (double)(int64_t)nr);
+    return nl == 0 || nr == 0 ? c * lambda : c;
+}
+
+/* Best SAH plane of a node (section 4.2 of Wald and Havran): one sweep per
+ * axis over its sorted events. Returns the cost, INFINITY when no plane. */
+static double find_plane(const kd_build *c, rt_box V, uint64_t *const list[3], const size_t cnt[3], size_t nprims,
+                         int *best_k, uint32_t *best_key, int *best_side)
+{
+    const float *vlo = &V.lo.x, *vhi = &V.hi.x;
+    double ext[3] = {(double)vhi[0] - vlo[0], (double)vhi[1] - vlo[1], (double)vhi[2] - vlo[2]};
+    double area = 2.0 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[2] * ext[0]);
+    double best = INFINITY;
+    if (!(area > 0.0) || !isfinite(area))
+        return best;
+    /* cost = kt + ki * (PL * nl + PR * nr) = kt + (2 ki / area) * ((ab + dl (a+b)) nl + (ab + dr (a+b)) nr) */
+    double scale = 2.0 * c->ki / area, kt = c->kt, lambda = c->lambda;
+    for (int k = 0; k < 3; k++) {
+        if (!(vlo[k] < vhi[k]))
+            continue;
+        double a = ext[(k + 1) % 3], b = ext[(k + 2) % 3], ab = a * b, apb = a + b;
+        uint32_t lo_key = f2o(vlo[k] + 0.0f), hi_key = f2o(vhi[k] + 0.0f);
+        const uint64_t *E = list[k];
+        size_t n = cnt[k], nl = 0, nr = nprims;
+        double lo = vlo[k], hi = vhi[k];
+        for (size_t i = 0; i < n;) {
+            uint64_t e = E[i];
+            uint32_t key = ev_key(e);
+            size_t pe, pp, ps;
+            if (i + 1 == n || ev_key(E[i + 1]) != key) { /* the usual lone event */
+                unsigned t = ev_type(e);
+                pe = t == EV_END, pp = t == EV_PLANAR, ps = t == EV_START;
+                i++;
+            } else {
+                pe = pp = ps = 0;
+                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_END)
+                    pe++, i++;
+                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_PLANAR)
+                    pp++, i++;
+                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_START)
+                    ps++, i++;
+            }
+            nr -= pp + pe;
+            if (key > lo_key && key < hi_key) {
+                double p = (double)o2f(key);
+                double wl = ab + (p - lo) * apb, wr = ab + (hi - p) * apb;
+                double c1 = plane_cost(kt, scale, lambda, wl, wr, nl + pp, nr); /* planar ones left */
+                if (c1 < best) {
+                    best = c1, *best_k = k, *best_key = key, *best_side = SIDE_LEFT;
+                }
+                if (pp > 0) { /* planar ones right */
+                    double c2 = plane_cost(kt, scale, lambda, wl, wr, nl, nr + pp);
+                    if (c2 < best) {
+                        best = c2, *best_k = k, *best_key = key, *best_side = SIDE_RIGHT;
+                    }
+                }
+            }
+            nl += ps + pp;
+        }
+    }
+    return best;
+}
+
+/* Fills in interior node `node` once both children are built: split
+ * position, axis, above child, and flags for children that are empty leaves
+ * (the traversal skips them unread). */
+static void set_interior(kd_build *c, uint32_t node, int k, float split, bool below_empty, uint32_t above)
+{
+    uint32_t bits;
+    memcpy(&bits, &split, 4);
+    c->nodes[node].a = bits;
+    uint32_t flags = (below_empty ? KD_BELOW_EMPTY : 0u) | (c->nodes[above].b == KD_LEAF_TAG ? KD_ABOVE_EMPTY : 0u);
+    c->nodes[node].b = (uint32_t)k | flags | (above << 4);
+}
+
+static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t nprims, int depth);
+
+static void *fork_worker(void *arg);
+static void free_forks(kd_build *c);
+
+/* Builds the subtree of box V from its event lists (one block `ev`, lists of
+ * cnt[0], cnt[1], cnt[2] events, owned and freed here) over nprims prims. */
+static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t nprims, int depth)
+{
+    uint32_t node = push_node(c);
+    if (c->oom) {
+        free(ev);
+        return;
+    }
+    uint64_t *list[3] = {ev, ev + cnt[0], ev + cnt[0] + cnt[1]};
+    int k = -1, best_side = SIDE_LEFT;
+    uint32_t best_key = 0;
+    double best = INFINITY;
+    if (nprims > 1 && depth < c->max_depth)
+        best = find_plane(c, V, list, cnt, nprims, &k, &best_key, &best_side);
+    if (k < 0 || !(best < c->ki * (double)nprims)) {
+        make_leaf(c, node, list[0], cnt[0], nprims, depth);
+        free(ev);
+        return;
+    }
+
+    /* classify in one pass over axis k (events of a primitive come in the
+     * order START, END): left, right, or both (a straddler) */
+    uint8_t *side = c->side;
+    const uint64_t *E = list[k];
+    size_t n = cnt[k], ns = 0;
+    if (!rt_grow((void **)&c->strad, &c->strad_cap, nprims, sizeof *c->strad)) {
+        c->oom = true;
+        free(ev);
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        uint64_t e = E[i];
+        uint32_t key = ev_key(e), p = ev_prim(e);
+        unsigned t = ev_type(e);
+        if (t == EV_START) {
+            side[p] = key >= best_key ? SIDE_RIGHT : SIDE_BOTH;
+        } else if (t == EV_END) {
+            if (key <= best_key)
+                side[p] = SIDE_LEFT;
+            else if (side[p] == SIDE_BOTH)
+                c->strad[ns++] = p;
+        } else {
+            side[p] = key < best_key || (key == best_key && best_side == SIDE_LEFT) ? SIDE_LEFT : SIDE_RIGHT;
+        }
+    }
+
+    float split = o2f(best_key);
+    rt_box VL = V, VR = V;
+    box_hi(&VL)[k] = split;
+    box_lo(&VR)[k] = split;
+
+    /* new events of the straddling primitives, clipped to each child */
+    uint64_t *nbuf = NULL;
+    uint64_t *nl_list[3] = {NULL, NULL, NULL}, *nr_list[3] = {NULL, NULL, NULL};
+    size_t nl_cnt[3] = {0, 0, 0}, nr_cnt[3] = {0, 0, 0};
+    size_t npl = 0, npr = 0; /* straddlers kept on each side */
+    if (ns > 0) {
+        nbuf = malloc(ns * 14 * sizeof *nbuf); /* 6 lists of 2 ns + sort scratch 2 ns */
+        if (!nbuf) {
+            c->oom = true;
+            free(ev);
+            return;
+        }
+        for (int d = 0; d < 3; d++) {
+            nl_list[d] = nbuf + (size_t)d * 2 * ns;
+            nr_list[d] = nbuf + (size_t)(3 + d) * 2 * ns;
+        }
+        for (size_t i = 0; i < ns; i++) {
+            uint32_t p = c->strad[i];
+            rt_box b;
+            if (prim_clip_bounds(c, p, VL, &b)) {
+                emit_events(b, p, nl_list, nl_cnt);
+                npl++;
+            }
+            if (prim_clip_bounds(c, p, VR, &b)) {
+                emit_events(b, p, nr_list, nr_cnt);
+                npr++;
+            }
+        }
+        uint64_t *scratch = nbuf + 12 * ns;
+        for (int d = 0; d < 3; d++) {
+            ev_sort(nl_list[d], nl_cnt[d], scratch);
+            ev_sort(nr_list[d], nr_cnt[d], scratch);
+        }
+    }
+
+    /* filter the parent lists into the children's blocks, merging the new
+     * events in; sized for the worst case, shrunk afterwards */
+    size_t total = cnt[0] + cnt[1] + cnt[2];
+    size_t lcap = total + nl_cnt[0] + nl_cnt[1] + nl_cnt[2], rcap = total + nr_cnt[0] + nr_cnt[1] + nr_cnt[2];
+    uint64_t *lev = malloc((lcap ? lcap : 1) * sizeof *lev);
+    uint64_t *rev = malloc((rcap ? rcap : 1) * sizeof *rev);
+    if (!lev || !rev) {
+        free(lev);
+        free(rev);
+        free(nbuf);
+        free(ev);
+        c->oom = true;
+        return;
+    }
+    size_t lc[3], rc[3], lo = 0, ro = 0;
+    size_t left_prims = npl, right_prims = npr;
+    for (int d = 0; d < 3; d++) {
+        uint64_t *lp = lev + lo, *rp = rev + ro;
+        const uint64_t *src = list[d];
+        size_t a = 0, b = 0, m = cnt[d];
+        for (size_t i = 0; i < m; i++) {
+            uint64_t e = src[i];
+            uint8_t sd = side[ev_prim(e)];
+            lp[a] = e; /* branch-free: write both, advance one */
+            rp[b] = e;
+            a += sd == SIDE_LEFT;
+            b += sd == SIDE_RIGHT;
+        }
+        if (d == k) {
+            for (size_t i = 0; i < a; i++)
+                left_prims += ev_type(lp[i]) != EV_END;
+            for (size_t i = 0; i < b; i++)
+                right_prims += ev_type(rp[i]) != EV_END;
+        }
+        if (ns > 0) {
+            merge_back(lp, a, nl_list[d], nl_cnt[d]);
+            merge_back(rp, b, nr_list[d], nr_cnt[d]);
+        }
+        lc[d] = a + nl_cnt[d];
+        rc[d] = b + nr_cnt[d];
+        lo += lc[d];
+        ro += rc[d];
+    }
+    free(nbuf);
+    free(ev);
+    /* give back what the worst case did not need (shrinking cannot fail for good) */
+    uint64_t *t;
+    if (lo < lcap && (t = realloc(lev, (lo ? lo : 1) * sizeof *lev)) != NULL)
+        lev = t;
+    if (ro < rcap && (t = realloc(rev, (ro ? ro : 1) * sizeof *rev)) != NULL)
+        rev = t;
+
+    kd_fork *f = NULL;
+    if (depth < c->fork_depth && left_prims >= c->fork_min &&
+        rt_grow((void **)&c->forks, &c->fork_cap, c->fork_count + 1, sizeof *c->forks) &&
+        (f = calloc(1, sizeof *f)) != NULL) {
+        uint32_t ph = push_node(c);
+        if (c->oom) {
+            free(f);
+            free(lev);
+            free(rev);
+            return;
+        }
+        c->nodes[ph].a = (uint32_t)c->fork_count;
+        c->nodes[ph].b = TASK_MARK;
+        c->forks[c->fork_count++] = f;
+        kd_build *o = &f->out;
+        o->s = c->s;
+        o->T = c->T, o->S = c->S, o->Q = c->Q;
+        o->kt = c->kt, o->ki = c->ki, o->lambda = c->lambda;
+        o->max_depth = c->max_depth;
+        o->fork_depth = c->fork_depth, o->fork_min = c->fork_min, o->nprims_total = c->nprims_total;
+        f->V = VL;
+        f->ev = lev;
+        memcpy(f->cnt, lc, sizeof f->cnt);
+        f->nprims = left_prims;
+        f->depth = depth + 1;
+        pthread_t th;
+        bool started = pthread_create(&th, NULL, fork_worker, f) == 0;
+        if (!started)
+            fork_worker(f);
+        uint32_t above = (uint32_t)c->node_count;
+        build_rec(c, VR, rev, rc, right_prims, depth + 1);
+        if (started)
+            pthread_join(th, NULL);
+        if (f->out.oom) {
+            c->oom = true;
+            c->limit |= f->out.limit;
+        }
+        if (c->oom)
+            return;
+        bool below_empty = f->out.node_count == 1 && f->out.nodes[0].b == KD_LEAF_TAG;
+        set_interior(c, node, k, split, below_empty, above);
+        return;
+    }
+    build_rec(c, VL, lev, lc, left_prims, depth + 1);
+    if (c->oom) {
+        free(rev);
+        return;
+    }
+    uint32_t above = (uint32_t)c->node_count;
+    build_rec(c, VR, rev, rc, right_prims, depth + 1);
+    if (c->oom)
+        return;
+    set_interior(c, node, k, split, c->nodes[node + 1].b == KD_LEAF_TAG, above);
+}
+
+/* ---------------------------------------------------- parallel build */
+
+static void *fork_worker(void *arg)
+{
+    kd_fork *f = arg;
+    kd_build *c = &f->out;
+    c->side = malloc(c->nprims_total ? c->nprims_total : 1);
+    if (!c->side) {
+        c->oom = true;
+        free(f->ev);
+    } else {
+        build_rec(c, f->V, f->ev, f->cnt, f->nprims, f->depth);
+    }
+    f->ev = NULL;
+    free(c->side);
+    free(c->strad);
+    c->side = NULL;
+    c->strad = NULL;
+    c->strad_cap = 0;
+    return NULL;
+}
+
+static void free_forks(kd_build *c)
+{
+    for (size_t i = 0; i < c->fork_count; i++) {
+        kd_fork *f = c->forks[i];
+        free_forks(&f->out);
+        free(f->ev);
+        free(f->out.nodes);
+        free(f->out.ids);
+        free(f);
+    }
+    free(c->forks);
+    c->forks = NULL;
+    c->fork_count = c->fork_cap = 0;
+}
+
+/* Sizes and stats of a builder with all its forks. */
+static void sum_forks(const kd_build *c, size_t *nodes, size_t *ids, rt_kdtree_stats *st, bool top)
+{
+    *nodes += c->node_count - c->fork_count;
+    *ids += c->id_count;
+    if (!top) {
+        st->leaves += c->st.leaves;
+        st->empty_leaves += c->st.empty_leaves;
+        st->prim_refs += c->st.prim_refs;
+        if (c->st.max_leaf_prims > st->max_leaf_prims)
+            st->max_leaf_prims = c->st.max_leaf_prims;
+        if (c->st.depth > st->depth)
+            st->depth = c->st.depth;
+    }
+    for (size_t i = 0; i < c->fork_count; i++)
+        sum_forks(&c->forks[i]->out, nodes, ids, st, false);
+}
+
+/* Copies the subtree at node i of builder b into (nodes, ids) in
+ * depth-first order, splicing forked subtrees in place of their
+ * placeholders. Returns the index in b after the subtree. */
+static size_t stitch(const kd_build *b, size_t i, rt_kdtree_node *nodes, size_t *nn, uint32_t *ids, size_t *ni)
+{
+    rt_kdtree_node nd = b->nodes[i];
+    if (nd.b == TASK_MARK) {
+        stitch(&b->forks[nd.a]->out, 0, nodes, nn, ids, ni);
+        return i + 1;
+    }
+    if ((nd.b & 3u) == KD_LEAF_TAG) {
+        if ((nd.b >> 2) > 1) {
+            memcpy(ids + *ni, b->ids + nd.a, (nd.b >> 2) * sizeof *ids);
+            nd.a = (uint32_t)*ni;
+            *ni += nd.b >> 2;
+        }
+        nodes[(*nn)++] = nd;
+        return i + 1;
+    }
+    size_t me = (*nn)++;
+    stitch(b, i + 1, nodes, nn, ids, ni);
+    uint32_t above = (uint32_t)*nn;
+    size_t next = stitch(b, nd.b >> 4, nodes, nn, ids, ni);
+    nodes[me].a = nd.a;
+    nodes[me].b = (nd.b & 15u) | (above << 4);
+    return next;
+}
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static bool finite_box(rt_box b) { return rt_finite3(b.lo) && rt_finite3(b.hi); }
+
+typedef struct kd_sort_job {
+    uint64_t *list[2];
+    size_t cnt[2];
+    uint64_t *tmp;
+} kd_sort_job;
+
+static void *sort_worker(void *arg)
+{
+    kd_sort_job *j = arg;
+    ev_sort(j->list[0], j->cnt[0], j->tmp);
+    ev_sort(j->list[1], j->cnt[1], j->tmp);
+    return NULL;
+}
+
+/* ------------------------------------------------------- the whole build */
+
+/* Bounds of every primitive (and the triangles' records), the root's three
+ * sorted event lists, the recursive build (forked near the root), the forks
+ * stitched into one depth-first array, then kdtree_pack.c. */
+rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
+{
+    double t0 = now_ms();
+    memset(tree, 0, sizeof *tree);
+    tree->scene = scene;
+    tree->bounds = rt_box_empty();
+    size_t T = scene->triangles.count, S = scene->spheres.count, Q = scene->quads.count, N = T + S + Q;
+    if (N >= (size_t)PRIM_MASK)
+        return rt_fail(err, RT_ERR_LIMIT, "kdtree: %zu primitives, at most %u supported", N, PRIM_MASK - 1u);
+    tree->triangle_count = T;
+    tree->simd_ok = T < (size_t)INT32_MAX / RT_KD_TRI;
+    tree->sphere_count = S;
+    tree->quad_count = Q;
+
+    kd_build c;
+    memset(&c, 0, sizeof c);
+    c.s = scene;
+    c.T = (uint32_t)T;
+    c.S = (uint32_t)S;
+    c.Q = (uint32_t)Q;
+    c.kt = params && params->traversal_cost > 0.0f ? params->traversal_cost : 4.0;
+    c.ki = params && params->intersect_cost > 0.0f ? params->intersect_cost : 1.0;
+    double eb = params && params->empty_bonus > 0.0f ? params->empty_bonus : 0.2;
+    if (eb > 1.0)
+        eb = 1.0;
+    c.lambda = 1.0 - eb;
+    int threads = params && params->threads > 0 ? params->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    if (threads < 1)
+        threads = 1;
+    if (threads > 64)
+        threads = 64;
+
+    uint64_t *ev = NULL, *tmp = NULL;
+    if (T > 0) {
+        tree->tri = malloc(T * 9 * sizeof *tree->tri);
+        if (!tree->tri)
+            goto oom;
+    }
+    ev = malloc((N ? 6 * N : 1) * sizeof *ev);
+    c.side = malloc(N ? N : 1);
+    if (!ev || !c.side)
+        goto oom;
+
+    /* valid primitives and their bounds: first a count, then the events.
+     * Spheres and quads are bounded as the splits will clip them, here
+     * against all of space; a triangle's box is its vertices' (the same
+     * numbers, without the clipping passes that a million triangles would
+     * pay for nothing). */
+    const rt_box everywhere = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
+    size_t nvalid = 0;
+    rt_box *pb = malloc((N ? N : 1) * sizeof *pb);
+    if (!pb)
+        goto oom;
+    size_t nverts = scene->vertices.count;
+    for (size_t i = 0; i < N; i++) {
+        rt_box b = rt_box_empty();
+        bool ok = true;
+        if (i < T) {
+            const uint32_t *ix = scene->triangles.index + 3 * i;
+            float *dst = tree->tri + 9 * i;
+            memset(dst, 0, 9 * sizeof *dst);
+            if (ix[0] >= nverts || ix[1] >= nverts || ix[2] >= nverts) {
+                ok = false;
+            } else {
+                rt_vec3 a = scene->vertices.position[ix[0]], bb = scene->vertices.position[ix[1]],
+                        cc = scene->vertices.position[ix[2]];
+                rt_vec3 e1 = rt_sub(bb, a), e2 = rt_sub(cc, a);
+                ok = rt_finite3(a) && rt_finite3(bb) && rt_finite3(cc) && rt_finite3(e1) && rt_finite3(e2) &&
+                     (e1.x != 0.0f || e1.y != 0.0f || e1.z != 0.0f) && (e2.x != 0.0f || e2.y != 0.0f || e2.z != 0.0f);
+                if (ok) {
+                    dst[0] = a.x, dst[1] = a.y, dst[2] = a.z;
+                    dst[3] = e1.x, dst[4] = e1.y, dst[5] = e1.z;
+                    dst[6] = e2.x, dst[7] = e2.y, dst[8] = e2.z;
+                    b = rt_box_point(rt_box_point(rt_box_point(b, a), bb), cc);
+                }
+            }
+        } else if (i < T + S) {
+            size_t j = i - T;
+            const rt_spheres *sp = &scene->spheres;
+            ok = isfinite(sp->cx[j]) && isfinite(sp->cy[j]) && isfinite(sp->cz[j]) && isfinite(sp->radius[j]) &&
+                 prim_clip_bounds(&c, (uint32_t)i, everywhere, &b);
+        } else {
+            size_t j = i - T - S;
+            const rt_quads *q = &scene->quads;
+            rt_vec3 p = rt_v3(q->px[j], q->py[j], q->pz[j]), u = rt_v3(q->ux[j], q->uy[j], q->uz[j]),
+                    v = rt_v3(q->vx[j], q->vy[j], q->vz[j]);
+            rt_vec3 nrm = rt_cross(u, v);
+            ok = rt_finite3(p) && rt_finite3(u) && rt_finite3(v) && rt_dot(nrm, nrm) > 0.0f &&
+                 prim_clip_bounds(&c, (uint32_t)i, everywhere, &b);
+        }
+        if (ok && !finite_box(b))
+            ok = false;
+        pb[i] = b;
+        if (ok) {
+            nvalid++;
+            tree->bounds = rt_box_union(tree->bounds, b);
+        } else {
+            pb[i] = rt_box_empty();
+        }
+    }
+    if (nvalid < N)
+        rt_info("kdtree: %zu of %zu primitives can never be hit (non-finite or degenerate) and are left out", N - nvalid,
+                N);
+
+    size_t cnt[3] = {0, 0, 0};
+    uint64_t *list[3] = {ev, ev + 2 * nvalid, ev + 4 * nvalid};
+    for (size_t i = 0; i < N; i++)
+        if (!rt_box_is_empty(pb[i]))
+            emit_events(pb[i], (uint32_t)i, list, cnt);
+    free(pb);
+    tmp = malloc((nvalid ? 2 * nvalid : 1) * sizeof *tmp);
+    if (!tmp)
+        goto oom;
+    {
+        /* the three axes sort independently: y and z on a helper thread */
+        kd_sort_job job = {{list[1], list[2]}, {cnt[1], cnt[2]}, NULL};
+        pthread_t th;
+        bool started = false;
+        if (threads > 1 && nvalid >= KD_FORK_MIN_PRIMS && (job.tmp = malloc(2 * nvalid * sizeof *job.tmp)) != NULL)
+            started = pthread_create(&th, NULL, sort_worker, &job) == 0;
+        ev_sort(list[0], cnt[0], tmp);
+        if (started) {
+            pthread_join(th, NULL);
+        } else {
+            ev_sort(list[1], cnt[1], tmp);
+            ev_sort(list[2], cnt[2], tmp);
+        }
+        free(job.tmp);
+    }
+    free(tmp);
+    tmp = NULL;
+    /* compact the three lists into one block */
+    memmove(ev + cnt[0], list[1], cnt[1] * sizeof *ev);
+    memmove(ev + cnt[0] + cnt[1], list[2], cnt[2] * sizeof *ev);
+
+    if (nvalid > 0) {
+        const float *lo = &tree->bounds.lo.x, *hi = &tree->bounds.hi.x;
+        for (int k = 0; k < 3; k++)
+            tree->scale = fmaxf(tree->scale, fmaxf(fabsf(lo[k]), fabsf(hi[k])));
+    }
+    int md = params && params->max_depth > 0 ? params->max_depth
+                                             : (int)(8.0 + 1.3 * log2((double)(nvalid > 1 ? nvalid : 1)) + 0.5);
+    if (md > KD_MAX_DEPTH)
+        md = KD_MAX_DEPTH;
+    c.max_depth = md;
+    tree->max_depth = md;
+
+    if (threads > 1 && nvalid >= KD_FORK_MIN_PRIMS) {
+        /* 4 subtrees per thread: the OS evens out uneven halves */
+        int f = 2;
+        while ((1 << (f - 2)) < threads && f < 8)
+            f++;
+        c.fork_depth = f;
+        c.fork_min = 4096;
+        c.nprims_total = N;
+    }
+    build_rec(&c, tree->bounds, ev, cnt, nvalid, 0);
+    ev = NULL;
+    if (c.oom)
+        goto oom;
+    if (c.fork_count > 0) {
+        size_t nn = 0, ni = 0;
+        sum_forks(&c, &nn, &ni, &c.st, true);
+        if (nn >= ((size_t)1 << KD_INDEX_BITS) || ni > KD_MAX_IDS) {
+            c.limit = true;
+            goto oom;
+        }
+        rt_kdtree_node *nodes = malloc(nn * sizeof *nodes);
+        uint32_t *ids = malloc((ni ? ni : 1) * sizeof *ids);
+        if (!nodes || !ids) {
+            free(nodes);
+            free(ids);
+            goto oom;
+        }
+        size_t on = 0, oi = 0;
+        stitch(&c, 0, nodes, &on, ids, &oi);
+        free_forks(&c);
+        free(c.nodes);
+        free(c.ids);
+        c.nodes = nodes;
+        c.ids = ids;
+        c.node_count = on;
+        c.id_count = oi;
+    }
+    free(c.side);
+    free(c.strad);
+    c.side = NULL;
+    c.strad = NULL;
+    rt_kd_binary bin = {c.nodes, c.node_count, c.ids, c.id_count};
+    if (!rt_kd_order_triangles(tree, &bin))
+        goto oom;
+    if (!rt_kd_pack_wide(tree, &bin, &c.limit))
+        goto oom;
+    c.st.nodes = c.node_count;
+    c.st.wide_nodes = tree->wide_count;
+    c.st.bytes = tree->wide_count * sizeof *tree->wide + tree->prim_id_count * sizeof *tree->prim_ids +
+                 T * RT_KD_TRI * sizeof(float);
+    free(c.nodes);
+    free(c.ids);
+    c.st.build_ms = now_ms() - t0;
+    tree->stats = c.st;
+    return RT_OK;
+
+oom:
+    free_forks(&c);
+    free(ev);
+    free(tmp);
+    free(c.side);
+    free(c.strad);
+    free(c.nodes);
+    free(c.ids);
+    free(tree->tri);
+    memset(tree, 0, sizeof *tree);
+    if (c.limit)
+        return rt_fail(err, RT_ERR_LIMIT, "kdtree: %zu primitives make more nodes or references than the node format holds",
+                       N);
+    return rt_fail(err, RT_ERR_NOMEM, "kdtree: out of memory building the tree over %zu primitives", N);
+}
+
+void rt_kdtree_free(rt_kdtree *tree)
+{
+    if (!tree)
+        return;
+    free(tree->wide);
+    free(tree->prim_ids);
+    free(tree->tri);
+    memset(tree, 0, sizeof *tree);
+}

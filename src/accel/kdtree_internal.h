@@ -1,0 +1,86 @@
+/* kdtree_internal.h - what the kd-tree's three files share (private to
+ * src/accel/; the public interface is include/rt/accel/kdtree.h).
+ *
+ * The files, in the order a tree passes through them:
+ *
+ *   kdtree_build.c  rt_kdtree_build: the SAH event sweep (Wald and Havran
+ *                   2006) on one or more threads, into a binary tree of
+ *                   8-byte rt_kdtree_node and leaf id lists (rt_kd_binary,
+ *                   which lives only during the build); then it calls
+ *   kdtree_pack.c   rt_kd_order_triangles and rt_kd_pack_wide, which make
+ *                   the arrays of rt_kdtree that the traversal reads: the
+ *                   triangles copied in leaf order, 64-byte wide nodes of
+ *                   three levels each, leaf lists with an end flag;
+ *   kdtree_trace.c  rt_kdtree_intersect and rt_kdtree_occluded over those
+ *                   arrays (the AVX2 step and the portable one).
+ *
+ * Only the build and packing use rt_kdtree_node; the traversal reads
+ * nothing but rt_kdtree and this file's KD_MAX_DEPTH and KD_IDS_PAD.
+ */
+#ifndef RT_KDTREE_INTERNAL_H
+#define RT_KDTREE_INTERNAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rt/accel/kdtree.h"
+
+/* The build's binary node. */
+typedef struct rt_kdtree_node {
+    uint32_t a; /* interior: split position (float bits); leaf: first index into the id lists (or the single prim) */
+    uint32_t b; /* low 2 bits: axis 0..2, or 3 = leaf (KD_LEAF_TAG). Leaf: b >> 2 = prim count (0 = empty leaf).
+                 * Interior: bit 2 = below child is an empty leaf, bit 3 = above child is,
+                 * b >> 4 = above-child index (the below child is the next node). */
+} rt_kdtree_node;
+#define KD_LEAF_TAG 3u
+/* Interior nodes: b = axis | empty-child flags << 2 | above child << 4. */
+#define KD_BELOW_EMPTY 4u
+#define KD_ABOVE_EMPTY 8u
+
+/* The build's depth limit; the traversal's stack is sized for it. */
+#define KD_MAX_DEPTH 60
+
+/* The tree's leaf lists (rt_kdtree.prim_ids) are followed by this many ids
+ * with RT_KD_LAST set, so the traversal can find a list's end by loading 8
+ * ids at a time. */
+#define KD_IDS_PAD 8
+
+/* Sorts a leaf's ids ascending (insertion sort: leaves are short). Leaf
+ * lists are kept so: triangles, the lowest ids, come first, and the
+ * traversal's 8-wide leaf test takes them as one run. */
+static inline void kd_sort_ids(uint32_t *p, size_t n)
+{
+    for (size_t i = 1; i < n; i++) {
+        uint32_t x = p[i];
+        size_t j = i;
+        while (j > 0 && p[j - 1] > x) {
+            p[j] = p[j - 1];
+            j--;
+        }
+        p[j] = x;
+    }
+}
+
+/* The build's result: nodes in depth-first order, and the id lists their
+ * leaves of two or more primitives point into (ascending ids: triangles,
+ * then the scene ids of spheres and quads). */
+typedef struct rt_kd_binary {
+    rt_kdtree_node *nodes;
+    size_t node_count;
+    uint32_t *ids;
+    size_t id_count;
+} rt_kd_binary;
+
+/* Renumbers the triangles in the order the leaves first use them, rewriting
+ * the leaves' ids, and replaces tree->tri (9 floats a triangle in scene
+ * order, as the build made them) with RT_KD_TRI-float records in the new
+ * order. false: out of memory (tree->tri is then unchanged). */
+bool rt_kd_order_triangles(rt_kdtree *tree, rt_kd_binary *bin);
+
+/* Packs the binary tree into tree->wide, tree->root and tree->prim_ids.
+ * false: out of memory, or with *limit set, more wide nodes or leaf ids than
+ * a child reference can address (nothing is then allocated). */
+bool rt_kd_pack_wide(rt_kdtree *tree, const rt_kd_binary *bin, bool *limit);
+
+#endif
