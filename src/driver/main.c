@@ -27,8 +27,9 @@
 #include "commands.h"
 #include "memory_budget.h"
 
-/* The kd-tree's primitive ids are 30 bits (src/accel/kdtree.c). */
-#define MAX_PRIMITIVES (((size_t)1 << 30) - 2)
+/* The kd-tree's primitive ids are the 30 payload bits of its references
+ * (RT_KD_PAYLOAD, rt/accel/kdtree.h), one value kept free. */
+#define MAX_PRIMITIVES ((size_t)RT_KD_PAYLOAD - 1)
 /* whitted: rays a camera sample may spawn through diffuse gathering
  * (diffuse_rays ^ diffuse_bounces); more is a render that never ends. */
 #define MAX_DIFFUSE_TREE ((double)(1 << 24))

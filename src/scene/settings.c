@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "rt/base/file.h"
 #include "rt/base/number.h"
 #include "rt/scene/texture.h"
 
@@ -303,14 +304,9 @@ static rt_result store_environment(rt_scene *s, const rt_setting *def, const rt_
                                    rt_setting_problem *pb)
 {
     char path[MAX_PATH_LEN];
-    int n;
     if (v->text[0] == '\0')
         return problem(pb, RT_ERR_INVALID, 0, false, "expected a file name, got an empty string");
-    if (v->text[0] == '/' || !dir || !dir[0])
-        n = snprintf(path, sizeof path, "%s", v->text);
-    else
-        n = snprintf(path, sizeof path, "%s/%s", dir, v->text);
-    if (n < 0 || (size_t)n >= sizeof path)
+    if (!rt_path_join(dir ? dir : "", v->text, path, sizeof path))
         return problem(pb, RT_ERR_LIMIT, 0, false, "file path is too long (at most %zu characters)", sizeof path - 1);
     if (!s)
         return RT_OK;
