@@ -24,10 +24,11 @@ fi
 SAN="-fsanitize=address,undefined -fno-sanitize-recover=undefined"
 CFLAGS="-std=c11 -g -O1 -fno-omit-frame-pointer -Iinclude -Itests -D_POSIX_C_SOURCE=200809L $SAN"
 mkdir -p $B/obj
-# the library, instrumented for coverage
-for src in src/base/*.c src/io/*.c src/scene/*.c src/accel/*.c src/render/*.c; do
-    obj=$B/obj/$(basename "$src" .c).o
-    if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find include -newer "$obj" 2>/dev/null | head -n 1)" ]; then
+# the library (every stage folder but the driver), instrumented for coverage
+for src in src/*/*.c; do
+    case $src in src/driver/*) continue ;; esac
+    obj=$B/obj/$(echo "${src#src/}" | tr / _ | sed 's/\.c$/.o/')
+    if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find include src -name "*.h" -newer "$obj" 2>/dev/null | head -n 1)" ]; then
         clang $CFLAGS -fsanitize=fuzzer-no-link -c -o "$obj" "$src"
     fi
 done
