@@ -24,10 +24,10 @@
 
 #include "rt/render/bsdf.h"
 #include "rt/render/camera.h"
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 #include "rt/render/integrator.h"
 #include "rt/accel/kdtree.h"
-#include "rt/render/path.h"
+#include "rt/render/pathtrace.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
 #include "rt/io/scene_parse.h"

@@ -6,7 +6,7 @@
 #include <unistd.h>
 
 #include "rt/render/camera.h"
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"

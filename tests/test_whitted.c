@@ -8,7 +8,7 @@
 
 #include <math.h>
 
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 #include "rt/render/integrator.h"
 #include "rt/accel/kdtree.h"
 #include "rt/render/render.h"

@@ -10,7 +10,7 @@
  */
 #include "rt/render/integrator.h"
 
-#include "rt/render/path.h"
+#include "rt/render/pathtrace.h"
 #include "rt/render/whitted.h"
 
 rt_vec3 rt_direct_lambert(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 albedo, rt_rng *rng)

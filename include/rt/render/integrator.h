@@ -11,7 +11,7 @@
  *          media, shadows through glass, diffuse bounces (whitted.c,
  *          rt/whitted.h; the model is specified in docs/shading.md).
  * path     physically based path tracing of glTF materials with
- *          next-event estimation and MIS (path.c, rt/path.h,
+ *          next-event estimation and MIS (pathtrace.c, rt/render/pathtrace.h,
  *          docs/path-tracer.md).
  */
 #ifndef RT_INTEGRATOR_H

@@ -19,7 +19,7 @@
 #include <stdint.h>
 
 #include "rt/base/error.h"
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"
 #include "rt/scene/scene.h"
 

@@ -1,4 +1,4 @@
-/* rt/path.h - the `path` integrator: unidirectional path tracing of the
+/* rt/render/pathtrace.h - the `path` integrator: unidirectional path tracing of the
  * glTF material model (rt/bsdf.h) with next-event estimation, multiple
  * importance sampling and Russian roulette. docs/path-tracer.md has the
  * estimator, its validation against Mitsuba 3, and the settings.
@@ -21,8 +21,8 @@
  * expectation: emissive primitives are then found only by BSDF-sampled
  * rays and counted in full (noisier for small bright emitters).
  */
-#ifndef RT_PATH_H
-#define RT_PATH_H
+#ifndef RT_PATHTRACE_H
+#define RT_PATHTRACE_H
 
 #include "rt/base/error.h"
 #include "rt/render/sampling.h"

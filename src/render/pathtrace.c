@@ -1,4 +1,4 @@
-/* path.c - the `path` integrator: unidirectional path tracing with
+/* pathtrace.c - the `path` integrator: unidirectional path tracing with
  * next-event estimation and multiple importance sampling.
  *
  * Estimator (Kajiya 1986, "The Rendering Equation"; the structure of pbrt
@@ -37,7 +37,7 @@
  * All random numbers come from the rng handed in, so images do not depend
  * on the thread count; every contribution is checked finite.
  */
-#include "rt/render/path.h"
+#include "rt/render/pathtrace.h"
 
 #include <stdlib.h>
 #include <string.h>
