@@ -14,7 +14,7 @@
 #include "rt/accel/kdtree.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
-#include "rt/render/shade.h"
+#include "rt/render/surface.h"
 #include "rt/scene/tangents.h"
 #include "rt/scene/texture.h"
 

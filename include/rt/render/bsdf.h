@@ -41,7 +41,7 @@
 
 #include <stdbool.h>
 
-#include "rt/render/shade.h"
+#include "rt/render/surface.h"
 
 #define RT_BSDF_MIN_ALPHA 1e-3f /* GGX alpha floor: roughness 0 is a very sharp lobe, never a delta */
 

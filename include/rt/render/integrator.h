@@ -18,7 +18,7 @@
 #define RT_INTEGRATOR_H
 
 #include "rt/render/sampling.h"
-#include "rt/render/shade.h"
+#include "rt/render/surface.h"
 
 rt_vec3 rt_radiance(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng);
 rt_vec3 rt_radiance_direct(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng);

@@ -26,7 +26,7 @@
 
 #include "rt/base/error.h"
 #include "rt/render/sampling.h"
-#include "rt/render/shade.h"
+#include "rt/render/surface.h"
 
 #define RT_PATH_RR_START 3     /* Russian roulette from this many bounces on */
 #define RT_PATH_HARD_LIMIT 1024 /* bounces when max_depth is 0 (unlimited): a guard, never reached in practice */

@@ -15,7 +15,7 @@
 #define RT_WHITTED_H
 
 #include "rt/render/sampling.h"
-#include "rt/render/shade.h"
+#include "rt/render/surface.h"
 
 /* Exact Fresnel equations for a smooth dielectric interface (Born and Wolf,
  * "Principles of Optics", 1.5.2), light going from index n1 into n2 at

@@ -1,4 +1,4 @@
-/* shade.c - the surface record at a hit, material lookups, light sampling
+/* surface.c - the surface record at a hit, material lookups, light sampling
  * and shadow transmittance: the pieces every integrator shares.
  *
  * Surface points are reconstructed from the primitive (barycentrics on a
@@ -16,7 +16,7 @@
  * Area lights are sampled uniformly by area and converted to solid angle
  * (pdf = d^2 / (A cos theta_l)); spot cones use glTF's smooth falloff.
  */
-#include "rt/render/shade.h"
+#include "rt/render/surface.h"
 
 #include <string.h>
 

@@ -1,4 +1,4 @@
-/* rt/shade.h - what every integrator needs at a hit: the surface record,
+/* rt/render/surface.h - what every integrator needs at a hit: the surface record,
  * material lookups, light sampling and shadow transmittance.
  *
  * Plain functions over the scene's tables (no virtual materials or lights):
@@ -17,8 +17,8 @@
  * the same side; sf.front says whether the ray hit the side the geometric
  * normal (triangle winding, quad cross(u, v), sphere outward) points to.
  */
-#ifndef RT_SHADE_H
-#define RT_SHADE_H
+#ifndef RT_SURFACE_H
+#define RT_SURFACE_H
 
 #include <stdatomic.h>
 
