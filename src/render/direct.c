@@ -1,4 +1,5 @@
-/* integrator.c - integrator dispatch and the `direct` integrator.
+/* direct.c - the `direct` integrator: emission plus direct light at a
+ * Lambertian surface, and one ray towards the environment.
  *
  * Direct lighting at a Lambertian surface: for a point light of intensity I
  * at distance r, L = albedo / pi * I * cos(theta) / r^2; for an area light
@@ -8,10 +9,10 @@
  * one cosine-distributed ray, whose pdf cancels the cosine and the 1/pi.
  * Alpha-tested surfaces are stepped through; blended ones mixed by alpha.
  */
-#include "rt/render/integrator.h"
+#include "rt/render/direct.h"
 
-#include "rt/render/pathtrace.h"
-#include "rt/render/whitted.h"
+#include "rt/render/environment.h"
+#include "rt/render/light.h"
 
 rt_vec3 rt_direct_lambert(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 albedo, rt_rng *rng)
 {
@@ -43,13 +44,13 @@ rt_vec3 rt_direct_lambert(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3
     }
     sum = rt_scale(rt_mul(sum, albedo), RT_INV_PI);
     /* environment light: one cosine-weighted ray */
-    rt_vec3 env_probe = rt_environment(ctx, sf->n);
+    rt_vec3 env_probe = rt_environment(ctx->scene, sf->n);
     if (s->settings.environment_texture != RT_NONE || rt_max3(env_probe) > 0.0f) {
         rt_vec3 h = rt_sample_cosine_hemisphere(rt_v2(rt_rng_float(rng), rt_rng_float(rng)));
         rt_vec3 d = rt_add(rt_add(rt_scale(sf->t, h.x), rt_scale(sf->b, h.y)), rt_scale(sf->n, h.z));
         if (rt_dot(d, sf->ng) > 0.0f) {
             rt_vec3 tr = rt_shadow_transmittance(ctx, sf, d, INFINITY);
-            sum = rt_add(sum, rt_mul(rt_mul(albedo, tr), rt_environment(ctx, d)));
+            sum = rt_add(sum, rt_mul(rt_mul(albedo, tr), rt_environment(ctx->scene, d)));
         }
     }
     return sum;
@@ -62,7 +63,7 @@ rt_vec3 rt_radiance_direct(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *r
     for (int layer = 0; layer < 32; layer++) {
         rt_hit hit;
         if (!rt_trace(ctx, &r, &hit))
-            return rt_add(result, rt_mul(weight, rt_environment(ctx, r.dir)));
+            return rt_add(result, rt_mul(weight, rt_environment(ctx->scene, r.dir)));
         rt_surface sf;
         rt_surface_at(ctx, &r, &hit, &sf);
         float coverage;
@@ -80,17 +81,4 @@ rt_vec3 rt_radiance_direct(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *r
         r.tmin = hit.t;
     }
     return result;
-}
-
-rt_vec3 rt_radiance(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng)
-{
-    switch (ctx->scene->settings.integrator) {
-    case RT_INTEGRATOR_WHITTED:
-        return rt_radiance_whitted(ctx, ray, rng);
-    case RT_INTEGRATOR_PATH:
-        return rt_radiance_path(ctx, ray, rng);
-    case RT_INTEGRATOR_DIRECT:
-    default:
-        return rt_radiance_direct(ctx, ray, rng);
-    }
 }

@@ -18,7 +18,7 @@
 
 #include "rt/render/camera.h"
 #include "rt/render/integrator.h"
-#include "rt/render/pathtrace.h"
+#include "rt/render/light.h"
 #include "rt/render/sampling.h"
 
 int rt_cpu_count(void)

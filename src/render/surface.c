@@ -1,5 +1,6 @@
-/* surface.c - the surface record at a hit, material lookups, light sampling
- * and shadow transmittance: the pieces every integrator shares.
+/* surface.c - the surface record at a hit and the material lookups on it:
+ * point, normals, tangent frame, UVs and vertex colour, normal mapping,
+ * base colour, emission, alpha cut-outs, and where secondary rays start.
  *
  * Surface points are reconstructed from the primitive (barycentrics on a
  * triangle, projection onto a sphere, (s, t) on a quad) rather than from
@@ -12,84 +13,11 @@
  * (green) is "up" in the image. Without vertex tangents the frame comes
  * from the UV derivatives of the primitive (dP/du), with w recording a
  * mirrored UV layout.
- *
- * Area lights are sampled uniformly by area and converted to solid angle
- * (pdf = d^2 / (A cos theta_l)); spot cones use glTF's smooth falloff.
  */
 #include "rt/render/surface.h"
 
-#include <string.h>
-
+#include "rt/render/environment.h"
 #include "rt/scene/texture.h"
-
-/* The whitted integrator's ambient radiance: the scene's ambient_light when
- * given, else the mean radiance of the environment over the sphere (for an
- * image, a 64 x 32 grid of lookups at cell centres weighted by sin(theta),
- * the solid angle of each latitude band). */
-static rt_vec3 ambient_radiance(const rt_scene *scene)
-{
-    const rt_settings *st = &scene->settings;
-    if (st->ambient_light_set)
-        return st->ambient_light;
-    if (st->environment_texture == RT_NONE)
-        return rt_scale(st->background, st->environment_strength);
-    enum { NU = 64, NV = 32 };
-    double sum[3] = {0, 0, 0}, wsum = 0;
-    for (int j = 0; j < NV; j++) {
-        float v = ((float)j + 0.5f) / (float)NV;
-        float w = sinf(v * RT_PI);
-        for (int i = 0; i < NU; i++) {
-            float u = ((float)i + 0.5f) / (float)NU;
-            rt_vec4 c = rt_texture_sample(scene, st->environment_texture, rt_v2(u, v), false);
-            if (!(isfinite(c.x) && isfinite(c.y) && isfinite(c.z)))
-                continue;
-            sum[0] += (double)(w * c.x);
-            sum[1] += (double)(w * c.y);
-            sum[2] += (double)(w * c.z);
-            wsum += (double)w;
-        }
-    }
-    if (!(wsum > 0.0))
-        return rt_v3s(0);
-    rt_vec3 mean = rt_v3((float)(sum[0] / wsum), (float)(sum[1] / wsum), (float)(sum[2] / wsum));
-    return rt_scale(mean, st->environment_strength);
-}
-
-void rt_trace_ctx_init(rt_trace_ctx *ctx, const rt_scene *scene, const rt_kdtree *tree)
-{
-    memset(ctx, 0, sizeof *ctx);
-    ctx->scene = scene;
-    ctx->tree = tree;
-    rt_box b = tree ? tree->bounds : rt_scene_bounds(scene);
-    float scale = 0.0f;
-    if (!rt_box_is_empty(b)) {
-        scale = fmaxf(rt_max3(rt_vmax(rt_v3(fabsf(b.lo.x), fabsf(b.lo.y), fabsf(b.lo.z)),
-                                      rt_v3(fabsf(b.hi.x), fabsf(b.hi.y), fabsf(b.hi.z)))), 0.0f);
-    }
-    ctx->scale = (isfinite(scale) && scale > 1e-30f) ? scale : 1.0f;
-    for (size_t i = 0; i < scene->material_count; i++) {
-        const rt_material *m = &scene->materials[i];
-        if (m->transmission > 0.0f || m->alpha_mode != RT_ALPHA_OPAQUE)
-            ctx->shadows_need_shading = true;
-    }
-    ctx->ambient = ambient_radiance(scene);
-}
-
-bool rt_trace(const rt_trace_ctx *ctx, const rt_ray *ray, rt_hit *hit)
-{
-    if (ctx->ray_count)
-        (*ctx->ray_count)++;
-    return rt_kdtree_intersect(ctx->tree, ray, hit);
-}
-
-/* Longitude/latitude mapping used for spheres and the environment:
- * u = 0.5 + atan2(x, z) / 2pi, v = acos(y) / pi (v = 0 at the north pole). */
-static inline rt_vec2 direction_to_latlong(rt_vec3 d)
-{
-    float u = 0.5f + atan2f(d.x, d.z) * (0.5f * RT_INV_PI);
-    float v = acosf(rt_clampf(d.y, -1.0f, 1.0f)) * RT_INV_PI;
-    return rt_v2(u, v);
-}
 
 /* Tangent from UV derivatives: t = dP/du, and the handedness sign w such
  * that cross(n, t) * w points along -dP/dv (towards the top of the image). */
@@ -214,7 +142,7 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
         sf->p = rt_madd(c, d, fabsf(r));
         ng = r < 0.0f ? rt_neg(d) : d;
         n = ng;
-        sf->uv0 = sf->uv1 = direction_to_latlong(d);
+        sf->uv0 = sf->uv1 = rt_latlong_from_dir(d);
         t = rt_v3(d.z, 0.0f, -d.x); /* dP/du; zero at the poles, fixed by orthonormal_tangent */
         sf->material = sp->material[i];
         break;
@@ -328,137 +256,4 @@ rt_vec3 rt_surface_spawn(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 
     rt_vec3 o = rt_offset_ray_origin(sf->p, side, ctx->scale);
     float extra = ctx->scene->settings.ray_offset;
     return extra > 0.0f ? rt_madd(o, side, extra) : o;
-}
-
-bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, rt_vec2 u, rt_light_sample *ls)
-{
-    (void)ctx;
-    rt_vec3 power = rt_scale(l->color, l->intensity);
-    switch (l->kind) {
-    case RT_LIGHT_POINT:
-    case RT_LIGHT_SPOT: {
-        rt_vec3 d = rt_sub(l->position, p);
-        float d2 = rt_length2(d);
-        if (!(d2 > 0.0f))
-            return false;
-        float dist = sqrtf(d2);
-        ls->wi = rt_scale(d, 1.0f / dist);
-        ls->dist = dist;
-        float atten = 1.0f / d2;
-        if (l->kind == RT_LIGHT_SPOT) {
-            float cd = rt_dot(rt_normalize(l->direction), rt_neg(ls->wi));
-            float co = cosf(l->outer_cone), ci = cosf(l->inner_cone);
-            float x = ci > co ? rt_clampf((cd - co) / (ci - co), 0.0f, 1.0f) : (cd >= co ? 1.0f : 0.0f);
-            atten *= x * x;
-        }
-        if (l->range > 0.0f) { /* glTF's recommended smooth window */
-            float r = dist / l->range, r4 = r * r * r * r;
-            float win = rt_clampf(1.0f - r4, 0.0f, 1.0f);
-            atten *= win * win;
-        }
-        if (!(atten > 0.0f))
-            return false;
-        ls->li = rt_scale(power, atten);
-        return true;
-    }
-    case RT_LIGHT_DIRECTIONAL:
-        ls->wi = rt_neg(rt_normalize(l->direction));
-        ls->dist = INFINITY;
-        ls->li = power;
-        return rt_length2(ls->wi) > 0.0f;
-    case RT_LIGHT_AREA:
-    default: {
-        rt_vec3 nl = rt_cross(l->edge_u, l->edge_v);
-        float area = rt_length(nl);
-        if (!(area > 0.0f))
-            return false;
-        nl = rt_scale(nl, 1.0f / area);
-        rt_vec3 q = rt_add(l->position, rt_add(rt_scale(l->edge_u, u.x), rt_scale(l->edge_v, u.y)));
-        rt_vec3 d = rt_sub(q, p);
-        float d2 = rt_length2(d);
-        if (!(d2 > 0.0f))
-            return false;
-        float dist = sqrtf(d2);
-        ls->wi = rt_scale(d, 1.0f / dist);
-        ls->dist = dist;
-        float cos_l = -rt_dot(nl, ls->wi);
-        if (!(cos_l > 0.0f))
-            return false; /* behind the one-sided emitter */
-        ls->li = rt_scale(power, area * cos_l / d2);
-        return true;
-    }
-    }
-}
-
-/* The material of a primitive, as rt_surface_at() resolves it. */
-static uint32_t prim_material(const rt_scene *s, uint32_t prim)
-{
-    uint32_t i, m;
-    switch (rt_prim_kind_of(s, prim, &i)) {
-    case RT_PRIM_TRIANGLE: m = s->triangles.material[i]; break;
-    case RT_PRIM_SPHERE: m = s->spheres.material[i]; break;
-    case RT_PRIM_QUAD:
-    default: m = s->quads.material[i]; break;
-    }
-    return m < s->material_count ? m : 0;
-}
-
-rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
-{
-    rt_vec3 o = rt_surface_spawn(ctx, sf, wi);
-    /* stop just short of the light's own surface (area lights are geometry
-     * too), measured from the offset origin: the offset moves it towards
-     * the light by up to ~1e-5 of the scene's scale, more than 1e-4 of a
-     * short distance in a small scene */
-    float tmax = INFINITY;
-    if (isfinite(dist))
-        tmax = rt_dot(rt_sub(rt_madd(sf->p, wi, dist), o), wi) * (1.0f - 1e-4f);
-    rt_ray r = rt_ray_make(o, wi, 0.0f, tmax);
-    if (ctx->ray_count)
-        (*ctx->ray_count)++;
-    if (!ctx->shadows_need_shading)
-        return rt_kdtree_occluded(ctx->tree, &r) ? rt_v3s(0) : rt_v3s(1);
-    /* walk the hits along the ray, letting light through glass and cut-outs */
-    rt_vec3 tr = rt_v3s(1);
-    for (int layer = 0; layer < 64; layer++) {
-        rt_hit h;
-        if (!rt_kdtree_intersect(ctx->tree, &r, &h))
-            return tr;
-        const rt_material *m = &ctx->scene->materials[prim_material(ctx->scene, h.prim)];
-        if (m->alpha_mode == RT_ALPHA_OPAQUE) { /* no surface record needed */
-            if (!(m->transmission > 0.0f))
-                return rt_v3s(0);
-            tr = rt_mul(tr, rt_scale(m->transmission_color, m->transmission));
-            if (rt_max3(tr) <= 0.0f)
-                return rt_v3s(0);
-            r.tmin = h.t;
-            continue;
-        }
-        rt_surface s2;
-        rt_surface_at(ctx, &r, &h, &s2);
-        float coverage;
-        if (!rt_surface_cut_away(ctx, &s2, &coverage)) {
-            if (m->transmission > 0.0f) {
-                tr = rt_mul(tr, rt_scale(m->transmission_color, m->transmission));
-            } else if (coverage < 1.0f) {
-                tr = rt_scale(tr, 1.0f - coverage);
-            } else {
-                return rt_v3s(0);
-            }
-        }
-        if (rt_max3(tr) <= 0.0f)
-            return rt_v3s(0);
-        r.tmin = h.t; /* continue past this surface */
-    }
-    return rt_v3s(0);
-}
-
-rt_vec3 rt_environment(const rt_trace_ctx *ctx, rt_vec3 d)
-{
-    const rt_settings *st = &ctx->scene->settings;
-    if (st->environment_texture != RT_NONE) {
-        rt_vec4 c = rt_texture_sample(ctx->scene, st->environment_texture, direction_to_latlong(rt_normalize(d)), false);
-        return rt_scale(rt_v3(c.x, c.y, c.z), st->environment_strength);
-    }
-    return rt_scale(st->background, st->environment_strength);
 }

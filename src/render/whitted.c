@@ -36,7 +36,8 @@
 
 #include <string.h>
 
-#include "rt/render/integrator.h"
+#include "rt/render/environment.h"
+#include "rt/render/light.h"
 
 #define MIN_WEIGHT (1.0f / 1024.0f)
 #define MAX_NESTING 1024 /* recursion guard: max_bounce <= 256 plus index-matched crossings */
@@ -138,18 +139,6 @@ typedef struct wctx {
 static rt_vec3 trace(wctx *w, rt_ray r, const rt_medium_stack *med, int depth, int level, float weight,
                      bool diffuse_ray);
 
-/* True when quad primitive `prim` is the visible emitter of a sampled area light. */
-static bool is_light_quad(const rt_scene *s, uint32_t prim)
-{
-    uint32_t q;
-    if (rt_prim_kind_of(s, prim, &q) != RT_PRIM_QUAD)
-        return false;
-    for (size_t i = 0; i < s->light_count; i++)
-        if (s->lights[i].kind == RT_LIGHT_AREA && s->lights[i].quad == q)
-            return true;
-    return false;
-}
-
 /* Sum over lights of E * (n.l) into *D and E * (r.v)^shininess into *S. */
 static void direct_phong(wctx *w, const rt_surface *sf, int area_samples, float shininess, bool want_spec,
                          rt_vec3 *D, rt_vec3 *S)
@@ -231,7 +220,7 @@ static rt_vec3 shade(wctx *w, const rt_surface *sf, const rt_medium_stack *med, 
      * light is already counted by direct sampling (and a mirror or glass
      * chain to it would be a caustic, which this model leaves out) */
     rt_vec3 L = rt_surface_emission(ctx, sf);
-    if (diffuse_ray && rt_max3(L) > 0.0f && is_light_quad(s, sf->prim))
+    if (diffuse_ray && rt_max3(L) > 0.0f && rt_area_light_of_prim(s, NULL, sf->prim) != RT_NONE)
         L = rt_v3s(0);
     if (m->unlit)
         return rt_add(L, base);
@@ -335,7 +324,7 @@ static rt_vec3 trace(wctx *w, rt_ray r, const rt_medium_stack *med, int depth, i
     for (int layer = 0; layer < 32; layer++) {
         rt_hit hit;
         if (!rt_trace(ctx, &r, &hit)) {
-            result = rt_add(result, rt_scale(rt_environment(ctx, r.dir), cov_weight));
+            result = rt_add(result, rt_scale(rt_environment(ctx->scene, r.dir), cov_weight));
             break;
         }
         rt_surface sf;

@@ -24,36 +24,11 @@
 #ifndef RT_PATHTRACE_H
 #define RT_PATHTRACE_H
 
-#include "rt/base/error.h"
+#include "rt/render/light.h"
 #include "rt/render/sampling.h"
-#include "rt/render/surface.h"
 
 #define RT_PATH_RR_START 3     /* Russian roulette from this many bounces on */
 #define RT_PATH_HARD_LIMIT 1024 /* bounces when max_depth is 0 (unlimited): a guard, never reached in practice */
-
-typedef struct rt_light_table {
-    size_t count;         /* emissive primitives (area lights' own quads excluded) */
-    uint32_t *prim;       /* their primitive ids */
-    float *cdf;           /* cumulative selection probability, cdf[count - 1] == 1 */
-    float *area;          /* their areas */
-    size_t prim_count;    /* primitive ids covered by prim_pdf */
-    float *prim_pdf;      /* per primitive id: selection probability / area (0 = not in the table) */
-    size_t quad_count;
-    uint32_t *quad_light; /* per quad: index of the area light it is the visible quad of, or RT_NONE */
-    /* environment image, importance-sampled by luminance x sin(theta) over
-     * an env_w x env_h grid of its latitude-longitude cells (0 = none) */
-    int env_w, env_h;
-    float *env_row_cdf;   /* env_h: cumulative probability of the rows */
-    float *env_col_cdf;   /* env_h x env_w: cumulative probability within each row */
-    float *env_cell;      /* env_h x env_w: probability of each cell */
-} rt_light_table;
-
-/* Solid-angle pdf with which the table samples the environment towards
- * unit direction d (0 without an environment image). */
-float rt_light_table_env_pdf(const rt_light_table *t, rt_vec3 d);
-
-rt_result rt_light_table_build(rt_light_table *t, const rt_scene *s, rt_error *err);
-void rt_light_table_free(rt_light_table *t);
 
 rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng);
 
