@@ -60,25 +60,22 @@ rt_vec3 rt_radiance_direct(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *r
 {
     rt_ray r = *ray;
     rt_vec3 result = rt_v3s(0), weight = rt_v3s(1);
-    for (int layer = 0; layer < 32; layer++) {
-        rt_hit hit;
-        if (!rt_trace(ctx, &r, &hit))
-            return rt_add(result, rt_mul(weight, rt_environment(ctx->scene, r.dir)));
+    int layers = 32;
+    for (;;) {
         rt_surface sf;
-        rt_surface_at(ctx, &r, &hit, &sf);
         float coverage;
-        if (rt_surface_cut_away(ctx, &sf, &coverage)) {
-            r.tmin = hit.t;
-            continue;
-        }
+        rt_surface_walk found = rt_trace_surface(ctx, &r, &layers, NULL, &sf, &coverage);
+        if (found == RT_WALK_MISS)
+            return rt_add(result, rt_mul(weight, rt_environment(ctx->scene, r.dir)));
+        if (found == RT_WALK_TOO_DEEP)
+            break;
         rt_vec4 base = rt_surface_base_color(ctx, &sf);
         rt_vec3 L = rt_surface_emission(ctx, &sf);
         L = rt_add(L, rt_direct_lambert(ctx, &sf, rt_v3(base.x, base.y, base.z), rng));
         result = rt_add(result, rt_mul(weight, rt_scale(L, coverage)));
         if (coverage >= 1.0f)
-            return result;
-        weight = rt_scale(weight, 1.0f - coverage);
-        r.tmin = hit.t;
+            break;
+        weight = rt_scale(weight, 1.0f - coverage); /* and on to what lies behind */
     }
     return result;
 }

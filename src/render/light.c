@@ -80,20 +80,11 @@ bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, r
     }
 }
 
-/* The material of a primitive, as rt_surface_at() resolves it. */
-static uint32_t prim_material(const rt_scene *s, uint32_t prim)
-{
-    uint32_t i, m;
-    switch (rt_prim_kind_of(s, prim, &i)) {
-    case RT_PRIM_TRIANGLE: m = s->triangles.material[i]; break;
-    case RT_PRIM_SPHERE: m = s->spheres.material[i]; break;
-    case RT_PRIM_QUAD:
-    default: m = s->quads.material[i]; break;
-    }
-    return m < s->material_count ? m : 0;
-}
-
-rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
+/* Light arriving along a shadow ray from sf->p towards wi, stopping just
+ * short of distance dist: walks the hits, passing alpha cut-outs, scaling
+ * by 1 - alpha through blended surfaces and, when glass_passes, by the
+ * transmission colour through transmissive ones (otherwise they block). */
+static rt_vec3 shadow_walk(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist, bool glass_passes)
 {
     rt_vec3 o = rt_surface_spawn(ctx, sf, wi);
     /* stop just short of the light's own surface (area lights are geometry
@@ -108,15 +99,18 @@ rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, r
         (*ctx->ray_count)++;
     if (!ctx->shadows_need_shading)
         return rt_kdtree_occluded(ctx->tree, &r) ? rt_v3s(0) : rt_v3s(1);
-    /* walk the hits along the ray, letting light through glass and cut-outs */
+    const rt_scene *s = ctx->scene;
     rt_vec3 tr = rt_v3s(1);
     for (int layer = 0; layer < 64; layer++) {
         rt_hit h;
         if (!rt_kdtree_intersect(ctx->tree, &r, &h))
             return tr;
-        const rt_material *m = &ctx->scene->materials[prim_material(ctx->scene, h.prim)];
+        uint32_t mi = rt_prim_material(s, h.prim);
+        RT_DCHECK(mi < s->material_count);
+        const rt_material *m = &s->materials[mi];
+        bool transmits = m->transmission > 0.0f;
         if (m->alpha_mode == RT_ALPHA_OPAQUE) { /* no surface record needed */
-            if (!(m->transmission > 0.0f))
+            if (!transmits || !glass_passes)
                 return rt_v3s(0);
             tr = rt_mul(tr, rt_scale(m->transmission_color, m->transmission));
             if (rt_max3(tr) <= 0.0f)
@@ -128,9 +122,9 @@ rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, r
         rt_surface_at(ctx, &r, &h, &s2);
         float coverage;
         if (!rt_surface_cut_away(ctx, &s2, &coverage)) {
-            if (m->transmission > 0.0f) {
+            if (transmits && glass_passes) {
                 tr = rt_mul(tr, rt_scale(m->transmission_color, m->transmission));
-            } else if (coverage < 1.0f) {
+            } else if (!transmits && coverage < 1.0f) {
                 tr = rt_scale(tr, 1.0f - coverage);
             } else {
                 return rt_v3s(0);
@@ -141,6 +135,16 @@ rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, r
         r.tmin = h.t; /* continue past this surface */
     }
     return rt_v3s(0);
+}
+
+rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
+{
+    return shadow_walk(ctx, sf, wi, dist, true);
+}
+
+float rt_shadow_visibility(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
+{
+    return shadow_walk(ctx, sf, wi, dist, false).x;
 }
 
 /* ------------------------------------------------------------ light table */

@@ -10,12 +10,11 @@
  *   - next-event estimation: every rt_light is sampled once (area lights
  *     uniformly by area, pdf d^2 / (A cos theta_l); point, spot and
  *     directional lights are deltas, weight 1), and, with a light table
- *     (rt/render/light.h),
- *     one emissive primitive chosen in proportion to its power (area x mean
- *     emitted radiance) and a uniform point on it, and one direction of the
- *     environment image drawn in proportion to luminance x sin(theta)
- *     (piecewise constant over its latitude-longitude cells, pbrt-v3
- *     14.2.4);
+ *     (rt/render/light.h), one emissive primitive chosen in proportion to
+ *     its power (area x mean emitted radiance) and a uniform point on it,
+ *     and one direction of the environment image drawn in proportion to
+ *     luminance x sin(theta) (piecewise constant over its
+ *     latitude-longitude cells, pbrt-v3 14.2.4);
  *   - the BSDF (rt/bsdf.h) samples the next direction, beta *= f cos / pdf.
  * Light and BSDF samples are combined with the power heuristic (Veach 1997,
  * "Robust Monte Carlo Methods for Light Transport Simulation", ch. 9,
@@ -43,44 +42,6 @@
 #include "rt/render/bsdf.h"
 #include "rt/render/environment.h"
 
-/* Fraction of light that reaches sf->p from distance dist along wi:
- * 0 behind opaque or refractive surfaces, through alpha cut-outs, scaled by
- * 1 - alpha through blended surfaces. */
-static float visibility(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
-{
-    rt_vec3 o = rt_surface_spawn(ctx, sf, wi);
-    /* stop just short of the emitter, measured from the offset origin */
-    float tmax = isfinite(dist) ? rt_dot(rt_sub(rt_madd(sf->p, wi, dist), o), wi) * (1.0f - 1e-4f) : INFINITY;
-    rt_ray r = rt_ray_make(o, wi, 0.0f, tmax);
-    if (ctx->ray_count)
-        (*ctx->ray_count)++;
-    if (!ctx->shadows_need_shading)
-        return rt_kdtree_occluded(ctx->tree, &r) ? 0.0f : 1.0f;
-    const rt_scene *s = ctx->scene;
-    float v = 1.0f;
-    for (int layer = 0; layer < 64; layer++) {
-        rt_hit h;
-        if (!rt_kdtree_intersect(ctx->tree, &r, &h))
-            return v;
-        uint32_t mi = rt_prim_material(s, h.prim);
-        const rt_material *m = mi < s->material_count ? &s->materials[mi] : NULL;
-        if (!m || (m->alpha_mode == RT_ALPHA_OPAQUE))
-            return 0.0f;
-        rt_surface s2;
-        rt_surface_at(ctx, &r, &h, &s2);
-        float coverage;
-        if (!rt_surface_cut_away(ctx, &s2, &coverage)) {
-            if (m->transmission > 0.0f || coverage >= 1.0f)
-                return 0.0f;
-            v *= 1.0f - coverage;
-        }
-        if (!(v > 0.0f))
-            return 0.0f;
-        r.tmin = h.t;
-    }
-    return 0.0f;
-}
-
 static inline rt_vec3 add_finite(rt_vec3 acc, rt_vec3 c)
 {
     return rt_finite3(c) ? rt_add(acc, rt_vmax(c, rt_v3s(0.0f))) : acc;
@@ -100,7 +61,7 @@ static rt_vec3 light_table_term(const rt_trace_ctx *ctx, const rt_surface *sf, c
     float w = rt_mis_power(pdf_l, pdf_b);
     if (!(rt_max3(f) > 0.0f && w > 0.0f))
         return rt_v3s(0.0f);
-    float vis = visibility(ctx, sf, d, dist);
+    float vis = rt_shadow_visibility(ctx, sf, d, dist);
     if (!(vis > 0.0f))
         return rt_v3s(0.0f);
     return rt_scale(rt_mul(f, Le ? *Le : rt_environment(ctx->scene, d)), wi.z * vis * w / pdf_l);
@@ -131,7 +92,7 @@ static rt_vec3 next_event(const rt_trace_ctx *ctx, const rt_surface *sf, const r
             w = rt_mis_power(rt_area_light_pdf(l, ls.wi, ls.dist), pdf_b);
         if (!(w > 0.0f))
             continue;
-        float vis = visibility(ctx, sf, ls.wi, ls.dist);
+        float vis = rt_shadow_visibility(ctx, sf, ls.wi, ls.dist);
         if (!(vis > 0.0f))
             continue;
         sum = add_finite(sum, rt_scale(rt_mul(f, ls.li), wi.z * vis * w));
@@ -219,29 +180,20 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
     bool prev_delta = true;     /* the camera "samples" its ray: no MIS */
     float prev_pdf = 0.0f;      /* BSDF pdf of the ray just traced */
     rt_vec3 prev_p = r.org;
-    int bounces = 0, layers = 0;
+    int bounces = 0;
     for (;;) {
-        rt_hit hit;
-        if (!rt_trace(ctx, &r, &hit)) {
+        int layers = 257; /* up to 256 cut-away surfaces per path segment */
+        rt_surface sf;
+        float coverage;
+        rt_surface_walk found = rt_trace_surface(ctx, &r, &layers, rng, &sf, &coverage);
+        if (found == RT_WALK_MISS) {
             float w = 1.0f; /* MIS against environment sampling, when the table does it */
             if (!prev_delta && ctx->light_table && ctx->light_table->env_w > 0)
                 w = rt_mis_power(prev_pdf, rt_light_table_env_pdf(ctx->light_table, r.dir));
             L = add_finite(L, rt_scale(rt_mul(beta, rt_environment(s, r.dir)), w));
+        }
+        if (found != RT_WALK_SURFACE)
             break;
-        }
-        rt_surface sf;
-        rt_surface_at(ctx, &r, &hit, &sf);
-        float coverage;
-        bool cut = rt_surface_cut_away(ctx, &sf, &coverage);
-        if (!cut && coverage < 1.0f && rt_rng_float(rng) >= coverage)
-            cut = true; /* stochastic alpha blending */
-        if (cut) {
-            if (++layers > 256)
-                break;
-            r.tmin = hit.t;
-            continue;
-        }
-        layers = 0;
         /* emission, MIS-weighted when it could have been light-sampled */
         rt_vec3 Le = rt_surface_emission(ctx, &sf);
         const rt_material *m = s->material_count ? &s->materials[sf.material] : NULL;

@@ -257,3 +257,21 @@ rt_vec3 rt_surface_spawn(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 
     float extra = ctx->scene->settings.ray_offset;
     return extra > 0.0f ? rt_madd(o, side, extra) : o;
 }
+rt_surface_walk rt_trace_surface(const rt_trace_ctx *ctx, rt_ray *r, int *layers_left, rt_rng *blend_rng,
+                                 rt_surface *sf, float *coverage)
+{
+    while (*layers_left > 0) {
+        (*layers_left)--;
+        rt_hit hit;
+        if (!rt_trace(ctx, r, &hit))
+            return RT_WALK_MISS;
+        rt_surface_at(ctx, r, &hit, sf);
+        bool cut = rt_surface_cut_away(ctx, sf, coverage);
+        if (!cut && blend_rng && *coverage < 1.0f && rt_rng_float(blend_rng) >= *coverage)
+            cut = true; /* stochastic alpha blending */
+        r->tmin = hit.t;
+        if (!cut)
+            return RT_WALK_SURFACE;
+    }
+    return RT_WALK_TOO_DEEP;
+}

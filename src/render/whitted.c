@@ -321,25 +321,20 @@ static rt_vec3 trace(wctx *w, rt_ray r, const rt_medium_stack *med, int depth, i
     if (w->nesting >= MAX_NESTING)
         return result;
     w->nesting++;
-    for (int layer = 0; layer < 32; layer++) {
-        rt_hit hit;
-        if (!rt_trace(ctx, &r, &hit)) {
-            result = rt_add(result, rt_scale(rt_environment(ctx->scene, r.dir), cov_weight));
-            break;
-        }
+    int layers = 32;
+    for (;;) {
         rt_surface sf;
-        rt_surface_at(ctx, &r, &hit, &sf);
         float coverage;
-        if (rt_surface_cut_away(ctx, &sf, &coverage)) {
-            r.tmin = hit.t;
-            continue;
-        }
+        rt_surface_walk found = rt_trace_surface(ctx, &r, &layers, NULL, &sf, &coverage);
+        if (found == RT_WALK_MISS)
+            result = rt_add(result, rt_scale(rt_environment(ctx->scene, r.dir), cov_weight));
+        if (found != RT_WALK_SURFACE)
+            break;
         rt_vec3 L = shade(w, &sf, med, depth, level, weight * cov_weight * coverage, diffuse_ray);
         result = rt_add(result, rt_scale(L, cov_weight * coverage));
         if (coverage >= 1.0f)
             break;
-        cov_weight *= 1.0f - coverage;
-        r.tmin = hit.t;
+        cov_weight *= 1.0f - coverage; /* and on to what lies behind */
     }
     w->nesting--;
     /* never hand back a non-finite or negative value */

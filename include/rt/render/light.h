@@ -49,6 +49,10 @@ float rt_area_light_pdf(const rt_light *l, rt_vec3 d, float dist);
  * 1 when clear, and in between through transmissive or alpha-blended
  * surfaces (coloured by their transmission colour). */
 rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist);
+/* The same for the path tracer, where light through glass arrives by BSDF
+ * sampling: transmissive surfaces block; alpha cut-outs pass, and blended
+ * surfaces let 1 - alpha through. */
+float rt_shadow_visibility(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist);
 
 /* ------------------------------------------------------------ light table */
 

@@ -5,6 +5,10 @@
  *
  *   rt_surface sf;
  *   rt_surface_at(&ctx, &ray, &hit, &sf);          // point, normals, uv, material
+ *   // or: the first surface along a ray that its alpha does not cut away
+ *   int layers = 32;
+ *   float coverage;
+ *   if (rt_trace_surface(&ctx, &ray, &layers, NULL, &sf, &coverage) == RT_WALK_SURFACE) ...
  *   rt_vec4 base = rt_surface_base_color(&ctx, &sf);
  *   rt_vec3 Le = rt_surface_emission(&ctx, &sf);
  *   rt_ray next = rt_ray_make(rt_surface_spawn(&ctx, &sf, d), d, 0.0f, INFINITY);
@@ -18,6 +22,7 @@
 #define RT_SURFACE_H
 
 #include "rt/render/render_state.h"
+#include "rt/render/sampling.h"
 
 typedef struct rt_surface {
     rt_vec3 p;            /* hit point */
@@ -56,5 +61,22 @@ rt_vec3 rt_surface_emission(const rt_trace_ctx *ctx, const rt_surface *sf);
 bool rt_surface_cut_away(const rt_trace_ctx *ctx, const rt_surface *sf, float *coverage);
 /* Point to start a secondary ray from, on the side of direction d. */
 rt_vec3 rt_surface_spawn(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 d);
+
+/* What rt_trace_surface found along a ray. */
+typedef enum rt_surface_walk {
+    RT_WALK_SURFACE = 0, /* a surface the alpha keeps */
+    RT_WALK_MISS,        /* the ray left the scene (the environment is seen along r->dir) */
+    RT_WALK_TOO_DEEP,    /* every layer the budget allowed was cut away */
+} rt_surface_walk;
+
+/* The alpha cut-out walk every integrator uses for camera and bounce rays:
+ * traces *r and steps past surfaces that rt_surface_cut_away removes
+ * (MASK below the cutoff, BLEND at alpha 0) until one is kept; with
+ * blend_rng, also steps past a BLEND surface with probability 1 - alpha
+ * (stochastic blending). Each trace spends one of *layers_left. For a kept
+ * surface, *sf is its record, *coverage its blend alpha (1 when opaque)
+ * and r->tmin its distance, so tracing r again continues behind it. */
+rt_surface_walk rt_trace_surface(const rt_trace_ctx *ctx, rt_ray *r, int *layers_left, rt_rng *blend_rng,
+                                 rt_surface *sf, float *coverage);
 
 #endif
