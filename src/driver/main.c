@@ -31,6 +31,7 @@
 #include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"
 #include "rt/io/mesh_io.h"
+#include "rt/render/integrator.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
 #include "rt/io/scene_parse.h"
@@ -201,8 +202,9 @@ static void report(const rt_error *err, const memory_budget *budget)
 
 static void usage(FILE *f)
 {
-    char default_budget_text[32];
+    char default_budget_text[32], integrators[256];
     format_size(default_memory_budget(), default_budget_text, sizeof default_budget_text);
+    rt_integrator_list(integrators, sizeof integrators, ", ", " or ");
     fprintf(f,
             "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off]\n"
             "\n"
@@ -216,7 +218,7 @@ static void usage(FILE *f)
             "  -r WxH             resolution, e.g. -r 1280x720 (overrides the scene)\n"
             "  -q                 quiet: no progress bar, no warnings\n"
             "  -v                 verbose: scene statistics, kd-tree build, render time, rays per second\n"
-            "  --integrator NAME  direct, whitted or path (overrides the scene)\n"
+            "  --integrator NAME  %s (overrides the scene)\n"
             "  --camera N         use camera N of the loaded glTF models\n"
             "  --seed N           random seed (default: the scene's, else 0)\n"
             "  --tile N           tile size in pixels (default 32)\n"
@@ -229,7 +231,7 @@ static void usage(FILE *f)
             "\n"
             "Scene format: docs/scene-format.md; limits and exit codes: docs/robustness.md.\n"
             "Exit status: 0 ok, 2 bad input (or over a limit), 130 interrupted.\n",
-            rt_cpu_count(), default_budget_text);
+            rt_cpu_count(), integrators, default_budget_text);
 }
 
 static int fail_usage(const char *fmt, const char *arg)
@@ -512,8 +514,13 @@ int main(int argc, char **argv)
             level = RT_LOG_VERBOSE;
         } else if (strcmp(a, "--integrator") == 0) {
             NEED_ARG();
-            if (strcmp(next, "direct") && strcmp(next, "whitted") && strcmp(next, "path"))
-                return fail_usage("--integrator wants direct, whitted or path, got '%s'", next);
+            rt_integrator id;
+            if (!rt_integrator_by_name(next, &id)) {
+                char names[256], msg[512];
+                rt_integrator_list(names, sizeof names, ", ", " or ");
+                snprintf(msg, sizeof msg, "--integrator wants %s, got '%s'", names, next);
+                return fail_usage("%s", msg);
+            }
             integrator = next;
         } else if (strcmp(a, "--camera") == 0) {
             NEED_ARG();
@@ -577,9 +584,7 @@ int main(int argc, char **argv)
     if (width) set->width = (int)width, set->height = (int)height;
     if (seed >= 0) set->seed = (uint32_t)seed;
     if (integrator)
-        set->integrator = strcmp(integrator, "whitted") == 0 ? RT_INTEGRATOR_WHITTED
-                          : strcmp(integrator, "path") == 0  ? RT_INTEGRATOR_PATH
-                                                             : RT_INTEGRATOR_DIRECT;
+        rt_integrator_by_name(integrator, &set->integrator);
     if (camera >= 0) {
         if ((size_t)camera >= scene.camera_count) {
             fprintf(stderr, "rt: --camera %ld: the loaded models have %zu camera%s\n", camera, scene.camera_count,
@@ -621,9 +626,7 @@ int main(int argc, char **argv)
     rt_info("  materials %zu, textures %zu, images %zu, lights %zu", scene.material_count, scene.texture_count,
             scene.image_count, scene.light_count);
     rt_info("  %dx%d, %d samples per pixel, integrator %s", set->width, set->height, set->samples,
-            set->integrator == RT_INTEGRATOR_WHITTED ? "whitted"
-            : set->integrator == RT_INTEGRATOR_PATH  ? "path"
-                                                     : "direct");
+            rt_integrator_name(set->integrator));
 
     rt_kdtree tree;
     if (rt_kdtree_build(&tree, &scene, NULL, &err) != RT_OK) {

@@ -35,6 +35,7 @@
 
 #include "rt/io/gltf.h"
 #include "rt/io/mesh_io.h"
+#include "rt/render/integrator.h"
 #include "rt/scene/texture.h"
 
 #define MAX_SCENE_BYTES ((size_t)256 << 20) /* 256 MiB of text keeps line and column in an int */
@@ -655,15 +656,20 @@ static rt_result st_seed(parser *p, const tok *kw)
 
 static rt_result st_integrator(parser *p, const tok *kw)
 {
-    static const char *const words[] = {"direct", "whitted", "path"};
-    static const rt_integrator values[] = {RT_INTEGRATOR_DIRECT, RT_INTEGRATOR_WHITTED, RT_INTEGRATOR_PATH};
+    const char *words[16]; /* the integrator table's names (rt/render/integrator.h) */
+    int n = (int)rt_integrator_count();
+    RT_CHECK((size_t)n <= sizeof words / sizeof *words);
+    for (int k = 0; k < n; k++)
+        words[k] = rt_integrator_name((rt_integrator)k);
+    char choices[256];
+    rt_integrator_list(choices, sizeof choices, "|", "|");
     int i = 0;
     rt_result r;
-    if ((r = get_choice(p, "an integrator", words, 3, "direct|whitted|path", &i)) != RT_OK ||
+    if ((r = get_choice(p, "an integrator", words, n, choices, &i)) != RT_OK ||
         (r = expect_end(p, "integrator")) != RT_OK)
         return r;
     note_setting(p, SET_INTEGRATOR, kw);
-    p->s->settings.integrator = values[i];
+    p->s->settings.integrator = (rt_integrator)i;
     return RT_OK;
 }
 

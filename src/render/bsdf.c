@@ -177,7 +177,7 @@ void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float rou
 
 void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
 {
-    const rt_scene *s = ctx->scene;
+    const rt_scene *s = ctx->state->scene;
     rt_material fallback;
     const rt_material *m = s->material_count ? &s->materials[sf->material] : NULL;
     if (!m) {

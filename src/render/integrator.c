@@ -1,19 +1,71 @@
-/* integrator.c - dispatch to the scene's integrator. */
+/* integrator.c - the integrator table and lookups in it: names for the
+ * scene format and the command line, the radiance function rt_render's
+ * workers call, and what each needs in the render state.
+ */
 #include "rt/render/integrator.h"
+
+#include <stdio.h>
+#include <string.h>
 
 #include "rt/render/direct.h"
 #include "rt/render/pathtrace.h"
 #include "rt/render/whitted.h"
 
+/* One line an integrator; the built-in ids (rt_integrator in rt/scene/scene.h)
+ * are pinned to their lines. */
+static const rt_integrator_info integrators[] = {
+    [RT_INTEGRATOR_DIRECT] = {"direct", rt_radiance_direct, 0},
+    [RT_INTEGRATOR_WHITTED] = {"whitted", rt_radiance_whitted, 0},
+    [RT_INTEGRATOR_PATH] = {"path", rt_radiance_path, RT_PREPARE_LIGHT_TABLE},
+};
+
+enum { INTEGRATOR_COUNT = sizeof integrators / sizeof integrators[0] };
+
+size_t rt_integrator_count(void)
+{
+    return INTEGRATOR_COUNT;
+}
+
+const rt_integrator_info *rt_integrator_info_of(rt_integrator id)
+{
+    return (size_t)id < INTEGRATOR_COUNT ? &integrators[id] : NULL;
+}
+
+bool rt_integrator_by_name(const char *name, rt_integrator *id)
+{
+    for (size_t i = 0; name && i < INTEGRATOR_COUNT; i++) {
+        if (strcmp(name, integrators[i].name) == 0) {
+            *id = (rt_integrator)i;
+            return true;
+        }
+    }
+    return false;
+}
+
+const char *rt_integrator_name(rt_integrator id)
+{
+    const rt_integrator_info *in = rt_integrator_info_of(id);
+    return in ? in->name : NULL;
+}
+
+void rt_integrator_list(char *buf, size_t size, const char *sep, const char *last_sep)
+{
+    if (!size)
+        return;
+    buf[0] = '\0';
+    size_t n = 0;
+    for (size_t i = 0; i < INTEGRATOR_COUNT && n < size; i++) {
+        const char *between = i == 0 ? "" : (i + 1 == INTEGRATOR_COUNT ? last_sep : sep);
+        int k = snprintf(buf + n, size - n, "%s%s", between, integrators[i].name);
+        if (k < 0)
+            break;
+        n += (size_t)k;
+    }
+}
+
 rt_vec3 rt_radiance(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng)
 {
-    switch (ctx->scene->settings.integrator) {
-    case RT_INTEGRATOR_WHITTED:
-        return rt_radiance_whitted(ctx, ray, rng);
-    case RT_INTEGRATOR_PATH:
-        return rt_radiance_path(ctx, ray, rng);
-    case RT_INTEGRATOR_DIRECT:
-    default:
-        return rt_radiance_direct(ctx, ray, rng);
-    }
+    const rt_integrator_info *in = rt_integrator_info_of(ctx->state->scene->settings.integrator);
+    RT_DCHECK(in != NULL);
+    return in->radiance(ctx, ray, rng);
 }

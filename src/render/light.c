@@ -97,13 +97,13 @@ static rt_vec3 shadow_walk(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec
     rt_ray r = rt_ray_make(o, wi, 0.0f, tmax);
     if (ctx->ray_count)
         (*ctx->ray_count)++;
-    if (!ctx->shadows_need_shading)
-        return rt_kdtree_occluded(ctx->tree, &r) ? rt_v3s(0) : rt_v3s(1);
-    const rt_scene *s = ctx->scene;
+    if (!ctx->state->shadows_need_shading)
+        return rt_kdtree_occluded(ctx->state->tree, &r) ? rt_v3s(0) : rt_v3s(1);
+    const rt_scene *s = ctx->state->scene;
     rt_vec3 tr = rt_v3s(1);
     for (int layer = 0; layer < 64; layer++) {
         rt_hit h;
-        if (!rt_kdtree_intersect(ctx->tree, &r, &h))
+        if (!rt_kdtree_intersect(ctx->state->tree, &r, &h))
             return tr;
         uint32_t mi = rt_prim_material(s, h.prim);
         RT_DCHECK(mi < s->material_count);

@@ -64,7 +64,7 @@ static rt_vec3 light_table_term(const rt_trace_ctx *ctx, const rt_surface *sf, c
     float vis = rt_shadow_visibility(ctx, sf, d, dist);
     if (!(vis > 0.0f))
         return rt_v3s(0.0f);
-    return rt_scale(rt_mul(f, Le ? *Le : rt_environment(ctx->scene, d)), wi.z * vis * w / pdf_l);
+    return rt_scale(rt_mul(f, Le ? *Le : rt_environment(ctx->state->scene, d)), wi.z * vis * w / pdf_l);
 }
 
 /* Light sampled at one vertex: sum over rt_lights plus one table emitter,
@@ -72,7 +72,7 @@ static rt_vec3 light_table_term(const rt_trace_ctx *ctx, const rt_surface *sf, c
 static rt_vec3 next_event(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo,
                           rt_rng *rng)
 {
-    const rt_scene *s = ctx->scene;
+    const rt_scene *s = ctx->state->scene;
     rt_vec3 sum = rt_v3s(0.0f);
     for (size_t i = 0; i < s->light_count; i++) {
         const rt_light *l = &s->lights[i];
@@ -97,7 +97,7 @@ static rt_vec3 next_event(const rt_trace_ctx *ctx, const rt_surface *sf, const r
             continue;
         sum = add_finite(sum, rt_scale(rt_mul(f, ls.li), wi.z * vis * w));
     }
-    const rt_light_table *t = ctx->light_table;
+    const rt_light_table *t = ctx->state->light_table;
     if (t && t->env_w > 0) {
         rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
         rt_vec3 d;
@@ -165,7 +165,7 @@ static rt_vec3 next_event(const rt_trace_ctx *ctx, const rt_surface *sf, const r
 
 rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng)
 {
-    const rt_scene *s = ctx->scene;
+    const rt_scene *s = ctx->state->scene;
     int max_depth = s->settings.max_depth > 0 ? s->settings.max_depth : RT_PATH_HARD_LIMIT;
     if (max_depth > RT_PATH_HARD_LIMIT)
         max_depth = RT_PATH_HARD_LIMIT;
@@ -188,8 +188,8 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         rt_surface_walk found = rt_trace_surface(ctx, &r, &layers, rng, &sf, &coverage);
         if (found == RT_WALK_MISS) {
             float w = 1.0f; /* MIS against environment sampling, when the table does it */
-            if (!prev_delta && ctx->light_table && ctx->light_table->env_w > 0)
-                w = rt_mis_power(prev_pdf, rt_light_table_env_pdf(ctx->light_table, r.dir));
+            if (!prev_delta && ctx->state->light_table && ctx->state->light_table->env_w > 0)
+                w = rt_mis_power(prev_pdf, rt_light_table_env_pdf(ctx->state->light_table, r.dir));
             L = add_finite(L, rt_scale(rt_mul(beta, rt_environment(s, r.dir)), w));
         }
         if (found != RT_WALK_SURFACE)
@@ -199,7 +199,7 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         const rt_material *m = s->material_count ? &s->materials[sf.material] : NULL;
         /* area lights' quads have emissive materials: look only those up */
         bool emissive = m && rt_max3(rt_scale(m->emission, m->emission_strength)) > 0.0f;
-        uint32_t light = emissive ? rt_area_light_of_prim(s, ctx->light_table, sf.prim) : RT_NONE;
+        uint32_t light = emissive ? rt_area_light_of_prim(s, ctx->state->light_table, sf.prim) : RT_NONE;
         if (rt_max3(Le) > 0.0f) {
             float w = 1.0f;
             if (!prev_delta) {
@@ -207,9 +207,9 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
                 float pdf_l = 0.0f;
                 if (light != RT_NONE) {
                     pdf_l = rt_area_light_pdf(&s->lights[light], r.dir, sqrtf(d2));
-                } else if (ctx->light_table && sf.prim < ctx->light_table->prim_count) {
+                } else if (ctx->state->light_table && sf.prim < ctx->state->light_table->prim_count) {
                     float cos_l = fabsf(rt_dot(sf.ng, r.dir));
-                    float pa = ctx->light_table->prim_pdf[sf.prim];
+                    float pa = ctx->state->light_table->prim_pdf[sf.prim];
                     pdf_l = (pa > 0.0f && cos_l > 0.0f) ? pa * d2 / cos_l : 0.0f;
                 }
                 if (pdf_l > 0.0f && isfinite(pdf_l))

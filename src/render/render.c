@@ -18,7 +18,6 @@
 
 #include "rt/render/camera.h"
 #include "rt/render/integrator.h"
-#include "rt/render/light.h"
 #include "rt/render/sampling.h"
 
 int rt_cpu_count(void)
@@ -36,7 +35,6 @@ static double now_seconds(void)
 
 typedef struct render_job {
     const rt_scene *scene;
-    const rt_kdtree *tree;
     rt_framebuffer *fb;
     rt_camera_frame camera;
     int tile_size, tiles_x, tiles_y, tiles_total;
@@ -44,7 +42,8 @@ typedef struct render_job {
     atomic_int tiles_done;
     atomic_uchar *tile_finished; /* per tile: 1 once its pixels are final */
     atomic_int *cancel;
-    const rt_light_table *lights; /* path tracer's emitter table, shared read-only */
+    const rt_render_state *state; /* prepared once, read by every worker */
+    rt_radiance_fn radiance;      /* the scene's integrator */
 } render_job;
 
 typedef struct worker {
@@ -79,7 +78,7 @@ static bool render_tile(render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
                 rt_ray ray = rt_camera_ray(&job->camera, (float)x + j.x, (float)y + j.y, lens);
                 rt_rng rng = rt_rng_for_sample(st->seed, pixel, s);
                 w->camera_rays++;
-                rt_vec3 L = rt_radiance(ctx, &ray, &rng);
+                rt_vec3 L = job->radiance(ctx, &ray, &rng);
                 if (!rt_finite3(L) || L.x < 0.0f || L.y < 0.0f || L.z < 0.0f) {
                     w->bad_samples++;
                     continue;
@@ -108,8 +107,7 @@ static void *worker_main(void *arg)
     worker *w = arg;
     render_job *job = w->job;
     rt_trace_ctx ctx;
-    rt_trace_ctx_init(&ctx, job->scene, job->tree);
-    ctx.light_table = job->lights;
+    rt_trace_ctx_init(&ctx, job->state);
     ctx.ray_count = &w->rays;
     for (;;) {
         if (job->cancel && atomic_load(job->cancel))
@@ -183,11 +181,14 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     if (fb->width != set->width || fb->height != set->height || !fb->rgb)
         return rt_fail(err, RT_ERR_INVALID, "framebuffer is %dx%d but the scene asks for %dx%d", fb->width,
                        fb->height, set->width, set->height);
+    const rt_integrator_info *integrator = rt_integrator_info_of(set->integrator);
+    if (!integrator)
+        return rt_fail(err, RT_ERR_INVALID, "integrator %d is not one of the %zu rt knows", (int)set->integrator,
+                       rt_integrator_count());
 
     render_job job;
     memset(&job, 0, sizeof job);
     job.scene = scene;
-    job.tree = tree;
     job.fb = fb;
     job.cancel = opt.cancel;
     rt_camera_frame_init(&job.camera, &scene->camera, fb->width, fb->height);
@@ -212,18 +213,16 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     }
     for (int t = 0; t < job.tiles_total; t++)
         atomic_init(&job.tile_finished[t], 0);
-    /* the path tracer's emitter table: built once, before the workers */
-    rt_light_table lights;
-    memset(&lights, 0, sizeof lights);
-    if (set->integrator == RT_INTEGRATOR_PATH) {
-        rt_result lr = rt_light_table_build(&lights, scene, err);
-        if (lr != RT_OK) {
-            free(job.tile_finished);
-            free(workers);
-            return lr;
-        }
-        job.lights = &lights;
+    /* what the integrator reads, derived once, before the workers start */
+    rt_render_state state;
+    rt_result sr = rt_render_state_prepare(&state, scene, tree, integrator->prepare, err);
+    if (sr != RT_OK) {
+        free(job.tile_finished);
+        free(workers);
+        return sr;
     }
+    job.state = &state;
+    job.radiance = integrator->radiance;
 
     double t0 = now_seconds();
     int started = 0;
@@ -286,7 +285,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     }
     free(job.tile_finished);
     free(workers);
-    rt_light_table_free(&lights);
+    rt_render_state_free(&state);
     if (stats)
         *stats = st;
     if (st.interrupted)

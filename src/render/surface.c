@@ -74,7 +74,7 @@ static rt_vec2 slot_uv(const rt_surface *sf, const rt_texture_slot *slot)
 
 void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf)
 {
-    const rt_scene *s = ctx->scene;
+    const rt_scene *s = ctx->state->scene;
     uint32_t i;
     rt_vec3 ng, n, t;
     float w = 1.0f;
@@ -203,7 +203,7 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
 
 rt_vec4 rt_surface_base_color(const rt_trace_ctx *ctx, const rt_surface *sf)
 {
-    const rt_scene *s = ctx->scene;
+    const rt_scene *s = ctx->state->scene;
     if (!s->material_count)
         return rt_v4(0.8f, 0.8f, 0.8f, 1.0f);
     const rt_material *m = &s->materials[sf->material];
@@ -218,7 +218,7 @@ rt_vec4 rt_surface_base_color(const rt_trace_ctx *ctx, const rt_surface *sf)
 
 rt_vec3 rt_surface_emission(const rt_trace_ctx *ctx, const rt_surface *sf)
 {
-    const rt_scene *s = ctx->scene;
+    const rt_scene *s = ctx->state->scene;
     if (!s->material_count)
         return rt_v3s(0);
     const rt_material *m = &s->materials[sf->material];
@@ -237,7 +237,7 @@ rt_vec3 rt_surface_emission(const rt_trace_ctx *ctx, const rt_surface *sf)
 bool rt_surface_cut_away(const rt_trace_ctx *ctx, const rt_surface *sf, float *coverage)
 {
     *coverage = 1.0f;
-    const rt_scene *s = ctx->scene;
+    const rt_scene *s = ctx->state->scene;
     if (!s->material_count)
         return false;
     const rt_material *m = &s->materials[sf->material];
@@ -253,8 +253,8 @@ bool rt_surface_cut_away(const rt_trace_ctx *ctx, const rt_surface *sf, float *c
 rt_vec3 rt_surface_spawn(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 d)
 {
     rt_vec3 side = rt_dot(d, sf->ng) >= 0.0f ? sf->ng : rt_neg(sf->ng);
-    rt_vec3 o = rt_offset_ray_origin(sf->p, side, ctx->scale);
-    float extra = ctx->scene->settings.ray_offset;
+    rt_vec3 o = rt_offset_ray_origin(sf->p, side, ctx->state->scale);
+    float extra = ctx->state->scene->settings.ray_offset;
     return extra > 0.0f ? rt_madd(o, side, extra) : o;
 }
 rt_surface_walk rt_trace_surface(const rt_trace_ctx *ctx, rt_ray *r, int *layers_left, rt_rng *blend_rng,

@@ -14,7 +14,7 @@
  * directional E, area lights averaged over shadow_samples stratified
  * points), times the shadow transmittance (rt_shadow_transmittance: clear,
  * blocked, or filtered by transmissive surfaces, the old renderer's "cheap
- * caustics"). A is the ambient radiance (ctx->ambient). The 1/pi makes
+ * caustics"). A is the ambient radiance (ctx->state->ambient). The 1/pi makes
  * kd = 1, ka = ks = 0 exactly the `direct` integrator's Lambert.
  *
  * Diffuse bounces: while level < diffuse_bounces the ambient term ka B A is
@@ -144,7 +144,7 @@ static void direct_phong(wctx *w, const rt_surface *sf, int area_samples, float 
                          rt_vec3 *D, rt_vec3 *S)
 {
     const rt_trace_ctx *ctx = w->ctx;
-    const rt_scene *s = ctx->scene;
+    const rt_scene *s = ctx->state->scene;
     rt_vec3 dsum = rt_v3s(0), ssum = rt_v3s(0);
     uint32_t pattern = rt_rng_u32(w->rng);
     for (size_t i = 0; i < s->light_count; i++) {
@@ -207,7 +207,7 @@ static rt_vec3 shade(wctx *w, const rt_surface *sf, const rt_medium_stack *med, 
                      float weight, bool diffuse_ray)
 {
     const rt_trace_ctx *ctx = w->ctx;
-    const rt_scene *s = ctx->scene;
+    const rt_scene *s = ctx->state->scene;
     rt_material fallback;
     const rt_material *m = s->material_count ? &s->materials[sf->material] : NULL;
     if (!m) {
@@ -246,7 +246,7 @@ static rt_vec3 shade(wctx *w, const rt_surface *sf, const rt_medium_stack *med, 
             rt_vec3 ind = gather_diffuse(w, sf, med, depth, level, kd_w);
             L = rt_add(L, rt_scale(rt_mul(base, ind), w_local * m->diffuse));
         } else if (m->ambient > 0.0f) {
-            L = rt_add(L, rt_scale(rt_mul(base, ctx->ambient), w_local * m->ambient));
+            L = rt_add(L, rt_scale(rt_mul(base, ctx->state->ambient), w_local * m->ambient));
         }
     }
 
@@ -327,7 +327,7 @@ static rt_vec3 trace(wctx *w, rt_ray r, const rt_medium_stack *med, int depth, i
         float coverage;
         rt_surface_walk found = rt_trace_surface(ctx, &r, &layers, NULL, &sf, &coverage);
         if (found == RT_WALK_MISS)
-            result = rt_add(result, rt_scale(rt_environment(ctx->scene, r.dir), cov_weight));
+            result = rt_add(result, rt_scale(rt_environment(ctx->state->scene, r.dir), cov_weight));
         if (found != RT_WALK_SURFACE)
             break;
         rt_vec3 L = shade(w, &sf, med, depth, level, weight * cov_weight * coverage, diffuse_ray);
@@ -345,7 +345,7 @@ static rt_vec3 trace(wctx *w, rt_ray r, const rt_medium_stack *med, int depth, i
 
 rt_vec3 rt_radiance_whitted_in(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng, const rt_medium_stack *start)
 {
-    const rt_settings *st = &ctx->scene->settings;
+    const rt_settings *st = &ctx->state->scene->settings;
     wctx w;
     w.ctx = ctx;
     w.rng = rng;

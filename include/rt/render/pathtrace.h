@@ -1,25 +1,26 @@
 /* rt/render/pathtrace.h - the `path` integrator: unidirectional path tracing of the
- * glTF material model (rt/bsdf.h) with next-event estimation, multiple
+ * glTF material model (rt/render/bsdf.h) with next-event estimation, multiple
  * importance sampling and Russian roulette. docs/path-tracer.md has the
  * estimator, its validation against Mitsuba 3, and the settings.
  *
  *   rt_vec3 L = rt_radiance_path(&ctx, &ray, &rng);   // via rt_radiance()
  *
  * Lights sampled at every path vertex: every rt_light (point, spot,
- * directional, area) and, when ctx->light_table is set, one emissive
- * primitive (triangle, quad or sphere with an emissive material) chosen by
- * power, and the environment image by its luminance. The table is per scene and read-only while rendering: build it
- * once after the scene is loaded, before the render threads start, and
- * point each thread's context at it:
+ * directional, area) and, when the render state holds a light table
+ * (rt/render/light.h; its line in the integrator table asks for
+ * RT_PREPARE_LIGHT_TABLE, so rt_render builds one), one emissive primitive
+ * (triangle, quad or sphere with an emissive material) chosen by power, and
+ * the environment image by its luminance:
  *
- *   rt_light_table lt;
- *   if (rt_light_table_build(&lt, &scene, &err) != RT_OK) ...
- *   ... in each worker: rt_trace_ctx_init(&ctx, &scene, &tree); ctx.light_table = &lt;
- *   rt_light_table_free(&lt);                            // after the render
+ *   rt_render_state rs;
+ *   rt_render_state_prepare(&rs, &scene, &tree, RT_PREPARE_LIGHT_TABLE, &err);
+ *   ... in each worker: rt_trace_ctx_init(&ctx, &rs); L = rt_radiance_path(&ctx, &ray, &rng);
+ *   rt_render_state_free(&rs);                           // after the render
  *
- * Without a table (ctx->light_table == NULL) the image is the same in
- * expectation: emissive primitives are then found only by BSDF-sampled
- * rays and counted in full (noisier for small bright emitters).
+ * Without a table (prepared without RT_PREPARE_LIGHT_TABLE) the image is
+ * the same in expectation: emissive primitives are then found only by
+ * BSDF-sampled rays and counted in full (noisier for small bright
+ * emitters).
  */
 #ifndef RT_PATHTRACE_H
 #define RT_PATHTRACE_H
