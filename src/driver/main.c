@@ -1,5 +1,6 @@
 /* main.c - the `rt` command: parse flags, load a scene or model, build the
- * kd-tree, render on all cores, write the image.
+ * kd-tree, render on all cores (progress.c draws the progress bar and the
+ * live preview), write the image.
  *
  * Exit status: 0 on success, 2 for bad input (flags, scene files, models,
  * images, an unwritable output), 130 when interrupted (the finished tiles
@@ -36,6 +37,8 @@
 #include "rt/scene/scene.h"
 #include "rt/io/scene_parse.h"
 #include "rt/scene/tangents.h"
+
+#include "progress.h"
 
 #define RT_VERSION "0.1.0"
 
@@ -654,14 +657,16 @@ int main(int argc, char **argv)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
+    progress_view view;
+    progress_view_init(&view, level >= RT_LOG_NORMAL && isatty(2), preview ? output : NULL, preview_seconds,
+                       set->exposure);
     rt_render_options ro;
     memset(&ro, 0, sizeof ro);
     ro.threads = (int)threads;
     ro.tile_size = (int)tile;
-    ro.progress = level >= RT_LOG_NORMAL;
     ro.cancel = &interrupted;
-    ro.preview_path = preview ? output : NULL;
-    ro.preview_seconds = preview_seconds;
+    ro.progress = view.bar || view.preview_path ? progress_report : NULL;
+    ro.progress_user = &view;
     rt_render_stats rs;
     rt_result r = rt_render(&scene, &tree, &ro, &fb, &rs, &err);
     int status = 0;
