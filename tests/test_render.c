@@ -11,6 +11,7 @@
 #include "rt/accel/kdtree.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
+#include "rt/scene/validate.h"
 
 static uint32_t add_lambert(rt_scene *s, const char *name, rt_vec3 albedo)
 {
@@ -23,6 +24,7 @@ static uint32_t add_lambert(rt_scene *s, const char *name, rt_vec3 albedo)
 static void render_scene(rt_scene *s, int threads, int tile, rt_framebuffer *fb)
 {
     rt_error err = {0};
+    assert_int_equal(rt_scene_validate(s, &err), RT_OK);
     rt_kdtree tree;
     assert_int_equal(rt_kdtree_build(&tree, s, NULL, &err), RT_OK);
     assert_int_equal(rt_framebuffer_init(fb, s->settings.width, s->settings.height, &err), RT_OK);
@@ -201,6 +203,7 @@ static void test_progress_reports(void **state)
     build_busy_scene(&s);
     s.settings.samples = 16;
     rt_error err = {0};
+    assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
     rt_kdtree tree;
     assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
     rt_framebuffer fb;

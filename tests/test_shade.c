@@ -17,6 +17,7 @@
 #include "rt/render/surface.h"
 #include "rt/scene/tangents.h"
 #include "rt/scene/texture.h"
+#include "rt/scene/validate.h"
 
 static bool near3(rt_vec3 a, rt_vec3 b, float eps)
 {
@@ -286,6 +287,7 @@ static void render_all(int map_kind, rt_framebuffer *fb)
     s.camera_set = true;
     rt_error err = {0};
     assert_int_equal(rt_scene_generate_tangents(&s, &err), RT_OK);
+    assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
     rt_kdtree tree;
     assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
     assert_int_equal(rt_framebuffer_init(fb, s.settings.width, s.settings.height, &err), RT_OK);

@@ -14,6 +14,7 @@
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/texture.h"
+#include "rt/scene/validate.h"
 #include "rt/render/whitted.h"
 
 /* ------------------------------------------------------------ optics */
@@ -156,6 +157,7 @@ typedef struct built {
 static void build(built *b, rt_scene *s)
 {
     rt_error err = {0};
+    assert_int_equal(rt_scene_validate(s, &err), RT_OK);
     assert_int_equal(rt_kdtree_build(&b->tree, s, NULL, &err), RT_OK);
     assert_int_equal(rt_render_state_prepare(&b->rs, s, &b->tree, 0, &err), RT_OK);
     rt_trace_ctx_init(&b->ctx, &b->rs);

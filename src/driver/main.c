@@ -37,6 +37,7 @@
 #include "rt/scene/scene.h"
 #include "rt/io/scene_parse.h"
 #include "rt/scene/tangents.h"
+#include "rt/scene/validate.h"
 
 #include "progress.h"
 
@@ -579,6 +580,13 @@ int main(int argc, char **argv)
     input_info info;
     if (load_input(&scene, input, true, &info, &err) != RT_OK) {
         report(&err, &budget);
+        rt_scene_free(&scene);
+        return 2;
+    }
+    if (rt_scene_validate(&scene, &err) != RT_OK) { /* from here on the tables are trusted */
+        rt_error named;
+        rt_fail(&named, err.code, "%s: %s", input ? input : "<built-in scene>", err.message);
+        report(&named, &budget);
         rt_scene_free(&scene);
         return 2;
     }

@@ -178,12 +178,8 @@ void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float rou
 void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
 {
     const rt_scene *s = ctx->state->scene;
-    rt_material fallback;
-    const rt_material *m = s->material_count ? &s->materials[sf->material] : NULL;
-    if (!m) {
-        rt_material_default(&fallback, "default");
-        m = &fallback;
-    }
+    RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
+    const rt_material *m = &s->materials[sf->material];
     /* frame: the shading normal, unless wo is not above it (normal maps,
      * interpolated normals at silhouettes); then the geometric normal */
     rt_vec3 n = sf->n;

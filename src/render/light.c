@@ -151,8 +151,7 @@ float rt_shadow_visibility(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec
 
 static bool emissive_material(const rt_scene *s, uint32_t m, float *power)
 {
-    if (m >= s->material_count)
-        return false;
+    RT_DCHECK(m < s->material_count); /* rt_scene_validate */
     const rt_material *mt = &s->materials[m];
     rt_vec3 e = rt_scale(mt->emission, mt->emission_strength);
     float p = (e.x + e.y + e.z) * (1.0f / 3.0f);
@@ -206,11 +205,12 @@ static bool build_env(rt_light_table *t, const rt_scene *s)
 {
     const rt_settings *st = &s->settings;
     uint32_t tex = st->environment_texture;
-    if (tex == RT_NONE || tex >= s->texture_count || !(st->environment_strength > 0.0f))
+    if (tex == RT_NONE || !(st->environment_strength > 0.0f))
         return true;
+    RT_DCHECK(tex < s->texture_count);
     int w = 256, h = 128;
     const rt_texture *tx = &s->textures[tex];
-    if (tx->kind == RT_TEX_IMAGE && tx->image < s->image_count) {
+    if (tx->kind == RT_TEX_IMAGE) {
         w = s->images[tx->image].width;
         h = s->images[tx->image].height;
         w = w < 1 ? 1 : (w > 1024 ? 1024 : w);

@@ -196,9 +196,9 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
             break;
         /* emission, MIS-weighted when it could have been light-sampled */
         rt_vec3 Le = rt_surface_emission(ctx, &sf);
-        const rt_material *m = s->material_count ? &s->materials[sf.material] : NULL;
+        const rt_material *m = &s->materials[sf.material];
         /* area lights' quads have emissive materials: look only those up */
-        bool emissive = m && rt_max3(rt_scale(m->emission, m->emission_strength)) > 0.0f;
+        bool emissive = rt_max3(rt_scale(m->emission, m->emission_strength)) > 0.0f;
         uint32_t light = emissive ? rt_area_light_of_prim(s, ctx->state->light_table, sf.prim) : RT_NONE;
         if (rt_max3(Le) > 0.0f) {
             float w = 1.0f;
@@ -219,7 +219,7 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         }
         if (light != RT_NONE)
             break; /* an area light's quad reflects nothing */
-        if (m && m->unlit) {
+        if (m->unlit) {
             rt_vec4 c = rt_surface_base_color(ctx, &sf);
             L = add_finite(L, rt_mul(beta, rt_v3(c.x, c.y, c.z)));
             break;

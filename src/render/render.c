@@ -18,6 +18,7 @@
 #include "rt/render/camera.h"
 #include "rt/render/integrator.h"
 #include "rt/render/sampling.h"
+#include "rt/scene/validate.h"
 
 int rt_cpu_count(void)
 {
@@ -146,6 +147,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     rt_render_stats st;
     memset(&st, 0, sizeof st);
     const rt_settings *set = &scene->settings;
+    RT_DCHECK(rt_scene_validate(scene, NULL) == RT_OK);
     if (fb->width != set->width || fb->height != set->height || !fb->rgb)
         return rt_fail(err, RT_ERR_INVALID, "framebuffer is %dx%d but the scene asks for %dx%d", fb->width,
                        fb->height, set->width, set->height);

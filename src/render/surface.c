@@ -118,12 +118,14 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
         } else {
             sf->uv1 = sf->uv0;
         }
-        if ((flags & RT_TRI_COLOR) && vx->color) {
+        RT_DCHECK(!(flags & RT_TRI_COLOR) || vx->color);
+        RT_DCHECK(!(flags & RT_TRI_TANGENT) || vx->tangent);
+        if (flags & RT_TRI_COLOR) {
             rt_vec4 c0 = vx->color[idx[0]], c1 = vx->color[idx[1]], c2 = vx->color[idx[2]];
             sf->vertex_color = rt_v4(c0.x * bw + c1.x * bu + c2.x * bv, c0.y * bw + c1.y * bu + c2.y * bv,
                                      c0.z * bw + c1.z * bu + c2.z * bv, c0.w * bw + c1.w * bu + c2.w * bv);
         }
-        if ((flags & RT_TRI_TANGENT) && vx->tangent) {
+        if (flags & RT_TRI_TANGENT) {
             rt_vec4 q0 = vx->tangent[idx[0]], q1 = vx->tangent[idx[1]], q2 = vx->tangent[idx[2]];
             t = rt_v3(q0.x * bw + q1.x * bu + q2.x * bv, q0.y * bw + q1.y * bu + q2.y * bv,
                       q0.z * bw + q1.z * bu + q2.z * bv);
@@ -131,7 +133,6 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
         } else {
             tangent_from_uv(e1, e2, rt_v2(t1.x - t0.x, t1.y - t0.y), rt_v2(t2.x - t0.x, t2.y - t0.y), ng, &t, &w);
         }
-        sf->material = s->triangles.material[i];
         break;
     }
     case RT_PRIM_SPHERE: {
@@ -144,7 +145,6 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
         n = ng;
         sf->uv0 = sf->uv1 = rt_latlong_from_dir(d);
         t = rt_v3(d.z, 0.0f, -d.x); /* dP/du; zero at the poles, fixed by orthonormal_tangent */
-        sf->material = sp->material[i];
         break;
     }
     case RT_PRIM_QUAD:
@@ -158,35 +158,33 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
         /* image top at the far end of edge v: uv = (s, 1 - t) */
         sf->uv0 = sf->uv1 = rt_v2(hit->u, 1.0f - hit->v);
         t = eu;
-        sf->material = q->material[i];
         break;
     }
     }
-    if (sf->material >= s->material_count)
-        sf->material = 0;
+    sf->material = rt_prim_material(s, hit->prim);
+    RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
     sf->wo = rt_neg(rt_normalize(ray->dir));
     sf->front = rt_dot(ng, ray->dir) < 0.0f;
 
     rt_vec3 tt = orthonormal_tangent(n, t);
     rt_vec3 bb = rt_scale(rt_cross(n, tt), w);
     /* normal map, in the frame of the front face */
-    if (s->material_count) {
-        const rt_material *m = &s->materials[sf->material];
-        if (m->normal_tex.texture != RT_NONE && m->normal_tex.texture < s->texture_count) {
-            const rt_texture *tx = &s->textures[m->normal_tex.texture];
-            bool unorm8 = tx->kind == RT_TEX_IMAGE && tx->image < s->image_count && s->images[tx->image].rgba8;
-            rt_vec4 c = rt_texture_sample(s, m->normal_tex.texture, slot_uv(sf, &m->normal_tex), false);
-            float x = normal_map_component(c.x, unorm8) * m->normal_scale;
-            float y = normal_map_component(c.y, unorm8) * m->normal_scale;
-            float z = normal_map_component(c.z, unorm8);
-            rt_vec3 nm = rt_add(rt_add(rt_scale(tt, x), rt_scale(bb, y)), rt_scale(n, z));
-            /* a flat texel (x = y = 0) leaves the surface exactly as unmapped */
-            bool flat = x == 0.0f && y == 0.0f && z > 0.0f;
-            if (!flat && rt_length2(nm) > 1e-20f && rt_finite3(nm)) {
-                n = rt_normalize(nm);
-                tt = orthonormal_tangent(n, tt);
-                bb = rt_scale(rt_cross(n, tt), w);
-            }
+    const rt_material *m = &s->materials[sf->material];
+    if (m->normal_tex.texture != RT_NONE) {
+        RT_DCHECK(m->normal_tex.texture < s->texture_count);
+        const rt_texture *tx = &s->textures[m->normal_tex.texture];
+        bool unorm8 = tx->kind == RT_TEX_IMAGE && s->images[tx->image].rgba8;
+        rt_vec4 c = rt_texture_sample(s, m->normal_tex.texture, slot_uv(sf, &m->normal_tex), false);
+        float x = normal_map_component(c.x, unorm8) * m->normal_scale;
+        float y = normal_map_component(c.y, unorm8) * m->normal_scale;
+        float z = normal_map_component(c.z, unorm8);
+        rt_vec3 nm = rt_add(rt_add(rt_scale(tt, x), rt_scale(bb, y)), rt_scale(n, z));
+        /* a flat texel (x = y = 0) leaves the surface exactly as unmapped */
+        bool flat = x == 0.0f && y == 0.0f && z > 0.0f;
+        if (!flat && rt_length2(nm) > 1e-20f && rt_finite3(nm)) {
+            n = rt_normalize(nm);
+            tt = orthonormal_tangent(n, tt);
+            bb = rt_scale(rt_cross(n, tt), w);
         }
     }
     if (!sf->front) {
@@ -204,8 +202,7 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
 rt_vec4 rt_surface_base_color(const rt_trace_ctx *ctx, const rt_surface *sf)
 {
     const rt_scene *s = ctx->state->scene;
-    if (!s->material_count)
-        return rt_v4(0.8f, 0.8f, 0.8f, 1.0f);
+    RT_DCHECK(sf->material < s->material_count);
     const rt_material *m = &s->materials[sf->material];
     rt_vec4 c = rt_v4(m->color.x, m->color.y, m->color.z, m->alpha);
     if (m->base_color_tex.texture != RT_NONE) {
@@ -219,8 +216,7 @@ rt_vec4 rt_surface_base_color(const rt_trace_ctx *ctx, const rt_surface *sf)
 rt_vec3 rt_surface_emission(const rt_trace_ctx *ctx, const rt_surface *sf)
 {
     const rt_scene *s = ctx->state->scene;
-    if (!s->material_count)
-        return rt_v3s(0);
+    RT_DCHECK(sf->material < s->material_count);
     const rt_material *m = &s->materials[sf->material];
     if (!(m->emission.x > 0.0f || m->emission.y > 0.0f || m->emission.z > 0.0f))
         return rt_v3s(0);
@@ -238,8 +234,7 @@ bool rt_surface_cut_away(const rt_trace_ctx *ctx, const rt_surface *sf, float *c
 {
     *coverage = 1.0f;
     const rt_scene *s = ctx->state->scene;
-    if (!s->material_count)
-        return false;
+    RT_DCHECK(sf->material < s->material_count);
     const rt_material *m = &s->materials[sf->material];
     if (m->alpha_mode == RT_ALPHA_OPAQUE)
         return false;

@@ -104,7 +104,8 @@ float rt_medium_ior(const rt_scene *s, const rt_medium_stack *m)
     if (!m || m->depth <= 0)
         return 1.0f;
     uint32_t mat = m->material[m->depth - 1];
-    return mat < s->material_count ? s->materials[mat].ior : 1.0f;
+    RT_DCHECK(mat < s->material_count);
+    return s->materials[mat].ior;
 }
 
 static void medium_push(rt_medium_stack *m, uint32_t mat)
@@ -208,12 +209,8 @@ static rt_vec3 shade(wctx *w, const rt_surface *sf, const rt_medium_stack *med, 
 {
     const rt_trace_ctx *ctx = w->ctx;
     const rt_scene *s = ctx->state->scene;
-    rt_material fallback;
-    const rt_material *m = s->material_count ? &s->materials[sf->material] : NULL;
-    if (!m) {
-        rt_material_default(&fallback, "default");
-        m = &fallback;
-    }
+    RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
+    const rt_material *m = &s->materials[sf->material];
     rt_vec4 b4 = rt_surface_base_color(ctx, sf);
     rt_vec3 base = rt_v3(b4.x, b4.y, b4.z);
     /* after a diffuse bounce, a sampled light's own quad is not seen: its
