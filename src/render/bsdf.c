@@ -1,5 +1,5 @@
 /* bsdf.c - Lambert and the glTF metallic-roughness BSDF for the path
- * tracer: evaluation, pdf and importance sampling (see rt/bsdf.h).
+ * tracer: evaluation, pdf and importance sampling (see rt/render/bsdf.h).
  *
  * Sources:
  * - The BRDF: glTF 2.0 specification, appendix B "BRDF Implementation"

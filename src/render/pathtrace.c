@@ -15,7 +15,7 @@
  *     and one direction of the environment image drawn in proportion to
  *     luminance x sin(theta) (piecewise constant over its
  *     latitude-longitude cells, pbrt-v3 14.2.4);
- *   - the BSDF (rt/bsdf.h) samples the next direction, beta *= f cos / pdf.
+ *   - the BSDF (rt/render/bsdf.h) samples the next direction, beta *= f cos / pdf.
  * Light and BSDF samples are combined with the power heuristic (Veach 1997,
  * "Robust Monte Carlo Methods for Light Transport Simulation", ch. 9,
  * beta = 2), so a BSDF-sampled ray that hits a light counts with weight

@@ -1,4 +1,4 @@
-/* rt/bsdf.h - the path tracer's scattering functions: Lambert and the glTF
+/* rt/render/bsdf.h - the path tracer's scattering functions: Lambert and the glTF
  * metallic-roughness model (GGX microfacets, height-correlated Smith
  * masking-shadowing, Schlick Fresnel), with a smooth dielectric
  * transmission lobe for KHR_materials_transmission.

@@ -1,4 +1,4 @@
-/* rt/whitted.h - the classic ray tracer: Phong shading, mirrors, refraction
+/* rt/render/whitted.h - the classic ray tracer: Phong shading, mirrors, refraction
  * with exact Fresnel, shadows through glass, diffuse bounces.
  *
  *   rt_vec3 L = rt_radiance_whitted(&ctx, &ray, &rng);
