@@ -44,13 +44,13 @@ rt_vec3 rt_direct_lambert(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3
     }
     sum = rt_scale(rt_mul(sum, albedo), RT_INV_PI);
     /* environment light: one cosine-weighted ray */
-    rt_vec3 env_probe = rt_environment(ctx->state->scene, sf->n);
+    rt_vec3 env_probe = rt_environment(s, sf->n);
     if (s->settings.environment_texture != RT_NONE || rt_max3(env_probe) > 0.0f) {
         rt_vec3 h = rt_sample_cosine_hemisphere(rt_v2(rt_rng_float(rng), rt_rng_float(rng)));
         rt_vec3 d = rt_add(rt_add(rt_scale(sf->t, h.x), rt_scale(sf->b, h.y)), rt_scale(sf->n, h.z));
         if (rt_dot(d, sf->ng) > 0.0f) {
             rt_vec3 tr = rt_shadow_transmittance(ctx, sf, d, INFINITY);
-            sum = rt_add(sum, rt_mul(rt_mul(albedo, tr), rt_environment(ctx->state->scene, d)));
+            sum = rt_add(sum, rt_mul(rt_mul(albedo, tr), rt_environment(s, d)));
         }
     }
     return sum;
