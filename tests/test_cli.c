@@ -19,7 +19,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 
 static char dir[256];     /* this run's scratch directory */
 static char out_png[512]; /* the "earlier image" every failing run must leave alone */

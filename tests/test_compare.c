@@ -14,7 +14,7 @@
 
 #include "rt/image/compare.h"
 #include "rt/image/flip.h"
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 
 #include "../src/driver/commands.h"
 

@@ -20,7 +20,7 @@
 #include <stb/stb_image_write.h>
 
 #include "rt/io/gltf.h"
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"
 #include "rt/io/mesh_io.h"
 #include "rt/render/render.h"

@@ -24,10 +24,10 @@
 
 #include "rt/render/bsdf.h"
 #include "rt/render/camera.h"
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 #include "rt/render/integrator.h"
 #include "rt/accel/kdtree.h"
-#include "rt/render/path.h"
+#include "rt/render/pathtrace.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
 #include "rt/io/scene_parse.h"
@@ -36,8 +36,8 @@
 typedef struct fixture {
     rt_scene s;
     rt_kdtree tree;
+    rt_render_state rs;
     rt_trace_ctx ctx;
-    rt_light_table lt;
 } fixture;
 
 static void load(fixture *f, const char *text, bool table)
@@ -47,17 +47,14 @@ static void load(fixture *f, const char *text, bool table)
     if (rt_scene_parse_string(&f->s, text, strlen(text), "test", NULL, &err) != RT_OK)
         fail_msg("parse: %s", err.message);
     assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
-    rt_trace_ctx_init(&f->ctx, &f->s, &f->tree);
-    memset(&f->lt, 0, sizeof f->lt);
-    if (table) {
-        assert_int_equal(rt_light_table_build(&f->lt, &f->s, &err), RT_OK);
-        f->ctx.light_table = &f->lt;
-    }
+    assert_int_equal(rt_render_state_prepare(&f->rs, &f->s, &f->tree, table ? RT_PREPARE_LIGHT_TABLE : 0, &err),
+                     RT_OK);
+    rt_trace_ctx_init(&f->ctx, &f->rs);
 }
 
 static void unload(fixture *f)
 {
-    rt_light_table_free(&f->lt);
+    rt_render_state_free(&f->rs);
     rt_kdtree_free(&f->tree);
     rt_scene_free(&f->s);
 }
@@ -192,7 +189,7 @@ static void test_closed_furnace(void **state)
                      depths[d]);
             fixture f;
             load(&f, text, t == 1);
-            assert_int_equal(f.lt.count, t == 1 ? 1 : 0);
+            assert_int_equal(f.rs.light_table ? f.rs.light_table->count : 0, t == 1 ? 1 : 0);
             double a = 0.6, want = depths[d] ? (1.0 - pow(a, depths[d] + 1)) / (1.0 - a) : 1.0 / (1.0 - a);
             double sum = 0.0, sum2 = 0.0;
             const uint32_t n = 40000;
@@ -348,12 +345,9 @@ static void load_env(fixture *f, const char *text, float sky, float sun, bool ta
         fail_msg("parse: %s", err.message);
     add_env(&f->s, 64, 32, sky, sun, 40, 8);
     assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
-    rt_trace_ctx_init(&f->ctx, &f->s, &f->tree);
-    memset(&f->lt, 0, sizeof f->lt);
-    if (table) {
-        assert_int_equal(rt_light_table_build(&f->lt, &f->s, &err), RT_OK);
-        f->ctx.light_table = &f->lt;
-    }
+    assert_int_equal(rt_render_state_prepare(&f->rs, &f->s, &f->tree, table ? RT_PREPARE_LIGHT_TABLE : 0, &err),
+                     RT_OK);
+    rt_trace_ctx_init(&f->ctx, &f->rs);
 }
 
 /* The environment's sampling density integrates to 1 over the sphere. */
@@ -362,8 +356,8 @@ static void test_env_pdf_normalised(void **state)
     (void)state;
     fixture f;
     load_env(&f, "integrator path\n", 0.1f, 1000.0f, true);
-    assert_int_equal(f.lt.env_w, 64);
-    assert_int_equal(f.lt.env_h, 32);
+    assert_int_equal(f.rs.light_table->env_w, 64);
+    assert_int_equal(f.rs.light_table->env_h, 32);
     /* midpoint rule in (u, v), 16 x 16 points per cell (the cells' edges
      * fall between points), dw = 2 pi^2 sin(theta) du dv */
     double sum = 0.0;
@@ -373,7 +367,7 @@ static void test_env_pdf_normalised(void **state)
         for (int i = 0; i < nu; i++) {
             double u = (i + 0.5) / nu, phi = (u - 0.5) * 2.0 * 3.14159265358979;
             rt_vec3 d = rt_v3((float)(sin(theta) * sin(phi)), (float)cos(theta), (float)(sin(theta) * cos(phi)));
-            sum += rt_light_table_env_pdf(&f.lt, d) * sin(theta);
+            sum += rt_light_table_env_pdf(f.rs.light_table, d) * sin(theta);
         }
     }
     double integral = sum * 2.0 * 3.14159265358979 * 3.14159265358979 / ((double)nu * nv);
@@ -473,21 +467,22 @@ static void test_every_material_finite_and_deterministic(void **state)
     rt_framebuffer_free(&a);
     rt_framebuffer_free(&b);
     /* the same through the emitter table: every sample finite */
-    rt_light_table lt;
+    rt_render_state rs;
     rt_error err;
-    assert_int_equal(rt_light_table_build(&lt, &f.s, &err), RT_OK);
-    assert_int_equal(lt.count, 1); /* the lamp triangle (the area light's quad is a light already) */
-    f.ctx.light_table = &lt;
+    assert_int_equal(rt_render_state_prepare(&rs, &f.s, &f.tree, RT_PREPARE_LIGHT_TABLE, &err), RT_OK);
+    assert_int_equal(rs.light_table->count, 1); /* the lamp triangle (the area light's quad is a light already) */
+    rt_trace_ctx ctx;
+    rt_trace_ctx_init(&ctx, &rs);
     rt_camera_frame cf;
     rt_camera_frame_init(&cf, &f.s.camera, 48, 32);
     for (uint32_t i = 0; i < 48 * 32 * 4; i++) {
         uint32_t p = i / 4;
         rt_rng rng = rt_rng_for_sample(3, p, i % 4);
         rt_ray r = rt_camera_ray(&cf, (float)(p % 48) + 0.5f, (float)(p / 48) + 0.5f, rt_v2(0.5f, 0.5f));
-        rt_vec3 L = rt_radiance_path(&f.ctx, &r, &rng);
+        rt_vec3 L = rt_radiance_path(&ctx, &r, &rng);
         assert_true(rt_finite3(L) && L.x >= 0.0f && L.y >= 0.0f && L.z >= 0.0f);
     }
-    rt_light_table_free(&lt);
+    rt_render_state_free(&rs);
     unload(&f);
 }
 
@@ -526,7 +521,7 @@ static void test_cornell_reference(void **state)
     f.s.settings.width = f.s.settings.height = 64;
     f.s.settings.samples = 256;
     assert_int_equal(rt_kdtree_build(&f.tree, &f.s, NULL, &err), RT_OK);
-    memset(&f.lt, 0, sizeof f.lt);
+    memset(&f.rs, 0, sizeof f.rs);
     rt_framebuffer img;
     rt_render_stats st;
     render_fixture(&f, 0, &img, &st);
@@ -588,7 +583,7 @@ static void test_cornell_emissive_triangles(void **state)
     fixture f;
     load(&f, text, true);
     assert_int_equal(f.s.light_count, 0);
-    assert_int_equal(f.lt.count, 2);
+    assert_int_equal(f.rs.light_table->count, 2);
     rt_camera_frame cf;
     rt_camera_frame_init(&cf, &f.s.camera, 64, 64);
     double mine[3] = {0, 0, 0}, theirs[3] = {0, 0, 0};

@@ -1,15 +1,17 @@
 /* test_render.c - end-to-end renders checked against analytic values, the
- * thread-count independence of the image, and image output. */
+ * thread-count independence of the image, progress reports, and image
+ * output. */
 #include "test_util.h"
 
 #include <math.h>
 #include <unistd.h>
 
 #include "rt/render/camera.h"
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
+#include "rt/scene/validate.h"
 
 static uint32_t add_lambert(rt_scene *s, const char *name, rt_vec3 albedo)
 {
@@ -22,6 +24,7 @@ static uint32_t add_lambert(rt_scene *s, const char *name, rt_vec3 albedo)
 static void render_scene(rt_scene *s, int threads, int tile, rt_framebuffer *fb)
 {
     rt_error err = {0};
+    assert_int_equal(rt_scene_validate(s, &err), RT_OK);
     rt_kdtree tree;
     assert_int_equal(rt_kdtree_build(&tree, s, NULL, &err), RT_OK);
     assert_int_equal(rt_framebuffer_init(fb, s->settings.width, s->settings.height, &err), RT_OK);
@@ -154,6 +157,84 @@ static void test_same_image_any_thread_count(void **state)
     rt_scene_free(&s);
 }
 
+/* What a progress callback sees: reports in order, the last one final with
+ * every tile done, tiles that cover the image exactly once, and finished
+ * tiles whose pixels are already the final ones (what --preview shows). */
+typedef struct progress_log {
+    int calls, finals, last_done;
+    bool final_was_last;
+    int *covered;   /* per pixel: how many tiles of the final report cover it */
+    float *seen;    /* pixels copied from finished tiles during the reports */
+} progress_log;
+
+static void log_progress(const rt_render_progress *p, void *user)
+{
+    progress_log *log = user;
+    log->calls++;
+    assert_true(p->tiles_done >= log->last_done && p->tiles_done <= p->tiles_total);
+    log->last_done = p->tiles_done;
+    log->final_was_last = p->final;
+    if (p->final) {
+        log->finals++;
+        assert_int_equal(p->tiles_done, p->tiles_total);
+    }
+    for (int i = 0; i < p->tiles_total; i++) {
+        rt_tile t = rt_render_progress_tile(p, i);
+        assert_true(t.x0 >= 0 && t.x0 < t.x1 && t.x1 <= p->fb->width);
+        assert_true(t.y0 >= 0 && t.y0 < t.y1 && t.y1 <= p->fb->height);
+        if (p->final)
+            assert_true(t.finished);
+        if (!t.finished)
+            continue;
+        for (int y = t.y0; y < t.y1; y++)
+            for (int x = t.x0; x < t.x1; x++) {
+                size_t k = (size_t)y * (size_t)p->fb->width + (size_t)x;
+                if (p->final)
+                    log->covered[k]++;
+                memcpy(log->seen + 3 * k, p->fb->rgb + 3 * k, 3 * sizeof(float));
+            }
+    }
+}
+
+static void test_progress_reports(void **state)
+{
+    (void)state;
+    rt_scene s;
+    build_busy_scene(&s);
+    s.settings.samples = 16;
+    rt_error err = {0};
+    assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
+    rt_kdtree tree;
+    assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
+    rt_framebuffer fb;
+    assert_int_equal(rt_framebuffer_init(&fb, s.settings.width, s.settings.height, &err), RT_OK);
+    size_t npx = (size_t)fb.width * (size_t)fb.height;
+    progress_log log;
+    memset(&log, 0, sizeof log);
+    log.covered = calloc(npx, sizeof *log.covered);
+    log.seen = calloc(3 * npx, sizeof *log.seen);
+    assert_true(log.covered && log.seen);
+    rt_render_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.threads = 2;
+    opt.tile_size = 7; /* edge tiles are cut short */
+    opt.progress = log_progress;
+    opt.progress_user = &log;
+    rt_render_stats st;
+    assert_int_equal(rt_render(&s, &tree, &opt, &fb, &st, &err), RT_OK);
+    assert_true(log.calls >= 1);
+    assert_int_equal(log.finals, 1);
+    assert_true(log.final_was_last);
+    for (size_t k = 0; k < npx; k++)
+        assert_int_equal(log.covered[k], 1);
+    assert_memory_equal(log.seen, fb.rgb, 3 * npx * sizeof(float));
+    free(log.covered);
+    free(log.seen);
+    rt_framebuffer_free(&fb);
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
 /* The area light's visible quad shows its radiance from below and nothing from above. */
 static void test_area_light_visible_one_sided(void **state)
 {
@@ -219,6 +300,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_lambert_plane_point_light),
         cmocka_unit_test(test_same_image_any_thread_count),
+        cmocka_unit_test(test_progress_reports),
         cmocka_unit_test(test_area_light_visible_one_sided),
         cmocka_unit_test(test_pfm_roundtrip_and_atomic_write),
     };

@@ -10,13 +10,14 @@
 #include <math.h>
 
 #include "rt/io/gltf.h"
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
-#include "rt/render/shade.h"
+#include "rt/render/surface.h"
 #include "rt/scene/tangents.h"
 #include "rt/scene/texture.h"
+#include "rt/scene/validate.h"
 
 static bool near3(rt_vec3 a, rt_vec3 b, float eps)
 {
@@ -86,12 +87,16 @@ static void add_square_mesh(rt_scene *s, const rt_mat4 *xf, uint32_t material, b
  * seen along -n from outside. */
 static rt_surface surface(const rt_scene *s, uint32_t prim, float u, float v, rt_vec3 p_expect, rt_vec3 view_dir)
 {
+    rt_render_state rs;
+    rt_error err;
+    assert_int_equal(rt_render_state_prepare(&rs, s, NULL, 0, &err), RT_OK);
     rt_trace_ctx ctx;
-    rt_trace_ctx_init(&ctx, s, NULL);
+    rt_trace_ctx_init(&ctx, &rs);
     rt_ray r = rt_ray_make(rt_sub(p_expect, view_dir), view_dir, 0.0f, INFINITY);
     rt_hit h = {1.0f, u, v, prim};
     rt_surface sf;
     rt_surface_at(&ctx, &r, &h, &sf);
+    rt_render_state_free(&rs);
     return sf;
 }
 
@@ -226,12 +231,16 @@ static void test_uv_conventions(void **state)
     m.color = rt_v3s(1);
     mi = rt_scene_add_material(&s, &m);
     rt_scene_add_quad(&s, rt_v3(0, 0, 0), rt_v3(1, 0, 0), rt_v3(0, 1, 0), mi);
+    rt_render_state rs;
+    rt_error err;
+    assert_int_equal(rt_render_state_prepare(&rs, &s, NULL, 0, &err), RT_OK);
     rt_trace_ctx ctx;
-    rt_trace_ctx_init(&ctx, &s, NULL);
+    rt_trace_ctx_init(&ctx, &rs);
     sf = surface(&s, 0, 0.1f, 0.9f, rt_v3(0.1f, 0.9f, 0), rt_v3(0, 0, -1));
     assert_true(rt_surface_base_color(&ctx, &sf).x == 1.0f);
     sf = surface(&s, 0, 0.1f, 0.1f, rt_v3(0.1f, 0.1f, 0), rt_v3(0, 0, -1));
     assert_true(rt_surface_base_color(&ctx, &sf).x == 0.0f);
+    rt_render_state_free(&rs);
     rt_scene_free(&s);
 }
 
@@ -278,6 +287,7 @@ static void render_all(int map_kind, rt_framebuffer *fb)
     s.camera_set = true;
     rt_error err = {0};
     assert_int_equal(rt_scene_generate_tangents(&s, &err), RT_OK);
+    assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
     rt_kdtree tree;
     assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
     assert_int_equal(rt_framebuffer_init(fb, s.settings.width, s.settings.height, &err), RT_OK);
@@ -427,8 +437,10 @@ static void check_domes(const char *rel, size_t expect_domes)
     assert_int_equal(rt_scene_generate_tangents(&s, &err), RT_OK);
     rt_kdtree tree;
     assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
+    rt_render_state rs;
+    assert_int_equal(rt_render_state_prepare(&rs, &s, &tree, 0, &err), RT_OK);
     rt_trace_ctx ctx;
-    rt_trace_ctx_init(&ctx, &s, &tree);
+    rt_trace_ctx_init(&ctx, &rs);
     rt_box b = rt_scene_bounds(&s);
     enum { W = 640, H = 512 };
     float *dx = calloc((size_t)W * H, sizeof *dx), *dy = calloc((size_t)W * H, sizeof *dy);
@@ -499,6 +511,7 @@ static void check_domes(const char *rel, size_t expect_domes)
     free(dy);
     free(label);
     free(stack);
+    rt_render_state_free(&rs);
     rt_kdtree_free(&tree);
     rt_scene_free(&s);
 }

@@ -9,7 +9,7 @@
 #include <math.h>
 #include <unistd.h>
 
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 #include "rt/scene/scene.h"
 #include "rt/io/scene_parse.h"
 #include "rt/scene/texture.h"

@@ -8,12 +8,13 @@
 
 #include <math.h>
 
-#include "rt/io/image.h"
-#include "rt/render/integrator.h"
+#include "rt/io/framebuffer.h"
+#include "rt/render/direct.h"
 #include "rt/accel/kdtree.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/texture.h"
+#include "rt/scene/validate.h"
 #include "rt/render/whitted.h"
 
 /* ------------------------------------------------------------ optics */
@@ -149,14 +150,23 @@ static void test_snell(void **state)
 
 typedef struct built {
     rt_kdtree tree;
+    rt_render_state rs;
     rt_trace_ctx ctx;
 } built;
 
 static void build(built *b, rt_scene *s)
 {
     rt_error err = {0};
+    assert_int_equal(rt_scene_validate(s, &err), RT_OK);
     assert_int_equal(rt_kdtree_build(&b->tree, s, NULL, &err), RT_OK);
-    rt_trace_ctx_init(&b->ctx, s, &b->tree);
+    assert_int_equal(rt_render_state_prepare(&b->rs, s, &b->tree, 0, &err), RT_OK);
+    rt_trace_ctx_init(&b->ctx, &b->rs);
+}
+
+static void unbuild(built *b)
+{
+    rt_render_state_free(&b->rs);
+    rt_kdtree_free(&b->tree);
 }
 
 static rt_vec3 radiance(built *b, rt_vec3 org, rt_vec3 dir)
@@ -230,12 +240,12 @@ static void test_glass_slab(void **state)
     assert_true(fabs(L.y - T * T) < 1e-4 && fabs(L.z - T * T) < 1e-4);
     /* a little to either side of the predicted exit misses the emitter: the
      * ray really lands there (1 cm target) and not at the straight line */
-    rt_kdtree_free(&b.tree);
+    unbuild(&b);
     s.quads.px[2] += 0.05f;
     build(&b, &s);
     L = radiance(&b, rt_v3(0, 1, 0), rt_v3((float)sin(th), (float)-cos(th), 0));
     assert_true(L.x == 0.0f);
-    rt_kdtree_free(&b.tree);
+    unbuild(&b);
     rt_scene_free(&s);
 }
 
@@ -291,7 +301,7 @@ static void test_mirror_shows_wall(void **state)
         assert_true(fabsf(fb.rgb[3 * i + 2] - R * C.z) < 1e-5f);
     }
     rt_framebuffer_free(&fb);
-    rt_kdtree_free(&b.tree);
+    unbuild(&b);
     rt_scene_free(&s);
 }
 
@@ -324,7 +334,7 @@ static void floor_image(const rt_material *sphere_mat, float *out, int n)
             rt_vec3 L = radiance(&b, org, rt_sub(target, org));
             out[y * n + x] = rt_luminance(L);
         }
-    rt_kdtree_free(&b.tree);
+    unbuild(&b);
     rt_scene_free(&s);
 }
 
@@ -376,7 +386,7 @@ static void test_transparent_sphere_no_shadow(void **state)
     rt_vec3 L = radiance(&b, rt_v3(3, 0.5f, 0), rt_v3(-3, -0.5f, 0));
     float expect = 9.0f / 9.0f * RT_INV_PI * 0.25f; /* E = I / d^2 = 1, times 0.5^2 */
     assert_true(fabsf(L.x - expect) < 1e-5f);
-    rt_kdtree_free(&b.tree);
+    unbuild(&b);
     rt_scene_free(&s);
 }
 
@@ -416,7 +426,7 @@ static void nested_image(float inner_ior, bool with_inner, float *out, int n)
             rt_vec3 target = rt_v3(-0.6f + 1.2f * (x + 0.5f) / n, -0.6f + 1.2f * (y + 0.5f) / n, 0);
             out[y * n + x] = rt_luminance(radiance(&b, org, rt_sub(target, org)));
         }
-    rt_kdtree_free(&b.tree);
+    unbuild(&b);
     rt_scene_free(&s);
 }
 
@@ -490,7 +500,7 @@ static void test_finite(void **state)
         assert_true(rt_finite3(L));
         assert_true(L.x >= 0.0f && L.y >= 0.0f && L.z >= 0.0f);
     }
-    rt_kdtree_free(&b.tree);
+    unbuild(&b);
     rt_scene_free(&s);
 }
 
@@ -524,7 +534,7 @@ static void test_diffuse_bounces_furnace(void **state)
             rt_vec3 got = radiance(&b, rt_v3(0.3f, 0.1f * i, 0), rt_v3(0.2f * i - 0.4f, 1, 0.3f));
             assert_true(fabs(got.x - L) < 1e-5 * L);
         }
-        rt_kdtree_free(&b.tree);
+        unbuild(&b);
         rt_scene_free(&s);
     }
 }
@@ -564,7 +574,7 @@ static float area_light_floor(int occluder) /* 0 none, 1 half, 2 full */
     float sum = 0;
     for (int i = 0; i < 8; i++) /* several rng streams: average out the jitter */
         sum += rt_luminance(radiance(&b, rt_v3(0, 0.5f, 0.5f), rt_v3(0, -0.5f, -0.5f + 1e-4f * i)));
-    rt_kdtree_free(&b.tree);
+    unbuild(&b);
     rt_scene_free(&s);
     return sum / 8;
 }
@@ -625,14 +635,14 @@ static void test_ambient_default(void **state)
         assert_true(fabsf(L.x - 0.5f * 1.0f * expect_a.x) < 1e-3f * expect_a.x);
         assert_true(fabsf(L.y - 0.5f * 0.5f * expect_a.y) < 1e-3f * expect_a.y);
         assert_true(fabsf(L.z - 0.5f * 0.25f * expect_a.z) < 1e-3f * expect_a.z);
-        rt_kdtree_free(&b.tree);
+        unbuild(&b);
         /* an explicit ambient_light wins */
         s.settings.ambient_light = rt_v3s(2.0f);
         s.settings.ambient_light_set = true;
         build(&b, &s);
         L = radiance(&b, rt_v3(0, 1, 0), rt_v3(0.1f, -1, 0.2f));
         assert_true(fabsf(L.x - 1.0f) < 1e-6f && fabsf(L.z - 0.25f) < 1e-6f);
-        rt_kdtree_free(&b.tree);
+        unbuild(&b);
         rt_scene_free(&s);
     }
 }
@@ -664,7 +674,7 @@ static void test_matches_direct(void **state)
         float expect = 0.6f * RT_INV_PI * 10.0f * (l.y / sqrtf(d2)) / d2;
         assert_true(fabsf(Lw.x - expect) < 1e-4f * expect);
     }
-    rt_kdtree_free(&b.tree);
+    unbuild(&b);
     rt_scene_free(&s);
 }
 

@@ -16,7 +16,7 @@
 
 #include "rt/image/compare.h"
 #include "rt/image/flip.h"
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 #include "rt/scene/texture.h"
 
 static const char usage[] =

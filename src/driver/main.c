@@ -1,7 +1,8 @@
 /* main.c - the `rt` command: the pipeline, one step a line. Parse the flags
- * (args.c), load the scene or model, apply the setting flags, frame the
- * camera and check the limits, build the kd-tree, render on all cores, write
- * the image.
+ * (args.c), load the scene or model, validate it, apply the setting flags,
+ * frame the camera and check the limits, build the kd-tree, render on all
+ * cores (progress.c draws the progress bar and the live preview), write the
+ * image.
  *
  * Exit status: 0 on success, 2 for bad input (flags, scene files, models,
  * images, an unwritable output), 130 when interrupted (the finished tiles
@@ -14,18 +15,22 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "rt/render/camera.h"
 #include "rt/accel/kdtree.h"
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 #include "rt/io/load.h"
+#include "rt/render/integrator.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/settings.h"
+#include "rt/scene/validate.h"
 
 #include "args.h"
 #include "commands.h"
 #include "memory_budget.h"
+#include "progress.h"
 
 /* The kd-tree's primitive ids are the 30 payload bits of its references
  * (RT_KD_PAYLOAD, rt/accel/kdtree.h), one value kept free. */
@@ -173,8 +178,13 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     rt_load_info info;
     rt_load_options lo = {.for_render = true};
     rt_result r;
-    if ((r = rt_load(scene, a->input, &lo, &info, err)) != RT_OK ||
-        (r = args_apply_settings(a, scene, err)) != RT_OK)
+    if ((r = rt_load(scene, a->input, &lo, &info, err)) != RT_OK)
+        return r;
+    if ((r = rt_scene_validate(scene, err)) != RT_OK) { /* from here on the tables are trusted */
+        rt_error inner = *err;
+        return rt_fail(err, inner.code, "%s: %s", a->input ? a->input : "<built-in scene>", inner.message);
+    }
+    if ((r = args_apply_settings(a, scene, err)) != RT_OK)
         return r;
     rt_settings *set = &scene->settings;
     if (a->camera >= 0) {
@@ -209,9 +219,7 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     rt_info("  materials %zu, textures %zu, images %zu, lights %zu", scene->material_count, scene->texture_count,
             scene->image_count, scene->light_count);
     rt_info("  %dx%d, %d samples per pixel, integrator %s", set->width, set->height, set->samples,
-            set->integrator == RT_INTEGRATOR_WHITTED ? "whitted"
-            : set->integrator == RT_INTEGRATOR_PATH  ? "path"
-                                                     : "direct");
+            rt_integrator_name(set->integrator));
     return RT_OK;
 }
 
@@ -245,14 +253,16 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
+    progress_view view;
+    progress_view_init(&view, a->log_level >= RT_LOG_NORMAL && isatty(2), a->preview_seconds > 0.0 ? output : NULL,
+                       a->preview_seconds, set->exposure);
     rt_render_options ro;
     memset(&ro, 0, sizeof ro);
     ro.threads = a->threads;
     ro.tile_size = a->tile;
-    ro.progress = a->log_level >= RT_LOG_NORMAL;
     ro.cancel = &interrupted;
-    ro.preview_path = a->preview_seconds > 0.0 ? output : NULL;
-    ro.preview_seconds = a->preview_seconds;
+    ro.progress = view.bar || view.preview_path ? progress_report : NULL;
+    ro.progress_user = &view;
     rt_render_stats rs;
     rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);
     int status = 0;

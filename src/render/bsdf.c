@@ -1,5 +1,5 @@
 /* bsdf.c - Lambert and the glTF metallic-roughness BSDF for the path
- * tracer: evaluation, pdf and importance sampling (see rt/bsdf.h).
+ * tracer: evaluation, pdf and importance sampling (see rt/render/bsdf.h).
  *
  * Sources:
  * - The BRDF: glTF 2.0 specification, appendix B "BRDF Implementation"
@@ -177,13 +177,9 @@ void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float rou
 
 void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
 {
-    const rt_scene *s = ctx->scene;
-    rt_material fallback;
-    const rt_material *m = s->material_count ? &s->materials[sf->material] : NULL;
-    if (!m) {
-        rt_material_default(&fallback, "default");
-        m = &fallback;
-    }
+    const rt_scene *s = ctx->state->scene;
+    RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
+    const rt_material *m = &s->materials[sf->material];
     /* frame: the shading normal, unless wo is not above it (normal maps,
      * interpolated normals at silhouettes); then the geometric normal */
     rt_vec3 n = sf->n;

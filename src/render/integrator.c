@@ -1,96 +1,78 @@
-/* integrator.c - integrator dispatch and the `direct` integrator.
- *
- * Direct lighting at a Lambertian surface: for a point light of intensity I
- * at distance r, L = albedo / pi * I * cos(theta) / r^2; for an area light
- * of radiance Le the estimator averages Le * A * cos(theta) * cos(theta_l) /
- * d^2 over stratified points on it (uniform area sampling); directional
- * lights give albedo / pi * E * cos(theta). The environment is sampled with
- * one cosine-distributed ray, whose pdf cancels the cosine and the 1/pi.
- * Alpha-tested surfaces are stepped through; blended ones mixed by alpha.
+/* integrator.c - the integrator table and lookups in it: names for the
+ * scene format and the command line, the radiance function rt_render's
+ * workers call, and what each needs in the render state.
  */
 #include "rt/render/integrator.h"
 
-#include "rt/render/path.h"
+#include <stdio.h>
+#include <string.h>
+
+#include "rt/render/direct.h"
+#include "rt/render/pathtrace.h"
 #include "rt/render/whitted.h"
 
-rt_vec3 rt_direct_lambert(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 albedo, rt_rng *rng)
+/* One line an integrator: id, name, radiance function, what it needs
+ * prepared. The built-in ids (rt_integrator in rt/scene/scene.h) are pinned
+ * to their lines; a new integrator takes the next number. */
+#define INTEGRATORS(X)                                                                                                 \
+    X(RT_INTEGRATOR_DIRECT, "direct", rt_radiance_direct, 0)                                                           \
+    X(RT_INTEGRATOR_WHITTED, "whitted", rt_radiance_whitted, 0)                                                        \
+    X(RT_INTEGRATOR_PATH, "path", rt_radiance_path, RT_PREPARE_LIGHT_TABLE)
+
+#define AS_INFO(id, name, fn, prepare) [id] = {name, fn, prepare},
+#define AS_WORD(id, name, fn, prepare) [id] = name,
+static const rt_integrator_info integrators[] = {INTEGRATORS(AS_INFO)};
+const char *const rt_integrator_words[] = {INTEGRATORS(AS_WORD) NULL};
+#undef AS_INFO
+#undef AS_WORD
+
+enum { INTEGRATOR_COUNT = sizeof integrators / sizeof integrators[0] };
+
+size_t rt_integrator_count(void)
 {
-    const rt_scene *s = ctx->scene;
-    rt_vec3 sum = rt_v3s(0);
-    if (rt_max3(albedo) <= 0.0f)
-        return sum;
-    int area_samples = s->settings.shadow_samples > 0 ? s->settings.shadow_samples : 1;
-    uint32_t pattern = rt_rng_u32(rng);
-    for (size_t i = 0; i < s->light_count; i++) {
-        const rt_light *l = &s->lights[i];
-        int n = l->kind == RT_LIGHT_AREA ? area_samples : 1;
-        rt_vec3 acc = rt_v3s(0);
-        for (int k = 0; k < n; k++) {
-            rt_vec2 u = n > 1 ? rt_cmj_sample((uint32_t)k, (uint32_t)n, pattern + (uint32_t)i)
-                              : rt_v2(rt_rng_float(rng), rt_rng_float(rng));
-            rt_light_sample ls;
-            if (!rt_light_sample_at(ctx, l, sf->p, u, &ls))
-                continue;
-            float cos_n = rt_dot(sf->n, ls.wi);
-            if (cos_n <= 0.0f || rt_dot(sf->ng, ls.wi) <= 0.0f)
-                continue; /* light behind the shading or the geometric surface */
-            rt_vec3 tr = rt_shadow_transmittance(ctx, sf, ls.wi, ls.dist);
-            if (rt_max3(tr) <= 0.0f)
-                continue;
-            acc = rt_add(acc, rt_scale(rt_mul(ls.li, tr), cos_n));
-        }
-        sum = rt_add(sum, rt_scale(acc, 1.0f / (float)n));
-    }
-    sum = rt_scale(rt_mul(sum, albedo), RT_INV_PI);
-    /* environment light: one cosine-weighted ray */
-    rt_vec3 env_probe = rt_environment(ctx, sf->n);
-    if (s->settings.environment_texture != RT_NONE || rt_max3(env_probe) > 0.0f) {
-        rt_vec3 h = rt_sample_cosine_hemisphere(rt_v2(rt_rng_float(rng), rt_rng_float(rng)));
-        rt_vec3 d = rt_add(rt_add(rt_scale(sf->t, h.x), rt_scale(sf->b, h.y)), rt_scale(sf->n, h.z));
-        if (rt_dot(d, sf->ng) > 0.0f) {
-            rt_vec3 tr = rt_shadow_transmittance(ctx, sf, d, INFINITY);
-            sum = rt_add(sum, rt_mul(rt_mul(albedo, tr), rt_environment(ctx, d)));
-        }
-    }
-    return sum;
+    return INTEGRATOR_COUNT;
 }
 
-rt_vec3 rt_radiance_direct(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng)
+const rt_integrator_info *rt_integrator_info_of(rt_integrator id)
 {
-    rt_ray r = *ray;
-    rt_vec3 result = rt_v3s(0), weight = rt_v3s(1);
-    for (int layer = 0; layer < 32; layer++) {
-        rt_hit hit;
-        if (!rt_trace(ctx, &r, &hit))
-            return rt_add(result, rt_mul(weight, rt_environment(ctx, r.dir)));
-        rt_surface sf;
-        rt_surface_at(ctx, &r, &hit, &sf);
-        float coverage;
-        if (rt_surface_cut_away(ctx, &sf, &coverage)) {
-            r.tmin = hit.t;
-            continue;
+    return (size_t)id < INTEGRATOR_COUNT ? &integrators[id] : NULL;
+}
+
+bool rt_integrator_by_name(const char *name, rt_integrator *id)
+{
+    for (size_t i = 0; name && i < INTEGRATOR_COUNT; i++) {
+        if (strcmp(name, integrators[i].name) == 0) {
+            *id = (rt_integrator)i;
+            return true;
         }
-        rt_vec4 base = rt_surface_base_color(ctx, &sf);
-        rt_vec3 L = rt_surface_emission(ctx, &sf);
-        L = rt_add(L, rt_direct_lambert(ctx, &sf, rt_v3(base.x, base.y, base.z), rng));
-        result = rt_add(result, rt_mul(weight, rt_scale(L, coverage)));
-        if (coverage >= 1.0f)
-            return result;
-        weight = rt_scale(weight, 1.0f - coverage);
-        r.tmin = hit.t;
     }
-    return result;
+    return false;
+}
+
+const char *rt_integrator_name(rt_integrator id)
+{
+    const rt_integrator_info *in = rt_integrator_info_of(id);
+    return in ? in->name : NULL;
+}
+
+void rt_integrator_list(char *buf, size_t size, const char *sep, const char *last_sep)
+{
+    if (!size)
+        return;
+    buf[0] = '\0';
+    size_t n = 0;
+    for (size_t i = 0; i < INTEGRATOR_COUNT && n < size; i++) {
+        const char *between = i == 0 ? "" : (i + 1 == INTEGRATOR_COUNT ? last_sep : sep);
+        int k = snprintf(buf + n, size - n, "%s%s", between, integrators[i].name);
+        if (k < 0)
+            break;
+        n += (size_t)k;
+    }
 }
 
 rt_vec3 rt_radiance(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng)
 {
-    switch (ctx->scene->settings.integrator) {
-    case RT_INTEGRATOR_WHITTED:
-        return rt_radiance_whitted(ctx, ray, rng);
-    case RT_INTEGRATOR_PATH:
-        return rt_radiance_path(ctx, ray, rng);
-    case RT_INTEGRATOR_DIRECT:
-    default:
-        return rt_radiance_direct(ctx, ray, rng);
-    }
+    const rt_integrator_info *in = rt_integrator_info_of(ctx->state->scene->settings.integrator);
+    RT_DCHECK(in != NULL);
+    return in->radiance(ctx, ray, rng);
 }

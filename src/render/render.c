@@ -1,5 +1,5 @@
-/* render.c - the tile queue and its worker threads, the pixel loop, the
- * progress bar and the live preview.
+/* render.c - the tile queue and its worker threads, the pixel loop, and
+ * progress reports to the caller (which draws them: src/driver/progress.c).
  *
  * Pixel estimate: the box-filtered average of `samples` radiance samples at
  * correlated multi-jittered positions in the pixel (Kensler 2013), so any
@@ -10,7 +10,6 @@
 #include "rt/render/render.h"
 
 #include <pthread.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -18,8 +17,8 @@
 
 #include "rt/render/camera.h"
 #include "rt/render/integrator.h"
-#include "rt/render/path.h"
 #include "rt/render/sampling.h"
+#include "rt/scene/validate.h"
 
 int rt_cpu_count(void)
 {
@@ -34,9 +33,8 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-typedef struct render_job {
+struct rt_render_job {
     const rt_scene *scene;
-    const rt_kdtree *tree;
     rt_framebuffer *fb;
     rt_camera_frame camera;
     int tile_size, tiles_x, tiles_y, tiles_total;
@@ -44,19 +42,21 @@ typedef struct render_job {
     atomic_int tiles_done;
     atomic_uchar *tile_finished; /* per tile: 1 once its pixels are final */
     atomic_int *cancel;
-    const rt_light_table *lights; /* path tracer's emitter table, shared read-only */
-} render_job;
+    const rt_render_state *state; /* prepared once, read by every worker */
+    rt_radiance_fn radiance;      /* the scene's integrator */
+};
+typedef struct rt_render_job rt_render_job;
 
 typedef struct worker {
     pthread_t thread;
-    render_job *job;
+    rt_render_job *job;
     uint64_t rays, camera_rays, bad_samples;
 } worker;
 
 /* Renders one tile; false when cancelled part-way (the tile then stays
  * unfinished and is cleared to black). The cancel flag is read once a
  * pixel, so Ctrl-C is answered within a pixel's samples, not a tile's. */
-static bool render_tile(render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
+static bool render_tile(rt_render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
 {
     const rt_settings *st = &job->scene->settings;
     int tx = tile % job->tiles_x, ty = tile / job->tiles_x;
@@ -79,7 +79,7 @@ static bool render_tile(render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
                 rt_ray ray = rt_camera_ray(&job->camera, (float)x + j.x, (float)y + j.y, lens);
                 rt_rng rng = rt_rng_for_sample(st->seed, pixel, s);
                 w->camera_rays++;
-                rt_vec3 L = rt_radiance(ctx, &ray, &rng);
+                rt_vec3 L = job->radiance(ctx, &ray, &rng);
                 if (!rt_finite3(L) || L.x < 0.0f || L.y < 0.0f || L.z < 0.0f) {
                     w->bad_samples++;
                     continue;
@@ -106,10 +106,9 @@ static bool render_tile(render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
 static void *worker_main(void *arg)
 {
     worker *w = arg;
-    render_job *job = w->job;
+    rt_render_job *job = w->job;
     rt_trace_ctx ctx;
-    rt_trace_ctx_init(&ctx, job->scene, job->tree);
-    ctx.light_table = job->lights;
+    rt_trace_ctx_init(&ctx, job->state);
     ctx.ray_count = &w->rays;
     for (;;) {
         if (job->cancel && atomic_load(job->cancel))
@@ -125,49 +124,17 @@ static void *worker_main(void *arg)
     return NULL;
 }
 
-static void draw_progress(int done, int total, double elapsed, bool final)
+rt_tile rt_render_progress_tile(const rt_render_progress *p, int index)
 {
-    const int width = 30;
-    double f = total ? (double)done / total : 1.0;
-    int bar = (int)(f * width + 0.5);
-    char line[128];
-    int n = 0;
-    line[n++] = '[';
-    for (int i = 0; i < width; i++)
-        line[n++] = i < bar ? '#' : ' ';
-    line[n++] = ']';
-    line[n] = 0;
-    double eta = (done > 0 && done < total) ? elapsed * (total - done) / done : 0.0;
-    fprintf(stderr, "\r%s %5.1f%%  %6.1fs elapsed", line, 100.0 * f, elapsed);
-    if (!final && done > 0)
-        fprintf(stderr, "  ETA %6.1fs ", eta);
-    else
-        fprintf(stderr, "              ");
-    if (final)
-        fputc('\n', stderr);
-    fflush(stderr);
-}
-
-/* Live view: a copy of the framebuffer where unfinished tiles are dim grey. */
-static void write_preview(render_job *job, const char *path)
-{
-    rt_framebuffer copy;
-    rt_error err;
-    if (rt_framebuffer_init(&copy, job->fb->width, job->fb->height, &err) != RT_OK)
-        return;
-    for (int t = 0; t < job->tiles_total; t++) {
-        bool fin = atomic_load(&job->tile_finished[t]);
-        int tx = t % job->tiles_x, ty = t / job->tiles_x;
-        for (int y = ty * job->tile_size; y < (ty + 1) * job->tile_size && y < copy.height; y++)
-            for (int x = tx * job->tile_size; x < (tx + 1) * job->tile_size && x < copy.width; x++) {
-                size_t i = 3 * ((size_t)y * (size_t)copy.width + (size_t)x);
-                for (int c = 0; c < 3; c++)
-                    copy.rgb[i + c] = fin ? job->fb->rgb[i + c] : 0.02f;
-            }
-    }
-    if (rt_framebuffer_write(&copy, path, job->scene->settings.exposure, &err) != RT_OK)
-        rt_warn("live preview: %s", err.message);
-    rt_framebuffer_free(&copy);
+    const rt_render_job *job = p->job;
+    rt_tile t;
+    int tx = index % job->tiles_x, ty = index / job->tiles_x;
+    t.x0 = tx * job->tile_size;
+    t.y0 = ty * job->tile_size;
+    t.x1 = t.x0 + job->tile_size < job->fb->width ? t.x0 + job->tile_size : job->fb->width;
+    t.y1 = t.y0 + job->tile_size < job->fb->height ? t.y0 + job->tile_size : job->fb->height;
+    t.finished = atomic_load(&job->tile_finished[index]) != 0;
+    return t;
 }
 
 rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_render_options *options,
@@ -180,14 +147,18 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     rt_render_stats st;
     memset(&st, 0, sizeof st);
     const rt_settings *set = &scene->settings;
+    RT_DCHECK(rt_scene_validate(scene, NULL) == RT_OK);
     if (fb->width != set->width || fb->height != set->height || !fb->rgb)
         return rt_fail(err, RT_ERR_INVALID, "framebuffer is %dx%d but the scene asks for %dx%d", fb->width,
                        fb->height, set->width, set->height);
+    const rt_integrator_info *integrator = rt_integrator_info_of(set->integrator);
+    if (!integrator)
+        return rt_fail(err, RT_ERR_INVALID, "integrator %d is not one of the %zu rt knows", (int)set->integrator,
+                       rt_integrator_count());
 
-    render_job job;
+    rt_render_job job;
     memset(&job, 0, sizeof job);
     job.scene = scene;
-    job.tree = tree;
     job.fb = fb;
     job.cancel = opt.cancel;
     rt_camera_frame_init(&job.camera, &scene->camera, fb->width, fb->height);
@@ -212,18 +183,16 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     }
     for (int t = 0; t < job.tiles_total; t++)
         atomic_init(&job.tile_finished[t], 0);
-    /* the path tracer's emitter table: built once, before the workers */
-    rt_light_table lights;
-    memset(&lights, 0, sizeof lights);
-    if (set->integrator == RT_INTEGRATOR_PATH) {
-        rt_result lr = rt_light_table_build(&lights, scene, err);
-        if (lr != RT_OK) {
-            free(job.tile_finished);
-            free(workers);
-            return lr;
-        }
-        job.lights = &lights;
+    /* what the integrator reads, derived once, before the workers start */
+    rt_render_state state;
+    rt_result sr = rt_render_state_prepare(&state, scene, tree, integrator->prepare, err);
+    if (sr != RT_OK) {
+        free(job.tile_finished);
+        free(workers);
+        return sr;
     }
+    job.state = &state;
+    job.radiance = integrator->radiance;
 
     double t0 = now_seconds();
     int started = 0;
@@ -241,21 +210,21 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
         workers[0].job = &job;
         worker_main(&workers[0]);
     }
-    bool show = opt.progress && isatty(2);
-    double preview_every = opt.preview_seconds > 0 ? opt.preview_seconds : 2.0;
-    double last_preview = t0;
+    rt_render_progress progress;
+    memset(&progress, 0, sizeof progress);
+    progress.tiles_total = job.tiles_total;
+    progress.fb = fb;
+    progress.job = &job;
     if (started > 0) {
         while (atomic_load(&job.tiles_done) < job.tiles_total) {
             if (job.cancel && atomic_load(job.cancel))
                 break;
             struct timespec ts = {0, 50 * 1000 * 1000};
             nanosleep(&ts, NULL);
-            double t = now_seconds();
-            if (show)
-                draw_progress(atomic_load(&job.tiles_done), job.tiles_total, t - t0, false);
-            if (opt.preview_path && t - last_preview >= preview_every) {
-                write_preview(&job, opt.preview_path);
-                last_preview = t;
+            if (opt.progress) {
+                progress.tiles_done = atomic_load(&job.tiles_done);
+                progress.elapsed = now_seconds() - t0;
+                opt.progress(&progress, opt.progress_user);
             }
         }
         for (int i = 0; i < started; i++)
@@ -270,8 +239,12 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
         st.camera_rays += workers[i].camera_rays;
         st.bad_samples += workers[i].bad_samples;
     }
-    if (show)
-        draw_progress(st.tiles_done, job.tiles_total, st.seconds, true);
+    if (opt.progress) {
+        progress.tiles_done = st.tiles_done;
+        progress.elapsed = st.seconds;
+        progress.final = true;
+        opt.progress(&progress, opt.progress_user);
+    }
     st.interrupted = st.tiles_done < job.tiles_total;
     if (st.interrupted) {
         /* clear tiles that were started but not finished: a partial tile is worse than a black one */
@@ -286,7 +259,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     }
     free(job.tile_finished);
     free(workers);
-    rt_light_table_free(&lights);
+    rt_render_state_free(&state);
     if (stats)
         *stats = st;
     if (st.interrupted)

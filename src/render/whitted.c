@@ -14,7 +14,7 @@
  * directional E, area lights averaged over shadow_samples stratified
  * points), times the shadow transmittance (rt_shadow_transmittance: clear,
  * blocked, or filtered by transmissive surfaces, the old renderer's "cheap
- * caustics"). A is the ambient radiance (ctx->ambient). The 1/pi makes
+ * caustics"). A is the ambient radiance (ctx->state->ambient). The 1/pi makes
  * kd = 1, ka = ks = 0 exactly the `direct` integrator's Lambert.
  *
  * Diffuse bounces: while level < diffuse_bounces the ambient term ka B A is
@@ -36,7 +36,8 @@
 
 #include <string.h>
 
-#include "rt/render/integrator.h"
+#include "rt/render/environment.h"
+#include "rt/render/light.h"
 
 #define MIN_WEIGHT (1.0f / 1024.0f)
 #define MAX_NESTING 1024 /* recursion guard: max_bounce <= 256 plus index-matched crossings */
@@ -103,7 +104,8 @@ float rt_medium_ior(const rt_scene *s, const rt_medium_stack *m)
     if (!m || m->depth <= 0)
         return 1.0f;
     uint32_t mat = m->material[m->depth - 1];
-    return mat < s->material_count ? s->materials[mat].ior : 1.0f;
+    RT_DCHECK(mat < s->material_count);
+    return s->materials[mat].ior;
 }
 
 static void medium_push(rt_medium_stack *m, uint32_t mat)
@@ -138,24 +140,12 @@ typedef struct wctx {
 static rt_vec3 trace(wctx *w, rt_ray r, const rt_medium_stack *med, int depth, int level, float weight,
                      bool diffuse_ray);
 
-/* True when quad primitive `prim` is the visible emitter of a sampled area light. */
-static bool is_light_quad(const rt_scene *s, uint32_t prim)
-{
-    uint32_t q;
-    if (rt_prim_kind_of(s, prim, &q) != RT_PRIM_QUAD)
-        return false;
-    for (size_t i = 0; i < s->light_count; i++)
-        if (s->lights[i].kind == RT_LIGHT_AREA && s->lights[i].quad == q)
-            return true;
-    return false;
-}
-
 /* Sum over lights of E * (n.l) into *D and E * (r.v)^shininess into *S. */
 static void direct_phong(wctx *w, const rt_surface *sf, int area_samples, float shininess, bool want_spec,
                          rt_vec3 *D, rt_vec3 *S)
 {
     const rt_trace_ctx *ctx = w->ctx;
-    const rt_scene *s = ctx->scene;
+    const rt_scene *s = ctx->state->scene;
     rt_vec3 dsum = rt_v3s(0), ssum = rt_v3s(0);
     uint32_t pattern = rt_rng_u32(w->rng);
     for (size_t i = 0; i < s->light_count; i++) {
@@ -218,20 +208,16 @@ static rt_vec3 shade(wctx *w, const rt_surface *sf, const rt_medium_stack *med, 
                      float weight, bool diffuse_ray)
 {
     const rt_trace_ctx *ctx = w->ctx;
-    const rt_scene *s = ctx->scene;
-    rt_material fallback;
-    const rt_material *m = s->material_count ? &s->materials[sf->material] : NULL;
-    if (!m) {
-        rt_material_default(&fallback, "default");
-        m = &fallback;
-    }
+    const rt_scene *s = ctx->state->scene;
+    RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
+    const rt_material *m = &s->materials[sf->material];
     rt_vec4 b4 = rt_surface_base_color(ctx, sf);
     rt_vec3 base = rt_v3(b4.x, b4.y, b4.z);
     /* after a diffuse bounce, a sampled light's own quad is not seen: its
      * light is already counted by direct sampling (and a mirror or glass
      * chain to it would be a caustic, which this model leaves out) */
     rt_vec3 L = rt_surface_emission(ctx, sf);
-    if (diffuse_ray && rt_max3(L) > 0.0f && is_light_quad(s, sf->prim))
+    if (diffuse_ray && rt_max3(L) > 0.0f && rt_area_light_of_prim(s, NULL, sf->prim) != RT_NONE)
         L = rt_v3s(0);
     if (m->unlit)
         return rt_add(L, base);
@@ -257,7 +243,7 @@ static rt_vec3 shade(wctx *w, const rt_surface *sf, const rt_medium_stack *med, 
             rt_vec3 ind = gather_diffuse(w, sf, med, depth, level, kd_w);
             L = rt_add(L, rt_scale(rt_mul(base, ind), w_local * m->diffuse));
         } else if (m->ambient > 0.0f) {
-            L = rt_add(L, rt_scale(rt_mul(base, ctx->ambient), w_local * m->ambient));
+            L = rt_add(L, rt_scale(rt_mul(base, ctx->state->ambient), w_local * m->ambient));
         }
     }
 
@@ -332,25 +318,20 @@ static rt_vec3 trace(wctx *w, rt_ray r, const rt_medium_stack *med, int depth, i
     if (w->nesting >= MAX_NESTING)
         return result;
     w->nesting++;
-    for (int layer = 0; layer < 32; layer++) {
-        rt_hit hit;
-        if (!rt_trace(ctx, &r, &hit)) {
-            result = rt_add(result, rt_scale(rt_environment(ctx, r.dir), cov_weight));
-            break;
-        }
+    int layers = 32;
+    for (;;) {
         rt_surface sf;
-        rt_surface_at(ctx, &r, &hit, &sf);
         float coverage;
-        if (rt_surface_cut_away(ctx, &sf, &coverage)) {
-            r.tmin = hit.t;
-            continue;
-        }
+        rt_surface_walk found = rt_trace_surface(ctx, &r, &layers, NULL, &sf, &coverage);
+        if (found == RT_WALK_MISS)
+            result = rt_add(result, rt_scale(rt_environment(ctx->state->scene, r.dir), cov_weight));
+        if (found != RT_WALK_SURFACE)
+            break;
         rt_vec3 L = shade(w, &sf, med, depth, level, weight * cov_weight * coverage, diffuse_ray);
         result = rt_add(result, rt_scale(L, cov_weight * coverage));
         if (coverage >= 1.0f)
             break;
-        cov_weight *= 1.0f - coverage;
-        r.tmin = hit.t;
+        cov_weight *= 1.0f - coverage; /* and on to what lies behind */
     }
     w->nesting--;
     /* never hand back a non-finite or negative value */
@@ -361,7 +342,7 @@ static rt_vec3 trace(wctx *w, rt_ray r, const rt_medium_stack *med, int depth, i
 
 rt_vec3 rt_radiance_whitted_in(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng, const rt_medium_stack *start)
 {
-    const rt_settings *st = &ctx->scene->settings;
+    const rt_settings *st = &ctx->state->scene->settings;
     wctx w;
     w.ctx = ctx;
     w.rng = rng;

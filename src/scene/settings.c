@@ -17,14 +17,11 @@
 
 #include "rt/base/file.h"
 #include "rt/base/number.h"
+#include "rt/render/integrator.h"
 #include "rt/scene/texture.h"
 
 #define MAX_PATH_LEN 4096 /* the scene format's limit on file paths */
 
-/* rt_integrator's values are the indices of these words. */
-static const char *const integrator_words[] = {"direct", "whitted", "path", NULL};
-_Static_assert(RT_INTEGRATOR_DIRECT == 0 && RT_INTEGRATOR_WHITTED == 1 && RT_INTEGRATOR_PATH == 2,
-               "integrator_words follows rt_integrator");
 _Static_assert(sizeof(rt_integrator) == sizeof(int), "enum settings are stored as int");
 
 #define FIELD(f) offsetof(rt_settings, f)
@@ -38,7 +35,7 @@ const rt_setting rt_settings_table[] = {
     {.name = "samples", .args = "N", .type = RT_SETTING_INT, .field = FIELD(samples), .min = 1,
      .max = RT_MAX_SAMPLES, .defaults = {1}, .what = "samples per pixel", .help = "samples per pixel"},
     {.name = "integrator", .args = "NAME", .type = RT_SETTING_ENUM, .field = FIELD(integrator),
-     .defaults = {RT_INTEGRATOR_DIRECT}, .words = integrator_words, .what = "an integrator",
+     .defaults = {RT_INTEGRATOR_DIRECT}, .words = rt_integrator_words, .what = "an integrator",
      .help = "light transport: direct light only, Whitted ray tracing or path tracing"},
     {.name = "max_bounce", .args = "N", .type = RT_SETTING_INT, .field = FIELD(max_bounce), .min = 0, .max = 256,
      .defaults = {1}, .what = "max_bounce", .help = "whitted: mirror and refraction recursion depth"},

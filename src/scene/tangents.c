@@ -8,7 +8,7 @@
  * points along +dP/dv (so that the bitangent cross(n, t) * w always points
  * towards decreasing v, the top of the image), else +1; n is the
  * triangle's outside normal (its vertex normals' sum for smooth triangles,
- * as in shade.c). Two passes over the triangles: the first votes each
+ * as in surface.c). Two passes over the triangles: the first votes each
  * vertex's sign (area-weighted, +1 on a tie), the second sums unit dP/du
  * times area from the triangles that agree with the vertex's sign, so a
  * mirrored-UV seam does not cancel its tangents out. Each vertex then

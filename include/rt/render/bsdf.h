@@ -1,4 +1,4 @@
-/* rt/bsdf.h - the path tracer's scattering functions: Lambert and the glTF
+/* rt/render/bsdf.h - the path tracer's scattering functions: Lambert and the glTF
  * metallic-roughness model (GGX microfacets, height-correlated Smith
  * masking-shadowing, Schlick Fresnel), with a smooth dielectric
  * transmission lobe for KHR_materials_transmission.
@@ -41,7 +41,7 @@
 
 #include <stdbool.h>
 
-#include "rt/render/shade.h"
+#include "rt/render/surface.h"
 
 #define RT_BSDF_MIN_ALPHA 1e-3f /* GGX alpha floor: roughness 0 is a very sharp lobe, never a delta */
 

@@ -1,30 +1,65 @@
-/* rt/integrator.h - radiance along a camera ray, by the scene's integrator.
+/* rt/render/integrator.h - the integrator table: every integrator's name,
+ * radiance function and what it needs prepared, in one place; and the
+ * radiance along a camera ray by the scene's integrator.
  *
- *   rt_vec3 L = rt_radiance(&ctx, &ray, &rng);
+ *   rt_integrator id;
+ *   if (!rt_integrator_by_name("path", &id)) ...      // the scene's and the CLI's words
+ *   const char *name = rt_integrator_name(id);          // "path"
+ *   const rt_integrator_info *in = rt_integrator_info_of(id);
+ *   rt_render_state_prepare(&rs, &scene, &tree, in->prepare, &err);
+ *   rt_vec3 L = in->radiance(&ctx, &ray, &rng);        // or rt_radiance(&ctx, &ray, &rng)
  *
- * direct   emission + direct light from every light (area lights with
- *          settings.shadow_samples stratified samples) with a Lambertian
- *          BRDF (albedo / pi), shadows through transmissive and alpha-tested
- *          surfaces, and one cosine-sampled ray towards a non-black
- *          environment. The foundation's integrator: exact for its scenes.
+ * The integrators (an id, settings.integrator, is a line of the table):
+ * direct   emission + direct light with a Lambertian BRDF (direct.c,
+ *          rt/render/direct.h).
  * whitted  Phong, mirrors, refraction with exact Fresnel through nested
  *          media, shadows through glass, diffuse bounces (whitted.c,
- *          rt/whitted.h; the model is specified in docs/shading.md).
+ *          rt/render/whitted.h; the model is specified in docs/shading.md).
  * path     physically based path tracing of glTF materials with
- *          next-event estimation and MIS (path.c, rt/path.h,
+ *          next-event estimation and MIS (pathtrace.c, rt/render/pathtrace.h,
  *          docs/path-tracer.md).
+ *
+ * Adding one: a file with its radiance function (and a header declaring
+ * it), and one line in the table in integrator.c. Its name then works in
+ * scene files, on the command line and in `rt --help`.
  */
 #ifndef RT_INTEGRATOR_H
 #define RT_INTEGRATOR_H
 
+#include <stdbool.h>
+#include <stddef.h>
+
 #include "rt/render/sampling.h"
-#include "rt/render/shade.h"
+#include "rt/render/surface.h"
 
+/* Radiance arriving along a camera ray. Called from every worker thread at
+ * once: it may only read the context's state and write through its rng. */
+typedef rt_vec3 (*rt_radiance_fn)(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng);
+
+typedef struct rt_integrator_info {
+    const char *name;        /* the word in scene files (`integrator NAME`) and for --integrator */
+    rt_radiance_fn radiance;
+    unsigned prepare;        /* RT_PREPARE_* bits (rt/render/render_state.h): what the render state must hold */
+} rt_integrator_info;
+
+/* Every name in table order, NULL-terminated: the words of the `integrator`
+ * setting (rt/scene/settings.h) and of --integrator. */
+extern const char *const rt_integrator_words[];
+
+/* Number of integrators; ids are 0 .. count - 1. */
+size_t rt_integrator_count(void);
+/* The table line of id, NULL when there is none. */
+const rt_integrator_info *rt_integrator_info_of(rt_integrator id);
+/* Name to id; false for an unknown name. */
+bool rt_integrator_by_name(const char *name, rt_integrator *id);
+/* Id to name; NULL for an unknown id. */
+const char *rt_integrator_name(rt_integrator id);
+/* Every name, in table order, into buf (truncated to size): separated by
+ * sep, the last two by last_sep ("|", "|" gives "direct|whitted|path";
+ * ", ", " or " gives "direct, whitted or path"). */
+void rt_integrator_list(char *buf, size_t size, const char *sep, const char *last_sep);
+
+/* Radiance along a camera ray by the scene's integrator (a valid id). */
 rt_vec3 rt_radiance(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng);
-rt_vec3 rt_radiance_direct(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng);
-
-/* Direct light from every light at a Lambertian surface of albedo `albedo`,
- * shared by the integrators. */
-rt_vec3 rt_direct_lambert(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 albedo, rt_rng *rng);
 
 #endif

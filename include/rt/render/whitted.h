@@ -1,4 +1,4 @@
-/* rt/whitted.h - the classic ray tracer: Phong shading, mirrors, refraction
+/* rt/render/whitted.h - the classic ray tracer: Phong shading, mirrors, refraction
  * with exact Fresnel, shadows through glass, diffuse bounces.
  *
  *   rt_vec3 L = rt_radiance_whitted(&ctx, &ray, &rng);
@@ -15,7 +15,7 @@
 #define RT_WHITTED_H
 
 #include "rt/render/sampling.h"
-#include "rt/render/shade.h"
+#include "rt/render/surface.h"
 
 /* Exact Fresnel equations for a smooth dielectric interface (Born and Wolf,
  * "Principles of Optics", 1.5.2), light going from index n1 into n2 at

@@ -47,6 +47,10 @@ typedef struct rt_camera {
     float aspect_ratio;   /* width / height the camera was made for (glTF); 0 = none, follow the image */
 } rt_camera;
 
+/* Which integrator renders: a line of the integrator table
+ * (rt/render/integrator.h), which also holds the names scene files and the
+ * command line use. The built-in ones are named here; an integrator added
+ * to the table needs no name here unless code refers to it. */
 typedef enum rt_integrator {
     RT_INTEGRATOR_DIRECT = 0, /* direct light, Lambert: the foundation slice */
     RT_INTEGRATOR_WHITTED,    /* Phong, mirrors, glass, diffuse bounces */

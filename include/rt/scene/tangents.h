@@ -9,7 +9,7 @@
  * of its triangles' dP/du, Gram-Schmidt orthogonalised against the vertex
  * normal; w = the handedness (+1 or -1) such that cross(n, t) * w points
  * towards decreasing v (the top of the image: glTF's convention, the one
- * shade.c reads). A vertex shared by triangles of opposite handedness (a
+ * surface.c reads). A vertex shared by triangles of opposite handedness (a
  * mirrored-UV seam) takes the majority sign, weighted by area, +1 on a tie,
  * and its tangent sums only the triangles of that sign. The function sets
  * RT_ATTR_TANGENT on the scene and RT_TRI_TANGENT on the triangles it

@@ -1,8 +1,8 @@
-/* image.c - framebuffer output: PNG (stb_image_write, 8-bit sRGB with
+/* framebuffer.c - framebuffer output: PNG (stb_image_write, 8-bit sRGB with
  * exposure), PFM (little-endian float RGB, bottom scanline first, as the
  * format defines) and Radiance HDR (stb_image_write), all written to a
  * temporary file beside the target and renamed into place. */
-#include "rt/io/image.h"
+#include "rt/io/framebuffer.h"
 
 #include <errno.h>
 #include <math.h>

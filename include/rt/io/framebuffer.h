@@ -1,4 +1,4 @@
-/* rt/image.h - the framebuffer and writing it out: PNG (8-bit sRGB), PFM
+/* rt/io/framebuffer.h - the framebuffer and writing it out: PNG (8-bit sRGB), PFM
  * (linear float) and Radiance HDR, chosen by the file extension.
  *
  * Writes are atomic: the image goes to a temporary file in the same
@@ -12,8 +12,8 @@
  *   rt_output_check("out.png", &err);                // before rendering
  *   rt_framebuffer_write(&fb, "out.png", 1.0f, &err);
  */
-#ifndef RT_IMAGE_H
-#define RT_IMAGE_H
+#ifndef RT_FRAMEBUFFER_H
+#define RT_FRAMEBUFFER_H
 
 #include "rt/base/error.h"
 
