@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt/base/log.h"
 #include "rt/io/load.h"
 #include "rt/accel/kdtree.h"
 #include "rt/scene/scene.h"

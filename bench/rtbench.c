@@ -26,6 +26,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "rt/base/log.h"
 #include "rt/io/load.h"
 #include "rt/accel/kdtree.h"
 #include "rt/io/rayset.h"

@@ -8,6 +8,7 @@
 
 #include "fuzz/harness.h"
 #include "rt/base/error.h"
+#include "rt/base/log.h"
 
 static int run_dir(const char *target)
 {

@@ -9,6 +9,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "rt/base/log.h"
 #include "rt/io/base64.h"
 #include "rt/io/gltf.h"
 #include "rt/io/json.h"

@@ -19,6 +19,8 @@
 
 #include <stb/stb_image_write.h>
 
+#include "rt/base/alloc.h"
+#include "rt/base/log.h"
 #include "rt/io/gltf.h"
 #include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"

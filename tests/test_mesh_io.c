@@ -15,6 +15,7 @@
 
 #include "../src/io/mesh_buffer.h"
 #include "../src/io/mesh_text.h"
+#include "rt/base/log.h"
 #include "rt/io/mesh_io.h"
 #include "rt/scene/texture.h"
 

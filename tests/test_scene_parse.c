@@ -13,6 +13,7 @@
 #include <errno.h>
 #include <math.h>
 
+#include "rt/base/log.h"
 #include "rt/io/scene_parse.h"
 #include "rt/scene/settings.h"
 

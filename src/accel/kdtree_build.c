@@ -65,6 +65,8 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#include "rt/base/log.h"
+#include "rt/base/alloc.h"
 
 /* ------------------------------------------------------------- events */
 

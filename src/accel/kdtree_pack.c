@@ -39,6 +39,7 @@
 #include <string.h>
 #if defined(__linux__)
 #include <sys/mman.h>
+#include "rt/base/alloc.h"
 #endif
 
 /* The arrays the traversal reads, when large, go on 2 MB pages where the

@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "rt/base/log.h"
 #include "rt/base/number.h"
 #include "rt/render/render.h"
 

@@ -23,6 +23,7 @@
 
 #include "memory_budget.h"
 #include "rt/base/error.h"
+#include "rt/base/log.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/settings.h"
 

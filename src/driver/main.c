@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "rt/base/log.h"
 #include "rt/render/camera.h"
 #include "rt/accel/kdtree.h"
 #include "rt/io/framebuffer.h"

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "rt/base/error.h"
+#include "rt/base/log.h"
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define RT_SANITIZED 1

@@ -9,6 +9,7 @@
 
 #include <stdio.h>
 #include <string.h>
+#include "rt/base/log.h"
 
 static void draw_bar(int done, int total, double elapsed, bool final)
 {

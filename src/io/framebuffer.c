@@ -16,6 +16,7 @@
 
 #include <stb/stb_image_write.h>
 
+#include "rt/base/alloc.h"
 #include "rt/scene/texture.h"
 
 rt_result rt_framebuffer_init(rt_framebuffer *fb, int width, int height, rt_error *err)

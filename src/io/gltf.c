@@ -49,7 +49,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt/base/alloc.h"
 #include "rt/base/file.h"
+#include "rt/base/log.h"
 #include "rt/io/base64.h"
 #include "rt/io/json.h"
 #include "rt/scene/texture.h"

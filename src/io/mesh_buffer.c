@@ -23,8 +23,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt/base/alloc.h"
 #include "rt/base/file.h"
-#include "rt/base/soa.h"
+#include "rt/base/log.h"
 
 /* ------------------------------------------------------ triangulation */
 

@@ -42,7 +42,9 @@
 #include "mesh_buffer.h"
 #include "mesh_readers.h"
 #include "mesh_text.h"
+#include "rt/base/alloc.h"
 #include "rt/base/file.h"
+#include "rt/base/log.h"
 #include "rt/scene/texture.h"
 
 #define OBJ_NAME_MAX 128

@@ -26,6 +26,8 @@
 #include "mesh_buffer.h"
 #include "mesh_readers.h"
 #include "mesh_text.h"
+#include "rt/base/log.h"
+#include "rt/base/alloc.h"
 
 typedef struct off_lines {
     const char *path;

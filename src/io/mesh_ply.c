@@ -39,6 +39,8 @@
 #include "mesh_buffer.h"
 #include "mesh_readers.h"
 #include "mesh_text.h"
+#include "rt/base/log.h"
+#include "rt/base/alloc.h"
 
 typedef enum ply_type { PT_NONE = 0, PT_I8, PT_U8, PT_I16, PT_U16, PT_I32, PT_U32, PT_F32, PT_F64 } ply_type;
 static const int type_size[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};

@@ -2,6 +2,8 @@
  * count checked against the file size before anything is allocated. */
 #include "rt/io/rayset.h"
 
+#include "rt/base/alloc.h"
+
 #include <errno.h>
 #include <stdint.h>
 #include <stdio.h>

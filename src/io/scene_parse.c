@@ -35,7 +35,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt/base/alloc.h"
 #include "rt/base/file.h"
+#include "rt/base/log.h"
 #include "rt/base/number.h"
 #include "rt/io/gltf.h"
 #include "rt/io/mesh_io.h"

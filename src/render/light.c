@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt/base/alloc.h"
 #include "rt/render/environment.h"
 
 bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, rt_vec2 u, rt_light_sample *ls)

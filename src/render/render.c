@@ -15,6 +15,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "rt/base/alloc.h"
+#include "rt/base/log.h"
 #include "rt/render/camera.h"
 #include "rt/render/integrator.h"
 #include "rt/render/sampling.h"

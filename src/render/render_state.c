@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt/base/alloc.h"
 #include "rt/render/environment.h"
 #include "rt/render/light.h"
 

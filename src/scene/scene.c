@@ -3,10 +3,11 @@
  * settings table.) */
 #include "rt/scene/scene.h"
 
+#include "rt/base/alloc.h"
+
 #include <stdlib.h>
 #include <string.h>
 
-#include "rt/base/soa.h"
 
 void rt_texture_slot_none(rt_texture_slot *slot)
 {

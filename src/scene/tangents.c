@@ -18,6 +18,8 @@
  */
 #include "rt/scene/tangents.h"
 
+#include "rt/base/alloc.h"
+
 #include <stdlib.h>
 #include <string.h>
 

@@ -6,6 +6,8 @@
  */
 #include "rt/scene/validate.h"
 
+#include "rt/base/alloc.h"
+
 #include <math.h>
 #include <stdlib.h>
 

@@ -6,6 +6,7 @@
 
 #include "harness.h"
 #include "rt/base/error.h"
+#include "rt/base/log.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

@@ -1,4 +1,4 @@
-/* rt/error.h - one result enum and one error record for every fallible call.
+/* rt/base/error.h - one result enum and one error record for every fallible call.
  *
  * A function that can fail on input returns rt_result and, on failure, fills
  * an rt_error whose message already names the place ("file:line:col: ..." or
@@ -10,8 +10,7 @@
  *       return 2;
  *   }
  *
- * Warnings (input that is odd but usable) go through rt_warn(), which prints
- * to stderr unless the process was made quiet with rt_log_set_level().
+ * Warnings go through rt/base/log.h, allocation through rt/base/alloc.h.
  */
 #ifndef RT_ERROR_H
 #define RT_ERROR_H
@@ -46,21 +45,6 @@ rt_result rt_fail(rt_error *err, rt_result code, const char *fmt, ...) RT_PRINTF
 
 /* Short name of a result ("parse error", "out of memory", ...). */
 const char *rt_result_name(rt_result code);
-
-typedef enum rt_log_level { RT_LOG_QUIET = 0, RT_LOG_NORMAL = 1, RT_LOG_VERBOSE = 2 } rt_log_level;
-
-/* Set once by the driver before any work starts; read-only afterwards. */
-void rt_log_set_level(rt_log_level level);
-rt_log_level rt_log_get_level(void);
-void rt_warn(const char *fmt, ...) RT_PRINTF(1, 2);   /* "rt: warning: ..." unless quiet */
-void rt_info(const char *fmt, ...) RT_PRINTF(1, 2);   /* only with -v */
-
-/* Checked allocation helpers: return NULL on failure (and on size overflow);
- * callers turn that into RT_ERR_NOMEM. rt_grow() makes room for `need`
- * elements of `size` bytes in *p, doubling *cap. */
-void *rt_alloc(size_t count, size_t size);       /* zeroed */
-void *rt_realloc_array(void *p, size_t count, size_t size);
-int rt_grow(void **p, size_t *cap, size_t need, size_t size);
 
 /* Invariant checks on the renderer's own state (never on input). RT_DCHECK
  * costs nothing unless built with -DRT_DEBUG. */
