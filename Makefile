@@ -7,7 +7,7 @@
 #   make profile      ./rt-profile: optimised, with symbols and frame pointers (for perf)
 #   make scenes       render every scene in scenes/ into docs/images/
 #   make install      rt, the library and its headers, and a pkg-config file
-#                     (PREFIX=/usr/local, DESTDIR for staging)
+#                     (PREFIX=/usr/local, DESTDIR for staging); make test-install checks it
 #   make clean
 #
 # Variables: WERROR=1 turns warnings into errors (CI sets it); SHARED=dir
@@ -36,7 +36,7 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 DEPS_OK  := $(BUILD)/.deps-ok
 
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build fuzz install uninstall
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build fuzz install uninstall test-install
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -133,6 +133,11 @@ install: $(RT) $(BUILD)/librt.a
 uninstall:
 	rm -f $(DESTDIR)$(BINDIR)/rt $(DESTDIR)$(LIBDIR)/librtrender.a $(DESTDIR)$(PCDIR)/rtrender.pc
 	rm -rf $(DESTDIR)$(INCLUDEDIR)/rt
+
+# Installs into a temporary DESTDIR and builds examples/library.c against it
+# through pkg-config, as a user of the library would (run by .ci/run).
+test-install: $(RT) $(BUILD)/librt.a
+	@CC="$(CC)" sh tests/install.sh
 
 clean:
 	rm -rf build build-asan build-tsan build-profile build-fuzz rt rt-profile bench/rtbench bench/buildscale
