@@ -928,6 +928,13 @@ static void test_errors_names(void **state)
     expect_error("material\n", RT_ERR_PARSE, "1:9", "expected a material name, got end of line");
     /* a material must be defined before it is used */
     expect_error("sphere 0 0 0 1 late\nmaterial late\n", RT_ERR_INVALID, "1:16", "undefined material 'late'");
+    /* a near miss is named, like an unknown keyword's */
+    expect_error("material steel color 0.5 0.5 0.5\nmaterial glass ior 1.5\nsphere 0 0 0 1 stel\n", RT_ERR_INVALID,
+                 "3:16", "undefined material 'stel' for the sphere (did you mean 'steel'?)");
+    expect_error("material steel\nsphere 0 0 0 1 Glass\n", RT_ERR_INVALID, "2:16",
+                 "undefined material 'Glass' for the sphere (define it with 'material' before use)");
+    expect_error("texture wood constant 1 1 1\nmaterial m texture wod\n", RT_ERR_INVALID, "2:20",
+                 "undefined texture 'wod' for material texture (did you mean 'wood'?)");
 }
 
 /* Many names: the hash index grows and still finds every name and duplicate. */

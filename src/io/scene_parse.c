@@ -446,6 +446,49 @@ static rt_result check_new_name(parser *p, const tok *t, name_table *table, cons
     return RT_OK;
 }
 
+/* Edit distance, for "did you mean" hints on short words. */
+static int edit_distance(const char *a, const char *b)
+{
+    size_t n = strlen(a), m = strlen(b);
+    if (n > 32 || m > 32)
+        return 99;
+    int d[33][33];
+    for (size_t i = 0; i <= n; i++)
+        d[i][0] = (int)i;
+    for (size_t j = 0; j <= m; j++)
+        d[0][j] = (int)j;
+    for (size_t i = 1; i <= n; i++)
+        for (size_t j = 1; j <= m; j++) {
+            int c = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
+            int del = d[i - 1][j] + 1, ins = d[i][j - 1] + 1;
+            d[i][j] = c < del ? (c < ins ? c : ins) : (del < ins ? del : ins);
+        }
+    return d[n][m];
+}
+
+/* The defined name closest to `word` (edit distance under 3), for "did
+ * you mean"; NULL when none is that close. Names the scene holds from other
+ * loaders count too, except the internal "__" ones. */
+static const char *closest_name(const parser *p, const name_table *table, bool scene_materials, const char *word)
+{
+    const char *best = NULL;
+    int best_d = 3;
+    for (size_t i = 0; i < table->count; i++) {
+        int d = edit_distance(word, table->items[i].name);
+        if (d < best_d)
+            best_d = d, best = table->items[i].name;
+    }
+    for (size_t i = 0; scene_materials && i < p->s->material_count; i++) {
+        const char *name = p->s->materials[i].name;
+        if (strncmp(name, "__", 2) == 0)
+            continue;
+        int d = edit_distance(word, name);
+        if (d < best_d)
+            best_d = d, best = name;
+    }
+    return best;
+}
+
 /* A material by name: those defined in this file first, then any other in
  * the scene (for example from an OBJ's MTL file loaded earlier). */
 static rt_result get_material(parser *p, const char *what, uint32_t *out)
@@ -465,6 +508,10 @@ static rt_result get_material(parser *p, const char *what, uint32_t *out)
         *out = m;
         return RT_OK;
     }
+    const char *near = closest_name(p, &p->materials, true, t->s);
+    if (near)
+        return perr(p, RT_ERR_INVALID, t, "undefined material %s for %s (did you mean '%s'?)", show(t, b, sizeof b),
+                    what, near);
     return perr(p, RT_ERR_INVALID, t, "undefined material %s for %s (define it with 'material' before use)",
                 show(t, b, sizeof b), what);
 }
@@ -514,6 +561,10 @@ static rt_result get_texture_ref(parser *p, const char *what, uint32_t *out)
         *out = e->index;
         return RT_OK;
     }
+    const char *near = strchr(t->s, '.') || strchr(t->s, '/') ? NULL : closest_name(p, &p->textures, false, t->s);
+    if (near)
+        return perr(p, RT_ERR_INVALID, t, "undefined texture %s for %s (did you mean '%s'?)", show(t, b, sizeof b),
+                    what, near);
     if (!strchr(t->s, '.') && !strchr(t->s, '/'))
         return perr(p, RT_ERR_INVALID, t,
                     "undefined texture %s for %s (define it with 'texture' before use, or give an image file)",
@@ -1256,26 +1307,6 @@ static const keyword keywords[] = {
     {"model", st_model},
     {"light", st_light},
 };
-
-/* Edit distance, for "did you mean" hints on short words. */
-static int edit_distance(const char *a, const char *b)
-{
-    size_t n = strlen(a), m = strlen(b);
-    if (n > 32 || m > 32)
-        return 99;
-    int d[33][33];
-    for (size_t i = 0; i <= n; i++)
-        d[i][0] = (int)i;
-    for (size_t j = 0; j <= m; j++)
-        d[0][j] = (int)j;
-    for (size_t i = 1; i <= n; i++)
-        for (size_t j = 1; j <= m; j++) {
-            int c = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
-            int del = d[i - 1][j] + 1, ins = d[i][j - 1] + 1;
-            d[i][j] = c < del ? (c < ins ? c : ins) : (del < ins ? del : ins);
-        }
-    return d[n][m];
-}
 
 static rt_result run_statement(parser *p)
 {
