@@ -432,6 +432,34 @@ static void test_help_flags_in_readme(void **state)
     unlink(help_path);
 }
 
+/* Every line rt writes to stderr starts with "rt: ", the -v lines too. */
+static void assert_lines_prefixed(const char *err)
+{
+    int lines = 0;
+    for (const char *l = err; *l; lines++) {
+        if (strncmp(l, "rt: ", 4) != 0)
+            fail_msg("a line without the 'rt: ' prefix:\n%s", l);
+        const char *nl = strchr(l, '\n');
+        l = nl ? nl + 1 : l + strlen(l);
+    }
+    assert_true(lines > 0);
+}
+
+static void test_verbose_lines_prefixed(void **state)
+{
+    (void)state;
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *const args[] = {"-v", "-r", "8x8", "-s", "1", "-o", path_in("v.png"), NULL};
+    run_args(r, args);
+    assert_int_equal(r->status, 0);
+    assert_contains(r->err, "rt: kd-tree: built in");
+    assert_contains(r->err, "rt: render: ");
+    assert_lines_prefixed(r->err);
+    unlink(path_in("v.png"));
+    free(r);
+}
+
 /* ------------------------------------------------------------ scene files */
 
 static void test_bad_scene_files(void **state)
@@ -844,6 +872,7 @@ int main(void)
         cmocka_unit_test(test_flag_forms),
         cmocka_unit_test(test_flag_forms_same_image),
         cmocka_unit_test(test_help_flags_in_readme),
+        cmocka_unit_test(test_verbose_lines_prefixed),
         cmocka_unit_test(test_bad_scene_files),
         cmocka_unit_test(test_bad_models),
         cmocka_unit_test(test_bad_images),
