@@ -460,6 +460,27 @@ static void test_verbose_lines_prefixed(void **state)
     free(r);
 }
 
+/* `rt` alone renders the built-in scene and says so first, unless -q. */
+static void test_no_input_says_so(void **state)
+{
+    (void)state;
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *const args[] = {"-r", "8x8", "-s", "1", "-o", path_in("b.png"), NULL};
+    run_args(r, args);
+    assert_int_equal(r->status, 0);
+    char want[800];
+    snprintf(want, sizeof want,
+             "rt: no input given; rendering the built-in Cornell box to %s (rt --help for usage)\n", path_in("b.png"));
+    assert_true(strncmp(r->err, want, strlen(want)) == 0);
+    const char *const quiet[] = {"-q", "-r", "8x8", "-s", "1", "-o", path_in("b.png"), NULL};
+    run_args(r, quiet);
+    assert_int_equal(r->status, 0);
+    assert_string_equal(r->err, "");
+    unlink(path_in("b.png"));
+    free(r);
+}
+
 /* ------------------------------------------------------------ scene files */
 
 static void test_bad_scene_files(void **state)
@@ -633,6 +654,20 @@ static void test_bad_output(void **state)
     REFUSE(o, "out: unknown output format", NULL, "-r", "8x8", "-o", path_in("out"));
     write_text("file", "a file, not a directory");
     REFUSE(o, "file/x.png: cannot write there", NULL, "-r", "8x8", "-o", path_in("file/x.png"));
+    /* a directory named like the output, refused before the scene is even
+     * loaded (the scene here would fail to load) */
+    const char *dpng = path_in("d.png");
+    assert_int_equal(mkdir(dpng, 0755), 0);
+    REFUSE(o, "d.png: is a directory", NULL, "-r", "8x8", "-o", dpng);
+    REFUSE(o, "d.png: is a directory", NULL, "-o", dpng, path_in("no-such-scene.txt"));
+    rmdir(dpng);
+    /* a scene's own output line naming a directory: refused before rendering */
+    char own[700];
+    assert_int_equal(mkdir(dpng, 0755), 0);
+    snprintf(own, sizeof own, "resolution 8 8\noutput \"%s\"\n", dpng);
+    write_text("own-dir.txt", own);
+    REFUSE(o, "d.png: is a directory", NULL, path_in("own-dir.txt"));
+    rmdir(dpng);
     /* too big for the PNG writer: refused before rendering, not after */
     REFUSE(o, "out.png: a 32768x32768 PNG", ".pfm", "-r", "32768x32768", "-o", o);
     if (geteuid() != 0) { /* root writes anywhere */
@@ -873,6 +908,7 @@ int main(void)
         cmocka_unit_test(test_flag_forms_same_image),
         cmocka_unit_test(test_help_flags_in_readme),
         cmocka_unit_test(test_verbose_lines_prefixed),
+        cmocka_unit_test(test_no_input_says_so),
         cmocka_unit_test(test_bad_scene_files),
         cmocka_unit_test(test_bad_models),
         cmocka_unit_test(test_bad_images),

@@ -179,6 +179,10 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     rt_load_info info;
     rt_load_options lo = {.for_render = true};
     rt_result r;
+    /* -o is checked before the load, which may take long; the scene's own
+     * `output` can only be checked after it */
+    if (a->output && (r = rt_output_check(a->output, err)) != RT_OK)
+        return r;
     if ((r = rt_load(scene, a->input, &lo, &info, err)) != RT_OK)
         return r;
     if ((r = rt_scene_validate(scene, err)) != RT_OK) { /* from here on the tables are trusted */
@@ -213,6 +217,9 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     if ((r = rt_output_check(output, err)) != RT_OK ||
         (r = rt_output_check_size(output, set->width, set->height, err)) != RT_OK)
         return r;
+    if (!a->input && a->log_level >= RT_LOG_NORMAL)
+        fprintf(stderr, "rt: no input given; rendering the built-in Cornell box to %s (rt --help for usage)\n",
+                output);
 
     rt_info("scene: %s (loaded in %.1f ms)", a->input ? a->input : "<built-in>", info.load_ms);
     rt_info("  triangles %zu, spheres %zu, quads %zu, vertices %zu", scene->triangles.count, scene->spheres.count,

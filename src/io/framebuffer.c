@@ -82,6 +82,13 @@ rt_result rt_output_check(const char *path, rt_error *err)
     rt_result r = rt_output_format(path, &fmt, err);
     if (r != RT_OK)
         return r;
+    /* the image is renamed over the exact path: a directory there (or a
+     * device, a FIFO) would fail only then, after the render */
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return rt_fail(err, RT_ERR_IO, "%s: is a directory; give an image file name", path);
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode))
+        return rt_fail(err, RT_ERR_IO, "%s: not a regular file; give an image file name", path);
     char tmp[4200];
     FILE *f = open_temp_beside(path, tmp, sizeof tmp);
     if (!f)
