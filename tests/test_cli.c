@@ -87,6 +87,8 @@ typedef struct run_result {
 
 /* Runs rt with args; its stdout goes to stdout_path (NULL = /dev/null), its
  * stderr to stderr.txt in the scratch directory. */
+static const char *stdin_path; /* the child's standard input when set, else /dev/null */
+
 static pid_t spawn_to(const char *const *args, const char *stdout_path)
 {
     const char *argv[64];
@@ -102,6 +104,10 @@ static pid_t spawn_to(const char *const *args, const char *stdout_path)
         int e = open(path_in("stderr.txt"), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         if (null < 0 || e < 0)
             _exit(127);
+        int in = open(stdin_path ? stdin_path : "/dev/null", O_RDONLY);
+        if (in < 0)
+            _exit(127);
+        dup2(in, 0);
         dup2(null, 1);
         dup2(e, 2);
         execv(argv[0], (char *const *)argv);
@@ -515,6 +521,61 @@ static void test_bad_scene_files(void **state)
     REFUSE(o, "own.txt:2:1: ", NULL, path_in("own.txt"));
 }
 
+/* `-` is standard input (scene text, glTF or a mesh by content); a
+ * directory and an unknown extension are refused; an empty scene warns. */
+static void test_inputs(void **state)
+{
+    (void)state;
+    const char *o = out_png;
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    /* the same scene from a file and from standard input: the same image */
+    write_text("in.txt", "resolution 12 10\nsamples 2\nmaterial m color 0.8 0.2 0.2\nsphere 0 0 -3 1 m\n");
+    char a[600], b[600];
+    snprintf(a, sizeof a, "%s", path_in("in-file.pfm"));
+    snprintf(b, sizeof b, "%s", path_in("in-stdin.pfm"));
+    const char *const from_file[] = {path_in("in.txt"), NULL};
+    render_ok(a, from_file);
+    stdin_path = path_in("in.txt");
+    const char *const from_stdin[] = {"-", NULL};
+    render_ok(b, from_stdin);
+    assert_same_file(a, b);
+    /* errors in it are named <stdin> */
+    write_text("bad-in.txt", "resolution 8 8\nsphere 0 0 0 1 stel\n");
+    stdin_path = path_in("bad-in.txt");
+    REFUSE(o, "<stdin>:2:16: undefined material 'stel'", NULL, "-", "-o", o);
+    /* a glTF and an OBJ by content */
+    stdin_path = "assets/box.gltf";
+    const char *const gltf[] = {"-r", "8x8", "-", NULL};
+    render_ok(a, gltf);
+    stdin_path = "assets/donut.obj";
+    render_ok(a, gltf);
+    const char *const info[] = {"--info", "-", NULL};
+    run_result *ri = malloc(sizeof *ri);
+    assert_non_null(ri);
+    wait_for(spawn_to(info, path_in("info.txt")), now_s(), 60.0, ri);
+    assert_int_equal(ri->status, 0);
+    static char text[4096];
+    assert_true(read_all(path_in("info.txt"), text, sizeof text) != (size_t)-1);
+    assert_contains(text, "file: <stdin>\nformat: mesh\n");
+    free(ri);
+    stdin_path = NULL;
+
+    REFUSE(o, "is a directory", NULL, dir, "-o", o);
+    write_text("cube.stl", "solid cube\n  facet normal 0 0 1\n");
+    REFUSE(o, "cube.stl: unknown input format '.stl'", ".obj, .ply, .off", path_in("cube.stl"), "-o", o);
+
+    /* a scene with nothing in it renders the background, with a warning */
+    write_text("empty.txt", "resolution 8 8\n");
+    const char *const empty[] = {"-o", a, path_in("empty.txt"), NULL};
+    run_args(r, empty);
+    assert_int_equal(r->status, 0);
+    assert_contains(r->err, "rt: warning: ");
+    assert_contains(r->err, "empty.txt: nothing to render");
+    unlink(a), unlink(b);
+    free(r);
+}
+
 /* --------------------------------------------------------------- models */
 
 static const char *gltf_doc(char *buf, size_t size, int count, int bad_index, const char *nodes)
@@ -910,6 +971,7 @@ int main(void)
         cmocka_unit_test(test_verbose_lines_prefixed),
         cmocka_unit_test(test_no_input_says_so),
         cmocka_unit_test(test_bad_scene_files),
+        cmocka_unit_test(test_inputs),
         cmocka_unit_test(test_bad_models),
         cmocka_unit_test(test_bad_images),
         cmocka_unit_test(test_bad_output),

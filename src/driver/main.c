@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "rt/base/file.h"
 #include "rt/base/log.h"
 #include "rt/render/camera.h"
 #include "rt/accel/kdtree.h"
@@ -79,7 +80,7 @@ static void default_output(const rt_scene *s, const char *input, char *out, size
         snprintf(out, size, "%s", s->settings.output);
         return;
     }
-    if (!input) {
+    if (!input || strcmp(input, "-") == 0) {
         snprintf(out, size, "out.png");
         return;
     }
@@ -95,9 +96,8 @@ static void default_output(const rt_scene *s, const char *input, char *out, size
  * diffuse-gather tree that would never finish, a usable camera, and every
  * setting in the range of the settings table (flags and the parser check
  * them as they read them; this catches what loaders set). */
-static rt_result check_limits(rt_scene *s, const char *input, bool camera_from_input, rt_error *err)
+static rt_result check_limits(rt_scene *s, const char *name, bool camera_from_input, rt_error *err)
 {
-    const char *name = input ? input : "<built-in scene>";
     size_t prims = rt_scene_prim_count(s);
     if (prims > MAX_PRIMITIVES)
         return rt_fail(err, RT_ERR_LIMIT, "%s: %zu primitives (triangles %zu, spheres %zu, quads %zu), over the limit of %zu",
@@ -129,6 +129,37 @@ static rt_result check_limits(rt_scene *s, const char *input, bool camera_from_i
     return RT_OK;
 }
 
+/* The input as rt_load takes it: a path, NULL for the built-in scene, or
+ * "-" for standard input, read whole and loaded from memory as "<stdin>"
+ * (scene text, or glTF or a mesh by its content; relative paths in it
+ * resolve against the current directory). */
+static rt_result load_input(rt_scene *s, const char *input, const rt_load_options *lo, rt_load_info *info,
+                            rt_error *err)
+{
+    if (!input || strcmp(input, "-") != 0)
+        return rt_load(s, input, lo, info, err);
+    memset(info, 0, sizeof *info);
+    if (isatty(0))
+        return rt_fail(err, RT_ERR_IO,
+                       "-: standard input is a terminal; pipe a scene in (rt - < scene.txt, or cat model.glb | rt -)");
+    char *bytes;
+    size_t size;
+    rt_error inner = {0};
+    if (rt_read_file("/dev/stdin", 0, &bytes, &size, &inner) != RT_OK) {
+        const char *what = strncmp(inner.message, "/dev/stdin: ", 12) == 0 ? inner.message + 12 : inner.message;
+        return rt_fail(err, inner.code, "<stdin>: %s", what);
+    }
+    rt_result r = rt_load_memory(s, bytes, size, "<stdin>", lo, info, err);
+    free(bytes);
+    return r;
+}
+
+/* The name messages use for an input. */
+static const char *input_name(const char *input)
+{
+    return !input ? "<built-in scene>" : strcmp(input, "-") == 0 ? "<stdin>" : input;
+}
+
 /* --info: one `key: value` line per figure, for people and scripts. */
 static int print_info(const char *path, const memory_budget *budget)
 {
@@ -136,14 +167,14 @@ static int print_info(const char *path, const memory_budget *budget)
     rt_scene_init(&s);
     rt_error err = {0};
     rt_load_info info;
-    rt_result r = rt_load(&s, path, NULL, &info, &err);
+    rt_result r = load_input(&s, path, NULL, &info, &err);
     if (r != RT_OK) {
         report(&err, budget);
         rt_scene_free(&s);
         return 2;
     }
     rt_box b = rt_scene_bounds(&s);
-    printf("file: %s\n", path);
+    printf("file: %s\n", input_name(path));
     printf("format: %s\n", rt_load_kind_name(info.kind));
     printf("triangles: %zu\n", s.triangles.count);
     printf("vertices: %zu\n", s.vertices.count);
@@ -183,12 +214,16 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
      * `output` can only be checked after it */
     if (a->output && (r = rt_output_check(a->output, err)) != RT_OK)
         return r;
-    if ((r = rt_load(scene, a->input, &lo, &info, err)) != RT_OK)
+    if ((r = load_input(scene, a->input, &lo, &info, err)) != RT_OK)
         return r;
     if ((r = rt_scene_validate(scene, err)) != RT_OK) { /* from here on the tables are trusted */
         rt_error inner = *err;
-        return rt_fail(err, inner.code, "%s: %s", a->input ? a->input : "<built-in scene>", inner.message);
+        return rt_fail(err, inner.code, "%s: %s", input_name(a->input), inner.message);
     }
+    if (rt_scene_prim_count(scene) == 0)
+        rt_warn("%s: nothing to render (no spheres, quads, triangles or meshes); the image will show only the "
+                "background",
+                input_name(a->input));
     if ((r = args_apply_settings(a, scene, err)) != RT_OK)
         return r;
     rt_settings *set = &scene->settings;
@@ -207,7 +242,7 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     bool camera_from_input = scene->camera_set;
     if (!scene->camera_set)
         rt_scene_frame_camera(scene);
-    if ((r = check_limits(scene, a->input, camera_from_input, err)) != RT_OK)
+    if ((r = check_limits(scene, input_name(a->input), camera_from_input, err)) != RT_OK)
         return r;
 
     if (a->output)
@@ -221,7 +256,7 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
         fprintf(stderr, "rt: no input given; rendering the built-in Cornell box to %s (rt --help for usage)\n",
                 output);
 
-    rt_info("scene: %s (loaded in %.1f ms)", a->input ? a->input : "<built-in>", info.load_ms);
+    rt_info("scene: %s (loaded in %.1f ms)", input_name(a->input), info.load_ms);
     rt_info("  triangles %zu, spheres %zu, quads %zu, vertices %zu", scene->triangles.count, scene->spheres.count,
             scene->quads.count, scene->vertices.count);
     rt_info("  materials %zu, textures %zu, images %zu, lights %zu", scene->material_count, scene->texture_count,

@@ -16,9 +16,13 @@
  * first, then by its extension (rt_load_kind_of):
  *   glTF   the GLB magic "glTF", or JSON (its first character is '{'); else
  *          the extension .gltf or .glb          -> rt_gltf_load_memory
- *   mesh   a PLY or OFF header; else .obj, .ply or .off (any case)
+ *   mesh   a PLY or OFF header; else .obj, .ply or .off (any case); else,
+ *          for a name without an extension ("<stdin>"), content that
+ *          starts like an OBJ (v, vn, vt, f, o, g, mtllib, usemtl)
  *                                               -> rt_mesh_load_memory
- *   scene  anything else                        -> rt_scene_parse_string
+ *   scene  .txt, .rt, .scene or no extension    -> rt_scene_parse_string
+ *   anything else (.stl, .fbx, ...) is refused: RT_ERR_UNSUPPORTED, with a
+ *   message naming the formats rt reads
  * A NULL path loads the built-in scene (rt_default_scene_text).
  *
  * A mesh gets a material "default" (added first) for faces the file gives
@@ -37,7 +41,7 @@
 #include "rt/base/error.h"
 #include "rt/scene/scene.h"
 
-typedef enum rt_load_kind { RT_LOAD_SCENE = 0, RT_LOAD_GLTF, RT_LOAD_MESH } rt_load_kind;
+typedef enum rt_load_kind { RT_LOAD_SCENE = 0, RT_LOAD_GLTF, RT_LOAD_MESH, RT_LOAD_UNKNOWN } rt_load_kind;
 
 typedef struct rt_load_options {
     bool for_render; /* add lighting, samples, the first camera and tangents (above); false = as the file is */
@@ -68,7 +72,11 @@ rt_result rt_load_memory(rt_scene *s, const void *bytes, size_t size, const char
  * file. */
 rt_load_kind rt_load_kind_of(const void *bytes, size_t size, const char *name);
 
-/* "scene", "gltf" or "mesh". */
+/* True when name is read as scene text unless its content says otherwise:
+ * .txt, .rt, .scene, no extension, or NULL. */
+bool rt_load_is_scene_name(const char *name);
+
+/* "scene", "gltf", "mesh" or "unknown". */
 const char *rt_load_kind_name(rt_load_kind kind);
 
 #endif
