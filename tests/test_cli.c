@@ -576,6 +576,64 @@ static void test_inputs(void **state)
     free(r);
 }
 
+/* Runs rt with args, its stdout into buf; returns the exit status. */
+static int run_stdout(const char *const *args, char *buf, size_t cap)
+{
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    wait_for(spawn_to(args, path_in("stdout.txt")), now_s(), 60.0, r);
+    int status = r->status;
+    free(r);
+    assert_true(read_all(path_in("stdout.txt"), buf, cap) != (size_t)-1);
+    unlink(path_in("stdout.txt"));
+    return status;
+}
+
+/* --info reports the file's own camera and settings, for every file given. */
+static void test_info(void **state)
+{
+    (void)state;
+    static char text[1 << 14];
+    write_text("i1.txt", "resolution 12 10\nsamples 3\nintegrator whitted\noutput i1-out.pfm\n"
+                         "camera position 0 1 5 look_at 0 1 0 fov 30\nmaterial m\nsphere 0 0 0 1 m\n");
+    write_text("i2.txt", "material m\nsphere 0 0 0 1 m\n");
+    const char *const args[] = {"--info", path_in("i1.txt"), path_in("i2.txt"), "assets/box.gltf", "assets/donut.obj",
+                                NULL};
+    assert_int_equal(run_stdout(args, text, sizeof text), 0);
+    char *b2 = strstr(text, "\n\nfile: ");
+    assert_non_null(b2);
+    *b2 = 0;
+    b2 += 2;
+    assert_contains(text, "format: scene\n");
+    assert_contains(text, "camera: scene file\ncamera.position: 0 1 5\ncamera.look_at: 0 1 0\ncamera.up: 0 1 0\n"
+                          "camera.fov: 30\n");
+    assert_contains(text, "resolution: 12x10\nsamples: 3\nintegrator: whitted\noutput: i1-out.pfm\n");
+    char *b3 = strstr(b2, "\n\nfile: ");
+    assert_non_null(b3);
+    *b3 = 0;
+    b3 += 2;
+    assert_contains(b2, "i2.txt\n");
+    assert_contains(b2, "camera: auto (framed to the bounds)\n");
+    assert_contains(b2, "resolution: 512x512\nsamples: 1\nintegrator: direct\noutput: i2.png\n");
+    char *b4 = strstr(b3, "\n\nfile: ");
+    assert_non_null(b4);
+    *b4 = 0;
+    b4 += 2;
+    assert_contains(b3, "file: assets/box.gltf\nformat: gltf\n");
+    assert_contains(b3, "camera: gltf camera 0\ncamera.position: 1.20000005 1.39999998 3.20000005\n");
+    assert_contains(b3, "output: box.png\n");
+    assert_contains(b4, "file: assets/donut.obj\nformat: mesh\n");
+    assert_contains(b4, "camera: auto");
+    assert_contains(b4, "output: donut.png\n");
+    /* a file that fails is reported and the rest still are, exit 2 */
+    const char *const bad[] = {"--info", path_in("missing.txt"), path_in("i2.txt"), NULL};
+    assert_int_equal(run_stdout(bad, text, sizeof text), 2);
+    assert_contains(text, "i2.txt\n");
+    /* a render still takes one input */
+    REFUSE(out_png, "only one input file", "--info takes several", path_in("i1.txt"), path_in("i2.txt"), "-o",
+           out_png);
+}
+
 /* --------------------------------------------------------------- models */
 
 static const char *gltf_doc(char *buf, size_t size, int count, int bad_index, const char *nodes)
@@ -972,6 +1030,7 @@ int main(void)
         cmocka_unit_test(test_no_input_says_so),
         cmocka_unit_test(test_bad_scene_files),
         cmocka_unit_test(test_inputs),
+        cmocka_unit_test(test_info),
         cmocka_unit_test(test_bad_models),
         cmocka_unit_test(test_bad_images),
         cmocka_unit_test(test_bad_output),

@@ -61,7 +61,9 @@ static const flag flags[] = {
     {NULL, "--tile", "N", FLAG_TILE, NULL, "tile size in pixels (default 32)"},
     {NULL, "--preview", "SECONDS", FLAG_PREVIEW, NULL,
      "live view: rewrite the output with the finished tiles every SECONDS"},
-    {NULL, "--info", "FILE", FLAG_INFO, NULL, "print what a scene or model contains (key: value lines) and exit"},
+    {NULL, "--info", "FILE", FLAG_INFO, NULL,
+     "print what a scene or model contains and how it would render (key: value lines) and exit; "
+     "more files may follow (rt --info a.glb b.txt), one block each"},
     {NULL, "--max-memory", "SIZE", FLAG_MAX_MEMORY, NULL, "memory budget, e.g. 4G or 512M; 'none' for no limit"},
     {"-h", "--help", NULL, FLAG_HELP, NULL, "this text"},
     {NULL, "--version", NULL, FLAG_VERSION, NULL, "print the version"},
@@ -271,9 +273,12 @@ int args_parse(args *a, int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         if (flags_ended || !looks_like_flag(arg)) {
-            if (a->input)
-                return fail_usage("only one input file, please (got a second: '%s')", arg);
-            a->input = arg;
+            if (!a->input)
+                a->input = arg;
+            else if (a->more_input_count < ARGS_MAX_INPUTS)
+                a->more_inputs[a->more_input_count++] = arg;
+            else
+                return fail_usage("too many input files (--info reports at most %d at once)", ARGS_MAX_INPUTS);
             continue;
         }
         if (strcmp(arg, "--") == 0) {
@@ -364,6 +369,9 @@ int args_parse(args *a, int argc, char **argv)
             break;
         }
     }
+    if (!a->info_path && a->more_input_count)
+        return fail_usage("only one input file, please (got a second: '%s'); --info takes several",
+                          a->more_inputs[0]);
     return ARGS_OK;
 }
 

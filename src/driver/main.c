@@ -160,7 +160,11 @@ static const char *input_name(const char *input)
     return !input ? "<built-in scene>" : strcmp(input, "-") == 0 ? "<stdin>" : input;
 }
 
-/* --info: one `key: value` line per figure, for people and scripts. */
+static void print_vec(const char *key, rt_vec3 v) { printf("%s: %.9g %.9g %.9g\n", key, v.x, v.y, v.z); }
+
+/* --info for one input: one `key: value` line per figure, for people and
+ * scripts. The counts are the file's own (loaded as it is); the settings
+ * and camera are what `rt FILE` would render with, before any flag. */
 static int print_info(const char *path, const memory_budget *budget)
 {
     rt_scene s;
@@ -197,9 +201,61 @@ static int print_info(const char *path, const memory_budget *budget)
         printf("image.%zu: %dx%d %s\n", i, s.images[i].width, s.images[i].height, s.images[i].name);
     printf("cameras: %zu\n", s.camera_count);
     printf("lights: %zu\n", s.light_count);
+
+    /* how it would render */
+    rt_settings set = s.settings;
+    if (info.kind != RT_LOAD_SCENE)
+        rt_load_model_settings(&set);
+    const rt_camera *cam = NULL;
+    if (s.camera_set) {
+        printf("camera: scene file\n");
+        cam = &s.camera;
+    } else if (info.kind == RT_LOAD_GLTF && s.camera_count) {
+        printf("camera: gltf camera 0\n");
+        cam = &s.cameras[0];
+        if (cam->aspect_ratio > 0.0f) { /* the width follows the camera's aspect ratio */
+            double w = (double)set.height * cam->aspect_ratio + 0.5;
+            set.width = w < 1.0 ? 1 : (w > (double)RT_MAX_IMAGE_SIDE ? RT_MAX_IMAGE_SIDE : (int)w);
+        }
+    } else {
+        printf("camera: auto (framed to the bounds)\n");
+    }
+    if (cam) {
+        print_vec("camera.position", cam->position);
+        print_vec("camera.look_at", cam->look_at);
+        print_vec("camera.up", cam->up);
+        printf("camera.fov: %.9g\n", cam->vfov_deg);
+    }
+    s.settings = set;
+    char output[1024];
+    default_output(&s, path, output, sizeof output);
+    printf("resolution: %dx%d\n", set.width, set.height);
+    printf("samples: %d\n", set.samples);
+    printf("integrator: %s\n", rt_integrator_name(set.integrator));
+    printf("output: %s\n", output);
     printf("load_ms: %.3f\n", info.load_ms);
     rt_scene_free(&s);
     return 0;
+}
+
+/* --info FILE [FILE...]: one block each, a blank line between; exit 2 when
+ * any of them failed to load (the others are still reported). */
+static int print_infos(const args *a)
+{
+    int status = print_info(a->info_path, &a->budget);
+    const char *rest[ARGS_MAX_INPUTS + 1];
+    size_t n = 0;
+    if (a->input)
+        rest[n++] = a->input;
+    for (size_t i = 0; i < a->more_input_count; i++)
+        rest[n++] = a->more_inputs[i];
+    for (size_t i = 0; i < n; i++) {
+        printf("\n");
+        fflush(stdout);
+        if (print_info(rest[i], &a->budget) != 0)
+            status = 2;
+    }
+    return status;
 }
 
 /* The loaded scene as the flags want it: setting flags applied, --camera
@@ -346,7 +402,7 @@ int main(int argc, char **argv)
     rt_log_set_level(a.log_level);
     memory_budget_apply(&a.budget);
     if (a.info_path)
-        return print_info(a.info_path, &a.budget);
+        return print_infos(&a);
 
     rt_scene scene;
     rt_scene_init(&scene);

@@ -105,12 +105,17 @@ const char *rt_load_kind_name(rt_load_kind kind)
     return "unknown";
 }
 
+void rt_load_model_settings(rt_settings *set)
+{
+    set->samples = 16;
+    set->background = rt_v3(0.55f, 0.6f, 0.7f);
+}
+
 /* Lighting and sampling for a bare model: a soft sky, a key light from
  * above when the model brings no lights, and enough samples for clean edges. */
 static bool add_default_lighting(rt_scene *s)
 {
-    s->settings.samples = 16;
-    s->settings.background = rt_v3(0.55f, 0.6f, 0.7f);
+    rt_load_model_settings(&s->settings);
     if (s->light_count == 0) {
         rt_light sun;
         memset(&sun, 0, sizeof sun);

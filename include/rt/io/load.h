@@ -72,6 +72,10 @@ rt_result rt_load_memory(rt_scene *s, const void *bytes, size_t size, const char
  * file. */
 rt_load_kind rt_load_kind_of(const void *bytes, size_t size, const char *name);
 
+/* The settings a glTF model or a mesh rendered on its own gets (for_render
+ * does this to the scene's settings): its samples, integrator and sky. */
+void rt_load_model_settings(rt_settings *set);
+
 /* True when name is read as scene text unless its content says otherwise:
  * .txt, .rt, .scene, no extension, or NULL. */
 bool rt_load_is_scene_name(const char *name);
