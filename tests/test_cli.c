@@ -379,6 +379,69 @@ static void test_flag_forms_same_image(void **state)
     unlink(ref), unlink(a), unlink(b);
 }
 
+static bool same_file(const char *a, const char *b)
+{
+    static char x[1 << 20], y[1 << 20];
+    size_t n = read_all(a, x, sizeof x), m = read_all(b, y, sizeof y);
+    assert_true(n != (size_t)-1 && m != (size_t)-1);
+    return n == m && memcmp(x, y, n) == 0;
+}
+
+/* --camera auto and the pose flags: the same image as a scene file saying
+ * the same; bad values and a degenerate camera refused, naming the flags. */
+static void test_camera_flags(void **state)
+{
+    (void)state;
+    const char *o = out_png;
+    static const char body[] = "resolution 16 12\nsamples 1\nmaterial m color 0.8 0.3 0.2\n"
+                               "sphere 0 0 0 1 m\nsphere 1.5 0 -1 0.5 m\n";
+    char text[1024];
+    write_text("cam-none.txt", body);
+    snprintf(text, sizeof text, "%scamera position 1 2 6 look_at 0.5 0 0 up 0 1 0 fov 35\n", body);
+    write_text("cam-own.txt", text);
+    char a[600], b[600];
+    snprintf(a, sizeof a, "%s", path_in("cam-a.pfm"));
+    snprintf(b, sizeof b, "%s", path_in("cam-b.pfm"));
+    /* the pose on the command line = the pose in the file */
+    const char *const own[] = {path_in("cam-own.txt"), NULL};
+    render_ok(a, own);
+    const char *const flags[] = {"--look-from", "1,2,6", "--look-at=0.5,0,0", "--up", "0,1,0", "--fov", "35",
+                                 path_in("cam-none.txt"), NULL};
+    render_ok(b, flags);
+    assert_same_file(a, b);
+    /* and over the file's own camera */
+    snprintf(text, sizeof text, "%scamera position 3 3 3 look_at 0.5 0 0 fov 60\n", body);
+    write_text("cam-other.txt", text);
+    const char *const over[] = {"--fov", "35", "--look-from", "1,2,6", path_in("cam-other.txt"), NULL};
+    render_ok(b, over);
+    assert_same_file(a, b);
+    /* --camera auto ignores the file's camera: the image of the file without one */
+    const char *const none[] = {path_in("cam-none.txt"), NULL};
+    render_ok(a, none);
+    const char *const autocam[] = {"--camera", "auto", path_in("cam-own.txt"), NULL};
+    render_ok(b, autocam);
+    assert_same_file(a, b);
+    /* a glTF's own camera, then framed automatically: a different view */
+    const char *const gltf_own[] = {"-r", "16x12", "-s", "1", "assets/box.gltf", NULL};
+    render_ok(a, gltf_own);
+    const char *const gltf_auto[] = {"-r", "16x12", "-s", "1", "--camera=auto", "assets/box.gltf", NULL};
+    render_ok(b, gltf_auto);
+    assert_false(same_file(a, b));
+    unlink(a), unlink(b);
+
+    REFUSE(o, "--look-from wants three numbers X,Y,Z", "'0,1'", "--look-from", "0,1", "-o", o);
+    REFUSE(o, "--look-at wants three numbers", "'0,1,x'", "--look-at", "0,1,x", "-o", o);
+    REFUSE(o, "--look-at wants three numbers", "'0,1,2,3'", "--look-at", "0,1,2,3", "-o", o);
+    REFUSE(o, "--up wants a direction", "'0,0,0'", "--up", "0,0,0", "-o", o);
+    REFUSE(o, "--fov wants a field of view in degrees between 0 and 180", "'180'", "--fov", "180", "-o", o);
+    REFUSE(o, "--fov wants", "'-5'", "--fov", "-5", "-o", o);
+    REFUSE(o, "--camera wants a camera index (0, 1, ...) or 'auto'", "'front'", "--camera", "front", "-o", o);
+    REFUSE(o, "--look-from 0,1,3 --look-at 0,1,3: the camera is degenerate", NULL, "-r", "8x8", "--look-from",
+           "0,1,3", "--look-at", "0,1,3", "-o", o);
+    REFUSE(o, "--look-at 0,5,0 --up 0,1,0: the camera is degenerate", NULL, "-r", "8x8", "--look-at", "0,5,0", "--up",
+           "0,1,0", "--look-from", "0,0,0", "-o", o);
+}
+
 /* Every flag `rt --help` lists is in README.md's flag table ("Using it"). */
 static void test_help_flags_in_readme(void **state)
 {
@@ -1025,6 +1088,7 @@ int main(void)
         cmocka_unit_test(test_bad_flags),
         cmocka_unit_test(test_flag_forms),
         cmocka_unit_test(test_flag_forms_same_image),
+        cmocka_unit_test(test_camera_flags),
         cmocka_unit_test(test_help_flags_in_readme),
         cmocka_unit_test(test_verbose_lines_prefixed),
         cmocka_unit_test(test_no_input_says_so),

@@ -50,6 +50,12 @@ typedef struct args {
     int threads;            /* -t; 0 = all cores */
     int tile;               /* --tile; 0 = the default */
     int camera;             /* --camera N; -1 = none */
+    bool camera_auto;       /* --camera auto: frame the model, ignoring its cameras */
+    /* --look-from, --look-at, --up, --fov: each replaces one part of the
+     * camera (after --camera and automatic framing) */
+    bool has_look_from, has_look_at, has_up, has_fov;
+    rt_vec3 look_from, look_at, up;
+    float fov;
     double preview_seconds; /* --preview; 0 = no live view */
     rt_log_level log_level; /* -q, -v */
     memory_budget budget;   /* --max-memory, else the default (not applied yet) */
