@@ -790,6 +790,44 @@ static void test_bad_models(void **state)
     REFUSE(o, "idx.off:", NULL, path_in("idx.off"), "-o", o);
 }
 
+/* One rule for missing textures in every format: a warning naming the
+ * file and line (the map_Kd line of an MTL, the image of a glTF), and the
+ * render goes on with the magenta checker. */
+static void test_missing_textures(void **state)
+{
+    (void)state;
+    static char doc[1 << 16];
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *o = path_in("miss.png");
+    write_text("miss.txt", "resolution 8 8\nmaterial m texture gone.png\nsphere 0 0 0 1 m\n");
+    write_text("miss.mtl", "newmtl a\nKd 1 1 1\nmap_Kd gone.png\n");
+    write_text("miss.obj", "mtllib miss.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\n"
+                           "f 1/1 2/2 3/3\n");
+    gltf_doc(doc + 1, sizeof doc - 200, 3, 0, "[{\"mesh\":0}]");
+    char *g = malloc(sizeof doc + 128);
+    assert_non_null(g);
+    snprintf(g, sizeof doc + 128, "{\"images\":[{\"uri\":\"gone.png\"}],\"textures\":[{\"source\":0}],%s", doc + 2);
+    write_text("miss.gltf", g);
+    free(g);
+    static const struct { const char *input, *where; } cases[] = {
+        {"miss.txt", "miss.txt:2:20: image '"},
+        {"miss.obj", "miss.mtl:3: map_Kd: image '"},
+        {"miss.gltf", "miss.gltf: images[0] (\"gone.png\"): image '"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        const char *const args[] = {"-r", "8x8", "-s", "1", "-o", o, path_in(cases[i].input), NULL};
+        run_args(r, args);
+        if (r->status != 0)
+            fail_msg("%s: exit %d: %s", cases[i].input, r->status, r->err);
+        assert_contains(r->err, "rt: warning: ");
+        assert_contains(r->err, cases[i].where);
+        assert_contains(r->err, "gone.png' not found; a magenta checker stands in");
+    }
+    unlink(o);
+    free(r);
+}
+
 /* ---------------------------------------------------------------- images */
 
 static void be32put(unsigned char *p, uint32_t v)
@@ -1096,6 +1134,7 @@ int main(void)
         cmocka_unit_test(test_inputs),
         cmocka_unit_test(test_info),
         cmocka_unit_test(test_bad_models),
+        cmocka_unit_test(test_missing_textures),
         cmocka_unit_test(test_bad_images),
         cmocka_unit_test(test_bad_output),
         cmocka_unit_test(test_memory_budget),

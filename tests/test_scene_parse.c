@@ -1005,12 +1005,30 @@ static void test_textures_from_files(void **state)
     /* loader errors keep their message, prefixed with the scene location */
     rt_error err;
     rt_scene_init(&s);
-    const char *text = "material m texture missing.png\n";
-    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", TMP_DIR, &err), RT_ERR_IO);
+    test_write_file(TMP_DIR "/garbage.png", "not an image", 12);
+    const char *text = "material m texture garbage.png\n";
+    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", TMP_DIR, &err), RT_ERR_INVALID);
     assert_true(strncmp(err.message, "t.txt:1:20: ", 12) == 0);
-    assert_non_null(strstr(err.message, TMP_DIR "/missing.png"));
+    assert_non_null(strstr(err.message, TMP_DIR "/garbage.png"));
     rt_scene_free(&s);
-    expect_error("texture t image nothing.jpg\n", RT_ERR_IO, "1:17", TMP_DIR "/nothing.jpg");
+    /* a missing image is a warning and the missing-texture rule: the
+     * magenta checker in colour slots, nothing in data slots */
+    rt_scene_init(&s);
+    text = "texture t image nothing.jpg\n"
+           "material m texture missing.png normal_map missing.png emission_map t metallic_roughness_map t\n";
+    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", TMP_DIR, &err), RT_OK);
+    const rt_material *mm = &s.materials[rt_scene_find_material(&s, "m")];
+    for (int k = 0; k < 2; k++) {
+        uint32_t t = k ? mm->emissive_tex.texture : mm->base_color_tex.texture;
+        assert_true(t < s.texture_count);
+        assert_int_equal(s.textures[t].kind, RT_TEX_CHECKER);
+        assert_float_equal(s.textures[t].color_a.x, 1.0, 0);
+        assert_float_equal(s.textures[t].color_a.y, 0.0, 0);
+    }
+    assert_int_equal(mm->normal_tex.texture, RT_NONE);
+    assert_int_equal(mm->metal_rough_tex.texture, RT_NONE);
+    assert_int_equal(s.image_count, 0);
+    rt_scene_free(&s);
     expect_error("environment sky.hdr\n", RT_ERR_IO, "1:13", TMP_DIR "/sky.hdr");
     expect_error("texture t image tex.ppm wrap sideways\n", RT_ERR_PARSE, "1:30",
                  "expected a wrap mode (repeat|clamp|mirror), got 'sideways'");
