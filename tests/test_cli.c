@@ -697,6 +697,35 @@ static void test_info(void **state)
            out_png);
 }
 
+/* A model given directly renders with the path tracer at 64 spp; a scene
+ * file keeps its integrator line. */
+static void test_model_defaults(void **state)
+{
+    (void)state;
+    static char text[1 << 14];
+    const char *const info[] = {"--info", "assets/donut.obj", "assets/box.gltf", "scenes/cornell.txt", NULL};
+    assert_int_equal(run_stdout(info, text, sizeof text), 0);
+    char *b2 = strstr(text, "file: assets/box.gltf");
+    char *b3 = strstr(text, "file: scenes/cornell.txt");
+    assert_true(b2 && b3);
+    b2[-1] = b3[-1] = 0;
+    assert_contains(text, "samples: 64\nintegrator: path\n");
+    assert_contains(b2, "samples: 64\nintegrator: path\n");
+    assert_contains(b3, "integrator: direct\n");
+    char a[600], b[600];
+    snprintf(a, sizeof a, "%s", path_in("md-a.pfm"));
+    snprintf(b, sizeof b, "%s", path_in("md-b.pfm"));
+    const char *const plain[] = {"-r", "16x12", "-s", "2", "assets/donut.obj", NULL};
+    render_ok(a, plain);
+    const char *const path[] = {"-r", "16x12", "-s", "2", "--integrator", "path", "assets/donut.obj", NULL};
+    render_ok(b, path);
+    assert_same_file(a, b);
+    const char *const direct[] = {"-r", "16x12", "-s", "2", "--integrator", "direct", "assets/donut.obj", NULL};
+    render_ok(b, direct);
+    assert_false(same_file(a, b));
+    unlink(a), unlink(b);
+}
+
 /* --------------------------------------------------------------- models */
 
 static const char *gltf_doc(char *buf, size_t size, int count, int bad_index, const char *nodes)
@@ -1133,6 +1162,7 @@ int main(void)
         cmocka_unit_test(test_bad_scene_files),
         cmocka_unit_test(test_inputs),
         cmocka_unit_test(test_info),
+        cmocka_unit_test(test_model_defaults),
         cmocka_unit_test(test_bad_models),
         cmocka_unit_test(test_missing_textures),
         cmocka_unit_test(test_bad_images),

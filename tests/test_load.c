@@ -336,7 +336,8 @@ static void test_for_render(void **state)
     rt_scene_init(&s);
     write_text("tri.ply", ply_text);
     assert_int_equal(rt_load(&s, tpath("tri.ply"), &opt, NULL, &err), RT_OK);
-    assert_int_equal(s.settings.samples, 16);
+    assert_int_equal(s.settings.samples, 64);
+    assert_int_equal(s.settings.integrator, RT_INTEGRATOR_PATH);
     assert_int_equal(s.light_count, 1);
     assert_int_equal(s.lights[0].kind, RT_LIGHT_DIRECTIONAL);
     assert_false(s.camera_set); /* framed by the driver later */

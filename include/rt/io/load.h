@@ -27,7 +27,8 @@
  *
  * A mesh gets a material "default" (added first) for faces the file gives
  * none. With for_render, a bare model also gets what rendering it needs:
- * 16 samples, a soft sky, a directional key light when it brings no lights,
+ * the path tracer at 64 samples per pixel (rt_load_model_settings), a soft
+ * sky, a directional key light when it brings no lights,
  * the first glTF camera as the view; and every input gets per-vertex
  * tangents where normal maps need them (rt_scene_generate_tangents). On any
  * error the scene is rolled back to where it was (rt_scene_rollback).
@@ -44,7 +45,7 @@
 typedef enum rt_load_kind { RT_LOAD_SCENE = 0, RT_LOAD_GLTF, RT_LOAD_MESH, RT_LOAD_UNKNOWN } rt_load_kind;
 
 typedef struct rt_load_options {
-    bool for_render; /* add lighting, samples, the first camera and tangents (above); false = as the file is */
+    bool for_render; /* add lighting, integrator, samples, the first camera and tangents (above); false = as the file is */
 } rt_load_options;
 
 /* What one load found (what `rt --info` prints beside the scene's counts). */
