@@ -1121,6 +1121,37 @@ static void test_second_sigint_exits_at_once(void **state)
     free(r);
 }
 
+/* An image write killed at any moment (a second Ctrl-C, SIGKILL) leaves no
+ * temporary file: the file being written has no name until it is complete
+ * (framebuffer.c). A child rewrites a 100 MB PFM in a loop and is killed
+ * at ten different moments; the scratch directory is checked each time. */
+static void test_killed_write_leaves_no_temp(void **state)
+{
+    (void)state;
+    const char *pfm = path_in("killed.pfm");
+    for (int i = 0; i < 10; i++) {
+        pid_t pid = fork();
+        assert_true(pid >= 0);
+        if (pid == 0) {
+            rt_framebuffer fb;
+            rt_error err;
+            if (rt_framebuffer_init(&fb, 3000, 3000, &err) != RT_OK)
+                _exit(3);
+            for (;;)
+                if (rt_framebuffer_write(&fb, pfm, 1.0f, &err) != RT_OK)
+                    _exit(4);
+        }
+        sleep_s(0.05 + 0.037 * i);
+        kill(pid, SIGKILL);
+        int st = 0;
+        waitpid(pid, &st, 0);
+        if (!WIFSIGNALED(st))
+            fail_msg("the writer exited with %d instead of being killed", WEXITSTATUS(st));
+        assert_no_temp_files();
+    }
+    unlink(pfm);
+}
+
 /* `rt compare` is reached from the command line: an image against itself
  * (every metric 0, exit 0), against a different one with a threshold that
  * fails (exit 1), and against a missing file (exit 2, the file named). */
@@ -1173,6 +1204,7 @@ int main(void)
         cmocka_unit_test(test_sigint_writes_finished_tiles),
         cmocka_unit_test(test_sigterm_writes_finished_tiles),
         cmocka_unit_test(test_second_sigint_exits_at_once),
+        cmocka_unit_test(test_killed_write_leaves_no_temp),
         cmocka_unit_test(test_compare_command),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

@@ -4,7 +4,8 @@
  * Writes are atomic: the image goes to a temporary file in the same
  * directory, which is renamed over the target only once complete, so a
  * failed or killed render never leaves a truncated file or clobbers an
- * earlier image.
+ * earlier image. On Linux that file has no name until it is complete
+ * (O_TMPFILE), so a process killed mid-write leaves no temporary file.
  *
  *   rt_framebuffer fb;
  *   rt_framebuffer_init(&fb, 640, 480, &err);
