@@ -88,12 +88,18 @@ typedef struct run_result {
 /* Runs rt with args; its stdout goes to stdout_path (NULL = /dev/null), its
  * stderr to stderr.txt in the scratch directory. */
 static const char *stdin_path; /* the child's standard input when set, else /dev/null */
+static const char *child_dir;  /* the child's working directory when set */
 
 static pid_t spawn_to(const char *const *args, const char *stdout_path)
 {
     const char *argv[64];
     int n = 0;
-    argv[n++] = rt_bin();
+    static char bin[4096], cwd[3000]; /* absolute, for a child that changes directory */
+    if (rt_bin()[0] != '/' && getcwd(cwd, sizeof cwd))
+        snprintf(bin, sizeof bin, "%s/%s", cwd, rt_bin());
+    else
+        snprintf(bin, sizeof bin, "%s", rt_bin());
+    argv[n++] = bin;
     for (int i = 0; args[i] && n < 63; i++)
         argv[n++] = args[i];
     argv[n] = NULL;
@@ -110,6 +116,8 @@ static pid_t spawn_to(const char *const *args, const char *stdout_path)
         dup2(in, 0);
         dup2(null, 1);
         dup2(e, 2);
+        if (child_dir && chdir(child_dir) != 0)
+            _exit(127);
         execv(argv[0], (char *const *)argv);
         _exit(127);
     }
@@ -916,6 +924,12 @@ static void test_bad_output(void **state)
     snprintf(own, sizeof own, "resolution 8 8\noutput \"%s\"\n", dpng);
     write_text("own-dir.txt", own);
     REFUSE(o, "d.png: is a directory", NULL, path_in("own-dir.txt"));
+    /* a model's default output (NAME.png here), before the model is loaded:
+     * d.gltf is not even valid */
+    write_text("d.gltf", "{ not json");
+    child_dir = dir;
+    REFUSE(o, "d.png: is a directory", NULL, "-r", "8x8", "d.gltf");
+    child_dir = NULL;
     rmdir(dpng);
     /* too big for the PNG writer: refused before rendering, not after */
     REFUSE(o, "out.png: a 32768x32768 PNG", ".pfm", "-r", "32768x32768", "-o", o);

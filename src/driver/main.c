@@ -76,7 +76,7 @@ static void report(const rt_error *err, const memory_budget *budget)
  * with .png, in the current directory. */
 static void default_output(const rt_scene *s, const char *input, char *out, size_t size)
 {
-    if (s->settings.output[0]) {
+    if (s && s->settings.output[0]) {
         snprintf(out, size, "%s", s->settings.output);
         return;
     }
@@ -310,10 +310,17 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     rt_load_info info;
     rt_load_options lo = {.for_render = true};
     rt_result r;
-    /* -o is checked before the load, which may take long; the scene's own
-     * `output` can only be checked after it */
+    /* -o is checked before the load, which may take long, and so is a
+     * model's default output (models have no `output` line); a scene's own
+     * `output` can only be checked after the load */
     if (a->output && (r = rt_output_check(a->output, err)) != RT_OK)
         return r;
+    if (!a->output && !args_sets(a, "output") && a->input && strcmp(a->input, "-") != 0 &&
+        !rt_load_is_scene_name(a->input)) {
+        default_output(NULL, a->input, output, size);
+        if ((r = rt_output_check(output, err)) != RT_OK)
+            return r;
+    }
     if ((r = load_input(scene, a->input, &lo, &info, err)) != RT_OK)
         return r;
     if ((r = rt_scene_validate(scene, err)) != RT_OK) { /* from here on the tables are trusted */
