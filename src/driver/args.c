@@ -115,10 +115,12 @@ static void print_wrapped(FILE *f, const char *text, int at, int indent)
 
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off]\n"
+    fprintf(f, "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off | -]\n"
                "       rt compare CANDIDATE REFERENCE [--max-rmse X] [--max-flip X] ...  (docs/compare.md)\n"
                "\n"
-               "Renders a scene to an image. With no input, renders the built-in Cornell box to out.png.\n"
+               "Renders a scene to an image. With no input, renders the built-in Cornell box to out.png;\n"
+               "'-' reads a scene, glTF or mesh from standard input. A model given directly renders with\n"
+               "the path tracer at 64 samples per pixel; a scene file keeps its own settings (defaults below).\n"
                "\n"
                "options (a value may also follow '=', as in --samples=64; the setting flags -s, -r,\n"
                "--integrator, --seed and --set override the scene, the later flag winning):\n");
