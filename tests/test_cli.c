@@ -165,10 +165,13 @@ static void assert_no_temp_files(void)
     DIR *d = opendir(dir);
     assert_non_null(d);
     struct dirent *e;
+    char left[300] = "";
     while ((e = readdir(d)))
         if (strncmp(e->d_name, ".rt-tmp-", 8) == 0)
-            fail_msg("temporary file %s/%s left behind", dir, e->d_name);
-    closedir(d);
+            snprintf(left, sizeof left, "%s", e->d_name);
+    closedir(d); /* before failing: fail_msg does not return */
+    if (left[0])
+        fail_msg("temporary file %s/%s left behind", dir, left);
 }
 
 static void put_precious(const char *path)
