@@ -87,11 +87,19 @@ typedef struct run_result {
 
 /* Runs rt with args; its stdout goes to stdout_path (NULL = /dev/null), its
  * stderr to stderr.txt in the scratch directory. */
+static const char *stdin_path; /* the child's standard input when set, else /dev/null */
+static const char *child_dir;  /* the child's working directory when set */
+
 static pid_t spawn_to(const char *const *args, const char *stdout_path)
 {
     const char *argv[64];
     int n = 0;
-    argv[n++] = rt_bin();
+    static char bin[4096], cwd[3000]; /* absolute, for a child that changes directory */
+    if (rt_bin()[0] != '/' && getcwd(cwd, sizeof cwd))
+        snprintf(bin, sizeof bin, "%s/%s", cwd, rt_bin());
+    else
+        snprintf(bin, sizeof bin, "%s", rt_bin());
+    argv[n++] = bin;
     for (int i = 0; args[i] && n < 63; i++)
         argv[n++] = args[i];
     argv[n] = NULL;
@@ -102,8 +110,14 @@ static pid_t spawn_to(const char *const *args, const char *stdout_path)
         int e = open(path_in("stderr.txt"), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         if (null < 0 || e < 0)
             _exit(127);
+        int in = open(stdin_path ? stdin_path : "/dev/null", O_RDONLY);
+        if (in < 0)
+            _exit(127);
+        dup2(in, 0);
         dup2(null, 1);
         dup2(e, 2);
+        if (child_dir && chdir(child_dir) != 0)
+            _exit(127);
         execv(argv[0], (char *const *)argv);
         _exit(127);
     }
@@ -151,10 +165,13 @@ static void assert_no_temp_files(void)
     DIR *d = opendir(dir);
     assert_non_null(d);
     struct dirent *e;
+    char left[300] = "";
     while ((e = readdir(d)))
         if (strncmp(e->d_name, ".rt-tmp-", 8) == 0)
-            fail_msg("temporary file %s/%s left behind", dir, e->d_name);
-    closedir(d);
+            snprintf(left, sizeof left, "%s", e->d_name);
+    closedir(d); /* before failing: fail_msg does not return */
+    if (left[0])
+        fail_msg("temporary file %s/%s left behind", dir, left);
 }
 
 static void put_precious(const char *path)
@@ -373,6 +390,69 @@ static void test_flag_forms_same_image(void **state)
     unlink(ref), unlink(a), unlink(b);
 }
 
+static bool same_file(const char *a, const char *b)
+{
+    static char x[1 << 20], y[1 << 20];
+    size_t n = read_all(a, x, sizeof x), m = read_all(b, y, sizeof y);
+    assert_true(n != (size_t)-1 && m != (size_t)-1);
+    return n == m && memcmp(x, y, n) == 0;
+}
+
+/* --camera auto and the pose flags: the same image as a scene file saying
+ * the same; bad values and a degenerate camera refused, naming the flags. */
+static void test_camera_flags(void **state)
+{
+    (void)state;
+    const char *o = out_png;
+    static const char body[] = "resolution 16 12\nsamples 1\nmaterial m color 0.8 0.3 0.2\n"
+                               "sphere 0 0 0 1 m\nsphere 1.5 0 -1 0.5 m\n";
+    char text[1024];
+    write_text("cam-none.txt", body);
+    snprintf(text, sizeof text, "%scamera position 1 2 6 look_at 0.5 0 0 up 0 1 0 fov 35\n", body);
+    write_text("cam-own.txt", text);
+    char a[600], b[600];
+    snprintf(a, sizeof a, "%s", path_in("cam-a.pfm"));
+    snprintf(b, sizeof b, "%s", path_in("cam-b.pfm"));
+    /* the pose on the command line = the pose in the file */
+    const char *const own[] = {path_in("cam-own.txt"), NULL};
+    render_ok(a, own);
+    const char *const flags[] = {"--look-from", "1,2,6", "--look-at=0.5,0,0", "--up", "0,1,0", "--fov", "35",
+                                 path_in("cam-none.txt"), NULL};
+    render_ok(b, flags);
+    assert_same_file(a, b);
+    /* and over the file's own camera */
+    snprintf(text, sizeof text, "%scamera position 3 3 3 look_at 0.5 0 0 fov 60\n", body);
+    write_text("cam-other.txt", text);
+    const char *const over[] = {"--fov", "35", "--look-from", "1,2,6", path_in("cam-other.txt"), NULL};
+    render_ok(b, over);
+    assert_same_file(a, b);
+    /* --camera auto ignores the file's camera: the image of the file without one */
+    const char *const none[] = {path_in("cam-none.txt"), NULL};
+    render_ok(a, none);
+    const char *const autocam[] = {"--camera", "auto", path_in("cam-own.txt"), NULL};
+    render_ok(b, autocam);
+    assert_same_file(a, b);
+    /* a glTF's own camera, then framed automatically: a different view */
+    const char *const gltf_own[] = {"-r", "16x12", "-s", "1", "assets/box.gltf", NULL};
+    render_ok(a, gltf_own);
+    const char *const gltf_auto[] = {"-r", "16x12", "-s", "1", "--camera=auto", "assets/box.gltf", NULL};
+    render_ok(b, gltf_auto);
+    assert_false(same_file(a, b));
+    unlink(a), unlink(b);
+
+    REFUSE(o, "--look-from wants three numbers X,Y,Z", "'0,1'", "--look-from", "0,1", "-o", o);
+    REFUSE(o, "--look-at wants three numbers", "'0,1,x'", "--look-at", "0,1,x", "-o", o);
+    REFUSE(o, "--look-at wants three numbers", "'0,1,2,3'", "--look-at", "0,1,2,3", "-o", o);
+    REFUSE(o, "--up wants a direction", "'0,0,0'", "--up", "0,0,0", "-o", o);
+    REFUSE(o, "--fov wants a field of view in degrees between 0 and 180", "'180'", "--fov", "180", "-o", o);
+    REFUSE(o, "--fov wants", "'-5'", "--fov", "-5", "-o", o);
+    REFUSE(o, "--camera wants a camera index (0, 1, ...) or 'auto'", "'front'", "--camera", "front", "-o", o);
+    REFUSE(o, "--look-from 0,1,3 --look-at 0,1,3: the camera is degenerate", NULL, "-r", "8x8", "--look-from",
+           "0,1,3", "--look-at", "0,1,3", "-o", o);
+    REFUSE(o, "--look-at 0,5,0 --up 0,1,0: the camera is degenerate", NULL, "-r", "8x8", "--look-at", "0,5,0", "--up",
+           "0,1,0", "--look-from", "0,0,0", "-o", o);
+}
+
 /* Every flag `rt --help` lists is in README.md's flag table ("Using it"). */
 static void test_help_flags_in_readme(void **state)
 {
@@ -432,6 +512,55 @@ static void test_help_flags_in_readme(void **state)
     unlink(help_path);
 }
 
+/* Every line rt writes to stderr starts with "rt: ", the -v lines too. */
+static void assert_lines_prefixed(const char *err)
+{
+    int lines = 0;
+    for (const char *l = err; *l; lines++) {
+        if (strncmp(l, "rt: ", 4) != 0)
+            fail_msg("a line without the 'rt: ' prefix:\n%s", l);
+        const char *nl = strchr(l, '\n');
+        l = nl ? nl + 1 : l + strlen(l);
+    }
+    assert_true(lines > 0);
+}
+
+static void test_verbose_lines_prefixed(void **state)
+{
+    (void)state;
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *const args[] = {"-v", "-r", "8x8", "-s", "1", "-o", path_in("v.png"), NULL};
+    run_args(r, args);
+    assert_int_equal(r->status, 0);
+    assert_contains(r->err, "rt: kd-tree: built in");
+    assert_contains(r->err, "rt: render: ");
+    assert_lines_prefixed(r->err);
+    unlink(path_in("v.png"));
+    free(r);
+}
+
+/* `rt` alone renders the built-in scene and says so first, unless -q. */
+static void test_no_input_says_so(void **state)
+{
+    (void)state;
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *const args[] = {"-r", "8x8", "-s", "1", "-o", path_in("b.png"), NULL};
+    run_args(r, args);
+    assert_int_equal(r->status, 0);
+    char want[800];
+    snprintf(want, sizeof want,
+             "rt: no input given; rendering the built-in Cornell box to %s (rt --help for usage)\n", path_in("b.png"));
+    assert_true(strncmp(r->err, want, strlen(want)) == 0);
+    const char *const quiet[] = {"-q", "-r", "8x8", "-s", "1", "-o", path_in("b.png"), NULL};
+    run_args(r, quiet);
+    assert_int_equal(r->status, 0);
+    assert_string_equal(r->err, "");
+    unlink(path_in("b.png"));
+    free(r);
+}
+
 /* ------------------------------------------------------------ scene files */
 
 static void test_bad_scene_files(void **state)
@@ -464,6 +593,148 @@ static void test_bad_scene_files(void **state)
     snprintf(own, sizeof own, "output \"%s\"\nbogus\n", o);
     write_text("own.txt", own);
     REFUSE(o, "own.txt:2:1: ", NULL, path_in("own.txt"));
+}
+
+/* `-` is standard input (scene text, glTF or a mesh by content); a
+ * directory and an unknown extension are refused; an empty scene warns. */
+static void test_inputs(void **state)
+{
+    (void)state;
+    const char *o = out_png;
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    /* the same scene from a file and from standard input: the same image */
+    write_text("in.txt", "resolution 12 10\nsamples 2\nmaterial m color 0.8 0.2 0.2\nsphere 0 0 -3 1 m\n");
+    char a[600], b[600];
+    snprintf(a, sizeof a, "%s", path_in("in-file.pfm"));
+    snprintf(b, sizeof b, "%s", path_in("in-stdin.pfm"));
+    const char *const from_file[] = {path_in("in.txt"), NULL};
+    render_ok(a, from_file);
+    stdin_path = path_in("in.txt");
+    const char *const from_stdin[] = {"-", NULL};
+    render_ok(b, from_stdin);
+    assert_same_file(a, b);
+    /* errors in it are named <stdin> */
+    write_text("bad-in.txt", "resolution 8 8\nsphere 0 0 0 1 stel\n");
+    stdin_path = path_in("bad-in.txt");
+    REFUSE(o, "<stdin>:2:16: undefined material 'stel'", NULL, "-", "-o", o);
+    /* a glTF and an OBJ by content */
+    stdin_path = "assets/box.gltf";
+    const char *const gltf[] = {"-r", "8x8", "-", NULL};
+    render_ok(a, gltf);
+    stdin_path = "assets/donut.obj";
+    render_ok(a, gltf);
+    const char *const info[] = {"--info", "-", NULL};
+    run_result *ri = malloc(sizeof *ri);
+    assert_non_null(ri);
+    wait_for(spawn_to(info, path_in("info.txt")), now_s(), 60.0, ri);
+    assert_int_equal(ri->status, 0);
+    static char text[4096];
+    assert_true(read_all(path_in("info.txt"), text, sizeof text) != (size_t)-1);
+    assert_contains(text, "file: <stdin>\nformat: mesh\n");
+    free(ri);
+    stdin_path = NULL;
+
+    REFUSE(o, "is a directory", NULL, dir, "-o", o);
+    write_text("cube.stl", "solid cube\n  facet normal 0 0 1\n");
+    REFUSE(o, "cube.stl: unknown input format '.stl'", ".obj, .ply, .off", path_in("cube.stl"), "-o", o);
+
+    /* a scene with nothing in it renders the background, with a warning */
+    write_text("empty.txt", "resolution 8 8\n");
+    const char *const empty[] = {"-o", a, path_in("empty.txt"), NULL};
+    run_args(r, empty);
+    assert_int_equal(r->status, 0);
+    assert_contains(r->err, "rt: warning: ");
+    assert_contains(r->err, "empty.txt: nothing to render");
+    unlink(a), unlink(b);
+    free(r);
+}
+
+/* Runs rt with args, its stdout into buf; returns the exit status. */
+static int run_stdout(const char *const *args, char *buf, size_t cap)
+{
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    wait_for(spawn_to(args, path_in("stdout.txt")), now_s(), 60.0, r);
+    int status = r->status;
+    free(r);
+    assert_true(read_all(path_in("stdout.txt"), buf, cap) != (size_t)-1);
+    unlink(path_in("stdout.txt"));
+    return status;
+}
+
+/* --info reports the file's own camera and settings, for every file given. */
+static void test_info(void **state)
+{
+    (void)state;
+    static char text[1 << 14];
+    write_text("i1.txt", "resolution 12 10\nsamples 3\nintegrator whitted\noutput i1-out.pfm\n"
+                         "camera position 0 1 5 look_at 0 1 0 fov 30\nmaterial m\nsphere 0 0 0 1 m\n");
+    write_text("i2.txt", "material m\nsphere 0 0 0 1 m\n");
+    const char *const args[] = {"--info", path_in("i1.txt"), path_in("i2.txt"), "assets/box.gltf", "assets/donut.obj",
+                                NULL};
+    assert_int_equal(run_stdout(args, text, sizeof text), 0);
+    char *b2 = strstr(text, "\n\nfile: ");
+    assert_non_null(b2);
+    *b2 = 0;
+    b2 += 2;
+    assert_contains(text, "format: scene\n");
+    assert_contains(text, "camera: scene file\ncamera.position: 0 1 5\ncamera.look_at: 0 1 0\ncamera.up: 0 1 0\n"
+                          "camera.fov: 30\n");
+    assert_contains(text, "resolution: 12x10\nsamples: 3\nintegrator: whitted\noutput: i1-out.pfm\n");
+    char *b3 = strstr(b2, "\n\nfile: ");
+    assert_non_null(b3);
+    *b3 = 0;
+    b3 += 2;
+    assert_contains(b2, "i2.txt\n");
+    assert_contains(b2, "camera: auto (framed to the bounds)\n");
+    assert_contains(b2, "resolution: 512x512\nsamples: 1\nintegrator: direct\noutput: i2.png\n");
+    char *b4 = strstr(b3, "\n\nfile: ");
+    assert_non_null(b4);
+    *b4 = 0;
+    b4 += 2;
+    assert_contains(b3, "file: assets/box.gltf\nformat: gltf\n");
+    assert_contains(b3, "camera: gltf camera 0\ncamera.position: 1.20000005 1.39999998 3.20000005\n");
+    assert_contains(b3, "output: box.png\n");
+    assert_contains(b4, "file: assets/donut.obj\nformat: mesh\n");
+    assert_contains(b4, "camera: auto");
+    assert_contains(b4, "output: donut.png\n");
+    /* a file that fails is reported and the rest still are, exit 2 */
+    const char *const bad[] = {"--info", path_in("missing.txt"), path_in("i2.txt"), NULL};
+    assert_int_equal(run_stdout(bad, text, sizeof text), 2);
+    assert_contains(text, "i2.txt\n");
+    /* a render still takes one input */
+    REFUSE(out_png, "only one input file", "--info takes several", path_in("i1.txt"), path_in("i2.txt"), "-o",
+           out_png);
+}
+
+/* A model given directly renders with the path tracer at 64 spp; a scene
+ * file keeps its integrator line. */
+static void test_model_defaults(void **state)
+{
+    (void)state;
+    static char text[1 << 14];
+    const char *const info[] = {"--info", "assets/donut.obj", "assets/box.gltf", "scenes/cornell.txt", NULL};
+    assert_int_equal(run_stdout(info, text, sizeof text), 0);
+    char *b2 = strstr(text, "file: assets/box.gltf");
+    char *b3 = strstr(text, "file: scenes/cornell.txt");
+    assert_true(b2 && b3);
+    b2[-1] = b3[-1] = 0;
+    assert_contains(text, "samples: 64\nintegrator: path\n");
+    assert_contains(b2, "samples: 64\nintegrator: path\n");
+    assert_contains(b3, "integrator: direct\n");
+    char a[600], b[600];
+    snprintf(a, sizeof a, "%s", path_in("md-a.pfm"));
+    snprintf(b, sizeof b, "%s", path_in("md-b.pfm"));
+    const char *const plain[] = {"-r", "16x12", "-s", "2", "assets/donut.obj", NULL};
+    render_ok(a, plain);
+    const char *const path[] = {"-r", "16x12", "-s", "2", "--integrator", "path", "assets/donut.obj", NULL};
+    render_ok(b, path);
+    assert_same_file(a, b);
+    const char *const direct[] = {"-r", "16x12", "-s", "2", "--integrator", "direct", "assets/donut.obj", NULL};
+    render_ok(b, direct);
+    assert_false(same_file(a, b));
+    unlink(a), unlink(b);
 }
 
 /* --------------------------------------------------------------- models */
@@ -559,6 +830,44 @@ static void test_bad_models(void **state)
     REFUSE(o, "idx.off:", NULL, path_in("idx.off"), "-o", o);
 }
 
+/* One rule for missing textures in every format: a warning naming the
+ * file and line (the map_Kd line of an MTL, the image of a glTF), and the
+ * render goes on with the magenta checker. */
+static void test_missing_textures(void **state)
+{
+    (void)state;
+    static char doc[1 << 16];
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *o = path_in("miss.png");
+    write_text("miss.txt", "resolution 8 8\nmaterial m texture gone.png\nsphere 0 0 0 1 m\n");
+    write_text("miss.mtl", "newmtl a\nKd 1 1 1\nmap_Kd gone.png\n");
+    write_text("miss.obj", "mtllib miss.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\n"
+                           "f 1/1 2/2 3/3\n");
+    gltf_doc(doc + 1, sizeof doc - 200, 3, 0, "[{\"mesh\":0}]");
+    char *g = malloc(sizeof doc + 128);
+    assert_non_null(g);
+    snprintf(g, sizeof doc + 128, "{\"images\":[{\"uri\":\"gone.png\"}],\"textures\":[{\"source\":0}],%s", doc + 2);
+    write_text("miss.gltf", g);
+    free(g);
+    static const struct { const char *input, *where; } cases[] = {
+        {"miss.txt", "miss.txt:2:20: image '"},
+        {"miss.obj", "miss.mtl:3: map_Kd: image '"},
+        {"miss.gltf", "miss.gltf: images[0] (\"gone.png\"): image '"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        const char *const args[] = {"-r", "8x8", "-s", "1", "-o", o, path_in(cases[i].input), NULL};
+        run_args(r, args);
+        if (r->status != 0)
+            fail_msg("%s: exit %d: %s", cases[i].input, r->status, r->err);
+        assert_contains(r->err, "rt: warning: ");
+        assert_contains(r->err, cases[i].where);
+        assert_contains(r->err, "gone.png' not found; a magenta checker stands in");
+    }
+    unlink(o);
+    free(r);
+}
+
 /* ---------------------------------------------------------------- images */
 
 static void be32put(unsigned char *p, uint32_t v)
@@ -605,6 +914,26 @@ static void test_bad_output(void **state)
     REFUSE(o, "out: unknown output format", NULL, "-r", "8x8", "-o", path_in("out"));
     write_text("file", "a file, not a directory");
     REFUSE(o, "file/x.png: cannot write there", NULL, "-r", "8x8", "-o", path_in("file/x.png"));
+    /* a directory named like the output, refused before the scene is even
+     * loaded (the scene here would fail to load) */
+    const char *dpng = path_in("d.png");
+    assert_int_equal(mkdir(dpng, 0755), 0);
+    REFUSE(o, "d.png: is a directory", NULL, "-r", "8x8", "-o", dpng);
+    REFUSE(o, "d.png: is a directory", NULL, "-o", dpng, path_in("no-such-scene.txt"));
+    rmdir(dpng);
+    /* a scene's own output line naming a directory: refused before rendering */
+    char own[700];
+    assert_int_equal(mkdir(dpng, 0755), 0);
+    snprintf(own, sizeof own, "resolution 8 8\noutput \"%s\"\n", dpng);
+    write_text("own-dir.txt", own);
+    REFUSE(o, "d.png: is a directory", NULL, path_in("own-dir.txt"));
+    /* a model's default output (NAME.png here), before the model is loaded:
+     * d.gltf is not even valid */
+    write_text("d.gltf", "{ not json");
+    child_dir = dir;
+    REFUSE(o, "d.png: is a directory", NULL, "-r", "8x8", "d.gltf");
+    child_dir = NULL;
+    rmdir(dpng);
     /* too big for the PNG writer: refused before rendering, not after */
     REFUSE(o, "out.png: a 32768x32768 PNG", ".pfm", "-r", "32768x32768", "-o", o);
     if (geteuid() != 0) { /* root writes anywhere */
@@ -809,6 +1138,37 @@ static void test_second_sigint_exits_at_once(void **state)
     free(r);
 }
 
+/* An image write killed at any moment (a second Ctrl-C, SIGKILL) leaves no
+ * temporary file: the file being written has no name until it is complete
+ * (framebuffer.c). A child rewrites a 100 MB PFM in a loop and is killed
+ * at ten different moments; the scratch directory is checked each time. */
+static void test_killed_write_leaves_no_temp(void **state)
+{
+    (void)state;
+    const char *pfm = path_in("killed.pfm");
+    for (int i = 0; i < 10; i++) {
+        pid_t pid = fork();
+        assert_true(pid >= 0);
+        if (pid == 0) {
+            rt_framebuffer fb;
+            rt_error err;
+            if (rt_framebuffer_init(&fb, 3000, 3000, &err) != RT_OK)
+                _exit(3);
+            for (;;)
+                if (rt_framebuffer_write(&fb, pfm, 1.0f, &err) != RT_OK)
+                    _exit(4);
+        }
+        sleep_s(0.05 + 0.037 * i);
+        kill(pid, SIGKILL);
+        int st = 0;
+        waitpid(pid, &st, 0);
+        if (!WIFSIGNALED(st))
+            fail_msg("the writer exited with %d instead of being killed", WEXITSTATUS(st));
+        assert_no_temp_files();
+    }
+    unlink(pfm);
+}
+
 /* `rt compare` is reached from the command line: an image against itself
  * (every metric 0, exit 0), against a different one with a threshold that
  * fails (exit 1), and against a missing file (exit 2, the file named). */
@@ -843,9 +1203,16 @@ int main(void)
         cmocka_unit_test(test_bad_flags),
         cmocka_unit_test(test_flag_forms),
         cmocka_unit_test(test_flag_forms_same_image),
+        cmocka_unit_test(test_camera_flags),
         cmocka_unit_test(test_help_flags_in_readme),
+        cmocka_unit_test(test_verbose_lines_prefixed),
+        cmocka_unit_test(test_no_input_says_so),
         cmocka_unit_test(test_bad_scene_files),
+        cmocka_unit_test(test_inputs),
+        cmocka_unit_test(test_info),
+        cmocka_unit_test(test_model_defaults),
         cmocka_unit_test(test_bad_models),
+        cmocka_unit_test(test_missing_textures),
         cmocka_unit_test(test_bad_images),
         cmocka_unit_test(test_bad_output),
         cmocka_unit_test(test_memory_budget),
@@ -854,6 +1221,7 @@ int main(void)
         cmocka_unit_test(test_sigint_writes_finished_tiles),
         cmocka_unit_test(test_sigterm_writes_finished_tiles),
         cmocka_unit_test(test_second_sigint_exits_at_once),
+        cmocka_unit_test(test_killed_write_leaves_no_temp),
         cmocka_unit_test(test_compare_command),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

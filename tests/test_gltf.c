@@ -838,11 +838,32 @@ static void test_broken_data(void **state)
              "\"images\":[{\"uri\":\"garbage.png\"}],\"textures\":[{\"source\":0}],%s}", tri_rest);
     write_text("img.gltf", text);
     expect_fail("img.gltf", RT_ERR_INVALID, "garbage.png");
+    /* a missing image file is the missing-texture rule (rt/scene/texture.h),
+     * not an error: the base colour gets the magenta checker, the normal
+     * map is left out */
     snprintf(text, sizeof text,
              "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":36,\"uri\":\"ok.bin\"}],"
-             "\"images\":[{\"uri\":\"missing.png\"}],\"textures\":[{\"source\":0}],%s}", tri_rest);
+             "\"images\":[{\"uri\":\"missing.png\"}],\"textures\":[{\"source\":0},{\"source\":0}],"
+             "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}},"
+             "\"normalTexture\":{\"index\":1}}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}");
     write_text("img2.gltf", text);
-    expect_fail("img2.gltf", RT_ERR_IO, "missing.png");
+    {
+        assert_int_equal(load(tmp_path("img2.gltf"), &s, &st, &err), RT_OK);
+        assert_int_equal(s.material_count, 1);
+        assert_int_equal(s.image_count, 0);
+        uint32_t t = s.materials[0].base_color_tex.texture;
+        assert_true(t < s.texture_count);
+        assert_int_equal(s.textures[t].kind, RT_TEX_CHECKER);
+        assert_float_equal(s.textures[t].color_a.x, 1.0, 0);
+        assert_float_equal(s.textures[t].color_a.y, 0.0, 0);
+        assert_float_equal(s.textures[t].color_a.z, 1.0, 0);
+        assert_int_equal(s.materials[0].normal_tex.texture, RT_NONE);
+        rt_scene_free(&s);
+    }
     /* node cycle, and an out-of-range index */
     write_gltf("cycle.gltf", pos, sizeof pos,
                "\"nodes\":[{\"children\":[1]},{\"children\":[2]},{\"children\":[0]}]");

@@ -119,8 +119,9 @@ static void test_read_file(void **state)
     assert_int_equal(rt_read_file(tpath("missing.txt"), 0, &bytes, &size, &err), RT_ERR_IO);
     assert_non_null(strstr(err.message, "missing.txt: cannot open: "));
     assert_int_equal(rt_read_file(tmp_dir, 0, &bytes, &size, &err), RT_ERR_IO);
-    assert_non_null(strstr(err.message, ": not a regular file"));
+    assert_non_null(strstr(err.message, ": is a directory"));
     assert_int_equal(rt_read_file("/dev/null", 0, &bytes, &size, &err), RT_ERR_IO); /* a device */
+    assert_non_null(strstr(err.message, "/dev/null: not a regular file"));
 
     /* a pipe: read to its end, its limit checked as it goes */
     for (int limit = 0; limit < 2; limit++) {
@@ -209,7 +210,14 @@ static void test_kind_of(void **state)
         {"# a scene\n", "m.off", RT_LOAD_MESH},
         {"# a scene\n", "scene.txt", RT_LOAD_SCENE},
         {"# a scene\n", "scene", RT_LOAD_SCENE},
-        {"", "m.stl", RT_LOAD_SCENE},
+        {"", "m.stl", RT_LOAD_UNKNOWN},   /* not parsed as scene text: refused, naming the formats */
+        {"solid cube\n", "cube.STL", RT_LOAD_UNKNOWN},
+        {"# a scene\n", "scene.rt", RT_LOAD_SCENE},
+        {"# a scene\n", "scene.Scene", RT_LOAD_SCENE},
+        {"v 0 0 0\n", "<stdin>", RT_LOAD_MESH}, /* a nameless input that starts like an OBJ */
+        {"# exported\n\n  mtllib a.mtl\n", "<stdin>", RT_LOAD_MESH},
+        {"vertices 3\n", "<stdin>", RT_LOAD_SCENE},
+        {"v 0 0 0\n", "scene.txt", RT_LOAD_SCENE}, /* a named scene file stays scene text */
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         rt_load_kind k = rt_load_kind_of(cases[i].bytes, strlen(cases[i].bytes) + (cases[i].bytes[0] == 'g' ? 4 : 0),
@@ -221,6 +229,8 @@ static void test_kind_of(void **state)
     assert_int_equal(rt_load_kind_of(NULL, 0, "a.glb"), RT_LOAD_GLTF);
     assert_int_equal(rt_load_kind_of(NULL, 0, NULL), RT_LOAD_SCENE);
     assert_string_equal(rt_load_kind_name(RT_LOAD_MESH), "mesh");
+    assert_true(rt_load_is_scene_name("a/b.d/scene"));
+    assert_false(rt_load_is_scene_name("cube.stl"));
     assert_int_equal(rt_mesh_format_of(ply_text, strlen(ply_text), "m.off"), RT_MESH_PLY);
     assert_int_equal(rt_mesh_format_of(off_text, strlen(off_text), "m.ply"), RT_MESH_OFF);
     assert_int_equal(rt_mesh_format_of("v 0 0 0\n", 8, "m.OBJ"), RT_MESH_OBJ);
@@ -274,6 +284,19 @@ static void test_load_by_content(void **state)
     assert_false(s.camera_set); /* not for_render */
     rt_scene_free(&s);
 
+    /* an unknown extension is refused with the formats named; a nameless
+     * OBJ loads from memory */
+    write_text("cube.stl", "solid cube\nfacet normal 0 0 1\n");
+    rt_scene_init(&s);
+    expect_failure(rt_load(&s, tpath("cube.stl"), NULL, NULL, &err), &err, "cube.stl: unknown input format '.stl'");
+    assert_non_null(strstr(err.message, ".gltf, .glb"));
+    assert_null(strstr(err.message, "unknown keyword"));
+    static const char obj[] = "# from a pipe\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    assert_int_equal(rt_load_memory(&s, obj, sizeof obj - 1, "<stdin>", NULL, &info, &err), RT_OK);
+    assert_int_equal(info.kind, RT_LOAD_MESH);
+    assert_int_equal(s.triangles.count, 1);
+    rt_scene_free(&s);
+
     /* the built-in scene */
     rt_scene_init(&s);
     assert_int_equal(rt_load(&s, NULL, NULL, &info, &err), RT_OK);
@@ -301,7 +324,8 @@ static void test_for_render(void **state)
     rt_scene_init(&s);
     write_text("tri.ply", ply_text);
     assert_int_equal(rt_load(&s, tpath("tri.ply"), &opt, NULL, &err), RT_OK);
-    assert_int_equal(s.settings.samples, 16);
+    assert_int_equal(s.settings.samples, 64);
+    assert_int_equal(s.settings.integrator, RT_INTEGRATOR_PATH);
     assert_int_equal(s.light_count, 1);
     assert_int_equal(s.lights[0].kind, RT_LIGHT_DIRECTIONAL);
     assert_false(s.camera_set); /* framed by the driver later */

@@ -294,6 +294,32 @@ static void test_obj_smoothing_groups(void **state)
     rt_scene_free(&l.s);
 }
 
+/* The missing-texture rule (rt/scene/texture.h): a map_Kd whose file does
+ * not exist gets the magenta checker, a missing bump map is left out, and
+ * an image that exists but is not one is an error naming the map_Kd line. */
+static void test_obj_missing_texture(void **state)
+{
+    (void)state;
+    write_text("miss.mtl", "newmtl a\nKd 1 1 1\nmap_Kd gone.png\nmap_Bump gone_n.png\n");
+    write_text("miss.obj", "mtllib miss.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+    loaded l;
+    load_ok(&l, tpath("miss.obj"), NULL);
+    uint32_t a = rt_scene_find_material(&l.s, "miss.obj:a");
+    assert_true(a != RT_NONE);
+    uint32_t t = l.s.materials[a].base_color_tex.texture;
+    assert_true(t < l.s.texture_count);
+    assert_int_equal(l.s.textures[t].kind, RT_TEX_CHECKER);
+    assert_float_equal(l.s.textures[t].color_a.x, 1.0, 0);
+    assert_float_equal(l.s.textures[t].color_a.y, 0.0, 0);
+    assert_int_equal(l.s.materials[a].normal_tex.texture, RT_NONE);
+    assert_int_equal(l.s.image_count, 0);
+    rt_scene_free(&l.s);
+    write_text("junk.png", "not an image");
+    write_text("junk.mtl", "newmtl a\nKd 1 1 1\n\nmap_Kd junk.png\n");
+    write_text("junk.obj", "mtllib junk.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+    load_fail(tpath("junk.obj"), RT_ERR_INVALID, "junk.mtl:4: map_Kd: ");
+}
+
 static void test_obj_mtl(void **state)
 {
     (void)state;
@@ -1093,6 +1119,7 @@ int main(void)
         cmocka_unit_test(test_obj_negative_indices_and_forms),
         cmocka_unit_test(test_obj_smoothing_groups),
         cmocka_unit_test(test_obj_mtl),
+        cmocka_unit_test(test_obj_missing_texture),
         cmocka_unit_test(test_obj_warnings),
         cmocka_unit_test(test_obj_many_names),
         cmocka_unit_test(test_obj_errors),

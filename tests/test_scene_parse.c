@@ -928,6 +928,13 @@ static void test_errors_names(void **state)
     expect_error("material\n", RT_ERR_PARSE, "1:9", "expected a material name, got end of line");
     /* a material must be defined before it is used */
     expect_error("sphere 0 0 0 1 late\nmaterial late\n", RT_ERR_INVALID, "1:16", "undefined material 'late'");
+    /* a near miss is named, like an unknown keyword's */
+    expect_error("material steel color 0.5 0.5 0.5\nmaterial glass ior 1.5\nsphere 0 0 0 1 stel\n", RT_ERR_INVALID,
+                 "3:16", "undefined material 'stel' for the sphere (did you mean 'steel'?)");
+    expect_error("material steel\nsphere 0 0 0 1 Glass\n", RT_ERR_INVALID, "2:16",
+                 "undefined material 'Glass' for the sphere (define it with 'material' before use)");
+    expect_error("texture wood constant 1 1 1\nmaterial m texture wod\n", RT_ERR_INVALID, "2:20",
+                 "undefined texture 'wod' for material texture (did you mean 'wood'?)");
 }
 
 /* Many names: the hash index grows and still finds every name and duplicate. */
@@ -998,12 +1005,30 @@ static void test_textures_from_files(void **state)
     /* loader errors keep their message, prefixed with the scene location */
     rt_error err;
     rt_scene_init(&s);
-    const char *text = "material m texture missing.png\n";
-    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", TMP_DIR, &err), RT_ERR_IO);
+    test_write_file(TMP_DIR "/garbage.png", "not an image", 12);
+    const char *text = "material m texture garbage.png\n";
+    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", TMP_DIR, &err), RT_ERR_INVALID);
     assert_true(strncmp(err.message, "t.txt:1:20: ", 12) == 0);
-    assert_non_null(strstr(err.message, TMP_DIR "/missing.png"));
+    assert_non_null(strstr(err.message, TMP_DIR "/garbage.png"));
     rt_scene_free(&s);
-    expect_error("texture t image nothing.jpg\n", RT_ERR_IO, "1:17", TMP_DIR "/nothing.jpg");
+    /* a missing image is a warning and the missing-texture rule: the
+     * magenta checker in colour slots, nothing in data slots */
+    rt_scene_init(&s);
+    text = "texture t image nothing.jpg\n"
+           "material m texture missing.png normal_map missing.png emission_map t metallic_roughness_map t\n";
+    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", TMP_DIR, &err), RT_OK);
+    const rt_material *mm = &s.materials[rt_scene_find_material(&s, "m")];
+    for (int k = 0; k < 2; k++) {
+        uint32_t t = k ? mm->emissive_tex.texture : mm->base_color_tex.texture;
+        assert_true(t < s.texture_count);
+        assert_int_equal(s.textures[t].kind, RT_TEX_CHECKER);
+        assert_float_equal(s.textures[t].color_a.x, 1.0, 0);
+        assert_float_equal(s.textures[t].color_a.y, 0.0, 0);
+    }
+    assert_int_equal(mm->normal_tex.texture, RT_NONE);
+    assert_int_equal(mm->metal_rough_tex.texture, RT_NONE);
+    assert_int_equal(s.image_count, 0);
+    rt_scene_free(&s);
     expect_error("environment sky.hdr\n", RT_ERR_IO, "1:13", TMP_DIR "/sky.hdr");
     expect_error("texture t image tex.ppm wrap sideways\n", RT_ERR_PARSE, "1:30",
                  "expected a wrap mode (repeat|clamp|mirror), got 'sideways'");

@@ -121,6 +121,8 @@ rt_result rt_read_file(const char *path, size_t max_size, char **bytes, size_t *
     int flags;
     if (fstat(fd, &st) != 0)
         r = rt_fail(err, RT_ERR_IO, "%s: cannot stat: %s", path, strerror(errno));
+    else if (S_ISDIR(st.st_mode))
+        r = rt_fail(err, RT_ERR_IO, "%s: is a directory", path);
     else if (!S_ISREG(st.st_mode) && !S_ISFIFO(st.st_mode))
         r = rt_fail(err, RT_ERR_IO, "%s: not a regular file", path);
     else if ((flags = fcntl(fd, F_GETFL)) < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0)

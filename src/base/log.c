@@ -28,6 +28,7 @@ void rt_info(const char *fmt, ...)
         return;
     va_list ap;
     va_start(ap, fmt);
+    fputs("rt: ", stderr);
     vfprintf(stderr, fmt, ap);
     fputc('\n', stderr);
     va_end(ap);

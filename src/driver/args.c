@@ -9,6 +9,7 @@
  */
 #include "args.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -26,6 +27,10 @@ typedef enum flag_kind {
     FLAG_QUIET,
     FLAG_VERBOSE,
     FLAG_CAMERA,
+    FLAG_LOOK_FROM,
+    FLAG_LOOK_AT,
+    FLAG_UP,
+    FLAG_FOV,
     FLAG_TILE,
     FLAG_PREVIEW,
     FLAG_INFO,
@@ -57,11 +62,19 @@ static const flag flags[] = {
     {NULL, "--seed", "N", FLAG_SETTING, "seed", NULL},
     {NULL, "--set", "KEY=VALUE", FLAG_SET, NULL,
      "set any scene setting listed below, as a scene file would (repeatable)"},
-    {NULL, "--camera", "N", FLAG_CAMERA, NULL, "use camera N of the loaded glTF models"},
+    {NULL, "--camera", "N|auto", FLAG_CAMERA, NULL,
+     "use camera N of the loaded glTF models, or 'auto': frame the whole scene automatically, ignoring the file's "
+     "camera"},
+    {NULL, "--look-from", "X,Y,Z", FLAG_LOOK_FROM, NULL, "camera position (replaces the file's or the automatic one)"},
+    {NULL, "--look-at", "X,Y,Z", FLAG_LOOK_AT, NULL, "point the camera looks at"},
+    {NULL, "--up", "X,Y,Z", FLAG_UP, NULL, "camera up direction"},
+    {NULL, "--fov", "DEG", FLAG_FOV, NULL, "vertical field of view in degrees, between 0 and 180"},
     {NULL, "--tile", "N", FLAG_TILE, NULL, "tile size in pixels (default 32)"},
     {NULL, "--preview", "SECONDS", FLAG_PREVIEW, NULL,
      "live view: rewrite the output with the finished tiles every SECONDS"},
-    {NULL, "--info", "FILE", FLAG_INFO, NULL, "print what a scene or model contains (key: value lines) and exit"},
+    {NULL, "--info", "FILE", FLAG_INFO, NULL,
+     "print what a scene or model contains and how it would render (key: value lines) and exit; "
+     "more files may follow (rt --info a.glb b.txt), one block each"},
     {NULL, "--max-memory", "SIZE", FLAG_MAX_MEMORY, NULL, "memory budget, e.g. 4G or 512M; 'none' for no limit"},
     {"-h", "--help", NULL, FLAG_HELP, NULL, "this text"},
     {NULL, "--version", NULL, FLAG_VERSION, NULL, "print the version"},
@@ -102,10 +115,12 @@ static void print_wrapped(FILE *f, const char *text, int at, int indent)
 
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off]\n"
+    fprintf(f, "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off | -]\n"
                "       rt compare CANDIDATE REFERENCE [--max-rmse X] [--max-flip X] ...  (docs/compare.md)\n"
                "\n"
-               "Renders a scene to an image. With no input, renders the built-in Cornell box to out.png.\n"
+               "Renders a scene to an image. With no input, renders the built-in Cornell box to out.png;\n"
+               "'-' reads a scene, glTF or mesh from standard input. A model given directly renders with\n"
+               "the path tracer at 64 samples per pixel; a scene file keeps its own settings (defaults below).\n"
                "\n"
                "options (a value may also follow '=', as in --samples=64; the setting flags -s, -r,\n"
                "--integrator, --seed and --set override the scene, the later flag winning):\n");
@@ -228,6 +243,25 @@ static void setting_wants(const rt_setting *def, char *buf, size_t size)
     }
 }
 
+/* "X,Y,Z": three finite numbers separated by commas. */
+static bool vec3_value(const char *s, rt_vec3 *out)
+{
+    float v[3];
+    char part[64];
+    for (int i = 0; i < 3; i++) {
+        size_t n = strcspn(s, ",");
+        if (n == 0 || n >= sizeof part || (i < 2 ? s[n] != ',' : s[n] != 0))
+            return false;
+        memcpy(part, s, n);
+        part[n] = 0;
+        if (rt_parse_float(part, &v[i]) != RT_NUMBER_OK || !isfinite(v[i]))
+            return false;
+        s += n + (i < 2);
+    }
+    *out = rt_v3(v[0], v[1], v[2]);
+    return true;
+}
+
 static int add_setting(args *a, const char *name, const char *arg, const rt_setting *def, const char *value)
 {
     if (a->setting_count >= ARGS_MAX_SETTINGS)
@@ -271,9 +305,12 @@ int args_parse(args *a, int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         if (flags_ended || !looks_like_flag(arg)) {
-            if (a->input)
-                return fail_usage("only one input file, please (got a second: '%s')", arg);
-            a->input = arg;
+            if (!a->input)
+                a->input = arg;
+            else if (a->more_input_count < ARGS_MAX_INPUTS)
+                a->more_inputs[a->more_input_count++] = arg;
+            else
+                return fail_usage("too many input files (--info reports at most %d at once)", ARGS_MAX_INPUTS);
             continue;
         }
         if (strcmp(arg, "--") == 0) {
@@ -338,9 +375,36 @@ int args_parse(args *a, int argc, char **argv)
             a->log_level = RT_LOG_VERBOSE;
             break;
         case FLAG_CAMERA:
-            if (!int_value(value, 0, INT32_MAX, &a->camera))
-                return fail_usage("%s wants a camera index (0, 1, ...), got '%s'", name, value);
+            a->camera_auto = strcmp(value, "auto") == 0;
+            a->camera = -1;
+            if (!a->camera_auto && !int_value(value, 0, INT32_MAX, &a->camera))
+                return fail_usage("%s wants a camera index (0, 1, ...) or 'auto', got '%s'", name, value);
             break;
+        case FLAG_LOOK_FROM:
+        case FLAG_LOOK_AT:
+        case FLAG_UP: {
+            rt_vec3 v;
+            if (!vec3_value(value, &v))
+                return fail_usage("%s wants three numbers X,Y,Z (e.g. 0,1,5), got '%s'", name, value);
+            if (fl->kind == FLAG_UP && v.x == 0.0f && v.y == 0.0f && v.z == 0.0f)
+                return fail_usage("%s wants a direction, got the zero vector '%s'", name, value);
+            if (fl->kind == FLAG_LOOK_FROM)
+                a->look_from = v, a->has_look_from = true;
+            else if (fl->kind == FLAG_LOOK_AT)
+                a->look_at = v, a->has_look_at = true;
+            else
+                a->up = v, a->has_up = true;
+            break;
+        }
+        case FLAG_FOV: {
+            float deg = 0.0f;
+            if (rt_parse_float(value, &deg) != RT_NUMBER_OK || !(deg > 0.0f && deg < 180.0f))
+                return fail_usage("%s wants a field of view in degrees between 0 and 180 (exclusive), got '%s'", name,
+                                  value);
+            a->fov = deg;
+            a->has_fov = true;
+            break;
+        }
         case FLAG_TILE:
             if (!int_value(value, 1, 4096, &a->tile))
                 return fail_usage("%s wants a tile size from 1 to 4096, got '%s'", name, value);
@@ -364,6 +428,9 @@ int args_parse(args *a, int argc, char **argv)
             break;
         }
     }
+    if (!a->info_path && a->more_input_count)
+        return fail_usage("only one input file, please (got a second: '%s'); --info takes several",
+                          a->more_inputs[0]);
     return ARGS_OK;
 }
 

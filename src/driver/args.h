@@ -29,6 +29,7 @@
 
 #define ARGS_OK (-1)
 #define ARGS_MAX_SETTINGS 64 /* setting flags on one command line */
+#define ARGS_MAX_INPUTS 256  /* files one --info reports */
 
 #define RT_VERSION "0.1.0"
 
@@ -44,9 +45,17 @@ typedef struct args {
     const char *input;      /* the scene or model; NULL = the built-in scene */
     const char *output;     /* -o; NULL = the scene's `output`, else INPUT-NAME.png */
     const char *info_path;  /* --info FILE: print what it contains and exit */
+    const char *more_inputs[ARGS_MAX_INPUTS]; /* with --info, the files after the first input */
+    size_t more_input_count;
     int threads;            /* -t; 0 = all cores */
     int tile;               /* --tile; 0 = the default */
     int camera;             /* --camera N; -1 = none */
+    bool camera_auto;       /* --camera auto: frame the model, ignoring its cameras */
+    /* --look-from, --look-at, --up, --fov: each replaces one part of the
+     * camera (after --camera and automatic framing) */
+    bool has_look_from, has_look_at, has_up, has_fov;
+    rt_vec3 look_from, look_at, up;
+    float fov;
     double preview_seconds; /* --preview; 0 = no live view */
     rt_log_level log_level; /* -q, -v */
     memory_budget budget;   /* --max-memory, else the default (not applied yet) */

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "rt/base/file.h"
 #include "rt/base/log.h"
 #include "rt/render/camera.h"
 #include "rt/accel/kdtree.h"
@@ -75,11 +76,11 @@ static void report(const rt_error *err, const memory_budget *budget)
  * with .png, in the current directory. */
 static void default_output(const rt_scene *s, const char *input, char *out, size_t size)
 {
-    if (s->settings.output[0]) {
+    if (s && s->settings.output[0]) {
         snprintf(out, size, "%s", s->settings.output);
         return;
     }
-    if (!input) {
+    if (!input || strcmp(input, "-") == 0) {
         snprintf(out, size, "out.png");
         return;
     }
@@ -95,9 +96,8 @@ static void default_output(const rt_scene *s, const char *input, char *out, size
  * diffuse-gather tree that would never finish, a usable camera, and every
  * setting in the range of the settings table (flags and the parser check
  * them as they read them; this catches what loaders set). */
-static rt_result check_limits(rt_scene *s, const char *input, bool camera_from_input, rt_error *err)
+static rt_result check_limits(rt_scene *s, const char *name, bool camera_from_input, rt_error *err)
 {
-    const char *name = input ? input : "<built-in scene>";
     size_t prims = rt_scene_prim_count(s);
     if (prims > MAX_PRIMITIVES)
         return rt_fail(err, RT_ERR_LIMIT, "%s: %zu primitives (triangles %zu, spheres %zu, quads %zu), over the limit of %zu",
@@ -129,21 +129,56 @@ static rt_result check_limits(rt_scene *s, const char *input, bool camera_from_i
     return RT_OK;
 }
 
-/* --info: one `key: value` line per figure, for people and scripts. */
+/* The input as rt_load takes it: a path, NULL for the built-in scene, or
+ * "-" for standard input, read whole and loaded from memory as "<stdin>"
+ * (scene text, or glTF or a mesh by its content; relative paths in it
+ * resolve against the current directory). */
+static rt_result load_input(rt_scene *s, const char *input, const rt_load_options *lo, rt_load_info *info,
+                            rt_error *err)
+{
+    if (!input || strcmp(input, "-") != 0)
+        return rt_load(s, input, lo, info, err);
+    memset(info, 0, sizeof *info);
+    if (isatty(0))
+        return rt_fail(err, RT_ERR_IO,
+                       "-: standard input is a terminal; pipe a scene in (rt - < scene.txt, or cat model.glb | rt -)");
+    char *bytes;
+    size_t size;
+    rt_error inner = {0};
+    if (rt_read_file("/dev/stdin", 0, &bytes, &size, &inner) != RT_OK) {
+        const char *what = strncmp(inner.message, "/dev/stdin: ", 12) == 0 ? inner.message + 12 : inner.message;
+        return rt_fail(err, inner.code, "<stdin>: %s", what);
+    }
+    rt_result r = rt_load_memory(s, bytes, size, "<stdin>", lo, info, err);
+    free(bytes);
+    return r;
+}
+
+/* The name messages use for an input. */
+static const char *input_name(const char *input)
+{
+    return !input ? "<built-in scene>" : strcmp(input, "-") == 0 ? "<stdin>" : input;
+}
+
+static void print_vec(const char *key, rt_vec3 v) { printf("%s: %.9g %.9g %.9g\n", key, v.x, v.y, v.z); }
+
+/* --info for one input: one `key: value` line per figure, for people and
+ * scripts. The counts are the file's own (loaded as it is); the settings
+ * and camera are what `rt FILE` would render with, before any flag. */
 static int print_info(const char *path, const memory_budget *budget)
 {
     rt_scene s;
     rt_scene_init(&s);
     rt_error err = {0};
     rt_load_info info;
-    rt_result r = rt_load(&s, path, NULL, &info, &err);
+    rt_result r = load_input(&s, path, NULL, &info, &err);
     if (r != RT_OK) {
         report(&err, budget);
         rt_scene_free(&s);
         return 2;
     }
     rt_box b = rt_scene_bounds(&s);
-    printf("file: %s\n", path);
+    printf("file: %s\n", input_name(path));
     printf("format: %s\n", rt_load_kind_name(info.kind));
     printf("triangles: %zu\n", s.triangles.count);
     printf("vertices: %zu\n", s.vertices.count);
@@ -166,9 +201,105 @@ static int print_info(const char *path, const memory_budget *budget)
         printf("image.%zu: %dx%d %s\n", i, s.images[i].width, s.images[i].height, s.images[i].name);
     printf("cameras: %zu\n", s.camera_count);
     printf("lights: %zu\n", s.light_count);
+
+    /* how it would render */
+    rt_settings set = s.settings;
+    if (info.kind != RT_LOAD_SCENE)
+        rt_load_model_settings(&set);
+    const rt_camera *cam = NULL;
+    if (s.camera_set) {
+        printf("camera: scene file\n");
+        cam = &s.camera;
+    } else if (info.kind == RT_LOAD_GLTF && s.camera_count) {
+        printf("camera: gltf camera 0\n");
+        cam = &s.cameras[0];
+        if (cam->aspect_ratio > 0.0f) { /* the width follows the camera's aspect ratio */
+            double w = (double)set.height * cam->aspect_ratio + 0.5;
+            set.width = w < 1.0 ? 1 : (w > (double)RT_MAX_IMAGE_SIDE ? RT_MAX_IMAGE_SIDE : (int)w);
+        }
+    } else {
+        printf("camera: auto (framed to the bounds)\n");
+    }
+    if (cam) {
+        print_vec("camera.position", cam->position);
+        print_vec("camera.look_at", cam->look_at);
+        print_vec("camera.up", cam->up);
+        printf("camera.fov: %.9g\n", cam->vfov_deg);
+    }
+    s.settings = set;
+    char output[1024];
+    default_output(&s, path, output, sizeof output);
+    printf("resolution: %dx%d\n", set.width, set.height);
+    printf("samples: %d\n", set.samples);
+    printf("integrator: %s\n", rt_integrator_name(set.integrator));
+    printf("output: %s\n", output);
     printf("load_ms: %.3f\n", info.load_ms);
     rt_scene_free(&s);
     return 0;
+}
+
+/* --info FILE [FILE...]: one block each, a blank line between; exit 2 when
+ * any of them failed to load (the others are still reported). */
+static int print_infos(const args *a)
+{
+    int status = print_info(a->info_path, &a->budget);
+    const char *rest[ARGS_MAX_INPUTS + 1];
+    size_t n = 0;
+    if (a->input)
+        rest[n++] = a->input;
+    for (size_t i = 0; i < a->more_input_count; i++)
+        rest[n++] = a->more_inputs[i];
+    for (size_t i = 0; i < n; i++) {
+        printf("\n");
+        fflush(stdout);
+        if (print_info(rest[i], &a->budget) != 0)
+            status = 2;
+    }
+    return status;
+}
+
+/* --look-from, --look-at, --up, --fov over the file's or the framed camera;
+ * a camera they leave degenerate is an error naming them. */
+static rt_result apply_pose_flags(rt_scene *scene, const args *a, rt_error *err)
+{
+    if (!a->has_look_from && !a->has_look_at && !a->has_up && !a->has_fov)
+        return RT_OK;
+    rt_camera *c = &scene->camera;
+    char given[512] = "", v[128];
+    if (a->has_look_from) {
+        snprintf(v, sizeof v, " --look-from %g,%g,%g", a->look_from.x, a->look_from.y, a->look_from.z);
+        strncat(given, v, sizeof given - strlen(given) - 1);
+    }
+    if (a->has_look_at) {
+        snprintf(v, sizeof v, " --look-at %g,%g,%g", a->look_at.x, a->look_at.y, a->look_at.z);
+        strncat(given, v, sizeof given - strlen(given) - 1);
+    }
+    if (a->has_up) {
+        snprintf(v, sizeof v, " --up %g,%g,%g", a->up.x, a->up.y, a->up.z);
+        strncat(given, v, sizeof given - strlen(given) - 1);
+    }
+    if (a->has_fov) {
+        snprintf(v, sizeof v, " --fov %g", a->fov);
+        strncat(given, v, sizeof given - strlen(given) - 1);
+    }
+    if (a->has_look_from)
+        c->position = a->look_from;
+    if (a->has_look_at)
+        c->look_at = a->look_at;
+    if (a->has_up)
+        c->up = a->up;
+    if (a->has_fov)
+        c->vfov_deg = a->fov;
+    if (a->has_look_from || a->has_look_at)
+        c->focus_distance = 0.0f; /* the distance to look_at, which moved */
+    rt_camera_frame cf;
+    if (!rt_camera_frame_init(&cf, c, scene->settings.width, scene->settings.height))
+        return rt_fail(err, RT_ERR_INVALID,
+                       "%s: the camera is degenerate (the position equals the point looked at, or up is parallel "
+                       "to the view direction)",
+                       given + 1);
+    scene->camera_set = true;
+    return RT_OK;
 }
 
 /* The loaded scene as the flags want it: setting flags applied, --camera
@@ -179,12 +310,27 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     rt_load_info info;
     rt_load_options lo = {.for_render = true};
     rt_result r;
-    if ((r = rt_load(scene, a->input, &lo, &info, err)) != RT_OK)
+    /* -o is checked before the load, which may take long, and so is a
+     * model's default output (models have no `output` line); a scene's own
+     * `output` can only be checked after the load */
+    if (a->output && (r = rt_output_check(a->output, err)) != RT_OK)
+        return r;
+    if (!a->output && !args_sets(a, "output") && a->input && strcmp(a->input, "-") != 0 &&
+        !rt_load_is_scene_name(a->input)) {
+        default_output(NULL, a->input, output, size);
+        if ((r = rt_output_check(output, err)) != RT_OK)
+            return r;
+    }
+    if ((r = load_input(scene, a->input, &lo, &info, err)) != RT_OK)
         return r;
     if ((r = rt_scene_validate(scene, err)) != RT_OK) { /* from here on the tables are trusted */
         rt_error inner = *err;
-        return rt_fail(err, inner.code, "%s: %s", a->input ? a->input : "<built-in scene>", inner.message);
+        return rt_fail(err, inner.code, "%s: %s", input_name(a->input), inner.message);
     }
+    if (rt_scene_prim_count(scene) == 0)
+        rt_warn("%s: nothing to render (no spheres, quads, triangles or meshes); the image will show only the "
+                "background",
+                input_name(a->input));
     if ((r = args_apply_settings(a, scene, err)) != RT_OK)
         return r;
     rt_settings *set = &scene->settings;
@@ -195,15 +341,22 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
         scene->camera = scene->cameras[a->camera];
         scene->camera_set = true;
     }
+    if (a->camera_auto) { /* ignore the file's camera: frame the scene below */
+        scene->camera_set = false;
+        scene->camera.aspect_ratio = 0.0f;
+    }
     /* a glTF camera made for another aspect ratio: keep the height, fit the width */
-    if (!args_sets(a, "resolution") && a->input && info.kind == RT_LOAD_GLTF && scene->camera.aspect_ratio > 0.0f) {
+    if (!args_sets(a, "resolution") && a->input && info.kind == RT_LOAD_GLTF && scene->camera_set &&
+        scene->camera.aspect_ratio > 0.0f) {
         double w = (double)set->height * scene->camera.aspect_ratio + 0.5;
         set->width = w < 1.0 ? 1 : (w > (double)RT_MAX_IMAGE_SIDE ? RT_MAX_IMAGE_SIDE : (int)w);
     }
     bool camera_from_input = scene->camera_set;
     if (!scene->camera_set)
         rt_scene_frame_camera(scene);
-    if ((r = check_limits(scene, a->input, camera_from_input, err)) != RT_OK)
+    if ((r = apply_pose_flags(scene, a, err)) != RT_OK)
+        return r;
+    if ((r = check_limits(scene, input_name(a->input), camera_from_input, err)) != RT_OK)
         return r;
 
     if (a->output)
@@ -213,8 +366,11 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     if ((r = rt_output_check(output, err)) != RT_OK ||
         (r = rt_output_check_size(output, set->width, set->height, err)) != RT_OK)
         return r;
+    if (!a->input && a->log_level >= RT_LOG_NORMAL)
+        fprintf(stderr, "rt: no input given; rendering the built-in Cornell box to %s (rt --help for usage)\n",
+                output);
 
-    rt_info("scene: %s (loaded in %.1f ms)", a->input ? a->input : "<built-in>", info.load_ms);
+    rt_info("scene: %s (loaded in %.1f ms)", input_name(a->input), info.load_ms);
     rt_info("  triangles %zu, spheres %zu, quads %zu, vertices %zu", scene->triangles.count, scene->spheres.count,
             scene->quads.count, scene->vertices.count);
     rt_info("  materials %zu, textures %zu, images %zu, lights %zu", scene->material_count, scene->texture_count,
@@ -304,7 +460,7 @@ int main(int argc, char **argv)
     rt_log_set_level(a.log_level);
     memory_budget_apply(&a.budget);
     if (a.info_path)
-        return print_info(a.info_path, &a.budget);
+        return print_infos(&a);
 
     rt_scene scene;
     rt_scene_init(&scene);

@@ -1,10 +1,20 @@
 /* framebuffer.c - framebuffer output: PNG (stb_image_write, 8-bit sRGB with
  * exposure), PFM (little-endian float RGB, bottom scanline first, as the
  * format defines) and Radiance HDR (stb_image_write), all written to a
- * temporary file beside the target and renamed into place. */
+ * temporary file beside the target and renamed into place.
+ *
+ * Where Linux offers it, the temporary file has no name while it is
+ * written (open(2) O_TMPFILE on the target's directory); only when it is
+ * complete is it linked in under a temporary name (linkat(2) through
+ * /proc/self/fd, as open(2) describes) and at once renamed over the
+ * target. A process killed during the write (a second Ctrl-C, SIGKILL)
+ * leaves no file behind. Elsewhere, or on a file system without O_TMPFILE,
+ * a mkstemp(3) file is written and renamed as before. */
+#define _GNU_SOURCE /* O_TMPFILE */
 #include "rt/io/framebuffer.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -52,28 +62,91 @@ rt_result rt_output_format(const char *path, rt_image_format *format, rt_error *
     return rt_fail(err, RT_ERR_INVALID, "%s: unknown output format (use .png, .pfm or .hdr)", path);
 }
 
+/* A temporary file beside the target: unnamed (O_TMPFILE) when it can be,
+ * else named by mkstemp. */
+typedef struct temp_file {
+    FILE *f;
+    bool unnamed;
+    char dir[4200];  /* the target's directory, "." for none */
+    char name[4300]; /* the mkstemp name, or the name an unnamed file is linked under */
+} temp_file;
+
+static FILE *fdopen_or_close(int fd)
+{
+    FILE *f = fdopen(fd, "wb");
+    if (!f)
+        close(fd);
+    return f;
+}
+
 /* Opens a fresh temporary file in the directory of `path`. */
-static FILE *open_temp_beside(const char *path, char *tmp, size_t tmp_size)
+static bool open_temp_beside(const char *path, temp_file *t)
 {
     const char *slash = strrchr(path, '/');
-    int n;
-    if (slash)
-        n = snprintf(tmp, tmp_size, "%.*s/.rt-tmp-XXXXXX", (int)(slash - path), path);
-    else
-        n = snprintf(tmp, tmp_size, ".rt-tmp-XXXXXX");
-    if (n < 0 || (size_t)n >= tmp_size) {
+    int n = slash ? snprintf(t->dir, sizeof t->dir, "%.*s", slash == path ? 1 : (int)(slash - path), path)
+                  : snprintf(t->dir, sizeof t->dir, ".");
+    if (n < 0 || (size_t)n >= sizeof t->dir) {
         errno = ENAMETOOLONG;
-        return NULL;
+        return false;
     }
-    int fd = mkstemp(tmp);
+    t->unnamed = false;
+    t->name[0] = 0;
+#ifdef O_TMPFILE
+    if (access("/proc/self/fd", X_OK) == 0) {
+        int fd = open(t->dir, O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+        if (fd >= 0) {
+            t->unnamed = true;
+            return (t->f = fdopen_or_close(fd)) != NULL;
+        }
+        if (errno != EOPNOTSUPP && errno != EISDIR && errno != EINVAL)
+            return false; /* no such directory, no permission: the same for mkstemp */
+    }
+#endif
+    n = snprintf(t->name, sizeof t->name, "%s/.rt-tmp-XXXXXX", t->dir);
+    if (n < 0 || (size_t)n >= sizeof t->name) {
+        errno = ENAMETOOLONG;
+        return false;
+    }
+    int fd = mkstemp(t->name);
     if (fd < 0)
-        return NULL;
-    FILE *f = fdopen(fd, "wb");
-    if (!f) {
-        close(fd);
-        unlink(tmp);
+        return false;
+    if (!(t->f = fdopen_or_close(fd))) {
+        int e = errno;
+        unlink(t->name);
+        errno = e;
+        return false;
     }
-    return f;
+    return true;
+}
+
+/* Closes the file and forgets it: a named one is removed. */
+static void discard_temp(temp_file *t)
+{
+    if (t->f)
+        fclose(t->f);
+    t->f = NULL;
+    if (!t->unnamed)
+        unlink(t->name);
+}
+
+/* Gives a closed-over, complete temporary file a name beside the target:
+ * an unnamed one is linked in now (a fresh name, retried if taken). */
+static bool name_temp(temp_file *t)
+{
+    if (!t->unnamed)
+        return true;
+    char proc[64];
+    snprintf(proc, sizeof proc, "/proc/self/fd/%d", fileno(t->f));
+    for (int attempt = 0; attempt < 100; attempt++) {
+        snprintf(t->name, sizeof t->name, "%s/.rt-tmp-%ld-%d", t->dir, (long)getpid(), attempt);
+        if (linkat(AT_FDCWD, proc, AT_FDCWD, t->name, AT_SYMLINK_FOLLOW) == 0) {
+            t->unnamed = false; /* from here on it is a named file like mkstemp's */
+            return true;
+        }
+        if (errno != EEXIST)
+            return false;
+    }
+    return false;
 }
 
 rt_result rt_output_check(const char *path, rt_error *err)
@@ -82,12 +155,17 @@ rt_result rt_output_check(const char *path, rt_error *err)
     rt_result r = rt_output_format(path, &fmt, err);
     if (r != RT_OK)
         return r;
-    char tmp[4200];
-    FILE *f = open_temp_beside(path, tmp, sizeof tmp);
-    if (!f)
+    /* the image is renamed over the exact path: a directory there (or a
+     * device, a FIFO) would fail only then, after the render */
+    struct stat st;
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return rt_fail(err, RT_ERR_IO, "%s: is a directory; give an image file name", path);
+    if (stat(path, &st) == 0 && !S_ISREG(st.st_mode))
+        return rt_fail(err, RT_ERR_IO, "%s: not a regular file; give an image file name", path);
+    temp_file t;
+    if (!open_temp_beside(path, &t))
         return rt_fail(err, RT_ERR_IO, "%s: cannot write there: %s", path, strerror(errno));
-    fclose(f);
-    unlink(tmp);
+    discard_temp(&t);
     return RT_OK;
 }
 
@@ -159,10 +237,10 @@ rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float
         return r;
     if ((r = rt_output_check_size(path, fb->width, fb->height, err)) != RT_OK)
         return r;
-    char tmp[4200];
-    FILE *f = open_temp_beside(path, tmp, sizeof tmp);
-    if (!f)
+    temp_file t;
+    if (!open_temp_beside(path, &t))
         return rt_fail(err, RT_ERR_IO, "%s: cannot create a file there: %s", path, strerror(errno));
+    FILE *f = t.f;
     int ok;
     switch (fmt) {
     case RT_FORMAT_PFM: ok = write_pfm(f, fb); break;
@@ -173,14 +251,13 @@ rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float
     if (fflush(f) != 0 || ferror(f))
         ok = 0;
     int saved = errno;
-    if (fclose(f) != 0)
-        ok = 0;
     if (!ok) {
-        unlink(tmp);
+        discard_temp(&t);
         return rt_fail(err, RT_ERR_IO, "%s: write failed: %s", path, strerror(saved ? saved : EIO));
     }
-    /* mkstemp made the file 0600: give it the mode a plain fopen would
-     * (0666 less the umask), or keep the mode of the image it replaces */
+    /* the temporary file is 0600 (mkstemp) or 0666 less the umask (O_TMPFILE):
+     * give it the mode a plain fopen would, or keep the mode of the image it
+     * replaces */
     struct stat st;
     mode_t mode;
     if (stat(path, &st) == 0) {
@@ -190,10 +267,22 @@ rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float
         umask(mask);
         mode = 0666 & ~mask;
     }
-    chmod(tmp, mode);
-    if (rename(tmp, path) != 0) {
+    fchmod(fileno(f), mode);
+    if (!name_temp(&t)) {
         saved = errno;
-        unlink(tmp);
+        discard_temp(&t);
+        return rt_fail(err, RT_ERR_IO, "%s: cannot link the finished image in: %s", path, strerror(saved));
+    }
+    if (fclose(f) != 0) {
+        saved = errno;
+        t.f = NULL;
+        discard_temp(&t);
+        return rt_fail(err, RT_ERR_IO, "%s: write failed: %s", path, strerror(saved));
+    }
+    t.f = NULL;
+    if (rename(t.name, path) != 0) {
+        saved = errno;
+        discard_temp(&t);
         return rt_fail(err, RT_ERR_IO, "%s: cannot rename the finished image into place: %s", path, strerror(saved));
     }
     return RT_OK;

@@ -177,6 +177,7 @@ typedef struct gl_doc {
     uint32_t *visit_of;     /* node -> its visit (valid once visited) */
     uint32_t *image_map;    /* glTF image -> scene image, RT_NONE = not loaded yet */
     uint32_t *texture_map;  /* glTF texture -> scene texture */
+    bool *texture_missing;  /* its image file does not exist: the missing-texture rule (rt/scene/texture.h) */
     float *scratch[ATTR_COUNT];
     size_t scratch_cap[ATTR_COUNT];
     uint32_t *idx_scratch;
@@ -1871,8 +1872,12 @@ static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t mesh, uint32_t 
     return RT_OK;
 }
 
-static rt_result load_image(gl_doc *d, rt_scene *s, uint32_t ii, uint32_t *out)
+/* Image ii into the scene. An external file that does not exist is a
+ * warning naming the image's JSON path, and *missing (then *out is
+ * RT_NONE); any other failure is an error. */
+static rt_result load_image(gl_doc *d, rt_scene *s, uint32_t ii, uint32_t *out, bool *missing)
 {
+    *missing = false;
     if (d->image_map[ii] != RT_NONE) {
         *out = d->image_map[ii];
         return RT_OK;
@@ -1914,7 +1919,18 @@ static rt_result load_image(gl_doc *d, rt_scene *s, uint32_t ii, uint32_t *out)
                 r = rt_image_load_file(s, path, &img, &inner);
             else
                 inner = *d->err;
+            if (r != RT_OK && path && rt_image_file_missing(path)) {
+                rt_warn("%s: %s (%s): image '%s' not found; %s", d->path, what, label, path,
+                        RT_MISSING_TEXTURE_NOTE);
+                *missing = true;
+                *out = RT_NONE;
+                r = RT_OK;
+            }
             free(path);
+            if (*missing) {
+                free(uri);
+                return RT_OK;
+            }
         }
         free(uri);
     }
@@ -1932,24 +1948,27 @@ static rt_result load_textures(gl_doc *d, rt_scene *s, rt_gltf_stats *st)
 {
     d->image_map = rt_alloc(d->image_count, sizeof(uint32_t));
     d->texture_map = rt_alloc(d->texture_count, sizeof(uint32_t));
-    if (!d->image_map || !d->texture_map)
+    d->texture_missing = rt_alloc(d->texture_count, sizeof(bool));
+    if (!d->image_map || !d->texture_map || !d->texture_missing)
         return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
     for (size_t i = 0; i < d->image_count; i++)
         d->image_map[i] = RT_NONE;
     for (size_t i = 0; i < d->texture_count; i++) {
         const gl_texture *gt = &d->textures[i];
         d->texture_map[i] = RT_NONE;
+        d->texture_missing[i] = false;
         if (gt->source == RT_NONE) {
             rt_warn("%s: textures[%zu] has no source rt can read (KTX2/WebP extensions are not supported); "
                     "left untextured", d->path, i);
             continue;
         }
-        bool fresh = d->image_map[gt->source] == RT_NONE;
+        bool fresh = d->image_map[gt->source] == RT_NONE, missing;
         uint32_t img = RT_NONE;
-        TRY(load_image(d, s, gt->source, &img));
-        if (fresh)
+        TRY(load_image(d, s, gt->source, &img, &missing));
+        if (fresh && !missing)
             st->images++;
-        rt_texture tex = rt_texture_image(img);
+        d->texture_missing[i] = missing;
+        rt_texture tex = missing ? rt_texture_missing() : rt_texture_image(img);
         if (gt->sampler != RT_NONE) {
             const gl_sampler *sm = &d->samplers[gt->sampler];
             int w[2] = {sm->wrap_s, sm->wrap_t};
@@ -2038,9 +2057,14 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
         rt_material m = d->materials[i].m;
         rt_texture_slot *slots[] = {&m.base_color_tex, &m.metal_rough_tex, &m.normal_tex,
                                     &m.occlusion_tex,  &m.emissive_tex,    &m.transmission_tex};
-        for (size_t k = 0; k < sizeof slots / sizeof slots[0]; k++)
-            if (slots[k]->texture != RT_NONE)
-                slots[k]->texture = d->texture_map[slots[k]->texture];
+        for (size_t k = 0; k < sizeof slots / sizeof slots[0]; k++) {
+            if (slots[k]->texture == RT_NONE)
+                continue;
+            /* a missing image: the checker for colour (base colour, emission), nothing for data */
+            bool colour = slots[k] == &m.base_color_tex || slots[k] == &m.emissive_tex;
+            uint32_t t = slots[k]->texture;
+            slots[k]->texture = d->texture_missing[t] && !colour ? RT_NONE : d->texture_map[t];
+        }
         if (rt_scene_add_material(s, &m) == RT_NONE)
             return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding materials", d->path);
         st->materials++;
@@ -2153,6 +2177,7 @@ static void doc_free(gl_doc *d)
     free(d->nodes); free(d->children); free(d->scenes); free(d->scene_nodes); free(d->materials);
     free(d->textures); free(d->samplers); free(d->images); free(d->cameras); free(d->lights);
     free(d->visits); free(d->visit_of); free(d->image_map); free(d->texture_map);
+    free(d->texture_missing);
     for (int k = 0; k < ATTR_COUNT; k++)
         free(d->scratch[k]);
     free(d->idx_scratch);

@@ -73,7 +73,7 @@ rt_result rt_mesh_load_memory(rt_scene *s, const void *bytes, size_t size, const
         name = "<memory>";
     if (!bytes && size)
         return rt_fail(err, RT_ERR_INVALID, "%s: no data", name);
-    rt_mesh_format format = rt_mesh_format_of(bytes, size, name);
+    rt_mesh_format format = options->format ? options->format : rt_mesh_format_of(bytes, size, name);
     if (format == RT_MESH_UNKNOWN) {
         const char *ext = rt_path_ext(name);
         if (!*ext)

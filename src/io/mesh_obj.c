@@ -24,7 +24,10 @@
  *   Ks, 1 when Ks is absent), illum 4/6/7 = refracting glass; map_Kd (sRGB
  *   base colour) and map_Bump/bump/norm (normal map, -bm scale). Ka above 1
  *   with no Ke is taken as emission (old Embree-style Cornell files mark the
- *   light that way). Other texture options are skipped with a warning.
+ *   light that way). Other texture options are skipped with a warning. A
+ *   texture file that does not exist follows the missing-texture rule
+ *   (rt/scene/texture.h: a warning at the map line, the magenta checker for
+ *   map_Kd, no normal map); one that exists but does not decode is an error.
  *   Unknown statements are warned about once per keyword per file.
  *   Smoothing groups (`s N`): faces without vn in a group other than 0/off
  *   get generated vertex normals, the area-weighted sum of the face normals
@@ -57,6 +60,7 @@ typedef struct obj_mtl {
     int illum;
     bool has_kd, has_ks, has_ke, has_ka, has_tf, has_ns, has_ni, has_alpha, has_pr, has_pm;
     char *map_kd, *map_bump; /* resolved texture paths (malloc'd) or NULL */
+    long map_kd_line, map_bump_line; /* where they were given */
     uint32_t file;           /* index into obj_parser.mtl_files, for messages */
     long line;
 } obj_mtl;
@@ -347,7 +351,7 @@ static rt_result mtl_scalar(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl
 
 /* A texture statement: options, then a file name (the rest of the line). */
 static rt_result mtl_map(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl, const char *p, const char *eol,
-                         char **path_out, float *bump_scale)
+                         char **path_out, long *line_out, float *bump_scale)
 {
     eol = cut_comment_ws(p, eol);
     for (;;) {
@@ -405,6 +409,7 @@ static rt_result mtl_map(mtl_ctx *mc, line_ctx *lc, const char *kw, size_t kl, c
         return rt_fail(mc->op->err, RT_ERR_NOMEM, "%s: out of memory", lc->file);
     free(*path_out);
     *path_out = copy;
+    *line_out = lc->line;
     return RT_OK;
 }
 
@@ -496,10 +501,10 @@ static rt_result mtl_line(void *ctx, line_ctx *lc, const char *p, const char *eo
         return RT_OK;
     }
     if (kw_is_ci(kw, kl, "map_Kd"))
-        return mtl_map(mc, lc, kw, kl, p, eol, &m->map_kd, &m->bump_scale);
+        return mtl_map(mc, lc, kw, kl, p, eol, &m->map_kd, &m->map_kd_line, &m->bump_scale);
     if (kw_is_ci(kw, kl, "map_Bump") || kw_is_ci(kw, kl, "bump") || kw_is_ci(kw, kl, "norm") ||
         kw_is_ci(kw, kl, "map_Norm"))
-        return mtl_map(mc, lc, kw, kl, p, eol, &m->map_bump, &m->bump_scale);
+        return mtl_map(mc, lc, kw, kl, p, eol, &m->map_bump, &m->map_bump_line, &m->bump_scale);
     warn_unknown(&mc->warned, lc, kw, kl);
     return RT_OK;
 }
@@ -904,22 +909,35 @@ static rt_result obj_line(void *ctx, line_ctx *lc, const char *p, const char *eo
 
 /* ------------------------------------------------------- materials */
 
-static uint32_t load_texture(rt_scene *s, const char *path, const char *where, const char *what)
+/* The texture for a map_Kd (colour) or bump map (data) line. A file that
+ * does not exist follows the missing-texture rule (rt/scene/texture.h): a
+ * warning at the map line, the checker for colour, nothing for data; an
+ * image that exists but does not load is an error at that line. */
+static rt_result load_texture(rt_scene *s, const char *path, const char *mtl_file, long line, const char *what,
+                              bool colour, uint32_t *out, rt_error *err)
 {
     rt_error e = {0};
     uint32_t img;
-    if (rt_image_load_file(s, path, &img, &e) != RT_OK) {
-        rt_warn("%s: %s: %s; ignoring the texture", where, what, e.message);
-        return RT_NONE;
+    rt_texture tex;
+    *out = RT_NONE;
+    if (rt_image_load_file(s, path, &img, &e) == RT_OK) {
+        tex = rt_texture_image(img);
+    } else if (rt_image_file_missing(path)) {
+        rt_warn("%s:%ld: %s: image '%s' not found; %s", mtl_file, line, what, path, RT_MISSING_TEXTURE_NOTE);
+        if (!colour)
+            return RT_OK;
+        tex = rt_texture_missing();
+    } else {
+        return rt_fail(err, e.code, "%s:%ld: %s: %s", mtl_file, line, what, e.message);
     }
-    rt_texture tex = rt_texture_image(img);
-    return rt_scene_add_texture(s, &tex);
+    if ((*out = rt_scene_add_texture(s, &tex)) == RT_NONE)
+        return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for textures", mtl_file);
+    return RT_OK;
 }
 
-static void make_material(rt_scene *s, const obj_mtl *om, const char *objname, const char *mtl_file, rt_material *m)
+static rt_result make_material(rt_scene *s, const obj_mtl *om, const char *objname, const char *mtl_file,
+                               rt_material *m, rt_error *err)
 {
-    char where[OBJ_PATH_MAX + 32];
-    snprintf(where, sizeof where, "%s:%ld", mtl_file, om->line);
     /* "<objfile>:<name>", cut to fit the 64-byte name field */
     char name[sizeof m->name];
     size_t on = strlen(objname), nn = strlen(om->name), cap = sizeof name - 1;
@@ -965,12 +983,18 @@ static void make_material(rt_scene *s, const obj_mtl *om, const char *objname, c
         m->alpha = 1.0f;
         m->alpha_mode = RT_ALPHA_OPAQUE;
     }
-    if (om->map_kd)
-        m->base_color_tex.texture = load_texture(s, om->map_kd, where, "map_Kd");
+    rt_result r;
+    if (om->map_kd &&
+        (r = load_texture(s, om->map_kd, mtl_file, om->map_kd_line, "map_Kd", true, &m->base_color_tex.texture,
+                          err)) != RT_OK)
+        return r;
     if (om->map_bump) {
-        m->normal_tex.texture = load_texture(s, om->map_bump, where, "normal map");
+        if ((r = load_texture(s, om->map_bump, mtl_file, om->map_bump_line, "normal map", false,
+                              &m->normal_tex.texture, err)) != RT_OK)
+            return r;
         m->normal_scale = om->bump_scale;
     }
+    return RT_OK;
 }
 
 /* Adds the MTL materials to the scene and resolves every usemtl slot. */
@@ -982,7 +1006,11 @@ static rt_result resolve_materials(obj_parser *op, rt_scene *s, uint32_t materia
         return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for materials", op->path);
     for (size_t i = 0; i < op->nmtl; i++) {
         rt_material m;
-        make_material(s, &op->mtls[i], objname, op->mtl_files[op->mtls[i].file], &m);
+        rt_result r = make_material(s, &op->mtls[i], objname, op->mtl_files[op->mtls[i].file], &m, op->err);
+        if (r != RT_OK) {
+            free(ids);
+            return r;
+        }
         if ((ids[i] = rt_scene_add_material(s, &m)) == RT_NONE) {
             free(ids);
             return rt_fail(op->err, RT_ERR_NOMEM, "%s: out of memory for materials", op->path);

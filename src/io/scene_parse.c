@@ -84,6 +84,10 @@ typedef struct parser {
 
     name_table materials, textures;
     uint32_t default_material; /* made on first use by a mesh without a material */
+    /* textures standing in for a missing image (rt_texture_missing): a data
+     * slot given one is left empty instead */
+    uint32_t *missing_tex;
+    size_t missing_count, missing_cap;
 
     int setting_line[RT_SETTINGS_MAX]; /* by settings-table index: where it was given, 0 = not yet */
     int camera_line;          /* line of the `camera` statement, 0 = none yet */
@@ -446,6 +450,49 @@ static rt_result check_new_name(parser *p, const tok *t, name_table *table, cons
     return RT_OK;
 }
 
+/* Edit distance, for "did you mean" hints on short words. */
+static int edit_distance(const char *a, const char *b)
+{
+    size_t n = strlen(a), m = strlen(b);
+    if (n > 32 || m > 32)
+        return 99;
+    int d[33][33];
+    for (size_t i = 0; i <= n; i++)
+        d[i][0] = (int)i;
+    for (size_t j = 0; j <= m; j++)
+        d[0][j] = (int)j;
+    for (size_t i = 1; i <= n; i++)
+        for (size_t j = 1; j <= m; j++) {
+            int c = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
+            int del = d[i - 1][j] + 1, ins = d[i][j - 1] + 1;
+            d[i][j] = c < del ? (c < ins ? c : ins) : (del < ins ? del : ins);
+        }
+    return d[n][m];
+}
+
+/* The defined name closest to `word` (edit distance under 3), for "did
+ * you mean"; NULL when none is that close. Names the scene holds from other
+ * loaders count too, except the internal "__" ones. */
+static const char *closest_name(const parser *p, const name_table *table, bool scene_materials, const char *word)
+{
+    const char *best = NULL;
+    int best_d = 3;
+    for (size_t i = 0; i < table->count; i++) {
+        int d = edit_distance(word, table->items[i].name);
+        if (d < best_d)
+            best_d = d, best = table->items[i].name;
+    }
+    for (size_t i = 0; scene_materials && i < p->s->material_count; i++) {
+        const char *name = p->s->materials[i].name;
+        if (strncmp(name, "__", 2) == 0)
+            continue;
+        int d = edit_distance(word, name);
+        if (d < best_d)
+            best_d = d, best = name;
+    }
+    return best;
+}
+
 /* A material by name: those defined in this file first, then any other in
  * the scene (for example from an OBJ's MTL file loaded earlier). */
 static rt_result get_material(parser *p, const char *what, uint32_t *out)
@@ -465,6 +512,10 @@ static rt_result get_material(parser *p, const char *what, uint32_t *out)
         *out = m;
         return RT_OK;
     }
+    const char *near = closest_name(p, &p->materials, true, t->s);
+    if (near)
+        return perr(p, RT_ERR_INVALID, t, "undefined material %s for %s (did you mean '%s'?)", show(t, b, sizeof b),
+                    what, near);
     return perr(p, RT_ERR_INVALID, t, "undefined material %s for %s (define it with 'material' before use)",
                 show(t, b, sizeof b), what);
 }
@@ -481,21 +532,47 @@ static rt_result resolve_path(parser *p, const tok *t, char *out, size_t size)
 
 /* Loads an image file named by token t and makes an image texture for it
  * (repeat, bilinear unless changed by the caller). */
-static rt_result image_texture(parser *p, const tok *t, rt_texture *tex)
+/* An image texture for the file named by t. A file that does not exist is
+ * a warning and the missing-texture checker (rt/scene/texture.h); *missing
+ * says so, for the caller to record once the texture has its index. */
+static rt_result image_texture(parser *p, const tok *t, rt_texture *tex, bool *missing)
 {
     char path[MAX_PATH_LEN];
+    *missing = false;
     rt_result r = resolve_path(p, t, path, sizeof path);
     if (r != RT_OK)
         return r;
     rt_error inner = {0};
     uint32_t img = RT_NONE;
     r = rt_image_load_file(p->s, path, &img, &inner);
+    if (r != RT_OK && rt_image_file_missing(path)) {
+        rt_warn("%s:%d:%d: image '%s' not found; %s", p->name, t->line, t->col, path, RT_MISSING_TEXTURE_NOTE);
+        *tex = rt_texture_missing();
+        *missing = true;
+        return RT_OK;
+    }
     if (r != RT_OK)
         return loader_err(p, t, r, &inner);
     if (img >= p->s->image_count)
         return perr(p, RT_ERR_INVALID, t, "image loader returned no image for '%s'", path);
     *tex = rt_texture_image(img);
     return RT_OK;
+}
+
+static bool note_missing(parser *p, uint32_t texture)
+{
+    if (!rt_grow((void **)&p->missing_tex, &p->missing_cap, p->missing_count + 1, sizeof *p->missing_tex))
+        return false;
+    p->missing_tex[p->missing_count++] = texture;
+    return true;
+}
+
+static bool is_missing(const parser *p, uint32_t texture)
+{
+    for (size_t i = 0; i < p->missing_count; i++)
+        if (p->missing_tex[i] == texture)
+            return true;
+    return false;
 }
 
 /* A texture for a material slot: a texture name, or a file path (then an
@@ -514,16 +591,21 @@ static rt_result get_texture_ref(parser *p, const char *what, uint32_t *out)
         *out = e->index;
         return RT_OK;
     }
+    const char *near = strchr(t->s, '.') || strchr(t->s, '/') ? NULL : closest_name(p, &p->textures, false, t->s);
+    if (near)
+        return perr(p, RT_ERR_INVALID, t, "undefined texture %s for %s (did you mean '%s'?)", show(t, b, sizeof b),
+                    what, near);
     if (!strchr(t->s, '.') && !strchr(t->s, '/'))
         return perr(p, RT_ERR_INVALID, t,
                     "undefined texture %s for %s (define it with 'texture' before use, or give an image file)",
                     show(t, b, sizeof b), what);
     rt_texture tex;
-    r = image_texture(p, t, &tex);
+    bool missing;
+    r = image_texture(p, t, &tex, &missing);
     if (r != RT_OK)
         return r;
     uint32_t id = rt_scene_add_texture(p->s, &tex);
-    if (id == RT_NONE)
+    if (id == RT_NONE || (missing && !note_missing(p, id)))
         return nomem(p, t);
     *out = id;
     return RT_OK;
@@ -657,6 +739,7 @@ static rt_result st_texture(parser *p, const tok *kw)
     if ((r = get_choice(p, "a texture kind", kinds, 3, "image|checker|constant", &kind)) != RT_OK)
         return r;
     rt_texture tex;
+    bool missing = false;
     if (kind == 0) {
         const tok *file = NULL;
         if ((r = get_word(p, "an image file", &file)) != RT_OK)
@@ -685,7 +768,7 @@ static rt_result st_texture(parser *p, const tok *kw)
                     return r;
             }
         }
-        if ((r = image_texture(p, file, &tex)) != RT_OK)
+        if ((r = image_texture(p, file, &tex, &missing)) != RT_OK)
             return r;
         static const rt_wrap wrap_values[] = {RT_WRAP_REPEAT, RT_WRAP_CLAMP, RT_WRAP_MIRROR};
         tex.wrap_s = tex.wrap_t = wrap_values[wrap];
@@ -711,7 +794,7 @@ static rt_result st_texture(parser *p, const tok *kw)
         tex = rt_texture_constant(rt_v4(c.x, c.y, c.z, 1));
     }
     uint32_t id = rt_scene_add_texture(p->s, &tex);
-    if (id == RT_NONE || !name_add(&p->textures, name->s, id, name->line))
+    if (id == RT_NONE || !name_add(&p->textures, name->s, id, name->line) || (missing && !note_missing(p, id)))
         return nomem(p, name);
     return RT_OK;
 }
@@ -846,6 +929,10 @@ static rt_result st_material(parser *p, const tok *kw)
         case MK_TEXTURE: {
             rt_texture_slot *slot = field;
             r = get_texture_ref(p, what, &slot->texture);
+            /* a missing image: the checker for colour, nothing for data */
+            bool colour = mk->offset == offsetof(rt_material, base_color_tex) || mk->offset == offsetof(rt_material, emissive_tex);
+            if (r == RT_OK && !colour && is_missing(p, slot->texture))
+                slot->texture = RT_NONE;
             break;
         }
         case MK_UV: {
@@ -1257,26 +1344,6 @@ static const keyword keywords[] = {
     {"light", st_light},
 };
 
-/* Edit distance, for "did you mean" hints on short words. */
-static int edit_distance(const char *a, const char *b)
-{
-    size_t n = strlen(a), m = strlen(b);
-    if (n > 32 || m > 32)
-        return 99;
-    int d[33][33];
-    for (size_t i = 0; i <= n; i++)
-        d[i][0] = (int)i;
-    for (size_t j = 0; j <= m; j++)
-        d[0][j] = (int)j;
-    for (size_t i = 1; i <= n; i++)
-        for (size_t j = 1; j <= m; j++) {
-            int c = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
-            int del = d[i - 1][j] + 1, ins = d[i][j - 1] + 1;
-            d[i][j] = c < del ? (c < ins ? c : ins) : (del < ins ? del : ins);
-        }
-    return d[n][m];
-}
-
 static rt_result run_statement(parser *p)
 {
     const tok *kw = &p->toks[0];
@@ -1492,6 +1559,7 @@ rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const
     if (r != RT_OK)
         rt_scene_rollback(s, &mark);
     free(p.toks);
+    free(p.missing_tex);
     name_table_free(&p.materials);
     name_table_free(&p.textures);
     free(buf);

@@ -11,10 +11,13 @@
  */
 #include "rt/scene/texture.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <sys/stat.h>
 
 #include <stb/stb_image.h>
 
@@ -309,6 +312,17 @@ rt_texture rt_texture_checker(rt_vec4 a, rt_vec4 b, float squares_per_unit)
     t.color_b = b;
     t.checker_scale = squares_per_unit;
     return t;
+}
+
+bool rt_image_file_missing(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) != 0 && (errno == ENOENT || errno == ENOTDIR);
+}
+
+rt_texture rt_texture_missing(void)
+{
+    return rt_texture_checker(rt_v4(1.0f, 0.0f, 1.0f, 1.0f), rt_v4(0.0f, 0.0f, 0.0f, 1.0f), 8.0f);
 }
 
 rt_vec2 rt_texture_slot_uv(const rt_texture_slot *slot, rt_vec2 uv)

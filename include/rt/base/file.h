@@ -38,8 +38,8 @@
 #define RT_FILE_MAX_BYTES (SIZE_MAX / 2)
 
 /* Reads the whole file at path into a fresh buffer of size + 1 bytes whose
- * last byte is 0 (free it). Regular files and pipes are read; directories,
- * devices and sockets are refused. max_size caps the size (0 = the default
+ * last byte is 0 (free it). Regular files and pipes are read; directories
+ * ("path: is a directory"), devices and sockets are refused. max_size caps the size (0 = the default
  * RT_FILE_MAX_BYTES); a regular file over it is refused before anything is
  * allocated. Errors (RT_ERR_IO, RT_ERR_LIMIT, RT_ERR_NOMEM) begin with
  * "path: ". On failure *bytes is NULL and *size 0. */

@@ -4,7 +4,8 @@
  * Writes are atomic: the image goes to a temporary file in the same
  * directory, which is renamed over the target only once complete, so a
  * failed or killed render never leaves a truncated file or clobbers an
- * earlier image.
+ * earlier image. On Linux that file has no name until it is complete
+ * (O_TMPFILE), so a process killed mid-write leaves no temporary file.
  *
  *   rt_framebuffer fb;
  *   rt_framebuffer_init(&fb, 640, 480, &err);
@@ -29,8 +30,10 @@ void rt_framebuffer_free(rt_framebuffer *fb);
 
 /* The format for a path's extension (.png, .pfm, .hdr; case-insensitive). */
 rt_result rt_output_format(const char *path, rt_image_format *format, rt_error *err);
-/* Checks before a render that the format is known and the directory is
- * writable (by creating and removing a temporary file there). */
+/* Checks before a render that the format is known, that the path is not a
+ * directory or anything else but a regular file, and that its directory is
+ * writable (by creating and removing the temporary file the write would
+ * use). Cheap: the driver calls it before loading the scene. */
 rt_result rt_output_check(const char *path, rt_error *err);
 /* Checks that the format can hold a width x height image (PNG output is
  * capped at 1 GiB of pixel data; RT_ERR_LIMIT beyond). */

@@ -16,14 +16,19 @@
  * first, then by its extension (rt_load_kind_of):
  *   glTF   the GLB magic "glTF", or JSON (its first character is '{'); else
  *          the extension .gltf or .glb          -> rt_gltf_load_memory
- *   mesh   a PLY or OFF header; else .obj, .ply or .off (any case)
+ *   mesh   a PLY or OFF header; else .obj, .ply or .off (any case); else,
+ *          for a name without an extension ("<stdin>"), content that
+ *          starts like an OBJ (v, vn, vt, f, o, g, mtllib, usemtl)
  *                                               -> rt_mesh_load_memory
- *   scene  anything else                        -> rt_scene_parse_string
+ *   scene  .txt, .rt, .scene or no extension    -> rt_scene_parse_string
+ *   anything else (.stl, .fbx, ...) is refused: RT_ERR_UNSUPPORTED, with a
+ *   message naming the formats rt reads
  * A NULL path loads the built-in scene (rt_default_scene_text).
  *
  * A mesh gets a material "default" (added first) for faces the file gives
  * none. With for_render, a bare model also gets what rendering it needs:
- * 16 samples, a soft sky, a directional key light when it brings no lights,
+ * the path tracer at 64 samples per pixel (rt_load_model_settings), a soft
+ * sky, a directional key light when it brings no lights,
  * the first glTF camera as the view; and every input gets per-vertex
  * tangents where normal maps need them (rt_scene_generate_tangents). On any
  * error the scene is rolled back to where it was (rt_scene_rollback).
@@ -37,10 +42,10 @@
 #include "rt/base/error.h"
 #include "rt/scene/scene.h"
 
-typedef enum rt_load_kind { RT_LOAD_SCENE = 0, RT_LOAD_GLTF, RT_LOAD_MESH } rt_load_kind;
+typedef enum rt_load_kind { RT_LOAD_SCENE = 0, RT_LOAD_GLTF, RT_LOAD_MESH, RT_LOAD_UNKNOWN } rt_load_kind;
 
 typedef struct rt_load_options {
-    bool for_render; /* add lighting, samples, the first camera and tangents (above); false = as the file is */
+    bool for_render; /* add lighting, integrator, samples, the first camera and tangents (above); false = as the file is */
 } rt_load_options;
 
 /* What one load found (what `rt --info` prints beside the scene's counts). */
@@ -68,7 +73,15 @@ rt_result rt_load_memory(rt_scene *s, const void *bytes, size_t size, const char
  * file. */
 rt_load_kind rt_load_kind_of(const void *bytes, size_t size, const char *name);
 
-/* "scene", "gltf" or "mesh". */
+/* The settings a glTF model or a mesh rendered on its own gets (for_render
+ * does this to the scene's settings): its samples, integrator and sky. */
+void rt_load_model_settings(rt_settings *set);
+
+/* True when name is read as scene text unless its content says otherwise:
+ * .txt, .rt, .scene, no extension, or NULL. */
+bool rt_load_is_scene_name(const char *name);
+
+/* "scene", "gltf", "mesh" or "unknown". */
 const char *rt_load_kind_name(rt_load_kind kind);
 
 #endif

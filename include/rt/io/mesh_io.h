@@ -47,17 +47,18 @@
 /* Zero means defaults: identity transform, the scene's material 0 (or a
  * default material when the scene has none) for faces without their own,
  * and the file's materials kept. */
+typedef enum rt_mesh_format { RT_MESH_UNKNOWN = 0, RT_MESH_OBJ, RT_MESH_PLY, RT_MESH_OFF } rt_mesh_format;
+
 typedef struct rt_mesh_options {
     const rt_mat4 *transform; /* NULL = identity */
     uint32_t material;        /* scene material for faces without one; RT_NONE = "<file>:default" */
     bool override_material;   /* every face takes `material` (OBJ then reads no MTL) */
+    rt_mesh_format format;    /* RT_MESH_UNKNOWN = by content, then name (rt_mesh_format_of); else this reader */
 } rt_mesh_options;
 
 typedef struct rt_mesh_load_stats {
     size_t triangles, vertices, materials, skipped_faces;
 } rt_mesh_load_stats;
-
-typedef enum rt_mesh_format { RT_MESH_UNKNOWN = 0, RT_MESH_OBJ, RT_MESH_PLY, RT_MESH_OFF } rt_mesh_format;
 
 /* The format of a mesh file: by content first (bytes may be NULL to skip
  * it): "ply" on the first line is PLY, an [ST][C][N][4|n]OFF keyword at the

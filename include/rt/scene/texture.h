@@ -30,6 +30,18 @@ rt_result rt_image_load_file(rt_scene *s, const char *path, uint32_t *image, rt_
 rt_result rt_image_load_memory(rt_scene *s, const void *data, size_t size, const char *name, uint32_t *image,
                                rt_error *err);
 
+/* Missing textures, one rule for every format (docs/scene-format.md,
+ * docs/gltf.md): an image file that does not exist is a warning naming
+ * where it was asked for, not an error. A colour map (base colour,
+ * emission) gets rt_texture_missing() in its place, a magenta and black
+ * checker that no one mistakes for the real thing; a data map (normal,
+ * metallic-roughness, occlusion, transmission) is left out, so the
+ * material's factors apply alone. An image that exists but cannot be read
+ * or decoded stays an error. */
+bool rt_image_file_missing(const char *path); /* true when path does not exist (ENOENT, ENOTDIR) */
+rt_texture rt_texture_missing(void);          /* magenta / black, 8 squares per UV unit */
+#define RT_MISSING_TEXTURE_NOTE "a magenta checker stands in for a colour map; a normal or other data map is left out"
+
 rt_texture rt_texture_image(uint32_t image);       /* repeat, bilinear */
 rt_texture rt_texture_constant(rt_vec4 color);
 rt_texture rt_texture_checker(rt_vec4 a, rt_vec4 b, float squares_per_unit);
