@@ -71,7 +71,6 @@ static void report(const rt_error *err, const memory_budget *budget)
     }
 }
 
-
 /* Output name: -o, else the scene's `output`, else the input's base name
  * with .png, in the current directory. */
 static void default_output(const rt_scene *s, const char *input, char *out, size_t size)
