@@ -2,11 +2,15 @@
  * tracer: evaluation, pdf and importance sampling (see rt/render/bsdf.h).
  *
  * Sources:
- * - The BRDF: glTF 2.0 specification, appendix B "BRDF Implementation"
- *   (B.3.5, metal-roughness material: c_diff, f0 = lerp(0.04, base,
- *   metallic), Schlick's F on |V.H|, f = (1 - F) c_diff / pi + F D V), with
- *   KHR_materials_ior (f0 from the index) and KHR_materials_transmission
- *   (the dielectric base lobe split between diffuse and a BTDF).
+ * - The BRDF: glTF 2.0 specification, appendix B "BRDF Implementation",
+ *   in its normative form (B.3.5: mix(dielectric_brdf, metal_brdf,
+ *   metallic), metal_brdf = conductor_fresnel(base, specular),
+ *   dielectric_brdf = fresnel_mix(ior, diffuse, specular), Schlick's F on
+ *   |V.H|), with KHR_materials_ior (F0 from the index) and
+ *   KHR_materials_transmission (the dielectric base lobe split between
+ *   diffuse and a BTDF).
+ * - Exact Fresnel equations for a dielectric (Born and Wolf, "Principles of
+ *   Optics", 7th ed., 1.5.2), used for transmissive surfaces.
  * - GGX / Trowbridge-Reitz distribution and its Smith Lambda: Walter,
  *   Marschner, Li, Torrance 2007, "Microfacet Models for Refraction through
  *   Rough Surfaces" (EGSR); height-correlated masking-shadowing: Heitz 2014,
@@ -22,9 +26,9 @@
  *
  * The transmission lobe refracts through a GGX microfacet normal sampled
  * from the visible normals (Walter et al. 2007's rough dielectric BTDF,
- * with the same alpha; the macro normal, i.e. a smooth dielectric, at the
- * smallest alpha), Snell's law with the material's ior. It is sampled
- * only, never evaluated: transmitted rays are not light-sampled, so an
+ * with the same alpha; the macro normal, i.e. a smooth dielectric, at
+ * roughness 0, where the reflection is a mirror too), Snell's law with the
+ * material's ior. It is sampled only, never evaluated: transmitted rays are not light-sampled, so an
  * emitter they hit counts in full (no MIS). Radiance is not rescaled by
  * eta^2 across the interface (it cancels for paths that leave the object
  * again). Every result is finite: grazing
@@ -115,22 +119,39 @@ static inline rt_vec3 schlick(rt_vec3 f0, float c)
     return rt_add(f0, rt_scale(rt_sub(rt_v3s(1.0f), f0), w));
 }
 
-/* Fresnel reflectance at a (micro)facet seen at cosine c from wo. glTF's
- * Schlick on |wo.h|; for a transmissive surface seen from inside (eta > 1)
- * Schlick on the refracted side's cosine, 1 beyond the critical angle
- * (total internal reflection), so reflection and refraction share one F. */
-static inline rt_vec3 fresnel(const rt_bsdf *b, float c)
+float rt_fresnel_exact(float cos_i, float eta)
 {
-    if (b->transmission > 0.0f && b->eta > 1.0f) {
-        float sin2_t = b->eta * b->eta * fmaxf(0.0f, 1.0f - c * c);
-        if (sin2_t >= 1.0f)
-            return rt_v3s(1.0f);
-        c = sqrtf(1.0f - sin2_t);
-    }
-    return schlick(b->f0, c);
+    float ci = rt_clampf(cos_i, 0.0f, 1.0f);
+    float sin2_t = eta * eta * (1.0f - ci * ci);
+    if (!(sin2_t < 1.0f))
+        return 1.0f; /* total internal reflection (or a NaN input) */
+    float ct = sqrtf(1.0f - sin2_t);
+    float rs = (eta * ci - ct) / (eta * ci + ct);
+    float rp = (ci - eta * ct) / (ci + eta * ct);
+    float f = 0.5f * (rs * rs + rp * rp);
+    return isfinite(f) ? rt_clampf(f, 0.0f, 1.0f) : 1.0f;
+}
+
+/* The dielectric Fresnel Fd at a (micro)facet seen at cosine c from wo:
+ * the exact equations for a transmissive surface (glass: reflection and
+ * refraction share one F, 1 past the critical angle), glTF's Schlick with
+ * the index's F0 for an opaque one. */
+static inline float fresnel_dielectric(const rt_bsdf *b, float c)
+{
+    if (b->transmission > 0.0f)
+        return rt_fresnel_exact(c, b->eta);
+    return b->f0 + (1.0f - b->f0) * schlick_weight(c);
 }
 
 static inline float mean3(rt_vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
+
+/* The specular lobe's Fresnel: the glTF mix by metallic of the metal's
+ * conductor_fresnel (Schlick on the base colour) and the dielectric's Fd. */
+static inline rt_vec3 fresnel_specular(const rt_bsdf *b, float c, float fd)
+{
+    rt_vec3 fm = b->metallic > 0.0f ? schlick(b->base, c) : rt_v3s(0.0f);
+    return rt_lerp3(rt_v3s(fd), fm, b->metallic);
+}
 
 static void set_frame(rt_bsdf *b, rt_vec3 n, rt_vec3 ng)
 {
@@ -151,18 +172,22 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
     if (!(ior > 0.0f) || !isfinite(ior))
         ior = 1.5f;
     b->lambert = lambert;
+    b->base = base;
     if (lambert) {
         b->diffuse = base;
-        b->f0 = rt_v3s(0.0f);
+        b->metallic = 0.0f;
+        b->f0 = 0.0f;
         b->alpha = 1.0f;
+        b->delta = false;
         b->transmission = 0.0f;
         b->eta = 1.0f;
         return;
     }
     float r0 = (ior - 1.0f) / (ior + 1.0f);
-    r0 *= r0;
     b->diffuse = rt_scale(base, 1.0f - metallic);
-    b->f0 = rt_lerp3(rt_v3s(r0), base, metallic);
+    b->metallic = metallic;
+    b->f0 = r0 * r0;
+    b->delta = roughness == 0.0f;
     b->alpha = fmaxf(roughness * roughness, RT_BSDF_MIN_ALPHA);
     b->transmission = transmission;
     b->eta = 1.0f / ior;
@@ -211,13 +236,19 @@ void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p
         *p_diffuse = mean3(b->diffuse) > 0.0f ? 1.0f : 0.0f;
         return;
     }
-    /* F at the macro normal estimates each lobe's share; the floors keep
-     * every lobe that can contribute at some microfacet sampleable (inside
-     * glass past the critical angle F is 1 at the normal, yet tilted
-     * facets still transmit) */
-    rt_vec3 F = fresnel(b, wo.z);
-    float ws = fmaxf(mean3(F), 0.02f);
-    float wd = mean3(rt_mul(rt_vmax(rt_sub(rt_v3s(1.0f), F), rt_v3s(0.1f)), b->diffuse));
+    /* F at the macro normal estimates each lobe's share. A delta interface
+     * uses it exactly; a rough one floors both shares, so every lobe that
+     * can contribute at some microfacet stays sampleable (inside glass past
+     * the critical angle Fd is 1 at the normal, yet tilted facets still
+     * transmit) */
+    float fd = fresnel_dielectric(b, wo.z);
+    rt_vec3 F = fresnel_specular(b, wo.z, fd);
+    float ws = mean3(F), td = 1.0f - fd;
+    if (!b->delta) {
+        ws = fmaxf(ws, 0.02f);
+        td = fmaxf(td, 0.1f);
+    }
+    float wd = mean3(b->diffuse) * td;
     float wt = wd * b->transmission;
     wd *= 1.0f - b->transmission;
     float sum = ws + wd + wt;
@@ -244,19 +275,23 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
         return rt_v3s(0.0f);
     h = rt_scale(h, 1.0f / sqrtf(l2));
     float voh = rt_dot(wo, h);
-    rt_vec3 F = fresnel(b, voh);
-    float D = rt_ggx_d(h, b->alpha);
-    float G = rt_ggx_g2(wo, wi, b->alpha);
-    float spec = D * G / (4.0f * wo.z * wi.z);
-    if (!isfinite(spec))
-        spec = 0.0f;
-    rt_vec3 f = rt_scale(rt_mul(rt_sub(rt_v3s(1.0f), F), b->diffuse), (1.0f - b->transmission) * RT_INV_PI);
-    f = rt_add(f, rt_scale(F, spec));
+    float fd = fresnel_dielectric(b, voh);
+    /* diffuse: the dielectric's fresnel_mix leaves 1 - Fd to the base */
+    rt_vec3 f = rt_scale(b->diffuse, (1.0f - fd) * (1.0f - b->transmission) * RT_INV_PI);
     float p = pd * wi.z * RT_INV_PI;
-    if (ps > 0.0f) {
-        float pv = rt_ggx_g1(wo, b->alpha) * D / (4.0f * wo.z);
-        if (isfinite(pv))
-            p += ps * pv;
+    if (!b->delta) {
+        rt_vec3 F = fresnel_specular(b, voh, fd);
+        float D = rt_ggx_d(h, b->alpha);
+        float G = rt_ggx_g2(wo, wi, b->alpha);
+        float spec = D * G / (4.0f * wo.z * wi.z);
+        if (!isfinite(spec))
+            spec = 0.0f;
+        f = rt_add(f, rt_scale(F, spec));
+        if (ps > 0.0f) {
+            float pv = rt_ggx_g1(wo, b->alpha) * D / (4.0f * wo.z);
+            if (isfinite(pv))
+                p += ps * pv;
+        }
     }
     *pdf = p;
     return f;
@@ -269,6 +304,15 @@ rt_vec3 rt_bsdf_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float *pdf)
     return eval_lobes(b, wo, wi, pd, ps, pdf ? pdf : &dummy);
 }
 
+static bool delta_sample(rt_bsdf_sample *s, rt_vec3 wi, rt_vec3 w)
+{
+    s->wi = wi;
+    s->weight = w;
+    s->pdf = 0.0f;
+    s->delta = true;
+    return rt_finite3(wi) && rt_finite3(w) && rt_max3(w) > 0.0f;
+}
+
 bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
 {
     if (!(wo.z > 0.0f))
@@ -278,12 +322,11 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
     if (!(pd + ps + pt > 0.0f))
         return false;
     if (pt > 0.0f && ulobe >= pd + ps) {
-        /* refraction through a microfacet: the macro normal for the
-         * smoothest surfaces, else a visible normal (Heitz 2018); the
-         * weight f |cos| / pdf of Walter et al.'s BTDF with that sampling
-         * is (1 - F) T c_diff G2 / G1(wo) */
-        bool rough = b->alpha > RT_BSDF_MIN_ALPHA;
-        rt_vec3 h = rough ? rt_ggx_sample_vndf(wo, b->alpha, u) : rt_v3(0.0f, 0.0f, 1.0f);
+        /* refraction through a microfacet: the macro normal for a delta
+         * interface, else a visible normal (Heitz 2018); the weight
+         * f |cos| / pdf of Walter et al.'s BTDF with that sampling is
+         * (1 - Fd) T c_diff G2 / G1(wo) */
+        rt_vec3 h = b->delta ? rt_v3(0.0f, 0.0f, 1.0f) : rt_ggx_sample_vndf(wo, b->alpha, u);
         float eta = b->eta;
         float ci = rt_dot(wo, h);
         if (!(ci > 0.0f))
@@ -296,17 +339,17 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
         if (!(wi.z < 0.0f))
             return false; /* the microfacet sends it back out */
         wi = rt_normalize(wi);
-        rt_vec3 F = fresnel(b, ci);
-        float g = rough ? rt_ggx_g2(wo, wi, b->alpha) / rt_ggx_g1(wo, b->alpha) : 1.0f;
-        rt_vec3 w = rt_scale(rt_mul(rt_sub(rt_v3s(1.0f), F), b->diffuse), g * b->transmission / pt);
-        s->wi = wi;
-        s->weight = w;
-        s->pdf = 0.0f;
-        s->delta = true;
-        return rt_finite3(s->wi) && rt_finite3(w);
+        float fd = fresnel_dielectric(b, ci);
+        float g = b->delta ? 1.0f : rt_ggx_g2(wo, wi, b->alpha) / rt_ggx_g1(wo, b->alpha);
+        return delta_sample(s, wi, rt_scale(b->diffuse, (1.0f - fd) * g * b->transmission / pt));
+    }
+    if (b->delta && ps > 0.0f && ulobe >= pd) {
+        /* mirror reflection about the normal: weight F / (its probability) */
+        float fd = fresnel_dielectric(b, wo.z);
+        return delta_sample(s, rt_v3(-wo.x, -wo.y, wo.z), rt_scale(fresnel_specular(b, wo.z, fd), 1.0f / ps));
     }
     rt_vec3 wi;
-    if (ulobe < pd || b->lambert || !(ps > 0.0f)) {
+    if (ulobe < pd || b->lambert || b->delta || !(ps > 0.0f)) {
         wi = rt_sample_cosine_hemisphere(u);
     } else {
         rt_vec3 h = rt_ggx_sample_vndf(wo, b->alpha, u);

@@ -16,25 +16,39 @@
  *       ... rt_bsdf_to_world(&b, s.wi) ...
  *
  * Model, for base colour B, metallic m, roughness r, alpha = r^2, index of
- * refraction eta, transmission T (glTF 2.0 spec, appendix B.3.5, with
- * KHR_materials_ior and KHR_materials_transmission):
+ * refraction eta, transmission T: the normative form of the glTF 2.0
+ * specification (appendix B.3.5, with KHR_materials_ior and
+ * KHR_materials_transmission), the mix by metallic of a metal BRDF and a
+ * dielectric one:
  *
- *   F0     = lerp(((eta - 1) / (eta + 1))^2, B, m)
- *   F      = F0 + (1 - F0) (1 - |wo.h|)^5           (Schlick)
- *   c_diff = lerp(B, 0, m)
- *   f      = (1 - F)(1 - T) c_diff / pi  +  F D(h) V(wo, wi)
+ *   metal      = conductor_fresnel(f0 = B, specular)      = Fm specular
+ *   dielectric = fresnel_mix(ior, base, layer = specular) = (1 - Fd) base + Fd specular
+ *   base       = (1 - T) B / pi + T btdf
+ *   f          = lerp(dielectric, metal, m)
+ *              = (1 - m)(1 - Fd)(1 - T) B / pi  +  lerp(Fd, Fm, m) D V   (+ transmission)
+ *   Fm         = B + (1 - B)(1 - |wo.h|)^5               (Schlick on the base colour)
+ *   Fd         = F0 + (1 - F0)(1 - |wo.h|)^5, F0 = ((eta - 1) / (eta + 1))^2,
+ *                or, for a transmissive surface (T > 0), the exact
+ *                unpolarised Fresnel equations (rt_fresnel_exact), 1 past
+ *                the critical angle
  *
  * with D the GGX (Trowbridge-Reitz) distribution and V = G2 / (4 |n.wo|
  * |n.wi|), G2 the height-correlated Smith masking-shadowing term. The
- * transmitted share (1 - F) T c_diff refracts through a GGX microfacet
- * (Walter et al. 2007; smooth at roughness 0), sampled only (a "delta"
- * sample: not light-sampled, no MIS). RT_BSDF_LAMBERT is exactly B / pi.
+ * spec's "simplified" single-F0 form, F = Schlick(lerp(F0, B, m)) on both
+ * lobes, has the same specular lobe (Schlick is linear in F0) but darkens
+ * the diffuse lobe of partly metallic texels by (1 - F) instead of
+ * (1 - m)(1 - Fd); rt no longer uses it. The transmitted share
+ * (1 - m)(1 - Fd) T B refracts through a GGX microfacet (Walter et al.
+ * 2007), sampled only (a "delta" sample: not light-sampled, no MIS).
+ * Roughness exactly 0 is a true delta interface: mirror reflection and
+ * refraction about the normal, both sampled only, so rt_bsdf_eval holds
+ * just the diffuse lobe. RT_BSDF_LAMBERT is exactly B / pi.
  *
  * Sampling picks a lobe by its estimated share of the reflected energy at
  * wo, then samples diffuse by the cosine, specular by the distribution of
  * visible normals (Heitz 2018, "Sampling the GGX Distribution of Visible
- * Normals", JCGT 7(4)); the pdf is the mixture of both (one-sample MIS over
- * the lobes), and rt_bsdf_eval returns the same pdf.
+ * Normals", JCGT 7(4)); the pdf is the mixture of the non-delta lobes
+ * (one-sample MIS over the lobes), and rt_bsdf_eval returns the same pdf.
  */
 #ifndef RT_BSDF_H
 #define RT_BSDF_H
@@ -49,9 +63,12 @@ typedef struct rt_bsdf {
     rt_vec3 t, b, n;  /* shading frame, world space; n on the side of wo */
     rt_vec3 ng;       /* geometric normal on the side of wo */
     bool lambert;     /* pure Lambert: f = diffuse / pi */
-    rt_vec3 diffuse;  /* c_diff (Lambert: the albedo) */
-    rt_vec3 f0;       /* Schlick normal-incidence reflectance per channel */
-    float alpha;      /* GGX alpha */
+    bool delta;       /* roughness 0: mirror reflection and refraction, sampled only */
+    rt_vec3 base;     /* base colour B: the metal's normal-incidence reflectance */
+    rt_vec3 diffuse;  /* (1 - m) B (Lambert: the albedo) */
+    float metallic;   /* m */
+    float f0;         /* the dielectric's normal-incidence reflectance ((eta - 1) / (eta + 1))^2 */
+    float alpha;      /* GGX alpha (at least RT_BSDF_MIN_ALPHA) */
     float transmission; /* T */
     float eta;        /* index ratio across the surface along a transmitted ray: n_incident / n_transmitted */
 } rt_bsdf;
@@ -59,9 +76,14 @@ typedef struct rt_bsdf {
 typedef struct rt_bsdf_sample {
     rt_vec3 wi;       /* local direction */
     rt_vec3 weight;   /* f |cos| / pdf, or the delta lobe's weight / its probability */
-    float pdf;        /* solid-angle pdf; 0 for a transmission sample */
-    bool delta;       /* transmission: sampled only, never light-sampled, so no MIS */
+    float pdf;        /* solid-angle pdf; 0 for a delta sample */
+    bool delta;       /* transmission or a mirror reflection: sampled only, never light-sampled, so no MIS */
 } rt_bsdf_sample;
+
+/* Exact unpolarised Fresnel reflectance of a smooth dielectric interface
+ * (Born and Wolf, Principles of Optics, 1.5.2) at incident cosine cos_i,
+ * eta = n_incident / n_transmitted; 1 past the critical angle. */
+float rt_fresnel_exact(float cos_i, float eta);
 
 /* GGX building blocks, local frame (z = normal). */
 float rt_ggx_d(rt_vec3 h, float alpha);              /* D(h), 0 below the surface */
