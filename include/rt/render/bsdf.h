@@ -57,7 +57,7 @@
 
 #include "rt/render/surface.h"
 
-#define RT_BSDF_MIN_ALPHA 1e-3f /* GGX alpha floor: roughness 0 is a very sharp lobe, never a delta */
+#define RT_BSDF_MIN_ALPHA 1e-4f /* GGX alpha floor for roughness > 0 (roughness 0 is a delta interface) */
 
 typedef struct rt_bsdf {
     rt_vec3 t, b, n;  /* shading frame, world space; n on the side of wo */
@@ -86,7 +86,7 @@ typedef struct rt_bsdf_sample {
 float rt_fresnel_exact(float cos_i, float eta);
 
 /* GGX building blocks, local frame (z = normal). */
-float rt_ggx_d(rt_vec3 h, float alpha);              /* D(h), 0 below the surface */
+float rt_ggx_d(rt_vec3 h, float alpha);              /* D(h), 0 below the surface; h unit, stable to alpha 1e-4 */
 float rt_ggx_lambda(rt_vec3 w, float alpha);         /* Smith Lambda(w) */
 float rt_ggx_g1(rt_vec3 w, float alpha);             /* 1 / (1 + Lambda) */
 float rt_ggx_g2(rt_vec3 wo, rt_vec3 wi, float alpha); /* height-correlated 1 / (1 + L(wo) + L(wi)) */
