@@ -210,6 +210,40 @@ static void test_closed_furnace(void **state)
     }
 }
 
+/* Russian roulette stays unbiased whatever rr_depth: inside the closed
+ * emissive sphere of albedo 0.6 every start depth, and the adaptive rule
+ * (0), give E / (1 - a). */
+static void test_rr_depth_unbiased(void **state)
+{
+    (void)state;
+    const int rr[] = {0, 1, 5};
+    for (int k = 0; k < 3; k++) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 "integrator path\nrr_depth %d\n"
+                 "material m color 0.6 0.6 0.6 bsdf lambert emission 1 1 1\nsphere 0 0 0 1 m\n",
+                 rr[k]);
+        fixture f;
+        load(&f, text, false);
+        assert_int_equal(f.s.settings.rr_depth, rr[k]);
+        double sum = 0.0, sum2 = 0.0;
+        const uint32_t n = 40000;
+        test_rng tr = {13};
+        for (uint32_t i = 0; i < n; i++) {
+            rt_vec3 dir = rt_v3(test_rng_float(&tr) - 0.5f, test_rng_float(&tr) - 0.5f, test_rng_float(&tr) - 0.5f);
+            if (rt_length2(dir) < 1e-6f)
+                dir = rt_v3(0, 0, 1);
+            double L = radiance(&f, rt_v3(0.1f, -0.2f, 0.3f), dir, i).x;
+            sum += L;
+            sum2 += L * L;
+        }
+        double mean = sum / n, sd = sqrt(fmax(0.0, sum2 / n - mean * mean) / n);
+        if (fabs(mean - 2.5) > 4.0 * sd + 1e-3)
+            fail_msg("rr_depth %d: %.4f +- %.4f, want 2.5", rr[k], mean, sd);
+        unload(&f);
+    }
+}
+
 /* ------------------------------------------------------------- lights */
 
 static void test_point_light_exact(void **state)
@@ -620,6 +654,7 @@ int main(void)
         cmocka_unit_test(test_furnace_metal),
         cmocka_unit_test(test_furnace_glass),
         cmocka_unit_test(test_closed_furnace),
+        cmocka_unit_test(test_rr_depth_unbiased),
         cmocka_unit_test(test_point_light_exact),
         cmocka_unit_test(test_area_light_one_sided),
         cmocka_unit_test(test_emissive_triangles_vs_area_light),

@@ -24,9 +24,11 @@
  * and environment images without a table, a constant background) count in
  * full on BSDF hits.
  *
- * Russian roulette (Arvo and Kirk 1990) from RT_PATH_RR_START bounces: the
+ * Russian roulette (Arvo and Kirk 1990) from settings.rr_depth bounces: the
  * path survives with q = min(max channel of beta, 0.95) and beta /= q, which
- * keeps the estimator unbiased. settings.max_depth caps the scattering
+ * keeps the estimator unbiased; rr_depth 0 is adaptive (pbrt-v4's rule):
+ * from the first bounce, whenever the max channel of beta has fallen below
+ * 1, the path survives with q = that channel. settings.max_depth caps the scattering
  * events of a path (0 = no cap).
  *
  * Area lights are pure emitters: their visible quad emits from its front
@@ -169,6 +171,7 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
     int max_depth = s->settings.max_depth > 0 ? s->settings.max_depth : RT_PATH_HARD_LIMIT;
     if (max_depth > RT_PATH_HARD_LIMIT)
         max_depth = RT_PATH_HARD_LIMIT;
+    int rr_depth = s->settings.rr_depth;
     rt_ray r = *ray;
     float len = rt_length(r.dir);
     if (!(len > 0.0f) || !isfinite(len))
@@ -249,8 +252,8 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         prev_pdf = bs.pdf;
         prev_p = sf.p;
         bounces++;
-        if (bounces >= RT_PATH_RR_START) {
-            float q = fminf(rt_max3(beta), 0.95f);
+        if (rr_depth == 0 ? rt_max3(beta) < 1.0f : bounces >= rr_depth) {
+            float q = rr_depth == 0 ? rt_max3(beta) : fminf(rt_max3(beta), 0.95f);
             if (rt_rng_float(rng) >= q)
                 break;
             beta = rt_scale(beta, 1.0f / q);
