@@ -9,6 +9,7 @@
  * at grazing and degenerate directions. */
 #include "test_util.h"
 
+#include <complex.h>
 #include <math.h>
 
 #include "rt/render/bsdf.h"
@@ -246,66 +247,74 @@ static void test_ggx_tiny_alpha_precision(void **state)
  * to the probability that it succeeds, and a histogram of its directions
  * over 16 x 16 cells in (cos theta, phi) matches the pdf integrated over
  * each cell. */
+static void pdf_histogram(const rt_bsdf *bp, rt_vec3 wo, uint64_t seed, const char *label)
+{
+    enum { NT = 16, NP = 16, N = 400000 };
+    static double hist[NT][NP], expect[NT][NP];
+    const rt_bsdf b = *bp;
+    memset(hist, 0, sizeof hist);
+    memset(expect, 0, sizeof expect);
+    rt_rng rng = rt_rng_seed(seed, 99);
+    int ok = 0;
+    for (int i = 0; i < N; i++) {
+        rt_bsdf_sample s;
+        float ul = rt_rng_float(&rng);
+        rt_vec2 u = rt_v2(rt_rng_float(&rng), rt_rng_float(&rng));
+        if (!rt_bsdf_sample_dir(&b, wo, u, ul, &s))
+            continue;
+        ok++;
+        /* the sample's pdf is the evaluated pdf */
+        float pe;
+        rt_bsdf_eval(&b, wo, s.wi, &pe);
+        assert_true(fabsf(pe - s.pdf) <= 1e-4f * s.pdf);
+        int it = (int)(s.wi.z * NT), ip = (int)((atan2f(s.wi.y, s.wi.x) + RT_PI) / (2.0f * RT_PI) * NP);
+        it = it < 0 ? 0 : (it >= NT ? NT - 1 : it);
+        ip = ip < 0 ? 0 : (ip >= NP ? NP - 1 : ip);
+        hist[it][ip] += 1.0 / N;
+    }
+    /* pdf integrated over each cell, 24 x 24 midpoints per cell */
+    double total = 0.0;
+    const int sub = 24;
+    for (int it = 0; it < NT; it++)
+        for (int ip = 0; ip < NP; ip++) {
+            double acc = 0.0;
+            for (int a = 0; a < sub; a++)
+                for (int bb = 0; bb < sub; bb++) {
+                    float ct = ((float)it + ((float)a + 0.5f) / sub) / NT;
+                    float ph = ((float)ip + ((float)bb + 0.5f) / sub) / NP * 2.0f * RT_PI - RT_PI;
+                    float pdf;
+                    rt_bsdf_eval(&b, wo, dir_from(ct, ph), &pdf);
+                    acc += pdf;
+                }
+            double cell = (1.0 / NT) * (2.0 * 3.14159265358979323846 / NP); /* solid angle of the cell */
+            expect[it][ip] = acc / (sub * sub) * cell;
+            total += expect[it][ip];
+        }
+    double p_ok = (double)ok / N;
+    assert_true(fabs(total - p_ok) < 0.01);
+    assert_true(total <= 1.0 + 0.01);
+    for (int it = 0; it < NT; it++)
+        for (int ip = 0; ip < NP; ip++) {
+            double e = expect[it][ip], h = hist[it][ip];
+            /* 5 standard deviations of a binomial count, plus the quadrature error */
+            double tol = 5.0 * sqrt(e / N) + 0.02 * e + 2e-5;
+            if (fabs(h - e) > tol)
+                fail_msg("%s cell (%d,%d): histogram %.5f, pdf %.5f", label, it, ip, h, e);
+        }
+}
+
+/* pdf_histogram over the glTF cases. */
 static void test_pdf_matches_sampling(void **state)
 {
     (void)state;
-    enum { NT = 16, NP = 16, N = 400000 };
-    static double hist[NT][NP], expect[NT][NP];
     for (size_t c = 0; c < NCASES; c++) {
         if (cases[c].roughness < 0.1f)
             continue;
         rt_bsdf b;
         make(&b, &cases[c]);
-        rt_vec3 wo = dir_from(0.6f, 0.0f);
-        memset(hist, 0, sizeof hist);
-        memset(expect, 0, sizeof expect);
-        rt_rng rng = rt_rng_seed(c, 99);
-        int ok = 0;
-        for (int i = 0; i < N; i++) {
-            rt_bsdf_sample s;
-            float ul = rt_rng_float(&rng);
-            rt_vec2 u = rt_v2(rt_rng_float(&rng), rt_rng_float(&rng));
-            if (!rt_bsdf_sample_dir(&b, wo, u, ul, &s))
-                continue;
-            ok++;
-            /* the sample's pdf is the evaluated pdf */
-            float pe;
-            rt_bsdf_eval(&b, wo, s.wi, &pe);
-            assert_true(fabsf(pe - s.pdf) <= 1e-4f * s.pdf);
-            int it = (int)(s.wi.z * NT), ip = (int)((atan2f(s.wi.y, s.wi.x) + RT_PI) / (2.0f * RT_PI) * NP);
-            it = it < 0 ? 0 : (it >= NT ? NT - 1 : it);
-            ip = ip < 0 ? 0 : (ip >= NP ? NP - 1 : ip);
-            hist[it][ip] += 1.0 / N;
-        }
-        /* pdf integrated over each cell, 24 x 24 midpoints per cell */
-        double total = 0.0;
-        const int sub = 24;
-        for (int it = 0; it < NT; it++)
-            for (int ip = 0; ip < NP; ip++) {
-                double acc = 0.0;
-                for (int a = 0; a < sub; a++)
-                    for (int bb = 0; bb < sub; bb++) {
-                        float ct = ((float)it + ((float)a + 0.5f) / sub) / NT;
-                        float ph = ((float)ip + ((float)bb + 0.5f) / sub) / NP * 2.0f * RT_PI - RT_PI;
-                        float pdf;
-                        rt_bsdf_eval(&b, wo, dir_from(ct, ph), &pdf);
-                        acc += pdf;
-                    }
-                double cell = (1.0 / NT) * (2.0 * 3.14159265358979323846 / NP); /* solid angle of the cell */
-                expect[it][ip] = acc / (sub * sub) * cell;
-                total += expect[it][ip];
-            }
-        double p_ok = (double)ok / N;
-        assert_true(fabs(total - p_ok) < 0.01);
-        assert_true(total <= 1.0 + 0.01);
-        for (int it = 0; it < NT; it++)
-            for (int ip = 0; ip < NP; ip++) {
-                double e = expect[it][ip], h = hist[it][ip];
-                /* 5 standard deviations of a binomial count, plus the quadrature error */
-                double tol = 5.0 * sqrt(e / N) + 0.02 * e + 2e-5;
-                if (fabs(h - e) > tol)
-                    fail_msg("case %zu cell (%d,%d): histogram %.5f, pdf %.5f", c, it, ip, h, e);
-            }
+        char label[32];
+        snprintf(label, sizeof label, "case %zu", c);
+        pdf_histogram(&b, dir_from(0.6f, 0.0f), c, label);
     }
 }
 
@@ -488,6 +497,108 @@ static void test_gltf_normative_form(void **state)
     assert_true(fabs(diffuse * 3.14159265358979323846 - 0.5 * 0.96 * 0.8) < 1e-4);
 }
 
+/* Conductor Fresnel by complex arithmetic in double precision: the
+ * amplitude ratios r_s = (cos_i - n cos_t) / (cos_i + n cos_t), r_p =
+ * (n cos_i - cos_t) / (n cos_i + cos_t) with n = eta + i k and
+ * n cos_t = sqrt(n^2 - sin^2), independent of rt's closed form. */
+static double fresnel_conductor_d(double ci, double eta, double k)
+{
+    double complex n = eta + k * I;
+    double complex nct = csqrt(n * n - (1.0 - ci * ci)); /* n cos_t */
+    double complex ct = nct / n;
+    double complex rs = (ci - nct) / (ci + nct);
+    double complex rp = (n * ci - ct) / (n * ci + ct);
+    return 0.5 * (creal(rs * conj(rs)) + creal(rp * conj(rp)));
+}
+
+static void test_conductor_fresnel(void **state)
+{
+    (void)state;
+    for (size_t m = 0; m < rt_metal_count; m++) {
+        const float *eta = &rt_metals[m].eta.x, *k = &rt_metals[m].k.x;
+        for (int i = 0; i <= 50; i++) {
+            float c = (float)i / 50.0f;
+            rt_vec3 f = rt_fresnel_conductor(c, rt_metals[m].eta, rt_metals[m].k);
+            const float *fc = &f.x;
+            for (int ch = 0; ch < 3; ch++) {
+                double want = fresnel_conductor_d(c, eta[ch], k[ch]);
+                if (fabs(fc[ch] - want) > 1e-5)
+                    fail_msg("%s channel %d cos %.2f: F %.6f, complex arithmetic %.6f", rt_metals[m].name, ch,
+                             (double)c, (double)fc[ch], want);
+            }
+        }
+        /* normal incidence: ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2) */
+        rt_vec3 f0 = rt_fresnel_conductor(1.0f, rt_metals[m].eta, rt_metals[m].k);
+        double e = eta[0], kk = k[0];
+        assert_true(fabs(f0.x - ((e - 1) * (e - 1) + kk * kk) / ((e + 1) * (e + 1) + kk * kk)) < 1e-5);
+    }
+    /* gold is yellow, silver near white and bright */
+    rt_vec3 au = rt_fresnel_conductor(1.0f, rt_metals[1].eta, rt_metals[1].k);
+    rt_vec3 ag = rt_fresnel_conductor(1.0f, rt_metals[2].eta, rt_metals[2].k);
+    assert_string_equal(rt_metals[1].name, "Au");
+    assert_true(au.x > 0.9f && au.z < 0.45f && ag.x > 0.94f && ag.z > 0.85f);
+}
+
+static void test_conductor_bsdf(void **state)
+{
+    (void)state;
+    const rt_metal *cu = &rt_metals[0];
+    const float ax[] = {0.3f, 0.5f, 0.1f, 0.6f}, ay[] = {0.3f, 0.5f, 0.5f, 0.2f};
+    for (int c = 0; c < 4; c++) {
+        for (int sm = 0; sm < 2; sm++) {
+            rt_bsdf b;
+            rt_bsdf_make_conductor(&b, rt_v3(0, 0, 1), cu->eta, cu->k, ax[c], ay[c], (rt_smith)sm);
+            test_rng r = {(uint64_t)(c * 2 + sm + 1)};
+            /* reciprocal; separable G1 G1 never above the correlated G2 */
+            for (int i = 0; i < 1000; i++) {
+                rt_vec3 wo = uniform_hemi(&r), wi = uniform_hemi(&r);
+                rt_vec3 f1 = rt_bsdf_eval(&b, wo, wi, NULL), f2 = rt_bsdf_eval(&b, wi, wo, NULL);
+                assert_true(fabsf(f1.y - f2.y) <= 1e-4f * fmaxf(f1.y, 1e-3f));
+                if (sm == 1) {
+                    rt_bsdf bc = b;
+                    bc.separable = false;
+                    assert_true(f1.y <= rt_bsdf_eval(&bc, wo, wi, NULL).y * (1.0f + 1e-5f) + 1e-7f);
+                }
+            }
+            /* albedo at most 1 (per channel) and equal by sampling and quadrature */
+            const float cos_o[] = {1.0f, 0.6f, 0.2f};
+            for (int k = 0; k < 3; k++) {
+                double es, eq;
+                albedo(&b, dir_from(cos_o[k], 0.7f), 65536, &es, &eq);
+                assert_true(es <= 1.0 + 5e-3 && eq <= 1.0 + 5e-3);
+                assert_true(fabs(es - eq) < 0.01 + 0.02 * eq);
+            }
+            char label[64];
+            snprintf(label, sizeof label, "conductor %.1f x %.1f smith %d", (double)ax[c], (double)ay[c], sm);
+            pdf_histogram(&b, dir_from(0.6f, 0.4f), (uint64_t)(100 + c * 2 + sm), label);
+        }
+    }
+    /* a perfect conductor (F = 1) of alpha 0.49 has the glTF white metal's
+     * directional albedo along the normal, 0.69775 (test_energy_conservation) */
+    rt_bsdf b;
+    rt_bsdf_make_conductor(&b, rt_v3(0, 0, 1), rt_v3s(1.0f), rt_v3s(1e4f), 0.49f, 0.49f, RT_SMITH_CORRELATED);
+    double es, eq;
+    albedo(&b, rt_v3(0, 0, 1), 65536, &es, &eq);
+    assert_true(fabs(es - 0.69775) < 0.003);
+    /* anisotropy: the lobe is wider along x (alpha 0.5) than along y (0.1) */
+    rt_bsdf_make_conductor(&b, rt_v3(0, 0, 1), cu->eta, cu->k, 0.5f, 0.1f, RT_SMITH_CORRELATED);
+    rt_vec3 wo = rt_v3(0, 0, 1);
+    float fx = rt_bsdf_eval(&b, wo, dir_from(cosf(0.4f), 0.0f), NULL).x;
+    float fy = rt_bsdf_eval(&b, wo, dir_from(cosf(0.4f), RT_PI / 2), NULL).x;
+    assert_true(fx > 10.0f * fy);
+    /* smooth: a delta mirror of weight F(cos_o), nothing to evaluate */
+    rt_bsdf_make_conductor(&b, rt_v3(0, 0, 1), cu->eta, cu->k, 0.0f, 0.0f, RT_SMITH_CORRELATED);
+    assert_true(b.delta);
+    rt_vec3 w = dir_from(0.5f, 1.0f);
+    rt_bsdf_sample s;
+    assert_true(rt_bsdf_sample_dir(&b, w, rt_v2(0.2f, 0.7f), 0.3f, &s) && s.delta);
+    rt_vec3 want = rt_fresnel_conductor(0.5f, cu->eta, cu->k);
+    assert_true(s.weight.x == want.x && s.weight.z == want.z && fabsf(s.wi.z - 0.5f) < 1e-6f);
+    float pdf;
+    rt_vec3 f = rt_bsdf_eval(&b, w, s.wi, &pdf);
+    assert_true(f.x == 0.0f && pdf == 0.0f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -503,6 +614,8 @@ int main(void)
         cmocka_unit_test(test_transmission_lobe),
         cmocka_unit_test(test_glass_exact_fresnel),
         cmocka_unit_test(test_gltf_normative_form),
+        cmocka_unit_test(test_conductor_fresnel),
+        cmocka_unit_test(test_conductor_bsdf),
     };
     return cmocka_run_group_tests_name("bsdf", tests, NULL, NULL);
 }

@@ -175,6 +175,27 @@ static void test_furnace_glass(void **state)
     }
 }
 
+/* A smooth gold sphere in a uniform environment of radiance 1: every
+ * camera ray reflects once off the convex sphere and leaves, so a ray
+ * meeting it at incidence cosine c sees exactly F_conductor(c) per
+ * channel. */
+static void test_smooth_conductor_sphere(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, "integrator path\nbackground 1 1 1\nmaterial au bsdf conductor metal Au ggx_alpha 0\n"
+             "sphere 0 0 0 1 au\n", false);
+    for (int i = 0; i < 9; i++) {
+        float x = 0.1f * (float)i;
+        rt_vec3 L = radiance(&f, rt_v3(x, 0, 5), rt_v3(0, 0, -1), (uint32_t)i);
+        rt_vec3 F = rt_fresnel_conductor(sqrtf(1.0f - x * x), rt_metals[1].eta, rt_metals[1].k);
+        if (fabsf(L.x - F.x) > 2e-4f || fabsf(L.y - F.y) > 2e-4f || fabsf(L.z - F.z) > 2e-4f)
+            fail_msg("x %.1f: L (%.5f %.5f %.5f), F (%.5f %.5f %.5f)", (double)x, (double)L.x, (double)L.y,
+                     (double)L.z, (double)F.x, (double)F.y, (double)F.z);
+    }
+    unload(&f);
+}
+
 /* Inside an emissive Lambertian sphere: L = E (1 - a^(k+1)) / (1 - a). */
 static void test_closed_furnace(void **state)
 {
@@ -653,6 +674,7 @@ int main(void)
         cmocka_unit_test(test_furnace_lambert),
         cmocka_unit_test(test_furnace_metal),
         cmocka_unit_test(test_furnace_glass),
+        cmocka_unit_test(test_smooth_conductor_sphere),
         cmocka_unit_test(test_closed_furnace),
         cmocka_unit_test(test_rr_depth_unbiased),
         cmocka_unit_test(test_point_light_exact),

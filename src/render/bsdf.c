@@ -1,5 +1,5 @@
-/* bsdf.c - Lambert and the glTF metallic-roughness BSDF for the path
- * tracer: evaluation, pdf and importance sampling (see rt/render/bsdf.h).
+/* bsdf.c - Lambert, the glTF metallic-roughness BSDF and the conductor
+ * for the path tracer: evaluation, pdf and importance sampling (see rt/render/bsdf.h).
  *
  * Sources:
  * - The BRDF: glTF 2.0 specification, appendix B "BRDF Implementation",
@@ -19,6 +19,11 @@
  * - Sampling visible normals: Heitz 2018, "Sampling the GGX Distribution
  *   of Visible Normals" (JCGT 7(4)), listing 1; its pdf D_wo(h) / (4 wo.h)
  *   = G1(wo) D(h) / (4 wo.z) for reflection.
+ * - Conductor: exact unpolarised Fresnel for a complex index (Born and
+ *   Wolf, 14.2; the closed form of pbrt-v3, Pharr, Jakob, Humphreys, 8.2.1);
+ *   anisotropic GGX D and Lambda (Heitz 2014, eqs. 85, 86) and the
+ *   separable Smith term G1 G1 (eq. 98) as the `smith separable` option;
+ *   anisotropic VNDF sampling (Heitz 2018, the stretch by (ax, ay)).
  * - Cosine sampling of the diffuse lobe (rt/sampling.h).
  * - Choosing one lobe by its estimated weight and returning the mixture pdf
  *   is one-sample MIS over the lobes with the balance heuristic (Veach 1997,
@@ -80,10 +85,10 @@ float rt_ggx_g2(rt_vec3 wo, rt_vec3 wi, float alpha)
     return 1.0f / (1.0f + lo + li);
 }
 
-rt_vec3 rt_ggx_sample_vndf(rt_vec3 wo, float alpha, rt_vec2 u)
+static rt_vec3 vndf_xy(rt_vec3 wo, float ax, float ay, rt_vec2 u)
 {
     /* stretch the view direction to the hemisphere configuration */
-    rt_vec3 vh = rt_normalize(rt_v3(alpha * wo.x, alpha * wo.y, wo.z));
+    rt_vec3 vh = rt_normalize(rt_v3(ax * wo.x, ay * wo.y, wo.z));
     float lensq = vh.x * vh.x + vh.y * vh.y;
     rt_vec3 t1 = lensq > 1e-14f ? rt_scale(rt_v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(lensq)) : rt_v3(1, 0, 0);
     rt_vec3 t2 = rt_cross(vh, t1);
@@ -95,8 +100,53 @@ rt_vec3 rt_ggx_sample_vndf(rt_vec3 wo, float alpha, rt_vec2 u)
     rt_vec3 nh = rt_add(rt_add(rt_scale(t1, p1), rt_scale(t2, p2)),
                         rt_scale(vh, sqrtf(fmaxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));
     /* unstretch */
-    rt_vec3 ne = rt_v3(alpha * nh.x, alpha * nh.y, fmaxf(1e-7f, nh.z));
+    rt_vec3 ne = rt_v3(ax * nh.x, ay * nh.y, fmaxf(1e-7f, nh.z));
     return rt_normalize(ne);
+}
+
+rt_vec3 rt_ggx_sample_vndf(rt_vec3 wo, float alpha, rt_vec2 u) { return vndf_xy(wo, alpha, alpha, u); }
+
+/* Anisotropic GGX (alpha ax along x, ay along y; Heitz 2014, eq. 85 and
+ * 86): D = 1 / (pi ax ay ((x/ax)^2 + (y/ay)^2 + z^2)^2), Lambda with
+ * alpha^2 tan^2 = (ax^2 x^2 + ay^2 y^2) / z^2; the isotropic forms when
+ * ax = ay. */
+static float d_xy(rt_vec3 h, float ax, float ay)
+{
+    if (ax == ay)
+        return rt_ggx_d(h, ax);
+    if (!(h.z > 0.0f))
+        return 0.0f;
+    float x = h.x / ax, y = h.y / ay;
+    float k = x * x + y * y + h.z * h.z;
+    float d = 1.0f / (RT_PI * ax * ay * k * k);
+    return isfinite(d) ? d : 0.0f;
+}
+
+static float lambda_xy(rt_vec3 w, float ax, float ay)
+{
+    if (ax == ay)
+        return rt_ggx_lambda(w, ax);
+    float c2 = w.z * w.z;
+    if (!(c2 > 0.0f))
+        return INFINITY;
+    float t2 = (ax * ax * w.x * w.x + ay * ay * w.y * w.y) / c2;
+    return 0.5f * t2 / (sqrtf(1.0f + t2) + 1.0f);
+}
+
+static float g1_xy(rt_vec3 w, float ax, float ay)
+{
+    float l = lambda_xy(w, ax, ay);
+    return isfinite(l) ? 1.0f / (1.0f + l) : 0.0f;
+}
+
+/* Smith G2: height-correlated 1 / (1 + L(wo) + L(wi)) (Heitz 2014, eq.
+ * 99), or separable G1(wo) G1(wi) (eq. 98, as older renderers use). */
+static float g2_xy(rt_vec3 wo, rt_vec3 wi, float ax, float ay, bool separable)
+{
+    float lo = lambda_xy(wo, ax, ay), li = lambda_xy(wi, ax, ay);
+    if (!isfinite(lo) || !isfinite(li))
+        return 0.0f;
+    return separable ? 1.0f / ((1.0f + lo) * (1.0f + li)) : 1.0f / (1.0f + lo + li);
 }
 
 float rt_ggx_reflect_pdf(rt_vec3 wo, rt_vec3 wi, float alpha)
@@ -110,6 +160,33 @@ float rt_ggx_reflect_pdf(rt_vec3 wo, rt_vec3 wi, float alpha)
     h = rt_scale(h, 1.0f / sqrtf(l2));
     float p = rt_ggx_g1(wo, alpha) * rt_ggx_d(h, alpha) / (4.0f * wo.z);
     return isfinite(p) ? p : 0.0f;
+}
+
+/* Exact unpolarised Fresnel reflectance of a conductor, eta + i k relative
+ * to the outside, one channel (the closed form of pbrt-v3, 8.2.1, after
+ * Born and Wolf 14.2). */
+static float fresnel_conductor1(float c, float eta, float k)
+{
+    c = rt_clampf(c, 0.0f, 1.0f);
+    float c2 = c * c, s2 = 1.0f - c2;
+    float eta2 = eta * eta, k2 = k * k;
+    float t0 = eta2 - k2 - s2;
+    float a2b2 = sqrtf(fmaxf(0.0f, t0 * t0 + 4.0f * eta2 * k2));
+    float t1 = a2b2 + c2;
+    float a = sqrtf(fmaxf(0.0f, 0.5f * (a2b2 + t0)));
+    float t2 = 2.0f * c * a;
+    float rs = (t1 - t2) / (t1 + t2);
+    float t3 = c2 * a2b2 + s2 * s2;
+    float t4 = t2 * s2;
+    float rp = rs * (t3 - t4) / (t3 + t4);
+    float f = 0.5f * (rs + rp);
+    return isfinite(f) ? rt_clampf(f, 0.0f, 1.0f) : 1.0f;
+}
+
+rt_vec3 rt_fresnel_conductor(float cos_i, rt_vec3 eta, rt_vec3 k)
+{
+    return rt_v3(fresnel_conductor1(cos_i, eta.x, k.x), fresnel_conductor1(cos_i, eta.y, k.y),
+                 fresnel_conductor1(cos_i, eta.z, k.z));
 }
 
 static inline float schlick_weight(float c)
@@ -178,8 +255,11 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
     if (!(ior > 0.0f) || !isfinite(ior))
         ior = 1.5f;
     b->lambert = lambert;
+    b->conductor = false;
+    b->separable = false;
     b->base = base;
     if (lambert) {
+        b->alpha_y = 1.0f;
         b->diffuse = base;
         b->metallic = 0.0f;
         b->f0 = 0.0f;
@@ -194,7 +274,7 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
     b->metallic = metallic;
     b->f0 = r0 * r0;
     b->delta = roughness == 0.0f;
-    b->alpha = fmaxf(roughness * roughness, RT_BSDF_MIN_ALPHA);
+    b->alpha = b->alpha_y = fmaxf(roughness * roughness, RT_BSDF_MIN_ALPHA);
     b->transmission = transmission;
     b->eta = 1.0f / ior;
 }
@@ -204,6 +284,27 @@ void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float rou
 {
     set_frame(b, n, n);
     set_params(b, base, metallic, roughness, ior, transmission, lambert);
+}
+
+static void set_conductor(rt_bsdf *b, rt_vec3 eta, rt_vec3 k, float ax, float ay, rt_smith smith)
+{
+    set_params(b, rt_v3s(0.0f), 0.0f, 1.0f, 1.5f, 0.0f, false);
+    b->conductor = true;
+    b->eta_c = rt_finite3(eta) ? rt_vmax(eta, rt_v3s(0.0f)) : rt_v3s(1.0f);
+    b->k_c = rt_finite3(k) ? rt_vmax(k, rt_v3s(0.0f)) : rt_v3s(0.0f);
+    ax = isfinite(ax) ? rt_clampf(ax, 0.0f, 1.0f) : 1.0f;
+    ay = isfinite(ay) ? rt_clampf(ay, 0.0f, 1.0f) : 1.0f;
+    b->delta = ax == 0.0f && ay == 0.0f;
+    b->alpha = fmaxf(ax, RT_BSDF_MIN_ALPHA);
+    b->alpha_y = fmaxf(ay, RT_BSDF_MIN_ALPHA);
+    b->separable = smith == RT_SMITH_SEPARABLE;
+}
+
+void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float alpha_x, float alpha_y,
+                            rt_smith smith)
+{
+    set_frame(b, n, n);
+    set_conductor(b, eta, k, alpha_x, alpha_y, smith);
 }
 
 void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
@@ -217,6 +318,26 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
     if (!(rt_dot(n, sf->wo) > 1e-4f) || !rt_finite3(n))
         n = sf->ng;
     set_frame(b, n, sf->ng);
+    if (m->bsdf == RT_BSDF_CONDUCTOR) {
+        float roughness = m->roughness;
+        if (m->metal_rough_tex.texture != RT_NONE) {
+            rt_vec2 uv = rt_texture_slot_uv(&m->metal_rough_tex,
+                                            m->metal_rough_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
+            roughness *= rt_texture_sample(s, m->metal_rough_tex.texture, uv, false).y;
+        }
+        float ax = m->alpha_u >= 0.0f ? m->alpha_u : roughness * roughness;
+        float ay = m->alpha_v >= 0.0f ? m->alpha_v : roughness * roughness;
+        if (ax != ay) { /* anisotropic: x along the surface tangent */
+            rt_vec3 t = rt_sub(sf->t, rt_scale(n, rt_dot(sf->t, n)));
+            float l2 = rt_length2(t);
+            if (l2 > 1e-12f && isfinite(l2)) {
+                b->t = rt_scale(t, 1.0f / sqrtf(l2));
+                b->b = rt_cross(n, b->t);
+            }
+        }
+        set_conductor(b, m->eta, m->k, ax, ay, m->smith);
+        return;
+    }
     rt_vec4 b4 = rt_surface_base_color(ctx, sf);
     float metallic = m->metallic, roughness = m->roughness, transmission = m->transmission;
     if (m->bsdf != RT_BSDF_LAMBERT && m->metal_rough_tex.texture != RT_NONE) {
@@ -238,6 +359,10 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
 void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit)
 {
     *p_diffuse = *p_specular = *p_transmit = 0.0f;
+    if (b->conductor) {
+        *p_specular = 1.0f;
+        return;
+    }
     if (b->lambert) {
         *p_diffuse = mean3(b->diffuse) > 0.0f ? 1.0f : 0.0f;
         return;
@@ -275,12 +400,24 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
         *pdf = pd * wi.z * RT_INV_PI;
         return rt_scale(b->diffuse, RT_INV_PI);
     }
+    if (b->conductor && b->delta)
+        return rt_v3s(0.0f);
     rt_vec3 h = rt_add(wo, wi);
     float l2 = rt_length2(h);
     if (!(l2 > 1e-20f)) /* opposite directions: both grazing */
         return rt_v3s(0.0f);
     h = rt_scale(h, 1.0f / sqrtf(l2));
     float voh = rt_dot(wo, h);
+    if (b->conductor) {
+        /* F(wo.h) D G2 / (4 cos_o cos_i), VNDF pdf G1(wo) D / (4 cos_o) */
+        float D = d_xy(h, b->alpha, b->alpha_y);
+        float spec = D * g2_xy(wo, wi, b->alpha, b->alpha_y, b->separable) / (4.0f * wo.z * wi.z);
+        float pv = g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
+        if (!isfinite(spec) || !isfinite(pv))
+            return rt_v3s(0.0f);
+        *pdf = ps * pv;
+        return rt_scale(rt_fresnel_conductor(voh, b->eta_c, b->k_c), spec);
+    }
     float fd = fresnel_dielectric(b, voh);
     /* diffuse: the dielectric's fresnel_mix leaves 1 - Fd to the base */
     rt_vec3 f = rt_scale(b->diffuse, (1.0f - fd) * (1.0f - b->transmission) * RT_INV_PI);
@@ -349,6 +486,8 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
         float g = b->delta ? 1.0f : rt_ggx_g2(wo, wi, b->alpha) / rt_ggx_g1(wo, b->alpha);
         return delta_sample(s, wi, rt_scale(b->diffuse, (1.0f - fd) * g * b->transmission / pt));
     }
+    if (b->conductor && b->delta)
+        return delta_sample(s, rt_v3(-wo.x, -wo.y, wo.z), rt_fresnel_conductor(wo.z, b->eta_c, b->k_c));
     if (b->delta && ps > 0.0f && ulobe >= pd) {
         /* mirror reflection about the normal: weight F / (its probability) */
         float fd = fresnel_dielectric(b, wo.z);
@@ -358,7 +497,7 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
     if (ulobe < pd || b->lambert || b->delta || !(ps > 0.0f)) {
         wi = rt_sample_cosine_hemisphere(u);
     } else {
-        rt_vec3 h = rt_ggx_sample_vndf(wo, b->alpha, u);
+        rt_vec3 h = vndf_xy(wo, b->alpha, b->alpha_y, u);
         wi = rt_sub(rt_scale(h, 2.0f * rt_dot(wo, h)), wo);
     }
     if (!(wi.z > 0.0f) || !rt_finite3(wi))

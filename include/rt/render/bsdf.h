@@ -44,6 +44,11 @@
  * refraction about the normal, both sampled only, so rt_bsdf_eval holds
  * just the diffuse lobe. RT_BSDF_LAMBERT is exactly B / pi.
  *
+ * RT_BSDF_CONDUCTOR (rt_bsdf.conductor) is a metal of complex index
+ * eta + i k per channel: f = F_conductor(wo.h) D G2 / (4 cos_o cos_i) with
+ * anisotropic GGX (alpha along t and b), G2 height-correlated or
+ * separable; alpha 0 is a delta mirror of weight F_conductor(cos_o).
+ *
  * Sampling picks a lobe by its estimated share of the reflected energy at
  * wo, then samples diffuse by the cosine, specular by the distribution of
  * visible normals (Heitz 2018, "Sampling the GGX Distribution of Visible
@@ -68,7 +73,11 @@ typedef struct rt_bsdf {
     rt_vec3 diffuse;  /* (1 - m) B (Lambert: the albedo) */
     float metallic;   /* m */
     float f0;         /* the dielectric's normal-incidence reflectance ((eta - 1) / (eta + 1))^2 */
-    float alpha;      /* GGX alpha (at least RT_BSDF_MIN_ALPHA) */
+    float alpha;      /* GGX alpha (at least RT_BSDF_MIN_ALPHA); along the tangent t for a conductor */
+    float alpha_y;    /* GGX alpha along the bitangent b (= alpha unless anisotropic) */
+    bool conductor;   /* bsdf conductor: F(eta_c, k_c) D G2 / (4 cos cos) */
+    bool separable;   /* conductor: separable Smith G1 G1 instead of height-correlated */
+    rt_vec3 eta_c, k_c; /* conductor: complex index relative to the outside */
     float transmission; /* T */
     float eta;        /* index ratio across the surface along a transmitted ray: n_incident / n_transmitted */
 } rt_bsdf;
@@ -84,6 +93,9 @@ typedef struct rt_bsdf_sample {
  * (Born and Wolf, Principles of Optics, 1.5.2) at incident cosine cos_i,
  * eta = n_incident / n_transmitted; 1 past the critical angle. */
 float rt_fresnel_exact(float cos_i, float eta);
+/* Exact unpolarised Fresnel reflectance of a conductor of complex index
+ * eta + i k (per channel, relative to the outside) at incident cosine cos_i. */
+rt_vec3 rt_fresnel_conductor(float cos_i, rt_vec3 eta, rt_vec3 k);
 
 /* GGX building blocks, local frame (z = normal). */
 float rt_ggx_d(rt_vec3 h, float alpha);              /* D(h), 0 below the surface; h unit, stable to alpha 1e-4 */
@@ -102,6 +114,10 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
 /* The same from plain parameters, frame n (unit) with ng = n; for tests. */
 void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float roughness, float ior,
                   float transmission, bool lambert);
+/* A conductor (bsdf conductor) the same way: GGX alphas along x and y of
+ * the frame (both 0: a delta mirror). */
+void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float alpha_x, float alpha_y,
+                            rt_smith smith);
 
 static inline rt_vec3 rt_bsdf_to_local(const rt_bsdf *b, rt_vec3 w)
 {

@@ -128,9 +128,13 @@ typedef struct rt_texture_slot {
 typedef enum rt_alpha_mode { RT_ALPHA_OPAQUE = 0, RT_ALPHA_MASK, RT_ALPHA_BLEND } rt_alpha_mode;
 
 /* The path tracer's scattering model (docs/path-tracer.md): the glTF
- * metallic-roughness BRDF (the default, zero) or a pure Lambertian
- * albedo / pi with no specular lobe (`bsdf lambert`). */
-typedef enum rt_bsdf_model { RT_BSDF_GLTF = 0, RT_BSDF_LAMBERT } rt_bsdf_model;
+ * metallic-roughness BRDF (the default, zero), a pure Lambertian
+ * albedo / pi with no specular lobe (`bsdf lambert`), or a conductor with a
+ * complex index of refraction eta + i k per channel (`bsdf conductor`). */
+typedef enum rt_bsdf_model { RT_BSDF_GLTF = 0, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR } rt_bsdf_model;
+
+/* Smith masking-shadowing term of the microfacet models. */
+typedef enum rt_smith { RT_SMITH_CORRELATED = 0, RT_SMITH_SEPARABLE } rt_smith;
 
 /* One material table for every source. The Phong fields drive the whitted
  * integrator; the PBR fields drive the path tracer; colour, textures,
@@ -158,6 +162,11 @@ typedef struct rt_material {
     bool double_sided;
     bool unlit;
     rt_bsdf_model bsdf;     /* path tracer: glTF metallic-roughness (default) or pure Lambert */
+    /* conductor (bsdf conductor): complex IOR relative to the outside, GGX
+     * alphas along the tangent and bitangent (negative: roughness^2) */
+    rt_vec3 eta, k;
+    float alpha_u, alpha_v;
+    rt_smith smith;
     float thickness;        /* KHR_materials_volume */
     rt_vec3 attenuation_color;
     float attenuation_distance; /* INFINITY = no absorption */
@@ -171,6 +180,18 @@ typedef struct rt_material {
 } rt_material;
 
 void rt_material_default(rt_material *m, const char *name);
+
+/* Named metals for `bsdf conductor` (`metal NAME`): complex IOR eta + i k at
+ * the red, green and blue wavelengths 650, 550 and 450 nm, from
+ * RefractiveIndex.INFO's "3D" data set (M. N. Polyanskiy, refractiveindex.info
+ * database, Sci. Data 11, 94 (2024)), as tabulated by C. Hindefjord, "RGB IOR
+ * values for common metals". The default conductor is Cu (as pbrt-v4's). */
+typedef struct rt_metal {
+    const char *name;
+    rt_vec3 eta, k;
+} rt_metal;
+extern const rt_metal rt_metals[];
+extern const size_t rt_metal_count;
 void rt_texture_slot_none(rt_texture_slot *slot);
 
 /* -------------------------------------------------------------- lights */
