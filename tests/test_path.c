@@ -196,6 +196,50 @@ static void test_smooth_conductor_sphere(void **state)
     unload(&f);
 }
 
+/* bsdf dielectric in closed forms: (1) smooth glass in a white furnace
+ * keeps all energy (the 1 / eta^2 in and eta^2 out cancel); (2) an
+ * index-matched absorbing ball (ior = exterior_ior: no refraction, F = 0)
+ * transmits exp(-sigma 2 sqrt(1 - x^2)) along a chord at offset x;
+ * (3) an emitter of radiance 1 inside a glass ball (ior 1.5, black
+ * background) seen through its centre: (1 - F0) / 1.5^2 = 0.42667. */
+static void test_dielectric_closed_forms(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, "integrator path\nbackground 1 1 1\nmaterial g bsdf dielectric ior 1.5\nsphere 0 0 0 1 g\n", false);
+    double sum = 0.0;
+    const uint32_t n = 20000;
+    test_rng tr = {5};
+    for (uint32_t i = 0; i < n; i++) {
+        float x = 1.4f * test_rng_float(&tr) - 0.7f, y = 1.4f * test_rng_float(&tr) - 0.7f;
+        sum += radiance(&f, rt_v3(x, y, 5), rt_v3(0, 0, -1), i).y;
+    }
+    fprintf(stderr, "dielectric furnace: %.4f\n", sum / n);
+    assert_true(fabs(sum / n - 1.0) < 0.01);
+    unload(&f);
+
+    load(&f, "integrator path\nbackground 1 1 1\n"
+             "material g bsdf dielectric ior 1.2 exterior_ior 1.2 absorption 0.1 0.5 2\nsphere 0 0 0 1 g\n", false);
+    for (int i = 0; i < 8; i++) {
+        float x = 0.12f * (float)i;
+        rt_vec3 L = radiance(&f, rt_v3(x, 0, 5), rt_v3(0, 0, -1), (uint32_t)i);
+        double d = 2.0 * sqrt(1.0 - (double)x * x);
+        if (fabs(L.x - exp(-0.1 * d)) > 1e-4 || fabs(L.y - exp(-0.5 * d)) > 1e-4 || fabs(L.z - exp(-2.0 * d)) > 1e-4)
+            fail_msg("x %.2f: L (%.5f %.5f %.5f), want (%.5f %.5f %.5f)", (double)x, (double)L.x, (double)L.y,
+                     (double)L.z, exp(-0.1 * d), exp(-0.5 * d), exp(-2.0 * d));
+    }
+    unload(&f);
+
+    load(&f, "integrator path\nbackground 0 0 0\nmaterial g bsdf dielectric ior 1.5\n"
+             "material e color 0 0 0 bsdf lambert emission 1 1 1\nsphere 0 0 0 1 g\nsphere 0 0 0 0.5 e\n", false);
+    sum = 0.0;
+    for (uint32_t i = 0; i < n; i++)
+        sum += radiance(&f, rt_v3(0, 0, 5), rt_v3(0, 0, -1), i).y;
+    fprintf(stderr, "emitter in glass: %.4f (want 0.42667)\n", sum / n);
+    assert_true(fabs(sum / n - 0.96 / 2.25) < 0.01);
+    unload(&f);
+}
+
 /* Inside an emissive Lambertian sphere: L = E (1 - a^(k+1)) / (1 - a). */
 static void test_closed_furnace(void **state)
 {
@@ -675,6 +719,7 @@ int main(void)
         cmocka_unit_test(test_furnace_metal),
         cmocka_unit_test(test_furnace_glass),
         cmocka_unit_test(test_smooth_conductor_sphere),
+        cmocka_unit_test(test_dielectric_closed_forms),
         cmocka_unit_test(test_closed_furnace),
         cmocka_unit_test(test_rr_depth_unbiased),
         cmocka_unit_test(test_point_light_exact),

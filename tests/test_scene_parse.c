@@ -877,6 +877,26 @@ static void test_conductor_material(void **state)
     expect_error("material m bsdf conductor smith maybe\n", RT_ERR_PARSE, "1:33",
                  "expected material smith (correlated|separable), got 'maybe'");
     expect_error("material m bsdf conductor eta 1 -1 1\n", RT_ERR_INVALID, "1:33", "material eta (green) must be >= 0");
+    /* bsdf dielectric: transmissive and smooth by default */
+    expect_ok("material g bsdf dielectric ior 1.33 exterior_ior 1.1 absorption 0.1 0.2 0.3\n"
+              "material r bsdf dielectric ggx_alpha 0.2 transmission 0.5\n",
+              &s);
+    m = &s.materials[0];
+    assert_int_equal(m->bsdf, RT_BSDF_DIELECTRIC);
+    assert_float_equal(m->transmission, 1, 0);
+    assert_float_equal(m->roughness, 0, 0);
+    assert_float_equal(m->exterior_ior, 1.1, 1e-6);
+    assert_vec3(m->absorption, 0.1f, 0.2f, 0.3f);
+    assert_float_equal(s.materials[1].alpha_u, 0.2, 1e-7);
+    assert_float_equal(s.materials[1].transmission, 0.5, 0);
+    rt_scene_free(&s);
+    expect_error("material m absorption 1 1 1\n", RT_ERR_INVALID, "1:12", "material key 'absorption' needs 'bsdf dielectric'");
+    expect_error("material m bsdf conductor exterior_ior 1.2\n", RT_ERR_INVALID, "1:27",
+                 "material key 'exterior_ior' needs 'bsdf dielectric'");
+    expect_error("material m ggx_alpha 0.1\n", RT_ERR_INVALID, "1:12",
+                 "material key 'ggx_alpha' needs 'bsdf conductor' or 'bsdf dielectric'");
+    expect_error("material m bsdf dielectric smith separable\n", RT_ERR_INVALID, "1:28",
+                 "material key 'smith' needs 'bsdf conductor'");
 }
 
 static void test_errors_values(void **state)

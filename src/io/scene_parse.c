@@ -764,6 +764,8 @@ static const mat_key mat_keys[] = {
     {"ggx_alpha", NULL, MK_GGX, 0, 0, 0},
     {"ggx_alpha_uv", NULL, MK_GGX, 1, 0, 0},
     {"smith", NULL, MK_SMITH, MOFF(smith), 0, 0},
+    {"exterior_ior", NULL, MK_FLOAT, MOFF(exterior_ior), 0.01f, 100},
+    {"absorption", NULL, MK_COLOR, MOFF(absorption), 0, 0},
     {"thickness", NULL, MK_FLOAT, MOFF(thickness), 0, FLT_MAX},
     {"attenuation_color", NULL, MK_COLOR, MOFF(attenuation_color), 0, 0},
     {"attenuation_distance", NULL, MK_DISTANCE, MOFF(attenuation_distance), 0, 0},
@@ -778,6 +780,15 @@ static const mat_key mat_keys[] = {
 };
 #undef MOFF
 #define MAT_KEY_COUNT (sizeof mat_keys / sizeof *mat_keys)
+
+static size_t mat_key_index(const char *key)
+{
+    size_t i = 0;
+    while (i < MAT_KEY_COUNT && strcmp(mat_keys[i].key, key) != 0)
+        i++;
+    RT_DCHECK(i < MAT_KEY_COUNT);
+    return i;
+}
 
 static rt_result st_material(parser *p, const tok *kw)
 {
@@ -838,10 +849,11 @@ static rt_result st_material(parser *p, const tok *kw)
             break;
         }
         case MK_BSDF: {
-            static const char *const models[] = {"gltf", "lambert", "conductor"};
-            static const rt_bsdf_model values[] = {RT_BSDF_GLTF, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR};
+            static const char *const models[] = {"gltf", "lambert", "conductor", "dielectric"};
+            static const rt_bsdf_model values[] = {RT_BSDF_GLTF, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR,
+                                                   RT_BSDF_DIELECTRIC};
             int i = 0;
-            r = get_choice(p, what, models, 3, "gltf|lambert|conductor", &i);
+            r = get_choice(p, what, models, 4, "gltf|lambert|conductor|dielectric", &i);
             if (r == RT_OK)
                 *(rt_bsdf_model *)field = values[i];
             break;
@@ -913,10 +925,18 @@ static rt_result st_material(parser *p, const tok *kw)
         const mat_key *mk = &mat_keys[i];
         bool complex_ior = mk->kind == MK_COLOR && (mk->offset == offsetof(rt_material, eta) ||
                                                     mk->offset == offsetof(rt_material, k));
-        if (!seen[i] || !(complex_ior || mk->kind == MK_METAL || mk->kind == MK_GGX || mk->kind == MK_SMITH))
+        bool glass_key = mk->offset == offsetof(rt_material, exterior_ior) ||
+                         (mk->kind == MK_COLOR && mk->offset == offsetof(rt_material, absorption));
+        if (!seen[i])
             continue;
-        if (m.bsdf != RT_BSDF_CONDUCTOR)
-            return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf conductor'", mk->key);
+        if (glass_key && m.bsdf != RT_BSDF_DIELECTRIC)
+            return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf dielectric'", mk->key);
+        if (!(complex_ior || mk->kind == MK_METAL || mk->kind == MK_GGX || mk->kind == MK_SMITH))
+            continue;
+        bool both = mk->kind == MK_GGX && mk->offset == 0; /* ggx_alpha: conductor or dielectric */
+        if (m.bsdf != RT_BSDF_CONDUCTOR && !(both && m.bsdf == RT_BSDF_DIELECTRIC))
+            return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf conductor'%s", mk->key,
+                        both ? " or 'bsdf dielectric'" : "");
         if (mk->kind == MK_METAL)
             k_metal = seen[i];
         else if (complex_ior && !k_eta)
@@ -929,6 +949,13 @@ static rt_result st_material(parser *p, const tok *kw)
                     k_eta->s);
     if (k_alpha && k_alpha_uv)
         return perr(p, RT_ERR_INVALID, k_alpha_uv, "give either 'ggx_alpha' or 'ggx_alpha_uv', not both");
+    /* glass transmits: whitted refracts it, shadow rays treat it as glass */
+    if (m.bsdf == RT_BSDF_DIELECTRIC && !seen[mat_key_index("transmission")])
+        m.transmission = 1.0f;
+    /* conductors and dielectrics are smooth unless given a roughness (as in
+     * pbrt-v4 and Mitsuba 3), not glTF's rough default */
+    if ((m.bsdf == RT_BSDF_DIELECTRIC || m.bsdf == RT_BSDF_CONDUCTOR) && !seen[mat_key_index("roughness")])
+        m.roughness = 0.0f;
     /* uv_scale / uv_offset apply to every slot: uv' = uv * scale + offset */
     rt_texture_slot *slots[] = {&m.base_color_tex, &m.metal_rough_tex, &m.normal_tex,
                                 &m.occlusion_tex, &m.emissive_tex, &m.transmission_tex};

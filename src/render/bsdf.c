@@ -257,6 +257,7 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
     b->lambert = lambert;
     b->conductor = false;
     b->separable = false;
+    b->radiance_eta2 = false;
     b->base = base;
     if (lambert) {
         b->alpha_y = 1.0f;
@@ -307,6 +308,35 @@ void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float
     set_conductor(b, eta, k, alpha_x, alpha_y, smith);
 }
 
+rt_vec3 rt_material_absorption(const rt_material *m)
+{
+    rt_vec3 sigma = rt_v3s(0.0f);
+    if (m->bsdf == RT_BSDF_DIELECTRIC)
+        sigma = m->absorption;
+    bool volume = m->bsdf == RT_BSDF_DIELECTRIC ||
+                  (m->bsdf == RT_BSDF_GLTF && m->thickness > 0.0f && m->transmission > 0.0f);
+    if (volume && isfinite(m->attenuation_distance) && m->attenuation_distance > 0.0f) {
+        rt_vec3 c = rt_vmax(m->attenuation_color, rt_v3s(1e-6f));
+        rt_vec3 a = rt_v3(-logf(fminf(c.x, 1.0f)), -logf(fminf(c.y, 1.0f)), -logf(fminf(c.z, 1.0f)));
+        sigma = rt_add(sigma, rt_scale(a, 1.0f / m->attenuation_distance));
+    }
+    return rt_finite3(sigma) ? rt_vmax(sigma, rt_v3s(0.0f)) : rt_v3s(0.0f);
+}
+
+void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha)
+{
+    set_frame(b, n, n);
+    set_params(b, rt_v3s(1.0f), 0.0f, 1.0f, 1.5f, 1.0f, false);
+    eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
+    float r0 = (eta - 1.0f) / (eta + 1.0f);
+    b->f0 = r0 * r0;
+    b->eta = eta;
+    alpha = isfinite(alpha) ? rt_clampf(alpha, 0.0f, 1.0f) : 1.0f;
+    b->delta = alpha == 0.0f;
+    b->alpha = b->alpha_y = fmaxf(alpha, RT_BSDF_MIN_ALPHA);
+    b->radiance_eta2 = true;
+}
+
 void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
 {
     const rt_scene *s = ctx->state->scene;
@@ -336,6 +366,14 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
             }
         }
         set_conductor(b, m->eta, m->k, ax, ay, m->smith);
+        return;
+    }
+    if (m->bsdf == RT_BSDF_DIELECTRIC) {
+        /* eta = n_wo / n_wi: exterior over interior entering the front */
+        float eta = m->exterior_ior / m->ior;
+        float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
+        rt_bsdf_make_dielectric(b, n, sf->front ? eta : 1.0f / eta, alpha);
+        set_frame(b, n, sf->ng);
         return;
     }
     rt_vec4 b4 = rt_surface_base_color(ctx, sf);
@@ -484,7 +522,8 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
         wi = rt_normalize(wi);
         float fd = fresnel_dielectric(b, ci);
         float g = b->delta ? 1.0f : rt_ggx_g2(wo, wi, b->alpha) / rt_ggx_g1(wo, b->alpha);
-        return delta_sample(s, wi, rt_scale(b->diffuse, (1.0f - fd) * g * b->transmission / pt));
+        float scale = b->radiance_eta2 ? eta * eta : 1.0f; /* L / n^2 is invariant */
+        return delta_sample(s, wi, rt_scale(b->diffuse, (1.0f - fd) * g * b->transmission * scale / pt));
     }
     if (b->conductor && b->delta)
         return delta_sample(s, rt_v3(-wo.x, -wo.y, wo.z), rt_fresnel_conductor(wo.z, b->eta_c, b->k_c));

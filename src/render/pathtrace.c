@@ -31,6 +31,11 @@
  * 1, the path survives with q = that channel. settings.max_depth caps the scattering
  * events of a path (0 = no cap).
  *
+ * Absorption (Beer-Lambert): a path segment that ends on the back of a
+ * dielectric (or a glTF KHR_materials_volume object) ran inside it, so
+ * beta is multiplied by exp(-sigma_a d) over its length d
+ * (rt_material_absorption); objects are assumed closed and not nested.
+ *
  * Area lights are pure emitters: their visible quad emits from its front
  * and reflects nothing. Shadow rays pass alpha cut-outs and blended
  * surfaces (times 1 - alpha); refractive (transmissive) surfaces block them,
@@ -197,9 +202,16 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         }
         if (found != RT_WALK_SURFACE)
             break;
+        const rt_material *m = &s->materials[sf.material];
+        if (!sf.front && (m->bsdf == RT_BSDF_DIELECTRIC || m->thickness > 0.0f)) {
+            /* the segment ran inside this object: Beer-Lambert absorption
+             * over its length (r.tmin is the hit distance, dir is unit) */
+            rt_vec3 sigma = rt_material_absorption(m);
+            if (rt_max3(sigma) > 0.0f)
+                beta = rt_mul(beta, rt_v3(expf(-sigma.x * r.tmin), expf(-sigma.y * r.tmin), expf(-sigma.z * r.tmin)));
+        }
         /* emission, MIS-weighted when it could have been light-sampled */
         rt_vec3 Le = rt_surface_emission(ctx, &sf);
-        const rt_material *m = &s->materials[sf.material];
         /* area lights' quads have emissive materials: look only those up */
         bool emissive = rt_max3(rt_scale(m->emission, m->emission_strength)) > 0.0f;
         uint32_t light = emissive ? rt_area_light_of_prim(s, ctx->state->light_table, sf.prim) : RT_NONE;

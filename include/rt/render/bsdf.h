@@ -77,6 +77,7 @@ typedef struct rt_bsdf {
     float alpha_y;    /* GGX alpha along the bitangent b (= alpha unless anisotropic) */
     bool conductor;   /* bsdf conductor: F(eta_c, k_c) D G2 / (4 cos cos) */
     bool separable;   /* conductor: separable Smith G1 G1 instead of height-correlated */
+    bool radiance_eta2; /* dielectric: refraction scales radiance by eta^2 (n_wo / n_wi)^2 */
     rt_vec3 eta_c, k_c; /* conductor: complex index relative to the outside */
     float transmission; /* T */
     float eta;        /* index ratio across the surface along a transmitted ray: n_incident / n_transmitted */
@@ -97,6 +98,13 @@ float rt_fresnel_exact(float cos_i, float eta);
  * eta + i k (per channel, relative to the outside) at incident cosine cos_i. */
 rt_vec3 rt_fresnel_conductor(float cos_i, rt_vec3 eta, rt_vec3 k);
 
+/* Absorption coefficient inside a material (Beer-Lambert: transmittance
+ * exp(-sigma d) over a distance d travelled inside): a dielectric's
+ * `absorption` plus, for a dielectric or a glTF volume (thickness > 0,
+ * transmission > 0), -ln(attenuation_color) / attenuation_distance. Zero
+ * when nothing absorbs. */
+rt_vec3 rt_material_absorption(const rt_material *m);
+
 /* GGX building blocks, local frame (z = normal). */
 float rt_ggx_d(rt_vec3 h, float alpha);              /* D(h), 0 below the surface; h unit, stable to alpha 1e-4 */
 float rt_ggx_lambda(rt_vec3 w, float alpha);         /* Smith Lambda(w) */
@@ -114,6 +122,8 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
 /* The same from plain parameters, frame n (unit) with ng = n; for tests. */
 void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float roughness, float ior,
                   float transmission, bool lambert);
+/* A dielectric (bsdf dielectric): eta = n_wo / n_wi, GGX alpha (0: smooth). */
+void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha);
 /* A conductor (bsdf conductor) the same way: GGX alphas along x and y of
  * the frame (both 0: a delta mirror). */
 void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float alpha_x, float alpha_y,

@@ -129,9 +129,11 @@ typedef enum rt_alpha_mode { RT_ALPHA_OPAQUE = 0, RT_ALPHA_MASK, RT_ALPHA_BLEND 
 
 /* The path tracer's scattering model (docs/path-tracer.md): the glTF
  * metallic-roughness BRDF (the default, zero), a pure Lambertian
- * albedo / pi with no specular lobe (`bsdf lambert`), or a conductor with a
- * complex index of refraction eta + i k per channel (`bsdf conductor`). */
-typedef enum rt_bsdf_model { RT_BSDF_GLTF = 0, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR } rt_bsdf_model;
+ * albedo / pi with no specular lobe (`bsdf lambert`), a conductor with a
+ * complex index of refraction eta + i k per channel (`bsdf conductor`), or
+ * clear glass with an interior and exterior index, absorption inside and
+ * radiance scaled by 1 / eta^2 across the interface (`bsdf dielectric`). */
+typedef enum rt_bsdf_model { RT_BSDF_GLTF = 0, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR, RT_BSDF_DIELECTRIC } rt_bsdf_model;
 
 /* Smith masking-shadowing term of the microfacet models. */
 typedef enum rt_smith { RT_SMITH_CORRELATED = 0, RT_SMITH_SEPARABLE } rt_smith;
@@ -167,6 +169,9 @@ typedef struct rt_material {
     rt_vec3 eta, k;
     float alpha_u, alpha_v;
     rt_smith smith;
+    /* dielectric (bsdf dielectric): ior is the inside's index */
+    float exterior_ior;     /* index outside (default 1) */
+    rt_vec3 absorption;     /* absorption coefficient inside, per scene unit (adds to attenuation_*) */
     float thickness;        /* KHR_materials_volume */
     rt_vec3 attenuation_color;
     float attenuation_distance; /* INFINITY = no absorption */
