@@ -656,6 +656,51 @@ static void test_dielectric_bsdf(void **state)
     }
 }
 
+/* bsdf plastic: the coat's diffuse reflectances (external 0.0918 and
+ * internal 1 - (1 - 0.0918) / 1.5^2 = 0.5964 at index 1.5, by fine
+ * quadrature); a white base under a smooth coat reflects exactly 1 at
+ * every angle (the internal reflections are summed in closed form);
+ * reciprocity, energy and pdf vs histogram for a rough coat. */
+static void test_plastic_bsdf(void **state)
+{
+    (void)state;
+    double ext = 0.0;
+    const int nq = 200000;
+    for (int i = 0; i < nq; i++)
+        ext += fresnel_exact_d(sqrt((i + 0.5) / nq), 1.0 / 1.5);
+    ext /= nq;
+    assert_true(fabs(rt_fresnel_diffuse_reflectance(1.0f / 1.5f) - ext) < 2e-4);
+    assert_true(fabs(rt_fresnel_diffuse_reflectance(1.5f) - (1.0 - (1.0 - ext) / 2.25)) < 2e-4);
+    rt_bsdf b;
+    rt_bsdf_make_plastic(&b, rt_v3(0, 0, 1), rt_v3s(1.0f), 1.0f / 1.5f, 0.0f);
+    const float cos_o[] = {1.0f, 0.7f, 0.3f, 0.1f};
+    for (int k = 0; k < 4; k++) {
+        double es = 0.0;
+        const int n = 65536;
+        rt_vec3 wo = dir_from(cos_o[k], 0.2f);
+        for (int i = 0; i < n; i++) {
+            rt_bsdf_sample s;
+            if (rt_bsdf_sample_dir(&b, wo, rt_cmj_sample((uint32_t)i, n, 4), rt_cmj_randfloat((uint32_t)i, 8), &s))
+                es += s.weight.x;
+        }
+        if (fabs(es / n - 1.0) > 3e-3)
+            fail_msg("white smooth plastic at cos %.1f: albedo %.5f, want 1", (double)cos_o[k], es / n);
+    }
+    rt_bsdf_make_plastic(&b, rt_v3(0, 0, 1), rt_v3(0.8f, 0.3f, 0.1f), 1.0f / 1.5f, 0.2f);
+    test_rng r = {17};
+    for (int i = 0; i < 1000; i++) {
+        rt_vec3 wo = uniform_hemi(&r), wi = uniform_hemi(&r);
+        rt_vec3 f1 = rt_bsdf_eval(&b, wo, wi, NULL), f2 = rt_bsdf_eval(&b, wi, wo, NULL);
+        assert_true(fabsf(f1.x - f2.x) <= 1e-4f * fmaxf(f1.x, 1e-3f));
+    }
+    for (int k = 0; k < 3; k++) {
+        double es, eq;
+        albedo(&b, dir_from(cos_o[k], 0.7f), 65536, &es, &eq);
+        assert_true(es <= 1.0 + 5e-3 && fabs(es - eq) < 0.01 + 0.02 * eq);
+    }
+    pdf_histogram(&b, dir_from(0.6f, 0.4f), 300, "rough plastic");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -674,6 +719,7 @@ int main(void)
         cmocka_unit_test(test_conductor_fresnel),
         cmocka_unit_test(test_conductor_bsdf),
         cmocka_unit_test(test_dielectric_bsdf),
+        cmocka_unit_test(test_plastic_bsdf),
     };
     return cmocka_run_group_tests_name("bsdf", tests, NULL, NULL);
 }

@@ -894,7 +894,13 @@ static void test_conductor_material(void **state)
     expect_error("material m bsdf conductor exterior_ior 1.2\n", RT_ERR_INVALID, "1:27",
                  "material key 'exterior_ior' needs 'bsdf dielectric'");
     expect_error("material m ggx_alpha 0.1\n", RT_ERR_INVALID, "1:12",
-                 "material key 'ggx_alpha' needs 'bsdf conductor' or 'bsdf dielectric'");
+                 "material key 'ggx_alpha' needs 'bsdf conductor', 'bsdf dielectric' or 'bsdf plastic'");
+    expect_ok("material p bsdf plastic color 0.5 0.1 0.1 ior 1.6 exterior_ior 1.1 ggx_alpha 0.1\n", &s);
+    assert_int_equal(s.materials[0].bsdf, RT_BSDF_PLASTIC);
+    assert_float_equal(s.materials[0].exterior_ior, 1.1, 1e-6);
+    assert_float_equal(s.materials[0].roughness, 0, 0);
+    assert_float_equal(s.materials[0].transmission, 0, 0);
+    rt_scene_free(&s);
     expect_error("material m bsdf dielectric smith separable\n", RT_ERR_INVALID, "1:28",
                  "material key 'smith' needs 'bsdf conductor'");
 }

@@ -849,11 +849,11 @@ static rt_result st_material(parser *p, const tok *kw)
             break;
         }
         case MK_BSDF: {
-            static const char *const models[] = {"gltf", "lambert", "conductor", "dielectric"};
+            static const char *const models[] = {"gltf", "lambert", "conductor", "dielectric", "plastic"};
             static const rt_bsdf_model values[] = {RT_BSDF_GLTF, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR,
-                                                   RT_BSDF_DIELECTRIC};
+                                                   RT_BSDF_DIELECTRIC, RT_BSDF_PLASTIC};
             int i = 0;
-            r = get_choice(p, what, models, 4, "gltf|lambert|conductor|dielectric", &i);
+            r = get_choice(p, what, models, 5, "gltf|lambert|conductor|dielectric|plastic", &i);
             if (r == RT_OK)
                 *(rt_bsdf_model *)field = values[i];
             break;
@@ -925,18 +925,21 @@ static rt_result st_material(parser *p, const tok *kw)
         const mat_key *mk = &mat_keys[i];
         bool complex_ior = mk->kind == MK_COLOR && (mk->offset == offsetof(rt_material, eta) ||
                                                     mk->offset == offsetof(rt_material, k));
-        bool glass_key = mk->offset == offsetof(rt_material, exterior_ior) ||
-                         (mk->kind == MK_COLOR && mk->offset == offsetof(rt_material, absorption));
+        bool exterior = mk->kind == MK_FLOAT && mk->offset == offsetof(rt_material, exterior_ior);
+        bool absorbs = mk->kind == MK_COLOR && mk->offset == offsetof(rt_material, absorption);
         if (!seen[i])
             continue;
-        if (glass_key && m.bsdf != RT_BSDF_DIELECTRIC)
+        if (absorbs && m.bsdf != RT_BSDF_DIELECTRIC)
             return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf dielectric'", mk->key);
+        if (exterior && m.bsdf != RT_BSDF_DIELECTRIC && m.bsdf != RT_BSDF_PLASTIC)
+            return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf dielectric' or 'bsdf plastic'",
+                        mk->key);
         if (!(complex_ior || mk->kind == MK_METAL || mk->kind == MK_GGX || mk->kind == MK_SMITH))
             continue;
-        bool both = mk->kind == MK_GGX && mk->offset == 0; /* ggx_alpha: conductor or dielectric */
-        if (m.bsdf != RT_BSDF_CONDUCTOR && !(both && m.bsdf == RT_BSDF_DIELECTRIC))
+        bool any = mk->kind == MK_GGX && mk->offset == 0; /* ggx_alpha: conductor, dielectric or plastic */
+        if (m.bsdf != RT_BSDF_CONDUCTOR && !(any && (m.bsdf == RT_BSDF_DIELECTRIC || m.bsdf == RT_BSDF_PLASTIC)))
             return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf conductor'%s", mk->key,
-                        both ? " or 'bsdf dielectric'" : "");
+                        any ? ", 'bsdf dielectric' or 'bsdf plastic'" : "");
         if (mk->kind == MK_METAL)
             k_metal = seen[i];
         else if (complex_ior && !k_eta)
@@ -954,7 +957,8 @@ static rt_result st_material(parser *p, const tok *kw)
         m.transmission = 1.0f;
     /* conductors and dielectrics are smooth unless given a roughness (as in
      * pbrt-v4 and Mitsuba 3), not glTF's rough default */
-    if ((m.bsdf == RT_BSDF_DIELECTRIC || m.bsdf == RT_BSDF_CONDUCTOR) && !seen[mat_key_index("roughness")])
+    if ((m.bsdf == RT_BSDF_DIELECTRIC || m.bsdf == RT_BSDF_CONDUCTOR || m.bsdf == RT_BSDF_PLASTIC) &&
+        !seen[mat_key_index("roughness")])
         m.roughness = 0.0f;
     /* uv_scale / uv_offset apply to every slot: uv' = uv * scale + offset */
     rt_texture_slot *slots[] = {&m.base_color_tex, &m.metal_rough_tex, &m.normal_tex,

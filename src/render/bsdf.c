@@ -221,7 +221,7 @@ float rt_fresnel_exact(float cos_i, float eta)
  * the index's F0 for an opaque one. */
 static inline float fresnel_dielectric(const rt_bsdf *b, float c)
 {
-    if (b->transmission > 0.0f)
+    if (b->transmission > 0.0f || b->plastic)
         return rt_fresnel_exact(c, b->eta);
     return b->f0 + (1.0f - b->f0) * schlick_weight(c);
 }
@@ -258,6 +258,7 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
     b->conductor = false;
     b->separable = false;
     b->radiance_eta2 = false;
+    b->plastic = false;
     b->base = base;
     if (lambert) {
         b->alpha_y = 1.0f;
@@ -337,6 +338,50 @@ void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha)
     b->radiance_eta2 = true;
 }
 
+float rt_fresnel_diffuse_reflectance(float eta)
+{
+    /* seen from the denser side: by reciprocity what does not reflect
+     * inside is what enters from outside, shrunk by the solid angle ratio,
+     * Fdr(eta) = 1 - (1 - Fdr(1 / eta)) / eta^2 (no kink to integrate) */
+    if (eta > 1.0f)
+        return 1.0f - (1.0f - rt_fresnel_diffuse_reflectance(1.0f / eta)) / (eta * eta);
+    /* integral of F(c) 2c dc, midpoint rule (F is smooth from outside:
+     * 64 points are within 2e-5) */
+    enum { N = 64 };
+    float sum = 0.0f;
+    for (int i = 0; i < N; i++) {
+        float c = ((float)i + 0.5f) / N;
+        sum += rt_fresnel_exact(c, eta) * 2.0f * c;
+    }
+    return sum / N;
+}
+
+void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alpha)
+{
+    set_frame(b, n, n);
+    set_params(b, R, 0.0f, 1.0f, 1.5f, 0.0f, false);
+    eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
+    float r0 = (eta - 1.0f) / (eta + 1.0f);
+    b->f0 = r0 * r0;
+    b->eta = eta;
+    b->plastic = true;
+    alpha = isfinite(alpha) ? rt_clampf(alpha, 0.0f, 1.0f) : 1.0f;
+    b->delta = alpha == 0.0f;
+    b->alpha = b->alpha_y = fmaxf(alpha, RT_BSDF_MIN_ALPHA);
+    /* light entering the coat (1 - Fi), bouncing between base and coat
+     * (the geometric series 1 / (1 - R Fdr_in), Fdr_in the coat's internal
+     * diffuse reflectance) and leaving (1 - Fo) loses 1 / eta_in^2 of its
+     * radiance to the wider cone outside (Weidlich and Wilkie 2007;
+     * Mitsuba's plastic) */
+    float inv_eta2 = eta * eta; /* (n_outside / n_coat)^2 */
+    float fdr_in = rt_fresnel_diffuse_reflectance(1.0f / eta);
+    rt_vec3 d = b->base;
+    b->diffuse = rt_v3(d.x / (1.0f - d.x * fdr_in), d.y / (1.0f - d.y * fdr_in), d.z / (1.0f - d.z * fdr_in));
+    b->diffuse = rt_scale(b->diffuse, inv_eta2);
+    if (!rt_finite3(b->diffuse))
+        b->diffuse = rt_v3s(0.0f);
+}
+
 void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
 {
     const rt_scene *s = ctx->state->scene;
@@ -373,6 +418,13 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
         float eta = m->exterior_ior / m->ior;
         float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
         rt_bsdf_make_dielectric(b, n, sf->front ? eta : 1.0f / eta, alpha);
+        set_frame(b, n, sf->ng);
+        return;
+    }
+    if (m->bsdf == RT_BSDF_PLASTIC) { /* opaque: the same from either side */
+        rt_vec4 c = rt_surface_base_color(ctx, sf);
+        float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
+        rt_bsdf_make_plastic(b, n, rt_v3(c.x, c.y, c.z), m->exterior_ior / m->ior, alpha);
         set_frame(b, n, sf->ng);
         return;
     }
@@ -413,6 +465,8 @@ void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p
     float fd = fresnel_dielectric(b, wo.z);
     rt_vec3 F = fresnel_specular(b, wo.z, fd);
     float ws = mean3(F), td = 1.0f - fd;
+    if (b->plastic) /* the diffuse lobe's albedo: (1 - Fo) diffuse (1 - Fdr_out), about (1 - Fo) diffuse */
+        td *= 1.0f - b->f0;
     if (!b->delta) {
         ws = fmaxf(ws, 0.02f);
         td = fmaxf(td, 0.1f);
@@ -457,8 +511,11 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
         return rt_scale(rt_fresnel_conductor(voh, b->eta_c, b->k_c), spec);
     }
     float fd = fresnel_dielectric(b, voh);
-    /* diffuse: the dielectric's fresnel_mix leaves 1 - Fd to the base */
-    rt_vec3 f = rt_scale(b->diffuse, (1.0f - fd) * (1.0f - b->transmission) * RT_INV_PI);
+    /* diffuse: the dielectric's fresnel_mix leaves 1 - Fd to the base;
+     * under a plastic's coat, what enters at wi and leaves at wo */
+    float tdiff = b->plastic ? (1.0f - fresnel_dielectric(b, wo.z)) * (1.0f - fresnel_dielectric(b, wi.z))
+                             : (1.0f - fd) * (1.0f - b->transmission);
+    rt_vec3 f = rt_scale(b->diffuse, tdiff * RT_INV_PI);
     float p = pd * wi.z * RT_INV_PI;
     if (!b->delta) {
         rt_vec3 F = fresnel_specular(b, voh, fd);

@@ -78,6 +78,7 @@ typedef struct rt_bsdf {
     bool conductor;   /* bsdf conductor: F(eta_c, k_c) D G2 / (4 cos cos) */
     bool separable;   /* conductor: separable Smith G1 G1 instead of height-correlated */
     bool radiance_eta2; /* dielectric: refraction scales radiance by eta^2 (n_wo / n_wi)^2 */
+    bool plastic;     /* coat over Lambert: diffuse = R / (1 - R Fdr_in) / eta_in^2, times (1 - Fo)(1 - Fi) / pi */
     rt_vec3 eta_c, k_c; /* conductor: complex index relative to the outside */
     float transmission; /* T */
     float eta;        /* index ratio across the surface along a transmitted ray: n_incident / n_transmitted */
@@ -124,6 +125,13 @@ void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float rou
                   float transmission, bool lambert);
 /* A dielectric (bsdf dielectric): eta = n_wo / n_wi, GGX alpha (0: smooth). */
 void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha);
+/* A plastic (bsdf plastic): Lambertian reflectance R under a dielectric
+ * coat, eta = n_outside / n_coat, coat GGX alpha (0: smooth). */
+void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alpha);
+/* Hemispherical (cosine-weighted) average of the exact Fresnel reflectance
+ * at an interface of index ratio eta = n_incident / n_transmitted:
+ * the internal diffuse reflectance for eta > 1. */
+float rt_fresnel_diffuse_reflectance(float eta);
 /* A conductor (bsdf conductor) the same way: GGX alphas along x and y of
  * the frame (both 0: a delta mirror). */
 void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float alpha_x, float alpha_y,

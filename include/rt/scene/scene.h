@@ -132,8 +132,12 @@ typedef enum rt_alpha_mode { RT_ALPHA_OPAQUE = 0, RT_ALPHA_MASK, RT_ALPHA_BLEND 
  * albedo / pi with no specular lobe (`bsdf lambert`), a conductor with a
  * complex index of refraction eta + i k per channel (`bsdf conductor`), or
  * clear glass with an interior and exterior index, absorption inside and
- * radiance scaled by 1 / eta^2 across the interface (`bsdf dielectric`). */
-typedef enum rt_bsdf_model { RT_BSDF_GLTF = 0, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR, RT_BSDF_DIELECTRIC } rt_bsdf_model;
+ * radiance scaled by 1 / eta^2 across the interface (`bsdf dielectric`), or
+ * a dielectric coat over a Lambertian base with the internal reflections
+ * between them summed (`bsdf plastic`). */
+typedef enum rt_bsdf_model {
+    RT_BSDF_GLTF = 0, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR, RT_BSDF_DIELECTRIC, RT_BSDF_PLASTIC
+} rt_bsdf_model;
 
 /* Smith masking-shadowing term of the microfacet models. */
 typedef enum rt_smith { RT_SMITH_CORRELATED = 0, RT_SMITH_SEPARABLE } rt_smith;
@@ -169,7 +173,7 @@ typedef struct rt_material {
     rt_vec3 eta, k;
     float alpha_u, alpha_v;
     rt_smith smith;
-    /* dielectric (bsdf dielectric): ior is the inside's index */
+    /* dielectric and plastic: ior is the inside's (the coat's) index */
     float exterior_ior;     /* index outside (default 1) */
     rt_vec3 absorption;     /* absorption coefficient inside, per scene unit (adds to attenuation_*) */
     float thickness;        /* KHR_materials_volume */
