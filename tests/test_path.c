@@ -175,6 +175,71 @@ static void test_furnace_glass(void **state)
     }
 }
 
+/* A smooth gold sphere in a uniform environment of radiance 1: every
+ * camera ray reflects once off the convex sphere and leaves, so a ray
+ * meeting it at incidence cosine c sees exactly F_conductor(c) per
+ * channel. */
+static void test_smooth_conductor_sphere(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, "integrator path\nbackground 1 1 1\nmaterial au bsdf conductor metal Au ggx_alpha 0\n"
+             "sphere 0 0 0 1 au\n", false);
+    for (int i = 0; i < 9; i++) {
+        float x = 0.1f * (float)i;
+        rt_vec3 L = radiance(&f, rt_v3(x, 0, 5), rt_v3(0, 0, -1), (uint32_t)i);
+        rt_vec3 F = rt_fresnel_conductor(sqrtf(1.0f - x * x), rt_metals[1].eta, rt_metals[1].k);
+        if (fabsf(L.x - F.x) > 2e-4f || fabsf(L.y - F.y) > 2e-4f || fabsf(L.z - F.z) > 2e-4f)
+            fail_msg("x %.1f: L (%.5f %.5f %.5f), F (%.5f %.5f %.5f)", (double)x, (double)L.x, (double)L.y,
+                     (double)L.z, (double)F.x, (double)F.y, (double)F.z);
+    }
+    unload(&f);
+}
+
+/* bsdf dielectric in closed forms: (1) smooth glass in a white furnace
+ * keeps all energy (the 1 / eta^2 in and eta^2 out cancel); (2) an
+ * index-matched absorbing ball (ior = exterior_ior: no refraction, F = 0)
+ * transmits exp(-sigma 2 sqrt(1 - x^2)) along a chord at offset x;
+ * (3) an emitter of radiance 1 inside a glass ball (ior 1.5, black
+ * background) seen through its centre: (1 - F0) / 1.5^2 = 0.42667. */
+static void test_dielectric_closed_forms(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, "integrator path\nbackground 1 1 1\nmaterial g bsdf dielectric ior 1.5\nsphere 0 0 0 1 g\n", false);
+    double sum = 0.0;
+    const uint32_t n = 20000;
+    test_rng tr = {5};
+    for (uint32_t i = 0; i < n; i++) {
+        float x = 1.4f * test_rng_float(&tr) - 0.7f, y = 1.4f * test_rng_float(&tr) - 0.7f;
+        sum += radiance(&f, rt_v3(x, y, 5), rt_v3(0, 0, -1), i).y;
+    }
+    fprintf(stderr, "dielectric furnace: %.4f\n", sum / n);
+    assert_true(fabs(sum / n - 1.0) < 0.01);
+    unload(&f);
+
+    load(&f, "integrator path\nbackground 1 1 1\n"
+             "material g bsdf dielectric ior 1.2 exterior_ior 1.2 absorption 0.1 0.5 2\nsphere 0 0 0 1 g\n", false);
+    for (int i = 0; i < 8; i++) {
+        float x = 0.12f * (float)i;
+        rt_vec3 L = radiance(&f, rt_v3(x, 0, 5), rt_v3(0, 0, -1), (uint32_t)i);
+        double d = 2.0 * sqrt(1.0 - (double)x * x);
+        if (fabs(L.x - exp(-0.1 * d)) > 1e-4 || fabs(L.y - exp(-0.5 * d)) > 1e-4 || fabs(L.z - exp(-2.0 * d)) > 1e-4)
+            fail_msg("x %.2f: L (%.5f %.5f %.5f), want (%.5f %.5f %.5f)", (double)x, (double)L.x, (double)L.y,
+                     (double)L.z, exp(-0.1 * d), exp(-0.5 * d), exp(-2.0 * d));
+    }
+    unload(&f);
+
+    load(&f, "integrator path\nbackground 0 0 0\nmaterial g bsdf dielectric ior 1.5\n"
+             "material e color 0 0 0 bsdf lambert emission 1 1 1\nsphere 0 0 0 1 g\nsphere 0 0 0 0.5 e\n", false);
+    sum = 0.0;
+    for (uint32_t i = 0; i < n; i++)
+        sum += radiance(&f, rt_v3(0, 0, 5), rt_v3(0, 0, -1), i).y;
+    fprintf(stderr, "emitter in glass: %.4f (want 0.42667)\n", sum / n);
+    assert_true(fabs(sum / n - 0.96 / 2.25) < 0.01);
+    unload(&f);
+}
+
 /* Inside an emissive Lambertian sphere: L = E (1 - a^(k+1)) / (1 - a). */
 static void test_closed_furnace(void **state)
 {
@@ -207,6 +272,40 @@ static void test_closed_furnace(void **state)
                 fail_msg("table %d max_depth %d: %.4f +- %.4f, want %.4f", t, depths[d], mean, sd, want);
             unload(&f);
         }
+    }
+}
+
+/* Russian roulette stays unbiased whatever rr_depth: inside the closed
+ * emissive sphere of albedo 0.6 every start depth, and the adaptive rule
+ * (0), give E / (1 - a). */
+static void test_rr_depth_unbiased(void **state)
+{
+    (void)state;
+    const int rr[] = {0, 1, 5};
+    for (int k = 0; k < 3; k++) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 "integrator path\nrr_depth %d\n"
+                 "material m color 0.6 0.6 0.6 bsdf lambert emission 1 1 1\nsphere 0 0 0 1 m\n",
+                 rr[k]);
+        fixture f;
+        load(&f, text, false);
+        assert_int_equal(f.s.settings.rr_depth, rr[k]);
+        double sum = 0.0, sum2 = 0.0;
+        const uint32_t n = 40000;
+        test_rng tr = {13};
+        for (uint32_t i = 0; i < n; i++) {
+            rt_vec3 dir = rt_v3(test_rng_float(&tr) - 0.5f, test_rng_float(&tr) - 0.5f, test_rng_float(&tr) - 0.5f);
+            if (rt_length2(dir) < 1e-6f)
+                dir = rt_v3(0, 0, 1);
+            double L = radiance(&f, rt_v3(0.1f, -0.2f, 0.3f), dir, i).x;
+            sum += L;
+            sum2 += L * L;
+        }
+        double mean = sum / n, sd = sqrt(fmax(0.0, sum2 / n - mean * mean) / n);
+        if (fabs(mean - 2.5) > 4.0 * sd + 1e-3)
+            fail_msg("rr_depth %d: %.4f +- %.4f, want 2.5", rr[k], mean, sd);
+        unload(&f);
     }
 }
 
@@ -619,7 +718,10 @@ int main(void)
         cmocka_unit_test(test_furnace_lambert),
         cmocka_unit_test(test_furnace_metal),
         cmocka_unit_test(test_furnace_glass),
+        cmocka_unit_test(test_smooth_conductor_sphere),
+        cmocka_unit_test(test_dielectric_closed_forms),
         cmocka_unit_test(test_closed_furnace),
+        cmocka_unit_test(test_rr_depth_unbiased),
         cmocka_unit_test(test_point_light_exact),
         cmocka_unit_test(test_area_light_one_sided),
         cmocka_unit_test(test_emissive_triangles_vs_area_light),

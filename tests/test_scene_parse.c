@@ -837,6 +837,74 @@ static void test_errors_syntax(void **state)
     expect_error(big, RT_ERR_PARSE, "1:9", "got 'xxxx");
 }
 
+/* bsdf conductor: a named metal, eta/k, isotropic and anisotropic alpha,
+ * the Smith term; and the keys' errors. */
+static void test_conductor_material(void **state)
+{
+    (void)state;
+    rt_scene s;
+    expect_ok("material au bsdf conductor metal Au roughness 0.3\n"
+              "material c bsdf conductor eta 0.2 0.9 1.1 k 3 2.5 2 ggx_alpha_uv 0.3 0.05 smith separable\n"
+              "material d bsdf conductor ggx_alpha 0.01\n",
+              &s);
+    assert_int_equal(s.material_count, 3);
+    const rt_material *m = &s.materials[0];
+    assert_int_equal(m->bsdf, RT_BSDF_CONDUCTOR);
+    assert_string_equal(rt_metals[1].name, "Au");
+    assert_vec3(m->eta, rt_metals[1].eta.x, rt_metals[1].eta.y, rt_metals[1].eta.z);
+    assert_vec3(m->k, rt_metals[1].k.x, rt_metals[1].k.y, rt_metals[1].k.z);
+    assert_true(m->alpha_u < 0.0f && m->smith == RT_SMITH_CORRELATED);
+    m = &s.materials[1];
+    assert_vec3(m->eta, 0.2f, 0.9f, 1.1f);
+    assert_vec3(m->k, 3, 2.5f, 2);
+    assert_float_equal(m->alpha_u, 0.3, 1e-7);
+    assert_float_equal(m->alpha_v, 0.05, 1e-7);
+    assert_int_equal(m->smith, RT_SMITH_SEPARABLE);
+    m = &s.materials[2];
+    assert_vec3(m->eta, rt_metals[0].eta.x, rt_metals[0].eta.y, rt_metals[0].eta.z); /* Cu by default */
+    assert_float_equal(m->alpha_u, 0.01, 1e-7);
+    assert_float_equal(m->alpha_v, 0.01, 1e-7);
+    rt_scene_free(&s);
+    expect_error("material m metal Au\n", RT_ERR_INVALID, "1:12", "material key 'metal' needs 'bsdf conductor'");
+    expect_error("material m bsdf conductor metal Zz\n", RT_ERR_PARSE, "1:33",
+                 "expected material metal (Cu|Au|Ag|Al|Ti|Pt|Fe|CuZn), got 'Zz'");
+    expect_error("material m bsdf conductor metal Au k 1 1 1\n", RT_ERR_INVALID, "1:36",
+                 "give either 'metal NAME' or 'eta' and 'k', not both");
+    expect_error("material m bsdf conductor ggx_alpha 0.1 ggx_alpha_uv 0.1 0.2\n", RT_ERR_INVALID, "1:41",
+                 "give either 'ggx_alpha' or 'ggx_alpha_uv', not both");
+    expect_error("material m bsdf conductor ggx_alpha_uv 0.1 2\n", RT_ERR_INVALID, "1:44",
+                 "material ggx_alpha_uv must be between 0 and 1, got '2'");
+    expect_error("material m bsdf conductor smith maybe\n", RT_ERR_PARSE, "1:33",
+                 "expected material smith (correlated|separable), got 'maybe'");
+    expect_error("material m bsdf conductor eta 1 -1 1\n", RT_ERR_INVALID, "1:33", "material eta (green) must be >= 0");
+    /* bsdf dielectric: transmissive and smooth by default */
+    expect_ok("material g bsdf dielectric ior 1.33 exterior_ior 1.1 absorption 0.1 0.2 0.3\n"
+              "material r bsdf dielectric ggx_alpha 0.2 transmission 0.5\n",
+              &s);
+    m = &s.materials[0];
+    assert_int_equal(m->bsdf, RT_BSDF_DIELECTRIC);
+    assert_float_equal(m->transmission, 1, 0);
+    assert_float_equal(m->roughness, 0, 0);
+    assert_float_equal(m->exterior_ior, 1.1, 1e-6);
+    assert_vec3(m->absorption, 0.1f, 0.2f, 0.3f);
+    assert_float_equal(s.materials[1].alpha_u, 0.2, 1e-7);
+    assert_float_equal(s.materials[1].transmission, 0.5, 0);
+    rt_scene_free(&s);
+    expect_error("material m absorption 1 1 1\n", RT_ERR_INVALID, "1:12", "material key 'absorption' needs 'bsdf dielectric'");
+    expect_error("material m bsdf conductor exterior_ior 1.2\n", RT_ERR_INVALID, "1:27",
+                 "material key 'exterior_ior' needs 'bsdf dielectric'");
+    expect_error("material m ggx_alpha 0.1\n", RT_ERR_INVALID, "1:12",
+                 "material key 'ggx_alpha' needs 'bsdf conductor', 'bsdf dielectric' or 'bsdf plastic'");
+    expect_ok("material p bsdf plastic color 0.5 0.1 0.1 ior 1.6 exterior_ior 1.1 ggx_alpha 0.1\n", &s);
+    assert_int_equal(s.materials[0].bsdf, RT_BSDF_PLASTIC);
+    assert_float_equal(s.materials[0].exterior_ior, 1.1, 1e-6);
+    assert_float_equal(s.materials[0].roughness, 0, 0);
+    assert_float_equal(s.materials[0].transmission, 0, 0);
+    rt_scene_free(&s);
+    expect_error("material m bsdf dielectric smith separable\n", RT_ERR_INVALID, "1:28",
+                 "material key 'smith' needs 'bsdf conductor'");
+}
+
 static void test_errors_values(void **state)
 {
     (void)state;
@@ -1216,6 +1284,7 @@ int main(void)
         cmocka_unit_test(test_light_values),
         cmocka_unit_test(test_comments_and_continuations),
         cmocka_unit_test(test_errors_syntax),
+        cmocka_unit_test(test_conductor_material),
         cmocka_unit_test(test_errors_values),
         cmocka_unit_test(test_errors_names),
         cmocka_unit_test(test_many_names),

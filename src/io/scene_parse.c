@@ -803,7 +803,12 @@ static rt_result st_texture(parser *p, const tok *kw)
 
 static int edit_distance(const char *a, const char *b);
 
-typedef enum mat_kind { MK_FLOAT, MK_COLOR, MK_BOOL, MK_TEXTURE, MK_ALPHA_MODE, MK_DISTANCE, MK_UV, MK_BSDF } mat_kind;
+typedef enum mat_kind {
+    MK_FLOAT, MK_COLOR, MK_BOOL, MK_TEXTURE, MK_ALPHA_MODE, MK_DISTANCE, MK_UV, MK_BSDF,
+    MK_METAL,    /* a named metal: sets eta and k */
+    MK_GGX,      /* GGX alpha, isotropic (one value: alpha_u = alpha_v) or two values (offset 1) */
+    MK_SMITH,
+} mat_kind;
 
 typedef struct mat_key {
     const char *key;
@@ -836,6 +841,14 @@ static const mat_key mat_keys[] = {
     {"double_sided", NULL, MK_BOOL, MOFF(double_sided), 0, 0},
     {"unlit", NULL, MK_BOOL, MOFF(unlit), 0, 0},
     {"bsdf", NULL, MK_BSDF, MOFF(bsdf), 0, 0},
+    {"eta", NULL, MK_COLOR, MOFF(eta), 0, 0},
+    {"k", NULL, MK_COLOR, MOFF(k), 0, 0},
+    {"metal", NULL, MK_METAL, 0, 0, 0},
+    {"ggx_alpha", NULL, MK_GGX, 0, 0, 0},
+    {"ggx_alpha_uv", NULL, MK_GGX, 1, 0, 0},
+    {"smith", NULL, MK_SMITH, MOFF(smith), 0, 0},
+    {"exterior_ior", NULL, MK_FLOAT, MOFF(exterior_ior), 0.01f, 100},
+    {"absorption", NULL, MK_COLOR, MOFF(absorption), 0, 0},
     {"thickness", NULL, MK_FLOAT, MOFF(thickness), 0, FLT_MAX},
     {"attenuation_color", NULL, MK_COLOR, MOFF(attenuation_color), 0, 0},
     {"attenuation_distance", NULL, MK_DISTANCE, MOFF(attenuation_distance), 0, 0},
@@ -850,6 +863,15 @@ static const mat_key mat_keys[] = {
 };
 #undef MOFF
 #define MAT_KEY_COUNT (sizeof mat_keys / sizeof *mat_keys)
+
+static size_t mat_key_index(const char *key)
+{
+    size_t i = 0;
+    while (i < MAT_KEY_COUNT && strcmp(mat_keys[i].key, key) != 0)
+        i++;
+    RT_DCHECK(i < MAT_KEY_COUNT);
+    return i;
+}
 
 static rt_result st_material(parser *p, const tok *kw)
 {
@@ -910,12 +932,46 @@ static rt_result st_material(parser *p, const tok *kw)
             break;
         }
         case MK_BSDF: {
-            static const char *const models[] = {"gltf", "lambert"};
-            static const rt_bsdf_model values[] = {RT_BSDF_GLTF, RT_BSDF_LAMBERT};
+            static const char *const models[] = {"gltf", "lambert", "conductor", "dielectric", "plastic"};
+            static const rt_bsdf_model values[] = {RT_BSDF_GLTF, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR,
+                                                   RT_BSDF_DIELECTRIC, RT_BSDF_PLASTIC};
             int i = 0;
-            r = get_choice(p, what, models, 2, "gltf|lambert", &i);
+            r = get_choice(p, what, models, 5, "gltf|lambert|conductor|dielectric|plastic", &i);
             if (r == RT_OK)
                 *(rt_bsdf_model *)field = values[i];
+            break;
+        }
+        case MK_METAL: {
+            const char *names[16];
+            char choices[128] = "";
+            RT_DCHECK(rt_metal_count <= 16);
+            for (size_t i = 0; i < rt_metal_count; i++) {
+                names[i] = rt_metals[i].name;
+                snprintf(choices + strlen(choices), sizeof choices - strlen(choices), "%s%s", i ? "|" : "",
+                         rt_metals[i].name);
+            }
+            int i = 0;
+            r = get_choice(p, what, names, (int)rt_metal_count, choices, &i);
+            if (r == RT_OK) {
+                m.eta = rt_metals[i].eta;
+                m.k = rt_metals[i].k;
+            }
+            break;
+        }
+        case MK_GGX:
+            r = get_float_in(p, what, 0.0f, 1.0f, &m.alpha_u);
+            if (r == RT_OK && mk->offset == 1)
+                r = get_float_in(p, what, 0.0f, 1.0f, &m.alpha_v);
+            else if (r == RT_OK)
+                m.alpha_v = m.alpha_u;
+            break;
+        case MK_SMITH: {
+            static const char *const terms[] = {"correlated", "separable"};
+            static const rt_smith values[] = {RT_SMITH_CORRELATED, RT_SMITH_SEPARABLE};
+            int i = 0;
+            r = get_choice(p, what, terms, 2, "correlated|separable", &i);
+            if (r == RT_OK)
+                *(rt_smith *)field = values[i];
             break;
         }
         case MK_DISTANCE:
@@ -950,6 +1006,47 @@ static rt_result st_material(parser *p, const tok *kw)
         if (r != RT_OK)
             return r;
     }
+    /* the conductor's keys: only with bsdf conductor, one way each */
+    const tok *k_metal = NULL, *k_eta = NULL, *k_alpha = NULL, *k_alpha_uv = NULL;
+    for (size_t i = 0; i < MAT_KEY_COUNT; i++) {
+        const mat_key *mk = &mat_keys[i];
+        bool complex_ior = mk->kind == MK_COLOR && (mk->offset == offsetof(rt_material, eta) ||
+                                                    mk->offset == offsetof(rt_material, k));
+        bool exterior = mk->kind == MK_FLOAT && mk->offset == offsetof(rt_material, exterior_ior);
+        bool absorbs = mk->kind == MK_COLOR && mk->offset == offsetof(rt_material, absorption);
+        if (!seen[i])
+            continue;
+        if (absorbs && m.bsdf != RT_BSDF_DIELECTRIC)
+            return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf dielectric'", mk->key);
+        if (exterior && m.bsdf != RT_BSDF_DIELECTRIC && m.bsdf != RT_BSDF_PLASTIC)
+            return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf dielectric' or 'bsdf plastic'",
+                        mk->key);
+        if (!(complex_ior || mk->kind == MK_METAL || mk->kind == MK_GGX || mk->kind == MK_SMITH))
+            continue;
+        bool any = mk->kind == MK_GGX && mk->offset == 0; /* ggx_alpha: conductor, dielectric or plastic */
+        if (m.bsdf != RT_BSDF_CONDUCTOR && !(any && (m.bsdf == RT_BSDF_DIELECTRIC || m.bsdf == RT_BSDF_PLASTIC)))
+            return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf conductor'%s", mk->key,
+                        any ? ", 'bsdf dielectric' or 'bsdf plastic'" : "");
+        if (mk->kind == MK_METAL)
+            k_metal = seen[i];
+        else if (complex_ior && !k_eta)
+            k_eta = seen[i];
+        else if (mk->kind == MK_GGX)
+            *(mk->offset ? &k_alpha_uv : &k_alpha) = seen[i];
+    }
+    if (k_metal && k_eta)
+        return perr(p, RT_ERR_INVALID, k_eta, "material key '%s': give either 'metal NAME' or 'eta' and 'k', not both",
+                    k_eta->s);
+    if (k_alpha && k_alpha_uv)
+        return perr(p, RT_ERR_INVALID, k_alpha_uv, "give either 'ggx_alpha' or 'ggx_alpha_uv', not both");
+    /* glass transmits: whitted refracts it, shadow rays treat it as glass */
+    if (m.bsdf == RT_BSDF_DIELECTRIC && !seen[mat_key_index("transmission")])
+        m.transmission = 1.0f;
+    /* conductors and dielectrics are smooth unless given a roughness (as in
+     * pbrt-v4 and Mitsuba 3), not glTF's rough default */
+    if ((m.bsdf == RT_BSDF_DIELECTRIC || m.bsdf == RT_BSDF_CONDUCTOR || m.bsdf == RT_BSDF_PLASTIC) &&
+        !seen[mat_key_index("roughness")])
+        m.roughness = 0.0f;
     /* uv_scale / uv_offset apply to every slot: uv' = uv * scale + offset */
     rt_texture_slot *slots[] = {&m.base_color_tex, &m.metal_rough_tex, &m.normal_tex,
                                 &m.occlusion_tex, &m.emissive_tex, &m.transmission_tex};

@@ -1,12 +1,16 @@
-/* bsdf.c - Lambert and the glTF metallic-roughness BSDF for the path
- * tracer: evaluation, pdf and importance sampling (see rt/render/bsdf.h).
+/* bsdf.c - Lambert, the glTF metallic-roughness BSDF and the conductor
+ * for the path tracer: evaluation, pdf and importance sampling (see rt/render/bsdf.h).
  *
  * Sources:
- * - The BRDF: glTF 2.0 specification, appendix B "BRDF Implementation"
- *   (B.3.5, metal-roughness material: c_diff, f0 = lerp(0.04, base,
- *   metallic), Schlick's F on |V.H|, f = (1 - F) c_diff / pi + F D V), with
- *   KHR_materials_ior (f0 from the index) and KHR_materials_transmission
- *   (the dielectric base lobe split between diffuse and a BTDF).
+ * - The BRDF: glTF 2.0 specification, appendix B "BRDF Implementation",
+ *   in its normative form (B.3.5: mix(dielectric_brdf, metal_brdf,
+ *   metallic), metal_brdf = conductor_fresnel(base, specular),
+ *   dielectric_brdf = fresnel_mix(ior, diffuse, specular), Schlick's F on
+ *   |V.H|), with KHR_materials_ior (F0 from the index) and
+ *   KHR_materials_transmission (the dielectric base lobe split between
+ *   diffuse and a BTDF).
+ * - Exact Fresnel equations for a dielectric (Born and Wolf, "Principles of
+ *   Optics", 7th ed., 1.5.2), used for transmissive surfaces.
  * - GGX / Trowbridge-Reitz distribution and its Smith Lambda: Walter,
  *   Marschner, Li, Torrance 2007, "Microfacet Models for Refraction through
  *   Rough Surfaces" (EGSR); height-correlated masking-shadowing: Heitz 2014,
@@ -15,6 +19,11 @@
  * - Sampling visible normals: Heitz 2018, "Sampling the GGX Distribution
  *   of Visible Normals" (JCGT 7(4)), listing 1; its pdf D_wo(h) / (4 wo.h)
  *   = G1(wo) D(h) / (4 wo.z) for reflection.
+ * - Conductor: exact unpolarised Fresnel for a complex index (Born and
+ *   Wolf, 14.2; the closed form of pbrt-v3, Pharr, Jakob, Humphreys, 8.2.1);
+ *   anisotropic GGX D and Lambda (Heitz 2014, eqs. 85, 86) and the
+ *   separable Smith term G1 G1 (eq. 98) as the `smith separable` option;
+ *   anisotropic VNDF sampling (Heitz 2018, the stretch by (ax, ay)).
  * - Cosine sampling of the diffuse lobe (rt/sampling.h).
  * - Choosing one lobe by its estimated weight and returning the mixture pdf
  *   is one-sample MIS over the lobes with the balance heuristic (Veach 1997,
@@ -22,9 +31,9 @@
  *
  * The transmission lobe refracts through a GGX microfacet normal sampled
  * from the visible normals (Walter et al. 2007's rough dielectric BTDF,
- * with the same alpha; the macro normal, i.e. a smooth dielectric, at the
- * smallest alpha), Snell's law with the material's ior. It is sampled
- * only, never evaluated: transmitted rays are not light-sampled, so an
+ * with the same alpha; the macro normal, i.e. a smooth dielectric, at
+ * roughness 0, where the reflection is a mirror too), Snell's law with the
+ * material's ior. It is sampled only, never evaluated: transmitted rays are not light-sampled, so an
  * emitter they hit counts in full (no MIS). Radiance is not rescaled by
  * eta^2 across the interface (it cancels for paths that leave the object
  * again). Every result is finite: grazing
@@ -35,13 +44,18 @@
 #include "rt/render/sampling.h"
 #include "rt/scene/texture.h"
 
+/* Both evaluated from the tangent components: sin^2 = x^2 + y^2 is exact
+ * near the normal, where 1 - cos^2 (and the textbook k = cos^2 (a^2 - 1)
+ * + 1) cancels to nothing in single precision once alpha^2 falls below
+ * the float epsilon. D = a^2 / (pi (a^2 cos^2 + sin^2)^2) then keeps full
+ * relative precision down to alpha 1e-4 and below (a peak of 3e7). */
 float rt_ggx_d(rt_vec3 h, float alpha)
 {
     if (!(h.z > 0.0f))
         return 0.0f;
     float a2 = alpha * alpha;
-    float c2 = h.z * h.z;
-    float k = c2 * (a2 - 1.0f) + 1.0f; /* = cos^2 (a^2 - 1) + 1 = a^2 cos^2 + sin^2 */
+    float s2 = h.x * h.x + h.y * h.y;
+    float k = a2 * (h.z * h.z) + s2;
     float d = a2 / (RT_PI * k * k);
     return isfinite(d) ? d : 0.0f;
 }
@@ -49,11 +63,12 @@ float rt_ggx_d(rt_vec3 h, float alpha)
 float rt_ggx_lambda(rt_vec3 w, float alpha)
 {
     float c2 = w.z * w.z;
-    float s2 = fmaxf(0.0f, w.x * w.x + w.y * w.y);
+    float s2 = w.x * w.x + w.y * w.y;
     if (!(c2 > 0.0f))
         return INFINITY;
     float t2 = alpha * alpha * s2 / c2; /* alpha^2 tan^2 theta */
-    return 0.5f * (sqrtf(1.0f + t2) - 1.0f);
+    /* sqrt(1 + t2) - 1 without cancellation for small t2 */
+    return 0.5f * t2 / (sqrtf(1.0f + t2) + 1.0f);
 }
 
 float rt_ggx_g1(rt_vec3 w, float alpha)
@@ -70,10 +85,10 @@ float rt_ggx_g2(rt_vec3 wo, rt_vec3 wi, float alpha)
     return 1.0f / (1.0f + lo + li);
 }
 
-rt_vec3 rt_ggx_sample_vndf(rt_vec3 wo, float alpha, rt_vec2 u)
+static rt_vec3 vndf_xy(rt_vec3 wo, float ax, float ay, rt_vec2 u)
 {
     /* stretch the view direction to the hemisphere configuration */
-    rt_vec3 vh = rt_normalize(rt_v3(alpha * wo.x, alpha * wo.y, wo.z));
+    rt_vec3 vh = rt_normalize(rt_v3(ax * wo.x, ay * wo.y, wo.z));
     float lensq = vh.x * vh.x + vh.y * vh.y;
     rt_vec3 t1 = lensq > 1e-14f ? rt_scale(rt_v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(lensq)) : rt_v3(1, 0, 0);
     rt_vec3 t2 = rt_cross(vh, t1);
@@ -85,8 +100,53 @@ rt_vec3 rt_ggx_sample_vndf(rt_vec3 wo, float alpha, rt_vec2 u)
     rt_vec3 nh = rt_add(rt_add(rt_scale(t1, p1), rt_scale(t2, p2)),
                         rt_scale(vh, sqrtf(fmaxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));
     /* unstretch */
-    rt_vec3 ne = rt_v3(alpha * nh.x, alpha * nh.y, fmaxf(1e-7f, nh.z));
+    rt_vec3 ne = rt_v3(ax * nh.x, ay * nh.y, fmaxf(1e-7f, nh.z));
     return rt_normalize(ne);
+}
+
+rt_vec3 rt_ggx_sample_vndf(rt_vec3 wo, float alpha, rt_vec2 u) { return vndf_xy(wo, alpha, alpha, u); }
+
+/* Anisotropic GGX (alpha ax along x, ay along y; Heitz 2014, eq. 85 and
+ * 86): D = 1 / (pi ax ay ((x/ax)^2 + (y/ay)^2 + z^2)^2), Lambda with
+ * alpha^2 tan^2 = (ax^2 x^2 + ay^2 y^2) / z^2; the isotropic forms when
+ * ax = ay. */
+static float d_xy(rt_vec3 h, float ax, float ay)
+{
+    if (ax == ay)
+        return rt_ggx_d(h, ax);
+    if (!(h.z > 0.0f))
+        return 0.0f;
+    float x = h.x / ax, y = h.y / ay;
+    float k = x * x + y * y + h.z * h.z;
+    float d = 1.0f / (RT_PI * ax * ay * k * k);
+    return isfinite(d) ? d : 0.0f;
+}
+
+static float lambda_xy(rt_vec3 w, float ax, float ay)
+{
+    if (ax == ay)
+        return rt_ggx_lambda(w, ax);
+    float c2 = w.z * w.z;
+    if (!(c2 > 0.0f))
+        return INFINITY;
+    float t2 = (ax * ax * w.x * w.x + ay * ay * w.y * w.y) / c2;
+    return 0.5f * t2 / (sqrtf(1.0f + t2) + 1.0f);
+}
+
+static float g1_xy(rt_vec3 w, float ax, float ay)
+{
+    float l = lambda_xy(w, ax, ay);
+    return isfinite(l) ? 1.0f / (1.0f + l) : 0.0f;
+}
+
+/* Smith G2: height-correlated 1 / (1 + L(wo) + L(wi)) (Heitz 2014, eq.
+ * 99), or separable G1(wo) G1(wi) (eq. 98, as older renderers use). */
+static float g2_xy(rt_vec3 wo, rt_vec3 wi, float ax, float ay, bool separable)
+{
+    float lo = lambda_xy(wo, ax, ay), li = lambda_xy(wi, ax, ay);
+    if (!isfinite(lo) || !isfinite(li))
+        return 0.0f;
+    return separable ? 1.0f / ((1.0f + lo) * (1.0f + li)) : 1.0f / (1.0f + lo + li);
 }
 
 float rt_ggx_reflect_pdf(rt_vec3 wo, rt_vec3 wi, float alpha)
@@ -102,6 +162,33 @@ float rt_ggx_reflect_pdf(rt_vec3 wo, rt_vec3 wi, float alpha)
     return isfinite(p) ? p : 0.0f;
 }
 
+/* Exact unpolarised Fresnel reflectance of a conductor, eta + i k relative
+ * to the outside, one channel (the closed form of pbrt-v3, 8.2.1, after
+ * Born and Wolf 14.2). */
+static float fresnel_conductor1(float c, float eta, float k)
+{
+    c = rt_clampf(c, 0.0f, 1.0f);
+    float c2 = c * c, s2 = 1.0f - c2;
+    float eta2 = eta * eta, k2 = k * k;
+    float t0 = eta2 - k2 - s2;
+    float a2b2 = sqrtf(fmaxf(0.0f, t0 * t0 + 4.0f * eta2 * k2));
+    float t1 = a2b2 + c2;
+    float a = sqrtf(fmaxf(0.0f, 0.5f * (a2b2 + t0)));
+    float t2 = 2.0f * c * a;
+    float rs = (t1 - t2) / (t1 + t2);
+    float t3 = c2 * a2b2 + s2 * s2;
+    float t4 = t2 * s2;
+    float rp = rs * (t3 - t4) / (t3 + t4);
+    float f = 0.5f * (rs + rp);
+    return isfinite(f) ? rt_clampf(f, 0.0f, 1.0f) : 1.0f;
+}
+
+rt_vec3 rt_fresnel_conductor(float cos_i, rt_vec3 eta, rt_vec3 k)
+{
+    return rt_v3(fresnel_conductor1(cos_i, eta.x, k.x), fresnel_conductor1(cos_i, eta.y, k.y),
+                 fresnel_conductor1(cos_i, eta.z, k.z));
+}
+
 static inline float schlick_weight(float c)
 {
     float x = 1.0f - rt_clampf(c, 0.0f, 1.0f);
@@ -115,22 +202,39 @@ static inline rt_vec3 schlick(rt_vec3 f0, float c)
     return rt_add(f0, rt_scale(rt_sub(rt_v3s(1.0f), f0), w));
 }
 
-/* Fresnel reflectance at a (micro)facet seen at cosine c from wo. glTF's
- * Schlick on |wo.h|; for a transmissive surface seen from inside (eta > 1)
- * Schlick on the refracted side's cosine, 1 beyond the critical angle
- * (total internal reflection), so reflection and refraction share one F. */
-static inline rt_vec3 fresnel(const rt_bsdf *b, float c)
+float rt_fresnel_exact(float cos_i, float eta)
 {
-    if (b->transmission > 0.0f && b->eta > 1.0f) {
-        float sin2_t = b->eta * b->eta * fmaxf(0.0f, 1.0f - c * c);
-        if (sin2_t >= 1.0f)
-            return rt_v3s(1.0f);
-        c = sqrtf(1.0f - sin2_t);
-    }
-    return schlick(b->f0, c);
+    float ci = rt_clampf(cos_i, 0.0f, 1.0f);
+    float sin2_t = eta * eta * (1.0f - ci * ci);
+    if (!(sin2_t < 1.0f))
+        return 1.0f; /* total internal reflection (or a NaN input) */
+    float ct = sqrtf(1.0f - sin2_t);
+    float rs = (eta * ci - ct) / (eta * ci + ct);
+    float rp = (ci - eta * ct) / (ci + eta * ct);
+    float f = 0.5f * (rs * rs + rp * rp);
+    return isfinite(f) ? rt_clampf(f, 0.0f, 1.0f) : 1.0f;
+}
+
+/* The dielectric Fresnel Fd at a (micro)facet seen at cosine c from wo:
+ * the exact equations for a transmissive surface (glass: reflection and
+ * refraction share one F, 1 past the critical angle), glTF's Schlick with
+ * the index's F0 for an opaque one. */
+static inline float fresnel_dielectric(const rt_bsdf *b, float c)
+{
+    if (b->transmission > 0.0f || b->plastic)
+        return rt_fresnel_exact(c, b->eta);
+    return b->f0 + (1.0f - b->f0) * schlick_weight(c);
 }
 
 static inline float mean3(rt_vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
+
+/* The specular lobe's Fresnel: the glTF mix by metallic of the metal's
+ * conductor_fresnel (Schlick on the base colour) and the dielectric's Fd. */
+static inline rt_vec3 fresnel_specular(const rt_bsdf *b, float c, float fd)
+{
+    rt_vec3 fm = b->metallic > 0.0f ? schlick(b->base, c) : rt_v3s(0.0f);
+    return rt_lerp3(rt_v3s(fd), fm, b->metallic);
+}
 
 static void set_frame(rt_bsdf *b, rt_vec3 n, rt_vec3 ng)
 {
@@ -151,19 +255,28 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
     if (!(ior > 0.0f) || !isfinite(ior))
         ior = 1.5f;
     b->lambert = lambert;
+    b->conductor = false;
+    b->separable = false;
+    b->radiance_eta2 = false;
+    b->plastic = false;
+    b->base = base;
     if (lambert) {
+        b->alpha_y = 1.0f;
         b->diffuse = base;
-        b->f0 = rt_v3s(0.0f);
+        b->metallic = 0.0f;
+        b->f0 = 0.0f;
         b->alpha = 1.0f;
+        b->delta = false;
         b->transmission = 0.0f;
         b->eta = 1.0f;
         return;
     }
     float r0 = (ior - 1.0f) / (ior + 1.0f);
-    r0 *= r0;
     b->diffuse = rt_scale(base, 1.0f - metallic);
-    b->f0 = rt_lerp3(rt_v3s(r0), base, metallic);
-    b->alpha = fmaxf(roughness * roughness, RT_BSDF_MIN_ALPHA);
+    b->metallic = metallic;
+    b->f0 = r0 * r0;
+    b->delta = roughness == 0.0f;
+    b->alpha = b->alpha_y = fmaxf(roughness * roughness, RT_BSDF_MIN_ALPHA);
     b->transmission = transmission;
     b->eta = 1.0f / ior;
 }
@@ -173,6 +286,100 @@ void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float rou
 {
     set_frame(b, n, n);
     set_params(b, base, metallic, roughness, ior, transmission, lambert);
+}
+
+static void set_conductor(rt_bsdf *b, rt_vec3 eta, rt_vec3 k, float ax, float ay, rt_smith smith)
+{
+    set_params(b, rt_v3s(0.0f), 0.0f, 1.0f, 1.5f, 0.0f, false);
+    b->conductor = true;
+    b->eta_c = rt_finite3(eta) ? rt_vmax(eta, rt_v3s(0.0f)) : rt_v3s(1.0f);
+    b->k_c = rt_finite3(k) ? rt_vmax(k, rt_v3s(0.0f)) : rt_v3s(0.0f);
+    ax = isfinite(ax) ? rt_clampf(ax, 0.0f, 1.0f) : 1.0f;
+    ay = isfinite(ay) ? rt_clampf(ay, 0.0f, 1.0f) : 1.0f;
+    b->delta = ax == 0.0f && ay == 0.0f;
+    b->alpha = fmaxf(ax, RT_BSDF_MIN_ALPHA);
+    b->alpha_y = fmaxf(ay, RT_BSDF_MIN_ALPHA);
+    b->separable = smith == RT_SMITH_SEPARABLE;
+}
+
+void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float alpha_x, float alpha_y,
+                            rt_smith smith)
+{
+    set_frame(b, n, n);
+    set_conductor(b, eta, k, alpha_x, alpha_y, smith);
+}
+
+rt_vec3 rt_material_absorption(const rt_material *m)
+{
+    rt_vec3 sigma = rt_v3s(0.0f);
+    if (m->bsdf == RT_BSDF_DIELECTRIC)
+        sigma = m->absorption;
+    bool volume = m->bsdf == RT_BSDF_DIELECTRIC ||
+                  (m->bsdf == RT_BSDF_GLTF && m->thickness > 0.0f && m->transmission > 0.0f);
+    if (volume && isfinite(m->attenuation_distance) && m->attenuation_distance > 0.0f) {
+        rt_vec3 c = rt_vmax(m->attenuation_color, rt_v3s(1e-6f));
+        rt_vec3 a = rt_v3(-logf(fminf(c.x, 1.0f)), -logf(fminf(c.y, 1.0f)), -logf(fminf(c.z, 1.0f)));
+        sigma = rt_add(sigma, rt_scale(a, 1.0f / m->attenuation_distance));
+    }
+    return rt_finite3(sigma) ? rt_vmax(sigma, rt_v3s(0.0f)) : rt_v3s(0.0f);
+}
+
+void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha)
+{
+    set_frame(b, n, n);
+    set_params(b, rt_v3s(1.0f), 0.0f, 1.0f, 1.5f, 1.0f, false);
+    eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
+    float r0 = (eta - 1.0f) / (eta + 1.0f);
+    b->f0 = r0 * r0;
+    b->eta = eta;
+    alpha = isfinite(alpha) ? rt_clampf(alpha, 0.0f, 1.0f) : 1.0f;
+    b->delta = alpha == 0.0f;
+    b->alpha = b->alpha_y = fmaxf(alpha, RT_BSDF_MIN_ALPHA);
+    b->radiance_eta2 = true;
+}
+
+float rt_fresnel_diffuse_reflectance(float eta)
+{
+    /* seen from the denser side: by reciprocity what does not reflect
+     * inside is what enters from outside, shrunk by the solid angle ratio,
+     * Fdr(eta) = 1 - (1 - Fdr(1 / eta)) / eta^2 (no kink to integrate) */
+    if (eta > 1.0f)
+        return 1.0f - (1.0f - rt_fresnel_diffuse_reflectance(1.0f / eta)) / (eta * eta);
+    /* integral of F(c) 2c dc, midpoint rule (F is smooth from outside:
+     * 64 points are within 2e-5) */
+    enum { N = 64 };
+    float sum = 0.0f;
+    for (int i = 0; i < N; i++) {
+        float c = ((float)i + 0.5f) / N;
+        sum += rt_fresnel_exact(c, eta) * 2.0f * c;
+    }
+    return sum / N;
+}
+
+void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alpha)
+{
+    set_frame(b, n, n);
+    set_params(b, R, 0.0f, 1.0f, 1.5f, 0.0f, false);
+    eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
+    float r0 = (eta - 1.0f) / (eta + 1.0f);
+    b->f0 = r0 * r0;
+    b->eta = eta;
+    b->plastic = true;
+    alpha = isfinite(alpha) ? rt_clampf(alpha, 0.0f, 1.0f) : 1.0f;
+    b->delta = alpha == 0.0f;
+    b->alpha = b->alpha_y = fmaxf(alpha, RT_BSDF_MIN_ALPHA);
+    /* light entering the coat (1 - Fi), bouncing between base and coat
+     * (the geometric series 1 / (1 - R Fdr_in), Fdr_in the coat's internal
+     * diffuse reflectance) and leaving (1 - Fo) loses 1 / eta_in^2 of its
+     * radiance to the wider cone outside (Weidlich and Wilkie 2007;
+     * Mitsuba's plastic) */
+    float inv_eta2 = eta * eta; /* (n_outside / n_coat)^2 */
+    float fdr_in = rt_fresnel_diffuse_reflectance(1.0f / eta);
+    rt_vec3 d = b->base;
+    b->diffuse = rt_v3(d.x / (1.0f - d.x * fdr_in), d.y / (1.0f - d.y * fdr_in), d.z / (1.0f - d.z * fdr_in));
+    b->diffuse = rt_scale(b->diffuse, inv_eta2);
+    if (!rt_finite3(b->diffuse))
+        b->diffuse = rt_v3s(0.0f);
 }
 
 void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
@@ -186,6 +393,41 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
     if (!(rt_dot(n, sf->wo) > 1e-4f) || !rt_finite3(n))
         n = sf->ng;
     set_frame(b, n, sf->ng);
+    if (m->bsdf == RT_BSDF_CONDUCTOR) {
+        float roughness = m->roughness;
+        if (m->metal_rough_tex.texture != RT_NONE) {
+            rt_vec2 uv = rt_texture_slot_uv(&m->metal_rough_tex,
+                                            m->metal_rough_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
+            roughness *= rt_texture_sample(s, m->metal_rough_tex.texture, uv, false).y;
+        }
+        float ax = m->alpha_u >= 0.0f ? m->alpha_u : roughness * roughness;
+        float ay = m->alpha_v >= 0.0f ? m->alpha_v : roughness * roughness;
+        if (ax != ay) { /* anisotropic: x along the surface tangent */
+            rt_vec3 t = rt_sub(sf->t, rt_scale(n, rt_dot(sf->t, n)));
+            float l2 = rt_length2(t);
+            if (l2 > 1e-12f && isfinite(l2)) {
+                b->t = rt_scale(t, 1.0f / sqrtf(l2));
+                b->b = rt_cross(n, b->t);
+            }
+        }
+        set_conductor(b, m->eta, m->k, ax, ay, m->smith);
+        return;
+    }
+    if (m->bsdf == RT_BSDF_DIELECTRIC) {
+        /* eta = n_wo / n_wi: exterior over interior entering the front */
+        float eta = m->exterior_ior / m->ior;
+        float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
+        rt_bsdf_make_dielectric(b, n, sf->front ? eta : 1.0f / eta, alpha);
+        set_frame(b, n, sf->ng);
+        return;
+    }
+    if (m->bsdf == RT_BSDF_PLASTIC) { /* opaque: the same from either side */
+        rt_vec4 c = rt_surface_base_color(ctx, sf);
+        float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
+        rt_bsdf_make_plastic(b, n, rt_v3(c.x, c.y, c.z), m->exterior_ior / m->ior, alpha);
+        set_frame(b, n, sf->ng);
+        return;
+    }
     rt_vec4 b4 = rt_surface_base_color(ctx, sf);
     float metallic = m->metallic, roughness = m->roughness, transmission = m->transmission;
     if (m->bsdf != RT_BSDF_LAMBERT && m->metal_rough_tex.texture != RT_NONE) {
@@ -207,17 +449,29 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
 void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit)
 {
     *p_diffuse = *p_specular = *p_transmit = 0.0f;
+    if (b->conductor) {
+        *p_specular = 1.0f;
+        return;
+    }
     if (b->lambert) {
         *p_diffuse = mean3(b->diffuse) > 0.0f ? 1.0f : 0.0f;
         return;
     }
-    /* F at the macro normal estimates each lobe's share; the floors keep
-     * every lobe that can contribute at some microfacet sampleable (inside
-     * glass past the critical angle F is 1 at the normal, yet tilted
-     * facets still transmit) */
-    rt_vec3 F = fresnel(b, wo.z);
-    float ws = fmaxf(mean3(F), 0.02f);
-    float wd = mean3(rt_mul(rt_vmax(rt_sub(rt_v3s(1.0f), F), rt_v3s(0.1f)), b->diffuse));
+    /* F at the macro normal estimates each lobe's share. A delta interface
+     * uses it exactly; a rough one floors both shares, so every lobe that
+     * can contribute at some microfacet stays sampleable (inside glass past
+     * the critical angle Fd is 1 at the normal, yet tilted facets still
+     * transmit) */
+    float fd = fresnel_dielectric(b, wo.z);
+    rt_vec3 F = fresnel_specular(b, wo.z, fd);
+    float ws = mean3(F), td = 1.0f - fd;
+    if (b->plastic) /* the diffuse lobe's albedo: (1 - Fo) diffuse (1 - Fdr_out), about (1 - Fo) diffuse */
+        td *= 1.0f - b->f0;
+    if (!b->delta) {
+        ws = fmaxf(ws, 0.02f);
+        td = fmaxf(td, 0.1f);
+    }
+    float wd = mean3(b->diffuse) * td;
     float wt = wd * b->transmission;
     wd *= 1.0f - b->transmission;
     float sum = ws + wd + wt;
@@ -238,25 +492,44 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
         *pdf = pd * wi.z * RT_INV_PI;
         return rt_scale(b->diffuse, RT_INV_PI);
     }
+    if (b->conductor && b->delta)
+        return rt_v3s(0.0f);
     rt_vec3 h = rt_add(wo, wi);
     float l2 = rt_length2(h);
     if (!(l2 > 1e-20f)) /* opposite directions: both grazing */
         return rt_v3s(0.0f);
     h = rt_scale(h, 1.0f / sqrtf(l2));
     float voh = rt_dot(wo, h);
-    rt_vec3 F = fresnel(b, voh);
-    float D = rt_ggx_d(h, b->alpha);
-    float G = rt_ggx_g2(wo, wi, b->alpha);
-    float spec = D * G / (4.0f * wo.z * wi.z);
-    if (!isfinite(spec))
-        spec = 0.0f;
-    rt_vec3 f = rt_scale(rt_mul(rt_sub(rt_v3s(1.0f), F), b->diffuse), (1.0f - b->transmission) * RT_INV_PI);
-    f = rt_add(f, rt_scale(F, spec));
+    if (b->conductor) {
+        /* F(wo.h) D G2 / (4 cos_o cos_i), VNDF pdf G1(wo) D / (4 cos_o) */
+        float D = d_xy(h, b->alpha, b->alpha_y);
+        float spec = D * g2_xy(wo, wi, b->alpha, b->alpha_y, b->separable) / (4.0f * wo.z * wi.z);
+        float pv = g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
+        if (!isfinite(spec) || !isfinite(pv))
+            return rt_v3s(0.0f);
+        *pdf = ps * pv;
+        return rt_scale(rt_fresnel_conductor(voh, b->eta_c, b->k_c), spec);
+    }
+    float fd = fresnel_dielectric(b, voh);
+    /* diffuse: the dielectric's fresnel_mix leaves 1 - Fd to the base;
+     * under a plastic's coat, what enters at wi and leaves at wo */
+    float tdiff = b->plastic ? (1.0f - fresnel_dielectric(b, wo.z)) * (1.0f - fresnel_dielectric(b, wi.z))
+                             : (1.0f - fd) * (1.0f - b->transmission);
+    rt_vec3 f = rt_scale(b->diffuse, tdiff * RT_INV_PI);
     float p = pd * wi.z * RT_INV_PI;
-    if (ps > 0.0f) {
-        float pv = rt_ggx_g1(wo, b->alpha) * D / (4.0f * wo.z);
-        if (isfinite(pv))
-            p += ps * pv;
+    if (!b->delta) {
+        rt_vec3 F = fresnel_specular(b, voh, fd);
+        float D = rt_ggx_d(h, b->alpha);
+        float G = rt_ggx_g2(wo, wi, b->alpha);
+        float spec = D * G / (4.0f * wo.z * wi.z);
+        if (!isfinite(spec))
+            spec = 0.0f;
+        f = rt_add(f, rt_scale(F, spec));
+        if (ps > 0.0f) {
+            float pv = rt_ggx_g1(wo, b->alpha) * D / (4.0f * wo.z);
+            if (isfinite(pv))
+                p += ps * pv;
+        }
     }
     *pdf = p;
     return f;
@@ -269,6 +542,15 @@ rt_vec3 rt_bsdf_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float *pdf)
     return eval_lobes(b, wo, wi, pd, ps, pdf ? pdf : &dummy);
 }
 
+static bool delta_sample(rt_bsdf_sample *s, rt_vec3 wi, rt_vec3 w)
+{
+    s->wi = wi;
+    s->weight = w;
+    s->pdf = 0.0f;
+    s->delta = true;
+    return rt_finite3(wi) && rt_finite3(w) && rt_max3(w) > 0.0f;
+}
+
 bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
 {
     if (!(wo.z > 0.0f))
@@ -278,12 +560,11 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
     if (!(pd + ps + pt > 0.0f))
         return false;
     if (pt > 0.0f && ulobe >= pd + ps) {
-        /* refraction through a microfacet: the macro normal for the
-         * smoothest surfaces, else a visible normal (Heitz 2018); the
-         * weight f |cos| / pdf of Walter et al.'s BTDF with that sampling
-         * is (1 - F) T c_diff G2 / G1(wo) */
-        bool rough = b->alpha > RT_BSDF_MIN_ALPHA;
-        rt_vec3 h = rough ? rt_ggx_sample_vndf(wo, b->alpha, u) : rt_v3(0.0f, 0.0f, 1.0f);
+        /* refraction through a microfacet: the macro normal for a delta
+         * interface, else a visible normal (Heitz 2018); the weight
+         * f |cos| / pdf of Walter et al.'s BTDF with that sampling is
+         * (1 - Fd) T c_diff G2 / G1(wo) */
+        rt_vec3 h = b->delta ? rt_v3(0.0f, 0.0f, 1.0f) : rt_ggx_sample_vndf(wo, b->alpha, u);
         float eta = b->eta;
         float ci = rt_dot(wo, h);
         if (!(ci > 0.0f))
@@ -296,20 +577,23 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
         if (!(wi.z < 0.0f))
             return false; /* the microfacet sends it back out */
         wi = rt_normalize(wi);
-        rt_vec3 F = fresnel(b, ci);
-        float g = rough ? rt_ggx_g2(wo, wi, b->alpha) / rt_ggx_g1(wo, b->alpha) : 1.0f;
-        rt_vec3 w = rt_scale(rt_mul(rt_sub(rt_v3s(1.0f), F), b->diffuse), g * b->transmission / pt);
-        s->wi = wi;
-        s->weight = w;
-        s->pdf = 0.0f;
-        s->delta = true;
-        return rt_finite3(s->wi) && rt_finite3(w);
+        float fd = fresnel_dielectric(b, ci);
+        float g = b->delta ? 1.0f : rt_ggx_g2(wo, wi, b->alpha) / rt_ggx_g1(wo, b->alpha);
+        float scale = b->radiance_eta2 ? eta * eta : 1.0f; /* L / n^2 is invariant */
+        return delta_sample(s, wi, rt_scale(b->diffuse, (1.0f - fd) * g * b->transmission * scale / pt));
+    }
+    if (b->conductor && b->delta)
+        return delta_sample(s, rt_v3(-wo.x, -wo.y, wo.z), rt_fresnel_conductor(wo.z, b->eta_c, b->k_c));
+    if (b->delta && ps > 0.0f && ulobe >= pd) {
+        /* mirror reflection about the normal: weight F / (its probability) */
+        float fd = fresnel_dielectric(b, wo.z);
+        return delta_sample(s, rt_v3(-wo.x, -wo.y, wo.z), rt_scale(fresnel_specular(b, wo.z, fd), 1.0f / ps));
     }
     rt_vec3 wi;
-    if (ulobe < pd || b->lambert || !(ps > 0.0f)) {
+    if (ulobe < pd || b->lambert || b->delta || !(ps > 0.0f)) {
         wi = rt_sample_cosine_hemisphere(u);
     } else {
-        rt_vec3 h = rt_ggx_sample_vndf(wo, b->alpha, u);
+        rt_vec3 h = vndf_xy(wo, b->alpha, b->alpha_y, u);
         wi = rt_sub(rt_scale(h, 2.0f * rt_dot(wo, h)), wo);
     }
     if (!(wi.z > 0.0f) || !rt_finite3(wi))

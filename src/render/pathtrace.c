@@ -24,10 +24,17 @@
  * and environment images without a table, a constant background) count in
  * full on BSDF hits.
  *
- * Russian roulette (Arvo and Kirk 1990) from RT_PATH_RR_START bounces: the
+ * Russian roulette (Arvo and Kirk 1990) from settings.rr_depth bounces: the
  * path survives with q = min(max channel of beta, 0.95) and beta /= q, which
- * keeps the estimator unbiased. settings.max_depth caps the scattering
+ * keeps the estimator unbiased; rr_depth 0 is adaptive (pbrt-v4's rule):
+ * from the first bounce, whenever the max channel of beta has fallen below
+ * 1, the path survives with q = that channel. settings.max_depth caps the scattering
  * events of a path (0 = no cap).
+ *
+ * Absorption (Beer-Lambert): a path segment that ends on the back of a
+ * dielectric (or a glTF KHR_materials_volume object) ran inside it, so
+ * beta is multiplied by exp(-sigma_a d) over its length d
+ * (rt_material_absorption); objects are assumed closed and not nested.
  *
  * Area lights are pure emitters: their visible quad emits from its front
  * and reflects nothing. Shadow rays pass alpha cut-outs and blended
@@ -169,6 +176,7 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
     int max_depth = s->settings.max_depth > 0 ? s->settings.max_depth : RT_PATH_HARD_LIMIT;
     if (max_depth > RT_PATH_HARD_LIMIT)
         max_depth = RT_PATH_HARD_LIMIT;
+    int rr_depth = s->settings.rr_depth;
     rt_ray r = *ray;
     float len = rt_length(r.dir);
     if (!(len > 0.0f) || !isfinite(len))
@@ -194,9 +202,16 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         }
         if (found != RT_WALK_SURFACE)
             break;
+        const rt_material *m = &s->materials[sf.material];
+        if (!sf.front && (m->bsdf == RT_BSDF_DIELECTRIC || m->thickness > 0.0f)) {
+            /* the segment ran inside this object: Beer-Lambert absorption
+             * over its length (r.tmin is the hit distance, dir is unit) */
+            rt_vec3 sigma = rt_material_absorption(m);
+            if (rt_max3(sigma) > 0.0f)
+                beta = rt_mul(beta, rt_v3(expf(-sigma.x * r.tmin), expf(-sigma.y * r.tmin), expf(-sigma.z * r.tmin)));
+        }
         /* emission, MIS-weighted when it could have been light-sampled */
         rt_vec3 Le = rt_surface_emission(ctx, &sf);
-        const rt_material *m = &s->materials[sf.material];
         /* area lights' quads have emissive materials: look only those up */
         bool emissive = rt_max3(rt_scale(m->emission, m->emission_strength)) > 0.0f;
         uint32_t light = emissive ? rt_area_light_of_prim(s, ctx->state->light_table, sf.prim) : RT_NONE;
@@ -249,8 +264,8 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         prev_pdf = bs.pdf;
         prev_p = sf.p;
         bounces++;
-        if (bounces >= RT_PATH_RR_START) {
-            float q = fminf(rt_max3(beta), 0.95f);
+        if (rr_depth == 0 ? rt_max3(beta) < 1.0f : bounces >= rr_depth) {
+            float q = rr_depth == 0 ? rt_max3(beta) : fminf(rt_max3(beta), 0.95f);
             if (rt_rng_float(rng) >= q)
                 break;
             beta = rt_scale(beta, 1.0f / q);

@@ -1,5 +1,6 @@
 /* scene.c - the scene tables: defaults, appends, marks and rollback, bounds,
- * automatic framing. (rt_settings_default() is in settings.c, driven by the
+ * automatic framing, and the named metals' constants (sources in
+ * rt/scene/scene.h). (rt_settings_default() is in settings.c, driven by the
  * settings table.) */
 #include "rt/scene/scene.h"
 
@@ -42,6 +43,12 @@ void rt_material_default(rt_material *m, const char *name)
     m->alpha_mode = RT_ALPHA_OPAQUE;
     m->alpha_cutoff = 0.5f;
     m->double_sided = true;
+    m->eta = rt_metals[0].eta; /* Cu */
+    m->k = rt_metals[0].k;
+    m->alpha_u = m->alpha_v = -1.0f;
+    m->smith = RT_SMITH_CORRELATED;
+    m->exterior_ior = 1.0f;
+    m->absorption = rt_v3s(0.0f);
     m->thickness = 0.0f;
     m->attenuation_color = rt_v3s(1.0f);
     m->attenuation_distance = INFINITY;
@@ -52,6 +59,18 @@ void rt_material_default(rt_material *m, const char *name)
     rt_texture_slot_none(&m->emissive_tex);
     rt_texture_slot_none(&m->transmission_tex);
 }
+
+const rt_metal rt_metals[] = {
+    {"Cu", {0.27105f, 0.67693f, 1.31640f}, {3.60920f, 2.62480f, 2.29210f}},
+    {"Au", {0.18299f, 0.42108f, 1.37340f}, {3.42420f, 2.34590f, 1.77040f}},
+    {"Ag", {0.15943f, 0.14512f, 0.13547f}, {3.92910f, 3.19000f, 2.38080f}},
+    {"Al", {1.34560f, 0.96521f, 0.61722f}, {7.47460f, 6.39950f, 5.30310f}},
+    {"Ti", {2.74070f, 2.54180f, 2.26700f}, {3.81430f, 3.43450f, 3.03850f}},
+    {"Pt", {2.37570f, 2.08470f, 1.84530f}, {4.26550f, 3.71530f, 3.13650f}},
+    {"Fe", {2.91140f, 2.94970f, 2.58450f}, {3.08930f, 2.93180f, 2.76700f}},
+    {"CuZn", {0.44400f, 0.52700f, 1.09400f}, {3.69500f, 2.76500f, 1.82900f}}, /* brass */
+};
+const size_t rt_metal_count = sizeof rt_metals / sizeof *rt_metals;
 
 void rt_scene_init(rt_scene *s)
 {

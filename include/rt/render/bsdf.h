@@ -16,25 +16,44 @@
  *       ... rt_bsdf_to_world(&b, s.wi) ...
  *
  * Model, for base colour B, metallic m, roughness r, alpha = r^2, index of
- * refraction eta, transmission T (glTF 2.0 spec, appendix B.3.5, with
- * KHR_materials_ior and KHR_materials_transmission):
+ * refraction eta, transmission T: the normative form of the glTF 2.0
+ * specification (appendix B.3.5, with KHR_materials_ior and
+ * KHR_materials_transmission), the mix by metallic of a metal BRDF and a
+ * dielectric one:
  *
- *   F0     = lerp(((eta - 1) / (eta + 1))^2, B, m)
- *   F      = F0 + (1 - F0) (1 - |wo.h|)^5           (Schlick)
- *   c_diff = lerp(B, 0, m)
- *   f      = (1 - F)(1 - T) c_diff / pi  +  F D(h) V(wo, wi)
+ *   metal      = conductor_fresnel(f0 = B, specular)      = Fm specular
+ *   dielectric = fresnel_mix(ior, base, layer = specular) = (1 - Fd) base + Fd specular
+ *   base       = (1 - T) B / pi + T btdf
+ *   f          = lerp(dielectric, metal, m)
+ *              = (1 - m)(1 - Fd)(1 - T) B / pi  +  lerp(Fd, Fm, m) D V   (+ transmission)
+ *   Fm         = B + (1 - B)(1 - |wo.h|)^5               (Schlick on the base colour)
+ *   Fd         = F0 + (1 - F0)(1 - |wo.h|)^5, F0 = ((eta - 1) / (eta + 1))^2,
+ *                or, for a transmissive surface (T > 0), the exact
+ *                unpolarised Fresnel equations (rt_fresnel_exact), 1 past
+ *                the critical angle
  *
  * with D the GGX (Trowbridge-Reitz) distribution and V = G2 / (4 |n.wo|
  * |n.wi|), G2 the height-correlated Smith masking-shadowing term. The
- * transmitted share (1 - F) T c_diff refracts through a GGX microfacet
- * (Walter et al. 2007; smooth at roughness 0), sampled only (a "delta"
- * sample: not light-sampled, no MIS). RT_BSDF_LAMBERT is exactly B / pi.
+ * spec's "simplified" single-F0 form, F = Schlick(lerp(F0, B, m)) on both
+ * lobes, has the same specular lobe (Schlick is linear in F0) but darkens
+ * the diffuse lobe of partly metallic texels by (1 - F) instead of
+ * (1 - m)(1 - Fd); rt no longer uses it. The transmitted share
+ * (1 - m)(1 - Fd) T B refracts through a GGX microfacet (Walter et al.
+ * 2007), sampled only (a "delta" sample: not light-sampled, no MIS).
+ * Roughness exactly 0 is a true delta interface: mirror reflection and
+ * refraction about the normal, both sampled only, so rt_bsdf_eval holds
+ * just the diffuse lobe. RT_BSDF_LAMBERT is exactly B / pi.
+ *
+ * RT_BSDF_CONDUCTOR (rt_bsdf.conductor) is a metal of complex index
+ * eta + i k per channel: f = F_conductor(wo.h) D G2 / (4 cos_o cos_i) with
+ * anisotropic GGX (alpha along t and b), G2 height-correlated or
+ * separable; alpha 0 is a delta mirror of weight F_conductor(cos_o).
  *
  * Sampling picks a lobe by its estimated share of the reflected energy at
  * wo, then samples diffuse by the cosine, specular by the distribution of
  * visible normals (Heitz 2018, "Sampling the GGX Distribution of Visible
- * Normals", JCGT 7(4)); the pdf is the mixture of both (one-sample MIS over
- * the lobes), and rt_bsdf_eval returns the same pdf.
+ * Normals", JCGT 7(4)); the pdf is the mixture of the non-delta lobes
+ * (one-sample MIS over the lobes), and rt_bsdf_eval returns the same pdf.
  */
 #ifndef RT_BSDF_H
 #define RT_BSDF_H
@@ -43,15 +62,24 @@
 
 #include "rt/render/surface.h"
 
-#define RT_BSDF_MIN_ALPHA 1e-3f /* GGX alpha floor: roughness 0 is a very sharp lobe, never a delta */
+#define RT_BSDF_MIN_ALPHA 1e-4f /* GGX alpha floor for roughness > 0 (roughness 0 is a delta interface) */
 
 typedef struct rt_bsdf {
     rt_vec3 t, b, n;  /* shading frame, world space; n on the side of wo */
     rt_vec3 ng;       /* geometric normal on the side of wo */
     bool lambert;     /* pure Lambert: f = diffuse / pi */
-    rt_vec3 diffuse;  /* c_diff (Lambert: the albedo) */
-    rt_vec3 f0;       /* Schlick normal-incidence reflectance per channel */
-    float alpha;      /* GGX alpha */
+    bool delta;       /* roughness 0: mirror reflection and refraction, sampled only */
+    rt_vec3 base;     /* base colour B: the metal's normal-incidence reflectance */
+    rt_vec3 diffuse;  /* (1 - m) B (Lambert: the albedo) */
+    float metallic;   /* m */
+    float f0;         /* the dielectric's normal-incidence reflectance ((eta - 1) / (eta + 1))^2 */
+    float alpha;      /* GGX alpha (at least RT_BSDF_MIN_ALPHA); along the tangent t for a conductor */
+    float alpha_y;    /* GGX alpha along the bitangent b (= alpha unless anisotropic) */
+    bool conductor;   /* bsdf conductor: F(eta_c, k_c) D G2 / (4 cos cos) */
+    bool separable;   /* conductor: separable Smith G1 G1 instead of height-correlated */
+    bool radiance_eta2; /* dielectric: refraction scales radiance by eta^2 (n_wo / n_wi)^2 */
+    bool plastic;     /* coat over Lambert: diffuse = R / (1 - R Fdr_in) / eta_in^2, times (1 - Fo)(1 - Fi) / pi */
+    rt_vec3 eta_c, k_c; /* conductor: complex index relative to the outside */
     float transmission; /* T */
     float eta;        /* index ratio across the surface along a transmitted ray: n_incident / n_transmitted */
 } rt_bsdf;
@@ -59,12 +87,27 @@ typedef struct rt_bsdf {
 typedef struct rt_bsdf_sample {
     rt_vec3 wi;       /* local direction */
     rt_vec3 weight;   /* f |cos| / pdf, or the delta lobe's weight / its probability */
-    float pdf;        /* solid-angle pdf; 0 for a transmission sample */
-    bool delta;       /* transmission: sampled only, never light-sampled, so no MIS */
+    float pdf;        /* solid-angle pdf; 0 for a delta sample */
+    bool delta;       /* transmission or a mirror reflection: sampled only, never light-sampled, so no MIS */
 } rt_bsdf_sample;
 
+/* Exact unpolarised Fresnel reflectance of a smooth dielectric interface
+ * (Born and Wolf, Principles of Optics, 1.5.2) at incident cosine cos_i,
+ * eta = n_incident / n_transmitted; 1 past the critical angle. */
+float rt_fresnel_exact(float cos_i, float eta);
+/* Exact unpolarised Fresnel reflectance of a conductor of complex index
+ * eta + i k (per channel, relative to the outside) at incident cosine cos_i. */
+rt_vec3 rt_fresnel_conductor(float cos_i, rt_vec3 eta, rt_vec3 k);
+
+/* Absorption coefficient inside a material (Beer-Lambert: transmittance
+ * exp(-sigma d) over a distance d travelled inside): a dielectric's
+ * `absorption` plus, for a dielectric or a glTF volume (thickness > 0,
+ * transmission > 0), -ln(attenuation_color) / attenuation_distance. Zero
+ * when nothing absorbs. */
+rt_vec3 rt_material_absorption(const rt_material *m);
+
 /* GGX building blocks, local frame (z = normal). */
-float rt_ggx_d(rt_vec3 h, float alpha);              /* D(h), 0 below the surface */
+float rt_ggx_d(rt_vec3 h, float alpha);              /* D(h), 0 below the surface; h unit, stable to alpha 1e-4 */
 float rt_ggx_lambda(rt_vec3 w, float alpha);         /* Smith Lambda(w) */
 float rt_ggx_g1(rt_vec3 w, float alpha);             /* 1 / (1 + Lambda) */
 float rt_ggx_g2(rt_vec3 wo, rt_vec3 wi, float alpha); /* height-correlated 1 / (1 + L(wo) + L(wi)) */
@@ -80,6 +123,19 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
 /* The same from plain parameters, frame n (unit) with ng = n; for tests. */
 void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float roughness, float ior,
                   float transmission, bool lambert);
+/* A dielectric (bsdf dielectric): eta = n_wo / n_wi, GGX alpha (0: smooth). */
+void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha);
+/* A plastic (bsdf plastic): Lambertian reflectance R under a dielectric
+ * coat, eta = n_outside / n_coat, coat GGX alpha (0: smooth). */
+void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alpha);
+/* Hemispherical (cosine-weighted) average of the exact Fresnel reflectance
+ * at an interface of index ratio eta = n_incident / n_transmitted:
+ * the internal diffuse reflectance for eta > 1. */
+float rt_fresnel_diffuse_reflectance(float eta);
+/* A conductor (bsdf conductor) the same way: GGX alphas along x and y of
+ * the frame (both 0: a delta mirror). */
+void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float alpha_x, float alpha_y,
+                            rt_smith smith);
 
 static inline rt_vec3 rt_bsdf_to_local(const rt_bsdf *b, rt_vec3 w)
 {

@@ -28,7 +28,6 @@
 #include "rt/render/light.h"
 #include "rt/render/sampling.h"
 
-#define RT_PATH_RR_START 3     /* Russian roulette from this many bounces on */
 #define RT_PATH_HARD_LIMIT 1024 /* bounces when max_depth is 0 (unlimited): a guard, never reached in practice */
 
 rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng);

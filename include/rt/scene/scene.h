@@ -65,6 +65,7 @@ typedef struct rt_settings {
     rt_integrator integrator;
     int max_bounce;       /* mirror/refraction recursion depth */
     int max_depth;        /* path: most scattering events a path may have; 0 = unlimited (Russian roulette ends paths) */
+    int rr_depth;         /* path: Russian roulette from this many bounces on; 0 = adaptive (once the throughput is below 1) */
     int diffuse_bounces;  /* levels of indirect diffuse light (whitted) */
     int diffuse_rays;     /* cosine-distributed rays per diffuse level */
     int shadow_samples;   /* samples per area light per shading point */
@@ -127,9 +128,19 @@ typedef struct rt_texture_slot {
 typedef enum rt_alpha_mode { RT_ALPHA_OPAQUE = 0, RT_ALPHA_MASK, RT_ALPHA_BLEND } rt_alpha_mode;
 
 /* The path tracer's scattering model (docs/path-tracer.md): the glTF
- * metallic-roughness BRDF (the default, zero) or a pure Lambertian
- * albedo / pi with no specular lobe (`bsdf lambert`). */
-typedef enum rt_bsdf_model { RT_BSDF_GLTF = 0, RT_BSDF_LAMBERT } rt_bsdf_model;
+ * metallic-roughness BRDF (the default, zero), a pure Lambertian
+ * albedo / pi with no specular lobe (`bsdf lambert`), a conductor with a
+ * complex index of refraction eta + i k per channel (`bsdf conductor`), or
+ * clear glass with an interior and exterior index, absorption inside and
+ * radiance scaled by 1 / eta^2 across the interface (`bsdf dielectric`), or
+ * a dielectric coat over a Lambertian base with the internal reflections
+ * between them summed (`bsdf plastic`). */
+typedef enum rt_bsdf_model {
+    RT_BSDF_GLTF = 0, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR, RT_BSDF_DIELECTRIC, RT_BSDF_PLASTIC
+} rt_bsdf_model;
+
+/* Smith masking-shadowing term of the microfacet models. */
+typedef enum rt_smith { RT_SMITH_CORRELATED = 0, RT_SMITH_SEPARABLE } rt_smith;
 
 /* One material table for every source. The Phong fields drive the whitted
  * integrator; the PBR fields drive the path tracer; colour, textures,
@@ -157,6 +168,14 @@ typedef struct rt_material {
     bool double_sided;
     bool unlit;
     rt_bsdf_model bsdf;     /* path tracer: glTF metallic-roughness (default) or pure Lambert */
+    /* conductor (bsdf conductor): complex IOR relative to the outside, GGX
+     * alphas along the tangent and bitangent (negative: roughness^2) */
+    rt_vec3 eta, k;
+    float alpha_u, alpha_v;
+    rt_smith smith;
+    /* dielectric and plastic: ior is the inside's (the coat's) index */
+    float exterior_ior;     /* index outside (default 1) */
+    rt_vec3 absorption;     /* absorption coefficient inside, per scene unit (adds to attenuation_*) */
     float thickness;        /* KHR_materials_volume */
     rt_vec3 attenuation_color;
     float attenuation_distance; /* INFINITY = no absorption */
@@ -170,6 +189,18 @@ typedef struct rt_material {
 } rt_material;
 
 void rt_material_default(rt_material *m, const char *name);
+
+/* Named metals for `bsdf conductor` (`metal NAME`): complex IOR eta + i k at
+ * the red, green and blue wavelengths 650, 550 and 450 nm, from
+ * RefractiveIndex.INFO's "3D" data set (M. N. Polyanskiy, refractiveindex.info
+ * database, Sci. Data 11, 94 (2024)), as tabulated by C. Hindefjord, "RGB IOR
+ * values for common metals". The default conductor is Cu (as pbrt-v4's). */
+typedef struct rt_metal {
+    const char *name;
+    rt_vec3 eta, k;
+} rt_metal;
+extern const rt_metal rt_metals[];
+extern const size_t rt_metal_count;
 void rt_texture_slot_none(rt_texture_slot *slot);
 
 /* -------------------------------------------------------------- lights */
