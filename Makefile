@@ -21,7 +21,7 @@ WARN    += -Werror
 endif
 CFLAGS  ?=
 CFLAGS  += -std=c11 $(WARN) $(OPT) -Iinclude -D_POSIX_C_SOURCE=200809L -MMD -MP
-LDLIBS  := -lstb -lpthread -lm
+LDLIBS  := -lstb -lOpenEXRCore -ldl -lpthread -lm
 BUILD   ?= build
 SHARED  ?= ../shared
 RT      ?= rt
@@ -69,6 +69,11 @@ $(BUILD)/tests/test_corpus: tests/test_corpus.c tests/fuzz/harness.c tests/fuzz/
 $(BUILD)/tests/test_compare: tests/test_compare.c src/driver/compare.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests -o $@ tests/test_compare.c src/driver/compare.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+
+# rt convert's driver code is tested in-process too
+$(BUILD)/tests/test_hdr: tests/test_hdr.c src/driver/convert.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Itests -o $@ tests/test_hdr.c src/driver/convert.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # the kd-tree's portable path (no AVX2), tested on machines that have AVX2 too
 TEST_BIN += $(BUILD)/tests/test_kdtree_scalar

@@ -24,6 +24,7 @@
 #include "memory_budget.h"
 #include "rt/base/error.h"
 #include "rt/base/log.h"
+#include "rt/image/tonemap.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/settings.h"
 
@@ -50,6 +51,9 @@ typedef struct args {
     double preview_seconds; /* --preview; 0 = no live view */
     rt_log_level log_level; /* -q, -v */
     memory_budget budget;   /* --max-memory, else the default (not applied yet) */
+    float exposure_ev;      /* --exposure: stops for 8-bit output, on top of the scene's */
+    rt_tonemap tonemap;     /* --tonemap: the curve for 8-bit output */
+    bool half;              /* --half: EXR in half floats */
     setting_flag settings[ARGS_MAX_SETTINGS];
     size_t setting_count;
 } args;

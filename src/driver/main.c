@@ -275,7 +275,9 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         status = 2;
     }
     if (status != 2) {
-        if (rt_framebuffer_write(&fb, output, set->exposure, &err) != RT_OK) {
+        rt_image_options io = {.exposure = set->exposure * rt_exposure_scale(a->exposure_ev), .tonemap = a->tonemap,
+                               .half = a->half};
+        if (rt_framebuffer_write_with(&fb, output, &io, &err) != RT_OK) {
             report(&err, &a->budget);
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL) {
@@ -297,6 +299,8 @@ int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "compare") == 0)
         return rt_cmd_compare(argc - 1, argv + 1);
+    if (argc > 1 && strcmp(argv[1], "convert") == 0)
+        return rt_cmd_convert(argc - 1, argv + 1);
     args a;
     int status = args_parse(&a, argc, argv);
     if (status != ARGS_OK)
