@@ -34,6 +34,7 @@ typedef enum flag_kind {
     FLAG_EXPOSURE,
     FLAG_TONEMAP,
     FLAG_HALF,
+    FLAG_DENOISE,
     FLAG_HELP,
     FLAG_VERSION,
 } flag_kind;
@@ -56,6 +57,8 @@ static const flag flags[] = {
      "exposure in stops for 8-bit output (x 2^EV, on top of the scene's `exposure`); float outputs stay linear"},
     {NULL, "--tonemap", "NAME", FLAG_TONEMAP, NULL, "tone curve for 8-bit output: clamp (default), filmic, aces or agx"},
     {NULL, "--half", NULL, FLAG_HALF, NULL, "EXR output in 16-bit half floats (default 32-bit float)"},
+    {NULL, "--denoise", NULL, FLAG_DENOISE, NULL,
+     "denoise the render with Intel Open Image Denoise (install it with 'make denoiser')"},
     {"-t", "--threads", "N", FLAG_THREADS, NULL, "render threads"},
     {"-s", "--samples", "N", FLAG_SETTING, "samples", NULL},
     {"-r", "--resolution", "WxH", FLAG_SETTING, "resolution", NULL},
@@ -375,6 +378,9 @@ int args_parse(args *a, int argc, char **argv)
             break;
         case FLAG_HALF:
             a->half = true;
+            break;
+        case FLAG_DENOISE:
+            a->denoise = true;
             break;
         case FLAG_MAX_MEMORY:
             if (!memory_budget_parse(value, &a->budget.bytes))

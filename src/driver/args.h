@@ -54,6 +54,7 @@ typedef struct args {
     float exposure_ev;      /* --exposure: stops for 8-bit output, on top of the scene's */
     rt_tonemap tonemap;     /* --tonemap: the curve for 8-bit output */
     bool half;              /* --half: EXR in half floats */
+    bool denoise;           /* --denoise: Intel Open Image Denoise on the render */
     setting_flag settings[ARGS_MAX_SETTINGS];
     size_t setting_count;
 } args;

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "output.h"
 #include "rt/base/log.h"
 #include "rt/render/camera.h"
 #include "rt/accel/kdtree.h"
@@ -275,9 +276,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         status = 2;
     }
     if (status != 2) {
-        rt_image_options io = {.exposure = set->exposure * rt_exposure_scale(a->exposure_ev), .tonemap = a->tonemap,
-                               .half = a->half};
-        if (rt_framebuffer_write_with(&fb, output, &io, &err) != RT_OK) {
+        if (output_write(a, set, &fb, output, &err) != RT_OK) {
             report(&err, &a->budget);
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL) {
@@ -310,9 +309,13 @@ int main(int argc, char **argv)
     if (a.info_path)
         return print_info(a.info_path, &a.budget);
 
+    rt_error err = {0};
+    if (output_check(&a, &err) != RT_OK) {
+        fprintf(stderr, "rt: %s\n", err.message);
+        return 2;
+    }
     rt_scene scene;
     rt_scene_init(&scene);
-    rt_error err = {0};
     char output[1024];
     if (prepare(&scene, &a, output, sizeof output, &err) != RT_OK) {
         report(&err, &a.budget);
