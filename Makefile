@@ -8,7 +8,7 @@
 #   make scenes       render every scene in scenes/ into docs/images/
 #   make denoiser     Intel Open Image Denoise for --denoise: the pyoidn wheel in build/oidn-venv
 #   make install      rt, the library and its headers, and a pkg-config file
-#                     (PREFIX=/usr/local, DESTDIR for staging)
+#                     (PREFIX=/usr/local, DESTDIR for staging); make test-install checks it
 #   make clean
 #
 # Variables: WERROR=1 turns warnings into errors (CI sets it); SHARED=dir
@@ -37,7 +37,7 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 DEPS_OK  := $(BUILD)/.deps-ok
 
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build fuzz install uninstall denoiser
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build fuzz install uninstall test-install denoiser
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -152,6 +152,11 @@ install: $(RT) $(BUILD)/librt.a
 uninstall:
 	rm -f $(DESTDIR)$(BINDIR)/rt $(DESTDIR)$(LIBDIR)/librtrender.a $(DESTDIR)$(PCDIR)/rtrender.pc
 	rm -rf $(DESTDIR)$(INCLUDEDIR)/rt
+
+# Installs into a temporary DESTDIR and builds examples/library.c against it
+# through pkg-config, as a user of the library would (run by .ci/run).
+test-install: $(RT) $(BUILD)/librt.a
+	@CC="$(CC)" sh tests/install.sh
 
 clean:
 	rm -rf build build-asan build-tsan build-profile build-fuzz rt rt-profile bench/rtbench bench/buildscale

@@ -31,25 +31,13 @@ static char tmp_dir[256];
 static int setup_tmp(void **state)
 {
     (void)state;
-    snprintf(tmp_dir, sizeof tmp_dir, "/tmp/rt_test_load_XXXXXX");
-    return mkdtemp(tmp_dir) ? 0 : -1;
+    return test_make_dir(tmp_dir, sizeof tmp_dir, "load") ? 0 : -1;
 }
 
 static int teardown_tmp(void **state)
 {
     (void)state;
-    DIR *dir = opendir(tmp_dir);
-    if (dir) {
-        struct dirent *e;
-        char p[600];
-        while ((e = readdir(dir)))
-            if (e->d_name[0] != '.') {
-                snprintf(p, sizeof p, "%s/%s", tmp_dir, e->d_name);
-                unlink(p);
-            }
-        closedir(dir);
-    }
-    rmdir(tmp_dir);
+    test_remove_dir(tmp_dir);
     return 0;
 }
 

@@ -15,7 +15,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cmocka.h>
 
@@ -47,6 +49,32 @@ static inline void test_write_file(const char *path, const void *data, size_t si
     if (size)
         assert_int_equal(fwrite(data, 1, size, f), size);
     fclose(f);
+}
+
+/* A fresh scratch directory /tmp/rt_test_TAG_XXXXXX into dir (size >= 64);
+ * false when it cannot be made. */
+static inline int test_make_dir(char *dir, size_t size, const char *tag)
+{
+    snprintf(dir, size, "/tmp/rt_test_%s_XXXXXX", tag);
+    return mkdtemp(dir) != NULL;
+}
+
+/* Removes a scratch directory made by test_make_dir with the files in it
+ * (no subdirectories). */
+static inline void test_remove_dir(const char *dir)
+{
+    DIR *d = opendir(dir);
+    if (d) {
+        struct dirent *e;
+        char p[4200];
+        while ((e = readdir(d)))
+            if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) {
+                snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
+                unlink(p);
+            }
+        closedir(d);
+    }
+    rmdir(dir);
 }
 
 /* A small deterministic PRNG for test data (xorshift64*). */

@@ -95,36 +95,57 @@ static const void *const_field_of(const rt_settings *st, size_t offset)
     return (const char *)st + offset;
 }
 
+/* Writes an already checked value into its field(s); the environment's
+ * image is loaded by store_environment() instead. */
+static void store_value(rt_settings *st, const rt_setting *def, const rt_setting_value *v)
+{
+    switch (def->type) {
+    case RT_SETTING_INT:
+    case RT_SETTING_ENUM:
+        *(int *)field_of(st, def->field) = (int)v->i[0];
+        break;
+    case RT_SETTING_UINT32:
+        *(uint32_t *)field_of(st, def->field) = (uint32_t)v->i[0];
+        break;
+    case RT_SETTING_SIZE:
+        *(int *)field_of(st, def->field) = (int)v->i[0];
+        *(int *)field_of(st, def->field2) = (int)v->i[1];
+        break;
+    case RT_SETTING_FLOAT:
+        *(float *)field_of(st, def->field) = v->f[0];
+        break;
+    case RT_SETTING_COLOR:
+        *(rt_vec3 *)field_of(st, def->field) = rt_v3(v->f[0], v->f[1], v->f[2]);
+        break;
+    case RT_SETTING_STRING:
+        memcpy(field_of(st, def->field), v->text, strlen(v->text) + 1);
+        break;
+    case RT_SETTING_ENVIRONMENT: /* store_environment() */
+        break;
+    }
+}
+
+/* Every setting at its table default: the defaults go through the same
+ * store as a value read from a file. */
 void rt_settings_default(rt_settings *st)
 {
     memset(st, 0, sizeof *st);
     for (size_t i = 0; i < rt_settings_count; i++) {
         const rt_setting *def = &rt_settings_table[i];
-        const double *d = def->defaults;
-        switch (def->type) {
-        case RT_SETTING_INT:
-        case RT_SETTING_ENUM:
-            *(int *)field_of(st, def->field) = (int)d[0];
-            break;
-        case RT_SETTING_UINT32:
-            *(uint32_t *)field_of(st, def->field) = (uint32_t)d[0];
-            break;
-        case RT_SETTING_SIZE:
-            *(int *)field_of(st, def->field) = (int)d[0];
-            *(int *)field_of(st, def->field2) = (int)d[1];
-            break;
-        case RT_SETTING_FLOAT:
-            *(float *)field_of(st, def->field) = (float)d[0];
-            break;
-        case RT_SETTING_COLOR:
-            *(rt_vec3 *)field_of(st, def->field) = rt_v3((float)d[0], (float)d[1], (float)d[2]);
-            break;
-        case RT_SETTING_STRING: /* empty: none */
-            break;
-        case RT_SETTING_ENVIRONMENT:
+        bool integer = def->type == RT_SETTING_INT || def->type == RT_SETTING_UINT32 ||
+                       def->type == RT_SETTING_ENUM || def->type == RT_SETTING_SIZE;
+        rt_setting_value v = {.text = ""};
+        for (int k = 0; k < 3; k++) {
+            if (integer && k < 2)
+                v.i[k] = (long long)def->defaults[k];
+            else if (!integer)
+                v.f[k] = (float)def->defaults[k];
+        }
+        if (def->type == RT_SETTING_ENVIRONMENT) {
             *(uint32_t *)field_of(st, def->field) = RT_NONE;
-            *(float *)field_of(st, def->field2) = (float)d[0];
-            break;
+            *(float *)field_of(st, def->field2) = v.f[0];
+        } else {
+            store_value(st, def, &v);
         }
     }
 }
@@ -340,33 +361,9 @@ rt_result rt_setting_store(rt_scene *s, const rt_setting *def, const rt_setting_
         return store_environment(s, def, v, dir, pb);
     if (!s)
         return RT_OK;
-    rt_settings *st = &s->settings;
-    switch (def->type) {
-    case RT_SETTING_INT:
-    case RT_SETTING_ENUM:
-        *(int *)field_of(st, def->field) = (int)v->i[0];
-        break;
-    case RT_SETTING_UINT32:
-        *(uint32_t *)field_of(st, def->field) = (uint32_t)v->i[0];
-        break;
-    case RT_SETTING_SIZE:
-        *(int *)field_of(st, def->field) = (int)v->i[0];
-        *(int *)field_of(st, def->field2) = (int)v->i[1];
-        break;
-    case RT_SETTING_FLOAT:
-        *(float *)field_of(st, def->field) = v->f[0];
-        break;
-    case RT_SETTING_COLOR:
-        *(rt_vec3 *)field_of(st, def->field) = rt_v3(v->f[0], v->f[1], v->f[2]);
-        break;
-    case RT_SETTING_STRING:
-        memcpy(field_of(st, def->field), v->text, strlen(v->text) + 1);
-        break;
-    case RT_SETTING_ENVIRONMENT: /* above */
-        break;
-    }
+    store_value(&s->settings, def, v);
     if (def->marks_given)
-        *(bool *)field_of(st, def->given) = true;
+        *(bool *)field_of(&s->settings, def->given) = true;
     return RT_OK;
 }
 
