@@ -35,6 +35,7 @@ typedef enum flag_kind {
     FLAG_TONEMAP,
     FLAG_HALF,
     FLAG_DENOISE,
+    FLAG_AOV,
     FLAG_HELP,
     FLAG_VERSION,
 } flag_kind;
@@ -48,6 +49,8 @@ typedef struct flag {
     const char *help;       /* lines for --help; FLAG_SETTING: the table's */
 } flag;
 
+const char *const aov_names[AOV_COUNT] = {"albedo", "normal", "depth", "position", "variance", "spp"};
+
 /* In --help order. */
 static const flag flags[] = {
     {"-o", "--output", "FILE", FLAG_OUTPUT, NULL,
@@ -59,6 +62,9 @@ static const flag flags[] = {
     {NULL, "--half", NULL, FLAG_HALF, NULL, "EXR output in 16-bit half floats (default 32-bit float)"},
     {NULL, "--denoise", NULL, FLAG_DENOISE, NULL,
      "denoise the render with Intel Open Image Denoise (install it with 'make denoiser')"},
+    {NULL, "--aov", "LIST", FLAG_AOV, NULL,
+     "extra images, comma-separated: albedo, normal, depth, position, variance, spp; layers of an .exr output, "
+     "else files NAME.albedo.pfm ..."},
     {"-t", "--threads", "N", FLAG_THREADS, NULL, "render threads"},
     {"-s", "--samples", "N", FLAG_SETTING, "samples", NULL},
     {"-r", "--resolution", "WxH", FLAG_SETTING, "resolution", NULL},
@@ -382,6 +388,23 @@ int args_parse(args *a, int argc, char **argv)
         case FLAG_DENOISE:
             a->denoise = true;
             break;
+        case FLAG_AOV: {
+            const char *s = value;
+            while (*s) {
+                size_t n = strcspn(s, ",");
+                int k = 0;
+                while (k < AOV_COUNT && !(strlen(aov_names[k]) == n && strncmp(s, aov_names[k], n) == 0))
+                    k++;
+                if (k == AOV_COUNT)
+                    return fail_usage("%s: unknown AOV '%.*s' (albedo, normal, depth, position, variance, spp)", name,
+                                      (int)n, s);
+                a->aovs |= 1u << k;
+                s += n + (s[n] == ',');
+            }
+            if (!a->aovs)
+                return fail_usage("%s wants a list such as albedo,normal", name);
+            break;
+        }
         case FLAG_MAX_MEMORY:
             if (!memory_budget_parse(value, &a->budget.bytes))
                 return fail_usage("%s wants a size such as 4G, 512M or 'none', got '%s'", name, value);

@@ -248,6 +248,14 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         return 2;
     }
 
+    output_aovs aov;
+    if (output_aovs_init(&aov, a, set->width, set->height, &err) != RT_OK) {
+        report(&err, &a->budget);
+        rt_framebuffer_free(&fb);
+        rt_kdtree_free(&tree);
+        return 2;
+    }
+
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
@@ -265,6 +273,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     ro.cancel = &interrupted;
     ro.progress = view.bar || view.preview_path ? progress_report : NULL;
     ro.progress_user = &view;
+    ro.aov = output_aovs_for_render(&aov);
     rt_render_stats rs;
     rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);
     int status = 0;
@@ -276,7 +285,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         status = 2;
     }
     if (status != 2) {
-        if (output_write(a, set, &fb, output, &err) != RT_OK) {
+        if (output_write(a, set, &fb, &aov, output, &err) != RT_OK) {
             report(&err, &a->budget);
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL) {
@@ -289,6 +298,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
             rs.seconds > 0 ? 1e-6 * (double)rs.rays / rs.seconds : 0.0);
     if (rs.bad_samples)
         rt_warn("%llu NaN/Inf samples were dropped", (unsigned long long)rs.bad_samples);
+    output_aovs_free(&aov);
     rt_framebuffer_free(&fb);
     rt_kdtree_free(&tree);
     return status;
