@@ -6,6 +6,7 @@
 #   make tsan         the threaded tests under ThreadSanitizer
 #   make profile      ./rt-profile: optimised, with symbols and frame pointers (for perf)
 #   make scenes       render every scene in scenes/ into docs/images/
+#   make denoiser     Intel Open Image Denoise for --denoise: the pyoidn wheel in build/oidn-venv
 #   make install      rt, the library and its headers, and a pkg-config file
 #                     (PREFIX=/usr/local, DESTDIR for staging); make test-install checks it
 #   make clean
@@ -21,7 +22,7 @@ WARN    += -Werror
 endif
 CFLAGS  ?=
 CFLAGS  += -std=c11 $(WARN) $(OPT) -Iinclude -D_POSIX_C_SOURCE=200809L -MMD -MP
-LDLIBS  := -lstb -lpthread -lm
+LDLIBS  := -lstb -lOpenEXRCore -ldl -lpthread -lm
 BUILD   ?= build
 SHARED  ?= ../shared
 RT      ?= rt
@@ -36,7 +37,7 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 DEPS_OK  := $(BUILD)/.deps-ok
 
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build fuzz install uninstall test-install
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build fuzz install uninstall test-install denoiser
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -70,6 +71,11 @@ $(BUILD)/tests/test_compare: tests/test_compare.c src/driver/compare.c src/drive
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests -o $@ tests/test_compare.c src/driver/compare.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
+# rt convert's driver code is tested in-process too
+$(BUILD)/tests/test_hdr: tests/test_hdr.c src/driver/convert.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Itests -o $@ tests/test_hdr.c src/driver/convert.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+
 # the kd-tree's portable path (no AVX2), tested on machines that have AVX2 too
 TEST_BIN += $(BUILD)/tests/test_kdtree_scalar
 # (only the traversal is compiled again, with RT_KD_SCALAR; its two functions
@@ -77,6 +83,19 @@ TEST_BIN += $(BUILD)/tests/test_kdtree_scalar
 $(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c src/accel/kdtree_trace.c src/accel/kdtree_internal.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -DRT_KD_SCALAR -Itests -o $@ tests/test_kdtree.c src/accel/kdtree_trace.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+
+# --denoise loads Intel Open Image Denoise at run time (src/image/denoise.c);
+# Debian has no package, so the pyoidn wheel (which ships the library and its
+# CPU device) goes into a project-local virtual environment. --no-deps: only
+# the shared libraries are used, not the Python binding's numpy.
+OIDN_VENV   := build/oidn-venv
+OIDN_WHEEL  := pyoidn==2.5.1.0
+denoiser: $(OIDN_VENV)/.installed
+$(OIDN_VENV)/.installed:
+	@echo "rt: installing Intel Open Image Denoise ($(OIDN_WHEEL)) into $(OIDN_VENV)" >&2
+	python3 -m venv $(OIDN_VENV)
+	$(OIDN_VENV)/bin/pip install -q --no-deps $(OIDN_WHEEL)
+	@touch $@
 
 test: $(RT) $(TEST_BIN)
 	@RT_SHARED=$(SHARED) RT_BIN=./$(RT) sh tests/run.sh $(TEST_BIN)

@@ -70,3 +70,5 @@ put("off", "coff.off", b"COFF\n3 1 0\n0 0 0 1 0 0 1\n1 0 0 0 1 0 1\n0 1 0 0 0 1 
 for p in glob.glob(os.path.join(shared, "assets/gltf/*/glTF/*.png")) + glob.glob("assets/*.png"):
     if os.path.getsize(p) <= 64 * 1024:
         put("image", os.path.basename(p), open(p, "rb").read())
+for p in sorted(glob.glob("tests/corpus/exr/*.exr")):
+    put("exr", os.path.basename(p), open(p, "rb").read())

@@ -4,6 +4,7 @@
 #   libstb-dev     stb_image / stb_image_write (PNG, JPEG, HDR in and out)
 #   libjsmn-dev    the JSON tokenizer under src/gltf.c
 #   libcmocka-dev  the test framework
+#   libopenexr-dev the OpenEXR Core C API (EXR images in and out)
 set -eu
 CC=${CC:-cc}
 missing=""
@@ -15,6 +16,7 @@ check() { # header package
 check stb/stb_image.h libstb-dev
 check jsmn.h libjsmn-dev
 check cmocka.h libcmocka-dev
+check OpenEXR/openexr.h libopenexr-dev
 [ -z "$missing" ] && exit 0
 
 echo "rt: installing missing build packages:$missing" >&2

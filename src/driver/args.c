@@ -17,6 +17,7 @@
 
 #include "rt/base/log.h"
 #include "rt/base/number.h"
+#include "rt/image/tonemap.h"
 #include "rt/render/render.h"
 
 typedef enum flag_kind {
@@ -35,6 +36,11 @@ typedef enum flag_kind {
     FLAG_PREVIEW,
     FLAG_INFO,
     FLAG_MAX_MEMORY,
+    FLAG_EXPOSURE,
+    FLAG_TONEMAP,
+    FLAG_HALF,
+    FLAG_DENOISE,
+    FLAG_AOV,
     FLAG_HELP,
     FLAG_VERSION,
 } flag_kind;
@@ -48,11 +54,22 @@ typedef struct flag {
     const char *help;       /* lines for --help; FLAG_SETTING: the table's */
 } flag;
 
+const char *const aov_names[AOV_COUNT] = {"albedo", "normal", "depth", "position", "variance", "spp"};
+
 /* In --help order. */
 static const flag flags[] = {
     {"-o", "--output", "FILE", FLAG_OUTPUT, NULL,
-     "output image: .png (8-bit sRGB), .pfm (linear float), .hdr (Radiance)\n"
+     "output image: .png (8-bit sRGB), .pfm (linear float), .hdr (Radiance), .exr (OpenEXR)\n"
      "default: the scene's `output`, else INPUT-NAME.png in this directory"},
+    {NULL, "--exposure", "EV", FLAG_EXPOSURE, NULL,
+     "exposure in stops for 8-bit output (x 2^EV, on top of the scene's `exposure`); float outputs stay linear"},
+    {NULL, "--tonemap", "NAME", FLAG_TONEMAP, NULL, "tone curve for 8-bit output: clamp (default), filmic, aces or agx"},
+    {NULL, "--half", NULL, FLAG_HALF, NULL, "EXR output in 16-bit half floats (default 32-bit float)"},
+    {NULL, "--denoise", NULL, FLAG_DENOISE, NULL,
+     "denoise the render with Intel Open Image Denoise (install it with 'make denoiser')"},
+    {NULL, "--aov", "LIST", FLAG_AOV, NULL,
+     "extra images, comma-separated: albedo, normal, depth, position, variance, spp; layers of an .exr output, "
+     "else files NAME.albedo.pfm ..."},
     {"-t", "--threads", "N", FLAG_THREADS, NULL, "render threads"},
     {"-s", "--samples", "N", FLAG_SETTING, "samples", NULL},
     {"-r", "--resolution", "WxH", FLAG_SETTING, "resolution", NULL},
@@ -117,6 +134,7 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off | -]\n"
                "       rt compare CANDIDATE REFERENCE [--max-rmse X] [--max-flip X] ...  (docs/compare.md)\n"
+               "       rt convert IN OUT [--exposure EV] [--tonemap NAME] [--half]  (docs/hdr.md)\n"
                "\n"
                "Renders a scene to an image. With no input, renders the built-in Cornell box to out.png;\n"
                "'-' reads a scene, glTF or mesh from standard input. A model given directly renders with\n"
@@ -419,6 +437,38 @@ int args_parse(args *a, int argc, char **argv)
         case FLAG_INFO:
             a->info_path = value;
             break;
+        case FLAG_EXPOSURE:
+            if (rt_parse_float(value, &a->exposure_ev) != RT_NUMBER_OK || !(a->exposure_ev >= -64.0f) ||
+                !(a->exposure_ev <= 64.0f))
+                return fail_usage("%s wants stops of exposure from -64 to 64, got '%s'", name, value);
+            break;
+        case FLAG_TONEMAP:
+            if (!rt_tonemap_parse(value, &a->tonemap))
+                return fail_usage("%s wants one of %s, got '%s'", name, RT_TONEMAP_NAMES, value);
+            break;
+        case FLAG_HALF:
+            a->half = true;
+            break;
+        case FLAG_DENOISE:
+            a->denoise = true;
+            break;
+        case FLAG_AOV: {
+            const char *s = value;
+            while (*s) {
+                size_t n = strcspn(s, ",");
+                int k = 0;
+                while (k < AOV_COUNT && !(strlen(aov_names[k]) == n && strncmp(s, aov_names[k], n) == 0))
+                    k++;
+                if (k == AOV_COUNT)
+                    return fail_usage("%s: unknown AOV '%.*s' (albedo, normal, depth, position, variance, spp)", name,
+                                      (int)n, s);
+                a->aovs |= 1u << k;
+                s += n + (s[n] == ',');
+            }
+            if (!a->aovs)
+                return fail_usage("%s wants a list such as albedo,normal", name);
+            break;
+        }
         case FLAG_MAX_MEMORY:
             if (!memory_budget_parse(value, &a->budget.bytes))
                 return fail_usage("%s wants a size such as 4G, 512M or 'none', got '%s'", name, value);

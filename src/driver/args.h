@@ -24,10 +24,12 @@
 #include "memory_budget.h"
 #include "rt/base/error.h"
 #include "rt/base/log.h"
+#include "rt/image/tonemap.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/settings.h"
 
 #define ARGS_OK (-1)
+
 #define ARGS_MAX_SETTINGS 64 /* setting flags on one command line */
 #define ARGS_MAX_INPUTS 256  /* files one --info reports */
 
@@ -59,9 +61,18 @@ typedef struct args {
     double preview_seconds; /* --preview; 0 = no live view */
     rt_log_level log_level; /* -q, -v */
     memory_budget budget;   /* --max-memory, else the default (not applied yet) */
+    float exposure_ev;      /* --exposure: stops for 8-bit output, on top of the scene's */
+    rt_tonemap tonemap;     /* --tonemap: the curve for 8-bit output */
+    bool half;              /* --half: EXR in half floats */
+    bool denoise;           /* --denoise: Intel Open Image Denoise on the render */
+    unsigned aovs;          /* --aov: bit k for aov_names[k] */
     setting_flag settings[ARGS_MAX_SETTINGS];
     size_t setting_count;
 } args;
+
+/* The AOVs --aov names, in bit order (rt/render/aov.h says what each holds). */
+enum { AOV_ALBEDO, AOV_NORMAL, AOV_DEPTH, AOV_POSITION, AOV_VARIANCE, AOV_SPP, AOV_COUNT };
+extern const char *const aov_names[AOV_COUNT];
 
 /* Parses argv into *a. Returns ARGS_OK to go on, else the exit status. */
 int args_parse(args *a, int argc, char **argv);

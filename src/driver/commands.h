@@ -19,4 +19,10 @@ int rt_cmd_compare(int argc, char **argv);
 /* The same, printing to `out` and `errs` instead of stdout and stderr (tests). */
 int rt_cmd_compare_to(int argc, char **argv, FILE *out, FILE *errs);
 
+/* rt convert IN OUT [--exposure EV] [--tonemap NAME] [--half]: an image from
+ * one format to another (EXR, PFM, HDR in; PNG, PFM, HDR, EXR out). Exit
+ * status 0 when written, 2 for bad input. */
+int rt_cmd_convert(int argc, char **argv);
+int rt_cmd_convert_to(int argc, char **argv, FILE *out, FILE *errs);
+
 #endif

@@ -17,12 +17,13 @@
 #include "rt/image/compare.h"
 #include "rt/image/flip.h"
 #include "rt/io/framebuffer.h"
+#include "rt/io/image_read.h"
 #include "rt/scene/texture.h"
 
 static const char usage[] =
-    "usage: rt compare CANDIDATE.pfm REFERENCE.pfm [options]\n"
+    "usage: rt compare CANDIDATE REFERENCE [options]\n"
     "\n"
-    "Compares a linear RGB image (PFM, as rt -o NAME.pfm writes) with a reference\n"
+    "Compares a linear RGB image (PFM, EXR or HDR, as rt -o NAME.pfm writes) with a reference\n"
     "of the same size and prints, as key: value lines:\n"
     "  MSE, RMSE, relMSE (mean (c - r)^2 / (r^2 + 0.01)), MAE, each image's mean R G B,\n"
     "  LDR-FLIP (both images clamped to [0,1] and sRGB-encoded, as their PNGs)\n"
@@ -135,14 +136,13 @@ static bool has_extension(const char *path, const char *ext)
     return n >= e && strcasecmp(path + n - e, ext) == 0;
 }
 
-/* Reads a PFM; fails with a message naming the file, including for
- * non-finite values, which no metric can take. */
+/* Reads a PFM, EXR, HDR (or 8-bit) image; fails with a message naming the
+ * file, including for non-finite values, which no metric can take. */
 static bool read_image(const char *path, rt_framebuffer *fb, FILE *errs)
 {
     rt_error err = {0};
-    if (rt_pfm_read(path, fb, &err) != RT_OK) {
-        fprintf(errs, "rt: compare: %s%s\n", err.message,
-                has_extension(path, ".pfm") ? "" : " (rt compare reads PFM images: render with -o NAME.pfm)");
+    if (rt_image_read(path, fb, &err) != RT_OK) {
+        fprintf(errs, "rt: compare: %s\n", err.message);
         return false;
     }
     size_t n = (size_t)fb->width * (size_t)fb->height * 3;

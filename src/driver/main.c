@@ -32,6 +32,7 @@
 #include "args.h"
 #include "commands.h"
 #include "memory_budget.h"
+#include "output.h"
 #include "progress.h"
 
 /* The kd-tree's primitive ids are the 30 payload bits of its references
@@ -402,6 +403,14 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         return 2;
     }
 
+    output_aovs aov;
+    if (output_aovs_init(&aov, a, set->width, set->height, &err) != RT_OK) {
+        report(&err, &a->budget);
+        rt_framebuffer_free(&fb);
+        rt_kdtree_free(&tree);
+        return 2;
+    }
+
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
@@ -419,6 +428,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     ro.cancel = &interrupted;
     ro.progress = view.bar || view.preview_path ? progress_report : NULL;
     ro.progress_user = &view;
+    ro.aov = output_aovs_for_render(&aov);
     rt_render_stats rs;
     rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);
     int status = 0;
@@ -430,7 +440,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         status = 2;
     }
     if (status != 2) {
-        if (rt_framebuffer_write(&fb, output, set->exposure, &err) != RT_OK) {
+        if (output_write(a, set, &fb, &aov, output, &err) != RT_OK) {
             report(&err, &a->budget);
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL) {
@@ -443,6 +453,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
             rs.seconds > 0 ? 1e-6 * (double)rs.rays / rs.seconds : 0.0);
     if (rs.bad_samples)
         rt_warn("%llu NaN/Inf samples were dropped", (unsigned long long)rs.bad_samples);
+    output_aovs_free(&aov);
     rt_framebuffer_free(&fb);
     rt_kdtree_free(&tree);
     return status;
@@ -452,6 +463,8 @@ int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "compare") == 0)
         return rt_cmd_compare(argc - 1, argv + 1);
+    if (argc > 1 && strcmp(argv[1], "convert") == 0)
+        return rt_cmd_convert(argc - 1, argv + 1);
     args a;
     int status = args_parse(&a, argc, argv);
     if (status != ARGS_OK)
@@ -461,9 +474,13 @@ int main(int argc, char **argv)
     if (a.info_path)
         return print_infos(&a);
 
+    rt_error err = {0};
+    if (output_check(&a, &err) != RT_OK) {
+        fprintf(stderr, "rt: %s\n", err.message);
+        return 2;
+    }
     rt_scene scene;
     rt_scene_init(&scene);
-    rt_error err = {0};
     char output[1024];
     if (prepare(&scene, &a, output, sizeof output, &err) != RT_OK) {
         report(&err, &a.budget);

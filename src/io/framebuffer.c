@@ -1,7 +1,10 @@
-/* framebuffer.c - framebuffer output: PNG (stb_image_write, 8-bit sRGB with
- * exposure), PFM (little-endian float RGB, bottom scanline first, as the
- * format defines) and Radiance HDR (stb_image_write), all written to a
- * temporary file beside the target and renamed into place.
+/* framebuffer.c - framebuffer output: PNG (stb_image_write, 8-bit sRGB after
+ * exposure and a tone curve, rt/image/tonemap.h), PFM (little-endian float
+ * RGB, bottom scanline first, as the format defines), Radiance HDR
+ * (stb_image_write) and OpenEXR (exr.c, with extra layers), all written to a
+ * temporary file beside the target and renamed into place. The float formats
+ * hold the render's linear radiance: exposure and tone mapping are for the
+ * 8-bit output only.
  *
  * Where Linux offers it, the temporary file has no name while it is
  * written (open(2) O_TMPFILE on the target's directory); only when it is
@@ -27,6 +30,8 @@
 #include <stb/stb_image_write.h>
 
 #include "rt/base/alloc.h"
+#include "rt/image/tonemap.h"
+#include "rt/io/exr.h"
 #include "rt/scene/texture.h"
 
 rt_result rt_framebuffer_init(rt_framebuffer *fb, int width, int height, rt_error *err)
@@ -58,8 +63,9 @@ rt_result rt_output_format(const char *path, rt_image_format *format, rt_error *
         if (strcasecmp(dot, ".png") == 0) { *format = RT_FORMAT_PNG; return RT_OK; }
         if (strcasecmp(dot, ".pfm") == 0) { *format = RT_FORMAT_PFM; return RT_OK; }
         if (strcasecmp(dot, ".hdr") == 0) { *format = RT_FORMAT_HDR; return RT_OK; }
+        if (strcasecmp(dot, ".exr") == 0) { *format = RT_FORMAT_EXR; return RT_OK; }
     }
-    return rt_fail(err, RT_ERR_INVALID, "%s: unknown output format (use .png, .pfm or .hdr)", path);
+    return rt_fail(err, RT_ERR_INVALID, "%s: unknown output format (use .png, .pfm, .hdr or .exr)", path);
 }
 
 /* A temporary file beside the target: unnamed (O_TMPFILE) when it can be,
@@ -214,22 +220,26 @@ static int write_pfm(FILE *f, const rt_framebuffer *fb)
     return 1;
 }
 
-static int write_png(FILE *f, const rt_framebuffer *fb, float exposure)
+static int write_png(FILE *f, const rt_framebuffer *fb, float exposure, rt_tonemap tonemap)
 {
     size_t n = (size_t)fb->width * (size_t)fb->height * 3;
     unsigned char *px = malloc(n);
     if (!px)
         return 0;
-    for (size_t i = 0; i < n; i++) {
-        float v = rt_linear_to_srgb(fb->rgb[i] * exposure);
-        px[i] = (unsigned char)(v * 255.0f + 0.5f);
-    }
+    rt_tonemap_to_srgb8(tonemap, exposure, fb->rgb, n / 3, px);
     int ok = stbi_write_png_to_func(write_to_file, f, fb->width, fb->height, 3, px, fb->width * 3);
     free(px);
     return ok;
 }
 
 rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float exposure, rt_error *err)
+{
+    rt_image_options opt = {.exposure = exposure};
+    return rt_framebuffer_write_with(fb, path, &opt, err);
+}
+
+rt_result rt_framebuffer_write_with(const rt_framebuffer *fb, const char *path, const rt_image_options *opt,
+                                    rt_error *err)
 {
     rt_image_format fmt;
     rt_result r = rt_output_format(path, &fmt, err);
@@ -242,11 +252,28 @@ rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float
         return rt_fail(err, RT_ERR_IO, "%s: cannot create a file there: %s", path, strerror(errno));
     FILE *f = t.f;
     int ok;
+    float exposure = opt->exposure;
     switch (fmt) {
     case RT_FORMAT_PFM: ok = write_pfm(f, fb); break;
     case RT_FORMAT_HDR: ok = stbi_write_hdr_to_func(write_to_file, f, fb->width, fb->height, 3, fb->rgb); break;
+    case RT_FORMAT_EXR: {
+        rt_exr_layer layers[1 + RT_MAX_IMAGE_LAYERS];
+        int count = 0;
+        layers[count++] = (rt_exr_layer){NULL, 3, fb->rgb};
+        for (int i = 0; i < opt->layer_count && i < RT_MAX_IMAGE_LAYERS; i++)
+            layers[count++] = (rt_exr_layer){opt->layers[i].name, opt->layers[i].channels, opt->layers[i].data};
+        r = rt_exr_write(f, path, fb->width, fb->height, layers, count, opt->half, err);
+        if (r != RT_OK) {
+            discard_temp(&t);
+            return r;
+        }
+        ok = 1;
+        break;
+    }
     case RT_FORMAT_PNG:
-    default: ok = write_png(f, fb, exposure > 0.0f && isfinite(exposure) ? exposure : 1.0f); break;
+    default:
+        ok = write_png(f, fb, exposure > 0.0f && isfinite(exposure) ? exposure : 1.0f, opt->tonemap);
+        break;
     }
     if (fflush(f) != 0 || ferror(f))
         ok = 0;

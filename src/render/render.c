@@ -17,6 +17,7 @@
 
 #include "rt/base/alloc.h"
 #include "rt/base/log.h"
+#include "rt/render/aov.h"
 #include "rt/render/camera.h"
 #include "rt/render/integrator.h"
 #include "rt/render/sampling.h"
@@ -46,6 +47,7 @@ struct rt_render_job {
     atomic_int *cancel;
     const rt_render_state *state; /* prepared once, read by every worker */
     rt_radiance_fn radiance;      /* the scene's integrator */
+    rt_aov_buffers *aov;          /* NULL = none */
 };
 typedef struct rt_render_job rt_render_job;
 
@@ -54,6 +56,32 @@ typedef struct worker {
     rt_render_job *job;
     uint64_t rays, camera_rays, bad_samples;
 } worker;
+
+/* The pixel's AOVs: means over its `good` samples; the variance of the mean
+ * luminance from the sample variance, sum of L^2 - (sum L)^2 / n over n - 1. */
+static void aov_store(rt_aov_buffers *aov, uint64_t pixel, const rt_aov_sample *s, uint32_t good, float lum_sum,
+                      double lum_sq)
+{
+    float inv = good ? 1.0f / (float)good : 0.0f;
+    const rt_vec3 *v3[3] = {&s->albedo, &s->normal, &s->position};
+    float *dst3[3] = {aov->albedo, aov->normal, aov->position};
+    for (int k = 0; k < 3; k++)
+        if (dst3[k]) {
+            dst3[k][3 * pixel] = v3[k]->x * inv;
+            dst3[k][3 * pixel + 1] = v3[k]->y * inv;
+            dst3[k][3 * pixel + 2] = v3[k]->z * inv;
+        }
+    if (aov->depth)
+        aov->depth[pixel] = s->depth * inv;
+    if (aov->spp)
+        aov->spp[pixel] = (float)good;
+    if (aov->variance) {
+        double n = (double)good, var = 0.0;
+        if (good > 1)
+            var = (lum_sq - (double)lum_sum * (double)lum_sum / n) / (n - 1.0) / n;
+        aov->variance[pixel] = (float)(var > 0.0 ? var : 0.0);
+    }
+}
 
 /* Renders one tile; false when cancelled part-way (the tile then stays
  * unfinished and is cleared to black). The cancel flag is read once a
@@ -75,6 +103,8 @@ static bool render_tile(rt_render_job *job, worker *w, rt_trace_ctx *ctx, int ti
             uint32_t pattern = (uint32_t)rt_mix64(pixel ^ ((uint64_t)st->seed << 40));
             rt_vec3 sum = rt_v3s(0);
             uint32_t good = 0;
+            rt_aov_sample aov_sum = {rt_v3s(0), rt_v3s(0), rt_v3s(0), 0.0f};
+            double lum_sq = 0.0;
             for (uint32_t s = 0; s < spp; s++) {
                 rt_vec2 j = spp > 1 ? rt_cmj_sample(s, spp, pattern) : rt_v2(0.5f, 0.5f);
                 rt_vec2 lens = rt_cmj_sample(s, spp, pattern ^ 0x68bc21ebu);
@@ -93,7 +123,19 @@ static bool render_tile(rt_render_job *job, worker *w, rt_trace_ctx *ctx, int ti
                 }
                 sum = rt_add(sum, L);
                 good++;
+                if (job->aov) { /* own random numbers: the image stays as it was */
+                    rt_rng arng = rt_rng_for_sample(st->seed ^ 0xa0f5eed5u, pixel, s);
+                    rt_aov_sample a;
+                    rt_aov_trace(ctx, ray, &arng, &a);
+                    aov_sum.albedo = rt_add(aov_sum.albedo, a.albedo);
+                    aov_sum.normal = rt_add(aov_sum.normal, a.normal);
+                    aov_sum.position = rt_add(aov_sum.position, a.position);
+                    aov_sum.depth += a.depth;
+                    lum_sq += (double)rt_luminance(L) * (double)rt_luminance(L);
+                }
             }
+            if (job->aov)
+                aov_store(job->aov, pixel, &aov_sum, good, rt_luminance(sum), lum_sq);
             if (good)
                 sum = rt_scale(sum, 1.0f / (float)good);
             float *px = job->fb->rgb + 3 * pixel;
@@ -195,6 +237,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     }
     job.state = &state;
     job.radiance = integrator->radiance;
+    job.aov = options ? options->aov : NULL;
 
     double t0 = now_seconds();
     int started = 0;

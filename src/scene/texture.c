@@ -1,4 +1,5 @@
-/* texture.c - images decoded once (stb_image behind our own size checks),
+/* texture.c - images decoded once (stb_image behind our own size checks,
+ * OpenEXR through rt/io/exr.h),
  * textures as image + sampler or a procedural pattern, and lookups.
  *
  * Lookups follow the glTF conventions, which are rt's internal ones: UV (0,0)
@@ -22,6 +23,7 @@
 #include <stb/stb_image.h>
 
 #include "rt/base/file.h"
+#include "rt/io/exr.h"
 
 /* sRGB 8-bit code -> linear value, from the IEC 61966-2-1 formula. */
 static const float srgb_table[256] = {
@@ -220,6 +222,22 @@ rt_result rt_image_load_memory(rt_scene *s, const void *data, size_t size, const
         if (pw > RT_MAX_IMAGE_DIM || ph > RT_MAX_IMAGE_DIM || (uint64_t)pw * ph > RT_MAX_IMAGE_PIXELS)
             return rt_fail(err, RT_ERR_LIMIT, "%s: image is %ux%u, over the limit of %dx%d and %u pixels", name, pw, ph,
                            RT_MAX_IMAGE_DIM, RT_MAX_IMAGE_DIM, (unsigned)RT_MAX_IMAGE_PIXELS);
+    }
+    if (rt_exr_is(bytes, size)) { /* linear float, like HDR: 16 bytes a texel */
+        rt_image img;
+        memset(&img, 0, sizeof img);
+        snprintf(img.name, sizeof img.name, "%s", name);
+        rt_result r = rt_exr_decode(bytes, size, name, RT_MAX_IMAGE_DIM, RT_MAX_IMAGE_PIXELS / 4, &img.rgbaf,
+                                    &img.width, &img.height, err);
+        if (r != RT_OK)
+            return r;
+        uint32_t idx = rt_scene_add_image(s, &img);
+        if (idx == RT_NONE) {
+            free(img.rgbaf);
+            return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", name);
+        }
+        *image = idx;
+        return RT_OK;
     }
     if (!stbi_info_from_memory(bytes, (int)size, &w, &h, &comp))
         return rt_fail(err, RT_ERR_INVALID, "%s: not a readable image (%s)", name, stbi_failure_reason());

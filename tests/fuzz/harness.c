@@ -9,11 +9,12 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "rt/io/exr.h"
 #include "rt/io/load.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/texture.h"
 
-const char *const rt_fuzz_targets[] = {"scene", "gltf", "glb", "gltf_bin", "obj", "ply", "off", "image", NULL};
+const char *const rt_fuzz_targets[] = {"scene", "gltf", "glb", "gltf_bin", "obj", "ply", "off", "image", "exr", NULL};
 
 static char dir[64];
 
@@ -108,6 +109,12 @@ int rt_fuzz_run(const char *target, const uint8_t *data, size_t size)
         uint32_t img;
         rt_image_load_memory(&s, data, size, "fuzz.img", &img, &err);
         rt_scene_free(&s);
+    } else if (strcmp(target, "exr") == 0) {
+        rt_error err;
+        float *rgba = NULL;
+        int w, h;
+        if (rt_exr_decode(data, size, "fuzz.exr", 4096, (uint64_t)1 << 22, &rgba, &w, &h, &err) == RT_OK)
+            free(rgba);
     } else {
         return -1;
     }

@@ -1,5 +1,8 @@
 /* rt/io/framebuffer.h - the framebuffer and writing it out: PNG (8-bit sRGB), PFM
- * (linear float) and Radiance HDR, chosen by the file extension.
+ * (linear float), Radiance HDR and OpenEXR (float or half, with extra layers
+ * such as AOVs), chosen by the file extension. The float formats (PFM, HDR,
+ * EXR) always hold linear radiance as rendered: exposure and the tone curve
+ * apply to PNG alone.
  *
  * Writes are atomic: the image goes to a temporary file in the same
  * directory, which is renamed over the target only once complete, so a
@@ -12,23 +15,47 @@
  *   ... fill fb.rgb (linear RGB floats, row 0 at the top) ...
  *   rt_output_check("out.png", &err);                // before rendering
  *   rt_framebuffer_write(&fb, "out.png", 1.0f, &err);
+ *
+ *   rt_image_options opt = {.exposure = 2.0f, .tonemap = RT_TONEMAP_AGX};
+ *   rt_framebuffer_write_with(&fb, "out.png", &opt, &err);   // or .half, .layers for EXR
  */
 #ifndef RT_FRAMEBUFFER_H
 #define RT_FRAMEBUFFER_H
 
+#include <stdbool.h>
+
 #include "rt/base/error.h"
+#include "rt/image/tonemap.h"
 
 typedef struct rt_framebuffer {
     int width, height;
     float *rgb; /* 3 floats a pixel, row-major, row 0 at the top */
 } rt_framebuffer;
 
-typedef enum rt_image_format { RT_FORMAT_PNG = 0, RT_FORMAT_PFM, RT_FORMAT_HDR } rt_image_format;
+typedef enum rt_image_format { RT_FORMAT_PNG = 0, RT_FORMAT_PFM, RT_FORMAT_HDR, RT_FORMAT_EXR } rt_image_format;
+
+#define RT_MAX_IMAGE_LAYERS 16
+
+/* An extra image beside the beauty one (an AOV): EXR writes it as a layer. */
+typedef struct rt_image_layer {
+    const char *name;  /* "albedo": channels albedo.R, .G, .B (or albedo.Y for one channel) */
+    int channels;      /* 1 or 3 */
+    const float *data; /* width * height * channels floats, row 0 at the top */
+} rt_image_layer;
+
+/* How to write; the zero value is rt_framebuffer_write's defaults with exposure 1. */
+typedef struct rt_image_options {
+    float exposure;       /* linear scale before the tone curve, PNG only (<= 0: 1) */
+    rt_tonemap tonemap;   /* PNG only; RT_TONEMAP_CLAMP (0) clamps to [0, 1] */
+    bool half;            /* EXR: 16-bit half channels instead of 32-bit float */
+    const rt_image_layer *layers; /* EXR: extra layers (at most RT_MAX_IMAGE_LAYERS) */
+    int layer_count;
+} rt_image_options;
 
 rt_result rt_framebuffer_init(rt_framebuffer *fb, int width, int height, rt_error *err);
 void rt_framebuffer_free(rt_framebuffer *fb);
 
-/* The format for a path's extension (.png, .pfm, .hdr; case-insensitive). */
+/* The format for a path's extension (.png, .pfm, .hdr, .exr; case-insensitive). */
 rt_result rt_output_format(const char *path, rt_image_format *format, rt_error *err);
 /* Checks before a render that the format is known, that the path is not a
  * directory or anything else but a regular file, and that its directory is
@@ -40,6 +67,9 @@ rt_result rt_output_check(const char *path, rt_error *err);
 rt_result rt_output_check_size(const char *path, int width, int height, rt_error *err);
 /* Writes atomically. exposure scales the values for PNG only. */
 rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float exposure, rt_error *err);
+/* Writes atomically with the options (tone curve, half floats, EXR layers). */
+rt_result rt_framebuffer_write_with(const rt_framebuffer *fb, const char *path, const rt_image_options *opt,
+                                    rt_error *err);
 
 /* Reads a PFM (for tests and comparisons against references). */
 rt_result rt_pfm_read(const char *path, rt_framebuffer *fb, rt_error *err);

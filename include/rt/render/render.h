@@ -67,6 +67,7 @@ typedef struct rt_render_options {
     atomic_int *cancel;        /* set non-zero (e.g. from a signal handler) to stop */
     rt_render_progress_fn progress; /* NULL = no reports; called from the calling thread */
     void *progress_user;       /* handed to progress */
+    struct rt_aov_buffers *aov; /* NULL = no AOVs; else the images to fill (rt/render/aov.h) */
 } rt_render_options;
 
 typedef struct rt_render_stats {

@@ -1,0 +1,45 @@
+/* rt/image/denoise.h - denoising with Intel Open Image Denoise (OIDN), loaded
+ * at run time.
+ *
+ * OIDN is not a Debian package; `make denoiser` installs the `pyoidn` wheel
+ * (which ships libOpenImageDenoise.so.2 and its CPU device) into
+ * build/oidn-venv. rt looks for the library, in order: the file named by
+ * RT_OIDN_LIBRARY; the system's libOpenImageDenoise.so.2; the wheel under
+ * build/oidn-venv beside the rt binary (or one or two folders up, for the
+ * test binaries), under $VIRTUAL_ENV, and under the Python user site
+ * (~/.local/lib/python3.X/site-packages). Nothing but --denoise needs it.
+ *
+ *   char where[4096];
+ *   if (rt_denoise_find(where, sizeof where, &err) != RT_OK)
+ *       ... err.message is one line saying how to install it ...
+ *   rt_denoise_image(&img, &err);   // in place
+ */
+#ifndef RT_DENOISE_H
+#define RT_DENOISE_H
+
+#include <stddef.h>
+
+#include "rt/base/error.h"
+
+/* What to denoise: linear HDR RGB, 3 floats a pixel, row 0 at the top. */
+typedef struct rt_denoise_input {
+    int width, height;
+    float *color;        /* denoised in place */
+    const float *albedo; /* optional (NULL): first non-specular hit's albedo */
+    const float *normal; /* optional, with albedo: its shading normal */
+} rt_denoise_input;
+
+/* The one-line hint printed when the library is missing. */
+#define RT_DENOISE_INSTALL_HINT "run 'make denoiser' (installs the pyoidn wheel into build/oidn-venv) or set RT_OIDN_LIBRARY"
+
+/* Finds and loads the library; `where` receives the path that loaded.
+ * RT_ERR_IO with a one-line message when it cannot be found. */
+rt_result rt_denoise_find(char *where, size_t size, rt_error *err);
+
+/* Runs OIDN's "RT" filter (hdr on) on in->color in place. With albedo and
+ * normal, they are denoised first by their own filters and passed as clean
+ * auxiliary images (cleanAux: the "prefiltered" mode OIDN recommends for
+ * final frames). Runs on OIDN's CPU device. */
+rt_result rt_denoise_image(const rt_denoise_input *in, rt_error *err);
+
+#endif

@@ -1,0 +1,22 @@
+/* rt/io/image_read.h - reading a whole image file into a framebuffer of
+ * linear RGB floats, whatever its format: OpenEXR (exr.h), PFM, Radiance HDR,
+ * and 8-bit images (PNG, JPEG...: sRGB-decoded to linear). The format is
+ * found from the file's first bytes, not its name. For `rt compare` and
+ * `rt convert`; scene textures load through rt/scene/texture.h instead.
+ *
+ *   rt_framebuffer fb;
+ *   if (rt_image_read("render.exr", &fb, &err) != RT_OK) ... err names the file ...
+ *   ... fb.rgb ...
+ *   rt_framebuffer_free(&fb);
+ */
+#ifndef RT_IMAGE_READ_H
+#define RT_IMAGE_READ_H
+
+#include "rt/base/error.h"
+#include "rt/io/framebuffer.h"
+
+/* Reads path into *fb (initialised here; free it with rt_framebuffer_free).
+ * Images over 65536 a side or 2^28 pixels are refused (RT_ERR_LIMIT). */
+rt_result rt_image_read(const char *path, rt_framebuffer *fb, rt_error *err);
+
+#endif

@@ -1,0 +1,165 @@
+/* output.c - a finished render to its files (output.h): --aov images as EXR
+ * layers or NAME.aov.pfm files, --denoise through rt/image/denoise.h (Intel
+ * Open Image Denoise's RT filter, with the albedo and normal AOVs), then the
+ * exposure (the scene's linear `exposure` times 2^--exposure) and tone curve
+ * for 8-bit output and --half for EXR, written by rt_framebuffer_write_with. */
+#include "output.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "rt/base/alloc.h"
+#include "rt/base/log.h"
+#include "rt/image/denoise.h"
+#include "rt/image/tonemap.h"
+
+rt_result output_check(const args *a, rt_error *err)
+{
+    if (!a->denoise)
+        return RT_OK;
+    char where[4096];
+    rt_result r = rt_denoise_find(where, sizeof where, err);
+    if (r == RT_OK)
+        rt_info("denoiser: %s", where);
+    return r;
+}
+
+static float **slot(rt_aov_buffers *b, int k)
+{
+    switch (k) {
+    case AOV_ALBEDO: return &b->albedo;
+    case AOV_NORMAL: return &b->normal;
+    case AOV_DEPTH: return &b->depth;
+    case AOV_POSITION: return &b->position;
+    case AOV_VARIANCE: return &b->variance;
+    case AOV_SPP:
+    default: return &b->spp;
+    }
+}
+
+static int channels_of(int k) { return k == AOV_ALBEDO || k == AOV_NORMAL || k == AOV_POSITION ? 3 : 1; }
+
+rt_result output_aovs_init(output_aovs *o, const args *a, int width, int height, rt_error *err)
+{
+    memset(o, 0, sizeof *o);
+    o->wanted = a->aovs;
+    unsigned need = a->aovs | (a->denoise ? (1u << AOV_ALBEDO) | (1u << AOV_NORMAL) : 0u);
+    for (int k = 0; k < AOV_COUNT; k++) {
+        if (!(need & (1u << k)))
+            continue;
+        float *p = rt_alloc((size_t)width * (size_t)height, (size_t)channels_of(k) * sizeof(float));
+        if (!p) {
+            output_aovs_free(o);
+            return rt_fail(err, RT_ERR_NOMEM, "out of memory for the %s AOV (%dx%d)", aov_names[k], width, height);
+        }
+        *slot(&o->buf, k) = p;
+    }
+    return RT_OK;
+}
+
+void output_aovs_free(output_aovs *o)
+{
+    for (int k = 0; k < AOV_COUNT; k++) {
+        free(*slot(&o->buf, k));
+        *slot(&o->buf, k) = NULL;
+    }
+}
+
+rt_aov_buffers *output_aovs_for_render(output_aovs *o)
+{
+    for (int k = 0; k < AOV_COUNT; k++)
+        if (*slot(&o->buf, k))
+            return &o->buf;
+    return NULL;
+}
+
+static double now_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* "dir/name.EXT" -> "dir/name.TAG.NEWEXT" (NEWEXT NULL: the same extension). */
+static void beside(const char *path, const char *tag, const char *new_ext, char *out, size_t size)
+{
+    const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
+    if (!dot || (slash && dot < slash))
+        dot = path + strlen(path);
+    snprintf(out, size, "%.*s.%s%s", (int)(dot - path), path, tag, new_ext ? new_ext : dot);
+}
+
+/* One image file of an AOV (1 channel: grey). */
+static rt_result write_aov_file(const float *data, int channels, int w, int h, const char *path, rt_error *err)
+{
+    rt_framebuffer fb;
+    rt_result r = rt_framebuffer_init(&fb, w, h, err);
+    if (r != RT_OK)
+        return r;
+    for (size_t i = 0; i < (size_t)w * (size_t)h; i++)
+        for (int c = 0; c < 3; c++)
+            fb.rgb[3 * i + (size_t)c] = data[(size_t)channels * i + (size_t)(channels == 3 ? c : 0)];
+    r = rt_framebuffer_write(&fb, path, 1.0f, err);
+    rt_framebuffer_free(&fb);
+    return r;
+}
+
+rt_result output_write(const args *a, const rt_settings *set, rt_framebuffer *fb, const output_aovs *aov,
+                       const char *path, rt_error *err)
+{
+    rt_image_options opt = {.exposure = set->exposure * rt_exposure_scale(a->exposure_ev), .tonemap = a->tonemap,
+                            .half = a->half};
+    rt_image_format fmt = RT_FORMAT_PNG;
+    rt_output_format(path, &fmt, err);
+    rt_image_layer layers[AOV_COUNT + 1];
+    int nl = 0;
+    float *noisy = NULL;
+    rt_result r = RT_OK;
+    if (a->denoise) {
+        if (aov->wanted) { /* the noisy image is kept beside the denoised one */
+            size_t n = (size_t)fb->width * (size_t)fb->height * 3;
+            noisy = rt_alloc(n, sizeof(float));
+            if (!noisy)
+                return rt_fail(err, RT_ERR_NOMEM, "out of memory for the noisy image");
+            memcpy(noisy, fb->rgb, n * sizeof(float));
+        }
+        double t0 = now_seconds();
+        rt_denoise_input in = {.width = fb->width, .height = fb->height, .color = fb->rgb,
+                               .albedo = aov->buf.albedo, .normal = aov->buf.normal};
+        r = rt_denoise_image(&in, err);
+        if (r != RT_OK)
+            goto done;
+        rt_info("denoise: %.3f s (albedo and normal, prefiltered)", now_seconds() - t0);
+    }
+    if (fmt == RT_FORMAT_EXR) {
+        if (noisy)
+            layers[nl++] = (rt_image_layer){"noisy", 3, noisy};
+        for (int k = 0; k < AOV_COUNT; k++)
+            if (aov->wanted & (1u << k))
+                layers[nl++] = (rt_image_layer){aov_names[k], channels_of(k), *slot((rt_aov_buffers *)&aov->buf, k)};
+        opt.layers = layers;
+        opt.layer_count = nl;
+    } else {
+        char p[4200];
+        const char *ext = fmt == RT_FORMAT_PNG ? ".pfm" : NULL;
+        for (int k = 0; k < AOV_COUNT && r == RT_OK; k++)
+            if (aov->wanted & (1u << k)) {
+                beside(path, aov_names[k], ext, p, sizeof p);
+                r = write_aov_file(*slot((rt_aov_buffers *)&aov->buf, k), channels_of(k), fb->width, fb->height, p,
+                                   err);
+            }
+        if (r == RT_OK && noisy) {
+            rt_framebuffer nf = {fb->width, fb->height, noisy};
+            beside(path, "noisy", NULL, p, sizeof p);
+            r = rt_framebuffer_write_with(&nf, p, &opt, err);
+        }
+        if (r != RT_OK)
+            goto done;
+    }
+    r = rt_framebuffer_write_with(fb, path, &opt, err);
+done:
+    free(noisy);
+    return r;
+}

@@ -1,0 +1,462 @@
+/* test_hdr.c - the HDR workflow: OpenEXR out and in (float exact, half to
+ * half precision, layers, textures, size limits, broken files), the tone
+ * curves at points worked out from their formulas, `rt convert` (round
+ * trips, refused flag combinations, exit codes), and --denoise: the 64x64
+ * Cornell render gets closer to the shared Mitsuba reference, and a missing
+ * library is one clear error before any rendering. */
+#include "test_util.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "rt/base/file.h"
+#include "rt/image/compare.h"
+#include "rt/image/denoise.h"
+#include "rt/image/tonemap.h"
+#include "rt/io/exr.h"
+#include "rt/io/framebuffer.h"
+#include "rt/io/image_read.h"
+#include "rt/scene/scene.h"
+#include "rt/scene/texture.h"
+
+#include "../src/driver/commands.h"
+
+#define assert_near(a, b, tol) assert_near_at((double)(a), (double)(b), (double)(tol), #a, __LINE__)
+static void assert_near_at(double a, double b, double tol, const char *what, int line)
+{
+    if (!(fabs(a - b) <= tol))
+        fail_msg("line %d: %s = %.9g, expected %.9g (within %g)", line, what, a, b, tol);
+}
+
+static char dir[64];
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(dir, sizeof dir, "/tmp/rt_test_hdr_XXXXXX");
+    return mkdtemp(dir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static const char *tmp(const char *name)
+{
+    static char paths[8][256];
+    static int next;
+    char *p = paths[next++ % 8];
+    snprintf(p, 256, "%s/%.120s", dir, name);
+    return p;
+}
+
+/* A w x h image with values over many magnitudes, negatives and zeros. */
+static void fill(rt_framebuffer *fb, int w, int h)
+{
+    assert_int_equal(rt_framebuffer_init(fb, w, h, NULL), RT_OK);
+    test_rng r = {12345};
+    for (size_t i = 0; i < (size_t)w * (size_t)h * 3; i++) {
+        float u = test_rng_float(&r);
+        fb->rgb[i] = i % 17 == 0 ? 0.0f : i % 13 == 0 ? -u : u * powf(10.0f, (float)(i % 9) - 4.0f);
+    }
+}
+
+static void test_exr_float_round_trip(void **state)
+{
+    (void)state;
+    rt_framebuffer a, b;
+    fill(&a, 37, 23); /* odd sizes: a last chunk of 7 lines */
+    rt_error err = {0};
+    assert_int_equal(rt_framebuffer_write(&a, tmp("f.exr"), 1.0f, &err), RT_OK);
+    assert_int_equal(rt_image_read(tmp("f.exr"), &b, &err), RT_OK);
+    assert_int_equal(b.width, 37);
+    assert_int_equal(b.height, 23);
+    assert_memory_equal(a.rgb, b.rgb, 37 * 23 * 3 * sizeof(float));
+    rt_framebuffer_free(&a);
+    rt_framebuffer_free(&b);
+}
+
+static void test_exr_half_round_trip(void **state)
+{
+    (void)state;
+    rt_framebuffer a, b;
+    fill(&a, 20, 18);
+    rt_error err = {0};
+    rt_image_options opt = {.half = true};
+    assert_int_equal(rt_framebuffer_write_with(&a, tmp("h.exr"), &opt, &err), RT_OK);
+    assert_int_equal(rt_image_read(tmp("h.exr"), &b, &err), RT_OK);
+    for (size_t i = 0; i < 20 * 18 * 3; i++) {
+        float x = a.rgb[i];
+        /* half: 11 significant bits; below 2^-14 the step is 2^-24 */
+        assert_near(b.rgb[i], x, fabsf(x) * (1.0f / 2048.0f) + 6e-8f);
+    }
+    /* half the bytes of float, or near it after ZIP */
+    char *fb_bytes, *hb_bytes;
+    size_t fs, hs;
+    assert_int_equal(rt_framebuffer_write(&a, tmp("f2.exr"), 1.0f, &err), RT_OK);
+    assert_int_equal(rt_read_file(tmp("f2.exr"), 0, &fb_bytes, &fs, &err), RT_OK);
+    assert_int_equal(rt_read_file(tmp("h.exr"), 0, &hb_bytes, &hs, &err), RT_OK);
+    assert_true(hs < fs);
+    free(fb_bytes);
+    free(hb_bytes);
+    rt_framebuffer_free(&a);
+    rt_framebuffer_free(&b);
+}
+
+static void test_exr_layers(void **state)
+{
+    (void)state;
+    rt_framebuffer a, b;
+    fill(&a, 8, 6);
+    float albedo[8 * 6 * 3], depth[8 * 6];
+    for (int i = 0; i < 8 * 6 * 3; i++)
+        albedo[i] = 0.5f;
+    for (int i = 0; i < 8 * 6; i++)
+        depth[i] = (float)i;
+    rt_image_layer layers[2] = {{"albedo", 3, albedo}, {"depth", 1, depth}};
+    rt_image_options opt = {.layers = layers, .layer_count = 2};
+    rt_error err = {0};
+    assert_int_equal(rt_framebuffer_write_with(&a, tmp("l.exr"), &opt, &err), RT_OK);
+    /* the beauty image reads back unchanged past the other layers */
+    assert_int_equal(rt_image_read(tmp("l.exr"), &b, &err), RT_OK);
+    assert_memory_equal(a.rgb, b.rgb, 8 * 6 * 3 * sizeof(float));
+    /* the header lists the layers' channels, by the naming convention */
+    char *bytes;
+    size_t size;
+    assert_int_equal(rt_read_file(tmp("l.exr"), 0, &bytes, &size, &err), RT_OK);
+    static const char *names[] = {"albedo.R", "albedo.G", "albedo.B", "depth.Y", "compression", NULL};
+    for (int i = 0; names[i]; i++) {
+        bool found = false;
+        for (size_t k = 0; k + strlen(names[i]) < size && !found; k++)
+            found = memcmp(bytes + k, names[i], strlen(names[i]) + 1) == 0;
+        if (!found)
+            fail_msg("no channel %s in the header", names[i]);
+    }
+    free(bytes);
+    rt_framebuffer_free(&a);
+    rt_framebuffer_free(&b);
+}
+
+static void test_exr_texture_and_limits(void **state)
+{
+    (void)state;
+    rt_framebuffer a;
+    fill(&a, 16, 10);
+    rt_error err = {0};
+    assert_int_equal(rt_framebuffer_write(&a, tmp("t.exr"), 1.0f, &err), RT_OK);
+    rt_scene s;
+    rt_scene_init(&s);
+    uint32_t img;
+    assert_int_equal(rt_image_load_file(&s, tmp("t.exr"), &img, &err), RT_OK);
+    const rt_image *im = &s.images[img];
+    assert_int_equal(im->width, 16);
+    assert_int_equal(im->height, 10);
+    assert_non_null(im->rgbaf);
+    for (size_t i = 0; i < 16 * 10; i++) {
+        assert_memory_equal(im->rgbaf + 4 * i, a.rgb + 3 * i, 3 * sizeof(float));
+        assert_true(im->rgbaf[4 * i + 3] == 1.0f);
+    }
+    rt_scene_free(&s);
+
+    /* size limits are checked on the header, before the pixels */
+    char *bytes;
+    size_t size;
+    assert_int_equal(rt_read_file(tmp("t.exr"), 0, &bytes, &size, &err), RT_OK);
+    float *rgba = NULL;
+    int w, h;
+    assert_int_equal(rt_exr_decode(bytes, size, "t.exr", 8, 1000, &rgba, &w, &h, &err), RT_ERR_LIMIT);
+    assert_int_equal(rt_exr_decode(bytes, size, "t.exr", 64, 100, &rgba, &w, &h, &err), RT_ERR_LIMIT);
+    assert_non_null(strstr(err.message, "t.exr"));
+    /* truncated anywhere: an error naming the file, never a crash */
+    for (size_t cut = 0; cut < size; cut += 1 + cut / 8) {
+        rt_result r = rt_exr_decode(bytes, cut, "cut.exr", 64, 1000, &rgba, &w, &h, &err);
+        if (r == RT_OK) { /* a cut in the last chunk's padding cannot be seen */
+            free(rgba);
+            continue;
+        }
+        assert_int_equal(r, RT_ERR_INVALID);
+        assert_non_null(strstr(err.message, "cut.exr"));
+    }
+    free(bytes);
+    rt_framebuffer_free(&a);
+}
+
+static void test_tonemap_curves(void **state)
+{
+    (void)state;
+    assert_near(rt_exposure_scale(0), 1, 0);
+    assert_near(rt_exposure_scale(1), 2, 0);
+    assert_near(rt_exposure_scale(-2), 0.25, 0);
+    rt_tonemap tm;
+    assert_true(rt_tonemap_parse("agx", &tm) && tm == RT_TONEMAP_AGX);
+    assert_false(rt_tonemap_parse("reinhard", &tm));
+    float o[3];
+    /* filmic: Hable's curve divided by its value at W = 11.2, on 2x: 1 at x = 5.6 */
+    rt_tonemap_rgb(RT_TONEMAP_FILMIC, (float[3]){5.6f, 0.0f, 100.0f}, o);
+    assert_near(o[0], 1.0, 1e-5);
+    assert_near(o[1], 0.0, 1e-6); /* f(0) = DE/DF - E/F = 0 */
+    assert_near(o[2], 1.0, 0);    /* clipped past white */
+    /* aces (Narkowicz): at x = 1, 0.6(2.51*0.6 + 0.03) / (0.6(2.43*0.6 + 0.59) + 0.14) */
+    rt_tonemap_rgb(RT_TONEMAP_ACES, (float[3]){1.0f, 0.0f, 1e6f}, o);
+    double x = 0.6;
+    assert_near(o[0], x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 1e-6);
+    assert_near(o[1], 0.0, 1e-7);
+    assert_near(o[2], 1.0, 0);
+    /* agx: grey stays grey (to the published matrices' rounding), black maps near 0 and the curve rises */
+    float prev = -1.0f;
+    for (float v = 0.0f; v < 100.0f; v = v * 2.0f + 0.001f) {
+        rt_tonemap_rgb(RT_TONEMAP_AGX, (float[3]){v, v, v}, o);
+        assert_near(o[0], o[1], 1e-3);
+        assert_near(o[1], o[2], 1e-3);
+        assert_true(o[0] >= prev - 1e-6f);
+        prev = o[0];
+    }
+    rt_tonemap_rgb(RT_TONEMAP_AGX, (float[3]){0, 0, 0}, o);
+    assert_true(o[0] < 1e-3f);
+    rt_tonemap_rgb(RT_TONEMAP_AGX, (float[3]){0.18f, 0.18f, 0.18f}, o);
+    assert_true(o[0] > 0.1f && o[0] < 0.3f); /* mid grey stays mid */
+    /* clamp is exactly the plain sRGB encode rt always wrote, NaN and negatives to 0 */
+    float rgb[6] = {0.5f, 2.0f, -1.0f, NAN, 0.0031308f, 0.2f};
+    unsigned char b[6];
+    rt_tonemap_to_srgb8(RT_TONEMAP_CLAMP, 1.5f, rgb, 2, b);
+    for (int i = 0; i < 6; i++)
+        assert_int_equal(b[i], (unsigned char)(rt_linear_to_srgb(rgb[i] * 1.5f) * 255.0f + 0.5f));
+    rt_tonemap_to_srgb8(RT_TONEMAP_AGX, 1.0f, rgb, 2, b);
+    assert_true(b[0] > 0 && b[1] < 255);
+}
+
+static int run_convert(const char *a, const char *b, const char *c, const char *d)
+{
+    char *argv[8] = {"convert"};
+    int argc = 1;
+    const char *in[4] = {a, b, c, d};
+    for (int i = 0; i < 4 && in[i]; i++)
+        argv[argc++] = (char *)in[i];
+    FILE *out = tmpfile(), *errs = tmpfile();
+    int status = rt_cmd_convert_to(argc, argv, out, errs);
+    fclose(out);
+    fclose(errs);
+    return status;
+}
+
+static void test_convert(void **state)
+{
+    (void)state;
+    rt_framebuffer a, b;
+    fill(&a, 12, 9);
+    rt_error err = {0};
+    assert_int_equal(rt_framebuffer_write(&a, tmp("c.pfm"), 1.0f, &err), RT_OK);
+    /* PFM -> EXR -> PFM keeps every bit */
+    assert_int_equal(run_convert(tmp("c.pfm"), tmp("c.exr"), NULL, NULL), 0);
+    assert_int_equal(run_convert(tmp("c.exr"), tmp("c2.pfm"), NULL, NULL), 0);
+    assert_int_equal(rt_image_read(tmp("c2.pfm"), &b, &err), RT_OK);
+    assert_memory_equal(a.rgb, b.rgb, 12 * 9 * 3 * sizeof(float));
+    rt_framebuffer_free(&b);
+    /* to PNG with exposure and a curve: the tone-mapped values, read back through sRGB */
+    assert_int_equal(run_convert(tmp("c.exr"), tmp("c.png"), "--tonemap", "aces"), 0);
+    assert_int_equal(rt_image_read(tmp("c.png"), &b, &err), RT_OK);
+    unsigned char want[12 * 9 * 3];
+    rt_tonemap_to_srgb8(RT_TONEMAP_ACES, 1.0f, a.rgb, 12 * 9, want);
+    for (size_t i = 0; i < 12 * 9 * 3; i++)
+        assert_near(b.rgb[i], rt_srgb_to_linear(want[i] / 255.0f), 1e-6);
+    rt_framebuffer_free(&b);
+    /* refused: curves on float output, --half on PFM, unknown flags and curves, missing files */
+    assert_int_equal(run_convert(tmp("c.exr"), tmp("x.pfm"), "--tonemap", "agx"), 2);
+    assert_int_equal(run_convert(tmp("c.exr"), tmp("x.exr"), "--exposure", "1"), 2);
+    assert_int_equal(run_convert(tmp("c.exr"), tmp("x.pfm"), "--half", NULL), 2);
+    assert_int_equal(run_convert(tmp("c.exr"), tmp("x.png"), "--tonemap", "reinhard"), 2);
+    assert_int_equal(run_convert(tmp("c.exr"), tmp("x.png"), "--bogus", NULL), 2);
+    assert_int_equal(run_convert(tmp("missing.exr"), tmp("x.png"), NULL, NULL), 2);
+    assert_int_equal(run_convert(tmp("c.exr"), NULL, NULL, NULL), 2);
+    assert_int_equal(access(tmp("x.pfm"), F_OK), -1);
+    /* a broken input leaves an existing output as it was */
+    test_write_file(tmp("bad.exr"), "\x76\x2f\x31\x01garbage", 11);
+    assert_int_equal(run_convert(tmp("bad.exr"), tmp("c2.pfm"), NULL, NULL), 2);
+    assert_int_equal(rt_image_read(tmp("c2.pfm"), &b, &err), RT_OK);
+    assert_memory_equal(a.rgb, b.rgb, 12 * 9 * 3 * sizeof(float));
+    rt_framebuffer_free(&b);
+    rt_framebuffer_free(&a);
+}
+
+/* Runs the rt binary (RT_BIN, default ./rt) through the shell; its status. */
+static int run_rt(const char *env, const char *args, const char *stderr_to)
+{
+    const char *bin = getenv("RT_BIN") ? getenv("RT_BIN") : "./rt";
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "%s %s %s 2>%s", env ? env : "", bin, args, stderr_to ? stderr_to : "/dev/null");
+    int st = system(cmd);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* The 512x512 reference box-averaged to 64x64 (test_path.c's comparison). */
+static bool reference_64(rt_framebuffer *out)
+{
+    rt_framebuffer ref;
+    rt_error err;
+    if (rt_pfm_read(test_shared_path("reference/cornell/reference.pfm"), &ref, &err) != RT_OK)
+        return false;
+    assert_int_equal(ref.width, 512);
+    assert_int_equal(rt_framebuffer_init(out, 64, 64, &err), RT_OK);
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++)
+            for (int c = 0; c < 3; c++) {
+                double r = 0.0;
+                for (int j = 0; j < 8; j++)
+                    for (int i = 0; i < 8; i++)
+                        r += ref.rgb[3 * ((size_t)(8 * y + j) * 512 + (size_t)(8 * x + i)) + (size_t)c];
+                out->rgb[3 * ((size_t)y * 64 + (size_t)x) + (size_t)c] = (float)(r / 64.0);
+            }
+    rt_framebuffer_free(&ref);
+    return true;
+}
+
+static void test_denoise_cornell(void **state)
+{
+    (void)state;
+    char where[4096];
+    rt_error err = {0};
+    if (rt_denoise_find(where, sizeof where, &err) != RT_OK) {
+        fprintf(stderr, "note: %s; skipping the denoiser test\n", err.message);
+        skip();
+    }
+    rt_framebuffer ref;
+    if (!reference_64(&ref)) {
+        fprintf(stderr, "note: no shared reference (set RT_SHARED); skipping the denoiser test\n");
+        skip();
+    }
+    char args[512];
+    snprintf(args, sizeof args, "-q -r 64x64 -s 16 -o %s scenes/cornell-reference.txt", tmp("noisy.pfm"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
+    snprintf(args, sizeof args, "-q -r 64x64 -s 16 --denoise -o %s scenes/cornell-reference.txt", tmp("den.pfm"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
+    rt_framebuffer noisy, den;
+    assert_int_equal(rt_image_read(tmp("noisy.pfm"), &noisy, &err), RT_OK);
+    assert_int_equal(rt_image_read(tmp("den.pfm"), &den, &err), RT_OK);
+    rt_metrics mn, md;
+    assert_int_equal(rt_image_metrics(noisy.rgb, ref.rgb, 64, 64, &mn, &err), RT_OK);
+    assert_int_equal(rt_image_metrics(den.rgb, ref.rgb, 64, 64, &md, &err), RT_OK);
+    fprintf(stderr, "cornell 64x64 @ 16 spp against the reference: RMSE noisy %.5f, denoised %.5f; relMSE %.5f, %.5f\n",
+            mn.rmse, md.rmse, mn.relmse, md.relmse);
+    /* relMSE (the error relative to the radiance, the measure for HDR
+     * images) drops many times; so does the RMSE over the lit box, without
+     * the light itself (reference over 1), whose radiance of ~17 a denoiser
+     * shifts by a few percent, which alone outweighs the whole box in RMSE */
+    assert_true(md.relmse < 0.25 * mn.relmse);
+    double sn = 0.0, sd = 0.0;
+    size_t count = 0;
+    for (size_t i = 0; i < 64 * 64; i++) {
+        const float *r = ref.rgb + 3 * i;
+        if (r[0] > 1.0f || r[1] > 1.0f || r[2] > 1.0f)
+            continue;
+        for (int c = 0; c < 3; c++) {
+            double en = noisy.rgb[3 * i + (size_t)c] - r[c], ed = den.rgb[3 * i + (size_t)c] - r[c];
+            sn += en * en;
+            sd += ed * ed;
+        }
+        count++;
+    }
+    fprintf(stderr, "  without the light (%zu pixels): RMSE noisy %.5f, denoised %.5f\n", count,
+            sqrt(sn / (3.0 * (double)count)), sqrt(sd / (3.0 * (double)count)));
+    assert_true(count > 3800);
+    assert_true(sd < 0.5 * sn);
+    /* and the image means stay: the denoiser removes noise, not light */
+    for (int c = 0; c < 3; c++)
+        assert_near(md.mean_candidate[c] / md.mean_reference[c], 1.0, 0.04);
+    rt_framebuffer_free(&noisy);
+    rt_framebuffer_free(&den);
+    rt_framebuffer_free(&ref);
+}
+
+static bool same_file(const char *a, const char *b)
+{
+    char *x, *y;
+    size_t nx, ny;
+    rt_error err;
+    if (rt_read_file(a, 0, &x, &nx, &err) != RT_OK || rt_read_file(b, 0, &y, &ny, &err) != RT_OK)
+        fail_msg("%s", err.message);
+    bool same = nx == ny && memcmp(x, y, nx) == 0;
+    free(x);
+    free(y);
+    return same;
+}
+
+/* AOVs: the beauty image is the same with them as without; every AOV is
+ * bit-identical for 1 and 3 threads and other tile sizes; the values are
+ * the scene's (the Cornell box's white floor: albedo 0.73 + 0.04, normal +y). */
+static void test_aovs(void **state)
+{
+    (void)state;
+    char args[512];
+    const char *common = "-q -r 48x40 -s 4 --integrator path scenes/cornell.txt";
+    snprintf(args, sizeof args, "%s -o %s", common, tmp("plain.pfm"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
+    snprintf(args, sizeof args, "%s -t 1 --aov albedo,normal,depth,position,variance,spp -o %s", common, tmp("a1.pfm"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
+    snprintf(args, sizeof args, "%s -t 3 --tile 7 --aov albedo,normal,depth,position,variance,spp -o %s", common,
+             tmp("a3.pfm"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
+    assert_true(same_file(tmp("plain.pfm"), tmp("a1.pfm")));
+    static const char *const names[] = {"albedo", "normal", "depth", "position", "variance", "spp"};
+    for (int k = 0; k < 6; k++) {
+        char p1[128], p3[128];
+        snprintf(p1, sizeof p1, "a1.%s.pfm", names[k]);
+        snprintf(p3, sizeof p3, "a3.%s.pfm", names[k]);
+        if (!same_file(tmp(p1), tmp(p3)))
+            fail_msg("the %s AOV differs between 1 and 3 threads", names[k]);
+    }
+    rt_framebuffer alb, nrm, spp;
+    rt_error err;
+    assert_int_equal(rt_image_read(tmp("a1.albedo.pfm"), &alb, &err), RT_OK);
+    assert_int_equal(rt_image_read(tmp("a1.normal.pfm"), &nrm, &err), RT_OK);
+    assert_int_equal(rt_image_read(tmp("a1.spp.pfm"), &spp, &err), RT_OK);
+    size_t px = 3 * ((size_t)38 * 48 + 24); /* bottom row, middle: the floor */
+    assert_near(alb.rgb[px], 0.73 + 0.04, 1e-4); /* diffuse 0.73 + the dielectric's specular f0 0.04 */
+    assert_near(nrm.rgb[px + 1], 1.0, 1e-3);
+    assert_near(spp.rgb[px], 4.0, 0);
+    rt_framebuffer_free(&alb);
+    rt_framebuffer_free(&nrm);
+    rt_framebuffer_free(&spp);
+    /* EXR: one file with the layers */
+    snprintf(args, sizeof args, "%s --aov albedo,depth -o %s", common, tmp("a.exr"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
+    assert_int_equal(access(tmp("a.albedo.pfm"), F_OK), -1);
+    snprintf(args, sizeof args, "%s --aov albedo,bogus -o %s", common, tmp("b.exr"));
+    assert_int_equal(run_rt(NULL, args, NULL), 2);
+}
+
+static void test_denoise_missing_library(void **state)
+{
+    (void)state;
+    char args[512];
+    snprintf(args, sizeof args, "--denoise -o %s", tmp("never.png"));
+    assert_int_equal(run_rt("RT_OIDN_LIBRARY=/nonexistent/libOpenImageDenoise.so.2", args, tmp("msg.txt")), 2);
+    assert_int_equal(access(tmp("never.png"), F_OK), -1);
+    char *msg;
+    size_t size;
+    rt_error err;
+    assert_int_equal(rt_read_file(tmp("msg.txt"), 0, &msg, &size, &err), RT_OK);
+    /* one line, naming what is missing */
+    assert_non_null(strstr(msg, "/nonexistent/libOpenImageDenoise.so.2"));
+    assert_non_null(strchr(msg, '\n'));
+    assert_null(strchr(msg, '\n') + 1 < msg + size ? strchr(strchr(msg, '\n') + 1, '\n') : NULL);
+    free(msg);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_exr_float_round_trip), cmocka_unit_test(test_exr_half_round_trip),
+        cmocka_unit_test(test_exr_layers),           cmocka_unit_test(test_exr_texture_and_limits),
+        cmocka_unit_test(test_tonemap_curves),       cmocka_unit_test(test_convert),
+        cmocka_unit_test(test_denoise_cornell),      cmocka_unit_test(test_denoise_missing_library),
+        cmocka_unit_test(test_aovs),
+    };
+    return cmocka_run_group_tests_name("hdr", tests, setup, teardown);
+}
