@@ -4,9 +4,11 @@
  * with status 2, print a message naming the file (and line or byte) and
  * what is wrong, leave an existing output image byte-identical and leave no
  * temporary file behind. Then the good paths that are easy to get wrong:
- * Ctrl-C / SIGTERM (exit 130, the finished tiles written, the rest black),
- * a second Ctrl-C (exits at once, the old image kept), a 1x1 image, and the
- * same bytes from 1, 64 and more-threads-than-tiles renders.
+ * Ctrl-C / SIGTERM (exit 130 / 143; in passes the whole image at the
+ * samples reached goes to the output, tiles to NAME.partial.EXT with the
+ * output left alone), --time-limit, a second Ctrl-C (exits at once, the
+ * old image kept), a 1x1 image, and the same bytes from 1, 64 and
+ * more-threads-than-tiles renders.
  */
 #include "test_util.h"
 
@@ -712,59 +714,128 @@ static void test_deep_recursion(void **state)
     }
 }
 
-/* A render interrupted by `sig` after 0.7 s: exit 130, the message, and a
- * complete image whose tiles are each either finished or black. Every
- * pixel of the scene is non-zero (a glowing sphere before a lit
- * background), so a finished tile has no black pixel. */
-static void interrupted_render(int sig)
+/* A scene where every pixel is non-zero (a glowing sphere before a lit
+ * background), so a finished tile or pass has no black pixel. */
+static const char *slow_scene(void)
 {
-    const char *pfm = path_in("int.pfm");
-    put_precious(pfm);
     write_text("slow.txt", "resolution 64 64\nbackground 0.5 0.6 0.7\n"
                            "camera position 0 0 4 look_at 0 0 0 up 0 1 0 fov 40\n"
                            "material glow color 0.5 0.5 0.5 emission 1 0.5 0.25\nsphere 0 0 0 1 glow\n");
-    const char *const args[] = {"-q", "--tile", "8", "-s", "8192", "-t", "2", "-o", pfm, path_in("slow.txt"), NULL};
+    return path_in("slow.txt");
+}
+
+/* Runs rt with args, sends `sig` after 0.7 s, and waits. */
+static void run_and_signal(const char *const *args, int sig, run_result *r)
+{
     double t0 = now_s();
     pid_t pid = spawn(args);
     sleep_s(0.7);
     kill(pid, sig);
+    wait_for(pid, t0, 60.0, r);
+    if (r->status != 128 + sig)
+        fail_msg("expected exit %d after signal %d, got %d (signal %d): %s", 128 + sig, sig, r->status, r->signal,
+                 r->err);
+}
+
+/* A tiled render interrupted by `sig`: exit 128 + sig, the output left as
+ * it was, and the finished tiles in NAME.partial.pfm, each tile either
+ * finished or black, as many finished as the message says (or, stopped
+ * before any tile finished, nothing written). */
+static void interrupted_tiles(int sig)
+{
+    const char *pfm = path_in("int.pfm"), *partial = path_in("int.partial.pfm");
+    put_precious(pfm);
+    unlink(partial);
+    const char *const args[] = {"-q", "--tile", "8", "-s", "8192", "-t", "2", "--integrator", "direct", "-o", pfm,
+                                slow_scene(), NULL};
     run_result *r = malloc(sizeof *r);
     assert_non_null(r);
-    wait_for(pid, t0, 60.0, r);
-    if (r->status != 130)
-        fail_msg("expected exit 130 after signal %d, got %d (signal %d): %s", sig, r->status, r->signal, r->err);
-    assert_contains(r->err, "render interrupted: ");
-    assert_contains(r->err, "of 64 tiles finished; writing the finished tiles to ");
-    rt_framebuffer fb;
-    rt_error err;
-    assert_int_equal(rt_pfm_read(pfm, &fb, &err), RT_OK);
-    assert_int_equal(fb.width, 64);
-    assert_int_equal(fb.height, 64);
-    int finished = 0, black = 0;
-    for (int ty = 0; ty < 8; ty++)
-        for (int tx = 0; tx < 8; tx++) {
-            int zero = 0;
-            for (int y = ty * 8; y < ty * 8 + 8; y++)
-                for (int x = tx * 8; x < tx * 8 + 8; x++) {
-                    const float *p = fb.rgb + 3 * ((size_t)y * 64 + (size_t)x);
-                    zero += p[0] == 0.0f && p[1] == 0.0f && p[2] == 0.0f;
-                }
-            if (zero == 64)
-                black++;
-            else if (zero == 0)
-                finished++;
-            else
-                fail_msg("tile (%d,%d) is partly black (%d of 64 pixels): a half-rendered tile was written", tx, ty,
-                         zero);
-        }
-    int reported = -1;
-    const char *p = strstr(r->err, "render interrupted: ");
-    assert_int_equal(sscanf(p, "render interrupted: %d of 64", &reported), 1);
-    assert_int_equal(reported, finished);
-    assert_true(black > 0);
-    fprintf(stderr, "note: signal %d after 0.7 s: %d tiles finished, %d black, exit after %.2f s\n", sig, finished,
-            black, r->seconds);
-    rt_framebuffer_free(&fb);
+    run_and_signal(args, sig, r);
+    assert_precious(pfm);
+    const char *word = sig == SIGTERM ? "terminated" : "interrupted";
+    if (strstr(r->err, "stopped before any tile finished")) {
+        assert_true(access(partial, F_OK) != 0);
+        fprintf(stderr, "note: signal %d after 0.7 s: no tile finished\n", sig);
+    } else {
+        char expect[700];
+        snprintf(expect, sizeof expect, "rt: wrote %s: 64x64, ", partial);
+        assert_contains(r->err, expect);
+        snprintf(expect, sizeof expect, " of 64 tiles at 8192 spp, %s; ", word);
+        assert_contains(r->err, expect);
+        assert_contains(r->err, " left as it was");
+        rt_framebuffer fb;
+        rt_error err;
+        assert_int_equal(rt_pfm_read(partial, &fb, &err), RT_OK);
+        assert_int_equal(fb.width, 64);
+        assert_int_equal(fb.height, 64);
+        int finished = 0, black = 0;
+        for (int ty = 0; ty < 8; ty++)
+            for (int tx = 0; tx < 8; tx++) {
+                int zero = 0;
+                for (int y = ty * 8; y < ty * 8 + 8; y++)
+                    for (int x = tx * 8; x < tx * 8 + 8; x++) {
+                        const float *p = fb.rgb + 3 * ((size_t)y * 64 + (size_t)x);
+                        zero += p[0] == 0.0f && p[1] == 0.0f && p[2] == 0.0f;
+                    }
+                if (zero == 64)
+                    black++;
+                else if (zero == 0)
+                    finished++;
+                else
+                    fail_msg("tile (%d,%d) is partly black (%d of 64 pixels): a half-rendered tile was written", tx,
+                             ty, zero);
+            }
+        int reported = -1;
+        snprintf(expect, sizeof expect, "rt: wrote %s: 64x64, ", partial);
+        const char *p = strstr(r->err, expect) + strlen(expect);
+        assert_int_equal(sscanf(p, "%d of 64", &reported), 1);
+        assert_int_equal(reported, finished);
+        assert_true(black > 0);
+        fprintf(stderr, "note: signal %d after 0.7 s: %d tiles finished, %d black, exit after %.2f s\n", sig,
+                finished, black, r->seconds);
+        rt_framebuffer_free(&fb);
+    }
+    assert_no_temp_files();
+    unlink(pfm);
+    unlink(partial);
+    free(r);
+}
+
+/* A render in passes interrupted by `sig`: exit 128 + sig and the whole
+ * image at the samples reached written to the output, labelled (no pixel
+ * black); or, stopped before the first pass, nothing written. */
+static void interrupted_passes(int sig)
+{
+    const char *pfm = path_in("pass.pfm");
+    put_precious(pfm);
+    const char *const args[] = {"-q", "-s", "100000", "-t", "2", "--integrator", "path", "-o", pfm, slow_scene(),
+                                NULL};
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_and_signal(args, sig, r);
+    if (strstr(r->err, "stopped before any pass finished")) {
+        assert_precious(pfm);
+        fprintf(stderr, "note: signal %d after 0.7 s: no pass finished\n", sig);
+    } else {
+        char expect[700];
+        snprintf(expect, sizeof expect, "rt: wrote %s: 64x64, ", pfm);
+        const char *p = strstr(r->err, expect);
+        if (!p)
+            fail_msg("expected \"%s\" in rt's message:\n%s", expect, r->err);
+        int spp = -1;
+        char word[32] = "";
+        assert_int_equal(sscanf(p + strlen(expect), "%d of 100000 spp, %31[a-z]", &spp, word), 2);
+        assert_string_equal(word, sig == SIGTERM ? "terminated" : "interrupted");
+        assert_true(spp > 0 && spp < 100000 && spp % 4 == 0); /* whole passes of 4 */
+        rt_framebuffer fb;
+        rt_error err;
+        assert_int_equal(rt_pfm_read(pfm, &fb, &err), RT_OK);
+        assert_int_equal(fb.width, 64);
+        for (size_t i = 0; i < 64 * 64; i++)
+            assert_true(fb.rgb[3 * i] > 0.0f && fb.rgb[3 * i + 1] > 0.0f && fb.rgb[3 * i + 2] > 0.0f);
+        rt_framebuffer_free(&fb);
+        fprintf(stderr, "note: signal %d after 0.7 s: %d spp, exit after %.2f s\n", sig, spp, r->seconds);
+    }
     assert_no_temp_files();
     unlink(pfm);
     free(r);
@@ -773,13 +844,60 @@ static void interrupted_render(int sig)
 static void test_sigint_writes_finished_tiles(void **state)
 {
     (void)state;
-    interrupted_render(SIGINT);
+    interrupted_tiles(SIGINT);
 }
 
 static void test_sigterm_writes_finished_tiles(void **state)
 {
     (void)state;
-    interrupted_render(SIGTERM);
+    interrupted_tiles(SIGTERM);
+}
+
+static void test_sigint_writes_passes(void **state)
+{
+    (void)state;
+    interrupted_passes(SIGINT);
+}
+
+static void test_sigterm_writes_passes(void **state)
+{
+    (void)state;
+    interrupted_passes(SIGTERM);
+}
+
+/* --time-limit already over when rendering starts: in passes, exactly the
+ * first pass (4 spp) is written to the output, labelled, exit 0; tiled, no
+ * tile is started (or, on a slow start, the finished ones go to
+ * NAME.partial.EXT) and the output is left alone. */
+static void test_time_limit(void **state)
+{
+    (void)state;
+    const char *pfm = path_in("tl.pfm"), *partial = path_in("tl.partial.pfm");
+    put_precious(pfm);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_args(r, (const char *const[]){"-q", "-s", "100000", "--integrator", "path", "--time-limit", "1e-6", "-o", pfm,
+                                      slow_scene(), NULL});
+    assert_int_equal(r->status, 0);
+    char expect[700];
+    snprintf(expect, sizeof expect, "rt: wrote %s: 64x64, 4 of 100000 spp, time limit; ", pfm);
+    assert_contains(r->err, expect);
+    rt_framebuffer fb;
+    rt_error err;
+    assert_int_equal(rt_pfm_read(pfm, &fb, &err), RT_OK);
+    rt_framebuffer_free(&fb);
+
+    put_precious(pfm);
+    run_args(r, (const char *const[]){"-q", "-s", "64", "--integrator", "path", "--passes", "0", "--time-limit",
+                                      "1e-6", "-o", pfm, slow_scene(), NULL});
+    assert_int_equal(r->status, 0);
+    assert_precious(pfm);
+    if (!strstr(r->err, "stopped before any tile finished (time limit); nothing written"))
+        assert_contains(r->err, " tiles at 64 spp, time limit; ");
+    assert_no_temp_files();
+    unlink(pfm);
+    unlink(partial);
+    free(r);
 }
 
 /* The second Ctrl-C leaves at once: a pixel of 2^20 samples takes seconds,
@@ -853,6 +971,9 @@ int main(void)
         cmocka_unit_test(test_deep_recursion),
         cmocka_unit_test(test_sigint_writes_finished_tiles),
         cmocka_unit_test(test_sigterm_writes_finished_tiles),
+        cmocka_unit_test(test_sigint_writes_passes),
+        cmocka_unit_test(test_sigterm_writes_passes),
+        cmocka_unit_test(test_time_limit),
         cmocka_unit_test(test_second_sigint_exits_at_once),
         cmocka_unit_test(test_compare_command),
     };

@@ -28,6 +28,8 @@ typedef enum flag_kind {
     FLAG_CAMERA,
     FLAG_TILE,
     FLAG_PREVIEW,
+    FLAG_PASSES,
+    FLAG_TIME_LIMIT,
     FLAG_INFO,
     FLAG_MAX_MEMORY,
     FLAG_HELP,
@@ -61,6 +63,11 @@ static const flag flags[] = {
     {NULL, "--tile", "N", FLAG_TILE, NULL, "tile size in pixels (default 32)"},
     {NULL, "--preview", "SECONDS", FLAG_PREVIEW, NULL,
      "live view: rewrite the output with the finished tiles every SECONDS"},
+    {NULL, "--passes", "N", FLAG_PASSES, NULL,
+     "render in passes of N samples per pixel over the whole image; 0 = tile by tile\n"
+     "(default: passes of 4 for path, tiles for direct and whitted)"},
+    {NULL, "--time-limit", "SECONDS", FLAG_TIME_LIMIT, NULL,
+     "stop after the pass (tiles: the tiles in hand) that crosses SECONDS of rendering and write the image"},
     {NULL, "--info", "FILE", FLAG_INFO, NULL, "print what a scene or model contains (key: value lines) and exit"},
     {NULL, "--max-memory", "SIZE", FLAG_MAX_MEMORY, NULL, "memory budget, e.g. 4G or 512M; 'none' for no limit"},
     {"-h", "--help", NULL, FLAG_HELP, NULL, "this text"},
@@ -151,7 +158,7 @@ static void usage(FILE *f)
     }
     fprintf(f, "\n"
                "Scene format: docs/scene-format.md; limits and exit codes: docs/robustness.md.\n"
-               "Exit status: 0 ok, 2 bad input (or over a limit), 130 interrupted.\n");
+               "Exit status: 0 ok, 2 bad input (or over a limit), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM).\n");
 }
 
 /* ------------------------------------------------------------ parsing */
@@ -350,6 +357,20 @@ int args_parse(args *a, int argc, char **argv)
             if (rt_parse_float(value, &s) != RT_NUMBER_OK || !(s >= 0.1f && s <= 3600.0f))
                 return fail_usage("%s wants seconds between updates (0.1 to 3600), got '%s'", name, value);
             a->preview_seconds = (double)s;
+            break;
+        }
+        case FLAG_PASSES:
+            if (!int_value(value, 0, 1 << 20, &a->pass_samples))
+                return fail_usage("%s wants samples per pixel a pass from 0 (tiles) to 1048576, got '%s'", name,
+                                  value);
+            if (a->pass_samples == 0)
+                a->pass_samples = -1; /* rt_render's "tiles" */
+            break;
+        case FLAG_TIME_LIMIT: {
+            float s = 0.0f;
+            if (rt_parse_float(value, &s) != RT_NUMBER_OK || !(s > 0.0f && s <= 1e7f))
+                return fail_usage("%s wants seconds (more than 0, at most 1e7), got '%s'", name, value);
+            a->time_limit = (double)s;
             break;
         }
         case FLAG_INFO:

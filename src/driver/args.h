@@ -48,6 +48,8 @@ typedef struct args {
     int tile;               /* --tile; 0 = the default */
     int camera;             /* --camera N; -1 = none */
     double preview_seconds; /* --preview; 0 = no live view */
+    int pass_samples;       /* --passes: rt_render_options.pass_samples (0 = the integrator's, -1 = tiles) */
+    double time_limit;      /* --time-limit seconds; 0 = none */
     rt_log_level log_level; /* -q, -v */
     memory_budget budget;   /* --max-memory, else the default (not applied yet) */
     setting_flag settings[ARGS_MAX_SETTINGS];

@@ -4,17 +4,23 @@
  * cores (progress.c draws the progress bar and the live preview), write the
  * image.
  *
- * Exit status: 0 on success, 2 for bad input (flags, scene files, models,
- * images, an unwritable output), 130 when interrupted (the finished tiles
- * are still written). Every failure says what and where on stderr, and never
- * leaves a partial file over an existing image. The process runs under a
- * memory budget (memory_budget.c).
+ * Exit status: 0 on success (also when --time-limit stopped the render),
+ * 2 for bad input (flags, scene files, models, images, an unwritable
+ * output), 128 + the signal when Ctrl-C (130) or SIGTERM (143) stopped it.
+ * A render stopped early keeps what it has: in passes the whole image at
+ * the samples reached goes to the output; a tiled render's finished tiles
+ * go to NAME.partial.EXT, never over the output. A second signal ends the
+ * process at once and removes the temporary file of a write under way.
+ * Every failure says what and where on stderr, and never leaves a partial
+ * file over an existing image. The process runs under a memory budget
+ * (memory_budget.c).
  */
 #include <signal.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "rt/base/log.h"
@@ -40,15 +46,39 @@
  * (diffuse_rays ^ diffuse_bounces); more is a render that never ends. */
 #define MAX_DIFFUSE_TREE ((double)(1 << 24))
 
+/* What the signal handler shares with the render: the first signal's
+ * number (the render's cancel flag), and the temporary file of an image
+ * write under way. */
 static atomic_int interrupted;
+static rt_write_temp write_temp;
 
 static void on_signal(int sig)
 {
-    if (atomic_exchange(&interrupted, 1)) {
-        /* second Ctrl-C: leave at once */
+    int expected = 0;
+    if (!atomic_compare_exchange_strong(&interrupted, &expected, sig)) {
+        /* the second signal: leave at once, leaving no temporary file */
+        if (write_temp.active)
+            unlink(write_temp.path);
         signal(sig, SIG_DFL);
         raise(sig);
     }
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* NAME.partial.EXT for NAME.EXT: where an incomplete image goes. */
+static void partial_name(const char *output, char *out, size_t size)
+{
+    const char *dot = strrchr(output, '.');
+    const char *slash = strrchr(output, '/');
+    if (!dot || (slash && dot < slash))
+        dot = output + strlen(output);
+    snprintf(out, size, "%.*s.partial%s", (int)(dot - output), output, dot);
 }
 
 /* Prints an error; out-of-memory errors also say which budget ran out and
@@ -224,9 +254,10 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     return RT_OK;
 }
 
-/* Builds the kd-tree, renders (Ctrl-C and SIGTERM stop the workers) and
- * writes the image; returns the exit status. */
-static int render_and_write(const rt_scene *scene, const args *a, const char *output)
+/* Builds the kd-tree, renders (Ctrl-C and SIGTERM stop the workers, as
+ * does --time-limit) and writes the image; returns the exit status.
+ * t_start: when the run began, for the wall time in the "wrote" line. */
+static int render_and_write(const rt_scene *scene, const args *a, const char *output, double t_start)
 {
     const rt_settings *set = &scene->settings;
     rt_error err = {0};
@@ -257,34 +288,57 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     progress_view view;
     progress_view_init(&view, a->log_level >= RT_LOG_NORMAL && isatty(2), a->preview_seconds > 0.0 ? output : NULL,
                        a->preview_seconds, set->exposure);
+    view.temp = &write_temp;
     rt_render_options ro;
     memset(&ro, 0, sizeof ro);
     ro.threads = a->threads;
     ro.tile_size = a->tile;
+    ro.pass_samples = a->pass_samples;
+    ro.time_limit = a->time_limit;
     ro.cancel = &interrupted;
     ro.progress = view.bar || view.preview_path ? progress_report : NULL;
     ro.progress_user = &view;
     rt_render_stats rs;
     rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);
     int status = 0;
-    if (r == RT_ERR_INTERRUPTED) {
-        fprintf(stderr, "rt: %s; writing the finished tiles to %s\n", err.message, output);
-        status = 130;
-    } else if (r != RT_OK) {
+    if (r != RT_OK && r != RT_ERR_INTERRUPTED) {
         report(&err, &a->budget);
         status = 2;
-    }
-    if (status != 2) {
-        if (rt_framebuffer_write(&fb, output, set->exposure, &err) != RT_OK) {
+    } else {
+        int sig = atomic_load(&interrupted);
+        if (r == RT_ERR_INTERRUPTED)
+            status = 128 + (sig ? sig : SIGINT);
+        const char *reason = r == RT_ERR_INTERRUPTED ? (sig == SIGTERM ? "terminated" : "interrupted")
+                             : rs.time_limited     ? "time limit"
+                                                   : NULL;
+        char why[32] = "";
+        if (reason)
+            snprintf(why, sizeof why, ", %s", reason);
+        bool stopped = r == RT_ERR_INTERRUPTED || rs.time_limited;
+        char partial[1100], what[160];
+        const char *target = output;
+        if (rs.partial) {
+            partial_name(output, partial, sizeof partial);
+            target = partial;
+            snprintf(what, sizeof what, "%d of %d tiles at %d spp%s", rs.tiles_done, rs.tiles_total, set->samples,
+                     why);
+        } else {
+            snprintf(what, sizeof what, "%d of %d spp%s", rs.samples_done, set->samples, why);
+        }
+        if (rs.partial && rs.tiles_done == 0) {
+            fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s left as it was\n",
+                    rs.passes ? "pass" : "tile", reason ? reason : "?", output);
+        } else if (rt_framebuffer_write_tracked(&fb, target, set->exposure, &write_temp, &err) != RT_OK) {
             report(&err, &a->budget);
             status = 2;
-        } else if (a->log_level >= RT_LOG_NORMAL) {
-            fprintf(stderr, "rt: wrote %s (%dx%d, %d spp, %.2f s)\n", output, fb.width, fb.height, set->samples,
-                    rs.seconds);
+        } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
+            fprintf(stderr, "rt: wrote %s: %dx%d, %s; %.2f s (render %.2f s)%s%s%s\n", target, fb.width, fb.height,
+                    what, now_seconds() - t_start, rs.seconds, rs.partial ? "; " : "", rs.partial ? output : "",
+                    rs.partial ? " left as it was" : "");
         }
     }
-    rt_info("render: %.3f s on %d threads, %llu camera rays, %llu rays, %.2f Mrays/s", rs.seconds, rs.threads,
-            (unsigned long long)rs.camera_rays, (unsigned long long)rs.rays,
+    rt_info("render: %.3f s on %d threads, %s, %llu camera rays, %llu rays, %.2f Mrays/s", rs.seconds, rs.threads,
+            rs.passes ? "passes" : "tiles", (unsigned long long)rs.camera_rays, (unsigned long long)rs.rays,
             rs.seconds > 0 ? 1e-6 * (double)rs.rays / rs.seconds : 0.0);
     if (rs.bad_samples)
         rt_warn("%llu NaN/Inf samples were dropped", (unsigned long long)rs.bad_samples);
@@ -295,6 +349,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
 
 int main(int argc, char **argv)
 {
+    double t_start = now_seconds();
     if (argc > 1 && strcmp(argv[1], "compare") == 0)
         return rt_cmd_compare(argc - 1, argv + 1);
     args a;
@@ -315,7 +370,7 @@ int main(int argc, char **argv)
         rt_scene_free(&scene);
         return 2;
     }
-    status = render_and_write(&scene, &a, output);
+    status = render_and_write(&scene, &a, output, t_start);
     rt_scene_free(&scene);
     return status;
 }

@@ -35,7 +35,7 @@ static void draw_bar(int done, int total, double elapsed, bool final)
 }
 
 /* Live view: a copy of the image where unfinished tiles are dim grey. */
-static void write_preview(const rt_render_progress *p, const char *path, float exposure)
+static void write_preview(const rt_render_progress *p, const char *path, float exposure, rt_write_temp *temp)
 {
     rt_framebuffer copy;
     rt_error err;
@@ -50,7 +50,7 @@ static void write_preview(const rt_render_progress *p, const char *path, float e
                     copy.rgb[k + c] = t.finished ? p->fb->rgb[k + c] : 0.02f;
             }
     }
-    if (rt_framebuffer_write(&copy, path, exposure, &err) != RT_OK)
+    if (rt_framebuffer_write_tracked(&copy, path, exposure, temp, &err) != RT_OK)
         rt_warn("live preview: %s", err.message);
     rt_framebuffer_free(&copy);
 }
@@ -71,7 +71,7 @@ void progress_report(const rt_render_progress *p, void *view)
     if (v->bar)
         draw_bar(p->tiles_done, p->tiles_total, p->elapsed, p->final);
     if (!p->final && v->preview_path && p->elapsed - v->last_preview >= v->preview_seconds) {
-        write_preview(p, v->preview_path, v->exposure);
+        write_preview(p, v->preview_path, v->exposure, v->temp);
         v->last_preview = p->elapsed;
     }
 }

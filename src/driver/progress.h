@@ -20,6 +20,7 @@ typedef struct progress_view {
     double preview_seconds;   /* ... this often (0 = 2 s) */
     float exposure;           /* the scene's, for PNG previews */
     double last_preview;      /* elapsed seconds at the last preview */
+    rt_write_temp *temp;      /* the preview write's temporary file, for the signal handler; may be NULL */
 } progress_view;
 
 void progress_view_init(progress_view *v, bool bar, const char *preview_path, double preview_seconds,

@@ -52,8 +52,9 @@ rt_result rt_output_format(const char *path, rt_image_format *format, rt_error *
     return rt_fail(err, RT_ERR_INVALID, "%s: unknown output format (use .png, .pfm or .hdr)", path);
 }
 
-/* Opens a fresh temporary file in the directory of `path`. */
-static FILE *open_temp_beside(const char *path, char *tmp, size_t tmp_size)
+/* Opens a fresh temporary file in the directory of `path`. With `temp`,
+ * its name is published before mkstemp creates the file. */
+static FILE *open_temp_beside(const char *path, char *tmp, size_t tmp_size, rt_write_temp *temp)
 {
     const char *slash = strrchr(path, '/');
     int n;
@@ -65,6 +66,8 @@ static FILE *open_temp_beside(const char *path, char *tmp, size_t tmp_size)
         errno = ENAMETOOLONG;
         return NULL;
     }
+    if (temp)
+        temp->active = 1;
     int fd = mkstemp(tmp);
     if (fd < 0)
         return NULL;
@@ -83,7 +86,7 @@ rt_result rt_output_check(const char *path, rt_error *err)
     if (r != RT_OK)
         return r;
     char tmp[4200];
-    FILE *f = open_temp_beside(path, tmp, sizeof tmp);
+    FILE *f = open_temp_beside(path, tmp, sizeof tmp, NULL);
     if (!f)
         return rt_fail(err, RT_ERR_IO, "%s: cannot write there: %s", path, strerror(errno));
     fclose(f);
@@ -153,14 +156,33 @@ static int write_png(FILE *f, const rt_framebuffer *fb, float exposure)
 
 rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float exposure, rt_error *err)
 {
+    return rt_framebuffer_write_tracked(fb, path, exposure, NULL, err);
+}
+
+static rt_result write_tracked(const rt_framebuffer *fb, const char *path, float exposure, rt_write_temp *temp,
+                               rt_error *err);
+
+rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *path, float exposure, rt_write_temp *temp,
+                                       rt_error *err)
+{
+    rt_result r = write_tracked(fb, path, exposure, temp, err);
+    if (temp)
+        temp->active = 0; /* renamed into place or removed */
+    return r;
+}
+
+static rt_result write_tracked(const rt_framebuffer *fb, const char *path, float exposure, rt_write_temp *temp,
+                               rt_error *err)
+{
     rt_image_format fmt;
     rt_result r = rt_output_format(path, &fmt, err);
     if (r != RT_OK)
         return r;
     if ((r = rt_output_check_size(path, fb->width, fb->height, err)) != RT_OK)
         return r;
-    char tmp[4200];
-    FILE *f = open_temp_beside(path, tmp, sizeof tmp);
+    char local[4200];
+    char *tmp = temp ? temp->path : local;
+    FILE *f = open_temp_beside(path, tmp, temp ? sizeof temp->path : sizeof local, temp);
     if (!f)
         return rt_fail(err, RT_ERR_IO, "%s: cannot create a file there: %s", path, strerror(errno));
     int ok;

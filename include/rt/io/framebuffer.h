@@ -15,6 +15,8 @@
 #ifndef RT_FRAMEBUFFER_H
 #define RT_FRAMEBUFFER_H
 
+#include <signal.h>
+
 #include "rt/base/error.h"
 
 typedef struct rt_framebuffer {
@@ -37,6 +39,18 @@ rt_result rt_output_check(const char *path, rt_error *err);
 rt_result rt_output_check_size(const char *path, int width, int height, rt_error *err);
 /* Writes atomically. exposure scales the values for PNG only. */
 rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float exposure, rt_error *err);
+
+/* A write's temporary file, for a signal handler that ends the process:
+ * while `active` is non-zero, `path` may name the temporary file of a
+ * write under way, and the handler may unlink(path) (async-signal-safe;
+ * a name not yet or no longer there is harmless). */
+typedef struct rt_write_temp {
+    char path[4200];
+    volatile sig_atomic_t active;
+} rt_write_temp;
+/* rt_framebuffer_write that keeps *temp up to date (temp may be NULL). */
+rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *path, float exposure, rt_write_temp *temp,
+                                       rt_error *err);
 
 /* Reads a PFM (for tests and comparisons against references). */
 rt_result rt_pfm_read(const char *path, rt_framebuffer *fb, rt_error *err);
