@@ -7,16 +7,20 @@
  * Ctrl-C / SIGTERM (exit 130 / 143; in passes the whole image at the
  * samples reached goes to the output, tiles to NAME.partial.EXT with the
  * output left alone), --time-limit, a second Ctrl-C (exits at once, the
- * old image kept), a 1x1 image, and the same bytes from 1, 64 and
- * more-threads-than-tiles renders.
+ * old image kept), a 1x1 image, the same bytes from 1, 64 and
+ * more-threads-than-tiles renders, and --display-server against a tev
+ * stand-in on loopback that decodes tev's packets.
  */
 #include "test_util.h"
 
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdbool.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -927,6 +931,290 @@ static void test_second_sigint_exits_at_once(void **state)
     free(r);
 }
 
+/* ------------------------------------------------------------ a tev stand-in */
+
+/* What a tev stand-in has received: the image CreateImage made, with every
+ * UpdateImageV3 rectangle applied. */
+typedef struct tev_view {
+    int width, height;
+    float *rgb;
+    int creates, updates;
+    char name[256];
+} tev_view;
+
+/* A loopback TCP socket on a free port, bound (listening when `listening`). */
+static int tev_socket(int *port, bool listening)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    assert_true(fd >= 0);
+    struct sockaddr_in a;
+    memset(&a, 0, sizeof a);
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = 0;
+    assert_int_equal(bind(fd, (struct sockaddr *)&a, sizeof a), 0);
+    socklen_t len = sizeof a;
+    assert_int_equal(getsockname(fd, (struct sockaddr *)&a, &len), 0);
+    *port = ntohs(a.sin_port);
+    if (listening)
+        assert_int_equal(listen(fd, 4), 0);
+    return fd;
+}
+
+static int tev_accept(int listener)
+{
+    struct pollfd pf = {listener, POLLIN, 0};
+    if (poll(&pf, 1, 60000) != 1)
+        fail_msg("rt did not connect to the tev stand-in within 60 s");
+    int fd = accept(listener, NULL, NULL);
+    assert_true(fd >= 0);
+    return fd;
+}
+
+/* Reads n bytes; false at end of stream before the first byte. */
+static bool read_n(int fd, unsigned char *buf, size_t n)
+{
+    size_t got = 0;
+    while (got < n) {
+        struct pollfd pf = {fd, POLLIN, 0};
+        if (poll(&pf, 1, 60000) != 1)
+            fail_msg("the tev stand-in got no data for 60 s");
+        ssize_t k = read(fd, buf + got, n - got);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0) {
+            if (got == 0)
+                return false;
+            fail_msg("a tev packet was cut off after %zu of %zu bytes", got, n);
+        }
+        got += (size_t)k;
+    }
+    return true;
+}
+
+static uint64_t le(const unsigned char *p, int bytes)
+{
+    uint64_t v = 0;
+    for (int i = bytes - 1; i >= 0; i--)
+        v = v << 8 | p[i];
+    return v;
+}
+
+/* A packet's reader: every field must lie inside the packet. */
+typedef struct field_reader {
+    const unsigned char *p;
+    size_t at, size;
+} field_reader;
+
+static uint64_t field(field_reader *r, int bytes)
+{
+    if (r->at + (size_t)bytes > r->size)
+        fail_msg("tev packet field past its end (%zu + %d > %zu)", r->at, bytes, r->size);
+    uint64_t v = le(r->p + r->at, bytes);
+    r->at += (size_t)bytes;
+    return v;
+}
+
+static const char *field_string(field_reader *r)
+{
+    const char *s = (const char *)r->p + r->at;
+    size_t n = strnlen(s, r->size - r->at);
+    if (r->at + n >= r->size)
+        fail_msg("tev packet string without its NUL");
+    r->at += n + 1;
+    return s;
+}
+
+/* Decodes one packet into v; false at the end of the stream. */
+static bool tev_read_packet(int fd, tev_view *v)
+{
+    unsigned char head[4];
+    if (!read_n(fd, head, 4))
+        return false;
+    size_t size = (size_t)le(head, 4);
+    assert_true(size >= 5 && size < ((size_t)64 << 20));
+    unsigned char *p = malloc(size);
+    assert_non_null(p);
+    memcpy(p, head, 4);
+    if (!read_n(fd, p + 4, size - 4))
+        fail_msg("tev packet of %zu bytes cut off after its length", size);
+    field_reader r = {p, 4, size};
+    int type = (int)field(&r, 1);
+    if (type == 4) { /* CreateImage */
+        assert_int_equal(field(&r, 1), 0); /* grabFocus */
+        snprintf(v->name, sizeof v->name, "%s", field_string(&r));
+        v->width = (int)(int32_t)field(&r, 4);
+        v->height = (int)(int32_t)field(&r, 4);
+        assert_int_equal(field(&r, 4), 3);
+        assert_string_equal(field_string(&r), "R");
+        assert_string_equal(field_string(&r), "G");
+        assert_string_equal(field_string(&r), "B");
+        assert_true(v->width > 0 && v->height > 0);
+        free(v->rgb);
+        v->rgb = calloc((size_t)v->width * (size_t)v->height * 3, sizeof(float));
+        assert_non_null(v->rgb);
+        v->creates++;
+    } else if (type == 6) { /* UpdateImageV3 */
+        assert_true(v->creates > 0);
+        field(&r, 1);
+        assert_string_equal(field_string(&r), v->name);
+        int n = (int)field(&r, 4);
+        assert_int_equal(n, 3);
+        const char *names[3];
+        for (int c = 0; c < 3; c++)
+            names[c] = field_string(&r);
+        int x = (int)(int32_t)field(&r, 4), y = (int)(int32_t)field(&r, 4);
+        int w = (int)(int32_t)field(&r, 4), h = (int)(int32_t)field(&r, 4);
+        assert_true(x >= 0 && y >= 0 && w > 0 && h > 0 && x + w <= v->width && y + h <= v->height);
+        int64_t off[3], stride[3];
+        for (int c = 0; c < 3; c++)
+            off[c] = (int64_t)field(&r, 8);
+        for (int c = 0; c < 3; c++)
+            stride[c] = (int64_t)field(&r, 8);
+        size_t npx = (size_t)w * (size_t)h, nfloats = 0;
+        for (int c = 0; c < 3; c++) {
+            assert_true(off[c] >= 0 && stride[c] >= 0);
+            size_t need = (size_t)off[c] + (npx - 1) * (size_t)stride[c] + 1;
+            nfloats = need > nfloats ? need : nfloats;
+        }
+        assert_int_equal(size - r.at, nfloats * 4); /* exactly the floats, nothing after */
+        const unsigned char *data = p + r.at;
+        for (int c = 0; c < 3; c++) {
+            int ch = names[c][0] == 'R' ? 0 : names[c][0] == 'G' ? 1 : 2;
+            for (size_t i = 0; i < npx; i++) {
+                union { uint32_t u; float f; } f;
+                f.u = (uint32_t)le(data + 4 * ((size_t)off[c] + i * (size_t)stride[c]), 4);
+                size_t px = (size_t)(y + (int)(i / (size_t)w)) * (size_t)v->width + (size_t)(x + (int)(i % (size_t)w));
+                v->rgb[3 * px + (size_t)ch] = f.f;
+            }
+        }
+        v->updates++;
+    } else {
+        fail_msg("the tev stand-in got packet type %d", type);
+    }
+    free(p);
+    return true;
+}
+
+/* What tev shows equals the image rt wrote, bit for bit. */
+static void assert_tev_shows(const tev_view *v, const char *pfm, const char *name)
+{
+    rt_framebuffer fb;
+    rt_error err;
+    assert_int_equal(rt_pfm_read(pfm, &fb, &err), RT_OK);
+    assert_string_equal(v->name, name);
+    assert_int_equal(v->width, fb.width);
+    assert_int_equal(v->height, fb.height);
+    assert_memory_equal(v->rgb, fb.rgb, (size_t)fb.width * (size_t)fb.height * 3 * sizeof(float));
+    rt_framebuffer_free(&fb);
+}
+
+/* --display-server with a tev stand-in listening: tiled and in passes, the
+ * image tev ends up showing is the written one, bit for bit. */
+static void test_display_server(void **state)
+{
+    (void)state;
+    const char *modes[2] = {"0", "2"};
+    for (int m = 0; m < 2; m++) {
+        int port;
+        int listener = tev_socket(&port, true);
+        char address[64];
+        snprintf(address, sizeof address, "127.0.0.1:%d", port);
+        const char *pfm = path_in("tev.pfm");
+        const char *const args[] = {"-q", "-r", "40x24", "-s", "6", "--tile", "8", "--integrator", "path", "--passes",
+                                    modes[m], "--display-server", address, "-o", pfm, slow_scene(), NULL};
+        double t0 = now_s();
+        pid_t pid = spawn(args);
+        int fd = tev_accept(listener);
+        tev_view v;
+        memset(&v, 0, sizeof v);
+        while (tev_read_packet(fd, &v))
+            ;
+        close(fd);
+        close(listener);
+        run_result *r = malloc(sizeof *r);
+        assert_non_null(r);
+        wait_for(pid, t0, 120.0, r);
+        assert_int_equal(r->status, 0);
+        assert_int_equal(v.creates, 1);
+        assert_true(v.updates >= 1);
+        assert_tev_shows(&v, pfm, "tev.pfm");
+        free(v.rgb);
+        free(r);
+        unlink(pfm);
+    }
+}
+
+/* tev not there: the render goes on quietly (nothing said without -v) and
+ * writes its image. */
+static void test_display_server_absent(void **state)
+{
+    (void)state;
+    int port;
+    int bound = tev_socket(&port, false); /* bound, not listening: connections are refused */
+    char address[64];
+    snprintf(address, sizeof address, "127.0.0.1:%d", port);
+    const char *pfm = path_in("absent.pfm");
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_args(r, (const char *const[]){"-r", "16x16", "-s", "2", "--display-server", address, "-o", pfm, NULL});
+    close(bound);
+    assert_int_equal(r->status, 0);
+    if (strstr(r->err, "display server") || strstr(r->err, "warning"))
+        fail_msg("rt should say nothing about a missing tev without -v:\n%s", r->err);
+    rt_framebuffer fb;
+    rt_error err;
+    assert_int_equal(rt_pfm_read(pfm, &fb, &err), RT_OK);
+    rt_framebuffer_free(&fb);
+    run_args(r, (const char *const[]){"--display-server", "nohost", "-o", pfm, NULL});
+    assert_int_equal(r->status, 2);
+    assert_contains(r->err, "--display-server wants HOST:PORT");
+    unlink(pfm);
+    free(r);
+}
+
+/* tev closed and opened again: rt connects again by itself and sends the
+ * image anew; after Ctrl-C the second connection shows the written image. */
+static void test_display_server_reconnects(void **state)
+{
+    (void)state;
+    int port;
+    int listener = tev_socket(&port, true);
+    char address[64];
+    snprintf(address, sizeof address, "127.0.0.1:%d", port);
+    const char *pfm = path_in("again.pfm");
+    const char *const args[] = {"-q", "-s", "100000", "-t", "2", "--integrator", "path", "--display-server", address,
+                                "-o", pfm, slow_scene(), NULL};
+    double t0 = now_s();
+    pid_t pid = spawn(args);
+    int fd = tev_accept(listener);
+    tev_view v;
+    memset(&v, 0, sizeof v);
+    while (v.updates == 0)
+        assert_true(tev_read_packet(fd, &v));
+    close(fd); /* tev goes away */
+    fd = tev_accept(listener);
+    tev_view w;
+    memset(&w, 0, sizeof w);
+    while (w.updates == 0)
+        assert_true(tev_read_packet(fd, &w));
+    kill(pid, SIGINT);
+    while (tev_read_packet(fd, &w))
+        ;
+    close(fd);
+    close(listener);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    wait_for(pid, t0, 120.0, r);
+    assert_int_equal(r->status, 130);
+    assert_int_equal(w.creates, 1);
+    assert_tev_shows(&w, pfm, "again.pfm");
+    free(v.rgb);
+    free(w.rgb);
+    free(r);
+    unlink(pfm);
+}
+
 /* `rt compare` is reached from the command line: an image against itself
  * (every metric 0, exit 0), against a different one with a threshold that
  * fails (exit 1), and against a missing file (exit 2, the file named). */
@@ -975,6 +1263,9 @@ int main(void)
         cmocka_unit_test(test_sigterm_writes_passes),
         cmocka_unit_test(test_time_limit),
         cmocka_unit_test(test_second_sigint_exits_at_once),
+        cmocka_unit_test(test_display_server),
+        cmocka_unit_test(test_display_server_absent),
+        cmocka_unit_test(test_display_server_reconnects),
         cmocka_unit_test(test_compare_command),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

@@ -17,6 +17,7 @@
 #include "rt/base/log.h"
 #include "rt/base/number.h"
 #include "rt/render/render.h"
+#include "tev.h"
 
 typedef enum flag_kind {
     FLAG_OUTPUT,
@@ -30,6 +31,7 @@ typedef enum flag_kind {
     FLAG_PREVIEW,
     FLAG_PASSES,
     FLAG_TIME_LIMIT,
+    FLAG_DISPLAY_SERVER,
     FLAG_INFO,
     FLAG_MAX_MEMORY,
     FLAG_HELP,
@@ -68,6 +70,8 @@ static const flag flags[] = {
      "(default: passes of 4 for path, tiles for direct and whitted)"},
     {NULL, "--time-limit", "SECONDS", FLAG_TIME_LIMIT, NULL,
      "stop after the pass (tiles: the tiles in hand) that crosses SECONDS of rendering and write the image"},
+    {NULL, "--display-server", "HOST:PORT", FLAG_DISPLAY_SERVER, NULL,
+     "stream the image as it renders to the tev viewer listening there (tev's default: 127.0.0.1:14158)"},
     {NULL, "--info", "FILE", FLAG_INFO, NULL, "print what a scene or model contains (key: value lines) and exit"},
     {NULL, "--max-memory", "SIZE", FLAG_MAX_MEMORY, NULL, "memory budget, e.g. 4G or 512M; 'none' for no limit"},
     {"-h", "--help", NULL, FLAG_HELP, NULL, "this text"},
@@ -371,6 +375,14 @@ int args_parse(args *a, int argc, char **argv)
             if (rt_parse_float(value, &s) != RT_NUMBER_OK || !(s > 0.0f && s <= 1e7f))
                 return fail_usage("%s wants seconds (more than 0, at most 1e7), got '%s'", name, value);
             a->time_limit = (double)s;
+            break;
+        }
+        case FLAG_DISPLAY_SERVER: {
+            char host[256], port[16];
+            if (!tev_parse_address(value, host, sizeof host, port, sizeof port))
+                return fail_usage("%s wants HOST:PORT with a port from 1 to 65535 (e.g. 127.0.0.1:14158), got '%s'",
+                                  name, value);
+            a->display_server = value;
             break;
         }
         case FLAG_INFO:

@@ -38,6 +38,7 @@
 #include "commands.h"
 #include "memory_budget.h"
 #include "progress.h"
+#include "tev.h"
 
 /* The kd-tree's primitive ids are the 30 payload bits of its references
  * (RT_KD_PAYLOAD, rt/accel/kdtree.h), one value kept free. */
@@ -257,12 +258,17 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
 /* Builds the kd-tree, renders (Ctrl-C and SIGTERM stop the workers, as
  * does --time-limit) and writes the image; returns the exit status.
  * t_start: when the run began, for the wall time in the "wrote" line. */
-static int render_and_write(const rt_scene *scene, const args *a, const char *output, double t_start)
+static int render_and_write(const rt_scene *scene, const args *a, const char *output, progress_view *view,
+                            double t_start)
 {
     const rt_settings *set = &scene->settings;
     rt_error err = {0};
     rt_kdtree tree;
+    char prims[64];
+    snprintf(prims, sizeof prims, "(%zu primitives)", rt_scene_prim_count(scene));
+    progress_phase(view, "kd-tree", prims);
     if (rt_kdtree_build(&tree, scene, NULL, &err) != RT_OK) {
+        progress_clear(view);
         report(&err, &a->budget);
         return 2;
     }
@@ -273,6 +279,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
 
     rt_framebuffer fb;
     if (rt_framebuffer_init(&fb, set->width, set->height, &err) != RT_OK) {
+        progress_clear(view);
         report(&err, &a->budget);
         rt_kdtree_free(&tree);
         return 2;
@@ -285,10 +292,17 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
-    progress_view view;
-    progress_view_init(&view, a->log_level >= RT_LOG_NORMAL && isatty(2), a->preview_seconds > 0.0 ? output : NULL,
-                       a->preview_seconds, set->exposure);
-    view.temp = &write_temp;
+    view->preview_path = a->preview_seconds > 0.0 ? output : NULL;
+    view->preview_seconds = a->preview_seconds;
+    view->exposure = set->exposure;
+    view->time_limit = a->time_limit;
+    view->temp = &write_temp;
+    tev_stream tev;
+    if (a->display_server) {
+        const char *base = strrchr(output, '/');
+        tev_stream_open(&tev, a->display_server, base ? base + 1 : output, fb.width, fb.height);
+        view->tev = &tev;
+    }
     rt_render_options ro;
     memset(&ro, 0, sizeof ro);
     ro.threads = a->threads;
@@ -296,12 +310,13 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     ro.pass_samples = a->pass_samples;
     ro.time_limit = a->time_limit;
     ro.cancel = &interrupted;
-    ro.progress = view.bar || view.preview_path ? progress_report : NULL;
-    ro.progress_user = &view;
+    ro.progress = view->bar || view->preview_path || view->tev ? progress_report : NULL;
+    ro.progress_user = view;
     rt_render_stats rs;
     rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);
     int status = 0;
     if (r != RT_OK && r != RT_ERR_INTERRUPTED) {
+        progress_clear(view);
         report(&err, &a->budget);
         status = 2;
     } else {
@@ -342,6 +357,9 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
             rs.seconds > 0 ? 1e-6 * (double)rs.rays / rs.seconds : 0.0);
     if (rs.bad_samples)
         rt_warn("%llu NaN/Inf samples were dropped", (unsigned long long)rs.bad_samples);
+    if (view->tev)
+        tev_stream_close(&tev);
+    view->tev = NULL;
     rt_framebuffer_free(&fb);
     rt_kdtree_free(&tree);
     return status;
@@ -365,12 +383,17 @@ int main(int argc, char **argv)
     rt_scene_init(&scene);
     rt_error err = {0};
     char output[1024];
+    progress_view view;
+    progress_view_init(&view, a.log_level >= RT_LOG_NORMAL && isatty(2));
+    progress_phase(&view, "load", a.input ? a.input : "the built-in scene");
     if (prepare(&scene, &a, output, sizeof output, &err) != RT_OK) {
+        progress_clear(&view);
         report(&err, &a.budget);
         rt_scene_free(&scene);
         return 2;
     }
-    status = render_and_write(&scene, &a, output, t_start);
+    status = render_and_write(&scene, &a, output, &view, t_start);
+    progress_view_free(&view);
     rt_scene_free(&scene);
     return status;
 }
