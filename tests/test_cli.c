@@ -25,6 +25,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <stb/stb_image.h>
+
 #include "rt/io/framebuffer.h"
 
 static char dir[256];     /* this run's scratch directory */
@@ -1215,6 +1217,112 @@ static void test_display_server_reconnects(void **state)
     unlink(pfm);
 }
 
+/* ------------------------------------------------------------ --window under Xvfb */
+
+/* Starts Xvfb on a display number it picks itself (-displayfd); returns
+ * its pid and the number, or -1 when there is no Xvfb. */
+static pid_t start_xvfb(int *display)
+{
+    if (access("/usr/bin/Xvfb", X_OK) != 0)
+        return -1;
+    int fds[2];
+    assert_int_equal(pipe(fds), 0);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        close(fds[0]);
+        char fd[16];
+        snprintf(fd, sizeof fd, "%d", fds[1]);
+        int null = open("/dev/null", O_WRONLY);
+        dup2(null, 1);
+        dup2(null, 2);
+        execl("/usr/bin/Xvfb", "Xvfb", "-displayfd", fd, "-screen", "0", "320x240x24", "-nolisten", "tcp", (char *)NULL);
+        _exit(127);
+    }
+    close(fds[1]);
+    char buf[32] = {0};
+    size_t n = 0;
+    struct pollfd pf = {fds[0], POLLIN, 0};
+    while (n < sizeof buf - 1 && poll(&pf, 1, 30000) == 1) {
+        ssize_t k = read(fds[0], buf + n, sizeof buf - 1 - n);
+        if (k <= 0)
+            break;
+        n += (size_t)k;
+        if (memchr(buf, '\n', n))
+            break;
+    }
+    close(fds[0]);
+    if (sscanf(buf, "%d", display) != 1) {
+        kill(pid, SIGTERM);
+        waitpid(pid, NULL, 0);
+        fail_msg("Xvfb did not report its display");
+    }
+    return pid;
+}
+
+/* --window under Xvfb: the window shows the rendered image, the PNG's very
+ * bytes (read back from the window through RT_WINDOW_SCREENSHOT). Without
+ * a display --window is refused with a clear message and exit 2. */
+static void test_window(void **state)
+{
+    (void)state;
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *png = path_in("win.png"), *shot = path_in("win.ppm");
+    const char *display = getenv("DISPLAY");
+    char saved[256] = "";
+    if (display)
+        snprintf(saved, sizeof saved, "%s", display);
+    unsetenv("DISPLAY");
+    put_precious(png);
+    run_args(r, (const char *const[]){"-q", "-r", "8x8", "-s", "1", "--window", "-o", png, NULL});
+    assert_int_equal(r->status, 2);
+    assert_contains(r->err, "rt: --window: cannot open a window: ");
+    assert_precious(png);
+    if (strstr(r->err, "built without SDL2")) {
+        free(r);
+        skip();
+    }
+    int dpy = -1;
+    pid_t xvfb = start_xvfb(&dpy);
+    if (xvfb < 0) {
+        free(r);
+        skip(); /* no Xvfb (Debian xvfb) */
+    }
+    char dname[32];
+    snprintf(dname, sizeof dname, ":%d", dpy);
+    setenv("DISPLAY", dname, 1);
+    setenv("RT_WINDOW_SCREENSHOT", shot, 1);
+    run_args(r, (const char *const[]){"-q", "-r", "40x24", "-s", "8", "--integrator", "path", "--passes", "2", "--window",
+                                      "-o", png, slow_scene(), NULL});
+    unsetenv("RT_WINDOW_SCREENSHOT");
+    if (saved[0])
+        setenv("DISPLAY", saved, 1);
+    else
+        unsetenv("DISPLAY");
+    kill(xvfb, SIGTERM);
+    waitpid(xvfb, NULL, 0);
+    if (r->status != 0)
+        fail_msg("rt --window under Xvfb failed (%d): %s", r->status, r->err);
+    int w = 0, h = 0, n = 0;
+    unsigned char *img = stbi_load(png, &w, &h, &n, 3);
+    assert_non_null(img);
+    static char ppm[64 * 1024];
+    size_t len = read_all(shot, ppm, sizeof ppm);
+    assert_true(len != (size_t)-1);
+    int sw = 0, sh = 0, maxv = 0, off = 0;
+    assert_int_equal(sscanf(ppm, "P6 %d %d %d%n", &sw, &sh, &maxv, &off), 3);
+    assert_int_equal(sw, w);
+    assert_int_equal(sh, h);
+    assert_int_equal(maxv, 255);
+    assert_int_equal(len, (size_t)off + 1 + 3 * (size_t)w * (size_t)h);
+    assert_memory_equal(ppm + off + 1, img, 3 * (size_t)w * (size_t)h);
+    stbi_image_free(img);
+    unlink(png);
+    unlink(shot);
+    free(r);
+}
+
 /* `rt compare` is reached from the command line: an image against itself
  * (every metric 0, exit 0), against a different one with a threshold that
  * fails (exit 1), and against a missing file (exit 2, the file named). */
@@ -1266,6 +1374,7 @@ int main(void)
         cmocka_unit_test(test_display_server),
         cmocka_unit_test(test_display_server_absent),
         cmocka_unit_test(test_display_server_reconnects),
+        cmocka_unit_test(test_window),
         cmocka_unit_test(test_compare_command),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

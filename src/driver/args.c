@@ -32,6 +32,7 @@ typedef enum flag_kind {
     FLAG_PASSES,
     FLAG_TIME_LIMIT,
     FLAG_DISPLAY_SERVER,
+    FLAG_WINDOW,
     FLAG_INFO,
     FLAG_MAX_MEMORY,
     FLAG_HELP,
@@ -72,6 +73,8 @@ static const flag flags[] = {
      "stop after the pass (tiles: the tiles in hand) that crosses SECONDS of rendering and write the image"},
     {NULL, "--display-server", "HOST:PORT", FLAG_DISPLAY_SERVER, NULL,
      "stream the image as it renders to the tev viewer listening there (tev's default: 127.0.0.1:14158)"},
+    {NULL, "--window", NULL, FLAG_WINDOW, NULL,
+     "show the image in a window as it renders (SDL2); it stays up after the render until closed (Esc, q)"},
     {NULL, "--info", "FILE", FLAG_INFO, NULL, "print what a scene or model contains (key: value lines) and exit"},
     {NULL, "--max-memory", "SIZE", FLAG_MAX_MEMORY, NULL, "memory budget, e.g. 4G or 512M; 'none' for no limit"},
     {"-h", "--help", NULL, FLAG_HELP, NULL, "this text"},
@@ -385,6 +388,9 @@ int args_parse(args *a, int argc, char **argv)
             a->display_server = value;
             break;
         }
+        case FLAG_WINDOW:
+            a->window = true;
+            break;
         case FLAG_INFO:
             a->info_path = value;
             break;

@@ -51,6 +51,7 @@ typedef struct args {
     int pass_samples;       /* --passes: rt_render_options.pass_samples (0 = the integrator's, -1 = tiles) */
     double time_limit;      /* --time-limit seconds; 0 = none */
     const char *display_server; /* --display-server HOST:PORT (tev); NULL = none */
+    bool window;            /* --window */
     rt_log_level log_level; /* -q, -v */
     memory_budget budget;   /* --max-memory, else the default (not applied yet) */
     setting_flag settings[ARGS_MAX_SETTINGS];

@@ -39,6 +39,7 @@
 #include "memory_budget.h"
 #include "progress.h"
 #include "tev.h"
+#include "window.h"
 
 /* The kd-tree's primitive ids are the 30 payload bits of its references
  * (RT_KD_PAYLOAD, rt/accel/kdtree.h), one value kept free. */
@@ -285,6 +286,20 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         return 2;
     }
 
+    window_view window;
+    if (a->window) {
+        char why[512], title[1100];
+        snprintf(title, sizeof title, "rt: %s", output);
+        if (!window_open(&window, fb.width, fb.height, title, why, sizeof why)) {
+            progress_clear(view);
+            fprintf(stderr, "rt: --window: cannot open a window: %s\n", why);
+            rt_framebuffer_free(&fb);
+            rt_kdtree_free(&tree);
+            return 2;
+        }
+        view->window = &window;
+    }
+
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
@@ -310,7 +325,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     ro.pass_samples = a->pass_samples;
     ro.time_limit = a->time_limit;
     ro.cancel = &interrupted;
-    ro.progress = view->bar || view->preview_path || view->tev ? progress_report : NULL;
+    ro.progress = view->bar || view->preview_path || view->tev || view->window ? progress_report : NULL;
     ro.progress_user = view;
     rt_render_stats rs;
     rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);
@@ -360,6 +375,12 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     if (view->tev)
         tev_stream_close(&tev);
     view->tev = NULL;
+    if (view->window) {
+        if (status != 2)
+            window_wait(&window); /* the final image stays up until the window is closed */
+        window_close(&window);
+    }
+    view->window = NULL;
     rt_framebuffer_free(&fb);
     rt_kdtree_free(&tree);
     return status;

@@ -6,7 +6,7 @@
  * few passes); and the live preview (--preview): the output image
  * rewritten every few seconds with the finished tiles and the others dim
  * grey, for a viewer that reloads it; and the stream to tev (tev.c) for
- * --display-server. rt_render calls progress_report from
+ * --display-server, and the window (window.c) for --window. rt_render calls progress_report from
  * its own thread about every 50 ms and after each pass
  * (src/render/render.c).
  */
@@ -119,7 +119,9 @@ void progress_view_init(progress_view *v, bool bar)
 void progress_view_free(progress_view *v)
 {
     free(v->tev_sent);
+    free(v->win_shown);
     v->tev_sent = NULL;
+    v->win_shown = NULL;
 }
 
 /* Streams what is new to tev: finished tiles not sent yet, the image
@@ -159,6 +161,29 @@ static void stream_to_tev(progress_view *v, const rt_render_progress *p)
     t->fresh = false;
 }
 
+/* The same for the window: finished tiles, the image after each pass. */
+static void show_in_window(progress_view *v, const rt_render_progress *p)
+{
+    window_view *w = v->window;
+    if (!w->open)
+        return;
+    if (p->final || (p->passes && p->samples_done > 0 && p->samples_done != v->win_samples)) {
+        window_show_rect(w, p->fb, v->exposure, 0, 0, p->fb->width, p->fb->height);
+        v->win_samples = p->samples_done;
+    } else if (!p->passes) {
+        if (!v->win_shown && !(v->win_shown = calloc((size_t)p->tiles_total, 1)))
+            return;
+        for (int i = 0; i < p->tiles_total; i++) {
+            rt_tile tile = rt_render_progress_tile(p, i);
+            if (tile.finished && !v->win_shown[i]) {
+                window_show_rect(w, p->fb, v->exposure, tile.x0, tile.y0, tile.x1, tile.y1);
+                v->win_shown[i] = 1;
+            }
+        }
+    }
+    window_present(w);
+}
+
 void progress_phase(progress_view *v, const char *name, const char *detail)
 {
     if (v->phases >= PROGRESS_MAX_PHASES)
@@ -187,6 +212,8 @@ void progress_report(const rt_render_progress *p, void *view)
         draw_bar(v, p);
     if (v->tev)
         stream_to_tev(v, p);
+    if (v->window)
+        show_in_window(v, p);
     double every = v->preview_seconds > 0.0 ? v->preview_seconds : 2.0;
     if (!p->final && v->preview_path && p->elapsed - v->last_preview >= every) {
         write_preview(p, v->preview_path, v->exposure, v->temp);

@@ -17,7 +17,8 @@
  *
  * With view.tev set (tev.h), progress_report also streams the image to tev:
  * finished tiles as they finish, the whole image after each pass, and the
- * final image (connecting again if tev went away).
+ * final image (connecting again if tev went away); with view.window set
+ * (window.h), it shows the same in the window.
  *
  * The render's line names the phases before it with their times, then the
  * bar: tiles, or samples per pixel when rendering in passes, the elapsed
@@ -33,6 +34,7 @@
 #include "rt/render/render.h"
 
 #include "tev.h"
+#include "window.h"
 
 #define PROGRESS_MAX_PHASES 4
 
@@ -50,6 +52,9 @@ typedef struct progress_view {
     tev_stream *tev;          /* --display-server: stream the image there; NULL = none */
     unsigned char *tev_sent;  /* tiles: per tile, sent to tev since it connected */
     int tev_samples;          /* passes: the samples per pixel last sent */
+    window_view *window;      /* --window: show the image there; NULL = none */
+    unsigned char *win_shown; /* tiles: per tile, shown in the window */
+    int win_samples;          /* passes: the samples per pixel shown */
 } progress_view;
 
 void progress_view_init(progress_view *v, bool bar);
