@@ -143,7 +143,10 @@ static void usage(FILE *f)
         } else {
             snprintf(text, sizeof text, "%s", fl->help);
         }
-        fprintf(f, "  %-*s", HELP_COLUMN - 2, names);
+        if ((int)strlen(names) >= HELP_COLUMN - 3) /* a long name: its help on the next line */
+            fprintf(f, "  %s\n%*s", names, HELP_COLUMN, "");
+        else
+            fprintf(f, "  %-*s", HELP_COLUMN - 2, names);
         print_wrapped(f, text, HELP_COLUMN, HELP_COLUMN);
     }
     fprintf(f, "\nsettings (a scene file's setting statements; --set KEY=VALUE gives any of them, its words\n"

@@ -377,7 +377,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     view->tev = NULL;
     if (view->window) {
         if (status != 2)
-            window_wait(&window); /* the final image stays up until the window is closed */
+            window_wait(&window, &interrupted); /* the final image stays up until closed or Ctrl-C */
         window_close(&window);
     }
     view->window = NULL;

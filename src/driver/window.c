@@ -141,14 +141,14 @@ static void screenshot(window_view *w, const char *path)
     free(px);
 }
 
-void window_wait(window_view *w)
+void window_wait(window_view *w, const atomic_int *stop)
 {
     const char *shot = getenv("RT_WINDOW_SCREENSHOT");
     if (shot && *shot) {
         screenshot(w, shot);
         return;
     }
-    while (w->renderer && w->open) {
+    while (w->renderer && w->open && !(stop && atomic_load(stop))) {
         window_present(w);
         SDL_Delay(30);
     }
@@ -187,9 +187,10 @@ void window_present(window_view *w)
     (void)w;
 }
 
-void window_wait(window_view *w)
+void window_wait(window_view *w, const atomic_int *stop)
 {
     (void)w;
+    (void)stop;
 }
 
 void window_close(window_view *w)

@@ -8,7 +8,7 @@
  *       ... "--window: cannot open a window: <why>" ...
  *   window_show_rect(&w, fb, exposure, x0, y0, x1, y1);  // pixels that are final
  *   window_present(&w);                                  // draws; handles events
- *   window_wait(&w);                                     // after the render: until closed
+ *   window_wait(&w, &stop);                              // after the render: until closed (or stop)
  *   window_close(&w);
  *
  * rt builds without SDL2 (the Makefile compiles this with RT_HAVE_SDL2
@@ -21,6 +21,7 @@
 #ifndef RT_DRIVER_WINDOW_H
 #define RT_DRIVER_WINDOW_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -39,8 +40,8 @@ void window_show_rect(window_view *w, const rt_framebuffer *fb, float exposure, 
 /* Puts the shown image on screen and handles pending events. */
 void window_present(window_view *w);
 /* Keeps the window up until the user closes it (Esc, q, or the close
- * button). */
-void window_wait(window_view *w);
+ * button) or *stop becomes non-zero (Ctrl-C). */
+void window_wait(window_view *w, const atomic_int *stop);
 void window_close(window_view *w);
 
 #endif
