@@ -328,6 +328,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     ro.progress = view->bar || view->preview_path || view->tev || view->window ? progress_report : NULL;
     ro.progress_user = view;
     rt_render_stats rs;
+    memset(&rs, 0, sizeof rs);
     rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);
     int status = 0;
     if (r != RT_OK && r != RT_ERR_INTERRUPTED) {
