@@ -25,6 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/time.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -190,7 +191,9 @@ static int connect_to(const char *host, const char *port, char *why, size_t why_
             fd = -1;
             continue;
         }
-        fcntl(fd, F_SETFL, flags); /* blocking sends from here on */
+        fcntl(fd, F_SETFL, flags); /* blocking sends from here on, */
+        struct timeval tv = {5, 0};  /* but a tev that stops reading for 5 s counts as gone */
+        setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
     }
     freeaddrinfo(list);
     return fd;
