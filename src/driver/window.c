@@ -43,6 +43,10 @@ bool window_open(window_view *w, int width, int height, const char *title, char 
         snprintf(why, why_size, "no display (DISPLAY and WAYLAND_DISPLAY are not set)");
         return false;
     }
+    /* a plain X11/Wayland surface, never an OpenGL one: nothing to gain for
+     * one texture a pass, and Mesa's threads are then out of the process */
+    SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
+    SDL_SetHint(SDL_HINT_RENDER_DRIVER, "software");
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
         snprintf(why, why_size, "%s", SDL_GetError());
         return false;
