@@ -50,12 +50,30 @@ $(BUILD)/obj/%.o: src/%.c | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -c -o $@ $<
 
+# --window needs SDL2 (libsdl2-dev): window.c is built against it when
+# pkg-config finds it at build time, else as stubs that say so; rt links it
+# only then. Its headers come in as system headers (-isystem): their
+# warnings are not ours.
+SDL2_CFLAGS = $$(pkg-config --exists sdl2 2>/dev/null && echo -DRT_HAVE_SDL2 $$(pkg-config --cflags sdl2 | sed 's/-I/-isystem /g'))
+SDL2_LIBS   = $$(pkg-config --exists sdl2 2>/dev/null && pkg-config --libs sdl2)
+
+# (a stamp named for whether SDL2 is there rebuilds window.o when that changes)
+SDL2_STAMP := $(BUILD)/.sdl2-$(shell pkg-config --exists sdl2 2>/dev/null && echo yes || echo no)
+$(SDL2_STAMP):
+	@mkdir -p $(BUILD)
+	@rm -f $(BUILD)/.sdl2-*
+	@touch $@
+
+$(BUILD)/obj/driver/window.o: src/driver/window.c $(SDL2_STAMP) | $(DEPS_OK)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(SDL2_CFLAGS) -c -o $@ $<
+
 $(BUILD)/librt.a: $(LIB_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
 $(RT): $(DRV_OBJ) $(BUILD)/librt.a
-	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
+	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS) $(SDL2_LIBS)
 
 $(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)

@@ -1,5 +1,6 @@
 /* test_render.c - end-to-end renders checked against analytic values, the
- * thread-count independence of the image, progress reports, and image
+ * thread-count independence of the image, passes giving the same bytes as
+ * tiles, time limits and cancelled passes, progress reports, and image
  * output. */
 #include "test_util.h"
 
@@ -218,6 +219,7 @@ static void test_progress_reports(void **state)
     memset(&opt, 0, sizeof opt);
     opt.threads = 2;
     opt.tile_size = 7; /* edge tiles are cut short */
+    opt.pass_samples = -1; /* tiles: passes are checked in test_pass_progress */
     opt.progress = log_progress;
     opt.progress_user = &log;
     rt_render_stats st;
@@ -232,6 +234,162 @@ static void test_progress_reports(void **state)
     free(log.seen);
     rt_framebuffer_free(&fb);
     rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
+/* Renders with explicit options; returns rt_render's result. */
+static rt_result render_with(rt_scene *s, const rt_render_options *opt, rt_framebuffer *fb, rt_render_stats *st)
+{
+    rt_error err = {0};
+    assert_int_equal(rt_scene_validate(s, &err), RT_OK);
+    rt_kdtree tree;
+    assert_int_equal(rt_kdtree_build(&tree, s, NULL, &err), RT_OK);
+    assert_int_equal(rt_framebuffer_init(fb, s->settings.width, s->settings.height, &err), RT_OK);
+    rt_result r = rt_render(s, &tree, opt, fb, st, &err);
+    rt_kdtree_free(&tree);
+    return r;
+}
+
+/* Passes of any size give the bytes of the tiled render, for 1, 2 and 3
+ * threads and several tile sizes, with every integrator; the path
+ * tracer's default is passes. 13 samples: passes of 1, 2, 4, 5 and 13 split
+ * it evenly and unevenly, and 32 is larger than the count. */
+static void test_passes_same_bytes_as_tiles(void **state)
+{
+    (void)state;
+    rt_scene s;
+    build_busy_scene(&s);
+    s.settings.samples = 13;
+    s.settings.clamp = 3.0f; /* the clamp's arithmetic too */
+    const rt_integrator integrators[] = {RT_INTEGRATOR_PATH, RT_INTEGRATOR_DIRECT, RT_INTEGRATOR_WHITTED};
+    const int pass_sizes[] = {1, 2, 4, 5, 13, 32, 0};
+    for (size_t k = 0; k < sizeof integrators / sizeof *integrators; k++) {
+        s.settings.integrator = integrators[k];
+        rt_render_options opt;
+        memset(&opt, 0, sizeof opt);
+        opt.threads = 1;
+        opt.tile_size = 32;
+        opt.pass_samples = -1;
+        rt_framebuffer ref;
+        rt_render_stats st;
+        assert_int_equal(render_with(&s, &opt, &ref, &st), RT_OK);
+        assert_false(st.passes);
+        assert_int_equal(st.samples_done, 13);
+        size_t n = (size_t)ref.width * ref.height * 3 * sizeof(float);
+        double sum = 0;
+        for (size_t i = 0; i < (size_t)ref.width * ref.height * 3; i++)
+            sum += ref.rgb[i];
+        assert_true(sum > 1.0);
+        for (int threads = 1; threads <= 3; threads++)
+            for (size_t p = 0; p < sizeof pass_sizes / sizeof *pass_sizes; p++) {
+                opt.threads = threads;
+                opt.tile_size = threads == 3 ? 5 : 16 * threads;
+                opt.pass_samples = pass_sizes[p];
+                rt_framebuffer fb;
+                assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
+                bool passes = pass_sizes[p] > 0 || integrators[k] == RT_INTEGRATOR_PATH;
+                assert_int_equal(st.passes, passes);
+                assert_int_equal(st.samples_done, 13);
+                assert_false(st.partial || st.interrupted || st.time_limited);
+                if (passes && pass_sizes[p] > 0)
+                    assert_int_equal(st.passes_done, (13 + pass_sizes[p] - 1) / pass_sizes[p]);
+                assert_memory_equal(ref.rgb, fb.rgb, n);
+                rt_framebuffer_free(&fb);
+            }
+        rt_framebuffer_free(&ref);
+    }
+    rt_scene_free(&s);
+}
+
+/* A time limit already over when the render starts: passes stop after the
+ * first pass with the whole image at its samples (the pass that crosses the
+ * budget is finished), tiles take no tile; both report it and return OK. */
+static void test_time_limit(void **state)
+{
+    (void)state;
+    rt_scene s;
+    build_busy_scene(&s);
+    s.settings.samples = 64;
+    s.settings.integrator = RT_INTEGRATOR_PATH;
+    rt_render_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.threads = 2;
+    opt.pass_samples = 3;
+    opt.time_limit = 1e-9;
+    rt_framebuffer fb;
+    rt_render_stats st;
+    assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
+    assert_true(st.passes && st.time_limited && !st.interrupted && !st.partial);
+    assert_int_equal(st.samples_done, 3);
+    assert_int_equal(st.passes_done, 1);
+    assert_int_equal(st.camera_rays, 3 * (uint64_t)fb.width * (uint64_t)fb.height); /* every pixel, 3 samples */
+    rt_framebuffer_free(&fb);
+
+    opt.pass_samples = -1;
+    assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
+    assert_true(!st.passes && st.time_limited && !st.interrupted && st.partial);
+    assert_true(st.tiles_done < st.tiles_total);
+    assert_int_equal(st.samples_done, 0);
+    rt_framebuffer_free(&fb);
+    rt_scene_free(&s);
+}
+
+/* Cancelled after the first pass (from the progress report that says it is
+ * done): RT_ERR_INTERRUPTED, fb is the whole image at that pass's samples,
+ * the same bytes a time-limited render stopping there gives; every tile
+ * reads as finished once a pass is done. */
+typedef struct cancel_after_pass {
+    atomic_int cancel;
+    int reports, last_samples;
+} cancel_after_pass;
+
+static void cancel_on_pass(const rt_render_progress *p, void *user)
+{
+    cancel_after_pass *c = user;
+    c->reports++;
+    assert_true(p->passes);
+    assert_int_equal(p->samples_total, 40);
+    assert_true(p->samples_done >= c->last_samples);
+    c->last_samples = p->samples_done;
+    for (int i = 0; i < p->tiles_total; i++)
+        assert_int_equal(rt_render_progress_tile(p, i).finished, p->samples_done > 0);
+    if (p->samples_done > 0)
+        atomic_store(&c->cancel, 1);
+}
+
+static void test_pass_progress_and_cancel(void **state)
+{
+    (void)state;
+    rt_scene s;
+    build_busy_scene(&s);
+    s.settings.samples = 40;
+    s.settings.integrator = RT_INTEGRATOR_PATH;
+    cancel_after_pass c;
+    memset(&c, 0, sizeof c);
+    atomic_init(&c.cancel, 0);
+    rt_render_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.threads = 3;
+    opt.tile_size = 8;
+    opt.pass_samples = 6;
+    opt.cancel = &c.cancel;
+    opt.progress = cancel_on_pass;
+    opt.progress_user = &c;
+    rt_framebuffer a, b;
+    rt_render_stats st;
+    assert_int_equal(render_with(&s, &opt, &a, &st), RT_ERR_INTERRUPTED);
+    assert_true(st.interrupted && !st.partial && !st.time_limited);
+    assert_int_equal(st.samples_done, 6);
+    assert_int_equal(c.last_samples, 6);
+    memset(&opt, 0, sizeof opt);
+    opt.threads = 1;
+    opt.pass_samples = 6;
+    opt.time_limit = 1e-9;
+    assert_int_equal(render_with(&s, &opt, &b, &st), RT_OK);
+    assert_int_equal(st.samples_done, 6);
+    assert_memory_equal(a.rgb, b.rgb, (size_t)a.width * a.height * 3 * sizeof(float));
+    rt_framebuffer_free(&a);
+    rt_framebuffer_free(&b);
     rt_scene_free(&s);
 }
 
@@ -301,6 +459,9 @@ int main(void)
         cmocka_unit_test(test_lambert_plane_point_light),
         cmocka_unit_test(test_same_image_any_thread_count),
         cmocka_unit_test(test_progress_reports),
+        cmocka_unit_test(test_passes_same_bytes_as_tiles),
+        cmocka_unit_test(test_time_limit),
+        cmocka_unit_test(test_pass_progress_and_cancel),
         cmocka_unit_test(test_area_light_visible_one_sided),
         cmocka_unit_test(test_pfm_roundtrip_and_atomic_write),
     };

@@ -5,6 +5,8 @@
 #   libjsmn-dev    the JSON tokenizer under src/gltf.c
 #   libcmocka-dev  the test framework
 #   libopenexr-dev the OpenEXR Core C API (EXR images in and out)
+# and, optionally (rt builds and runs without them; a failed install is only
+# reported): libsdl2-dev for --window, xvfb for the test that opens it.
 set -eu
 CC=${CC:-cc}
 missing=""
@@ -17,7 +19,29 @@ check stb/stb_image.h libstb-dev
 check jsmn.h libjsmn-dev
 check cmocka.h libcmocka-dev
 check OpenEXR/openexr.h libopenexr-dev
-[ -z "$missing" ] && exit 0
+
+install_optional() {
+    optional=""
+    pkg-config --exists sdl2 2>/dev/null || optional="$optional libsdl2-dev"
+    [ -x /usr/bin/Xvfb ] || optional="$optional xvfb"
+    [ -n "$optional" ] || return 0
+    if [ "$(id -u)" -eq 0 ]; then
+        S=""
+    elif sudo -n true 2>/dev/null; then
+        S="sudo -n"
+    else
+        echo "rt: optional packages not installed:$optional (for --window and its test)" >&2
+        return 0
+    fi
+    echo "rt: installing optional packages:$optional" >&2
+    DEBIAN_FRONTEND=noninteractive $S apt-get install -y -q $optional >&2 ||
+        echo "rt: could not install$optional; rt builds without --window" >&2
+}
+
+if [ -z "$missing" ]; then
+    install_optional
+    exit 0
+fi
 
 echo "rt: installing missing build packages:$missing" >&2
 if [ "$(id -u)" -eq 0 ]; then
@@ -37,3 +61,4 @@ if ! $SUDO apt-get install -y -q $missing >&2; then
     $SUDO apt-get install -y -q $missing >&2
 fi
 echo "rt: installed:$missing" >&2
+install_optional

@@ -19,6 +19,7 @@
 #include "rt/base/number.h"
 #include "rt/image/tonemap.h"
 #include "rt/render/render.h"
+#include "tev.h"
 
 typedef enum flag_kind {
     FLAG_OUTPUT,
@@ -34,6 +35,10 @@ typedef enum flag_kind {
     FLAG_FOV,
     FLAG_TILE,
     FLAG_PREVIEW,
+    FLAG_PASSES,
+    FLAG_TIME_LIMIT,
+    FLAG_DISPLAY_SERVER,
+    FLAG_WINDOW,
     FLAG_INFO,
     FLAG_MAX_MEMORY,
     FLAG_EXPOSURE,
@@ -89,6 +94,15 @@ static const flag flags[] = {
     {NULL, "--tile", "N", FLAG_TILE, NULL, "tile size in pixels (default 32)"},
     {NULL, "--preview", "SECONDS", FLAG_PREVIEW, NULL,
      "live view: rewrite the output with the finished tiles every SECONDS"},
+    {NULL, "--passes", "N", FLAG_PASSES, NULL,
+     "render in passes of N samples per pixel over the whole image; 0 = tile by tile\n"
+     "(default: passes of 4 for path, tiles for direct and whitted)"},
+    {NULL, "--time-limit", "SECONDS", FLAG_TIME_LIMIT, NULL,
+     "stop after the pass (tiles: the tiles in hand) that crosses SECONDS of rendering and write the image"},
+    {NULL, "--display-server", "HOST:PORT", FLAG_DISPLAY_SERVER, NULL,
+     "stream the image as it renders to the tev viewer listening there (tev's default: 127.0.0.1:14158)"},
+    {NULL, "--window", NULL, FLAG_WINDOW, NULL,
+     "show the image in a window as it renders (SDL2); it stays up after the render until closed (Esc, q)"},
     {NULL, "--info", "FILE", FLAG_INFO, NULL,
      "print what a scene or model contains and how it would render (key: value lines) and exit; "
      "more files may follow (rt --info a.glb b.txt), one block each"},
@@ -162,7 +176,10 @@ static void usage(FILE *f)
         } else {
             snprintf(text, sizeof text, "%s", fl->help);
         }
-        fprintf(f, "  %-*s", HELP_COLUMN - 2, names);
+        if ((int)strlen(names) >= HELP_COLUMN - 3) /* a long name: its help on the next line */
+            fprintf(f, "  %s\n%*s", names, HELP_COLUMN, "");
+        else
+            fprintf(f, "  %-*s", HELP_COLUMN - 2, names);
         print_wrapped(f, text, HELP_COLUMN, HELP_COLUMN);
     }
     fprintf(f, "\nsettings (a scene file's setting statements; --set KEY=VALUE gives any of them, its words\n"
@@ -184,7 +201,7 @@ static void usage(FILE *f)
     }
     fprintf(f, "\n"
                "Scene format: docs/scene-format.md; limits and exit codes: docs/robustness.md.\n"
-               "Exit status: 0 ok, 2 bad input (or over a limit), 130 interrupted.\n");
+               "Exit status: 0 ok, 2 bad input (or over a limit), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM).\n");
 }
 
 /* ------------------------------------------------------------ parsing */
@@ -434,6 +451,31 @@ int args_parse(args *a, int argc, char **argv)
             a->preview_seconds = (double)s;
             break;
         }
+        case FLAG_PASSES:
+            if (!int_value(value, 0, 1 << 20, &a->pass_samples))
+                return fail_usage("%s wants samples per pixel a pass from 0 (tiles) to 1048576, got '%s'", name,
+                                  value);
+            if (a->pass_samples == 0)
+                a->pass_samples = -1; /* rt_render's "tiles" */
+            break;
+        case FLAG_TIME_LIMIT: {
+            float s = 0.0f;
+            if (rt_parse_float(value, &s) != RT_NUMBER_OK || !(s > 0.0f && s <= 1e7f))
+                return fail_usage("%s wants seconds (more than 0, at most 1e7), got '%s'", name, value);
+            a->time_limit = (double)s;
+            break;
+        }
+        case FLAG_DISPLAY_SERVER: {
+            char host[256], port[16];
+            if (!tev_parse_address(value, host, sizeof host, port, sizeof port))
+                return fail_usage("%s wants HOST:PORT with a port from 1 to 65535 (e.g. 127.0.0.1:14158), got '%s'",
+                                  name, value);
+            a->display_server = value;
+            break;
+        }
+        case FLAG_WINDOW:
+            a->window = true;
+            break;
         case FLAG_INFO:
             a->info_path = value;
             break;

@@ -59,6 +59,10 @@ typedef struct args {
     rt_vec3 look_from, look_at, up;
     float fov;
     double preview_seconds; /* --preview; 0 = no live view */
+    int pass_samples;       /* --passes: rt_render_options.pass_samples (0 = the integrator's, -1 = tiles) */
+    double time_limit;      /* --time-limit seconds; 0 = none */
+    const char *display_server; /* --display-server HOST:PORT (tev); NULL = none */
+    bool window;            /* --window */
     rt_log_level log_level; /* -q, -v */
     memory_budget budget;   /* --max-memory, else the default (not applied yet) */
     float exposure_ev;      /* --exposure: stops for 8-bit output, on top of the scene's */

@@ -4,17 +4,23 @@
  * cores (progress.c draws the progress bar and the live preview), write the
  * image.
  *
- * Exit status: 0 on success, 2 for bad input (flags, scene files, models,
- * images, an unwritable output), 130 when interrupted (the finished tiles
- * are still written). Every failure says what and where on stderr, and never
- * leaves a partial file over an existing image. The process runs under a
- * memory budget (memory_budget.c).
+ * Exit status: 0 on success (also when --time-limit stopped the render),
+ * 2 for bad input (flags, scene files, models, images, an unwritable
+ * output), 128 + the signal when Ctrl-C (130) or SIGTERM (143) stopped it.
+ * A render stopped early keeps what it has: in passes the whole image at
+ * the samples reached goes to the output; a tiled render's finished tiles
+ * go to NAME.partial.EXT, never over the output. A second signal ends the
+ * process at once and removes the temporary file of a write under way.
+ * Every failure says what and where on stderr, and never leaves a partial
+ * file over an existing image. The process runs under a memory budget
+ * (memory_budget.c).
  */
 #include <signal.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "rt/base/file.h"
@@ -34,6 +40,8 @@
 #include "memory_budget.h"
 #include "output.h"
 #include "progress.h"
+#include "tev.h"
+#include "window.h"
 
 /* The kd-tree's primitive ids are the 30 payload bits of its references
  * (RT_KD_PAYLOAD, rt/accel/kdtree.h), one value kept free. */
@@ -42,15 +50,39 @@
  * (diffuse_rays ^ diffuse_bounces); more is a render that never ends. */
 #define MAX_DIFFUSE_TREE ((double)(1 << 24))
 
+/* What the signal handler shares with the render: the first signal's
+ * number (the render's cancel flag), and the temporary file of an image
+ * write under way. */
 static atomic_int interrupted;
+static rt_write_temp write_temp;
 
 static void on_signal(int sig)
 {
-    if (atomic_exchange(&interrupted, 1)) {
-        /* second Ctrl-C: leave at once */
+    int expected = 0;
+    if (!atomic_compare_exchange_strong(&interrupted, &expected, sig)) {
+        /* the second signal: leave at once, leaving no temporary file */
+        if (write_temp.active)
+            unlink(write_temp.path);
         signal(sig, SIG_DFL);
         raise(sig);
     }
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* NAME.partial.EXT for NAME.EXT: where an incomplete image goes. */
+static void partial_name(const char *output, char *out, size_t size)
+{
+    const char *dot = strrchr(output, '.');
+    const char *slash = strrchr(output, '/');
+    if (!dot || (slash && dot < slash))
+        dot = output + strlen(output);
+    snprintf(out, size, "%.*s.partial%s", (int)(dot - output), output, dot);
 }
 
 /* Prints an error; out-of-memory errors also say which budget ran out and
@@ -380,14 +412,20 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     return RT_OK;
 }
 
-/* Builds the kd-tree, renders (Ctrl-C and SIGTERM stop the workers) and
- * writes the image; returns the exit status. */
-static int render_and_write(const rt_scene *scene, const args *a, const char *output)
+/* Builds the kd-tree, renders (Ctrl-C and SIGTERM stop the workers, as
+ * does --time-limit) and writes the image; returns the exit status.
+ * t_start: when the run began, for the wall time in the "wrote" line. */
+static int render_and_write(const rt_scene *scene, const args *a, const char *output, progress_view *view,
+                            double t_start)
 {
     const rt_settings *set = &scene->settings;
     rt_error err = {0};
     rt_kdtree tree;
+    char prims[64];
+    snprintf(prims, sizeof prims, "(%zu primitives)", rt_scene_prim_count(scene));
+    progress_phase(view, "kd-tree", prims);
     if (rt_kdtree_build(&tree, scene, NULL, &err) != RT_OK) {
+        progress_clear(view);
         report(&err, &a->budget);
         return 2;
     }
@@ -398,6 +436,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
 
     rt_framebuffer fb;
     if (rt_framebuffer_init(&fb, set->width, set->height, &err) != RT_OK) {
+        progress_clear(view);
         report(&err, &a->budget);
         rt_kdtree_free(&tree);
         return 2;
@@ -405,10 +444,26 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
 
     output_aovs aov;
     if (output_aovs_init(&aov, a, set->width, set->height, &err) != RT_OK) {
+        progress_clear(view);
         report(&err, &a->budget);
         rt_framebuffer_free(&fb);
         rt_kdtree_free(&tree);
         return 2;
+    }
+
+    window_view window;
+    if (a->window) {
+        char why[512], title[1100];
+        snprintf(title, sizeof title, "rt: %s", output);
+        if (!window_open(&window, fb.width, fb.height, title, why, sizeof why)) {
+            progress_clear(view);
+            fprintf(stderr, "rt: --window: cannot open a window: %s\n", why);
+            output_aovs_free(&aov);
+            rt_framebuffer_free(&fb);
+            rt_kdtree_free(&tree);
+            return 2;
+        }
+        view->window = &window;
     }
 
     struct sigaction sa;
@@ -418,41 +473,82 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
-    progress_view view;
-    progress_view_init(&view, a->log_level >= RT_LOG_NORMAL && isatty(2), a->preview_seconds > 0.0 ? output : NULL,
-                       a->preview_seconds, set->exposure);
+    view->preview_path = a->preview_seconds > 0.0 ? output : NULL;
+    view->preview_seconds = a->preview_seconds;
+    view->exposure = set->exposure;
+    view->time_limit = a->time_limit;
+    view->temp = &write_temp;
+    tev_stream tev;
+    if (a->display_server) {
+        const char *base = strrchr(output, '/');
+        tev_stream_open(&tev, a->display_server, base ? base + 1 : output, fb.width, fb.height);
+        view->tev = &tev;
+    }
     rt_render_options ro;
     memset(&ro, 0, sizeof ro);
     ro.threads = a->threads;
     ro.tile_size = a->tile;
+    ro.pass_samples = a->pass_samples;
+    ro.time_limit = a->time_limit;
     ro.cancel = &interrupted;
-    ro.progress = view.bar || view.preview_path ? progress_report : NULL;
-    ro.progress_user = &view;
+    ro.progress = view->bar || view->preview_path || view->tev || view->window ? progress_report : NULL;
+    ro.progress_user = view;
     ro.aov = output_aovs_for_render(&aov);
     rt_render_stats rs;
+    memset(&rs, 0, sizeof rs);
     rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);
     int status = 0;
-    if (r == RT_ERR_INTERRUPTED) {
-        fprintf(stderr, "rt: %s; writing the finished tiles to %s\n", err.message, output);
-        status = 130;
-    } else if (r != RT_OK) {
+    if (r != RT_OK && r != RT_ERR_INTERRUPTED) {
+        progress_clear(view);
         report(&err, &a->budget);
         status = 2;
-    }
-    if (status != 2) {
-        if (output_write(a, set, &fb, &aov, output, &err) != RT_OK) {
+    } else {
+        int sig = atomic_load(&interrupted);
+        if (r == RT_ERR_INTERRUPTED)
+            status = 128 + (sig ? sig : SIGINT);
+        const char *reason = r == RT_ERR_INTERRUPTED ? (sig == SIGTERM ? "terminated" : "interrupted")
+                             : rs.time_limited     ? "time limit"
+                                                   : NULL;
+        char why[32] = "";
+        if (reason)
+            snprintf(why, sizeof why, ", %s", reason);
+        bool stopped = r == RT_ERR_INTERRUPTED || rs.time_limited;
+        char partial[1100], what[160];
+        const char *target = output;
+        if (rs.partial) {
+            partial_name(output, partial, sizeof partial);
+            target = partial;
+            snprintf(what, sizeof what, "%d of %d tiles at %d spp%s", rs.tiles_done, rs.tiles_total, set->samples,
+                     why);
+        } else {
+            snprintf(what, sizeof what, "%d of %d spp%s", rs.samples_done, set->samples, why);
+        }
+        if (rs.partial && rs.tiles_done == 0) {
+            fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s left as it was\n",
+                    rs.passes ? "pass" : "tile", reason ? reason : "?", output);
+        } else if (output_write(a, set, &fb, &aov, target, &write_temp, &err) != RT_OK) {
             report(&err, &a->budget);
             status = 2;
-        } else if (a->log_level >= RT_LOG_NORMAL) {
-            fprintf(stderr, "rt: wrote %s (%dx%d, %d spp, %.2f s)\n", output, fb.width, fb.height, set->samples,
-                    rs.seconds);
+        } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
+            fprintf(stderr, "rt: wrote %s: %dx%d, %s; %.2f s (render %.2f s)%s%s%s\n", target, fb.width, fb.height,
+                    what, now_seconds() - t_start, rs.seconds, rs.partial ? "; " : "", rs.partial ? output : "",
+                    rs.partial ? " left as it was" : "");
         }
     }
-    rt_info("render: %.3f s on %d threads, %llu camera rays, %llu rays, %.2f Mrays/s", rs.seconds, rs.threads,
-            (unsigned long long)rs.camera_rays, (unsigned long long)rs.rays,
+    rt_info("render: %.3f s on %d threads, %s, %llu camera rays, %llu rays, %.2f Mrays/s", rs.seconds, rs.threads,
+            rs.passes ? "passes" : "tiles", (unsigned long long)rs.camera_rays, (unsigned long long)rs.rays,
             rs.seconds > 0 ? 1e-6 * (double)rs.rays / rs.seconds : 0.0);
     if (rs.bad_samples)
         rt_warn("%llu NaN/Inf samples were dropped", (unsigned long long)rs.bad_samples);
+    if (view->tev)
+        tev_stream_close(&tev);
+    view->tev = NULL;
+    if (view->window) {
+        if (status != 2)
+            window_wait(&window, &interrupted); /* the final image stays up until closed or Ctrl-C */
+        window_close(&window);
+    }
+    view->window = NULL;
     output_aovs_free(&aov);
     rt_framebuffer_free(&fb);
     rt_kdtree_free(&tree);
@@ -461,6 +557,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
 
 int main(int argc, char **argv)
 {
+    double t_start = now_seconds();
     if (argc > 1 && strcmp(argv[1], "compare") == 0)
         return rt_cmd_compare(argc - 1, argv + 1);
     if (argc > 1 && strcmp(argv[1], "convert") == 0)
@@ -482,12 +579,17 @@ int main(int argc, char **argv)
     rt_scene scene;
     rt_scene_init(&scene);
     char output[1024];
+    progress_view view;
+    progress_view_init(&view, a.log_level >= RT_LOG_NORMAL && isatty(2));
+    progress_phase(&view, "load", a.input ? a.input : "the built-in scene");
     if (prepare(&scene, &a, output, sizeof output, &err) != RT_OK) {
+        progress_clear(&view);
         report(&err, &a.budget);
         rt_scene_free(&scene);
         return 2;
     }
-    status = render_and_write(&scene, &a, output);
+    status = render_and_write(&scene, &a, output, &view, t_start);
+    progress_view_free(&view);
     rt_scene_free(&scene);
     return status;
 }

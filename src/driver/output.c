@@ -107,7 +107,7 @@ static rt_result write_aov_file(const float *data, int channels, int w, int h, c
 }
 
 rt_result output_write(const args *a, const rt_settings *set, rt_framebuffer *fb, const output_aovs *aov,
-                       const char *path, rt_error *err)
+                       const char *path, rt_write_temp *temp, rt_error *err)
 {
     rt_image_options opt = {.exposure = set->exposure * rt_exposure_scale(a->exposure_ev), .tonemap = a->tonemap,
                             .half = a->half};
@@ -158,7 +158,7 @@ rt_result output_write(const args *a, const rt_settings *set, rt_framebuffer *fb
         if (r != RT_OK)
             goto done;
     }
-    r = rt_framebuffer_write_with(fb, path, &opt, err);
+    r = rt_framebuffer_write_tracked(fb, path, &opt, temp, err);
 done:
     free(noisy);
     return r;

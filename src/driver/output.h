@@ -36,8 +36,9 @@ rt_aov_buffers *output_aovs_for_render(output_aovs *o);
 /* Denoises fb in place when asked (writing the noisy image beside it when
  * AOVs are asked for too), then writes it and the AOVs: layers of an .exr,
  * else files NAME.albedo.EXT beside it (NAME.EXT the output; PNG output
- * writes them as .pfm, which keeps their values). */
+ * writes them as .pfm, which keeps their values). The image's own write
+ * keeps *temp up to date for the signal handler (temp may be NULL). */
 rt_result output_write(const args *a, const rt_settings *set, rt_framebuffer *fb, const output_aovs *aov,
-                       const char *path, rt_error *err);
+                       const char *path, rt_write_temp *temp, rt_error *err);
 
 #endif

@@ -1,41 +1,95 @@
-/* progress.c - what the terminal shows of a running render: a progress
- * bar on stderr (tiles done, elapsed time, a linear estimate of the time
- * left), and the live preview (--preview): the output image rewritten
- * every few seconds with the finished tiles and the others dim grey, for
- * a viewer that reloads it. rt_render calls progress_report from its own
- * thread about every 50 ms (src/render/render.c).
+/* progress.c - what the terminal shows of a run: one progress line on
+ * stderr, rewritten in place, naming the phase (load, kd-tree, render)
+ * and, while rendering, a bar of tiles or samples per pixel done, the
+ * elapsed time and a linear estimate of the time left (work left times
+ * the mean time per unit of work so far, so in passes it settles within a
+ * few passes); and the live preview (--preview): the output image
+ * rewritten every few seconds with the finished tiles and the others dim
+ * grey, for a viewer that reloads it; and the stream to tev (tev.c) for
+ * --display-server, and the window (window.c) for --window. rt_render calls progress_report from
+ * its own thread about every 50 ms and after each pass
+ * (src/render/render.c).
  */
 #include "progress.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
+
 #include "rt/base/log.h"
 
-static void draw_bar(int done, int total, double elapsed, bool final)
+static double now_seconds(void)
 {
-    const int width = 30;
-    double f = total ? (double)done / total : 1.0;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* "load 0.31s, kd-tree 0.12s, " for the phases before rendering. */
+static void phase_times(const progress_view *v, char *buf, size_t size, double render_start)
+{
+    size_t n = 0;
+    buf[0] = 0;
+    for (int i = 0; i < v->phases && n < size; i++) {
+        double end = i + 1 < v->phases ? v->phase_start[i + 1] : render_start;
+        int k = snprintf(buf + n, size - n, "%s %.2fs, ", v->phase_name[i], end - v->phase_start[i]);
+        if (k < 0)
+            break;
+        n += (size_t)k;
+    }
+}
+
+/* The fraction of the render done: tiles, or samples per pixel counting
+ * the pass under way by its finished tiles. */
+static double fraction_done(const rt_render_progress *p)
+{
+    double f;
+    if (p->passes) {
+        double spp = (double)p->samples_done;
+        if (!p->final && p->tiles_total > 0)
+            spp += (double)p->pass_samples * p->tiles_done / p->tiles_total;
+        f = p->samples_total > 0 ? spp / p->samples_total : 1.0;
+    } else {
+        f = p->tiles_total ? (double)p->tiles_done / p->tiles_total : 1.0;
+    }
+    return f < 0.0 ? 0.0 : (f > 1.0 ? 1.0 : f);
+}
+
+static void draw_bar(const progress_view *v, const rt_render_progress *p)
+{
+    const int width = 24;
+    double f = fraction_done(p);
+    char count[64];
+    if (p->passes)
+        snprintf(count, sizeof count, "%d/%d spp", p->samples_done, p->samples_total);
+    else
+        snprintf(count, sizeof count, "%d/%d tiles", p->tiles_done, p->tiles_total);
     int bar = (int)(f * width + 0.5);
-    char line[128];
+    char line[64];
     int n = 0;
     line[n++] = '[';
     for (int i = 0; i < width; i++)
         line[n++] = i < bar ? '#' : ' ';
     line[n++] = ']';
     line[n] = 0;
-    double eta = (done > 0 && done < total) ? elapsed * (total - done) / done : 0.0;
-    fprintf(stderr, "\r%s %5.1f%%  %6.1fs elapsed", line, 100.0 * f, elapsed);
-    if (!final && done > 0)
-        fprintf(stderr, "  ETA %6.1fs ", eta);
-    else
-        fprintf(stderr, "              ");
-    if (final)
+    char phases[160];
+    phase_times(v, phases, sizeof phases, now_seconds() - p->elapsed);
+    fprintf(stderr, "\r%srender %s %5.1f%% %s %6.1fs", phases, line, 100.0 * f, count, p->elapsed);
+    if (!p->final && f > 0.0) {
+        double eta = p->elapsed * (1.0 - f) / f;
+        if (v->time_limit > 0.0 && eta > v->time_limit - p->elapsed)
+            eta = v->time_limit > p->elapsed ? v->time_limit - p->elapsed : 0.0;
+        fprintf(stderr, "  ETA %6.1fs", eta);
+    }
+    fputs("\033[K", stderr); /* clear what a longer line left */
+    if (p->final)
         fputc('\n', stderr);
     fflush(stderr);
 }
 
 /* Live view: a copy of the image where unfinished tiles are dim grey. */
-static void write_preview(const rt_render_progress *p, const char *path, float exposure)
+static void write_preview(const rt_render_progress *p, const char *path, float exposure, rt_write_temp *temp)
 {
     rt_framebuffer copy;
     rt_error err;
@@ -50,28 +104,120 @@ static void write_preview(const rt_render_progress *p, const char *path, float e
                     copy.rgb[k + c] = t.finished ? p->fb->rgb[k + c] : 0.02f;
             }
     }
-    if (rt_framebuffer_write(&copy, path, exposure, &err) != RT_OK)
+    rt_image_options opt = {.exposure = exposure};
+    if (rt_framebuffer_write_tracked(&copy, path, &opt, temp, &err) != RT_OK)
         rt_warn("live preview: %s", err.message);
     rt_framebuffer_free(&copy);
 }
 
-void progress_view_init(progress_view *v, bool bar, const char *preview_path, double preview_seconds,
-                        float exposure)
+void progress_view_init(progress_view *v, bool bar)
 {
     memset(v, 0, sizeof *v);
     v->bar = bar;
-    v->preview_path = preview_path;
-    v->preview_seconds = preview_seconds > 0.0 ? preview_seconds : 2.0;
-    v->exposure = exposure;
+    v->exposure = 1.0f;
+}
+
+void progress_view_free(progress_view *v)
+{
+    free(v->tev_sent);
+    free(v->win_shown);
+    v->tev_sent = NULL;
+    v->win_shown = NULL;
+}
+
+/* Streams what is new to tev: finished tiles not sent yet, the image
+ * after a pass, everything again after a reconnection, and the final
+ * image. Only pixels that are final are read while workers run. */
+static void stream_to_tev(progress_view *v, const rt_render_progress *p)
+{
+    tev_stream *t = v->tev;
+    if (p->final) {
+        tev_stream_image(t, p->fb, true);
+        return;
+    }
+    if (!tev_stream_connect(t, false))
+        return;
+    bool fresh = tev_stream_wants_image(t);
+    if (p->passes) {
+        if (p->samples_done > 0 && (fresh || p->samples_done != v->tev_samples)) {
+            tev_stream_image(t, p->fb, false);
+            v->tev_samples = p->samples_done;
+        }
+        return;
+    }
+    if (!v->tev_sent) {
+        v->tev_sent = calloc((size_t)p->tiles_total, 1);
+        if (!v->tev_sent)
+            return;
+    }
+    if (fresh)
+        memset(v->tev_sent, 0, (size_t)p->tiles_total);
+    for (int i = 0; i < p->tiles_total; i++) {
+        rt_tile tile = rt_render_progress_tile(p, i);
+        if (tile.finished && !v->tev_sent[i]) {
+            tev_stream_rect(t, p->fb, tile.x0, tile.y0, tile.x1, tile.y1);
+            v->tev_sent[i] = 1;
+        }
+    }
+    t->fresh = false;
+}
+
+/* The same for the window: finished tiles, the image after each pass. */
+static void show_in_window(progress_view *v, const rt_render_progress *p)
+{
+    window_view *w = v->window;
+    if (!w->open)
+        return;
+    if (p->final || (p->passes && p->samples_done > 0 && p->samples_done != v->win_samples)) {
+        window_show_rect(w, p->fb, v->exposure, 0, 0, p->fb->width, p->fb->height);
+        v->win_samples = p->samples_done;
+    } else if (!p->passes) {
+        if (!v->win_shown && !(v->win_shown = calloc((size_t)p->tiles_total, 1)))
+            return;
+        for (int i = 0; i < p->tiles_total; i++) {
+            rt_tile tile = rt_render_progress_tile(p, i);
+            if (tile.finished && !v->win_shown[i]) {
+                window_show_rect(w, p->fb, v->exposure, tile.x0, tile.y0, tile.x1, tile.y1);
+                v->win_shown[i] = 1;
+            }
+        }
+    }
+    window_present(w);
+}
+
+void progress_phase(progress_view *v, const char *name, const char *detail)
+{
+    if (v->phases >= PROGRESS_MAX_PHASES)
+        return;
+    v->phase_name[v->phases] = name;
+    v->phase_start[v->phases] = now_seconds();
+    v->phases++;
+    if (v->bar) {
+        fprintf(stderr, "\r%s%s%s ...\033[K", name, detail ? " " : "", detail ? detail : "");
+        fflush(stderr);
+    }
+}
+
+void progress_clear(progress_view *v)
+{
+    if (v->bar) {
+        fputs("\r\033[K", stderr);
+        fflush(stderr);
+    }
 }
 
 void progress_report(const rt_render_progress *p, void *view)
 {
     progress_view *v = view;
     if (v->bar)
-        draw_bar(p->tiles_done, p->tiles_total, p->elapsed, p->final);
-    if (!p->final && v->preview_path && p->elapsed - v->last_preview >= v->preview_seconds) {
-        write_preview(p, v->preview_path, v->exposure);
+        draw_bar(v, p);
+    if (v->tev)
+        stream_to_tev(v, p);
+    if (v->window)
+        show_in_window(v, p);
+    double every = v->preview_seconds > 0.0 ? v->preview_seconds : 2.0;
+    if (!p->final && v->preview_path && p->elapsed - v->last_preview >= every) {
+        write_preview(p, v->preview_path, v->exposure, v->temp);
         v->last_preview = p->elapsed;
     }
 }

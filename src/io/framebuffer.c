@@ -75,7 +75,22 @@ typedef struct temp_file {
     bool unnamed;
     char dir[4200];  /* the target's directory, "." for none */
     char name[4300]; /* the mkstemp name, or the name an unnamed file is linked under */
+    rt_write_temp *track; /* NULL, or where a signal handler finds the name while one exists */
 } temp_file;
+
+/* Tells the signal handler the temporary file's name (or that there is
+ * none): `active` is dropped while the path is rewritten, so the handler
+ * never reads a half-written name. */
+static void publish_name(temp_file *t, const char *name)
+{
+    if (!t->track)
+        return;
+    t->track->active = 0;
+    if (name) {
+        snprintf(t->track->path, sizeof t->track->path, "%s", name);
+        t->track->active = 1;
+    }
+}
 
 static FILE *fdopen_or_close(int fd)
 {
@@ -85,9 +100,11 @@ static FILE *fdopen_or_close(int fd)
     return f;
 }
 
-/* Opens a fresh temporary file in the directory of `path`. */
-static bool open_temp_beside(const char *path, temp_file *t)
+/* Opens a fresh temporary file in the directory of `path`; with track, its
+ * name is published from before mkstemp creates it. */
+static bool open_temp_beside(const char *path, temp_file *t, rt_write_temp *track)
 {
+    t->track = track;
     const char *slash = strrchr(path, '/');
     int n = slash ? snprintf(t->dir, sizeof t->dir, "%.*s", slash == path ? 1 : (int)(slash - path), path)
                   : snprintf(t->dir, sizeof t->dir, ".");
@@ -113,9 +130,18 @@ static bool open_temp_beside(const char *path, temp_file *t)
         errno = ENAMETOOLONG;
         return false;
     }
-    int fd = mkstemp(t->name);
-    if (fd < 0)
+    int fd;
+    if (track) { /* mkstemp fills in the published name itself */
+        publish_name(t, t->name);
+        fd = mkstemp(track->path);
+        snprintf(t->name, sizeof t->name, "%s", track->path);
+    } else {
+        fd = mkstemp(t->name);
+    }
+    if (fd < 0) {
+        publish_name(t, NULL);
         return false;
+    }
     if (!(t->f = fdopen_or_close(fd))) {
         int e = errno;
         unlink(t->name);
@@ -133,6 +159,7 @@ static void discard_temp(temp_file *t)
     t->f = NULL;
     if (!t->unnamed)
         unlink(t->name);
+    publish_name(t, NULL);
 }
 
 /* Gives a closed-over, complete temporary file a name beside the target:
@@ -145,6 +172,7 @@ static bool name_temp(temp_file *t)
     snprintf(proc, sizeof proc, "/proc/self/fd/%d", fileno(t->f));
     for (int attempt = 0; attempt < 100; attempt++) {
         snprintf(t->name, sizeof t->name, "%s/.rt-tmp-%ld-%d", t->dir, (long)getpid(), attempt);
+        publish_name(t, t->name);
         if (linkat(AT_FDCWD, proc, AT_FDCWD, t->name, AT_SYMLINK_FOLLOW) == 0) {
             t->unnamed = false; /* from here on it is a named file like mkstemp's */
             return true;
@@ -169,7 +197,7 @@ rt_result rt_output_check(const char *path, rt_error *err)
     if (stat(path, &st) == 0 && !S_ISREG(st.st_mode))
         return rt_fail(err, RT_ERR_IO, "%s: not a regular file; give an image file name", path);
     temp_file t;
-    if (!open_temp_beside(path, &t))
+    if (!open_temp_beside(path, &t, NULL))
         return rt_fail(err, RT_ERR_IO, "%s: cannot write there: %s", path, strerror(errno));
     discard_temp(&t);
     return RT_OK;
@@ -241,6 +269,12 @@ rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float
 rt_result rt_framebuffer_write_with(const rt_framebuffer *fb, const char *path, const rt_image_options *opt,
                                     rt_error *err)
 {
+    return rt_framebuffer_write_tracked(fb, path, opt, NULL, err);
+}
+
+rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *path, const rt_image_options *opt,
+                                       rt_write_temp *temp, rt_error *err)
+{
     rt_image_format fmt;
     rt_result r = rt_output_format(path, &fmt, err);
     if (r != RT_OK)
@@ -248,7 +282,7 @@ rt_result rt_framebuffer_write_with(const rt_framebuffer *fb, const char *path, 
     if ((r = rt_output_check_size(path, fb->width, fb->height, err)) != RT_OK)
         return r;
     temp_file t;
-    if (!open_temp_beside(path, &t))
+    if (!open_temp_beside(path, &t, temp))
         return rt_fail(err, RT_ERR_IO, "%s: cannot create a file there: %s", path, strerror(errno));
     FILE *f = t.f;
     int ok;
@@ -312,6 +346,7 @@ rt_result rt_framebuffer_write_with(const rt_framebuffer *fb, const char *path, 
         discard_temp(&t);
         return rt_fail(err, RT_ERR_IO, "%s: cannot rename the finished image into place: %s", path, strerror(saved));
     }
+    publish_name(&t, NULL); /* renamed: nothing left to remove */
     return RT_OK;
 }
 

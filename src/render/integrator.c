@@ -12,15 +12,16 @@
 #include "rt/render/whitted.h"
 
 /* One line an integrator: id, name, radiance function, what it needs
- * prepared. The built-in ids (rt_integrator in rt/scene/scene.h) are pinned
+ * prepared, samples per pixel in each of rt_render's passes (0 = tile by
+ * tile; rt/render/render.h says why direct and whitted stay tiled). The built-in ids (rt_integrator in rt/scene/scene.h) are pinned
  * to their lines; a new integrator takes the next number. */
 #define INTEGRATORS(X)                                                                                                 \
-    X(RT_INTEGRATOR_DIRECT, "direct", rt_radiance_direct, 0)                                                           \
-    X(RT_INTEGRATOR_WHITTED, "whitted", rt_radiance_whitted, 0)                                                        \
-    X(RT_INTEGRATOR_PATH, "path", rt_radiance_path, RT_PREPARE_LIGHT_TABLE)
+    X(RT_INTEGRATOR_DIRECT, "direct", rt_radiance_direct, 0, 0)                                                        \
+    X(RT_INTEGRATOR_WHITTED, "whitted", rt_radiance_whitted, 0, 0)                                                     \
+    X(RT_INTEGRATOR_PATH, "path", rt_radiance_path, RT_PREPARE_LIGHT_TABLE, 4)
 
-#define AS_INFO(id, name, fn, prepare) [id] = {name, fn, prepare},
-#define AS_WORD(id, name, fn, prepare) [id] = name,
+#define AS_INFO(id, name, fn, prepare, pass) [id] = {name, fn, prepare, pass},
+#define AS_WORD(id, name, fn, prepare, pass) [id] = name,
 static const rt_integrator_info integrators[] = {INTEGRATORS(AS_INFO)};
 const char *const rt_integrator_words[] = {INTEGRATORS(AS_WORD) NULL};
 #undef AS_INFO

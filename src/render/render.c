@@ -1,11 +1,21 @@
-/* render.c - the tile queue and its worker threads, the pixel loop, and
- * progress reports to the caller (which draws them: src/driver/progress.c).
+/* render.c - the tile queue and its worker threads, the pixel loop, passes
+ * over the whole image, time limits, and progress reports to the caller
+ * (which draws them: src/driver/progress.c).
  *
  * Pixel estimate: the box-filtered average of `samples` radiance samples at
  * correlated multi-jittered positions in the pixel (Kensler 2013), so any
  * sample count is stratified. A sample that comes back NaN or infinite is
  * dropped and counted (it shows a bug, not light); the pixel averages the
  * rest. settings.clamp, when set, caps a sample's luminance.
+ *
+ * Passes keep per pixel the float sum of its good samples and their count;
+ * a pass adds its samples in sample order with the same operations the tile
+ * loop uses (add_samples below serves both), and the image is resolved as
+ * sum * (1 / good) after each pass, so a pass split cannot change a bit.
+ * (The build's -std=c11 keeps GCC from contracting a*b+c into an FMA.)
+ * Workers are started for each pass and joined at its end: the join is the
+ * barrier that keeps two passes off one pixel, and a start costs far less
+ * than a pass.
  */
 #include "rt/render/render.h"
 
@@ -41,13 +51,26 @@ struct rt_render_job {
     rt_framebuffer *fb;
     rt_camera_frame camera;
     int tile_size, tiles_x, tiles_y, tiles_total;
+    uint32_t spp;                 /* settings.samples */
+    bool passes;                  /* pass mode: accumulate into sum/good */
+    uint32_t s0, s1;              /* passes: this pass's samples [s0, s1) */
+    float *sum;                   /* passes: per pixel, RGB sum of the good samples so far */
+    uint32_t *good;               /* passes: per pixel, how many samples were good */
+    int samples_done;             /* passes: samples in fb (read by progress reports) */
+    double deadline;              /* tiles: take no tile after this time; 0 = none */
+    atomic_int time_up;           /* tiles: a worker saw the deadline pass */
     atomic_int next_tile;
     atomic_int tiles_done;
-    atomic_uchar *tile_finished; /* per tile: 1 once its pixels are final */
+    atomic_uchar *tile_finished;  /* per tile: 1 once its pixels are final (this pass) */
     atomic_int *cancel;
     const rt_render_state *state; /* prepared once, read by every worker */
     rt_radiance_fn radiance;      /* the scene's integrator */
     rt_aov_buffers *aov;          /* NULL = none */
+    rt_aov_sample *aov_sum;       /* with aov: per pixel, the sums of its good samples' AOVs */
+    double *lum_sq;               /* with aov: per pixel, the sum of its good samples' squared luminance */
+    pthread_mutex_t lock;         /* guards running; done signals it falling */
+    pthread_cond_t done;
+    int running;                  /* workers of this pass still going */
 };
 typedef struct rt_render_job rt_render_job;
 
@@ -58,8 +81,9 @@ typedef struct worker {
 } worker;
 
 /* The pixel's AOVs: means over its `good` samples; the variance of the mean
- * luminance from the sample variance, sum of L^2 - (sum L)^2 / n over n - 1. */
-static void aov_store(rt_aov_buffers *aov, uint64_t pixel, const rt_aov_sample *s, uint32_t good, float lum_sum,
+ * luminance from the sample variance, sum of L^2 - (sum L)^2 / n over n - 1.
+ * Reads the accumulated sums only, so it may run after every pass. */
+static void aov_store(rt_aov_buffers *aov, size_t pixel, const rt_aov_sample *s, uint32_t good, float lum_sum,
                       double lum_sq)
 {
     float inv = good ? 1.0f / (float)good : 0.0f;
@@ -83,65 +107,98 @@ static void aov_store(rt_aov_buffers *aov, uint64_t pixel, const rt_aov_sample *
     }
 }
 
-/* Renders one tile; false when cancelled part-way (the tile then stays
- * unfinished and is cleared to black). The cancel flag is read once a
- * pixel, so Ctrl-C is answered within a pixel's samples, not a tile's. */
-static bool render_tile(rt_render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
+/* Adds samples [s0, s1) of pixel (x, y) to *sum and *good, in sample order:
+ * the one place a pixel's arithmetic happens, for tiles and passes alike. */
+static inline void add_samples(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, uint32_t s0,
+                               uint32_t s1, rt_vec3 *sum_io, uint32_t *good_io)
 {
     const rt_settings *st = &job->scene->settings;
+    uint32_t spp = job->spp;
+    uint64_t pixel = (uint64_t)y * (uint64_t)job->fb->width + (uint64_t)x;
+    uint32_t pattern = (uint32_t)rt_mix64(pixel ^ ((uint64_t)st->seed << 40));
+    rt_vec3 sum = *sum_io;
+    uint32_t good = *good_io;
+    for (uint32_t s = s0; s < s1; s++) {
+        rt_vec2 j = spp > 1 ? rt_cmj_sample(s, spp, pattern) : rt_v2(0.5f, 0.5f);
+        rt_vec2 lens = rt_cmj_sample(s, spp, pattern ^ 0x68bc21ebu);
+        rt_ray ray = rt_camera_ray(&job->camera, (float)x + j.x, (float)y + j.y, lens);
+        rt_rng rng = rt_rng_for_sample(st->seed, pixel, s);
+        w->camera_rays++;
+        rt_vec3 L = job->radiance(ctx, &ray, &rng);
+        if (!rt_finite3(L) || L.x < 0.0f || L.y < 0.0f || L.z < 0.0f) {
+            w->bad_samples++;
+            continue;
+        }
+        if (st->clamp > 0.0f) {
+            float lum = rt_luminance(L);
+            if (lum > st->clamp)
+                L = rt_scale(L, st->clamp / lum);
+        }
+        sum = rt_add(sum, L);
+        good++;
+        if (job->aov) { /* own random numbers: the image stays as it was */
+            rt_rng arng = rt_rng_for_sample(st->seed ^ 0xa0f5eed5u, pixel, s);
+            rt_aov_sample a;
+            rt_aov_trace(ctx, ray, &arng, &a);
+            rt_aov_sample *acc = &job->aov_sum[pixel];
+            acc->albedo = rt_add(acc->albedo, a.albedo);
+            acc->normal = rt_add(acc->normal, a.normal);
+            acc->position = rt_add(acc->position, a.position);
+            acc->depth += a.depth;
+            job->lum_sq[pixel] += (double)rt_luminance(L) * (double)rt_luminance(L);
+        }
+    }
+    *sum_io = sum;
+    *good_io = good;
+}
+
+/* The pixel value of a sum of `good` samples. */
+static inline rt_vec3 resolve(rt_vec3 sum, uint32_t good)
+{
+    return good ? rt_scale(sum, 1.0f / (float)good) : sum;
+}
+
+static void tile_bounds(const rt_render_job *job, int tile, int *x0, int *y0, int *x1, int *y1)
+{
     int tx = tile % job->tiles_x, ty = tile / job->tiles_x;
-    int x0 = tx * job->tile_size, y0 = ty * job->tile_size;
-    int x1 = x0 + job->tile_size, y1 = y0 + job->tile_size;
-    if (x1 > job->fb->width) x1 = job->fb->width;
-    if (y1 > job->fb->height) y1 = job->fb->height;
-    uint32_t spp = st->samples > 0 ? (uint32_t)st->samples : 1;
+    *x0 = tx * job->tile_size;
+    *y0 = ty * job->tile_size;
+    *x1 = *x0 + job->tile_size < job->fb->width ? *x0 + job->tile_size : job->fb->width;
+    *y1 = *y0 + job->tile_size < job->fb->height ? *y0 + job->tile_size : job->fb->height;
+}
+
+/* Renders one tile (tiles: all its samples into fb; passes: this pass's
+ * samples into sum/good); false when cancelled part-way (the tile then
+ * stays unfinished). The cancel flag is read once a pixel, so Ctrl-C is
+ * answered within a pixel's samples, not a tile's. */
+static bool render_tile(rt_render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
+{
+    int x0, y0, x1, y1;
+    tile_bounds(job, tile, &x0, &y0, &x1, &y1);
     for (int y = y0; y < y1; y++) {
         for (int x = x0; x < x1; x++) {
             if (job->cancel && atomic_load_explicit(job->cancel, memory_order_relaxed))
                 return false;
-            uint64_t pixel = (uint64_t)y * (uint64_t)job->fb->width + (uint64_t)x;
-            uint32_t pattern = (uint32_t)rt_mix64(pixel ^ ((uint64_t)st->seed << 40));
-            rt_vec3 sum = rt_v3s(0);
-            uint32_t good = 0;
-            rt_aov_sample aov_sum = {rt_v3s(0), rt_v3s(0), rt_v3s(0), 0.0f};
-            double lum_sq = 0.0;
-            for (uint32_t s = 0; s < spp; s++) {
-                rt_vec2 j = spp > 1 ? rt_cmj_sample(s, spp, pattern) : rt_v2(0.5f, 0.5f);
-                rt_vec2 lens = rt_cmj_sample(s, spp, pattern ^ 0x68bc21ebu);
-                rt_ray ray = rt_camera_ray(&job->camera, (float)x + j.x, (float)y + j.y, lens);
-                rt_rng rng = rt_rng_for_sample(st->seed, pixel, s);
-                w->camera_rays++;
-                rt_vec3 L = job->radiance(ctx, &ray, &rng);
-                if (!rt_finite3(L) || L.x < 0.0f || L.y < 0.0f || L.z < 0.0f) {
-                    w->bad_samples++;
-                    continue;
-                }
-                if (st->clamp > 0.0f) {
-                    float lum = rt_luminance(L);
-                    if (lum > st->clamp)
-                        L = rt_scale(L, st->clamp / lum);
-                }
-                sum = rt_add(sum, L);
-                good++;
-                if (job->aov) { /* own random numbers: the image stays as it was */
-                    rt_rng arng = rt_rng_for_sample(st->seed ^ 0xa0f5eed5u, pixel, s);
-                    rt_aov_sample a;
-                    rt_aov_trace(ctx, ray, &arng, &a);
-                    aov_sum.albedo = rt_add(aov_sum.albedo, a.albedo);
-                    aov_sum.normal = rt_add(aov_sum.normal, a.normal);
-                    aov_sum.position = rt_add(aov_sum.position, a.position);
-                    aov_sum.depth += a.depth;
-                    lum_sq += (double)rt_luminance(L) * (double)rt_luminance(L);
-                }
+            size_t pixel = (size_t)y * (size_t)job->fb->width + (size_t)x;
+            if (job->passes) {
+                float *acc = job->sum + 3 * pixel;
+                rt_vec3 sum = rt_v3(acc[0], acc[1], acc[2]);
+                add_samples(job, w, ctx, x, y, job->s0, job->s1, &sum, &job->good[pixel]);
+                acc[0] = sum.x;
+                acc[1] = sum.y;
+                acc[2] = sum.z;
+            } else {
+                rt_vec3 sum = rt_v3s(0);
+                uint32_t good = 0;
+                add_samples(job, w, ctx, x, y, 0, job->spp, &sum, &good);
+                if (job->aov)
+                    aov_store(job->aov, pixel, &job->aov_sum[pixel], good, rt_luminance(sum), job->lum_sq[pixel]);
+                sum = resolve(sum, good);
+                float *px = job->fb->rgb + 3 * pixel;
+                px[0] = sum.x;
+                px[1] = sum.y;
+                px[2] = sum.z;
             }
-            if (job->aov)
-                aov_store(job->aov, pixel, &aov_sum, good, rt_luminance(sum), lum_sq);
-            if (good)
-                sum = rt_scale(sum, 1.0f / (float)good);
-            float *px = job->fb->rgb + 3 * pixel;
-            px[0] = sum.x;
-            px[1] = sum.y;
-            px[2] = sum.z;
         }
     }
     return true;
@@ -157,6 +214,10 @@ static void *worker_main(void *arg)
     for (;;) {
         if (job->cancel && atomic_load(job->cancel))
             break;
+        if (job->deadline > 0.0 && now_seconds() >= job->deadline) {
+            atomic_store(&job->time_up, 1);
+            break;
+        }
         int tile = atomic_fetch_add(&job->next_tile, 1);
         if (tile >= job->tiles_total)
             break;
@@ -165,6 +226,10 @@ static void *worker_main(void *arg)
         atomic_store(&job->tile_finished[tile], 1);
         atomic_fetch_add(&job->tiles_done, 1);
     }
+    pthread_mutex_lock(&job->lock);
+    job->running--;
+    pthread_cond_signal(&job->done);
+    pthread_mutex_unlock(&job->lock);
     return NULL;
 }
 
@@ -172,13 +237,88 @@ rt_tile rt_render_progress_tile(const rt_render_progress *p, int index)
 {
     const rt_render_job *job = p->job;
     rt_tile t;
-    int tx = index % job->tiles_x, ty = index / job->tiles_x;
-    t.x0 = tx * job->tile_size;
-    t.y0 = ty * job->tile_size;
-    t.x1 = t.x0 + job->tile_size < job->fb->width ? t.x0 + job->tile_size : job->fb->width;
-    t.y1 = t.y0 + job->tile_size < job->fb->height ? t.y0 + job->tile_size : job->fb->height;
-    t.finished = atomic_load(&job->tile_finished[index]) != 0;
+    tile_bounds(job, index, &t.x0, &t.y0, &t.x1, &t.y1);
+    t.finished = job->passes ? job->samples_done > 0 : atomic_load(&job->tile_finished[index]) != 0;
     return t;
+}
+
+/* Runs the workers over the tile queue once (a whole tiled render, or one
+ * pass), reporting progress about every 50 ms; returns the threads that
+ * could be started (0: the work was done on this thread). */
+static int run_workers(rt_render_job *job, worker *workers, int nthreads, const rt_render_options *opt,
+                       rt_render_progress *progress, double t0)
+{
+    atomic_store(&job->next_tile, 0);
+    atomic_store(&job->tiles_done, 0);
+    for (int t = 0; t < job->tiles_total; t++)
+        atomic_store(&job->tile_finished[t], 0);
+    int started = 0;
+    pthread_mutex_lock(&job->lock);
+    for (int i = 0; i < nthreads; i++) {
+        workers[i].job = job;
+        job->running++;
+        if (pthread_create(&workers[i].thread, NULL, worker_main, &workers[i]) != 0) {
+            job->running--;
+            break;
+        }
+        started++;
+    }
+    if (started == 0) {
+        /* no threads could be started: render on this one */
+        job->running = 1;
+        pthread_mutex_unlock(&job->lock);
+        workers[0].job = job;
+        worker_main(&workers[0]);
+        return 0;
+    }
+    while (job->running > 0) {
+        struct timespec ts;
+        clock_gettime(CLOCK_MONOTONIC, &ts);
+        ts.tv_nsec += 50 * 1000 * 1000;
+        if (ts.tv_nsec >= 1000000000L) {
+            ts.tv_sec++;
+            ts.tv_nsec -= 1000000000L;
+        }
+        pthread_cond_timedwait(&job->done, &job->lock, &ts);
+        if (job->running > 0 && opt->progress && now_seconds() - t0 >= progress->elapsed + 0.045) {
+            pthread_mutex_unlock(&job->lock);
+            progress->tiles_done = atomic_load(&job->tiles_done);
+            progress->elapsed = now_seconds() - t0;
+            opt->progress(progress, opt->progress_user);
+            pthread_mutex_lock(&job->lock);
+        }
+    }
+    pthread_mutex_unlock(&job->lock);
+    for (int i = 0; i < started; i++)
+        pthread_join(workers[i].thread, NULL);
+    return started;
+}
+
+/* fb = the accumulated samples of every pixel. */
+static void resolve_image(rt_render_job *job)
+{
+    size_t n = (size_t)job->fb->width * (size_t)job->fb->height;
+    for (size_t k = 0; k < n; k++) {
+        const float *acc = job->sum + 3 * k;
+        if (job->aov)
+            aov_store(job->aov, k, &job->aov_sum[k], job->good[k], rt_luminance(rt_v3(acc[0], acc[1], acc[2])),
+                      job->lum_sq[k]);
+        rt_vec3 v = resolve(rt_v3(acc[0], acc[1], acc[2]), job->good[k]);
+        float *px = job->fb->rgb + 3 * k;
+        px[0] = v.x;
+        px[1] = v.y;
+        px[2] = v.z;
+    }
+}
+
+static void free_job(rt_render_job *job, worker *workers)
+{
+    free(job->tile_finished);
+    free(job->sum);
+    free(job->good);
+    free(job->aov_sum);
+    free(job->lum_sq);
+    free(workers);
 }
 
 rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_render_options *options,
@@ -205,6 +345,9 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     job.scene = scene;
     job.fb = fb;
     job.cancel = opt.cancel;
+    job.spp = set->samples > 0 ? (uint32_t)set->samples : 1;
+    int pass_samples = opt.pass_samples != 0 ? opt.pass_samples : integrator->pass_samples;
+    job.passes = pass_samples > 0;
     rt_camera_frame_init(&job.camera, &scene->camera, fb->width, fb->height);
     job.tile_size = opt.tile_size > 0 ? (opt.tile_size < 65536 ? opt.tile_size : 65536) : 32;
     job.tiles_x = (int)(((int64_t)fb->width + job.tile_size - 1) / job.tile_size);
@@ -215,70 +358,122 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     job.tiles_total = job.tiles_x * job.tiles_y;
     atomic_init(&job.next_tile, 0);
     atomic_init(&job.tiles_done, 0);
+    atomic_init(&job.time_up, 0);
     job.tile_finished = rt_alloc((size_t)job.tiles_total, sizeof *job.tile_finished);
+    size_t npx = (size_t)fb->width * (size_t)fb->height;
+    if (job.passes) {
+        job.sum = rt_alloc(npx, 3 * sizeof *job.sum);
+        job.good = rt_alloc(npx, sizeof *job.good);
+    }
+    job.aov = opt.aov;
+    if (job.aov) {
+        job.aov_sum = rt_alloc(npx, sizeof *job.aov_sum);
+        job.lum_sq = rt_alloc(npx, sizeof *job.lum_sq);
+    }
     int nthreads = opt.threads > 0 ? opt.threads : rt_cpu_count();
     if (nthreads > 1024)
         nthreads = 1024;
     worker *workers = rt_alloc((size_t)nthreads, sizeof *workers);
-    if (!job.tile_finished || !workers) {
-        free(job.tile_finished);
-        free(workers);
-        return rt_fail(err, RT_ERR_NOMEM, "out of memory setting up %d render threads", nthreads);
+    if (!job.tile_finished || !workers || (job.passes && (!job.sum || !job.good)) ||
+        (job.aov && (!job.aov_sum || !job.lum_sq))) {
+        free_job(&job, workers);
+        return rt_fail(err, RT_ERR_NOMEM, "out of memory setting up %d render threads for a %dx%d image", nthreads,
+                       fb->width, fb->height);
     }
     for (int t = 0; t < job.tiles_total; t++)
         atomic_init(&job.tile_finished[t], 0);
+    if (job.passes) {
+        memset(job.sum, 0, npx * 3 * sizeof *job.sum);
+        memset(job.good, 0, npx * sizeof *job.good);
+        memset(fb->rgb, 0, npx * 3 * sizeof *fb->rgb);
+    }
     /* what the integrator reads, derived once, before the workers start */
     rt_render_state state;
     rt_result sr = rt_render_state_prepare(&state, scene, tree, integrator->prepare, err);
     if (sr != RT_OK) {
-        free(job.tile_finished);
-        free(workers);
+        free_job(&job, workers);
         return sr;
     }
     job.state = &state;
     job.radiance = integrator->radiance;
-    job.aov = options ? options->aov : NULL;
+    pthread_mutex_init(&job.lock, NULL);
+    pthread_condattr_t ca;
+    pthread_condattr_init(&ca);
+    pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+    pthread_cond_init(&job.done, &ca);
+    pthread_condattr_destroy(&ca);
 
-    double t0 = now_seconds();
-    int started = 0;
-    for (int i = 0; i < nthreads; i++) {
-        workers[i].job = &job;
-        if (pthread_create(&workers[i].thread, NULL, worker_main, &workers[i]) != 0)
-            break;
-        started++;
-    }
-    if (started < nthreads) /* out of memory for stacks, or a process limit: fewer threads, same image */
-        rt_warn("could start only %d of %d render threads%s", started, nthreads,
-                started ? "" : "; rendering on the main thread");
-    if (started == 0) {
-        /* no threads could be started: render on this one */
-        workers[0].job = &job;
-        worker_main(&workers[0]);
-    }
     rt_render_progress progress;
     memset(&progress, 0, sizeof progress);
     progress.tiles_total = job.tiles_total;
+    progress.passes = job.passes;
+    progress.samples_total = (int)job.spp;
     progress.fb = fb;
     progress.job = &job;
-    if (started > 0) {
-        while (atomic_load(&job.tiles_done) < job.tiles_total) {
-            if (job.cancel && atomic_load(job.cancel))
+
+    double t0 = now_seconds();
+    int started = 0;
+    bool cancelled = false;
+    if (!job.passes) {
+        job.deadline = opt.time_limit > 0.0 ? t0 + opt.time_limit : 0.0;
+        started = run_workers(&job, workers, nthreads, &opt, &progress, t0);
+        st.tiles_done = atomic_load(&job.tiles_done);
+        st.partial = st.tiles_done < job.tiles_total;
+        st.samples_done = st.partial ? 0 : (int)job.spp;
+        cancelled = st.partial && !atomic_load(&job.time_up);
+        st.time_limited = st.partial && !cancelled;
+        if (st.partial) {
+            /* clear tiles that were started but not finished: a partial tile is worse than a black one */
+            for (int t = 0; t < job.tiles_total; t++) {
+                if (atomic_load(&job.tile_finished[t]))
+                    continue;
+                int x0, y0, x1, y1;
+                tile_bounds(&job, t, &x0, &y0, &x1, &y1);
+                for (int y = y0; y < y1; y++)
+                    memset(fb->rgb + 3 * ((size_t)y * (size_t)fb->width + (size_t)x0), 0,
+                           3 * sizeof(float) * (size_t)(x1 - x0));
+            }
+        }
+    } else {
+        for (uint32_t s0 = 0; s0 < job.spp;) {
+            if (job.cancel && atomic_load(job.cancel)) {
+                cancelled = true;
                 break;
-            struct timespec ts = {0, 50 * 1000 * 1000};
-            nanosleep(&ts, NULL);
-            if (opt.progress) {
-                progress.tiles_done = atomic_load(&job.tiles_done);
+            }
+            job.s0 = s0;
+            job.s1 = job.spp - s0 > (uint32_t)pass_samples ? s0 + (uint32_t)pass_samples : job.spp;
+            progress.pass_samples = (int)(job.s1 - job.s0);
+            int n = run_workers(&job, workers, nthreads, &opt, &progress, t0);
+            started = n > started ? n : started;
+            if (atomic_load(&job.tiles_done) < job.tiles_total) {
+                cancelled = true; /* the pass was cut short: fb keeps the last whole pass */
+                break;
+            }
+            resolve_image(&job);
+            job.samples_done = (int)job.s1;
+            st.passes_done++;
+            s0 = job.s1;
+            if (opt.progress && s0 < job.spp) {
+                progress.tiles_done = job.tiles_total;
+                progress.samples_done = job.samples_done;
                 progress.elapsed = now_seconds() - t0;
                 opt.progress(&progress, opt.progress_user);
             }
+            if (opt.time_limit > 0.0 && s0 < job.spp && now_seconds() - t0 >= opt.time_limit) {
+                st.time_limited = true;
+                break;
+            }
         }
-        for (int i = 0; i < started; i++)
-            pthread_join(workers[i].thread, NULL);
+        st.samples_done = job.samples_done;
+        st.partial = job.samples_done == 0;
+        st.tiles_done = st.partial ? 0 : job.tiles_total;
     }
     st.seconds = now_seconds() - t0;
     st.tiles_total = job.tiles_total;
-    st.tiles_done = atomic_load(&job.tiles_done);
     st.threads = started > 0 ? started : 1;
+    st.passes = job.passes;
+    st.pass_samples = job.passes ? pass_samples : 0;
+    st.interrupted = cancelled;
     for (int i = 0; i < nthreads; i++) {
         st.rays += workers[i].rays;
         st.camera_rays += workers[i].camera_rays;
@@ -286,29 +481,23 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     }
     if (opt.progress) {
         progress.tiles_done = st.tiles_done;
+        progress.samples_done = st.samples_done;
         progress.elapsed = st.seconds;
         progress.final = true;
         opt.progress(&progress, opt.progress_user);
     }
-    st.interrupted = st.tiles_done < job.tiles_total;
-    if (st.interrupted) {
-        /* clear tiles that were started but not finished: a partial tile is worse than a black one */
-        for (int t = 0; t < job.tiles_total; t++) {
-            if (atomic_load(&job.tile_finished[t]))
-                continue;
-            int tx = t % job.tiles_x, ty = t / job.tiles_x;
-            for (int y = ty * job.tile_size; y < (ty + 1) * job.tile_size && y < fb->height; y++)
-                for (int x = tx * job.tile_size; x < (tx + 1) * job.tile_size && x < fb->width; x++)
-                    memset(fb->rgb + 3 * ((size_t)y * (size_t)fb->width + (size_t)x), 0, 3 * sizeof(float));
-        }
-    }
-    free(job.tile_finished);
-    free(workers);
+    pthread_cond_destroy(&job.done);
+    pthread_mutex_destroy(&job.lock);
+    free_job(&job, workers);
     rt_render_state_free(&state);
     if (stats)
         *stats = st;
-    if (st.interrupted)
+    if (st.interrupted) {
+        if (st.passes)
+            return rt_fail(err, RT_ERR_INTERRUPTED, "render interrupted: %d of %d samples per pixel done",
+                           st.samples_done, (int)job.spp);
         return rt_fail(err, RT_ERR_INTERRUPTED, "render interrupted: %d of %d tiles finished", st.tiles_done,
                        st.tiles_total);
+    }
     return RT_OK;
 }

@@ -22,6 +22,7 @@
 #ifndef RT_FRAMEBUFFER_H
 #define RT_FRAMEBUFFER_H
 
+#include <signal.h>
 #include <stdbool.h>
 
 #include "rt/base/error.h"
@@ -70,6 +71,18 @@ rt_result rt_framebuffer_write(const rt_framebuffer *fb, const char *path, float
 /* Writes atomically with the options (tone curve, half floats, EXR layers). */
 rt_result rt_framebuffer_write_with(const rt_framebuffer *fb, const char *path, const rt_image_options *opt,
                                     rt_error *err);
+
+/* A write's temporary file, for a signal handler that ends the process:
+ * while `active` is non-zero, `path` may name the temporary file of a
+ * write under way, and the handler may unlink(path) (async-signal-safe;
+ * a name not yet or no longer there is harmless). */
+typedef struct rt_write_temp {
+    char path[4300]; /* as long as any temporary name framebuffer.c makes */
+    volatile sig_atomic_t active;
+} rt_write_temp;
+/* rt_framebuffer_write_with that keeps *temp up to date (temp may be NULL). */
+rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *path, const rt_image_options *opt,
+                                       rt_write_temp *temp, rt_error *err);
 
 /* Reads a PFM (for tests and comparisons against references). */
 rt_result rt_pfm_read(const char *path, rt_framebuffer *fb, rt_error *err);

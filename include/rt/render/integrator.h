@@ -40,6 +40,7 @@ typedef struct rt_integrator_info {
     const char *name;        /* the word in scene files (`integrator NAME`) and for --integrator */
     rt_radiance_fn radiance;
     unsigned prepare;        /* RT_PREPARE_* bits (rt/render/render_state.h): what the render state must hold */
+    int pass_samples;        /* rt_render's default: samples per pixel a pass; 0 = tile by tile */
 } rt_integrator_info;
 
 /* Every name in table order, NULL-terminated: the words of the `integrator`

@@ -1,22 +1,43 @@
 /* rt/render/render.h - rendering an image: a pthread pool over a queue of
- * tiles.
+ * tiles, tile by tile or in passes over the whole image.
  *
  * The image is cut into square tiles; worker threads take the next tile from
  * an atomic counter until none are left. Each pixel's samples use random
  * streams seeded from (seed, pixel, sample), so the image is bit-identical
- * for any thread count. What the scene's integrator needs (rt_render_state)
- * is prepared once before the workers start. The scene must have passed
- * rt_scene_validate (rt/scene/validate.h).
+ * for any thread count and tile size. What the scene's integrator needs
+ * (rt_render_state) is prepared once before the workers start. The scene
+ * must have passed rt_scene_validate (rt/scene/validate.h).
  *
- *   rt_render_options opt = {0};       // zero = defaults: all cores, 32px tiles
- *   opt.threads = 4;
+ *   rt_render_options opt = {0};       // zero = defaults: all cores, 32px tiles,
+ *   opt.threads = 4;                   //   the integrator's pass size, no time limit
  *   rt_render_stats st;
  *   rt_render(&scene, &tree, &opt, &fb, &st, &err);
  *
+ * Two ways to spend the samples:
+ * - Tiles: each tile gets all its samples, then the next tile. A finished
+ *   tile is final; an interrupted render has some tiles done, others black.
+ * - Passes (opt.pass_samples > 0): every pixel gets pass_samples samples a
+ *   pass (the last pass what is left), passes repeat until settings.samples.
+ *   After each pass fb holds the whole image at the samples done so far, so
+ *   stopping early (cancel, opt.time_limit) still leaves a complete image.
+ *   Per pixel the samples are summed in sample order in the same float
+ *   arithmetic as tiles (the sums and counts of good samples are kept
+ *   between passes), so the final image is bit-identical to the tiled one.
+ * The default is the integrator's (rt_integrator_info.pass_samples): passes
+ * of 4 for `path`, which takes hundreds of samples and is worth watching
+ * converge; tiles for `direct` and `whitted`, which are usually rendered
+ * with a few samples (one pass would be the whole render) and then need no
+ * accumulation buffer (16 bytes a pixel) and no sweep over the image each
+ * pass.
+ *
+ * opt.time_limit stops after the pass that crosses it (tiles: each worker
+ * finishes the tile in hand and takes no more); stats say how far it got.
+ *
  * Progress: the calling thread waits for the workers; with opt.progress set
- * it calls it about every 50 ms, and once more when they are done
- * (p->final), with the tiles done so far. The finished tiles' pixels may be
- * read from inside the call (a live preview):
+ * it calls it about every 50 ms, after each pass, and once more when they
+ * are done (p->final). The finished tiles' pixels may be read from inside
+ * the call (a live preview); in pass mode every tile counts as finished once
+ * a pass is done (fb then holds the image at p->samples_done):
  *
  *   static void show(const rt_render_progress *p, void *user)
  *   {
@@ -49,7 +70,11 @@ typedef struct rt_tile {
 
 /* A progress report, valid only during the call it is passed to. */
 typedef struct rt_render_progress {
-    int tiles_done, tiles_total;
+    int tiles_done, tiles_total;  /* passes: of the pass under way */
+    bool passes;                  /* rendering in passes */
+    int samples_done;             /* passes: samples per pixel in fb (complete passes) */
+    int samples_total;            /* settings.samples */
+    int pass_samples;             /* passes: samples per pixel of the pass under way */
     double elapsed;               /* seconds since the workers started */
     bool final;                   /* the last report: the workers have stopped */
     const rt_framebuffer *fb;     /* the image; only finished tiles' pixels are final */
@@ -64,6 +89,8 @@ rt_tile rt_render_progress_tile(const rt_render_progress *p, int index);
 typedef struct rt_render_options {
     int threads;               /* 0 = one per core */
     int tile_size;             /* 0 = 32 */
+    int pass_samples;          /* samples per pixel a pass; 0 = the integrator's default, < 0 = tiles */
+    double time_limit;         /* seconds; > 0: stop after the pass (tile) that crosses it */
     atomic_int *cancel;        /* set non-zero (e.g. from a signal handler) to stop */
     rt_render_progress_fn progress; /* NULL = no reports; called from the calling thread */
     void *progress_user;       /* handed to progress */
@@ -76,12 +103,20 @@ typedef struct rt_render_stats {
     uint64_t bad_samples;       /* NaN/Inf samples dropped */
     int tiles_done, tiles_total;
     int threads;
-    bool interrupted;
+    bool passes;                /* rendered in passes */
+    int pass_samples, passes_done;
+    int samples_done;           /* samples per pixel in every pixel of fb (0 when partial) */
+    bool partial;               /* tiles: some tiles are missing (black) */
+    bool interrupted;           /* stopped by cancel */
+    bool time_limited;          /* stopped by the time limit */
 } rt_render_stats;
 
 /* Renders the scene's camera view into fb (which must be sized
- * settings.width x settings.height). On interruption returns
- * RT_ERR_INTERRUPTED with the finished tiles in fb (the others black). */
+ * settings.width x settings.height). When cancelled returns
+ * RT_ERR_INTERRUPTED: tiles leave the finished tiles in fb (the others
+ * black, stats.partial), passes the image at stats.samples_done (partial
+ * when no pass finished). Stopped by the time limit it returns RT_OK with
+ * stats.time_limited and the same kind of image. */
 rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_render_options *options,
                     rt_framebuffer *fb, rt_render_stats *stats, rt_error *err);
 
