@@ -213,12 +213,18 @@ static void walk_ref(walk_state *w, uint32_t ref)
     if (c > w->maxleaf)
         w->maxleaf = c;
     for (size_t j = 0; j < c; j++) {
-        assert_true(ids[j] < w->n);
         if (j > 0) /* ascending: triangles first, as the leaf loop expects */
             assert_true(ids[j - 1] < ids[j]);
-        /* triangles are numbered in leaf order and carry the scene's id */
-        size_t id = ids[j] < w->s->triangles.count ? rt_kdtree_scene_triangle(tree, ids[j]) : ids[j];
+        /* a triangle is its record's offset in the leaf blocks, the record
+         * carries the scene's id; spheres and quads come above other_base */
+        if (ids[j] < tree->other_base) {
+            assert_true(ids[j] + RT_KD_TRI <= tree->prim_id_count);
+            if (ref < RT_KD_ONE) /* not inside the leaf's own id list */
+                assert_true(ids[j] >= one + c || ids[j] + RT_KD_TRI <= one);
+        }
+        size_t id = rt_kdtree_scene_prim(tree, ids[j]);
         assert_true(id < w->n);
+        assert_true(ids[j] >= tree->other_base || id < w->s->triangles.count);
         w->seen[id] = 1;
     }
 }

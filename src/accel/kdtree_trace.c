@@ -1,7 +1,8 @@
 /* kdtree_trace.c - the kd-tree's traversal: the closest hit
  * (rt_kdtree_intersect) and any hit (rt_kdtree_occluded) along a ray,
  * exactly the hit brute force would find, over the arrays kdtree_pack.c
- * made (wide nodes, leaf lists, triangles in leaf order).
+ * made (wide nodes, leaf blocks: a leaf's id list, then the triangles it
+ * was the first to use; a triangle's id is its record's offset).
  *
  * Traversal: the recursive ray segment algorithm (Havran's thesis, "TA_B^rec",
  * and pbrt's KdTreeAccel) with a fixed stack, three levels per step. In a
@@ -196,21 +197,21 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
 KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit)
 {
     float t, u, v;
-    if (id < tree->triangle_count) {
-        const float *p = tree->tri + RT_KD_TRI * (size_t)id;
+    if (id < tree->other_base) {
+        const float *p = tree->tri + id;
         if (!rt_intersect_triangle(ray->org, ray->dir, rt_v3(p[0], p[1], p[2]), rt_v3(p[3], p[4], p[5]),
                                    rt_v3(p[6], p[7], p[8]), ray->tmin, *best, &t, &u, &v))
             return false;
-    } else if (id < tree->triangle_count + tree->sphere_count) {
+    } else if (id - tree->other_base < tree->sphere_count) {
         const rt_spheres *s = &tree->scene->spheres;
-        size_t i = id - tree->triangle_count;
+        size_t i = id - tree->other_base;
         if (!rt_intersect_sphere(ray->org, ray->dir, rt_v3(s->cx[i], s->cy[i], s->cz[i]), s->radius[i], ray->tmin,
                                  *best, &t))
             return false;
         u = v = 0.0f;
     } else {
         const rt_quads *q = &tree->scene->quads;
-        size_t i = id - tree->triangle_count - tree->sphere_count;
+        size_t i = id - tree->other_base - tree->sphere_count;
         if (!rt_intersect_quad(ray->org, ray->dir, rt_v3(q->px[i], q->py[i], q->pz[i]),
                                rt_v3(q->ux[i], q->uy[i], q->uz[i]), rt_v3(q->vx[i], q->vy[i], q->vz[i]), ray->tmin,
                                *best, &t, &u, &v))
@@ -240,7 +241,7 @@ KD_INLINE bool tri8(const float *tri, const uint32_t *ids, uint32_t n, const rt_
     __m256i id = _mm256_maskload_epi32((const int *)ids, live);
     id = _mm256_and_si256(_mm256_blendv_epi8(_mm256_set1_epi32((int)ids[0]), id, live),
                           _mm256_set1_epi32((int)RT_KD_PAYLOAD)); /* the last id carries RT_KD_LAST */
-    __m256i base = _mm256_mullo_epi32(id, _mm256_set1_epi32(RT_KD_TRI));
+    __m256i base = id; /* ids are the records' offsets */
     /* floats 0-7 of each triangle: one unaligned load per lane and an 8x8
      * transpose (cheaper than eight gathers); float 8 by one gather */
     uint32_t off[8];
@@ -342,8 +343,8 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, c
     bool found = false;
     uint32_t i = 0;
 #ifdef KD_SIMD
-    if (n >= KD_SIMD_MIN && tree->simd_ok) {
-        uint32_t T = (uint32_t)tree->triangle_count;
+    if (n >= KD_SIMD_MIN) {
+        uint32_t T = tree->other_base;
         while (i < n && (p[i] & RT_KD_PAYLOAD) < T) {
             uint32_t m = n - i < 8 ? n - i : 8;
             while ((p[i + m - 1] & RT_KD_PAYLOAD) >= T)
@@ -735,8 +736,7 @@ KD_FLATTEN bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt
 {
     hit->prim = RT_NONE;
     if (traverse(tree, ray, hit, false)) {
-        if (hit->prim < tree->triangle_count)
-            hit->prim = rt_kdtree_scene_triangle(tree, hit->prim);
+        hit->prim = rt_kdtree_scene_prim(tree, hit->prim);
         return true;
     }
     hit->prim = RT_NONE;
