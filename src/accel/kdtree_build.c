@@ -49,7 +49,7 @@
  * traversal (v0, e1 = v1 - v0, e2 = v2 - v0, computed exactly as the
  * reference tests of intersect.h do, so t is bit-identical to testing the
  * scene's triangle directly) are made here with the primitives' bounds;
- * kdtree_pack.c puts them in leaf order and packs the nodes.
+ * kdtree_pack.c puts them into the leaf blocks and packs the nodes.
  *
  * Measured and not kept (docs/performance.md has the numbers): K_T 1.5-6,
  * empty bonus 0.2-0.8 and depth limits up to 50 (no gain on both ray
@@ -805,7 +805,6 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     if (N >= (size_t)PRIM_MASK)
         return rt_fail(err, RT_ERR_LIMIT, "kdtree: %zu primitives, at most %u supported", N, PRIM_MASK - 1u);
     tree->triangle_count = T;
-    tree->simd_ok = T < (size_t)INT32_MAX / RT_KD_TRI;
     tree->sphere_count = S;
     tree->quad_count = Q;
 
@@ -984,14 +983,11 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     c.side = NULL;
     c.strad = NULL;
     rt_kd_binary bin = {c.nodes, c.node_count, c.ids, c.id_count};
-    if (!rt_kd_order_triangles(tree, &bin))
-        goto oom;
     if (!rt_kd_pack_wide(tree, &bin, &c.limit))
         goto oom;
     c.st.nodes = c.node_count;
     c.st.wide_nodes = tree->wide_count;
-    c.st.bytes = tree->wide_count * sizeof *tree->wide + tree->prim_id_count * sizeof *tree->prim_ids +
-                 T * RT_KD_TRI * sizeof(float);
+    c.st.bytes = tree->wide_count * sizeof *tree->wide + tree->prim_id_count * sizeof *tree->prim_ids;
     free(c.nodes);
     free(c.ids);
     c.st.build_ms = now_ms() - t0;
@@ -1019,7 +1015,6 @@ void rt_kdtree_free(rt_kdtree *tree)
     if (!tree)
         return;
     free(tree->wide);
-    free(tree->prim_ids);
-    free(tree->tri);
+    free(tree->prim_ids); /* tree->tri is the same array */
     memset(tree, 0, sizeof *tree);
 }

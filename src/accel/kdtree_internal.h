@@ -7,10 +7,10 @@
  *                   2006) on one or more threads, into a binary tree of
  *                   8-byte rt_kdtree_node and leaf id lists (rt_kd_binary,
  *                   which lives only during the build); then it calls
- *   kdtree_pack.c   rt_kd_order_triangles and rt_kd_pack_wide, which make
- *                   the arrays of rt_kdtree that the traversal reads: the
- *                   triangles copied in leaf order, 64-byte wide nodes of
- *                   three levels each, leaf lists with an end flag;
+ *   kdtree_pack.c   rt_kd_pack_wide, which makes the arrays of rt_kdtree
+ *                   that the traversal reads: 64-byte wide nodes of three
+ *                   levels each, and leaf blocks (a leaf's id list with an
+ *                   end flag, then the triangles it is the first to use);
  *   kdtree_trace.c  rt_kdtree_intersect and rt_kdtree_occluded over those
  *                   arrays (the AVX2 step and the portable one).
  *
@@ -41,7 +41,7 @@ typedef struct rt_kdtree_node {
 /* The build's depth limit; the traversal's stack is sized for it. */
 #define KD_MAX_DEPTH 60
 
-/* The tree's leaf lists (rt_kdtree.prim_ids) are followed by this many ids
+/* The tree's leaf blocks (rt_kdtree.prim_ids) are followed by this many ids
  * with RT_KD_LAST set, so the traversal can find a list's end by loading 8
  * ids at a time. */
 #define KD_IDS_PAD 8
@@ -72,15 +72,11 @@ typedef struct rt_kd_binary {
     size_t id_count;
 } rt_kd_binary;
 
-/* Renumbers the triangles in the order the leaves first use them, rewriting
- * the leaves' ids, and replaces tree->tri (9 floats a triangle in scene
- * order, as the build made them) with RT_KD_TRI-float records in the new
- * order. false: out of memory (tree->tri is then unchanged). */
-bool rt_kd_order_triangles(rt_kdtree *tree, rt_kd_binary *bin);
-
-/* Packs the binary tree into tree->wide, tree->root and tree->prim_ids.
- * false: out of memory, or with *limit set, more wide nodes or leaf ids than
- * a child reference can address (nothing is then allocated). */
+/* Packs the binary tree into tree->wide, tree->root and the leaf blocks
+ * (tree->prim_ids, tree->tri: the same array), replacing tree->tri (9
+ * floats a triangle in scene order, as the build made them). false: out of
+ * memory, or with *limit set, more wide nodes or block words than a child
+ * reference can address (tree->tri is then unchanged). */
 bool rt_kd_pack_wide(rt_kdtree *tree, const rt_kd_binary *bin, bool *limit);
 
 #endif

@@ -1,27 +1,37 @@
 /* kdtree_pack.c - the arrays the kd-tree's traversal reads, made from the
- * build's binary tree (kdtree_build.c): the triangles copied in leaf order,
+ * build's binary tree (kdtree_build.c): leaf blocks holding the triangles,
  * and 64-byte wide nodes of three levels each.
  *
  * Triangles: each is stored as v0, e1 = v1 - v0, e2 = v2 - v0 (as the build
  * computed them, exactly as the reference tests do, so t is bit-identical
- * to testing the scene's triangle directly) plus its scene id, 10 floats
- * (RT_KD_TRI). After the build the triangles are renumbered in the order
- * the depth-first leaves first use them and stored in that order, so a
- * leaf's triangles mostly share cache lines: on the 1M-triangle model
- * +15-30% rays/s (profile: ~40% of the time was the first triangle gather
- * waiting on memory); the scene id in the same record spares the hit a last
- * cache miss into a separate map. Arrays over 2 MB go on transparent huge
- * pages (madvise): +5-15% there, the TLB no longer misses on every node.
+ * to testing the scene's triangle directly) plus its scene id, 10 words
+ * (RT_KD_TRI). Leaf blocks: one array of 32-bit words holds, leaf after
+ * leaf in depth-first order, a leaf's id list (ending with a flag on the
+ * last id) followed by the records of the triangles that no earlier leaf
+ * used; a triangle's id is its record's offset in that array, a one-
+ * primitive leaf's reference is the id itself. So the list and the
+ * triangles met first in a leaf share cache lines (or the adjacent line),
+ * and the triangles a leaf shares with the leaf before it, which a ray
+ * often has just tested, are the only ones elsewhere. Every triangle is
+ * stored once (a perfect-split kd-tree puts one in 1.8-2.9 leaves, and a
+ * copy per leaf would take 75-115 bytes a triangle where the bound is 64).
+ * Before, the triangles were one array in first-use order and the lists
+ * another: leaf -> list -> triangles was two dependent cache misses on the
+ * 1M-triangle model. Session 1's ordering by first use (one or two cache
+ * lines per leaf instead of one per triangle: +15-30% rays/s on the
+ * 1M-triangle model) is kept by the same placement; the scene id in the
+ * record spares the hit a last cache miss into a separate map. Arrays over
+ * 2 MB go on transparent huge pages (madvise): +5-15% there, the TLB no
+ * longer misses on every node.
  *
  * Wide nodes: for tracing, the binary tree is then packed three levels at a
  * time into 64-byte, cache-line-aligned nodes (rt_kdtree_wide: 7 planes, 8
  * cells, a reference per cell to a wide node, a leaf or nothing; missing
- * planes below a leaf are +inf), in depth-first order. Leaf lists end with
- * a flag on the last id. The binary node loop cost ~20 cycles a level on
- * incoherent rays (a load, then a mispredicted choice of child), and on the
- * 1M-triangle model every other level missed the cache; a wide node costs
- * one line for three levels and one SIMD step (see "Traversal" in
- * kdtree_trace.c).
+ * planes below a leaf are +inf), in depth-first order. The binary node loop
+ * cost ~20 cycles a level on incoherent rays (a load, then a mispredicted
+ * choice of child), and on the 1M-triangle model every other level missed
+ * the cache; a wide node costs one line for three levels and one SIMD step
+ * (see "Traversal" in kdtree_trace.c).
  *
  * Measured and not kept (docs/performance.md has the numbers): leaves whose
  * triangles got consecutive numbers stored as a range without an id list
@@ -64,65 +74,11 @@ static void *alloc_hot(size_t size)
     return posix_memalign(&p, 64, size ? size : 64) == 0 ? p : NULL;
 }
 
-/* ------------------------------------------- triangles in leaf order */
-
-/* Renumbers the triangles in the order the depth-first node array first
- * references them and stores their data in that order, so the triangles of
- * a leaf mostly sit next to each other in memory (one or two cache lines
- * per leaf instead of one per triangle); each record ends with the
- * triangle's scene id. Leaf lists stay ascending. */
-bool rt_kd_order_triangles(rt_kdtree *tree, rt_kd_binary *bin)
-{
-    size_t T = tree->triangle_count;
-    if (T == 0)
-        return true;
-    uint32_t *newid = malloc(T * sizeof *newid);
-    uint32_t *old = malloc(T * sizeof *old);
-    float *tri = alloc_hot(T * RT_KD_TRI * sizeof *tri);
-    if (!newid || !old || !tri) {
-        free(newid);
-        free(old);
-        free(tri);
-        return false;
-    }
-    memset(newid, 0xff, T * sizeof *newid);
-    uint32_t next = 0;
-    for (size_t i = 0; i < bin->node_count; i++) {
-        rt_kdtree_node *nd = &bin->nodes[i];
-        if ((nd->b & 3u) != KD_LEAF_TAG || nd->b == KD_LEAF_TAG)
-            continue;
-        uint32_t n = nd->b >> 2;
-        uint32_t *p = n == 1 ? &nd->a : bin->ids + nd->a;
-        for (uint32_t j = 0; j < n && p[j] < T; j++) {
-            if (newid[p[j]] == UINT32_MAX) {
-                old[next] = p[j];
-                newid[p[j]] = next++;
-            }
-            p[j] = newid[p[j]];
-        }
-        kd_sort_ids(p, n); /* ascending again (spheres and quads keep their ids, above every triangle's) */
-    }
-    for (size_t i = 0; i < T; i++) /* triangles in no leaf (never hit) go last */
-        if (newid[i] == UINT32_MAX) {
-            old[next] = (uint32_t)i;
-            newid[i] = next++;
-        }
-    for (size_t i = 0; i < T; i++) { /* 9 floats, then the scene id (the hit's, in the same cache line) */
-        memcpy(tri + RT_KD_TRI * i, tree->tri + 9 * (size_t)old[i], 9 * sizeof *tri);
-        memcpy(tri + RT_KD_TRI * i + 9, &old[i], sizeof old[i]);
-    }
-    free(newid);
-    free(old);
-    free(tree->tri);
-    tree->tri = tri;
-    return true;
-}
-
 /* ------------------------------------------------------- wide nodes */
 
 /* Packs the binary tree (bin->nodes, bin->ids) into 64-byte nodes of three
  * levels each (rt_kdtree_wide in kdtree.h), in depth-first order, and
- * copies the leaf lists with RT_KD_LAST set on each list's last id. Cell by cell: follow
+ * writes the leaf blocks as it meets the leaves. Cell by cell: follow
  * the cell's three below/above choices down from the top node; a leaf met
  * above the third level takes the cell whose remaining choices are all
  * "below" (the missing planes are +inf, so that cell is the leaf's whole
@@ -132,28 +88,48 @@ typedef struct kd_widen {
     const uint32_t *bids;
     rt_kdtree_wide *w;
     size_t wn, wcap;
-    uint32_t *ids;
-    size_t in;
+    uint32_t *blk;      /* the leaf blocks */
+    size_t in;          /* words of blk written */
+    uint32_t *where;    /* per scene triangle: its record's offset in blk, or KD_NO_NODE */
+    const float *tri9;  /* the build's triangles, 9 floats each in scene order */
+    uint32_t T, other;  /* triangle count; first id of spheres and quads */
     bool oom, limit;
 } kd_widen;
 
 #define KD_NO_NODE UINT32_MAX
 
+/* The block id of primitive p (a scene id): a triangle's record, stored
+ * here when no earlier leaf stored it, or a sphere's or quad's id. */
+static uint32_t block_id(kd_widen *x, uint32_t p)
+{
+    if (p >= x->T)
+        return x->other + (p - x->T);
+    if (x->where[p] == KD_NO_NODE) {
+        uint32_t *r = x->blk + x->in;
+        memcpy(r, x->tri9 + 9 * (size_t)p, 9 * sizeof *r);
+        r[9] = p;
+        x->where[p] = (uint32_t)x->in;
+        x->in += RT_KD_TRI;
+    }
+    return x->where[p];
+}
+
+/* A leaf's reference: one primitive, or a block (the id list, then the
+ * records of the triangles first used here). */
 static uint32_t widen_leaf(kd_widen *x, const rt_kdtree_node *nd)
 {
     uint32_t n = nd->b >> 2;
     if (n == 0)
         return RT_KD_EMPTY;
     if (n == 1)
-        return RT_KD_ONE | nd->a;
-    if (x->in > RT_KD_PAYLOAD) {
-        x->limit = true;
-        return RT_KD_EMPTY;
-    }
+        return RT_KD_ONE | block_id(x, nd->a);
     uint32_t off = (uint32_t)x->in;
-    memcpy(x->ids + x->in, x->bids + nd->a, n * sizeof *x->ids);
+    uint32_t *list = x->blk + off;
     x->in += n;
-    x->ids[x->in - 1] |= RT_KD_LAST;
+    for (uint32_t j = 0; j < n; j++)
+        list[j] = block_id(x, x->bids[nd->a + j]);
+    kd_sort_ids(list, n); /* triangles, the lower ids, first */
+    list[n - 1] |= RT_KD_LAST;
     return RT_KD_LEAF | off;
 }
 
@@ -236,25 +212,62 @@ bool rt_kd_pack_wide(rt_kdtree *tree, const rt_kd_binary *bin, bool *limit)
     memset(&x, 0, sizeof x);
     x.bn = bin->nodes;
     x.bids = bin->ids;
-    /* + KD_IDS_PAD: a leaf's length is found by loading 8 ids at a time */
-    x.ids = alloc_hot((bin->id_count + KD_IDS_PAD) * sizeof *x.ids);
-    if (!x.ids)
+    x.tri9 = tree->tri;
+    x.T = (uint32_t)tree->triangle_count;
+    /* the blocks' size: every multi-primitive leaf's list, and one record
+     * per triangle that some leaf holds */
+    x.where = malloc((x.T ? x.T : 1) * sizeof *x.where);
+    if (!x.where)
         return false;
+    memset(x.where, 0xff, (x.T ? x.T : 1) * sizeof *x.where);
+    size_t words = 0;
+    for (size_t i = 0; i < bin->node_count; i++) {
+        const rt_kdtree_node *nd = &bin->nodes[i];
+        if ((nd->b & 3u) != KD_LEAF_TAG || nd->b == KD_LEAF_TAG)
+            continue;
+        uint32_t n = nd->b >> 2;
+        const uint32_t *p = n == 1 ? &nd->a : bin->ids + nd->a;
+        if (n > 1)
+            words += n;
+        for (uint32_t j = 0; j < n; j++)
+            if (p[j] < x.T && x.where[p[j]] == KD_NO_NODE) {
+                x.where[p[j]] = 0;
+                words += RT_KD_TRI;
+            }
+    }
+    memset(x.where, 0xff, (x.T ? x.T : 1) * sizeof *x.where);
+    size_t others = tree->sphere_count + tree->quad_count;
+    if (words + others > RT_KD_PAYLOAD) {
+        free(x.where);
+        *limit = true;
+        return false;
+    }
+    x.other = (uint32_t)words;
+    /* + KD_IDS_PAD: a leaf's length is found by loading 8 ids at a time */
+    x.blk = alloc_hot((words + KD_IDS_PAD) * sizeof *x.blk);
+    if (!x.blk) {
+        free(x.where);
+        return false;
+    }
     tree->root = bin->node_count ? widen_rec(&x, 0) : RT_KD_EMPTY;
+    free(x.where);
     for (size_t i = 0; i < KD_IDS_PAD; i++)
-        x.ids[x.in + i] = RT_KD_LAST;
+        x.blk[words + i] = RT_KD_LAST;
     rt_kdtree_wide *w = NULL;
     if (!x.oom && !x.limit && (w = alloc_hot(x.wn * sizeof *w)) != NULL && x.wn)
         memcpy(w, x.w, x.wn * sizeof *w);
     free(x.w);
     if (!w) {
-        free(x.ids);
+        free(x.blk);
         *limit = x.limit;
         return false;
     }
     tree->wide = w;
     tree->wide_count = x.wn;
-    tree->prim_ids = x.ids;
-    tree->prim_id_count = x.in;
+    free(tree->tri);
+    tree->prim_ids = x.blk;
+    tree->tri = (float *)(void *)x.blk;
+    tree->prim_id_count = words;
+    tree->other_base = x.other;
     return true;
 }

@@ -18,11 +18,14 @@
  * cache-line-aligned rt_kdtree_wide (7 split planes, 8 cells), so a ray
  * resolves three levels with one memory access and one SIMD step instead of
  * three dependent branches. The planes and cells are exactly the binary
- * tree's. Triangles are copied into one buffer of 9 floats each (v0, e1,
- * e2) in the order the leaves first use them, so a leaf's triangles are
- * mostly adjacent; each carries its scene id (hits report scene ids). The
- * build, this packing and the traversal are described, with their sources,
- * at the top of src/accel/kdtree_build.c, kdtree_pack.c and kdtree_trace.c.
+ * tree's. Leaves and triangles share one array of leaf blocks: a block is
+ * the leaf's id list followed by the records (v0, e1, e2 and the scene id,
+ * RT_KD_TRI words) of the triangles no earlier leaf used, so a leaf's list
+ * and most of its triangles sit in the same or adjacent cache lines; a
+ * triangle's id is the offset of its record in that array (hits report
+ * scene ids). The build, this packing and the traversal are described,
+ * with their sources, at the top of src/accel/kdtree_build.c,
+ * kdtree_pack.c and kdtree_trace.c.
  *
  * Results are exactly those of testing every primitive with the functions
  * of intersect.h (same t bits; either id when two primitives tie). Rays with
@@ -61,7 +64,7 @@ typedef struct rt_kdtree_stats {
     size_t max_leaf_prims;
     int depth;
     double build_ms;
-    size_t bytes;         /* nodes + leaf ids + triangle buffers */
+    size_t bytes;         /* wide nodes + leaf blocks (ids and triangles) */
 } rt_kdtree_stats;
 
 /* Three levels of the binary tree: planes in breadth-first order (0 the top
@@ -69,9 +72,11 @@ typedef struct rt_kdtree_stats {
  * are 2p+1 and 2p+2), cells c = 4 b0 + 2 b1 + b2 with b = 0 for the below
  * side at each level. A plane that does not exist (a leaf above level 3)
  * is +inf on x, which keeps the whole cell below it. A child reference is
- * another wide node (< RT_KD_LEAF), RT_KD_EMPTY, RT_KD_ONE | primitive, or
- * RT_KD_LEAF | offset into prim_ids, where the list's last id has RT_KD_LAST
- * set. */
+ * another wide node (< RT_KD_LEAF), RT_KD_EMPTY, RT_KD_ONE | primitive id, or
+ * RT_KD_LEAF | offset into prim_ids of a list of primitive ids (ascending,
+ * the last with RT_KD_LAST set). A primitive id below other_base is the
+ * offset of a triangle's record in the same array, an id above it a sphere
+ * or quad (scene id = id - other_base + triangle_count). */
 typedef struct rt_kdtree_wide {
     float split[7];
     uint32_t axes;      /* axis of plane p in bits 2p, 2p+1 */
@@ -88,14 +93,16 @@ typedef struct rt_kdtree {
     rt_kdtree_wide *wide; /* 64-byte aligned */
     size_t wide_count;
     uint32_t root;        /* a child reference: the whole tree */
-    uint32_t *prim_ids;   /* leaf lists: tree triangle numbers, then scene ids of spheres and quads */
+    /* the leaf blocks: tri and prim_ids are the same array (64-byte aligned,
+     * prim_id_count words, then KD_IDS_PAD words of padding), read as floats
+     * for triangle records (RT_KD_TRI words each: v0.xyz, e1.xyz, e2.xyz,
+     * then the bits of the scene's triangle id) and as ids for leaf lists */
+    uint32_t *prim_ids;
     size_t prim_id_count;
-    /* triangles in leaf order (tree triangle numbers), RT_KD_TRI floats each:
-     * v0.xyz, e1.xyz, e2.xyz, then the bits of the scene's triangle id */
     float *tri;
+    uint32_t other_base;  /* primitive ids >= this are spheres and quads */
     size_t triangle_count, sphere_count, quad_count; /* at build time */
     float scale; /* largest absolute coordinate of bounds (traversal epsilon) */
-    bool simd_ok; /* triangle offsets fit the 32-bit lanes of the 8-wide leaf test */
     const rt_scene *scene;
     rt_box bounds;
     int max_depth;
@@ -105,11 +112,14 @@ typedef struct rt_kdtree {
 rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err);
 void rt_kdtree_free(rt_kdtree *tree);
 
-/* The scene's id of tree triangle number n. */
-static inline uint32_t rt_kdtree_scene_triangle(const rt_kdtree *tree, uint32_t n)
+/* The scene's id of primitive id n (a triangle's record offset, or a
+ * sphere or quad above other_base). */
+static inline uint32_t rt_kdtree_scene_prim(const rt_kdtree *tree, uint32_t n)
 {
     uint32_t id;
-    memcpy(&id, tree->tri + (size_t)RT_KD_TRI * n + 9, sizeof id);
+    if (n >= tree->other_base)
+        return n - tree->other_base + (uint32_t)tree->triangle_count;
+    memcpy(&id, tree->tri + (size_t)n + 9, sizeof id);
     return id;
 }
 
