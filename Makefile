@@ -11,11 +11,21 @@
 #                     (PREFIX=/usr/local, DESTDIR for staging); make test-install checks it
 #   make clean
 #
-# Variables: WERROR=1 turns warnings into errors (CI sets it); SHARED=dir
+# Variables: WERROR=1 turns warnings into errors (CI sets it); PORTABLE=1
+# builds for any x86-64 instead of this machine's CPU; SHARED=dir
 # points the tests at the shared assets (default ../shared).
 
 CC      ?= cc
+# -march=native: the kd-tree's AVX2 traversal and the compiler's vector code
+# for this machine. A binary for other machines of a farm: PORTABLE=1 (x86-64
+# baseline, the kd-tree's portable step; same images, slower traversal).
+ifeq ($(PORTABLE),1)
+OPT     ?= -O2
+BUILD   ?= build-portable
+RT      ?= rt-portable
+else
 OPT     ?= -O2 -march=native
+endif
 WARN    := -Wall -Wextra -Wpedantic -Wshadow
 ifeq ($(WERROR),1)
 WARN    += -Werror
@@ -177,7 +187,7 @@ test-install: $(RT) $(BUILD)/librt.a
 	@CC="$(CC)" sh tests/install.sh
 
 clean:
-	rm -rf build build-asan build-tsan build-profile build-fuzz rt rt-profile bench/rtbench bench/buildscale
+	rm -rf build build-asan build-tsan build-profile build-fuzz build-portable rt rt-portable rt-profile bench/rtbench bench/buildscale
 
 -include $(LIB_OBJ:.o=.d) $(DRV_OBJ:.o=.d)
 
