@@ -65,6 +65,7 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#include "rt/base/clock.h"
 #include "rt/base/log.h"
 #include "rt/base/alloc.h"
 
@@ -767,13 +768,6 @@ static size_t stitch(const kd_build *b, size_t i, rt_kdtree_node *nodes, size_t 
     return next;
 }
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
 static bool finite_box(rt_box b) { return rt_finite3(b.lo) && rt_finite3(b.hi); }
 
 typedef struct kd_sort_job {
@@ -797,7 +791,7 @@ static void *sort_worker(void *arg)
  * stitched into one depth-first array, then kdtree_pack.c. */
 rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
 {
-    double t0 = now_ms();
+    double t0 = 1e3 * rt_now_seconds();
     memset(tree, 0, sizeof *tree);
     tree->scene = scene;
     tree->bounds = rt_box_empty();
@@ -990,7 +984,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     c.st.bytes = tree->wide_count * sizeof *tree->wide + tree->prim_id_count * sizeof *tree->prim_ids;
     free(c.nodes);
     free(c.ids);
-    c.st.build_ms = now_ms() - t0;
+    c.st.build_ms = 1e3 * rt_now_seconds() - t0;
     tree->stats = c.st;
     return RT_OK;
 

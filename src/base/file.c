@@ -14,6 +14,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -189,4 +190,13 @@ bool rt_path_join(const char *dir, const char *rel, char *out, size_t size)
         out[dl] = '/';
     memcpy(out + dl + slash, rel, rl + 1);
     return true;
+}
+
+bool rt_path_tagged(const char *path, const char *tag, const char *new_ext, char *out, size_t size)
+{
+    const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
+    if (!dot || (slash && dot < slash))
+        dot = path + strlen(path);
+    int n = snprintf(out, size, "%.*s.%s%s", (int)(dot - path), path, tag, new_ext ? new_ext : dot);
+    return n >= 0 && (size_t)n < size;
 }

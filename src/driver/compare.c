@@ -14,6 +14,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "rt/base/file.h"
 #include "rt/image/compare.h"
 #include "rt/image/flip.h"
 #include "rt/io/framebuffer.h"
@@ -130,12 +131,6 @@ static int parse_args(int argc, char **argv, compare_args *a, FILE *out, FILE *e
     return 0;
 }
 
-static bool has_extension(const char *path, const char *ext)
-{
-    size_t n = strlen(path), e = strlen(ext);
-    return n >= e && strcasecmp(path + n - e, ext) == 0;
-}
-
 /* Reads a PFM, EXR, HDR (or 8-bit) image; fails with a message naming the
  * file, including for non-finite values, which no metric can take. */
 static bool read_image(const char *path, rt_framebuffer *fb, FILE *errs)
@@ -166,7 +161,7 @@ static bool write_error_map(const char *path, const float *map, int w, int h, FI
         fprintf(errs, "rt: compare: %s: %s\n", path, err.message);
         return false;
     }
-    bool png = has_extension(path, ".png");
+    bool png = rt_path_has_ext(path, ".png");
     for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
         float *px = fb.rgb + 3 * i;
         if (png) {

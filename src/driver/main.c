@@ -23,6 +23,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "rt/base/clock.h"
 #include "rt/base/file.h"
 #include "rt/base/log.h"
 #include "rt/render/camera.h"
@@ -66,23 +67,6 @@ static void on_signal(int sig)
         signal(sig, SIG_DFL);
         raise(sig);
     }
-}
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* NAME.partial.EXT for NAME.EXT: where an incomplete image goes. */
-static void partial_name(const char *output, char *out, size_t size)
-{
-    const char *dot = strrchr(output, '.');
-    const char *slash = strrchr(output, '/');
-    if (!dot || (slash && dot < slash))
-        dot = output + strlen(output);
-    snprintf(out, size, "%.*s.partial%s", (int)(dot - output), output, dot);
 }
 
 /* Prints an error; out-of-memory errors also say which budget ran out and
@@ -516,7 +500,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         char partial[1100], what[160];
         const char *target = output;
         if (rs.partial) {
-            partial_name(output, partial, sizeof partial);
+            rt_path_tagged(output, "partial", NULL, partial, sizeof partial); /* where an incomplete image goes */
             target = partial;
             snprintf(what, sizeof what, "%d of %d tiles at %d spp%s", rs.tiles_done, rs.tiles_total, set->samples,
                      why);
@@ -531,7 +515,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
             fprintf(stderr, "rt: wrote %s: %dx%d, %s; %.2f s (render %.2f s)%s%s%s\n", target, fb.width, fb.height,
-                    what, now_seconds() - t_start, rs.seconds, rs.partial ? "; " : "", rs.partial ? output : "",
+                    what, rt_now_seconds() - t_start, rs.seconds, rs.partial ? "; " : "", rs.partial ? output : "",
                     rs.partial ? " left as it was" : "");
         }
     }
@@ -557,7 +541,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
 
 int main(int argc, char **argv)
 {
-    double t_start = now_seconds();
+    double t_start = rt_now_seconds();
     if (argc > 1 && strcmp(argv[1], "compare") == 0)
         return rt_cmd_compare(argc - 1, argv + 1);
     if (argc > 1 && strcmp(argv[1], "convert") == 0)

@@ -11,6 +11,8 @@
 #include <time.h>
 
 #include "rt/base/alloc.h"
+#include "rt/base/clock.h"
+#include "rt/base/file.h"
 #include "rt/base/log.h"
 #include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
@@ -75,22 +77,6 @@ rt_aov_buffers *output_aovs_for_render(output_aovs *o)
     return NULL;
 }
 
-static double now_seconds(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-/* "dir/name.EXT" -> "dir/name.TAG.NEWEXT" (NEWEXT NULL: the same extension). */
-static void beside(const char *path, const char *tag, const char *new_ext, char *out, size_t size)
-{
-    const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
-    if (!dot || (slash && dot < slash))
-        dot = path + strlen(path);
-    snprintf(out, size, "%.*s.%s%s", (int)(dot - path), path, tag, new_ext ? new_ext : dot);
-}
-
 /* One image file of an AOV (1 channel: grey). */
 static rt_result write_aov_file(const float *data, int channels, int w, int h, const char *path, rt_error *err)
 {
@@ -125,13 +111,13 @@ rt_result output_write(const args *a, const rt_settings *set, rt_framebuffer *fb
                 return rt_fail(err, RT_ERR_NOMEM, "out of memory for the noisy image");
             memcpy(noisy, fb->rgb, n * sizeof(float));
         }
-        double t0 = now_seconds();
+        double t0 = rt_now_seconds();
         rt_denoise_input in = {.width = fb->width, .height = fb->height, .color = fb->rgb,
                                .albedo = aov->buf.albedo, .normal = aov->buf.normal};
         r = rt_denoise_image(&in, err);
         if (r != RT_OK)
             goto done;
-        rt_info("denoise: %.3f s (albedo and normal, prefiltered)", now_seconds() - t0);
+        rt_info("denoise: %.3f s (albedo and normal, prefiltered)", rt_now_seconds() - t0);
     }
     if (fmt == RT_FORMAT_EXR) {
         if (noisy)
@@ -146,13 +132,13 @@ rt_result output_write(const args *a, const rt_settings *set, rt_framebuffer *fb
         const char *ext = fmt == RT_FORMAT_PNG ? ".pfm" : NULL;
         for (int k = 0; k < AOV_COUNT && r == RT_OK; k++)
             if (aov->wanted & (1u << k)) {
-                beside(path, aov_names[k], ext, p, sizeof p);
+                rt_path_tagged(path, aov_names[k], ext, p, sizeof p);
                 r = write_aov_file(*slot((rt_aov_buffers *)&aov->buf, k), channels_of(k), fb->width, fb->height, p,
                                    err);
             }
         if (r == RT_OK && noisy) {
             rt_framebuffer nf = {fb->width, fb->height, noisy};
-            beside(path, "noisy", NULL, p, sizeof p);
+            rt_path_tagged(path, "noisy", NULL, p, sizeof p);
             r = rt_framebuffer_write_with(&nf, p, &opt, err);
         }
         if (r != RT_OK)

@@ -17,14 +17,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "rt/base/clock.h"
 #include "rt/base/log.h"
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* "load 0.31s, kd-tree 0.12s, " for the phases before rendering. */
 static void phase_times(const progress_view *v, char *buf, size_t size, double render_start)
@@ -74,7 +68,7 @@ static void draw_bar(const progress_view *v, const rt_render_progress *p)
     line[n++] = ']';
     line[n] = 0;
     char phases[160];
-    phase_times(v, phases, sizeof phases, now_seconds() - p->elapsed);
+    phase_times(v, phases, sizeof phases, rt_now_seconds() - p->elapsed);
     fprintf(stderr, "\r%srender %s %5.1f%% %s %6.1fs", phases, line, 100.0 * f, count, p->elapsed);
     if (!p->final && f > 0.0) {
         double eta = p->elapsed * (1.0 - f) / f;
@@ -190,7 +184,7 @@ void progress_phase(progress_view *v, const char *name, const char *detail)
     if (v->phases >= PROGRESS_MAX_PHASES)
         return;
     v->phase_name[v->phases] = name;
-    v->phase_start[v->phases] = now_seconds();
+    v->phase_start[v->phases] = rt_now_seconds();
     v->phases++;
     if (v->bar) {
         fprintf(stderr, "\r%s%s%s ...\033[K", name, detail ? " " : "", detail ? detail : "");

@@ -29,18 +29,12 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "rt/base/clock.h"
 #include "rt/base/log.h"
 
 enum { TEV_CREATE_IMAGE = 4, TEV_UPDATE_IMAGE_V3 = 6 };
 #define TEV_RETRY_SECONDS 2.0
 #define TEV_BAND_BYTES ((size_t)4 << 20)
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* ------------------------------------------------------------ packets */
 
@@ -240,7 +234,7 @@ bool tev_stream_connect(tev_stream *t, bool force)
 {
     if (t->fd >= 0)
         return true;
-    double now = now_seconds();
+    double now = rt_now_seconds();
     if (!force && t->last_try > 0.0 && now - t->last_try < TEV_RETRY_SECONDS)
         return false;
     t->last_try = now;

@@ -23,18 +23,12 @@
 #include <string.h>
 #include <time.h>
 
+#include "rt/base/clock.h"
 #include "rt/base/file.h"
 #include "rt/io/gltf.h"
 #include "rt/io/mesh_io.h"
 #include "rt/io/scene_parse.h"
 #include "rt/scene/tangents.h"
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
-}
 
 /* JSON text may start with a UTF-8 byte order mark and white space. */
 static bool starts_like_json(const unsigned char *p, size_t size)
@@ -198,14 +192,14 @@ static rt_result load_marked(rt_scene *s, const void *bytes, size_t size, const 
         r = rt_scene_generate_tangents(s, err);
     if (r != RT_OK)
         rt_scene_rollback(s, &mark);
-    info->load_ms = now_ms() - t0;
+    info->load_ms = 1e3 * rt_now_seconds() - t0;
     return r;
 }
 
 rt_result rt_load_memory(rt_scene *s, const void *bytes, size_t size, const char *name,
                          const rt_load_options *options, rt_load_info *info, rt_error *err)
 {
-    double t0 = now_ms();
+    double t0 = 1e3 * rt_now_seconds();
     rt_load_info local_info;
     if (!info)
         info = &local_info;
@@ -221,7 +215,7 @@ rt_result rt_load_memory(rt_scene *s, const void *bytes, size_t size, const char
 rt_result rt_load(rt_scene *s, const char *path, const rt_load_options *options, rt_load_info *info,
                   rt_error *err)
 {
-    double t0 = now_ms();
+    double t0 = 1e3 * rt_now_seconds();
     rt_load_info local_info;
     if (!info)
         info = &local_info;
@@ -234,7 +228,7 @@ rt_result rt_load(rt_scene *s, const char *path, const rt_load_options *options,
     rt_result r = rt_read_file(path, 0, &bytes, &size, err);
     if (r != RT_OK) {
         info->kind = rt_load_kind_of(NULL, 0, path);
-        info->load_ms = now_ms() - t0;
+        info->load_ms = 1e3 * rt_now_seconds() - t0;
         return r;
     }
     info->kind = rt_load_kind_of(bytes, size, path);

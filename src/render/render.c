@@ -26,6 +26,7 @@
 #include <unistd.h>
 
 #include "rt/base/alloc.h"
+#include "rt/base/clock.h"
 #include "rt/base/log.h"
 #include "rt/render/aov.h"
 #include "rt/render/camera.h"
@@ -37,13 +38,6 @@ int rt_cpu_count(void)
 {
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     return n > 0 ? (n > 1024 ? 1024 : (int)n) : 1;
-}
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 struct rt_render_job {
@@ -214,7 +208,7 @@ static void *worker_main(void *arg)
     for (;;) {
         if (job->cancel && atomic_load(job->cancel))
             break;
-        if (job->deadline > 0.0 && now_seconds() >= job->deadline) {
+        if (job->deadline > 0.0 && rt_now_seconds() >= job->deadline) {
             atomic_store(&job->time_up, 1);
             break;
         }
@@ -280,10 +274,10 @@ static int run_workers(rt_render_job *job, worker *workers, int nthreads, const 
             ts.tv_nsec -= 1000000000L;
         }
         pthread_cond_timedwait(&job->done, &job->lock, &ts);
-        if (job->running > 0 && opt->progress && now_seconds() - t0 >= progress->elapsed + 0.045) {
+        if (job->running > 0 && opt->progress && rt_now_seconds() - t0 >= progress->elapsed + 0.045) {
             pthread_mutex_unlock(&job->lock);
             progress->tiles_done = atomic_load(&job->tiles_done);
-            progress->elapsed = now_seconds() - t0;
+            progress->elapsed = rt_now_seconds() - t0;
             opt->progress(progress, opt->progress_user);
             pthread_mutex_lock(&job->lock);
         }
@@ -411,7 +405,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     progress.fb = fb;
     progress.job = &job;
 
-    double t0 = now_seconds();
+    double t0 = rt_now_seconds();
     int started = 0;
     bool cancelled = false;
     if (!job.passes) {
@@ -456,10 +450,10 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
             if (opt.progress && s0 < job.spp) {
                 progress.tiles_done = job.tiles_total;
                 progress.samples_done = job.samples_done;
-                progress.elapsed = now_seconds() - t0;
+                progress.elapsed = rt_now_seconds() - t0;
                 opt.progress(&progress, opt.progress_user);
             }
-            if (opt.time_limit > 0.0 && s0 < job.spp && now_seconds() - t0 >= opt.time_limit) {
+            if (opt.time_limit > 0.0 && s0 < job.spp && rt_now_seconds() - t0 >= opt.time_limit) {
                 st.time_limited = true;
                 break;
             }
@@ -468,7 +462,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
         st.partial = job.samples_done == 0;
         st.tiles_done = st.partial ? 0 : job.tiles_total;
     }
-    st.seconds = now_seconds() - t0;
+    st.seconds = rt_now_seconds() - t0;
     st.tiles_total = job.tiles_total;
     st.threads = started > 0 ? started : 1;
     st.passes = job.passes;

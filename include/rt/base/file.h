@@ -61,5 +61,10 @@ bool rt_path_dirname(const char *path, char *out, size_t size);
  * empty, else dir, a '/' unless dir ends in one, and rel. false when the
  * result does not fit in size bytes. */
 bool rt_path_join(const char *dir, const char *rel, char *out, size_t size);
+/* path with a tag before its extension, into out: "dir/name.EXT" gives
+ * "dir/name.TAG.EXT", or "dir/name.TAG.NEWEXT" when new_ext (with its dot)
+ * is given; a path without an extension gets ".TAG" (and new_ext). false
+ * when the result does not fit in size bytes. */
+bool rt_path_tagged(const char *path, const char *tag, const char *new_ext, char *out, size_t size);
 
 #endif
