@@ -246,9 +246,12 @@ static int setup(void **state)
     return 0;
 }
 
+static void stop_xvfb(void);
+
 static int teardown(void **state)
 {
     (void)state;
+    stop_xvfb();
     DIR *d = opendir(dir);
     if (d) {
         struct dirent *e;
@@ -1580,7 +1583,20 @@ static void test_display_server_reconnects(void **state)
 /* ------------------------------------------------------------ --window under Xvfb */
 
 /* Starts Xvfb on a display number it picks itself (-displayfd); returns
- * its pid and the number, or -1 when there is no Xvfb. */
+ * its pid and the number, or -1 when there is no Xvfb. The pid is kept in
+ * running_xvfb until stop_xvfb, so teardown stops an Xvfb that a failing
+ * test left running. */
+static pid_t running_xvfb = -1;
+
+static void stop_xvfb(void)
+{
+    if (running_xvfb > 0) {
+        kill(running_xvfb, SIGTERM);
+        waitpid(running_xvfb, NULL, 0);
+    }
+    running_xvfb = -1;
+}
+
 static pid_t start_xvfb(int *display)
 {
     if (access("/usr/bin/Xvfb", X_OK) != 0)
@@ -1617,6 +1633,7 @@ static pid_t start_xvfb(int *display)
         waitpid(pid, NULL, 0);
         fail_msg("Xvfb did not report its display");
     }
+    running_xvfb = pid;
     return pid;
 }
 
@@ -1667,8 +1684,7 @@ static void test_window(void **state)
         setenv("DISPLAY", saved, 1);
     else
         unsetenv("DISPLAY");
-    kill(xvfb, SIGTERM);
-    waitpid(xvfb, NULL, 0);
+    stop_xvfb();
     if (r->status != 0) {
         static char msg[sizeof r->err];
         snprintf(msg, sizeof msg, "%s", r->err);
@@ -1692,6 +1708,127 @@ static void test_window(void **state)
     stbi_image_free(img);
     unlink(png);
     unlink(shot);
+    free(r);
+}
+
+/* Runs rt under the Xvfb display dpy with RT_WINDOW_SCRIPT=script, its
+ * stdout to `out`; LeakSanitizer off as in test_window. */
+static void run_window_script(run_result *r, int dpy, const char *script, const char *out, const char *const *args)
+{
+    char dname[32];
+    snprintf(dname, sizeof dname, ":%d", dpy);
+    setenv("DISPLAY", dname, 1);
+    setenv("RT_WINDOW_SCRIPT", script, 1);
+    setenv("LSAN_OPTIONS", "detect_leaks=0", 1);
+    double t0 = now_s();
+    wait_for(spawn_to(args, out), t0, 120.0, r);
+    unsetenv("RT_WINDOW_SCRIPT");
+    unsetenv("LSAN_OPTIONS");
+    unsetenv("DISPLAY");
+}
+
+static int count_of(const char *hay, const char *needle)
+{
+    int n = 0;
+    for (const char *p = strstr(hay, needle); p; p = strstr(p + 1, needle))
+        n++;
+    return n;
+}
+
+/* The window's camera under Xvfb, driven through SDL's own event queue
+ * (RT_WINDOW_SCRIPT): a drag after the render finished moves the camera
+ * and renders again from sample 0 (a new image, written again); P prints
+ * a `camera` line which, pasted into the scene and rendered without a
+ * window, gives the window's final image byte for byte; ] three times
+ * and F12 write NAME.1.EXT, the image an --exposure 1 render writes;
+ * closing the window mid-render writes the image at the samples reached,
+ * labelled "window closed", exit 0. */
+static void test_window_camera(void **state)
+{
+    (void)state;
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *png = path_in("cam.png"), *out = path_in("cam.out");
+    const char *display = getenv("DISPLAY");
+    char saved[256] = "";
+    if (display)
+        snprintf(saved, sizeof saved, "%s", display);
+    unsetenv("DISPLAY");
+    run_args(r, (const char *const[]){"-q", "-r", "8x8", "-s", "1", "--window", "-o", png, NULL});
+    int dpy = -1;
+    pid_t xvfb = strstr(r->err, "built without SDL2") ? -1 : start_xvfb(&dpy);
+    if (xvfb < 0) {
+        if (saved[0])
+            setenv("DISPLAY", saved, 1);
+        free(r);
+        skip(); /* no SDL2 or no Xvfb */
+    }
+    const char *scene = slow_scene();
+    /* 1. a drag, then P, then Esc */
+    run_window_script(r, dpy, "wait done; drag left 20 12 30 14; wait done; key P; key Escape", out,
+                      (const char *const[]){"-v", "-r", "40x24", "-s", "8", "--integrator", "path", "--passes", "2",
+                                            "--window", "-o", png, scene, NULL});
+    static char printed[2048], moved[4096];
+    read_all(out, printed, sizeof printed);
+    int status1 = r->status;
+    bool restarted = strstr(r->err, "the camera moved; rendering again from sample 0") != NULL;
+    int wrote1 = count_of(r->err, "rt: wrote ");
+
+    /* 2. exposure keys and a snapshot */
+    const char *png2 = path_in("cam2.png"), *shot = path_in("cam2.1.png");
+    unlink(shot);
+    run_window_script(r, dpy, "wait done; key ]; key ]; key ]; key F12; key Escape", NULL,
+                      (const char *const[]){"-q", "-r", "40x24", "-s", "8", "--integrator", "path", "--window", "-o",
+                                            png2, scene, NULL});
+    int status2 = r->status;
+    bool snap2 = strstr(r->err, "cam2.1.png: 40x24, 8 of 8 spp (window snapshot)") != NULL;
+
+    /* 3. closed mid-render */
+    const char *png3 = path_in("cam3.png");
+    run_window_script(r, dpy, "wait pass; drag right 10 10 15 12; wait pass; key Escape", NULL,
+                      (const char *const[]){"-r", "40x24", "-s", "100000", "--integrator", "path", "--passes", "2",
+                                            "--window", "-o", png3, scene, NULL});
+    stop_xvfb();
+    if (saved[0])
+        setenv("DISPLAY", saved, 1);
+    assert_int_equal(status1, 0);
+    assert_true(restarted);
+    assert_int_equal(wrote1, 2); /* the first camera's image, then the moved one's */
+    assert_int_equal(strncmp(printed, "camera position ", 16), 0);
+    assert_null(strstr(printed, "camera position 0 0 4 look_at 0 0 0 "));
+    assert_int_equal(status2, 0);
+    assert_true(snap2);
+    if (r->status != 0)
+        fail_msg("closing the window mid-render: exit %d: %s", r->status, r->err);
+    assert_contains(r->err, "of 100000 spp, window closed");
+    assert_contains(r->err, "rt: wrote ");
+
+    /* the drag changed the image: the first camera's render differs */
+    const char *orig = path_in("cam-orig.png"), *again = path_in("cam-again.png");
+    render_ok(orig, (const char *const[]){"-r", "40x24", "-s", "8", "--integrator", "path", scene, NULL});
+    assert_false(same_file(orig, png));
+    /* the printed line, pasted into the scene, renders the window's image */
+    *strchr(printed, '\n') = 0;
+    snprintf(moved, sizeof moved,
+             "resolution 64 64\nbackground 0.5 0.6 0.7\n%s\n"
+             "material glow color 0.5 0.5 0.5 emission 1 0.5 0.25\nsphere 0 0 0 1 glow\n",
+             printed);
+    write_text("moved.txt", moved);
+    render_ok(again, (const char *const[]){"-r", "40x24", "-s", "8", "--integrator", "path", path_in("moved.txt"),
+                                           NULL});
+    assert_same_file(again, png);
+    /* ] ] ] = +1 stop: the snapshot is what --exposure 1 writes */
+    render_ok(again, (const char *const[]){"-r", "40x24", "-s", "8", "--integrator", "path", "--exposure", "1", scene,
+                                           NULL});
+    assert_same_file(again, shot);
+    assert_no_temp_files();
+    unlink(png);
+    unlink(png2);
+    unlink(png3);
+    unlink(shot);
+    unlink(orig);
+    unlink(again);
+    unlink(out);
     free(r);
 }
 
@@ -1755,6 +1892,7 @@ int main(void)
         cmocka_unit_test(test_display_server_absent),
         cmocka_unit_test(test_display_server_reconnects),
         cmocka_unit_test(test_window),
+        cmocka_unit_test(test_window_camera),
         cmocka_unit_test(test_compare_command),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

@@ -27,6 +27,7 @@
 #include "rt/base/file.h"
 #include "rt/base/log.h"
 #include "rt/render/camera.h"
+#include "rt/image/tonemap.h"
 #include "rt/accel/kdtree.h"
 #include "rt/io/framebuffer.h"
 #include "rt/io/load.h"
@@ -42,6 +43,7 @@
 #include "output.h"
 #include "progress.h"
 #include "tev.h"
+#include "viewer.h"
 #include "window.h"
 
 /* The kd-tree's primitive ids are the 30 payload bits of its references
@@ -52,15 +54,19 @@
 #define MAX_DIFFUSE_TREE ((double)(1 << 24))
 
 /* What the signal handler shares with the render: the first signal's
- * number (the render's cancel flag), and the temporary file of an image
- * write under way. */
+ * number, the render's cancel flag (raised by the first signal, and by
+ * the window when its camera moves or it closes), and the temporary file
+ * of an image write under way. */
 static atomic_int interrupted;
+static atomic_int render_stop;
 static rt_write_temp write_temp;
 
 static void on_signal(int sig)
 {
     int expected = 0;
-    if (!atomic_compare_exchange_strong(&interrupted, &expected, sig)) {
+    if (atomic_compare_exchange_strong(&interrupted, &expected, sig)) {
+        atomic_store(&render_stop, 1);
+    } else {
         /* the second signal: leave at once, leaving no temporary file */
         if (write_temp.active)
             unlink(write_temp.path);
@@ -396,6 +402,57 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     return RT_OK;
 }
 
+/* Writes a render's image (rt_render returned r with stats rs) where its
+ * state says: the output, or NAME.partial.EXT for an incomplete tiled
+ * image, and says so; returns the exit status (128 + the signal that
+ * stopped it, 2 on an error, else 0: also when the window was closed). */
+static int write_result(const args *a, const rt_settings *set, rt_result r, const rt_render_stats *rsp,
+                        rt_framebuffer *fb, output_aovs *aov, const char *output, progress_view *view, double t_start,
+                        rt_error *err)
+{
+    const rt_render_stats rs = *rsp;
+    int status = 0;
+    if (r != RT_OK && r != RT_ERR_INTERRUPTED) {
+        progress_clear(view);
+        report(err, &a->budget);
+        status = 2;
+    } else {
+        int sig = atomic_load(&interrupted);
+        if (r == RT_ERR_INTERRUPTED && sig)
+            status = 128 + sig;
+        const char *reason = r != RT_ERR_INTERRUPTED ? (rs.time_limited ? "time limit" : NULL)
+                             : sig == SIGTERM        ? "terminated"
+                             : sig                   ? "interrupted"
+                                                     : "window closed";
+        char why[32] = "";
+        if (reason)
+            snprintf(why, sizeof why, ", %s", reason);
+        bool stopped = r == RT_ERR_INTERRUPTED || rs.time_limited;
+        char partial[1100], what[160];
+        const char *target = output;
+        if (rs.partial) {
+            rt_path_tagged(output, "partial", NULL, partial, sizeof partial); /* where an incomplete image goes */
+            target = partial;
+            snprintf(what, sizeof what, "%d of %d tiles at %d spp%s", rs.tiles_done, rs.tiles_total, set->samples,
+                     why);
+        } else {
+            snprintf(what, sizeof what, "%d of %d spp%s", rs.samples_done, set->samples, why);
+        }
+        if (rs.partial && rs.tiles_done == 0) {
+            fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s left as it was\n",
+                    rs.passes ? "pass" : "tile", reason ? reason : "?", output);
+        } else if (output_write(a, set, fb, aov, target, &write_temp, err) != RT_OK) {
+            report(err, &a->budget);
+            status = 2;
+        } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
+            fprintf(stderr, "rt: wrote %s: %dx%d, %s; %.2f s (render %.2f s)%s%s%s\n", target, fb->width, fb->height,
+                    what, rt_now_seconds() - t_start, rs.seconds, rs.partial ? "; " : "", rs.partial ? output : "",
+                    rs.partial ? " left as it was" : "");
+        }
+    }
+    return status;
+}
+
 /* Builds the kd-tree, renders (Ctrl-C and SIGTERM stop the workers, as
  * does --time-limit) and writes the image; returns the exit status.
  * t_start: when the run began, for the wall time in the "wrote" line. */
@@ -474,51 +531,53 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     ro.tile_size = a->tile;
     ro.pass_samples = a->pass_samples;
     ro.time_limit = a->time_limit;
-    ro.cancel = &interrupted;
+    ro.cancel = &render_stop;
     ro.progress = view->bar || view->preview_path || view->tev || view->window ? progress_report : NULL;
     ro.progress_user = view;
     ro.aov = output_aovs_for_render(&aov);
     rt_render_stats rs;
     memset(&rs, 0, sizeof rs);
-    rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);
-    int status = 0;
-    if (r != RT_OK && r != RT_ERR_INTERRUPTED) {
-        progress_clear(view);
-        report(&err, &a->budget);
-        status = 2;
-    } else {
-        int sig = atomic_load(&interrupted);
-        if (r == RT_ERR_INTERRUPTED)
-            status = 128 + (sig ? sig : SIGINT);
-        const char *reason = r == RT_ERR_INTERRUPTED ? (sig == SIGTERM ? "terminated" : "interrupted")
-                             : rs.time_limited     ? "time limit"
-                                                   : NULL;
-        char why[32] = "";
-        if (reason)
-            snprintf(why, sizeof why, ", %s", reason);
-        bool stopped = r == RT_ERR_INTERRUPTED || rs.time_limited;
-        char partial[1100], what[160];
-        const char *target = output;
-        if (rs.partial) {
-            rt_path_tagged(output, "partial", NULL, partial, sizeof partial); /* where an incomplete image goes */
-            target = partial;
-            snprintf(what, sizeof what, "%d of %d tiles at %d spp%s", rs.tiles_done, rs.tiles_total, set->samples,
-                     why);
-        } else {
-            snprintf(what, sizeof what, "%d of %d spp%s", rs.samples_done, set->samples, why);
-        }
-        if (rs.partial && rs.tiles_done == 0) {
-            fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s left as it was\n",
-                    rs.passes ? "pass" : "tile", reason ? reason : "?", output);
-        } else if (output_write(a, set, &fb, &aov, target, &write_temp, &err) != RT_OK) {
-            report(&err, &a->budget);
-            status = 2;
-        } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
-            fprintf(stderr, "rt: wrote %s: %dx%d, %s; %.2f s (render %.2f s)%s%s%s\n", target, fb.width, fb.height,
-                    what, rt_now_seconds() - t_start, rs.seconds, rs.partial ? "; " : "", rs.partial ? output : "",
-                    rs.partial ? " left as it was" : "");
-        }
+    /* --window: the scene at the window's camera; a camera move cancels the
+     * render, which starts again from sample 0 (docs/watching.md) */
+    rt_scene shown = *scene;
+    viewer session = {.window = &window, .cancel = &render_stop, .output = output,
+                      .image = {.exposure = set->exposure * rt_exposure_scale(a->exposure_ev),
+                                .tonemap = a->tonemap, .half = a->half},
+                      .temp = &write_temp, .samples_total = set->samples};
+    if (a->window) {
+        rt_box b = rt_scene_bounds(scene);
+        float diag = rt_box_diagonal(b), d = rt_length(rt_sub(scene->camera.look_at, scene->camera.position));
+        window.exposure = session.image.exposure;
+        window.tonemap = a->tonemap;
+        window_set_camera(&window, &scene->camera, isfinite(diag) && diag > 0.0f ? 0.02f * diag : 0.05f * d);
+        view->viewer = &session;
     }
+    bool written = false;
+    rt_result r;
+    int status = 0;
+    for (;;) {
+        r = rt_render(&shown, &tree, &ro, &fb, &rs, &err);
+        if (!a->window || atomic_load(&interrupted) || (r != RT_OK && r != RT_ERR_INTERRUPTED))
+            break;
+        if (r == RT_OK) { /* finished (or the time limit): written now, then the window waits */
+            status = write_result(a, set, r, &rs, &fb, &aov, output, view, t_start, &err);
+            written = true;
+            if (status == 2 || !viewer_wait(&session, &fb, rs.samples_done, &interrupted))
+                break;
+        } else if (!session.moved) {
+            break; /* the window was closed */
+        }
+        shown.camera = window.camera;
+        session.moved = false;
+        written = false;
+        atomic_store(&render_stop, 0);
+        if (atomic_load(&interrupted)) /* a signal since the check above */
+            atomic_store(&render_stop, 1);
+        progress_restart(view, rs.tiles_total);
+        rt_info("window: the camera moved; rendering again from sample 0");
+    }
+    if (!written)
+        status = write_result(a, set, r, &rs, &fb, &aov, output, view, t_start, &err);
     rt_info("render: %.3f s on %d threads, %s, %llu camera rays, %llu rays, %.2f Mrays/s", rs.seconds, rs.threads,
             rs.passes ? "passes" : "tiles", (unsigned long long)rs.camera_rays, (unsigned long long)rs.rays,
             rs.seconds > 0 ? 1e-6 * (double)rs.rays / rs.seconds : 0.0);
@@ -527,12 +586,10 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     if (view->tev)
         tev_stream_close(&tev);
     view->tev = NULL;
-    if (view->window) {
-        if (status != 2)
-            window_wait(&window, &interrupted); /* the final image stays up until closed or Ctrl-C */
+    if (view->window)
         window_close(&window);
-    }
     view->window = NULL;
+    view->viewer = NULL;
     output_aovs_free(&aov);
     rt_framebuffer_free(&fb);
     rt_kdtree_free(&tree);

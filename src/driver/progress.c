@@ -20,6 +20,8 @@
 #include "rt/base/clock.h"
 #include "rt/base/log.h"
 
+#include "viewer.h"
+
 /* "load 0.31s, kd-tree 0.12s, " for the phases before rendering. */
 static void phase_times(const progress_view *v, char *buf, size_t size, double render_start)
 {
@@ -156,27 +158,48 @@ static void stream_to_tev(progress_view *v, const rt_render_progress *p)
     t->fresh = false;
 }
 
-/* The same for the window: finished tiles, the image after each pass. */
+/* The same for the window: finished tiles, the image after each pass;
+ * then the window's requests (viewer.c). After a cancel for a camera move
+ * the final report is not shown (a tiled image then has holes); the next
+ * render's first pass or tiles replace it. */
 static void show_in_window(progress_view *v, const rt_render_progress *p)
 {
     window_view *w = v->window;
-    if (!w->open)
+    if (!w->open) {
+        if (v->viewer)
+            viewer_poll(v->viewer, p);
         return;
-    if (p->final || (p->passes && p->samples_done > 0 && p->samples_done != v->win_samples)) {
-        window_show_rect(w, p->fb, v->exposure, 0, 0, p->fb->width, p->fb->height);
+    }
+    bool moved = v->viewer && v->viewer->moved;
+    if ((p->final && !moved) || (p->passes && p->samples_done > 0 && p->samples_done != v->win_samples)) {
+        window_show_rect(w, p->fb, 0, 0, p->fb->width, p->fb->height);
         v->win_samples = p->samples_done;
-    } else if (!p->passes) {
+        w->shown++;
+    } else if (!p->passes && !moved) {
         if (!v->win_shown && !(v->win_shown = calloc((size_t)p->tiles_total, 1)))
             return;
         for (int i = 0; i < p->tiles_total; i++) {
             rt_tile tile = rt_render_progress_tile(p, i);
             if (tile.finished && !v->win_shown[i]) {
-                window_show_rect(w, p->fb, v->exposure, tile.x0, tile.y0, tile.x1, tile.y1);
+                window_show_rect(w, p->fb, tile.x0, tile.y0, tile.x1, tile.y1);
                 v->win_shown[i] = 1;
+                w->shown++;
             }
         }
     }
     window_present(w);
+    if (v->viewer)
+        viewer_poll(v->viewer, p);
+}
+
+void progress_restart(progress_view *v, int tiles_total)
+{
+    v->tev_samples = 0;
+    v->win_samples = 0;
+    if (v->tev_sent)
+        memset(v->tev_sent, 0, (size_t)tiles_total);
+    if (v->win_shown)
+        memset(v->win_shown, 0, (size_t)tiles_total);
 }
 
 void progress_phase(progress_view *v, const char *name, const char *detail)
@@ -203,9 +226,12 @@ void progress_clear(progress_view *v)
 void progress_report(const rt_render_progress *p, void *view)
 {
     progress_view *v = view;
-    if (v->bar)
+    /* a render cancelled because the window's camera moved ends quietly:
+     * the next one takes over the line, the window and tev */
+    bool restarting = p->final && v->viewer && v->viewer->moved;
+    if (v->bar && !restarting)
         draw_bar(v, p);
-    if (v->tev)
+    if (v->tev && !restarting)
         stream_to_tev(v, p);
     if (v->window)
         show_in_window(v, p);

@@ -18,7 +18,8 @@
  * With view.tev set (tev.h), progress_report also streams the image to tev:
  * finished tiles as they finish, the whole image after each pass, and the
  * final image (connecting again if tev went away); with view.window set
- * (window.h), it shows the same in the window.
+ * (window.h), it shows the same in the window, and with view.viewer set
+ * (viewer.h) it acts on what the window's keys and mouse asked for.
  *
  * The render's line names the phases before it with their times, then the
  * bar: tiles, or samples per pixel when rendering in passes, the elapsed
@@ -55,6 +56,7 @@ typedef struct progress_view {
     window_view *window;      /* --window: show the image there; NULL = none */
     unsigned char *win_shown; /* tiles: per tile, shown in the window */
     int win_samples;          /* passes: the samples per pixel shown */
+    struct viewer *viewer;    /* --window: the interactive session (viewer.h); NULL = none */
 } progress_view;
 
 void progress_view_init(progress_view *v, bool bar);
@@ -63,6 +65,10 @@ void progress_view_free(progress_view *v);
 /* Starts a phase (ending the one before); detail may be NULL. Shown at
  * once on the progress line, and with its time on the render's line. */
 void progress_phase(progress_view *v, const char *name, const char *detail);
+
+/* Before rendering again (the window's camera moved): the image shown
+ * and streamed starts over; tiles_total: the render's tile count. */
+void progress_restart(progress_view *v, int tiles_total);
 
 /* Clears the progress line (before an error message). */
 void progress_clear(progress_view *v);

@@ -1,43 +1,115 @@
 /* window.c - the --window view (window.h) over SDL2 (libsdl2-dev): a
  * streaming RGB24 texture updated from the image as tiles or passes
- * finish, with the tone curve of the PNG writer (exposure, then the sRGB
- * transfer function, rounded to 8 bits; rt_linear_to_srgb in
- * src/scene/texture.c). The software renderer is asked for, so what the
- * window shows is exactly those bytes (and works under Xvfb). Without
- * SDL2 at build time every call is a stub and window_open says why.
+ * finish, through the PNG writer's exposure, tone curve and sRGB encoding
+ * (rt_tonemap_to_srgb8, rt/image/tonemap.h). The software renderer is
+ * asked for, so what the window shows is exactly those bytes (and works
+ * under Xvfb). Mouse and keys move the window's camera with the pure
+ * functions of rt/render/camera_control.h (a turntable orbit about
+ * look_at, as yocto-gl's and pbrt-v4's viewers do) and raise request bits
+ * for the driver. RT_WINDOW_SCRIPT pushes synthetic events into SDL's own
+ * queue (SDL_PushEvent), so a test drives the very code a mouse does.
+ * Without SDL2 at build time every call is a stub and window_open says
+ * why.
  */
 #include "window.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "rt/scene/texture.h"
+#include "rt/render/camera.h"
+#include "rt/render/camera_control.h"
 
 #ifdef RT_HAVE_SDL2
 #include <SDL.h>
 #endif
 
-void window_show_rect(window_view *w, const rt_framebuffer *fb, float exposure, int x0, int y0, int x1, int y1)
+#define WINDOW_PI 3.14159265358979323846f
+
+void window_show_rect(window_view *w, const rt_framebuffer *fb, int x0, int y0, int x1, int y1)
 {
-    if (!w->rgb)
+    if (!w->rgb || x1 <= x0)
         return;
-    float e = exposure > 0.0f ? exposure : 1.0f;
-    for (int y = y0; y < y1; y++)
-        for (int x = x0; x < x1; x++) {
-            size_t k = 3 * ((size_t)y * (size_t)fb->width + (size_t)x);
-            for (int c = 0; c < 3; c++) {
-                float v = rt_linear_to_srgb(fb->rgb[k + (size_t)c] * e);
-                w->rgb[k + (size_t)c] = (unsigned char)(v * 255.0f + 0.5f);
-            }
-        }
+    float e = (w->exposure > 0.0f ? w->exposure : 1.0f) * rt_exposure_scale(w->view_ev);
+    for (int y = y0; y < y1; y++) {
+        size_t k = 3 * ((size_t)y * (size_t)fb->width + (size_t)x0);
+        rt_tonemap_to_srgb8(w->tonemap, e, fb->rgb + k, (size_t)(x1 - x0), w->rgb + k);
+    }
+}
+
+void window_set_camera(window_view *w, const rt_camera *c, float step)
+{
+    w->interactive = true;
+    w->camera = *c;
+    w->home = *c;
+    w->step = step > 0.0f && isfinite(step) ? step : 1.0f;
+}
+
+unsigned window_take_requests(window_view *w)
+{
+    unsigned r = w->requests;
+    w->requests = 0;
+    return r;
 }
 
 #ifdef RT_HAVE_SDL2
 
+/* Parses RT_WINDOW_SCRIPT into w->script; false (and why) when malformed. */
+static bool parse_script(window_view *w, const char *text, char *why, size_t why_size)
+{
+    char buf[4096];
+    snprintf(buf, sizeof buf, "%s", text);
+    char *save = NULL;
+    for (char *step = strtok_r(buf, ";", &save); step; step = strtok_r(NULL, ";", &save)) {
+        while (*step == ' ')
+            step++;
+        if (!*step)
+            continue;
+        if (w->script_len == WINDOW_SCRIPT_MAX) {
+            snprintf(why, why_size, "RT_WINDOW_SCRIPT: more than %d steps", WINDOW_SCRIPT_MAX);
+            return false;
+        }
+        window_step *s = &w->script[w->script_len];
+        memset(s, 0, sizeof *s);
+        char a[32] = "", b[32] = "";
+        int n = 0;
+        bool ok = false;
+        if (sscanf(step, "wait %31s %n", a, &n) == 1 && !step[n]) {
+            s->kind = strcmp(a, "done") == 0 ? 'd' : strcmp(a, "pass") == 0 ? 'p' : 0;
+            ok = s->kind != 0;
+        } else if (sscanf(step, "drag %31s %d %d %d %d %n", a, &s->v[0], &s->v[1], &s->v[2], &s->v[3], &n) == 5 &&
+                   !step[n]) {
+            s->kind = 'g';
+            s->button = strcmp(a, "left") == 0     ? SDL_BUTTON_LEFT
+                        : strcmp(a, "right") == 0  ? SDL_BUTTON_RIGHT
+                        : strcmp(a, "middle") == 0 ? SDL_BUTTON_MIDDLE
+                                                   : 0;
+            ok = s->button != 0;
+        } else if (sscanf(step, "wheel %d %n", &s->v[0], &n) == 1 && !step[n]) {
+            s->kind = 'w';
+            ok = true;
+        } else if (sscanf(step, "key %31s %n", b, &n) == 1 && !step[n]) {
+            s->kind = 'k';
+            s->key = (int)SDL_GetKeyFromName(b);
+            ok = s->key != SDLK_UNKNOWN;
+        }
+        if (!ok) {
+            snprintf(why, why_size, "RT_WINDOW_SCRIPT: cannot read step %d, '%s'", w->script_len + 1, step);
+            return false;
+        }
+        w->script_len++;
+    }
+    return true;
+}
+
 bool window_open(window_view *w, int width, int height, const char *title, char *why, size_t why_size)
 {
     memset(w, 0, sizeof *w);
+    w->exposure = 1.0f;
+    const char *script = getenv("RT_WINDOW_SCRIPT");
+    if (script && *script && !parse_script(w, script, why, why_size))
+        return false;
     const char *x11 = getenv("DISPLAY"), *wayland = getenv("WAYLAND_DISPLAY"), *chosen = getenv("SDL_VIDEODRIVER");
     if (!(x11 && *x11) && !(wayland && *wayland) && !(chosen && *chosen)) {
         snprintf(why, why_size, "no display (DISPLAY and WAYLAND_DISPLAY are not set)");
@@ -87,7 +159,7 @@ bool window_open(window_view *w, int width, int height, const char *title, char 
         SDL_Quit();
         return false;
     }
-    SDL_RenderSetLogicalSize(ren, width, height);
+    SDL_RenderSetLogicalSize(ren, width, height); /* mouse coordinates in image pixels too */
     w->window = win;
     w->renderer = ren;
     w->texture = tex;
@@ -99,15 +171,154 @@ bool window_open(window_view *w, int width, int height, const char *title, char 
     return true;
 }
 
+/* ------------------------------------------------------------ input */
+
+static void camera_moved(window_view *w, rt_camera c)
+{
+    rt_camera_frame cf;
+    if (!rt_camera_frame_init(&cf, &c, w->width, w->height) || memcmp(&c, &w->camera, sizeof c) == 0)
+        return; /* a move that would break the camera, or none */
+    w->camera = c;
+    w->requests |= WINDOW_CAMERA;
+    w->render_done = false;
+}
+
+/* A mouse move of (dx, dy) image pixels with a button held: orbit (a drag
+ * across the image's width turns half a turn; the scene follows the
+ * mouse) or pan (the point at look_at's distance stays under the mouse). */
+static void drag_by(window_view *w, int dx, int dy)
+{
+    rt_camera c = w->camera;
+    if (w->drag == 'o') {
+        float rate = WINDOW_PI / (float)(w->width > w->height ? w->width : w->height);
+        c = rt_camera_orbit(c, c.look_at, -(float)dx * rate, (float)dy * rate);
+    } else {
+        float s = rt_camera_pan_scale(&c, w->height);
+        c = rt_camera_pan(c, -(float)dx * s, (float)dy * s);
+    }
+    camera_moved(w, c);
+}
+
+static void key_down(window_view *w, const SDL_Keysym *k)
+{
+    bool ctrl = (k->mod & KMOD_CTRL) != 0;
+    float s = w->step;
+    switch (k->sym) {
+    case SDLK_ESCAPE: w->open = false; return;
+    case SDLK_F12: w->requests |= WINDOW_SAVE; return;
+    case SDLK_p: w->requests |= WINDOW_PRINT; return;
+    case SDLK_LEFTBRACKET: w->view_ev -= 1.0f / 3.0f; w->requests |= WINDOW_EXPOSURE; return;
+    case SDLK_RIGHTBRACKET: w->view_ev += 1.0f / 3.0f; w->requests |= WINDOW_EXPOSURE; return;
+    case SDLK_0: w->view_ev = 0.0f; w->requests |= WINDOW_EXPOSURE; return;
+    default: break;
+    }
+    if (ctrl && k->sym == SDLK_s) {
+        w->requests |= WINDOW_SAVE;
+        return;
+    }
+    if (!w->interactive || ctrl)
+        return;
+    switch (k->sym) {
+    case SDLK_w: camera_moved(w, rt_camera_walk(w->camera, s, 0, 0)); break;
+    case SDLK_s: camera_moved(w, rt_camera_walk(w->camera, -s, 0, 0)); break;
+    case SDLK_a: camera_moved(w, rt_camera_walk(w->camera, 0, -s, 0)); break;
+    case SDLK_d: camera_moved(w, rt_camera_walk(w->camera, 0, s, 0)); break;
+    case SDLK_e: camera_moved(w, rt_camera_walk(w->camera, 0, 0, s)); break;
+    case SDLK_q: camera_moved(w, rt_camera_walk(w->camera, 0, 0, -s)); break;
+    case SDLK_r: camera_moved(w, w->home); break;
+    default: break;
+    }
+}
+
+static void handle_event(window_view *w, const SDL_Event *ev)
+{
+    switch (ev->type) {
+    case SDL_QUIT: w->open = false; break;
+    case SDL_WINDOWEVENT:
+        if (ev->window.event == SDL_WINDOWEVENT_CLOSE)
+            w->open = false;
+        break;
+    case SDL_KEYDOWN: key_down(w, &ev->key.keysym); break;
+    case SDL_MOUSEBUTTONDOWN:
+        if (w->interactive && !w->drag)
+            w->drag = ev->button.button == SDL_BUTTON_LEFT && !(SDL_GetModState() & KMOD_SHIFT) ? 'o' : 'p';
+        break;
+    case SDL_MOUSEBUTTONUP: w->drag = 0; break;
+    case SDL_MOUSEMOTION:
+        if (w->drag && (ev->motion.xrel || ev->motion.yrel))
+            drag_by(w, ev->motion.xrel, ev->motion.yrel);
+        break;
+    case SDL_MOUSEWHEEL:
+        if (w->interactive) {
+            int n = ev->wheel.direction == SDL_MOUSEWHEEL_FLIPPED ? -ev->wheel.y : ev->wheel.y;
+            if (n)
+                camera_moved(w, rt_camera_dolly(w->camera, powf(0.85f, (float)n)));
+        }
+        break;
+    default: break;
+    }
+}
+
+/* RT_WINDOW_SCRIPT: pushes the next steps whose wait is over. */
+static void push(SDL_Event *e)
+{
+    SDL_PushEvent(e);
+}
+
+static void run_script(window_view *w)
+{
+    while (w->script_at < w->script_len) {
+        const window_step *s = &w->script[w->script_at];
+        if (!w->script_armed) { /* the step's start */
+            w->script_armed = true;
+            w->script_mark = w->shown;
+        }
+        if ((s->kind == 'd' && !w->render_done) || (s->kind == 'p' && w->shown == w->script_mark))
+            return;
+        SDL_Event e;
+        Uint32 id = SDL_GetWindowID((SDL_Window *)w->window);
+        if (s->kind == 'g') {
+            memset(&e, 0, sizeof e);
+            e.type = SDL_MOUSEBUTTONDOWN;
+            e.button = (SDL_MouseButtonEvent){.type = SDL_MOUSEBUTTONDOWN, .windowID = id, .button = (Uint8)s->button,
+                                              .state = SDL_PRESSED, .clicks = 1, .x = s->v[0], .y = s->v[1]};
+            push(&e);
+            memset(&e, 0, sizeof e);
+            e.motion = (SDL_MouseMotionEvent){.type = SDL_MOUSEMOTION, .windowID = id,
+                                              .state = SDL_BUTTON((Uint32)s->button), .x = s->v[2], .y = s->v[3],
+                                              .xrel = s->v[2] - s->v[0], .yrel = s->v[3] - s->v[1]};
+            push(&e);
+            memset(&e, 0, sizeof e);
+            e.button = (SDL_MouseButtonEvent){.type = SDL_MOUSEBUTTONUP, .windowID = id, .button = (Uint8)s->button,
+                                              .state = SDL_RELEASED, .clicks = 1, .x = s->v[2], .y = s->v[3]};
+            push(&e);
+        } else if (s->kind == 'w') {
+            memset(&e, 0, sizeof e);
+            e.wheel = (SDL_MouseWheelEvent){.type = SDL_MOUSEWHEEL, .windowID = id, .y = s->v[0],
+                                            .direction = SDL_MOUSEWHEEL_NORMAL};
+            push(&e);
+        } else if (s->kind == 'k') {
+            memset(&e, 0, sizeof e);
+            e.key = (SDL_KeyboardEvent){.type = SDL_KEYDOWN, .windowID = id, .state = SDL_PRESSED,
+                                        .keysym = {.scancode = SDL_GetScancodeFromKey(s->key), .sym = s->key}};
+            push(&e);
+            e.key.type = SDL_KEYUP;
+            e.key.state = SDL_RELEASED;
+            push(&e);
+        }
+        w->script_at++;
+        w->script_armed = false;
+        if (s->kind == 'g' || s->kind == 'w' || s->kind == 'k')
+            return; /* one input step per round of events: the driver sees each */
+    }
+}
+
 static void handle_events(window_view *w)
 {
+    run_script(w);
     SDL_Event ev;
-    while (SDL_PollEvent(&ev)) {
-        if (ev.type == SDL_QUIT ||
-            (ev.type == SDL_WINDOWEVENT && ev.window.event == SDL_WINDOWEVENT_CLOSE) ||
-            (ev.type == SDL_KEYDOWN && (ev.key.keysym.sym == SDLK_ESCAPE || ev.key.keysym.sym == SDLK_q)))
-            w->open = false;
-    }
+    while (SDL_PollEvent(&ev))
+        handle_event(w, &ev);
 }
 
 void window_present(window_view *w)
@@ -150,11 +361,13 @@ void window_wait(window_view *w, const atomic_int *stop)
     const char *shot = getenv("RT_WINDOW_SCREENSHOT");
     if (shot && *shot) {
         screenshot(w, shot);
+        w->open = false;
         return;
     }
-    while (w->renderer && w->open && !(stop && atomic_load(stop))) {
+    while (w->renderer && w->open && !w->requests && !(stop && atomic_load(stop))) {
         window_present(w);
-        SDL_Delay(30);
+        if (!w->requests)
+            SDL_Delay(30);
     }
 }
 
