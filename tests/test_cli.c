@@ -1300,12 +1300,24 @@ static void test_killed_write_leaves_no_temp(void **state)
 
 /* What a tev stand-in has received: the image CreateImage made, with every
  * UpdateImageV3 rectangle applied. */
+#define TEV_VIEW_CHANNELS 16
+
 typedef struct tev_view {
     int width, height;
-    float *rgb;
+    float *rgb;                            /* the channels R, G, B, interleaved */
+    int nch;                               /* every channel: R, G, B, then the layers' */
+    char ch[TEV_VIEW_CHANNELS][64];        /* their names */
+    float *plane[TEV_VIEW_CHANNELS];       /* their pixels */
     int creates, updates;
     char name[256];
 } tev_view;
+
+static void tev_view_free(tev_view *v)
+{
+    free(v->rgb);
+    for (int c = 0; c < TEV_VIEW_CHANNELS; c++)
+        free(v->plane[c]);
+}
 
 /* A loopback TCP socket on a free port, bound (listening when `listening`). */
 static int tev_socket(int *port, bool listening)
@@ -1410,47 +1422,64 @@ static bool tev_read_packet(int fd, tev_view *v)
         snprintf(v->name, sizeof v->name, "%s", field_string(&r));
         v->width = (int)(int32_t)field(&r, 4);
         v->height = (int)(int32_t)field(&r, 4);
-        assert_int_equal(field(&r, 4), 3);
-        assert_string_equal(field_string(&r), "R");
-        assert_string_equal(field_string(&r), "G");
-        assert_string_equal(field_string(&r), "B");
+        v->nch = (int)field(&r, 4);
+        assert_true(v->nch >= 3 && v->nch <= TEV_VIEW_CHANNELS);
+        for (int c = 0; c < v->nch; c++)
+            snprintf(v->ch[c], sizeof v->ch[c], "%s", field_string(&r));
+        assert_string_equal(v->ch[0], "R");
+        assert_string_equal(v->ch[1], "G");
+        assert_string_equal(v->ch[2], "B");
         assert_true(v->width > 0 && v->height > 0);
+        assert_int_equal(r.at, size); /* nothing after the names */
         free(v->rgb);
         v->rgb = calloc((size_t)v->width * (size_t)v->height * 3, sizeof(float));
         assert_non_null(v->rgb);
+        for (int c = 0; c < TEV_VIEW_CHANNELS; c++) {
+            free(v->plane[c]);
+            v->plane[c] = c < v->nch ? calloc((size_t)v->width * (size_t)v->height, sizeof(float)) : NULL;
+        }
         v->creates++;
     } else if (type == 6) { /* UpdateImageV3 */
         assert_true(v->creates > 0);
         field(&r, 1);
         assert_string_equal(field_string(&r), v->name);
         int n = (int)field(&r, 4);
-        assert_int_equal(n, 3);
-        const char *names[3];
-        for (int c = 0; c < 3; c++)
-            names[c] = field_string(&r);
+        assert_true(n >= 1 && n <= v->nch);
+        int chan[TEV_VIEW_CHANNELS]; /* the image's channel of each listed name */
+        for (int c = 0; c < n; c++) {
+            const char *name = field_string(&r);
+            chan[c] = -1;
+            for (int k = 0; k < v->nch; k++)
+                if (strcmp(v->ch[k], name) == 0)
+                    chan[c] = k;
+            if (chan[c] < 0)
+                fail_msg("tev update names channel '%s', which CreateImage did not", name);
+        }
         int x = (int)(int32_t)field(&r, 4), y = (int)(int32_t)field(&r, 4);
         int w = (int)(int32_t)field(&r, 4), h = (int)(int32_t)field(&r, 4);
         assert_true(x >= 0 && y >= 0 && w > 0 && h > 0 && x + w <= v->width && y + h <= v->height);
-        int64_t off[3], stride[3];
-        for (int c = 0; c < 3; c++)
+        int64_t off[TEV_VIEW_CHANNELS], stride[TEV_VIEW_CHANNELS];
+        for (int c = 0; c < n; c++)
             off[c] = (int64_t)field(&r, 8);
-        for (int c = 0; c < 3; c++)
+        for (int c = 0; c < n; c++)
             stride[c] = (int64_t)field(&r, 8);
         size_t npx = (size_t)w * (size_t)h, nfloats = 0;
-        for (int c = 0; c < 3; c++) {
+        for (int c = 0; c < n; c++) {
             assert_true(off[c] >= 0 && stride[c] >= 0);
             size_t need = (size_t)off[c] + (npx - 1) * (size_t)stride[c] + 1;
             nfloats = need > nfloats ? need : nfloats;
         }
         assert_int_equal(size - r.at, nfloats * 4); /* exactly the floats, nothing after */
         const unsigned char *data = p + r.at;
-        for (int c = 0; c < 3; c++) {
-            int ch = names[c][0] == 'R' ? 0 : names[c][0] == 'G' ? 1 : 2;
+        for (int c = 0; c < n; c++) {
+            int ch = chan[c];
             for (size_t i = 0; i < npx; i++) {
                 union { uint32_t u; float f; } f;
                 f.u = (uint32_t)le(data + 4 * ((size_t)off[c] + i * (size_t)stride[c]), 4);
                 size_t px = (size_t)(y + (int)(i / (size_t)w)) * (size_t)v->width + (size_t)(x + (int)(i % (size_t)w));
-                v->rgb[3 * px + (size_t)ch] = f.f;
+                v->plane[ch][px] = f.f;
+                if (ch < 3)
+                    v->rgb[3 * px + (size_t)ch] = f.f;
             }
         }
         v->updates++;
@@ -1471,6 +1500,33 @@ static void assert_tev_shows(const tev_view *v, const char *pfm, const char *nam
     assert_int_equal(v->width, fb.width);
     assert_int_equal(v->height, fb.height);
     assert_memory_equal(v->rgb, fb.rgb, (size_t)fb.width * (size_t)fb.height * 3 * sizeof(float));
+    rt_framebuffer_free(&fb);
+}
+
+/* tev's layer `layer` equals the AOV file rt wrote (a PFM; one-channel
+ * AOVs are written grey, so LAYER.Y is compared with its R). */
+static void assert_tev_layer(const tev_view *v, const char *layer, int channels, const char *pfm)
+{
+    rt_framebuffer fb;
+    rt_error err;
+    assert_int_equal(rt_pfm_read(pfm, &fb, &err), RT_OK);
+    assert_int_equal(v->width, fb.width);
+    assert_int_equal(v->height, fb.height);
+    static const char *const rgb[3] = {"R", "G", "B"};
+    for (int c = 0; c < channels; c++) {
+        char name[64];
+        snprintf(name, sizeof name, "%s.%s", layer, channels == 1 ? "Y" : rgb[c]);
+        int k = -1;
+        for (int i = 0; i < v->nch; i++)
+            if (strcmp(v->ch[i], name) == 0)
+                k = i;
+        if (k < 0)
+            fail_msg("tev has no channel %s", name);
+        for (size_t px = 0; px < (size_t)fb.width * (size_t)fb.height; px++)
+            if (memcmp(&v->plane[k][px], &fb.rgb[3 * px + (size_t)c], sizeof(float)) != 0)
+                fail_msg("tev's %s at pixel %zu is %.9g, the written %s has %.9g", name, px, v->plane[k][px], pfm,
+                         fb.rgb[3 * px + (size_t)c]);
+    }
     rt_framebuffer_free(&fb);
 }
 
@@ -1504,9 +1560,61 @@ static void test_display_server(void **state)
         assert_int_equal(v.creates, 1);
         assert_true(v.updates >= 1);
         assert_tev_shows(&v, pfm, "tev.pfm");
-        free(v.rgb);
+        tev_view_free(&v);
         free(r);
         unlink(pfm);
+    }
+}
+
+/* --aov with --display-server: the AOVs go along as extra layers, named
+ * as in rt's EXR output (albedo.R ... depth.Y), updated with the image;
+ * what tev ends up with equals the written AOV files bit for bit, tiled
+ * and in passes. */
+static void test_display_server_aovs(void **state)
+{
+    (void)state;
+    const char *modes[2] = {"0", "2"};
+    static const char *const want[] = {"R", "G", "B", "albedo.R", "albedo.G", "albedo.B", "normal.R", "normal.G",
+                                       "normal.B", "depth.Y", "spp.Y"};
+    for (int m = 0; m < 2; m++) {
+        int port;
+        int listener = tev_socket(&port, true);
+        char address[64];
+        snprintf(address, sizeof address, "127.0.0.1:%d", port);
+        const char *pfm = path_in("tevaov.pfm");
+        const char *const args[] = {"-q", "-r", "40x24", "-s", "6", "--tile", "8", "--integrator", "path",
+                                    "--passes", modes[m], "--aov", "albedo,normal,depth,spp", "--display-server",
+                                    address, "-o", pfm, slow_scene(), NULL};
+        double t0 = now_s();
+        pid_t pid = spawn(args);
+        int fd = tev_accept(listener);
+        tev_view v;
+        memset(&v, 0, sizeof v);
+        while (tev_read_packet(fd, &v))
+            ;
+        close(fd);
+        close(listener);
+        run_result *r = malloc(sizeof *r);
+        assert_non_null(r);
+        wait_for(pid, t0, 120.0, r);
+        assert_int_equal(r->status, 0);
+        assert_int_equal(v.creates, 1);
+        assert_true(v.updates >= 1);
+        assert_int_equal(v.nch, (int)(sizeof want / sizeof want[0]));
+        for (int c = 0; c < v.nch; c++)
+            assert_string_equal(v.ch[c], want[c]);
+        assert_tev_shows(&v, pfm, "tevaov.pfm");
+        assert_tev_layer(&v, "albedo", 3, path_in("tevaov.albedo.pfm"));
+        assert_tev_layer(&v, "normal", 3, path_in("tevaov.normal.pfm"));
+        assert_tev_layer(&v, "depth", 1, path_in("tevaov.depth.pfm"));
+        assert_tev_layer(&v, "spp", 1, path_in("tevaov.spp.pfm"));
+        tev_view_free(&v);
+        free(r);
+        unlink(pfm);
+        unlink(path_in("tevaov.albedo.pfm"));
+        unlink(path_in("tevaov.normal.pfm"));
+        unlink(path_in("tevaov.depth.pfm"));
+        unlink(path_in("tevaov.spp.pfm"));
     }
 }
 
@@ -1574,8 +1682,8 @@ static void test_display_server_reconnects(void **state)
     assert_int_equal(r->status, 130);
     assert_int_equal(w.creates, 1);
     assert_tev_shows(&w, pfm, "again.pfm");
-    free(v.rgb);
-    free(w.rgb);
+    tev_view_free(&v);
+    tev_view_free(&w);
     free(r);
     unlink(pfm);
 }
@@ -1889,6 +1997,7 @@ int main(void)
         cmocka_unit_test(test_second_sigint_exits_at_once),
         cmocka_unit_test(test_killed_write_leaves_no_temp),
         cmocka_unit_test(test_display_server),
+        cmocka_unit_test(test_display_server_aovs),
         cmocka_unit_test(test_display_server_absent),
         cmocka_unit_test(test_display_server_reconnects),
         cmocka_unit_test(test_window),

@@ -522,7 +522,9 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     tev_stream tev;
     if (a->display_server) {
         const char *base = strrchr(output, '/');
-        tev_stream_open(&tev, a->display_server, base ? base + 1 : output, fb.width, fb.height);
+        rt_image_layer layers[AOV_COUNT];
+        int nl = output_aovs_layers(&aov, layers, AOV_COUNT); /* --aov: extra layers in tev */
+        tev_stream_open(&tev, a->display_server, base ? base + 1 : output, fb.width, fb.height, layers, nl);
         view->tev = &tev;
     }
     rt_render_options ro;

@@ -77,6 +77,15 @@ rt_aov_buffers *output_aovs_for_render(output_aovs *o)
     return NULL;
 }
 
+int output_aovs_layers(const output_aovs *o, rt_image_layer *layers, int max)
+{
+    int n = 0;
+    for (int k = 0; k < AOV_COUNT && n < max; k++)
+        if (o->wanted & (1u << k))
+            layers[n++] = (rt_image_layer){aov_names[k], channels_of(k), *slot((rt_aov_buffers *)&o->buf, k)};
+    return n;
+}
+
 /* One image file of an AOV (1 channel: grey). */
 static rt_result write_aov_file(const float *data, int channels, int w, int h, const char *path, rt_error *err)
 {
@@ -122,9 +131,7 @@ rt_result output_write(const args *a, const rt_settings *set, rt_framebuffer *fb
     if (fmt == RT_FORMAT_EXR) {
         if (noisy)
             layers[nl++] = (rt_image_layer){"noisy", 3, noisy};
-        for (int k = 0; k < AOV_COUNT; k++)
-            if (aov->wanted & (1u << k))
-                layers[nl++] = (rt_image_layer){aov_names[k], channels_of(k), *slot((rt_aov_buffers *)&aov->buf, k)};
+        nl += output_aovs_layers(aov, layers + nl, AOV_COUNT);
         opt.layers = layers;
         opt.layer_count = nl;
     } else {

@@ -30,6 +30,9 @@ rt_result output_check(const args *a, rt_error *err);
 /* Allocates the AOV images --aov and --denoise need (zeroed). */
 rt_result output_aovs_init(output_aovs *o, const args *a, int width, int height, rt_error *err);
 void output_aovs_free(output_aovs *o);
+/* The AOVs asked for (--aov) as image layers (name, channels, data), at
+ * most max; returns how many: what EXR output and the tev stream carry. */
+int output_aovs_layers(const output_aovs *o, rt_image_layer *layers, int max);
 /* The render's .aov: NULL when no AOV is needed. */
 rt_aov_buffers *output_aovs_for_render(output_aovs *o);
 

@@ -11,8 +11,14 @@
  *                      then the floats; channel c of pixel i (row-major in
  *                      the rectangle) is float offset_c + i * stride_c.
  * The channels are R, G, B: linear radiance, as the PFM holds it (tev
- * applies its own exposure and tone curve). Rectangles go in bands of
- * rows of at most 4 MiB, so tev's buffer never has to grow much.
+ * applies its own exposure and tone curve), then each extra layer (the
+ * --aov images) as LAYER.R, LAYER.G, LAYER.B, or LAYER.Y for a one-channel
+ * layer: the names rt's EXR layers have (rt_exr_write), which tev shows as
+ * one layer each. One UpdateImageV3 packet carries every channel of a
+ * rectangle, each layer's floats in a block of their own (offset of the
+ * block plus the component, stride the layer's channel count). Rectangles
+ * go in bands of rows of at most 4 MiB, so tev's buffer never has to grow
+ * much.
  */
 #include "tev.h"
 
@@ -108,7 +114,44 @@ static void finish(packet *p)
         p->data[i] = (unsigned char)(n >> (8 * i));
 }
 
-static const char *const channel_names[3] = {"R", "G", "B"};
+/* Channel c of the stream: the beauty's R, G, B, then the layers'. */
+static void channel_name(const tev_stream *t, int c, char *buf, size_t size)
+{
+    static const char *const rgb[3] = {"R", "G", "B"};
+    if (c < 3) {
+        snprintf(buf, size, "%s", rgb[c]);
+        return;
+    }
+    c -= 3;
+    for (int l = 0; l < t->layer_count; l++) {
+        const rt_image_layer *L = &t->layers[l];
+        if (c < L->channels) {
+            snprintf(buf, size, "%s.%s", L->name, L->channels == 1 ? "Y" : rgb[c]);
+            return;
+        }
+        c -= L->channels;
+    }
+    snprintf(buf, size, "?");
+}
+
+static int channel_count(const tev_stream *t)
+{
+    int n = 3;
+    for (int l = 0; l < t->layer_count; l++)
+        n += t->layers[l].channels;
+    return n;
+}
+
+static void put_channel_names(packet *p, const tev_stream *t)
+{
+    int n = channel_count(t);
+    put_le(p, (uint32_t)n, 4);
+    for (int c = 0; c < n; c++) {
+        char name[80];
+        channel_name(t, c, name, sizeof name);
+        put_string(p, name);
+    }
+}
 
 /* ------------------------------------------------------------ the connection */
 
@@ -222,9 +265,7 @@ static void send_create(tev_stream *t)
     put_string(&p, t->name);
     put_le(&p, (uint32_t)t->width, 4);
     put_le(&p, (uint32_t)t->height, 4);
-    put_le(&p, 3, 4);
-    for (int c = 0; c < 3; c++)
-        put_string(&p, channel_names[c]);
+    put_channel_names(&p, t);
     finish(&p);
     send_all(t, &p);
     free(p.data);
@@ -254,7 +295,8 @@ bool tev_stream_connect(tev_stream *t, bool force)
     return t->fd >= 0;
 }
 
-void tev_stream_open(tev_stream *t, const char *address, const char *name, int width, int height)
+void tev_stream_open(tev_stream *t, const char *address, const char *name, int width, int height,
+                     const rt_image_layer *layers, int layer_count)
 {
     memset(t, 0, sizeof *t);
     t->fd = -1;
@@ -263,6 +305,9 @@ void tev_stream_open(tev_stream *t, const char *address, const char *name, int w
     snprintf(t->name, sizeof t->name, "%s", name);
     t->width = width;
     t->height = height;
+    for (int l = 0; l < layer_count && t->layer_count < TEV_MAX_LAYERS; l++)
+        if (layers[l].data && (layers[l].channels == 1 || layers[l].channels == 3))
+            t->layers[t->layer_count++] = layers[l];
     tev_stream_connect(t, true);
 }
 
@@ -275,8 +320,8 @@ void tev_stream_rect(tev_stream *t, const rt_framebuffer *fb, int x0, int y0, in
 {
     if (t->fd < 0 || x1 <= x0 || y1 <= y0)
         return;
-    int w = x1 - x0;
-    size_t row_bytes = (size_t)w * 3 * sizeof(float);
+    int w = x1 - x0, nch = channel_count(t);
+    size_t row_bytes = (size_t)w * (size_t)nch * sizeof(float);
     int band = (int)(TEV_BAND_BYTES / row_bytes);
     band = band < 1 ? 1 : band;
     packet p = {0};
@@ -285,21 +330,37 @@ void tev_stream_rect(tev_stream *t, const rt_framebuffer *fb, int x0, int y0, in
         begin(&p, TEV_UPDATE_IMAGE_V3);
         put_u8(&p, 0);
         put_string(&p, t->name);
-        put_le(&p, 3, 4);
-        for (int c = 0; c < 3; c++)
-            put_string(&p, channel_names[c]);
+        put_channel_names(&p, t);
         put_le(&p, (uint32_t)x0, 4);
         put_le(&p, (uint32_t)y, 4);
         put_le(&p, (uint32_t)w, 4);
         put_le(&p, (uint32_t)h, 4);
+        /* blocks: the beauty's interleaved RGB, then each layer's pixels */
+        size_t npx = (size_t)w * (size_t)h, base = 3 * npx;
         for (int c = 0; c < 3; c++)
-            put_le(&p, (uint64_t)c, 8); /* offsets: interleaved RGB */
+            put_le(&p, (uint64_t)c, 8); /* offsets */
+        for (int l = 0; l < t->layer_count; l++) {
+            for (int c = 0; c < t->layers[l].channels; c++)
+                put_le(&p, (uint64_t)(base + (size_t)c), 8);
+            base += npx * (size_t)t->layers[l].channels;
+        }
         for (int c = 0; c < 3; c++)
             put_le(&p, 3, 8); /* strides */
+        for (int l = 0; l < t->layer_count; l++)
+            for (int c = 0; c < t->layers[l].channels; c++)
+                put_le(&p, (uint64_t)t->layers[l].channels, 8);
         for (int yy = y; yy < y + h; yy++) {
             const float *row = fb->rgb + 3 * ((size_t)yy * (size_t)fb->width + (size_t)x0);
             for (size_t i = 0; i < 3 * (size_t)w; i++)
                 put_float(&p, row[i]);
+        }
+        for (int l = 0; l < t->layer_count; l++) {
+            size_t k = (size_t)t->layers[l].channels;
+            for (int yy = y; yy < y + h; yy++) {
+                const float *row = t->layers[l].data + k * ((size_t)yy * (size_t)t->width + (size_t)x0);
+                for (size_t i = 0; i < k * (size_t)w; i++)
+                    put_float(&p, row[i]);
+            }
         }
         finish(&p);
         send_all(t, &p);
