@@ -124,6 +124,8 @@ void viewer_poll(viewer *v, const rt_render_progress *p)
 bool viewer_wait(viewer *v, const rt_framebuffer *fb, int samples_done, const atomic_int *stop)
 {
     window_view *w = v->window;
+    if (v->moved) /* a move answered in the render's last report: render again at once */
+        return w->open;
     w->render_done = true;
     for (;;) {
         window_wait(w, stop);

@@ -259,10 +259,13 @@ static void handle_event(window_view *w, const SDL_Event *ev)
     }
 }
 
-/* RT_WINDOW_SCRIPT: pushes the next steps whose wait is over. */
+/* RT_WINDOW_SCRIPT: pushes the events of the next steps whose wait is
+ * over into SDL's queue (at most one input step a call, so the driver
+ * answers each before the next). */
 static void push(SDL_Event *e)
 {
-    SDL_PushEvent(e);
+    if (SDL_PushEvent(e) < 0)
+        fprintf(stderr, "rt: RT_WINDOW_SCRIPT: SDL_PushEvent: %s\n", SDL_GetError());
 }
 
 static void run_script(window_view *w)
@@ -309,7 +312,7 @@ static void run_script(window_view *w)
         w->script_at++;
         w->script_armed = false;
         if (s->kind == 'g' || s->kind == 'w' || s->kind == 'k')
-            return; /* one input step per round of events: the driver sees each */
+            return;
     }
 }
 
