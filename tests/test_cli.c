@@ -1940,6 +1940,141 @@ static void test_window_camera(void **state)
     free(r);
 }
 
+/* Runs xdotool with args on display dpy; its stdout into `out` (cap
+ * bytes, may be NULL); returns its exit status. */
+static int xdo(int dpy, char *out, size_t cap, const char *const *args)
+{
+    const char *xout = path_in("xdo.out");
+    const char *argv[32];
+    int n = 0;
+    argv[n++] = "xdotool";
+    for (int i = 0; args[i] && n < 31; i++)
+        argv[n++] = args[i];
+    argv[n] = NULL;
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        char dname[32];
+        snprintf(dname, sizeof dname, ":%d", dpy);
+        setenv("DISPLAY", dname, 1);
+        int o = open(xout, O_WRONLY | O_CREAT | O_TRUNC, 0644), null = open("/dev/null", O_RDWR);
+        if (o < 0 || null < 0)
+            _exit(127);
+        dup2(null, 0);
+        dup2(o, 1);
+        dup2(null, 2);
+        execv("/usr/bin/xdotool", (char *const *)argv);
+        _exit(127);
+    }
+    int st = 0;
+    double t0 = now_s();
+    while (waitpid(pid, &st, WNOHANG) == 0) {
+        if (now_s() - t0 > 30.0) {
+            kill(pid, SIGKILL);
+            waitpid(pid, &st, 0);
+            return -1;
+        }
+        sleep_s(0.01);
+    }
+    if (out && read_all(xout, out, cap) == (size_t)-1)
+        out[0] = 0;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* Waits until file `path` holds `needle` `times` times, or 60 s. */
+static bool wait_for_text(const char *path, const char *needle, int times)
+{
+    static char buf[16384];
+    for (double t0 = now_s(); now_s() - t0 < 60.0; sleep_s(0.02))
+        if (read_all(path, buf, sizeof buf) != (size_t)-1 && count_of(buf, needle) >= times)
+            return true;
+    return false;
+}
+
+/* The same through real X input: xdotool (Debian xdotool; tools/install-deps.sh
+ * installs it when it can) moves Xvfb's pointer with XTEST, drags over the
+ * window, presses P and Esc; the steps wait on what rt says (its "wrote"
+ * lines, the printed camera). The drag renders again at a new camera, and
+ * the printed line pasted into the scene renders the window's final image.
+ * Skipped without SDL2, Xvfb or xdotool. */
+static void test_window_camera_xdotool(void **state)
+{
+    (void)state;
+    if (access("/usr/bin/xdotool", X_OK) != 0)
+        skip();
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *png = path_in("xdo.png"), *out = path_in("xdo.txt"), *err = path_in("stderr.txt");
+    const char *display = getenv("DISPLAY");
+    char saved[256] = "";
+    if (display)
+        snprintf(saved, sizeof saved, "%s", display);
+    unsetenv("DISPLAY");
+    run_args(r, (const char *const[]){"-q", "-r", "8x8", "-s", "1", "--window", "-o", png, NULL});
+    int dpy = -1;
+    pid_t xvfb = strstr(r->err, "built without SDL2") ? -1 : start_xvfb(&dpy);
+    if (xvfb < 0) {
+        if (saved[0])
+            setenv("DISPLAY", saved, 1);
+        free(r);
+        skip();
+    }
+    const char *scene = slow_scene();
+    char dname[32];
+    snprintf(dname, sizeof dname, ":%d", dpy);
+    setenv("DISPLAY", dname, 1);
+    setenv("LSAN_OPTIONS", "detect_leaks=0", 1);
+    double t0 = now_s();
+    pid_t pid = spawn_to((const char *const[]){"-v", "-r", "40x24", "-s", "8", "--integrator", "path", "--passes", "2",
+                                               "--window", "-o", png, scene, NULL},
+                         out);
+    unsetenv("LSAN_OPTIONS");
+    if (saved[0])
+        setenv("DISPLAY", saved, 1);
+    else
+        unsetenv("DISPLAY");
+    static char wid[64], printed[2048], moved[4096];
+    bool ok = xdo(dpy, wid, sizeof wid, (const char *const[]){"search", "--sync", "--name", "^rt: ", NULL}) == 0;
+    if (ok)
+        *strchr(wid, '\n') = 0;
+    bool first = ok && wait_for_text(err, "rt: wrote ", 1);
+    /* a drag of 10 pixels right, 2 down with the left button */
+    bool dragged = first && xdo(dpy, NULL, 0,
+                                (const char *const[]){"mousemove", "--window", wid, "20", "12", "mousedown", "1",
+                                                      "mousemove", "--window", wid, "30", "14", "mouseup", "1",
+                                                      NULL}) == 0;
+    bool again = dragged && wait_for_text(err, "the camera moved; rendering again from sample 0", 1) &&
+                 wait_for_text(err, "rt: wrote ", 2);
+    bool keyed = again && xdo(dpy, NULL, 0, (const char *const[]){"windowfocus", "--sync", wid, "key", "p", NULL}) == 0;
+    bool printed_ok = keyed && wait_for_text(out, "camera position ", 1);
+    xdo(dpy, NULL, 0, (const char *const[]){"key", "Escape", NULL});
+    wait_for(pid, t0, 120.0, r);
+    stop_xvfb();
+    assert_true(ok);
+    assert_true(first);
+    assert_true(dragged);
+    if (!again)
+        fail_msg("the drag did not render again:\n%s", r->err);
+    assert_true(printed_ok);
+    assert_int_equal(r->status, 0);
+    read_all(out, printed, sizeof printed);
+    assert_null(strstr(printed, "camera position 0 0 4 look_at 0 0 0 "));
+    *strchr(printed, '\n') = 0;
+    snprintf(moved, sizeof moved,
+             "resolution 64 64\nbackground 0.5 0.6 0.7\n%s\n"
+             "material glow color 0.5 0.5 0.5 emission 1 0.5 0.25\nsphere 0 0 0 1 glow\n",
+             printed);
+    write_text("moved.txt", moved);
+    const char *again_png = path_in("xdo-again.png");
+    render_ok(again_png, (const char *const[]){"-r", "40x24", "-s", "8", "--integrator", "path",
+                                               path_in("moved.txt"), NULL});
+    assert_same_file(again_png, png);
+    unlink(png);
+    unlink(again_png);
+    unlink(out);
+    free(r);
+}
+
 /* `rt compare` is reached from the command line: an image against itself
  * (every metric 0, exit 0), against a different one with a threshold that
  * fails (exit 1), and against a missing file (exit 2, the file named). */
@@ -2002,6 +2137,7 @@ int main(void)
         cmocka_unit_test(test_display_server_reconnects),
         cmocka_unit_test(test_window),
         cmocka_unit_test(test_window_camera),
+        cmocka_unit_test(test_window_camera_xdotool),
         cmocka_unit_test(test_compare_command),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

@@ -6,7 +6,8 @@
 #   libcmocka-dev  the test framework
 #   libopenexr-dev the OpenEXR Core C API (EXR images in and out)
 # and, optionally (rt builds and runs without them; a failed install is only
-# reported): libsdl2-dev for --window, xvfb for the test that opens it.
+# reported): libsdl2-dev for --window, xvfb and xdotool for the tests that
+# open it and move its camera with real X input.
 set -eu
 CC=${CC:-cc}
 missing=""
@@ -24,18 +25,19 @@ install_optional() {
     optional=""
     pkg-config --exists sdl2 2>/dev/null || optional="$optional libsdl2-dev"
     [ -x /usr/bin/Xvfb ] || optional="$optional xvfb"
+    command -v xdotool >/dev/null 2>&1 || optional="$optional xdotool"
     [ -n "$optional" ] || return 0
     if [ "$(id -u)" -eq 0 ]; then
         S=""
     elif sudo -n true 2>/dev/null; then
         S="sudo -n"
     else
-        echo "rt: optional packages not installed:$optional (for --window and its test)" >&2
+        echo "rt: optional packages not installed:$optional (for --window and its tests)" >&2
         return 0
     fi
     echo "rt: installing optional packages:$optional" >&2
     DEBIAN_FRONTEND=noninteractive $S apt-get install -y -q $optional >&2 ||
-        echo "rt: could not install$optional; rt builds without --window" >&2
+        echo "rt: could not install$optional; rt builds and tests without them (--window needs libsdl2-dev)" >&2
 }
 
 if [ -z "$missing" ]; then
