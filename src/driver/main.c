@@ -2,7 +2,10 @@
  * (args.c), load the scene or model, validate it, apply the setting flags,
  * frame the camera and check the limits, build the kd-tree, render on all
  * cores (progress.c draws the progress bar and the live preview), write the
- * image.
+ * image. With --window the render loops: a move of the window's camera
+ * (viewer.c) cancels it and it starts again at the new camera from sample
+ * 0; a finished render is written at once, and closing the window
+ * mid-render writes the image at the samples reached ("window closed").
  *
  * Exit status: 0 on success (also when --time-limit stopped the render),
  * 2 for bad input (flags, scene files, models, images, an unwritable
@@ -454,7 +457,8 @@ static int write_result(const args *a, const rt_settings *set, rt_result r, cons
 }
 
 /* Builds the kd-tree, renders (Ctrl-C and SIGTERM stop the workers, as
- * does --time-limit) and writes the image; returns the exit status.
+ * does --time-limit; with --window, again at each new camera) and writes
+ * the image; returns the exit status.
  * t_start: when the run began, for the wall time in the "wrote" line. */
 static int render_and_write(const rt_scene *scene, const args *a, const char *output, progress_view *view,
                             double t_start)

@@ -6,7 +6,8 @@
  * few passes); and the live preview (--preview): the output image
  * rewritten every few seconds with the finished tiles and the others dim
  * grey, for a viewer that reloads it; and the stream to tev (tev.c) for
- * --display-server, and the window (window.c) for --window. rt_render calls progress_report from
+ * --display-server, and the window (window.c) for --window, whose
+ * requests viewer.c answers. rt_render calls progress_report from
  * its own thread about every 50 ms and after each pass
  * (src/render/render.c).
  */
