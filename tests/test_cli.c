@@ -16,6 +16,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
@@ -1940,6 +1941,118 @@ static void test_window_camera(void **state)
     free(r);
 }
 
+typedef struct printed_camera {
+    double p[3], at[3], up[3], fov;
+} printed_camera;
+
+/* The `camera` lines in text, in order; returns how many (at most max). */
+static int printed_cameras(const char *text, printed_camera *c, int max)
+{
+    int n = 0;
+    for (const char *l = strstr(text, "camera position "); l && n < max; l = strstr(l + 1, "\ncamera position ")) {
+        if (*l == '\n')
+            l++;
+        printed_camera *k = &c[n];
+        if (sscanf(l, "camera position %lf %lf %lf look_at %lf %lf %lf up %lf %lf %lf fov %lf", &k->p[0], &k->p[1],
+                   &k->p[2], &k->at[0], &k->at[1], &k->at[2], &k->up[0], &k->up[1], &k->up[2], &k->fov) != 10)
+            fail_msg("cannot read the printed camera line: %.200s", l);
+        n++;
+    }
+    return n;
+}
+
+static double cam_dist(const printed_camera *c)
+{
+    double d = 0.0;
+    for (int i = 0; i < 3; i++)
+        d += (c->at[i] - c->p[i]) * (c->at[i] - c->p[i]);
+    return sqrt(d);
+}
+
+/* |unit view direction of a - that of b| */
+static double cam_turn(const printed_camera *a, const printed_camera *b)
+{
+    double da = cam_dist(a), db = cam_dist(b), t = 0.0;
+    for (int i = 0; i < 3; i++) {
+        double d = (a->at[i] - a->p[i]) / da - (b->at[i] - b->p[i]) / db;
+        t += d * d;
+    }
+    return sqrt(t);
+}
+
+static double cam_moved(const printed_camera *a, const printed_camera *b)
+{
+    double t = 0.0;
+    for (int i = 0; i < 3; i++)
+        t += (a->at[i] - b->at[i]) * (a->at[i] - b->at[i]);
+    return sqrt(t);
+}
+
+/* Each input reaches the camera as documented (scripted SDL events, P
+ * after each): a right drag pans (direction and distance kept, look_at
+ * moved), two wheel notches dolly to 0.85^2 of the distance (look_at
+ * kept), W walks 2% of the scene's bounding-box diagonal forward, R goes
+ * back to the first camera, whose finished render is then the image a
+ * render without a window writes. */
+static void test_window_inputs(void **state)
+{
+    (void)state;
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *png = path_in("in.png"), *out = path_in("in.out");
+    const char *display = getenv("DISPLAY");
+    char saved[256] = "";
+    if (display)
+        snprintf(saved, sizeof saved, "%s", display);
+    unsetenv("DISPLAY");
+    run_args(r, (const char *const[]){"-q", "-r", "8x8", "-s", "1", "--window", "-o", png, NULL});
+    int dpy = -1;
+    pid_t xvfb = strstr(r->err, "built without SDL2") ? -1 : start_xvfb(&dpy);
+    if (xvfb < 0) {
+        if (saved[0])
+            setenv("DISPLAY", saved, 1);
+        free(r);
+        skip();
+    }
+    const char *scene = slow_scene(); /* a sphere of radius 1 at the origin: diagonal 2 sqrt(3) */
+    run_window_script(r, dpy,
+                      "wait done; key P; drag right 20 12 25 12; key P; wheel 2; key P; key W; key P; key R; key P; "
+                      "wait done; key Escape",
+                      out,
+                      (const char *const[]){"-q", "-r", "40x24", "-s", "4", "--integrator", "path", "--window", "-o",
+                                            png, scene, NULL});
+    stop_xvfb();
+    if (saved[0])
+        setenv("DISPLAY", saved, 1);
+    if (r->status != 0)
+        fail_msg("rt --window failed (%d): %s", r->status, r->err);
+    static char text[8192];
+    read_all(out, text, sizeof text);
+    printed_camera c[5];
+    assert_int_equal(printed_cameras(text, c, 5), 5);
+    assert_true(strstr(text, "camera position 0 0 4 look_at 0 0 0 up 0 1 0 fov 40\n") == text);
+    /* pan */
+    assert_true(cam_turn(&c[1], &c[0]) < 1e-6);
+    assert_true(fabs(cam_dist(&c[1]) - cam_dist(&c[0])) < 1e-5);
+    assert_true(cam_moved(&c[1], &c[0]) > 0.01);
+    /* dolly */
+    assert_true(cam_moved(&c[2], &c[1]) == 0.0);
+    assert_true(fabs(cam_dist(&c[2]) - 0.85 * 0.85 * cam_dist(&c[1])) < 1e-5);
+    /* walk */
+    assert_true(cam_turn(&c[3], &c[2]) < 1e-6);
+    assert_true(fabs(cam_moved(&c[3], &c[2]) - 0.02 * 2.0 * sqrt(3.0)) < 1e-5);
+    assert_true(fabs(cam_dist(&c[3]) - cam_dist(&c[2])) < 1e-5);
+    /* home */
+    assert_memory_equal(&c[4], &c[0], sizeof c[0]);
+    const char *plain = path_in("in-plain.png");
+    render_ok(plain, (const char *const[]){"-r", "40x24", "-s", "4", "--integrator", "path", scene, NULL});
+    assert_same_file(plain, png);
+    unlink(plain);
+    unlink(png);
+    unlink(out);
+    free(r);
+}
+
 /* Runs xdotool with args on display dpy; its stdout into `out` (cap
  * bytes, may be NULL); returns its exit status. */
 static int xdo(int dpy, char *out, size_t cap, const char *const *args)
@@ -2138,6 +2251,7 @@ int main(void)
         cmocka_unit_test(test_window),
         cmocka_unit_test(test_window_camera),
         cmocka_unit_test(test_window_camera_xdotool),
+        cmocka_unit_test(test_window_inputs),
         cmocka_unit_test(test_compare_command),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);
