@@ -257,6 +257,12 @@ static void test_resume_exact(void **state)
     assert_same_bytes(in_dir("r.png"), in_dir("full.png"));
     /* a resumed part that is not the whole image is a part again */
     assert_int_equal(RUN("-q", "--resume", in_dir("a.pfm"), "--spp-range", "5:16", "-o", in_dir("x.pfm"), scene), 2);
+    /* a part of another render is refused, naming what differs */
+    assert_int_equal(RUN("-q", "--resume", in_dir("a.pfm"), "--seed", "9", "-o", in_dir("x.png"), scene), 2);
+    assert_non_null(strstr(err_text, "seed 7, not 9"));
+    assert_int_equal(RUN("-q", "--resume", in_dir("a.pfm"), "--set", "clamp=3", "-o", in_dir("x.png"), scene), 2);
+    assert_non_null(strstr(err_text, "clamp"));
+    assert_int_equal(access(in_dir("x.png"), F_OK), -1);
     /* a part of all samples has nothing left to resume */
     RUN_OK("-q", "--spp-range", "0:16", "-o", in_dir("all.exr"), scene);
     assert_int_equal(RUN("-q", "--resume", in_dir("all.exr"), "-o", in_dir("x.png"), scene), 2);

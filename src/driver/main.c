@@ -480,7 +480,9 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
-    view->preview_path = a->preview_seconds > 0.0 ? output : NULL;
+    view->preview_path = a->preview_seconds > 0.0 && !pj.to_part ? output : NULL;
+    if (a->preview_seconds > 0.0 && pj.to_part)
+        rt_warn("--preview: a part's output holds sums, not an image; no preview is written");
     view->preview_seconds = a->preview_seconds;
     view->exposure = set->exposure;
     view->time_limit = a->time_limit;
@@ -627,8 +629,9 @@ int main(int argc, char **argv)
         rt_path_tagged(name, "part", ".exr", part_default, sizeof part_default);
         a.output = part_default;
     }
-    if (a.part_out && !rt_part_path_ok(a.part_out)) {
-        fprintf(stderr, "rt: --part-out %s: a part is written as .exr or .pfm\n", a.part_out);
+    if (a.part_out && (!rt_part_path_ok(a.part_out) || rt_output_check(a.part_out, &err) != RT_OK)) {
+        fprintf(stderr, "rt: --part-out %s: %s\n", a.part_out,
+                rt_part_path_ok(a.part_out) ? err.message : "a part is written as .exr or .pfm");
         return 2;
     }
     progress_view view;
