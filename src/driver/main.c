@@ -434,6 +434,17 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         rt_kdtree_free(&tree);
         return 2;
     }
+    const char *aov_part = pj.info.layer_count == 0                            ? NULL
+                           : pj.to_part && !rt_path_has_ext(output, ".exr")    ? output
+                           : a->part_out && !rt_path_has_ext(a->part_out, ".exr") ? a->part_out
+                                                                                 : NULL;
+    if (aov_part) {
+        progress_clear(view);
+        fprintf(stderr, "rt: %s: a part with AOVs is written as .exr (their sums are layers of it)\n", aov_part);
+        part_job_free(&pj);
+        rt_kdtree_free(&tree);
+        return 2;
+    }
     if (pj.to_part)
         rt_info("part: pixels [%d, %d) x [%d, %d), samples %d:%d", pj.region.x0, pj.region.x1, pj.region.y0,
                 pj.region.y1, pj.s_begin, pj.s_end);
