@@ -303,6 +303,32 @@ static void test_aov_parts(void **state)
     assert_int_equal(access(in_dir("x.pfm"), F_OK), -1);
 }
 
+/* --frames A:B: one file a frame, named from the pattern; no animation
+ * yet, so each is the single render; bad patterns are refused up front. */
+static void test_frames(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    RUN_OK("-q", "-s", "2", "-o", in_dir("one.png"), scene);
+    char pattern[600];
+    snprintf(pattern, sizeof pattern, "%s/f%%%%.%%04d.png", dir);
+    RUN_OK("-q", "-s", "2", "--frames", "8:11", "--fps", "30", "-o", pattern, scene);
+    assert_same_bytes(in_dir("f%.0008.png"), in_dir("one.png"));
+    assert_same_bytes(in_dir("f%.0010.png"), in_dir("one.png"));
+    assert_int_equal(access(in_dir("f%.0011.png"), F_OK), -1);
+    assert_int_equal(access(in_dir("f%.0007.png"), F_OK), -1);
+    snprintf(pattern, sizeof pattern, "%s/fp%%d.exr", dir);
+    RUN_OK("-q", "-s", "2", "--frames", "0:2", "--part", "1/2", "-o", pattern, scene);
+    assert_int_equal(access(in_dir("fp1.exr.json"), F_OK), 0);
+    const char *bad[] = {"plain.png", "two%d%d.png", "s%s.png", "w%010d.png", "%"};
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        assert_int_equal(RUN("-q", "--frames", "0:2", "-o", in_dir(bad[i]), scene), 2);
+        assert_non_null(strstr(err_text, "%0Nd"));
+    }
+    assert_int_equal(RUN("-q", "--frames", "2:2", "-o", pattern, scene), 2);
+    assert_int_equal(RUN("-q", "--frames", "0:2", "--fps", "0", "-o", pattern, scene), 2);
+}
+
 /* The samples [0, k] a sidecar says its part holds. */
 static int sidecar_end(const char *json)
 {
@@ -490,6 +516,7 @@ int main(void)
         cmocka_unit_test(test_time_limit_then_resume),
         cmocka_unit_test(test_merge_refusals),
         cmocka_unit_test(test_aov_parts),
+        cmocka_unit_test(test_frames),
         cmocka_unit_test(test_part_bands),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
