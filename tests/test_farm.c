@@ -460,6 +460,10 @@ static void test_merge_refusals(void **state)
     copy(in_dir("g1.exr"), in_dir("n.exr"), 0);
     REFUSE("n.exr.json", in_dir("g0.exr"), in_dir("n.exr"), in_dir("g2.exr"));
     REFUSE("not a part", in_dir("g0.exr"), scene);
+    /* the output over a part's own image or sidecar */
+    assert_int_equal(RUN("merge", in_dir("g0.exr"), in_dir("g1.exr"), in_dir("g2.exr"), "-o", in_dir("g1.exr")), 2);
+    assert_non_null(strstr(err_text, "part's own files"));
+    RUN_OK("merge", in_dir("g0.exr"), in_dir("g1.exr"), in_dir("g2.exr"), "-o", in_dir("ok.exr"));
     /* flags */
     REFUSE(NULL, in_dir("g0.exr"), "--bogus");
     REFUSE("needs at least one PART", "--half");
