@@ -2,7 +2,10 @@
  * (args.c), load the scene or model, validate it, apply the setting flags,
  * frame the camera and check the limits, build the kd-tree, render on all
  * cores (progress.c draws the progress bar and the live preview), write the
- * image.
+ * image. A part of a render spread over machines (--part, --crop,
+ * --spp-range, --resume, --part-out: part.c, docs/farm.md) renders its
+ * region and samples and writes its sums; `rt merge` (merge.c) puts parts
+ * together. --frames A:B runs the whole pipeline once a frame (frames.c).
  *
  * Exit status: 0 on success (also when --time-limit stopped the render),
  * 2 for bad input (flags, scene files, models, images, an unwritable
