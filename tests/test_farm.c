@@ -223,7 +223,7 @@ static void test_sample_ranges(void **state)
     RUN_OK("-q", "--spp-range", "5:16", "-o", in_dir("b.exr"), scene);
     RUN_OK("merge", in_dir("b.exr"), in_dir("a.exr"), "-o", in_dir("two.pfm"));
     assert_within_summation_bound(in_dir("two.pfm"), in_dir("full.pfm"), 16);
-    RUN_OK("-q", "--spp-range", "0:3", "-o", in_dir("r0.exr"), scene);
+    RUN_OK("-q", "--spp-range", "0:3", "--passes", "0", "-o", in_dir("r0.exr"), scene); /* tiles */
     RUN_OK("-q", "--spp-range", "3:9", "--passes", "2", "-o", in_dir("r1.pfm"), scene);
     RUN_OK("-q", "--spp-range", "9:16", "-o", in_dir("r2.exr"), scene);
     RUN_OK("merge", in_dir("r0.exr"), in_dir("r1.pfm"), in_dir("r2.exr"), "-o", in_dir("three.pfm"));
@@ -253,6 +253,8 @@ static void test_resume_exact(void **state)
     RUN_OK("-q", "--spp-range", "0:5", "-o", in_dir("a.pfm"), scene);
     RUN_OK("-q", "--resume", in_dir("a.pfm"), "-o", in_dir("r.pfm"), scene);
     assert_same_bytes(in_dir("r.pfm"), in_dir("full.pfm"));
+    RUN_OK("-q", "--resume", in_dir("a.pfm"), "--passes", "0", "-o", in_dir("rt.pfm"), scene); /* tiles */
+    assert_same_bytes(in_dir("rt.pfm"), in_dir("full.pfm"));
     RUN_OK("-q", "--resume", in_dir("a.pfm.json"), "-o", in_dir("r.png"), scene);
     assert_same_bytes(in_dir("r.png"), in_dir("full.png"));
     /* a resumed part that is not the whole image is a part again */
