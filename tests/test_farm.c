@@ -11,6 +11,8 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <signal.h>
+#include <time.h>
 #include <sys/wait.h>
 
 #include "rt/io/framebuffer.h"
@@ -375,6 +377,48 @@ static void test_time_limit_then_resume(void **state)
     }
 }
 
+/* Ctrl-C in passes: the part holds the whole passes done (a pass cut short
+ * is not in it), and resumed it is the straight render. When the signal
+ * lands does not matter to the assertions. */
+static void test_interrupt_then_resume(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    RUN_OK("-q", "-s", "64", "-o", in_dir("full64i.pfm"), scene);
+    unlink(in_dir("int.exr.json"));
+    const char *argv[] = {rt_bin(), "-q", "-s", "64", "--passes", "1", "-t", "2", "--part-out", in_dir("int.exr"), "-o",
+                          in_dir("int.pfm"), scene, NULL};
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        int nul = open("/dev/null", O_RDWR);
+        dup2(nul, 0);
+        dup2(nul, 1);
+        dup2(nul, 2);
+        execv(argv[0], (char *const *)argv);
+        _exit(127);
+    }
+    struct timespec ts = {0, 150 * 1000 * 1000};
+    nanosleep(&ts, NULL);
+    kill(pid, SIGINT);
+    int st = 0;
+    while (waitpid(pid, &st, 0) < 0 && errno == EINTR)
+        ;
+    assert_true(WIFEXITED(st));
+    int code = WEXITSTATUS(st);
+    assert_true(code == 130 || code == 0);
+    if (access(in_dir("int.exr.json"), F_OK) != 0)
+        return; /* stopped before the first pass: nothing to resume */
+    int k = sidecar_end(in_dir("int.exr.json"));
+    assert_true(k >= 1 && k <= 64);
+    if (code == 0)
+        assert_int_equal(k, 64);
+    if (k < 64) {
+        RUN_OK("-q", "-s", "64", "--resume", in_dir("int.exr"), "-o", in_dir("int-resumed.pfm"), scene);
+        assert_same_bytes(in_dir("int-resumed.pfm"), in_dir("full64i.pfm"));
+    }
+}
+
 static const char precious[] = "an earlier image the user keeps\n";
 
 /* merge with args must exit 2 naming `names` and leave the output alone. */
@@ -520,6 +564,7 @@ int main(void)
         cmocka_unit_test(test_sample_ranges),
         cmocka_unit_test(test_resume_exact),
         cmocka_unit_test(test_time_limit_then_resume),
+        cmocka_unit_test(test_interrupt_then_resume),
         cmocka_unit_test(test_merge_refusals),
         cmocka_unit_test(test_aov_parts),
         cmocka_unit_test(test_frames),
