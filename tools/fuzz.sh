@@ -43,7 +43,7 @@ printf '%-10s %12s %14s %8s\n' target execs/s total_execs crashes | tee "$summar
 for t in $TARGETS; do
     clang $CFLAGS -fsanitize=fuzzer -DRT_FUZZ_TARGET="\"$t\"" -o $B/fuzz_$t tests/fuzz/fuzz_main.c $B/harness.o $B/obj/*.o \
         -lstb -lOpenEXRCore -ldl -lpthread -lm
-    mkdir -p $B/corpus/$t $B/crashes/$t
+    mkdir -p $B/corpus/$t $B/crashes/$t $B/seeds/$t
     dict=""
     case $t in
         gltf|glb|gltf_bin) dict="-dict=tests/fuzz/gltf.dict" ;;
