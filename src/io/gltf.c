@@ -2289,10 +2289,11 @@ static rt_result pose_channel(gl_doc *d, uint32_t anim, uint32_t c, float t)
     size_t keys = d->accessors[sa->input].count;
     for (size_t k = 1; k < keys; k++)
         if (!(times[k] > times[k - 1])) {
+            double now = times[k], before = times[k - 1];
             free(times);
             return fail_at(d, d->accessors[sa->input].tok, RT_ERR_INVALID,
                            "accessors[%u] (%s): key times must increase, element %zu is %g after %g", sa->input, w_in,
-                           k, (double)times[k], (double)times[k - 1]);
+                           k, now, before);
         }
     size_t per = sa->interp == RT_INTERP_CUBICSPLINE ? 3 : 1;
     rt_result r = ch->path == PATH_WEIGHTS ? posing_floats(d, sa->output, 1, keys * per * (size_t)ncomp, w_out, &values)
