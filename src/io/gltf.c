@@ -2135,8 +2135,8 @@ static rt_result fill_from_draco(gl_doc *d, size_t p, const rt_draco_mesh *m)
     size_t nidx = d->accessors[pr->indices].count;
     if (faces > SIZE_MAX / 3 || faces * 3 != nidx)
         return fail_at(d, tok, RT_ERR_INVALID,
-                       "%s: the Draco mesh has %zu triangles, the indices accessor %u has %zu indices", prim_name(d, p, name, sizeof name),
-                       faces, pr->indices, nidx);
+                       "%s: the Draco mesh has %zu triangles, the indices accessor %u has %zu indices",
+                       prim_name(d, p, name, sizeof name), faces, pr->indices, nidx);
     TRY(decoded_budget(d, tok, nidx * sizeof(uint32_t)));
     uint32_t *idx = malloc((nidx ? nidx : 1) * sizeof *idx);
     if (!idx)
@@ -2144,9 +2144,10 @@ static rt_result fill_from_draco(gl_doc *d, size_t p, const rt_draco_mesh *m)
     rt_draco_indices(m, idx);
     for (size_t k = 0; k < nidx; k++)
         if (idx[k] >= points) {
+            uint32_t bad = idx[k];
             free(idx);
-            return fail_at(d, tok, RT_ERR_INVALID, "%s: a Draco triangle names point %u of %zu", prim_name(d, p, name, sizeof name),
-                           idx[k], points);
+            return fail_at(d, tok, RT_ERR_INVALID, "%s: a Draco triangle names point %u of %zu",
+                           prim_name(d, p, name, sizeof name), bad, points);
         }
     TRY(fill_accessor(d, pr->indices, tok, idx, nidx * sizeof *idx, GL_UNSIGNED_INT));
     for (int k = 0; k < ATTR_COUNT; k++) {
