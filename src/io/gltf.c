@@ -2187,8 +2187,8 @@ static rt_result decode_draco_prims(gl_doc *d)
         rt_draco_mesh *m = rt_draco_decode(view_ptr(d, pr->draco_view, 0), d->views[pr->draco_view].length, why,
                                            sizeof why);
         if (!m)
-            return fail_at(d, pr->draco_tok, RT_ERR_INVALID, "%s: KHR_draco_mesh_compression: %s", prim_name(d, p, name, sizeof name),
-                           why);
+            return fail_at(d, pr->draco_tok, RT_ERR_INVALID, "%s: KHR_draco_mesh_compression: %s",
+                           prim_name(d, p, name, sizeof name), why);
         rt_result r = fill_from_draco(d, p, m);
         rt_draco_free(m);
         TRY(r);
