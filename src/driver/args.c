@@ -173,7 +173,8 @@ static void usage(FILE *f)
             rt_setting_default_text(def, dflt, sizeof dflt);
             snprintf(text, sizeof text, "%s (%s; default %s)", def->help, range, dflt);
         } else if (fl->kind == FLAG_THREADS) {
-            snprintf(text, sizeof text, "%s (default: all %d cores)", fl->help, rt_cpu_count());
+            int n = rt_cpu_count();
+            snprintf(text, sizeof text, "%s (default: %d, every CPU this process may use)", fl->help, n);
         } else if (fl->kind == FLAG_MAX_MEMORY) {
             char budget[32];
             memory_budget_format(memory_budget_default(), budget, sizeof budget);
