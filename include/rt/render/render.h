@@ -63,6 +63,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "rt/base/cpu.h" /* rt_cpu_count: the default thread count */
 #include "rt/base/error.h"
 #include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"
@@ -147,6 +148,5 @@ typedef struct rt_render_stats {
 rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_render_options *options,
                     rt_framebuffer *fb, rt_render_stats *stats, rt_error *err);
 
-int rt_cpu_count(void);
 
 #endif
