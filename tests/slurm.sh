@@ -1,0 +1,156 @@
+#!/bin/sh
+# make test-slurm: the Slurm launcher (examples/slurm/) against a real Slurm
+# on this one machine. Installs Debian's slurm-wlm when it is missing, writes
+# a throwaway slurm.conf in a temporary directory (auth/none and cred/none,
+# so no munge; one node: this machine as `slurmd -C` reports it; state,
+# spool, pid files and logs in the temporary directory; ports not in use),
+# starts slurmctld and slurmd with it, submits the job array and the merge
+# job through examples/slurm/submit.sh as a user would, waits for them, and
+# checks that the merged image is the single-machine render byte for byte.
+# Whether it passes, fails, times out or is interrupted, it cancels its
+# jobs, stops both daemons by their pid files, ends anything they left (found
+# by a marker in the environment it gave them) and removes the directory.
+# Needs root (slurmd starts jobs as their user). Environment: RT_BIN
+# (default ./rt), RT_SLURM_PARTS (default 3), RT_SLURM_TIMEOUT (seconds for
+# the jobs, default 300).
+set -eu
+. tests/launch-common.sh
+launch_setup test-slurm
+parts=${RT_SLURM_PARTS:-3}
+timeout=${RT_SLURM_TIMEOUT:-300}
+
+# The processes this test starts carry RT_SLURM_TEST=$work in their
+# environment (the daemons, and through them the jobs' slurmstepd and
+# scripts): the last resort of the clean-up ends exactly those.
+marked() {
+    for e in /proc/[0-9]*/environ; do
+        if tr '\0' '\n' 2>/dev/null < "$e" | grep -qxF "RT_SLURM_TEST=$work"; then
+            p=${e#/proc/}
+            [ "${p%/environ}" = $$ ] || echo "${p%/environ}"
+        fi
+    done
+}
+
+stop_pidfile() { # FILE
+    [ -s "$1" ] || return 0
+    pid=$(cat "$1")
+    kill "$pid" 2>/dev/null || return 0
+    i=0
+    while kill -0 "$pid" 2>/dev/null && [ $i -lt 50 ]; do sleep 0.2; i=$((i + 1)); done
+    kill -9 "$pid" 2>/dev/null || true
+}
+
+cleanup() {
+    status=$?
+    trap '' INT TERM
+    unset RT_SLURM_TEST   # (so that the clean-up's own commands are not marked)
+    if [ -f "$work/slurm.conf" ]; then
+        timeout 15 scancel --quiet --user="$(id -un)" 2>/dev/null || true
+        stop_pidfile "$work/slurmd.pid"
+        stop_pidfile "$work/slurmctld.pid"
+        left=$(marked)
+        if [ -n "$left" ]; then
+            # shellcheck disable=SC2086 # a list of process ids
+            kill -9 $left 2>/dev/null || true
+        fi
+    fi
+    rm -rf "$work"
+    exit $status
+}
+trap cleanup EXIT
+trap 'exit 130' INT
+trap 'exit 143' TERM HUP
+
+if [ "$(id -u)" -ne 0 ]; then
+    launch_fail "needs root: slurmd runs the jobs as the user who submits them"
+fi
+sh tools/install-deps.sh slurm-wlm:slurmctld slurm-wlm:slurmd slurm-wlm:sbatch
+plugins=$(dirname "$(find /usr/lib -name auth_none.so -path '*slurm*' 2>/dev/null | head -n 1)")
+[ -f "$plugins/auth_none.so" ] && [ -f "$plugins/cred_none.so" ] ||
+    launch_fail "this Slurm ($(slurmctld -V)) has no auth/none or cred/none plugin"
+
+# Two free TCP ports from 16817 up (not Slurm's 6817/6818: a real Slurm may run here).
+port_free() { [ -z "$(ss -Hltn "sport = :$1" 2>/dev/null)" ]; }
+ctld_port=16817
+while ! port_free $ctld_port || ! port_free $((ctld_port + 1)); do ctld_port=$((ctld_port + 2)); done
+
+node=$(slurmd -C | sed -n '1s/^NodeName=[^ ]* //p')
+host=$(hostname -s)
+mkdir -p "$work/state" "$work/spool" "$work/run"
+cat > "$work/slurm.conf" <<CONF
+# written by tests/slurm.sh; removed with its directory
+ClusterName=rttest
+SlurmctldHost=$host(127.0.0.1)
+SlurmctldPort=$ctld_port
+SlurmdPort=$((ctld_port + 1))
+AuthType=auth/none
+CredType=cred/none
+SlurmUser=root
+SlurmdUser=root
+StateSaveLocation=$work/state
+SlurmdSpoolDir=$work/spool
+SlurmctldPidFile=$work/slurmctld.pid
+SlurmdPidFile=$work/slurmd.pid
+SlurmctldLogFile=$work/slurmctld.log
+SlurmdLogFile=$work/slurmd.log
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+SelectType=select/cons_tres
+SelectTypeParameters=CR_CPU
+ReturnToService=2
+MpiDefault=none
+JobCompType=jobcomp/none
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+NodeName=$host NodeAddr=127.0.0.1 $node State=UNKNOWN
+PartitionName=rt Nodes=$host Default=YES MaxTime=INFINITE State=UP
+CONF
+export SLURM_CONF="$work/slurm.conf" RT_SLURM_TEST="$work"
+
+show_logs() {
+    for f in "$work"/slurmctld.log "$work"/slurmd.log "$work"/run/*.out; do
+        [ -f "$f" ] || continue
+        echo "--- $f (last lines)" >&2
+        tail -n 15 "$f" >&2
+    done
+}
+
+echo "test-slurm: $(slurmctld -V), a controller and a node on ports $ctld_port, $((ctld_port + 1))"
+slurmctld -f "$SLURM_CONF" || { show_logs; launch_fail "slurmctld did not start"; }
+slurmd -f "$SLURM_CONF" || { show_logs; launch_fail "slurmd did not start"; }
+i=0
+until [ "$(sinfo -h -o %t 2>/dev/null)" = idle ]; do
+    i=$((i + 1))
+    [ $i -le 60 ] || { show_logs; launch_fail "the node is not idle after 30 s: $(sinfo 2>&1)"; }
+    sleep 0.5
+done
+
+cd "$work/run"
+launch_scene scene.txt
+launch_single scene.txt single.pfm
+ids=$(RT="$RT" sh "$REPO/examples/slurm/submit.sh" "$parts" scene.txt parts image.pfm)
+array=${ids% *}
+merge=${ids#* }
+
+job_state() { scontrol -o show job "$1" 2>/dev/null | tr ' ' '\n' | sed -n 's/^JobState=//p' | sort -u | tr '\n' ' '; }
+start=$(date +%s)
+while :; do
+    state=$(job_state "$merge")
+    case $state in
+        'COMPLETED ') break ;;
+        *FAILED* | *CANCELLED* | *TIMEOUT* | *OUT_OF_MEMORY* | *NODE_FAIL* | *BOOT_FAIL* | *DEADLINE*)
+            show_logs
+            launch_fail "the merge job $merge ended $state(array $array: $(job_state "$array"))" ;;
+    esac
+    if [ $(($(date +%s) - start)) -ge "$timeout" ]; then
+        show_logs
+        launch_fail "the jobs did not finish in $timeout s (array $array: $(job_state "$array"), merge: $state)"
+    fi
+    sleep 1
+done
+[ "$(job_state "$array")" = 'COMPLETED ' ] || launch_fail "array job $array: $(job_state "$array")"
+for i in $(seq 0 $((parts - 1))); do
+    [ -f "parts/part.$i.exr" ] && [ -f "parts/part.$i.exr.json" ] || launch_fail "task $i left no part.$i.exr with its sidecar"
+done
+launch_same image.pfm single.pfm "$parts parts on Slurm, merged"
+echo "test-slurm: 1 passed, 0 failed ($parts array tasks and a merge job in $(($(date +%s) - start)) s)"
