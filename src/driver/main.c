@@ -40,6 +40,7 @@
 #include "commands.h"
 #include "memory_budget.h"
 #include "output.h"
+#include "part.h"
 #include "progress.h"
 #include "tev.h"
 #include "window.h"
@@ -418,19 +419,40 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
             tree.stats.build_ms, tree.stats.nodes, tree.stats.leaves, tree.stats.empty_leaves, tree.stats.prim_refs,
             tree.stats.depth, tree.stats.wide_nodes, (double)tree.stats.bytes / (1024.0 * 1024.0));
 
-    rt_framebuffer fb;
-    if (rt_framebuffer_init(&fb, set->width, set->height, &err) != RT_OK) {
+    part_job pj;
+    if (part_job_init(&pj, a, scene, &tree, &err) != RT_OK) {
         progress_clear(view);
         report(&err, &a->budget);
         rt_kdtree_free(&tree);
         return 2;
     }
+    if (pj.to_part && !rt_part_path_ok(output)) {
+        progress_clear(view);
+        fprintf(stderr, "rt: %s: a part is written as .exr or .pfm (with %s.json beside it), not as an 8-bit image\n",
+                output, output);
+        part_job_free(&pj);
+        rt_kdtree_free(&tree);
+        return 2;
+    }
+    if (pj.to_part)
+        rt_info("part: pixels [%d, %d) x [%d, %d), samples %d:%d", pj.region.x0, pj.region.x1, pj.region.y0,
+                pj.region.y1, pj.s_begin, pj.s_end);
+
+    rt_framebuffer fb;
+    if (rt_framebuffer_init(&fb, pj.region.x1 - pj.region.x0, pj.region.y1 - pj.region.y0, &err) != RT_OK) {
+        progress_clear(view);
+        report(&err, &a->budget);
+        part_job_free(&pj);
+        rt_kdtree_free(&tree);
+        return 2;
+    }
 
     output_aovs aov;
-    if (output_aovs_init(&aov, a, set->width, set->height, &err) != RT_OK) {
+    if (output_aovs_init(&aov, a, fb.width, fb.height, &err) != RT_OK) {
         progress_clear(view);
         report(&err, &a->budget);
         rt_framebuffer_free(&fb);
+        part_job_free(&pj);
         rt_kdtree_free(&tree);
         return 2;
     }
@@ -444,6 +466,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
             fprintf(stderr, "rt: --window: cannot open a window: %s\n", why);
             output_aovs_free(&aov);
             rt_framebuffer_free(&fb);
+            part_job_free(&pj);
             rt_kdtree_free(&tree);
             return 2;
         }
@@ -478,6 +501,10 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     ro.progress = view->bar || view->preview_path || view->tev || view->window ? progress_report : NULL;
     ro.progress_user = view;
     ro.aov = output_aovs_for_render(&aov);
+    ro.region = pj.region;
+    ro.sample_begin = pj.s_begin;
+    ro.sample_end = pj.s_end;
+    ro.accum = pj.need_accum ? &pj.accum : NULL;
     rt_render_stats rs;
     memset(&rs, 0, sizeof rs);
     rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);
@@ -499,15 +526,32 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         bool stopped = r == RT_ERR_INTERRUPTED || rs.time_limited;
         char partial[1100], what[160];
         const char *target = output;
-        if (rs.partial) {
+        if (pj.to_part) {
+            if (rs.partial) {
+                fprintf(stderr, "rt: stopped before any %s finished (%s); no part written, %s left as it was%s\n",
+                        rs.passes ? "pass" : "tile", reason ? reason : "?", output,
+                        rs.passes ? "" : " (a tiled part keeps nothing when stopped: render parts in --passes N)");
+            } else if (part_job_write(&pj, output, rs.samples_done, &write_temp, &err) != RT_OK) {
+                report(&err, &a->budget);
+                status = 2;
+            } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
+                fprintf(stderr, "rt: wrote %s and %s.json: part [%d, %d) x [%d, %d) of %dx%d, samples %d:%d of %d%s; "
+                                "%.2f s (render %.2f s)\n",
+                        output, output, pj.region.x0, pj.region.x1, pj.region.y0, pj.region.y1, set->width,
+                        set->height, pj.part_begin, pj.s_begin + rs.samples_done, set->samples, why,
+                        rt_now_seconds() - t_start, rs.seconds);
+            }
+        } else if (rs.partial) {
             rt_path_tagged(output, "partial", NULL, partial, sizeof partial); /* where an incomplete image goes */
             target = partial;
             snprintf(what, sizeof what, "%d of %d tiles at %d spp%s", rs.tiles_done, rs.tiles_total, set->samples,
                      why);
         } else {
-            snprintf(what, sizeof what, "%d of %d spp%s", rs.samples_done, set->samples, why);
+            snprintf(what, sizeof what, "%d of %d spp%s", pj.s_begin + rs.samples_done, set->samples, why);
         }
-        if (rs.partial && rs.tiles_done == 0) {
+        if (pj.to_part) {
+            /* written above */
+        } else if (rs.partial && rs.tiles_done == 0) {
             fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s left as it was\n",
                     rs.passes ? "pass" : "tile", reason ? reason : "?", output);
         } else if (output_write(a, set, &fb, &aov, target, &write_temp, &err) != RT_OK) {
@@ -517,6 +561,16 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
             fprintf(stderr, "rt: wrote %s: %dx%d, %s; %.2f s (render %.2f s)%s%s%s\n", target, fb.width, fb.height,
                     what, rt_now_seconds() - t_start, rs.seconds, rs.partial ? "; " : "", rs.partial ? output : "",
                     rs.partial ? " left as it was" : "");
+        }
+        if (status != 2 && a->part_out) {
+            if (rs.partial)
+                fprintf(stderr, "rt: %s: no part written: no %s finished\n", a->part_out, rs.passes ? "pass" : "tile");
+            else if (part_job_write(&pj, a->part_out, rs.samples_done, &write_temp, &err) != RT_OK) {
+                report(&err, &a->budget);
+                status = 2;
+            } else if (a->log_level >= RT_LOG_NORMAL || stopped)
+                fprintf(stderr, "rt: wrote %s and %s.json: samples %d:%d of %d\n", a->part_out, a->part_out,
+                        pj.part_begin, pj.s_begin + rs.samples_done, set->samples);
         }
     }
     rt_info("render: %.3f s on %d threads, %s, %llu camera rays, %llu rays, %.2f Mrays/s", rs.seconds, rs.threads,
@@ -535,6 +589,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     view->window = NULL;
     output_aovs_free(&aov);
     rt_framebuffer_free(&fb);
+    part_job_free(&pj);
     rt_kdtree_free(&tree);
     return status;
 }
@@ -546,6 +601,8 @@ int main(int argc, char **argv)
         return rt_cmd_compare(argc - 1, argv + 1);
     if (argc > 1 && strcmp(argv[1], "convert") == 0)
         return rt_cmd_convert(argc - 1, argv + 1);
+    if (argc > 1 && strcmp(argv[1], "merge") == 0)
+        return rt_cmd_merge(argc - 1, argv + 1);
     args a;
     int status = args_parse(&a, argc, argv);
     if (status != ARGS_OK)
@@ -563,6 +620,17 @@ int main(int argc, char **argv)
     rt_scene scene;
     rt_scene_init(&scene);
     char output[1024];
+    char part_default[1100];
+    if (args_output_is_part(&a) && !a.output) { /* a part goes to NAME.part.exr */
+        char name[1024];
+        default_output(NULL, a.input, name, sizeof name);
+        rt_path_tagged(name, "part", ".exr", part_default, sizeof part_default);
+        a.output = part_default;
+    }
+    if (a.part_out && !rt_part_path_ok(a.part_out)) {
+        fprintf(stderr, "rt: --part-out %s: a part is written as .exr or .pfm\n", a.part_out);
+        return 2;
+    }
     progress_view view;
     progress_view_init(&view, a.log_level >= RT_LOG_NORMAL && isatty(2));
     progress_phase(&view, "load", a.input ? a.input : "the built-in scene");
