@@ -8,7 +8,8 @@
 # render container's command locally for every index as the kubelet would
 # (the manifest's environment, requests.cpu through resourceFieldRef,
 # $(VAR) expanded, JOB_COMPLETION_INDEX set; WORK, the mount, a local
-# directory; rt on the PATH), then the merge container's command, and checks
+# directory; rt on the PATH; one part already half rendered, as an evicted
+# pod leaves it, which its pod resumes), then the merge container's command, and checks
 # the merged image against a single-machine render byte for byte: PNG as
 # the manifest writes it, and PFM (IMAGE=image.pfm) for the float pixels.
 # Needs python3 with PyYAML (Debian's python3-yaml, installed when missing).
@@ -133,9 +134,20 @@ if failures:
         print("test-kubernetes: " + f, file=sys.stderr)
     sys.exit(1)
 
-# The pods, as the kubelet would start them, in an order of their own
+# The pods, as the kubelet would start them, in an order of their own; pod 2
+# finds its part there with samples 0..2 of 8, as an evicted pod leaves it
+os.makedirs(os.path.join(volume, "parts"))
+r = subprocess.run(["rt", "-q", "--part", f"2/{n}", "--spp-range", "0:3", "-o",
+                    os.path.join(volume, "parts", "part.2.exr"), os.path.join(volume, renv["SCENE"])])
+check(r.returncode == 0, "the partial part 2 was not rendered")
 for i in reversed(range(n)):
     run("render-job.yaml", rc, dict(renv, WORK=volume), {"JOB_COMPLETION_INDEX": str(i)})
+with open(os.path.join(volume, "parts", "part.2.exr.json")) as f:
+    check('"samples": [0, 8]' in f.read(), "pod 2 did not complete the part it found")
+# pods started again (a retry after the merge failed) keep the complete parts
+stamp = os.stat(os.path.join(volume, "parts", "part.0.exr")).st_mtime_ns
+run("render-job.yaml", rc, dict(renv, WORK=volume), {"JOB_COMPLETION_INDEX": "0"})
+check(os.stat(os.path.join(volume, "parts", "part.0.exr")).st_mtime_ns == stamp, "pod 0 rendered its complete part again")
 run("merge-job.yaml", mc, dict(menv, WORK=volume), {})
 run("merge-job.yaml", mc, dict(menv, WORK=volume, IMAGE="image.pfm"), {})
 if failures:

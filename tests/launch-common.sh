@@ -17,6 +17,7 @@ launch_setup() {
     RT=${RT_BIN:-./rt}
     case $RT in /*) ;; *) RT=$REPO/$RT ;; esac
     [ -x "$RT" ] || launch_fail "no rt binary at $RT (make first)"
+    # shellcheck disable=SC2034 # used by the tests that source this file
     work=$(mktemp -d "${TMPDIR:-/tmp}/rt-$launch_name.XXXXXX")
 }
 

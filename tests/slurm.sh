@@ -5,8 +5,10 @@
 # so no munge; one node: this machine as `slurmd -C` reports it; state,
 # spool, pid files and logs in the temporary directory; ports not in use),
 # starts slurmctld and slurmd with it, submits the job array and the merge
-# job through examples/slurm/submit.sh as a user would, waits for them, and
-# checks that the merged image is the single-machine render byte for byte.
+# job through examples/slurm/submit.sh as a user would (one part already
+# there, half rendered, as a task stopped by its time limit leaves it:
+# submit.sh --resume), waits for them, and checks that the merged image is
+# the single-machine render byte for byte.
 # Whether it passes, fails, times out or is interrupted, it cancels its
 # jobs, stops both daemons by their pid files, ends anything they left (found
 # by a marker in the environment it gave them) and removes the directory.
@@ -128,7 +130,15 @@ done
 cd "$work/run"
 launch_scene scene.txt
 launch_single scene.txt single.pfm
-ids=$(RT="$RT" sh "$REPO/examples/slurm/submit.sh" "$parts" scene.txt parts image.pfm)
+# Part 1 is there already with samples 0..2 of 8, as a task stopped by its
+# time limit leaves it: submit.sh refuses the directory without --resume,
+# and with it task 1 resumes the part while the others render theirs.
+mkdir parts
+"$RT" -q --part "1/$parts" --spp-range 0:3 -o parts/part.1.exr scene.txt || launch_fail "the partial part 1 was not rendered"
+if RT="$RT" sh "$REPO/examples/slurm/submit.sh" "$parts" scene.txt parts image.pfm 2>/dev/null; then
+    launch_fail "submit.sh took a directory with parts in it without --resume"
+fi
+ids=$(RT="$RT" sh "$REPO/examples/slurm/submit.sh" --resume "$parts" scene.txt parts image.pfm)
 array=${ids% *}
 merge=${ids#* }
 
@@ -152,5 +162,6 @@ done
 for i in $(seq 0 $((parts - 1))); do
     [ -f "parts/part.$i.exr" ] && [ -f "parts/part.$i.exr.json" ] || launch_fail "task $i left no part.$i.exr with its sidecar"
 done
-launch_same image.pfm single.pfm "$parts parts on Slurm, merged"
+grep -q 'resuming it' rt-part-"${array}"_1.out || launch_fail "task 1 did not resume its part: $(cat rt-part-"${array}"_1.out)"
+launch_same image.pfm single.pfm "$parts parts on Slurm (one resumed), merged"
 echo "test-slurm: 1 passed, 0 failed ($parts array tasks and a merge job in $(($(date +%s) - start)) s)"
