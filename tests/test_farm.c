@@ -257,10 +257,50 @@ static void test_resume_exact(void **state)
     assert_same_bytes(in_dir("r.png"), in_dir("full.png"));
     /* a resumed part that is not the whole image is a part again */
     assert_int_equal(RUN("-q", "--resume", in_dir("a.pfm"), "--spp-range", "5:16", "-o", in_dir("x.pfm"), scene), 2);
+    /* a part of another render is refused, naming what differs */
+    assert_int_equal(RUN("-q", "--resume", in_dir("a.pfm"), "--seed", "9", "-o", in_dir("x.png"), scene), 2);
+    assert_non_null(strstr(err_text, "seed 7, not 9"));
+    assert_int_equal(RUN("-q", "--resume", in_dir("a.pfm"), "--set", "clamp=3", "-o", in_dir("x.png"), scene), 2);
+    assert_non_null(strstr(err_text, "clamp"));
+    assert_int_equal(access(in_dir("x.png"), F_OK), -1);
     /* a part of all samples has nothing left to resume */
     RUN_OK("-q", "--spp-range", "0:16", "-o", in_dir("all.exr"), scene);
     assert_int_equal(RUN("-q", "--resume", in_dir("all.exr"), "-o", in_dir("x.png"), scene), 2);
     assert_non_null(strstr(err_text, "all there are"));
+}
+
+/* AOVs in parts: their sums travel as EXR layers; merged and resumed they
+ * are the single render's bytes, EXR layers and PFM files alike. */
+static void test_aov_parts(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    const char *aovs = "albedo,normal,depth,position";
+    RUN_OK("-q", "--aov", aovs, "-o", in_dir("af.exr"), scene);
+    RUN_OK("-q", "--aov", aovs, "-o", in_dir("af.png"), scene);
+    RUN_OK("-q", "--aov", aovs, "--part", "0/3", "-o", in_dir("ap0.exr"), scene);
+    RUN_OK("-q", "--aov", aovs, "--part", "1/3", "--passes", "0", "-o", in_dir("ap1.exr"), scene);
+    RUN_OK("-q", "--aov", aovs, "--part", "2/3", "--spp-range", "0:6", "-o", in_dir("ap2a.exr"), scene);
+    RUN_OK("-q", "--aov", aovs, "--resume", in_dir("ap2a.exr"), "-o", in_dir("ap2.exr"), scene);
+    RUN_OK("merge", in_dir("ap0.exr"), in_dir("ap1.exr"), in_dir("ap2.exr"), "-o", in_dir("am.exr"));
+    assert_same_bytes(in_dir("am.exr"), in_dir("af.exr"));
+    RUN_OK("merge", in_dir("ap0.exr"), in_dir("ap1.exr"), in_dir("ap2.exr"), "-o", in_dir("am.png"));
+    assert_same_bytes(in_dir("am.png"), in_dir("af.png"));
+    const char *names[4] = {"albedo", "normal", "depth", "position"};
+    for (int k = 0; k < 4; k++) {
+        char a[64], b[64];
+        snprintf(a, sizeof a, "am.%s.pfm", names[k]);
+        snprintf(b, sizeof b, "af.%s.pfm", names[k]);
+        assert_same_bytes(in_dir(a), in_dir(b));
+    }
+    /* parts with other AOVs are of another render; variance and spp are not kept */
+    RUN_OK("-q", "--aov", "albedo", "--part", "2/3", "-o", in_dir("ap2x.exr"), scene);
+    assert_int_equal(RUN("merge", in_dir("ap0.exr"), in_dir("ap1.exr"), in_dir("ap2x.exr"), "-o", in_dir("x.exr")), 2);
+    assert_non_null(strstr(err_text, "other AOVs"));
+    assert_int_equal(RUN("-q", "--aov", "variance", "--part", "0/3", "-o", in_dir("x.exr"), scene), 2);
+    assert_int_equal(RUN("-q", "--aov", "albedo", "--part", "0/3", "-o", in_dir("x.pfm"), scene), 2);
+    assert_int_equal(access(in_dir("x.exr"), F_OK), -1);
+    assert_int_equal(access(in_dir("x.pfm"), F_OK), -1);
 }
 
 /* The samples [0, k] a sidecar says its part holds. */
@@ -449,6 +489,7 @@ int main(void)
         cmocka_unit_test(test_resume_exact),
         cmocka_unit_test(test_time_limit_then_resume),
         cmocka_unit_test(test_merge_refusals),
+        cmocka_unit_test(test_aov_parts),
         cmocka_unit_test(test_part_bands),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -166,6 +166,7 @@ static void usage(FILE *f)
     fprintf(f, "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off | -]\n"
                "       rt compare CANDIDATE REFERENCE [--max-rmse X] [--max-flip X] ...  (docs/compare.md)\n"
                "       rt convert IN OUT [--exposure EV] [--tonemap NAME] [--half]  (docs/hdr.md)\n"
+               "       rt merge PART... -o OUT [--exposure EV] [--tonemap NAME] [--half]  (docs/farm.md)\n"
                "\n"
                "Renders a scene to an image. With no input, renders the built-in Cornell box to out.png;\n"
                "'-' reads a scene, glTF or mesh from standard input. A model given directly renders with\n"

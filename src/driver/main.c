@@ -434,6 +434,17 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         rt_kdtree_free(&tree);
         return 2;
     }
+    const char *aov_part = pj.info.layer_count == 0                            ? NULL
+                           : pj.to_part && !rt_path_has_ext(output, ".exr")    ? output
+                           : a->part_out && !rt_path_has_ext(a->part_out, ".exr") ? a->part_out
+                                                                                 : NULL;
+    if (aov_part) {
+        progress_clear(view);
+        fprintf(stderr, "rt: %s: a part with AOVs is written as .exr (their sums are layers of it)\n", aov_part);
+        part_job_free(&pj);
+        rt_kdtree_free(&tree);
+        return 2;
+    }
     if (pj.to_part)
         rt_info("part: pixels [%d, %d) x [%d, %d), samples %d:%d", pj.region.x0, pj.region.x1, pj.region.y0,
                 pj.region.y1, pj.s_begin, pj.s_end);
@@ -480,7 +491,9 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
-    view->preview_path = a->preview_seconds > 0.0 ? output : NULL;
+    view->preview_path = a->preview_seconds > 0.0 && !pj.to_part ? output : NULL;
+    if (a->preview_seconds > 0.0 && pj.to_part)
+        rt_warn("--preview: a part's output holds sums, not an image; no preview is written");
     view->preview_seconds = a->preview_seconds;
     view->exposure = set->exposure;
     view->time_limit = a->time_limit;
@@ -627,8 +640,9 @@ int main(int argc, char **argv)
         rt_path_tagged(name, "part", ".exr", part_default, sizeof part_default);
         a.output = part_default;
     }
-    if (a.part_out && !rt_part_path_ok(a.part_out)) {
-        fprintf(stderr, "rt: --part-out %s: a part is written as .exr or .pfm\n", a.part_out);
+    if (a.part_out && (!rt_part_path_ok(a.part_out) || rt_output_check(a.part_out, &err) != RT_OK)) {
+        fprintf(stderr, "rt: --part-out %s: %s\n", a.part_out,
+                rt_part_path_ok(a.part_out) ? err.message : "a part is written as .exr or .pfm");
         return 2;
     }
     progress_view view;

@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "output.h"
 #include "part.h"
 #include "rt/base/alloc.h"
 #include "rt/base/number.h"
@@ -70,9 +71,9 @@ static void sort_group(int *idx, int n, const rt_part *parts)
         }
 }
 
-/* Checks that the parts fit together and sums them into sum/good (whole
- * image); 0 or 2 (the message printed). */
-static int assemble(const merge_state *m, float *sum, uint32_t *good, FILE *errs)
+/* Checks that the parts fit together and sums them into sum/good and the
+ * layers' sums (whole image); 0 or 2 (the message printed). */
+static int assemble(const merge_state *m, float *sum, uint32_t *good, float *const *layer, FILE *errs)
 {
     const rt_part *P = m->parts;
     const rt_part_info *first = &P[0].info;
@@ -152,6 +153,15 @@ static int assemble(const merge_state *m, float *sum, uint32_t *good, FILE *errs
                 sum[3 * px + 1] = s1;
                 sum[3 * px + 2] = s2;
                 good[px] = c;
+                for (int l = 0; l < first->layer_count; l++) {
+                    size_t ch = (size_t)first->layer_channels[l];
+                    for (size_t q = 0; q < ch; q++) {
+                        float v = P[idx[0]].layer[l][ch * local + q];
+                        for (int k = 1; k < n; k++)
+                            v += P[idx[k]].layer[l][ch * local + q];
+                        layer[l][ch * px + q] = v;
+                    }
+                }
             }
     }
     for (size_t i = 0; i < (size_t)W * (size_t)H && status == 0; i++)
@@ -268,27 +278,73 @@ int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs)
     rt_framebuffer fb = {0};
     float *sum = NULL;
     uint32_t *good = NULL;
+    float *layer[RT_PART_MAX_LAYERS] = {NULL};
+    output_aovs aov;
+    memset(&aov, 0, sizeof aov);
+    args oa; /* what output_write reads: the AOVs, the tone flags */
+    memset(&oa, 0, sizeof oa);
+    oa.exposure_ev = ev;
+    oa.tonemap = tm;
+    oa.half = half;
     if (status == 0) {
         const rt_part_info *first = &m.parts[0].info;
-        sum = rt_alloc((size_t)first->width * (size_t)first->height, 3 * sizeof(float));
-        good = rt_alloc((size_t)first->width * (size_t)first->height, sizeof(uint32_t));
-        if (!sum || !good || rt_framebuffer_init(&fb, first->width, first->height, &err) != RT_OK) {
+        size_t np = (size_t)first->width * (size_t)first->height;
+        sum = rt_alloc(np, 3 * sizeof(float));
+        good = rt_alloc(np, sizeof(uint32_t));
+        bool ok = sum && good;
+        for (int l = 0; l < first->layer_count; l++) {
+            layer[l] = rt_alloc(np, (size_t)first->layer_channels[l] * sizeof(float));
+            ok = ok && layer[l];
+            for (int k = 0; k < AOV_COUNT; k++)
+                if (strcmp(aov_names[k], first->layer_name[l]) == 0)
+                    oa.aovs |= 1u << k;
+        }
+        if (!ok || rt_framebuffer_init(&fb, first->width, first->height, &err) != RT_OK ||
+            output_aovs_init(&aov, &oa, first->width, first->height, &err) != RT_OK) {
             fprintf(errs, "rt: merge: out of memory for a %dx%d image\n", first->width, first->height);
             status = 2;
         }
     }
     if (status == 0)
-        status = assemble(&m, sum, good, errs);
+        status = assemble(&m, sum, good, layer, errs);
     if (status == 0) {
-        /* the resolve of src/render/render.c, operation for operation */
-        for (size_t i = 0; i < (size_t)fb.width * (size_t)fb.height; i++) {
-            float inv = good[i] ? 1.0f / (float)good[i] : 1.0f;
-            for (int c = 0; c < 3; c++)
-                fb.rgb[3 * i + (size_t)c] = good[i] ? sum[3 * i + (size_t)c] * inv : sum[3 * i + (size_t)c];
+        const rt_part_info *first = &m.parts[0].info;
+        /* the resolve of src/render/render.c, operation for operation:
+         * sum * (1 / good) for the image, sum * (1 / good or 0) for the AOVs */
+        rt_aov_sample *acc = rt_alloc((size_t)fb.width, sizeof *acc);
+        if (!acc) {
+            fprintf(errs, "rt: merge: out of memory\n");
+            status = 2;
         }
-        rt_image_options opt = {.exposure = m.parts[0].info.exposure * rt_exposure_scale(ev), .tonemap = tm,
-                                .half = half};
-        if (rt_framebuffer_write_with(&fb, dst, &opt, &err) != RT_OK) {
+        for (int y = 0; y < fb.height && status == 0; y++) {
+            size_t row = (size_t)y * (size_t)fb.width;
+            const float *rows[RT_PART_MAX_LAYERS] = {NULL};
+            for (int l = 0; l < first->layer_count; l++)
+                rows[l] = layer[l] + row * (size_t)first->layer_channels[l];
+            layers_to_aov(first, rows, acc, (size_t)fb.width);
+            for (size_t x = 0; x < (size_t)fb.width; x++) {
+                size_t i = row + x;
+                float inv = good[i] ? 1.0f / (float)good[i] : 1.0f;
+                for (int c = 0; c < 3; c++)
+                    fb.rgb[3 * i + (size_t)c] = good[i] ? sum[3 * i + (size_t)c] * inv : sum[3 * i + (size_t)c];
+                float ainv = good[i] ? 1.0f / (float)good[i] : 0.0f;
+                const rt_vec3 *v3[3] = {&acc[x].albedo, &acc[x].normal, &acc[x].position};
+                float *dst3[3] = {aov.buf.albedo, aov.buf.normal, aov.buf.position};
+                for (int k = 0; k < 3; k++)
+                    if (dst3[k]) {
+                        dst3[k][3 * i] = v3[k]->x * ainv;
+                        dst3[k][3 * i + 1] = v3[k]->y * ainv;
+                        dst3[k][3 * i + 2] = v3[k]->z * ainv;
+                    }
+                if (aov.buf.depth)
+                    aov.buf.depth[i] = acc[x].depth * ainv;
+            }
+        }
+        free(acc);
+        rt_settings set;
+        memset(&set, 0, sizeof set);
+        set.exposure = first->exposure;
+        if (status == 0 && output_write(&oa, &set, &fb, &aov, dst, NULL, &err) != RT_OK) {
             fprintf(errs, "rt: merge: %s\n", err.message);
             status = 2;
         } else {
@@ -297,6 +353,9 @@ int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs)
         }
     }
     rt_framebuffer_free(&fb);
+    output_aovs_free(&aov);
+    for (int l = 0; l < RT_PART_MAX_LAYERS; l++)
+        free(layer[l]);
     free(sum);
     free(good);
     for (int i = 0; i < m.count; i++)

@@ -14,6 +14,7 @@
 #include "part_split.h"
 #include "rt/base/alloc.h"
 #include "rt/base/file.h"
+#include "rt/render/aov.h"
 #include "rt/render/integrator.h"
 
 /* Appends "key value\n" to the settings text. */
@@ -67,6 +68,40 @@ static void settings_text(const rt_scene *scene, char *buf, size_t size)
     line(buf, size, "camera.fov %a", (double)c->vfov_deg);
     line(buf, size, "camera.aperture %a", (double)c->aperture);
     line(buf, size, "camera.focus_distance %a", (double)c->focus_distance);
+}
+
+/* Component q of the AOV a layer holds (name: albedo, normal, position, depth). */
+static float *aov_field(rt_aov_sample *s, const char *name, int q)
+{
+    rt_vec3 *v = strcmp(name, "albedo") == 0   ? &s->albedo
+                 : strcmp(name, "normal") == 0 ? &s->normal
+                 : strcmp(name, "position") == 0 ? &s->position
+                                                 : NULL;
+    if (!v)
+        return &s->depth;
+    return q == 0 ? &v->x : q == 1 ? &v->y : &v->z;
+}
+
+void aov_to_layers(const rt_part_info *info, const rt_aov_sample *sums, float *const *layers, size_t n)
+{
+    for (int k = 0; k < info->layer_count; k++) {
+        int c = info->layer_channels[k];
+        for (size_t i = 0; i < n; i++) {
+            rt_aov_sample s = sums[i];
+            for (int q = 0; q < c; q++)
+                layers[k][(size_t)c * i + (size_t)q] = *aov_field(&s, info->layer_name[k], q);
+        }
+    }
+}
+
+void layers_to_aov(const rt_part_info *info, const float *const *layers, rt_aov_sample *sums, size_t n)
+{
+    for (int k = 0; k < info->layer_count; k++) {
+        int c = info->layer_channels[k];
+        for (size_t i = 0; i < n; i++)
+            for (int q = 0; q < c; q++)
+                *aov_field(&sums[i], info->layer_name[k], q) = layers[k][(size_t)c * i + (size_t)q];
+    }
 }
 
 rt_result part_identity(const rt_scene *scene, const char *input, rt_part_info *info, rt_error *err)
@@ -133,6 +168,10 @@ const char *part_mismatch(const rt_part_info *a, const rt_part_info *b, char *bu
         snprintf(buf, size, "%d samples per pixel, not %d", a->spp, b->spp);
     else if (a->seed != b->seed)
         snprintf(buf, size, "seed %u, not %u", (unsigned)a->seed, (unsigned)b->seed);
+    else if (a->layer_count != b->layer_count ||
+             memcmp(a->layer_name, b->layer_name, sizeof a->layer_name) != 0)
+        snprintf(buf, size, "other AOVs (%d layer%s, not %d)", a->layer_count, a->layer_count == 1 ? "" : "s",
+                 b->layer_count);
     else if (strcmp(a->settings, b->settings) != 0) {
         char x[256], y[256];
         first_difference(a->settings, b->settings, x, y, sizeof x);
@@ -174,9 +213,18 @@ rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, cons
         pj->s_end = a->spp_end;
     }
     pj->part_begin = pj->s_begin;
-    if ((pj->to_part || a->resume) && (a->aovs || a->denoise))
+    if ((pj->to_part || a->resume || a->part_out) &&
+        (a->denoise || (a->aovs & ((1u << AOV_VARIANCE) | (1u << AOV_SPP)))))
         return rt_fail(err, RT_ERR_INVALID,
-                       "--aov and --denoise are not available for parts yet; merge the parts, then denoise the image");
+                       "parts keep the albedo, normal, depth and position AOVs; not the variance or spp AOVs, nor "
+                       "--denoise (merge the parts, then denoise the image)");
+    /* the AOV sums a part carries: its layers, in aov_names order */
+    for (int k = 0; k < AOV_COUNT; k++)
+        if (a->aovs & (1u << k)) {
+            rt_part_info *in = &pj->info;
+            snprintf(in->layer_name[in->layer_count], sizeof in->layer_name[0], "%s", aov_names[k]);
+            in->layer_channels[in->layer_count++] = k == AOV_DEPTH ? 1 : 3;
+        }
     size_t n = (size_t)(pj->region.x1 - pj->region.x0) * (size_t)(pj->region.y1 - pj->region.y0);
     pj->need_accum = true;
     if (a->resume) {
@@ -201,6 +249,18 @@ rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, cons
         pj->s_end = s->samples;
         pj->accum.sum = p.sum;
         pj->accum.good = p.good;
+        p.sum = NULL;
+        p.good = NULL;
+        if (pj->info.layer_count) {
+            size_t np = (size_t)(p.info.x1 - p.info.x0) * (size_t)(p.info.y1 - p.info.y0);
+            pj->accum.aov_sum = rt_alloc(np, sizeof *pj->accum.aov_sum);
+            if (!pj->accum.aov_sum) {
+                rt_part_free(&p);
+                return rt_fail(err, RT_ERR_NOMEM, "out of memory for the AOV sums of %s", a->resume);
+            }
+            layers_to_aov(&p.info, (const float *const *)p.layer, pj->accum.aov_sum, np);
+        }
+        rt_part_free(&p);
         bool whole = pj->region.x0 == 0 && pj->region.y0 == 0 && pj->region.x1 == s->width &&
                      pj->region.y1 == s->height && pj->part_begin == 0;
         pj->to_part = !whole;
@@ -208,7 +268,9 @@ rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, cons
     }
     pj->accum.sum = rt_alloc(n, 3 * sizeof(float));
     pj->accum.good = rt_alloc(n, sizeof(uint32_t));
-    if (!pj->accum.sum || !pj->accum.good) {
+    if (pj->info.layer_count)
+        pj->accum.aov_sum = rt_alloc(n, sizeof *pj->accum.aov_sum);
+    if (!pj->accum.sum || !pj->accum.good || (pj->info.layer_count && !pj->accum.aov_sum)) {
         part_job_free(pj);
         return rt_fail(err, RT_ERR_NOMEM, "out of memory for the sums of a %zu-pixel part", n);
     }
@@ -221,8 +283,10 @@ void part_job_free(part_job *pj)
 {
     free(pj->accum.sum);
     free(pj->accum.good);
+    free(pj->accum.aov_sum);
     pj->accum.sum = NULL;
     pj->accum.good = NULL;
+    pj->accum.aov_sum = NULL;
 }
 
 rt_result part_job_write(const part_job *pj, const char *path, int samples_done, rt_write_temp *temp, rt_error *err)
@@ -234,5 +298,17 @@ rt_result part_job_write(const part_job *pj, const char *path, int samples_done,
     info.y1 = pj->region.y1;
     info.s_begin = pj->part_begin;
     info.s_end = pj->s_begin + samples_done;
-    return rt_part_write(path, &info, pj->accum.sum, pj->accum.good, temp, err);
+    size_t n = (size_t)(info.x1 - info.x0) * (size_t)(info.y1 - info.y0);
+    float *layers[RT_PART_MAX_LAYERS] = {NULL};
+    rt_result r = RT_OK;
+    for (int k = 0; k < info.layer_count && r == RT_OK; k++)
+        if (!(layers[k] = rt_alloc(n, (size_t)info.layer_channels[k] * sizeof(float))))
+            r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the AOV layers", path);
+    if (r == RT_OK) {
+        aov_to_layers(&info, pj->accum.aov_sum, layers, n);
+        r = rt_part_write(path, &info, pj->accum.sum, pj->accum.good, (const float *const *)layers, temp, err);
+    }
+    for (int k = 0; k < info.layer_count; k++)
+        free(layers[k]);
+    return r;
 }

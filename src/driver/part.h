@@ -28,7 +28,7 @@ typedef struct part_job {
     int part_begin;          /* the first sample the sums hold (--resume: the part's; else s_begin) */
     bool need_accum;         /* sums kept: a part output, --part-out or --resume */
     rt_render_accum accum;   /* region-sized; zeros, or the resumed part's sums */
-    rt_part_info info;       /* what the parts written are parts of */
+    rt_part_info info;       /* what the parts written are parts of (with the AOV layers) */
 } part_job;
 
 /* The identity of a render (scene hash, settings text, size, samples, seed,
@@ -43,6 +43,11 @@ void part_job_free(part_job *pj);
 /* Writes the sums as a part at path covering samples [part_begin, s_begin +
  * samples_done). */
 rt_result part_job_write(const part_job *pj, const char *path, int samples_done, rt_write_temp *temp, rt_error *err);
+
+/* A part's AOV layers (info->layer_name: albedo, normal, position, depth)
+ * to and from the render's per-pixel AOV sums, n pixels. */
+void aov_to_layers(const rt_part_info *info, const struct rt_aov_sample *sums, float *const *layers, size_t n);
+void layers_to_aov(const rt_part_info *info, const float *const *layers, struct rt_aov_sample *sums, size_t n);
 
 /* NULL when a and b are parts of the same render; else what differs, in
  * words ("settings differ: 'samples 64' against 'samples 16'"), in buf. */

@@ -112,13 +112,16 @@ static void put_string(text *t, const char *s)
 }
 
 rt_result rt_part_write(const char *path, const rt_part_info *info, const float *sum, const uint32_t *good,
-                        rt_write_temp *temp, rt_error *err)
+                        const float *const *layers, rt_write_temp *temp, rt_error *err)
 {
     char side[4200], cpath[4200];
     if (!rt_part_path_ok(path))
         return rt_fail(err, RT_ERR_INVALID, "%s: a part is written as .exr or .pfm", path);
     if (!rt_part_sidecar_path(path, side, sizeof side) || !count_path(path, cpath, sizeof cpath))
         return rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
+    if (info->layer_count < 0 || info->layer_count > RT_PART_MAX_LAYERS ||
+        (info->layer_count > 0 && !rt_path_has_ext(path, ".exr")))
+        return rt_fail(err, RT_ERR_INVALID, "%s: a part with AOVs is written as .exr", path);
     int w = info->x1 - info->x0, h = info->y1 - info->y0;
     size_t n = (size_t)w * (size_t)h;
     float *counts = rt_alloc(n, sizeof(float));
@@ -131,8 +134,10 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
     rt_result r = RT_OK;
     uint64_t image_hash = 0, count_hash = 0;
     if (exr) {
-        rt_image_layer layer = {"count", 1, counts};
-        rt_image_options opt = {.layers = &layer, .layer_count = 1};
+        rt_image_layer layer[1 + RT_PART_MAX_LAYERS] = {{"count", 1, counts}};
+        for (int k = 0; k < info->layer_count; k++)
+            layer[1 + k] = (rt_image_layer){info->layer_name[k], info->layer_channels[k], layers[k]};
+        rt_image_options opt = {.layers = layer, .layer_count = 1 + info->layer_count};
         r = rt_framebuffer_write_tracked(&fb, path, &opt, temp, err);
     } else {
         float *grey = rt_alloc(n, 3 * sizeof(float));
@@ -178,7 +183,13 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
         info->x0, info->y0, info->x1, info->y1);
     put(&t, "  \"spp\": %d,\n  \"samples\": [%d, %d],\n  \"seed\": %" PRIu32 ",\n", info->spp, info->s_begin,
         info->s_end, info->seed);
-    put(&t, "  \"exposure\": \"%a\"\n}\n", (double)info->exposure);
+    put(&t, "  \"exposure\": \"%a\",\n  \"layers\": [", (double)info->exposure);
+    for (int k = 0; k < info->layer_count; k++) {
+        put(&t, "%s[", k ? ", " : "");
+        put_string(&t, info->layer_name[k]);
+        put(&t, ", %d]", info->layer_channels[k]);
+    }
+    put(&t, "]\n}\n");
     if (t.failed) {
         free(t.buf);
         return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the sidecar", side);
@@ -297,6 +308,21 @@ static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *im
         r = bad(err, side, "\"seed\" must be an integer from 0 to 4294967295");
     else if (!get_string(&j, 0, "exposure", expo, sizeof expo) || !float_text(expo, &info->exposure))
         r = bad(err, side, "\"exposure\" missing or not a number");
+    int li = r == RT_OK ? rt_json_get(&j, 0, "layers") : -1;
+    if (r == RT_OK && li >= 0) {
+        if (j.tok[li].type != RT_JSON_ARRAY || j.tok[li].size > RT_PART_MAX_LAYERS)
+            r = bad(err, side, "\"layers\" must be an array of at most 4 [name, channels] pairs");
+        int e = li + 1;
+        for (int k = 0; r == RT_OK && k < j.tok[li].size; k++, e = rt_json_skip(&j, e)) {
+            double ch = 0;
+            if (j.tok[e].type != RT_JSON_ARRAY || j.tok[e].size != 2 ||
+                rt_json_string(&j, e + 1, info->layer_name[k], sizeof info->layer_name[k]) <= 0 ||
+                strchr(info->layer_name[k], '.') || !rt_json_number(&j, e + 2, &ch) || (ch != 1 && ch != 3))
+                r = bad(err, side, "\"layers\" entries must be [\"name\", 1 or 3]");
+            info->layer_channels[k] = (int)ch;
+            info->layer_count = k + 1;
+        }
+    }
     if (r == RT_OK) {
         info->width = (int)w;
         info->height = (int)h;
@@ -314,8 +340,10 @@ static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *im
     return r;
 }
 
-/* The image at path, checked against its hash: n floats a pixel. */
-static rt_result read_image(const char *path, uint64_t want, bool exr, float **px, int *w, int *h, rt_error *err)
+/* The image at path, checked against its hash: an EXR's `count` named
+ * channels, else a PFM's three. */
+static rt_result read_image(const char *path, uint64_t want, bool exr, const char *const *names, int count,
+                            float **px, int *w, int *h, rt_error *err)
 {
     char *bytes;
     size_t size;
@@ -330,8 +358,7 @@ static rt_result read_image(const char *path, uint64_t want, bool exr, float **p
                        path);
     }
     if (exr) {
-        static const char *const names[4] = {"R", "G", "B", "count.Y"};
-        r = rt_exr_decode_channels(bytes, size, path, 32768, 1ull << 30, names, 4, px, w, h, err);
+        r = rt_exr_decode_channels(bytes, size, path, 32768, 1ull << 30, names, count, px, w, h, err);
         free(bytes);
         return r;
     }
@@ -373,13 +400,25 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
     int rw = info->x1 - info->x0, rh = info->y1 - info->y0, w = 0, h = 0;
     size_t n = (size_t)rw * (size_t)rh;
     float *px = NULL, *cpx = NULL;
-    r = read_image(image, image_hash, exr, &px, &w, &h, err);
+    /* the channels: R, G, B, count.Y, then each layer's */
+    char names_buf[4 + 3 * RT_PART_MAX_LAYERS][24];
+    const char *names[4 + 3 * RT_PART_MAX_LAYERS] = {"R", "G", "B", "count.Y"};
+    int nc = 4;
+    for (int k = 0; k < info->layer_count; k++)
+        for (int c = 0; c < info->layer_channels[k]; c++, nc++) {
+            snprintf(names_buf[nc], sizeof names_buf[nc], "%s.%s", info->layer_name[k],
+                     info->layer_channels[k] == 1 ? "Y" : c == 0 ? "R" : c == 1 ? "G" : "B");
+            names[nc] = names_buf[nc];
+        }
+    if (!exr && info->layer_count)
+        return rt_fail(err, RT_ERR_INVALID, "%s: a .pfm part cannot have layers", side);
+    r = read_image(image, image_hash, exr, names, nc, &px, &w, &h, err);
     if (r == RT_OK && (w != rw || h != rh))
         r = rt_fail(err, RT_ERR_INVALID, "%s: the image is %dx%d but its sidecar's region is %dx%d", image, w, h, rw,
                     rh);
     int cw = 0, ch = 0;
     if (r == RT_OK && !exr) {
-        r = read_image(cpath, count_hash, false, &cpx, &cw, &ch, err);
+        r = read_image(cpath, count_hash, false, NULL, 0, &cpx, &cw, &ch, err);
         if (r == RT_OK && (cw != rw || ch != rh))
             r = rt_fail(err, RT_ERR_INVALID, "%s: the image is %dx%d but its sidecar's region is %dx%d", cpath, cw,
                         ch, rw, rh);
@@ -387,13 +426,18 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
     if (r == RT_OK) {
         part->sum = rt_alloc(n, 3 * sizeof(float));
         part->good = rt_alloc(n, sizeof(uint32_t));
-        if (!part->sum || !part->good)
+        bool ok = part->sum && part->good;
+        for (int k = 0; k < info->layer_count; k++) {
+            part->layer[k] = rt_alloc(n, (size_t)info->layer_channels[k] * sizeof(float));
+            ok = ok && part->layer[k];
+        }
+        if (!ok)
             r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for a %dx%d part", image, rw, rh);
     }
     float most = (float)(info->s_end - info->s_begin);
     for (size_t i = 0; i < n && r == RT_OK; i++) {
-        const float *s = exr ? px + 4 * i : px + 3 * i;
-        float c = exr ? px[4 * i + 3] : cpx[3 * i];
+        const float *s = exr ? px + (size_t)nc * i : px + 3 * i;
+        float c = exr ? s[3] : cpx[3 * i];
         if (!(c >= 0.0f && c <= most && c == floorf(c)) || !(s[0] >= 0.0f) || !(s[1] >= 0.0f) || !(s[2] >= 0.0f) ||
             !isfinite(s[0]) || !isfinite(s[1]) || !isfinite(s[2])) {
             r = rt_fail(err, RT_ERR_INVALID,
@@ -407,6 +451,17 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
         part->sum[3 * i + 1] = s[1];
         part->sum[3 * i + 2] = s[2];
         part->good[i] = (uint32_t)c;
+        for (int k = 0, at = 4; k < info->layer_count; at += info->layer_channels[k], k++)
+            for (int q = 0; q < info->layer_channels[k]; q++) {
+                float v = s[at + q];
+                if (!isfinite(v)) {
+                    r = rt_fail(err, RT_ERR_INVALID, "%s: layer %s of pixel (%zu, %zu) is not finite", image,
+                                info->layer_name[k], i % (size_t)rw + (size_t)info->x0,
+                                i / (size_t)rw + (size_t)info->y0);
+                    break;
+                }
+                part->layer[k][(size_t)info->layer_channels[k] * i + (size_t)q] = v;
+            }
     }
     free(px);
     free(cpx);
@@ -421,4 +476,8 @@ void rt_part_free(rt_part *part)
     free(part->good);
     part->sum = NULL;
     part->good = NULL;
+    for (int k = 0; k < RT_PART_MAX_LAYERS; k++) {
+        free(part->layer[k]);
+        part->layer[k] = NULL;
+    }
 }

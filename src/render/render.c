@@ -414,6 +414,9 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     }
     for (int t = 0; t < job.tiles_total; t++)
         atomic_init(&job.tile_finished[t], 0);
+    bool aov_accum = job.aov && job.accum && job.accum->aov_sum;
+    if (aov_accum) /* the AOV sums continue the caller's too */
+        memcpy(job.aov_sum, job.accum->aov_sum, npx * sizeof *job.aov_sum);
     if (job.passes) {
         if (job.accum) { /* continue the caller's sums; they get them back after each whole pass */
             memcpy(job.sum, job.accum->sum, npx * 3 * sizeof *job.sum);
@@ -454,6 +457,8 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     if (!job.passes) {
         job.deadline = opt.time_limit > 0.0 ? t0 + opt.time_limit : 0.0;
         started = run_workers(&job, workers, nthreads, &opt, &progress, t0);
+        if (aov_accum)
+            memcpy(job.accum->aov_sum, job.aov_sum, npx * sizeof *job.aov_sum);
         st.tiles_done = atomic_load(&job.tiles_done);
         st.partial = st.tiles_done < job.tiles_total;
         st.samples_done = st.partial ? 0 : (int)(job.s_end - job.s_begin);
@@ -491,6 +496,8 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
                 memcpy(job.accum->sum, job.sum, npx * 3 * sizeof *job.sum);
                 memcpy(job.accum->good, job.good, npx * sizeof *job.good);
             }
+            if (aov_accum)
+                memcpy(job.accum->aov_sum, job.aov_sum, npx * sizeof *job.aov_sum);
             job.samples_done = (int)(job.s1 - job.s_begin);
             st.passes_done++;
             s0 = job.s1;

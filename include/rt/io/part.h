@@ -12,7 +12,7 @@
  * first.
  *
  *   rt_part_info info = {...};                     // what the part is
- *   rt_part_write("p.exr", &info, sum, good, NULL, &err);
+ *   rt_part_write("p.exr", &info, sum, good, NULL, NULL, &err);   // layers: NULL when info.layer_count is 0
  *
  *   rt_part p;
  *   if (rt_part_read("p.exr", &p, &err) != RT_OK) ... err names the file and what is wrong ...
@@ -30,6 +30,7 @@
 
 #define RT_PART_FORMAT 1            /* the sidecar's "rt_part" version */
 #define RT_PART_SETTINGS_MAX 8192   /* bytes of the settings text */
+#define RT_PART_MAX_LAYERS 4        /* extra sums a part may carry (AOVs) */
 
 typedef struct rt_part_info {
     char version[32];          /* rt's version that rendered it */
@@ -42,12 +43,16 @@ typedef struct rt_part_info {
     int s_begin, s_end;        /* the samples summed: [s_begin, s_end) */
     uint32_t seed;
     float exposure;            /* the scene's exposure, for 8-bit output of a merge */
+    int layer_count;           /* extra per-pixel sums (EXR parts only): "albedo", "depth" ... */
+    char layer_name[RT_PART_MAX_LAYERS][16];
+    int layer_channels[RT_PART_MAX_LAYERS]; /* 1 or 3 */
 } rt_part_info;
 
 typedef struct rt_part {
     rt_part_info info;
     float *sum;                /* 3 floats a pixel of the region, row-major */
     uint32_t *good;            /* 1 a pixel */
+    float *layer[RT_PART_MAX_LAYERS]; /* info.layer_channels[k] floats a pixel */
     char path[4096];           /* the image's path (messages) */
 } rt_part;
 
@@ -60,11 +65,12 @@ bool rt_part_path_ok(const char *path);
 /* The sidecar's path for a part image: path + ".json". false when it does not fit. */
 bool rt_part_sidecar_path(const char *path, char *out, size_t size);
 
-/* Writes the part's image(s), then its sidecar. sum and good are the
+/* Writes the part's image(s), then its sidecar. sum, good and the
+ * info->layer_count layers (EXR layers NAME.R/G/B or NAME.Y) are the
  * region's. temp (may be NULL) tracks the temporary file for a signal
  * handler. */
 rt_result rt_part_write(const char *path, const rt_part_info *info, const float *sum, const uint32_t *good,
-                        rt_write_temp *temp, rt_error *err);
+                        const float *const *layers, rt_write_temp *temp, rt_error *err);
 
 /* Reads a part: `path` is its image or its sidecar (NAME.json). Checks the
  * sidecar's fields and ranges, the image hashes, the image size against the

@@ -106,6 +106,8 @@ typedef struct rt_render_region {
 typedef struct rt_render_accum {
     float *sum;     /* 3 floats a pixel: the RGB float sum of the good samples, in sample order */
     uint32_t *good; /* 1 a pixel: how many samples were good */
+    struct rt_aov_sample *aov_sum; /* NULL, or with opt.aov: the sums of the good samples' albedo, normal,
+                                      position and depth (rt/render/aov.h), continued alike */
 } rt_render_accum;
 
 typedef struct rt_render_options {
