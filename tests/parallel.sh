@@ -14,7 +14,7 @@ launch_setup test-parallel
 trap 'rm -rf "$work"' EXIT
 trap 'exit 130' INT
 trap 'exit 143' TERM
-sh tools/install-deps.sh parallel:parallel rsync:rsync
+sh tools/install-deps.sh parallel rsync:rsync   # (the package: moreutils has a parallel too)
 
 # ssh [OPTIONS] HOST COMMAND...: the command through sh in $work/hosts/HOST
 cat > "$work/ssh" <<FAKE

@@ -12,7 +12,7 @@
 # the packages whose COMMAND is not on the PATH (or in /usr/sbin), or which
 # dpkg does not list as installed, for the launcher tests:
 #   sh tools/install-deps.sh slurm-wlm:slurmctld   (make test-slurm)
-#   sh tools/install-deps.sh parallel:parallel     (make test-parallel)
+#   sh tools/install-deps.sh parallel rsync:rsync  (make test-parallel)
 #   sh tools/install-deps.sh python3-yaml          (make test-kubernetes)
 set -eu
 CC=${CC:-cc}
@@ -31,15 +31,17 @@ apt_install() {
         exit 1
     fi
     export DEBIAN_FRONTEND=noninteractive
-    if ! $SUDO apt-get install -y -q "$@" >&2; then
-        $SUDO apt-get update -q >&2
-        $SUDO apt-get install -y -q "$@" >&2
+    # (DPkg::Lock::Timeout: waiting up to 5 minutes for another apt-get or dpkg)
+    if ! $SUDO apt-get install -o DPkg::Lock::Timeout=300 -y -q "$@" >&2; then
+        $SUDO apt-get update -o DPkg::Lock::Timeout=300 -q >&2
+        $SUDO apt-get install -o DPkg::Lock::Timeout=300 -y -q "$@" >&2
     fi
 }
 
 if [ $# -gt 0 ]; then
     tools=""
     for a in "$@"; do
+        case " $tools " in *" ${a%%:*} "*) continue ;; esac
         case $a in
             *:*) command -v "${a#*:}" >/dev/null 2>&1 || [ -x "/usr/sbin/${a#*:}" ] || tools="$tools ${a%%:*}" ;;
             *) dpkg-query -W -f '${Status}' "$a" 2>/dev/null | grep -q 'ok installed' || tools="$tools $a" ;;

@@ -39,7 +39,10 @@ case $n in
     '' | *[!0-9]* | 0) echo "render.sh: N must be a number of parts >= 1, not '$n'" >&2; exit 2 ;;
 esac
 [ -r "$scene" ] || { echo "render.sh: cannot read the scene $scene" >&2; exit 2; }
-command -v parallel >/dev/null || { echo "render.sh: GNU parallel is not installed (apt-get install parallel)" >&2; exit 2; }
+if ! parallel --version 2>/dev/null | grep -q '^GNU parallel'; then
+    echo "render.sh: GNU parallel is not installed (apt-get install parallel; moreutils' parallel is another program)" >&2
+    exit 2
+fi
 rt=${RT:-rt}
 stem=$(basename "${image%.*}")
 for f in "$stem".part.*; do
