@@ -11,6 +11,8 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <signal.h>
+#include <time.h>
 #include <sys/wait.h>
 
 #include "rt/io/framebuffer.h"
@@ -223,7 +225,7 @@ static void test_sample_ranges(void **state)
     RUN_OK("-q", "--spp-range", "5:16", "-o", in_dir("b.exr"), scene);
     RUN_OK("merge", in_dir("b.exr"), in_dir("a.exr"), "-o", in_dir("two.pfm"));
     assert_within_summation_bound(in_dir("two.pfm"), in_dir("full.pfm"), 16);
-    RUN_OK("-q", "--spp-range", "0:3", "-o", in_dir("r0.exr"), scene);
+    RUN_OK("-q", "--spp-range", "0:3", "--passes", "0", "-o", in_dir("r0.exr"), scene); /* tiles */
     RUN_OK("-q", "--spp-range", "3:9", "--passes", "2", "-o", in_dir("r1.pfm"), scene);
     RUN_OK("-q", "--spp-range", "9:16", "-o", in_dir("r2.exr"), scene);
     RUN_OK("merge", in_dir("r0.exr"), in_dir("r1.pfm"), in_dir("r2.exr"), "-o", in_dir("three.pfm"));
@@ -253,6 +255,8 @@ static void test_resume_exact(void **state)
     RUN_OK("-q", "--spp-range", "0:5", "-o", in_dir("a.pfm"), scene);
     RUN_OK("-q", "--resume", in_dir("a.pfm"), "-o", in_dir("r.pfm"), scene);
     assert_same_bytes(in_dir("r.pfm"), in_dir("full.pfm"));
+    RUN_OK("-q", "--resume", in_dir("a.pfm"), "--passes", "0", "-o", in_dir("rt.pfm"), scene); /* tiles */
+    assert_same_bytes(in_dir("rt.pfm"), in_dir("full.pfm"));
     RUN_OK("-q", "--resume", in_dir("a.pfm.json"), "-o", in_dir("r.png"), scene);
     assert_same_bytes(in_dir("r.png"), in_dir("full.png"));
     /* a resumed part that is not the whole image is a part again */
@@ -303,6 +307,32 @@ static void test_aov_parts(void **state)
     assert_int_equal(access(in_dir("x.pfm"), F_OK), -1);
 }
 
+/* --frames A:B: one file a frame, named from the pattern; no animation
+ * yet, so each is the single render; bad patterns are refused up front. */
+static void test_frames(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    RUN_OK("-q", "-s", "2", "-o", in_dir("one.png"), scene);
+    char pattern[600];
+    snprintf(pattern, sizeof pattern, "%s/f%%%%.%%04d.png", dir);
+    RUN_OK("-q", "-s", "2", "--frames", "8:11", "--fps", "30", "-o", pattern, scene);
+    assert_same_bytes(in_dir("f%.0008.png"), in_dir("one.png"));
+    assert_same_bytes(in_dir("f%.0010.png"), in_dir("one.png"));
+    assert_int_equal(access(in_dir("f%.0011.png"), F_OK), -1);
+    assert_int_equal(access(in_dir("f%.0007.png"), F_OK), -1);
+    snprintf(pattern, sizeof pattern, "%s/fp%%d.exr", dir);
+    RUN_OK("-q", "-s", "2", "--frames", "0:2", "--part", "1/2", "-o", pattern, scene);
+    assert_int_equal(access(in_dir("fp1.exr.json"), F_OK), 0);
+    const char *bad[] = {"plain.png", "two%d%d.png", "s%s.png", "w%010d.png", "%"};
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        assert_int_equal(RUN("-q", "--frames", "0:2", "-o", in_dir(bad[i]), scene), 2);
+        assert_non_null(strstr(err_text, "%0Nd"));
+    }
+    assert_int_equal(RUN("-q", "--frames", "2:2", "-o", pattern, scene), 2);
+    assert_int_equal(RUN("-q", "--frames", "0:2", "--fps", "0", "-o", pattern, scene), 2);
+}
+
 /* The samples [0, k] a sidecar says its part holds. */
 static int sidecar_end(const char *json)
 {
@@ -344,6 +374,48 @@ static void test_time_limit_then_resume(void **state)
     if (k < 64) {
         RUN_OK("-q", "-s", "64", "--resume", in_dir("p.exr"), "-o", in_dir("p-resumed.pfm"), scene);
         assert_same_bytes(in_dir("p-resumed.pfm"), in_dir("full64.pfm"));
+    }
+}
+
+/* Ctrl-C in passes: the part holds the whole passes done (a pass cut short
+ * is not in it), and resumed it is the straight render. When the signal
+ * lands does not matter to the assertions. */
+static void test_interrupt_then_resume(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    RUN_OK("-q", "-s", "64", "-o", in_dir("full64i.pfm"), scene);
+    unlink(in_dir("int.exr.json"));
+    const char *argv[] = {rt_bin(), "-q", "-s", "64", "--passes", "1", "-t", "2", "--part-out", in_dir("int.exr"), "-o",
+                          in_dir("int.pfm"), scene, NULL};
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        int nul = open("/dev/null", O_RDWR);
+        dup2(nul, 0);
+        dup2(nul, 1);
+        dup2(nul, 2);
+        execv(argv[0], (char *const *)argv);
+        _exit(127);
+    }
+    struct timespec ts = {0, 150 * 1000 * 1000};
+    nanosleep(&ts, NULL);
+    kill(pid, SIGINT);
+    int st = 0;
+    while (waitpid(pid, &st, 0) < 0 && errno == EINTR)
+        ;
+    assert_true(WIFEXITED(st));
+    int code = WEXITSTATUS(st);
+    assert_true(code == 130 || code == 0);
+    if (access(in_dir("int.exr.json"), F_OK) != 0)
+        return; /* stopped before the first pass: nothing to resume */
+    int k = sidecar_end(in_dir("int.exr.json"));
+    assert_true(k >= 1 && k <= 64);
+    if (code == 0)
+        assert_int_equal(k, 64);
+    if (k < 64) {
+        RUN_OK("-q", "-s", "64", "--resume", in_dir("int.exr"), "-o", in_dir("int-resumed.pfm"), scene);
+        assert_same_bytes(in_dir("int-resumed.pfm"), in_dir("full64i.pfm"));
     }
 }
 
@@ -434,6 +506,10 @@ static void test_merge_refusals(void **state)
     copy(in_dir("g1.exr"), in_dir("n.exr"), 0);
     REFUSE("n.exr.json", in_dir("g0.exr"), in_dir("n.exr"), in_dir("g2.exr"));
     REFUSE("not a part", in_dir("g0.exr"), scene);
+    /* the output over a part's own image or sidecar */
+    assert_int_equal(RUN("merge", in_dir("g0.exr"), in_dir("g1.exr"), in_dir("g2.exr"), "-o", in_dir("g1.exr")), 2);
+    assert_non_null(strstr(err_text, "part's own files"));
+    RUN_OK("merge", in_dir("g0.exr"), in_dir("g1.exr"), in_dir("g2.exr"), "-o", in_dir("ok.exr"));
     /* flags */
     REFUSE(NULL, in_dir("g0.exr"), "--bogus");
     REFUSE("needs at least one PART", "--half");
@@ -488,8 +564,10 @@ int main(void)
         cmocka_unit_test(test_sample_ranges),
         cmocka_unit_test(test_resume_exact),
         cmocka_unit_test(test_time_limit_then_resume),
+        cmocka_unit_test(test_interrupt_then_resume),
         cmocka_unit_test(test_merge_refusals),
         cmocka_unit_test(test_aov_parts),
+        cmocka_unit_test(test_frames),
         cmocka_unit_test(test_part_bands),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

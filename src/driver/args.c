@@ -51,6 +51,8 @@ typedef enum flag_kind {
     FLAG_SPP_RANGE,
     FLAG_RESUME,
     FLAG_PART_OUT,
+    FLAG_FRAMES,
+    FLAG_FPS,
     FLAG_HELP,
     FLAG_VERSION,
 } flag_kind;
@@ -124,6 +126,9 @@ static const flag flags[] = {
      "makes"},
     {NULL, "--part-out", "FILE", FLAG_PART_OUT, NULL,
      "also write the render as a part FILE (.exr or .pfm, with FILE.json), e.g. to --resume it after a stop"},
+    {NULL, "--frames", "A:B", FLAG_FRAMES, NULL,
+     "render frames A .. B-1, each on its own, at time frame / fps; -o names them with %04d (out.%04d.png)"},
+    {NULL, "--fps", "F", FLAG_FPS, NULL, "frames per second for --frames (default 24)"},
     {"-h", "--help", NULL, FLAG_HELP, NULL, "this text"},
     {NULL, "--version", NULL, FLAG_VERSION, NULL, "print the version"},
 };
@@ -354,6 +359,7 @@ int args_parse(args *a, int argc, char **argv)
     a->camera = -1;
     a->log_level = RT_LOG_NORMAL;
     a->budget.bytes = memory_budget_default();
+    a->fps = 24.0;
     bool flags_ended = false;
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
@@ -593,6 +599,27 @@ int args_parse(args *a, int argc, char **argv)
         case FLAG_PART_OUT:
             a->part_out = value;
             break;
+        case FLAG_FRAMES: {
+            const char *colon = strchr(value, ':');
+            char fb[32];
+            if (!colon || (size_t)(colon - value) >= sizeof fb)
+                return fail_usage("%s wants A:B (frames A to B-1), got '%s'", name, value);
+            memcpy(fb, value, (size_t)(colon - value));
+            fb[colon - value] = 0;
+            if (!int_value(fb, 0, 99999999, &a->frame_begin) || !int_value(colon + 1, 1, 100000000, &a->frame_end) ||
+                a->frame_begin >= a->frame_end)
+                return fail_usage("%s wants A:B with 0 <= A < B <= 100000000 (frames A to B-1), got '%s'", name,
+                                  value);
+            a->has_frames = true;
+            break;
+        }
+        case FLAG_FPS: {
+            float f = 0.0f;
+            if (rt_parse_float(value, &f) != RT_NUMBER_OK || !(f > 0.0f && f <= 10000.0f))
+                return fail_usage("%s wants frames per second (more than 0, at most 10000), got '%s'", name, value);
+            a->fps = (double)f;
+            break;
+        }
         case FLAG_MAX_MEMORY:
             if (!memory_budget_parse(value, &a->budget.bytes))
                 return fail_usage("%s wants a size such as 4G, 512M or 'none', got '%s'", name, value);

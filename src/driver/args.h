@@ -78,6 +78,9 @@ typedef struct args {
     int spp_begin, spp_end;
     const char *resume;     /* --resume PART: continue that part */
     const char *part_out;   /* --part-out FILE: also write the render as a part */
+    bool has_frames;        /* --frames A:B: frames A .. B-1, the output a %04d pattern */
+    int frame_begin, frame_end;
+    double fps;             /* --fps; 24 unless given */
     setting_flag settings[ARGS_MAX_SETTINGS];
     size_t setting_count;
 } args;

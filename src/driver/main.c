@@ -2,7 +2,10 @@
  * (args.c), load the scene or model, validate it, apply the setting flags,
  * frame the camera and check the limits, build the kd-tree, render on all
  * cores (progress.c draws the progress bar and the live preview), write the
- * image.
+ * image. A part of a render spread over machines (--part, --crop,
+ * --spp-range, --resume, --part-out: part.c, docs/farm.md) renders its
+ * region and samples and writes its sums; `rt merge` (merge.c) puts parts
+ * together. --frames A:B runs the whole pipeline once a frame (frames.c).
  *
  * Exit status: 0 on success (also when --time-limit stopped the render),
  * 2 for bad input (flags, scene files, models, images, an unwritable
@@ -39,6 +42,7 @@
 #include "args.h"
 #include "commands.h"
 #include "memory_budget.h"
+#include "frames.h"
 #include "output.h"
 #include "part.h"
 #include "progress.h"
@@ -607,6 +611,26 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     return status;
 }
 
+/* Loads, prepares, poses at time t (frames.h), renders and writes one
+ * image (or part); the exit status. */
+static int render_one(rt_scene *scene, const args *a, double t, double t_start)
+{
+    rt_error err = {0};
+    char output[1024];
+    progress_view view;
+    progress_view_init(&view, a->log_level >= RT_LOG_NORMAL && isatty(2));
+    progress_phase(&view, "load", a->input ? a->input : "the built-in scene");
+    if (prepare(scene, a, output, sizeof output, &err) != RT_OK || frames_apply(scene, t, &err) != RT_OK) {
+        progress_clear(&view);
+        report(&err, &a->budget);
+        progress_view_free(&view);
+        return 2;
+    }
+    int status = render_and_write(scene, a, output, &view, t_start);
+    progress_view_free(&view);
+    return status;
+}
+
 int main(int argc, char **argv)
 {
     double t_start = rt_now_seconds();
@@ -632,7 +656,6 @@ int main(int argc, char **argv)
     }
     rt_scene scene;
     rt_scene_init(&scene);
-    char output[1024];
     char part_default[1100];
     if (args_output_is_part(&a) && !a.output) { /* a part goes to NAME.part.exr */
         char name[1024];
@@ -645,17 +668,37 @@ int main(int argc, char **argv)
                 rt_part_path_ok(a.part_out) ? err.message : "a part is written as .exr or .pfm");
         return 2;
     }
-    progress_view view;
-    progress_view_init(&view, a.log_level >= RT_LOG_NORMAL && isatty(2));
-    progress_phase(&view, "load", a.input ? a.input : "the built-in scene");
-    if (prepare(&scene, &a, output, sizeof output, &err) != RT_OK) {
-        progress_clear(&view);
-        report(&err, &a.budget);
+    if (!a.has_frames) {
+        status = render_one(&scene, &a, 0.0, t_start);
+        rt_scene_free(&scene);
+        return status;
+    }
+    /* --frames A:B: one render a frame, named from the pattern; the first failure ends the run */
+    const char *pattern = a.output;
+    if (!pattern || !frames_pattern_ok(pattern)) {
+        fprintf(stderr, "rt: --frames %d:%d: -o must name the frames with one %%d or %%0Nd (e.g. -o out.%%04d.png), "
+                        "got %s%s%s\n",
+                a.frame_begin, a.frame_end, pattern ? "'" : "", pattern ? pattern : "no -o", pattern ? "'" : "");
         rt_scene_free(&scene);
         return 2;
     }
-    status = render_and_write(&scene, &a, output, &view, t_start);
-    progress_view_free(&view);
+    const char *part_pattern = a.part_out && frames_pattern_ok(a.part_out) ? a.part_out : NULL;
+    char name[1100], part_name[1100];
+    status = 0;
+    for (int f = a.frame_begin; f < a.frame_end && status == 0; f++) {
+        if (!frames_name(pattern, f, name, sizeof name) ||
+            (part_pattern && !frames_name(part_pattern, f, part_name, sizeof part_name))) {
+            fprintf(stderr, "rt: -o %s: the name of frame %d is too long\n", pattern, f);
+            status = 2;
+            break;
+        }
+        a.output = name;
+        if (part_pattern)
+            a.part_out = part_name;
+        rt_scene_free(&scene);
+        rt_scene_init(&scene);
+        status = render_one(&scene, &a, frames_time(f, a.fps), rt_now_seconds());
+    }
     rt_scene_free(&scene);
     return status;
 }

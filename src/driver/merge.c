@@ -18,6 +18,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "output.h"
 #include "part.h"
@@ -260,6 +261,15 @@ int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs)
         if (i > 0 && part_mismatch(&m.parts[i].info, &m.parts[0].info, why, sizeof why)) {
             fprintf(errs, "rt: merge: %s: not a part of the same render as %s: %s\n", m.parts[i].path,
                     m.parts[0].path, why);
+            status = 2;
+            break;
+        }
+        struct stat so, sp;
+        char side[4200];
+        rt_part_sidecar_path(m.parts[i].path, side, sizeof side);
+        if (stat(dst, &so) == 0 && ((stat(m.parts[i].path, &sp) == 0 && so.st_dev == sp.st_dev && so.st_ino == sp.st_ino) ||
+                                    (stat(side, &sp) == 0 && so.st_dev == sp.st_dev && so.st_ino == sp.st_ino))) {
+            fprintf(errs, "rt: merge: %s: the output is one of the part's own files; write the image elsewhere\n", dst);
             status = 2;
             break;
         }

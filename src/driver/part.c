@@ -57,7 +57,7 @@ static void settings_text(const rt_scene *scene, char *buf, size_t size)
     const char *env = "none";
     if (s->environment_texture != RT_NONE && s->environment_texture < scene->texture_count &&
         scene->textures[s->environment_texture].image < scene->image_count)
-        env = scene->images[scene->textures[s->environment_texture].image].name;
+        env = rt_path_basename(scene->images[scene->textures[s->environment_texture].image].name);
     line(buf, size, "environment %s strength %a", env, (double)s->environment_strength);
     if (s->ambient_light_set)
         line(buf, size, "ambient_light %a %a %a", (double)s->ambient_light.x, (double)s->ambient_light.y,

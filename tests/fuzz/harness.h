@@ -8,7 +8,9 @@
  * length, the JSON, then the buffer, which the JSON must name
  * "buffer.bin"), obj (u32 OBJ length, the OBJ, then an MTL named
  * "m.mtl"), ply, off, image (any image bytes through our size checks),
- * exr (OpenEXR bytes straight into rt_exr_decode, capped at 4096 a side).
+ * exr (OpenEXR bytes straight into rt_exr_decode, capped at 4096 a side),
+ * part (u32 sidecar length, a part's JSON sidecar, then its EXR image, read
+ * by rt_part_read; "@HASH@" in the sidecar becomes the image's hash).
  * Every target but image loads through rt_load_memory, as `rt` loads a file
  * of that kind (fuzz.txt, fuzz.gltf, fuzz.obj, ...): the content picks the
  * reader before the name does.
