@@ -7,8 +7,10 @@
 # starts slurmctld and slurmd with it, submits the job array and the merge
 # job through examples/slurm/submit.sh as a user would (one part already
 # there, half rendered, as a task stopped by its time limit leaves it:
-# submit.sh --resume), waits for them, and checks that the merged image is
-# the single-machine render byte for byte.
+# submit.sh --resume) and, beside them, an array of frames
+# (examples/slurm/render-frames.sbatch, one frame already there), waits for
+# them, and checks that the merged image and every frame are the
+# single-machine render byte for byte.
 # Whether it passes, fails, times out or is interrupted, it cancels its
 # jobs, stops both daemons by their pid files, ends anything they left (found
 # by a marker in the environment it gave them) and removes the directory.
@@ -141,27 +143,45 @@ fi
 ids=$(RT="$RT" sh "$REPO/examples/slurm/submit.sh" --resume "$parts" scene.txt parts image.pfm)
 array=${ids% *}
 merge=${ids#* }
+# An animation beside it: 2 tasks of 2 frames (frames 0..3; the scene has no
+# animation yet, so each is the single render), frame 1 already there.
+mkdir frames
+cp single.pfm frames/f.0001.pfm
+frames=$(RT="$RT" RT_FRAMES_PER_TASK=2 sbatch --parsable --array=0-1 \
+    "$REPO/examples/slurm/render-frames.sbatch" scene.txt 'frames/f.%04d.pfm')
+frames=${frames%%;*}
 
+# the states of a job's tasks, sorted, one space after each
 job_state() { scontrol -o show job "$1" 2>/dev/null | tr ' ' '\n' | sed -n 's/^JobState=//p' | sort -u | tr '\n' ' '; }
 start=$(date +%s)
-while :; do
-    state=$(job_state "$merge")
-    case $state in
-        'COMPLETED ') break ;;
-        *FAILED* | *CANCELLED* | *TIMEOUT* | *OUT_OF_MEMORY* | *NODE_FAIL* | *BOOT_FAIL* | *DEADLINE*)
+for job in "$merge" "$frames"; do
+    while :; do
+        state=$(job_state "$job")
+        case $state in
+            *PENDING* | *RUNNING* | *CONFIGURING* | *COMPLETING* | *REQUEUE* | *SUSPENDED* | '') ;;
+            *) break ;;
+        esac
+        if [ $(($(date +%s) - start)) -ge "$timeout" ]; then
             show_logs
-            launch_fail "the merge job $merge ended $state(array $array: $(job_state "$array"))" ;;
-    esac
-    if [ $(($(date +%s) - start)) -ge "$timeout" ]; then
-        show_logs
-        launch_fail "the jobs did not finish in $timeout s (array $array: $(job_state "$array"), merge: $state)"
-    fi
-    sleep 1
+            launch_fail "the jobs did not finish in $timeout s (parts $array: $(job_state "$array"), merge $merge:" \
+                "$(job_state "$merge"), frames $frames: $(job_state "$frames"))"
+        fi
+        sleep 1
+    done
 done
-[ "$(job_state "$array")" = 'COMPLETED ' ] || launch_fail "array job $array: $(job_state "$array")"
+for job in "$array" "$merge" "$frames"; do
+    if [ "$(job_state "$job")" != 'COMPLETED ' ]; then
+        show_logs
+        launch_fail "job $job ended $(job_state "$job")(parts $array, merge $merge, frames $frames)"
+    fi
+done
 for i in $(seq 0 $((parts - 1))); do
     [ -f "parts/part.$i.exr" ] && [ -f "parts/part.$i.exr.json" ] || launch_fail "task $i left no part.$i.exr with its sidecar"
 done
 grep -q 'resuming it' rt-part-"${array}"_1.out || launch_fail "task 1 did not resume its part: $(cat rt-part-"${array}"_1.out)"
 launch_same image.pfm single.pfm "$parts parts on Slurm (one resumed), merged"
-echo "test-slurm: 1 passed, 0 failed ($parts array tasks and a merge job in $(($(date +%s) - start)) s)"
+grep -q 'frame 1: .* is there, kept' rt-frames-"${frames}"_0.out || launch_fail "frame 1 was rendered again"
+for f in 0 1 2 3; do
+    launch_same "frames/f.000$f.pfm" single.pfm "frame $f of the frames array"
+done
+echo "test-slurm: 1 passed, 0 failed ($parts array tasks, a merge job and 2 tasks of frames in $(($(date +%s) - start)) s)"
