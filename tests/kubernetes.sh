@@ -1,17 +1,19 @@
 #!/bin/sh
 # make test-kubernetes: the Kubernetes launcher (examples/kubernetes/)
-# without a cluster. Checks the manifests' structure (an Indexed batch/v1
-# Job whose completions equal the PARTS its command uses, a merge Job, both
-# with a restartPolicy a Job accepts and the shared ReadWriteMany claim of
-# pvc.yaml mounted where WORK says, one image for all) and that the
-# Dockerfile installs what tools/install-deps.sh checks for; then runs the
-# render container's command locally for every index as the kubelet would
-# (the manifest's environment, requests.cpu through resourceFieldRef,
-# $(VAR) expanded, JOB_COMPLETION_INDEX set; WORK, the mount, a local
-# directory; rt on the PATH; one part already half rendered, as an evicted
-# pod leaves it, which its pod resumes), then the merge container's command, and checks
-# the merged image against a single-machine render byte for byte: PNG as
-# the manifest writes it, and PFM (IMAGE=image.pfm) for the float pixels.
+# without a cluster. Checks the manifests' structure (Indexed batch/v1 Jobs
+# for the parts, whose completions equal the PARTS its command uses, and for
+# the frames; a merge Job; restartPolicy Never or OnFailure; the shared
+# ReadWriteMany claim of pvc.yaml mounted where WORK says in every pod; one
+# image for all) and that the Dockerfile installs what tools/install-deps.sh
+# checks for. Then runs the containers' commands locally as the kubelet would
+# (the manifest's environment, requests.cpu through resourceFieldRef, $(VAR)
+# expanded, JOB_COMPLETION_INDEX set; WORK, the mount, a local directory; rt
+# on the PATH): the parts Job for every index, one part already half rendered
+# as an evicted pod leaves it (resumed) and one pod started again (its
+# complete part kept); the merge Job, checked against a single-machine render
+# byte for byte, PNG as the manifest writes it and PFM (IMAGE=image.pfm) for
+# the float pixels; the frames Job's pods 0, 1 and the last, frame 1 already
+# there (kept), each frame against the single render (no animation yet).
 # Needs python3 with PyYAML (Debian's python3-yaml, installed when missing).
 # Environment: RT_BIN (default ./rt).
 set -eu
@@ -30,10 +32,10 @@ launch_scene "$work/volume/scene/scene.txt"
 launch_single "$work/volume/scene/scene.txt" "$work/single.png"
 launch_single "$work/volume/scene/scene.txt" "$work/single.pfm"
 
-PATH="$work/bin:$PATH" python3 - examples/kubernetes "$work/volume" <<'PY' || launch_fail "see above"
+PATH="$work/bin:$PATH" python3 - examples/kubernetes "$work/volume" "$work/single.png" <<'PY' || launch_fail "see above"
 import os, re, subprocess, sys, yaml
 
-kdir, volume = sys.argv[1], sys.argv[2]
+kdir, volume, single = sys.argv[1], sys.argv[2], sys.argv[3]
 failures = []
 
 def check(cond, what):
@@ -101,12 +103,20 @@ def run(name, c, env, extra):
     check(r.returncode == 0, f"{name}: the container command failed (exit {r.returncode}) with {extra}")
 
 render, rc, renv, rmount = job("render-job.yaml")
+frames, fc, fenv, fmount = job("render-frames-job.yaml")
 merge, mc, menv, mmount = job("merge-job.yaml")
 shell = load("shell-pod.yaml")
 check(shell.get("apiVersion") == "v1" and shell.get("kind") == "Pod", "shell-pod.yaml: not a v1 Pod")
 _, sc, _, smount = pod_spec("shell-pod.yaml", shell)
-check(rmount == mmount == smount, f"the volume is mounted at {rmount}, {mmount}, {smount}: use one path")
-check(rc["image"] == mc["image"] == sc["image"], "the three pods run different images")
+check(rmount == mmount == smount == fmount, f"the volume is mounted at {rmount}, {mmount}, {smount}, {fmount}: use one path")
+check(rc["image"] == mc["image"] == sc["image"] == fc["image"], "the pods run different images")
+fspec = frames["spec"]
+nf = fspec.get("completions")
+check(fspec.get("completionMode") == "Indexed", "render-frames-job.yaml: completionMode is not Indexed")
+check(isinstance(nf, int) and nf >= 3, "render-frames-job.yaml: completions is not a number of frames")
+check("%" in fenv.get("OUTPUT", ""), "render-frames-job.yaml: OUTPUT is not a frame pattern")
+fcmd = " ".join(fc.get("command", []) + fc.get("args", []))
+check("JOB_COMPLETION_INDEX" in fcmd and "--frames" in fcmd, "render-frames-job.yaml: the command does not pass JOB_COMPLETION_INDEX to --frames")
 
 spec = render["spec"]
 n = spec.get("completions")
@@ -150,11 +160,31 @@ run("render-job.yaml", rc, dict(renv, WORK=volume), {"JOB_COMPLETION_INDEX": "0"
 check(os.stat(os.path.join(volume, "parts", "part.0.exr")).st_mtime_ns == stamp, "pod 0 rendered its complete part again")
 run("merge-job.yaml", mc, dict(menv, WORK=volume), {})
 run("merge-job.yaml", mc, dict(menv, WORK=volume, IMAGE="image.pfm"), {})
+
+# The frames Job (its scene, a glTF in the manifest, is the test's scene
+# here): pods 0, 1 and the last, frame 1 already there (kept, not rendered)
+with open(single, "rb") as f:
+    want = f.read()
+fdir = os.path.join(volume, "frames")
+os.makedirs(fdir)
+kept = os.path.join(fdir, "f.0001.png")
+with open(kept, "wb") as f:
+    f.write(want)
+stamp = os.stat(kept).st_mtime_ns
+for i in (0, 1, nf - 1):
+    run("render-frames-job.yaml", fc, dict(fenv, WORK=volume, SCENE=renv["SCENE"]), {"JOB_COMPLETION_INDEX": str(i)})
+check(os.stat(kept).st_mtime_ns == stamp, "frame 1 was there but its pod rendered it again")
+for i in (0, 1, nf - 1):
+    name = os.path.join(volume, fenv["OUTPUT"] % i)
+    if check(os.path.exists(name), f"render-frames-job.yaml: pod {i} wrote no {name}"):
+        with open(name, "rb") as f:
+            check(f.read() == want, f"frame {i} differs from the single render (the scene has no animation)")
+
 if failures:
     for f in failures:
         print("test-kubernetes: " + f, file=sys.stderr)
     sys.exit(1)
-print(f"test-kubernetes: manifests checked; {n} indexed pods and the merge run locally")
+print(f"test-kubernetes: manifests checked; {n} indexed pods and the merge, 3 of {nf} frame pods run locally")
 PY
 [ -f "$work/volume/parts/part.0.exr.json" ] || launch_fail "no sidecar part.0.exr.json beside part.0.exr"
 launch_same "$work/volume/image.png" "$work/single.png" "the Indexed Job's parts merged (PNG)"
