@@ -7,7 +7,9 @@
 # back (--return) and are removed there (--cleanup); `:` (this machine) runs
 # parts too. Checks the merged image against a single-machine render byte for
 # byte, that the hosts' homes are left empty, and that the launcher refuses
-# to run over the parts of an earlier render. Environment: RT_BIN (./rt).
+# to run over the parts of an earlier render; then frames.sh, 4 frames over
+# the same hosts with one already there (kept), each frame against the
+# single render (the scene has no animation yet). Environment: RT_BIN (./rt).
 set -eu
 . tests/launch-common.sh
 launch_setup test-parallel
@@ -49,4 +51,14 @@ done
 if RT_HOSTS=: sh "$REPO/examples/parallel/render.sh" 5 scene.txt image.pfm 2>/dev/null; then
     launch_fail "render.sh ran over the parts of the earlier render"
 fi
+# An animation: frames 0..3 over the same hosts, frame 2 already here (kept)
+cp single.pfm f.0002.pfm
+RT_HOSTS=1/hostA,1/hostB,1/: sh "$REPO/examples/parallel/frames.sh" 0:4 scene.txt 'f.%04d.pfm' 2> frames.log ||
+    { cat frames.log >&2; launch_fail "examples/parallel/frames.sh failed"; }
+grep -q 'frame 2: f.0002.pfm is there, kept' frames.log || launch_fail "frame 2 was not kept: $(cat frames.log)"
+for f in 0 1 2 3; do
+    launch_same "f.000$f.pfm" single.pfm "frame $f over GNU parallel"
+done
+left=$(find "$work/hosts" -type f)
+[ -z "$left" ] || launch_fail "--cleanup left frames on the hosts: $left"
 echo "test-parallel: 1 passed, 0 failed"
