@@ -539,6 +539,50 @@ static void test_conductor_fresnel(void **state)
     assert_true(au.x > 0.9f && au.z < 0.45f && ag.x > 0.94f && ag.z > 0.85f);
 }
 
+/* Every metal the issue names is built in, and its normal-incidence
+ * reflectance F(1) = ((n - 1)^2 + k^2) / ((n + 1)^2 + k^2) falls in the
+ * band the published reflectance spectra give at 450-650 nm (Palik's
+ * handbook; Bass et al., Handbook of Optics vol. IV, the reflectance of
+ * metals): the noble metals and aluminium above 0.9 in the red, gold and
+ * copper dropping towards the blue, the transition metals between about
+ * 0.45 and 0.75. */
+static void test_named_metals(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *name;
+        float lo[3], hi[3];
+    } want[] = {
+        {"Au", {0.90f, 0.70f, 0.30f}, {0.98f, 0.85f, 0.45f}}, {"Ag", {0.94f, 0.93f, 0.88f}, {0.99f, 0.98f, 0.97f}},
+        {"Cu", {0.90f, 0.60f, 0.45f}, {0.97f, 0.80f, 0.60f}}, {"Al", {0.88f, 0.88f, 0.88f}, {0.94f, 0.94f, 0.94f}},
+        {"Cr", {0.55f, 0.55f, 0.55f}, {0.75f, 0.75f, 0.75f}}, {"Ti", {0.50f, 0.45f, 0.45f}, {0.68f, 0.65f, 0.62f}},
+        {"Ni", {0.60f, 0.55f, 0.45f}, {0.72f, 0.68f, 0.62f}}, {"Pt", {0.60f, 0.58f, 0.52f}, {0.75f, 0.70f, 0.65f}},
+        {"Fe", {0.45f, 0.45f, 0.42f}, {0.62f, 0.60f, 0.58f}}, {"W", {0.45f, 0.44f, 0.42f}, {0.56f, 0.54f, 0.52f}},
+    };
+    for (size_t w = 0; w < sizeof want / sizeof *want; w++) {
+        const rt_metal *m = NULL;
+        for (size_t i = 0; i < rt_metal_count; i++)
+            if (strcmp(rt_metals[i].name, want[w].name) == 0)
+                m = &rt_metals[i];
+        if (!m)
+            fail_msg("metal %s is not built in", want[w].name);
+        rt_vec3 f = rt_fresnel_conductor(1.0f, m->eta, m->k);
+        const float *fc = &f.x, *eta = &m->eta.x, *k = &m->k.x;
+        for (int ch = 0; ch < 3; ch++) {
+            double n = eta[ch], kk = k[ch];
+            double closed = ((n - 1) * (n - 1) + kk * kk) / ((n + 1) * (n + 1) + kk * kk);
+            if (fabs(fc[ch] - closed) > 1e-5)
+                fail_msg("%s channel %d: F(1) %.6f, closed form %.6f", m->name, ch, (double)fc[ch], closed);
+            if (!(fc[ch] >= want[w].lo[ch] && fc[ch] <= want[w].hi[ch]))
+                fail_msg("%s channel %d: F(1) %.3f outside the published %.2f..%.2f", m->name, ch, (double)fc[ch],
+                         (double)want[w].lo[ch], (double)want[w].hi[ch]);
+        }
+    }
+    /* gold and copper are red-yellow (red above blue), silver near white */
+    rt_vec3 au = rt_fresnel_conductor(1.0f, rt_metals[1].eta, rt_metals[1].k);
+    assert_true(au.x > au.y && au.y > au.z);
+}
+
 static void test_conductor_bsdf(void **state)
 {
     (void)state;
@@ -717,6 +761,7 @@ int main(void)
         cmocka_unit_test(test_glass_exact_fresnel),
         cmocka_unit_test(test_gltf_normative_form),
         cmocka_unit_test(test_conductor_fresnel),
+        cmocka_unit_test(test_named_metals),
         cmocka_unit_test(test_conductor_bsdf),
         cmocka_unit_test(test_dielectric_bsdf),
         cmocka_unit_test(test_plastic_bsdf),

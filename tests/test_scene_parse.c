@@ -867,7 +867,7 @@ static void test_conductor_material(void **state)
     rt_scene_free(&s);
     expect_error("material m metal Au\n", RT_ERR_INVALID, "1:12", "material key 'metal' needs 'bsdf conductor'");
     expect_error("material m bsdf conductor metal Zz\n", RT_ERR_PARSE, "1:33",
-                 "expected material metal (Cu|Au|Ag|Al|Ti|Pt|Fe|CuZn), got 'Zz'");
+                 "expected material metal (Cu|Au|Ag|Al|Ti|Pt|Fe|CuZn|Cr|Ni|W), got 'Zz'");
     expect_error("material m bsdf conductor metal Au k 1 1 1\n", RT_ERR_INVALID, "1:36",
                  "give either 'metal NAME' or 'eta' and 'k', not both");
     expect_error("material m bsdf conductor ggx_alpha 0.1 ggx_alpha_uv 0.1 0.2\n", RT_ERR_INVALID, "1:41",

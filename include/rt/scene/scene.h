@@ -194,7 +194,10 @@ void rt_material_default(rt_material *m, const char *name);
  * the red, green and blue wavelengths 650, 550 and 450 nm, from
  * RefractiveIndex.INFO's "3D" data set (M. N. Polyanskiy, refractiveindex.info
  * database, Sci. Data 11, 94 (2024)), as tabulated by C. Hindefjord, "RGB IOR
- * values for common metals". The default conductor is Cu (as pbrt-v4's). */
+ * values for common metals"; Cr, Ni and W from E. D. Palik (ed.), "Handbook
+ * of Optical Constants of Solids" (1985), as tabulated in Mitsuba 0.6's
+ * spectral data, interpolated linearly at the same three wavelengths. The
+ * default conductor is Cu (as pbrt-v4's). */
 typedef struct rt_metal {
     const char *name;
     rt_vec3 eta, k;
