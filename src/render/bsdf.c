@@ -338,6 +338,14 @@ void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha)
     b->radiance_eta2 = true;
 }
 
+void rt_bsdf_set_eta(rt_bsdf *b, float eta)
+{
+    eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
+    float r0 = (eta - 1.0f) / (eta + 1.0f);
+    b->f0 = r0 * r0;
+    b->eta = eta;
+}
+
 float rt_fresnel_diffuse_reflectance(float eta)
 {
     /* seen from the denser side: by reciprocity what does not reflect

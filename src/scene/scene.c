@@ -48,6 +48,7 @@ void rt_material_default(rt_material *m, const char *name)
     m->alpha_u = m->alpha_v = -1.0f;
     m->smith = RT_SMITH_CORRELATED;
     m->exterior_ior = 1.0f;
+    m->priority = 0;
     m->absorption = rt_v3s(0.0f);
     m->thickness = 0.0f;
     m->attenuation_color = rt_v3s(1.0f);

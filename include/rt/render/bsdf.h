@@ -125,6 +125,9 @@ void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float rou
                   float transmission, bool lambert);
 /* A dielectric (bsdf dielectric): eta = n_wo / n_wi, GGX alpha (0: smooth). */
 void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha);
+/* Re-aims a dielectric at another medium beyond its surface (nested
+ * media, rt/render/medium.h): eta = n_wo / n_wi, F0 from it. */
+void rt_bsdf_set_eta(rt_bsdf *b, float eta);
 /* A plastic (bsdf plastic): Lambertian reflectance R under a dielectric
  * coat, eta = n_outside / n_coat, coat GGX alpha (0: smooth). */
 void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alpha);

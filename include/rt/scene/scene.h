@@ -175,6 +175,7 @@ typedef struct rt_material {
     rt_smith smith;
     /* dielectric and plastic: ior is the inside's (the coat's) index */
     float exterior_ior;     /* index outside (default 1) */
+    int priority;           /* dielectric: nested-media priority, higher wins (rt/render/medium.h) */
     rt_vec3 absorption;     /* absorption coefficient inside, per scene unit (adds to attenuation_*) */
     float thickness;        /* KHR_materials_volume */
     rt_vec3 attenuation_color;
