@@ -66,6 +66,7 @@ typedef struct rt_settings {
     int max_bounce;       /* mirror/refraction recursion depth */
     int max_depth;        /* path: most scattering events a path may have; 0 = unlimited (Russian roulette ends paths) */
     int rr_depth;         /* path: Russian roulette from this many bounces on; 0 = adaptive (once the throughput is below 1) */
+    int energy_compensation; /* path: 1 = Kulla-Conty multiple-scattering lobe on rough conductors (default 0, off) */
     int diffuse_bounces;  /* levels of indirect diffuse light (whitted) */
     int diffuse_rays;     /* cosine-distributed rays per diffuse level */
     int shadow_samples;   /* samples per area light per shading point */
