@@ -33,6 +33,8 @@ typedef enum flag_kind {
     FLAG_LOOK_AT,
     FLAG_UP,
     FLAG_FOV,
+    FLAG_FRAME_TIME,
+    FLAG_ANIMATION,
     FLAG_TILE,
     FLAG_PREVIEW,
     FLAG_PASSES,
@@ -91,6 +93,9 @@ static const flag flags[] = {
     {NULL, "--look-at", "X,Y,Z", FLAG_LOOK_AT, NULL, "point the camera looks at"},
     {NULL, "--up", "X,Y,Z", FLAG_UP, NULL, "camera up direction"},
     {NULL, "--fov", "DEG", FLAG_FOV, NULL, "vertical field of view in degrees, between 0 and 180"},
+    {NULL, "--frame-time", "SECONDS", FLAG_FRAME_TIME, NULL,
+     "pose an animated glTF at this time: its animation, skins and morph targets (default: the file's static pose)"},
+    {NULL, "--animation", "N", FLAG_ANIMATION, NULL, "which glTF animation --frame-time plays (default 0, the first)"},
     {NULL, "--tile", "N", FLAG_TILE, NULL, "tile size in pixels (default 32)"},
     {NULL, "--preview", "SECONDS", FLAG_PREVIEW, NULL,
      "live view: rewrite the output with the finished tiles every SECONDS"},
@@ -168,7 +173,8 @@ static void usage(FILE *f)
             rt_setting_default_text(def, dflt, sizeof dflt);
             snprintf(text, sizeof text, "%s (%s; default %s)", def->help, range, dflt);
         } else if (fl->kind == FLAG_THREADS) {
-            snprintf(text, sizeof text, "%s (default: all %d cores)", fl->help, rt_cpu_count());
+            int n = rt_cpu_count();
+            snprintf(text, sizeof text, "%s (default: %d, every CPU this process may use)", fl->help, n);
         } else if (fl->kind == FLAG_MAX_MEMORY) {
             char budget[32];
             memory_budget_format(memory_budget_default(), budget, sizeof budget);
@@ -458,6 +464,22 @@ int args_parse(args *a, int argc, char **argv)
             if (a->pass_samples == 0)
                 a->pass_samples = -1; /* rt_render's "tiles" */
             break;
+        case FLAG_FRAME_TIME: {
+            float t = 0.0f;
+            if (rt_parse_float(value, &t) != RT_NUMBER_OK || !(fabsf(t) <= 1e7f))
+                return fail_usage("%s wants seconds (a finite number, at most 1e7 in size), got '%s'", name, value);
+            a->frame_time = t;
+            a->posed = true;
+            break;
+        }
+        case FLAG_ANIMATION: {
+            long long n = 0;
+            if (rt_parse_int(value, &n) != RT_NUMBER_OK || n < 0 || n > 1000000)
+                return fail_usage("%s wants an animation index (0 = the first), got '%s'", name, value);
+            a->animation = (int)n;
+            a->posed = true;
+            break;
+        }
         case FLAG_TIME_LIMIT: {
             float s = 0.0f;
             if (rt_parse_float(value, &s) != RT_NUMBER_OK || !(s > 0.0f && s <= 1e7f))

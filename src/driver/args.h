@@ -58,6 +58,9 @@ typedef struct args {
     bool has_look_from, has_look_at, has_up, has_fov;
     rt_vec3 look_from, look_at, up;
     float fov;
+    bool posed;             /* --frame-time or --animation: pose an animated glTF */
+    float frame_time;       /* --frame-time seconds (0 with --animation alone) */
+    int animation;          /* --animation N (0 = the first) */
     double preview_seconds; /* --preview; 0 = no live view */
     int pass_samples;       /* --passes: rt_render_options.pass_samples (0 = the integrator's, -1 = tiles) */
     double time_limit;      /* --time-limit seconds; 0 = none */

@@ -181,13 +181,15 @@ static void print_vec(const char *key, rt_vec3 v) { printf("%s: %.9g %.9g %.9g\n
 /* --info for one input: one `key: value` line per figure, for people and
  * scripts. The counts are the file's own (loaded as it is); the settings
  * and camera are what `rt FILE` would render with, before any flag. */
-static int print_info(const char *path, const memory_budget *budget)
+static int print_info(const char *path, const args *a)
 {
+    const memory_budget *budget = &a->budget;
     rt_scene s;
     rt_scene_init(&s);
     rt_error err = {0};
     rt_load_info info;
-    rt_result r = load_input(&s, path, NULL, &info, &err);
+    rt_load_options lo = {.use_time = a->posed, .time = a->frame_time, .animation = a->animation};
+    rt_result r = load_input(&s, path, &lo, &info, &err);
     if (r != RT_OK) {
         report(&err, budget);
         rt_scene_free(&s);
@@ -258,7 +260,7 @@ static int print_info(const char *path, const memory_budget *budget)
  * any of them failed to load (the others are still reported). */
 static int print_infos(const args *a)
 {
-    int status = print_info(a->info_path, &a->budget);
+    int status = print_info(a->info_path, a);
     const char *rest[ARGS_MAX_INPUTS + 1];
     size_t n = 0;
     if (a->input)
@@ -268,7 +270,7 @@ static int print_infos(const args *a)
     for (size_t i = 0; i < n; i++) {
         printf("\n");
         fflush(stdout);
-        if (print_info(rest[i], &a->budget) != 0)
+        if (print_info(rest[i], a) != 0)
             status = 2;
     }
     return status;
@@ -324,7 +326,8 @@ static rt_result apply_pose_flags(rt_scene *scene, const args *a, rt_error *err)
 static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t size, rt_error *err)
 {
     rt_load_info info;
-    rt_load_options lo = {.for_render = true};
+    rt_load_options lo = {
+        .for_render = true, .use_time = a->posed, .time = a->frame_time, .animation = a->animation};
     rt_result r;
     /* -o is checked before the load, which may take long, and so is a
      * model's default output (models have no `output` line); a scene's own

@@ -23,7 +23,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "rt/base/alloc.h"
 #include "rt/base/clock.h"
@@ -33,12 +32,6 @@
 #include "rt/render/integrator.h"
 #include "rt/render/sampling.h"
 #include "rt/scene/validate.h"
-
-int rt_cpu_count(void)
-{
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    return n > 0 ? (n > 1024 ? 1024 : (int)n) : 1;
-}
 
 struct rt_render_job {
     const rt_scene *scene;

@@ -56,6 +56,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "rt/base/cpu.h" /* rt_cpu_count: the default thread count */
 #include "rt/base/error.h"
 #include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"
@@ -120,6 +121,5 @@ typedef struct rt_render_stats {
 rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_render_options *options,
                     rt_framebuffer *fb, rt_render_stats *stats, rt_error *err);
 
-int rt_cpu_count(void);
 
 #endif
