@@ -56,7 +56,7 @@ DEPS_OK  := $(BUILD)/.deps-ok
 
 
 .PHONY: test-slurm test-kubernetes test-parallel test-launchers
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build fuzz install uninstall test-install denoiser
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build fuzz install uninstall test-install denoiser ggx-albedo-table
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -169,6 +169,13 @@ bench/buildscale: bench/buildscale.c $(BUILD)/librt.a | $(DEPS_OK)
 # kd-tree build time from 10k to 2M triangles (the N log N check) and on the shared bench models.
 bench-build: bench/buildscale
 	@./bench/buildscale $$(sed -n 's#^| [A-Za-z0-9_]* | `\([^`]*\)`.*#$(SHARED)/\1#p' $(SHARED)/bench/MANIFEST.md 2>/dev/null)
+
+# Regenerates the committed GGX albedo tables of the energy compensation
+# (src/render/ggx_albedo_table.c) from tools/ggx_albedo.c; about 15 s of CPU.
+ggx-albedo-table:
+	@mkdir -p $(BUILD)
+	$(CC) -std=c11 -O2 -D_DEFAULT_SOURCE -o $(BUILD)/ggx_albedo tools/ggx_albedo.c -lm
+	$(BUILD)/ggx_albedo > src/render/ggx_albedo_table.c.tmp && mv src/render/ggx_albedo_table.c.tmp src/render/ggx_albedo_table.c
 
 SCENES := $(wildcard scenes/*.txt)
 scenes: $(RT)

@@ -867,7 +867,7 @@ static void test_conductor_material(void **state)
     rt_scene_free(&s);
     expect_error("material m metal Au\n", RT_ERR_INVALID, "1:12", "material key 'metal' needs 'bsdf conductor'");
     expect_error("material m bsdf conductor metal Zz\n", RT_ERR_PARSE, "1:33",
-                 "expected material metal (Cu|Au|Ag|Al|Ti|Pt|Fe|CuZn), got 'Zz'");
+                 "expected material metal (Cu|Au|Ag|Al|Ti|Pt|Fe|CuZn|Cr|Ni|W), got 'Zz'");
     expect_error("material m bsdf conductor metal Au k 1 1 1\n", RT_ERR_INVALID, "1:36",
                  "give either 'metal NAME' or 'eta' and 'k', not both");
     expect_error("material m bsdf conductor ggx_alpha 0.1 ggx_alpha_uv 0.1 0.2\n", RT_ERR_INVALID, "1:41",
@@ -891,6 +891,16 @@ static void test_conductor_material(void **state)
     assert_float_equal(s.materials[1].transmission, 0.5, 0);
     rt_scene_free(&s);
     expect_error("material m absorption 1 1 1\n", RT_ERR_INVALID, "1:12", "material key 'absorption' needs 'bsdf dielectric'");
+    /* nested media: an integer priority, dielectrics only */
+    expect_ok("material w bsdf dielectric ior 1.33 priority 7\n", &s);
+    assert_int_equal(s.materials[0].priority, 7);
+    rt_scene_free(&s);
+    expect_error("material m bsdf plastic priority 1\n", RT_ERR_INVALID, "1:25",
+                 "material key 'priority' needs 'bsdf dielectric'");
+    expect_error("material m bsdf dielectric priority 1.5\n", RT_ERR_PARSE, "1:37",
+                 "expected an integer for material priority, got '1.5'");
+    expect_error("material m bsdf dielectric priority -1\n", RT_ERR_INVALID, "1:37",
+                 "material priority must be between 0 and 1000, got '-1'");
     expect_error("material m bsdf conductor exterior_ior 1.2\n", RT_ERR_INVALID, "1:27",
                  "material key 'exterior_ior' needs 'bsdf dielectric'");
     expect_error("material m ggx_alpha 0.1\n", RT_ERR_INVALID, "1:12",

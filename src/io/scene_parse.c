@@ -804,7 +804,7 @@ static rt_result st_texture(parser *p, const tok *kw)
 static int edit_distance(const char *a, const char *b);
 
 typedef enum mat_kind {
-    MK_FLOAT, MK_COLOR, MK_BOOL, MK_TEXTURE, MK_ALPHA_MODE, MK_DISTANCE, MK_UV, MK_BSDF,
+    MK_FLOAT, MK_INT, MK_COLOR, MK_BOOL, MK_TEXTURE, MK_ALPHA_MODE, MK_DISTANCE, MK_UV, MK_BSDF,
     MK_METAL,    /* a named metal: sets eta and k */
     MK_GGX,      /* GGX alpha, isotropic (one value: alpha_u = alpha_v) or two values (offset 1) */
     MK_SMITH,
@@ -815,7 +815,7 @@ typedef struct mat_key {
     const char *alias; /* another accepted spelling, or NULL */
     mat_kind kind;
     size_t offset;     /* into rt_material (MK_UV: 0 = uv_scale, 1 = uv_offset) */
-    float lo, hi;      /* MK_FLOAT range */
+    float lo, hi;      /* MK_FLOAT, MK_INT range */
 } mat_key;
 
 #define MOFF(f) offsetof(rt_material, f)
@@ -848,6 +848,7 @@ static const mat_key mat_keys[] = {
     {"ggx_alpha_uv", NULL, MK_GGX, 1, 0, 0},
     {"smith", NULL, MK_SMITH, MOFF(smith), 0, 0},
     {"exterior_ior", NULL, MK_FLOAT, MOFF(exterior_ior), 0.01f, 100},
+    {"priority", NULL, MK_INT, MOFF(priority), 0, 1000},
     {"absorption", NULL, MK_COLOR, MOFF(absorption), 0, 0},
     {"thickness", NULL, MK_FLOAT, MOFF(thickness), 0, FLT_MAX},
     {"attenuation_color", NULL, MK_COLOR, MOFF(attenuation_color), 0, 0},
@@ -920,6 +921,13 @@ static rt_result st_material(parser *p, const tok *kw)
         void *field = (char *)&m + mk->offset;
         switch (mk->kind) {
         case MK_FLOAT: r = get_float_in(p, what, mk->lo, mk->hi, (float *)field); break;
+        case MK_INT: {
+            long long v = 0;
+            r = get_int(p, what, (long long)mk->lo, (long long)mk->hi, &v);
+            if (r == RT_OK)
+                *(int *)field = (int)v;
+            break;
+        }
         case MK_COLOR: r = get_color(p, what, (rt_vec3 *)field); break;
         case MK_BOOL: r = get_bool(p, what, (bool *)field); break;
         case MK_ALPHA_MODE: {
@@ -1013,7 +1021,8 @@ static rt_result st_material(parser *p, const tok *kw)
         bool complex_ior = mk->kind == MK_COLOR && (mk->offset == offsetof(rt_material, eta) ||
                                                     mk->offset == offsetof(rt_material, k));
         bool exterior = mk->kind == MK_FLOAT && mk->offset == offsetof(rt_material, exterior_ior);
-        bool absorbs = mk->kind == MK_COLOR && mk->offset == offsetof(rt_material, absorption);
+        bool absorbs = (mk->kind == MK_COLOR && mk->offset == offsetof(rt_material, absorption)) ||
+                       (mk->kind == MK_INT && mk->offset == offsetof(rt_material, priority));
         if (!seen[i])
             continue;
         if (absorbs && m.bsdf != RT_BSDF_DIELECTRIC)

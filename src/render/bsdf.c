@@ -24,6 +24,13 @@
  *   anisotropic GGX D and Lambda (Heitz 2014, eqs. 85, 86) and the
  *   separable Smith term G1 G1 (eq. 98) as the `smith separable` option;
  *   anisotropic VNDF sampling (Heitz 2018, the stretch by (ax, ay)).
+ * - Energy compensation of rough conductors: C. Kulla and A. Conty,
+ *   "Revisiting Physically Based Shading at Imageworks" (SIGGRAPH 2017
+ *   course "Physically Based Shading in Theory and Practice"): the lobe
+ *   (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - E_avg)) restores the energy
+ *   single scattering loses with F = 1, times F_avg^2 E_avg / (1 - F_avg
+ *   (1 - E_avg)) for the Fresnel-weighted sum over the extra bounces; E
+ *   and E_avg from rt/render/ggx_albedo.h.
  * - Cosine sampling of the diffuse lobe (rt/sampling.h).
  * - Choosing one lobe by its estimated weight and returning the mixture pdf
  *   is one-sample MIS over the lobes with the balance heuristic (Veach 1997,
@@ -41,6 +48,7 @@
  */
 #include "rt/render/bsdf.h"
 
+#include "rt/render/ggx_albedo.h"
 #include "rt/render/sampling.h"
 #include "rt/scene/texture.h"
 
@@ -256,6 +264,7 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
         ior = 1.5f;
     b->lambert = lambert;
     b->conductor = false;
+    b->ms = false;
     b->separable = false;
     b->radiance_eta2 = false;
     b->plastic = false;
@@ -309,6 +318,25 @@ void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float
     set_conductor(b, eta, k, alpha_x, alpha_y, smith);
 }
 
+void rt_bsdf_compensate(rt_bsdf *b)
+{
+    if (!b->conductor || b->delta || b->separable)
+        return;
+    float alpha = sqrtf(b->alpha * b->alpha_y);
+    float ea = rt_ggx_albedo_avg(alpha);
+    if (!(1.0f - ea > 1e-5f))
+        return; /* a near-mirror loses nothing */
+    rt_vec3 fa = rt_fresnel_conductor_avg(b->eta_c, b->k_c);
+    rt_vec3 one = rt_v3s(1.0f);
+    rt_vec3 fms = rt_div(rt_scale(rt_mul(fa, fa), ea), rt_sub(one, rt_scale(fa, 1.0f - ea)));
+    rt_vec3 scale = rt_scale(fms, 1.0f / (RT_PI * (1.0f - ea)));
+    if (!rt_finite3(scale))
+        return;
+    b->ms = true;
+    b->ms_alpha = alpha;
+    b->ms_scale = scale;
+}
+
 rt_vec3 rt_material_absorption(const rt_material *m)
 {
     rt_vec3 sigma = rt_v3s(0.0f);
@@ -336,6 +364,14 @@ void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha)
     b->delta = alpha == 0.0f;
     b->alpha = b->alpha_y = fmaxf(alpha, RT_BSDF_MIN_ALPHA);
     b->radiance_eta2 = true;
+}
+
+void rt_bsdf_set_eta(rt_bsdf *b, float eta)
+{
+    eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
+    float r0 = (eta - 1.0f) / (eta + 1.0f);
+    b->f0 = r0 * r0;
+    b->eta = eta;
 }
 
 float rt_fresnel_diffuse_reflectance(float eta)
@@ -411,6 +447,8 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
             }
         }
         set_conductor(b, m->eta, m->k, ax, ay, m->smith);
+        if (s->settings.energy_compensation)
+            rt_bsdf_compensate(b);
         return;
     }
     if (m->bsdf == RT_BSDF_DIELECTRIC) {
@@ -451,6 +489,14 @@ void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p
     *p_diffuse = *p_specular = *p_transmit = 0.0f;
     if (b->conductor) {
         *p_specular = 1.0f;
+        if (b->ms) { /* the lobes' albedos at wo: about F E(mu_o) and F_ms (1 - E(mu_o)) */
+            float e = rt_ggx_albedo(wo.z, b->ms_alpha);
+            float ws = mean3(rt_fresnel_conductor(wo.z, b->eta_c, b->k_c)) * e;
+            float wm = mean3(b->ms_scale) * RT_PI * (1.0f - rt_ggx_albedo_avg(b->ms_alpha)) * (1.0f - e);
+            float pm = (ws + wm > 0.0f) ? wm / (ws + wm) : 0.0f;
+            *p_diffuse = isfinite(pm) ? rt_clampf(pm, 0.0f, 0.95f) : 0.0f;
+            *p_specular = 1.0f - *p_diffuse;
+        }
         return;
     }
     if (b->lambert) {
@@ -508,7 +554,13 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
         if (!isfinite(spec) || !isfinite(pv))
             return rt_v3s(0.0f);
         *pdf = ps * pv;
-        return rt_scale(rt_fresnel_conductor(voh, b->eta_c, b->k_c), spec);
+        rt_vec3 f = rt_scale(rt_fresnel_conductor(voh, b->eta_c, b->k_c), spec);
+        if (b->ms) {
+            float m = (1.0f - rt_ggx_albedo(wo.z, b->ms_alpha)) * (1.0f - rt_ggx_albedo(wi.z, b->ms_alpha));
+            f = rt_add(f, rt_scale(b->ms_scale, m));
+            *pdf += pd * wi.z * RT_INV_PI;
+        }
+        return f;
     }
     float fd = fresnel_dielectric(b, voh);
     /* diffuse: the dielectric's fresnel_mix leaves 1 - Fd to the base;

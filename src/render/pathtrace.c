@@ -31,10 +31,15 @@
  * 1, the path survives with q = that channel. settings.max_depth caps the scattering
  * events of a path (0 = no cap).
  *
- * Absorption (Beer-Lambert): a path segment that ends on the back of a
- * dielectric (or a glTF KHR_materials_volume object) ran inside it, so
- * beta is multiplied by exp(-sigma_a d) over its length d
- * (rt_material_absorption); objects are assumed closed and not nested.
+ * Media (rt/render/medium.h): the path carries a stack of the dielectric
+ * objects it is inside (Schmidt and Budge 2002's nested dielectrics). Each
+ * segment is attenuated by Beer-Lambert absorption exp(-sigma_a d) of the
+ * medium it ran through (a glTF KHR_materials_volume object: the segment
+ * ending on its back); a false intersection (a lower-priority medium's
+ * surface inside a higher-priority one) is passed straight through
+ * without counting as a bounce; a true one refracts between the current
+ * medium's index and the next one's, and a transmitted sample pushes or
+ * pops the stack.
  *
  * Area lights are pure emitters: their visible quad emits from its front
  * and reflects nothing. Shadow rays pass alpha cut-outs and blended
@@ -48,6 +53,7 @@
 
 #include "rt/render/bsdf.h"
 #include "rt/render/environment.h"
+#include "rt/render/medium.h"
 
 static inline rt_vec3 add_finite(rt_vec3 acc, rt_vec3 c)
 {
@@ -189,6 +195,9 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
     float prev_pdf = 0.0f;      /* BSDF pdf of the ray just traced */
     rt_vec3 prev_p = r.org;
     int bounces = 0;
+    rt_medium_stack media;
+    rt_medium_stack_init(&media);
+    int skips = RT_PATH_HARD_LIMIT; /* false intersections a path may pass */
     for (;;) {
         int layers = 257; /* up to 256 cut-away surfaces per path segment */
         rt_surface sf;
@@ -203,12 +212,18 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         if (found != RT_WALK_SURFACE)
             break;
         const rt_material *m = &s->materials[sf.material];
-        if (!sf.front && (m->bsdf == RT_BSDF_DIELECTRIC || m->thickness > 0.0f)) {
-            /* the segment ran inside this object: Beer-Lambert absorption
-             * over its length (r.tmin is the hit distance, dir is unit) */
-            rt_vec3 sigma = rt_material_absorption(m);
-            if (rt_max3(sigma) > 0.0f)
-                beta = rt_mul(beta, rt_v3(expf(-sigma.x * r.tmin), expf(-sigma.y * r.tmin), expf(-sigma.z * r.tmin)));
+        /* Beer-Lambert absorption of the medium the segment ran through
+         * (r.tmin is the hit distance, dir is unit) */
+        uint32_t medium = rt_medium_of_segment(&media, s->materials, sf.material, sf.front);
+        if (medium != RT_NONE)
+            beta = rt_mul(beta, rt_medium_transmittance(s->materials, medium, r.tmin));
+        if (rt_medium_false_hit(&media, s->materials, sf.material, sf.front)) {
+            /* an interface inside a higher-priority medium: straight on */
+            rt_medium_cross(&media, s->materials, sf.material, sf.front);
+            if (--skips < 0)
+                break;
+            r = rt_ray_make(rt_surface_spawn(ctx, &sf, r.dir), r.dir, 0.0f, INFINITY);
+            continue;
         }
         /* emission, MIS-weighted when it could have been light-sampled */
         rt_vec3 Le = rt_surface_emission(ctx, &sf);
@@ -243,6 +258,10 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
             break;
         rt_bsdf b;
         rt_bsdf_from_surface(ctx, &sf, &b);
+        if (rt_medium_is_medium(m)) { /* the index ratio to the medium beyond */
+            float eta = rt_medium_outside_ior(&media, s->materials, sf.material, sf.front) / m->ior;
+            rt_bsdf_set_eta(&b, sf.front ? eta : 1.0f / eta);
+        }
         rt_vec3 wo = rt_bsdf_to_local(&b, sf.wo);
         if (!(wo.z > 0.0f))
             break;
@@ -260,6 +279,8 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         beta = rt_mul(beta, bs.weight);
         if (!rt_finite3(beta) || !(rt_max3(beta) > 0.0f))
             break;
+        if (bs.wi.z < 0.0f) /* transmitted: into or out of the medium */
+            rt_medium_cross(&media, s->materials, sf.material, sf.front);
         prev_delta = bs.delta;
         prev_pdf = bs.pdf;
         prev_p = sf.p;

@@ -48,6 +48,7 @@ void rt_material_default(rt_material *m, const char *name)
     m->alpha_u = m->alpha_v = -1.0f;
     m->smith = RT_SMITH_CORRELATED;
     m->exterior_ior = 1.0f;
+    m->priority = 0;
     m->absorption = rt_v3s(0.0f);
     m->thickness = 0.0f;
     m->attenuation_color = rt_v3s(1.0f);
@@ -69,6 +70,11 @@ const rt_metal rt_metals[] = {
     {"Pt", {2.37570f, 2.08470f, 1.84530f}, {4.26550f, 3.71530f, 3.13650f}},
     {"Fe", {2.91140f, 2.94970f, 2.58450f}, {3.08930f, 2.93180f, 2.76700f}},
     {"CuZn", {0.44400f, 0.52700f, 1.09400f}, {3.69500f, 2.76500f, 1.82900f}}, /* brass */
+    /* Palik's handbook as tabulated in Mitsuba 0.6's data/ior (Cr.*.spd,
+     * Ni_palik.*.spd, W.*.spd), linearly interpolated at 650, 550, 450 nm */
+    {"Cr", {3.63755f, 3.11576f, 1.92770f}, {4.36438f, 4.42285f, 4.16754f}},
+    {"Ni", {2.01396f, 1.77236f, 1.62880f}, {3.80792f, 3.25260f, 2.65399f}},
+    {"W", {3.69245f, 3.50000f, 3.30896f}, {2.93698f, 2.72915f, 2.52585f}},
 };
 const size_t rt_metal_count = sizeof rt_metals / sizeof *rt_metals;
 

@@ -27,6 +27,8 @@ _Static_assert(sizeof(rt_integrator) == sizeof(int), "enum settings are stored a
 #define FIELD(f) offsetof(rt_settings, f)
 #define FIELD_SIZE(f) sizeof(((rt_settings *)0)->f)
 
+static const char *const onoff_words[] = {"off", "on", NULL};
+
 /* Table order is the order of --help and of the scene parser's "did you mean" search. */
 const rt_setting rt_settings_table[] = {
     {.name = "resolution", .args = "W H", .type = RT_SETTING_SIZE, .field = FIELD(width), .field2 = FIELD(height),
@@ -44,6 +46,9 @@ const rt_setting rt_settings_table[] = {
     {.name = "rr_depth", .args = "N", .type = RT_SETTING_INT, .field = FIELD(rr_depth), .min = 0, .max = 1024,
      .defaults = {3}, .what = "rr_depth",
      .help = "path: Russian roulette from this many bounces on; 0 = adaptive (once the throughput is below 1)"},
+    {.name = "energy_compensation", .args = "MODE", .type = RT_SETTING_ENUM, .field = FIELD(energy_compensation),
+     .defaults = {0}, .words = onoff_words, .what = "energy_compensation",
+     .help = "path: restore the energy rough conductors lose to multiple scattering (Kulla-Conty 2017)"},
     {.name = "diffuse_bounces", .args = "N", .type = RT_SETTING_INT, .field = FIELD(diffuse_bounces), .min = 0,
      .max = 64, .defaults = {0}, .what = "diffuse_bounces", .help = "whitted: levels of indirect diffuse light"},
     {.name = "diffuse_rays", .args = "N", .type = RT_SETTING_INT, .field = FIELD(diffuse_rays), .min = 1,

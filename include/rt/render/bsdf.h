@@ -47,7 +47,9 @@
  * RT_BSDF_CONDUCTOR (rt_bsdf.conductor) is a metal of complex index
  * eta + i k per channel: f = F_conductor(wo.h) D G2 / (4 cos_o cos_i) with
  * anisotropic GGX (alpha along t and b), G2 height-correlated or
- * separable; alpha 0 is a delta mirror of weight F_conductor(cos_o).
+ * separable; alpha 0 is a delta mirror of weight F_conductor(cos_o). With
+ * energy compensation (rt_bsdf_compensate) a diffuse-like lobe adds back
+ * the energy single scattering loses (Kulla and Conty 2017).
  *
  * Sampling picks a lobe by its estimated share of the reflected energy at
  * wo, then samples diffuse by the cosine, specular by the distribution of
@@ -80,6 +82,9 @@ typedef struct rt_bsdf {
     bool radiance_eta2; /* dielectric: refraction scales radiance by eta^2 (n_wo / n_wi)^2 */
     bool plastic;     /* coat over Lambert: diffuse = R / (1 - R Fdr_in) / eta_in^2, times (1 - Fo)(1 - Fi) / pi */
     rt_vec3 eta_c, k_c; /* conductor: complex index relative to the outside */
+    bool ms;          /* conductor: Kulla-Conty multiple-scattering lobe (rt_bsdf_compensate) */
+    float ms_alpha;   /* its table alpha, sqrt(alpha alpha_y) */
+    rt_vec3 ms_scale; /* F_ms / (pi (1 - E_avg)): f_ms = ms_scale (1 - E(mu_o)) (1 - E(mu_i)) */
     float transmission; /* T */
     float eta;        /* index ratio across the surface along a transmitted ray: n_incident / n_transmitted */
 } rt_bsdf;
@@ -125,6 +130,9 @@ void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float rou
                   float transmission, bool lambert);
 /* A dielectric (bsdf dielectric): eta = n_wo / n_wi, GGX alpha (0: smooth). */
 void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha);
+/* Re-aims a dielectric at another medium beyond its surface (nested
+ * media, rt/render/medium.h): eta = n_wo / n_wi, F0 from it. */
+void rt_bsdf_set_eta(rt_bsdf *b, float eta);
 /* A plastic (bsdf plastic): Lambertian reflectance R under a dielectric
  * coat, eta = n_outside / n_coat, coat GGX alpha (0: smooth). */
 void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alpha);
@@ -136,6 +144,15 @@ float rt_fresnel_diffuse_reflectance(float eta);
  * the frame (both 0: a delta mirror). */
 void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float alpha_x, float alpha_y,
                             rt_smith smith);
+
+/* Adds Kulla and Conty's (2017) multiple-scattering lobe to a rough
+ * conductor (height-correlated Smith; nothing for a delta or separable
+ * one): f_ms = F_ms (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - E_avg)),
+ * F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)) per channel, with the
+ * tables of rt/render/ggx_albedo.h at alpha = sqrt(alpha_x alpha_y).
+ * Sampled by the cosine with the probability of its share of the albedo.
+ * rt_bsdf_from_surface calls it when the scene's energy_compensation is on. */
+void rt_bsdf_compensate(rt_bsdf *b);
 
 static inline rt_vec3 rt_bsdf_to_local(const rt_bsdf *b, rt_vec3 w)
 {

@@ -14,6 +14,7 @@
 #ifndef RT_WHITTED_H
 #define RT_WHITTED_H
 
+#include "rt/render/medium.h"
 #include "rt/render/sampling.h"
 #include "rt/render/surface.h"
 
@@ -38,17 +39,12 @@ rt_fresnel rt_fresnel_dielectric(float cos_i, float n1, float n2);
  * False on total internal reflection. n1 == n2 gives d unchanged. */
 bool rt_refract(rt_vec3 d, rt_vec3 n, float n1, float n2, rt_vec3 *t);
 
-/* The media a ray is inside, innermost last, as material indices: entering
- * a transmissive surface from its front pushes its material, leaving it
- * removes it. The index of refraction a ray travels in is that of the top
- * material, 1 (vacuum/air) when empty. Deeper nesting than the capacity
- * keeps the outer levels. */
-#define RT_MEDIUM_STACK_MAX 8
-typedef struct rt_medium_stack {
-    int depth;
-    uint32_t material[RT_MEDIUM_STACK_MAX];
-} rt_medium_stack;
-
+/* The media a ray is inside (rt_medium_stack of rt/render/medium.h),
+ * innermost last, as material indices: whitted's rules, without
+ * priorities: entering a transmissive surface from its front pushes its
+ * material, leaving it removes it. The index of refraction a ray travels
+ * in is that of the top material, 1 (vacuum/air) when empty. Deeper
+ * nesting than the capacity keeps the outer levels. */
 float rt_medium_ior(const rt_scene *s, const rt_medium_stack *m);
 
 rt_vec3 rt_radiance_whitted(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng);

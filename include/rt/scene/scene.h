@@ -66,6 +66,7 @@ typedef struct rt_settings {
     int max_bounce;       /* mirror/refraction recursion depth */
     int max_depth;        /* path: most scattering events a path may have; 0 = unlimited (Russian roulette ends paths) */
     int rr_depth;         /* path: Russian roulette from this many bounces on; 0 = adaptive (once the throughput is below 1) */
+    int energy_compensation; /* path: 1 = Kulla-Conty multiple-scattering lobe on rough conductors (default 0, off) */
     int diffuse_bounces;  /* levels of indirect diffuse light (whitted) */
     int diffuse_rays;     /* cosine-distributed rays per diffuse level */
     int shadow_samples;   /* samples per area light per shading point */
@@ -175,6 +176,7 @@ typedef struct rt_material {
     rt_smith smith;
     /* dielectric and plastic: ior is the inside's (the coat's) index */
     float exterior_ior;     /* index outside (default 1) */
+    int priority;           /* dielectric: nested-media priority, higher wins (rt/render/medium.h) */
     rt_vec3 absorption;     /* absorption coefficient inside, per scene unit (adds to attenuation_*) */
     float thickness;        /* KHR_materials_volume */
     rt_vec3 attenuation_color;
@@ -194,7 +196,10 @@ void rt_material_default(rt_material *m, const char *name);
  * the red, green and blue wavelengths 650, 550 and 450 nm, from
  * RefractiveIndex.INFO's "3D" data set (M. N. Polyanskiy, refractiveindex.info
  * database, Sci. Data 11, 94 (2024)), as tabulated by C. Hindefjord, "RGB IOR
- * values for common metals". The default conductor is Cu (as pbrt-v4's). */
+ * values for common metals"; Cr, Ni and W from E. D. Palik (ed.), "Handbook
+ * of Optical Constants of Solids" (1985), as tabulated in Mitsuba 0.6's
+ * spectral data, interpolated linearly at the same three wavelengths. The
+ * default conductor is Cu (as pbrt-v4's). */
 typedef struct rt_metal {
     const char *name;
     rt_vec3 eta, k;
