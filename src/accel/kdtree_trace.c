@@ -133,7 +133,9 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
     a = _mm_max_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(2, 3, 0, 1)));
     b = _mm_min_ps(b, _mm_shuffle_ps(b, b, _MM_SHUFFLE(1, 0, 3, 2)));
     b = _mm_min_ps(b, _mm_shuffle_ps(b, b, _MM_SHUFFLE(2, 3, 0, 1)));
-    float tn = fmaxf(ray->tmin, _mm_cvtss_f32(a)), tf = fminf(ray->tmax, _mm_cvtss_f32(b));
+    /* fmaxf and fminf, but inline (libm calls here): tmin and tmax are
+     * not NaN (tmin < tmax), nor are a and b for a finite ray */
+    float tn = _mm_cvtss_f32(_mm_max_ss(_mm_set_ss(ray->tmin), a)), tf = _mm_cvtss_f32(_mm_min_ss(_mm_set_ss(ray->tmax), b));
     if (!(tn <= tf))
         return false;
     r->tn = tn;
