@@ -106,5 +106,8 @@ typedef struct kd_ray {
 bool rt_kd_ray_prepare(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r);
 bool rt_kd_leaf_hit(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr, float *best,
                     rt_hit *hit);
+/* One primitive (a tree id, as in a leaf list) for one ray, the same way. */
+bool rt_kd_prim_hit(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
+                    rt_hit *hit);
 
 #endif

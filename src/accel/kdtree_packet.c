@@ -49,6 +49,88 @@ static unsigned single_rays(const rt_kdtree *tree, const rt_ray *rays, int n, rt
 #define KD_PSTACK 192 /* as kdtree_trace.c's stack: 7 pushes a wide level */
 _Static_assert(7 * ((KD_MAX_DEPTH + 2) / 3) + 1 <= KD_PSTACK, "packet traversal stack");
 
+/* The packet's rays for the triangle test, one ray a lane: the shear of
+ * each (rt_tri_ray), when all share the axis kz. */
+typedef struct kd_pray {
+    __m256 ox, oy, oz, sx, sy, sz, adz, ad, tmin;
+    int kx, ky, kz;
+} kd_pray;
+
+/* One triangle (tree id) against the rays of mask m, one a lane: the
+ * operations of rt_intersect_triangle_ray, lane by lane (each lane its
+ * ray's shear; the vertices broadcast), so each ray gets the reference's
+ * bits; a lane whose edge function rounds to zero is left to the
+ * reference itself (which recomputes it in double). */
+static inline void tri_rays(const rt_kdtree *tree, uint32_t id, unsigned m, const kd_pray *P, const rt_ray *rays,
+                            const rt_tri_ray *tr, float *best, rt_hit *h, unsigned *found)
+{
+    RT_NO_FP_CONTRACT
+    const float *v = tree->tri + id;
+    __m256 ax = _mm256_set1_ps(v[P->kx]), ay = _mm256_set1_ps(v[P->ky]), az = _mm256_set1_ps(v[P->kz]);
+    __m256 bx = _mm256_set1_ps(v[3 + P->kx]), by = _mm256_set1_ps(v[3 + P->ky]), bz = _mm256_set1_ps(v[3 + P->kz]);
+    __m256 cx = _mm256_set1_ps(v[6 + P->kx]), cy = _mm256_set1_ps(v[6 + P->ky]), cz = _mm256_set1_ps(v[6 + P->kz]);
+    __m256 akz = _mm256_sub_ps(az, P->oz), bkz = _mm256_sub_ps(bz, P->oz), ckz = _mm256_sub_ps(cz, P->oz);
+    __m256 Ax = _mm256_sub_ps(_mm256_sub_ps(ax, P->ox), _mm256_mul_ps(P->sx, akz));
+    __m256 Ay = _mm256_sub_ps(_mm256_sub_ps(ay, P->oy), _mm256_mul_ps(P->sy, akz));
+    __m256 Bx = _mm256_sub_ps(_mm256_sub_ps(bx, P->ox), _mm256_mul_ps(P->sx, bkz));
+    __m256 By = _mm256_sub_ps(_mm256_sub_ps(by, P->oy), _mm256_mul_ps(P->sy, bkz));
+    __m256 Cx = _mm256_sub_ps(_mm256_sub_ps(cx, P->ox), _mm256_mul_ps(P->sx, ckz));
+    __m256 Cy = _mm256_sub_ps(_mm256_sub_ps(cy, P->oy), _mm256_mul_ps(P->sy, ckz));
+    __m256 U = _mm256_sub_ps(_mm256_mul_ps(Cx, By), _mm256_mul_ps(Cy, Bx));
+    __m256 V = _mm256_sub_ps(_mm256_mul_ps(Ax, Cy), _mm256_mul_ps(Ay, Cx));
+    __m256 W = _mm256_sub_ps(_mm256_mul_ps(Bx, Ay), _mm256_mul_ps(By, Ax));
+    __m256 zero = _mm256_setzero_ps();
+    __m256 neg = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(U, zero, _CMP_LT_OQ), _mm256_cmp_ps(V, zero, _CMP_LT_OQ)),
+                              _mm256_cmp_ps(W, zero, _CMP_LT_OQ));
+    __m256 pos = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(U, zero, _CMP_GT_OQ), _mm256_cmp_ps(V, zero, _CMP_GT_OQ)),
+                              _mm256_cmp_ps(W, zero, _CMP_GT_OQ));
+    unsigned live = m & ~(unsigned)_mm256_movemask_ps(_mm256_and_ps(neg, pos));
+    if (!live)
+        return;
+    __m256 z = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(U, zero, _CMP_EQ_OQ), _mm256_cmp_ps(V, zero, _CMP_EQ_OQ)),
+                            _mm256_cmp_ps(W, zero, _CMP_EQ_OQ));
+    unsigned zm = live & (unsigned)_mm256_movemask_ps(z);
+    live &= ~zm;
+    while (zm) { /* an edge function rounded to zero: the reference decides */
+        int i = __builtin_ctz(zm);
+        zm &= zm - 1;
+        if (rt_kd_prim_hit(tree, id, &rays[i], &tr[i], &best[i], &h[i]))
+            *found |= 1u << i;
+    }
+    if (!live)
+        return;
+    __m256 det = _mm256_add_ps(_mm256_add_ps(U, V), W);
+    __m256 adet = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), det);
+    __m256 ok = _mm256_and_ps(_mm256_cmp_ps(det, zero, _CMP_NEQ_OQ), _mm256_cmp_ps(adet, _mm256_set1_ps(INFINITY), _CMP_LT_OQ));
+    __m256 T = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(U, _mm256_mul_ps(P->sz, akz)), _mm256_mul_ps(V, _mm256_mul_ps(P->sz, bkz))),
+                             _mm256_mul_ps(W, _mm256_mul_ps(P->sz, ckz)));
+    __m256 inv = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
+    __m256 t = _mm256_mul_ps(T, inv);
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, P->tmin, _CMP_GT_OQ));
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_load_ps(best), _CMP_LT_OQ));
+    live &= (unsigned)_mm256_movemask_ps(ok);
+    if (!live)
+        return;
+    /* the grazing/degenerate guard, edges as the reference computes them */
+    float e1x = v[3] - v[0], e1y = v[4] - v[1], e1z = v[5] - v[2], e2x = v[6] - v[0], e2y = v[7] - v[1], e2z = v[8] - v[2];
+    float a1 = fabsf(e1x) + fabsf(e1y) + fabsf(e1z), a2 = fabsf(e2x) + fabsf(e2y) + fabsf(e2z);
+    __m256 lhs = _mm256_div_ps(_mm256_div_ps(_mm256_mul_ps(adet, P->adz), _mm256_set1_ps(a1)), _mm256_set1_ps(a2));
+    live &= (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(lhs, _mm256_mul_ps(_mm256_set1_ps(0x1p-16f), P->ad), _CMP_GT_OQ));
+    if (!live)
+        return;
+    _Alignas(32) float tl[8], ul[8], vl[8];
+    _mm256_store_ps(tl, t);
+    _mm256_store_ps(ul, _mm256_mul_ps(V, inv));
+    _mm256_store_ps(vl, _mm256_mul_ps(W, inv));
+    *found |= live;
+    while (live) {
+        int i = __builtin_ctz(live);
+        live &= live - 1;
+        best[i] = tl[i];
+        h[i].t = tl[i], h[i].u = ul[i], h[i].v = vl[i], h[i].prim = id;
+    }
+}
+
 typedef struct kd_pentry {
     __m256 lo, hi; /* per ray: its interval in the cell (empty: not crossing) */
     uint32_t ref;
@@ -91,6 +173,24 @@ unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, 
         return 0;
     for (int k = 0; k < 3; k++)
         neg[k] = neg[k] == 1; /* axes no active ray has: any order */
+    /* the triangle test across rays, when the rays share the shear's axes */
+    kd_pray P;
+    bool across = true;
+    {
+        _Alignas(32) float q[9][8];
+        int first = __builtin_ctz(active);
+        P.kx = tr[first].kx, P.ky = tr[first].ky, P.kz = tr[first].kz;
+        for (int i = 0; i < 8; i++) {
+            const rt_tri_ray *t = &tr[active >> i & 1 ? i : first];
+            if (t->kz != P.kz)
+                across = false;
+            q[0][i] = t->okx, q[1][i] = t->oky, q[2][i] = t->okz, q[3][i] = t->sx, q[4][i] = t->sy, q[5][i] = t->sz;
+            q[6][i] = t->adz, q[7][i] = t->ad, q[8][i] = rays[active >> i & 1 ? i : first].tmin;
+        }
+        P.ox = _mm256_load_ps(q[0]), P.oy = _mm256_load_ps(q[1]), P.oz = _mm256_load_ps(q[2]);
+        P.sx = _mm256_load_ps(q[3]), P.sy = _mm256_load_ps(q[4]), P.sz = _mm256_load_ps(q[5]);
+        P.adz = _mm256_load_ps(q[6]), P.ad = _mm256_load_ps(q[7]), P.tmin = _mm256_load_ps(q[8]);
+    }
     __m256 O[3], INV[3], MA[3];
     for (int k = 0; k < 3; k++)
         O[k] = _mm256_load_ps(o[k]), INV[k] = _mm256_load_ps(inv[k]), MA[k] = _mm256_load_ps(ma[k]);
@@ -144,11 +244,30 @@ unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, 
             /* a leaf: each ray that crosses its cell */
             unsigned m = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(L, _mm256_min_ps(H, BEST), _CMP_LE_OQ)) & active;
             _mm256_store_ps(best, BEST);
-            while (m) {
-                int i = __builtin_ctz(m);
-                m &= m - 1;
-                if (rt_kd_leaf_hit(tree, ref, &rays[i], &tr[i], &best[i], &h[i]))
-                    found |= 1u << i;
+            if (across && m & (m - 1)) { /* two or more rays: primitive by primitive, rays in lanes */
+                uint32_t one = ref & RT_KD_PAYLOAD;
+                const uint32_t *p = ref >= RT_KD_ONE ? &one : tree->prim_ids + (ref & RT_KD_PAYLOAD);
+                for (;; p++) {
+                    uint32_t id = *p & RT_KD_PAYLOAD;
+                    if (id < tree->other_base) {
+                        tri_rays(tree, id, m, &P, rays, tr, best, h, &found);
+                    } else {
+                        for (unsigned mm = m; mm; mm &= mm - 1) {
+                            int i = __builtin_ctz(mm);
+                            if (rt_kd_prim_hit(tree, id, &rays[i], &tr[i], &best[i], &h[i]))
+                                found |= 1u << i;
+                        }
+                    }
+                    if (ref >= RT_KD_ONE || (*p & RT_KD_LAST))
+                        break;
+                }
+            } else {
+                while (m) {
+                    int i = __builtin_ctz(m);
+                    m &= m - 1;
+                    if (rt_kd_leaf_hit(tree, ref, &rays[i], &tr[i], &best[i], &h[i]))
+                        found |= 1u << i;
+                }
             }
             BEST = _mm256_load_ps(best);
         }

@@ -819,3 +819,9 @@ KD_FLATTEN bool rt_kd_leaf_hit(const rt_kdtree *tree, uint32_t ref, const rt_ray
     const uint32_t *p = tree->prim_ids + (ref & RT_KD_PAYLOAD);
     return test_leaf(tree, p, leaf_length(p), ray, tr, best, hit, false);
 }
+
+KD_FLATTEN bool rt_kd_prim_hit(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
+                               rt_hit *hit)
+{
+    return test_prim(tree, id, ray, tr, best, hit);
+}
