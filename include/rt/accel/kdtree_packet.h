@@ -9,8 +9,9 @@
  *   // gives (the same t bits; either primitive when two tie); else a miss
  *
  * The rays share the walk down the tree: one step through a wide node
- * computes the 8 rays' intervals in every cell at once, and a cell is
- * entered when any ray crosses it. Packets whose rays run in different
+ * computes the 8 rays' intervals in every cell at once, a cell is
+ * entered when any ray crosses it, and a leaf's triangles are tested
+ * against all the rays that reach it at once. Packets whose rays run in different
  * directions along some axis (the cells' order would differ), or with a
  * ray parallel to an axis, are traced as single rays. A 4x4 tile is two
  * calls.
