@@ -99,11 +99,11 @@ typedef struct kd_ray {
     rt_tri_ray tr; /* the watertight triangle test's shear (intersect.h) */
 } kd_ray;
 
-/* kdtree_trace.c's single-ray pieces, for kdtree_packet.c: the set-up
- * (false: the ray can hit nothing) and the primitives of one leaf
- * reference (RT_KD_ONE or RT_KD_LEAF) tested on (ray->tmin, *best), as the
- * single-ray traversal tests them; hit->prim is the tree's primitive id. */
-bool rt_kd_ray_prepare(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r);
+/* kdtree_trace.c's single-ray leaf test, for kdtree_packet.c (whose ray
+ * set-up repeats ray_setup's operations for 8 rays in lanes): the
+ * primitives of one leaf reference (RT_KD_ONE or RT_KD_LEAF) tested on
+ * (ray->tmin, *best), as the single-ray traversal tests them; hit->prim is
+ * the tree's primitive id. */
 bool rt_kd_leaf_hit(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr, float *best,
                     rt_hit *hit);
 /* One primitive (a tree id, as in a leaf list) for one ray, the same way. */

@@ -804,13 +804,8 @@ KD_FLATTEN bool rt_kdtree_occluded(const rt_kdtree *tree, const rt_ray *ray)
     return traverse(tree, ray, &h, true);
 }
 
-/* For the packet traversal (kdtree_packet.c): the single-ray set-up and
- * one leaf for one ray, out of line. */
-bool rt_kd_ray_prepare(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r)
-{
-    return ray_setup(tree, ray, r);
-}
-
+/* For the packet traversal (kdtree_packet.c): one leaf, or one primitive,
+ * for one ray, out of line. */
 KD_FLATTEN bool rt_kd_leaf_hit(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr, float *best,
                                rt_hit *hit)
 {
