@@ -2,7 +2,8 @@
  * checked against Embree's reference hits.
  *
  *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
- *           [--build-threads N] [--occluded]
+ *           [--build-threads N] [--occluded] [--limit N]
+ *           [--packets W H [--image-width N]]
  *
  * Loads the model with rt_load, as `rt` does (a glTF: every triangle of
  * the default scene in world space, as ../shared/bench/FORMAT.md defines;
@@ -17,7 +18,13 @@
  * go through the any-hit query (shadow rays) instead, and a mismatch is a
  * ray whose hit/miss differs from the reference. Exits 1 when more than
  * 0.01% of the rays disagree with the reference: speed bought with wrong
- * answers does not count. Exit 2 on bad arguments or files.
+ * answers does not count. --limit N keeps N rays spread evenly over the set
+ * (every count/N-th, with its reference hit): a fixed small subset for
+ * instruction counts under callgrind. --packets W H traces the set (a
+ * primary set: one ray per pixel, row by row, N pixels wide, default 640)
+ * in tiles of W x H pixels (W H = 4 2 or 4 4; at most 64 rays), 8 rays at a
+ * time with rt_kdtree_intersect8 (kdtree_packet.h); the answers must be
+ * the same. Exit 2 on bad arguments or files.
  */
 #include <pthread.h>
 #include <stdatomic.h>
@@ -29,6 +36,7 @@
 #include "rt/base/log.h"
 #include "rt/io/load.h"
 #include "rt/accel/kdtree.h"
+#include "rt/accel/kdtree_packet.h"
 #include "rt/io/rayset.h"
 #include "rt/scene/scene.h"
 
@@ -51,8 +59,25 @@ typedef struct job {
     const rt_rayset *rays;
     float *t_out;
     bool occluded;
+    const size_t *order; /* packets: ray indices tile by tile, pack rays a tile (NULL: single rays) */
+    size_t pack;
     atomic_size_t next;
 } job;
+
+/* The rays of one tile, 8 at a time. */
+static void trace_tile(const job *j, const size_t *idx, size_t n)
+{
+    for (size_t g = 0; g < n; g += 8) {
+        int m = n - g < 8 ? (int)(n - g) : 8;
+        rt_ray r[8];
+        rt_hit h[8];
+        for (int i = 0; i < m; i++)
+            r[i] = j->rays->rays[idx[g + (size_t)i]];
+        unsigned hit = rt_kdtree_intersect8(j->tree, r, m, h);
+        for (int i = 0; i < m; i++)
+            j->t_out[idx[g + (size_t)i]] = (hit >> i & 1) ? h[i].t : INFINITY;
+    }
+}
 
 enum { CHUNK = 1024 };
 
@@ -64,7 +89,10 @@ static void *trace_worker(void *arg)
         if (start >= j->rays->count)
             break;
         size_t end = start + CHUNK < j->rays->count ? start + CHUNK : j->rays->count;
-        if (j->occluded) {
+        if (j->order) { /* CHUNK is a multiple of every tile size */
+            for (size_t i = start; i < end; i += j->pack)
+                trace_tile(j, j->order + i, end - i < j->pack ? end - i : j->pack);
+        } else if (j->occluded) {
             for (size_t i = start; i < end; i++) /* hit/miss only: 0 for a hit */
                 j->t_out[i] = rt_kdtree_occluded(j->tree, &j->rays->rays[i]) ? 0.0f : INFINITY;
         } else {
@@ -79,9 +107,9 @@ static void *trace_worker(void *arg)
 
 /* Wall seconds of one pass; *cpu gets the CPU seconds of all threads. */
 static double trace_all(const rt_kdtree *tree, const rt_rayset *rays, float *t_out, int threads, bool occluded,
-                        double *cpu)
+                        const size_t *order, size_t pack, double *cpu)
 {
-    job j = {tree, rays, t_out, occluded, 0};
+    job j = {tree, rays, t_out, occluded, order, pack, 0};
     atomic_init(&j.next, 0);
     pthread_t th[256];
     double c0 = cpu_s(), t0 = now_s();
@@ -106,7 +134,7 @@ static int cmp_double(const void *a, const void *b)
 static int usage(void)
 {
     fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K] [--build-threads N] "
-                    "[--occluded]\n");
+                    "[--occluded] [--limit N] [--packets W H [--image-width N]]\n");
     return 2;
 }
 
@@ -114,6 +142,8 @@ int main(int argc, char **argv)
 {
     const char *model = NULL, *rays_path = NULL, *hits_path = NULL;
     int threads = 1, runs = 5, build_threads = 0;
+    long limit = 0;
+    int pw = 0, ph = 0, image_width = 640;
     bool occluded = false;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--ref") == 0 && i + 1 < argc)
@@ -124,6 +154,15 @@ int main(int argc, char **argv)
             runs = atoi(argv[++i]);
         else if (strcmp(argv[i], "--build-threads") == 0 && i + 1 < argc)
             build_threads = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--limit") == 0 && i + 1 < argc)
+            limit = atol(argv[++i]);
+        else if (strcmp(argv[i], "--packets") == 0 && i + 2 < argc) {
+            pw = atoi(argv[++i]);
+            ph = atoi(argv[++i]);
+            if (pw < 1 || ph < 1 || pw * ph > 64 || 1024 % (pw * ph) != 0)
+                return usage();
+        } else if (strcmp(argv[i], "--image-width") == 0 && i + 1 < argc)
+            image_width = atoi(argv[++i]);
         else if (strcmp(argv[i], "--occluded") == 0)
             occluded = true;
         else if (argv[i][0] == '-')
@@ -136,7 +175,7 @@ int main(int argc, char **argv)
             return usage();
     }
     if (!model || !rays_path || threads < 1 || threads > 256 || runs < 1 || runs > 1000 || build_threads < 0 ||
-        build_threads > 64)
+        build_threads > 64 || limit < 0 || image_width < 1 || (pw && (occluded || limit)))
         return usage();
     rt_log_set_level(RT_LOG_QUIET);
 
@@ -154,6 +193,15 @@ int main(int argc, char **argv)
         fprintf(stderr, "rtbench: %s\n", err.message);
         return 2;
     }
+    if (limit > 0 && (size_t)limit < rs.count) { /* every count/limit-th ray, in place */
+        for (size_t i = 0; i < (size_t)limit; i++) {
+            size_t k = i * rs.count / (size_t)limit;
+            rs.rays[i] = rs.rays[k];
+            if (rs.ref_t)
+                rs.ref_t[i] = rs.ref_t[k];
+        }
+        rs.count = (size_t)limit;
+    }
     rt_kdtree tree;
     rt_kdtree_params params;
     memset(&params, 0, sizeof params);
@@ -162,6 +210,25 @@ int main(int argc, char **argv)
         fprintf(stderr, "rtbench: %s\n", err.message);
         return 2;
     }
+    size_t *order = NULL;
+    if (pw) { /* tile by tile (W x H pixels), each tile's rays row by row */
+        size_t W = (size_t)image_width, Hh = rs.count / W, k = 0;
+        if (Hh * W != rs.count || W % (size_t)pw || Hh % (size_t)ph) {
+            fprintf(stderr, "rtbench: %s: %zu rays are not an image %zu wide in %dx%d tiles\n", rays_path, rs.count, W,
+                    pw, ph);
+            return 2;
+        }
+        order = malloc(rs.count * sizeof *order);
+        if (!order) {
+            fprintf(stderr, "rtbench: out of memory\n");
+            return 2;
+        }
+        for (size_t ty = 0; ty < Hh; ty += (size_t)ph)
+            for (size_t tx = 0; tx < W; tx += (size_t)pw)
+                for (size_t y = ty; y < ty + (size_t)ph; y++)
+                    for (size_t x = tx; x < tx + (size_t)pw; x++)
+                        order[k++] = y * W + x;
+    }
     float *t_out = malloc((rs.count ? rs.count : 1) * sizeof(float));
     double *times = malloc((size_t)runs * sizeof(double)), *cpus = malloc((size_t)runs * sizeof(double));
     if (!t_out || !times || !cpus) {
@@ -169,7 +236,7 @@ int main(int argc, char **argv)
         return 2;
     }
     for (int r = 0; r < runs; r++)
-        times[r] = trace_all(&tree, &rs, t_out, threads, occluded, &cpus[r]);
+        times[r] = trace_all(&tree, &rs, t_out, threads, occluded, order, (size_t)pw * (size_t)ph, &cpus[r]);
     qsort(times, (size_t)runs, sizeof(double), cmp_double);
     qsort(cpus, (size_t)runs, sizeof(double), cmp_double);
     double median = runs % 2 ? times[runs / 2] : 0.5 * (times[runs / 2 - 1] + times[runs / 2]);
@@ -197,6 +264,8 @@ int main(int argc, char **argv)
     printf("threads: %d\n", threads);
     printf("rays: %zu\n", rs.count);
     printf("query: %s\n", occluded ? "occluded" : "closest");
+    if (pw)
+        printf("packets: %dx%d tiles, 8 rays a call\n", pw, ph);
     printf("mrays_per_s: %.3f\n", median > 0 ? 1e-6 * (double)rs.count / median : 0.0);
     printf("mrays_per_s_best: %.3f\n", times[0] > 0 ? 1e-6 * (double)rs.count / times[0] : 0.0);
     printf("cpu_mrays_per_s: %.3f\n", cpu_median > 0 ? 1e-6 * (double)rs.count / cpu_median : 0.0);
@@ -208,6 +277,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "rtbench: %zu of %zu rays disagree with %s (over 0.01%%)\n", mismatches, rs.count, hits_path);
         status = 1;
     }
+    free(order);
     free(t_out);
     free(times);
     free(cpus);

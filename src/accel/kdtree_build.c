@@ -46,8 +46,8 @@
  * Output (kdtree_internal.h): 8-byte nodes in depth-first order (below
  * child = next node, above child index in the node) and leaf id lists in a
  * second array, ascending, triangles first. The triangles' records for the
- * traversal (v0, e1 = v1 - v0, e2 = v2 - v0, computed exactly as the
- * reference tests of intersect.h do, so t is bit-identical to testing the
+ * traversal (the scene's v0, v1, v2, which the watertight test of
+ * intersect.h reads as they are, so t is bit-identical to testing the
  * scene's triangle directly) are made here with the primitives' bounds;
  * kdtree_pack.c puts them into the leaf blocks and packs the nodes.
  *
@@ -859,8 +859,8 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
                      (e1.x != 0.0f || e1.y != 0.0f || e1.z != 0.0f) && (e2.x != 0.0f || e2.y != 0.0f || e2.z != 0.0f);
                 if (ok) {
                     dst[0] = a.x, dst[1] = a.y, dst[2] = a.z;
-                    dst[3] = e1.x, dst[4] = e1.y, dst[5] = e1.z;
-                    dst[6] = e2.x, dst[7] = e2.y, dst[8] = e2.z;
+                    dst[3] = bb.x, dst[4] = bb.y, dst[5] = bb.z;
+                    dst[6] = cc.x, dst[7] = cc.y, dst[8] = cc.z;
                     b = rt_box_point(rt_box_point(rt_box_point(b, a), bb), cc);
                 }
             }

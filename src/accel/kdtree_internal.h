@@ -12,7 +12,9 @@
  *                   levels each, and leaf blocks (a leaf's id list with an
  *                   end flag, then the triangles it is the first to use);
  *   kdtree_trace.c  rt_kdtree_intersect and rt_kdtree_occluded over those
- *                   arrays (the AVX2 step and the portable one).
+ *                   arrays (the AVX2 step and the portable one);
+ *   kdtree_packet.c rt_kdtree_intersect8: up to 8 coherent rays through
+ *                   the same arrays at once (the leaves by kdtree_trace.c).
  *
  * Only the build and packing use rt_kdtree_node; the traversal reads
  * nothing but rt_kdtree and this file's KD_MAX_DEPTH and KD_IDS_PAD.
@@ -24,6 +26,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "rt/accel/intersect.h"
 #include "rt/accel/kdtree.h"
 
 /* The build's binary node. */
@@ -78,5 +81,33 @@ typedef struct rt_kd_binary {
  * memory, or with *limit set, more wide nodes or block words than a child
  * reference can address (tree->tri is then unchanged). */
 bool rt_kd_pack_wide(rt_kdtree *tree, const rt_kd_binary *bin, bool *limit);
+
+/* The ray as the wide step of kdtree_trace.c reads it: per axis (lanes 0-2
+ * of 8, which the AVX2 step loads whole and permutes by axis; the SSE
+ * set-up repeats the values in lanes 3-7, which are never selected)
+ * origin, 1/direction, cell widening in t, "direction negative" and
+ * "parallel to the axis". */
+typedef struct kd_ray {
+    _Alignas(32) float o[8];
+    _Alignas(32) float inv[8];
+    _Alignas(32) float ma[8];
+    _Alignas(32) int32_t neg[8]; /* -1: the above side comes first */
+    _Alignas(32) int32_t par[8]; /* -1: parallel (the ray moves less than mp along the axis) */
+    float mp; /* widening of every cell, in scene units */
+    float tn, tf;
+    bool any_par;
+    rt_tri_ray tr; /* the watertight triangle test's shear (intersect.h) */
+} kd_ray;
+
+/* kdtree_trace.c's single-ray leaf test, for kdtree_packet.c (whose ray
+ * set-up repeats ray_setup's operations for 8 rays in lanes): the
+ * primitives of one leaf reference (RT_KD_ONE or RT_KD_LEAF) tested on
+ * (ray->tmin, *best), as the single-ray traversal tests them; hit->prim is
+ * the tree's primitive id. */
+bool rt_kd_leaf_hit(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr, float *best,
+                    rt_hit *hit);
+/* One primitive (a tree id, as in a leaf list) for one ray, the same way. */
+bool rt_kd_prim_hit(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
+                    rt_hit *hit);
 
 #endif

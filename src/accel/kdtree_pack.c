@@ -2,9 +2,10 @@
  * build's binary tree (kdtree_build.c): leaf blocks holding the triangles,
  * and 64-byte wide nodes of three levels each.
  *
- * Triangles: each is stored as v0, e1 = v1 - v0, e2 = v2 - v0 (as the build
- * computed them, exactly as the reference tests do, so t is bit-identical
- * to testing the scene's triangle directly) plus its scene id, 10 words
+ * Triangles: each is stored as its vertices v0, v1, v2 (the scene's, so
+ * the watertight test gives the bits of testing the scene's triangle
+ * directly, and a vertex shared by two triangles is the same number in
+ * both: no cracks) plus its scene id, 10 words
  * (RT_KD_TRI). Leaf blocks: one array of 32-bit words holds, leaf after
  * leaf in depth-first order, a leaf's id list (ending with a flag on the
  * last id) followed by the records of the triangles that no earlier leaf

@@ -37,25 +37,27 @@
  *
  * Leaves with 3 or more triangles are tested 8 at a time with AVX2 (when
  * compiled for it): the same IEEE operations per lane as the scalar
- * Moeller-Trumbore of intersect.h, so the same bits (tests check it).
- * Before its divide, the test rejects the lanes it surely fails from the
- * signs and bounds of u, v and t times det (see tri8): 64-65% of the
- * 8-triangle groups of primary rays and 88-95% of diffuse rays' groups end
- * there (the ones the divide would reject are 1-7%). The
- * eight triangles are loaded with one unaligned 8-float load each and an
- * 8x8 transpose, plus one gather for the ninth float: nine gathers were the
- * hottest instructions in the profile (+10-30% rays/s without them).
+ * watertight test of intersect.h (Woop, Benthin and Wald 2013; its shear
+ * is made once per ray, in kd_ray), so the same bits (tests check it). Its
+ * three edge functions need no divide, so a group whose lanes all have
+ * edge functions of both signs ends before the divide (most groups; the
+ * early reject of session 3 did the same for Moeller-Trumbore with
+ * bounds); a lane whose edge function rounds to zero sends the group to
+ * the scalar reference (which recomputes it in double), so the rare case
+ * costs no code in the vector path. The vertex columns are taken in the
+ * ray's axis order by one branch on a per-ray constant (three inlined
+ * copies of the test). The eight triangles are loaded with one unaligned
+ * 8-float load each and an 8x8 transpose, plus one gather for the ninth
+ * float: nine gathers were the hottest instructions in the profile
+ * (+10-30% rays/s without them).
  *
  * Everything the two entry points use is in this file and inlined into
  * them (always_inline, flatten), intersect.h's tests included: keep new
  * traversal helpers here, not in another file, or they lose that.
  *
- * Measured and not kept (docs/performance.md has the numbers): the
- * watertight triangle test of Woop, Benthin and Wald 2013 (zero mismatches
- * against Embree on every set, but -10 to -17% rays/s on diffuse rays with
- * the per-ray shear set-up and the permuted gathers); the 8-wide test from
- * 2 or 5 triangles instead of 3; prefetching the cell on top of the stack
- * (-12% on DamagedHelmet diffuse); the leaf test out of line.
+ * Measured and not kept (docs/performance.md has the numbers): the 8-wide
+ * test from 2 or 5 triangles instead of 3; prefetching the cell on top of
+ * the stack (-12% on DamagedHelmet diffuse); the leaf test out of line.
  */
 #include "kdtree_internal.h"
 
@@ -71,20 +73,6 @@
 
 /* -------------------------------------------------------------- the ray */
 
-/* The ray as the wide step reads it: per axis (lanes 0-2 of 8, which the
- * AVX2 step loads whole and permutes by axis; the SSE set-up repeats the
- * values in lanes 3-7, which are never selected) origin, 1/direction, cell
- * widening in t, "direction negative" and "parallel to the axis". */
-typedef struct kd_ray {
-    _Alignas(32) float o[8];
-    _Alignas(32) float inv[8];
-    _Alignas(32) float ma[8];
-    _Alignas(32) int32_t neg[8]; /* -1: the above side comes first */
-    _Alignas(32) int32_t par[8]; /* -1: parallel (the ray moves less than mp along the axis) */
-    float mp; /* widening of every cell, in scene units */
-    float tn, tf;
-    bool any_par;
-} kd_ray;
 
 /* What both set-ups below share: rays that can hit nothing (an empty tree,
  * an empty interval, a non-finite or zero vector) are turned away, and the
@@ -99,6 +87,7 @@ static inline bool ray_accept(const rt_kdtree *tree, const rt_ray *ray, kd_ray *
         return false;
     float omax = fmaxf(fabsf(ray->org.x), fmaxf(fabsf(ray->org.y), fabsf(ray->org.z)));
     r->mp = (tree->scale + omax) * 0x1p-18f;
+    r->tr = rt_tri_ray_make(ray->org, ray->dir);
     return true;
 }
 
@@ -109,15 +98,27 @@ static inline bool ray_accept(const rt_kdtree *tree, const rt_ray *ray, kd_ray *
 #ifdef KD_SIMD
 static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r)
 {
-    if (!ray_accept(tree, ray, r))
-        return false;
     /* the same operations as the scalar set-up below, three axes at once
-     * (lane 3 repeats x) */
+     * (lane 3 repeats x); ray_accept's tests on SSE lanes (its scalar
+     * isfinite and fmaxf calls were 6% of a primary ray's instructions) */
+    if (tree->root == RT_KD_EMPTY || !(ray->tmin < ray->tmax))
+        return false;
     const rt_box *bb = &tree->bounds;
     __m128 o = _mm_setr_ps(ray->org.x, ray->org.y, ray->org.z, ray->org.x);
     __m128 d = _mm_setr_ps(ray->dir.x, ray->dir.y, ray->dir.z, ray->dir.x);
+    __m128 inf = _mm_set1_ps(INFINITY), sign = _mm_set1_ps(-0.0f);
+    __m128 ao = _mm_andnot_ps(sign, o);
+    if (_mm_movemask_ps(_mm_and_ps(_mm_cmp_ps(ao, inf, _CMP_LT_OQ), _mm_cmp_ps(_mm_andnot_ps(sign, d), inf, _CMP_LT_OQ))) != 0xf ||
+        _mm_movemask_ps(_mm_cmp_ps(d, _mm_setzero_ps(), _CMP_EQ_OQ)) == 0xf)
+        return false; /* non-finite, or a zero direction */
     __m128 lo = _mm_setr_ps(bb->lo.x, bb->lo.y, bb->lo.z, bb->lo.x), hi = _mm_setr_ps(bb->hi.x, bb->hi.y, bb->hi.z, bb->hi.x);
-    __m128 mp = _mm_set1_ps(r->mp), inf = _mm_set1_ps(INFINITY);
+    if (_mm_movemask_ps(_mm_cmp_ps(lo, hi, _CMP_LE_OQ)) != 0xf)
+        return false; /* an empty tree box */
+    __m128 om = _mm_max_ps(ao, _mm_shuffle_ps(ao, ao, _MM_SHUFFLE(1, 0, 3, 2)));
+    om = _mm_max_ps(om, _mm_shuffle_ps(om, om, _MM_SHUFFLE(2, 3, 0, 1)));
+    r->mp = (tree->scale + _mm_cvtss_f32(om)) * 0x1p-18f;
+    r->tr = rt_tri_ray_make(ray->org, ray->dir);
+    __m128 mp = _mm_set1_ps(r->mp);
     __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), d);
     __m128 ma = _mm_mul_ps(mp, _mm_andnot_ps(_mm_set1_ps(-0.0f), inv));
     __m128 par = _mm_cmp_ps(ma, inf, _CMP_NLT_UQ);
@@ -132,7 +133,9 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
     a = _mm_max_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(2, 3, 0, 1)));
     b = _mm_min_ps(b, _mm_shuffle_ps(b, b, _MM_SHUFFLE(1, 0, 3, 2)));
     b = _mm_min_ps(b, _mm_shuffle_ps(b, b, _MM_SHUFFLE(2, 3, 0, 1)));
-    float tn = fmaxf(ray->tmin, _mm_cvtss_f32(a)), tf = fminf(ray->tmax, _mm_cvtss_f32(b));
+    /* fmaxf and fminf, but inline (libm calls here): tmin and tmax are
+     * not NaN (tmin < tmax), nor are a and b for a finite ray */
+    float tn = _mm_cvtss_f32(_mm_max_ss(_mm_set_ss(ray->tmin), a)), tf = _mm_cvtss_f32(_mm_min_ss(_mm_set_ss(ray->tmax), b));
     if (!(tn <= tf))
         return false;
     r->tn = tn;
@@ -198,13 +201,14 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
 #endif
 
 /* Tests one primitive with the reference functions on (tmin, *best). */
-KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit)
+KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
+                         rt_hit *hit)
 {
     float t, u, v;
     if (id < tree->other_base) {
         const float *p = tree->tri + id;
-        if (!rt_intersect_triangle(ray->org, ray->dir, rt_v3(p[0], p[1], p[2]), rt_v3(p[3], p[4], p[5]),
-                                   rt_v3(p[6], p[7], p[8]), ray->tmin, *best, &t, &u, &v))
+        if (!rt_intersect_triangle_ray(tr, rt_v3(p[0], p[1], p[2]), rt_v3(p[3], p[4], p[5]),
+                                       rt_v3(p[6], p[7], p[8]), ray->tmin, *best, &t, &u, &v))
             return false;
     } else if (id - tree->other_base < tree->sphere_count) {
         const rt_spheres *s = &tree->scene->spheres;
@@ -232,14 +236,70 @@ KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, 
 #ifdef KD_SIMD
 #define KD_SIMD_MIN 3 /* leaves with at least this many triangles go 8 at a time */
 
-/* Up to 8 triangles (ids, all triangles) at once: the very operations of
- * rt_intersect_triangle, lane by lane (IEEE add, sub, mul and div round the
- * same in a vector lane as in a scalar register, and -std=c11 contracts
- * nothing into FMAs), so each lane's t, u, v are the scalar test's bits. The
- * closest valid lane wins; on a tie, the first, like the scalar loop. */
-KD_INLINE bool tri8(const float *tri, const uint32_t *ids, uint32_t n, const rt_ray *ray, float *best, rt_hit *hit)
+/* The watertight test of intersect.h on 8 triangles whose vertex
+ * coordinates come permuted to the ray's (kx, ky, kz) (see tri8): the very
+ * IEEE operations of rt_intersect_triangle_ray, lane by lane (add, sub, mul
+ * and div round the same in a vector lane as in a scalar register, and
+ * -std=c11 contracts nothing into FMAs). Returns 1 when some lane may hit
+ * (ok, t, u, v, det set), 0 when none does, -1 when a live lane's edge
+ * function is zero (the reference then recomputes it in double: the
+ * caller tests those 8 triangles with the reference, one by one). The
+ * edge functions need no divide, so most groups end before it. */
+KD_INLINE int tri8_core(__m256 ax, __m256 ay, __m256 az, __m256 bx, __m256 by, __m256 bz, __m256 cx, __m256 cy,
+                        __m256 cz, const rt_ray *ray, const rt_tri_ray *tr, float best, __m256 *ok, __m256 *t_out,
+                        __m256 *u_out, __m256 *v_out, __m256 *det_out)
 {
     RT_NO_FP_CONTRACT
+    __m256 ox = _mm256_set1_ps(tr->okx), oy = _mm256_set1_ps(tr->oky), oz = _mm256_set1_ps(tr->okz);
+    __m256 sx = _mm256_set1_ps(tr->sx), sy = _mm256_set1_ps(tr->sy), sz = _mm256_set1_ps(tr->sz);
+    __m256 akz = _mm256_sub_ps(az, oz), bkz = _mm256_sub_ps(bz, oz), ckz = _mm256_sub_ps(cz, oz);
+    __m256 Ax = _mm256_sub_ps(_mm256_sub_ps(ax, ox), _mm256_mul_ps(sx, akz));
+    __m256 Ay = _mm256_sub_ps(_mm256_sub_ps(ay, oy), _mm256_mul_ps(sy, akz));
+    __m256 Bx = _mm256_sub_ps(_mm256_sub_ps(bx, ox), _mm256_mul_ps(sx, bkz));
+    __m256 By = _mm256_sub_ps(_mm256_sub_ps(by, oy), _mm256_mul_ps(sy, bkz));
+    __m256 Cx = _mm256_sub_ps(_mm256_sub_ps(cx, ox), _mm256_mul_ps(sx, ckz));
+    __m256 Cy = _mm256_sub_ps(_mm256_sub_ps(cy, oy), _mm256_mul_ps(sy, ckz));
+    __m256 U = _mm256_sub_ps(_mm256_mul_ps(Cx, By), _mm256_mul_ps(Cy, Bx));
+    __m256 V = _mm256_sub_ps(_mm256_mul_ps(Ax, Cy), _mm256_mul_ps(Ay, Cx));
+    __m256 W = _mm256_sub_ps(_mm256_mul_ps(Bx, Ay), _mm256_mul_ps(By, Ax));
+    __m256 zero = _mm256_setzero_ps();
+    __m256 neg = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(U, zero, _CMP_LT_OQ), _mm256_cmp_ps(V, zero, _CMP_LT_OQ)),
+                              _mm256_cmp_ps(W, zero, _CMP_LT_OQ));
+    __m256 pos = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(U, zero, _CMP_GT_OQ), _mm256_cmp_ps(V, zero, _CMP_GT_OQ)),
+                              _mm256_cmp_ps(W, zero, _CMP_GT_OQ));
+    __m256 m = _mm256_andnot_ps(_mm256_and_ps(neg, pos), *ok);
+    if (_mm256_testz_ps(m, m)) /* the edge functions' signs differ in every lane */
+        return 0;
+    __m256 z = _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(U, zero, _CMP_EQ_OQ), _mm256_cmp_ps(V, zero, _CMP_EQ_OQ)),
+                            _mm256_cmp_ps(W, zero, _CMP_EQ_OQ));
+    if (!_mm256_testz_ps(z, *ok))
+        return -1;
+    __m256 det = _mm256_add_ps(_mm256_add_ps(U, V), W);
+    __m256 adet = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), det);
+    m = _mm256_and_ps(m, _mm256_cmp_ps(det, zero, _CMP_NEQ_OQ));
+    m = _mm256_and_ps(m, _mm256_cmp_ps(adet, _mm256_set1_ps(INFINITY), _CMP_LT_OQ));
+    __m256 T = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(U, _mm256_mul_ps(sz, akz)), _mm256_mul_ps(V, _mm256_mul_ps(sz, bkz))),
+                             _mm256_mul_ps(W, _mm256_mul_ps(sz, ckz)));
+    __m256 inv = _mm256_div_ps(_mm256_set1_ps(1.0f), det);
+    __m256 t = _mm256_mul_ps(T, inv);
+    m = _mm256_and_ps(m, _mm256_cmp_ps(t, _mm256_set1_ps(ray->tmin), _CMP_GT_OQ));
+    m = _mm256_and_ps(m, _mm256_cmp_ps(t, _mm256_set1_ps(best), _CMP_LT_OQ));
+    *ok = m;
+    *t_out = t;
+    *u_out = _mm256_mul_ps(V, inv);
+    *v_out = _mm256_mul_ps(W, inv);
+    *det_out = adet;
+    return !_mm256_testz_ps(m, m);
+}
+
+/* Up to 8 triangles (ids, all triangles) at once with the watertight test
+ * (tri8_core), bit for bit the reference's; the closest valid lane wins,
+ * on a tie the first, like the scalar loop. */
+KD_INLINE bool tri8(const rt_kdtree *tree, const uint32_t *ids, uint32_t n, const rt_ray *ray, const rt_tri_ray *tr,
+                    float *best, rt_hit *hit)
+{
+    RT_NO_FP_CONTRACT
+    const float *tri = tree->tri;
     __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)n), lane);
     __m256i id = _mm256_maskload_epi32((const int *)ids, live);
@@ -253,7 +313,7 @@ KD_INLINE bool tri8(const float *tri, const uint32_t *ids, uint32_t n, const rt_
     __m256 r0 = _mm256_loadu_ps(tri + off[0]), r1 = _mm256_loadu_ps(tri + off[1]), r2 = _mm256_loadu_ps(tri + off[2]),
            r3 = _mm256_loadu_ps(tri + off[3]), r4 = _mm256_loadu_ps(tri + off[4]), r5 = _mm256_loadu_ps(tri + off[5]),
            r6 = _mm256_loadu_ps(tri + off[6]), r7 = _mm256_loadu_ps(tri + off[7]);
-    __m256 e2z = _mm256_i32gather_ps(tri + 8, base, 4);
+    __m256 v2z = _mm256_i32gather_ps(tri + 8, base, 4);
     __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1), t2 = _mm256_unpacklo_ps(r2, r3),
            t3 = _mm256_unpackhi_ps(r2, r3), t4 = _mm256_unpacklo_ps(r4, r5), t5 = _mm256_unpackhi_ps(r4, r5),
            t6 = _mm256_unpacklo_ps(r6, r7), t7 = _mm256_unpackhi_ps(r6, r7);
@@ -262,69 +322,37 @@ KD_INLINE bool tri8(const float *tri, const uint32_t *ids, uint32_t n, const rt_
            s4 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(1, 0, 1, 0)), s5 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(3, 2, 3, 2)),
            s6 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(1, 0, 1, 0)), s7 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(3, 2, 3, 2));
     __m256 v0x = _mm256_permute2f128_ps(s0, s4, 0x20), v0y = _mm256_permute2f128_ps(s1, s5, 0x20),
-           v0z = _mm256_permute2f128_ps(s2, s6, 0x20), e1x = _mm256_permute2f128_ps(s3, s7, 0x20),
-           e1y = _mm256_permute2f128_ps(s0, s4, 0x31), e1z = _mm256_permute2f128_ps(s1, s5, 0x31),
-           e2x = _mm256_permute2f128_ps(s2, s6, 0x31), e2y = _mm256_permute2f128_ps(s3, s7, 0x31);
-    __m256 dx = _mm256_set1_ps(ray->dir.x), dy = _mm256_set1_ps(ray->dir.y), dz = _mm256_set1_ps(ray->dir.z);
-    __m256 px = _mm256_sub_ps(_mm256_mul_ps(dy, e2z), _mm256_mul_ps(dz, e2y));
-    __m256 py = _mm256_sub_ps(_mm256_mul_ps(dz, e2x), _mm256_mul_ps(dx, e2z));
-    __m256 pz = _mm256_sub_ps(_mm256_mul_ps(dx, e2y), _mm256_mul_ps(dy, e2x));
-    __m256 det = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(e1x, px), _mm256_mul_ps(e1y, py)), _mm256_mul_ps(e1z, pz));
-    __m256 absmask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)), zero = _mm256_setzero_ps(),
-           one = _mm256_set1_ps(1.0f);
-    __m256 adet = _mm256_and_ps(det, absmask);
-    __m256 ok = _mm256_and_ps(_mm256_castsi256_ps(live), _mm256_cmp_ps(adet, _mm256_set1_ps(INFINITY), _CMP_LT_OQ));
-    ok = _mm256_and_ps(ok, _mm256_cmp_ps(det, zero, _CMP_NEQ_OQ));
-    __m256 sx = _mm256_sub_ps(_mm256_set1_ps(ray->org.x), v0x), sy = _mm256_sub_ps(_mm256_set1_ps(ray->org.y), v0y),
-           sz = _mm256_sub_ps(_mm256_set1_ps(ray->org.z), v0z);
-    __m256 qx = _mm256_sub_ps(_mm256_mul_ps(sy, e1z), _mm256_mul_ps(sz, e1y));
-    __m256 qy = _mm256_sub_ps(_mm256_mul_ps(sz, e1x), _mm256_mul_ps(sx, e1z));
-    __m256 qz = _mm256_sub_ps(_mm256_mul_ps(sx, e1y), _mm256_mul_ps(sy, e1x));
-    /* u, v, t times det: the reference's numerators, before its divide */
-    __m256 un = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(sx, px), _mm256_mul_ps(sy, py)), _mm256_mul_ps(sz, pz));
-    __m256 vn = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, qx), _mm256_mul_ps(dy, qy)), _mm256_mul_ps(dz, qz));
-    __m256 tnum = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(e2x, qx), _mm256_mul_ps(e2y, qy)), _mm256_mul_ps(e2z, qz));
-    {
-        /* Early reject, no divide: lanes that the reference test below
-         * surely rejects, from the numerators' signs and bounds against
-         * |det| (x_s = x_n * sign(det), so x = x_s / |det| up to the two
-         * roundings of x_n * (1 / det)). x_s < -2^-100 |det| makes x < 0
-         * (too far from 0 to round to -0; a 1/det that overflows gives
-         * -inf); u_s + v_s > (1 + 2^-20) |det| makes u + v > 1 whatever
-         * the 3-4 roundings (relative 2^-24 each), as u_s, v_s are then at
-         * worst tiny negatives. (min passes a NaN u_s or v_s through only
-         * as "not rejected".) If every lane is rejected so, the divide and
-         * the rest are skipped; otherwise the reference test decides every
-         * lane. The same bounds on t (t_s beyond best or below 0) cost more
-         * instructions than they saved (callgrind). */
-        __m256 sgn = _mm256_andnot_ps(absmask, det);
-        __m256 us = _mm256_xor_ps(un, sgn), vs = _mm256_xor_ps(vn, sgn);
-        __m256 nlo = _mm256_mul_ps(adet, _mm256_set1_ps(-0x1p-100f));
-        __m256 hi = _mm256_mul_ps(adet, _mm256_set1_ps(1.0f + 0x1p-20f));
-        __m256 rej = _mm256_or_ps(_mm256_cmp_ps(_mm256_min_ps(us, vs), nlo, _CMP_LT_OQ),
-                                  _mm256_cmp_ps(_mm256_add_ps(us, vs), hi, _CMP_GT_OQ));
-        if (_mm256_testc_ps(rej, ok)) /* every ok lane rejected */
+           v0z = _mm256_permute2f128_ps(s2, s6, 0x20), v1x = _mm256_permute2f128_ps(s3, s7, 0x20),
+           v1y = _mm256_permute2f128_ps(s0, s4, 0x31), v1z = _mm256_permute2f128_ps(s1, s5, 0x31),
+           v2x = _mm256_permute2f128_ps(s2, s6, 0x31), v2y = _mm256_permute2f128_ps(s3, s7, 0x31);
+    __m256 ok = _mm256_castsi256_ps(live), t, u, v, adet;
+    int res;
+    /* the columns in the ray's axis order: three inlined copies, one
+     * branch on a per-ray constant */
+    if (tr->kz == 2)
+        res = tri8_core(v0x, v0y, v0z, v1x, v1y, v1z, v2x, v2y, v2z, ray, tr, *best, &ok, &t, &u, &v, &adet);
+    else if (tr->kz == 1)
+        res = tri8_core(v0z, v0x, v0y, v1z, v1x, v1y, v2z, v2x, v2y, ray, tr, *best, &ok, &t, &u, &v, &adet);
+    else
+        res = tri8_core(v0y, v0z, v0x, v1y, v1z, v1x, v2y, v2z, v2x, ray, tr, *best, &ok, &t, &u, &v, &adet);
+    if (res <= 0) {
+        if (res == 0)
             return false;
+        bool found = false; /* an edge function rounded to zero: the reference decides, in order */
+        for (uint32_t i = 0; i < n; i++)
+            found |= test_prim(tree, ids[i] & RT_KD_PAYLOAD, ray, tr, best, hit);
+        return found;
     }
-    __m256 inv = _mm256_div_ps(one, det);
-    __m256 u = _mm256_mul_ps(un, inv);
-    ok = _mm256_andnot_ps(_mm256_or_ps(_mm256_cmp_ps(u, zero, _CMP_LT_OQ), _mm256_cmp_ps(u, one, _CMP_GT_OQ)), ok);
-    __m256 v = _mm256_mul_ps(vn, inv);
-    ok = _mm256_andnot_ps(
-        _mm256_or_ps(_mm256_cmp_ps(v, zero, _CMP_LT_OQ), _mm256_cmp_ps(_mm256_add_ps(u, v), one, _CMP_GT_OQ)), ok);
-    __m256 t = _mm256_mul_ps(tnum, inv);
-    ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_set1_ps(ray->tmin), _CMP_GT_OQ));
-    ok = _mm256_and_ps(ok, _mm256_cmp_ps(t, _mm256_set1_ps(*best), _CMP_LT_OQ));
-    if (_mm256_testz_ps(ok, ok))
-        return false;
     /* intersect.h's guard against determinants that are rounding noise */
+    __m256 absmask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    __m256 e1x = _mm256_sub_ps(v1x, v0x), e1y = _mm256_sub_ps(v1y, v0y), e1z = _mm256_sub_ps(v1z, v0z);
+    __m256 e2x = _mm256_sub_ps(v2x, v0x), e2y = _mm256_sub_ps(v2y, v0y), e2z = _mm256_sub_ps(v2z, v0z);
     __m256 a1 = _mm256_add_ps(_mm256_add_ps(_mm256_and_ps(e1x, absmask), _mm256_and_ps(e1y, absmask)),
                               _mm256_and_ps(e1z, absmask));
     __m256 a2 = _mm256_add_ps(_mm256_add_ps(_mm256_and_ps(e2x, absmask), _mm256_and_ps(e2y, absmask)),
                               _mm256_and_ps(e2z, absmask));
-    float ad = fabsf(ray->dir.x) + fabsf(ray->dir.y) + fabsf(ray->dir.z);
-    __m256 lhs = _mm256_div_ps(_mm256_div_ps(adet, a1), a2);
-    ok = _mm256_and_ps(ok, _mm256_cmp_ps(lhs, _mm256_set1_ps(0x1p-16f * ad), _CMP_GT_OQ));
+    __m256 lhs = _mm256_div_ps(_mm256_div_ps(_mm256_mul_ps(adet, _mm256_set1_ps(tr->adz)), a1), a2);
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(lhs, _mm256_set1_ps(0x1p-16f * tr->ad), _CMP_GT_OQ));
     int mask = _mm256_movemask_ps(ok);
     if (!mask)
         return false;
@@ -364,8 +392,8 @@ KD_INLINE uint32_t leaf_length(const uint32_t *p)
 }
 
 /* All primitives of a multi-primitive leaf (ids ascending: triangles first). */
-KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, const rt_ray *ray, float *best,
-                         rt_hit *hit, bool any)
+KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, const rt_ray *ray, const rt_tri_ray *tr,
+                         float *best, rt_hit *hit, bool any)
 {
     bool found = false;
     uint32_t i = 0;
@@ -376,7 +404,7 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, c
             uint32_t m = n - i < 8 ? n - i : 8;
             while ((p[i + m - 1] & RT_KD_PAYLOAD) >= T)
                 m--;
-            if (tri8(tree->tri, p + i, m, ray, best, hit)) {
+            if (tri8(tree, p + i, m, ray, tr, best, hit)) {
                 found = true;
                 if (any)
                     return true;
@@ -386,7 +414,7 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, c
     }
 #endif
     for (; i < n; i++)
-        if (test_prim(tree, p[i] & RT_KD_PAYLOAD, ray, best, hit)) {
+        if (test_prim(tree, p[i] & RT_KD_PAYLOAD, ray, tr, best, hit)) {
             found = true;
             if (any)
                 return true;
@@ -720,14 +748,14 @@ KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hi
 #endif
         }
         if (ref >= RT_KD_ONE) {
-            if (test_prim(tree, ref & RT_KD_PAYLOAD, ray, &best, hit)) {
+            if (test_prim(tree, ref & RT_KD_PAYLOAD, ray, &r->tr, &best, hit)) {
                 found = true;
                 if (any)
                     return true;
             }
         } else {
             const uint32_t *p = ids + (ref & RT_KD_PAYLOAD);
-            if (test_leaf(tree, p, leaf_length(p), ray, &best, hit, any)) {
+            if (test_leaf(tree, p, leaf_length(p), ray, &r->tr, &best, hit, any)) {
                 found = true;
                 if (any)
                     return true;
@@ -774,4 +802,21 @@ KD_FLATTEN bool rt_kdtree_occluded(const rt_kdtree *tree, const rt_ray *ray)
 {
     rt_hit h;
     return traverse(tree, ray, &h, true);
+}
+
+/* For the packet traversal (kdtree_packet.c): one leaf, or one primitive,
+ * for one ray, out of line. */
+KD_FLATTEN bool rt_kd_leaf_hit(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr, float *best,
+                               rt_hit *hit)
+{
+    if (ref >= RT_KD_ONE)
+        return test_prim(tree, ref & RT_KD_PAYLOAD, ray, tr, best, hit);
+    const uint32_t *p = tree->prim_ids + (ref & RT_KD_PAYLOAD);
+    return test_leaf(tree, p, leaf_length(p), ray, tr, best, hit, false);
+}
+
+KD_FLATTEN bool rt_kd_prim_hit(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
+                               rt_hit *hit)
+{
+    return test_prim(tree, id, ray, tr, best, hit);
 }

@@ -7,13 +7,23 @@
  *
  *   rt_ray r = rt_ray_make(origin, dir, 0.0f, INFINITY);
  *   float t, u, v;
- *   if (rt_intersect_triangle(r.org, r.dir, v0, e1, e2, r.tmin, r.tmax, &t, &u, &v)) ...
+ *   if (rt_intersect_triangle(r.org, r.dir, v0, v1, v2, r.tmin, r.tmax, &t, &u, &v)) ...
+ *   rt_tri_ray tr = rt_tri_ray_make(r.org, r.dir);   // once per ray, then per triangle:
+ *   if (rt_intersect_triangle_ray(&tr, v0, v1, v2, r.tmin, r.tmax, &t, &u, &v)) ...
  *
- * Triangle: Moeller and Trumbore (1997), "Fast, Minimum Storage Ray/Triangle
- * Intersection", with precomputed edges e1 = v1 - v0, e2 = v2 - v0; (u, v)
- * are the barycentrics of v1 and v2. Degenerate triangles (zero area, or
- * collinear edges up to rounding) never hit, and neither does a ray within
- * about 1e-5 rad of a triangle's or quad's plane: there the determinant is
+ * Triangle: watertight, Woop, Benthin and Wald (2013), "Watertight
+ * Ray/Triangle Intersection", JCGT 2(1): the vertices are moved to the
+ * ray's origin and sheared so that the ray is the +z axis (the shear made
+ * once per ray, rt_tri_ray), then the three 2D edge functions decide
+ * inside or out (recomputed in double when one rounds to zero). Each edge
+ * function depends only on its two vertices, so a ray never passes between
+ * two triangles that share an edge, and a hit never lies outside the
+ * triangle by more than the rounding of its vertices relative to the ray
+ * (Moeller-Trumbore, used before, put hits up to 1e-4 of the scene beyond
+ * the tips of slivers thinner than 1:300). Two-sided; (u, v) are the
+ * barycentrics of v1 and v2. Degenerate triangles (zero area, or collinear
+ * vertices up to rounding) never hit, and neither does a ray within about
+ * 1e-5 rad of a triangle's or quad's plane: there the determinant is
  * rounding noise and the computed hit could lie anywhere on the ray.
  * Sphere: the numerically robust quadratic of Haines et al., "Precision
  * Improvements for Ray/Sphere Intersection", Ray Tracing Gems ch. 7.
@@ -28,38 +38,91 @@
 /* The tests below must round the same wherever they are compiled (the
  * kd-tree's 8-wide leaf test reproduces them bit for bit): no fused
  * multiply-adds, see RT_NO_FP_CONTRACT in vec.h. */
-static inline bool rt_intersect_triangle(rt_vec3 org, rt_vec3 dir, rt_vec3 v0, rt_vec3 e1, rt_vec3 e2, float tmin,
-                                         float tmax, float *t_out, float *u_out, float *v_out)
+
+/* A ray prepared for the watertight triangle test: kz is the axis of the
+ * direction's largest component, kx and ky the next two (cyclically), and
+ * (sx, sy, sz) = (d[kx], d[ky], 1) / d[kz]: the shear that maps the ray to
+ * the +kz axis through the origin. Made once per ray. */
+typedef struct rt_tri_ray {
+    rt_vec3 org, dir;
+    int kx, ky, kz;
+    float sx, sy, sz;
+    float okx, oky, okz; /* org[kx], org[ky], org[kz] */
+    float adz, ad;       /* |d[kz]|, |d.x| + |d.y| + |d.z| */
+} rt_tri_ray;
+
+static inline float rt__axis(rt_vec3 a, int k) { return k == 0 ? a.x : k == 1 ? a.y : a.z; }
+
+static inline rt_tri_ray rt_tri_ray_make(rt_vec3 org, rt_vec3 dir)
 {
     RT_NO_FP_CONTRACT
-    rt_vec3 p = rt_cross(dir, e2);
-    float det = rt_dot(e1, p);
+    rt_tri_ray r;
+    float ax = fabsf(dir.x), ay = fabsf(dir.y), az = fabsf(dir.z);
+    r.kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    r.kx = r.kz == 2 ? 0 : r.kz + 1;
+    r.ky = r.kx == 2 ? 0 : r.kx + 1;
+    r.org = org;
+    r.dir = dir;
+    r.sz = 1.0f / rt__axis(dir, r.kz);
+    r.sx = rt__axis(dir, r.kx) * r.sz;
+    r.sy = rt__axis(dir, r.ky) * r.sz;
+    r.okx = rt__axis(org, r.kx);
+    r.oky = rt__axis(org, r.ky);
+    r.okz = rt__axis(org, r.kz);
+    r.adz = fabsf(rt__axis(dir, r.kz));
+    r.ad = ax + ay + az;
+    return r;
+}
+
+/* The triangle (a, b, c) against a prepared ray. */
+static inline bool rt_intersect_triangle_ray(const rt_tri_ray *r, rt_vec3 a, rt_vec3 b, rt_vec3 c, float tmin,
+                                             float tmax, float *t_out, float *u_out, float *v_out)
+{
+    RT_NO_FP_CONTRACT
+    /* the vertices relative to the origin, as arrays (indexed by axis) */
+    const float A[3] = {a.x - r->org.x, a.y - r->org.y, a.z - r->org.z},
+                B[3] = {b.x - r->org.x, b.y - r->org.y, b.z - r->org.z},
+                C[3] = {c.x - r->org.x, c.y - r->org.y, c.z - r->org.z};
+    const int kx = r->kx, ky = r->ky, kz = r->kz;
+    float Akz = A[kz], Bkz = B[kz], Ckz = C[kz];
+    float Ax = A[kx] - r->sx * Akz, Ay = A[ky] - r->sy * Akz;
+    float Bx = B[kx] - r->sx * Bkz, By = B[ky] - r->sy * Bkz;
+    float Cx = C[kx] - r->sx * Ckz, Cy = C[ky] - r->sy * Ckz;
+    float U = Cx * By - Cy * Bx, V = Ax * Cy - Ay * Cx, W = Bx * Ay - By * Ax;
+    if (U == 0.0f || V == 0.0f || W == 0.0f) { /* on an edge up to rounding: decide exactly */
+        U = (float)((double)Cx * (double)By - (double)Cy * (double)Bx);
+        V = (float)((double)Ax * (double)Cy - (double)Ay * (double)Cx);
+        W = (float)((double)Bx * (double)Ay - (double)By * (double)Ax);
+    }
+    if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f))
+        return false;
+    float det = U + V + W;
     if (det == 0.0f || !isfinite(det))
         return false;
+    float T = U * (r->sz * Akz) + V * (r->sz * Bkz) + W * (r->sz * Ckz);
     float inv = 1.0f / det;
-    rt_vec3 s = rt_sub(org, v0);
-    float u = rt_dot(s, p) * inv;
-    if (u < 0.0f || u > 1.0f)
-        return false;
-    rt_vec3 q = rt_cross(s, e1);
-    float v = rt_dot(dir, q) * inv;
-    if (v < 0.0f || u + v > 1.0f)
-        return false;
-    float t = rt_dot(e2, q) * inv;
+    float t = T * inv;
     if (!(t > tmin && t < tmax))
         return false;
     /* A (near-)degenerate triangle, or a ray within ~1e-5 rad of its plane:
-     * det is then rounding noise and u, v, t are garbage (a collinear
-     * triangle with non-zero edges would "hit" anywhere). Checked on hits
-     * only, so it costs nothing in the common miss path. */
+     * det is then rounding noise and t is garbage (a collinear triangle
+     * would "hit" anywhere). |det d[kz]| is |(b - a) x (c - a) . d| up to
+     * rounding. Checked on hits only. */
+    rt_vec3 e1 = rt_sub(b, a), e2 = rt_sub(c, a);
     float a1 = fabsf(e1.x) + fabsf(e1.y) + fabsf(e1.z), a2 = fabsf(e2.x) + fabsf(e2.y) + fabsf(e2.z);
-    float ad = fabsf(dir.x) + fabsf(dir.y) + fabsf(dir.z);
-    if (!(fabsf(det) / a1 / a2 > 0x1p-16f * ad))
+    if (!(fabsf(det) * r->adz / a1 / a2 > 0x1p-16f * r->ad))
         return false;
     *t_out = t;
-    *u_out = u;
-    *v_out = v;
+    *u_out = V * inv;
+    *v_out = W * inv;
     return true;
+}
+
+static inline bool rt_intersect_triangle(rt_vec3 org, rt_vec3 dir, rt_vec3 a, rt_vec3 b, rt_vec3 c, float tmin,
+                                         float tmax, float *t_out, float *u_out, float *v_out)
+{
+    rt_tri_ray r = rt_tri_ray_make(org, dir);
+    return rt_intersect_triangle_ray(&r, a, b, c, tmin, tmax, t_out, u_out, v_out);
 }
 
 static inline bool rt_intersect_sphere(rt_vec3 org, rt_vec3 dir, rt_vec3 center, float radius, float tmin, float tmax,

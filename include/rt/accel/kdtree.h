@@ -19,7 +19,7 @@
  * resolves three levels with one memory access and one SIMD step instead of
  * three dependent branches. The planes and cells are exactly the binary
  * tree's. Leaves and triangles share one array of leaf blocks: a block is
- * the leaf's id list followed by the records (v0, e1, e2 and the scene id,
+ * the leaf's id list followed by the records (v0, v1, v2 and the scene id,
  * RT_KD_TRI words) of the triangles no earlier leaf used, so a leaf's list
  * and most of its triangles sit in the same or adjacent cache lines; a
  * triangle's id is the offset of its record in that array (hits report
@@ -95,7 +95,7 @@ typedef struct rt_kdtree {
     uint32_t root;        /* a child reference: the whole tree */
     /* the leaf blocks: tri and prim_ids are the same array (64-byte aligned,
      * prim_id_count words, then KD_IDS_PAD words of padding), read as floats
-     * for triangle records (RT_KD_TRI words each: v0.xyz, e1.xyz, e2.xyz,
+     * for triangle records (RT_KD_TRI words each: v0.xyz, v1.xyz, v2.xyz,
      * then the bits of the scene's triangle id) and as ids for leaf lists */
     uint32_t *prim_ids;
     size_t prim_id_count;
