@@ -47,7 +47,7 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 DEPS_OK  := $(BUILD)/.deps-ok
 
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build fuzz install uninstall test-install denoiser
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build bench-render bench-denoise fuzz install uninstall test-install denoiser
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -149,6 +149,16 @@ bench: bench/rtbench
 # rt and Embree side by side on the same rays, as ratios (installs Embree 3 on first use).
 bench-compare: bench/rtbench
 	@SHARED=$(SHARED) sh bench/compare.sh
+
+# rt's path tracer against Mitsuba 3 on the shared Cornell box (sets up Mitsuba in build/mitsuba-venv
+# and Debian's libllvm19 on first use); RT_BINS="./rt other/rt" compares rt builds too.
+RT_BINS ?= ./$(RT)
+bench-render: $(RT)
+	@SHARED=$(SHARED) sh bench/render.sh $(RT_BINS)
+
+# --denoise on the shared Cornell box: 4/16/64 spp denoised against raw 256 and 1024 spp (docs/hdr.md).
+bench-denoise: $(RT) denoiser
+	@SHARED=$(SHARED) sh bench/denoise.sh ./$(RT)
 
 bench/buildscale: bench/buildscale.c $(BUILD)/librt.a | $(DEPS_OK)
 	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/librt.a $(LDLIBS)
