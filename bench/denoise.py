@@ -15,7 +15,8 @@ the time it took against raw 1024's.
 
 The raw renders are slow (1024 spp takes minutes even on a quiet machine):
 an image already in OUT with its timing file (raw-N.pfm, raw-N.json) is
-reused; delete them to measure again. Environment: SHARED (default
+reused; delete them to measure again. REUSE_DENOISED=1 reuses the
+denoised renders the same way (dn-N.pfm, dn-N.json). Environment: SHARED (default
 ../shared), THREADS (default 2), DENOISED_SPP (default "4 16 64"), RAW_SPP
 (default "256 1024"), OUT (default build/bench-denoise), CROP (a region
 "x,y,w,h" of the 16-spp images written as PNGs for docs/images, default
@@ -30,6 +31,7 @@ den_spps = [int(s) for s in os.environ.get("DENOISED_SPP", "4 16 64").split()]
 raw_spps = [int(s) for s in os.environ.get("RAW_SPP", "256 1024").split()]
 out_dir = os.environ.get("OUT", "build/bench-denoise")
 crop = os.environ.get("CROP", "")
+reuse = os.environ.get("REUSE_DENOISED", "") == "1"
 rt = sys.argv[1] if len(sys.argv) > 1 else "./rt"
 scene = os.path.join(here, "..", "scenes", "cornell-reference.txt")
 reference = os.path.join(shared, "reference", "cornell", "reference.pfm")
@@ -87,13 +89,17 @@ for spp in raw_spps:
                      denoise_cpu_s=None, cpu_s=t.get("cpu_s"), load=t["load"], **compare(image)))
 
 for spp in den_spps:
-    image = os.path.join(out_dir, "dn-%d.pfm" % spp)
-    load0 = loadavg()
-    err, cpu = run(["-s", str(spp), "--denoise", "--aov", "albedo,normal", "-o", image, scene])
-    render_s = seconds(r"\(render ([0-9.]+) s\)", err)
-    denoise_s = seconds(r"rt: denoise: ([0-9.]+) s", err)
-    denoise_cpu = seconds(r"execute [0-9.]+ ms \(CPU ([0-9.]+) ms\)", err)
-    load = load0 + " / " + loadavg()
+    image, timing = os.path.join(out_dir, "dn-%d.pfm" % spp), os.path.join(out_dir, "dn-%d.json" % spp)
+    if reuse and os.path.exists(image) and os.path.exists(timing):
+        render_s, denoise_s, denoise_cpu, cpu, load = json.load(open(timing))
+    else:
+        load0 = loadavg()
+        err, cpu = run(["-s", str(spp), "--denoise", "--aov", "albedo,normal", "-o", image, scene])
+        render_s = seconds(r"\(render ([0-9.]+) s\)", err)
+        denoise_s = seconds(r"rt: denoise: ([0-9.]+) s", err)
+        denoise_cpu = seconds(r"execute [0-9.]+ ms \(CPU ([0-9.]+) ms\)", err)
+        load = load0 + " / " + loadavg()
+        json.dump([render_s, denoise_s, denoise_cpu, cpu, load], open(timing, "w"))
     noisy = os.path.join(out_dir, "dn-%d.noisy.pfm" % spp)
     rows.append(dict(name="%d spp, raw" % spp, spp=spp, denoised=False, render_s=render_s, denoise_s=None,
                      denoise_cpu_s=None, cpu_s=None, load=load, **compare(noisy)))

@@ -3,7 +3,7 @@
 
 Run with the Python of build/mitsuba-venv (bench/render.sh makes it):
 
-    mitsuba_render.py SCENE_XML VARIANT SPP THREADS RES OUT.exr
+    mitsuba_render.py SCENE_XML VARIANT SPP THREADS RES OUT.pfm
 
 Loads SCENE_XML (the shared reference/cornell/scene.xml) with its sampler
 switched from `independent` to `multijitter` (stratified, like rt's CMJ),
@@ -19,6 +19,16 @@ as both. Prints one JSON line: first_s, warm_s, cpu_s (process CPU seconds
 of the warm render, all threads), and the variant's versions.
 """
 import json, os, sys, time
+
+
+def write_pfm(path, img):
+    """The image as a colour PFM (rows bottom to top), by hand: Mitsuba's
+    own EXR writer hung (a futex wait) with a one-thread Dr.Jit pool."""
+    import numpy as np
+    a = np.ascontiguousarray(np.array(img, dtype=np.float32)[::-1, :, :3])
+    with open(path, "wb") as f:
+        f.write(b"PF\n%d %d\n-1.0\n" % (a.shape[1], a.shape[0]))
+        f.write(a.astype("<f4").tobytes())
 
 
 def main():
@@ -50,7 +60,7 @@ def main():
     warm = first
     if variant.startswith(("llvm", "cuda")):
         img, warm, cpu = render()
-    mi.Bitmap(img).write(out)
+    write_pfm(out, img)
     print(json.dumps({"first_s": first, "warm_s": warm, "cpu_s": cpu, "mitsuba": mi.__version__,
                       "drjit": dr.__version__, "variant": variant, "threads": threads}))
 

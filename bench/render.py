@@ -88,7 +88,7 @@ def run_rt(binary, spp, threads, tag):
 
 
 def run_mitsuba(variant, spp, threads):
-    image = os.path.join(out_dir, "mitsuba-%s-%dspp-%dt.exr" % (variant, spp, threads))
+    image = os.path.join(out_dir, "mitsuba-%s-%dspp-%dt.pfm" % (variant, spp, threads))
     out = subprocess.run([python, os.path.join(here, "mitsuba_render.py"), scene_xml, variant, str(spp),
                           str(threads), str(res), image], capture_output=True, text=True)
     if out.returncode != 0:
