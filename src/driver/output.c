@@ -117,7 +117,7 @@ rt_result output_write(const args *a, const rt_settings *set, rt_framebuffer *fb
         r = rt_denoise_image(&in, err);
         if (r != RT_OK)
             goto done;
-        rt_info("denoise: %.3f s (albedo and normal, prefiltered)", rt_now_seconds() - t0);
+        rt_info("denoise: %.3f s (albedo and normal as clean auxiliary images)", rt_now_seconds() - t0);
     }
     if (fmt == RT_FORMAT_EXR) {
         if (noisy)
