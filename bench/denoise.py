@@ -15,7 +15,7 @@ the time it took against raw 1024's.
 
 The raw renders are slow (1024 spp takes minutes even on a quiet machine):
 an image already in OUT with its timing file (raw-N.pfm, raw-N.json) is
-reused; delete them to measure again. REUSE_DENOISED=1 reuses the
+reused; delete them to measure again. rt's -v output goes to OUT/*.log. REUSE_DENOISED=1 reuses the
 denoised renders the same way (dn-N.pfm, dn-N.json). Environment: SHARED (default
 ../shared), THREADS (default 2), DENOISED_SPP (default "4 16 64"), RAW_SPP
 (default "256 1024"), OUT (default build/bench-denoise), CROP (a region
@@ -85,6 +85,7 @@ for spp in raw_spps:
         err, cpu = run(["-s", str(spp), "-o", image, scene])
         t = {"render_s": seconds(r"\(render ([0-9.]+) s\)", err), "cpu_s": cpu, "load": load0 + " / " + loadavg()}
         json.dump(t, open(timing, "w"))
+        open(os.path.join(out_dir, "raw-%d.log" % spp), "w").write(err)
     rows.append(dict(name="%d spp, raw" % spp, spp=spp, denoised=False, render_s=t["render_s"], denoise_s=None,
                      denoise_cpu_s=None, cpu_s=t.get("cpu_s"), load=t["load"], **compare(image)))
 
@@ -100,6 +101,7 @@ for spp in den_spps:
         denoise_cpu = seconds(r"execute [0-9.]+ ms \(CPU ([0-9.]+) ms\)", err)
         load = load0 + " / " + loadavg()
         json.dump([render_s, denoise_s, denoise_cpu, cpu, load], open(timing, "w"))
+        open(os.path.join(out_dir, "dn-%d.log" % spp), "w").write(err)
     noisy = os.path.join(out_dir, "dn-%d.noisy.pfm" % spp)
     rows.append(dict(name="%d spp, raw" % spp, spp=spp, denoised=False, render_s=render_s, denoise_s=None,
                      denoise_cpu_s=None, cpu_s=None, load=load, **compare(noisy)))
