@@ -478,6 +478,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     ro.progress = view->bar || view->preview_path || view->tev || view->window ? progress_report : NULL;
     ro.progress_user = view;
     ro.aov = output_aovs_for_render(&aov);
+    aov.noisy_aux = scene->camera.aperture > 0.0f; /* depth of field blurs albedo and normal with noise */
     rt_render_stats rs;
     memset(&rs, 0, sizeof rs);
     rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);

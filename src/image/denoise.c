@@ -12,15 +12,19 @@
  * One RT filter, with rt's albedo and normal passed as clean auxiliary
  * images (cleanAux). OIDN's documentation recommends prefiltering noisy
  * auxiliary images (each denoised by its own RT filter first); rt's are not
- * noisy: a pinhole camera and no motion blur, the first non-specular hit
+ * noisy with a pinhole camera: no motion blur, the first non-specular hit
  * seen through perfect mirrors and glass, so what varies between a pixel's
  * samples is only which surface its edge samples land on. Measured on the
  * shared Cornell box at 16 spp (docs/hdr.md), prefiltering changed the
  * denoised image's relMSE and FLIP by under 1% and took two thirds of the
  * time (two more filters, OIDN 2.3+'s larger prefilter networks in high
- * quality). The default quality is OIDN's "balanced" (its pre-2.3 network):
- * 2.4x less CPU time than "high" on that image for a relMSE 1.35x higher,
- * both ~60x below the noisy image's.
+ * quality). A camera with an aperture (depth of field) does make them noisy
+ * where out of focus: rt_denoise_input.prefilter_aux then runs OIDN's
+ * recipe, the albedo and normal each through an RT filter of its own (as
+ * its `albedo` and `normal` inputs) before the beauty. The default quality
+ * is OIDN's "balanced" (its pre-2.3 network): 2.4x less CPU time than
+ * "high" on that image for a relMSE 1.35x higher, both ~60x below the
+ * noisy image's.
  *
  * Sanitizer builds refuse --denoise with a clear message: OIDN's TBB
  * dlopens a helper with RTLD_DEEPBIND, which ASan and TSan abort on.
@@ -244,6 +248,42 @@ static rt_result pick_quality(const rt_denoise_input *in, rt_denoise_quality *q,
     return rt_fail(err, RT_ERR_IO, "--denoise: RT_OIDN_QUALITY=%s is not fast, balanced or high", env);
 }
 
+/* One RT filter, in place on `image` fed as its `input` ("color", or
+ * "albedo"/"normal" to prefilter those), with optional clean aux images.
+ * *cpu_ms: the CPU time of its execution. */
+static rt_result run_filter(const oidn_api *api, void *device, const char *input, float *image, const float *albedo,
+                            const float *normal, rt_denoise_quality quality, size_t w, size_t h, double *cpu_ms,
+                            rt_error *err)
+{
+    void *f = api->new_filter(device, "RT");
+    rt_result r = device_error(api, device, "creating the RT filter", err);
+    if (r == RT_OK && !f)
+        r = rt_fail(err, RT_ERR_IO, "denoise: no RT filter");
+    if (r != RT_OK)
+        return r;
+    const bool color = strcmp(input, "color") == 0;
+    api->set_shared_filter_image(f, input, image, OIDN_FORMAT_FLOAT3, w, h, 0, 0, 0);
+    if (albedo)
+        api->set_shared_filter_image(f, "albedo", (void *)albedo, OIDN_FORMAT_FLOAT3, w, h, 0, 0, 0);
+    if (albedo && normal)
+        api->set_shared_filter_image(f, "normal", (void *)normal, OIDN_FORMAT_FLOAT3, w, h, 0, 0, 0);
+    api->set_shared_filter_image(f, "output", image, OIDN_FORMAT_FLOAT3, w, h, 0, 0, 0);
+    if (color)
+        api->set_filter_bool(f, "hdr", true);
+    api->set_filter_bool(f, "cleanAux", albedo != NULL);
+    api->set_filter_int(f, "quality", oidn_quality(quality));
+    api->commit_filter(f);
+    r = device_error(api, device, "setting up the filter", err);
+    double c0 = cpu_seconds();
+    if (r == RT_OK) {
+        api->execute_filter(f);
+        r = device_error(api, device, "filtering", err);
+    }
+    *cpu_ms = 1e3 * (cpu_seconds() - c0);
+    api->release_filter(f);
+    return r;
+}
+
 rt_result rt_denoise_image(const rt_denoise_input *in, rt_error *err)
 {
     double t0 = rt_now_seconds();
@@ -255,51 +295,48 @@ rt_result rt_denoise_image(const rt_denoise_input *in, rt_error *err)
     r = load(&api, NULL, 0, err);
     if (r != RT_OK)
         return r;
+    const size_t w = (size_t)in->width, h = (size_t)in->height, n = w * h * 3;
+    const float *albedo = in->albedo, *normal = in->albedo ? in->normal : NULL;
+    float *aux = NULL; /* prefiltered copies of albedo and normal */
+    if (in->prefilter_aux && albedo) {
+        aux = malloc((normal ? 2 : 1) * n * sizeof(float));
+        if (!aux)
+            return rt_fail(err, RT_ERR_NOMEM, "denoise: out of memory for the auxiliary images");
+        memcpy(aux, albedo, n * sizeof(float));
+        if (normal)
+            memcpy(aux + n, normal, n * sizeof(float));
+    }
     double t1 = rt_now_seconds();
     void *device = api.new_device(OIDN_DEVICE_TYPE_CPU);
-    if (!device)
+    if (!device) {
+        free(aux);
         return rt_fail(err, RT_ERR_IO, "denoise: Open Image Denoise has no CPU device");
+    }
     if (in->threads > 0)
         api.set_device_int(device, "numThreads", in->threads);
     api.commit_device(device);
     r = device_error(&api, device, "starting the CPU device", err);
-    double t2 = rt_now_seconds();
-    void *f = NULL;
-    if (r == RT_OK) {
-        f = api.new_filter(device, "RT");
-        r = device_error(&api, device, "creating the RT filter", err);
-        if (r == RT_OK && !f)
-            r = rt_fail(err, RT_ERR_IO, "denoise: no RT filter");
-    }
-    const size_t w = (size_t)in->width, h = (size_t)in->height;
-    double t3 = t2, t4 = t2, c3 = 0.0, c4 = 0.0;
-    if (r == RT_OK) {
-        api.set_shared_filter_image(f, "color", in->color, OIDN_FORMAT_FLOAT3, w, h, 0, 0, 0);
-        if (in->albedo)
-            api.set_shared_filter_image(f, "albedo", (void *)in->albedo, OIDN_FORMAT_FLOAT3, w, h, 0, 0, 0);
-        if (in->albedo && in->normal)
-            api.set_shared_filter_image(f, "normal", (void *)in->normal, OIDN_FORMAT_FLOAT3, w, h, 0, 0, 0);
-        api.set_shared_filter_image(f, "output", in->color, OIDN_FORMAT_FLOAT3, w, h, 0, 0, 0);
-        api.set_filter_bool(f, "hdr", true);
-        api.set_filter_bool(f, "cleanAux", in->albedo != NULL);
-        api.set_filter_int(f, "quality", oidn_quality(quality));
-        api.commit_filter(f);
-        r = device_error(&api, device, "setting up the filter", err);
-        t3 = rt_now_seconds();
-        c3 = cpu_seconds();
-        if (r == RT_OK) {
-            api.execute_filter(f);
-            r = device_error(&api, device, "filtering", err);
+    double t2 = rt_now_seconds(), cpu_ms = 0.0;
+    if (r == RT_OK && aux) { /* OIDN's recipe for noisy aux: each denoised by its own filter first */
+        r = run_filter(&api, device, "albedo", aux, NULL, NULL, quality, w, h, &cpu_ms, err);
+        albedo = aux;
+        if (r == RT_OK && normal) {
+            double more = 0.0;
+            r = run_filter(&api, device, "normal", aux + n, NULL, NULL, quality, w, h, &more, err);
+            cpu_ms += more;
+            normal = aux + n;
         }
-        t4 = rt_now_seconds();
-        c4 = cpu_seconds();
+        rt_info("denoise: albedo and normal prefiltered: %.1f ms (CPU %.1f ms)", 1e3 * (rt_now_seconds() - t2),
+                cpu_ms);
     }
-    if (f)
-        api.release_filter(f);
+    double t3 = rt_now_seconds();
+    if (r == RT_OK)
+        r = run_filter(&api, device, "color", in->color, albedo, normal, quality, w, h, &cpu_ms, err);
+    double t4 = rt_now_seconds();
     api.release_device(device);
-    rt_info("denoise: OIDN RT filter, %s quality%s: load %.1f ms, device %.1f ms, filter setup %.1f ms, "
-            "execute %.1f ms (CPU %.1f ms), release %.1f ms", quality_names[quality],
-            in->albedo ? (in->normal ? ", albedo and normal" : ", albedo") : "", 1e3 * (t1 - t0), 1e3 * (t2 - t1),
-            1e3 * (t3 - t2), 1e3 * (t4 - t3), 1e3 * (c4 - c3), 1e3 * (rt_now_seconds() - t4));
+    free(aux);
+    rt_info("denoise: OIDN RT filter, %s quality%s: load %.1f ms, device %.1f ms, filter %.1f ms (CPU %.1f ms), "
+            "release %.1f ms", quality_names[quality], albedo ? (normal ? ", albedo and normal" : ", albedo") : "",
+            1e3 * (t1 - t0), 1e3 * (t2 - t1), 1e3 * (t4 - t3), cpu_ms, 1e3 * (rt_now_seconds() - t4));
     return r;
 }

@@ -21,6 +21,7 @@
 #ifndef RT_DENOISE_H
 #define RT_DENOISE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "rt/base/error.h"
@@ -42,7 +43,8 @@ typedef struct rt_denoise_input {
     const float *albedo; /* optional (NULL): first non-specular hit's albedo, noise-free but for edges */
     const float *normal; /* optional, with albedo: its shading normal */
     rt_denoise_quality quality;
-    int threads; /* OIDN's worker threads; 0: one per core */
+    int threads;        /* OIDN's worker threads; 0: one per core */
+    bool prefilter_aux; /* albedo and normal are noisy (depth of field): denoise them first */
 } rt_denoise_input;
 
 /* The one-line hint printed when the library is missing. */
@@ -54,9 +56,10 @@ typedef struct rt_denoise_input {
 rt_result rt_denoise_find(char *where, size_t size, rt_error *err);
 
 /* Runs OIDN's "RT" filter (hdr on) on in->color in place, on OIDN's CPU
- * device. RT_ERR_IO for a bad RT_OIDN_QUALITY (before any work). Albedo and normal, when given, go in as clean auxiliary images
- * (cleanAux), as rt renders them: they are not prefiltered (denoise.c says
- * why). */
+ * device; RT_ERR_IO for a bad RT_OIDN_QUALITY (before any work). Albedo
+ * and normal, when given, go in as clean auxiliary images (cleanAux), as
+ * rt renders them: not prefiltered (denoise.c says why) unless
+ * prefilter_aux asks for it. */
 rt_result rt_denoise_image(const rt_denoise_input *in, rt_error *err);
 
 #endif
