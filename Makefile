@@ -9,6 +9,8 @@
 #   make denoiser     Intel Open Image Denoise for --denoise: the pyoidn wheel in build/oidn-venv
 #   make install      rt, the library and its headers, and a pkg-config file
 #                     (PREFIX=/usr/local, DESTDIR for staging); make test-install checks it
+#   make test-slurm   the Slurm launcher (examples/slurm) on a real Slurm started here (root)
+#   make test-kubernetes / test-parallel   the Kubernetes and GNU parallel launchers, run locally
 #   make clean
 #
 # Variables: WERROR=1 turns warnings into errors (CI sets it); PORTABLE=1
@@ -32,7 +34,11 @@ WARN    += -Werror
 endif
 CFLAGS  ?=
 CFLAGS  += -std=c11 $(WARN) $(OPT) -Iinclude -D_POSIX_C_SOURCE=200809L -MMD -MP
-LDLIBS  := -lstb -lOpenEXRCore -ldl -lpthread -lm
+# C++ only for src/io/draco.cc, the wrapper over libdraco (rt/io/draco.h)
+CXX     ?= c++
+CXXFLAGS ?=
+CXXFLAGS += -std=c++17 $(WARN) $(OPT) -Iinclude -MMD -MP
+LDLIBS  := -lstb -lOpenEXRCore -lmeshoptimizer -ldraco -lwebp -lstdc++ -ldl -lpthread -lm
 BUILD   ?= build
 SHARED  ?= ../shared
 RT      ?= rt
@@ -40,13 +46,16 @@ RT      ?= rt
 # The library, by pipeline stage (docs/architecture.md); the driver is src/driver.
 STAGES   := base io scene accel render image
 LIB_SRC  := $(foreach d,$(STAGES),$(wildcard src/$(d)/*.c))
-LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
+LIB_CXX  := $(foreach d,$(STAGES),$(wildcard src/$(d)/*.cc))
+LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:src/%.cc=$(BUILD)/obj/%.o)
 DRV_SRC  := $(wildcard src/driver/*.c)
 DRV_OBJ  := $(DRV_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 DEPS_OK  := $(BUILD)/.deps-ok
 
+
+.PHONY: test-slurm test-kubernetes test-parallel test-launchers
 .PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build bench-render bench-denoise fuzz install uninstall test-install denoiser
 all: $(RT)
 
@@ -59,6 +68,10 @@ $(DEPS_OK): tools/install-deps.sh
 $(BUILD)/obj/%.o: src/%.c | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -c -o $@ $<
+
+$(BUILD)/obj/%.o: src/%.cc | $(DEPS_OK)
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -c -o $@ $<
 
 # --window needs SDL2 (libsdl2-dev): window.c is built against it when
 # pkg-config finds it at build time, else as stubs that say so; rt links it
@@ -195,6 +208,17 @@ uninstall:
 # through pkg-config, as a user of the library would (run by .ci/run).
 test-install: $(RT) $(BUILD)/librt.a
 	@CC="$(CC)" sh tests/install.sh
+
+# The launchers of examples/ (docs/farm.md), not in `make test`: they install
+# tools (slurm-wlm, parallel) and start daemons. Each renders a small scene
+# through its launcher and checks the merged image against a single render.
+test-slurm: $(RT)
+	@RT_BIN=./$(RT) sh tests/slurm.sh
+test-kubernetes: $(RT)
+	@RT_BIN=./$(RT) sh tests/kubernetes.sh
+test-parallel: $(RT)
+	@RT_BIN=./$(RT) sh tests/parallel.sh
+test-launchers: test-kubernetes test-parallel test-slurm
 
 clean:
 	rm -rf build build-asan build-tsan build-profile build-fuzz build-portable rt rt-portable rt-profile bench/rtbench bench/buildscale

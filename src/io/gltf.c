@@ -53,7 +53,10 @@
 #include "rt/base/file.h"
 #include "rt/base/log.h"
 #include "rt/io/base64.h"
+#include "rt/io/draco.h"
+#include "rt/io/gltf_animation.h"
 #include "rt/io/json.h"
+#include "rt/io/meshopt.h"
 #include "rt/scene/texture.h"
 
 #define GL_MAX_DEPTH 1024                    /* node hierarchy levels */
@@ -62,6 +65,7 @@
                                                 per load (instances included): such data costs no file bytes */
 #define GL_MAX_TRIANGLES ((size_t)1 << 25)   /* per load: 32M triangles */
 #define GL_MAX_FILE ((size_t)0x7fffffff)     /* .gltf, .glb, .bin: 2 GiB */
+#define GL_MAX_DECODED ((size_t)1 << 30)     /* per load: bytes decoded from meshopt and Draco streams */
 
 enum { GL_BYTE = 5120, GL_UNSIGNED_BYTE = 5121, GL_SHORT = 5122, GL_UNSIGNED_SHORT = 5123,
        GL_UNSIGNED_INT = 5125, GL_FLOAT = 5126 };
@@ -77,12 +81,18 @@ typedef struct gl_buffer {
     int uri;              /* string token, -1 = none (GLB BIN chunk) */
     const uint8_t *data;  /* after loading: at least byte_length bytes */
     uint8_t *owned;
+    bool fallback;        /* EXT_meshopt_compression: may have no data, only decoded views use it */
     int tok;
 } gl_buffer;
 
 typedef struct gl_view {
     uint32_t buffer;
     size_t offset, length, stride; /* stride 0 = tightly packed */
+    uint8_t *decoded;              /* EXT_meshopt_compression or Draco: the view's bytes, owned */
+    bool meshopt;                  /* the fields below hold its compressed source */
+    uint32_t mo_buffer;
+    size_t mo_offset, mo_length, mo_stride, mo_count;
+    int mo_mode, mo_filter, mo_tok;
     int tok;
 } gl_view;
 
@@ -96,6 +106,7 @@ typedef struct gl_accessor {
     uint32_t sp_idx_view, sp_val_view;
     size_t sp_idx_offset, sp_val_offset;
     int sp_idx_ctype;
+    bool draco;          /* filled by a KHR_draco_mesh_compression primitive */
     int tok;
 } gl_accessor;
 
@@ -104,22 +115,42 @@ typedef struct gl_prim {
     uint32_t indices, material;
     uint32_t attr[ATTR_COUNT];
     bool targets;
+    uint32_t first_target, target_count; /* morph targets, into doc.targets */
+    uint32_t joints[2], weights[2];      /* JOINTS_0/1, WEIGHTS_0/1 accessors, RT_NONE = absent */
+    uint32_t draco_view;          /* KHR_draco_mesh_compression: RT_NONE = not compressed */
+    uint32_t draco_id[ATTR_COUNT]; /* its attribute unique ids, RT_NONE = not in the stream */
+    int draco_tok;
     int tok;
 } gl_prim;
 
-typedef struct gl_mesh { uint32_t first, count; int tok; } gl_mesh;
+typedef struct gl_mesh { uint32_t first, count; int weights; int tok; } gl_mesh; /* weights: token, -1 = none */
+
+/* A morph target: its POSITION, NORMAL and TANGENT displacement accessors. */
+typedef struct gl_target { uint32_t attr[3]; } gl_target;
+
+/* Animations: channels and samplers of every animation in two tables. */
+typedef enum { PATH_TRANSLATION, PATH_ROTATION, PATH_SCALE, PATH_WEIGHTS } gl_path;
+typedef struct gl_channel { uint32_t sampler, node; int path; int tok; } gl_channel; /* sampler: of its animation */
+typedef struct gl_asampler { uint32_t input, output; int interp; int tok; } gl_asampler;
+typedef struct gl_anim { uint32_t first_channel, channel_count, first_sampler, sampler_count; int tok; } gl_anim;
+typedef struct gl_skin { uint32_t first_joint, joint_count, ibm; int tok; } gl_skin; /* joints in doc.skin_joints */
 
 typedef struct gl_node {
     uint32_t mesh, camera, light, skin;
     uint32_t first_child, child_count; /* into doc.children */
     uint32_t parent;
     rt_mat4 local;
+    bool has_matrix;                 /* else local = T * R * S of the fields below */
+    float tr[3], rot[4], sc[3];
+    int weights;                     /* token of its morph weights, -1 = none */
+    float *pose_weights;             /* when posed: its morph weights (pose_weight_count), owned */
+    uint32_t pose_weight_count;
     int tok;
 } gl_node;
 
 typedef struct gl_scene { uint32_t first, count; int tok; } gl_scene; /* into doc.scene_nodes */
 
-typedef struct gl_texture { uint32_t source, sampler; int tok; } gl_texture;
+typedef struct gl_texture { uint32_t source, sampler; bool other_source; int tok; } gl_texture;
 typedef struct gl_sampler { int mag, min, wrap_s, wrap_t; int tok; } gl_sampler;
 typedef struct gl_image { int uri; uint32_t view; int tok; } gl_image;
 
@@ -169,7 +200,15 @@ typedef struct gl_doc {
     gl_image *images;       size_t image_count;
     gl_camera *cameras;     size_t camera_count;
     gl_light *lights;       size_t light_count;
-    size_t skin_count;
+    gl_skin *skins;         size_t skin_count;
+    uint32_t *skin_joints;  size_t skin_joints_count, skin_joints_cap;
+    gl_target *targets;     size_t target_count, target_cap;
+    gl_anim *anims;         size_t anim_count;
+    gl_channel *channels;   size_t channel_count, channel_cap;
+    gl_asampler *asamplers; size_t asampler_count, asampler_cap;
+    bool posed;             /* rt_gltf_options.use_time: animation, skins and morphs applied */
+    rt_mat4 *skin_scratch;  size_t skin_scratch_cap; /* per-vertex skin matrices of one primitive */
+    size_t decoded_bytes;   /* meshopt and Draco output so far (GL_MAX_DECODED) */
     uint32_t default_scene; /* RT_NONE = absent */
 
     /* flattening */
@@ -408,6 +447,8 @@ static const struct { const char *name; bool supported; } known_extensions[] = {
     {"KHR_materials_volume", true},            {"KHR_materials_unlit", true},
     {"KHR_lights_punctual", true},             {"KHR_mesh_quantization", true},
     {"KHR_xmp", true},                         {"KHR_xmp_json_ld", true}, /* metadata only */
+    {"EXT_meshopt_compression", true},         {"KHR_draco_mesh_compression", true},
+    {"EXT_texture_webp", true},
 };
 
 static bool extension_supported(const gl_doc *d, int t)
@@ -480,11 +521,58 @@ static rt_result parse_buffers(gl_doc *d, int t)
                 b->uri = v;
             } else if (KEY(k, "byteLength")) {
                 TRY(get_size(d, where, "byteLength", v, &b->byte_length));
+            } else if (KEY(k, "extensions")) {
+                int mo = rt_json_get(&d->j, v, "EXT_meshopt_compression");
+                int fb = mo >= 0 ? rt_json_get(&d->j, mo, "fallback") : -1;
+                if (fb >= 0)
+                    TRY(get_bool(d, where, "extensions.EXT_meshopt_compression.fallback", fb, &b->fallback));
             }
         }
         if (b->byte_length == SIZE_MAX || b->byte_length == 0)
             return fail_at(d, e, RT_ERR_INVALID, "%s: byteLength is missing or 0", where);
     }
+    return RT_OK;
+}
+
+/* A view's EXT_meshopt_compression object: where its compressed bytes are
+ * and how they decode (rt/io/meshopt.h). */
+static rt_result parse_meshopt_view(gl_doc *d, const char *view, int t, gl_view *bv)
+{
+    char where[96];
+    snprintf(where, sizeof where, "%s.extensions.EXT_meshopt_compression", view);
+    TRY(expect_object(d, t, where));
+    bv->meshopt = true;
+    bv->mo_tok = t;
+    bv->mo_buffer = RT_NONE;
+    bv->mo_length = bv->mo_stride = bv->mo_count = SIZE_MAX;
+    bv->mo_mode = -1;
+    bv->mo_filter = RT_MESHOPT_FILTER_NONE;
+    char name[32];
+    FOR_KEYS(d, t, k, v) {
+        if (KEY(k, "buffer")) TRY(get_index(d, where, "buffer", v, &bv->mo_buffer));
+        else if (KEY(k, "byteOffset")) TRY(get_size(d, where, "byteOffset", v, &bv->mo_offset));
+        else if (KEY(k, "byteLength")) TRY(get_size(d, where, "byteLength", v, &bv->mo_length));
+        else if (KEY(k, "byteStride")) TRY(get_size(d, where, "byteStride", v, &bv->mo_stride));
+        else if (KEY(k, "count")) TRY(get_size(d, where, "count", v, &bv->mo_count));
+        else if (KEY(k, "mode")) {
+            TRY(get_string(d, where, "mode", v, name, sizeof name));
+            if ((bv->mo_mode = rt_meshopt_mode_from_name(name)) < 0)
+                return fail_at(d, v, RT_ERR_INVALID, "%s.mode \"%s\" is not ATTRIBUTES, TRIANGLES or INDICES", where,
+                               name);
+        } else if (KEY(k, "filter")) {
+            TRY(get_string(d, where, "filter", v, name, sizeof name));
+            if ((bv->mo_filter = rt_meshopt_filter_from_name(name)) < 0)
+                return fail_at(d, v, RT_ERR_INVALID,
+                               "%s.filter \"%s\" is not NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL", where, name);
+        }
+    }
+    if (bv->mo_buffer == RT_NONE || bv->mo_length == SIZE_MAX || bv->mo_stride == SIZE_MAX ||
+        bv->mo_count == SIZE_MAX || bv->mo_mode < 0)
+        return fail_at(d, t, RT_ERR_INVALID, "%s: needs buffer, byteLength, byteStride, count and mode", where);
+    const char *why = rt_meshopt_check((rt_meshopt_mode)bv->mo_mode, (rt_meshopt_filter)bv->mo_filter,
+                                       bv->mo_count, bv->mo_stride);
+    if (why)
+        return fail_at(d, t, RT_ERR_INVALID, "%s: %s", where, why);
     return RT_OK;
 }
 
@@ -508,6 +596,10 @@ static rt_result parse_views(gl_doc *d, int t)
                 if (bv->stride < 4 || bv->stride > 252 || bv->stride % 4)
                     return fail_at(d, v, RT_ERR_INVALID, "%s.byteStride %zu must be a multiple of 4 in [4, 252]",
                                    where, bv->stride);
+            } else if (KEY(k, "extensions")) {
+                int mo = rt_json_get(&d->j, v, "EXT_meshopt_compression");
+                if (mo >= 0)
+                    TRY(parse_meshopt_view(d, where, mo, bv));
             }
         }
         if (bv->buffer == RT_NONE)
@@ -629,6 +721,59 @@ static rt_result parse_accessors(gl_doc *d, int t)
     return RT_OK;
 }
 
+/* A primitive's KHR_draco_mesh_compression object: the view holding the
+ * compressed mesh and the unique ids of the attributes rt reads. */
+static rt_result parse_draco_prim(gl_doc *d, const char *prim, int t, gl_prim *pr)
+{
+    char where[128];
+    snprintf(where, sizeof where, "%s.extensions.KHR_draco_mesh_compression", prim);
+    TRY(expect_object(d, t, where));
+    pr->draco_tok = t;
+    int attrs = -1;
+    FOR_KEYS(d, t, k, v) {
+        if (KEY(k, "bufferView")) TRY(get_index(d, where, "bufferView", v, &pr->draco_view));
+        else if (KEY(k, "attributes")) attrs = v;
+    }
+    if (pr->draco_view == RT_NONE || attrs < 0)
+        return fail_at(d, t, RT_ERR_INVALID, "%s: needs bufferView and attributes", where);
+    char wa[160];
+    snprintf(wa, sizeof wa, "%s.attributes", where);
+    TRY(expect_object(d, attrs, wa));
+    FOR_KEYS(d, attrs, k2, v2) {
+        for (int a = 0; a < ATTR_COUNT; a++)
+            if (KEY(k2, attr_names[a]))
+                TRY(get_index(d, wa, attr_names[a], v2, &pr->draco_id[a]));
+    }
+    if (pr->draco_id[ATTR_POSITION] == RT_NONE)
+        return fail_at(d, attrs, RT_ERR_INVALID, "%s: POSITION is missing", wa);
+    return RT_OK;
+}
+
+/* A primitive's morph targets: POSITION, NORMAL, TANGENT displacements. */
+static rt_result parse_targets(gl_doc *d, const char *prim, int t, gl_prim *pr)
+{
+    TRY(expect_array(d, t, prim, "targets"));
+    pr->first_target = (uint32_t)d->target_count;
+    pr->target_count = (uint32_t)jsize(d, t);
+    pr->targets = pr->target_count > 0;
+    static const char *const names[3] = {"POSITION", "NORMAL", "TANGENT"};
+    FOR_ITEMS(d, t, i, e) {
+        char where[96];
+        snprintf(where, sizeof where, "%s.targets[%d]", prim, i);
+        TRY(expect_object(d, e, where));
+        if (!rt_grow((void **)&d->targets, &d->target_cap, d->target_count + 1, sizeof(gl_target)))
+            return fail_at(d, e, RT_ERR_NOMEM, "out of memory for morph targets");
+        gl_target *g = &d->targets[d->target_count++];
+        g->attr[0] = g->attr[1] = g->attr[2] = RT_NONE;
+        FOR_KEYS(d, e, k, v) {
+            for (int a = 0; a < 3; a++)
+                if (KEY(k, names[a]))
+                    TRY(get_index(d, where, names[a], v, &g->attr[a]));
+        }
+    }
+    return RT_OK;
+}
+
 static rt_result parse_meshes(gl_doc *d, int t)
 {
     TRY(alloc_table(d, t, "meshes", sizeof(gl_mesh), (void **)&d->meshes, &d->mesh_count));
@@ -652,6 +797,7 @@ static rt_result parse_meshes(gl_doc *d, int t)
     FOR_ITEMS(d, t, i, e) {
         gl_mesh *m = &d->meshes[i];
         m->tok = e;
+        m->weights = rt_json_get(&d->j, e, "weights");
         int p = rt_json_get(&d->j, e, "primitives");
         m->first = (uint32_t)d->prim_count;
         m->count = (uint32_t)jsize(d, p);
@@ -661,9 +807,10 @@ static rt_result parse_meshes(gl_doc *d, int t)
             gl_prim *pr = &d->prims[d->prim_count++];
             pr->tok = pe;
             pr->mode = 4;
-            pr->indices = pr->material = RT_NONE;
+            pr->indices = pr->material = pr->draco_view = RT_NONE;
             for (int a = 0; a < ATTR_COUNT; a++)
-                pr->attr[a] = RT_NONE;
+                pr->attr[a] = pr->draco_id[a] = RT_NONE;
+            pr->joints[0] = pr->joints[1] = pr->weights[0] = pr->weights[1] = RT_NONE;
             TRY(expect_object(d, pe, where));
             bool have_attrs = false;
             FOR_KEYS(d, pe, k, v) {
@@ -674,8 +821,11 @@ static rt_result parse_meshes(gl_doc *d, int t)
                     if (pr->mode < 0 || pr->mode > 6)
                         return fail_at(d, v, RT_ERR_INVALID, "%s.mode %d is not in [0, 6]", where, pr->mode);
                 } else if (KEY(k, "targets")) {
-                    TRY(expect_array(d, v, where, "targets"));
-                    pr->targets = jsize(d, v) > 0;
+                    TRY(parse_targets(d, where, v, pr));
+                } else if (KEY(k, "extensions")) {
+                    int dr = rt_json_get(&d->j, v, "KHR_draco_mesh_compression");
+                    if (dr >= 0)
+                        TRY(parse_draco_prim(d, where, dr, pr));
                 } else if (KEY(k, "attributes")) {
                     char wa[96];
                     snprintf(wa, sizeof wa, "%s.attributes", where);
@@ -685,6 +835,11 @@ static rt_result parse_meshes(gl_doc *d, int t)
                         for (int a = 0; a < ATTR_COUNT; a++)
                             if (KEY(k2, attr_names[a]))
                                 TRY(get_index(d, wa, attr_names[a], v2, &pr->attr[a]));
+                        static const char *const skin_attrs[4] = {"JOINTS_0", "JOINTS_1", "WEIGHTS_0", "WEIGHTS_1"};
+                        for (int a = 0; a < 4; a++)
+                            if (KEY(k2, skin_attrs[a]))
+                                TRY(get_index(d, wa, skin_attrs[a], v2,
+                                              a < 2 ? &pr->joints[a] : &pr->weights[a - 2]));
                     }
                 }
             }
@@ -755,6 +910,7 @@ static rt_result parse_nodes(gl_doc *d, int t)
         n->tok = e;
         n->mesh = n->camera = n->light = n->skin = n->parent = RT_NONE;
         n->first_child = (uint32_t)d->children_count;
+        n->weights = -1;
         bool have_matrix = false, have_trs = false;
         float matrix[16], tr[3] = {0, 0, 0}, rot[4] = {0, 0, 0, 1}, sc[3] = {1, 1, 1};
         FOR_KEYS(d, e, k, v) {
@@ -773,6 +929,8 @@ static rt_result parse_nodes(gl_doc *d, int t)
             } else if (KEY(k, "scale")) {
                 TRY(get_floats(d, where, "scale", v, sc, 3));
                 have_trs = true;
+            } else if (KEY(k, "weights")) {
+                n->weights = v;
             } else if (KEY(k, "extensions")) {
                 int l = rt_json_get(&d->j, v, "KHR_lights_punctual");
                 if (l >= 0) {
@@ -784,6 +942,9 @@ static rt_result parse_nodes(gl_doc *d, int t)
             }
         }
         TRY(read_index_list(d, e, where, "children", d->children, &d->children_count, &n->child_count));
+        memcpy(n->tr, tr, sizeof tr);
+        memcpy(n->sc, sc, sizeof sc);
+        n->has_matrix = have_matrix;
         if (have_matrix) {
             if (have_trs)
                 rt_warn("%s: %s has both matrix and TRS; using the matrix", d->path, where);
@@ -798,6 +959,7 @@ static rt_result parse_nodes(gl_doc *d, int t)
             } else {
                 rt_warn("%s: %s.rotation is a zero quaternion; using identity", d->path, where);
             }
+            n->rot[0] = q.x; n->rot[1] = q.y; n->rot[2] = q.z; n->rot[3] = q.w;
             n->local = rt_mat4_mul(rt_mat4_translate(rt_v3(tr[0], tr[1], tr[2])),
                                    rt_mat4_mul(rt_mat4_quat(q), rt_mat4_scale(rt_v3(sc[0], sc[1], sc[2]))));
         }
@@ -1027,10 +1189,21 @@ static rt_result parse_textures(gl_doc *d, int t)
         tx->tok = e;
         tx->source = tx->sampler = RT_NONE;
         TRY(expect_object(d, e, where));
+        uint32_t webp = RT_NONE;
         FOR_KEYS(d, e, k, v) {
             if (KEY(k, "source")) TRY(get_index(d, where, "source", v, &tx->source));
             else if (KEY(k, "sampler")) TRY(get_index(d, where, "sampler", v, &tx->sampler));
+            else if (KEY(k, "extensions")) {
+                int ew = rt_json_get(&d->j, v, "EXT_texture_webp");
+                int src = ew >= 0 ? rt_json_get(&d->j, ew, "source") : -1;
+                if (src >= 0)
+                    TRY(get_index(d, where, "extensions.EXT_texture_webp.source", src, &webp));
+                tx->other_source = tx->other_source || rt_json_get(&d->j, v, "KHR_texture_basisu") >= 0 ||
+                                   rt_json_get(&d->j, v, "MSFT_texture_dds") >= 0;
+            }
         }
+        if (webp != RT_NONE) /* EXT_texture_webp: the WebP image replaces the fallback source */
+            tx->source = webp;
     }
     return RT_OK;
 }
@@ -1175,6 +1348,121 @@ static rt_result parse_lights(gl_doc *d, int ext)
     return RT_OK;
 }
 
+static rt_result parse_skins(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "skins", sizeof(gl_skin), (void **)&d->skins, &d->skin_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "skins[%d]", i);
+        gl_skin *sk = &d->skins[i];
+        sk->tok = e;
+        sk->ibm = RT_NONE;
+        TRY(expect_object(d, e, where));
+        int joints = -1;
+        FOR_KEYS(d, e, k, v) {
+            if (KEY(k, "inverseBindMatrices")) TRY(get_index(d, where, "inverseBindMatrices", v, &sk->ibm));
+            else if (KEY(k, "joints")) joints = v;
+        }
+        if (joints < 0)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: joints is missing", where);
+        TRY(expect_array(d, joints, where, "joints"));
+        if (jsize(d, joints) == 0)
+            return fail_at(d, joints, RT_ERR_INVALID, "%s.joints is empty", where);
+        sk->first_joint = (uint32_t)d->skin_joints_count;
+        FOR_ITEMS(d, joints, j, je) {
+            if (!rt_grow((void **)&d->skin_joints, &d->skin_joints_cap, d->skin_joints_count + 1, sizeof(uint32_t)))
+                return fail_at(d, je, RT_ERR_NOMEM, "out of memory for joints");
+            TRY(get_index(d, where, "joints", je, &d->skin_joints[d->skin_joints_count++]));
+        }
+        sk->joint_count = (uint32_t)(d->skin_joints_count - sk->first_joint);
+    }
+    return RT_OK;
+}
+
+static rt_result parse_animations(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "animations", sizeof(gl_anim), (void **)&d->anims, &d->anim_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "animations[%d]", i);
+        gl_anim *an = &d->anims[i];
+        an->tok = e;
+        TRY(expect_object(d, e, where));
+        int chans = rt_json_get(&d->j, e, "channels"), samps = rt_json_get(&d->j, e, "samplers");
+        if (chans < 0 || samps < 0)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: needs channels and samplers", where);
+        TRY(expect_array(d, samps, where, "samplers"));
+        TRY(expect_array(d, chans, where, "channels"));
+        an->first_sampler = (uint32_t)d->asampler_count;
+        FOR_ITEMS(d, samps, j, se) {
+            char w[80];
+            snprintf(w, sizeof w, "%s.samplers[%d]", where, j);
+            TRY(expect_object(d, se, w));
+            if (!rt_grow((void **)&d->asamplers, &d->asampler_cap, d->asampler_count + 1, sizeof(gl_asampler)))
+                return fail_at(d, se, RT_ERR_NOMEM, "out of memory for animation samplers");
+            gl_asampler *sa = &d->asamplers[d->asampler_count++];
+            sa->input = sa->output = RT_NONE;
+            sa->interp = RT_INTERP_LINEAR;
+            sa->tok = se;
+            FOR_KEYS(d, se, k, v) {
+                if (KEY(k, "input")) TRY(get_index(d, w, "input", v, &sa->input));
+                else if (KEY(k, "output")) TRY(get_index(d, w, "output", v, &sa->output));
+                else if (KEY(k, "interpolation")) {
+                    char name[32];
+                    TRY(get_string(d, w, "interpolation", v, name, sizeof name));
+                    if (strcmp(name, "LINEAR") == 0) sa->interp = RT_INTERP_LINEAR;
+                    else if (strcmp(name, "STEP") == 0) sa->interp = RT_INTERP_STEP;
+                    else if (strcmp(name, "CUBICSPLINE") == 0) sa->interp = RT_INTERP_CUBICSPLINE;
+                    else
+                        return fail_at(d, v, RT_ERR_INVALID,
+                                       "%s.interpolation \"%s\" is not LINEAR, STEP or CUBICSPLINE", w, name);
+                }
+            }
+            if (sa->input == RT_NONE || sa->output == RT_NONE)
+                return fail_at(d, se, RT_ERR_INVALID, "%s: needs input and output", w);
+        }
+        an->sampler_count = (uint32_t)(d->asampler_count - an->first_sampler);
+        an->first_channel = (uint32_t)d->channel_count;
+        FOR_ITEMS(d, chans, j, ce) {
+            char w[80];
+            snprintf(w, sizeof w, "%s.channels[%d]", where, j);
+            TRY(expect_object(d, ce, w));
+            if (!rt_grow((void **)&d->channels, &d->channel_cap, d->channel_count + 1, sizeof(gl_channel)))
+                return fail_at(d, ce, RT_ERR_NOMEM, "out of memory for animation channels");
+            gl_channel *ch = &d->channels[d->channel_count++];
+            ch->sampler = ch->node = RT_NONE;
+            ch->path = -1;
+            ch->tok = ce;
+            FOR_KEYS(d, ce, k, v) {
+                if (KEY(k, "sampler")) TRY(get_index(d, w, "sampler", v, &ch->sampler));
+                else if (KEY(k, "target")) {
+                    TRY(expect_object(d, v, w));
+                    FOR_KEYS(d, v, k2, v2) {
+                        if (KEY(k2, "node")) TRY(get_index(d, w, "target.node", v2, &ch->node));
+                        else if (KEY(k2, "path")) {
+                            char name[32];
+                            TRY(get_string(d, w, "target.path", v2, name, sizeof name));
+                            if (strcmp(name, "translation") == 0) ch->path = PATH_TRANSLATION;
+                            else if (strcmp(name, "rotation") == 0) ch->path = PATH_ROTATION;
+                            else if (strcmp(name, "scale") == 0) ch->path = PATH_SCALE;
+                            else if (strcmp(name, "weights") == 0) ch->path = PATH_WEIGHTS;
+                            else
+                                ch->path = -2; /* "pointer" (KHR_animation_pointer) and others: not ours */
+                        }
+                    }
+                }
+            }
+            if (ch->sampler == RT_NONE || ch->path == -1)
+                return fail_at(d, ce, RT_ERR_INVALID, "%s: needs sampler and target.path", w);
+            if (ch->sampler >= an->sampler_count)
+                return fail_at(d, ce, RT_ERR_INVALID, "%s.sampler %u is out of range (the animation has %u samplers)",
+                               w, ch->sampler, an->sampler_count);
+        }
+        an->channel_count = (uint32_t)(d->channel_count - an->first_channel);
+    }
+    return RT_OK;
+}
+
 static rt_result parse_document(gl_doc *d)
 {
     TRY(rt_json_parse(&d->j, d->json_text, d->json_len, d->path, d->json_base, d->err));
@@ -1197,10 +1485,8 @@ static rt_result parse_document(gl_doc *d)
         else if (KEY(k, "images")) TRY(parse_images(d, v));
         else if (KEY(k, "cameras")) TRY(parse_cameras(d, v));
         else if (KEY(k, "extensions")) TRY(parse_lights(d, v));
-        else if (KEY(k, "skins")) {
-            TRY(expect_array(d, v, "glTF", "skins"));
-            d->skin_count = (size_t)jsize(d, v);
-        }
+        else if (KEY(k, "skins")) TRY(parse_skins(d, v));
+        else if (KEY(k, "animations")) TRY(parse_animations(d, v));
     }
     if (!have_asset)
         return fail_at(d, 0, RT_ERR_INVALID, "asset is missing (not a glTF file?)");
@@ -1230,6 +1516,84 @@ static bool span_fits(size_t offset, size_t count, size_t stride, size_t elem, s
     return stride == 0 ? true : (count - 1) <= room / stride;
 }
 
+/* "meshes[m].primitives[k]" for the primitive at index p of doc.prims. */
+static const char *prim_name(const gl_doc *d, size_t p, char *buf, size_t cap)
+{
+    for (size_t m = 0; m < d->mesh_count; m++)
+        if (p >= d->meshes[m].first && p - d->meshes[m].first < d->meshes[m].count) {
+            snprintf(buf, cap, "meshes[%zu].primitives[%zu]", m, p - d->meshes[m].first);
+            return buf;
+        }
+    snprintf(buf, cap, "primitive %zu", p);
+    return buf;
+}
+
+/* An EXT_meshopt_compression view: its source inside a buffer with data,
+ * its decoded size its byteLength; a plain view of a fallback buffer
+ * without data has nothing to read. */
+static rt_result validate_meshopt_view(gl_doc *d, size_t i)
+{
+    gl_view *v = &d->views[i];
+    const gl_buffer *b = &d->buffers[v->buffer];
+    if (!v->meshopt) {
+        if (b->fallback && b->uri < 0)
+            return fail_at(d, v->tok, RT_ERR_INVALID,
+                           "bufferViews[%zu] reads buffer %u, an EXT_meshopt_compression fallback with no data", i,
+                           v->buffer);
+        return RT_OK;
+    }
+    CHECK_INDEX(v->mo_buffer, d->buffer_count, v->mo_tok, "buffers",
+                "bufferViews[%zu].extensions.EXT_meshopt_compression.buffer", i);
+    const gl_buffer *src = &d->buffers[v->mo_buffer];
+    if (src->fallback)
+        return fail_at(d, v->mo_tok, RT_ERR_INVALID,
+                       "bufferViews[%zu]: compressed data in buffer %u, which is a fallback buffer", i, v->mo_buffer);
+    if (!span_fits(v->mo_offset, 1, 0, v->mo_length, src->byte_length))
+        return fail_at(d, v->mo_tok, RT_ERR_INVALID,
+                       "bufferViews[%zu]: compressed byteOffset %zu + byteLength %zu runs past buffer %u (%zu bytes)",
+                       i, v->mo_offset, v->mo_length, v->mo_buffer, src->byte_length);
+    if (v->mo_count > v->length / v->mo_stride || v->mo_count * v->mo_stride != v->length)
+        return fail_at(d, v->mo_tok, RT_ERR_INVALID,
+                       "bufferViews[%zu]: count %zu x byteStride %zu is not the view's byteLength %zu", i, v->mo_count,
+                       v->mo_stride, v->length);
+    return RT_OK;
+}
+
+/* Draco primitives: triangles with indices, and every accessor they fill
+ * marked (such accessors need no bufferView, so the limit on all-zero
+ * accessors does not apply to them). */
+static rt_result validate_draco_prims(gl_doc *d)
+{
+    for (size_t p = 0; p < d->prim_count; p++) {
+        gl_prim *pr = &d->prims[p];
+        if (pr->draco_view == RT_NONE)
+            continue;
+        char name[64];
+        prim_name(d, p, name, sizeof name);
+        CHECK_INDEX(pr->draco_view, d->view_count, pr->draco_tok, "bufferViews",
+                    "%s.extensions.KHR_draco_mesh_compression.bufferView", name);
+        if (pr->mode != 4 || pr->indices == RT_NONE)
+            return fail_at(d, pr->draco_tok, RT_ERR_UNSUPPORTED,
+                           "%s: a KHR_draco_mesh_compression primitive must be indexed triangles (mode 4 with "
+                           "indices)", name);
+        CHECK_INDEX(pr->indices, d->accessor_count, pr->tok, "accessors", "%s.indices", name);
+        d->accessors[pr->indices].draco = true;
+        for (int k = 0; k < ATTR_COUNT; k++) {
+            if (pr->draco_id[k] == RT_NONE)
+                continue;
+            if (pr->attr[k] == RT_NONE)
+                return fail_at(d, pr->draco_tok, RT_ERR_INVALID,
+                               "%s: KHR_draco_mesh_compression.attributes.%s has no accessor in the "
+                               "primitive's attributes",
+                               name, attr_names[k]);
+            CHECK_INDEX(pr->attr[k], d->accessor_count, pr->tok, "accessors", "%s.attributes.%s", name,
+                        attr_names[k]);
+            d->accessors[pr->attr[k]].draco = true;
+        }
+    }
+    return RT_OK;
+}
+
 static rt_result validate(gl_doc *d)
 {
     for (size_t i = 0; i < d->view_count; i++) {
@@ -1240,7 +1604,9 @@ static rt_result validate(gl_doc *d)
             return fail_at(d, v->tok, RT_ERR_INVALID,
                            "bufferViews[%zu]: byteOffset %zu + byteLength %zu runs past buffer %u (%zu bytes)", i,
                            v->offset, v->length, v->buffer, blen);
+        TRY(validate_meshopt_view(d, i));
     }
+    TRY(validate_draco_prims(d));
     for (size_t i = 0; i < d->accessor_count; i++) {
         gl_accessor *a = &d->accessors[i];
         size_t es = elem_size(a);
@@ -1257,7 +1623,7 @@ static rt_result validate(gl_doc *d)
                                "accessors[%zu]: byteOffset %zu + %zu elements of %zu bytes (stride %zu) run past "
                                "bufferView %u (%zu bytes)",
                                i, a->offset, a->count, es, stride, a->view, v->length);
-        } else if (a->count > GL_MAX_ZEROS) {
+        } else if (a->count > GL_MAX_ZEROS && !a->draco) {
             return fail_at(d, a->tok, RT_ERR_LIMIT,
                            "accessors[%zu]: count %zu without a bufferView is over the limit %zu", i, a->count,
                            GL_MAX_ZEROS);
@@ -1541,7 +1907,9 @@ static rt_result load_buffers(gl_doc *d)
         char what[48];
         snprintf(what, sizeof what, "buffers[%zu]", i);
         size_t have = 0;
-        if (b->uri < 0) {
+        if (b->uri < 0 && b->fallback && !(d->glb && i == 0 && d->bin)) {
+            continue; /* no data: only compressed views refer to it (validate_meshopt_view) */
+        } else if (b->uri < 0) {
             if (!d->glb || i != 0 || !d->bin)
                 return fail_at(d, b->tok, RT_ERR_INVALID, "%s has no uri and there is no GLB BIN chunk", what);
             b->data = d->bin;
@@ -1601,6 +1969,8 @@ static inline uint32_t comp_uint(const uint8_t *p, int ct)
 static const uint8_t *view_ptr(const gl_doc *d, uint32_t view, size_t offset)
 {
     const gl_view *v = &d->views[view];
+    if (v->decoded)
+        return v->decoded + offset;
     return d->buffers[v->buffer].data + v->offset + offset;
 }
 
@@ -1688,6 +2058,144 @@ static rt_result read_uints(gl_doc *d, uint32_t ai, uint32_t *out)
     return RT_OK;
 }
 
+/* ------------------------------------------------ compressed geometry */
+
+/* Counts bytes about to be decoded against the per-load limit. */
+static rt_result decoded_budget(gl_doc *d, int tok, size_t bytes)
+{
+    if (bytes > GL_MAX_DECODED - d->decoded_bytes)
+        return fail_at(d, tok, RT_ERR_LIMIT, "decompressed data would pass the limit of %zu bytes per file",
+                       GL_MAX_DECODED);
+    d->decoded_bytes += bytes;
+    return RT_OK;
+}
+
+/* EXT_meshopt_compression: every compressed view decoded into its own
+ * bytes, which view_ptr then reads in place of the (fallback) buffer. */
+static rt_result decode_meshopt_views(gl_doc *d)
+{
+    for (size_t i = 0; i < d->view_count; i++) {
+        gl_view *v = &d->views[i];
+        if (!v->meshopt)
+            continue;
+        TRY(decoded_budget(d, v->mo_tok, v->length));
+        v->decoded = malloc(v->length);
+        if (!v->decoded)
+            return fail_at(d, v->mo_tok, RT_ERR_NOMEM, "out of memory for %zu decompressed bytes", v->length);
+        const gl_buffer *src = &d->buffers[v->mo_buffer];
+        const char *why = rt_meshopt_decode(v->decoded, v->mo_count, v->mo_stride, src->data + v->mo_offset,
+                                            v->mo_length, (rt_meshopt_mode)v->mo_mode,
+                                            (rt_meshopt_filter)v->mo_filter);
+        if (why)
+            return fail_at(d, v->mo_tok, RT_ERR_INVALID, "bufferViews[%zu]: EXT_meshopt_compression: %s", i, why);
+    }
+    return RT_OK;
+}
+
+/* Points accessor a at decoded bytes (owned by a new view), as plain
+ * unsigned ints or floats. An accessor fills once: two Draco primitives
+ * sharing one would each claim it. */
+static rt_result fill_accessor(gl_doc *d, uint32_t ai, int tok, void *bytes, size_t length, int ctype)
+{
+    gl_accessor *a = &d->accessors[ai];
+    if (!a->draco) {
+        free(bytes);
+        return fail_at(d, tok, RT_ERR_UNSUPPORTED, "accessors[%u] is filled by two KHR_draco_mesh_compression "
+                       "primitives", ai);
+    }
+    gl_view *views = realloc(d->views, (d->view_count + 1) * sizeof *views);
+    if (!views) {
+        free(bytes);
+        return fail_at(d, tok, RT_ERR_NOMEM, "out of memory");
+    }
+    d->views = views;
+    gl_view *v = &d->views[d->view_count];
+    memset(v, 0, sizeof *v);
+    v->buffer = RT_NONE;
+    v->length = length;
+    v->decoded = bytes;
+    v->tok = tok;
+    a->view = (uint32_t)d->view_count++;
+    a->offset = 0;
+    a->ctype = ctype;
+    a->normalized = false;
+    a->sparse_count = 0;
+    a->draco = false;
+    return RT_OK;
+}
+
+/* One KHR_draco_mesh_compression primitive's indices and attributes from
+ * its decoded mesh, checked against the counts its accessors declare. */
+static rt_result fill_from_draco(gl_doc *d, size_t p, const rt_draco_mesh *m)
+{
+    const gl_prim *pr = &d->prims[p];
+    int tok = pr->draco_tok;
+    char name[64];
+    size_t faces = rt_draco_faces(m), points = rt_draco_points(m);
+    size_t nidx = d->accessors[pr->indices].count;
+    if (faces > SIZE_MAX / 3 || faces * 3 != nidx)
+        return fail_at(d, tok, RT_ERR_INVALID,
+                       "%s: the Draco mesh has %zu triangles, the indices accessor %u has %zu indices",
+                       prim_name(d, p, name, sizeof name), faces, pr->indices, nidx);
+    TRY(decoded_budget(d, tok, nidx * sizeof(uint32_t)));
+    uint32_t *idx = malloc((nidx ? nidx : 1) * sizeof *idx);
+    if (!idx)
+        return fail_at(d, tok, RT_ERR_NOMEM, "out of memory for %zu indices", nidx);
+    rt_draco_indices(m, idx);
+    for (size_t k = 0; k < nidx; k++)
+        if (idx[k] >= points) {
+            uint32_t bad = idx[k];
+            free(idx);
+            return fail_at(d, tok, RT_ERR_INVALID, "%s: a Draco triangle names point %u of %zu",
+                           prim_name(d, p, name, sizeof name), bad, points);
+        }
+    TRY(fill_accessor(d, pr->indices, tok, idx, nidx * sizeof *idx, GL_UNSIGNED_INT));
+    for (int k = 0; k < ATTR_COUNT; k++) {
+        if (pr->draco_id[k] == RT_NONE)
+            continue;
+        uint32_t ai = pr->attr[k];
+        const gl_accessor *a = &d->accessors[ai];
+        if (points != a->count)
+            return fail_at(d, tok, RT_ERR_INVALID, "%s: the Draco mesh has %zu points, accessor %u (%s) "
+                           "has %zu", prim_name(d, p, name, sizeof name), points, ai, attr_names[k], a->count);
+        int have = rt_draco_components(m, pr->draco_id[k]);
+        if (have == 0)
+            return fail_at(d, tok, RT_ERR_INVALID, "%s: %s is attribute %u, which the Draco mesh does "
+                           "not have", prim_name(d, p, name, sizeof name), attr_names[k], pr->draco_id[k]);
+        size_t n = points * (size_t)a->ncomp;
+        TRY(decoded_budget(d, tok, n * sizeof(float)));
+        float *vals = malloc((n ? n : 1) * sizeof *vals);
+        if (!vals)
+            return fail_at(d, tok, RT_ERR_NOMEM, "out of memory for %zu values", n);
+        if (!rt_draco_attribute(m, pr->draco_id[k], a->ncomp, vals)) {
+            free(vals);
+            return fail_at(d, tok, RT_ERR_INVALID, "%s: Draco attribute %u (%s) cannot be read as "
+                           "%d floats", prim_name(d, p, name, sizeof name), pr->draco_id[k], attr_names[k], a->ncomp);
+        }
+        TRY(fill_accessor(d, ai, tok, vals, n * sizeof *vals, GL_FLOAT));
+    }
+    return RT_OK;
+}
+
+static rt_result decode_draco_prims(gl_doc *d)
+{
+    for (size_t p = 0; p < d->prim_count; p++) {
+        const gl_prim *pr = &d->prims[p];
+        if (pr->draco_view == RT_NONE)
+            continue;
+        char why[200], name[64];
+        rt_draco_mesh *m = rt_draco_decode(view_ptr(d, pr->draco_view, 0), d->views[pr->draco_view].length, why,
+                                           sizeof why);
+        if (!m)
+            return fail_at(d, pr->draco_tok, RT_ERR_INVALID, "%s: KHR_draco_mesh_compression: %s",
+                           prim_name(d, p, name, sizeof name), why);
+        rt_result r = fill_from_draco(d, p, m);
+        rt_draco_free(m);
+        TRY(r);
+    }
+    return RT_OK;
+}
+
 static rt_result scratch(gl_doc *d, int slot, size_t floats, float **out)
 {
     if (!rt_grow((void **)&d->scratch[slot], &d->scratch_cap[slot], floats ? floats : 1, sizeof(float)))
@@ -1706,6 +2214,136 @@ static size_t prim_triangles(const gl_doc *d, const gl_prim *p)
     if (p->mode == 4)
         return n / 3;
     return n >= 3 ? n - 2 : 0;
+}
+
+/* ------------------------------------------------------------- posing */
+
+/* Accessor ai as floats in a fresh buffer (the caller frees it), checked:
+ * ncomp components per element, `count` elements (SIZE_MAX: any), finite. */
+static rt_result posing_floats(gl_doc *d, uint32_t ai, int ncomp, size_t count, const char *what, float **out)
+{
+    *out = NULL;
+    if (ai >= d->accessor_count)
+        return rt_fail(d->err, RT_ERR_INVALID, "%s: %s: accessor %u is out of range (the file has %zu)", d->path, what,
+                       ai, d->accessor_count);
+    const gl_accessor *a = &d->accessors[ai];
+    if (a->ncomp != ncomp)
+        return fail_at(d, a->tok, RT_ERR_INVALID, "accessors[%u] (%s): expected %d components per element, not %d",
+                       ai, what, ncomp, a->ncomp);
+    if (count != SIZE_MAX && a->count != count)
+        return fail_at(d, a->tok, RT_ERR_INVALID, "accessors[%u] (%s): has %zu elements, expected %zu", ai, what,
+                       a->count, count);
+    float *f = rt_alloc(a->count * (size_t)ncomp, sizeof(float));
+    if (!f)
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %s", d->path, what);
+    rt_result r = read_floats(d, ai, f);
+    if (r != RT_OK) {
+        free(f);
+        return r;
+    }
+    for (size_t i = 0; i < a->count * (size_t)ncomp; i++)
+        if (!isfinite(f[i])) {
+            free(f);
+            return fail_at(d, a->tok, RT_ERR_INVALID, "accessors[%u] (%s): element %zu is not finite", ai, what,
+                           i / (size_t)ncomp);
+        }
+    *out = f;
+    return RT_OK;
+}
+
+/* Morph target count of a node's mesh (that of its first primitive; the
+ * spec requires all primitives of a mesh to have the same). */
+static uint32_t node_targets(const gl_doc *d, uint32_t node)
+{
+    const gl_node *n = &d->nodes[node];
+    return n->mesh == RT_NONE ? 0 : d->prims[d->meshes[n->mesh].first].target_count;
+}
+
+/* One channel of the chosen animation applied to its node at time t. */
+static rt_result pose_channel(gl_doc *d, uint32_t anim, uint32_t c, float t)
+{
+    const gl_anim *an = &d->anims[anim];
+    const gl_channel *ch = &d->channels[an->first_channel + c];
+    if (ch->path < 0 || ch->node == RT_NONE)
+        return RT_OK; /* a path rt does not animate, or no target node */
+    char what[96];
+    snprintf(what, sizeof what, "animations[%u].channels[%u]", anim, c);
+    if (ch->node >= d->node_count)
+        return fail_at(d, ch->tok, RT_ERR_INVALID, "%s: target node %u is out of range (the file has %zu nodes)",
+                       what, ch->node, d->node_count);
+    gl_node *n = &d->nodes[ch->node];
+    if (n->has_matrix && ch->path != PATH_WEIGHTS)
+        return fail_at(d, ch->tok, RT_ERR_INVALID, "%s: node %u has a matrix, which animations cannot target",
+                       what, ch->node);
+    const gl_asampler *sa = &d->asamplers[an->first_sampler + ch->sampler];
+    int ncomp = ch->path == PATH_ROTATION ? 4 : ch->path == PATH_WEIGHTS ? (int)node_targets(d, ch->node) : 3;
+    if (ncomp == 0)
+        return fail_at(d, ch->tok, RT_ERR_INVALID, "%s: animates the weights of node %u, whose mesh has no morph "
+                       "targets", what, ch->node);
+    if (ncomp > 64)
+        return fail_at(d, ch->tok, RT_ERR_LIMIT, "%s: over 64 morph targets", what);
+    char w_in[128], w_out[128];
+    snprintf(w_in, sizeof w_in, "input of %s", what);
+    snprintf(w_out, sizeof w_out, "output of %s", what);
+    float *times = NULL, *values = NULL;
+    TRY(posing_floats(d, sa->input, 1, SIZE_MAX, w_in, &times));
+    size_t keys = d->accessors[sa->input].count;
+    for (size_t k = 1; k < keys; k++)
+        if (!(times[k] > times[k - 1])) {
+            double now = times[k], before = times[k - 1];
+            free(times);
+            return fail_at(d, d->accessors[sa->input].tok, RT_ERR_INVALID,
+                           "accessors[%u] (%s): key times must increase, element %zu is %g after %g", sa->input, w_in,
+                           k, now, before);
+        }
+    size_t per = sa->interp == RT_INTERP_CUBICSPLINE ? 3 : 1;
+    rt_result r = ch->path == PATH_WEIGHTS ? posing_floats(d, sa->output, 1, keys * per * (size_t)ncomp, w_out, &values)
+                                           : posing_floats(d, sa->output, ncomp, keys * per, w_out, &values);
+    if (r != RT_OK) {
+        free(times);
+        return r;
+    }
+    float out[64];
+    rt_anim_sample((rt_interp)sa->interp, times, keys, values, ncomp, ch->path == PATH_ROTATION, t, out);
+    free(times);
+    free(values);
+    switch (ch->path) {
+    case PATH_TRANSLATION: memcpy(n->tr, out, sizeof n->tr); break;
+    case PATH_ROTATION: memcpy(n->rot, out, sizeof n->rot); break;
+    case PATH_SCALE: memcpy(n->sc, out, sizeof n->sc); break;
+    default:
+        free(n->pose_weights);
+        n->pose_weights = malloc((size_t)ncomp * sizeof(float));
+        if (!n->pose_weights)
+            return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
+        memcpy(n->pose_weights, out, (size_t)ncomp * sizeof(float));
+        n->pose_weight_count = (uint32_t)ncomp;
+    }
+    if (ch->path != PATH_WEIGHTS)
+        n->local = rt_mat4_mul(rt_mat4_translate(rt_v3(n->tr[0], n->tr[1], n->tr[2])),
+                               rt_mat4_mul(rt_mat4_quat(rt_v4(n->rot[0], n->rot[1], n->rot[2], n->rot[3])),
+                                           rt_mat4_scale(rt_v3(n->sc[0], n->sc[1], n->sc[2]))));
+    return RT_OK;
+}
+
+/* rt_gltf_options.use_time: the chosen animation's channels at the time,
+ * before the world matrices are made. */
+static rt_result pose_nodes(gl_doc *d, const rt_gltf_options *opt)
+{
+    d->posed = true;
+    if (d->anim_count == 0) {
+        if (opt->animation > 0)
+            return rt_fail(d->err, RT_ERR_INVALID, "%s: animation %d requested, the file has none", d->path,
+                           opt->animation);
+        return RT_OK; /* skins and morph weights still pose the meshes */
+    }
+    if (opt->animation < 0 || (size_t)opt->animation >= d->anim_count)
+        return rt_fail(d->err, RT_ERR_INVALID, "%s: animation %d requested, the file has %zu (0 to %zu)", d->path,
+                       opt->animation, d->anim_count, d->anim_count - 1);
+    uint32_t a = (uint32_t)opt->animation;
+    for (uint32_t c = 0; c < d->anims[a].channel_count; c++)
+        TRY(pose_channel(d, a, c, opt->time));
+    return RT_OK;
 }
 
 /* The nodes of the chosen scene in depth-first order with world matrices. */
@@ -1766,17 +2404,163 @@ static rt_result collect_visits(gl_doc *d, const rt_gltf_options *opt)
     return RT_OK;
 }
 
-static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t mesh, uint32_t pi, const rt_mat4 *M,
-                                uint32_t material, size_t vbase)
+/* The morph weights of a posed node's mesh: animated, else the node's
+ * `weights`, else the mesh's, else zeros. */
+static rt_result morph_weights(gl_doc *d, uint32_t node, uint32_t count, float *w)
 {
+    const gl_node *n = &d->nodes[node];
+    memset(w, 0, count * sizeof *w);
+    if (n->pose_weights) {
+        memcpy(w, n->pose_weights, count * sizeof *w);
+        return RT_OK;
+    }
+    int tok = n->weights >= 0 ? n->weights : d->meshes[n->mesh].weights;
+    if (tok < 0)
+        return RT_OK;
+    char where[48];
+    snprintf(where, sizeof where, n->weights >= 0 ? "nodes[%u]" : "meshes[%u]", n->weights >= 0 ? node : n->mesh);
+    return get_floats(d, where, "weights", tok, w, (int)count);
+}
+
+/* Adds the weighted morph target displacements of one attribute (slot 0
+ * POSITION, 1 NORMAL, 2 TANGENT) to f (stride floats a vertex, xyz first). */
+static rt_result apply_morph(gl_doc *d, const gl_prim *p, const float *w, int slot, float *f, size_t stride,
+                             size_t vcount)
+{
+    static const char *const names[3] = {"POSITION", "NORMAL", "TANGENT"};
+    for (uint32_t k = 0; k < p->target_count; k++) {
+        uint32_t ai = d->targets[p->first_target + k].attr[slot];
+        if (w[k] == 0.0f || ai == RT_NONE)
+            continue;
+        char what[64];
+        snprintf(what, sizeof what, "%s of morph target %u", names[slot], k);
+        float *delta;
+        TRY(posing_floats(d, ai, 3, vcount, what, &delta));
+        for (size_t i = 0; i < vcount; i++)
+            for (size_t c = 0; c < 3; c++)
+                f[i * stride + c] += w[k] * delta[3 * i + c];
+        free(delta);
+    }
+    return RT_OK;
+}
+
+/* World matrix of any node (joints need not be in the chosen scene). */
+static rt_mat4 node_world(const gl_doc *d, uint32_t n, const rt_mat4 *top)
+{
+    rt_mat4 m = d->nodes[n].local;
+    for (uint32_t p = d->nodes[n].parent; p != RT_NONE; p = d->nodes[p].parent)
+        m = rt_mat4_mul(d->nodes[p].local, m);
+    return rt_mat4_mul(*top, m);
+}
+
+/* Per-vertex skin matrices of a primitive of a skinned node (glTF 2.0,
+ * 3.7.3 "Skins"): joint matrix j = world(joint j) * inverseBind(j); a
+ * vertex's matrix is the sum over its JOINTS_n / WEIGHTS_n sets of weight x
+ * joint matrix. The mesh node's own transform does not apply. A vertex whose
+ * weights sum to 0 keeps the node's transform M. */
+static rt_result skin_matrices(gl_doc *d, const gl_prim *p, uint32_t node, const rt_mat4 *M, const rt_mat4 *top,
+                               size_t vcount, rt_mat4 **out)
+{
+    const gl_skin *sk = &d->skins[d->nodes[node].skin];
+    char what[64];
+    snprintf(what, sizeof what, "inverseBindMatrices of skins[%u]", d->nodes[node].skin);
+    float *ibm = NULL;
+    if (sk->ibm != RT_NONE)
+        TRY(posing_floats(d, sk->ibm, 16, SIZE_MAX, what, &ibm));
+    if (ibm && d->accessors[sk->ibm].count < sk->joint_count) {
+        free(ibm);
+        return fail_at(d, sk->tok, RT_ERR_INVALID, "skins[%u]: %u joints but %zu inverseBindMatrices",
+                       d->nodes[node].skin, sk->joint_count, d->accessors[sk->ibm].count);
+    }
+    rt_mat4 *jm = rt_alloc(sk->joint_count, sizeof *jm);
+    if (!jm) {
+        free(ibm);
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for joints", d->path);
+    }
+    for (uint32_t j = 0; j < sk->joint_count; j++) {
+        uint32_t jn = d->skin_joints[sk->first_joint + j];
+        if (jn >= d->node_count) {
+            free(ibm);
+            free(jm);
+            return fail_at(d, sk->tok, RT_ERR_INVALID, "skins[%u].joints: node %u is out of range (the file has %zu)",
+                           d->nodes[node].skin, jn, d->node_count);
+        }
+        jm[j] = rt_mat4_mul(node_world(d, jn, top), ibm ? mat_from_gltf(ibm + 16 * j) : rt_mat4_identity());
+    }
+    free(ibm);
+    rt_result r = RT_OK;
+    if (!rt_grow((void **)&d->skin_scratch, &d->skin_scratch_cap, vcount ? vcount : 1, sizeof(rt_mat4))) {
+        free(jm);
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for skinning", d->path);
+    }
+    rt_mat4 *vm = d->skin_scratch;
+    memset(vm, 0, vcount * sizeof *vm);
+    float *wsum = rt_alloc(vcount ? vcount : 1, sizeof(float));
+    if (!wsum)
+        r = rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for skinning", d->path);
+    for (int set = 0; set < 2 && r == RT_OK; set++) {
+        if (p->joints[set] == RT_NONE || p->weights[set] == RT_NONE)
+            continue;
+        float *js = NULL, *ws = NULL;
+        snprintf(what, sizeof what, "JOINTS_%d", set);
+        r = posing_floats(d, p->joints[set], 4, vcount, what, &js);
+        snprintf(what, sizeof what, "WEIGHTS_%d", set);
+        if (r == RT_OK)
+            r = posing_floats(d, p->weights[set], 4, vcount, what, &ws);
+        for (size_t i = 0; i < vcount && r == RT_OK; i++)
+            for (int c = 0; c < 4; c++) {
+                float w = ws[4 * i + c], jf = js[4 * i + c];
+                if (w == 0.0f)
+                    continue;
+                if (!(jf >= 0) || jf >= (float)sk->joint_count) {
+                    r = fail_at(d, d->accessors[p->joints[set]].tok, RT_ERR_INVALID,
+                                "accessors[%u] (JOINTS_%d): element %zu names joint %g of %u", p->joints[set], set, i,
+                                (double)jf, sk->joint_count);
+                    break;
+                }
+                const rt_mat4 *J = &jm[(uint32_t)jf];
+                for (int a = 0; a < 4; a++)
+                    for (int b = 0; b < 4; b++)
+                        vm[i].m[a][b] += w * J->m[a][b];
+                wsum[i] += w;
+            }
+        free(js);
+        free(ws);
+    }
+    for (size_t i = 0; i < vcount && r == RT_OK; i++)
+        if (wsum[i] == 0.0f)
+            vm[i] = *M;
+    free(wsum);
+    free(jm);
+    *out = r == RT_OK ? vm : NULL;
+    return r;
+}
+
+static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t node, uint32_t pi, const rt_mat4 *M,
+                                const rt_mat4 *top, uint32_t material, size_t vbase)
+{
+    uint32_t mesh = d->nodes[node].mesh;
     const gl_prim *p = &d->prims[d->meshes[mesh].first + pi];
     const gl_accessor *pos = &d->accessors[p->attr[ATTR_POSITION]];
     size_t vcount = pos->count;
     rt_vertices *V = &s->vertices;
     float *f = NULL;
+    /* posed: morph weights and, for a skinned node, a matrix per vertex */
+    float mw[64];
+    bool morph = d->posed && p->target_count > 0;
+    rt_mat4 *vm = NULL;
+    if (morph) {
+        if (p->target_count > 64)
+            return fail_at(d, p->tok, RT_ERR_LIMIT, "meshes[%u].primitives[%u]: over 64 morph targets", mesh, pi);
+        TRY(morph_weights(d, node, p->target_count, mw));
+    }
+    if (d->posed && d->nodes[node].skin != RT_NONE && p->joints[0] != RT_NONE && p->weights[0] != RT_NONE)
+        TRY(skin_matrices(d, p, node, M, top, vcount, &vm));
 
     TRY(scratch(d, ATTR_POSITION, vcount * 3, &f));
     TRY(read_floats(d, p->attr[ATTR_POSITION], f));
+    if (morph)
+        TRY(apply_morph(d, p, mw, 0, f, 3, vcount));
     for (size_t i = 0; i < vcount; i++) {
         rt_vec3 q = rt_v3(f[3 * i], f[3 * i + 1], f[3 * i + 2]);
         if (!rt_finite3(q))
@@ -1784,26 +2568,34 @@ static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t mesh, uint32_t 
                            "accessors[%u] (POSITION of meshes[%u].primitives[%u]): element %zu is not finite "
                            "(%g, %g, %g)",
                            p->attr[ATTR_POSITION], mesh, pi, i, (double)q.x, (double)q.y, (double)q.z);
-        V->position[vbase + i] = rt_mat4_point(M, q);
+        V->position[vbase + i] = rt_mat4_point(vm ? &vm[i] : M, q);
     }
-    float det = rt_mat4_det3(M);
+    float det = rt_mat4_det3(vm && vcount ? &vm[0] : M);
     rt_mat4 N;
     bool have_n = p->attr[ATTR_NORMAL] != RT_NONE && rt_mat4_normal_matrix(M, &N);
     uint8_t flags = 0;
     if (have_n) {
         TRY(scratch(d, ATTR_NORMAL, vcount * 3, &f));
         TRY(read_floats(d, p->attr[ATTR_NORMAL], f));
+        if (morph)
+            TRY(apply_morph(d, p, mw, 1, f, 3, vcount));
         for (size_t i = 0; i < vcount; i++) {
             rt_vec3 n = rt_v3(f[3 * i], f[3 * i + 1], f[3 * i + 2]);
-            V->normal[vbase + i] = rt_finite3(n) ? rt_normalize(rt_mat4_vector(&N, n)) : rt_v3s(0);
+            rt_mat4 Ni;
+            const rt_mat4 *NM = &N;
+            if (vm)
+                NM = rt_mat4_normal_matrix(&vm[i], &Ni) ? &Ni : &N;
+            V->normal[vbase + i] = rt_finite3(n) ? rt_normalize(rt_mat4_vector(NM, n)) : rt_v3s(0);
         }
         flags |= RT_TRI_SMOOTH;
         if (p->attr[ATTR_TANGENT] != RT_NONE) {
             TRY(scratch(d, ATTR_TANGENT, vcount * 4, &f));
             TRY(read_floats(d, p->attr[ATTR_TANGENT], f));
+            if (morph)
+                TRY(apply_morph(d, p, mw, 2, f, 4, vcount));
             float sign = det < 0 ? -1.0f : 1.0f;
             for (size_t i = 0; i < vcount; i++) {
-                rt_vec3 t = rt_mat4_vector(M, rt_v3(f[4 * i], f[4 * i + 1], f[4 * i + 2]));
+                rt_vec3 t = rt_mat4_vector(vm ? &vm[i] : M, rt_v3(f[4 * i], f[4 * i + 1], f[4 * i + 2]));
                 t = rt_finite3(t) ? rt_normalize(t) : rt_v3s(0);
                 float w = f[4 * i + 3] < 0 ? -sign : sign;
                 V->tangent[vbase + i] = rt_v4(t.x, t.y, t.z, w);
@@ -1894,7 +2686,7 @@ static rt_result load_image(gl_doc *d, rt_scene *s, uint32_t ii, uint32_t *out, 
         snprintf(label, sizeof label, "bufferView %u", im->view);
         char name[300];
         snprintf(name, sizeof name, "%.250s#image%u", d->path, ii);
-        r = rt_image_load_memory(s, d->buffers[v->buffer].data + v->offset, v->length, name, &img, &inner);
+        r = rt_image_load_memory(s, view_ptr(d, im->view, 0), v->length, name, &img, &inner);
     } else {
         char *uri;
         TRY(token_string(d, im->uri, what, &uri));
@@ -1958,8 +2750,8 @@ static rt_result load_textures(gl_doc *d, rt_scene *s, rt_gltf_stats *st)
         d->texture_map[i] = RT_NONE;
         d->texture_missing[i] = false;
         if (gt->source == RT_NONE) {
-            rt_warn("%s: textures[%zu] has no source rt can read (KTX2/WebP extensions are not supported); "
-                    "left untextured", d->path, i);
+            rt_warn("%s: textures[%zu] has no source rt can read%s; left untextured", d->path, i,
+                    gt->other_source ? " (KHR_texture_basisu / KTX2 and DDS images are not supported)" : "");
             continue;
         }
         bool fresh = d->image_map[gt->source] == RT_NONE, missing;
@@ -1990,7 +2782,10 @@ static rt_result load_textures(gl_doc *d, rt_scene *s, rt_gltf_stats *st)
 
 static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st)
 {
+    if (opt && opt->use_time)
+        TRY(pose_nodes(d, opt));
     TRY(collect_visits(d, opt));
+    rt_mat4 top = opt && opt->use_transform ? opt->transform : rt_mat4_identity();
     st->nodes = d->visit_count;
 
     /* Count what the scene will hold, then reserve it all at once. */
@@ -1999,8 +2794,9 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
     bool need_default = false, warned_modes = false, warned_skin = false, warned_pos = false;
     for (size_t v = 0; v < d->visit_count; v++) {
         const gl_node *n = &d->nodes[d->visits[v].node];
-        if ((n->skin != RT_NONE) && !warned_skin) {
-            rt_warn("%s: skins and morph targets are not applied; meshes are loaded in their rest pose", d->path);
+        if (n->skin != RT_NONE && !warned_skin && !d->posed) {
+            rt_warn("%s: skins and morph targets are not applied; meshes are loaded in their rest pose "
+                        "(pose them at a time: --frame-time)", d->path);
             warned_skin = true;
         }
         if (n->mesh == RT_NONE)
@@ -2008,8 +2804,9 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
         const gl_mesh *m = &d->meshes[n->mesh];
         for (uint32_t k = 0; k < m->count; k++) {
             const gl_prim *p = &d->prims[m->first + k];
-            if (p->targets && !warned_skin) {
-                rt_warn("%s: skins and morph targets are not applied; meshes are loaded in their rest pose", d->path);
+            if (p->targets && !warned_skin && !d->posed) {
+                rt_warn("%s: skins and morph targets are not applied; meshes are loaded in their rest pose "
+                        "(pose them at a time: --frame-time)", d->path);
                 warned_skin = true;
             }
             if (!is_triangles(p->mode)) {
@@ -2104,7 +2901,7 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
             if (!is_triangles(p->mode) || p->attr[ATTR_POSITION] == RT_NONE)
                 continue;
             uint32_t mat = p->material == RT_NONE ? default_mat : mat_base + p->material;
-            TRY(emit_primitive(d, s, n->mesh, k, &d->visits[v].world, mat, vbase));
+            TRY(emit_primitive(d, s, d->visits[v].node, k, &d->visits[v].world, &top, mat, vbase));
             vbase += d->accessors[p->attr[ATTR_POSITION]].count;
         }
     }
@@ -2173,6 +2970,12 @@ static void doc_free(gl_doc *d)
 {
     for (size_t i = 0; i < d->buffer_count; i++)
         free(d->buffers[i].owned);
+    for (size_t i = 0; i < d->view_count; i++)
+        free(d->views[i].decoded);
+    for (size_t i = 0; i < d->node_count; i++)
+        free(d->nodes[i].pose_weights);
+    free(d->skins); free(d->skin_joints); free(d->targets); free(d->anims); free(d->channels); free(d->asamplers);
+    free(d->skin_scratch);
     free(d->buffers); free(d->views); free(d->accessors); free(d->meshes); free(d->prims);
     free(d->nodes); free(d->children); free(d->scenes); free(d->scene_nodes); free(d->materials);
     free(d->textures); free(d->samplers); free(d->images); free(d->cameras); free(d->lights);
@@ -2212,6 +3015,8 @@ static rt_result load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_glt
     TRY(parse_document(d));
     TRY(validate(d));
     TRY(load_buffers(d));
+    TRY(decode_meshopt_views(d));
+    TRY(decode_draco_prims(d));
     return flatten(d, s, opt, st);
 }
 

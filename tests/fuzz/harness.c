@@ -9,18 +9,22 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "rt/io/draco.h"
 #include "rt/io/exr.h"
 #include "rt/io/load.h"
+#include "rt/io/meshopt.h"
+#include "rt/io/part.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/texture.h"
 
-const char *const rt_fuzz_targets[] = {"scene", "gltf", "glb", "gltf_bin", "obj", "ply", "off", "image", "exr", NULL};
+const char *const rt_fuzz_targets[] = {"scene", "gltf",  "glb", "gltf_bin", "obj",   "ply",  "off",
+                                       "image", "exr",   "meshopt", "draco", "part", NULL};
 
 static char dir[64];
 
 static void remove_temp_dir(void)
 {
-    static const char *const files[] = {"buffer.bin", "m.mtl", NULL};
+    static const char *const files[] = {"buffer.bin", "m.mtl", "p.exr", "p.exr.json", NULL};
     char path[256];
     for (int i = 0; files[i]; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, files[i]);
@@ -79,6 +83,51 @@ static void load(const char *name, const uint8_t *data, size_t size)
     rt_scene_free(&s);
 }
 
+/* meshopt: mode, filter, stride / 4 - 1 (or the index size), count (u16
+ * little-endian), then the stream; shapes the extension forbids are
+ * refused by rt_meshopt_check as in a glTF file. */
+static void fuzz_meshopt(const uint8_t *data, size_t size)
+{
+    if (size < 5)
+        return;
+    rt_meshopt_mode mode = (rt_meshopt_mode)(data[0] % 3);
+    rt_meshopt_filter filter = (rt_meshopt_filter)(data[1] % 4);
+    size_t stride = mode == RT_MESHOPT_ATTRIBUTES ? ((size_t)data[2] % 64 + 1) * 4 : (data[2] & 1 ? 4 : 2);
+    size_t count = (size_t)data[3] | (size_t)data[4] << 8;
+    if (rt_meshopt_check(mode, filter, count, stride))
+        return;
+    uint8_t *dst = malloc(count * stride);
+    if (dst)
+        rt_meshopt_decode(dst, count, stride, data + 5, size - 5, mode, filter);
+    free(dst);
+}
+
+/* draco: a Draco stream, decoded, then its indices and the attributes of
+ * unique ids 0..7 read as a glTF loader reads them. */
+static void fuzz_draco(const uint8_t *data, size_t size)
+{
+    char why[200];
+    rt_draco_mesh *m = rt_draco_decode(data, size, why, sizeof why);
+    if (!m)
+        return;
+    size_t faces = rt_draco_faces(m), points = rt_draco_points(m);
+    if (faces <= ((size_t)1 << 22) && points <= ((size_t)1 << 22)) {
+        uint32_t *idx = malloc((3 * faces + 1) * sizeof *idx);
+        float *vals = malloc((4 * points + 1) * sizeof *vals);
+        if (idx && vals) {
+            rt_draco_indices(m, idx);
+            for (uint32_t id = 0; id < 8; id++) {
+                int n = rt_draco_components(m, id);
+                if (n > 0)
+                    rt_draco_attribute(m, id, n < 4 ? n : 4, vals);
+            }
+        }
+        free(idx);
+        free(vals);
+    }
+    rt_draco_free(m);
+}
+
 int rt_fuzz_run(const char *target, const uint8_t *data, size_t size)
 {
     char path[256];
@@ -109,12 +158,48 @@ int rt_fuzz_run(const char *target, const uint8_t *data, size_t size)
         uint32_t img;
         rt_image_load_memory(&s, data, size, "fuzz.img", &img, &err);
         rt_scene_free(&s);
+    } else if (strcmp(target, "part") == 0) {
+        /* u32 length, the sidecar (its "@HASH@" replaced by the image's
+         * FNV-1a, so the fuzzer gets past the hash check), the image */
+        size_t n;
+        split(data, size, &n);
+        const uint8_t *json = size >= 4 ? data + 4 : data, *img = json + n;
+        size_t img_size = size >= 4 ? size - 4 - n : 0;
+        write_temp("p.exr", img, img_size, path, sizeof path);
+        char hash[17];
+        snprintf(hash, sizeof hash, "%016llx", (unsigned long long)rt_fnv1a64(img, img_size, RT_FNV1A64_INIT));
+        char *text = malloc(n + 17);
+        if (!text)
+            abort();
+        size_t o = 0;
+        for (size_t i = 0; i < n;) {
+            if (i + 6 <= n && memcmp(json + i, "@HASH@", 6) == 0) {
+                memcpy(text + o, hash, 16);
+                o += 16;
+                i += 6;
+                memcpy(text + o, json + i, n - i);
+                o += n - i;
+                break;
+            }
+            text[o++] = (char)json[i++];
+        }
+        write_temp("p.exr.json", (const uint8_t *)text, o, path, sizeof path);
+        free(text);
+        rt_part part;
+        rt_error err;
+        snprintf(path, sizeof path, "%s/p.exr", temp_dir());
+        if (rt_part_read(path, &part, &err) == RT_OK)
+            rt_part_free(&part);
     } else if (strcmp(target, "exr") == 0) {
         rt_error err;
         float *rgba = NULL;
         int w, h;
         if (rt_exr_decode(data, size, "fuzz.exr", 4096, (uint64_t)1 << 22, &rgba, &w, &h, &err) == RT_OK)
             free(rgba);
+    } else if (strcmp(target, "meshopt") == 0) {
+        fuzz_meshopt(data, size);
+    } else if (strcmp(target, "draco") == 0) {
+        fuzz_draco(data, size);
     } else {
         return -1;
     }
