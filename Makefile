@@ -7,6 +7,8 @@
 #   make profile      ./rt-profile: optimised, with symbols and frame pointers (for perf)
 #   make scenes       render every scene in scenes/ into docs/images/
 #   make denoiser     Intel Open Image Denoise for --denoise: the pyoidn wheel in build/oidn-venv
+#   make bench-render rt's path tracer against Mitsuba 3 (sets it up in build/mitsuba-venv)
+#   make bench-denoise --denoise at 4/16/64 spp against raw 256 and 1024 spp
 #   make install      rt, the library and its headers, and a pkg-config file
 #                     (PREFIX=/usr/local, DESTDIR for staging); make test-install checks it
 #   make test-slurm   the Slurm launcher (examples/slurm) on a real Slurm started here (root)
