@@ -7,6 +7,8 @@
 #   make profile      ./rt-profile: optimised, with symbols and frame pointers (for perf)
 #   make scenes       render every scene in scenes/ into docs/images/
 #   make denoiser     Intel Open Image Denoise for --denoise: the pyoidn wheel in build/oidn-venv
+#   make bench-render rt's path tracer against Mitsuba 3 (sets it up in build/mitsuba-venv)
+#   make bench-denoise --denoise at 4/16/64 spp against raw 256 and 1024 spp
 #   make install      rt, the library and its headers, and a pkg-config file
 #                     (PREFIX=/usr/local, DESTDIR for staging); make test-install checks it
 #   make test-slurm   the Slurm launcher (examples/slurm) on a real Slurm started here (root)
@@ -56,7 +58,7 @@ DEPS_OK  := $(BUILD)/.deps-ok
 
 
 .PHONY: test-slurm test-kubernetes test-parallel test-launchers
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build fuzz install uninstall test-install denoiser ggx-albedo-table
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build bench-render bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -162,6 +164,16 @@ bench: bench/rtbench
 # rt and Embree side by side on the same rays, as ratios (installs Embree 3 on first use).
 bench-compare: bench/rtbench
 	@SHARED=$(SHARED) sh bench/compare.sh
+
+# rt's path tracer against Mitsuba 3 on the shared Cornell box (sets up Mitsuba in build/mitsuba-venv
+# and Debian's libllvm19 on first use); RT_BINS="./rt other/rt" compares rt builds too.
+RT_BINS ?= ./$(RT)
+bench-render: $(RT)
+	@SHARED=$(SHARED) sh bench/render.sh $(RT_BINS)
+
+# --denoise on the shared Cornell box: 4/16/64 spp denoised against raw 256 and 1024 spp (docs/hdr.md).
+bench-denoise: $(RT) denoiser
+	@SHARED=$(SHARED) sh bench/denoise.sh ./$(RT)
 
 bench/buildscale: bench/buildscale.c $(BUILD)/librt.a | $(DEPS_OK)
 	$(CC) $(CFLAGS) -o $@ $< $(BUILD)/librt.a $(LDLIBS)

@@ -122,11 +122,12 @@ rt_result output_write(const args *a, const rt_settings *set, rt_framebuffer *fb
         }
         double t0 = rt_now_seconds();
         rt_denoise_input in = {.width = fb->width, .height = fb->height, .color = fb->rgb,
-                               .albedo = aov->buf.albedo, .normal = aov->buf.normal};
+                               .albedo = aov->buf.albedo, .normal = aov->buf.normal,
+                               .prefilter_aux = aov->noisy_aux};
         r = rt_denoise_image(&in, err);
         if (r != RT_OK)
             goto done;
-        rt_info("denoise: %.3f s (albedo and normal, prefiltered)", rt_now_seconds() - t0);
+        rt_info("denoise: %.3f s (albedo and normal as clean auxiliary images)", rt_now_seconds() - t0);
     }
     if (fmt == RT_FORMAT_EXR) {
         if (noisy)

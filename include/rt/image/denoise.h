@@ -12,34 +12,54 @@
  *   char where[4096];
  *   if (rt_denoise_find(where, sizeof where, &err) != RT_OK)
  *       ... err.message is one line saying how to install it ...
- *   rt_denoise_image(&img, &err);   // in place
+ *   rt_denoise_input in = {.width = w, .height = h, .color = rgb, .albedo = albedo, .normal = normal};
+ *   rt_denoise_image(&in, &err);   // rgb denoised in place
+ *
+ * With -v it prints one line timing its steps (load, device, filter setup,
+ * execute with its CPU time, release).
  */
 #ifndef RT_DENOISE_H
 #define RT_DENOISE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "rt/base/error.h"
+
+/* OIDN's quality modes (its "quality" filter parameter). RT_DENOISE_DEFAULT
+ * is RT_OIDN_QUALITY from the environment (fast, balanced or high), else
+ * balanced: measured in docs/hdr.md against fast and high. */
+typedef enum rt_denoise_quality {
+    RT_DENOISE_DEFAULT = 0, /* = RT_DENOISE_BALANCED */
+    RT_DENOISE_FAST,
+    RT_DENOISE_BALANCED,
+    RT_DENOISE_HIGH
+} rt_denoise_quality;
 
 /* What to denoise: linear HDR RGB, 3 floats a pixel, row 0 at the top. */
 typedef struct rt_denoise_input {
     int width, height;
     float *color;        /* denoised in place */
-    const float *albedo; /* optional (NULL): first non-specular hit's albedo */
+    const float *albedo; /* optional (NULL): first non-specular hit's albedo, noise-free but for edges */
     const float *normal; /* optional, with albedo: its shading normal */
+    rt_denoise_quality quality;
+    int threads;        /* OIDN's worker threads; 0: one per core */
+    bool prefilter_aux; /* albedo and normal are noisy (depth of field): denoise them first */
 } rt_denoise_input;
 
 /* The one-line hint printed when the library is missing. */
 #define RT_DENOISE_INSTALL_HINT "run 'make denoiser' (installs the pyoidn wheel into build/oidn-venv) or set RT_OIDN_LIBRARY"
 
 /* Finds and loads the library; `where` receives the path that loaded.
- * RT_ERR_IO with a one-line message when it cannot be found. */
+ * RT_ERR_IO with a one-line message when it cannot be found or
+ * RT_OIDN_QUALITY is not a quality's name. */
 rt_result rt_denoise_find(char *where, size_t size, rt_error *err);
 
-/* Runs OIDN's "RT" filter (hdr on) on in->color in place. With albedo and
- * normal, they are denoised first by their own filters and passed as clean
- * auxiliary images (cleanAux: the "prefiltered" mode OIDN recommends for
- * final frames). Runs on OIDN's CPU device. */
+/* Runs OIDN's "RT" filter (hdr on) on in->color in place, on OIDN's CPU
+ * device; RT_ERR_IO for a bad RT_OIDN_QUALITY (before any work). Albedo
+ * and normal, when given, go in as clean auxiliary images (cleanAux), as
+ * rt renders them: not prefiltered (denoise.c says why) unless
+ * prefilter_aux asks for it. */
 rt_result rt_denoise_image(const rt_denoise_input *in, rt_error *err);
 
 #endif
