@@ -329,6 +329,28 @@ static void test_frames(void **state)
         assert_int_equal(RUN("-q", "--frames", "0:2", "-o", in_dir(bad[i]), scene), 2);
         assert_non_null(strstr(err_text, "%0Nd"));
     }
+    /* an animated glTF: frame f is the model posed at f / fps, as --frame-time poses it */
+    if (test_have_shared()) {
+        const char *truck = test_shared_path("assets/gltf/CesiumMilkTruck/glTF-Binary/CesiumMilkTruck.glb");
+        static char model[4096];
+        snprintf(model, sizeof model, "%s", truck);
+        snprintf(pattern, sizeof pattern, "%s/truck.%%d.png", dir);
+        RUN_OK("-q", "-r", "48x36", "-s", "2", "--frames", "0:3", "--fps", "4", "-o", pattern, model);
+        RUN_OK("-q", "-r", "48x36", "-s", "2", "--frame-time", "0.5", "-o", in_dir("truck-t.png"), model);
+        assert_same_bytes(in_dir("truck.2.png"), in_dir("truck-t.png"));
+        size_t n0, n2;
+        char *f0 = slurp(in_dir("truck.0.png"), &n0), *f2 = slurp(in_dir("truck.2.png"), &n2);
+        assert_true(n0 != n2 || memcmp(f0, f2, n0) != 0); /* the truck moved */
+        free(f0);
+        free(f2);
+        /* parts of different frames are parts of different renders */
+        snprintf(pattern, sizeof pattern, "%s/tp.%%d.exr", dir);
+        RUN_OK("-q", "-r", "48x36", "-s", "2", "--frames", "0:2", "--part", "0/2", "-o", pattern, model);
+        RUN_OK("-q", "-r", "48x36", "-s", "2", "--frames", "1:2", "--part", "1/2", "-o", pattern, model);
+        assert_int_equal(RUN("merge", in_dir("tp.0.exr"), in_dir("tp.1.exr"), "-o", in_dir("tp.png")), 2);
+        assert_non_null(strstr(err_text, "not a part of the same render"));
+    }
+    assert_int_equal(RUN("-q", "--frames", "0:2", "--frame-time", "1", "-o", pattern, scene), 2);
     assert_int_equal(RUN("-q", "--frames", "2:2", "-o", pattern, scene), 2);
     assert_int_equal(RUN("-q", "--frames", "0:2", "--fps", "0", "-o", pattern, scene), 2);
 }

@@ -132,7 +132,8 @@ static const flag flags[] = {
     {NULL, "--part-out", "FILE", FLAG_PART_OUT, NULL,
      "also write the render as a part FILE (.exr or .pfm, with FILE.json), e.g. to --resume it after a stop"},
     {NULL, "--frames", "A:B", FLAG_FRAMES, NULL,
-     "render frames A .. B-1, each on its own, at time frame / fps; -o names them with %04d (out.%04d.png)"},
+     "render frames A .. B-1 of an animated glTF (--animation N), each on its own at time frame / fps; -o names "
+     "them with %04d (out.%04d.png)"},
     {NULL, "--fps", "F", FLAG_FPS, NULL, "frames per second for --frames (default 24)"},
     {"-h", "--help", NULL, FLAG_HELP, NULL, "this text"},
     {NULL, "--version", NULL, FLAG_VERSION, NULL, "print the version"},
@@ -653,6 +654,8 @@ int args_parse(args *a, int argc, char **argv)
     }
     if (a->part_count && a->has_crop)
         return fail_usage("--part and --crop both choose the region; give one of them");
+    if (a->has_frames && a->posed && a->frame_time != 0.0f)
+        return fail_usage("--frames sets each frame's time (frame / fps); drop --frame-time");
     if (a->resume && (a->part_count || a->has_crop || a->has_spp_range))
         return fail_usage("--resume takes the region and samples from the part it continues; drop --part, --crop "
                           "and --spp-range");

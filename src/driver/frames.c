@@ -1,7 +1,8 @@
 /* frames.c - frame names and times for `--frames A:B` (frames.h). A name
  * pattern takes one printf-style integer conversion, %d or %0Nd, as ffmpeg
  * and Blender's `####` do for image sequences; the frame's time is
- * frame / fps. */
+ * frame / fps, at which main.c poses an animated glTF (as --frame-time
+ * does). */
 #include "frames.h"
 
 #include <stdio.h>
@@ -67,11 +68,3 @@ bool frames_name(const char *pattern, int frame, char *out, size_t size)
 }
 
 double frames_time(int frame, double fps) { return (double)frame / fps; }
-
-rt_result frames_apply(rt_scene *scene, double t, rt_error *err)
-{
-    (void)scene;
-    (void)t;
-    (void)err;
-    return RT_OK;
-}

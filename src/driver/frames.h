@@ -5,8 +5,7 @@
  *
  *   char name[1024];
  *   if (!frames_name("out.%04d.png", 7, name, sizeof name)) ...   // "out.0007.png"
- *   double t = frames_time(7, 24.0);                             // 7 / 24 s
- *   frames_apply(&scene, t, &err);                               // the scene at time t
+ *   double t = frames_time(7, 24.0);                             // 7 / 24 s: the --frame-time of frame 7
  */
 #ifndef RT_DRIVER_FRAMES_H
 #define RT_DRIVER_FRAMES_H
@@ -25,9 +24,5 @@ bool frames_pattern_ok(const char *pattern);
 bool frames_name(const char *pattern, int frame, char *out, size_t size);
 /* A frame's time in seconds: frame / fps. */
 double frames_time(int frame, double fps);
-/* Poses the loaded scene at time t. The scene formats hold no animation
- * yet, so this changes nothing; glTF animation (another branch) hooks in
- * here, keeping the frame loop and the naming as they are. */
-rt_result frames_apply(rt_scene *scene, double t, rt_error *err);
 
 #endif

@@ -5,7 +5,8 @@
  * image. A part of a render spread over machines (--part, --crop,
  * --spp-range, --resume, --part-out: part.c, docs/farm.md) renders its
  * region and samples and writes its sums; `rt merge` (merge.c) puts parts
- * together. --frames A:B runs the whole pipeline once a frame (frames.c).
+ * together. --frames A:B runs the whole pipeline once a frame, each posed
+ * at its time (frames.c).
  * With --window the render loops: a move of the window's camera
  * (viewer.c) cancels it and it starts again at the new camera from sample
  * 0; a finished render is written at once, and closing the window
@@ -681,16 +682,16 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     return status;
 }
 
-/* Loads, prepares, poses at time t (frames.h), renders and writes one
- * image (or part); the exit status. */
-static int render_one(rt_scene *scene, const args *a, double t, double t_start)
+/* Loads, prepares (posed at a->frame_time when a->posed), renders and
+ * writes one image (or part); the exit status. */
+static int render_one(rt_scene *scene, const args *a, double t_start)
 {
     rt_error err = {0};
     char output[1024];
     progress_view view;
     progress_view_init(&view, a->log_level >= RT_LOG_NORMAL && isatty(2));
     progress_phase(&view, "load", a->input ? a->input : "the built-in scene");
-    if (prepare(scene, a, output, sizeof output, &err) != RT_OK || frames_apply(scene, t, &err) != RT_OK) {
+    if (prepare(scene, a, output, sizeof output, &err) != RT_OK) {
         progress_clear(&view);
         report(&err, &a->budget);
         progress_view_free(&view);
@@ -739,7 +740,7 @@ int main(int argc, char **argv)
         return 2;
     }
     if (!a.has_frames) {
-        status = render_one(&scene, &a, 0.0, t_start);
+        status = render_one(&scene, &a, t_start);
         rt_scene_free(&scene);
         return status;
     }
@@ -765,9 +766,11 @@ int main(int argc, char **argv)
         a.output = name;
         if (part_pattern)
             a.part_out = part_name;
+        a.frame_time = (float)frames_time(f, a.fps); /* an animated glTF posed at the frame's time */
+        a.posed = true;
         rt_scene_free(&scene);
         rt_scene_init(&scene);
-        status = render_one(&scene, &a, frames_time(f, a.fps), rt_now_seconds());
+        status = render_one(&scene, &a, rt_now_seconds());
     }
     rt_scene_free(&scene);
     return status;

@@ -195,6 +195,9 @@ rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, cons
     rt_result r = part_identity(scene, a->input, &pj->info, err);
     if (r != RT_OK)
         return r;
+    if (a->posed) /* the pose changes pixels: frame time and animation are settings of the render */
+        line(pj->info.settings, sizeof pj->info.settings, "frame_time %a animation %d", (double)a->frame_time,
+             a->animation);
     if (a->has_crop) {
         if (a->crop[2] > s->width || a->crop[3] > s->height)
             return rt_fail(err, RT_ERR_INVALID, "--crop %d %d %d %d: the image is only %dx%d", a->crop[0], a->crop[1],
