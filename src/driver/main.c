@@ -632,9 +632,8 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         float diag = rt_box_diagonal(b), d = rt_length(rt_sub(scene->camera.look_at, scene->camera.position));
         window.exposure = session.image.exposure;
         window.tonemap = a->tonemap;
-        /* a render whose sums are kept (a part, --part-out, --resume) stays at its camera */
-        if (!pj.need_accum)
-            window_set_camera(&window, &scene->camera, isfinite(diag) && diag > 0.0f ? 0.02f * diag : 0.05f * d);
+        window_set_camera(&window, &scene->camera, isfinite(diag) && diag > 0.0f ? 0.02f * diag : 0.05f * d);
+        window.interactive = !pj.need_accum; /* kept sums (a part, --part-out, --resume): the camera stays */
         view->viewer = &session;
     }
     bool written = false;
