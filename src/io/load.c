@@ -135,14 +135,17 @@ static bool add_default_lighting(rt_scene *s)
 
 /* The reader for kind, then what for_render adds to that kind. */
 static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const char *name, rt_load_kind kind,
-                           bool for_render, rt_load_info *info, rt_error *err)
+                           bool for_render, const char *variant, rt_load_info *info, rt_error *err)
 {
     rt_result r;
     switch (kind) {
     case RT_LOAD_GLTF: {
         rt_gltf_stats gs;
         memset(&gs, 0, sizeof gs);
-        r = rt_gltf_load_memory(s, bytes, size, name, NULL, &gs, err);
+        rt_gltf_options go;
+        memset(&go, 0, sizeof go);
+        go.variant = variant;
+        r = rt_gltf_load_memory(s, bytes, size, name, &go, &gs, err);
         info->meshes = gs.meshes;
         info->primitives = gs.primitives;
         info->nodes = gs.nodes;
@@ -187,7 +190,13 @@ static rt_result load_marked(rt_scene *s, const void *bytes, size_t size, const 
 {
     bool for_render = options && options->for_render;
     rt_scene_mark mark = rt_scene_mark_of(s);
-    rt_result r = load_kind(s, bytes, size, name, kind, for_render, info, err);
+    const char *variant = options ? options->variant : NULL;
+    if (variant && kind != RT_LOAD_GLTF) {
+        info->load_ms = 1e3 * rt_now_seconds() - t0;
+        return rt_fail(err, RT_ERR_INVALID, "%s: --variant picks a glTF model's material variant; this is not a glTF file",
+                       name ? name : "the built-in scene");
+    }
+    rt_result r = load_kind(s, bytes, size, name, kind, for_render, variant, info, err);
     if (r == RT_OK && for_render) /* normal-mapped meshes without tangents get per-vertex ones */
         r = rt_scene_generate_tangents(s, err);
     if (r != RT_OK)

@@ -22,6 +22,7 @@ typedef struct rt_gltf_options {
     bool use_scene_index;
     rt_mat4 transform;     /* applied on top of the node transforms */
     bool use_transform;    /* false = identity */
+    const char *variant;   /* KHR_materials_variants: the variant to show, by name; NULL = the default materials */
 } rt_gltf_options;
 
 /* What one load added. meshes/primitives count instances (a mesh used by
