@@ -16,6 +16,8 @@ regenerate bit for bit:
   anisotropy.gltf     white metal: strength 0, 0.5, 1, rotated by 90 degrees
   iridescence.gltf    film thickness 200, 400, 600 nm over a dark dielectric and a metal
   transmission.gltf   diffuse transmission 0, 0.5, 1 (green), and dispersion on glass
+  gallery.gltf        one sphere of each: coat 0.3, gold sheen, blue F0, anisotropic
+                      metal, 400 nm film, diffuse transmission (the README picture)
   variants.gltf       KHR_materials_variants: two grey spheres; variant "blue" turns the
                       first blue, "red" the second red
 """
@@ -182,6 +184,10 @@ def main():
                 KHR_materials_dispersion={"dispersion": 0.5}),
         ],
     }
+    files["gallery"] = [  # one of each, for docs/images/gltf-extensions.png
+        files["clearcoat"][2], files["sheen"][3], files["specular"][3], files["anisotropy"][2],
+        files["iridescence"][1], files["transmission"][2],
+    ]
     for name, mats in files.items():
         doc = document(mats, len(data), nv, ni)
         with open(os.path.join(out, name + ".gltf"), "w") as f:
