@@ -1174,6 +1174,7 @@ static rt_result parse_materials(gl_doc *d, int t)
         m->transmission_color = m->color;
         /* KHR_materials_volume: thickness 0 (or no volume) is thin-walled */
         m->thin_walled = !(m->thickness > 0.0f);
+        m->extended = rt_material_extended(m);
         derive_phong(m);
     }
     return RT_OK;

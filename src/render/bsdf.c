@@ -388,17 +388,6 @@ void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alp
         b->diffuse = rt_v3s(0.0f);
 }
 
-static bool material_has_ext(const rt_material *m)
-{
-    bool tex = false;
-    for (int i = 0; i < RT_XTEX_COUNT; i++)
-        tex = tex || m->ext_tex[i].texture != RT_NONE;
-    return tex || m->clearcoat > 0.0f || m->specular_weight != 1.0f || m->specular_color.x != 1.0f ||
-           m->specular_color.y != 1.0f || m->specular_color.z != 1.0f || rt_max3(m->sheen_color) > 0.0f ||
-           m->anisotropy > 0.0f || m->iridescence > 0.0f || m->diffuse_transmission > 0.0f ||
-           (m->dispersion > 0.0f && m->transmission > 0.0f);
-}
-
 static rt_vec4 ext_sample(const rt_scene *s, const rt_surface *sf, const rt_material *m, rt_ext_slot k, bool srgb,
                           bool *present)
 {
@@ -546,7 +535,7 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
         b->eta = 1.0f / b->eta; /* leaving the object through its back */
     /* a glTF material without a volume (KHR_materials_volume thickness 0) is thin-walled */
     b->thin = m->bsdf == RT_BSDF_GLTF && b->transmission > 0.0f && m->thin_walled;
-    if (m->bsdf == RT_BSDF_GLTF && material_has_ext(m))
+    if (m->extended && m->bsdf == RT_BSDF_GLTF)
         set_ext_from_surface(ctx, sf, m, b);
 }
 

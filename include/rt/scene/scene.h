@@ -223,9 +223,13 @@ typedef struct rt_material {
     float diffuse_transmission;   /* KHR_materials_diffuse_transmission factor (0) */
     rt_vec3 diffuse_transmission_color; /* (1, 1, 1) */
     rt_texture_slot ext_tex[RT_XTEX_COUNT]; /* the extensions' textures, by rt_ext_slot */
+    bool extended;                /* rt_material_extended(), set once by the loader: the BSDF reads the fields above */
 } rt_material;
 
 void rt_material_default(rt_material *m, const char *name);
+/* True when some extension field or texture above differs from its default
+ * (loaders store it in `extended`, so a hit need not check each field). */
+bool rt_material_extended(const rt_material *m);
 
 /* Named metals for `bsdf conductor` (`metal NAME`): complex IOR eta + i k at
  * the red, green and blue wavelengths 650, 550 and 450 nm, from
