@@ -135,21 +135,20 @@ static bool add_default_lighting(rt_scene *s)
 
 /* The reader for kind, then what for_render adds to that kind. */
 static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const char *name, rt_load_kind kind,
-                           bool for_render, const char *variant, rt_load_info *info, rt_error *err)
+                           const rt_load_options *opt, rt_load_info *info, rt_error *err)
 {
     rt_result r;
     switch (kind) {
     case RT_LOAD_GLTF: {
         rt_gltf_stats gs;
         memset(&gs, 0, sizeof gs);
-        rt_gltf_options go;
-        memset(&go, 0, sizeof go);
-        go.variant = variant;
+        rt_gltf_options go = {
+            .use_time = opt->use_time, .time = opt->time, .animation = opt->animation, .variant = opt->variant};
         r = rt_gltf_load_memory(s, bytes, size, name, &go, &gs, err);
         info->meshes = gs.meshes;
         info->primitives = gs.primitives;
         info->nodes = gs.nodes;
-        if (r == RT_OK && for_render) {
+        if (r == RT_OK && opt->for_render) {
             if (!add_default_lighting(s))
                 r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", name);
             if (s->camera_count) {
@@ -168,7 +167,7 @@ static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const ch
         r = mo.material == RT_NONE ? rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", name)
                                    : rt_mesh_load_memory(s, bytes, size, name, &mo, NULL, err);
         info->meshes = info->primitives = r == RT_OK ? 1 : 0;
-        if (r == RT_OK && for_render && !add_default_lighting(s))
+        if (r == RT_OK && opt->for_render && !add_default_lighting(s))
             r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", name);
         return r;
     }
@@ -188,15 +187,17 @@ static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const ch
 static rt_result load_marked(rt_scene *s, const void *bytes, size_t size, const char *name, rt_load_kind kind,
                              const rt_load_options *options, rt_load_info *info, double t0, rt_error *err)
 {
-    bool for_render = options && options->for_render;
+    static const rt_load_options defaults = {0};
+    if (!options)
+        options = &defaults;
+    bool for_render = options->for_render;
     rt_scene_mark mark = rt_scene_mark_of(s);
-    const char *variant = options ? options->variant : NULL;
-    if (variant && kind != RT_LOAD_GLTF) {
+    if (options->variant && kind != RT_LOAD_GLTF) {
         info->load_ms = 1e3 * rt_now_seconds() - t0;
         return rt_fail(err, RT_ERR_INVALID, "%s: --variant picks a glTF model's material variant; this is not a glTF file",
                        name ? name : "the built-in scene");
     }
-    rt_result r = load_kind(s, bytes, size, name, kind, for_render, variant, info, err);
+    rt_result r = load_kind(s, bytes, size, name, kind, options, info, err);
     if (r == RT_OK && for_render) /* normal-mapped meshes without tangents get per-vertex ones */
         r = rt_scene_generate_tangents(s, err);
     if (r != RT_OK)

@@ -23,7 +23,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "rt/base/alloc.h"
 #include "rt/base/clock.h"
@@ -34,20 +33,18 @@
 #include "rt/render/sampling.h"
 #include "rt/scene/validate.h"
 
-int rt_cpu_count(void)
-{
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    return n > 0 ? (n > 1024 ? 1024 : (int)n) : 1;
-}
-
 struct rt_render_job {
     const rt_scene *scene;
-    rt_framebuffer *fb;
+    rt_framebuffer *fb;           /* the region's pixels */
     rt_camera_frame camera;
+    int width, height;            /* the whole image (settings) */
+    int rx0, ry0, rw, rh;         /* the region rendered: [rx0, rx0 + rw) x [ry0, ry0 + rh) */
     int tile_size, tiles_x, tiles_y, tiles_total;
     uint32_t spp;                 /* settings.samples */
+    uint32_t s_begin, s_end;      /* the samples this render adds: [s_begin, s_end) */
     bool passes;                  /* pass mode: accumulate into sum/good */
     uint32_t s0, s1;              /* passes: this pass's samples [s0, s1) */
+    rt_render_accum *accum;       /* NULL, or the caller's sums and counts, continued */
     float *sum;                   /* passes: per pixel, RGB sum of the good samples so far */
     uint32_t *good;               /* passes: per pixel, how many samples were good */
     int samples_done;             /* passes: samples in fb (read by progress reports) */
@@ -101,14 +98,15 @@ static void aov_store(rt_aov_buffers *aov, size_t pixel, const rt_aov_sample *s,
     }
 }
 
-/* Adds samples [s0, s1) of pixel (x, y) to *sum and *good, in sample order:
- * the one place a pixel's arithmetic happens, for tiles and passes alike. */
-static inline void add_samples(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, uint32_t s0,
-                               uint32_t s1, rt_vec3 *sum_io, uint32_t *good_io)
+/* Adds samples [s0, s1) of pixel (x, y) of the whole image (`local`: its
+ * index in the region's buffers) to *sum and *good, in sample order: the one
+ * place a pixel's arithmetic happens, for tiles and passes alike. */
+static inline void add_samples(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, size_t local,
+                               uint32_t s0, uint32_t s1, rt_vec3 *sum_io, uint32_t *good_io)
 {
     const rt_settings *st = &job->scene->settings;
     uint32_t spp = job->spp;
-    uint64_t pixel = (uint64_t)y * (uint64_t)job->fb->width + (uint64_t)x;
+    uint64_t pixel = (uint64_t)y * (uint64_t)job->width + (uint64_t)x;
     uint32_t pattern = (uint32_t)rt_mix64(pixel ^ ((uint64_t)st->seed << 40));
     rt_vec3 sum = *sum_io;
     uint32_t good = *good_io;
@@ -134,12 +132,12 @@ static inline void add_samples(const rt_render_job *job, worker *w, rt_trace_ctx
             rt_rng arng = rt_rng_for_sample(st->seed ^ 0xa0f5eed5u, pixel, s);
             rt_aov_sample a;
             rt_aov_trace(ctx, ray, &arng, &a);
-            rt_aov_sample *acc = &job->aov_sum[pixel];
+            rt_aov_sample *acc = &job->aov_sum[local];
             acc->albedo = rt_add(acc->albedo, a.albedo);
             acc->normal = rt_add(acc->normal, a.normal);
             acc->position = rt_add(acc->position, a.position);
             acc->depth += a.depth;
-            job->lum_sq[pixel] += (double)rt_luminance(L) * (double)rt_luminance(L);
+            job->lum_sq[local] += (double)rt_luminance(L) * (double)rt_luminance(L);
         }
     }
     *sum_io = sum;
@@ -152,13 +150,14 @@ static inline rt_vec3 resolve(rt_vec3 sum, uint32_t good)
     return good ? rt_scale(sum, 1.0f / (float)good) : sum;
 }
 
+/* Tile `tile` of the region, in the region's (fb's) coordinates. */
 static void tile_bounds(const rt_render_job *job, int tile, int *x0, int *y0, int *x1, int *y1)
 {
     int tx = tile % job->tiles_x, ty = tile / job->tiles_x;
     *x0 = tx * job->tile_size;
     *y0 = ty * job->tile_size;
-    *x1 = *x0 + job->tile_size < job->fb->width ? *x0 + job->tile_size : job->fb->width;
-    *y1 = *y0 + job->tile_size < job->fb->height ? *y0 + job->tile_size : job->fb->height;
+    *x1 = *x0 + job->tile_size < job->rw ? *x0 + job->tile_size : job->rw;
+    *y1 = *y0 + job->tile_size < job->rh ? *y0 + job->tile_size : job->rh;
 }
 
 /* Renders one tile (tiles: all its samples into fb; passes: this pass's
@@ -173,18 +172,31 @@ static bool render_tile(rt_render_job *job, worker *w, rt_trace_ctx *ctx, int ti
         for (int x = x0; x < x1; x++) {
             if (job->cancel && atomic_load_explicit(job->cancel, memory_order_relaxed))
                 return false;
-            size_t pixel = (size_t)y * (size_t)job->fb->width + (size_t)x;
+            size_t pixel = (size_t)y * (size_t)job->rw + (size_t)x;
+            int gx = x + job->rx0, gy = y + job->ry0;
             if (job->passes) {
                 float *acc = job->sum + 3 * pixel;
                 rt_vec3 sum = rt_v3(acc[0], acc[1], acc[2]);
-                add_samples(job, w, ctx, x, y, job->s0, job->s1, &sum, &job->good[pixel]);
+                add_samples(job, w, ctx, gx, gy, pixel, job->s0, job->s1, &sum, &job->good[pixel]);
                 acc[0] = sum.x;
                 acc[1] = sum.y;
                 acc[2] = sum.z;
             } else {
                 rt_vec3 sum = rt_v3s(0);
                 uint32_t good = 0;
-                add_samples(job, w, ctx, x, y, 0, job->spp, &sum, &good);
+                if (job->accum) { /* continue the caller's sums */
+                    const float *acc = job->accum->sum + 3 * pixel;
+                    sum = rt_v3(acc[0], acc[1], acc[2]);
+                    good = job->accum->good[pixel];
+                }
+                add_samples(job, w, ctx, gx, gy, pixel, job->s_begin, job->s_end, &sum, &good);
+                if (job->accum) {
+                    float *acc = job->accum->sum + 3 * pixel;
+                    acc[0] = sum.x;
+                    acc[1] = sum.y;
+                    acc[2] = sum.z;
+                    job->accum->good[pixel] = good;
+                }
                 if (job->aov)
                     aov_store(job->aov, pixel, &job->aov_sum[pixel], good, rt_luminance(sum), job->lum_sq[pixel]);
                 sum = resolve(sum, good);
@@ -291,7 +303,7 @@ static int run_workers(rt_render_job *job, worker *workers, int nthreads, const 
 /* fb = the accumulated samples of every pixel. */
 static void resolve_image(rt_render_job *job)
 {
-    size_t n = (size_t)job->fb->width * (size_t)job->fb->height;
+    size_t n = (size_t)job->rw * (size_t)job->rh;
     for (size_t k = 0; k < n; k++) {
         const float *acc = job->sum + 3 * k;
         if (job->aov)
@@ -326,9 +338,16 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     memset(&st, 0, sizeof st);
     const rt_settings *set = &scene->settings;
     RT_DCHECK(rt_scene_validate(scene, NULL) == RT_OK);
-    if (fb->width != set->width || fb->height != set->height || !fb->rgb)
-        return rt_fail(err, RT_ERR_INVALID, "framebuffer is %dx%d but the scene asks for %dx%d", fb->width,
-                       fb->height, set->width, set->height);
+    rt_render_region reg = opt.region;
+    if (reg.x0 == 0 && reg.y0 == 0 && reg.x1 == 0 && reg.y1 == 0)
+        reg = (rt_render_region){0, 0, set->width, set->height};
+    if (reg.x0 < 0 || reg.y0 < 0 || reg.x1 > set->width || reg.y1 > set->height || reg.x0 >= reg.x1 ||
+        reg.y0 >= reg.y1)
+        return rt_fail(err, RT_ERR_INVALID, "region [%d, %d) x [%d, %d) is not inside the %dx%d image", reg.x0,
+                       reg.x1, reg.y0, reg.y1, set->width, set->height);
+    if (fb->width != reg.x1 - reg.x0 || fb->height != reg.y1 - reg.y0 || !fb->rgb)
+        return rt_fail(err, RT_ERR_INVALID, "framebuffer is %dx%d but the region rendered is %dx%d", fb->width,
+                       fb->height, reg.x1 - reg.x0, reg.y1 - reg.y0);
     const rt_integrator_info *integrator = rt_integrator_info_of(set->integrator);
     if (!integrator)
         return rt_fail(err, RT_ERR_INVALID, "integrator %d is not one of the %zu rt knows", (int)set->integrator,
@@ -340,12 +359,24 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     job.fb = fb;
     job.cancel = opt.cancel;
     job.spp = set->samples > 0 ? (uint32_t)set->samples : 1;
+    job.s_begin = (uint32_t)(opt.sample_begin > 0 ? opt.sample_begin : 0);
+    job.s_end = opt.sample_end > 0 ? (uint32_t)opt.sample_end : job.spp;
+    if (job.s_end > job.spp || job.s_begin >= job.s_end)
+        return rt_fail(err, RT_ERR_INVALID, "sample range %u:%u is not inside the %u samples per pixel",
+                       job.s_begin, job.s_end, job.spp);
+    job.width = set->width;
+    job.height = set->height;
+    job.rx0 = reg.x0;
+    job.ry0 = reg.y0;
+    job.rw = reg.x1 - reg.x0;
+    job.rh = reg.y1 - reg.y0;
+    job.accum = opt.accum;
     int pass_samples = opt.pass_samples != 0 ? opt.pass_samples : integrator->pass_samples;
     job.passes = pass_samples > 0;
-    rt_camera_frame_init(&job.camera, &scene->camera, fb->width, fb->height);
+    rt_camera_frame_init(&job.camera, &scene->camera, set->width, set->height);
     job.tile_size = opt.tile_size > 0 ? (opt.tile_size < 65536 ? opt.tile_size : 65536) : 32;
-    job.tiles_x = (int)(((int64_t)fb->width + job.tile_size - 1) / job.tile_size);
-    job.tiles_y = (int)(((int64_t)fb->height + job.tile_size - 1) / job.tile_size);
+    job.tiles_x = (int)(((int64_t)job.rw + job.tile_size - 1) / job.tile_size);
+    job.tiles_y = (int)(((int64_t)job.rh + job.tile_size - 1) / job.tile_size);
     if ((int64_t)job.tiles_x * job.tiles_y > (int64_t)(1 << 26))
         return rt_fail(err, RT_ERR_LIMIT, "%dx%d image in %d-pixel tiles makes %lld tiles, over the limit of %d; use larger tiles",
                        fb->width, fb->height, job.tile_size, (long long)job.tiles_x * job.tiles_y, 1 << 26);
@@ -376,9 +407,17 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     }
     for (int t = 0; t < job.tiles_total; t++)
         atomic_init(&job.tile_finished[t], 0);
+    bool aov_accum = job.aov && job.accum && job.accum->aov_sum;
+    if (aov_accum) /* the AOV sums continue the caller's too */
+        memcpy(job.aov_sum, job.accum->aov_sum, npx * sizeof *job.aov_sum);
     if (job.passes) {
-        memset(job.sum, 0, npx * 3 * sizeof *job.sum);
-        memset(job.good, 0, npx * sizeof *job.good);
+        if (job.accum) { /* continue the caller's sums; they get them back after each whole pass */
+            memcpy(job.sum, job.accum->sum, npx * 3 * sizeof *job.sum);
+            memcpy(job.good, job.accum->good, npx * sizeof *job.good);
+        } else {
+            memset(job.sum, 0, npx * 3 * sizeof *job.sum);
+            memset(job.good, 0, npx * sizeof *job.good);
+        }
         memset(fb->rgb, 0, npx * 3 * sizeof *fb->rgb);
     }
     /* what the integrator reads, derived once, before the workers start */
@@ -401,7 +440,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     memset(&progress, 0, sizeof progress);
     progress.tiles_total = job.tiles_total;
     progress.passes = job.passes;
-    progress.samples_total = (int)job.spp;
+    progress.samples_total = (int)(job.s_end - job.s_begin);
     progress.fb = fb;
     progress.job = &job;
 
@@ -411,9 +450,11 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     if (!job.passes) {
         job.deadline = opt.time_limit > 0.0 ? t0 + opt.time_limit : 0.0;
         started = run_workers(&job, workers, nthreads, &opt, &progress, t0);
+        if (aov_accum)
+            memcpy(job.accum->aov_sum, job.aov_sum, npx * sizeof *job.aov_sum);
         st.tiles_done = atomic_load(&job.tiles_done);
         st.partial = st.tiles_done < job.tiles_total;
-        st.samples_done = st.partial ? 0 : (int)job.spp;
+        st.samples_done = st.partial ? 0 : (int)(job.s_end - job.s_begin);
         cancelled = st.partial && !atomic_load(&job.time_up);
         st.time_limited = st.partial && !cancelled;
         if (st.partial) {
@@ -424,18 +465,18 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
                 int x0, y0, x1, y1;
                 tile_bounds(&job, t, &x0, &y0, &x1, &y1);
                 for (int y = y0; y < y1; y++)
-                    memset(fb->rgb + 3 * ((size_t)y * (size_t)fb->width + (size_t)x0), 0,
+                    memset(fb->rgb + 3 * ((size_t)y * (size_t)job.rw + (size_t)x0), 0,
                            3 * sizeof(float) * (size_t)(x1 - x0));
             }
         }
     } else {
-        for (uint32_t s0 = 0; s0 < job.spp;) {
+        for (uint32_t s0 = job.s_begin; s0 < job.s_end;) {
             if (job.cancel && atomic_load(job.cancel)) {
                 cancelled = true;
                 break;
             }
             job.s0 = s0;
-            job.s1 = job.spp - s0 > (uint32_t)pass_samples ? s0 + (uint32_t)pass_samples : job.spp;
+            job.s1 = job.s_end - s0 > (uint32_t)pass_samples ? s0 + (uint32_t)pass_samples : job.s_end;
             progress.pass_samples = (int)(job.s1 - job.s0);
             int n = run_workers(&job, workers, nthreads, &opt, &progress, t0);
             started = n > started ? n : started;
@@ -444,16 +485,22 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
                 break;
             }
             resolve_image(&job);
-            job.samples_done = (int)job.s1;
+            if (job.accum) {
+                memcpy(job.accum->sum, job.sum, npx * 3 * sizeof *job.sum);
+                memcpy(job.accum->good, job.good, npx * sizeof *job.good);
+            }
+            if (aov_accum)
+                memcpy(job.accum->aov_sum, job.aov_sum, npx * sizeof *job.aov_sum);
+            job.samples_done = (int)(job.s1 - job.s_begin);
             st.passes_done++;
             s0 = job.s1;
-            if (opt.progress && s0 < job.spp) {
+            if (opt.progress && s0 < job.s_end) {
                 progress.tiles_done = job.tiles_total;
                 progress.samples_done = job.samples_done;
                 progress.elapsed = rt_now_seconds() - t0;
                 opt.progress(&progress, opt.progress_user);
             }
-            if (opt.time_limit > 0.0 && s0 < job.spp && rt_now_seconds() - t0 >= opt.time_limit) {
+            if (opt.time_limit > 0.0 && s0 < job.s_end && rt_now_seconds() - t0 >= opt.time_limit) {
                 st.time_limited = true;
                 break;
             }
@@ -489,7 +536,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     if (st.interrupted) {
         if (st.passes)
             return rt_fail(err, RT_ERR_INTERRUPTED, "render interrupted: %d of %d samples per pixel done",
-                           st.samples_done, (int)job.spp);
+                           st.samples_done, (int)(job.s_end - job.s_begin));
         return rt_fail(err, RT_ERR_INTERRUPTED, "render interrupted: %d of %d tiles finished", st.tiles_done,
                        st.tiles_total);
     }
