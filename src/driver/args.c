@@ -29,6 +29,7 @@ typedef enum flag_kind {
     FLAG_QUIET,
     FLAG_VERBOSE,
     FLAG_CAMERA,
+    FLAG_VARIANT,
     FLAG_LOOK_FROM,
     FLAG_LOOK_AT,
     FLAG_UP,
@@ -96,6 +97,8 @@ static const flag flags[] = {
     {NULL, "--camera", "N|auto", FLAG_CAMERA, NULL,
      "use camera N of the loaded glTF models, or 'auto': frame the whole scene automatically, ignoring the file's "
      "camera"},
+    {NULL, "--variant", "NAME", FLAG_VARIANT, NULL,
+     "show a glTF model's material variant NAME (KHR_materials_variants); default: the file's default materials"},
     {NULL, "--look-from", "X,Y,Z", FLAG_LOOK_FROM, NULL, "camera position (replaces the file's or the automatic one)"},
     {NULL, "--look-at", "X,Y,Z", FLAG_LOOK_AT, NULL, "point the camera looks at"},
     {NULL, "--up", "X,Y,Z", FLAG_UP, NULL, "camera up direction"},
@@ -445,6 +448,11 @@ int args_parse(args *a, int argc, char **argv)
             a->camera = -1;
             if (!a->camera_auto && !int_value(value, 0, INT32_MAX, &a->camera))
                 return fail_usage("%s wants a camera index (0, 1, ...) or 'auto', got '%s'", name, value);
+            break;
+        case FLAG_VARIANT:
+            if (!*value)
+                return fail_usage("%s wants the name of a material variant", name);
+            a->variant = value;
             break;
         case FLAG_LOOK_FROM:
         case FLAG_LOOK_AT:

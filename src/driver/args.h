@@ -53,6 +53,7 @@ typedef struct args {
     int tile;               /* --tile; 0 = the default */
     int camera;             /* --camera N; -1 = none */
     bool camera_auto;       /* --camera auto: frame the model, ignoring its cameras */
+    const char *variant;    /* --variant NAME: the glTF material variant; NULL = the default materials */
     /* --look-from, --look-at, --up, --fov: each replaces one part of the
      * camera (after --camera and automatic framing) */
     bool has_look_from, has_look_at, has_up, has_fov;

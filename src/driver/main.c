@@ -342,8 +342,11 @@ static rt_result apply_pose_flags(rt_scene *scene, const args *a, rt_error *err)
 static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t size, rt_error *err)
 {
     rt_load_info info;
-    rt_load_options lo = {
-        .for_render = true, .use_time = a->posed, .time = a->frame_time, .animation = a->animation};
+    rt_load_options lo = {.for_render = true,
+                          .use_time = a->posed,
+                          .time = a->frame_time,
+                          .animation = a->animation,
+                          .variant = a->variant};
     rt_result r;
     /* -o is checked before the load, which may take long, and so is a
      * model's default output (models have no `output` line); a scene's own

@@ -121,6 +121,7 @@ typedef struct gl_prim {
     uint32_t draco_id[ATTR_COUNT]; /* its attribute unique ids, RT_NONE = not in the stream */
     int draco_tok;
     int tok;
+    int variants_tok;       /* extensions.KHR_materials_variants.mappings, or -1 */
 } gl_prim;
 
 typedef struct gl_mesh { uint32_t first, count; int weights; int tok; } gl_mesh; /* weights: token, -1 = none */
@@ -210,6 +211,7 @@ typedef struct gl_doc {
     rt_mat4 *skin_scratch;  size_t skin_scratch_cap; /* per-vertex skin matrices of one primitive */
     size_t decoded_bytes;   /* meshopt and Draco output so far (GL_MAX_DECODED) */
     uint32_t default_scene; /* RT_NONE = absent */
+    int variants_tok;       /* extensions.KHR_materials_variants.variants (names), or -1 */
 
     /* flattening */
     gl_visit *visits;       size_t visit_count;
@@ -447,6 +449,10 @@ static const struct { const char *name; bool supported; } known_extensions[] = {
     {"KHR_materials_volume", true},            {"KHR_materials_unlit", true},
     {"KHR_lights_punctual", true},             {"KHR_mesh_quantization", true},
     {"KHR_xmp", true},                         {"KHR_xmp_json_ld", true}, /* metadata only */
+    {"KHR_materials_clearcoat", true},         {"KHR_materials_specular", true},
+    {"KHR_materials_sheen", true},             {"KHR_materials_anisotropy", true},
+    {"KHR_materials_iridescence", true},       {"KHR_materials_dispersion", true},
+    {"KHR_materials_diffuse_transmission", true}, {"KHR_materials_variants", true},
     {"EXT_meshopt_compression", true},         {"KHR_draco_mesh_compression", true},
     {"EXT_texture_webp", true},
 };
@@ -808,6 +814,7 @@ static rt_result parse_meshes(gl_doc *d, int t)
             pr->tok = pe;
             pr->mode = 4;
             pr->indices = pr->material = pr->draco_view = RT_NONE;
+            pr->variants_tok = -1;
             for (int a = 0; a < ATTR_COUNT; a++)
                 pr->attr[a] = pr->draco_id[a] = RT_NONE;
             pr->joints[0] = pr->joints[1] = pr->weights[0] = pr->weights[1] = RT_NONE;
@@ -826,6 +833,18 @@ static rt_result parse_meshes(gl_doc *d, int t)
                     int dr = rt_json_get(&d->j, v, "KHR_draco_mesh_compression");
                     if (dr >= 0)
                         TRY(parse_draco_prim(d, where, dr, pr));
+                    /* KHR_materials_variants: the mappings are checked in apply_variant */
+                    int x = rt_json_get(&d->j, v, "KHR_materials_variants");
+                    if (jtype(d, v) == RT_JSON_OBJECT && x >= 0) {
+                        char wx[128];
+                        snprintf(wx, sizeof wx, "%s.extensions.KHR_materials_variants", where);
+                        TRY(expect_object(d, x, wx));
+                        int mp = rt_json_get(&d->j, x, "mappings");
+                        if (mp < 0)
+                            return fail_at(d, x, RT_ERR_INVALID, "%s: mappings is missing", wx);
+                        TRY(expect_array(d, mp, wx, "mappings"));
+                        pr->variants_tok = mp;
+                    }
                 } else if (KEY(k, "attributes")) {
                     char wa[96];
                     snprintf(wa, sizeof wa, "%s.attributes", where);
@@ -1046,11 +1065,148 @@ static void derive_phong(rt_material *m)
     float f0 = 0.04f + (1.0f - 0.04f) * metal;       /* mean normal-incidence reflectance */
     m->diffuse = 0.8f * (1.0f - metal) + 0.2f * metal; /* metals keep a little colour */
     m->specular = f0 * (1.0f - 0.5f * rough);
+    /* KHR_materials_specular scales the dielectric's share of the highlight */
+    rt_vec3 sc = m->specular_color;
+    if (m->specular_weight != 1.0f || sc.x != 1.0f || sc.y != 1.0f || sc.z != 1.0f) {
+        sc = rt_vmin(rt_scale(sc, 0.04f), rt_v3s(1.0f));
+        float fd = m->specular_weight * (sc.x + sc.y + sc.z) / 3.0f;
+        m->specular = (fd + (1.0f - fd) * metal) * (1.0f - 0.5f * rough);
+    }
     float a = rough * rough;                          /* GGX alpha */
     float a2 = a * a;
     m->shininess = a2 > 1e-6f ? rt_clampf(2.0f / a2 - 2.0f, 1.0f, 4096.0f) : 4096.0f;
     float smooth = (1.0f - rough) * (1.0f - rough);
     m->reflectivity = metal * smooth;
+}
+
+/* A factor of a material extension that must lie in [lo, hi]. */
+static rt_result get_ranged(gl_doc *d, const char *where, const char *key, int t, float lo, float hi, float *out)
+{
+    TRY(get_float(d, where, key, t, out));
+    if (!(*out >= lo && *out <= hi))
+        return fail_at(d, t, RT_ERR_INVALID, "%s.%s %g is outside [%g, %g]", where, key, (double)*out, (double)lo,
+                       (double)hi);
+    return RT_OK;
+}
+
+/* An RGB factor with every component in [lo, hi]. */
+static rt_result get_color_ranged(gl_doc *d, const char *where, const char *key, int t, float lo, float hi,
+                                  rt_vec3 *out)
+{
+    float c[3];
+    TRY(get_floats(d, where, key, t, c, 3));
+    for (int i = 0; i < 3; i++)
+        if (!(c[i] >= lo && c[i] <= hi))
+            return fail_at(d, t, RT_ERR_INVALID, "%s.%s component %d (%g) is outside [%g, %g]", where, key, i,
+                           (double)c[i], (double)lo, (double)hi);
+    *out = rt_v3(c[0], c[1], c[2]);
+    return RT_OK;
+}
+
+/* The PBR-next material extensions (KHR_materials_clearcoat, specular,
+ * sheen, anisotropy, iridescence, dispersion, diffuse_transmission), each
+ * into its fields of the material table; *known is false for any other
+ * key. Ranges are the extensions' schemas'. */
+static rt_result parse_material_ext(gl_doc *d, const char *wx, int k2, int v2, rt_material *m, bool *known)
+{
+    char we[160];
+    float big = 3.0e38f;
+    *known = true;
+    if (KEY(k2, "KHR_materials_clearcoat")) {
+        snprintf(we, sizeof we, "%s.KHR_materials_clearcoat", wx);
+        TRY(expect_object(d, v2, we));
+        FOR_KEYS(d, v2, k3, v3) {
+            if (KEY(k3, "clearcoatFactor")) TRY(get_ranged(d, we, "clearcoatFactor", v3, 0, 1, &m->clearcoat));
+            else if (KEY(k3, "clearcoatRoughnessFactor"))
+                TRY(get_ranged(d, we, "clearcoatRoughnessFactor", v3, 0, 1, &m->clearcoat_roughness));
+            else if (KEY(k3, "clearcoatTexture"))
+                TRY(parse_texinfo(d, we, "clearcoatTexture", v3, &m->ext_tex[RT_XTEX_CLEARCOAT], NULL, NULL));
+            else if (KEY(k3, "clearcoatRoughnessTexture"))
+                TRY(parse_texinfo(d, we, "clearcoatRoughnessTexture", v3, &m->ext_tex[RT_XTEX_CLEARCOAT_ROUGHNESS],
+                                  NULL, NULL));
+            else if (KEY(k3, "clearcoatNormalTexture"))
+                TRY(parse_texinfo(d, we, "clearcoatNormalTexture", v3, &m->ext_tex[RT_XTEX_CLEARCOAT_NORMAL],
+                                  &m->clearcoat_normal_scale, "scale"));
+        }
+    } else if (KEY(k2, "KHR_materials_specular")) {
+        snprintf(we, sizeof we, "%s.KHR_materials_specular", wx);
+        TRY(expect_object(d, v2, we));
+        FOR_KEYS(d, v2, k3, v3) {
+            if (KEY(k3, "specularFactor")) TRY(get_ranged(d, we, "specularFactor", v3, 0, 1, &m->specular_weight));
+            else if (KEY(k3, "specularColorFactor"))
+                TRY(get_color_ranged(d, we, "specularColorFactor", v3, 0, big, &m->specular_color));
+            else if (KEY(k3, "specularTexture"))
+                TRY(parse_texinfo(d, we, "specularTexture", v3, &m->ext_tex[RT_XTEX_SPECULAR], NULL, NULL));
+            else if (KEY(k3, "specularColorTexture"))
+                TRY(parse_texinfo(d, we, "specularColorTexture", v3, &m->ext_tex[RT_XTEX_SPECULAR_COLOR], NULL,
+                                  NULL));
+        }
+    } else if (KEY(k2, "KHR_materials_sheen")) {
+        snprintf(we, sizeof we, "%s.KHR_materials_sheen", wx);
+        TRY(expect_object(d, v2, we));
+        FOR_KEYS(d, v2, k3, v3) {
+            if (KEY(k3, "sheenColorFactor")) TRY(get_color_ranged(d, we, "sheenColorFactor", v3, 0, 1, &m->sheen_color));
+            else if (KEY(k3, "sheenRoughnessFactor"))
+                TRY(get_ranged(d, we, "sheenRoughnessFactor", v3, 0, 1, &m->sheen_roughness));
+            else if (KEY(k3, "sheenColorTexture"))
+                TRY(parse_texinfo(d, we, "sheenColorTexture", v3, &m->ext_tex[RT_XTEX_SHEEN_COLOR], NULL, NULL));
+            else if (KEY(k3, "sheenRoughnessTexture"))
+                TRY(parse_texinfo(d, we, "sheenRoughnessTexture", v3, &m->ext_tex[RT_XTEX_SHEEN_ROUGHNESS], NULL,
+                                  NULL));
+        }
+    } else if (KEY(k2, "KHR_materials_anisotropy")) {
+        snprintf(we, sizeof we, "%s.KHR_materials_anisotropy", wx);
+        TRY(expect_object(d, v2, we));
+        FOR_KEYS(d, v2, k3, v3) {
+            if (KEY(k3, "anisotropyStrength")) TRY(get_ranged(d, we, "anisotropyStrength", v3, 0, 1, &m->anisotropy));
+            else if (KEY(k3, "anisotropyRotation"))
+                TRY(get_ranged(d, we, "anisotropyRotation", v3, -big, big, &m->anisotropy_rotation));
+            else if (KEY(k3, "anisotropyTexture"))
+                TRY(parse_texinfo(d, we, "anisotropyTexture", v3, &m->ext_tex[RT_XTEX_ANISOTROPY], NULL, NULL));
+        }
+    } else if (KEY(k2, "KHR_materials_iridescence")) {
+        snprintf(we, sizeof we, "%s.KHR_materials_iridescence", wx);
+        TRY(expect_object(d, v2, we));
+        FOR_KEYS(d, v2, k3, v3) {
+            if (KEY(k3, "iridescenceFactor")) TRY(get_ranged(d, we, "iridescenceFactor", v3, 0, 1, &m->iridescence));
+            else if (KEY(k3, "iridescenceIor"))
+                TRY(get_ranged(d, we, "iridescenceIor", v3, 1, big, &m->iridescence_ior));
+            else if (KEY(k3, "iridescenceThicknessMinimum"))
+                TRY(get_ranged(d, we, "iridescenceThicknessMinimum", v3, 0, big, &m->iridescence_thickness_min));
+            else if (KEY(k3, "iridescenceThicknessMaximum"))
+                TRY(get_ranged(d, we, "iridescenceThicknessMaximum", v3, 0, big, &m->iridescence_thickness_max));
+            else if (KEY(k3, "iridescenceTexture"))
+                TRY(parse_texinfo(d, we, "iridescenceTexture", v3, &m->ext_tex[RT_XTEX_IRIDESCENCE], NULL, NULL));
+            else if (KEY(k3, "iridescenceThicknessTexture"))
+                TRY(parse_texinfo(d, we, "iridescenceThicknessTexture", v3,
+                                  &m->ext_tex[RT_XTEX_IRIDESCENCE_THICKNESS], NULL, NULL));
+        }
+    } else if (KEY(k2, "KHR_materials_dispersion")) {
+        snprintf(we, sizeof we, "%s.KHR_materials_dispersion", wx);
+        TRY(expect_object(d, v2, we));
+        int s = rt_json_get(&d->j, v2, "dispersion");
+        if (s >= 0)
+            TRY(get_ranged(d, we, "dispersion", s, 0, big, &m->dispersion));
+    } else if (KEY(k2, "KHR_materials_diffuse_transmission")) {
+        snprintf(we, sizeof we, "%s.KHR_materials_diffuse_transmission", wx);
+        TRY(expect_object(d, v2, we));
+        FOR_KEYS(d, v2, k3, v3) {
+            if (KEY(k3, "diffuseTransmissionFactor"))
+                TRY(get_ranged(d, we, "diffuseTransmissionFactor", v3, 0, 1, &m->diffuse_transmission));
+            else if (KEY(k3, "diffuseTransmissionColorFactor"))
+                TRY(get_color_ranged(d, we, "diffuseTransmissionColorFactor", v3, 0, 1,
+                                     &m->diffuse_transmission_color));
+            else if (KEY(k3, "diffuseTransmissionTexture"))
+                TRY(parse_texinfo(d, we, "diffuseTransmissionTexture", v3,
+                                  &m->ext_tex[RT_XTEX_DIFFUSE_TRANSMISSION], NULL, NULL));
+            else if (KEY(k3, "diffuseTransmissionColorTexture"))
+                TRY(parse_texinfo(d, we, "diffuseTransmissionColorTexture", v3,
+                                  &m->ext_tex[RT_XTEX_DIFFUSE_TRANSMISSION_COLOR], NULL, NULL));
+        }
+    } else {
+        *known = false;
+    }
+    return RT_OK;
 }
 
 static rt_result parse_materials(gl_doc *d, int t)
@@ -1130,6 +1286,10 @@ static rt_result parse_materials(gl_doc *d, int t)
                 TRY(expect_object(d, v, wx));
                 FOR_KEYS(d, v, k2, v2) {
                     char we[160];
+                    bool known;
+                    TRY(parse_material_ext(d, wx, k2, v2, m, &known));
+                    if (known)
+                        continue;
                     if (KEY(k2, "KHR_materials_emissive_strength")) {
                         snprintf(we, sizeof we, "%s.KHR_materials_emissive_strength", wx);
                         TRY(expect_object(d, v2, we));
@@ -1174,6 +1334,9 @@ static rt_result parse_materials(gl_doc *d, int t)
         }
         /* transmitted light is tinted by the base colour (KHR_materials_transmission) */
         m->transmission_color = m->color;
+        /* KHR_materials_volume: thickness 0 (or no volume) is thin-walled */
+        m->thin_walled = !(m->thickness > 0.0f);
+        m->extended = rt_material_extended(m);
         derive_phong(m);
     }
     return RT_OK;
@@ -1470,6 +1633,7 @@ static rt_result parse_document(gl_doc *d)
     TRY(check_extensions(d));
     bool have_asset = false;
     d->default_scene = RT_NONE;
+    d->variants_tok = -1;
     FOR_KEYS(d, 0, k, v) {
         if (KEY(k, "asset")) { TRY(parse_asset(d, v)); have_asset = true; }
         else if (KEY(k, "buffers")) TRY(parse_buffers(d, v));
@@ -1484,7 +1648,17 @@ static rt_result parse_document(gl_doc *d)
         else if (KEY(k, "samplers")) TRY(parse_samplers(d, v));
         else if (KEY(k, "images")) TRY(parse_images(d, v));
         else if (KEY(k, "cameras")) TRY(parse_cameras(d, v));
-        else if (KEY(k, "extensions")) TRY(parse_lights(d, v));
+        else if (KEY(k, "extensions")) {
+            TRY(parse_lights(d, v));
+            int x = rt_json_get(&d->j, v, "KHR_materials_variants");
+            if (x >= 0) {
+                TRY(expect_object(d, x, "extensions.KHR_materials_variants"));
+                d->variants_tok = rt_json_get(&d->j, x, "variants");
+                if (d->variants_tok < 0)
+                    return fail_at(d, x, RT_ERR_INVALID, "extensions.KHR_materials_variants: variants is missing");
+                TRY(expect_array(d, d->variants_tok, "extensions.KHR_materials_variants", "variants"));
+            }
+        }
         else if (KEY(k, "skins")) TRY(parse_skins(d, v));
         else if (KEY(k, "animations")) TRY(parse_animations(d, v));
     }
@@ -1800,6 +1974,9 @@ static rt_result validate(gl_doc *d)
         for (size_t k = 0; k < sizeof slots / sizeof slots[0]; k++)
             CHECK_INDEX(slots[k]->texture, d->texture_count, d->materials[i].tok, "textures",
                         "materials[%zu]: texture", i);
+        for (int k = 0; k < RT_XTEX_COUNT; k++)
+            CHECK_INDEX(m->ext_tex[k].texture, d->texture_count, d->materials[i].tok, "textures",
+                        "materials[%zu].extensions: texture", i);
     }
     for (size_t i = 0; i < d->texture_count; i++) {
         CHECK_INDEX(d->textures[i].source, d->image_count, d->textures[i].tok, "images", "textures[%zu].source", i);
@@ -2862,6 +3039,11 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
             uint32_t t = slots[k]->texture;
             slots[k]->texture = d->texture_missing[t] && !colour ? RT_NONE : d->texture_map[t];
         }
+        for (int k = 0; k < RT_XTEX_COUNT; k++) { /* the extensions' maps: left out when missing */
+            uint32_t t = m.ext_tex[k].texture;
+            if (t != RT_NONE)
+                m.ext_tex[k].texture = d->texture_missing[t] ? RT_NONE : d->texture_map[t];
+        }
         if (rt_scene_add_material(s, &m) == RT_NONE)
             return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding materials", d->path);
         st->materials++;
@@ -2988,6 +3170,68 @@ static void doc_free(gl_doc *d)
     free(d->dir);
 }
 
+/* KHR_materials_variants: checks every primitive's mappings (material and
+ * variant indices in range) and, when opt->variant names one of the file's
+ * variants, gives each primitive the material its mapping for that variant
+ * says (primitives without one keep their own). */
+static rt_result apply_variant(gl_doc *d, const rt_gltf_options *opt)
+{
+    const char *want = opt ? opt->variant : NULL;
+    size_t count = d->variants_tok >= 0 ? (size_t)jsize(d, d->variants_tok) : 0;
+    uint32_t chosen = RT_NONE;
+    char names[512] = "";
+    if (d->variants_tok >= 0) {
+        FOR_ITEMS(d, d->variants_tok, i, e) {
+            char where[64], name[128];
+            snprintf(where, sizeof where, "extensions.KHR_materials_variants.variants[%d]", i);
+            TRY(expect_object(d, e, where));
+            int n = rt_json_get(&d->j, e, "name");
+            if (n < 0)
+                return fail_at(d, e, RT_ERR_INVALID, "%s: name is missing", where);
+            TRY(get_string(d, where, "name", n, name, sizeof name));
+            if (want && strcmp(want, name) == 0 && chosen == RT_NONE)
+                chosen = (uint32_t)i;
+            size_t used = strlen(names);
+            snprintf(names + used, sizeof names - used, "%s'%s'", used ? ", " : "", name);
+        }
+    }
+    if (want && chosen == RT_NONE)
+        return rt_fail(d->err, RT_ERR_INVALID, "%s: no material variant named '%s' (%s%s)", d->path, want,
+                       count ? "the file's variants: " : "the file has no KHR_materials_variants",
+                       count ? names : "");
+    for (size_t p = 0; p < d->prim_count; p++) {
+        gl_prim *pr = &d->prims[p];
+        if (pr->variants_tok < 0)
+            continue;
+        uint32_t material = pr->material;
+        FOR_ITEMS(d, pr->variants_tok, i, e) {
+            char where[96];
+            snprintf(where, sizeof where, "primitive %zu: KHR_materials_variants.mappings[%d]", p, i);
+            TRY(expect_object(d, e, where));
+            uint32_t m = RT_NONE;
+            int mt = rt_json_get(&d->j, e, "material"), vt = rt_json_get(&d->j, e, "variants");
+            if (mt < 0 || vt < 0)
+                return fail_at(d, e, RT_ERR_INVALID, "%s: material or variants is missing", where);
+            TRY(get_index(d, where, "material", mt, &m));
+            if (m >= d->material_count)
+                return fail_at(d, mt, RT_ERR_INVALID, "%s: material %u is out of range (the file has %zu materials)",
+                               where, m, d->material_count);
+            TRY(expect_array(d, vt, where, "variants"));
+            FOR_ITEMS(d, vt, j, ve) {
+                uint32_t v;
+                TRY(get_index(d, where, "variants", ve, &v));
+                if (v >= count)
+                    return fail_at(d, ve, RT_ERR_INVALID, "%s: variant %u is out of range (the file has %zu)", where,
+                                   v, count);
+                if (v == chosen)
+                    material = m;
+            }
+        }
+        pr->material = material;
+    }
+    return RT_OK;
+}
+
 static rt_result load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st)
 {
     size_t dir_size = strlen(d->path) + 1;
@@ -3013,6 +3257,7 @@ static rt_result load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_glt
         }
     }
     TRY(parse_document(d));
+    TRY(apply_variant(d, opt));
     TRY(validate(d));
     TRY(load_buffers(d));
     TRY(decode_meshopt_views(d));

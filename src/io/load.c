@@ -142,7 +142,8 @@ static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const ch
     case RT_LOAD_GLTF: {
         rt_gltf_stats gs;
         memset(&gs, 0, sizeof gs);
-        rt_gltf_options go = {.use_time = opt->use_time, .time = opt->time, .animation = opt->animation};
+        rt_gltf_options go = {
+            .use_time = opt->use_time, .time = opt->time, .animation = opt->animation, .variant = opt->variant};
         r = rt_gltf_load_memory(s, bytes, size, name, &go, &gs, err);
         info->meshes = gs.meshes;
         info->primitives = gs.primitives;
@@ -191,6 +192,11 @@ static rt_result load_marked(rt_scene *s, const void *bytes, size_t size, const 
         options = &defaults;
     bool for_render = options->for_render;
     rt_scene_mark mark = rt_scene_mark_of(s);
+    if (options->variant && kind != RT_LOAD_GLTF) {
+        info->load_ms = 1e3 * rt_now_seconds() - t0;
+        return rt_fail(err, RT_ERR_INVALID, "%s: --variant picks a glTF model's material variant; this is not a glTF file",
+                       name ? name : "the built-in scene");
+    }
     rt_result r = load_kind(s, bytes, size, name, kind, options, info, err);
     if (r == RT_OK && for_render) /* normal-mapped meshes without tangents get per-vertex ones */
         r = rt_scene_generate_tangents(s, err);

@@ -49,6 +49,9 @@
 #include "rt/render/bsdf.h"
 
 #include "rt/render/ggx_albedo.h"
+#include "rt/render/bsdf_clearcoat.h"
+#include "rt/render/bsdf_iridescence.h"
+#include "rt/render/bsdf_sheen.h"
 #include "rt/render/sampling.h"
 #include "rt/scene/texture.h"
 
@@ -263,6 +266,8 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
     if (!(ior > 0.0f) || !isfinite(ior))
         ior = 1.5f;
     b->lambert = lambert;
+    b->layered = false;
+    b->thin = false;
     b->conductor = false;
     b->ms = false;
     b->separable = false;
@@ -343,7 +348,8 @@ rt_vec3 rt_material_absorption(const rt_material *m)
     if (m->bsdf == RT_BSDF_DIELECTRIC)
         sigma = m->absorption;
     bool volume = m->bsdf == RT_BSDF_DIELECTRIC ||
-                  (m->bsdf == RT_BSDF_GLTF && m->thickness > 0.0f && m->transmission > 0.0f);
+                  (m->bsdf == RT_BSDF_GLTF && m->thickness > 0.0f &&
+                   (m->transmission > 0.0f || m->diffuse_transmission > 0.0f));
     if (volume && isfinite(m->attenuation_distance) && m->attenuation_distance > 0.0f) {
         rt_vec3 c = rt_vmax(m->attenuation_color, rt_v3s(1e-6f));
         rt_vec3 a = rt_v3(-logf(fminf(c.x, 1.0f)), -logf(fminf(c.y, 1.0f)), -logf(fminf(c.z, 1.0f)));
@@ -418,6 +424,89 @@ void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alp
         b->diffuse = rt_v3s(0.0f);
 }
 
+static rt_vec4 ext_sample(const rt_scene *s, const rt_surface *sf, const rt_material *m, rt_ext_slot k, bool srgb,
+                          bool *present)
+{
+    const rt_texture_slot *slot = &m->ext_tex[k];
+    *present = slot->texture != RT_NONE;
+    if (!*present)
+        return rt_v4(1.0f, 1.0f, 1.0f, 1.0f);
+    rt_vec2 uv = rt_texture_slot_uv(slot, slot->texcoord == 1 ? sf->uv1 : sf->uv0);
+    return rt_texture_sample(s, slot->texture, uv, srgb);
+}
+
+/* A tangent-space normal map's texel as a unit vector (2c - 1, scaled in x, y). */
+static rt_vec3 normal_texel(rt_vec4 c, float scale)
+{
+    rt_vec3 v = rt_v3((2.0f * c.x - 1.0f) * scale, (2.0f * c.y - 1.0f) * scale, 2.0f * c.z - 1.0f);
+    float l2 = rt_length2(v);
+    return l2 > 1e-12f && isfinite(l2) ? rt_scale(v, 1.0f / sqrtf(l2)) : rt_v3(0.0f, 0.0f, 1.0f);
+}
+
+/* The extensions' factors x textures at a hit (KHR_materials_*), and the
+ * anisotropy direction as the frame's x. */
+static void set_ext_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_material *m, rt_bsdf *b)
+{
+    const rt_scene *s = ctx->state->scene;
+    rt_bsdf_ext e;
+    bool has;
+    rt_bsdf_ext_default(&e);
+    e.clearcoat = m->clearcoat * ext_sample(s, sf, m, RT_XTEX_CLEARCOAT, false, &has).x;
+    e.clearcoat_roughness = m->clearcoat_roughness * ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_ROUGHNESS, false, &has).y;
+    /* the tangent frame before the coat's map: sf's (t, b, n) made orthonormal about b->n */
+    rt_vec3 t = rt_sub(sf->t, rt_scale(b->n, rt_dot(sf->t, b->n)));
+    float tl2 = rt_length2(t);
+    bool have_t = tl2 > 1e-12f && isfinite(tl2);
+    if (have_t)
+        t = rt_scale(t, 1.0f / sqrtf(tl2));
+    rt_vec3 bt = rt_cross(b->n, t);
+    if (have_t && rt_dot(bt, sf->b) < 0.0f)
+        bt = rt_neg(bt); /* keep the UV handedness */
+    if (e.clearcoat > 0.0f && have_t) {
+        rt_vec4 c = ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_NORMAL, false, &has);
+        if (has) {
+            rt_vec3 v = normal_texel(c, m->clearcoat_normal_scale);
+            rt_vec3 w = rt_add(rt_add(rt_scale(t, v.x), rt_scale(bt, v.y)), rt_scale(b->n, v.z));
+            e.clearcoat_normal = rt_bsdf_to_local(b, w);
+        }
+    }
+    rt_vec4 sp = ext_sample(s, sf, m, RT_XTEX_SPECULAR, false, &has);
+    e.spec_weight = m->specular_weight * sp.w;
+    rt_vec4 sc = ext_sample(s, sf, m, RT_XTEX_SPECULAR_COLOR, true, &has);
+    e.spec_color = rt_mul(m->specular_color, rt_v3(sc.x, sc.y, sc.z));
+    rt_vec4 sh = ext_sample(s, sf, m, RT_XTEX_SHEEN_COLOR, true, &has);
+    e.sheen_color = rt_mul(m->sheen_color, rt_v3(sh.x, sh.y, sh.z));
+    e.sheen_roughness = m->sheen_roughness * ext_sample(s, sf, m, RT_XTEX_SHEEN_ROUGHNESS, false, &has).w;
+    e.iridescence = m->iridescence * ext_sample(s, sf, m, RT_XTEX_IRIDESCENCE, false, &has).x;
+    rt_vec4 th = ext_sample(s, sf, m, RT_XTEX_IRIDESCENCE_THICKNESS, false, &has);
+    e.iridescence_ior = m->iridescence_ior;
+    e.iridescence_thickness = has ? m->iridescence_thickness_min +
+                                        (m->iridescence_thickness_max - m->iridescence_thickness_min) * th.y
+                                  : m->iridescence_thickness_max;
+    e.diffuse_transmission = m->diffuse_transmission * ext_sample(s, sf, m, RT_XTEX_DIFFUSE_TRANSMISSION, false, &has).w;
+    rt_vec4 dc = ext_sample(s, sf, m, RT_XTEX_DIFFUSE_TRANSMISSION_COLOR, true, &has);
+    e.diffuse_transmission_color = rt_mul(m->diffuse_transmission_color, rt_v3(dc.x, dc.y, dc.z));
+    e.dispersion = m->thin_walled ? 0.0f : m->dispersion; /* a thin wall does not bend light */
+    /* anisotropy: direction (cos r, sin r) in the tangent frame, or the
+     * texture's (2 RG - 1) rotated by r; strength x texture B */
+    rt_vec4 an = ext_sample(s, sf, m, RT_XTEX_ANISOTROPY, false, &has);
+    e.anisotropy = m->anisotropy * (has ? an.z : 1.0f);
+    if (e.anisotropy > 0.0f && have_t) {
+        float dx = has ? 2.0f * an.x - 1.0f : 1.0f, dy = has ? 2.0f * an.y - 1.0f : 0.0f;
+        float cr = cosf(m->anisotropy_rotation), sr = sinf(m->anisotropy_rotation);
+        float x = cr * dx - sr * dy, y = sr * dx + cr * dy;
+        rt_vec3 dir = rt_add(rt_scale(t, x), rt_scale(bt, y));
+        float l2 = rt_length2(dir);
+        if (l2 > 1e-12f && isfinite(l2)) {
+            rt_vec3 cn = rt_bsdf_to_world(b, e.clearcoat_normal); /* keep the coat's normal in world space */
+            b->t = rt_scale(dir, 1.0f / sqrtf(l2));
+            b->b = rt_cross(b->n, b->t);
+            e.clearcoat_normal = rt_bsdf_to_local(b, cn);
+        }
+    }
+    rt_bsdf_set_ext(b, &e);
+}
+
 void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
 {
     const rt_scene *s = ctx->state->scene;
@@ -482,11 +571,29 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
     set_params(b, rt_v3(b4.x, b4.y, b4.z), metallic, roughness, m->ior, transmission, m->bsdf == RT_BSDF_LAMBERT);
     if (!sf->front)
         b->eta = 1.0f / b->eta; /* leaving the object through its back */
+    /* a glTF material without a volume (KHR_materials_volume thickness 0) is thin-walled */
+    b->thin = m->bsdf == RT_BSDF_GLTF && b->transmission > 0.0f && m->thin_walled;
+    if (m->extended && m->bsdf == RT_BSDF_GLTF)
+        set_ext_from_surface(ctx, sf, m, b);
 }
+
+/* Lobe probabilities of the layered glTF BSDF (the extensions' section below). */
+typedef struct layered_probs {
+    float d, s, c, t, dt; /* diffuse (with sheen), specular, coat, refraction, diffuse transmission */
+} layered_probs;
+static layered_probs layered_lobe_probs(const rt_bsdf *b, rt_vec3 wo);
+static rt_vec3 layered_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, const layered_probs *p, float *pdf);
 
 void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit)
 {
     *p_diffuse = *p_specular = *p_transmit = 0.0f;
+    if (b->layered) {
+        layered_probs p = layered_lobe_probs(b, wo);
+        *p_diffuse = p.d;
+        *p_specular = p.s + p.c;
+        *p_transmit = p.t + p.dt;
+        return;
+    }
     if (b->conductor) {
         *p_specular = 1.0f;
         if (b->ms) { /* the lobes' albedos at wo: about F E(mu_o) and F_ms (1 - E(mu_o)) */
@@ -589,6 +696,11 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
 
 rt_vec3 rt_bsdf_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float *pdf)
 {
+    if (b->layered) {
+        float dummy_l;
+        layered_probs p = layered_lobe_probs(b, wo);
+        return layered_eval(b, wo, wi, &p, pdf ? pdf : &dummy_l);
+    }
     float pd, ps, pt, dummy;
     rt_bsdf_lobe_probs(b, wo, &pd, &ps, &pt);
     return eval_lobes(b, wo, wi, pd, ps, pdf ? pdf : &dummy);
@@ -603,14 +715,352 @@ static bool delta_sample(rt_bsdf_sample *s, rt_vec3 wi, rt_vec3 w)
     return rt_finite3(wi) && rt_finite3(w) && rt_max3(w) > 0.0f;
 }
 
+/* Transmission through a thin-walled surface (KHR_materials_volume with
+ * thickness 0: both interfaces of an infinitely thin sheet in one): the
+ * microfacet reflection of wo (the macro normal's mirror when delta)
+ * mirrored through the surface plane, so a smooth sheet passes light
+ * straight on (wi = -wo) and a rough one blurs it as it blurs reflections;
+ * weight c (1 - F(wo.h)) T G2 / G1 times `scale` (the share above it). */
+static bool thin_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, rt_vec3 c, float scale, rt_bsdf_sample *s)
+{
+    rt_vec3 h = b->delta ? rt_v3(0.0f, 0.0f, 1.0f) : rt_ggx_sample_vndf(wo, b->alpha, u);
+    float ci = rt_dot(wo, h);
+    if (!(ci > 0.0f))
+        return false;
+    rt_vec3 r = rt_sub(rt_scale(h, 2.0f * ci), wo);
+    if (!(r.z > 0.0f))
+        return false;
+    float g = b->delta ? 1.0f : rt_ggx_g2(wo, r, b->alpha) / rt_ggx_g1(wo, b->alpha);
+    float f = b->transmission > 0.0f ? rt_fresnel_exact(ci, b->eta) : 0.0f;
+    rt_vec3 wi = rt_normalize(rt_v3(r.x, r.y, -r.z));
+    return delta_sample(s, wi, rt_scale(c, (1.0f - f) * g * b->transmission * scale));
+}
+
+/* ------------------------------------------------ extension layering
+ *
+ * The glTF material with the PBR-next extensions, as the extensions
+ * define its layers (docs/shading.md, "Extension layering"):
+ *
+ *   Fd   = spec_weight schlick(min(F0 spec_color, 1), v.h)      KHR_materials_specular
+ *          (the exact Fresnel times spec_color for a transmissive surface),
+ *          mixed with the thin film's Fresnel by the iridescence factor
+ *   Fm   = schlick(B, v.h), mixed with the film's Fresnel the same way
+ *   base = (1 - m)(1 - max3(Fd)) ((1 - T)(1 - dt) B / pi + ...) + lerp(Fd, Fm, m) D V
+ *          with D, V anisotropic GGX (alpha along t = mix(alpha, 1, s^2))
+ *   sheen_layer = sheen f_sheen + base (1 - max3(sheen) max(E(wo), E(wi)))
+ *   f    = sheen_layer min(1 - c Fc(n_c.wo), 1 - c Fc(n_c.wi)) + c f_coat
+ *
+ * The two albedo-scaling factors take the larger loss of the two
+ * directions, so f stays reciprocal (the extensions' non-normative
+ * shading uses wo only). Diffuse transmission (dt) and the refraction lobe
+ * are sampled only (delta samples), as transmission is. */
+
+void rt_bsdf_ext_default(rt_bsdf_ext *e)
+{
+    e->spec_weight = 1.0f;
+    e->spec_color = rt_v3s(1.0f);
+    e->clearcoat = 0.0f;
+    e->clearcoat_roughness = 0.0f;
+    e->clearcoat_normal = rt_v3(0.0f, 0.0f, 1.0f);
+    e->sheen_color = rt_v3s(0.0f);
+    e->sheen_roughness = 0.0f;
+    e->anisotropy = 0.0f;
+    e->iridescence = 0.0f;
+    e->iridescence_ior = 1.3f;
+    e->iridescence_thickness = 400.0f;
+    e->diffuse_transmission = 0.0f;
+    e->diffuse_transmission_color = rt_v3s(1.0f);
+    e->dispersion = 0.0f;
+}
+
+/* KHR_materials_dispersion: the index at wavelength lambda (nm) from the
+ * index n_d at 587.6 nm and the Abbe number V = 20 / dispersion, Cauchy's
+ * n = A + B / lambda^2 through the Abbe definition (the extension's
+ * max(n_d + (n_d - 1) / V (523655 / lambda^2 - 1.5168), 1)). */
+static float dispersed_ior(float n_d, float dispersion, float lambda)
+{
+    float v_inv = dispersion / 20.0f;
+    return fmaxf(n_d + (n_d - 1.0f) * v_inv * (523655.0f / (lambda * lambda) - 1.5168f), 1.0f);
+}
+
+static float clamp01(float x) { return isfinite(x) ? rt_clampf(x, 0.0f, 1.0f) : 0.0f; }
+
+void rt_bsdf_set_ext(rt_bsdf *b, const rt_bsdf_ext *e)
+{
+    if (b->lambert || b->conductor || b->plastic || b->radiance_eta2)
+        return; /* the extensions extend the glTF BSDF only */
+    b->spec_weight = clamp01(e->spec_weight);
+    b->spec_color = rt_finite3(e->spec_color) ? rt_vmax(e->spec_color, rt_v3s(0.0f)) : rt_v3s(1.0f);
+    b->clearcoat = clamp01(e->clearcoat);
+    float cr = clamp01(e->clearcoat_roughness);
+    b->cc_delta = cr == 0.0f;
+    b->cc_alpha = fmaxf(cr * cr, RT_BSDF_MIN_ALPHA);
+    rt_vec3 cn = e->clearcoat_normal;
+    if (!rt_finite3(cn) || !(cn.z > 0.05f))
+        cn = rt_v3(0.0f, 0.0f, 1.0f);
+    b->cc_n = rt_normalize(cn);
+    if (cn.x == 0.0f && cn.y == 0.0f) {
+        b->cc_t = rt_v3(1.0f, 0.0f, 0.0f);
+        b->cc_b = rt_v3(0.0f, 1.0f, 0.0f);
+    } else {
+        rt_onb(b->cc_n, &b->cc_t, &b->cc_b);
+    }
+    b->sheen = rt_finite3(e->sheen_color) ? rt_vmin(rt_vmax(e->sheen_color, rt_v3s(0.0f)), rt_v3s(1.0f)) : rt_v3s(0.0f);
+    b->sheen_alpha = rt_sheen_alpha(e->sheen_roughness);
+    b->iridescence = clamp01(e->iridescence);
+    b->irid_ior = isfinite(e->iridescence_ior) && e->iridescence_ior >= 1.0f ? e->iridescence_ior : 1.3f;
+    b->irid_thickness = isfinite(e->iridescence_thickness) ? fmaxf(e->iridescence_thickness, 0.0f) : 0.0f;
+    b->diffuse_transmission = clamp01(e->diffuse_transmission);
+    b->dt_color = rt_finite3(e->diffuse_transmission_color)
+                      ? rt_vmin(rt_vmax(e->diffuse_transmission_color, rt_v3s(0.0f)), rt_v3s(1.0f))
+                      : rt_v3s(1.0f);
+    float s = clamp01(e->anisotropy);
+    if (s > 0.0f) { /* KHR_materials_anisotropy: alpha along t grows to 1 with s^2 */
+        float a = b->delta ? 0.0f : b->alpha;
+        b->alpha = fmaxf(a + (1.0f - a) * s * s, RT_BSDF_MIN_ALPHA);
+        b->delta = false;
+    }
+    /* dispersion: R, G, B at the Fraunhofer C, d and F lines, on the side
+     * b->eta says (n_i / n_t: below 1 entering the denser material) */
+    b->dispersive = false;
+    if (isfinite(e->dispersion) && e->dispersion > 0.0f && b->transmission > 0.0f && b->eta > 0.0f &&
+        b->eta != 1.0f) {
+        bool entering = b->eta < 1.0f;
+        float n_d = entering ? 1.0f / b->eta : b->eta;
+        float n[3] = {dispersed_ior(n_d, e->dispersion, 656.3f), n_d, dispersed_ior(n_d, e->dispersion, 486.1f)};
+        for (int k = 0; k < 3; k++)
+            n[k] = entering ? 1.0f / n[k] : n[k];
+        b->eta_rgb = rt_v3(n[0], n[1], n[2]);
+        b->dispersive = true;
+    }
+    b->layered = b->dispersive || b->spec_weight != 1.0f || b->spec_color.x != 1.0f || b->spec_color.y != 1.0f ||
+                 b->spec_color.z != 1.0f || b->clearcoat > 0.0f || rt_max3(b->sheen) > 0.0f || s > 0.0f ||
+                 b->iridescence > 0.0f || b->diffuse_transmission > 0.0f;
+}
+
+static inline rt_vec3 to_coat(const rt_bsdf *b, rt_vec3 w)
+{
+    return rt_v3(rt_dot(w, b->cc_t), rt_dot(w, b->cc_b), rt_dot(w, b->cc_n));
+}
+
+/* The dielectric and metal Fresnel of the layered glTF BSDF at cosine c
+ * (v.h or, for the lobe estimates, n.v): *fd_max is max3(Fd), what the
+ * dielectric's base loses. */
+static rt_vec3 layered_fresnel(const rt_bsdf *b, float c, float *fd_max)
+{
+    rt_vec3 fd;
+    rt_vec3 f0 = rt_vmin(rt_scale(b->spec_color, b->f0), rt_v3s(1.0f));
+    if (b->transmission > 0.0f)
+        fd = rt_vmin(rt_scale(b->spec_color, rt_fresnel_exact(c, b->eta)), rt_v3s(1.0f));
+    else
+        fd = schlick(f0, c);
+    rt_vec3 fm = b->metallic > 0.0f ? schlick(b->base, c) : rt_v3s(0.0f);
+    if (b->iridescence > 0.0f) {
+        rt_vec3 fi = rt_iridescence_fresnel(1.0f, b->irid_ior, f0, b->irid_thickness, c);
+        fd = rt_lerp3(fd, rt_vmin(fi, rt_v3s(1.0f)), b->iridescence);
+        if (b->metallic > 0.0f)
+            fm = rt_lerp3(fm, rt_vmin(rt_iridescence_fresnel(1.0f, b->irid_ior, b->base, b->irid_thickness, c),
+                                      rt_v3s(1.0f)),
+                          b->iridescence);
+    }
+    fd = rt_scale(fd, b->spec_weight);
+    *fd_max = rt_max3(fd);
+    return rt_lerp3(fd, fm, b->metallic);
+}
+
+/* The sheen layer's scaling of what lies under it, at one direction. */
+static inline float sheen_scale(const rt_bsdf *b, float c)
+{
+    float s = rt_max3(b->sheen);
+    return s > 0.0f ? 1.0f - s * rt_sheen_albedo(c, b->sheen_alpha) : 1.0f;
+}
+
+static inline float coat_scale(const rt_bsdf *b, float c)
+{
+    return b->clearcoat > 0.0f ? 1.0f - b->clearcoat * rt_clearcoat_fresnel(c) : 1.0f;
+}
+
+static layered_probs layered_lobe_probs(const rt_bsdf *b, rt_vec3 wo)
+{
+    layered_probs p = {0, 0, 0, 0, 0};
+    float fd_max;
+    rt_vec3 F = layered_fresnel(b, wo.z, &fd_max);
+    float co = coat_scale(b, to_coat(b, wo).z), so = sheen_scale(b, wo.z);
+    float ws = mean3(F) * co * so, td = 1.0f - fd_max;
+    float wc = b->clearcoat * rt_clearcoat_fresnel(to_coat(b, wo).z);
+    if (!b->delta) { /* floors as the core BSDF's, for lobes that can reflect at all */
+        if (b->spec_weight > 0.0f || b->metallic > 0.0f)
+            ws = fmaxf(ws, 0.02f);
+        td = fmaxf(td, 0.1f);
+    }
+    if (!b->cc_delta && b->clearcoat > 0.0f)
+        wc = fmaxf(wc, 0.02f);
+    float wbase = mean3(b->diffuse) * td * co * so;
+    float wsheen = co * mean3(b->sheen) * rt_sheen_albedo(wo.z, b->sheen_alpha);
+    float wt = wbase * b->transmission;
+    wbase *= 1.0f - b->transmission;
+    float wdt = wbase * b->diffuse_transmission * mean3(b->dt_color);
+    wbase *= 1.0f - b->diffuse_transmission;
+    float wd = wbase + wsheen;
+    float sum = wd + ws + wc + wt + wdt;
+    if (!(sum > 0.0f) || !isfinite(sum))
+        return p;
+    p.d = wd / sum;
+    p.s = ws / sum;
+    p.c = wc / sum;
+    p.t = wt / sum;
+    p.dt = wdt / sum;
+    return p;
+}
+
+static rt_vec3 layered_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, const layered_probs *p, float *pdf)
+{
+    *pdf = 0.0f;
+    if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
+        return rt_v3s(0.0f);
+    rt_vec3 h = rt_add(wo, wi);
+    float l2 = rt_length2(h);
+    if (!(l2 > 1e-20f))
+        return rt_v3s(0.0f);
+    h = rt_scale(h, 1.0f / sqrtf(l2));
+    float voh = rt_dot(wo, h);
+    float fd_max;
+    rt_vec3 F = layered_fresnel(b, voh, &fd_max);
+    /* the base: diffuse under the dielectric, the specular lobe */
+    float tdiff = (1.0f - fd_max) * (1.0f - b->transmission) * (1.0f - b->diffuse_transmission);
+    rt_vec3 f = rt_scale(b->diffuse, tdiff * RT_INV_PI);
+    float pr = p->d * wi.z * RT_INV_PI;
+    if (!b->delta) {
+        float D = d_xy(h, b->alpha, b->alpha_y);
+        float spec = D * g2_xy(wo, wi, b->alpha, b->alpha_y, false) / (4.0f * wo.z * wi.z);
+        if (isfinite(spec))
+            f = rt_add(f, rt_scale(F, spec));
+        float pv = g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
+        if (p->s > 0.0f && isfinite(pv))
+            pr += p->s * pv;
+    }
+    /* sheen over the base */
+    if (rt_max3(b->sheen) > 0.0f) {
+        float sc = fminf(sheen_scale(b, wo.z), sheen_scale(b, wi.z));
+        f = rt_add(rt_scale(f, sc), rt_scale(b->sheen, rt_sheen_brdf(wo, wi, b->sheen_alpha)));
+    }
+    /* the coat over both */
+    if (b->clearcoat > 0.0f) {
+        rt_vec3 co = to_coat(b, wo), ci = to_coat(b, wi);
+        float cs = fminf(coat_scale(b, co.z), coat_scale(b, ci.z));
+        f = rt_scale(f, cs);
+        if (!b->cc_delta) {
+            float pc;
+            float fc = b->clearcoat * rt_clearcoat_brdf(co, ci, b->cc_alpha, &pc);
+            f = rt_add(f, rt_v3s(fc));
+            pr += p->c * pc;
+        }
+    }
+    *pdf = isfinite(pr) ? pr : 0.0f;
+    return rt_finite3(f) ? f : rt_v3s(0.0f);
+}
+
+static bool layered_sample(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
+{
+    layered_probs p = layered_lobe_probs(b, wo);
+    float total = p.d + p.s + p.c + p.t + p.dt;
+    if (!(total > 0.0f))
+        return false;
+    rt_vec3 co = to_coat(b, wo);
+    float over = coat_scale(b, co.z) * sheen_scale(b, wo.z); /* what reaches the base from wo */
+    float fd_max;
+    if (ulobe >= p.d + p.s + p.c + p.t && p.dt > 0.0f) {
+        /* diffuse transmission: a cosine lobe on the other side */
+        rt_vec3 wi = rt_sample_cosine_hemisphere(u);
+        wi.z = -wi.z;
+        layered_fresnel(b, wo.z, &fd_max);
+        float w = (1.0f - fd_max) * (1.0f - b->transmission) * b->diffuse_transmission * over / p.dt;
+        return delta_sample(s, rt_normalize(wi), rt_scale(rt_mul(b->dt_color, rt_v3s(1.0f - b->metallic)), w));
+    }
+    if (ulobe >= p.d + p.s + p.c && p.t > 0.0f) {
+        /* refraction, as the core BSDF's, under the coat and sheen; a
+         * dispersive one refracts one channel, picked uniformly by the rest
+         * of ulobe, with its own eta and 3 times its weight (the others 0) */
+        if (b->thin)
+            return thin_transmit(b, wo, u, b->diffuse, over / p.t, s);
+        rt_vec3 h = b->delta ? rt_v3(0.0f, 0.0f, 1.0f) : rt_ggx_sample_vndf(wo, b->alpha, u);
+        float eta = b->eta, ci = rt_dot(wo, h);
+        rt_vec3 channel = rt_v3s(1.0f);
+        if (b->dispersive) {
+            float r = (ulobe - (p.d + p.s + p.c)) / p.t;
+            int k = r < 1.0f / 3.0f ? 0 : (r < 2.0f / 3.0f ? 1 : 2);
+            eta = k == 0 ? b->eta_rgb.x : (k == 1 ? b->eta_rgb.y : b->eta_rgb.z);
+            channel = rt_v3(k == 0 ? 3.0f : 0.0f, k == 1 ? 3.0f : 0.0f, k == 2 ? 3.0f : 0.0f);
+        }
+        if (!(ci > 0.0f))
+            return false;
+        float sin2_t = eta * eta * fmaxf(0.0f, 1.0f - ci * ci);
+        if (sin2_t >= 1.0f)
+            return false;
+        float ct = sqrtf(1.0f - sin2_t);
+        rt_vec3 wi = rt_add(rt_scale(wo, -eta), rt_scale(h, eta * ci - ct));
+        if (!(wi.z < 0.0f))
+            return false;
+        wi = rt_normalize(wi);
+        layered_fresnel(b, ci, &fd_max);
+        float g = b->delta ? 1.0f : rt_ggx_g2(wo, wi, b->alpha) / rt_ggx_g1(wo, b->alpha);
+        rt_vec3 w = rt_mul(b->diffuse, channel);
+        return delta_sample(s, wi, rt_scale(w, (1.0f - fd_max) * g * b->transmission * over / p.t));
+    }
+    if (ulobe >= p.d + p.s && p.c > 0.0f && b->cc_delta) {
+        /* a mirror coat: reflect about the coat normal */
+        rt_vec3 wi = rt_sub(rt_scale(b->cc_n, 2.0f * co.z), wo);
+        if (!(wi.z > 0.0f))
+            return false;
+        return delta_sample(s, wi, rt_v3s(b->clearcoat * rt_clearcoat_fresnel(co.z) / p.c));
+    }
+    if (ulobe >= p.d && ulobe < p.d + p.s && b->delta) {
+        /* the base's mirror (roughness 0) under the coat and sheen */
+        rt_vec3 F = layered_fresnel(b, wo.z, &fd_max);
+        rt_vec3 wi = rt_v3(-wo.x, -wo.y, wo.z);
+        float cs = fminf(coat_scale(b, co.z), coat_scale(b, to_coat(b, wi).z));
+        float ss = sheen_scale(b, wo.z);
+        return delta_sample(s, wi, rt_scale(F, cs * ss / p.s));
+    }
+    rt_vec3 wi;
+    if (ulobe < p.d || (b->delta && ulobe < p.d + p.s)) {
+        wi = rt_sample_cosine_hemisphere(u);
+    } else if (ulobe < p.d + p.s) {
+        rt_vec3 h = vndf_xy(wo, b->alpha, b->alpha_y, u);
+        wi = rt_sub(rt_scale(h, 2.0f * rt_dot(wo, h)), wo);
+    } else {
+        rt_vec3 wc = rt_clearcoat_sample(co, b->cc_alpha, u);
+        wi = rt_add(rt_add(rt_scale(b->cc_t, wc.x), rt_scale(b->cc_b, wc.y)), rt_scale(b->cc_n, wc.z));
+    }
+    if (!(wi.z > 0.0f) || !rt_finite3(wi))
+        return false;
+    wi = rt_normalize(wi);
+    float pdf;
+    rt_vec3 f = layered_eval(b, wo, wi, &p, &pdf);
+    if (!(pdf > 0.0f) || !isfinite(pdf))
+        return false;
+    rt_vec3 w = rt_scale(f, wi.z / pdf);
+    if (!rt_finite3(w))
+        return false;
+    s->wi = wi;
+    s->weight = w;
+    s->pdf = pdf;
+    s->delta = false;
+    return true;
+}
+
 bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
 {
     if (!(wo.z > 0.0f))
         return false;
+    if (b->layered)
+        return layered_sample(b, wo, u, ulobe, s);
     float pd, ps, pt;
     rt_bsdf_lobe_probs(b, wo, &pd, &ps, &pt);
     if (!(pd + ps + pt > 0.0f))
         return false;
+    if (pt > 0.0f && ulobe >= pd + ps && b->thin)
+        return thin_transmit(b, wo, u, b->diffuse, 1.0f / pt, s);
     if (pt > 0.0f && ulobe >= pd + ps) {
         /* refraction through a microfacet: the macro normal for a delta
          * interface, else a visible normal (Heitz 2018); the weight

@@ -27,6 +27,12 @@
  * in (rt_medium_stack), so the index on each side of an interface is known
  * even for nested media (a glass ball in water: 1.33 -> 1.5, not 1 -> 1.5).
  *
+ * glTF extensions (docs/gltf.md, "Material mapping"): a clearcoat c adds
+ * a mirror of weight c F_coat(n.v) (Schlick, F0 = 0.04) over the rest,
+ * i.e. R becomes R + (1 - R) c F_coat; KHR_materials_specular scales ks at
+ * load; sheen, anisotropy, iridescence and diffuse transmission are
+ * path-tracer effects this model leaves out.
+ *
  * Recursion: reflection/refraction up to settings.max_bounce events; a
  * branch whose accumulated weight is below 1/1024 is not traced (Hall and
  * Greenberg 1983). Every value stays finite: degenerate normals, grazing
@@ -36,6 +42,7 @@
 
 #include <string.h>
 
+#include "rt/render/bsdf_clearcoat.h"
 #include "rt/render/environment.h"
 #include "rt/render/light.h"
 
@@ -223,6 +230,8 @@ static rt_vec3 shade(wctx *w, const rt_surface *sf, const rt_medium_stack *med, 
         return rt_add(L, base);
 
     float R = rt_clampf(m->reflectivity, 0.0f, 1.0f), T = rt_clampf(m->transmission, 0.0f, 1.0f);
+    if (m->clearcoat > 0.0f) /* KHR_materials_clearcoat: a mirror of the coat's Fresnel over the rest */
+        R += (1.0f - R) * rt_clampf(m->clearcoat, 0.0f, 1.0f) * rt_clearcoat_fresnel(rt_dot(sf->wo, sf->n));
     float w_local = (1.0f - R) * (1.0f - T);
 
     /* local Phong: ambient (or gathered indirect), diffuse, specular */

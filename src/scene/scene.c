@@ -51,6 +51,7 @@ void rt_material_default(rt_material *m, const char *name)
     m->priority = 0;
     m->absorption = rt_v3s(0.0f);
     m->thickness = 0.0f;
+    m->thin_walled = false;
     m->attenuation_color = rt_v3s(1.0f);
     m->attenuation_distance = INFINITY;
     rt_texture_slot_none(&m->base_color_tex);
@@ -59,6 +60,36 @@ void rt_material_default(rt_material *m, const char *name)
     rt_texture_slot_none(&m->occlusion_tex);
     rt_texture_slot_none(&m->emissive_tex);
     rt_texture_slot_none(&m->transmission_tex);
+    m->clearcoat = 0.0f;
+    m->clearcoat_roughness = 0.0f;
+    m->clearcoat_normal_scale = 1.0f;
+    m->specular_weight = 1.0f;
+    m->specular_color = rt_v3s(1.0f);
+    m->sheen_color = rt_v3s(0.0f);
+    m->sheen_roughness = 0.0f;
+    m->anisotropy = 0.0f;
+    m->anisotropy_rotation = 0.0f;
+    m->iridescence = 0.0f;
+    m->iridescence_ior = 1.3f;
+    m->iridescence_thickness_min = 100.0f;
+    m->iridescence_thickness_max = 400.0f;
+    m->dispersion = 0.0f;
+    m->diffuse_transmission = 0.0f;
+    m->diffuse_transmission_color = rt_v3s(1.0f);
+    for (int i = 0; i < RT_XTEX_COUNT; i++)
+        rt_texture_slot_none(&m->ext_tex[i]);
+    m->extended = false;
+}
+
+bool rt_material_extended(const rt_material *m)
+{
+    for (int i = 0; i < RT_XTEX_COUNT; i++)
+        if (m->ext_tex[i].texture != RT_NONE)
+            return true;
+    rt_vec3 sc = m->specular_color;
+    return m->clearcoat > 0.0f || m->specular_weight != 1.0f || sc.x != 1.0f || sc.y != 1.0f || sc.z != 1.0f ||
+           m->sheen_color.x > 0.0f || m->sheen_color.y > 0.0f || m->sheen_color.z > 0.0f || m->anisotropy > 0.0f ||
+           m->iridescence > 0.0f || m->diffuse_transmission > 0.0f || (m->dispersion > 0.0f && m->transmission > 0.0f);
 }
 
 const rt_metal rt_metals[] = {

@@ -51,6 +51,11 @@ static rt_result check_materials(const rt_scene *s, rt_error *err)
             if (r != RT_OK)
                 return r;
         }
+        for (int k = 0; k < RT_XTEX_COUNT; k++) {
+            rt_result r = check_slot(s, i, &m->ext_tex[k], "extension", err);
+            if (r != RT_OK)
+                return r;
+        }
     }
     return RT_OK;
 }

@@ -87,6 +87,26 @@ typedef struct rt_bsdf {
     rt_vec3 ms_scale; /* F_ms / (pi (1 - E_avg)): f_ms = ms_scale (1 - E(mu_o)) (1 - E(mu_i)) */
     float transmission; /* T */
     float eta;        /* index ratio across the surface along a transmitted ray: n_incident / n_transmitted */
+    bool thin;        /* glTF transmission without a volume (thickness 0, thin-walled): light goes straight
+                       * through, the microfacet reflection mirrored through the surface, no bending */
+    /* The glTF PBR-next extensions over the glTF BSDF (docs/shading.md,
+     * "Extension layering"); layered false: none is on, and the fields
+     * below are not read (the core BSDF above, bit for bit). */
+    bool layered;
+    float spec_weight;     /* KHR_materials_specular: specularFactor x texture (A) */
+    rt_vec3 spec_color;    /* specularColorFactor x texture: dielectric F0 = min(F0 spec_color, 1) */
+    float clearcoat;       /* KHR_materials_clearcoat weight c */
+    float cc_alpha;        /* the coat's GGX alpha (floored) */
+    bool cc_delta;         /* coat roughness 0: a mirror coat */
+    rt_vec3 cc_t, cc_b, cc_n; /* the coat's frame in the local frame (cc_n = (0,0,1) without a coat normal map) */
+    rt_vec3 sheen;         /* KHR_materials_sheen colour (0: no sheen) */
+    float sheen_alpha;     /* its alpha (rt_sheen_alpha) */
+    float iridescence;     /* KHR_materials_iridescence factor */
+    float irid_ior, irid_thickness; /* film index, thickness in nm */
+    float diffuse_transmission; /* KHR_materials_diffuse_transmission factor */
+    rt_vec3 dt_color;      /* its colour */
+    bool dispersive;       /* KHR_materials_dispersion: refraction picks one channel's eta */
+    rt_vec3 eta_rgb;       /* eta per channel (Cauchy through the Abbe number, at 656.3, 587.6, 486.1 nm) */
 } rt_bsdf;
 
 typedef struct rt_bsdf_sample {
@@ -153,6 +173,27 @@ void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float
  * Sampled by the cosine with the probability of its share of the albedo.
  * rt_bsdf_from_surface calls it when the scene's energy_compensation is on. */
 void rt_bsdf_compensate(rt_bsdf *b);
+
+/* The glTF PBR-next extensions' parameters at a point (rt_bsdf_set_ext);
+ * rt_bsdf_ext_default gives the values that leave the core BSDF. */
+typedef struct rt_bsdf_ext {
+    float spec_weight;          /* KHR_materials_specular: specularFactor */
+    rt_vec3 spec_color;         /* specularColorFactor */
+    float clearcoat, clearcoat_roughness; /* KHR_materials_clearcoat */
+    rt_vec3 clearcoat_normal;   /* the coat's normal in the local frame ((0,0,1): the shading normal) */
+    rt_vec3 sheen_color;        /* KHR_materials_sheen */
+    float sheen_roughness;
+    float anisotropy;           /* KHR_materials_anisotropy strength, along the frame's x (b->t) */
+    float iridescence, iridescence_ior, iridescence_thickness; /* thickness in nm */
+    float diffuse_transmission; /* KHR_materials_diffuse_transmission */
+    rt_vec3 diffuse_transmission_color;
+    float dispersion;           /* KHR_materials_dispersion: 20 / Abbe number (needs transmission) */
+} rt_bsdf_ext;
+void rt_bsdf_ext_default(rt_bsdf_ext *e);
+/* Puts the extensions' layers over a glTF BSDF from rt_bsdf_make or
+ * rt_bsdf_from_surface (anything else is left as it is); with the default
+ * parameters b stays the core BSDF. */
+void rt_bsdf_set_ext(rt_bsdf *b, const rt_bsdf_ext *e);
 
 static inline rt_vec3 rt_bsdf_to_local(const rt_bsdf *b, rt_vec3 w)
 {

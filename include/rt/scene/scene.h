@@ -143,6 +143,24 @@ typedef enum rt_bsdf_model {
 /* Smith masking-shadowing term of the microfacet models. */
 typedef enum rt_smith { RT_SMITH_CORRELATED = 0, RT_SMITH_SEPARABLE } rt_smith;
 
+/* Texture slots of the glTF material extensions (rt_material.ext_tex),
+ * with the channel each reads. */
+typedef enum rt_ext_slot {
+    RT_XTEX_CLEARCOAT = 0,          /* R: times clearcoat */
+    RT_XTEX_CLEARCOAT_ROUGHNESS,    /* G: times clearcoat_roughness */
+    RT_XTEX_CLEARCOAT_NORMAL,       /* tangent-space normal map of the coat */
+    RT_XTEX_SPECULAR,               /* A: times specular_weight */
+    RT_XTEX_SPECULAR_COLOR,         /* RGB (sRGB): times specular_color */
+    RT_XTEX_SHEEN_COLOR,            /* RGB (sRGB): times sheen_color */
+    RT_XTEX_SHEEN_ROUGHNESS,        /* A: times sheen_roughness */
+    RT_XTEX_ANISOTROPY,             /* RG: direction in tangent space (2c - 1), B: times anisotropy */
+    RT_XTEX_IRIDESCENCE,            /* R: times iridescence */
+    RT_XTEX_IRIDESCENCE_THICKNESS,  /* G: mix of thickness min .. max */
+    RT_XTEX_DIFFUSE_TRANSMISSION,   /* A: times diffuse_transmission */
+    RT_XTEX_DIFFUSE_TRANSMISSION_COLOR, /* RGB (sRGB): times diffuse_transmission_color */
+    RT_XTEX_COUNT
+} rt_ext_slot;
+
 /* One material table for every source. The Phong fields drive the whitted
  * integrator; the PBR fields drive the path tracer; colour, textures,
  * reflection and transmission are read by both. rt_material_default() gives
@@ -179,6 +197,7 @@ typedef struct rt_material {
     int priority;           /* dielectric: nested-media priority, higher wins (rt/render/medium.h) */
     rt_vec3 absorption;     /* absorption coefficient inside, per scene unit (adds to attenuation_*) */
     float thickness;        /* KHR_materials_volume */
+    bool thin_walled;       /* glTF: no volume (thickness 0), transmission goes straight through; scene text: false */
     rt_vec3 attenuation_color;
     float attenuation_distance; /* INFINITY = no absorption */
     /* textures */
@@ -188,9 +207,31 @@ typedef struct rt_material {
     rt_texture_slot occlusion_tex;   /* R */
     rt_texture_slot emissive_tex;    /* sRGB colour */
     rt_texture_slot transmission_tex; /* R */
+    /* glTF PBR-next extensions (docs/gltf.md, docs/shading.md); the
+     * defaults leave the core glTF BRDF exactly as without them */
+    float clearcoat;              /* KHR_materials_clearcoat: coat weight (0) */
+    float clearcoat_roughness;    /* coat roughness (0: a mirror coat) */
+    float clearcoat_normal_scale; /* scale of the coat's normal map (1) */
+    float specular_weight;        /* KHR_materials_specular: specularFactor (1) */
+    rt_vec3 specular_color;       /* specularColorFactor (1, 1, 1): scales the dielectric F0 */
+    rt_vec3 sheen_color;          /* KHR_materials_sheen: sheenColorFactor (0: no sheen) */
+    float sheen_roughness;        /* sheenRoughnessFactor (0) */
+    float anisotropy;             /* KHR_materials_anisotropy: anisotropyStrength (0) */
+    float anisotropy_rotation;    /* anisotropyRotation, radians from the tangent (0) */
+    float iridescence;            /* KHR_materials_iridescence: iridescenceFactor (0) */
+    float iridescence_ior;        /* film index (1.3) */
+    float iridescence_thickness_min, iridescence_thickness_max; /* film thickness, nm (100, 400) */
+    float dispersion;             /* KHR_materials_dispersion: 20 / Abbe number (0: none) */
+    float diffuse_transmission;   /* KHR_materials_diffuse_transmission factor (0) */
+    rt_vec3 diffuse_transmission_color; /* (1, 1, 1) */
+    rt_texture_slot ext_tex[RT_XTEX_COUNT]; /* the extensions' textures, by rt_ext_slot */
+    bool extended;                /* rt_material_extended(), set once by the loader: the BSDF reads the fields above */
 } rt_material;
 
 void rt_material_default(rt_material *m, const char *name);
+/* True when some extension field or texture above differs from its default
+ * (loaders store it in `extended`, so a hit need not check each field). */
+bool rt_material_extended(const rt_material *m);
 
 /* Named metals for `bsdf conductor` (`metal NAME`): complex IOR eta + i k at
  * the red, green and blue wavelengths 650, 550 and 450 nm, from

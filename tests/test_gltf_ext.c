@@ -1,0 +1,368 @@
+/* test_gltf_ext.c - the glTF PBR-next material extensions end to end:
+ * parsed into the material table (factors, textures, defaults), refused
+ * with the file and byte when out of range, loaded without warnings and
+ * path traced (tiny renders of the sphere rows tools/gen_ext_assets.py
+ * writes to assets/ext/, checked for what each extension must do to the
+ * picture), and the shared Khronos sample models that use them, when
+ * ../shared has them; KHR_materials_variants through rt_load_options. */
+#include "test_util.h"
+
+#include <fcntl.h>
+#include <math.h>
+#include <unistd.h>
+
+#include "rt/accel/kdtree.h"
+#include "rt/io/framebuffer.h"
+#include "rt/io/gltf.h"
+#include "rt/io/load.h"
+#include "rt/render/render.h"
+#include "rt/scene/scene.h"
+#include "rt/scene/validate.h"
+
+static char tmp_dir[256];
+
+static int setup_tmp(void **state)
+{
+    (void)state;
+    return test_make_dir(tmp_dir, sizeof tmp_dir, "gltf_ext") ? 0 : -1;
+}
+
+static int teardown_tmp(void **state)
+{
+    (void)state;
+    test_remove_dir(tmp_dir);
+    return 0;
+}
+
+/* Loads path into a fresh scene (for rendering: with the first camera and
+ * the default sky) with stderr captured; *warned is true when
+ * anything was written to it (a warning). */
+static rt_result load_quiet(const char *path, rt_scene *s, rt_error *err, bool *warned, bool for_render)
+{
+    char log[512];
+    snprintf(log, sizeof log, "%s/stderr.txt", tmp_dir);
+    fflush(stderr);
+    int saved = dup(2);
+    int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    assert_true(saved >= 0 && fd >= 0);
+    dup2(fd, 2);
+    close(fd);
+    rt_scene_init(s);
+    memset(err, 0, sizeof *err);
+    rt_load_options opt = {.for_render = for_render};
+    rt_result r = rt_load(s, path, &opt, NULL, err);
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    FILE *f = fopen(log, "rb");
+    assert_non_null(f);
+    fseek(f, 0, SEEK_END);
+    *warned = ftell(f) > 0;
+    if (*warned) {
+        char buf[512] = {0};
+        fseek(f, 0, SEEK_SET);
+        size_t n = fread(buf, 1, sizeof buf - 1, f);
+        buf[n] = 0;
+        fprintf(stderr, "%s warned: %s", path, buf);
+    }
+    fclose(f);
+    return r;
+}
+
+static const rt_material *find_material(const rt_scene *s, const char *name)
+{
+    for (size_t i = 0; i < s->material_count; i++)
+        if (strcmp(s->materials[i].name, name) == 0)
+            return &s->materials[i];
+    fail_msg("no material named '%s'", name);
+    return NULL;
+}
+
+static void test_parse_generated(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_error err;
+    bool warned;
+    assert_int_equal(load_quiet("assets/ext/clearcoat.gltf", &s, &err, &warned, false), RT_OK);
+    assert_false(warned);
+    const rt_material *m = find_material(&s, "coat 0.3");
+    assert_true(m->clearcoat == 1.0f && fabsf(m->clearcoat_roughness - 0.3f) < 1e-7f);
+    m = find_material(&s, "no coat");
+    assert_true(m->clearcoat == 0.0f && m->specular_weight == 1.0f && m->iridescence == 0.0f);
+    rt_scene_free(&s);
+
+    assert_int_equal(load_quiet("assets/ext/specular.gltf", &s, &err, &warned, false), RT_OK);
+    assert_false(warned);
+    m = find_material(&s, "blue F0");
+    assert_true(m->specular_color.x == 0.5f && m->specular_color.z == 2.0f && m->specular_weight == 1.0f);
+    assert_true(find_material(&s, "specular 0")->specular_weight == 0.0f);
+    rt_scene_free(&s);
+
+    assert_int_equal(load_quiet("assets/ext/sheen.gltf", &s, &err, &warned, false), RT_OK);
+    m = find_material(&s, "gold sheen 0.5");
+    assert_true(m->sheen_color.y == 0.7f && m->sheen_roughness == 0.5f);
+    rt_scene_free(&s);
+
+    assert_int_equal(load_quiet("assets/ext/anisotropy.gltf", &s, &err, &warned, false), RT_OK);
+    m = find_material(&s, "strength 1, rotated");
+    assert_true(m->anisotropy == 1.0f && fabsf(m->anisotropy_rotation - 1.5707963f) < 1e-6f);
+    rt_scene_free(&s);
+
+    assert_int_equal(load_quiet("assets/ext/iridescence.gltf", &s, &err, &warned, false), RT_OK);
+    m = find_material(&s, "200 nm");
+    assert_true(m->iridescence == 1.0f && m->iridescence_ior == 1.3f && m->iridescence_thickness_min == 100.0f &&
+                m->iridescence_thickness_max == 200.0f);
+    assert_true(find_material(&s, "metal 400 nm")->iridescence_ior == 1.8f);
+    rt_scene_free(&s);
+
+    assert_int_equal(load_quiet("assets/ext/transmission.gltf", &s, &err, &warned, false), RT_OK);
+    assert_false(warned);
+    m = find_material(&s, "half diffuse transmission");
+    assert_true(m->diffuse_transmission == 0.5f && m->diffuse_transmission_color.y == 0.8f);
+    assert_true(find_material(&s, "dispersive glass")->dispersion == 0.5f);
+    rt_scene_free(&s);
+}
+
+/* Out-of-range factors are refused naming the file, the byte and the key. */
+static void test_refused(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *ext, *what;
+    } bad[] = {
+        {"\"KHR_materials_clearcoat\": {\"clearcoatFactor\": 1.5}", "clearcoatFactor"},
+        {"\"KHR_materials_clearcoat\": {\"clearcoatRoughnessFactor\": -0.1}", "clearcoatRoughnessFactor"},
+        {"\"KHR_materials_specular\": {\"specularFactor\": 2}", "specularFactor"},
+        {"\"KHR_materials_specular\": {\"specularColorFactor\": [1, -1, 1]}", "specularColorFactor"},
+        {"\"KHR_materials_sheen\": {\"sheenColorFactor\": [1, 1]}", "sheenColorFactor"},
+        {"\"KHR_materials_sheen\": {\"sheenRoughnessFactor\": \"rough\"}", "sheenRoughnessFactor"},
+        {"\"KHR_materials_anisotropy\": {\"anisotropyStrength\": 1.01}", "anisotropyStrength"},
+        {"\"KHR_materials_iridescence\": {\"iridescenceIor\": 0.5}", "iridescenceIor"},
+        {"\"KHR_materials_iridescence\": {\"iridescenceThicknessMinimum\": -5}", "iridescenceThicknessMinimum"},
+        {"\"KHR_materials_dispersion\": {\"dispersion\": -1}", "dispersion"},
+        {"\"KHR_materials_diffuse_transmission\": {\"diffuseTransmissionFactor\": 3}", "diffuseTransmissionFactor"},
+        {"\"KHR_materials_clearcoat\": {\"clearcoatTexture\": {\"index\": 7}}", "texture 7 is out of range"},
+        {"\"KHR_materials_sheen\": []", "expected an object"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char text[1024], path[512];
+        snprintf(text, sizeof text,
+                 "{\"asset\": {\"version\": \"2.0\"}, \"materials\": [{\"name\": \"m\", \"extensions\": {%s}}]}",
+                 bad[i].ext);
+        snprintf(path, sizeof path, "%s/bad%zu.gltf", tmp_dir, i);
+        test_write_file(path, text, strlen(text));
+        rt_scene s;
+        rt_error err;
+        bool warned;
+        rt_result r = load_quiet(path, &s, &err, &warned, false);
+        if (r == RT_OK || !strstr(err.message, path) || !strstr(err.message, bad[i].what) ||
+            (!strstr(err.message, "byte") && !strstr(bad[i].what, "out of range")))
+            fail_msg("%s: got %s \"%s\"", bad[i].ext, rt_result_name(r), err.message);
+        assert_int_equal(s.material_count, 0); /* all or nothing */
+        rt_scene_free(&s);
+    }
+}
+
+/* Renders a generated file at W x H with the path tracer. */
+enum { W = 96, H = 48 };
+static void render_file(const char *path, rt_framebuffer *fb)
+{
+    rt_scene s;
+    rt_error err;
+    bool warned;
+    assert_int_equal(load_quiet(path, &s, &err, &warned, true), RT_OK);
+    assert_false(warned);
+    s.settings.width = W;
+    s.settings.height = H;
+    s.settings.samples = 64;
+    s.settings.integrator = RT_INTEGRATOR_PATH;
+    assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
+    rt_kdtree tree;
+    assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
+    assert_int_equal(rt_framebuffer_init(fb, W, H, &err), RT_OK);
+    rt_render_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.threads = 2;
+    rt_render_stats st;
+    assert_int_equal(rt_render(&s, &tree, &opt, fb, &st, &err), RT_OK);
+    assert_int_equal(st.bad_samples, 0);
+    for (int i = 0; i < W * H * 3; i++)
+        assert_true(isfinite(fb->rgb[i]) && fb->rgb[i] >= 0.0f);
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
+/* Mean radiance over a disc at the centre of sphere k of n (the generator's
+ * layout: spheres 1 apart along x, camera yfov 0.5, aspect 2, at
+ * n / (4 tan 0.25) + 1.2). */
+static rt_vec3 sphere_mean(const rt_framebuffer *fb, int k, int n)
+{
+    double dist = (n > 2 ? n : 2) / (4.0 * tan(0.25)) + 1.2;
+    double x = (k - (n - 1) / 2.0) / dist; /* tan of the angle */
+    double r = 0.4 / dist * 0.6;           /* inside the silhouette */
+    double scale = (H / 2.0) / tan(0.25);  /* pixels per unit tangent */
+    double cx = W / 2.0 + x * scale, cy = H / 2.0;
+    double sum[3] = {0, 0, 0};
+    int cnt = 0;
+    for (int py = 0; py < H; py++)
+        for (int px = 0; px < W; px++) {
+            double dx = (px + 0.5 - cx) / scale, dy = (py + 0.5 - cy) / scale;
+            if (dx * dx + dy * dy > r * r)
+                continue;
+            for (int c = 0; c < 3; c++)
+                sum[c] += fb->rgb[(py * W + px) * 3 + c];
+            cnt++;
+        }
+    assert_true(cnt > 4);
+    return rt_v3((float)(sum[0] / cnt), (float)(sum[1] / cnt), (float)(sum[2] / cnt));
+}
+
+static void test_render_generated(void **state)
+{
+    (void)state;
+    rt_framebuffer fb;
+    /* a coat reflects the bluish sky over the red base: more blue */
+    render_file("assets/ext/clearcoat.gltf", &fb);
+    rt_vec3 bare = sphere_mean(&fb, 0, 5), coat = sphere_mean(&fb, 1, 5);
+    assert_true(coat.z > bare.z * 1.2f);
+    rt_framebuffer_free(&fb);
+    /* a white sheen brightens the dark blue cloth */
+    render_file("assets/ext/sheen.gltf", &fb);
+    bare = sphere_mean(&fb, 0, 4);
+    rt_vec3 sheen = sphere_mean(&fb, 2, 4);
+    assert_true(sheen.x + sheen.y + sheen.z > 1.1f * (bare.x + bare.y + bare.z));
+    rt_framebuffer_free(&fb);
+    /* specularColorFactor (0.5, 1, 2): a bluer highlight than the plain one */
+    render_file("assets/ext/specular.gltf", &fb);
+    rt_vec3 plain = sphere_mean(&fb, 2, 5), blue = sphere_mean(&fb, 3, 5);
+    assert_true(blue.z / blue.x > plain.z / plain.x);
+    rt_framebuffer_free(&fb);
+    /* full diffuse transmission: the sphere passes light instead of reflecting it */
+    render_file("assets/ext/transmission.gltf", &fb);
+    rt_framebuffer_free(&fb);
+    render_file("assets/ext/anisotropy.gltf", &fb);
+    rt_framebuffer_free(&fb);
+    render_file("assets/ext/iridescence.gltf", &fb);
+    rt_vec3 thin = sphere_mean(&fb, 0, 4), thick = sphere_mean(&fb, 2, 4);
+    assert_true(fabsf(thin.x / (thin.z + 1e-6f) - thick.x / (thick.z + 1e-6f)) > 0.01f); /* the film's colour changes */
+    rt_framebuffer_free(&fb);
+}
+
+/* Names of the materials of the first and last triangle (sphere 0 and the last sphere). */
+static void first_last_material(const rt_scene *s, const char **first, const char **last)
+{
+    assert_true(s->triangles.count > 0);
+    *first = s->materials[s->triangles.material[0]].name;
+    *last = s->materials[s->triangles.material[s->triangles.count - 1]].name;
+}
+
+/* KHR_materials_variants (rt --variant NAME): each primitive takes the
+ * material its mapping gives for the variant; others keep theirs. */
+static void test_variants(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *variant, *first, *last;
+    } want[] = {{NULL, "grey", "grey"}, {"red", "grey", "red"}, {"blue", "blue", "grey"}};
+    for (size_t i = 0; i < 3; i++) {
+        rt_scene s;
+        rt_scene_init(&s);
+        rt_error err = {0};
+        rt_load_options opt = {.variant = want[i].variant};
+        assert_int_equal(rt_load(&s, "assets/ext/variants.gltf", &opt, NULL, &err), RT_OK);
+        const char *first, *last;
+        first_last_material(&s, &first, &last);
+        if (strcmp(first, want[i].first) != 0 || strcmp(last, want[i].last) != 0)
+            fail_msg("variant %s: spheres have '%s' and '%s'", want[i].variant ? want[i].variant : "(none)", first,
+                     last);
+        rt_scene_free(&s);
+    }
+    /* an unknown name lists the file's variants; a scene file refuses the flag */
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_error err = {0};
+    rt_load_options opt = {.variant = "green"};
+    assert_int_equal(rt_load(&s, "assets/ext/variants.gltf", &opt, NULL, &err), RT_ERR_INVALID);
+    assert_non_null(strstr(err.message, "variants.gltf"));
+    assert_non_null(strstr(err.message, "'green'"));
+    assert_non_null(strstr(err.message, "'red', 'blue'"));
+    assert_int_equal(s.material_count, 0);
+    assert_int_equal(rt_load(&s, "scenes/cornell.txt", &opt, NULL, &err), RT_ERR_INVALID);
+    rt_scene_free(&s);
+    /* a mapping to a material or a variant that does not exist */
+    static const char *const bad[] = {
+        "[{\"material\": 5, \"variants\": [0]}]",
+        "[{\"material\": 0, \"variants\": [3]}]",
+        "[{\"variants\": [0]}]",
+    };
+    for (size_t i = 0; i < 3; i++) {
+        char text[2048], path[512];
+        snprintf(text, sizeof text,
+                 "{\"asset\": {\"version\": \"2.0\"}, \"extensions\": {\"KHR_materials_variants\": "
+                 "{\"variants\": [{\"name\": \"a\"}]}}, \"materials\": [{}], \"buffers\": [{\"byteLength\": 36, "
+                 "\"uri\": \"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}], "
+                 "\"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}], \"accessors\": [{\"bufferView\": 0, "
+                 "\"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]}], "
+                 "\"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"material\": 0, "
+                 "\"extensions\": {\"KHR_materials_variants\": {\"mappings\": %s}}}]}], "
+                 "\"nodes\": [{\"mesh\": 0}], \"scenes\": [{\"nodes\": [0]}]}",
+                 bad[i]);
+        snprintf(path, sizeof path, "%s/variants%zu.gltf", tmp_dir, i);
+        test_write_file(path, text, strlen(text));
+        rt_scene_init(&s);
+        rt_result r = rt_load(&s, path, NULL, NULL, &err);
+        if (r != RT_ERR_INVALID || !strstr(err.message, path) || !strstr(err.message, "byte"))
+            fail_msg("mapping %s: got %s \"%s\"", bad[i], rt_result_name(r), err.message);
+        rt_scene_free(&s);
+    }
+}
+
+/* Khronos sample models that use the extensions: each must load without a
+ * warning and render, when ../shared has it. */
+static void test_shared_models(void **state)
+{
+    (void)state;
+    static const char *const models[] = {
+        "ClearCoatTest", "ClearcoatWicker", "SheenChair", "SheenCloth", "IridescenceLamp", "IridescenceSuzanne",
+        "ToyCar", "DispersionTest", "AnisotropyBarnLamp", "AnisotropyStrengthTest", "SpecularTest",
+        "DiffuseTransmissionTest", "MaterialsVariantsShoe",
+    };
+    int found = 0;
+    for (size_t i = 0; i < sizeof models / sizeof models[0]; i++) {
+        char rel[256], path[4200];
+        const char *kinds[] = {"glTF-Binary/%s.glb", "glTF/%s.gltf", "%s.glb", "%s.gltf"};
+        bool have = false;
+        for (size_t k = 0; k < 4 && !have; k++) {
+            char name[200];
+            snprintf(name, sizeof name, kinds[k], models[i]);
+            snprintf(rel, sizeof rel, "assets/gltf/%s/%s", models[i], name);
+            snprintf(path, sizeof path, "%s", test_shared_path(rel));
+            have = access(path, R_OK) == 0;
+        }
+        if (!have) {
+            printf("skipped: %s is not in %s\n", models[i], test_shared_path("assets/gltf"));
+            continue;
+        }
+        found++;
+        rt_scene s;
+        rt_error err;
+        bool warned;
+        assert_int_equal(load_quiet(path, &s, &err, &warned, false), RT_OK);
+        assert_false(warned);
+        rt_scene_free(&s);
+    }
+    printf("%d of %zu extension sample models present\n", found, sizeof models / sizeof models[0]);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_parse_generated),
+        cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_render_generated),
+        cmocka_unit_test(test_variants),
+        cmocka_unit_test(test_shared_models),
+    };
+    return cmocka_run_group_tests_name("gltf_ext", tests, setup_tmp, teardown_tmp);
+}
