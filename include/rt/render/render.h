@@ -95,6 +95,7 @@ typedef struct rt_render_options {
     rt_render_progress_fn progress; /* NULL = no reports; called from the calling thread */
     void *progress_user;       /* handed to progress */
     struct rt_aov_buffers *aov; /* NULL = no AOVs; else the images to fill (rt/render/aov.h) */
+    int batch_size;            /* wavefront integrators: paths in flight per worker; 0 = RT_WAVEFRONT_BATCH (same image for any) */
 } rt_render_options;
 
 typedef struct rt_render_stats {
