@@ -58,7 +58,8 @@ rt_ray rt_camera_pixel_sample(const rt_camera_frame *cf, int width, uint32_t see
     uint64_t pixel = (uint64_t)y * (uint64_t)width + (uint64_t)x;
     uint32_t pattern = (uint32_t)rt_mix64(pixel ^ ((uint64_t)seed << 40));
     rt_vec2 j = spp > 1 ? rt_cmj_sample(s, spp, pattern) : rt_v2(0.5f, 0.5f);
-    rt_vec2 lens = rt_cmj_sample(s, spp, pattern ^ 0x68bc21ebu);
+    /* a pinhole camera reads no lens point: skip its pattern (half the CMJ work) */
+    rt_vec2 lens = cf->lens_radius > 0.0f ? rt_cmj_sample(s, spp, pattern ^ 0x68bc21ebu) : rt_v2(0.5f, 0.5f);
     *rng = rt_rng_for_sample(seed, pixel, s);
     return rt_camera_ray(cf, (float)x + j.x, (float)y + j.y, lens);
 }

@@ -303,7 +303,7 @@ float rt_light_table_env_pdf(const rt_light_table *t, rt_vec3 d)
 {
     if (!t || t->env_w <= 0)
         return 0.0f;
-    float sin_t = sqrtf(fmaxf(0.0f, 1.0f - d.y * d.y));
+    float sin_t = sqrtf(rt_fmaxf(0.0f, 1.0f - d.y * d.y));
     if (!(sin_t > 0.0f))
         return 0.0f;
     rt_vec2 uv = rt_latlong_from_dir(d);

@@ -145,7 +145,7 @@ bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_surface *sf, const rt
         break;
     }
     case RT_PRIM_SPHERE: {
-        float z = 1.0f - 2.0f * u.x, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * RT_PI * u.y;
+        float z = 1.0f - 2.0f * u.x, r = sqrtf(rt_fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * RT_PI * u.y;
         const rt_spheres *sp = &s->spheres;
         q = rt_madd(rt_v3(sp->cx[local], sp->cy[local], sp->cz[local]),
                     rt_v3(r * cosf(phi), r * sinf(phi), z), fabsf(sp->radius[local]));
@@ -285,7 +285,7 @@ bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_sur
     ps->prev_p = sf->p;
     ps->bounces++;
     if (rr_depth == 0 ? rt_max3(beta) < 1.0f : ps->bounces >= rr_depth) {
-        float q = rr_depth == 0 ? rt_max3(beta) : fminf(rt_max3(beta), 0.95f);
+        float q = rr_depth == 0 ? rt_max3(beta) : rt_fminf(rt_max3(beta), 0.95f);
         if (rt_rng_float(rng) >= q)
             return false;
         ps->beta = rt_scale(beta, 1.0f / q);
