@@ -94,7 +94,9 @@ static rt_vec3 vndf_xy(rt_vec3 wo, float ax, float ay, rt_vec2 u)
     rt_vec3 t2 = rt_cross(vh, t1);
     /* a point on the projected area of the hemisphere */
     float r = sqrtf(u.x), phi = 2.0f * RT_PI * u.y;
-    float p1 = r * cosf(phi), p2 = r * sinf(phi);
+    float sn, cs;
+    rt_sincosf(phi, &sn, &cs);
+    float p1 = r * cs, p2 = r * sn;
     float s = 0.5f * (1.0f + vh.z);
     p2 = (1.0f - s) * sqrtf(rt_fmaxf(0.0f, 1.0f - p1 * p1)) + s * p2;
     rt_vec3 nh = rt_add(rt_add(rt_scale(t1, p1), rt_scale(t2, p2)),

@@ -147,8 +147,10 @@ bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_surface *sf, const rt
     case RT_PRIM_SPHERE: {
         float z = 1.0f - 2.0f * u.x, r = sqrtf(rt_fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * RT_PI * u.y;
         const rt_spheres *sp = &s->spheres;
-        q = rt_madd(rt_v3(sp->cx[local], sp->cy[local], sp->cz[local]),
-                    rt_v3(r * cosf(phi), r * sinf(phi), z), fabsf(sp->radius[local]));
+        float sn, cs;
+        rt_sincosf(phi, &sn, &cs);
+        q = rt_madd(rt_v3(sp->cx[local], sp->cy[local], sp->cz[local]), rt_v3(r * cs, r * sn, z),
+                    fabsf(sp->radius[local]));
         h.u = h.v = 0.0f;
         break;
     }

@@ -112,7 +112,9 @@ static inline rt_vec3 rt_sample_cosine_hemisphere(rt_vec2 u)
     } else {
         r = b; phi = (RT_PI / 2.0f) - (RT_PI / 4.0f) * (a / b);
     }
-    float x = r * cosf(phi), y = r * sinf(phi);
+    float sn, cs;
+    rt_sincosf(phi, &sn, &cs);
+    float x = r * cs, y = r * sn;
     float z = sqrtf(rt_fmaxf(0.0f, 1.0f - x * x - y * y));
     return rt_v3(x, y, z);
 }
