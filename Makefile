@@ -32,7 +32,11 @@ WARN    += -Werror
 endif
 CFLAGS  ?=
 CFLAGS  += -std=c11 $(WARN) $(OPT) -Iinclude -D_POSIX_C_SOURCE=200809L -MMD -MP
-LDLIBS  := -lstb -lOpenEXRCore -ldl -lpthread -lm
+# C++ only for src/io/draco.cc, the wrapper over libdraco (rt/io/draco.h)
+CXX     ?= c++
+CXXFLAGS ?=
+CXXFLAGS += -std=c++17 $(WARN) $(OPT) -Iinclude -MMD -MP
+LDLIBS  := -lstb -lOpenEXRCore -lmeshoptimizer -ldraco -lwebp -lstdc++ -ldl -lpthread -lm
 BUILD   ?= build
 SHARED  ?= ../shared
 RT      ?= rt
@@ -40,7 +44,8 @@ RT      ?= rt
 # The library, by pipeline stage (docs/architecture.md); the driver is src/driver.
 STAGES   := base io scene accel render image
 LIB_SRC  := $(foreach d,$(STAGES),$(wildcard src/$(d)/*.c))
-LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o)
+LIB_CXX  := $(foreach d,$(STAGES),$(wildcard src/$(d)/*.cc))
+LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:src/%.cc=$(BUILD)/obj/%.o)
 DRV_SRC  := $(wildcard src/driver/*.c)
 DRV_OBJ  := $(DRV_SRC:src/%.c=$(BUILD)/obj/%.o)
 TEST_SRC := $(wildcard tests/test_*.c)
@@ -59,6 +64,10 @@ $(DEPS_OK): tools/install-deps.sh
 $(BUILD)/obj/%.o: src/%.c | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -c -o $@ $<
+
+$(BUILD)/obj/%.o: src/%.cc | $(DEPS_OK)
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -c -o $@ $<
 
 # --window needs SDL2 (libsdl2-dev): window.c is built against it when
 # pkg-config finds it at build time, else as stubs that say so; rt links it

@@ -12,7 +12,7 @@
 set -eu
 SECONDS_EACH=${FUZZ_SECONDS:-60}
 SHARED=${SHARED:-../shared}
-TARGETS=${FUZZ_TARGETS:-"scene gltf glb gltf_bin obj ply off image exr"}
+TARGETS=${FUZZ_TARGETS:-"scene gltf glb gltf_bin obj ply off image exr meshopt draco"}
 B=build-fuzz
 
 if ! command -v clang >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
@@ -32,6 +32,13 @@ for src in src/*/*.c; do
         clang $CFLAGS -fsanitize=fuzzer-no-link -c -o "$obj" "$src"
     fi
 done
+# the one C++ file (the Draco wrapper)
+for src in src/*/*.cc; do
+    obj=$B/obj/$(echo "${src#src/}" | tr / _ | sed 's/\.cc$/.o/')
+    if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ include/rt/io/draco.h -nt "$obj" ]; then
+        clang++ -std=c++17 -g -O1 -fno-omit-frame-pointer -Iinclude $SAN -fno-sanitize=vptr -fsanitize=fuzzer-no-link -c -o "$obj" "$src"
+    fi
+done
 clang $CFLAGS -fsanitize=fuzzer-no-link -c -o $B/harness.o tests/fuzz/harness.c
 
 # seed corpora
@@ -42,7 +49,7 @@ summary=$B/summary.txt
 printf '%-10s %12s %14s %8s\n' target execs/s total_execs crashes | tee "$summary"
 for t in $TARGETS; do
     clang $CFLAGS -fsanitize=fuzzer -DRT_FUZZ_TARGET="\"$t\"" -o $B/fuzz_$t tests/fuzz/fuzz_main.c $B/harness.o $B/obj/*.o \
-        -lstb -lOpenEXRCore -ldl -lpthread -lm
+        -lstb -lOpenEXRCore -lmeshoptimizer -ldraco -lwebp -lstdc++ -ldl -lpthread -lm
     mkdir -p $B/corpus/$t $B/crashes/$t
     dict=""
     case $t in

@@ -72,3 +72,31 @@ for p in glob.glob(os.path.join(shared, "assets/gltf/*/glTF/*.png")) + glob.glob
         put("image", os.path.basename(p), open(p, "rb").read())
 for p in sorted(glob.glob("tests/corpus/exr/*.exr")):
     put("exr", os.path.basename(p), open(p, "rb").read())
+
+# meshopt and draco streams, cut out of the compressed glTF test files
+# (tools/gen_compressed_assets.sh) in the layouts of tests/fuzz/harness.h
+MODES = {"ATTRIBUTES": 0, "TRIANGLES": 1, "INDICES": 2}
+FILTERS = {"NONE": 0, "OCTAHEDRAL": 1, "QUATERNION": 2, "EXPONENTIAL": 3}
+for p in sorted(glob.glob("tests/corpus/glb/compressed-*.glb")):
+    data = open(p, "rb").read()
+    jlen = struct.unpack_from("<I", data, 12)[0]
+    doc = json.loads(data[20:20 + jlen])
+    bin_ = data[20 + jlen + 8:]
+    base = os.path.basename(p)[:-4]
+    for i, v in enumerate(doc.get("bufferViews", [])):
+        mo = v.get("extensions", {}).get("EXT_meshopt_compression")
+        if not mo or mo.get("buffer", 0) != 0 or mo["count"] > 65535:
+            continue
+        stream = bin_[mo.get("byteOffset", 0):mo.get("byteOffset", 0) + mo["byteLength"]]
+        mode = MODES[mo["mode"]]
+        stride = mo["byteStride"]
+        code = stride // 4 - 1 if mode == 0 else (1 if stride == 4 else 0)
+        head = bytes([mode, FILTERS[mo.get("filter", "NONE")], code]) + struct.pack("<H", mo["count"])
+        put("meshopt", "%s-view%d" % (base, i), head + stream)
+    for m in doc.get("meshes", []):
+        for pr in m["primitives"]:
+            dr = pr.get("extensions", {}).get("KHR_draco_mesh_compression")
+            if dr:
+                v = doc["bufferViews"][dr["bufferView"]]
+                put("draco", "%s-view%d" % (base, dr["bufferView"]),
+                    bin_[v.get("byteOffset", 0):v.get("byteOffset", 0) + v["byteLength"]])

@@ -5,13 +5,18 @@
 #   libjsmn-dev    the JSON tokenizer under src/gltf.c
 #   libcmocka-dev  the test framework
 #   libopenexr-dev the OpenEXR Core C API (EXR images in and out)
+#   libmeshoptimizer-dev, libdraco-dev, libwebp-dev
+#                  compressed glTF: EXT_meshopt_compression,
+#                  KHR_draco_mesh_compression (C++; g++ builds src/io/draco.cc),
+#                  EXT_texture_webp
 # and, optionally (rt builds and runs without them; a failed install is only
 # reported): libsdl2-dev for --window, xvfb for the test that opens it.
 set -eu
 CC=${CC:-cc}
+CXX=${CXX:-c++}
 missing=""
-check() { # header package
-    if ! printf '#include <%s>\n' "$1" | "$CC" -E -x c - >/dev/null 2>&1; then
+check() { # header package [language]
+    if ! printf '#include <%s>\n' "$1" | "${4:-$CC}" -E -x "${3:-c}" - >/dev/null 2>&1; then
         missing="$missing $2"
     fi
 }
@@ -19,6 +24,10 @@ check stb/stb_image.h libstb-dev
 check jsmn.h libjsmn-dev
 check cmocka.h libcmocka-dev
 check OpenEXR/openexr.h libopenexr-dev
+check meshoptimizer.h libmeshoptimizer-dev
+check webp/decode.h libwebp-dev
+command -v "$CXX" >/dev/null 2>&1 || missing="$missing g++"
+check draco/compression/decode.h libdraco-dev c++ "$CXX"
 
 install_optional() {
     optional=""
@@ -56,9 +65,10 @@ else
 fi
 export DEBIAN_FRONTEND=noninteractive
 # A fresh machine has no package lists yet; refresh them once if the install fails.
-if ! $SUDO apt-get install -y -q $missing >&2; then
+# (DPkg::Lock::Timeout: wait for another apt run instead of failing at once)
+if ! $SUDO apt-get install -y -q -o DPkg::Lock::Timeout=300 $missing >&2; then
     $SUDO apt-get update -q >&2
-    $SUDO apt-get install -y -q $missing >&2
+    $SUDO apt-get install -y -q -o DPkg::Lock::Timeout=300 $missing >&2
 fi
 echo "rt: installed:$missing" >&2
 install_optional

@@ -53,7 +53,9 @@
 #include "rt/base/file.h"
 #include "rt/base/log.h"
 #include "rt/io/base64.h"
+#include "rt/io/draco.h"
 #include "rt/io/json.h"
+#include "rt/io/meshopt.h"
 #include "rt/scene/texture.h"
 
 #define GL_MAX_DEPTH 1024                    /* node hierarchy levels */
@@ -62,6 +64,7 @@
                                                 per load (instances included): such data costs no file bytes */
 #define GL_MAX_TRIANGLES ((size_t)1 << 25)   /* per load: 32M triangles */
 #define GL_MAX_FILE ((size_t)0x7fffffff)     /* .gltf, .glb, .bin: 2 GiB */
+#define GL_MAX_DECODED ((size_t)1 << 30)     /* per load: bytes decoded from meshopt and Draco streams */
 
 enum { GL_BYTE = 5120, GL_UNSIGNED_BYTE = 5121, GL_SHORT = 5122, GL_UNSIGNED_SHORT = 5123,
        GL_UNSIGNED_INT = 5125, GL_FLOAT = 5126 };
@@ -77,12 +80,18 @@ typedef struct gl_buffer {
     int uri;              /* string token, -1 = none (GLB BIN chunk) */
     const uint8_t *data;  /* after loading: at least byte_length bytes */
     uint8_t *owned;
+    bool fallback;        /* EXT_meshopt_compression: may have no data, only decoded views use it */
     int tok;
 } gl_buffer;
 
 typedef struct gl_view {
     uint32_t buffer;
     size_t offset, length, stride; /* stride 0 = tightly packed */
+    uint8_t *decoded;              /* EXT_meshopt_compression or Draco: the view's bytes, owned */
+    bool meshopt;                  /* the fields below hold its compressed source */
+    uint32_t mo_buffer;
+    size_t mo_offset, mo_length, mo_stride, mo_count;
+    int mo_mode, mo_filter, mo_tok;
     int tok;
 } gl_view;
 
@@ -96,6 +105,7 @@ typedef struct gl_accessor {
     uint32_t sp_idx_view, sp_val_view;
     size_t sp_idx_offset, sp_val_offset;
     int sp_idx_ctype;
+    bool draco;          /* filled by a KHR_draco_mesh_compression primitive */
     int tok;
 } gl_accessor;
 
@@ -104,6 +114,9 @@ typedef struct gl_prim {
     uint32_t indices, material;
     uint32_t attr[ATTR_COUNT];
     bool targets;
+    uint32_t draco_view;          /* KHR_draco_mesh_compression: RT_NONE = not compressed */
+    uint32_t draco_id[ATTR_COUNT]; /* its attribute unique ids, RT_NONE = not in the stream */
+    int draco_tok;
     int tok;
 } gl_prim;
 
@@ -119,7 +132,7 @@ typedef struct gl_node {
 
 typedef struct gl_scene { uint32_t first, count; int tok; } gl_scene; /* into doc.scene_nodes */
 
-typedef struct gl_texture { uint32_t source, sampler; int tok; } gl_texture;
+typedef struct gl_texture { uint32_t source, sampler; bool other_source; int tok; } gl_texture;
 typedef struct gl_sampler { int mag, min, wrap_s, wrap_t; int tok; } gl_sampler;
 typedef struct gl_image { int uri; uint32_t view; int tok; } gl_image;
 
@@ -170,6 +183,7 @@ typedef struct gl_doc {
     gl_camera *cameras;     size_t camera_count;
     gl_light *lights;       size_t light_count;
     size_t skin_count;
+    size_t decoded_bytes;   /* meshopt and Draco output so far (GL_MAX_DECODED) */
     uint32_t default_scene; /* RT_NONE = absent */
 
     /* flattening */
@@ -408,6 +422,8 @@ static const struct { const char *name; bool supported; } known_extensions[] = {
     {"KHR_materials_volume", true},            {"KHR_materials_unlit", true},
     {"KHR_lights_punctual", true},             {"KHR_mesh_quantization", true},
     {"KHR_xmp", true},                         {"KHR_xmp_json_ld", true}, /* metadata only */
+    {"EXT_meshopt_compression", true},         {"KHR_draco_mesh_compression", true},
+    {"EXT_texture_webp", true},
 };
 
 static bool extension_supported(const gl_doc *d, int t)
@@ -480,11 +496,58 @@ static rt_result parse_buffers(gl_doc *d, int t)
                 b->uri = v;
             } else if (KEY(k, "byteLength")) {
                 TRY(get_size(d, where, "byteLength", v, &b->byte_length));
+            } else if (KEY(k, "extensions")) {
+                int mo = rt_json_get(&d->j, v, "EXT_meshopt_compression");
+                int fb = mo >= 0 ? rt_json_get(&d->j, mo, "fallback") : -1;
+                if (fb >= 0)
+                    TRY(get_bool(d, where, "extensions.EXT_meshopt_compression.fallback", fb, &b->fallback));
             }
         }
         if (b->byte_length == SIZE_MAX || b->byte_length == 0)
             return fail_at(d, e, RT_ERR_INVALID, "%s: byteLength is missing or 0", where);
     }
+    return RT_OK;
+}
+
+/* A view's EXT_meshopt_compression object: where its compressed bytes are
+ * and how they decode (rt/io/meshopt.h). */
+static rt_result parse_meshopt_view(gl_doc *d, const char *view, int t, gl_view *bv)
+{
+    char where[96];
+    snprintf(where, sizeof where, "%s.extensions.EXT_meshopt_compression", view);
+    TRY(expect_object(d, t, where));
+    bv->meshopt = true;
+    bv->mo_tok = t;
+    bv->mo_buffer = RT_NONE;
+    bv->mo_length = bv->mo_stride = bv->mo_count = SIZE_MAX;
+    bv->mo_mode = -1;
+    bv->mo_filter = RT_MESHOPT_FILTER_NONE;
+    char name[32];
+    FOR_KEYS(d, t, k, v) {
+        if (KEY(k, "buffer")) TRY(get_index(d, where, "buffer", v, &bv->mo_buffer));
+        else if (KEY(k, "byteOffset")) TRY(get_size(d, where, "byteOffset", v, &bv->mo_offset));
+        else if (KEY(k, "byteLength")) TRY(get_size(d, where, "byteLength", v, &bv->mo_length));
+        else if (KEY(k, "byteStride")) TRY(get_size(d, where, "byteStride", v, &bv->mo_stride));
+        else if (KEY(k, "count")) TRY(get_size(d, where, "count", v, &bv->mo_count));
+        else if (KEY(k, "mode")) {
+            TRY(get_string(d, where, "mode", v, name, sizeof name));
+            if ((bv->mo_mode = rt_meshopt_mode_from_name(name)) < 0)
+                return fail_at(d, v, RT_ERR_INVALID, "%s.mode \"%s\" is not ATTRIBUTES, TRIANGLES or INDICES", where,
+                               name);
+        } else if (KEY(k, "filter")) {
+            TRY(get_string(d, where, "filter", v, name, sizeof name));
+            if ((bv->mo_filter = rt_meshopt_filter_from_name(name)) < 0)
+                return fail_at(d, v, RT_ERR_INVALID,
+                               "%s.filter \"%s\" is not NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL", where, name);
+        }
+    }
+    if (bv->mo_buffer == RT_NONE || bv->mo_length == SIZE_MAX || bv->mo_stride == SIZE_MAX ||
+        bv->mo_count == SIZE_MAX || bv->mo_mode < 0)
+        return fail_at(d, t, RT_ERR_INVALID, "%s: needs buffer, byteLength, byteStride, count and mode", where);
+    const char *why = rt_meshopt_check((rt_meshopt_mode)bv->mo_mode, (rt_meshopt_filter)bv->mo_filter,
+                                       bv->mo_count, bv->mo_stride);
+    if (why)
+        return fail_at(d, t, RT_ERR_INVALID, "%s: %s", where, why);
     return RT_OK;
 }
 
@@ -508,6 +571,10 @@ static rt_result parse_views(gl_doc *d, int t)
                 if (bv->stride < 4 || bv->stride > 252 || bv->stride % 4)
                     return fail_at(d, v, RT_ERR_INVALID, "%s.byteStride %zu must be a multiple of 4 in [4, 252]",
                                    where, bv->stride);
+            } else if (KEY(k, "extensions")) {
+                int mo = rt_json_get(&d->j, v, "EXT_meshopt_compression");
+                if (mo >= 0)
+                    TRY(parse_meshopt_view(d, where, mo, bv));
             }
         }
         if (bv->buffer == RT_NONE)
@@ -629,6 +696,34 @@ static rt_result parse_accessors(gl_doc *d, int t)
     return RT_OK;
 }
 
+/* A primitive's KHR_draco_mesh_compression object: the view holding the
+ * compressed mesh and the unique ids of the attributes rt reads. */
+static rt_result parse_draco_prim(gl_doc *d, const char *prim, int t, gl_prim *pr)
+{
+    char where[128];
+    snprintf(where, sizeof where, "%s.extensions.KHR_draco_mesh_compression", prim);
+    TRY(expect_object(d, t, where));
+    pr->draco_tok = t;
+    int attrs = -1;
+    FOR_KEYS(d, t, k, v) {
+        if (KEY(k, "bufferView")) TRY(get_index(d, where, "bufferView", v, &pr->draco_view));
+        else if (KEY(k, "attributes")) attrs = v;
+    }
+    if (pr->draco_view == RT_NONE || attrs < 0)
+        return fail_at(d, t, RT_ERR_INVALID, "%s: needs bufferView and attributes", where);
+    char wa[160];
+    snprintf(wa, sizeof wa, "%s.attributes", where);
+    TRY(expect_object(d, attrs, wa));
+    FOR_KEYS(d, attrs, k2, v2) {
+        for (int a = 0; a < ATTR_COUNT; a++)
+            if (KEY(k2, attr_names[a]))
+                TRY(get_index(d, wa, attr_names[a], v2, &pr->draco_id[a]));
+    }
+    if (pr->draco_id[ATTR_POSITION] == RT_NONE)
+        return fail_at(d, attrs, RT_ERR_INVALID, "%s: POSITION is missing", wa);
+    return RT_OK;
+}
+
 static rt_result parse_meshes(gl_doc *d, int t)
 {
     TRY(alloc_table(d, t, "meshes", sizeof(gl_mesh), (void **)&d->meshes, &d->mesh_count));
@@ -661,9 +756,9 @@ static rt_result parse_meshes(gl_doc *d, int t)
             gl_prim *pr = &d->prims[d->prim_count++];
             pr->tok = pe;
             pr->mode = 4;
-            pr->indices = pr->material = RT_NONE;
+            pr->indices = pr->material = pr->draco_view = RT_NONE;
             for (int a = 0; a < ATTR_COUNT; a++)
-                pr->attr[a] = RT_NONE;
+                pr->attr[a] = pr->draco_id[a] = RT_NONE;
             TRY(expect_object(d, pe, where));
             bool have_attrs = false;
             FOR_KEYS(d, pe, k, v) {
@@ -676,6 +771,10 @@ static rt_result parse_meshes(gl_doc *d, int t)
                 } else if (KEY(k, "targets")) {
                     TRY(expect_array(d, v, where, "targets"));
                     pr->targets = jsize(d, v) > 0;
+                } else if (KEY(k, "extensions")) {
+                    int dr = rt_json_get(&d->j, v, "KHR_draco_mesh_compression");
+                    if (dr >= 0)
+                        TRY(parse_draco_prim(d, where, dr, pr));
                 } else if (KEY(k, "attributes")) {
                     char wa[96];
                     snprintf(wa, sizeof wa, "%s.attributes", where);
@@ -1027,10 +1126,21 @@ static rt_result parse_textures(gl_doc *d, int t)
         tx->tok = e;
         tx->source = tx->sampler = RT_NONE;
         TRY(expect_object(d, e, where));
+        uint32_t webp = RT_NONE;
         FOR_KEYS(d, e, k, v) {
             if (KEY(k, "source")) TRY(get_index(d, where, "source", v, &tx->source));
             else if (KEY(k, "sampler")) TRY(get_index(d, where, "sampler", v, &tx->sampler));
+            else if (KEY(k, "extensions")) {
+                int ew = rt_json_get(&d->j, v, "EXT_texture_webp");
+                int src = ew >= 0 ? rt_json_get(&d->j, ew, "source") : -1;
+                if (src >= 0)
+                    TRY(get_index(d, where, "extensions.EXT_texture_webp.source", src, &webp));
+                tx->other_source = tx->other_source || rt_json_get(&d->j, v, "KHR_texture_basisu") >= 0 ||
+                                   rt_json_get(&d->j, v, "MSFT_texture_dds") >= 0;
+            }
         }
+        if (webp != RT_NONE) /* EXT_texture_webp: the WebP image replaces the fallback source */
+            tx->source = webp;
     }
     return RT_OK;
 }
@@ -1230,6 +1340,84 @@ static bool span_fits(size_t offset, size_t count, size_t stride, size_t elem, s
     return stride == 0 ? true : (count - 1) <= room / stride;
 }
 
+/* "meshes[m].primitives[k]" for the primitive at index p of doc.prims. */
+static const char *prim_name(const gl_doc *d, size_t p, char *buf, size_t cap)
+{
+    for (size_t m = 0; m < d->mesh_count; m++)
+        if (p >= d->meshes[m].first && p - d->meshes[m].first < d->meshes[m].count) {
+            snprintf(buf, cap, "meshes[%zu].primitives[%zu]", m, p - d->meshes[m].first);
+            return buf;
+        }
+    snprintf(buf, cap, "primitive %zu", p);
+    return buf;
+}
+
+/* An EXT_meshopt_compression view: its source inside a buffer with data,
+ * its decoded size its byteLength; a plain view of a fallback buffer
+ * without data has nothing to read. */
+static rt_result validate_meshopt_view(gl_doc *d, size_t i)
+{
+    gl_view *v = &d->views[i];
+    const gl_buffer *b = &d->buffers[v->buffer];
+    if (!v->meshopt) {
+        if (b->fallback && b->uri < 0)
+            return fail_at(d, v->tok, RT_ERR_INVALID,
+                           "bufferViews[%zu] reads buffer %u, an EXT_meshopt_compression fallback with no data", i,
+                           v->buffer);
+        return RT_OK;
+    }
+    CHECK_INDEX(v->mo_buffer, d->buffer_count, v->mo_tok, "buffers",
+                "bufferViews[%zu].extensions.EXT_meshopt_compression.buffer", i);
+    const gl_buffer *src = &d->buffers[v->mo_buffer];
+    if (src->fallback)
+        return fail_at(d, v->mo_tok, RT_ERR_INVALID,
+                       "bufferViews[%zu]: compressed data in buffer %u, which is a fallback buffer", i, v->mo_buffer);
+    if (!span_fits(v->mo_offset, 1, 0, v->mo_length, src->byte_length))
+        return fail_at(d, v->mo_tok, RT_ERR_INVALID,
+                       "bufferViews[%zu]: compressed byteOffset %zu + byteLength %zu runs past buffer %u (%zu bytes)",
+                       i, v->mo_offset, v->mo_length, v->mo_buffer, src->byte_length);
+    if (v->mo_count > v->length / v->mo_stride || v->mo_count * v->mo_stride != v->length)
+        return fail_at(d, v->mo_tok, RT_ERR_INVALID,
+                       "bufferViews[%zu]: count %zu x byteStride %zu is not the view's byteLength %zu", i, v->mo_count,
+                       v->mo_stride, v->length);
+    return RT_OK;
+}
+
+/* Draco primitives: triangles with indices, and every accessor they fill
+ * marked (such accessors need no bufferView, so the limit on all-zero
+ * accessors does not apply to them). */
+static rt_result validate_draco_prims(gl_doc *d)
+{
+    for (size_t p = 0; p < d->prim_count; p++) {
+        gl_prim *pr = &d->prims[p];
+        if (pr->draco_view == RT_NONE)
+            continue;
+        char name[64];
+        prim_name(d, p, name, sizeof name);
+        CHECK_INDEX(pr->draco_view, d->view_count, pr->draco_tok, "bufferViews",
+                    "%s.extensions.KHR_draco_mesh_compression.bufferView", name);
+        if (pr->mode != 4 || pr->indices == RT_NONE)
+            return fail_at(d, pr->draco_tok, RT_ERR_UNSUPPORTED,
+                           "%s: a KHR_draco_mesh_compression primitive must be indexed triangles (mode 4 with "
+                           "indices)", name);
+        CHECK_INDEX(pr->indices, d->accessor_count, pr->tok, "accessors", "%s.indices", name);
+        d->accessors[pr->indices].draco = true;
+        for (int k = 0; k < ATTR_COUNT; k++) {
+            if (pr->draco_id[k] == RT_NONE)
+                continue;
+            if (pr->attr[k] == RT_NONE)
+                return fail_at(d, pr->draco_tok, RT_ERR_INVALID,
+                               "%s: KHR_draco_mesh_compression.attributes.%s has no accessor in the "
+                               "primitive's attributes",
+                               name, attr_names[k]);
+            CHECK_INDEX(pr->attr[k], d->accessor_count, pr->tok, "accessors", "%s.attributes.%s", name,
+                        attr_names[k]);
+            d->accessors[pr->attr[k]].draco = true;
+        }
+    }
+    return RT_OK;
+}
+
 static rt_result validate(gl_doc *d)
 {
     for (size_t i = 0; i < d->view_count; i++) {
@@ -1240,7 +1428,9 @@ static rt_result validate(gl_doc *d)
             return fail_at(d, v->tok, RT_ERR_INVALID,
                            "bufferViews[%zu]: byteOffset %zu + byteLength %zu runs past buffer %u (%zu bytes)", i,
                            v->offset, v->length, v->buffer, blen);
+        TRY(validate_meshopt_view(d, i));
     }
+    TRY(validate_draco_prims(d));
     for (size_t i = 0; i < d->accessor_count; i++) {
         gl_accessor *a = &d->accessors[i];
         size_t es = elem_size(a);
@@ -1257,7 +1447,7 @@ static rt_result validate(gl_doc *d)
                                "accessors[%zu]: byteOffset %zu + %zu elements of %zu bytes (stride %zu) run past "
                                "bufferView %u (%zu bytes)",
                                i, a->offset, a->count, es, stride, a->view, v->length);
-        } else if (a->count > GL_MAX_ZEROS) {
+        } else if (a->count > GL_MAX_ZEROS && !a->draco) {
             return fail_at(d, a->tok, RT_ERR_LIMIT,
                            "accessors[%zu]: count %zu without a bufferView is over the limit %zu", i, a->count,
                            GL_MAX_ZEROS);
@@ -1541,7 +1731,9 @@ static rt_result load_buffers(gl_doc *d)
         char what[48];
         snprintf(what, sizeof what, "buffers[%zu]", i);
         size_t have = 0;
-        if (b->uri < 0) {
+        if (b->uri < 0 && b->fallback && !(d->glb && i == 0 && d->bin)) {
+            continue; /* no data: only compressed views refer to it (validate_meshopt_view) */
+        } else if (b->uri < 0) {
             if (!d->glb || i != 0 || !d->bin)
                 return fail_at(d, b->tok, RT_ERR_INVALID, "%s has no uri and there is no GLB BIN chunk", what);
             b->data = d->bin;
@@ -1601,6 +1793,8 @@ static inline uint32_t comp_uint(const uint8_t *p, int ct)
 static const uint8_t *view_ptr(const gl_doc *d, uint32_t view, size_t offset)
 {
     const gl_view *v = &d->views[view];
+    if (v->decoded)
+        return v->decoded + offset;
     return d->buffers[v->buffer].data + v->offset + offset;
 }
 
@@ -1684,6 +1878,143 @@ static rt_result read_uints(gl_doc *d, uint32_t ai, uint32_t *out)
             TRY(sparse_index(d, ai, k, &prev, &idx));
             out[idx] = comp_uint(vals + k * cs, a->ctype);
         }
+    }
+    return RT_OK;
+}
+
+/* ------------------------------------------------ compressed geometry */
+
+/* Counts bytes about to be decoded against the per-load limit. */
+static rt_result decoded_budget(gl_doc *d, int tok, size_t bytes)
+{
+    if (bytes > GL_MAX_DECODED - d->decoded_bytes)
+        return fail_at(d, tok, RT_ERR_LIMIT, "decompressed data would pass the limit of %zu bytes per file",
+                       GL_MAX_DECODED);
+    d->decoded_bytes += bytes;
+    return RT_OK;
+}
+
+/* EXT_meshopt_compression: every compressed view decoded into its own
+ * bytes, which view_ptr then reads in place of the (fallback) buffer. */
+static rt_result decode_meshopt_views(gl_doc *d)
+{
+    for (size_t i = 0; i < d->view_count; i++) {
+        gl_view *v = &d->views[i];
+        if (!v->meshopt)
+            continue;
+        TRY(decoded_budget(d, v->mo_tok, v->length));
+        v->decoded = malloc(v->length);
+        if (!v->decoded)
+            return fail_at(d, v->mo_tok, RT_ERR_NOMEM, "out of memory for %zu decompressed bytes", v->length);
+        const gl_buffer *src = &d->buffers[v->mo_buffer];
+        const char *why = rt_meshopt_decode(v->decoded, v->mo_count, v->mo_stride, src->data + v->mo_offset,
+                                            v->mo_length, (rt_meshopt_mode)v->mo_mode,
+                                            (rt_meshopt_filter)v->mo_filter);
+        if (why)
+            return fail_at(d, v->mo_tok, RT_ERR_INVALID, "bufferViews[%zu]: EXT_meshopt_compression: %s", i, why);
+    }
+    return RT_OK;
+}
+
+/* Points accessor a at decoded bytes (owned by a new view), as plain
+ * unsigned ints or floats. An accessor fills once: two Draco primitives
+ * sharing one would each claim it. */
+static rt_result fill_accessor(gl_doc *d, uint32_t ai, int tok, void *bytes, size_t length, int ctype)
+{
+    gl_accessor *a = &d->accessors[ai];
+    if (!a->draco) {
+        free(bytes);
+        return fail_at(d, tok, RT_ERR_UNSUPPORTED, "accessors[%u] is filled by two KHR_draco_mesh_compression "
+                       "primitives", ai);
+    }
+    gl_view *views = realloc(d->views, (d->view_count + 1) * sizeof *views);
+    if (!views) {
+        free(bytes);
+        return fail_at(d, tok, RT_ERR_NOMEM, "out of memory");
+    }
+    d->views = views;
+    gl_view *v = &d->views[d->view_count];
+    memset(v, 0, sizeof *v);
+    v->buffer = RT_NONE;
+    v->length = length;
+    v->decoded = bytes;
+    v->tok = tok;
+    a->view = (uint32_t)d->view_count++;
+    a->offset = 0;
+    a->ctype = ctype;
+    a->normalized = false;
+    a->sparse_count = 0;
+    a->draco = false;
+    return RT_OK;
+}
+
+/* One KHR_draco_mesh_compression primitive's indices and attributes from
+ * its decoded mesh, checked against the counts its accessors declare. */
+static rt_result fill_from_draco(gl_doc *d, size_t p, const rt_draco_mesh *m)
+{
+    const gl_prim *pr = &d->prims[p];
+    int tok = pr->draco_tok;
+    char name[64];
+    size_t faces = rt_draco_faces(m), points = rt_draco_points(m);
+    size_t nidx = d->accessors[pr->indices].count;
+    if (faces > SIZE_MAX / 3 || faces * 3 != nidx)
+        return fail_at(d, tok, RT_ERR_INVALID,
+                       "%s: the Draco mesh has %zu triangles, the indices accessor %u has %zu indices", prim_name(d, p, name, sizeof name),
+                       faces, pr->indices, nidx);
+    TRY(decoded_budget(d, tok, nidx * sizeof(uint32_t)));
+    uint32_t *idx = malloc((nidx ? nidx : 1) * sizeof *idx);
+    if (!idx)
+        return fail_at(d, tok, RT_ERR_NOMEM, "out of memory for %zu indices", nidx);
+    rt_draco_indices(m, idx);
+    for (size_t k = 0; k < nidx; k++)
+        if (idx[k] >= points) {
+            free(idx);
+            return fail_at(d, tok, RT_ERR_INVALID, "%s: a Draco triangle names point %u of %zu", prim_name(d, p, name, sizeof name),
+                           idx[k], points);
+        }
+    TRY(fill_accessor(d, pr->indices, tok, idx, nidx * sizeof *idx, GL_UNSIGNED_INT));
+    for (int k = 0; k < ATTR_COUNT; k++) {
+        if (pr->draco_id[k] == RT_NONE)
+            continue;
+        uint32_t ai = pr->attr[k];
+        const gl_accessor *a = &d->accessors[ai];
+        if (points != a->count)
+            return fail_at(d, tok, RT_ERR_INVALID, "%s: the Draco mesh has %zu points, accessor %u (%s) "
+                           "has %zu", prim_name(d, p, name, sizeof name), points, ai, attr_names[k], a->count);
+        int have = rt_draco_components(m, pr->draco_id[k]);
+        if (have == 0)
+            return fail_at(d, tok, RT_ERR_INVALID, "%s: %s is attribute %u, which the Draco mesh does "
+                           "not have", prim_name(d, p, name, sizeof name), attr_names[k], pr->draco_id[k]);
+        size_t n = points * (size_t)a->ncomp;
+        TRY(decoded_budget(d, tok, n * sizeof(float)));
+        float *vals = malloc((n ? n : 1) * sizeof *vals);
+        if (!vals)
+            return fail_at(d, tok, RT_ERR_NOMEM, "out of memory for %zu values", n);
+        if (!rt_draco_attribute(m, pr->draco_id[k], a->ncomp, vals)) {
+            free(vals);
+            return fail_at(d, tok, RT_ERR_INVALID, "%s: Draco attribute %u (%s) cannot be read as "
+                           "%d floats", prim_name(d, p, name, sizeof name), pr->draco_id[k], attr_names[k], a->ncomp);
+        }
+        TRY(fill_accessor(d, ai, tok, vals, n * sizeof *vals, GL_FLOAT));
+    }
+    return RT_OK;
+}
+
+static rt_result decode_draco_prims(gl_doc *d)
+{
+    for (size_t p = 0; p < d->prim_count; p++) {
+        const gl_prim *pr = &d->prims[p];
+        if (pr->draco_view == RT_NONE)
+            continue;
+        char why[200], name[64];
+        rt_draco_mesh *m = rt_draco_decode(view_ptr(d, pr->draco_view, 0), d->views[pr->draco_view].length, why,
+                                           sizeof why);
+        if (!m)
+            return fail_at(d, pr->draco_tok, RT_ERR_INVALID, "%s: KHR_draco_mesh_compression: %s", prim_name(d, p, name, sizeof name),
+                           why);
+        rt_result r = fill_from_draco(d, p, m);
+        rt_draco_free(m);
+        TRY(r);
     }
     return RT_OK;
 }
@@ -1894,7 +2225,7 @@ static rt_result load_image(gl_doc *d, rt_scene *s, uint32_t ii, uint32_t *out, 
         snprintf(label, sizeof label, "bufferView %u", im->view);
         char name[300];
         snprintf(name, sizeof name, "%.250s#image%u", d->path, ii);
-        r = rt_image_load_memory(s, d->buffers[v->buffer].data + v->offset, v->length, name, &img, &inner);
+        r = rt_image_load_memory(s, view_ptr(d, im->view, 0), v->length, name, &img, &inner);
     } else {
         char *uri;
         TRY(token_string(d, im->uri, what, &uri));
@@ -1958,8 +2289,8 @@ static rt_result load_textures(gl_doc *d, rt_scene *s, rt_gltf_stats *st)
         d->texture_map[i] = RT_NONE;
         d->texture_missing[i] = false;
         if (gt->source == RT_NONE) {
-            rt_warn("%s: textures[%zu] has no source rt can read (KTX2/WebP extensions are not supported); "
-                    "left untextured", d->path, i);
+            rt_warn("%s: textures[%zu] has no source rt can read%s; left untextured", d->path, i,
+                    gt->other_source ? " (KHR_texture_basisu / KTX2 and DDS images are not supported)" : "");
             continue;
         }
         bool fresh = d->image_map[gt->source] == RT_NONE, missing;
@@ -2173,6 +2504,8 @@ static void doc_free(gl_doc *d)
 {
     for (size_t i = 0; i < d->buffer_count; i++)
         free(d->buffers[i].owned);
+    for (size_t i = 0; i < d->view_count; i++)
+        free(d->views[i].decoded);
     free(d->buffers); free(d->views); free(d->accessors); free(d->meshes); free(d->prims);
     free(d->nodes); free(d->children); free(d->scenes); free(d->scene_nodes); free(d->materials);
     free(d->textures); free(d->samplers); free(d->images); free(d->cameras); free(d->lights);
@@ -2212,6 +2545,8 @@ static rt_result load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_glt
     TRY(parse_document(d));
     TRY(validate(d));
     TRY(load_buffers(d));
+    TRY(decode_meshopt_views(d));
+    TRY(decode_draco_prims(d));
     return flatten(d, s, opt, st);
 }
 

@@ -1,5 +1,5 @@
 /* texture.c - images decoded once (stb_image behind our own size checks,
- * OpenEXR through rt/io/exr.h),
+ * OpenEXR through rt/io/exr.h, WebP through rt/io/webp.h),
  * textures as image + sampler or a procedural pattern, and lookups.
  *
  * Lookups follow the glTF conventions, which are rt's internal ones: UV (0,0)
@@ -24,6 +24,7 @@
 
 #include "rt/base/file.h"
 #include "rt/io/exr.h"
+#include "rt/io/webp.h"
 
 /* sRGB 8-bit code -> linear value, from the IEC 61966-2-1 formula. */
 static const float srgb_table[256] = {
@@ -234,6 +235,22 @@ rt_result rt_image_load_memory(rt_scene *s, const void *data, size_t size, const
         uint32_t idx = rt_scene_add_image(s, &img);
         if (idx == RT_NONE) {
             free(img.rgbaf);
+            return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", name);
+        }
+        *image = idx;
+        return RT_OK;
+    }
+    if (rt_webp_is(bytes, size)) { /* 8-bit RGBA like PNG */
+        rt_image img;
+        memset(&img, 0, sizeof img);
+        snprintf(img.name, sizeof img.name, "%s", name);
+        rt_result r = rt_webp_decode(bytes, size, name, RT_MAX_IMAGE_DIM, RT_MAX_IMAGE_PIXELS, &img.rgba8, &img.width,
+                                     &img.height, err);
+        if (r != RT_OK)
+            return r;
+        uint32_t idx = rt_scene_add_image(s, &img);
+        if (idx == RT_NONE) {
+            free(img.rgba8);
             return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", name);
         }
         *image = idx;

@@ -9,12 +9,15 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "rt/io/draco.h"
 #include "rt/io/exr.h"
 #include "rt/io/load.h"
+#include "rt/io/meshopt.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/texture.h"
 
-const char *const rt_fuzz_targets[] = {"scene", "gltf", "glb", "gltf_bin", "obj", "ply", "off", "image", "exr", NULL};
+const char *const rt_fuzz_targets[] = {"scene", "gltf",  "glb", "gltf_bin", "obj",   "ply",
+                                       "off",   "image", "exr", "meshopt",  "draco", NULL};
 
 static char dir[64];
 
@@ -79,6 +82,51 @@ static void load(const char *name, const uint8_t *data, size_t size)
     rt_scene_free(&s);
 }
 
+/* meshopt: mode, filter, stride / 4 - 1 (or the index size), count (u16
+ * little-endian), then the stream; shapes the extension forbids are
+ * refused by rt_meshopt_check as in a glTF file. */
+static void fuzz_meshopt(const uint8_t *data, size_t size)
+{
+    if (size < 5)
+        return;
+    rt_meshopt_mode mode = (rt_meshopt_mode)(data[0] % 3);
+    rt_meshopt_filter filter = (rt_meshopt_filter)(data[1] % 4);
+    size_t stride = mode == RT_MESHOPT_ATTRIBUTES ? ((size_t)data[2] % 64 + 1) * 4 : (data[2] & 1 ? 4 : 2);
+    size_t count = (size_t)data[3] | (size_t)data[4] << 8;
+    if (rt_meshopt_check(mode, filter, count, stride))
+        return;
+    uint8_t *dst = malloc(count * stride);
+    if (dst)
+        rt_meshopt_decode(dst, count, stride, data + 5, size - 5, mode, filter);
+    free(dst);
+}
+
+/* draco: a Draco stream, decoded, then its indices and the attributes of
+ * unique ids 0..7 read as a glTF loader reads them. */
+static void fuzz_draco(const uint8_t *data, size_t size)
+{
+    char why[200];
+    rt_draco_mesh *m = rt_draco_decode(data, size, why, sizeof why);
+    if (!m)
+        return;
+    size_t faces = rt_draco_faces(m), points = rt_draco_points(m);
+    if (faces <= ((size_t)1 << 22) && points <= ((size_t)1 << 22)) {
+        uint32_t *idx = malloc((3 * faces + 1) * sizeof *idx);
+        float *vals = malloc((4 * points + 1) * sizeof *vals);
+        if (idx && vals) {
+            rt_draco_indices(m, idx);
+            for (uint32_t id = 0; id < 8; id++) {
+                int n = rt_draco_components(m, id);
+                if (n > 0)
+                    rt_draco_attribute(m, id, n < 4 ? n : 4, vals);
+            }
+        }
+        free(idx);
+        free(vals);
+    }
+    rt_draco_free(m);
+}
+
 int rt_fuzz_run(const char *target, const uint8_t *data, size_t size)
 {
     char path[256];
@@ -115,6 +163,10 @@ int rt_fuzz_run(const char *target, const uint8_t *data, size_t size)
         int w, h;
         if (rt_exr_decode(data, size, "fuzz.exr", 4096, (uint64_t)1 << 22, &rgba, &w, &h, &err) == RT_OK)
             free(rgba);
+    } else if (strcmp(target, "meshopt") == 0) {
+        fuzz_meshopt(data, size);
+    } else if (strcmp(target, "draco") == 0) {
+        fuzz_draco(data, size);
     } else {
         return -1;
     }

@@ -8,8 +8,11 @@
  * length, the JSON, then the buffer, which the JSON must name
  * "buffer.bin"), obj (u32 OBJ length, the OBJ, then an MTL named
  * "m.mtl"), ply, off, image (any image bytes through our size checks),
- * exr (OpenEXR bytes straight into rt_exr_decode, capped at 4096 a side).
- * Every target but image loads through rt_load_memory, as `rt` loads a file
+ * exr (OpenEXR bytes straight into rt_exr_decode, capped at 4096 a side),
+ * meshopt (an EXT_meshopt_compression stream: mode, filter, stride and a
+ * u16 count in the first five bytes) and draco (a Draco mesh stream, its
+ * indices and attributes read back).
+ * Every target but image, exr, meshopt and draco loads through rt_load_memory, as `rt` loads a file
  * of that kind (fuzz.txt, fuzz.gltf, fuzz.obj, ...): the content picks the
  * reader before the name does.
  */

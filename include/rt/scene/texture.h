@@ -1,7 +1,8 @@
 /* rt/texture.h - images (decoded once, cached by name) and texture lookups.
  *
  * Images are decoded with stb_image (PNG, JPEG, HDR, and the rest of what it
- * reads) behind our own checks: a header whose size is over the limit is
+ * reads), OpenEXR (rt/io/exr.h) and libwebp (rt/io/webp.h), chosen by
+ * content, behind our own checks: a header whose size is over the limit is
  * refused before any pixel memory is allocated. Loading the same file twice
  * returns the same image index.
  *
