@@ -251,6 +251,19 @@ static void test_wavefront_equals_scalar(void **state)
     for (size_t b = 0; b < 4; b++)
         check_against_scalar(&f, batches[b], b == 1 ? 5 : 48, 0, 16, 6);
     unload(&f);
+    /* 300 lights: the batch shrinks to keep its light samples bounded */
+    static char many[300 * 64 + 512];
+    int n = snprintf(many, sizeof many, "integrator path\nresolution 16 8\nsamples 2\n"
+                                        "camera position 0 1 5 look_at 0 0 0 fov 50\n"
+                                        "material m color 0.7 0.7 0.7\nquad -5 0 5  10 0 0  0 0 -10  m\n"
+                                        "sphere 0 0.5 0 0.5 m\n");
+    for (int l = 0; l < 300; l++)
+        n += snprintf(many + n, sizeof many - (size_t)n, "light point %d 2 %d  1 1 1  0.1\n", l % 20 - 10,
+                      l / 20 - 7);
+    load_text(&f, many);
+    assert_int_equal(f.s.light_count, 300);
+    check_against_scalar(&f, 4096, 128, 0, 8, 2);
+    unload(&f);
     load_cornell(&f, 32);
     assert_false(f.rs.shadows_need_shading);
     check_against_scalar(&f, 64, 13, 8, 24, 8);

@@ -47,6 +47,9 @@ enum lane_status {
 };
 
 enum { KIND_BUCKETS = 8 }; /* material kinds (rt_bsdf_model) sorted apart; more fold into the last */
+/* light-sampling records a batch holds at most (about 80 bytes each with
+ * their shadow rays): the batch shrinks in scenes with many lights */
+#define MAX_RECORDS ((size_t)1 << 18)
 
 struct rt_wavefront {
     size_t batch;        /* lanes */
@@ -94,6 +97,8 @@ rt_wavefront *rt_wavefront_new(size_t batch, const rt_render_state *state)
     if (B > ((size_t)1 << 24))
         B = (size_t)1 << 24;
     size_t K = state->scene->light_count + 2;
+    if (B * K > MAX_RECORDS) /* many lights: fewer paths, not gigabytes of light samples */
+        B = MAX_RECORDS / K > 0 ? MAX_RECORDS / K : 1;
     size_t R = B * K;
     wf->batch = B;
     wf->rec_per_path = K;

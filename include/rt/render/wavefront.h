@@ -44,7 +44,8 @@ typedef struct rt_wavefront_work {
 } rt_wavefront_work;
 
 /* Room for batch paths (0: RT_WAVEFRONT_BATCH) and their light samples in
- * the scene of `state`; NULL when out of memory. */
+ * the scene of `state` (fewer paths when its lights would need more than
+ * 2^18 light-sample records: about 20 MB); NULL when out of memory. */
 rt_wavefront *rt_wavefront_new(size_t batch, const rt_render_state *state);
 void rt_wavefront_free(rt_wavefront *wf);
 
