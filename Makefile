@@ -9,6 +9,8 @@
 #   make denoiser     Intel Open Image Denoise for --denoise: the pyoidn wheel in build/oidn-venv
 #   make install      rt, the library and its headers, and a pkg-config file
 #                     (PREFIX=/usr/local, DESTDIR for staging); make test-install checks it
+#   make test-slurm   the Slurm launcher (examples/slurm) on a real Slurm started here (root)
+#   make test-kubernetes / test-parallel   the Kubernetes and GNU parallel launchers, run locally
 #   make clean
 #
 # Variables: WERROR=1 turns warnings into errors (CI sets it); PORTABLE=1
@@ -52,6 +54,8 @@ TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 DEPS_OK  := $(BUILD)/.deps-ok
 
+
+.PHONY: test-slurm test-kubernetes test-parallel test-launchers
 .PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build fuzz install uninstall test-install denoiser
 all: $(RT)
 
@@ -194,6 +198,17 @@ uninstall:
 # through pkg-config, as a user of the library would (run by .ci/run).
 test-install: $(RT) $(BUILD)/librt.a
 	@CC="$(CC)" sh tests/install.sh
+
+# The launchers of examples/ (docs/farm.md), not in `make test`: they install
+# tools (slurm-wlm, parallel) and start daemons. Each renders a small scene
+# through its launcher and checks the merged image against a single render.
+test-slurm: $(RT)
+	@RT_BIN=./$(RT) sh tests/slurm.sh
+test-kubernetes: $(RT)
+	@RT_BIN=./$(RT) sh tests/kubernetes.sh
+test-parallel: $(RT)
+	@RT_BIN=./$(RT) sh tests/parallel.sh
+test-launchers: test-kubernetes test-parallel test-slurm
 
 clean:
 	rm -rf build build-asan build-tsan build-profile build-fuzz build-portable rt rt-portable rt-profile bench/rtbench bench/buildscale

@@ -12,7 +12,7 @@
 set -eu
 SECONDS_EACH=${FUZZ_SECONDS:-60}
 SHARED=${SHARED:-../shared}
-TARGETS=${FUZZ_TARGETS:-"scene gltf glb gltf_bin obj ply off image exr meshopt draco"}
+TARGETS=${FUZZ_TARGETS:-"scene gltf glb gltf_bin obj ply off image exr meshopt draco part"}
 B=build-fuzz
 
 if ! command -v clang >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
@@ -50,7 +50,7 @@ printf '%-10s %12s %14s %8s\n' target execs/s total_execs crashes | tee "$summar
 for t in $TARGETS; do
     clang $CFLAGS -fsanitize=fuzzer -DRT_FUZZ_TARGET="\"$t\"" -o $B/fuzz_$t tests/fuzz/fuzz_main.c $B/harness.o $B/obj/*.o \
         -lstb -lOpenEXRCore -lmeshoptimizer -ldraco -lwebp -lstdc++ -ldl -lpthread -lm
-    mkdir -p $B/corpus/$t $B/crashes/$t
+    mkdir -p $B/corpus/$t $B/crashes/$t $B/seeds/$t
     dict=""
     case $t in
         gltf|glb|gltf_bin) dict="-dict=tests/fuzz/gltf.dict" ;;

@@ -11,9 +11,54 @@
 #                  EXT_texture_webp
 # and, optionally (rt builds and runs without them; a failed install is only
 # reported): libsdl2-dev for --window, xvfb for the test that opens it.
+#
+# With arguments PACKAGE:COMMAND or PACKAGE ..., it installs instead just
+# the packages whose COMMAND is not on the PATH (or in /usr/sbin), or which
+# dpkg does not list as installed, for the launcher tests:
+#   sh tools/install-deps.sh slurm-wlm:slurmctld   (make test-slurm)
+#   sh tools/install-deps.sh parallel rsync:rsync  (make test-parallel)
+#   sh tools/install-deps.sh python3-yaml          (make test-kubernetes)
 set -eu
 CC=${CC:-cc}
 CXX=${CXX:-c++}
+
+# apt-get install PACKAGE..., as root or through sudo; refreshes the package
+# lists once if the install fails (a fresh machine has none yet).
+apt_install() {
+    if [ "$(id -u)" -eq 0 ]; then
+        SUDO=""
+    elif command -v sudo >/dev/null 2>&1; then
+        SUDO="sudo"
+        echo "rt: (using sudo for apt-get)" >&2
+    else
+        echo "rt: error: need root or sudo to install:$*" >&2
+        echo "rt: install them yourself with: apt-get install $*" >&2
+        exit 1
+    fi
+    export DEBIAN_FRONTEND=noninteractive
+    # (DPkg::Lock::Timeout: waiting up to 5 minutes for another apt-get or dpkg)
+    if ! $SUDO apt-get install -o DPkg::Lock::Timeout=300 -y -q "$@" >&2; then
+        $SUDO apt-get update -o DPkg::Lock::Timeout=300 -q >&2
+        $SUDO apt-get install -o DPkg::Lock::Timeout=300 -y -q "$@" >&2
+    fi
+}
+
+if [ $# -gt 0 ]; then
+    tools=""
+    for a in "$@"; do
+        case " $tools " in *" ${a%%:*} "*) continue ;; esac
+        case $a in
+            *:*) command -v "${a#*:}" >/dev/null 2>&1 || [ -x "/usr/sbin/${a#*:}" ] || tools="$tools ${a%%:*}" ;;
+            *) dpkg-query -W -f '${Status}' "$a" 2>/dev/null | grep -q 'ok installed' || tools="$tools $a" ;;
+        esac
+    done
+    [ -n "$tools" ] || exit 0
+    echo "rt: installing missing packages:$tools" >&2
+    # shellcheck disable=SC2086 # the package names are words
+    apt_install $tools
+    echo "rt: installed:$tools" >&2
+    exit 0
+fi
 missing=""
 check() { # header package [language]
     if ! printf '#include <%s>\n' "$1" | "${4:-$CC}" -E -x "${3:-c}" - >/dev/null 2>&1; then
@@ -53,22 +98,7 @@ if [ -z "$missing" ]; then
 fi
 
 echo "rt: installing missing build packages:$missing" >&2
-if [ "$(id -u)" -eq 0 ]; then
-    SUDO=""
-elif command -v sudo >/dev/null 2>&1; then
-    SUDO="sudo"
-    echo "rt: (using sudo for apt-get)" >&2
-else
-    echo "rt: error: need root or sudo to install:$missing" >&2
-    echo "rt: install them yourself with: apt-get install$missing" >&2
-    exit 1
-fi
-export DEBIAN_FRONTEND=noninteractive
-# A fresh machine has no package lists yet; refresh them once if the install fails.
-# (DPkg::Lock::Timeout: wait for another apt run instead of failing at once)
-if ! $SUDO apt-get install -y -q -o DPkg::Lock::Timeout=300 $missing >&2; then
-    $SUDO apt-get update -q >&2
-    $SUDO apt-get install -y -q -o DPkg::Lock::Timeout=300 $missing >&2
-fi
+# shellcheck disable=SC2086 # the package names are words
+apt_install $missing
 echo "rt: installed:$missing" >&2
 install_optional

@@ -64,8 +64,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 #include "rt/base/clock.h"
+#include "rt/base/cpu.h"
 #include "rt/base/log.h"
 #include "rt/base/alloc.h"
 
@@ -814,7 +814,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     if (eb > 1.0)
         eb = 1.0;
     c.lambda = 1.0 - eb;
-    int threads = params && params->threads > 0 ? params->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    int threads = params && params->threads > 0 ? params->threads : rt_cpu_count();
     if (threads < 1)
         threads = 1;
     if (threads > 64)

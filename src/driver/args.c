@@ -33,6 +33,8 @@ typedef enum flag_kind {
     FLAG_LOOK_AT,
     FLAG_UP,
     FLAG_FOV,
+    FLAG_FRAME_TIME,
+    FLAG_ANIMATION,
     FLAG_TILE,
     FLAG_PREVIEW,
     FLAG_PASSES,
@@ -46,6 +48,13 @@ typedef enum flag_kind {
     FLAG_HALF,
     FLAG_DENOISE,
     FLAG_AOV,
+    FLAG_CROP,
+    FLAG_PART,
+    FLAG_SPP_RANGE,
+    FLAG_RESUME,
+    FLAG_PART_OUT,
+    FLAG_FRAMES,
+    FLAG_FPS,
     FLAG_HELP,
     FLAG_VERSION,
 } flag_kind;
@@ -91,6 +100,9 @@ static const flag flags[] = {
     {NULL, "--look-at", "X,Y,Z", FLAG_LOOK_AT, NULL, "point the camera looks at"},
     {NULL, "--up", "X,Y,Z", FLAG_UP, NULL, "camera up direction"},
     {NULL, "--fov", "DEG", FLAG_FOV, NULL, "vertical field of view in degrees, between 0 and 180"},
+    {NULL, "--frame-time", "SECONDS", FLAG_FRAME_TIME, NULL,
+     "pose an animated glTF at this time: its animation, skins and morph targets (default: the file's static pose)"},
+    {NULL, "--animation", "N", FLAG_ANIMATION, NULL, "which glTF animation --frame-time plays (default 0, the first)"},
     {NULL, "--tile", "N", FLAG_TILE, NULL, "tile size in pixels (default 32)"},
     {NULL, "--preview", "SECONDS", FLAG_PREVIEW, NULL,
      "live view: rewrite the output with the finished tiles every SECONDS"},
@@ -107,6 +119,21 @@ static const flag flags[] = {
      "print what a scene or model contains and how it would render (key: value lines) and exit; "
      "more files may follow (rt --info a.glb b.txt), one block each"},
     {NULL, "--max-memory", "SIZE", FLAG_MAX_MEMORY, NULL, "memory budget, e.g. 4G or 512M; 'none' for no limit"},
+    {NULL, "--crop", "X0 Y0 X1 Y1", FLAG_CROP, NULL,
+     "render only pixels X0 <= x < X1, Y0 <= y < Y1 as a part (docs/farm.md): a float image of sums and counts "
+     "(.exr or .pfm) with a NAME.json sidecar, for rt merge"},
+    {NULL, "--part", "I/N", FLAG_PART, NULL,
+     "render part I (0 .. N-1) of N bands of rows of similar cost, as a part (docs/farm.md)"},
+    {NULL, "--spp-range", "A:B", FLAG_SPP_RANGE, NULL,
+     "render only samples A .. B-1 of every pixel (of the -s samples), as a part (docs/farm.md)"},
+    {NULL, "--resume", "PART", FLAG_RESUME, NULL,
+     "continue a part (one stopped by --time-limit or Ctrl-C) to all samples: exactly the sums a straight render "
+     "makes"},
+    {NULL, "--part-out", "FILE", FLAG_PART_OUT, NULL,
+     "also write the render as a part FILE (.exr or .pfm, with FILE.json), e.g. to --resume it after a stop"},
+    {NULL, "--frames", "A:B", FLAG_FRAMES, NULL,
+     "render frames A .. B-1, each on its own, at time frame / fps; -o names them with %04d (out.%04d.png)"},
+    {NULL, "--fps", "F", FLAG_FPS, NULL, "frames per second for --frames (default 24)"},
     {"-h", "--help", NULL, FLAG_HELP, NULL, "this text"},
     {NULL, "--version", NULL, FLAG_VERSION, NULL, "print the version"},
 };
@@ -149,6 +176,7 @@ static void usage(FILE *f)
     fprintf(f, "usage: rt [options] [SCENE.txt | MODEL.gltf | MODEL.glb | MESH.obj | MESH.ply | MESH.off | -]\n"
                "       rt compare CANDIDATE REFERENCE [--max-rmse X] [--max-flip X] ...  (docs/compare.md)\n"
                "       rt convert IN OUT [--exposure EV] [--tonemap NAME] [--half]  (docs/hdr.md)\n"
+               "       rt merge PART... -o OUT [--exposure EV] [--tonemap NAME] [--half]  (docs/farm.md)\n"
                "\n"
                "Renders a scene to an image. With no input, renders the built-in Cornell box to out.png;\n"
                "'-' reads a scene, glTF or mesh from standard input. A model given directly renders with\n"
@@ -168,7 +196,8 @@ static void usage(FILE *f)
             rt_setting_default_text(def, dflt, sizeof dflt);
             snprintf(text, sizeof text, "%s (%s; default %s)", def->help, range, dflt);
         } else if (fl->kind == FLAG_THREADS) {
-            snprintf(text, sizeof text, "%s (default: all %d cores)", fl->help, rt_cpu_count());
+            int n = rt_cpu_count();
+            snprintf(text, sizeof text, "%s (default: %d, every CPU this process may use)", fl->help, n);
         } else if (fl->kind == FLAG_MAX_MEMORY) {
             char budget[32];
             memory_budget_format(memory_budget_default(), budget, sizeof budget);
@@ -336,6 +365,7 @@ int args_parse(args *a, int argc, char **argv)
     a->camera = -1;
     a->log_level = RT_LOG_NORMAL;
     a->budget.bytes = memory_budget_default();
+    a->fps = 24.0;
     bool flags_ended = false;
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
@@ -458,6 +488,22 @@ int args_parse(args *a, int argc, char **argv)
             if (a->pass_samples == 0)
                 a->pass_samples = -1; /* rt_render's "tiles" */
             break;
+        case FLAG_FRAME_TIME: {
+            float t = 0.0f;
+            if (rt_parse_float(value, &t) != RT_NUMBER_OK || !(fabsf(t) <= 1e7f))
+                return fail_usage("%s wants seconds (a finite number, at most 1e7 in size), got '%s'", name, value);
+            a->frame_time = t;
+            a->posed = true;
+            break;
+        }
+        case FLAG_ANIMATION: {
+            long long n = 0;
+            if (rt_parse_int(value, &n) != RT_NUMBER_OK || n < 0 || n > 1000000)
+                return fail_usage("%s wants an animation index (0 = the first), got '%s'", name, value);
+            a->animation = (int)n;
+            a->posed = true;
+            break;
+        }
         case FLAG_TIME_LIMIT: {
             float s = 0.0f;
             if (rt_parse_float(value, &s) != RT_NUMBER_OK || !(s > 0.0f && s <= 1e7f))
@@ -511,6 +557,91 @@ int args_parse(args *a, int argc, char **argv)
                 return fail_usage("%s wants a list such as albedo,normal", name);
             break;
         }
+        case FLAG_CROP: {
+            /* four numbers, as four words (pbrt's habit) or X0,Y0,X1,Y1 */
+            const char *w[4] = {value, NULL, NULL, NULL};
+            char buf[128];
+            int nw = 1;
+            if (strchr(value, ',')) {
+                snprintf(buf, sizeof buf, "%s", value);
+                char *c = buf;
+                for (nw = 0; nw < 4 && c; nw++) {
+                    w[nw] = c;
+                    c = strchr(c, ',');
+                    if (c)
+                        *c++ = 0;
+                }
+                if (c)
+                    nw = 5;
+            } else {
+                while (nw < 4 && i + 1 < argc && !looks_like_flag(argv[i + 1]))
+                    w[nw++] = argv[++i];
+            }
+            bool ok = nw == 4;
+            for (int k = 0; k < 4 && ok; k++)
+                ok = int_value(w[k], 0, 32768, &a->crop[k]);
+            if (!ok || a->crop[0] >= a->crop[2] || a->crop[1] >= a->crop[3])
+                return fail_usage("%s wants four pixel bounds X0 Y0 X1 Y1 with X0 < X1 and Y0 < Y1 (half-open: "
+                                  "--crop 0 0 64 32 is the top-left 64x32 pixels)",
+                                  name);
+            a->has_crop = true;
+            break;
+        }
+        case FLAG_PART: {
+            const char *slash = strchr(value, '/');
+            char ib[32];
+            if (!slash || (size_t)(slash - value) >= sizeof ib)
+                return fail_usage("%s wants I/N (part I of N, I from 0 to N-1), got '%s'", name, value);
+            memcpy(ib, value, (size_t)(slash - value));
+            ib[slash - value] = 0;
+            if (!int_value(ib, 0, 32767, &a->part_index) || !int_value(slash + 1, 1, 32768, &a->part_count) ||
+                a->part_index >= a->part_count)
+                return fail_usage("%s wants I/N with N from 1 to 32768 and I from 0 to N-1 (parts count from 0), "
+                                  "got '%s'",
+                                  name, value);
+            break;
+        }
+        case FLAG_SPP_RANGE: {
+            const char *colon = strchr(value, ':');
+            char ab[32];
+            if (!colon || (size_t)(colon - value) >= sizeof ab)
+                return fail_usage("%s wants A:B (samples A to B-1), got '%s'", name, value);
+            memcpy(ab, value, (size_t)(colon - value));
+            ab[colon - value] = 0;
+            if (!int_value(ab, 0, RT_MAX_SAMPLES - 1, &a->spp_begin) ||
+                !int_value(colon + 1, 1, RT_MAX_SAMPLES, &a->spp_end) || a->spp_begin >= a->spp_end)
+                return fail_usage("%s wants A:B with 0 <= A < B <= %d (samples A to B-1), got '%s'", name,
+                                  RT_MAX_SAMPLES, value);
+            a->has_spp_range = true;
+            break;
+        }
+        case FLAG_RESUME:
+            a->resume = value;
+            break;
+        case FLAG_PART_OUT:
+            a->part_out = value;
+            break;
+        case FLAG_FRAMES: {
+            const char *colon = strchr(value, ':');
+            char fb[32];
+            if (!colon || (size_t)(colon - value) >= sizeof fb)
+                return fail_usage("%s wants A:B (frames A to B-1), got '%s'", name, value);
+            memcpy(fb, value, (size_t)(colon - value));
+            fb[colon - value] = 0;
+            if (!int_value(fb, 0, 99999999, &a->frame_begin) || !int_value(colon + 1, 1, 100000000, &a->frame_end) ||
+                a->frame_begin >= a->frame_end)
+                return fail_usage("%s wants A:B with 0 <= A < B <= 100000000 (frames A to B-1), got '%s'", name,
+                                  value);
+            a->has_frames = true;
+            break;
+        }
+        case FLAG_FPS: {
+            float f = 0.0f;
+            if (rt_parse_float(value, &f) != RT_NUMBER_OK || !(f > 0.0f && f <= 10000.0f))
+                return fail_usage("%s wants frames per second (more than 0, at most 10000), got '%s'", name, value);
+            a->fps = (double)f;
+            break;
+        }
         case FLAG_MAX_MEMORY:
             if (!memory_budget_parse(value, &a->budget.bytes))
                 return fail_usage("%s wants a size such as 4G, 512M or 'none', got '%s'", name, value);
@@ -520,11 +651,18 @@ int args_parse(args *a, int argc, char **argv)
             break;
         }
     }
+    if (a->part_count && a->has_crop)
+        return fail_usage("--part and --crop both choose the region; give one of them");
+    if (a->resume && (a->part_count || a->has_crop || a->has_spp_range))
+        return fail_usage("--resume takes the region and samples from the part it continues; drop --part, --crop "
+                          "and --spp-range");
     if (!a->info_path && a->more_input_count)
         return fail_usage("only one input file, please (got a second: '%s'); --info takes several",
                           a->more_inputs[0]);
     return ARGS_OK;
 }
+
+bool args_output_is_part(const args *a) { return a->has_crop || a->part_count > 0 || a->has_spp_range; }
 
 bool args_sets(const args *a, const char *name)
 {

@@ -58,6 +58,9 @@ typedef struct args {
     bool has_look_from, has_look_at, has_up, has_fov;
     rt_vec3 look_from, look_at, up;
     float fov;
+    bool posed;             /* --frame-time or --animation: pose an animated glTF */
+    float frame_time;       /* --frame-time seconds (0 with --animation alone) */
+    int animation;          /* --animation N (0 = the first) */
     double preview_seconds; /* --preview; 0 = no live view */
     int pass_samples;       /* --passes: rt_render_options.pass_samples (0 = the integrator's, -1 = tiles) */
     double time_limit;      /* --time-limit seconds; 0 = none */
@@ -70,6 +73,17 @@ typedef struct args {
     bool half;              /* --half: EXR in half floats */
     bool denoise;           /* --denoise: Intel Open Image Denoise on the render */
     unsigned aovs;          /* --aov: bit k for aov_names[k] */
+    /* parts of a render spread over machines (docs/farm.md) */
+    bool has_crop;          /* --crop X0 Y0 X1 Y1 */
+    int crop[4];
+    int part_index, part_count; /* --part I/N; part_count 0 = none */
+    bool has_spp_range;     /* --spp-range A:B */
+    int spp_begin, spp_end;
+    const char *resume;     /* --resume PART: continue that part */
+    const char *part_out;   /* --part-out FILE: also write the render as a part */
+    bool has_frames;        /* --frames A:B: frames A .. B-1, the output a %04d pattern */
+    int frame_begin, frame_end;
+    double fps;             /* --fps; 24 unless given */
     setting_flag settings[ARGS_MAX_SETTINGS];
     size_t setting_count;
 } args;
@@ -82,6 +96,9 @@ extern const char *const aov_names[AOV_COUNT];
 int args_parse(args *a, int argc, char **argv);
 /* True when a flag sets the setting called `name` (e.g. "resolution"). */
 bool args_sets(const args *a, const char *name);
+/* True when the output is a part rather than an image: --crop, --part or
+ * --spp-range given (--resume decides later, from the part it continues). */
+bool args_output_is_part(const args *a);
 /* Applies the setting flags to the loaded scene, in command-line order. */
 rt_result args_apply_settings(const args *a, rt_scene *s, rt_error *err);
 

@@ -25,4 +25,10 @@ int rt_cmd_compare_to(int argc, char **argv, FILE *out, FILE *errs);
 int rt_cmd_convert(int argc, char **argv);
 int rt_cmd_convert_to(int argc, char **argv, FILE *out, FILE *errs);
 
+/* rt merge PART... -o OUT [--exposure EV] [--tonemap NAME] [--half]
+ * (docs/farm.md): the parts of one render into its image. Exit status 0
+ * when written, 2 when the parts do not make one image (nothing written). */
+int rt_cmd_merge(int argc, char **argv);
+int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs);
+
 #endif

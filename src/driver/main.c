@@ -2,7 +2,10 @@
  * (args.c), load the scene or model, validate it, apply the setting flags,
  * frame the camera and check the limits, build the kd-tree, render on all
  * cores (progress.c draws the progress bar and the live preview), write the
- * image.
+ * image. A part of a render spread over machines (--part, --crop,
+ * --spp-range, --resume, --part-out: part.c, docs/farm.md) renders its
+ * region and samples and writes its sums; `rt merge` (merge.c) puts parts
+ * together. --frames A:B runs the whole pipeline once a frame (frames.c).
  *
  * Exit status: 0 on success (also when --time-limit stopped the render),
  * 2 for bad input (flags, scene files, models, images, an unwritable
@@ -39,7 +42,9 @@
 #include "args.h"
 #include "commands.h"
 #include "memory_budget.h"
+#include "frames.h"
 #include "output.h"
+#include "part.h"
 #include "progress.h"
 #include "tev.h"
 #include "window.h"
@@ -181,13 +186,15 @@ static void print_vec(const char *key, rt_vec3 v) { printf("%s: %.9g %.9g %.9g\n
 /* --info for one input: one `key: value` line per figure, for people and
  * scripts. The counts are the file's own (loaded as it is); the settings
  * and camera are what `rt FILE` would render with, before any flag. */
-static int print_info(const char *path, const memory_budget *budget)
+static int print_info(const char *path, const args *a)
 {
+    const memory_budget *budget = &a->budget;
     rt_scene s;
     rt_scene_init(&s);
     rt_error err = {0};
     rt_load_info info;
-    rt_result r = load_input(&s, path, NULL, &info, &err);
+    rt_load_options lo = {.use_time = a->posed, .time = a->frame_time, .animation = a->animation};
+    rt_result r = load_input(&s, path, &lo, &info, &err);
     if (r != RT_OK) {
         report(&err, budget);
         rt_scene_free(&s);
@@ -258,7 +265,7 @@ static int print_info(const char *path, const memory_budget *budget)
  * any of them failed to load (the others are still reported). */
 static int print_infos(const args *a)
 {
-    int status = print_info(a->info_path, &a->budget);
+    int status = print_info(a->info_path, a);
     const char *rest[ARGS_MAX_INPUTS + 1];
     size_t n = 0;
     if (a->input)
@@ -268,7 +275,7 @@ static int print_infos(const args *a)
     for (size_t i = 0; i < n; i++) {
         printf("\n");
         fflush(stdout);
-        if (print_info(rest[i], &a->budget) != 0)
+        if (print_info(rest[i], a) != 0)
             status = 2;
     }
     return status;
@@ -324,7 +331,8 @@ static rt_result apply_pose_flags(rt_scene *scene, const args *a, rt_error *err)
 static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t size, rt_error *err)
 {
     rt_load_info info;
-    rt_load_options lo = {.for_render = true};
+    rt_load_options lo = {
+        .for_render = true, .use_time = a->posed, .time = a->frame_time, .animation = a->animation};
     rt_result r;
     /* -o is checked before the load, which may take long, and so is a
      * model's default output (models have no `output` line); a scene's own
@@ -418,19 +426,51 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
             tree.stats.build_ms, tree.stats.nodes, tree.stats.leaves, tree.stats.empty_leaves, tree.stats.prim_refs,
             tree.stats.depth, tree.stats.wide_nodes, (double)tree.stats.bytes / (1024.0 * 1024.0));
 
-    rt_framebuffer fb;
-    if (rt_framebuffer_init(&fb, set->width, set->height, &err) != RT_OK) {
+    part_job pj;
+    if (part_job_init(&pj, a, scene, &tree, &err) != RT_OK) {
         progress_clear(view);
         report(&err, &a->budget);
         rt_kdtree_free(&tree);
         return 2;
     }
+    if (pj.to_part && !rt_part_path_ok(output)) {
+        progress_clear(view);
+        fprintf(stderr, "rt: %s: a part is written as .exr or .pfm (with %s.json beside it), not as an 8-bit image\n",
+                output, output);
+        part_job_free(&pj);
+        rt_kdtree_free(&tree);
+        return 2;
+    }
+    const char *aov_part = pj.info.layer_count == 0                            ? NULL
+                           : pj.to_part && !rt_path_has_ext(output, ".exr")    ? output
+                           : a->part_out && !rt_path_has_ext(a->part_out, ".exr") ? a->part_out
+                                                                                 : NULL;
+    if (aov_part) {
+        progress_clear(view);
+        fprintf(stderr, "rt: %s: a part with AOVs is written as .exr (their sums are layers of it)\n", aov_part);
+        part_job_free(&pj);
+        rt_kdtree_free(&tree);
+        return 2;
+    }
+    if (pj.to_part)
+        rt_info("part: pixels [%d, %d) x [%d, %d), samples %d:%d", pj.region.x0, pj.region.x1, pj.region.y0,
+                pj.region.y1, pj.s_begin, pj.s_end);
+
+    rt_framebuffer fb;
+    if (rt_framebuffer_init(&fb, pj.region.x1 - pj.region.x0, pj.region.y1 - pj.region.y0, &err) != RT_OK) {
+        progress_clear(view);
+        report(&err, &a->budget);
+        part_job_free(&pj);
+        rt_kdtree_free(&tree);
+        return 2;
+    }
 
     output_aovs aov;
-    if (output_aovs_init(&aov, a, set->width, set->height, &err) != RT_OK) {
+    if (output_aovs_init(&aov, a, fb.width, fb.height, &err) != RT_OK) {
         progress_clear(view);
         report(&err, &a->budget);
         rt_framebuffer_free(&fb);
+        part_job_free(&pj);
         rt_kdtree_free(&tree);
         return 2;
     }
@@ -444,6 +484,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
             fprintf(stderr, "rt: --window: cannot open a window: %s\n", why);
             output_aovs_free(&aov);
             rt_framebuffer_free(&fb);
+            part_job_free(&pj);
             rt_kdtree_free(&tree);
             return 2;
         }
@@ -457,7 +498,9 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
-    view->preview_path = a->preview_seconds > 0.0 ? output : NULL;
+    view->preview_path = a->preview_seconds > 0.0 && !pj.to_part ? output : NULL;
+    if (a->preview_seconds > 0.0 && pj.to_part)
+        rt_warn("--preview: a part's output holds sums, not an image; no preview is written");
     view->preview_seconds = a->preview_seconds;
     view->exposure = set->exposure;
     view->time_limit = a->time_limit;
@@ -478,6 +521,10 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     ro.progress = view->bar || view->preview_path || view->tev || view->window ? progress_report : NULL;
     ro.progress_user = view;
     ro.aov = output_aovs_for_render(&aov);
+    ro.region = pj.region;
+    ro.sample_begin = pj.s_begin;
+    ro.sample_end = pj.s_end;
+    ro.accum = pj.need_accum ? &pj.accum : NULL;
     rt_render_stats rs;
     memset(&rs, 0, sizeof rs);
     rt_result r = rt_render(scene, &tree, &ro, &fb, &rs, &err);
@@ -499,15 +546,32 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
         bool stopped = r == RT_ERR_INTERRUPTED || rs.time_limited;
         char partial[1100], what[160];
         const char *target = output;
-        if (rs.partial) {
+        if (pj.to_part) {
+            if (rs.partial) {
+                fprintf(stderr, "rt: stopped before any %s finished (%s); no part written, %s left as it was%s\n",
+                        rs.passes ? "pass" : "tile", reason ? reason : "?", output,
+                        rs.passes ? "" : " (a tiled part keeps nothing when stopped: render parts in --passes N)");
+            } else if (part_job_write(&pj, output, rs.samples_done, &write_temp, &err) != RT_OK) {
+                report(&err, &a->budget);
+                status = 2;
+            } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
+                fprintf(stderr, "rt: wrote %s and %s.json: part [%d, %d) x [%d, %d) of %dx%d, samples %d:%d of %d%s; "
+                                "%.2f s (render %.2f s)\n",
+                        output, output, pj.region.x0, pj.region.x1, pj.region.y0, pj.region.y1, set->width,
+                        set->height, pj.part_begin, pj.s_begin + rs.samples_done, set->samples, why,
+                        rt_now_seconds() - t_start, rs.seconds);
+            }
+        } else if (rs.partial) {
             rt_path_tagged(output, "partial", NULL, partial, sizeof partial); /* where an incomplete image goes */
             target = partial;
             snprintf(what, sizeof what, "%d of %d tiles at %d spp%s", rs.tiles_done, rs.tiles_total, set->samples,
                      why);
         } else {
-            snprintf(what, sizeof what, "%d of %d spp%s", rs.samples_done, set->samples, why);
+            snprintf(what, sizeof what, "%d of %d spp%s", pj.s_begin + rs.samples_done, set->samples, why);
         }
-        if (rs.partial && rs.tiles_done == 0) {
+        if (pj.to_part) {
+            /* written above */
+        } else if (rs.partial && rs.tiles_done == 0) {
             fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s left as it was\n",
                     rs.passes ? "pass" : "tile", reason ? reason : "?", output);
         } else if (output_write(a, set, &fb, &aov, target, &write_temp, &err) != RT_OK) {
@@ -517,6 +581,16 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
             fprintf(stderr, "rt: wrote %s: %dx%d, %s; %.2f s (render %.2f s)%s%s%s\n", target, fb.width, fb.height,
                     what, rt_now_seconds() - t_start, rs.seconds, rs.partial ? "; " : "", rs.partial ? output : "",
                     rs.partial ? " left as it was" : "");
+        }
+        if (status != 2 && a->part_out) {
+            if (rs.partial)
+                fprintf(stderr, "rt: %s: no part written: no %s finished\n", a->part_out, rs.passes ? "pass" : "tile");
+            else if (part_job_write(&pj, a->part_out, rs.samples_done, &write_temp, &err) != RT_OK) {
+                report(&err, &a->budget);
+                status = 2;
+            } else if (a->log_level >= RT_LOG_NORMAL || stopped)
+                fprintf(stderr, "rt: wrote %s and %s.json: samples %d:%d of %d\n", a->part_out, a->part_out,
+                        pj.part_begin, pj.s_begin + rs.samples_done, set->samples);
         }
     }
     rt_info("render: %.3f s on %d threads, %s, %llu camera rays, %llu rays, %.2f Mrays/s", rs.seconds, rs.threads,
@@ -535,7 +609,28 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     view->window = NULL;
     output_aovs_free(&aov);
     rt_framebuffer_free(&fb);
+    part_job_free(&pj);
     rt_kdtree_free(&tree);
+    return status;
+}
+
+/* Loads, prepares, poses at time t (frames.h), renders and writes one
+ * image (or part); the exit status. */
+static int render_one(rt_scene *scene, const args *a, double t, double t_start)
+{
+    rt_error err = {0};
+    char output[1024];
+    progress_view view;
+    progress_view_init(&view, a->log_level >= RT_LOG_NORMAL && isatty(2));
+    progress_phase(&view, "load", a->input ? a->input : "the built-in scene");
+    if (prepare(scene, a, output, sizeof output, &err) != RT_OK || frames_apply(scene, t, &err) != RT_OK) {
+        progress_clear(&view);
+        report(&err, &a->budget);
+        progress_view_free(&view);
+        return 2;
+    }
+    int status = render_and_write(scene, a, output, &view, t_start);
+    progress_view_free(&view);
     return status;
 }
 
@@ -546,6 +641,8 @@ int main(int argc, char **argv)
         return rt_cmd_compare(argc - 1, argv + 1);
     if (argc > 1 && strcmp(argv[1], "convert") == 0)
         return rt_cmd_convert(argc - 1, argv + 1);
+    if (argc > 1 && strcmp(argv[1], "merge") == 0)
+        return rt_cmd_merge(argc - 1, argv + 1);
     args a;
     int status = args_parse(&a, argc, argv);
     if (status != ARGS_OK)
@@ -562,18 +659,49 @@ int main(int argc, char **argv)
     }
     rt_scene scene;
     rt_scene_init(&scene);
-    char output[1024];
-    progress_view view;
-    progress_view_init(&view, a.log_level >= RT_LOG_NORMAL && isatty(2));
-    progress_phase(&view, "load", a.input ? a.input : "the built-in scene");
-    if (prepare(&scene, &a, output, sizeof output, &err) != RT_OK) {
-        progress_clear(&view);
-        report(&err, &a.budget);
+    char part_default[1100];
+    if (args_output_is_part(&a) && !a.output) { /* a part goes to NAME.part.exr */
+        char name[1024];
+        default_output(NULL, a.input, name, sizeof name);
+        rt_path_tagged(name, "part", ".exr", part_default, sizeof part_default);
+        a.output = part_default;
+    }
+    if (a.part_out && (!rt_part_path_ok(a.part_out) || rt_output_check(a.part_out, &err) != RT_OK)) {
+        fprintf(stderr, "rt: --part-out %s: %s\n", a.part_out,
+                rt_part_path_ok(a.part_out) ? err.message : "a part is written as .exr or .pfm");
+        return 2;
+    }
+    if (!a.has_frames) {
+        status = render_one(&scene, &a, 0.0, t_start);
+        rt_scene_free(&scene);
+        return status;
+    }
+    /* --frames A:B: one render a frame, named from the pattern; the first failure ends the run */
+    const char *pattern = a.output;
+    if (!pattern || !frames_pattern_ok(pattern)) {
+        fprintf(stderr, "rt: --frames %d:%d: -o must name the frames with one %%d or %%0Nd (e.g. -o out.%%04d.png), "
+                        "got %s%s%s\n",
+                a.frame_begin, a.frame_end, pattern ? "'" : "", pattern ? pattern : "no -o", pattern ? "'" : "");
         rt_scene_free(&scene);
         return 2;
     }
-    status = render_and_write(&scene, &a, output, &view, t_start);
-    progress_view_free(&view);
+    const char *part_pattern = a.part_out && frames_pattern_ok(a.part_out) ? a.part_out : NULL;
+    char name[1100], part_name[1100];
+    status = 0;
+    for (int f = a.frame_begin; f < a.frame_end && status == 0; f++) {
+        if (!frames_name(pattern, f, name, sizeof name) ||
+            (part_pattern && !frames_name(part_pattern, f, part_name, sizeof part_name))) {
+            fprintf(stderr, "rt: -o %s: the name of frame %d is too long\n", pattern, f);
+            status = 2;
+            break;
+        }
+        a.output = name;
+        if (part_pattern)
+            a.part_out = part_name;
+        rt_scene_free(&scene);
+        rt_scene_init(&scene);
+        status = render_one(&scene, &a, frames_time(f, a.fps), rt_now_seconds());
+    }
     rt_scene_free(&scene);
     return status;
 }

@@ -202,28 +202,41 @@ rt_result rt_exr_write(FILE *f, const char *path, int width, int height, const r
 
 /* ------------------------------------------------------------ reading */
 
+/* The channels a decode fills: want[k] goes to component k of n a pixel. */
+typedef struct want_channels {
+    const char *const *want;
+    int n;
+} want_channels;
+
+static int wanted_index(const want_channels *wc, const char *name)
+{
+    for (int k = 0; k < wc->n; k++)
+        if (strcmp(wc->want[k], name) == 0)
+            return k;
+    return -1;
+}
+
 /* Decodes one chunk (a band of scanlines or a tile) at pixel (x0, y0) of the
- * data window into the RGBA buffer. want[c]: which RGBA component channel c
- * of the part fills (-1: skipped); grey: Y fills R, G and B. */
+ * data window into the buffer of wc->n floats a pixel; channels not wanted
+ * are skipped. */
 static exr_result_t decode_chunk(exr_context_t ctx, const exr_chunk_info_t *cinfo, exr_decode_pipeline_t *dec,
-                                 bool *started, float *rgba, int w, int x0, int y0, bool grey)
+                                 bool *started, float *buf, int w, int x0, int y0, const want_channels *wc)
 {
     exr_result_t rv = *started ? exr_decoding_update(ctx, 0, cinfo, dec) : exr_decoding_initialize(ctx, 0, cinfo, dec);
     if (rv != EXR_ERR_SUCCESS)
         return rv;
-    float *at = rgba + ((size_t)y0 * (size_t)w + (size_t)x0) * 4;
+    int n = wc->n;
+    float *at = buf + ((size_t)y0 * (size_t)w + (size_t)x0) * (size_t)n;
     for (int c = 0; c < dec->channel_count; c++) {
         exr_coding_channel_info_t *oc = &dec->channels[c];
-        const char *n = oc->channel_name;
-        int k = strcmp(n, "R") == 0 ? 0 : strcmp(n, "G") == 0 ? 1 : strcmp(n, "B") == 0 ? 2 : strcmp(n, "A") == 0 ? 3
-              : grey && strcmp(n, "Y") == 0 ? 0 : -1;
+        int k = wanted_index(wc, oc->channel_name);
         oc->decode_to_ptr = NULL;
         if (k < 0)
             continue;
         oc->user_bytes_per_element = 4;
         oc->user_data_type = EXR_PIXEL_FLOAT;
-        oc->user_pixel_stride = 4 * (int32_t)sizeof(float);
-        oc->user_line_stride = w * 4 * (int32_t)sizeof(float);
+        oc->user_pixel_stride = n * (int32_t)sizeof(float);
+        oc->user_line_stride = w * n * (int32_t)sizeof(float);
         oc->decode_to_ptr = (uint8_t *)(at + k);
     }
     if (!*started) {
@@ -235,8 +248,12 @@ static exr_result_t decode_chunk(exr_context_t ctx, const exr_chunk_info_t *cinf
     return exr_decoding_run(ctx, 0, dec);
 }
 
-rt_result rt_exr_decode(const void *data, size_t size, const char *name, int max_dim, uint64_t max_pixels,
-                        float **rgba_out, int *width, int *height, rt_error *err)
+/* The decoder both entry points share: channels `channels` (all required
+ * when `required`, else the RGBA/Y rules of rt_exr_decode) into
+ * n floats a pixel. */
+static rt_result decode(const void *data, size_t size, const char *name, int max_dim, uint64_t max_pixels,
+                        const char *const *channels, int nchan, bool required, float **rgba_out, int *width,
+                        int *height, rt_error *err)
 {
     *rgba_out = NULL;
     *width = *height = 0;
@@ -285,11 +302,18 @@ rt_result rt_exr_decode(const void *data, size_t size, const char *name, int max
         goto done;
     }
     bool has_rgb = false, has_y = false;
+    int found = 0;
     for (int c = 0; c < chl->num_channels; c++) {
         const exr_attr_chlist_entry_t *e = &chl->entries[c];
         const char *n = e->name.str;
-        bool used = strcmp(n, "R") == 0 || strcmp(n, "G") == 0 || strcmp(n, "B") == 0 || strcmp(n, "A") == 0 ||
-                    strcmp(n, "Y") == 0;
+        bool used = required ? false
+                             : strcmp(n, "R") == 0 || strcmp(n, "G") == 0 || strcmp(n, "B") == 0 ||
+                                   strcmp(n, "A") == 0 || strcmp(n, "Y") == 0;
+        for (int k = 0; k < nchan && required; k++)
+            if (strcmp(n, channels[k]) == 0) {
+                used = true;
+                found++;
+            }
         if (used && (e->x_sampling != 1 || e->y_sampling != 1)) {
             result = rt_fail(err, RT_ERR_INVALID, "%s: EXR channel %s is subsampled (%dx%d), which rt does not read",
                              name, n, e->x_sampling, e->y_sampling);
@@ -298,21 +322,30 @@ rt_result rt_exr_decode(const void *data, size_t size, const char *name, int max
         has_rgb |= strcmp(n, "R") == 0 || strcmp(n, "G") == 0 || strcmp(n, "B") == 0;
         has_y |= strcmp(n, "Y") == 0;
     }
-    if (!has_rgb && !has_y) {
+    if (required && found < nchan) {
+        char list[256] = "";
+        for (int k = 0; k < nchan; k++) {
+            strncat(list, k ? ", " : "", sizeof list - strlen(list) - 1);
+            strncat(list, channels[k], sizeof list - strlen(list) - 1);
+        }
+        result = rt_fail(err, RT_ERR_INVALID, "%s: EXR part 0 lacks some of the channels %s", name, list);
+        goto done;
+    }
+    if (!required && !has_rgb && !has_y) {
         result = rt_fail(err, RT_ERR_INVALID, "%s: EXR part 0 has no R, G, B or Y channel", name);
         goto done;
     }
     int w = (int)w64, h = (int)h64;
-    rgba = rt_alloc((size_t)w * (size_t)h, 4 * sizeof(float));
+    rgba = rt_alloc((size_t)w * (size_t)h, (size_t)nchan * sizeof(float));
     if (!rgba) {
         result = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for a %dx%d EXR image", name, w, h);
         goto done;
     }
-    for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
-        rgba[4 * i + 0] = rgba[4 * i + 1] = rgba[4 * i + 2] = 0.0f;
-        rgba[4 * i + 3] = 1.0f;
-    }
-    bool grey = has_y && !has_rgb;
+    for (size_t i = 0; i < (size_t)w * (size_t)h * (size_t)nchan; i++)
+        rgba[i] = !required && i % 4 == 3 ? 1.0f : 0.0f;
+    bool grey = !required && has_y && !has_rgb;
+    static const char *const grey_names[4] = {"Y", "-", "-", "-"};
+    want_channels wc = {grey ? grey_names : channels, nchan};
     exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
     bool started = false;
     if (storage == EXR_STORAGE_SCANLINE) {
@@ -328,7 +361,7 @@ rt_result rt_exr_decode(const void *data, size_t size, const char *name, int max
                 rv = EXR_ERR_BAD_CHUNK_LEADER;
                 break;
             }
-            rv = decode_chunk(ctx, &cinfo, &dec, &started, rgba, w, 0, (int)y0, grey);
+            rv = decode_chunk(ctx, &cinfo, &dec, &started, rgba, w, 0, (int)y0, &wc);
         }
     } else {
         int32_t tw = 0, th = 0;
@@ -346,7 +379,7 @@ rt_result rt_exr_decode(const void *data, size_t size, const char *name, int max
                     rv = EXR_ERR_BAD_CHUNK_LEADER;
                     break;
                 }
-                rv = decode_chunk(ctx, &cinfo, &dec, &started, rgba, w, (int)x0, (int)y0, grey);
+                rv = decode_chunk(ctx, &cinfo, &dec, &started, rgba, w, (int)x0, (int)y0, &wc);
             }
         }
     }
@@ -367,4 +400,20 @@ done:
     free(rgba);
     exr_finish(&ctx);
     return result;
+}
+
+rt_result rt_exr_decode(const void *data, size_t size, const char *name, int max_dim, uint64_t max_pixels,
+                        float **rgba, int *width, int *height, rt_error *err)
+{
+    static const char *const rgba_names[4] = {"R", "G", "B", "A"};
+    return decode(data, size, name, max_dim, max_pixels, rgba_names, 4, false, rgba, width, height, err);
+}
+
+rt_result rt_exr_decode_channels(const void *data, size_t size, const char *name, int max_dim, uint64_t max_pixels,
+                                 const char *const *channels, int count, float **pixels, int *width, int *height,
+                                 rt_error *err)
+{
+    if (count < 1 || count > MAX_CHANNELS)
+        return rt_fail(err, RT_ERR_INVALID, "%s: %d EXR channels asked for", name, count);
+    return decode(data, size, name, max_dim, max_pixels, channels, count, true, pixels, width, height, err);
 }

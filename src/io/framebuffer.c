@@ -272,6 +272,8 @@ rt_result rt_framebuffer_write_with(const rt_framebuffer *fb, const char *path, 
     return rt_framebuffer_write_tracked(fb, path, opt, NULL, err);
 }
 
+static rt_result finish_temp(temp_file *t, const char *path, int ok, rt_error *err);
+
 rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *path, const rt_image_options *opt,
                                        rt_write_temp *temp, rt_error *err)
 {
@@ -309,11 +311,19 @@ rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *pat
         ok = write_png(f, fb, exposure > 0.0f && isfinite(exposure) ? exposure : 1.0f, opt->tonemap);
         break;
     }
+    return finish_temp(&t, path, ok, err);
+}
+
+/* Completes a write: flushes the temporary file, gives it its mode, names
+ * it and renames it over path; on any failure removes it. */
+static rt_result finish_temp(temp_file *t, const char *path, int ok, rt_error *err)
+{
+    FILE *f = t->f;
     if (fflush(f) != 0 || ferror(f))
         ok = 0;
     int saved = errno;
     if (!ok) {
-        discard_temp(&t);
+        discard_temp(t);
         return rt_fail(err, RT_ERR_IO, "%s: write failed: %s", path, strerror(saved ? saved : EIO));
     }
     /* the temporary file is 0600 (mkstemp) or 0666 less the umask (O_TMPFILE):
@@ -329,25 +339,34 @@ rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *pat
         mode = 0666 & ~mask;
     }
     fchmod(fileno(f), mode);
-    if (!name_temp(&t)) {
+    if (!name_temp(t)) {
         saved = errno;
-        discard_temp(&t);
+        discard_temp(t);
         return rt_fail(err, RT_ERR_IO, "%s: cannot link the finished image in: %s", path, strerror(saved));
     }
     if (fclose(f) != 0) {
         saved = errno;
-        t.f = NULL;
-        discard_temp(&t);
+        t->f = NULL;
+        discard_temp(t);
         return rt_fail(err, RT_ERR_IO, "%s: write failed: %s", path, strerror(saved));
     }
-    t.f = NULL;
-    if (rename(t.name, path) != 0) {
+    t->f = NULL;
+    if (rename(t->name, path) != 0) {
         saved = errno;
-        discard_temp(&t);
+        discard_temp(t);
         return rt_fail(err, RT_ERR_IO, "%s: cannot rename the finished image into place: %s", path, strerror(saved));
     }
-    publish_name(&t, NULL); /* renamed: nothing left to remove */
+    publish_name(t, NULL); /* renamed: nothing left to remove */
     return RT_OK;
+}
+
+rt_result rt_file_write_atomic(const char *path, const void *bytes, size_t size, rt_write_temp *temp, rt_error *err)
+{
+    temp_file t;
+    if (!open_temp_beside(path, &t, temp))
+        return rt_fail(err, RT_ERR_IO, "%s: cannot create a file there: %s", path, strerror(errno));
+    int ok = fwrite(bytes, 1, size, t.f) == size;
+    return finish_temp(&t, path, ok, err);
 }
 
 rt_result rt_pfm_read(const char *path, rt_framebuffer *fb, rt_error *err)

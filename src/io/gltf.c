@@ -54,6 +54,7 @@
 #include "rt/base/log.h"
 #include "rt/io/base64.h"
 #include "rt/io/draco.h"
+#include "rt/io/gltf_animation.h"
 #include "rt/io/json.h"
 #include "rt/io/meshopt.h"
 #include "rt/scene/texture.h"
@@ -114,19 +115,36 @@ typedef struct gl_prim {
     uint32_t indices, material;
     uint32_t attr[ATTR_COUNT];
     bool targets;
+    uint32_t first_target, target_count; /* morph targets, into doc.targets */
+    uint32_t joints[2], weights[2];      /* JOINTS_0/1, WEIGHTS_0/1 accessors, RT_NONE = absent */
     uint32_t draco_view;          /* KHR_draco_mesh_compression: RT_NONE = not compressed */
     uint32_t draco_id[ATTR_COUNT]; /* its attribute unique ids, RT_NONE = not in the stream */
     int draco_tok;
     int tok;
 } gl_prim;
 
-typedef struct gl_mesh { uint32_t first, count; int tok; } gl_mesh;
+typedef struct gl_mesh { uint32_t first, count; int weights; int tok; } gl_mesh; /* weights: token, -1 = none */
+
+/* A morph target: its POSITION, NORMAL and TANGENT displacement accessors. */
+typedef struct gl_target { uint32_t attr[3]; } gl_target;
+
+/* Animations: channels and samplers of every animation in two tables. */
+typedef enum { PATH_TRANSLATION, PATH_ROTATION, PATH_SCALE, PATH_WEIGHTS } gl_path;
+typedef struct gl_channel { uint32_t sampler, node; int path; int tok; } gl_channel; /* sampler: of its animation */
+typedef struct gl_asampler { uint32_t input, output; int interp; int tok; } gl_asampler;
+typedef struct gl_anim { uint32_t first_channel, channel_count, first_sampler, sampler_count; int tok; } gl_anim;
+typedef struct gl_skin { uint32_t first_joint, joint_count, ibm; int tok; } gl_skin; /* joints in doc.skin_joints */
 
 typedef struct gl_node {
     uint32_t mesh, camera, light, skin;
     uint32_t first_child, child_count; /* into doc.children */
     uint32_t parent;
     rt_mat4 local;
+    bool has_matrix;                 /* else local = T * R * S of the fields below */
+    float tr[3], rot[4], sc[3];
+    int weights;                     /* token of its morph weights, -1 = none */
+    float *pose_weights;             /* when posed: its morph weights (pose_weight_count), owned */
+    uint32_t pose_weight_count;
     int tok;
 } gl_node;
 
@@ -182,7 +200,14 @@ typedef struct gl_doc {
     gl_image *images;       size_t image_count;
     gl_camera *cameras;     size_t camera_count;
     gl_light *lights;       size_t light_count;
-    size_t skin_count;
+    gl_skin *skins;         size_t skin_count;
+    uint32_t *skin_joints;  size_t skin_joints_count, skin_joints_cap;
+    gl_target *targets;     size_t target_count, target_cap;
+    gl_anim *anims;         size_t anim_count;
+    gl_channel *channels;   size_t channel_count, channel_cap;
+    gl_asampler *asamplers; size_t asampler_count, asampler_cap;
+    bool posed;             /* rt_gltf_options.use_time: animation, skins and morphs applied */
+    rt_mat4 *skin_scratch;  size_t skin_scratch_cap; /* per-vertex skin matrices of one primitive */
     size_t decoded_bytes;   /* meshopt and Draco output so far (GL_MAX_DECODED) */
     uint32_t default_scene; /* RT_NONE = absent */
 
@@ -724,6 +749,31 @@ static rt_result parse_draco_prim(gl_doc *d, const char *prim, int t, gl_prim *p
     return RT_OK;
 }
 
+/* A primitive's morph targets: POSITION, NORMAL, TANGENT displacements. */
+static rt_result parse_targets(gl_doc *d, const char *prim, int t, gl_prim *pr)
+{
+    TRY(expect_array(d, t, prim, "targets"));
+    pr->first_target = (uint32_t)d->target_count;
+    pr->target_count = (uint32_t)jsize(d, t);
+    pr->targets = pr->target_count > 0;
+    static const char *const names[3] = {"POSITION", "NORMAL", "TANGENT"};
+    FOR_ITEMS(d, t, i, e) {
+        char where[96];
+        snprintf(where, sizeof where, "%s.targets[%d]", prim, i);
+        TRY(expect_object(d, e, where));
+        if (!rt_grow((void **)&d->targets, &d->target_cap, d->target_count + 1, sizeof(gl_target)))
+            return fail_at(d, e, RT_ERR_NOMEM, "out of memory for morph targets");
+        gl_target *g = &d->targets[d->target_count++];
+        g->attr[0] = g->attr[1] = g->attr[2] = RT_NONE;
+        FOR_KEYS(d, e, k, v) {
+            for (int a = 0; a < 3; a++)
+                if (KEY(k, names[a]))
+                    TRY(get_index(d, where, names[a], v, &g->attr[a]));
+        }
+    }
+    return RT_OK;
+}
+
 static rt_result parse_meshes(gl_doc *d, int t)
 {
     TRY(alloc_table(d, t, "meshes", sizeof(gl_mesh), (void **)&d->meshes, &d->mesh_count));
@@ -747,6 +797,7 @@ static rt_result parse_meshes(gl_doc *d, int t)
     FOR_ITEMS(d, t, i, e) {
         gl_mesh *m = &d->meshes[i];
         m->tok = e;
+        m->weights = rt_json_get(&d->j, e, "weights");
         int p = rt_json_get(&d->j, e, "primitives");
         m->first = (uint32_t)d->prim_count;
         m->count = (uint32_t)jsize(d, p);
@@ -759,6 +810,7 @@ static rt_result parse_meshes(gl_doc *d, int t)
             pr->indices = pr->material = pr->draco_view = RT_NONE;
             for (int a = 0; a < ATTR_COUNT; a++)
                 pr->attr[a] = pr->draco_id[a] = RT_NONE;
+            pr->joints[0] = pr->joints[1] = pr->weights[0] = pr->weights[1] = RT_NONE;
             TRY(expect_object(d, pe, where));
             bool have_attrs = false;
             FOR_KEYS(d, pe, k, v) {
@@ -769,8 +821,7 @@ static rt_result parse_meshes(gl_doc *d, int t)
                     if (pr->mode < 0 || pr->mode > 6)
                         return fail_at(d, v, RT_ERR_INVALID, "%s.mode %d is not in [0, 6]", where, pr->mode);
                 } else if (KEY(k, "targets")) {
-                    TRY(expect_array(d, v, where, "targets"));
-                    pr->targets = jsize(d, v) > 0;
+                    TRY(parse_targets(d, where, v, pr));
                 } else if (KEY(k, "extensions")) {
                     int dr = rt_json_get(&d->j, v, "KHR_draco_mesh_compression");
                     if (dr >= 0)
@@ -784,6 +835,11 @@ static rt_result parse_meshes(gl_doc *d, int t)
                         for (int a = 0; a < ATTR_COUNT; a++)
                             if (KEY(k2, attr_names[a]))
                                 TRY(get_index(d, wa, attr_names[a], v2, &pr->attr[a]));
+                        static const char *const skin_attrs[4] = {"JOINTS_0", "JOINTS_1", "WEIGHTS_0", "WEIGHTS_1"};
+                        for (int a = 0; a < 4; a++)
+                            if (KEY(k2, skin_attrs[a]))
+                                TRY(get_index(d, wa, skin_attrs[a], v2,
+                                              a < 2 ? &pr->joints[a] : &pr->weights[a - 2]));
                     }
                 }
             }
@@ -854,6 +910,7 @@ static rt_result parse_nodes(gl_doc *d, int t)
         n->tok = e;
         n->mesh = n->camera = n->light = n->skin = n->parent = RT_NONE;
         n->first_child = (uint32_t)d->children_count;
+        n->weights = -1;
         bool have_matrix = false, have_trs = false;
         float matrix[16], tr[3] = {0, 0, 0}, rot[4] = {0, 0, 0, 1}, sc[3] = {1, 1, 1};
         FOR_KEYS(d, e, k, v) {
@@ -872,6 +929,8 @@ static rt_result parse_nodes(gl_doc *d, int t)
             } else if (KEY(k, "scale")) {
                 TRY(get_floats(d, where, "scale", v, sc, 3));
                 have_trs = true;
+            } else if (KEY(k, "weights")) {
+                n->weights = v;
             } else if (KEY(k, "extensions")) {
                 int l = rt_json_get(&d->j, v, "KHR_lights_punctual");
                 if (l >= 0) {
@@ -883,6 +942,9 @@ static rt_result parse_nodes(gl_doc *d, int t)
             }
         }
         TRY(read_index_list(d, e, where, "children", d->children, &d->children_count, &n->child_count));
+        memcpy(n->tr, tr, sizeof tr);
+        memcpy(n->sc, sc, sizeof sc);
+        n->has_matrix = have_matrix;
         if (have_matrix) {
             if (have_trs)
                 rt_warn("%s: %s has both matrix and TRS; using the matrix", d->path, where);
@@ -897,6 +959,7 @@ static rt_result parse_nodes(gl_doc *d, int t)
             } else {
                 rt_warn("%s: %s.rotation is a zero quaternion; using identity", d->path, where);
             }
+            n->rot[0] = q.x; n->rot[1] = q.y; n->rot[2] = q.z; n->rot[3] = q.w;
             n->local = rt_mat4_mul(rt_mat4_translate(rt_v3(tr[0], tr[1], tr[2])),
                                    rt_mat4_mul(rt_mat4_quat(q), rt_mat4_scale(rt_v3(sc[0], sc[1], sc[2]))));
         }
@@ -1285,6 +1348,121 @@ static rt_result parse_lights(gl_doc *d, int ext)
     return RT_OK;
 }
 
+static rt_result parse_skins(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "skins", sizeof(gl_skin), (void **)&d->skins, &d->skin_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "skins[%d]", i);
+        gl_skin *sk = &d->skins[i];
+        sk->tok = e;
+        sk->ibm = RT_NONE;
+        TRY(expect_object(d, e, where));
+        int joints = -1;
+        FOR_KEYS(d, e, k, v) {
+            if (KEY(k, "inverseBindMatrices")) TRY(get_index(d, where, "inverseBindMatrices", v, &sk->ibm));
+            else if (KEY(k, "joints")) joints = v;
+        }
+        if (joints < 0)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: joints is missing", where);
+        TRY(expect_array(d, joints, where, "joints"));
+        if (jsize(d, joints) == 0)
+            return fail_at(d, joints, RT_ERR_INVALID, "%s.joints is empty", where);
+        sk->first_joint = (uint32_t)d->skin_joints_count;
+        FOR_ITEMS(d, joints, j, je) {
+            if (!rt_grow((void **)&d->skin_joints, &d->skin_joints_cap, d->skin_joints_count + 1, sizeof(uint32_t)))
+                return fail_at(d, je, RT_ERR_NOMEM, "out of memory for joints");
+            TRY(get_index(d, where, "joints", je, &d->skin_joints[d->skin_joints_count++]));
+        }
+        sk->joint_count = (uint32_t)(d->skin_joints_count - sk->first_joint);
+    }
+    return RT_OK;
+}
+
+static rt_result parse_animations(gl_doc *d, int t)
+{
+    TRY(alloc_table(d, t, "animations", sizeof(gl_anim), (void **)&d->anims, &d->anim_count));
+    FOR_ITEMS(d, t, i, e) {
+        char where[48];
+        snprintf(where, sizeof where, "animations[%d]", i);
+        gl_anim *an = &d->anims[i];
+        an->tok = e;
+        TRY(expect_object(d, e, where));
+        int chans = rt_json_get(&d->j, e, "channels"), samps = rt_json_get(&d->j, e, "samplers");
+        if (chans < 0 || samps < 0)
+            return fail_at(d, e, RT_ERR_INVALID, "%s: needs channels and samplers", where);
+        TRY(expect_array(d, samps, where, "samplers"));
+        TRY(expect_array(d, chans, where, "channels"));
+        an->first_sampler = (uint32_t)d->asampler_count;
+        FOR_ITEMS(d, samps, j, se) {
+            char w[80];
+            snprintf(w, sizeof w, "%s.samplers[%d]", where, j);
+            TRY(expect_object(d, se, w));
+            if (!rt_grow((void **)&d->asamplers, &d->asampler_cap, d->asampler_count + 1, sizeof(gl_asampler)))
+                return fail_at(d, se, RT_ERR_NOMEM, "out of memory for animation samplers");
+            gl_asampler *sa = &d->asamplers[d->asampler_count++];
+            sa->input = sa->output = RT_NONE;
+            sa->interp = RT_INTERP_LINEAR;
+            sa->tok = se;
+            FOR_KEYS(d, se, k, v) {
+                if (KEY(k, "input")) TRY(get_index(d, w, "input", v, &sa->input));
+                else if (KEY(k, "output")) TRY(get_index(d, w, "output", v, &sa->output));
+                else if (KEY(k, "interpolation")) {
+                    char name[32];
+                    TRY(get_string(d, w, "interpolation", v, name, sizeof name));
+                    if (strcmp(name, "LINEAR") == 0) sa->interp = RT_INTERP_LINEAR;
+                    else if (strcmp(name, "STEP") == 0) sa->interp = RT_INTERP_STEP;
+                    else if (strcmp(name, "CUBICSPLINE") == 0) sa->interp = RT_INTERP_CUBICSPLINE;
+                    else
+                        return fail_at(d, v, RT_ERR_INVALID,
+                                       "%s.interpolation \"%s\" is not LINEAR, STEP or CUBICSPLINE", w, name);
+                }
+            }
+            if (sa->input == RT_NONE || sa->output == RT_NONE)
+                return fail_at(d, se, RT_ERR_INVALID, "%s: needs input and output", w);
+        }
+        an->sampler_count = (uint32_t)(d->asampler_count - an->first_sampler);
+        an->first_channel = (uint32_t)d->channel_count;
+        FOR_ITEMS(d, chans, j, ce) {
+            char w[80];
+            snprintf(w, sizeof w, "%s.channels[%d]", where, j);
+            TRY(expect_object(d, ce, w));
+            if (!rt_grow((void **)&d->channels, &d->channel_cap, d->channel_count + 1, sizeof(gl_channel)))
+                return fail_at(d, ce, RT_ERR_NOMEM, "out of memory for animation channels");
+            gl_channel *ch = &d->channels[d->channel_count++];
+            ch->sampler = ch->node = RT_NONE;
+            ch->path = -1;
+            ch->tok = ce;
+            FOR_KEYS(d, ce, k, v) {
+                if (KEY(k, "sampler")) TRY(get_index(d, w, "sampler", v, &ch->sampler));
+                else if (KEY(k, "target")) {
+                    TRY(expect_object(d, v, w));
+                    FOR_KEYS(d, v, k2, v2) {
+                        if (KEY(k2, "node")) TRY(get_index(d, w, "target.node", v2, &ch->node));
+                        else if (KEY(k2, "path")) {
+                            char name[32];
+                            TRY(get_string(d, w, "target.path", v2, name, sizeof name));
+                            if (strcmp(name, "translation") == 0) ch->path = PATH_TRANSLATION;
+                            else if (strcmp(name, "rotation") == 0) ch->path = PATH_ROTATION;
+                            else if (strcmp(name, "scale") == 0) ch->path = PATH_SCALE;
+                            else if (strcmp(name, "weights") == 0) ch->path = PATH_WEIGHTS;
+                            else
+                                ch->path = -2; /* "pointer" (KHR_animation_pointer) and others: not ours */
+                        }
+                    }
+                }
+            }
+            if (ch->sampler == RT_NONE || ch->path == -1)
+                return fail_at(d, ce, RT_ERR_INVALID, "%s: needs sampler and target.path", w);
+            if (ch->sampler >= an->sampler_count)
+                return fail_at(d, ce, RT_ERR_INVALID, "%s.sampler %u is out of range (the animation has %u samplers)",
+                               w, ch->sampler, an->sampler_count);
+        }
+        an->channel_count = (uint32_t)(d->channel_count - an->first_channel);
+    }
+    return RT_OK;
+}
+
 static rt_result parse_document(gl_doc *d)
 {
     TRY(rt_json_parse(&d->j, d->json_text, d->json_len, d->path, d->json_base, d->err));
@@ -1307,10 +1485,8 @@ static rt_result parse_document(gl_doc *d)
         else if (KEY(k, "images")) TRY(parse_images(d, v));
         else if (KEY(k, "cameras")) TRY(parse_cameras(d, v));
         else if (KEY(k, "extensions")) TRY(parse_lights(d, v));
-        else if (KEY(k, "skins")) {
-            TRY(expect_array(d, v, "glTF", "skins"));
-            d->skin_count = (size_t)jsize(d, v);
-        }
+        else if (KEY(k, "skins")) TRY(parse_skins(d, v));
+        else if (KEY(k, "animations")) TRY(parse_animations(d, v));
     }
     if (!have_asset)
         return fail_at(d, 0, RT_ERR_INVALID, "asset is missing (not a glTF file?)");
@@ -1959,8 +2135,8 @@ static rt_result fill_from_draco(gl_doc *d, size_t p, const rt_draco_mesh *m)
     size_t nidx = d->accessors[pr->indices].count;
     if (faces > SIZE_MAX / 3 || faces * 3 != nidx)
         return fail_at(d, tok, RT_ERR_INVALID,
-                       "%s: the Draco mesh has %zu triangles, the indices accessor %u has %zu indices", prim_name(d, p, name, sizeof name),
-                       faces, pr->indices, nidx);
+                       "%s: the Draco mesh has %zu triangles, the indices accessor %u has %zu indices",
+                       prim_name(d, p, name, sizeof name), faces, pr->indices, nidx);
     TRY(decoded_budget(d, tok, nidx * sizeof(uint32_t)));
     uint32_t *idx = malloc((nidx ? nidx : 1) * sizeof *idx);
     if (!idx)
@@ -1968,9 +2144,10 @@ static rt_result fill_from_draco(gl_doc *d, size_t p, const rt_draco_mesh *m)
     rt_draco_indices(m, idx);
     for (size_t k = 0; k < nidx; k++)
         if (idx[k] >= points) {
+            uint32_t bad = idx[k];
             free(idx);
-            return fail_at(d, tok, RT_ERR_INVALID, "%s: a Draco triangle names point %u of %zu", prim_name(d, p, name, sizeof name),
-                           idx[k], points);
+            return fail_at(d, tok, RT_ERR_INVALID, "%s: a Draco triangle names point %u of %zu",
+                           prim_name(d, p, name, sizeof name), bad, points);
         }
     TRY(fill_accessor(d, pr->indices, tok, idx, nidx * sizeof *idx, GL_UNSIGNED_INT));
     for (int k = 0; k < ATTR_COUNT; k++) {
@@ -2010,8 +2187,8 @@ static rt_result decode_draco_prims(gl_doc *d)
         rt_draco_mesh *m = rt_draco_decode(view_ptr(d, pr->draco_view, 0), d->views[pr->draco_view].length, why,
                                            sizeof why);
         if (!m)
-            return fail_at(d, pr->draco_tok, RT_ERR_INVALID, "%s: KHR_draco_mesh_compression: %s", prim_name(d, p, name, sizeof name),
-                           why);
+            return fail_at(d, pr->draco_tok, RT_ERR_INVALID, "%s: KHR_draco_mesh_compression: %s",
+                           prim_name(d, p, name, sizeof name), why);
         rt_result r = fill_from_draco(d, p, m);
         rt_draco_free(m);
         TRY(r);
@@ -2037,6 +2214,136 @@ static size_t prim_triangles(const gl_doc *d, const gl_prim *p)
     if (p->mode == 4)
         return n / 3;
     return n >= 3 ? n - 2 : 0;
+}
+
+/* ------------------------------------------------------------- posing */
+
+/* Accessor ai as floats in a fresh buffer (the caller frees it), checked:
+ * ncomp components per element, `count` elements (SIZE_MAX: any), finite. */
+static rt_result posing_floats(gl_doc *d, uint32_t ai, int ncomp, size_t count, const char *what, float **out)
+{
+    *out = NULL;
+    if (ai >= d->accessor_count)
+        return rt_fail(d->err, RT_ERR_INVALID, "%s: %s: accessor %u is out of range (the file has %zu)", d->path, what,
+                       ai, d->accessor_count);
+    const gl_accessor *a = &d->accessors[ai];
+    if (a->ncomp != ncomp)
+        return fail_at(d, a->tok, RT_ERR_INVALID, "accessors[%u] (%s): expected %d components per element, not %d",
+                       ai, what, ncomp, a->ncomp);
+    if (count != SIZE_MAX && a->count != count)
+        return fail_at(d, a->tok, RT_ERR_INVALID, "accessors[%u] (%s): has %zu elements, expected %zu", ai, what,
+                       a->count, count);
+    float *f = rt_alloc(a->count * (size_t)ncomp, sizeof(float));
+    if (!f)
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %s", d->path, what);
+    rt_result r = read_floats(d, ai, f);
+    if (r != RT_OK) {
+        free(f);
+        return r;
+    }
+    for (size_t i = 0; i < a->count * (size_t)ncomp; i++)
+        if (!isfinite(f[i])) {
+            free(f);
+            return fail_at(d, a->tok, RT_ERR_INVALID, "accessors[%u] (%s): element %zu is not finite", ai, what,
+                           i / (size_t)ncomp);
+        }
+    *out = f;
+    return RT_OK;
+}
+
+/* Morph target count of a node's mesh (that of its first primitive; the
+ * spec requires all primitives of a mesh to have the same). */
+static uint32_t node_targets(const gl_doc *d, uint32_t node)
+{
+    const gl_node *n = &d->nodes[node];
+    return n->mesh == RT_NONE ? 0 : d->prims[d->meshes[n->mesh].first].target_count;
+}
+
+/* One channel of the chosen animation applied to its node at time t. */
+static rt_result pose_channel(gl_doc *d, uint32_t anim, uint32_t c, float t)
+{
+    const gl_anim *an = &d->anims[anim];
+    const gl_channel *ch = &d->channels[an->first_channel + c];
+    if (ch->path < 0 || ch->node == RT_NONE)
+        return RT_OK; /* a path rt does not animate, or no target node */
+    char what[96];
+    snprintf(what, sizeof what, "animations[%u].channels[%u]", anim, c);
+    if (ch->node >= d->node_count)
+        return fail_at(d, ch->tok, RT_ERR_INVALID, "%s: target node %u is out of range (the file has %zu nodes)",
+                       what, ch->node, d->node_count);
+    gl_node *n = &d->nodes[ch->node];
+    if (n->has_matrix && ch->path != PATH_WEIGHTS)
+        return fail_at(d, ch->tok, RT_ERR_INVALID, "%s: node %u has a matrix, which animations cannot target",
+                       what, ch->node);
+    const gl_asampler *sa = &d->asamplers[an->first_sampler + ch->sampler];
+    int ncomp = ch->path == PATH_ROTATION ? 4 : ch->path == PATH_WEIGHTS ? (int)node_targets(d, ch->node) : 3;
+    if (ncomp == 0)
+        return fail_at(d, ch->tok, RT_ERR_INVALID, "%s: animates the weights of node %u, whose mesh has no morph "
+                       "targets", what, ch->node);
+    if (ncomp > 64)
+        return fail_at(d, ch->tok, RT_ERR_LIMIT, "%s: over 64 morph targets", what);
+    char w_in[128], w_out[128];
+    snprintf(w_in, sizeof w_in, "input of %s", what);
+    snprintf(w_out, sizeof w_out, "output of %s", what);
+    float *times = NULL, *values = NULL;
+    TRY(posing_floats(d, sa->input, 1, SIZE_MAX, w_in, &times));
+    size_t keys = d->accessors[sa->input].count;
+    for (size_t k = 1; k < keys; k++)
+        if (!(times[k] > times[k - 1])) {
+            double now = times[k], before = times[k - 1];
+            free(times);
+            return fail_at(d, d->accessors[sa->input].tok, RT_ERR_INVALID,
+                           "accessors[%u] (%s): key times must increase, element %zu is %g after %g", sa->input, w_in,
+                           k, now, before);
+        }
+    size_t per = sa->interp == RT_INTERP_CUBICSPLINE ? 3 : 1;
+    rt_result r = ch->path == PATH_WEIGHTS ? posing_floats(d, sa->output, 1, keys * per * (size_t)ncomp, w_out, &values)
+                                           : posing_floats(d, sa->output, ncomp, keys * per, w_out, &values);
+    if (r != RT_OK) {
+        free(times);
+        return r;
+    }
+    float out[64];
+    rt_anim_sample((rt_interp)sa->interp, times, keys, values, ncomp, ch->path == PATH_ROTATION, t, out);
+    free(times);
+    free(values);
+    switch (ch->path) {
+    case PATH_TRANSLATION: memcpy(n->tr, out, sizeof n->tr); break;
+    case PATH_ROTATION: memcpy(n->rot, out, sizeof n->rot); break;
+    case PATH_SCALE: memcpy(n->sc, out, sizeof n->sc); break;
+    default:
+        free(n->pose_weights);
+        n->pose_weights = malloc((size_t)ncomp * sizeof(float));
+        if (!n->pose_weights)
+            return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
+        memcpy(n->pose_weights, out, (size_t)ncomp * sizeof(float));
+        n->pose_weight_count = (uint32_t)ncomp;
+    }
+    if (ch->path != PATH_WEIGHTS)
+        n->local = rt_mat4_mul(rt_mat4_translate(rt_v3(n->tr[0], n->tr[1], n->tr[2])),
+                               rt_mat4_mul(rt_mat4_quat(rt_v4(n->rot[0], n->rot[1], n->rot[2], n->rot[3])),
+                                           rt_mat4_scale(rt_v3(n->sc[0], n->sc[1], n->sc[2]))));
+    return RT_OK;
+}
+
+/* rt_gltf_options.use_time: the chosen animation's channels at the time,
+ * before the world matrices are made. */
+static rt_result pose_nodes(gl_doc *d, const rt_gltf_options *opt)
+{
+    d->posed = true;
+    if (d->anim_count == 0) {
+        if (opt->animation > 0)
+            return rt_fail(d->err, RT_ERR_INVALID, "%s: animation %d requested, the file has none", d->path,
+                           opt->animation);
+        return RT_OK; /* skins and morph weights still pose the meshes */
+    }
+    if (opt->animation < 0 || (size_t)opt->animation >= d->anim_count)
+        return rt_fail(d->err, RT_ERR_INVALID, "%s: animation %d requested, the file has %zu (0 to %zu)", d->path,
+                       opt->animation, d->anim_count, d->anim_count - 1);
+    uint32_t a = (uint32_t)opt->animation;
+    for (uint32_t c = 0; c < d->anims[a].channel_count; c++)
+        TRY(pose_channel(d, a, c, opt->time));
+    return RT_OK;
 }
 
 /* The nodes of the chosen scene in depth-first order with world matrices. */
@@ -2097,17 +2404,163 @@ static rt_result collect_visits(gl_doc *d, const rt_gltf_options *opt)
     return RT_OK;
 }
 
-static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t mesh, uint32_t pi, const rt_mat4 *M,
-                                uint32_t material, size_t vbase)
+/* The morph weights of a posed node's mesh: animated, else the node's
+ * `weights`, else the mesh's, else zeros. */
+static rt_result morph_weights(gl_doc *d, uint32_t node, uint32_t count, float *w)
 {
+    const gl_node *n = &d->nodes[node];
+    memset(w, 0, count * sizeof *w);
+    if (n->pose_weights) {
+        memcpy(w, n->pose_weights, count * sizeof *w);
+        return RT_OK;
+    }
+    int tok = n->weights >= 0 ? n->weights : d->meshes[n->mesh].weights;
+    if (tok < 0)
+        return RT_OK;
+    char where[48];
+    snprintf(where, sizeof where, n->weights >= 0 ? "nodes[%u]" : "meshes[%u]", n->weights >= 0 ? node : n->mesh);
+    return get_floats(d, where, "weights", tok, w, (int)count);
+}
+
+/* Adds the weighted morph target displacements of one attribute (slot 0
+ * POSITION, 1 NORMAL, 2 TANGENT) to f (stride floats a vertex, xyz first). */
+static rt_result apply_morph(gl_doc *d, const gl_prim *p, const float *w, int slot, float *f, size_t stride,
+                             size_t vcount)
+{
+    static const char *const names[3] = {"POSITION", "NORMAL", "TANGENT"};
+    for (uint32_t k = 0; k < p->target_count; k++) {
+        uint32_t ai = d->targets[p->first_target + k].attr[slot];
+        if (w[k] == 0.0f || ai == RT_NONE)
+            continue;
+        char what[64];
+        snprintf(what, sizeof what, "%s of morph target %u", names[slot], k);
+        float *delta;
+        TRY(posing_floats(d, ai, 3, vcount, what, &delta));
+        for (size_t i = 0; i < vcount; i++)
+            for (size_t c = 0; c < 3; c++)
+                f[i * stride + c] += w[k] * delta[3 * i + c];
+        free(delta);
+    }
+    return RT_OK;
+}
+
+/* World matrix of any node (joints need not be in the chosen scene). */
+static rt_mat4 node_world(const gl_doc *d, uint32_t n, const rt_mat4 *top)
+{
+    rt_mat4 m = d->nodes[n].local;
+    for (uint32_t p = d->nodes[n].parent; p != RT_NONE; p = d->nodes[p].parent)
+        m = rt_mat4_mul(d->nodes[p].local, m);
+    return rt_mat4_mul(*top, m);
+}
+
+/* Per-vertex skin matrices of a primitive of a skinned node (glTF 2.0,
+ * 3.7.3 "Skins"): joint matrix j = world(joint j) * inverseBind(j); a
+ * vertex's matrix is the sum over its JOINTS_n / WEIGHTS_n sets of weight x
+ * joint matrix. The mesh node's own transform does not apply. A vertex whose
+ * weights sum to 0 keeps the node's transform M. */
+static rt_result skin_matrices(gl_doc *d, const gl_prim *p, uint32_t node, const rt_mat4 *M, const rt_mat4 *top,
+                               size_t vcount, rt_mat4 **out)
+{
+    const gl_skin *sk = &d->skins[d->nodes[node].skin];
+    char what[64];
+    snprintf(what, sizeof what, "inverseBindMatrices of skins[%u]", d->nodes[node].skin);
+    float *ibm = NULL;
+    if (sk->ibm != RT_NONE)
+        TRY(posing_floats(d, sk->ibm, 16, SIZE_MAX, what, &ibm));
+    if (ibm && d->accessors[sk->ibm].count < sk->joint_count) {
+        free(ibm);
+        return fail_at(d, sk->tok, RT_ERR_INVALID, "skins[%u]: %u joints but %zu inverseBindMatrices",
+                       d->nodes[node].skin, sk->joint_count, d->accessors[sk->ibm].count);
+    }
+    rt_mat4 *jm = rt_alloc(sk->joint_count, sizeof *jm);
+    if (!jm) {
+        free(ibm);
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for joints", d->path);
+    }
+    for (uint32_t j = 0; j < sk->joint_count; j++) {
+        uint32_t jn = d->skin_joints[sk->first_joint + j];
+        if (jn >= d->node_count) {
+            free(ibm);
+            free(jm);
+            return fail_at(d, sk->tok, RT_ERR_INVALID, "skins[%u].joints: node %u is out of range (the file has %zu)",
+                           d->nodes[node].skin, jn, d->node_count);
+        }
+        jm[j] = rt_mat4_mul(node_world(d, jn, top), ibm ? mat_from_gltf(ibm + 16 * j) : rt_mat4_identity());
+    }
+    free(ibm);
+    rt_result r = RT_OK;
+    if (!rt_grow((void **)&d->skin_scratch, &d->skin_scratch_cap, vcount ? vcount : 1, sizeof(rt_mat4))) {
+        free(jm);
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for skinning", d->path);
+    }
+    rt_mat4 *vm = d->skin_scratch;
+    memset(vm, 0, vcount * sizeof *vm);
+    float *wsum = rt_alloc(vcount ? vcount : 1, sizeof(float));
+    if (!wsum)
+        r = rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for skinning", d->path);
+    for (int set = 0; set < 2 && r == RT_OK; set++) {
+        if (p->joints[set] == RT_NONE || p->weights[set] == RT_NONE)
+            continue;
+        float *js = NULL, *ws = NULL;
+        snprintf(what, sizeof what, "JOINTS_%d", set);
+        r = posing_floats(d, p->joints[set], 4, vcount, what, &js);
+        snprintf(what, sizeof what, "WEIGHTS_%d", set);
+        if (r == RT_OK)
+            r = posing_floats(d, p->weights[set], 4, vcount, what, &ws);
+        for (size_t i = 0; i < vcount && r == RT_OK; i++)
+            for (int c = 0; c < 4; c++) {
+                float w = ws[4 * i + c], jf = js[4 * i + c];
+                if (w == 0.0f)
+                    continue;
+                if (!(jf >= 0) || jf >= (float)sk->joint_count) {
+                    r = fail_at(d, d->accessors[p->joints[set]].tok, RT_ERR_INVALID,
+                                "accessors[%u] (JOINTS_%d): element %zu names joint %g of %u", p->joints[set], set, i,
+                                (double)jf, sk->joint_count);
+                    break;
+                }
+                const rt_mat4 *J = &jm[(uint32_t)jf];
+                for (int a = 0; a < 4; a++)
+                    for (int b = 0; b < 4; b++)
+                        vm[i].m[a][b] += w * J->m[a][b];
+                wsum[i] += w;
+            }
+        free(js);
+        free(ws);
+    }
+    for (size_t i = 0; i < vcount && r == RT_OK; i++)
+        if (wsum[i] == 0.0f)
+            vm[i] = *M;
+    free(wsum);
+    free(jm);
+    *out = r == RT_OK ? vm : NULL;
+    return r;
+}
+
+static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t node, uint32_t pi, const rt_mat4 *M,
+                                const rt_mat4 *top, uint32_t material, size_t vbase)
+{
+    uint32_t mesh = d->nodes[node].mesh;
     const gl_prim *p = &d->prims[d->meshes[mesh].first + pi];
     const gl_accessor *pos = &d->accessors[p->attr[ATTR_POSITION]];
     size_t vcount = pos->count;
     rt_vertices *V = &s->vertices;
     float *f = NULL;
+    /* posed: morph weights and, for a skinned node, a matrix per vertex */
+    float mw[64];
+    bool morph = d->posed && p->target_count > 0;
+    rt_mat4 *vm = NULL;
+    if (morph) {
+        if (p->target_count > 64)
+            return fail_at(d, p->tok, RT_ERR_LIMIT, "meshes[%u].primitives[%u]: over 64 morph targets", mesh, pi);
+        TRY(morph_weights(d, node, p->target_count, mw));
+    }
+    if (d->posed && d->nodes[node].skin != RT_NONE && p->joints[0] != RT_NONE && p->weights[0] != RT_NONE)
+        TRY(skin_matrices(d, p, node, M, top, vcount, &vm));
 
     TRY(scratch(d, ATTR_POSITION, vcount * 3, &f));
     TRY(read_floats(d, p->attr[ATTR_POSITION], f));
+    if (morph)
+        TRY(apply_morph(d, p, mw, 0, f, 3, vcount));
     for (size_t i = 0; i < vcount; i++) {
         rt_vec3 q = rt_v3(f[3 * i], f[3 * i + 1], f[3 * i + 2]);
         if (!rt_finite3(q))
@@ -2115,26 +2568,34 @@ static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t mesh, uint32_t 
                            "accessors[%u] (POSITION of meshes[%u].primitives[%u]): element %zu is not finite "
                            "(%g, %g, %g)",
                            p->attr[ATTR_POSITION], mesh, pi, i, (double)q.x, (double)q.y, (double)q.z);
-        V->position[vbase + i] = rt_mat4_point(M, q);
+        V->position[vbase + i] = rt_mat4_point(vm ? &vm[i] : M, q);
     }
-    float det = rt_mat4_det3(M);
+    float det = rt_mat4_det3(vm && vcount ? &vm[0] : M);
     rt_mat4 N;
     bool have_n = p->attr[ATTR_NORMAL] != RT_NONE && rt_mat4_normal_matrix(M, &N);
     uint8_t flags = 0;
     if (have_n) {
         TRY(scratch(d, ATTR_NORMAL, vcount * 3, &f));
         TRY(read_floats(d, p->attr[ATTR_NORMAL], f));
+        if (morph)
+            TRY(apply_morph(d, p, mw, 1, f, 3, vcount));
         for (size_t i = 0; i < vcount; i++) {
             rt_vec3 n = rt_v3(f[3 * i], f[3 * i + 1], f[3 * i + 2]);
-            V->normal[vbase + i] = rt_finite3(n) ? rt_normalize(rt_mat4_vector(&N, n)) : rt_v3s(0);
+            rt_mat4 Ni;
+            const rt_mat4 *NM = &N;
+            if (vm)
+                NM = rt_mat4_normal_matrix(&vm[i], &Ni) ? &Ni : &N;
+            V->normal[vbase + i] = rt_finite3(n) ? rt_normalize(rt_mat4_vector(NM, n)) : rt_v3s(0);
         }
         flags |= RT_TRI_SMOOTH;
         if (p->attr[ATTR_TANGENT] != RT_NONE) {
             TRY(scratch(d, ATTR_TANGENT, vcount * 4, &f));
             TRY(read_floats(d, p->attr[ATTR_TANGENT], f));
+            if (morph)
+                TRY(apply_morph(d, p, mw, 2, f, 4, vcount));
             float sign = det < 0 ? -1.0f : 1.0f;
             for (size_t i = 0; i < vcount; i++) {
-                rt_vec3 t = rt_mat4_vector(M, rt_v3(f[4 * i], f[4 * i + 1], f[4 * i + 2]));
+                rt_vec3 t = rt_mat4_vector(vm ? &vm[i] : M, rt_v3(f[4 * i], f[4 * i + 1], f[4 * i + 2]));
                 t = rt_finite3(t) ? rt_normalize(t) : rt_v3s(0);
                 float w = f[4 * i + 3] < 0 ? -sign : sign;
                 V->tangent[vbase + i] = rt_v4(t.x, t.y, t.z, w);
@@ -2321,7 +2782,10 @@ static rt_result load_textures(gl_doc *d, rt_scene *s, rt_gltf_stats *st)
 
 static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st)
 {
+    if (opt && opt->use_time)
+        TRY(pose_nodes(d, opt));
     TRY(collect_visits(d, opt));
+    rt_mat4 top = opt && opt->use_transform ? opt->transform : rt_mat4_identity();
     st->nodes = d->visit_count;
 
     /* Count what the scene will hold, then reserve it all at once. */
@@ -2330,8 +2794,9 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
     bool need_default = false, warned_modes = false, warned_skin = false, warned_pos = false;
     for (size_t v = 0; v < d->visit_count; v++) {
         const gl_node *n = &d->nodes[d->visits[v].node];
-        if ((n->skin != RT_NONE) && !warned_skin) {
-            rt_warn("%s: skins and morph targets are not applied; meshes are loaded in their rest pose", d->path);
+        if (n->skin != RT_NONE && !warned_skin && !d->posed) {
+            rt_warn("%s: skins and morph targets are not applied; meshes are loaded in their rest pose "
+                        "(pose them at a time: --frame-time)", d->path);
             warned_skin = true;
         }
         if (n->mesh == RT_NONE)
@@ -2339,8 +2804,9 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
         const gl_mesh *m = &d->meshes[n->mesh];
         for (uint32_t k = 0; k < m->count; k++) {
             const gl_prim *p = &d->prims[m->first + k];
-            if (p->targets && !warned_skin) {
-                rt_warn("%s: skins and morph targets are not applied; meshes are loaded in their rest pose", d->path);
+            if (p->targets && !warned_skin && !d->posed) {
+                rt_warn("%s: skins and morph targets are not applied; meshes are loaded in their rest pose "
+                        "(pose them at a time: --frame-time)", d->path);
                 warned_skin = true;
             }
             if (!is_triangles(p->mode)) {
@@ -2435,7 +2901,7 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
             if (!is_triangles(p->mode) || p->attr[ATTR_POSITION] == RT_NONE)
                 continue;
             uint32_t mat = p->material == RT_NONE ? default_mat : mat_base + p->material;
-            TRY(emit_primitive(d, s, n->mesh, k, &d->visits[v].world, mat, vbase));
+            TRY(emit_primitive(d, s, d->visits[v].node, k, &d->visits[v].world, &top, mat, vbase));
             vbase += d->accessors[p->attr[ATTR_POSITION]].count;
         }
     }
@@ -2506,6 +2972,10 @@ static void doc_free(gl_doc *d)
         free(d->buffers[i].owned);
     for (size_t i = 0; i < d->view_count; i++)
         free(d->views[i].decoded);
+    for (size_t i = 0; i < d->node_count; i++)
+        free(d->nodes[i].pose_weights);
+    free(d->skins); free(d->skin_joints); free(d->targets); free(d->anims); free(d->channels); free(d->asamplers);
+    free(d->skin_scratch);
     free(d->buffers); free(d->views); free(d->accessors); free(d->meshes); free(d->prims);
     free(d->nodes); free(d->children); free(d->scenes); free(d->scene_nodes); free(d->materials);
     free(d->textures); free(d->samplers); free(d->images); free(d->cameras); free(d->lights);

@@ -135,18 +135,19 @@ static bool add_default_lighting(rt_scene *s)
 
 /* The reader for kind, then what for_render adds to that kind. */
 static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const char *name, rt_load_kind kind,
-                           bool for_render, rt_load_info *info, rt_error *err)
+                           const rt_load_options *opt, rt_load_info *info, rt_error *err)
 {
     rt_result r;
     switch (kind) {
     case RT_LOAD_GLTF: {
         rt_gltf_stats gs;
         memset(&gs, 0, sizeof gs);
-        r = rt_gltf_load_memory(s, bytes, size, name, NULL, &gs, err);
+        rt_gltf_options go = {.use_time = opt->use_time, .time = opt->time, .animation = opt->animation};
+        r = rt_gltf_load_memory(s, bytes, size, name, &go, &gs, err);
         info->meshes = gs.meshes;
         info->primitives = gs.primitives;
         info->nodes = gs.nodes;
-        if (r == RT_OK && for_render) {
+        if (r == RT_OK && opt->for_render) {
             if (!add_default_lighting(s))
                 r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", name);
             if (s->camera_count) {
@@ -165,7 +166,7 @@ static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const ch
         r = mo.material == RT_NONE ? rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", name)
                                    : rt_mesh_load_memory(s, bytes, size, name, &mo, NULL, err);
         info->meshes = info->primitives = r == RT_OK ? 1 : 0;
-        if (r == RT_OK && for_render && !add_default_lighting(s))
+        if (r == RT_OK && opt->for_render && !add_default_lighting(s))
             r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", name);
         return r;
     }
@@ -185,9 +186,12 @@ static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const ch
 static rt_result load_marked(rt_scene *s, const void *bytes, size_t size, const char *name, rt_load_kind kind,
                              const rt_load_options *options, rt_load_info *info, double t0, rt_error *err)
 {
-    bool for_render = options && options->for_render;
+    static const rt_load_options defaults = {0};
+    if (!options)
+        options = &defaults;
+    bool for_render = options->for_render;
     rt_scene_mark mark = rt_scene_mark_of(s);
-    rt_result r = load_kind(s, bytes, size, name, kind, for_render, info, err);
+    rt_result r = load_kind(s, bytes, size, name, kind, options, info, err);
     if (r == RT_OK && for_render) /* normal-mapped meshes without tangents get per-vertex ones */
         r = rt_scene_generate_tangents(s, err);
     if (r != RT_OK)

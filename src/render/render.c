@@ -23,7 +23,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "rt/base/alloc.h"
 #include "rt/base/clock.h"
@@ -35,20 +34,18 @@
 #include "rt/render/wavefront.h"
 #include "rt/scene/validate.h"
 
-int rt_cpu_count(void)
-{
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    return n > 0 ? (n > 1024 ? 1024 : (int)n) : 1;
-}
-
 struct rt_render_job {
     const rt_scene *scene;
-    rt_framebuffer *fb;
+    rt_framebuffer *fb;           /* the region's pixels */
     rt_camera_frame camera;
+    int width, height;            /* the whole image (settings) */
+    int rx0, ry0, rw, rh;         /* the region rendered: [rx0, rx0 + rw) x [ry0, ry0 + rh) */
     int tile_size, tiles_x, tiles_y, tiles_total;
     uint32_t spp;                 /* settings.samples */
+    uint32_t s_begin, s_end;      /* the samples this render adds: [s_begin, s_end) */
     bool passes;                  /* pass mode: accumulate into sum/good */
     uint32_t s0, s1;              /* passes: this pass's samples [s0, s1) */
+    rt_render_accum *accum;       /* NULL, or the caller's sums and counts, continued */
     float *sum;                   /* passes: per pixel, RGB sum of the good samples so far */
     uint32_t *good;               /* passes: per pixel, how many samples were good */
     int samples_done;             /* passes: samples in fb (read by progress reports) */
@@ -110,14 +107,15 @@ static void aov_store(rt_aov_buffers *aov, size_t pixel, const rt_aov_sample *s,
     }
 }
 
-/* Adds radiance sample L (sample s of pixel (x, y)) to *sum and *good:
- * the one place a pixel's arithmetic happens, for tiles and passes, one
- * path at a time or a wavefront, alike; samples come in sample order. */
-static inline void add_sample(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, uint32_t s,
-                              rt_vec3 L, rt_vec3 *sum, uint32_t *good)
+/* Adds radiance sample L, sample s of pixel (x, y) of the whole image
+ * (`local`: its index in the region's buffers), to *sum and *good: the one
+ * place a pixel's arithmetic happens, for tiles and passes, one path at a
+ * time or a wavefront, alike; samples come in sample order. */
+static inline void add_sample(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, size_t local,
+                              uint32_t s, rt_vec3 L, rt_vec3 *sum, uint32_t *good)
 {
     const rt_settings *st = &job->scene->settings;
-    uint64_t pixel = (uint64_t)y * (uint64_t)job->fb->width + (uint64_t)x;
+    uint64_t pixel = (uint64_t)y * (uint64_t)job->width + (uint64_t)x;
     if (!rt_finite3(L) || L.x < 0.0f || L.y < 0.0f || L.z < 0.0f) {
         w->bad_samples++;
         return;
@@ -131,33 +129,33 @@ static inline void add_sample(const rt_render_job *job, worker *w, rt_trace_ctx 
     (*good)++;
     if (job->aov) { /* own random numbers: the image stays as it was */
         rt_rng unused;
-        rt_ray ray = rt_camera_pixel_sample(&job->camera, job->fb->width, st->seed, job->spp, x, y, s, &unused);
+        rt_ray ray = rt_camera_pixel_sample(&job->camera, job->width, st->seed, job->spp, x, y, s, &unused);
         rt_rng arng = rt_rng_for_sample(st->seed ^ 0xa0f5eed5u, pixel, s);
         rt_aov_sample a;
         rt_aov_trace(ctx, ray, &arng, &a);
-        rt_aov_sample *acc = &job->aov_sum[pixel];
+        rt_aov_sample *acc = &job->aov_sum[local];
         acc->albedo = rt_add(acc->albedo, a.albedo);
         acc->normal = rt_add(acc->normal, a.normal);
         acc->position = rt_add(acc->position, a.position);
         acc->depth += a.depth;
-        job->lum_sq[pixel] += (double)rt_luminance(L) * (double)rt_luminance(L);
+        job->lum_sq[local] += (double)rt_luminance(L) * (double)rt_luminance(L);
     }
 }
 
 /* Adds samples [s0, s1) of pixel (x, y) to *sum_io and *good_io, in sample
  * order, one path at a time. */
-static inline void add_samples(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, uint32_t s0,
-                               uint32_t s1, rt_vec3 *sum_io, uint32_t *good_io)
+static inline void add_samples(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, size_t local,
+                               uint32_t s0, uint32_t s1, rt_vec3 *sum_io, uint32_t *good_io)
 {
     const rt_settings *st = &job->scene->settings;
     rt_vec3 sum = *sum_io;
     uint32_t good = *good_io;
     for (uint32_t s = s0; s < s1; s++) {
         rt_rng rng;
-        rt_ray ray = rt_camera_pixel_sample(&job->camera, job->fb->width, st->seed, job->spp, x, y, s, &rng);
+        rt_ray ray = rt_camera_pixel_sample(&job->camera, job->width, st->seed, job->spp, x, y, s, &rng);
         w->camera_rays++;
         rt_vec3 L = job->radiance(ctx, &ray, &rng);
-        add_sample(job, w, ctx, x, y, s, L, &sum, &good);
+        add_sample(job, w, ctx, x, y, local, s, L, &sum, &good);
     }
     *sum_io = sum;
     *good_io = good;
@@ -169,30 +167,37 @@ static inline rt_vec3 resolve(rt_vec3 sum, uint32_t good)
     return good ? rt_scale(sum, 1.0f / (float)good) : sum;
 }
 
+/* Tile `tile` of the region, in the region's (fb's) coordinates. */
 static void tile_bounds(const rt_render_job *job, int tile, int *x0, int *y0, int *x1, int *y1)
 {
     int tx = tile % job->tiles_x, ty = tile / job->tiles_x;
     *x0 = tx * job->tile_size;
     *y0 = ty * job->tile_size;
-    *x1 = *x0 + job->tile_size < job->fb->width ? *x0 + job->tile_size : job->fb->width;
-    *y1 = *y0 + job->tile_size < job->fb->height ? *y0 + job->tile_size : job->fb->height;
+    *x1 = *x0 + job->tile_size < job->rw ? *x0 + job->tile_size : job->rw;
+    *y1 = *y0 + job->tile_size < job->rh ? *y0 + job->tile_size : job->rh;
 }
 
-/* A pixel's running sum before its samples: passes continue the
- * accumulated one, tiles start from zero. */
+/* A pixel's running sum before its samples (`pixel`: its index in the
+ * region): passes continue the accumulated one, tiles start from zero or
+ * from the caller's sums. */
 static void pixel_begin(const rt_render_job *job, size_t pixel, rt_vec3 *sum, uint32_t *good)
 {
+    const float *acc = NULL;
+    *sum = rt_v3s(0);
+    *good = 0;
     if (job->passes) {
-        const float *acc = job->sum + 3 * pixel;
-        *sum = rt_v3(acc[0], acc[1], acc[2]);
+        acc = job->sum + 3 * pixel;
         *good = job->good[pixel];
-    } else {
-        *sum = rt_v3s(0);
-        *good = 0;
+    } else if (job->accum) { /* continue the caller's sums */
+        acc = job->accum->sum + 3 * pixel;
+        *good = job->accum->good[pixel];
     }
+    if (acc)
+        *sum = rt_v3(acc[0], acc[1], acc[2]);
 }
 
-/* ... and after them: passes keep the sum, tiles write the pixel. */
+/* ... and after them: passes keep the sum, tiles write the pixel (and the
+ * caller's sums). */
 static void pixel_end(rt_render_job *job, size_t pixel, rt_vec3 sum, uint32_t good)
 {
     if (job->passes) {
@@ -202,6 +207,13 @@ static void pixel_end(rt_render_job *job, size_t pixel, rt_vec3 sum, uint32_t go
         acc[2] = sum.z;
         job->good[pixel] = good;
         return;
+    }
+    if (job->accum) {
+        float *acc = job->accum->sum + 3 * pixel;
+        acc[0] = sum.x;
+        acc[1] = sum.y;
+        acc[2] = sum.z;
+        job->accum->good[pixel] = good;
     }
     if (job->aov)
         aov_store(job->aov, pixel, &job->aov_sum[pixel], good, rt_luminance(sum), job->lum_sq[pixel]);
@@ -217,17 +229,19 @@ static inline bool cancelled(const rt_render_job *job)
     return job->cancel && atomic_load_explicit(job->cancel, memory_order_relaxed);
 }
 
-/* render_tile for a wavefront integrator: the tile's pixels in chunks of at
- * most WAVE_CHUNK samples (a pixel with more samples than that in chunks of
- * its samples), each traced as one wavefront, then added pixel by pixel in
- * sample order exactly as the one-path-at-a-time loop adds them. */
+/* render_tile for a wavefront integrator: the tile's pixels (region
+ * coordinates [x0, x1) x [y0, y1)) in chunks of at most WAVE_CHUNK samples
+ * (a pixel with more samples than that in chunks of its samples), each
+ * traced as one wavefront, then added pixel by pixel in sample order exactly
+ * as the one-path-at-a-time loop adds them. */
 static bool render_tile_wavefront(rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x0, int y0, int x1, int y1)
 {
-    uint32_t s0 = job->passes ? job->s0 : 0, s1 = job->passes ? job->s1 : job->spp;
+    uint32_t s0 = job->passes ? job->s0 : job->s_begin, s1 = job->passes ? job->s1 : job->s_end;
     uint32_t ns = s1 - s0, tw = (uint32_t)(x1 - x0);
     uint32_t npx = tw * (uint32_t)(y1 - y0);
     uint32_t per_chunk = ns >= WAVE_CHUNK ? 1 : WAVE_CHUNK / ns;
-    rt_wavefront_work wk = {&job->camera, job->fb->width, job->scene->settings.seed, job->spp, x0, x1, y0, 0, 0, 0, 0};
+    rt_wavefront_work wk = {&job->camera, job->width, job->scene->settings.seed, job->spp, x0 + job->rx0,
+                            x1 + job->rx0, y0 + job->ry0, 0, 0, 0, 0};
     for (uint32_t p = 0; p < npx; p += per_chunk) {
         if (cancelled(job))
             return false;
@@ -240,20 +254,21 @@ static bool render_tile_wavefront(rt_render_job *job, worker *w, rt_trace_ctx *c
             w->camera_rays += (uint64_t)wk.count * ns;
             for (uint32_t i = 0; i < wk.count; i++) {
                 int x = x0 + (int)((p + i) % tw), y = y0 + (int)((p + i) / tw);
-                size_t pixel = (size_t)y * (size_t)job->fb->width + (size_t)x;
+                size_t pixel = (size_t)y * (size_t)job->rw + (size_t)x;
                 rt_vec3 sum;
                 uint32_t good;
                 pixel_begin(job, pixel, &sum, &good);
                 const float *o = w->wf_out + 3 * (size_t)i * ns;
                 for (uint32_t s = s0; s < s1; s++, o += 3)
-                    add_sample(job, w, ctx, x, y, s, rt_v3(o[0], o[1], o[2]), &sum, &good);
+                    add_sample(job, w, ctx, x + job->rx0, y + job->ry0, pixel, s, rt_v3(o[0], o[1], o[2]), &sum,
+                               &good);
                 pixel_end(job, pixel, sum, good);
             }
             continue;
         }
         /* one pixel, its samples in chunks */
         int x = x0 + (int)(p % tw), y = y0 + (int)(p / tw);
-        size_t pixel = (size_t)y * (size_t)job->fb->width + (size_t)x;
+        size_t pixel = (size_t)y * (size_t)job->rw + (size_t)x;
         rt_vec3 sum;
         uint32_t good;
         pixel_begin(job, pixel, &sum, &good);
@@ -266,7 +281,8 @@ static bool render_tile_wavefront(rt_render_job *job, worker *w, rt_trace_ctx *c
             w->camera_rays += wk.s1 - wk.s0;
             const float *o = w->wf_out;
             for (uint32_t s = wk.s0; s < wk.s1; s++, o += 3)
-                add_sample(job, w, ctx, x, y, s, rt_v3(o[0], o[1], o[2]), &sum, &good);
+                add_sample(job, w, ctx, x + job->rx0, y + job->ry0, pixel, s, rt_v3(o[0], o[1], o[2]), &sum,
+                           &good);
         }
         pixel_end(job, pixel, sum, good);
     }
@@ -283,16 +299,16 @@ static bool render_tile(rt_render_job *job, worker *w, rt_trace_ctx *ctx, int ti
     tile_bounds(job, tile, &x0, &y0, &x1, &y1);
     if (w->wf)
         return render_tile_wavefront(job, w, ctx, x0, y0, x1, y1);
-    uint32_t s0 = job->passes ? job->s0 : 0, s1 = job->passes ? job->s1 : job->spp;
+    uint32_t s0 = job->passes ? job->s0 : job->s_begin, s1 = job->passes ? job->s1 : job->s_end;
     for (int y = y0; y < y1; y++) {
         for (int x = x0; x < x1; x++) {
             if (cancelled(job))
                 return false;
-            size_t pixel = (size_t)y * (size_t)job->fb->width + (size_t)x;
+            size_t pixel = (size_t)y * (size_t)job->rw + (size_t)x;
             rt_vec3 sum;
             uint32_t good;
             pixel_begin(job, pixel, &sum, &good);
-            add_samples(job, w, ctx, x, y, s0, s1, &sum, &good);
+            add_samples(job, w, ctx, x + job->rx0, y + job->ry0, pixel, s0, s1, &sum, &good);
             pixel_end(job, pixel, sum, good);
         }
     }
@@ -400,7 +416,7 @@ static int run_workers(rt_render_job *job, worker *workers, int nthreads, const 
 /* fb = the accumulated samples of every pixel. */
 static void resolve_image(rt_render_job *job)
 {
-    size_t n = (size_t)job->fb->width * (size_t)job->fb->height;
+    size_t n = (size_t)job->rw * (size_t)job->rh;
     for (size_t k = 0; k < n; k++) {
         const float *acc = job->sum + 3 * k;
         if (job->aov)
@@ -439,9 +455,16 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     memset(&st, 0, sizeof st);
     const rt_settings *set = &scene->settings;
     RT_DCHECK(rt_scene_validate(scene, NULL) == RT_OK);
-    if (fb->width != set->width || fb->height != set->height || !fb->rgb)
-        return rt_fail(err, RT_ERR_INVALID, "framebuffer is %dx%d but the scene asks for %dx%d", fb->width,
-                       fb->height, set->width, set->height);
+    rt_render_region reg = opt.region;
+    if (reg.x0 == 0 && reg.y0 == 0 && reg.x1 == 0 && reg.y1 == 0)
+        reg = (rt_render_region){0, 0, set->width, set->height};
+    if (reg.x0 < 0 || reg.y0 < 0 || reg.x1 > set->width || reg.y1 > set->height || reg.x0 >= reg.x1 ||
+        reg.y0 >= reg.y1)
+        return rt_fail(err, RT_ERR_INVALID, "region [%d, %d) x [%d, %d) is not inside the %dx%d image", reg.x0,
+                       reg.x1, reg.y0, reg.y1, set->width, set->height);
+    if (fb->width != reg.x1 - reg.x0 || fb->height != reg.y1 - reg.y0 || !fb->rgb)
+        return rt_fail(err, RT_ERR_INVALID, "framebuffer is %dx%d but the region rendered is %dx%d", fb->width,
+                       fb->height, reg.x1 - reg.x0, reg.y1 - reg.y0);
     const rt_integrator_info *integrator = rt_integrator_info_of(set->integrator);
     if (!integrator)
         return rt_fail(err, RT_ERR_INVALID, "integrator %d is not one of the %zu rt knows", (int)set->integrator,
@@ -453,12 +476,24 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     job.fb = fb;
     job.cancel = opt.cancel;
     job.spp = set->samples > 0 ? (uint32_t)set->samples : 1;
+    job.s_begin = (uint32_t)(opt.sample_begin > 0 ? opt.sample_begin : 0);
+    job.s_end = opt.sample_end > 0 ? (uint32_t)opt.sample_end : job.spp;
+    if (job.s_end > job.spp || job.s_begin >= job.s_end)
+        return rt_fail(err, RT_ERR_INVALID, "sample range %u:%u is not inside the %u samples per pixel",
+                       job.s_begin, job.s_end, job.spp);
+    job.width = set->width;
+    job.height = set->height;
+    job.rx0 = reg.x0;
+    job.ry0 = reg.y0;
+    job.rw = reg.x1 - reg.x0;
+    job.rh = reg.y1 - reg.y0;
+    job.accum = opt.accum;
     int pass_samples = opt.pass_samples != 0 ? opt.pass_samples : integrator->pass_samples;
     job.passes = pass_samples > 0;
-    rt_camera_frame_init(&job.camera, &scene->camera, fb->width, fb->height);
+    rt_camera_frame_init(&job.camera, &scene->camera, set->width, set->height);
     job.tile_size = opt.tile_size > 0 ? (opt.tile_size < 65536 ? opt.tile_size : 65536) : 32;
-    job.tiles_x = (int)(((int64_t)fb->width + job.tile_size - 1) / job.tile_size);
-    job.tiles_y = (int)(((int64_t)fb->height + job.tile_size - 1) / job.tile_size);
+    job.tiles_x = (int)(((int64_t)job.rw + job.tile_size - 1) / job.tile_size);
+    job.tiles_y = (int)(((int64_t)job.rh + job.tile_size - 1) / job.tile_size);
     if ((int64_t)job.tiles_x * job.tiles_y > (int64_t)(1 << 26))
         return rt_fail(err, RT_ERR_LIMIT, "%dx%d image in %d-pixel tiles makes %lld tiles, over the limit of %d; use larger tiles",
                        fb->width, fb->height, job.tile_size, (long long)job.tiles_x * job.tiles_y, 1 << 26);
@@ -489,9 +524,17 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     }
     for (int t = 0; t < job.tiles_total; t++)
         atomic_init(&job.tile_finished[t], 0);
+    bool aov_accum = job.aov && job.accum && job.accum->aov_sum;
+    if (aov_accum) /* the AOV sums continue the caller's too */
+        memcpy(job.aov_sum, job.accum->aov_sum, npx * sizeof *job.aov_sum);
     if (job.passes) {
-        memset(job.sum, 0, npx * 3 * sizeof *job.sum);
-        memset(job.good, 0, npx * sizeof *job.good);
+        if (job.accum) { /* continue the caller's sums; they get them back after each whole pass */
+            memcpy(job.sum, job.accum->sum, npx * 3 * sizeof *job.sum);
+            memcpy(job.good, job.accum->good, npx * sizeof *job.good);
+        } else {
+            memset(job.sum, 0, npx * 3 * sizeof *job.sum);
+            memset(job.good, 0, npx * sizeof *job.good);
+        }
         memset(fb->rgb, 0, npx * 3 * sizeof *fb->rgb);
     }
     /* what the integrator reads, derived once, before the workers start */
@@ -516,7 +559,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     memset(&progress, 0, sizeof progress);
     progress.tiles_total = job.tiles_total;
     progress.passes = job.passes;
-    progress.samples_total = (int)job.spp;
+    progress.samples_total = (int)(job.s_end - job.s_begin);
     progress.fb = fb;
     progress.job = &job;
 
@@ -526,9 +569,11 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     if (!job.passes) {
         job.deadline = opt.time_limit > 0.0 ? t0 + opt.time_limit : 0.0;
         started = run_workers(&job, workers, nthreads, &opt, &progress, t0);
+        if (aov_accum)
+            memcpy(job.accum->aov_sum, job.aov_sum, npx * sizeof *job.aov_sum);
         st.tiles_done = atomic_load(&job.tiles_done);
         st.partial = st.tiles_done < job.tiles_total;
-        st.samples_done = st.partial ? 0 : (int)job.spp;
+        st.samples_done = st.partial ? 0 : (int)(job.s_end - job.s_begin);
         cancelled = st.partial && !atomic_load(&job.time_up);
         st.time_limited = st.partial && !cancelled;
         if (st.partial) {
@@ -539,18 +584,18 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
                 int x0, y0, x1, y1;
                 tile_bounds(&job, t, &x0, &y0, &x1, &y1);
                 for (int y = y0; y < y1; y++)
-                    memset(fb->rgb + 3 * ((size_t)y * (size_t)fb->width + (size_t)x0), 0,
+                    memset(fb->rgb + 3 * ((size_t)y * (size_t)job.rw + (size_t)x0), 0,
                            3 * sizeof(float) * (size_t)(x1 - x0));
             }
         }
     } else {
-        for (uint32_t s0 = 0; s0 < job.spp;) {
+        for (uint32_t s0 = job.s_begin; s0 < job.s_end;) {
             if (job.cancel && atomic_load(job.cancel)) {
                 cancelled = true;
                 break;
             }
             job.s0 = s0;
-            job.s1 = job.spp - s0 > (uint32_t)pass_samples ? s0 + (uint32_t)pass_samples : job.spp;
+            job.s1 = job.s_end - s0 > (uint32_t)pass_samples ? s0 + (uint32_t)pass_samples : job.s_end;
             progress.pass_samples = (int)(job.s1 - job.s0);
             int n = run_workers(&job, workers, nthreads, &opt, &progress, t0);
             started = n > started ? n : started;
@@ -559,16 +604,22 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
                 break;
             }
             resolve_image(&job);
-            job.samples_done = (int)job.s1;
+            if (job.accum) {
+                memcpy(job.accum->sum, job.sum, npx * 3 * sizeof *job.sum);
+                memcpy(job.accum->good, job.good, npx * sizeof *job.good);
+            }
+            if (aov_accum)
+                memcpy(job.accum->aov_sum, job.aov_sum, npx * sizeof *job.aov_sum);
+            job.samples_done = (int)(job.s1 - job.s_begin);
             st.passes_done++;
             s0 = job.s1;
-            if (opt.progress && s0 < job.spp) {
+            if (opt.progress && s0 < job.s_end) {
                 progress.tiles_done = job.tiles_total;
                 progress.samples_done = job.samples_done;
                 progress.elapsed = rt_now_seconds() - t0;
                 opt.progress(&progress, opt.progress_user);
             }
-            if (opt.time_limit > 0.0 && s0 < job.spp && rt_now_seconds() - t0 >= opt.time_limit) {
+            if (opt.time_limit > 0.0 && s0 < job.s_end && rt_now_seconds() - t0 >= opt.time_limit) {
                 st.time_limited = true;
                 break;
             }
@@ -604,7 +655,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     if (st.interrupted) {
         if (st.passes)
             return rt_fail(err, RT_ERR_INTERRUPTED, "render interrupted: %d of %d samples per pixel done",
-                           st.samples_done, (int)job.spp);
+                           st.samples_done, (int)(job.s_end - job.s_begin));
         return rt_fail(err, RT_ERR_INTERRUPTED, "render interrupted: %d of %d tiles finished", st.tiles_done,
                        st.tiles_total);
     }

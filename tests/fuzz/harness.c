@@ -13,17 +13,18 @@
 #include "rt/io/exr.h"
 #include "rt/io/load.h"
 #include "rt/io/meshopt.h"
+#include "rt/io/part.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/texture.h"
 
-const char *const rt_fuzz_targets[] = {"scene", "gltf",  "glb", "gltf_bin", "obj",   "ply",
-                                       "off",   "image", "exr", "meshopt",  "draco", NULL};
+const char *const rt_fuzz_targets[] = {"scene", "gltf",  "glb", "gltf_bin", "obj",   "ply",  "off",
+                                       "image", "exr",   "meshopt", "draco", "part", NULL};
 
 static char dir[64];
 
 static void remove_temp_dir(void)
 {
-    static const char *const files[] = {"buffer.bin", "m.mtl", NULL};
+    static const char *const files[] = {"buffer.bin", "m.mtl", "p.exr", "p.exr.json", NULL};
     char path[256];
     for (int i = 0; files[i]; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, files[i]);
@@ -157,6 +158,38 @@ int rt_fuzz_run(const char *target, const uint8_t *data, size_t size)
         uint32_t img;
         rt_image_load_memory(&s, data, size, "fuzz.img", &img, &err);
         rt_scene_free(&s);
+    } else if (strcmp(target, "part") == 0) {
+        /* u32 length, the sidecar (its "@HASH@" replaced by the image's
+         * FNV-1a, so the fuzzer gets past the hash check), the image */
+        size_t n;
+        split(data, size, &n);
+        const uint8_t *json = size >= 4 ? data + 4 : data, *img = json + n;
+        size_t img_size = size >= 4 ? size - 4 - n : 0;
+        write_temp("p.exr", img, img_size, path, sizeof path);
+        char hash[17];
+        snprintf(hash, sizeof hash, "%016llx", (unsigned long long)rt_fnv1a64(img, img_size, RT_FNV1A64_INIT));
+        char *text = malloc(n + 17);
+        if (!text)
+            abort();
+        size_t o = 0;
+        for (size_t i = 0; i < n;) {
+            if (i + 6 <= n && memcmp(json + i, "@HASH@", 6) == 0) {
+                memcpy(text + o, hash, 16);
+                o += 16;
+                i += 6;
+                memcpy(text + o, json + i, n - i);
+                o += n - i;
+                break;
+            }
+            text[o++] = (char)json[i++];
+        }
+        write_temp("p.exr.json", (const uint8_t *)text, o, path, sizeof path);
+        free(text);
+        rt_part part;
+        rt_error err;
+        snprintf(path, sizeof path, "%s/p.exr", temp_dir());
+        if (rt_part_read(path, &part, &err) == RT_OK)
+            rt_part_free(&part);
     } else if (strcmp(target, "exr") == 0) {
         rt_error err;
         float *rgba = NULL;

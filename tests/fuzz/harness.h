@@ -10,9 +10,11 @@
  * "m.mtl"), ply, off, image (any image bytes through our size checks),
  * exr (OpenEXR bytes straight into rt_exr_decode, capped at 4096 a side),
  * meshopt (an EXT_meshopt_compression stream: mode, filter, stride and a
- * u16 count in the first five bytes) and draco (a Draco mesh stream, its
- * indices and attributes read back).
- * Every target but image, exr, meshopt and draco loads through rt_load_memory, as `rt` loads a file
+ * u16 count in the first five bytes), draco (a Draco mesh stream, its
+ * indices and attributes read back) and part (u32 sidecar length, a
+ * part's JSON sidecar, then its EXR image, read by rt_part_read; "@HASH@"
+ * in the sidecar becomes the image's hash).
+ * Every target but image, exr, meshopt, draco and part loads through rt_load_memory, as `rt` loads a file
  * of that kind (fuzz.txt, fuzz.gltf, fuzz.obj, ...): the content picks the
  * reader before the name does.
  */

@@ -21,6 +21,11 @@
  *   if (rt_exr_decode(bytes, size, "sky.exr", 32768, 1u << 26, &rgba, &w, &h, &err) != RT_OK) ...
  *   ... rgba: w * h * 4 floats, row 0 at the top, alpha 1 where the file has none ...
  *   free(rgba);
+ *
+ * Named channels (all required), for files with layers of their own:
+ *
+ *   const char *names[4] = {"R", "G", "B", "count.Y"};
+ *   rt_exr_decode_channels(bytes, size, "part.exr", 32768, 1u << 28, names, 4, &px, &w, &h, &err);
  */
 #ifndef RT_EXR_H
 #define RT_EXR_H
@@ -51,5 +56,13 @@ rt_result rt_exr_write(FILE *f, const char *path, int width, int height, const r
  * Refuses images over max_dim a side or max_pixels in all (RT_ERR_LIMIT). */
 rt_result rt_exr_decode(const void *data, size_t size, const char *name, int max_dim, uint64_t max_pixels,
                         float **rgba, int *width, int *height, rt_error *err);
+
+/* Decodes the named channels (all of them must be there, float or half) of
+ * an EXR held in memory: count floats a pixel, channels[k] at component k
+ * (malloc'ed; the caller frees). For files rt wrote itself with extra
+ * layers (a part's "count.Y", docs/farm.md). */
+rt_result rt_exr_decode_channels(const void *data, size_t size, const char *name, int max_dim, uint64_t max_pixels,
+                                 const char *const *channels, int count, float **pixels, int *width, int *height,
+                                 rt_error *err);
 
 #endif

@@ -84,6 +84,9 @@ typedef struct rt_write_temp {
 rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *path, const rt_image_options *opt,
                                        rt_write_temp *temp, rt_error *err);
 
+/* Writes bytes to path the same atomic way (a part's sidecar, docs/farm.md). */
+rt_result rt_file_write_atomic(const char *path, const void *bytes, size_t size, rt_write_temp *temp, rt_error *err);
+
 /* Reads a PFM (for tests and comparisons against references). */
 rt_result rt_pfm_read(const char *path, rt_framebuffer *fb, rt_error *err);
 

@@ -22,6 +22,9 @@ typedef struct rt_gltf_options {
     bool use_scene_index;
     rt_mat4 transform;     /* applied on top of the node transforms */
     bool use_transform;    /* false = identity */
+    bool use_time;         /* pose at `time`: the animation's channels, skins and morph weights */
+    float time;            /* seconds on the animation's clock (clamped to its keys) */
+    int animation;         /* which animation, when use_time (0 = the first) */
 } rt_gltf_options;
 
 /* What one load added. meshes/primitives count instances (a mesh used by

@@ -46,6 +46,9 @@ typedef enum rt_load_kind { RT_LOAD_SCENE = 0, RT_LOAD_GLTF, RT_LOAD_MESH, RT_LO
 
 typedef struct rt_load_options {
     bool for_render; /* add lighting, integrator, samples, the first camera and tangents (above); false = as the file is */
+    bool use_time;   /* a glTF input is posed at `time` by its animation `animation` (rt_gltf_options) */
+    float time;
+    int animation;
 } rt_load_options;
 
 /* What one load found (what `rt --info` prints beside the scene's counts). */

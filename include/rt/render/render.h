@@ -30,6 +30,13 @@
  * accumulation buffer (16 bytes a pixel) and no sweep over the image each
  * pass.
  *
+ * Parts of an image (docs/farm.md): opt.region renders a rectangle of the
+ * image into a framebuffer of the rectangle's size, opt.sample_begin/end a
+ * range of each pixel's samples; both give exactly the samples (and so the
+ * bits) the whole render has there, since the random streams depend only on
+ * (seed, pixel of the whole image, sample, settings.samples). opt.accum hands
+ * in and out the per-pixel sums and counts a merge or a resume needs.
+ *
  * opt.time_limit stops after the pass that crosses it (tiles: each worker
  * finishes the tile in hand and takes no more); stats say how far it got.
  *
@@ -56,6 +63,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "rt/base/cpu.h" /* rt_cpu_count: the default thread count */
 #include "rt/base/error.h"
 #include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"
@@ -73,7 +81,7 @@ typedef struct rt_render_progress {
     int tiles_done, tiles_total;  /* passes: of the pass under way */
     bool passes;                  /* rendering in passes */
     int samples_done;             /* passes: samples per pixel in fb (complete passes) */
-    int samples_total;            /* settings.samples */
+    int samples_total;            /* settings.samples (of a sample range: its length) */
     int pass_samples;             /* passes: samples per pixel of the pass under way */
     double elapsed;               /* seconds since the workers started */
     bool final;                   /* the last report: the workers have stopped */
@@ -86,6 +94,23 @@ typedef void (*rt_render_progress_fn)(const rt_render_progress *p, void *user);
 /* Tile `index` (0 .. tiles_total - 1, row by row) of a progress report. */
 rt_tile rt_render_progress_tile(const rt_render_progress *p, int index);
 
+/* A rectangle of the image: pixels [x0, x1) x [y0, y1). All zero = the whole image. */
+typedef struct rt_render_region {
+    int x0, y0, x1, y1;
+} rt_render_region;
+
+/* The caller's per-pixel sums (parts, docs/farm.md): region-sized arrays the
+ * render continues (zeros for a fresh start, a stored part's values to
+ * resume it) and leaves holding the samples before it plus the ones it
+ * added: on return, in pass mode, up to the last whole pass (also when
+ * stopped); in tile mode, exact only when no tile is missing. */
+typedef struct rt_render_accum {
+    float *sum;     /* 3 floats a pixel: the RGB float sum of the good samples, in sample order */
+    uint32_t *good; /* 1 a pixel: how many samples were good */
+    struct rt_aov_sample *aov_sum; /* NULL, or with opt.aov: the sums of the good samples' albedo, normal,
+                                      position and depth (rt/render/aov.h), continued alike */
+} rt_render_accum;
+
 typedef struct rt_render_options {
     int threads;               /* 0 = one per core */
     int tile_size;             /* 0 = 32 */
@@ -96,6 +121,9 @@ typedef struct rt_render_options {
     void *progress_user;       /* handed to progress */
     struct rt_aov_buffers *aov; /* NULL = no AOVs; else the images to fill (rt/render/aov.h) */
     int batch_size;            /* wavefront integrators: paths in flight per worker; 0 = RT_WAVEFRONT_BATCH (same image for any) */
+    rt_render_region region;   /* only these pixels (fb is their size); zero = the whole image */
+    int sample_begin, sample_end; /* only samples [begin, end) of settings.samples; 0, 0 = all */
+    rt_render_accum *accum;    /* NULL, or sums and counts to continue and fill (a part, a resume) */
 } rt_render_options;
 
 typedef struct rt_render_stats {
@@ -106,14 +134,14 @@ typedef struct rt_render_stats {
     int threads;
     bool passes;                /* rendered in passes */
     int pass_samples, passes_done;
-    int samples_done;           /* samples per pixel in every pixel of fb (0 when partial) */
+    int samples_done;           /* samples per pixel this render added to every pixel of fb (0 when partial) */
     bool partial;               /* tiles: some tiles are missing (black) */
     bool interrupted;           /* stopped by cancel */
     bool time_limited;          /* stopped by the time limit */
 } rt_render_stats;
 
 /* Renders the scene's camera view into fb (which must be sized
- * settings.width x settings.height). When cancelled returns
+ * settings.width x settings.height, or the region's size). When cancelled returns
  * RT_ERR_INTERRUPTED: tiles leave the finished tiles in fb (the others
  * black, stats.partial), passes the image at stats.samples_done (partial
  * when no pass finished). Stopped by the time limit it returns RT_OK with
@@ -121,6 +149,5 @@ typedef struct rt_render_stats {
 rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_render_options *options,
                     rt_framebuffer *fb, rt_render_stats *stats, rt_error *err);
 
-int rt_cpu_count(void);
 
 #endif

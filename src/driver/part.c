@@ -1,0 +1,314 @@
+/* part.c - the driver's side of parts (part.h, docs/farm.md): the region
+ * and samples the part flags ask for, the identity of a render that every
+ * part of it carries (the FNV-1a hash of the input's bytes, the settings
+ * that change pixels as "key value" lines with floats in C99 hexadecimal
+ * so they compare exactly, the image size, the samples, the seed, rt's
+ * version), and --resume's check that a part belongs to this render. */
+#include "part.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "part_split.h"
+#include "rt/base/alloc.h"
+#include "rt/base/file.h"
+#include "rt/render/aov.h"
+#include "rt/render/integrator.h"
+
+/* Appends "key value\n" to the settings text. */
+static void line(char *buf, size_t size, const char *fmt, ...) RT_PRINTF(3, 4);
+static void line(char *buf, size_t size, const char *fmt, ...)
+{
+    size_t n = strlen(buf);
+    if (n + 1 >= size)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf + n, size - n, fmt, ap);
+    va_end(ap);
+    n = strlen(buf);
+    if (n + 1 < size) {
+        buf[n] = '\n';
+        buf[n + 1] = 0;
+    }
+}
+
+static void settings_text(const rt_scene *scene, char *buf, size_t size)
+{
+    const rt_settings *s = &scene->settings;
+    const rt_camera *c = &scene->camera;
+    buf[0] = 0;
+    line(buf, size, "resolution %d %d", s->width, s->height);
+    line(buf, size, "samples %d", s->samples);
+    line(buf, size, "seed %u", (unsigned)s->seed);
+    line(buf, size, "integrator %s", rt_integrator_name(s->integrator));
+    line(buf, size, "max_bounce %d", s->max_bounce);
+    line(buf, size, "max_depth %d", s->max_depth);
+    line(buf, size, "rr_depth %d", s->rr_depth);
+    line(buf, size, "diffuse_bounces %d", s->diffuse_bounces);
+    line(buf, size, "diffuse_rays %d", s->diffuse_rays);
+    line(buf, size, "shadow_samples %d", s->shadow_samples);
+    line(buf, size, "ray_offset %a", (double)s->ray_offset);
+    line(buf, size, "clamp %a", (double)s->clamp);
+    line(buf, size, "background %a %a %a", (double)s->background.x, (double)s->background.y,
+         (double)s->background.z);
+    const char *env = "none";
+    if (s->environment_texture != RT_NONE && s->environment_texture < scene->texture_count &&
+        scene->textures[s->environment_texture].image < scene->image_count)
+        env = rt_path_basename(scene->images[scene->textures[s->environment_texture].image].name);
+    line(buf, size, "environment %s strength %a", env, (double)s->environment_strength);
+    if (s->ambient_light_set)
+        line(buf, size, "ambient_light %a %a %a", (double)s->ambient_light.x, (double)s->ambient_light.y,
+             (double)s->ambient_light.z);
+    line(buf, size, "camera.position %a %a %a", (double)c->position.x, (double)c->position.y, (double)c->position.z);
+    line(buf, size, "camera.look_at %a %a %a", (double)c->look_at.x, (double)c->look_at.y, (double)c->look_at.z);
+    line(buf, size, "camera.up %a %a %a", (double)c->up.x, (double)c->up.y, (double)c->up.z);
+    line(buf, size, "camera.fov %a", (double)c->vfov_deg);
+    line(buf, size, "camera.aperture %a", (double)c->aperture);
+    line(buf, size, "camera.focus_distance %a", (double)c->focus_distance);
+}
+
+/* Component q of the AOV a layer holds (name: albedo, normal, position, depth). */
+static float *aov_field(rt_aov_sample *s, const char *name, int q)
+{
+    rt_vec3 *v = strcmp(name, "albedo") == 0   ? &s->albedo
+                 : strcmp(name, "normal") == 0 ? &s->normal
+                 : strcmp(name, "position") == 0 ? &s->position
+                                                 : NULL;
+    if (!v)
+        return &s->depth;
+    return q == 0 ? &v->x : q == 1 ? &v->y : &v->z;
+}
+
+void aov_to_layers(const rt_part_info *info, const rt_aov_sample *sums, float *const *layers, size_t n)
+{
+    for (int k = 0; k < info->layer_count; k++) {
+        int c = info->layer_channels[k];
+        for (size_t i = 0; i < n; i++) {
+            rt_aov_sample s = sums[i];
+            for (int q = 0; q < c; q++)
+                layers[k][(size_t)c * i + (size_t)q] = *aov_field(&s, info->layer_name[k], q);
+        }
+    }
+}
+
+void layers_to_aov(const rt_part_info *info, const float *const *layers, rt_aov_sample *sums, size_t n)
+{
+    for (int k = 0; k < info->layer_count; k++) {
+        int c = info->layer_channels[k];
+        for (size_t i = 0; i < n; i++)
+            for (int q = 0; q < c; q++)
+                *aov_field(&sums[i], info->layer_name[k], q) = layers[k][(size_t)c * i + (size_t)q];
+    }
+}
+
+rt_result part_identity(const rt_scene *scene, const char *input, rt_part_info *info, rt_error *err)
+{
+    memset(info, 0, sizeof *info);
+    snprintf(info->version, sizeof info->version, "%s", RT_VERSION);
+    if (input && strcmp(input, "-") == 0)
+        return rt_fail(err, RT_ERR_INVALID,
+                       "<stdin>: a part needs its scene in a file, which every machine reads and whose hash the "
+                       "parts compare (standard input cannot be read twice)");
+    if (input) {
+        char *bytes;
+        size_t size;
+        rt_result r = rt_read_file(input, 0, &bytes, &size, err);
+        if (r != RT_OK)
+            return r;
+        info->scene_hash = rt_fnv1a64(bytes, size, RT_FNV1A64_INIT);
+        free(bytes);
+        snprintf(info->scene, sizeof info->scene, "%s", input);
+    } else {
+        static const char builtin[] = "rt built-in Cornell box";
+        info->scene_hash = rt_fnv1a64(builtin, sizeof builtin - 1, RT_FNV1A64_INIT);
+        snprintf(info->scene, sizeof info->scene, "<built-in scene>");
+    }
+    settings_text(scene, info->settings, sizeof info->settings);
+    const rt_settings *s = &scene->settings;
+    info->width = s->width;
+    info->height = s->height;
+    info->spp = s->samples;
+    info->seed = s->seed;
+    info->exposure = s->exposure;
+    info->x1 = s->width;
+    info->y1 = s->height;
+    info->s_end = s->samples;
+    return RT_OK;
+}
+
+/* The first line where two settings texts differ, into a and b. */
+static void first_difference(const char *x, const char *y, char *a, char *b, size_t size)
+{
+    while (*x || *y) {
+        size_t nx = strcspn(x, "\n"), ny = strcspn(y, "\n");
+        if (nx != ny || memcmp(x, y, nx) != 0) {
+            snprintf(a, size, "%.*s", (int)nx, x);
+            snprintf(b, size, "%.*s", (int)ny, y);
+            return;
+        }
+        x += nx + (x[nx] == '\n');
+        y += ny + (y[ny] == '\n');
+    }
+    a[0] = b[0] = 0;
+}
+
+const char *part_mismatch(const rt_part_info *a, const rt_part_info *b, char *buf, size_t size)
+{
+    if (strcmp(a->version, b->version) != 0)
+        snprintf(buf, size, "rendered by rt %s, not rt %s", a->version, b->version);
+    else if (a->scene_hash != b->scene_hash)
+        snprintf(buf, size, "another scene file (%s, FNV-1a %016llx; not %s, %016llx)", a->scene,
+                 (unsigned long long)a->scene_hash, b->scene, (unsigned long long)b->scene_hash);
+    else if (a->width != b->width || a->height != b->height)
+        snprintf(buf, size, "image size %dx%d, not %dx%d", a->width, a->height, b->width, b->height);
+    else if (a->spp != b->spp)
+        snprintf(buf, size, "%d samples per pixel, not %d", a->spp, b->spp);
+    else if (a->seed != b->seed)
+        snprintf(buf, size, "seed %u, not %u", (unsigned)a->seed, (unsigned)b->seed);
+    else if (a->layer_count != b->layer_count ||
+             memcmp(a->layer_name, b->layer_name, sizeof a->layer_name) != 0)
+        snprintf(buf, size, "other AOVs (%d layer%s, not %d)", a->layer_count, a->layer_count == 1 ? "" : "s",
+                 b->layer_count);
+    else if (strcmp(a->settings, b->settings) != 0) {
+        char x[256], y[256];
+        first_difference(a->settings, b->settings, x, y, sizeof x);
+        snprintf(buf, size, "other settings: '%s', not '%s'", x, y);
+    } else
+        return NULL;
+    return buf;
+}
+
+rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, const rt_kdtree *tree, rt_error *err)
+{
+    memset(pj, 0, sizeof *pj);
+    const rt_settings *s = &scene->settings;
+    pj->to_part = args_output_is_part(a);
+    pj->region = (rt_render_region){0, 0, s->width, s->height};
+    pj->s_begin = 0;
+    pj->s_end = s->samples;
+    bool any = pj->to_part || a->resume || a->part_out;
+    if (!any)
+        return RT_OK;
+    rt_result r = part_identity(scene, a->input, &pj->info, err);
+    if (r != RT_OK)
+        return r;
+    if (a->has_crop) {
+        if (a->crop[2] > s->width || a->crop[3] > s->height)
+            return rt_fail(err, RT_ERR_INVALID, "--crop %d %d %d %d: the image is only %dx%d", a->crop[0], a->crop[1],
+                           a->crop[2], a->crop[3], s->width, s->height);
+        pj->region = (rt_render_region){a->crop[0], a->crop[1], a->crop[2], a->crop[3]};
+    }
+    if (a->part_count && (r = part_split(scene, tree, a->part_index, a->part_count, &pj->region, err)) != RT_OK)
+        return r;
+    if (a->has_spp_range) {
+        if (a->spp_end > s->samples)
+            return rt_fail(err, RT_ERR_INVALID,
+                           "--spp-range %d:%d: the render has %d samples per pixel; the range must end at or before "
+                           "them (set the total with -s)",
+                           a->spp_begin, a->spp_end, s->samples);
+        pj->s_begin = a->spp_begin;
+        pj->s_end = a->spp_end;
+    }
+    pj->part_begin = pj->s_begin;
+    if ((pj->to_part || a->resume || a->part_out) &&
+        (a->denoise || (a->aovs & ((1u << AOV_VARIANCE) | (1u << AOV_SPP)))))
+        return rt_fail(err, RT_ERR_INVALID,
+                       "parts keep the albedo, normal, depth and position AOVs; not the variance or spp AOVs, nor "
+                       "--denoise (merge the parts, then denoise the image)");
+    /* the AOV sums a part carries: its layers, in aov_names order */
+    for (int k = 0; k < AOV_COUNT; k++)
+        if (a->aovs & (1u << k)) {
+            rt_part_info *in = &pj->info;
+            snprintf(in->layer_name[in->layer_count], sizeof in->layer_name[0], "%s", aov_names[k]);
+            in->layer_channels[in->layer_count++] = k == AOV_DEPTH ? 1 : 3;
+        }
+    size_t n = (size_t)(pj->region.x1 - pj->region.x0) * (size_t)(pj->region.y1 - pj->region.y0);
+    pj->need_accum = true;
+    if (a->resume) {
+        rt_part p;
+        if ((r = rt_part_read(a->resume, &p, err)) != RT_OK)
+            return r;
+        char why[1024];
+        if (part_mismatch(&p.info, &pj->info, why, sizeof why)) {
+            r = rt_fail(err, RT_ERR_INVALID, "--resume %s: the part is of another render: %s", a->resume, why);
+            rt_part_free(&p);
+            return r;
+        }
+        if (p.info.s_end >= s->samples) {
+            r = rt_fail(err, RT_ERR_INVALID, "--resume %s: the part already holds samples %d:%d, all there are",
+                        a->resume, p.info.s_begin, p.info.s_end);
+            rt_part_free(&p);
+            return r;
+        }
+        pj->region = (rt_render_region){p.info.x0, p.info.y0, p.info.x1, p.info.y1};
+        pj->part_begin = p.info.s_begin;
+        pj->s_begin = p.info.s_end;
+        pj->s_end = s->samples;
+        pj->accum.sum = p.sum;
+        pj->accum.good = p.good;
+        p.sum = NULL;
+        p.good = NULL;
+        if (pj->info.layer_count) {
+            size_t np = (size_t)(p.info.x1 - p.info.x0) * (size_t)(p.info.y1 - p.info.y0);
+            pj->accum.aov_sum = rt_alloc(np, sizeof *pj->accum.aov_sum);
+            if (!pj->accum.aov_sum) {
+                rt_part_free(&p);
+                return rt_fail(err, RT_ERR_NOMEM, "out of memory for the AOV sums of %s", a->resume);
+            }
+            layers_to_aov(&p.info, (const float *const *)p.layer, pj->accum.aov_sum, np);
+        }
+        rt_part_free(&p);
+        bool whole = pj->region.x0 == 0 && pj->region.y0 == 0 && pj->region.x1 == s->width &&
+                     pj->region.y1 == s->height && pj->part_begin == 0;
+        pj->to_part = !whole;
+        return RT_OK;
+    }
+    pj->accum.sum = rt_alloc(n, 3 * sizeof(float));
+    pj->accum.good = rt_alloc(n, sizeof(uint32_t));
+    if (pj->info.layer_count)
+        pj->accum.aov_sum = rt_alloc(n, sizeof *pj->accum.aov_sum);
+    if (!pj->accum.sum || !pj->accum.good || (pj->info.layer_count && !pj->accum.aov_sum)) {
+        part_job_free(pj);
+        return rt_fail(err, RT_ERR_NOMEM, "out of memory for the sums of a %zu-pixel part", n);
+    }
+    memset(pj->accum.sum, 0, n * 3 * sizeof(float));
+    memset(pj->accum.good, 0, n * sizeof(uint32_t));
+    return RT_OK;
+}
+
+void part_job_free(part_job *pj)
+{
+    free(pj->accum.sum);
+    free(pj->accum.good);
+    free(pj->accum.aov_sum);
+    pj->accum.sum = NULL;
+    pj->accum.good = NULL;
+    pj->accum.aov_sum = NULL;
+}
+
+rt_result part_job_write(const part_job *pj, const char *path, int samples_done, rt_write_temp *temp, rt_error *err)
+{
+    rt_part_info info = pj->info;
+    info.x0 = pj->region.x0;
+    info.y0 = pj->region.y0;
+    info.x1 = pj->region.x1;
+    info.y1 = pj->region.y1;
+    info.s_begin = pj->part_begin;
+    info.s_end = pj->s_begin + samples_done;
+    size_t n = (size_t)(info.x1 - info.x0) * (size_t)(info.y1 - info.y0);
+    float *layers[RT_PART_MAX_LAYERS] = {NULL};
+    rt_result r = RT_OK;
+    for (int k = 0; k < info.layer_count && r == RT_OK; k++)
+        if (!(layers[k] = rt_alloc(n, (size_t)info.layer_channels[k] * sizeof(float))))
+            r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the AOV layers", path);
+    if (r == RT_OK) {
+        aov_to_layers(&info, pj->accum.aov_sum, layers, n);
+        r = rt_part_write(path, &info, pj->accum.sum, pj->accum.good, (const float *const *)layers, temp, err);
+    }
+    for (int k = 0; k < info.layer_count; k++)
+        free(layers[k]);
+    return r;
+}

@@ -1,0 +1,56 @@
+/* part.h - the driver's side of parts (driver-private; docs/farm.md):
+ * what a render with --crop, --part, --spp-range, --resume or --part-out
+ * renders, the per-pixel sums it keeps, and the part it writes; and the
+ * identity check `rt merge` and --resume share.
+ *
+ *   part_job pj;
+ *   if (part_job_init(&pj, &a, &scene, &tree, &err) != RT_OK) ...      // after the kd-tree
+ *   ro.region = pj.region; ro.sample_begin = pj.s_begin; ro.sample_end = pj.s_end;
+ *   ro.accum = pj.need_accum ? &pj.accum : NULL;
+ *   ... render into a framebuffer of the region's size ...
+ *   part_job_write(&pj, "p.exr", stats.samples_done, &temp, &err);
+ *   part_job_free(&pj);
+ */
+#ifndef RT_DRIVER_PART_H
+#define RT_DRIVER_PART_H
+
+#include <stdbool.h>
+
+#include "args.h"
+#include "rt/accel/kdtree.h"
+#include "rt/io/part.h"
+#include "rt/render/render.h"
+
+typedef struct part_job {
+    bool to_part;            /* the output is a part, not an image */
+    rt_render_region region; /* the pixels rendered (the whole image when no part flag) */
+    int s_begin, s_end;      /* the samples this run adds */
+    int part_begin;          /* the first sample the sums hold (--resume: the part's; else s_begin) */
+    bool need_accum;         /* sums kept: a part output, --part-out or --resume */
+    rt_render_accum accum;   /* region-sized; zeros, or the resumed part's sums */
+    rt_part_info info;       /* what the parts written are parts of (with the AOV layers) */
+} part_job;
+
+/* The identity of a render (scene hash, settings text, size, samples, seed,
+ * version) into info; the region and samples are left for the caller. */
+rt_result part_identity(const rt_scene *scene, const char *input, rt_part_info *info, rt_error *err);
+
+/* Plans the render from the flags (and the part --resume names), checks
+ * them against the scene, allocates the sums. */
+rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, const rt_kdtree *tree, rt_error *err);
+void part_job_free(part_job *pj);
+
+/* Writes the sums as a part at path covering samples [part_begin, s_begin +
+ * samples_done). */
+rt_result part_job_write(const part_job *pj, const char *path, int samples_done, rt_write_temp *temp, rt_error *err);
+
+/* A part's AOV layers (info->layer_name: albedo, normal, position, depth)
+ * to and from the render's per-pixel AOV sums, n pixels. */
+void aov_to_layers(const rt_part_info *info, const struct rt_aov_sample *sums, float *const *layers, size_t n);
+void layers_to_aov(const rt_part_info *info, const float *const *layers, struct rt_aov_sample *sums, size_t n);
+
+/* NULL when a and b are parts of the same render; else what differs, in
+ * words ("settings differ: 'samples 64' against 'samples 16'"), in buf. */
+const char *part_mismatch(const rt_part_info *a, const rt_part_info *b, char *buf, size_t size);
+
+#endif

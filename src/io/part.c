@@ -1,0 +1,483 @@
+/* part.c - a part's image and JSON sidecar out and in (rt/io/part.h,
+ * docs/farm.md). The image holds the exact float sums and counts the render
+ * kept (not their ratio), so a merge can resolve pixels with the very
+ * operations of a single render. Integrity: the sidecar carries FNV-1a 64
+ * hashes (Fowler, Noll, Vo; the parameters of the IETF draft
+ * draft-eastlake-fnv) of the image files, of the scene's bytes and of the
+ * settings text; reading checks the ones it can. JSON (RFC 8259) through
+ * the jsmn walker of rt/io/json.h. */
+#include "rt/io/part.h"
+
+#include <inttypes.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rt/base/alloc.h"
+#include "rt/base/file.h"
+#include "rt/io/exr.h"
+#include "rt/io/json.h"
+
+#define SIDECAR_MAX_BYTES (1u << 20)
+
+uint64_t rt_fnv1a64(const void *data, size_t size, uint64_t h)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < size; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+bool rt_part_path_ok(const char *path) { return rt_path_has_ext(path, ".exr") || rt_path_has_ext(path, ".pfm"); }
+
+bool rt_part_sidecar_path(const char *path, char *out, size_t size)
+{
+    int n = snprintf(out, size, "%s.json", path);
+    return n > 0 && (size_t)n < size;
+}
+
+/* The counts file of a PFM part: NAME.count.pfm. */
+static bool count_path(const char *path, char *out, size_t size)
+{
+    return rt_path_tagged(path, "count", NULL, out, size);
+}
+
+static rt_result hash_file(const char *path, uint64_t *h, rt_error *err)
+{
+    char *bytes;
+    size_t size;
+    rt_result r = rt_read_file(path, 0, &bytes, &size, err);
+    if (r != RT_OK)
+        return r;
+    *h = rt_fnv1a64(bytes, size, RT_FNV1A64_INIT);
+    free(bytes);
+    return RT_OK;
+}
+
+/* ------------------------------------------------------------ writing */
+
+typedef struct text {
+    char *buf;
+    size_t len, cap;
+    bool failed;
+} text;
+
+static void put(text *t, const char *fmt, ...) RT_PRINTF(2, 3);
+static void put(text *t, const char *fmt, ...)
+{
+    va_list ap;
+    for (;;) {
+        va_start(ap, fmt);
+        int n = vsnprintf(t->buf ? t->buf + t->len : NULL, t->buf ? t->cap - t->len : 0, fmt, ap);
+        va_end(ap);
+        if (n < 0) {
+            t->failed = true;
+            return;
+        }
+        if (t->buf && t->len + (size_t)n < t->cap) {
+            t->len += (size_t)n;
+            return;
+        }
+        size_t cap = (t->cap ? t->cap * 2 : 4096) + (size_t)n;
+        char *nb = realloc(t->buf, cap);
+        if (!nb) {
+            t->failed = true;
+            return;
+        }
+        t->buf = nb;
+        t->cap = cap;
+    }
+}
+
+/* A JSON string: quotes, backslashes and control bytes escaped. */
+static void put_string(text *t, const char *s)
+{
+    put(t, "\"");
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            put(t, "\\%c", c);
+        else if (c == '\n')
+            put(t, "\\n");
+        else if (c < 0x20)
+            put(t, "\\u%04x", c);
+        else
+            put(t, "%c", c);
+    }
+    put(t, "\"");
+}
+
+rt_result rt_part_write(const char *path, const rt_part_info *info, const float *sum, const uint32_t *good,
+                        const float *const *layers, rt_write_temp *temp, rt_error *err)
+{
+    char side[4200], cpath[4200];
+    if (!rt_part_path_ok(path))
+        return rt_fail(err, RT_ERR_INVALID, "%s: a part is written as .exr or .pfm", path);
+    if (!rt_part_sidecar_path(path, side, sizeof side) || !count_path(path, cpath, sizeof cpath))
+        return rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
+    if (info->layer_count < 0 || info->layer_count > RT_PART_MAX_LAYERS ||
+        (info->layer_count > 0 && !rt_path_has_ext(path, ".exr")))
+        return rt_fail(err, RT_ERR_INVALID, "%s: a part with AOVs is written as .exr", path);
+    int w = info->x1 - info->x0, h = info->y1 - info->y0;
+    size_t n = (size_t)w * (size_t)h;
+    float *counts = rt_alloc(n, sizeof(float));
+    if (!counts)
+        return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the counts", path);
+    for (size_t i = 0; i < n; i++)
+        counts[i] = (float)good[i];
+    rt_framebuffer fb = {w, h, (float *)sum};
+    bool exr = rt_path_has_ext(path, ".exr");
+    rt_result r = RT_OK;
+    uint64_t image_hash = 0, count_hash = 0;
+    if (exr) {
+        rt_image_layer layer[1 + RT_PART_MAX_LAYERS] = {{"count", 1, counts}};
+        for (int k = 0; k < info->layer_count; k++)
+            layer[1 + k] = (rt_image_layer){info->layer_name[k], info->layer_channels[k], layers[k]};
+        rt_image_options opt = {.layers = layer, .layer_count = 1 + info->layer_count};
+        r = rt_framebuffer_write_tracked(&fb, path, &opt, temp, err);
+    } else {
+        float *grey = rt_alloc(n, 3 * sizeof(float));
+        if (!grey) {
+            free(counts);
+            return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the counts", path);
+        }
+        for (size_t i = 0; i < n; i++)
+            grey[3 * i] = grey[3 * i + 1] = grey[3 * i + 2] = counts[i];
+        rt_framebuffer cfb = {w, h, grey};
+        rt_image_options opt = {0};
+        r = rt_framebuffer_write_tracked(&cfb, cpath, &opt, temp, err);
+        free(grey);
+        if (r == RT_OK)
+            r = rt_framebuffer_write_tracked(&fb, path, &opt, temp, err);
+        if (r == RT_OK)
+            r = hash_file(cpath, &count_hash, err);
+    }
+    free(counts);
+    if (r == RT_OK)
+        r = hash_file(path, &image_hash, err);
+    if (r != RT_OK)
+        return r;
+
+    text t = {0};
+    put(&t, "{\n  \"rt_part\": %d,\n  \"rt_version\": ", RT_PART_FORMAT);
+    put_string(&t, info->version);
+    put(&t, ",\n  \"image\": ");
+    put_string(&t, rt_path_basename(path));
+    put(&t, ",\n  \"image_fnv1a64\": \"%016" PRIx64 "\",\n", image_hash);
+    if (!exr) {
+        put(&t, "  \"count_image\": ");
+        put_string(&t, rt_path_basename(cpath));
+        put(&t, ",\n  \"count_fnv1a64\": \"%016" PRIx64 "\",\n", count_hash);
+    }
+    put(&t, "  \"scene\": ");
+    put_string(&t, info->scene);
+    put(&t, ",\n  \"scene_fnv1a64\": \"%016" PRIx64 "\",\n", info->scene_hash);
+    put(&t, "  \"settings_fnv1a64\": \"%016" PRIx64 "\",\n  \"settings\": ",
+        rt_fnv1a64(info->settings, strlen(info->settings), RT_FNV1A64_INIT));
+    put_string(&t, info->settings);
+    put(&t, ",\n  \"width\": %d,\n  \"height\": %d,\n  \"region\": [%d, %d, %d, %d],\n", info->width, info->height,
+        info->x0, info->y0, info->x1, info->y1);
+    put(&t, "  \"spp\": %d,\n  \"samples\": [%d, %d],\n  \"seed\": %" PRIu32 ",\n", info->spp, info->s_begin,
+        info->s_end, info->seed);
+    put(&t, "  \"exposure\": \"%a\",\n  \"layers\": [", (double)info->exposure);
+    for (int k = 0; k < info->layer_count; k++) {
+        put(&t, "%s[", k ? ", " : "");
+        put_string(&t, info->layer_name[k]);
+        put(&t, ", %d]", info->layer_channels[k]);
+    }
+    put(&t, "]\n}\n");
+    if (t.failed) {
+        free(t.buf);
+        return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the sidecar", side);
+    }
+    r = rt_file_write_atomic(side, t.buf, t.len, temp, err);
+    free(t.buf);
+    return r;
+}
+
+/* ------------------------------------------------------------ reading */
+
+static rt_result bad(rt_error *err, const char *side, const char *what)
+{
+    return rt_fail(err, RT_ERR_INVALID, "%s: %s", side, what);
+}
+
+static bool get_int(const rt_json *j, int obj, const char *key, long long lo, long long hi, long long *out)
+{
+    int i = rt_json_get(j, obj, key);
+    double v;
+    if (i < 0 || !rt_json_number(j, i, &v) || v != floor(v) || v < (double)lo || v > (double)hi)
+        return false;
+    *out = (long long)v;
+    return true;
+}
+
+static bool get_string(const rt_json *j, int obj, const char *key, char *out, size_t cap)
+{
+    int i = rt_json_get(j, obj, key);
+    return i >= 0 && rt_json_string(j, i, out, cap) >= 0;
+}
+
+static bool get_hash(const rt_json *j, int obj, const char *key, uint64_t *out)
+{
+    char s[32], *end;
+    if (!get_string(j, obj, key, s, sizeof s) || strlen(s) != 16)
+        return false;
+    *out = strtoull(s, &end, 16);
+    return *end == 0;
+}
+
+/* An array of n integers in [lo, hi]. */
+static bool get_ints(const rt_json *j, int obj, const char *key, int n, long long lo, long long hi, int *out)
+{
+    int i = rt_json_get(j, obj, key);
+    if (i < 0 || j->tok[i].type != RT_JSON_ARRAY || j->tok[i].size != n)
+        return false;
+    for (int k = 0; k < n; k++) {
+        double v;
+        if (!rt_json_number(j, i + 1 + k, &v) || v != floor(v) || v < (double)lo || v > (double)hi)
+            return false;
+        out[k] = (int)v;
+    }
+    return true;
+}
+
+/* A finite float written with %a (exact). */
+static bool float_text(const char *s, float *out)
+{
+    char *end = NULL;
+    *out = strtof(s, &end);
+    return end != s && *end == 0 && isfinite(*out);
+}
+
+/* The sidecar's fields into info; the image hashes into the rest. */
+static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *image_hash, uint64_t *count_hash,
+                              bool *has_count, rt_error *err)
+{
+    char *bytes;
+    size_t size;
+    rt_result r = rt_read_file(side, SIDECAR_MAX_BYTES, &bytes, &size, err);
+    if (r != RT_OK)
+        return r;
+    rt_json j;
+    r = rt_json_parse(&j, bytes, size, side, 0, err);
+    if (r != RT_OK) {
+        free(bytes);
+        return r;
+    }
+    memset(info, 0, sizeof *info);
+    long long fmt, w, h, spp, seed;
+    int reg[4], smp[2];
+    char expo[64];
+    uint64_t settings_hash = 0;
+    *has_count = rt_json_get(&j, 0, "count_fnv1a64") >= 0;
+    if (!get_int(&j, 0, "rt_part", 1, 1000, &fmt))
+        r = bad(err, side, "not a part sidecar (no \"rt_part\" format number)");
+    else if (fmt != RT_PART_FORMAT)
+        r = rt_fail(err, RT_ERR_INVALID, "%s: part format %lld, this rt reads format %d", side, fmt, RT_PART_FORMAT);
+    else if (!get_string(&j, 0, "rt_version", info->version, sizeof info->version))
+        r = bad(err, side, "\"rt_version\" missing or not a string");
+    else if (!get_hash(&j, 0, "image_fnv1a64", image_hash))
+        r = bad(err, side, "\"image_fnv1a64\" missing or not 16 hex digits");
+    else if (*has_count && !get_hash(&j, 0, "count_fnv1a64", count_hash))
+        r = bad(err, side, "\"count_fnv1a64\" not 16 hex digits");
+    else if (!get_string(&j, 0, "scene", info->scene, sizeof info->scene))
+        r = bad(err, side, "\"scene\" missing or not a string");
+    else if (!get_hash(&j, 0, "scene_fnv1a64", &info->scene_hash))
+        r = bad(err, side, "\"scene_fnv1a64\" missing or not 16 hex digits");
+    else if (!get_hash(&j, 0, "settings_fnv1a64", &settings_hash))
+        r = bad(err, side, "\"settings_fnv1a64\" missing or not 16 hex digits");
+    else if (!get_string(&j, 0, "settings", info->settings, sizeof info->settings))
+        r = bad(err, side, "\"settings\" missing, not a string or too long");
+    else if (rt_fnv1a64(info->settings, strlen(info->settings), RT_FNV1A64_INIT) != settings_hash)
+        r = bad(err, side, "\"settings\" do not match \"settings_fnv1a64\" (the sidecar was edited or damaged)");
+    else if (!get_int(&j, 0, "width", 1, 32768, &w) || !get_int(&j, 0, "height", 1, 32768, &h))
+        r = bad(err, side, "\"width\" and \"height\" must be integers from 1 to 32768");
+    else if (!get_ints(&j, 0, "region", 4, 0, 32768, reg) || reg[0] >= reg[2] || reg[1] >= reg[3] || reg[2] > w ||
+             reg[3] > h)
+        r = bad(err, side, "\"region\" must be [x0, y0, x1, y1] with x0 < x1 <= width and y0 < y1 <= height");
+    else if (!get_int(&j, 0, "spp", 1, 1 << 20, &spp))
+        r = bad(err, side, "\"spp\" must be an integer from 1 to 1048576");
+    else if (!get_ints(&j, 0, "samples", 2, 0, 1 << 20, smp) || smp[0] >= smp[1] || smp[1] > spp)
+        r = bad(err, side, "\"samples\" must be [begin, end] with begin < end <= spp");
+    else if (!get_int(&j, 0, "seed", 0, UINT32_MAX, &seed))
+        r = bad(err, side, "\"seed\" must be an integer from 0 to 4294967295");
+    else if (!get_string(&j, 0, "exposure", expo, sizeof expo) || !float_text(expo, &info->exposure))
+        r = bad(err, side, "\"exposure\" missing or not a number");
+    int li = r == RT_OK ? rt_json_get(&j, 0, "layers") : -1;
+    if (r == RT_OK && li >= 0) {
+        if (j.tok[li].type != RT_JSON_ARRAY || j.tok[li].size > RT_PART_MAX_LAYERS)
+            r = bad(err, side, "\"layers\" must be an array of at most 4 [name, channels] pairs");
+        int e = li + 1;
+        for (int k = 0; r == RT_OK && k < j.tok[li].size; k++, e = rt_json_skip(&j, e)) {
+            double ch = 0;
+            if (j.tok[e].type != RT_JSON_ARRAY || j.tok[e].size != 2 ||
+                rt_json_string(&j, e + 1, info->layer_name[k], sizeof info->layer_name[k]) <= 0 ||
+                strchr(info->layer_name[k], '.') || !rt_json_number(&j, e + 2, &ch) || (ch != 1 && ch != 3))
+                r = bad(err, side, "\"layers\" entries must be [\"name\", 1 or 3]");
+            info->layer_channels[k] = (int)ch;
+            info->layer_count = k + 1;
+        }
+    }
+    if (r == RT_OK) {
+        info->width = (int)w;
+        info->height = (int)h;
+        info->x0 = reg[0];
+        info->y0 = reg[1];
+        info->x1 = reg[2];
+        info->y1 = reg[3];
+        info->spp = (int)spp;
+        info->s_begin = smp[0];
+        info->s_end = smp[1];
+        info->seed = (uint32_t)seed;
+    }
+    rt_json_free(&j);
+    free(bytes);
+    return r;
+}
+
+/* The image at path, checked against its hash: an EXR's `count` named
+ * channels, else a PFM's three. */
+static rt_result read_image(const char *path, uint64_t want, bool exr, const char *const *names, int count,
+                            float **px, int *w, int *h, rt_error *err)
+{
+    char *bytes;
+    size_t size;
+    rt_result r = rt_read_file(path, 0, &bytes, &size, err);
+    if (r != RT_OK)
+        return r;
+    if (rt_fnv1a64(bytes, size, RT_FNV1A64_INIT) != want) {
+        free(bytes);
+        return rt_fail(err, RT_ERR_INVALID,
+                       "%s: the image's bytes do not match the hash in its sidecar (truncated, damaged, or from "
+                       "another render)",
+                       path);
+    }
+    if (exr) {
+        r = rt_exr_decode_channels(bytes, size, path, 32768, 1ull << 30, names, count, px, w, h, err);
+        free(bytes);
+        return r;
+    }
+    free(bytes);
+    rt_framebuffer fb;
+    if ((r = rt_pfm_read(path, &fb, err)) != RT_OK)
+        return r;
+    *px = fb.rgb;
+    *w = fb.width;
+    *h = fb.height;
+    return RT_OK;
+}
+
+rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
+{
+    memset(part, 0, sizeof *part);
+    char image[4096], side[4200], cpath[4200];
+    size_t len = strlen(path);
+    if (len >= sizeof image)
+        return rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
+    memcpy(image, path, len + 1);
+    if (rt_path_has_ext(image, ".json"))
+        image[len - 5] = 0;
+    snprintf(part->path, sizeof part->path, "%s", image);
+    if (!rt_part_path_ok(image))
+        return rt_fail(err, RT_ERR_INVALID, "%s: not a part (a part is a .exr or .pfm image with a .json sidecar)",
+                       path);
+    if (!rt_part_sidecar_path(image, side, sizeof side) || !count_path(image, cpath, sizeof cpath))
+        return rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
+    uint64_t image_hash = 0, count_hash = 0;
+    bool has_count = false;
+    rt_part_info *info = &part->info;
+    rt_result r = read_sidecar(side, info, &image_hash, &count_hash, &has_count, err);
+    if (r != RT_OK)
+        return r;
+    bool exr = rt_path_has_ext(image, ".exr");
+    if (!exr && !has_count)
+        return rt_fail(err, RT_ERR_INVALID, "%s: a .pfm part's sidecar must name \"count_fnv1a64\"", side);
+    int rw = info->x1 - info->x0, rh = info->y1 - info->y0, w = 0, h = 0;
+    size_t n = (size_t)rw * (size_t)rh;
+    float *px = NULL, *cpx = NULL;
+    /* the channels: R, G, B, count.Y, then each layer's */
+    char names_buf[4 + 3 * RT_PART_MAX_LAYERS][24];
+    const char *names[4 + 3 * RT_PART_MAX_LAYERS] = {"R", "G", "B", "count.Y"};
+    int nc = 4;
+    for (int k = 0; k < info->layer_count; k++)
+        for (int c = 0; c < info->layer_channels[k]; c++, nc++) {
+            snprintf(names_buf[nc], sizeof names_buf[nc], "%s.%s", info->layer_name[k],
+                     info->layer_channels[k] == 1 ? "Y" : c == 0 ? "R" : c == 1 ? "G" : "B");
+            names[nc] = names_buf[nc];
+        }
+    if (!exr && info->layer_count)
+        return rt_fail(err, RT_ERR_INVALID, "%s: a .pfm part cannot have layers", side);
+    r = read_image(image, image_hash, exr, names, nc, &px, &w, &h, err);
+    if (r == RT_OK && (w != rw || h != rh))
+        r = rt_fail(err, RT_ERR_INVALID, "%s: the image is %dx%d but its sidecar's region is %dx%d", image, w, h, rw,
+                    rh);
+    int cw = 0, ch = 0;
+    if (r == RT_OK && !exr) {
+        r = read_image(cpath, count_hash, false, NULL, 0, &cpx, &cw, &ch, err);
+        if (r == RT_OK && (cw != rw || ch != rh))
+            r = rt_fail(err, RT_ERR_INVALID, "%s: the image is %dx%d but its sidecar's region is %dx%d", cpath, cw,
+                        ch, rw, rh);
+    }
+    if (r == RT_OK) {
+        part->sum = rt_alloc(n, 3 * sizeof(float));
+        part->good = rt_alloc(n, sizeof(uint32_t));
+        bool ok = part->sum && part->good;
+        for (int k = 0; k < info->layer_count; k++) {
+            part->layer[k] = rt_alloc(n, (size_t)info->layer_channels[k] * sizeof(float));
+            ok = ok && part->layer[k];
+        }
+        if (!ok)
+            r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for a %dx%d part", image, rw, rh);
+    }
+    float most = (float)(info->s_end - info->s_begin);
+    for (size_t i = 0; i < n && r == RT_OK; i++) {
+        const float *s = exr ? px + (size_t)nc * i : px + 3 * i;
+        float c = exr ? s[3] : cpx[3 * i];
+        if (!(c >= 0.0f && c <= most && c == floorf(c)) || !(s[0] >= 0.0f) || !(s[1] >= 0.0f) || !(s[2] >= 0.0f) ||
+            !isfinite(s[0]) || !isfinite(s[1]) || !isfinite(s[2])) {
+            r = rt_fail(err, RT_ERR_INVALID,
+                        "%s: pixel (%zu, %zu) of the part holds a sum or count no render makes (sums are finite and "
+                        ">= 0, counts whole numbers up to %d)",
+                        image, i % (size_t)rw + (size_t)info->x0, i / (size_t)rw + (size_t)info->y0,
+                        info->s_end - info->s_begin);
+            break;
+        }
+        part->sum[3 * i] = s[0];
+        part->sum[3 * i + 1] = s[1];
+        part->sum[3 * i + 2] = s[2];
+        part->good[i] = (uint32_t)c;
+        for (int k = 0, at = 4; k < info->layer_count; at += info->layer_channels[k], k++)
+            for (int q = 0; q < info->layer_channels[k]; q++) {
+                float v = s[at + q];
+                if (!isfinite(v)) {
+                    r = rt_fail(err, RT_ERR_INVALID, "%s: layer %s of pixel (%zu, %zu) is not finite", image,
+                                info->layer_name[k], i % (size_t)rw + (size_t)info->x0,
+                                i / (size_t)rw + (size_t)info->y0);
+                    break;
+                }
+                part->layer[k][(size_t)info->layer_channels[k] * i + (size_t)q] = v;
+            }
+    }
+    free(px);
+    free(cpx);
+    if (r != RT_OK)
+        rt_part_free(part);
+    return r;
+}
+
+void rt_part_free(rt_part *part)
+{
+    free(part->sum);
+    free(part->good);
+    part->sum = NULL;
+    part->good = NULL;
+    for (int k = 0; k < RT_PART_MAX_LAYERS; k++) {
+        free(part->layer[k]);
+        part->layer[k] = NULL;
+    }
+}

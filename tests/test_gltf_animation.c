@@ -1,0 +1,332 @@
+/* test_gltf_animation.c - posing animated glTF (docs/gltf.md, "Animation"):
+ * keyframe curves against closed forms, and small files written here (a
+ * triangle translated, rotated, skinned and morphed) whose posed vertices
+ * are known exactly; broken animation data refused with a clear message;
+ * the shared Fox (skinned, 3 animations) posed at two times. */
+#include "test_util.h"
+
+#include <math.h>
+
+#include "rt/io/gltf.h"
+#include "rt/io/gltf_animation.h"
+#include "rt/scene/scene.h"
+
+#define PI_F 3.14159265358979f
+
+static void test_curves(void **state)
+{
+    (void)state;
+    float out[4];
+    const float t2[2] = {1.0f, 3.0f};
+    const float lin[2] = {10.0f, 20.0f};
+    rt_anim_sample(RT_INTERP_LINEAR, t2, 2, lin, 1, false, 2.5f, out);
+    assert_float_equal(out[0], 17.5f, 1e-6);
+    rt_anim_sample(RT_INTERP_LINEAR, t2, 2, lin, 1, false, 0.0f, out); /* clamped before the first key */
+    assert_float_equal(out[0], 10.0f, 0);
+    rt_anim_sample(RT_INTERP_LINEAR, t2, 2, lin, 1, false, 9.0f, out); /* and after the last */
+    assert_float_equal(out[0], 20.0f, 0);
+    rt_anim_sample(RT_INTERP_STEP, t2, 2, lin, 1, false, 2.99f, out);
+    assert_float_equal(out[0], 10.0f, 0);
+    rt_anim_sample(RT_INTERP_STEP, t2, 2, lin, 1, false, 3.0f, out);
+    assert_float_equal(out[0], 20.0f, 0);
+    /* CUBICSPLINE: in-tangent, value, out-tangent per key. Hermite with
+     * v0 = 0, v1 = 1, b0 = 2, a1 = -1 over an interval of 2 at u = 0.25:
+     * h00 v0 + h10 td b0 + h01 v1 + h11 td a1 */
+    const float cubic[6] = {0, 0, 2, -1, 1, 0};
+    rt_anim_sample(RT_INTERP_CUBICSPLINE, t2, 2, cubic, 1, false, 1.5f, out);
+    float u = 0.25f, u2 = u * u, u3 = u2 * u;
+    float want = (u3 - 2 * u2 + u) * 2 * 2 + (-2 * u3 + 3 * u2) * 1 + (u3 - u2) * 2 * -1;
+    assert_float_equal(out[0], want, 1e-6);
+    /* slerp: 0 -> 90 degrees about z; halfway is 45 degrees */
+    float s45 = sinf(PI_F / 8), c45 = cosf(PI_F / 8);
+    const float q[8] = {0, 0, 0, 1, 0, 0, sinf(PI_F / 4), cosf(PI_F / 4)};
+    rt_anim_sample(RT_INTERP_LINEAR, t2, 2, q, 4, true, 2.0f, out);
+    assert_float_equal(out[2], s45, 1e-6);
+    assert_float_equal(out[3], c45, 1e-6);
+    /* the shorter arc: -q2 is the same rotation */
+    const float qn[8] = {0, 0, 0, 1, 0, 0, -sinf(PI_F / 4), -cosf(PI_F / 4)};
+    rt_anim_sample(RT_INTERP_LINEAR, t2, 2, qn, 4, true, 2.0f, out);
+    assert_float_equal(fabsf(out[2]), s45, 1e-6);
+    assert_float_equal(fabsf(out[3]), c45, 1e-6);
+}
+
+/* ------------------------------------------------------ written files */
+
+static char *b64(const void *data, size_t n)
+{
+    static const char al[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const uint8_t *p = data;
+    char *out = malloc(4 * ((n + 2) / 3) + 1);
+    size_t o = 0;
+    for (size_t i = 0; i < n; i += 3) {
+        uint32_t w = (uint32_t)p[i] << 16 | (i + 1 < n ? (uint32_t)p[i + 1] << 8 : 0) | (i + 2 < n ? p[i + 2] : 0);
+        out[o++] = al[w >> 18 & 63];
+        out[o++] = al[w >> 12 & 63];
+        out[o++] = i + 1 < n ? al[w >> 6 & 63] : '=';
+        out[o++] = i + 2 < n ? al[w & 63] : '=';
+    }
+    out[o] = 0;
+    return out;
+}
+
+/* One buffer of floats: the triangle (0,0,0) (1,0,0) (0,1,0) at 0, then
+ * `extra` floats. Views and accessors are written by the caller. */
+static char dir[64];
+
+static const char *path_of(const char *name)
+{
+    static char buf[128];
+    snprintf(buf, sizeof buf, "%s/%s", dir, name);
+    return buf;
+}
+
+static void write_gltf(const char *name, const float *data, size_t nfloats, const char *body)
+{
+    char *enc = b64(data, nfloats * sizeof(float));
+    size_t cap = strlen(enc) + strlen(body) + 512;
+    char *json = malloc(cap);
+    snprintf(json, cap,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,"
+             "\"uri\":\"data:application/octet-stream;base64,%s\"}],%s}",
+             nfloats * sizeof(float), enc, body);
+    test_write_file(path_of(name), json, strlen(json));
+    free(enc);
+    free(json);
+}
+
+static rt_result load_at(const char *name, bool posed, float t, int anim, rt_scene *s, rt_error *err)
+{
+    rt_scene_init(s);
+    memset(err, 0, sizeof *err);
+    rt_gltf_options o = {.use_time = posed, .time = t, .animation = anim};
+    return rt_gltf_load(s, path_of(name), &o, NULL, err);
+}
+
+static void expect_vertex(const rt_scene *s, size_t i, float x, float y, float z)
+{
+    rt_vec3 p = s->vertices.position[i];
+    if (fabsf(p.x - x) > 1e-5f || fabsf(p.y - y) > 1e-5f || fabsf(p.z - z) > 1e-5f)
+        fprintf(stderr, "vertex %zu: (%g %g %g), expected (%g %g %g)\n", i, p.x, p.y, p.z, x, y, z);
+    assert_float_equal(p.x, x, 1e-5);
+    assert_float_equal(p.y, y, 1e-5);
+    assert_float_equal(p.z, z, 1e-5);
+}
+
+/* floats 0..8: the triangle; 9..10: key times 0, 2; then per test */
+#define TRI 0, 0, 0, 1, 0, 0, 0, 1, 0
+#define TRI_VIEWS "{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":8}"
+#define TRI_ACCESSORS                                                                                             \
+    "{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},"   \
+    "{\"bufferView\":1,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\"}"
+
+static void test_node_animation(void **state)
+{
+    (void)state;
+    assert_true(test_make_dir(dir, sizeof dir, "anim"));
+    rt_scene s;
+    rt_error err;
+    /* translation 0 -> (2,0,0) over [0, 2], LINEAR and STEP */
+    static const char *const interps[2] = {"LINEAR", "STEP"};
+    for (int k = 0; k < 2; k++) {
+        const float data[] = {TRI, 0, 2, 0, 0, 0, 2, 0, 0};
+        char body[2048];
+        snprintf(body, sizeof body,
+                 "\"bufferViews\":[" TRI_VIEWS ",{\"buffer\":0,\"byteOffset\":44,\"byteLength\":24}],"
+                 "\"accessors\":[" TRI_ACCESSORS ",{\"bufferView\":2,\"componentType\":5126,\"count\":2,"
+                 "\"type\":\"VEC3\"}],"
+                 "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+                 "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+                 "\"animations\":[{\"samplers\":[{\"input\":1,\"output\":2,\"interpolation\":\"%s\"}],"
+                 "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]",
+                 interps[k]);
+        write_gltf("move.gltf", data, sizeof data / sizeof *data, body);
+        assert_int_equal(load_at("move.gltf", true, 0.5f, 0, &s, &err), RT_OK);
+        expect_vertex(&s, 1, k == 0 ? 1.5f : 1.0f, 0, 0);
+        rt_scene_free(&s);
+        assert_int_equal(load_at("move.gltf", false, 0, 0, &s, &err), RT_OK); /* unposed: the static pose */
+        expect_vertex(&s, 1, 1, 0, 0);
+        rt_scene_free(&s);
+    }
+    /* rotation 0 -> 90 degrees about z: at t = 1, 45 degrees */
+    {
+        float h = sqrtf(0.5f);
+        const float data[] = {TRI, 0, 2, 0, 0, 0, 1, 0, 0, h, h};
+        write_gltf("turn.gltf", data, sizeof data / sizeof *data,
+                   "\"bufferViews\":[" TRI_VIEWS ",{\"buffer\":0,\"byteOffset\":44,\"byteLength\":32}],"
+                   "\"accessors\":[" TRI_ACCESSORS ",{\"bufferView\":2,\"componentType\":5126,\"count\":2,"
+                   "\"type\":\"VEC4\"}],"
+                   "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+                   "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+                   "\"animations\":[{\"samplers\":[{\"input\":1,\"output\":2}],"
+                   "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"rotation\"}}]}]");
+        assert_int_equal(load_at("turn.gltf", true, 1.0f, 0, &s, &err), RT_OK);
+        expect_vertex(&s, 1, cosf(PI_F / 4), sinf(PI_F / 4), 0);
+        rt_scene_free(&s);
+        assert_int_equal(load_at("turn.gltf", true, 5.0f, 0, &s, &err), RT_OK); /* after the last key */
+        expect_vertex(&s, 1, 0, 1, 0);
+        rt_scene_free(&s);
+        /* an animation that does not exist */
+        assert_int_equal(load_at("turn.gltf", true, 1.0f, 3, &s, &err), RT_ERR_INVALID);
+        assert_non_null(strstr(err.message, "animation 3 requested, the file has 1"));
+        rt_scene_free(&s);
+    }
+    test_remove_dir(dir);
+}
+
+/* Two joints at the origin; vertex 1 follows joint 1, rotated 90 degrees
+ * about z (its rest rotation), vertex 2 half joint 0 and half joint 1. */
+static void test_skin(void **state)
+{
+    (void)state;
+    assert_true(test_make_dir(dir, sizeof dir, "skin"));
+    /* JOINTS_0 as floats is not allowed: write them as unsigned bytes in
+     * a float-sized slot (4 bytes a vertex), WEIGHTS_0 as floats */
+    float data[9 + 2 + 3 + 12];
+    const float tri[9] = {TRI};
+    memcpy(data, tri, sizeof tri);
+    data[9] = 0;
+    data[10] = 2;
+    uint8_t joints[12] = {0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0};
+    memcpy(&data[11], joints, 12);
+    const float weights[12] = {1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0};
+    memcpy(&data[14], weights, sizeof weights);
+    write_gltf("skin.gltf", data, sizeof data / sizeof *data,
+               "\"bufferViews\":[" TRI_VIEWS ",{\"buffer\":0,\"byteOffset\":44,\"byteLength\":12},"
+               "{\"buffer\":0,\"byteOffset\":56,\"byteLength\":48}],"
+               "\"accessors\":[" TRI_ACCESSORS ",{\"bufferView\":2,\"componentType\":5121,\"count\":3,"
+               "\"type\":\"VEC4\"},{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"}],"
+               "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":2,\"WEIGHTS_0\":3}}]}],"
+               "\"skins\":[{\"joints\":[1,2]}],"
+               "\"nodes\":[{\"mesh\":0,\"skin\":0,\"translation\":[100,0,0]},{},"
+               "{\"rotation\":[0,0,0.70710678,0.70710678]}],"
+               "\"scenes\":[{\"nodes\":[0,1,2]}]");
+    rt_scene s;
+    rt_error err;
+    rt_result r = load_at("skin.gltf", true, 0.0f, 0, &s, &err);
+    if (r != RT_OK)
+        fprintf(stderr, "%s\n", err.message);
+    assert_int_equal(r, RT_OK);
+    expect_vertex(&s, 0, 0, 0, 0);      /* joint 0: identity (the mesh node's translation does not apply) */
+    expect_vertex(&s, 1, 0, 1, 0);      /* joint 1: (1,0,0) turned 90 degrees */
+    expect_vertex(&s, 2, -0.5f, 0.5f, 0); /* (0,1,0): half of itself, half of (-1,0,0) */
+    rt_scene_free(&s);
+    /* a joint index past the skin's joints */
+    joints[4] = 7;
+    memcpy(&data[11], joints, 12);
+    write_gltf("badjoint.gltf", data, sizeof data / sizeof *data,
+               "\"bufferViews\":[" TRI_VIEWS ",{\"buffer\":0,\"byteOffset\":44,\"byteLength\":12},"
+               "{\"buffer\":0,\"byteOffset\":56,\"byteLength\":48}],"
+               "\"accessors\":[" TRI_ACCESSORS ",{\"bufferView\":2,\"componentType\":5121,\"count\":3,"
+               "\"type\":\"VEC4\"},{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"}],"
+               "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":2,\"WEIGHTS_0\":3}}]}],"
+               "\"skins\":[{\"joints\":[1,2]}],"
+               "\"nodes\":[{\"mesh\":0,\"skin\":0},{},{}],\"scenes\":[{\"nodes\":[0,1,2]}]");
+    assert_int_equal(load_at("badjoint.gltf", true, 0.0f, 0, &s, &err), RT_ERR_INVALID);
+    assert_non_null(strstr(err.message, "badjoint.gltf"));
+    assert_non_null(strstr(err.message, "names joint 7 of 2"));
+    rt_scene_free(&s);
+    test_remove_dir(dir);
+}
+
+/* One morph target moving vertex 0 by (0,0,1); the mesh's weight 0.25,
+ * then an animation of the weight to 1 at t = 2. */
+static void test_morph(void **state)
+{
+    (void)state;
+    assert_true(test_make_dir(dir, sizeof dir, "morph"));
+    const float data[] = {TRI, 0, 2, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0.25f, 1};
+    write_gltf("morph.gltf", data, sizeof data / sizeof *data,
+               "\"bufferViews\":[" TRI_VIEWS ",{\"buffer\":0,\"byteOffset\":44,\"byteLength\":36},"
+               "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":8}],"
+               "\"accessors\":[" TRI_ACCESSORS ",{\"bufferView\":2,\"componentType\":5126,\"count\":3,"
+               "\"type\":\"VEC3\"},{\"bufferView\":3,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\"}],"
+               "\"meshes\":[{\"weights\":[0.25],\"primitives\":[{\"attributes\":{\"POSITION\":0},"
+               "\"targets\":[{\"POSITION\":2}]}]}],"
+               "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+               "\"animations\":[{\"samplers\":[{\"input\":1,\"output\":3}],"
+               "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"weights\"}}]}]");
+    rt_scene s;
+    rt_error err;
+    assert_int_equal(load_at("morph.gltf", false, 0, 0, &s, &err), RT_OK); /* unposed: no morphing */
+    expect_vertex(&s, 0, 0, 0, 0);
+    rt_scene_free(&s);
+    assert_int_equal(load_at("morph.gltf", true, 0.0f, 0, &s, &err), RT_OK); /* animated weight 0.25 at t = 0 */
+    expect_vertex(&s, 0, 0, 0, 0.25f);
+    rt_scene_free(&s);
+    assert_int_equal(load_at("morph.gltf", true, 1.0f, 0, &s, &err), RT_OK); /* 0.625 halfway */
+    expect_vertex(&s, 0, 0, 0, 0.625f);
+    expect_vertex(&s, 1, 1, 0, 0);
+    rt_scene_free(&s);
+    test_remove_dir(dir);
+}
+
+static void test_broken_animation(void **state)
+{
+    (void)state;
+    assert_true(test_make_dir(dir, sizeof dir, "badanim"));
+    rt_scene s;
+    rt_error err;
+    /* key times that go back */
+    const float data[] = {TRI, 2, 0, 0, 0, 0, 2, 0, 0};
+    const char *body = "\"bufferViews\":[" TRI_VIEWS ",{\"buffer\":0,\"byteOffset\":44,\"byteLength\":24}],"
+                       "\"accessors\":[" TRI_ACCESSORS ",{\"bufferView\":2,\"componentType\":5126,\"count\":2,"
+                       "\"type\":\"VEC3\"}],"
+                       "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+                       "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+                       "\"animations\":[{\"samplers\":[{\"input\":1,\"output\":2}],"
+                       "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]";
+    write_gltf("back.gltf", data, sizeof data / sizeof *data, body);
+    assert_int_equal(load_at("back.gltf", true, 1.0f, 0, &s, &err), RT_ERR_INVALID);
+    assert_non_null(strstr(err.message, "back.gltf"));
+    assert_non_null(strstr(err.message, "key times must increase"));
+    rt_scene_free(&s);
+    /* an output with the wrong count: rotation (VEC4) read from the VEC3 accessor */
+    const float ok[] = {TRI, 0, 2, 0, 0, 0, 2, 0, 0};
+    char body2[2048];
+    snprintf(body2, sizeof body2, "%s", body);
+    char *path = strstr(body2, "\"translation\"");
+    memcpy(path, "\"rotation\"   ", 13);
+    write_gltf("wrongtype.gltf", ok, sizeof ok / sizeof *ok, body2);
+    assert_int_equal(load_at("wrongtype.gltf", true, 1.0f, 0, &s, &err), RT_ERR_INVALID);
+    assert_non_null(strstr(err.message, "wrongtype.gltf"));
+    assert_non_null(strstr(err.message, "output of animations[0].channels[0]"));
+    rt_scene_free(&s);
+    test_remove_dir(dir);
+}
+
+/* The shared Fox: skinned, three animations; posed at two times of its
+ * run cycle the bounds differ, and both stay near the rest pose's size. */
+static void test_fox(void **state)
+{
+    (void)state;
+    if (!test_have_shared())
+        skip();
+    const char *fox = test_shared_path("assets/gltf/Fox/glTF-Binary/Fox.glb");
+    rt_gltf_stats a, b, rest;
+    rt_scene s;
+    rt_error err;
+    rt_gltf_options o = {.use_time = true, .time = 0.2f, .animation = 2};
+    rt_scene_init(&s);
+    assert_int_equal(rt_gltf_load(&s, fox, &o, &a, &err), RT_OK);
+    rt_scene_free(&s);
+    o.time = 0.5f;
+    rt_scene_init(&s);
+    assert_int_equal(rt_gltf_load(&s, fox, &o, &b, &err), RT_OK);
+    rt_scene_free(&s);
+    rt_scene_init(&s);
+    assert_int_equal(rt_gltf_load(&s, fox, NULL, &rest, &err), RT_OK);
+    rt_scene_free(&s);
+    assert_int_equal(a.triangles, rest.triangles);
+    assert_true(memcmp(&a.bounds, &b.bounds, sizeof a.bounds) != 0);
+    float hr = rest.bounds.hi.y - rest.bounds.lo.y, ha = a.bounds.hi.y - a.bounds.lo.y;
+    assert_true(ha > 0.7f * hr && ha < 1.3f * hr);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_curves), cmocka_unit_test(test_node_animation), cmocka_unit_test(test_skin),
+        cmocka_unit_test(test_morph),  cmocka_unit_test(test_broken_animation), cmocka_unit_test(test_fox),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
