@@ -454,7 +454,7 @@ static void test_settings_text_form(void **state)
     assert_int_equal(rt_setting_set(&s, rt_setting_find("samples"), "", &pb), RT_ERR_PARSE);
     assert_string_equal(pb.message, "expected an integer for samples per pixel, got nothing");
     assert_int_equal(rt_setting_set(&s, rt_setting_find("integrator"), "magic", &pb), RT_ERR_PARSE);
-    assert_string_equal(pb.message, "expected an integrator (direct|whitted|path), got 'magic'");
+    assert_string_equal(pb.message, "expected an integrator (direct|whitted|path|path_scalar), got 'magic'");
 
     assert_int_equal(rt_setting_set(&s, rt_setting_find("background"), "0.1,0.2 0.3", &pb), RT_OK);
     assert_vec3(s.settings.background, 0.1f, 0.2f, 0.3f);
@@ -786,13 +786,13 @@ static void test_errors_syntax(void **state)
     expect_error("samples\n", RT_ERR_PARSE, "1:8", "expected an integer for samples per pixel, got end of line");
     expect_error("resolution 640\n", RT_ERR_PARSE, "1:15", "expected an integer for the image height, got end of line");
     expect_error("integrator fancy\n", RT_ERR_PARSE, "1:12",
-                 "expected an integrator (direct|whitted|path), got 'fancy'");
+                 "expected an integrator (direct|whitted|path|path_scalar), got 'fancy'");
     expect_error("material m\nsphere 0 0 0 1 m\nsphere 1 2 \\\n  3 x m\n", RT_ERR_PARSE, "4:5",
                  "expected a number for the sphere radius, got 'x'");
     expect_error("material \"unterminated\n", RT_ERR_PARSE, "1:10", "unterminated quoted string");
     expect_error("material \"a\"b\n", RT_ERR_PARSE, "1:13", "expected a blank after the closing quote");
     expect_error("samples \"4\"\n", RT_ERR_PARSE, "1:9", "expected an integer for samples per pixel, got '4'");
-    expect_error("integrator \"path\"\n", RT_ERR_PARSE, "1:12", "expected an integrator (direct|whitted|path)");
+    expect_error("integrator \"path\"\n", RT_ERR_PARSE, "1:12", "expected an integrator (direct|whitted|path|path_scalar)");
     expect_error("samples 4\x01\n", RT_ERR_PARSE, "1:10", "unexpected control character 0x01");
     expect_error("samples 4\n\x7f", RT_ERR_PARSE, "2:1", "unexpected control character 0x7f");
     {

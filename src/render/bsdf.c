@@ -105,13 +105,15 @@ static rt_vec3 vndf_xy(rt_vec3 wo, float ax, float ay, rt_vec2 u)
     rt_vec3 t2 = rt_cross(vh, t1);
     /* a point on the projected area of the hemisphere */
     float r = sqrtf(u.x), phi = 2.0f * RT_PI * u.y;
-    float p1 = r * cosf(phi), p2 = r * sinf(phi);
+    float sn, cs;
+    rt_sincosf(phi, &sn, &cs);
+    float p1 = r * cs, p2 = r * sn;
     float s = 0.5f * (1.0f + vh.z);
-    p2 = (1.0f - s) * sqrtf(fmaxf(0.0f, 1.0f - p1 * p1)) + s * p2;
+    p2 = (1.0f - s) * sqrtf(rt_fmaxf(0.0f, 1.0f - p1 * p1)) + s * p2;
     rt_vec3 nh = rt_add(rt_add(rt_scale(t1, p1), rt_scale(t2, p2)),
-                        rt_scale(vh, sqrtf(fmaxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));
+                        rt_scale(vh, sqrtf(rt_fmaxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));
     /* unstretch */
-    rt_vec3 ne = rt_v3(ax * nh.x, ay * nh.y, fmaxf(1e-7f, nh.z));
+    rt_vec3 ne = rt_v3(ax * nh.x, ay * nh.y, rt_fmaxf(1e-7f, nh.z));
     return rt_normalize(ne);
 }
 
@@ -182,9 +184,9 @@ static float fresnel_conductor1(float c, float eta, float k)
     float c2 = c * c, s2 = 1.0f - c2;
     float eta2 = eta * eta, k2 = k * k;
     float t0 = eta2 - k2 - s2;
-    float a2b2 = sqrtf(fmaxf(0.0f, t0 * t0 + 4.0f * eta2 * k2));
+    float a2b2 = sqrtf(rt_fmaxf(0.0f, t0 * t0 + 4.0f * eta2 * k2));
     float t1 = a2b2 + c2;
-    float a = sqrtf(fmaxf(0.0f, 0.5f * (a2b2 + t0)));
+    float a = sqrtf(rt_fmaxf(0.0f, 0.5f * (a2b2 + t0)));
     float t2 = 2.0f * c * a;
     float rs = (t1 - t2) / (t1 + t2);
     float t3 = c2 * a2b2 + s2 * s2;
@@ -290,7 +292,7 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
     b->metallic = metallic;
     b->f0 = r0 * r0;
     b->delta = roughness == 0.0f;
-    b->alpha = b->alpha_y = fmaxf(roughness * roughness, RT_BSDF_MIN_ALPHA);
+    b->alpha = b->alpha_y = rt_fmaxf(roughness * roughness, RT_BSDF_MIN_ALPHA);
     b->transmission = transmission;
     b->eta = 1.0f / ior;
 }
@@ -311,8 +313,8 @@ static void set_conductor(rt_bsdf *b, rt_vec3 eta, rt_vec3 k, float ax, float ay
     ax = isfinite(ax) ? rt_clampf(ax, 0.0f, 1.0f) : 1.0f;
     ay = isfinite(ay) ? rt_clampf(ay, 0.0f, 1.0f) : 1.0f;
     b->delta = ax == 0.0f && ay == 0.0f;
-    b->alpha = fmaxf(ax, RT_BSDF_MIN_ALPHA);
-    b->alpha_y = fmaxf(ay, RT_BSDF_MIN_ALPHA);
+    b->alpha = rt_fmaxf(ax, RT_BSDF_MIN_ALPHA);
+    b->alpha_y = rt_fmaxf(ay, RT_BSDF_MIN_ALPHA);
     b->separable = smith == RT_SMITH_SEPARABLE;
 }
 
@@ -352,7 +354,7 @@ rt_vec3 rt_material_absorption(const rt_material *m)
                    (m->transmission > 0.0f || m->diffuse_transmission > 0.0f));
     if (volume && isfinite(m->attenuation_distance) && m->attenuation_distance > 0.0f) {
         rt_vec3 c = rt_vmax(m->attenuation_color, rt_v3s(1e-6f));
-        rt_vec3 a = rt_v3(-logf(fminf(c.x, 1.0f)), -logf(fminf(c.y, 1.0f)), -logf(fminf(c.z, 1.0f)));
+        rt_vec3 a = rt_v3(-logf(rt_fminf(c.x, 1.0f)), -logf(rt_fminf(c.y, 1.0f)), -logf(rt_fminf(c.z, 1.0f)));
         sigma = rt_add(sigma, rt_scale(a, 1.0f / m->attenuation_distance));
     }
     return rt_finite3(sigma) ? rt_vmax(sigma, rt_v3s(0.0f)) : rt_v3s(0.0f);
@@ -368,7 +370,7 @@ void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha)
     b->eta = eta;
     alpha = isfinite(alpha) ? rt_clampf(alpha, 0.0f, 1.0f) : 1.0f;
     b->delta = alpha == 0.0f;
-    b->alpha = b->alpha_y = fmaxf(alpha, RT_BSDF_MIN_ALPHA);
+    b->alpha = b->alpha_y = rt_fmaxf(alpha, RT_BSDF_MIN_ALPHA);
     b->radiance_eta2 = true;
 }
 
@@ -409,7 +411,7 @@ void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alp
     b->plastic = true;
     alpha = isfinite(alpha) ? rt_clampf(alpha, 0.0f, 1.0f) : 1.0f;
     b->delta = alpha == 0.0f;
-    b->alpha = b->alpha_y = fmaxf(alpha, RT_BSDF_MIN_ALPHA);
+    b->alpha = b->alpha_y = rt_fmaxf(alpha, RT_BSDF_MIN_ALPHA);
     /* light entering the coat (1 - Fi), bouncing between base and coat
      * (the geometric series 1 / (1 - R Fdr_in), Fdr_in the coat's internal
      * diffuse reflectance) and leaving (1 - Fo) loses 1 / eta_in^2 of its
@@ -621,8 +623,8 @@ void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p
     if (b->plastic) /* the diffuse lobe's albedo: (1 - Fo) diffuse (1 - Fdr_out), about (1 - Fo) diffuse */
         td *= 1.0f - b->f0;
     if (!b->delta) {
-        ws = fmaxf(ws, 0.02f);
-        td = fmaxf(td, 0.1f);
+        ws = rt_fmaxf(ws, 0.02f);
+        td = rt_fmaxf(td, 0.1f);
     }
     float wd = mean3(b->diffuse) * td;
     float wt = wd * b->transmission;
@@ -1071,7 +1073,7 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
         float ci = rt_dot(wo, h);
         if (!(ci > 0.0f))
             return false;
-        float sin2_t = eta * eta * fmaxf(0.0f, 1.0f - ci * ci);
+        float sin2_t = eta * eta * rt_fmaxf(0.0f, 1.0f - ci * ci);
         if (sin2_t >= 1.0f)
             return false; /* total internal reflection: F = 1, the reflection lobe carries it */
         float ct = sqrtf(1.0f - sin2_t);

@@ -1,7 +1,8 @@
 /* camera.c - pinhole and thin-lens camera rays (see rt/camera.h for the
  * exact convention). Thin lens: the origin is sampled on a disk of radius
  * aperture/2 around the eye and the ray aimed at the point the pinhole ray
- * reaches on the plane of focus (pbrt, section 6.2.3). */
+ * reaches on the plane of focus (pbrt, section 6.2.3). Pixel samples:
+ * correlated multi-jittered positions (Kensler 2013, rt/render/sampling.h). */
 #include "rt/render/camera.h"
 
 #include "rt/render/sampling.h"
@@ -49,4 +50,16 @@ rt_ray rt_camera_ray(const rt_camera_frame *cf, float film_x, float film_y, rt_v
         return rt_ray_make(o, rt_normalize(rt_sub(focus, o)), 0.0f, INFINITY);
     }
     return rt_ray_make(cf->origin, rt_normalize(d), 0.0f, INFINITY);
+}
+
+rt_ray rt_camera_pixel_sample(const rt_camera_frame *cf, int width, uint32_t seed, uint32_t spp, int x, int y,
+                              uint32_t s, rt_rng *rng)
+{
+    uint64_t pixel = (uint64_t)y * (uint64_t)width + (uint64_t)x;
+    uint32_t pattern = (uint32_t)rt_mix64(pixel ^ ((uint64_t)seed << 40));
+    rt_vec2 j = spp > 1 ? rt_cmj_sample(s, spp, pattern) : rt_v2(0.5f, 0.5f);
+    /* a pinhole camera reads no lens point: skip its pattern (half the CMJ work) */
+    rt_vec2 lens = cf->lens_radius > 0.0f ? rt_cmj_sample(s, spp, pattern ^ 0x68bc21ebu) : rt_v2(0.5f, 0.5f);
+    *rng = rt_rng_for_sample(seed, pixel, s);
+    return rt_camera_ray(cf, (float)x + j.x, (float)y + j.y, lens);
 }

@@ -13,15 +13,19 @@
 
 /* One line an integrator: id, name, radiance function, what it needs
  * prepared, samples per pixel in each of rt_render's passes (0 = tile by
- * tile; rt/render/render.h says why direct and whitted stay tiled). The built-in ids (rt_integrator in rt/scene/scene.h) are pinned
- * to their lines; a new integrator takes the next number. */
+ * tile; rt/render/render.h says why direct and whitted stay tiled), and
+ * whether rt_render runs it as a wavefront of paths (rt/render/wavefront.h:
+ * the same radiance as the function, batch by batch). The built-in ids
+ * (rt_integrator in rt/scene/scene.h) are pinned to their lines; a new
+ * integrator takes the next number. */
 #define INTEGRATORS(X)                                                                                                 \
-    X(RT_INTEGRATOR_DIRECT, "direct", rt_radiance_direct, 0, 0)                                                        \
-    X(RT_INTEGRATOR_WHITTED, "whitted", rt_radiance_whitted, 0, 0)                                                     \
-    X(RT_INTEGRATOR_PATH, "path", rt_radiance_path, RT_PREPARE_LIGHT_TABLE, 4)
+    X(RT_INTEGRATOR_DIRECT, "direct", rt_radiance_direct, 0, 0, false)                                                 \
+    X(RT_INTEGRATOR_WHITTED, "whitted", rt_radiance_whitted, 0, 0, false)                                              \
+    X(RT_INTEGRATOR_PATH, "path", rt_radiance_path, RT_PREPARE_LIGHT_TABLE, 4, true)                                   \
+    X(RT_INTEGRATOR_PATH_SCALAR, "path_scalar", rt_radiance_path, RT_PREPARE_LIGHT_TABLE, 4, false)
 
-#define AS_INFO(id, name, fn, prepare, pass) [id] = {name, fn, prepare, pass},
-#define AS_WORD(id, name, fn, prepare, pass) [id] = name,
+#define AS_INFO(id, name, fn, prepare, pass, wave) [id] = {name, fn, prepare, pass, wave},
+#define AS_WORD(id, name, fn, prepare, pass, wave) [id] = name,
 static const rt_integrator_info integrators[] = {INTEGRATORS(AS_INFO)};
 const char *const rt_integrator_words[] = {INTEGRATORS(AS_WORD) NULL};
 #undef AS_INFO

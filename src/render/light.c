@@ -85,7 +85,7 @@ bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, r
  * short of distance dist: walks the hits, passing alpha cut-outs, scaling
  * by 1 - alpha through blended surfaces and, when glass_passes, by the
  * transmission colour through transmissive ones (otherwise they block). */
-static rt_vec3 shadow_walk(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist, bool glass_passes)
+rt_ray rt_shadow_ray(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
 {
     rt_vec3 o = rt_surface_spawn(ctx, sf, wi);
     /* stop just short of the light's own surface (area lights are geometry
@@ -95,7 +95,12 @@ static rt_vec3 shadow_walk(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec
     float tmax = INFINITY;
     if (isfinite(dist))
         tmax = rt_dot(rt_sub(rt_madd(sf->p, wi, dist), o), wi) * (1.0f - 1e-4f);
-    rt_ray r = rt_ray_make(o, wi, 0.0f, tmax);
+    return rt_ray_make(o, wi, 0.0f, tmax);
+}
+
+static rt_vec3 shadow_walk(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist, bool glass_passes)
+{
+    rt_ray r = rt_shadow_ray(ctx, sf, wi, dist);
     if (ctx->ray_count)
         (*ctx->ray_count)++;
     if (!ctx->state->shadows_need_shading)
@@ -298,7 +303,7 @@ float rt_light_table_env_pdf(const rt_light_table *t, rt_vec3 d)
 {
     if (!t || t->env_w <= 0)
         return 0.0f;
-    float sin_t = sqrtf(fmaxf(0.0f, 1.0f - d.y * d.y));
+    float sin_t = sqrtf(rt_fmaxf(0.0f, 1.0f - d.y * d.y));
     if (!(sin_t > 0.0f))
         return 0.0f;
     rt_vec2 uv = rt_latlong_from_dir(d);

@@ -37,9 +37,9 @@
  * medium it ran through (a glTF KHR_materials_volume object: the segment
  * ending on its back); a false intersection (a lower-priority medium's
  * surface inside a higher-priority one) is passed straight through
- * without counting as a bounce; a true one refracts between the current
- * medium's index and the next one's, and a transmitted sample pushes or
- * pops the stack.
+ * without counting as a bounce (rt_path_vertex_begin returns
+ * RT_VERTEX_PASS); a true one refracts between the current medium's index
+ * and the next one's, and a transmitted sample pushes or pops the stack.
  *
  * Area lights are pure emitters: their visible quad emits from its front
  * and reflects nothing. Shadow rays pass alpha cut-outs and blended
@@ -51,127 +51,269 @@
  */
 #include "rt/render/pathtrace.h"
 
-#include "rt/render/bsdf.h"
 #include "rt/render/environment.h"
 #include "rt/render/medium.h"
 
-static inline rt_vec3 add_finite(rt_vec3 acc, rt_vec3 c)
+/* One light-sampling term, f cos vis w / pdf times the radiance; zero when
+ * the shadow ray is blocked (vis 0). */
+rt_vec3 rt_path_nee_add(rt_vec3 sum, const rt_nee_record *rec, float vis)
 {
-    return rt_finite3(c) ? rt_add(acc, rt_vmax(c, rt_v3s(0.0f))) : acc;
+    if (!(vis > 0.0f))
+        return sum;
+    return rt_path_add_finite(sum, rt_scale(rec->fl, rec->cos * vis * rec->w / rec->pdf));
 }
 
-/* One sample of a light from the light table in direction d (world, above
+/* A record for a light from the light table in direction d (world, above
  * the geometric surface) with light-sampling density pdf_l, weighted against
- * BSDF sampling by the power heuristic: f cos vis w / pdf_l times the
- * radiance, which is *Le or, for Le NULL, the environment in d (looked up
- * only when the sample counts). */
-static rt_vec3 light_table_term(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo, rt_vec3 d,
-                                const rt_vec3 *Le, float pdf_l, float dist)
+ * BSDF sampling by the power heuristic; the radiance is *Le or, for Le NULL,
+ * the environment in d. False when it cannot contribute. */
+static bool light_table_record(const rt_trace_ctx *ctx, const rt_bsdf *b, rt_vec3 wo, rt_vec3 d, const rt_vec3 *Le,
+                               float pdf_l, float dist, rt_nee_record *rec)
 {
     rt_vec3 wi = rt_bsdf_to_local(b, d);
     float pdf_b;
     rt_vec3 f = rt_bsdf_eval(b, wo, wi, &pdf_b);
     float w = rt_mis_power(pdf_l, pdf_b);
     if (!(rt_max3(f) > 0.0f && w > 0.0f))
-        return rt_v3s(0.0f);
-    float vis = rt_shadow_visibility(ctx, sf, d, dist);
-    if (!(vis > 0.0f))
-        return rt_v3s(0.0f);
-    return rt_scale(rt_mul(f, Le ? *Le : rt_environment(ctx->state->scene, d)), wi.z * vis * w / pdf_l);
+        return false;
+    rec->fl = rt_mul(f, Le ? *Le : rt_environment(ctx->state->scene, d));
+    rec->cos = wi.z;
+    rec->w = w;
+    rec->pdf = pdf_l;
+    rec->wi = d;
+    rec->dist = dist;
+    return true;
 }
 
-/* Light sampled at one vertex: sum over rt_lights plus one table emitter,
- * each f cos Le / pdf_light times its MIS weight. */
-static rt_vec3 next_event(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo,
-                          rt_rng *rng)
+bool rt_path_nee_light(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
+                       size_t i, rt_nee_record *rec)
+{
+    const rt_light *l = &ctx->state->scene->lights[i];
+    rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
+    rt_light_sample ls;
+    if (!rt_light_sample_at(ctx, l, sf->p, u, &ls))
+        return false;
+    if (!(rt_dot(ls.wi, b->ng) > 0.0f))
+        return false; /* below the geometric surface */
+    rt_vec3 wi = rt_bsdf_to_local(b, ls.wi);
+    float pdf_b;
+    rt_vec3 f = rt_bsdf_eval(b, wo, wi, &pdf_b);
+    if (!(rt_max3(f) > 0.0f))
+        return false;
+    float w = 1.0f;
+    if (l->kind == RT_LIGHT_AREA && l->quad != RT_NONE)
+        w = rt_mis_power(rt_area_light_pdf(l, ls.wi, ls.dist), pdf_b);
+    if (!(w > 0.0f))
+        return false;
+    rec->fl = rt_mul(f, ls.li);
+    rec->cos = wi.z;
+    rec->w = w;
+    rec->pdf = 1.0f; /* ls.li is already divided by it */
+    rec->wi = ls.wi;
+    rec->dist = ls.dist;
+    return true;
+}
+
+bool rt_path_nee_env(const rt_trace_ctx *ctx, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng, rt_nee_record *rec)
+{
+    const rt_light_table *t = ctx->state->light_table;
+    if (!(t && t->env_w > 0))
+        return false;
+    rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
+    rt_vec3 d;
+    float pdf_l;
+    if (rt_light_table_sample_env(t, u, &d, &pdf_l) && rt_dot(d, b->ng) > 0.0f)
+        return light_table_record(ctx, b, wo, d, NULL, pdf_l, INFINITY, rec);
+    return false;
+}
+
+bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
+                         rt_nee_record *rec)
 {
     const rt_scene *s = ctx->state->scene;
-    rt_vec3 sum = rt_v3s(0.0f);
-    for (size_t i = 0; i < s->light_count; i++) {
-        const rt_light *l = &s->lights[i];
-        rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
-        rt_light_sample ls;
-        if (!rt_light_sample_at(ctx, l, sf->p, u, &ls))
-            continue;
-        if (!(rt_dot(ls.wi, b->ng) > 0.0f))
-            continue; /* below the geometric surface */
-        rt_vec3 wi = rt_bsdf_to_local(b, ls.wi);
-        float pdf_b;
-        rt_vec3 f = rt_bsdf_eval(b, wo, wi, &pdf_b);
-        if (!(rt_max3(f) > 0.0f))
-            continue;
-        float w = 1.0f;
-        if (l->kind == RT_LIGHT_AREA && l->quad != RT_NONE)
-            w = rt_mis_power(rt_area_light_pdf(l, ls.wi, ls.dist), pdf_b);
-        if (!(w > 0.0f))
-            continue;
-        float vis = rt_shadow_visibility(ctx, sf, ls.wi, ls.dist);
-        if (!(vis > 0.0f))
-            continue;
-        sum = add_finite(sum, rt_scale(rt_mul(f, ls.li), wi.z * vis * w));
-    }
     const rt_light_table *t = ctx->state->light_table;
-    if (t && t->env_w > 0) {
-        rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
-        rt_vec3 d;
-        float pdf_l;
-        if (rt_light_table_sample_env(t, u, &d, &pdf_l) && rt_dot(d, b->ng) > 0.0f)
-            sum = add_finite(sum, light_table_term(ctx, sf, b, wo, d, NULL, pdf_l, INFINITY));
+    if (!(t && t->count))
+        return false;
+    float ul = rt_rng_float(rng);
+    rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
+    size_t k = rt_light_table_pick(t, ul);
+    uint32_t prim = t->prim[k], local;
+    rt_hit h;
+    h.prim = prim;
+    rt_vec3 q;
+    switch (rt_prim_kind_of(s, prim, &local)) {
+    case RT_PRIM_TRIANGLE: {
+        float su = sqrtf(u.x);
+        h.u = u.y * su;        /* weight of vertex 1 */
+        h.v = 1.0f - su;       /* weight of vertex 2 */
+        rt_vec3 a = rt_tri_vertex(s, local, 0), bb = rt_tri_vertex(s, local, 1), c = rt_tri_vertex(s, local, 2);
+        q = rt_add(rt_add(rt_scale(a, 1.0f - h.u - h.v), rt_scale(bb, h.u)), rt_scale(c, h.v));
+        break;
     }
-    if (t && t->count) {
-        float ul = rt_rng_float(rng);
-        rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
-        size_t k = rt_light_table_pick(t, ul);
-        uint32_t prim = t->prim[k], local;
-        rt_hit h;
-        h.prim = prim;
-        rt_vec3 q;
-        switch (rt_prim_kind_of(s, prim, &local)) {
-        case RT_PRIM_TRIANGLE: {
-            float su = sqrtf(u.x);
-            h.u = u.y * su;        /* weight of vertex 1 */
-            h.v = 1.0f - su;       /* weight of vertex 2 */
-            rt_vec3 a = rt_tri_vertex(s, local, 0), bb = rt_tri_vertex(s, local, 1), c = rt_tri_vertex(s, local, 2);
-            q = rt_add(rt_add(rt_scale(a, 1.0f - h.u - h.v), rt_scale(bb, h.u)), rt_scale(c, h.v));
-            break;
-        }
-        case RT_PRIM_SPHERE: {
-            float z = 1.0f - 2.0f * u.x, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * RT_PI * u.y;
-            const rt_spheres *sp = &s->spheres;
-            q = rt_madd(rt_v3(sp->cx[local], sp->cy[local], sp->cz[local]),
-                        rt_v3(r * cosf(phi), r * sinf(phi), z), fabsf(sp->radius[local]));
-            h.u = h.v = 0.0f;
-            break;
-        }
-        case RT_PRIM_QUAD:
-        default: {
-            const rt_quads *qd = &s->quads;
-            h.u = u.x;
-            h.v = u.y;
-            q = rt_add(rt_v3(qd->px[local], qd->py[local], qd->pz[local]),
-                       rt_add(rt_scale(rt_v3(qd->ux[local], qd->uy[local], qd->uz[local]), u.x),
-                              rt_scale(rt_v3(qd->vx[local], qd->vy[local], qd->vz[local]), u.y)));
-            break;
-        }
-        }
-        rt_vec3 d = rt_sub(q, sf->p);
-        float d2 = rt_length2(d);
-        if (d2 > 0.0f && isfinite(d2)) {
-            float dist = sqrtf(d2);
-            rt_vec3 wdir = rt_scale(d, 1.0f / dist);
-            h.t = dist;
-            rt_ray r = rt_ray_make(sf->p, wdir, 0.0f, INFINITY);
-            rt_surface se;
-            rt_surface_at(ctx, &r, &h, &se);
-            float cos_l = fabsf(rt_dot(se.ng, wdir));
-            rt_vec3 Le = rt_surface_emission(ctx, &se);
-            float pdf_l = t->prim_pdf[prim] * d2 / cos_l;
-            if (rt_max3(Le) > 0.0f && cos_l > 0.0f && pdf_l > 0.0f && isfinite(pdf_l) &&
-                rt_dot(wdir, b->ng) > 0.0f)
-                sum = add_finite(sum, light_table_term(ctx, sf, b, wo, wdir, &Le, pdf_l, dist));
-        }
+    case RT_PRIM_SPHERE: {
+        float z = 1.0f - 2.0f * u.x, r = sqrtf(rt_fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * RT_PI * u.y;
+        const rt_spheres *sp = &s->spheres;
+        float sn, cs;
+        rt_sincosf(phi, &sn, &cs);
+        q = rt_madd(rt_v3(sp->cx[local], sp->cy[local], sp->cz[local]), rt_v3(r * cs, r * sn, z),
+                    fabsf(sp->radius[local]));
+        h.u = h.v = 0.0f;
+        break;
     }
-    return sum;
+    case RT_PRIM_QUAD:
+    default: {
+        const rt_quads *qd = &s->quads;
+        h.u = u.x;
+        h.v = u.y;
+        q = rt_add(rt_v3(qd->px[local], qd->py[local], qd->pz[local]),
+                   rt_add(rt_scale(rt_v3(qd->ux[local], qd->uy[local], qd->uz[local]), u.x),
+                          rt_scale(rt_v3(qd->vx[local], qd->vy[local], qd->vz[local]), u.y)));
+        break;
+    }
+    }
+    rt_vec3 d = rt_sub(q, sf->p);
+    float d2 = rt_length2(d);
+    if (!(d2 > 0.0f && isfinite(d2)))
+        return false;
+    float dist = sqrtf(d2);
+    rt_vec3 wdir = rt_scale(d, 1.0f / dist);
+    h.t = dist;
+    rt_ray r = rt_ray_make(sf->p, wdir, 0.0f, INFINITY);
+    rt_surface se;
+    rt_surface_at(ctx, &r, &h, &se);
+    float cos_l = fabsf(rt_dot(se.ng, wdir));
+    rt_vec3 Le = rt_surface_emission(ctx, &se);
+    float pdf_l = t->prim_pdf[prim] * d2 / cos_l;
+    if (rt_max3(Le) > 0.0f && cos_l > 0.0f && pdf_l > 0.0f && isfinite(pdf_l) && rt_dot(wdir, b->ng) > 0.0f)
+        return light_table_record(ctx, b, wo, wdir, &Le, pdf_l, dist, rec);
+    return false;
+}
+
+/* ------------------------------------------------------------ one vertex */
+
+bool rt_path_start(const rt_trace_ctx *ctx, const rt_ray *ray, rt_path_state *ps)
+{
+    (void)ctx;
+    rt_ray r = *ray;
+    float len = rt_length(r.dir);
+    if (!(len > 0.0f) || !isfinite(len))
+        return false;
+    r.dir = rt_scale(r.dir, 1.0f / len);
+    r.tmin *= len;
+    r.tmax *= len;
+    ps->r = r;
+    ps->L = rt_v3s(0.0f);
+    ps->beta = rt_v3s(1.0f);
+    ps->prev_delta = true; /* the camera "samples" its ray: no MIS */
+    ps->prev_pdf = 0.0f;   /* BSDF pdf of the ray just traced */
+    ps->prev_p = r.org;
+    ps->bounces = 0;
+    rt_medium_stack_init(&ps->media);
+    ps->skips = RT_PATH_HARD_LIMIT;
+    return true;
+}
+
+void rt_path_miss(const rt_trace_ctx *ctx, rt_path_state *ps)
+{
+    float w = 1.0f; /* MIS against environment sampling, when the table does it */
+    if (!ps->prev_delta && ctx->state->light_table && ctx->state->light_table->env_w > 0)
+        w = rt_mis_power(ps->prev_pdf, rt_light_table_env_pdf(ctx->state->light_table, ps->r.dir));
+    ps->L = rt_path_add_finite(ps->L, rt_scale(rt_mul(ps->beta, rt_environment(ctx->state->scene, ps->r.dir)), w));
+}
+
+rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, rt_bsdf *b,
+                                    rt_vec3 *wo)
+{
+    const rt_scene *s = ctx->state->scene;
+    int max_depth = s->settings.max_depth > 0 ? s->settings.max_depth : RT_PATH_HARD_LIMIT;
+    if (max_depth > RT_PATH_HARD_LIMIT)
+        max_depth = RT_PATH_HARD_LIMIT;
+    const rt_material *m = &s->materials[sf->material];
+    /* Beer-Lambert absorption of the medium the segment ran through
+     * (r.tmin is the hit distance, dir is unit) */
+    uint32_t medium = rt_medium_of_segment(&ps->media, s->materials, sf->material, sf->front);
+    if (medium != RT_NONE)
+        ps->beta = rt_mul(ps->beta, rt_medium_transmittance(s->materials, medium, ps->r.tmin));
+    if (rt_medium_false_hit(&ps->media, s->materials, sf->material, sf->front)) {
+        /* an interface inside a higher-priority medium: straight on */
+        rt_medium_cross(&ps->media, s->materials, sf->material, sf->front);
+        if (--ps->skips < 0)
+            return RT_VERTEX_STOP;
+        ps->r = rt_ray_make(rt_surface_spawn(ctx, sf, ps->r.dir), ps->r.dir, 0.0f, INFINITY);
+        return RT_VERTEX_PASS;
+    }
+    /* emission, MIS-weighted when it could have been light-sampled */
+    rt_vec3 Le = rt_surface_emission(ctx, sf);
+    /* area lights' quads have emissive materials: look only those up */
+    bool emissive = rt_max3(rt_scale(m->emission, m->emission_strength)) > 0.0f;
+    uint32_t light = emissive ? rt_area_light_of_prim(s, ctx->state->light_table, sf->prim) : RT_NONE;
+    if (rt_max3(Le) > 0.0f) {
+        float w = 1.0f;
+        if (!ps->prev_delta) {
+            float d2 = rt_length2(rt_sub(sf->p, ps->prev_p));
+            float pdf_l = 0.0f;
+            if (light != RT_NONE) {
+                pdf_l = rt_area_light_pdf(&s->lights[light], ps->r.dir, sqrtf(d2));
+            } else if (ctx->state->light_table && sf->prim < ctx->state->light_table->prim_count) {
+                float cos_l = fabsf(rt_dot(sf->ng, ps->r.dir));
+                float pa = ctx->state->light_table->prim_pdf[sf->prim];
+                pdf_l = (pa > 0.0f && cos_l > 0.0f) ? pa * d2 / cos_l : 0.0f;
+            }
+            if (pdf_l > 0.0f && isfinite(pdf_l))
+                w = rt_mis_power(ps->prev_pdf, pdf_l);
+        }
+        ps->L = rt_path_add_finite(ps->L, rt_scale(rt_mul(ps->beta, Le), w));
+    }
+    if (light != RT_NONE)
+        return RT_VERTEX_STOP; /* an area light's quad reflects nothing */
+    if (m->unlit) {
+        rt_vec4 c = rt_surface_base_color(ctx, sf);
+        ps->L = rt_path_add_finite(ps->L, rt_mul(ps->beta, rt_v3(c.x, c.y, c.z)));
+        return RT_VERTEX_STOP;
+    }
+    if (ps->bounces >= max_depth)
+        return RT_VERTEX_STOP;
+    rt_bsdf_from_surface(ctx, sf, b);
+    if (rt_medium_is_medium(m)) { /* the index ratio to the medium beyond */
+        float eta = rt_medium_outside_ior(&ps->media, s->materials, sf->material, sf->front) / m->ior;
+        rt_bsdf_set_eta(b, sf->front ? eta : 1.0f / eta);
+    }
+    *wo = rt_bsdf_to_local(b, sf->wo);
+    return wo->z > 0.0f ? RT_VERTEX_SHADE : RT_VERTEX_STOP;
+}
+
+bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
+                        rt_vec3 wo, rt_rng *rng)
+{
+    int rr_depth = ctx->state->scene->settings.rr_depth;
+    /* continue the path by sampling the BSDF */
+    float ulobe = rt_rng_float(rng);
+    rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
+    rt_bsdf_sample bs;
+    if (!rt_bsdf_sample_dir(b, wo, u, ulobe, &bs))
+        return false;
+    rt_vec3 wi = rt_normalize(rt_bsdf_to_world(b, bs.wi));
+    float side = rt_dot(wi, sf->ng);
+    if (bs.wi.z > 0.0f ? !(side > 0.0f) : !(side < 0.0f))
+        return false; /* the shading normal disagrees with the geometry: no light leaks */
+    rt_vec3 beta = rt_mul(ps->beta, bs.weight);
+    ps->beta = beta;
+    if (!rt_finite3(beta) || !(rt_max3(beta) > 0.0f))
+        return false;
+    if (bs.wi.z < 0.0f) /* transmitted: into or out of the medium */
+        rt_medium_cross(&ps->media, ctx->state->scene->materials, sf->material, sf->front);
+    ps->prev_delta = bs.delta;
+    ps->prev_pdf = bs.pdf;
+    ps->prev_p = sf->p;
+    ps->bounces++;
+    if (rr_depth == 0 ? rt_max3(beta) < 1.0f : ps->bounces >= rr_depth) {
+        float q = rr_depth == 0 ? rt_max3(beta) : rt_fminf(rt_max3(beta), 0.95f);
+        if (rt_rng_float(rng) >= q)
+            return false;
+        ps->beta = rt_scale(beta, 1.0f / q);
+    }
+    ps->r = rt_ray_make(rt_surface_spawn(ctx, sf, wi), wi, 0.0f, INFINITY);
+    return true;
 }
 
 /* ------------------------------------------------------------ integrator */
@@ -179,119 +321,38 @@ static rt_vec3 next_event(const rt_trace_ctx *ctx, const rt_surface *sf, const r
 rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng)
 {
     const rt_scene *s = ctx->state->scene;
-    int max_depth = s->settings.max_depth > 0 ? s->settings.max_depth : RT_PATH_HARD_LIMIT;
-    if (max_depth > RT_PATH_HARD_LIMIT)
-        max_depth = RT_PATH_HARD_LIMIT;
-    int rr_depth = s->settings.rr_depth;
-    rt_ray r = *ray;
-    float len = rt_length(r.dir);
-    if (!(len > 0.0f) || !isfinite(len))
+    rt_path_state ps;
+    if (!rt_path_start(ctx, ray, &ps))
         return rt_v3s(0.0f);
-    r.dir = rt_scale(r.dir, 1.0f / len);
-    r.tmin *= len;
-    r.tmax *= len;
-    rt_vec3 L = rt_v3s(0.0f), beta = rt_v3s(1.0f);
-    bool prev_delta = true;     /* the camera "samples" its ray: no MIS */
-    float prev_pdf = 0.0f;      /* BSDF pdf of the ray just traced */
-    rt_vec3 prev_p = r.org;
-    int bounces = 0;
-    rt_medium_stack media;
-    rt_medium_stack_init(&media);
-    int skips = RT_PATH_HARD_LIMIT; /* false intersections a path may pass */
     for (;;) {
-        int layers = 257; /* up to 256 cut-away surfaces per path segment */
+        int layers = RT_PATH_LAYERS;
         rt_surface sf;
         float coverage;
-        rt_surface_walk found = rt_trace_surface(ctx, &r, &layers, rng, &sf, &coverage);
-        if (found == RT_WALK_MISS) {
-            float w = 1.0f; /* MIS against environment sampling, when the table does it */
-            if (!prev_delta && ctx->state->light_table && ctx->state->light_table->env_w > 0)
-                w = rt_mis_power(prev_pdf, rt_light_table_env_pdf(ctx->state->light_table, r.dir));
-            L = add_finite(L, rt_scale(rt_mul(beta, rt_environment(s, r.dir)), w));
-        }
+        rt_surface_walk found = rt_trace_surface(ctx, &ps.r, &layers, rng, &sf, &coverage);
+        if (found == RT_WALK_MISS)
+            rt_path_miss(ctx, &ps);
         if (found != RT_WALK_SURFACE)
             break;
-        const rt_material *m = &s->materials[sf.material];
-        /* Beer-Lambert absorption of the medium the segment ran through
-         * (r.tmin is the hit distance, dir is unit) */
-        uint32_t medium = rt_medium_of_segment(&media, s->materials, sf.material, sf.front);
-        if (medium != RT_NONE)
-            beta = rt_mul(beta, rt_medium_transmittance(s->materials, medium, r.tmin));
-        if (rt_medium_false_hit(&media, s->materials, sf.material, sf.front)) {
-            /* an interface inside a higher-priority medium: straight on */
-            rt_medium_cross(&media, s->materials, sf.material, sf.front);
-            if (--skips < 0)
-                break;
-            r = rt_ray_make(rt_surface_spawn(ctx, &sf, r.dir), r.dir, 0.0f, INFINITY);
-            continue;
-        }
-        /* emission, MIS-weighted when it could have been light-sampled */
-        rt_vec3 Le = rt_surface_emission(ctx, &sf);
-        /* area lights' quads have emissive materials: look only those up */
-        bool emissive = rt_max3(rt_scale(m->emission, m->emission_strength)) > 0.0f;
-        uint32_t light = emissive ? rt_area_light_of_prim(s, ctx->state->light_table, sf.prim) : RT_NONE;
-        if (rt_max3(Le) > 0.0f) {
-            float w = 1.0f;
-            if (!prev_delta) {
-                float d2 = rt_length2(rt_sub(sf.p, prev_p));
-                float pdf_l = 0.0f;
-                if (light != RT_NONE) {
-                    pdf_l = rt_area_light_pdf(&s->lights[light], r.dir, sqrtf(d2));
-                } else if (ctx->state->light_table && sf.prim < ctx->state->light_table->prim_count) {
-                    float cos_l = fabsf(rt_dot(sf.ng, r.dir));
-                    float pa = ctx->state->light_table->prim_pdf[sf.prim];
-                    pdf_l = (pa > 0.0f && cos_l > 0.0f) ? pa * d2 / cos_l : 0.0f;
-                }
-                if (pdf_l > 0.0f && isfinite(pdf_l))
-                    w = rt_mis_power(prev_pdf, pdf_l);
-            }
-            L = add_finite(L, rt_scale(rt_mul(beta, Le), w));
-        }
-        if (light != RT_NONE)
-            break; /* an area light's quad reflects nothing */
-        if (m->unlit) {
-            rt_vec4 c = rt_surface_base_color(ctx, &sf);
-            L = add_finite(L, rt_mul(beta, rt_v3(c.x, c.y, c.z)));
-            break;
-        }
-        if (bounces >= max_depth)
-            break;
         rt_bsdf b;
-        rt_bsdf_from_surface(ctx, &sf, &b);
-        if (rt_medium_is_medium(m)) { /* the index ratio to the medium beyond */
-            float eta = rt_medium_outside_ior(&media, s->materials, sf.material, sf.front) / m->ior;
-            rt_bsdf_set_eta(&b, sf.front ? eta : 1.0f / eta);
-        }
-        rt_vec3 wo = rt_bsdf_to_local(&b, sf.wo);
-        if (!(wo.z > 0.0f))
+        rt_vec3 wo;
+        rt_path_vertex v = rt_path_vertex_begin(ctx, &ps, &sf, &b, &wo);
+        if (v == RT_VERTEX_PASS)
+            continue;
+        if (v == RT_VERTEX_STOP)
             break;
-        L = add_finite(L, rt_mul(beta, next_event(ctx, &sf, &b, wo, rng)));
-        /* continue the path by sampling the BSDF */
-        float ulobe = rt_rng_float(rng);
-        rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
-        rt_bsdf_sample bs;
-        if (!rt_bsdf_sample_dir(&b, wo, u, ulobe, &bs))
+        /* next-event estimation: every light, the environment, one emitter */
+        rt_vec3 sum = rt_v3s(0.0f);
+        rt_nee_record rec;
+        for (size_t i = 0; i < s->light_count; i++)
+            if (rt_path_nee_light(ctx, &sf, &b, wo, rng, i, &rec))
+                sum = rt_path_nee_add(sum, &rec, rt_shadow_visibility(ctx, &sf, rec.wi, rec.dist));
+        if (rt_path_nee_env(ctx, &b, wo, rng, &rec))
+            sum = rt_path_nee_add(sum, &rec, rt_shadow_visibility(ctx, &sf, rec.wi, rec.dist));
+        if (rt_path_nee_emitter(ctx, &sf, &b, wo, rng, &rec))
+            sum = rt_path_nee_add(sum, &rec, rt_shadow_visibility(ctx, &sf, rec.wi, rec.dist));
+        ps.L = rt_path_add_finite(ps.L, rt_mul(ps.beta, sum));
+        if (!rt_path_vertex_end(ctx, &ps, &sf, &b, wo, rng))
             break;
-        rt_vec3 wi = rt_normalize(rt_bsdf_to_world(&b, bs.wi));
-        float side = rt_dot(wi, sf.ng);
-        if (bs.wi.z > 0.0f ? !(side > 0.0f) : !(side < 0.0f))
-            break; /* the shading normal disagrees with the geometry: no light leaks */
-        beta = rt_mul(beta, bs.weight);
-        if (!rt_finite3(beta) || !(rt_max3(beta) > 0.0f))
-            break;
-        if (bs.wi.z < 0.0f) /* transmitted: into or out of the medium */
-            rt_medium_cross(&media, s->materials, sf.material, sf.front);
-        prev_delta = bs.delta;
-        prev_pdf = bs.pdf;
-        prev_p = sf.p;
-        bounces++;
-        if (rr_depth == 0 ? rt_max3(beta) < 1.0f : bounces >= rr_depth) {
-            float q = rr_depth == 0 ? rt_max3(beta) : fminf(rt_max3(beta), 0.95f);
-            if (rt_rng_float(rng) >= q)
-                break;
-            beta = rt_scale(beta, 1.0f / q);
-        }
-        r = rt_ray_make(rt_surface_spawn(ctx, &sf, wi), wi, 0.0f, INFINITY);
     }
-    return rt_finite3(L) ? L : rt_v3s(0.0f);
+    return rt_finite3(ps.L) ? ps.L : rt_v3s(0.0f);
 }

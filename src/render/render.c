@@ -31,6 +31,7 @@
 #include "rt/render/camera.h"
 #include "rt/render/integrator.h"
 #include "rt/render/sampling.h"
+#include "rt/render/wavefront.h"
 #include "rt/scene/validate.h"
 
 struct rt_render_job {
@@ -56,6 +57,8 @@ struct rt_render_job {
     atomic_int *cancel;
     const rt_render_state *state; /* prepared once, read by every worker */
     rt_radiance_fn radiance;      /* the scene's integrator */
+    bool wavefront;               /* ... run as batches of paths (rt/render/wavefront.h) */
+    int batch_size;               /* wavefront: paths per worker (0 = the default) */
     rt_aov_buffers *aov;          /* NULL = none */
     rt_aov_sample *aov_sum;       /* with aov: per pixel, the sums of its good samples' AOVs */
     double *lum_sq;               /* with aov: per pixel, the sum of its good samples' squared luminance */
@@ -69,7 +72,13 @@ typedef struct worker {
     pthread_t thread;
     rt_render_job *job;
     uint64_t rays, camera_rays, bad_samples;
+    rt_wavefront *wf;             /* wavefront integrators: this worker's batch (NULL: one path at a time) */
+    float *wf_out;                /* its radiance per sample of a chunk, WAVE_CHUNK x 3 */
 } worker;
+
+/* Samples a wavefront chunk holds at most: the cancel flag is read between
+ * chunks, and the radiance buffer is WAVE_CHUNK x 12 bytes a worker. */
+enum { WAVE_CHUNK = 16384 };
 
 /* The pixel's AOVs: means over its `good` samples; the variance of the mean
  * luminance from the sample variance, sum of L^2 - (sum L)^2 / n over n - 1.
@@ -98,47 +107,55 @@ static void aov_store(rt_aov_buffers *aov, size_t pixel, const rt_aov_sample *s,
     }
 }
 
-/* Adds samples [s0, s1) of pixel (x, y) of the whole image (`local`: its
- * index in the region's buffers) to *sum and *good, in sample order: the one
- * place a pixel's arithmetic happens, for tiles and passes alike. */
+/* Adds radiance sample L, sample s of pixel (x, y) of the whole image
+ * (`local`: its index in the region's buffers), to *sum and *good: the one
+ * place a pixel's arithmetic happens, for tiles and passes, one path at a
+ * time or a wavefront, alike; samples come in sample order. */
+static inline void add_sample(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, size_t local,
+                              uint32_t s, rt_vec3 L, rt_vec3 *sum, uint32_t *good)
+{
+    const rt_settings *st = &job->scene->settings;
+    uint64_t pixel = (uint64_t)y * (uint64_t)job->width + (uint64_t)x;
+    if (!rt_finite3(L) || L.x < 0.0f || L.y < 0.0f || L.z < 0.0f) {
+        w->bad_samples++;
+        return;
+    }
+    if (st->clamp > 0.0f) {
+        float lum = rt_luminance(L);
+        if (lum > st->clamp)
+            L = rt_scale(L, st->clamp / lum);
+    }
+    *sum = rt_add(*sum, L);
+    (*good)++;
+    if (job->aov) { /* own random numbers: the image stays as it was */
+        rt_rng unused;
+        rt_ray ray = rt_camera_pixel_sample(&job->camera, job->width, st->seed, job->spp, x, y, s, &unused);
+        rt_rng arng = rt_rng_for_sample(st->seed ^ 0xa0f5eed5u, pixel, s);
+        rt_aov_sample a;
+        rt_aov_trace(ctx, ray, &arng, &a);
+        rt_aov_sample *acc = &job->aov_sum[local];
+        acc->albedo = rt_add(acc->albedo, a.albedo);
+        acc->normal = rt_add(acc->normal, a.normal);
+        acc->position = rt_add(acc->position, a.position);
+        acc->depth += a.depth;
+        job->lum_sq[local] += (double)rt_luminance(L) * (double)rt_luminance(L);
+    }
+}
+
+/* Adds samples [s0, s1) of pixel (x, y) to *sum_io and *good_io, in sample
+ * order, one path at a time. */
 static inline void add_samples(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, size_t local,
                                uint32_t s0, uint32_t s1, rt_vec3 *sum_io, uint32_t *good_io)
 {
     const rt_settings *st = &job->scene->settings;
-    uint32_t spp = job->spp;
-    uint64_t pixel = (uint64_t)y * (uint64_t)job->width + (uint64_t)x;
-    uint32_t pattern = (uint32_t)rt_mix64(pixel ^ ((uint64_t)st->seed << 40));
     rt_vec3 sum = *sum_io;
     uint32_t good = *good_io;
     for (uint32_t s = s0; s < s1; s++) {
-        rt_vec2 j = spp > 1 ? rt_cmj_sample(s, spp, pattern) : rt_v2(0.5f, 0.5f);
-        rt_vec2 lens = rt_cmj_sample(s, spp, pattern ^ 0x68bc21ebu);
-        rt_ray ray = rt_camera_ray(&job->camera, (float)x + j.x, (float)y + j.y, lens);
-        rt_rng rng = rt_rng_for_sample(st->seed, pixel, s);
+        rt_rng rng;
+        rt_ray ray = rt_camera_pixel_sample(&job->camera, job->width, st->seed, job->spp, x, y, s, &rng);
         w->camera_rays++;
         rt_vec3 L = job->radiance(ctx, &ray, &rng);
-        if (!rt_finite3(L) || L.x < 0.0f || L.y < 0.0f || L.z < 0.0f) {
-            w->bad_samples++;
-            continue;
-        }
-        if (st->clamp > 0.0f) {
-            float lum = rt_luminance(L);
-            if (lum > st->clamp)
-                L = rt_scale(L, st->clamp / lum);
-        }
-        sum = rt_add(sum, L);
-        good++;
-        if (job->aov) { /* own random numbers: the image stays as it was */
-            rt_rng arng = rt_rng_for_sample(st->seed ^ 0xa0f5eed5u, pixel, s);
-            rt_aov_sample a;
-            rt_aov_trace(ctx, ray, &arng, &a);
-            rt_aov_sample *acc = &job->aov_sum[local];
-            acc->albedo = rt_add(acc->albedo, a.albedo);
-            acc->normal = rt_add(acc->normal, a.normal);
-            acc->position = rt_add(acc->position, a.position);
-            acc->depth += a.depth;
-            job->lum_sq[local] += (double)rt_luminance(L) * (double)rt_luminance(L);
-        }
+        add_sample(job, w, ctx, x, y, local, s, L, &sum, &good);
     }
     *sum_io = sum;
     *good_io = good;
@@ -160,51 +177,139 @@ static void tile_bounds(const rt_render_job *job, int tile, int *x0, int *y0, in
     *y1 = *y0 + job->tile_size < job->rh ? *y0 + job->tile_size : job->rh;
 }
 
+/* A pixel's running sum before its samples (`pixel`: its index in the
+ * region): passes continue the accumulated one, tiles start from zero or
+ * from the caller's sums. */
+static void pixel_begin(const rt_render_job *job, size_t pixel, rt_vec3 *sum, uint32_t *good)
+{
+    const float *acc = NULL;
+    *sum = rt_v3s(0);
+    *good = 0;
+    if (job->passes) {
+        acc = job->sum + 3 * pixel;
+        *good = job->good[pixel];
+    } else if (job->accum) { /* continue the caller's sums */
+        acc = job->accum->sum + 3 * pixel;
+        *good = job->accum->good[pixel];
+    }
+    if (acc)
+        *sum = rt_v3(acc[0], acc[1], acc[2]);
+}
+
+/* ... and after them: passes keep the sum, tiles write the pixel (and the
+ * caller's sums). */
+static void pixel_end(rt_render_job *job, size_t pixel, rt_vec3 sum, uint32_t good)
+{
+    if (job->passes) {
+        float *acc = job->sum + 3 * pixel;
+        acc[0] = sum.x;
+        acc[1] = sum.y;
+        acc[2] = sum.z;
+        job->good[pixel] = good;
+        return;
+    }
+    if (job->accum) {
+        float *acc = job->accum->sum + 3 * pixel;
+        acc[0] = sum.x;
+        acc[1] = sum.y;
+        acc[2] = sum.z;
+        job->accum->good[pixel] = good;
+    }
+    if (job->aov)
+        aov_store(job->aov, pixel, &job->aov_sum[pixel], good, rt_luminance(sum), job->lum_sq[pixel]);
+    sum = resolve(sum, good);
+    float *px = job->fb->rgb + 3 * pixel;
+    px[0] = sum.x;
+    px[1] = sum.y;
+    px[2] = sum.z;
+}
+
+static inline bool cancelled(const rt_render_job *job)
+{
+    return job->cancel && atomic_load_explicit(job->cancel, memory_order_relaxed);
+}
+
+/* render_tile for a wavefront integrator: the tile's pixels (region
+ * coordinates [x0, x1) x [y0, y1)) in chunks of at most WAVE_CHUNK samples
+ * (a pixel with more samples than that in chunks of its samples), each
+ * traced as one wavefront, then added pixel by pixel in sample order exactly
+ * as the one-path-at-a-time loop adds them. */
+static bool render_tile_wavefront(rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x0, int y0, int x1, int y1)
+{
+    uint32_t s0 = job->passes ? job->s0 : job->s_begin, s1 = job->passes ? job->s1 : job->s_end;
+    uint32_t ns = s1 - s0, tw = (uint32_t)(x1 - x0);
+    uint32_t npx = tw * (uint32_t)(y1 - y0);
+    uint32_t per_chunk = ns >= WAVE_CHUNK ? 1 : WAVE_CHUNK / ns;
+    rt_wavefront_work wk = {&job->camera, job->width, job->scene->settings.seed, job->spp, x0 + job->rx0,
+                            x1 + job->rx0, y0 + job->ry0, 0, 0, 0, 0};
+    for (uint32_t p = 0; p < npx; p += per_chunk) {
+        if (cancelled(job))
+            return false;
+        wk.first = p;
+        wk.count = npx - p < per_chunk ? npx - p : per_chunk;
+        if (wk.count > 1 || ns <= WAVE_CHUNK) {
+            wk.s0 = s0;
+            wk.s1 = s1;
+            rt_wavefront_radiance(w->wf, ctx, &wk, w->wf_out);
+            w->camera_rays += (uint64_t)wk.count * ns;
+            for (uint32_t i = 0; i < wk.count; i++) {
+                int x = x0 + (int)((p + i) % tw), y = y0 + (int)((p + i) / tw);
+                size_t pixel = (size_t)y * (size_t)job->rw + (size_t)x;
+                rt_vec3 sum;
+                uint32_t good;
+                pixel_begin(job, pixel, &sum, &good);
+                const float *o = w->wf_out + 3 * (size_t)i * ns;
+                for (uint32_t s = s0; s < s1; s++, o += 3)
+                    add_sample(job, w, ctx, x + job->rx0, y + job->ry0, pixel, s, rt_v3(o[0], o[1], o[2]), &sum,
+                               &good);
+                pixel_end(job, pixel, sum, good);
+            }
+            continue;
+        }
+        /* one pixel, its samples in chunks */
+        int x = x0 + (int)(p % tw), y = y0 + (int)(p / tw);
+        size_t pixel = (size_t)y * (size_t)job->rw + (size_t)x;
+        rt_vec3 sum;
+        uint32_t good;
+        pixel_begin(job, pixel, &sum, &good);
+        for (uint32_t sa = s0; sa < s1; sa += WAVE_CHUNK) {
+            if (cancelled(job))
+                return false;
+            wk.s0 = sa;
+            wk.s1 = s1 - sa < WAVE_CHUNK ? s1 : sa + WAVE_CHUNK;
+            rt_wavefront_radiance(w->wf, ctx, &wk, w->wf_out);
+            w->camera_rays += wk.s1 - wk.s0;
+            const float *o = w->wf_out;
+            for (uint32_t s = wk.s0; s < wk.s1; s++, o += 3)
+                add_sample(job, w, ctx, x + job->rx0, y + job->ry0, pixel, s, rt_v3(o[0], o[1], o[2]), &sum,
+                           &good);
+        }
+        pixel_end(job, pixel, sum, good);
+    }
+    return true;
+}
+
 /* Renders one tile (tiles: all its samples into fb; passes: this pass's
  * samples into sum/good); false when cancelled part-way (the tile then
- * stays unfinished). The cancel flag is read once a pixel, so Ctrl-C is
- * answered within a pixel's samples, not a tile's. */
+ * stays unfinished). The cancel flag is read once a pixel (a wavefront
+ * chunk), so Ctrl-C is answered within a pixel's samples, not a tile's. */
 static bool render_tile(rt_render_job *job, worker *w, rt_trace_ctx *ctx, int tile)
 {
     int x0, y0, x1, y1;
     tile_bounds(job, tile, &x0, &y0, &x1, &y1);
+    if (w->wf)
+        return render_tile_wavefront(job, w, ctx, x0, y0, x1, y1);
+    uint32_t s0 = job->passes ? job->s0 : job->s_begin, s1 = job->passes ? job->s1 : job->s_end;
     for (int y = y0; y < y1; y++) {
         for (int x = x0; x < x1; x++) {
-            if (job->cancel && atomic_load_explicit(job->cancel, memory_order_relaxed))
+            if (cancelled(job))
                 return false;
             size_t pixel = (size_t)y * (size_t)job->rw + (size_t)x;
-            int gx = x + job->rx0, gy = y + job->ry0;
-            if (job->passes) {
-                float *acc = job->sum + 3 * pixel;
-                rt_vec3 sum = rt_v3(acc[0], acc[1], acc[2]);
-                add_samples(job, w, ctx, gx, gy, pixel, job->s0, job->s1, &sum, &job->good[pixel]);
-                acc[0] = sum.x;
-                acc[1] = sum.y;
-                acc[2] = sum.z;
-            } else {
-                rt_vec3 sum = rt_v3s(0);
-                uint32_t good = 0;
-                if (job->accum) { /* continue the caller's sums */
-                    const float *acc = job->accum->sum + 3 * pixel;
-                    sum = rt_v3(acc[0], acc[1], acc[2]);
-                    good = job->accum->good[pixel];
-                }
-                add_samples(job, w, ctx, gx, gy, pixel, job->s_begin, job->s_end, &sum, &good);
-                if (job->accum) {
-                    float *acc = job->accum->sum + 3 * pixel;
-                    acc[0] = sum.x;
-                    acc[1] = sum.y;
-                    acc[2] = sum.z;
-                    job->accum->good[pixel] = good;
-                }
-                if (job->aov)
-                    aov_store(job->aov, pixel, &job->aov_sum[pixel], good, rt_luminance(sum), job->lum_sq[pixel]);
-                sum = resolve(sum, good);
-                float *px = job->fb->rgb + 3 * pixel;
-                px[0] = sum.x;
-                px[1] = sum.y;
-                px[2] = sum.z;
-            }
+            rt_vec3 sum;
+            uint32_t good;
+            pixel_begin(job, pixel, &sum, &good);
+            add_samples(job, w, ctx, x + job->rx0, y + job->ry0, pixel, s0, s1, &sum, &good);
+            pixel_end(job, pixel, sum, good);
         }
     }
     return true;
@@ -217,6 +322,14 @@ static void *worker_main(void *arg)
     rt_trace_ctx ctx;
     rt_trace_ctx_init(&ctx, job->state);
     ctx.ray_count = &w->rays;
+    if (job->wavefront && !w->wf) { /* kept across passes; out of memory: one path at a time, same image */
+        w->wf = rt_wavefront_new((size_t)job->batch_size, job->state);
+        w->wf_out = w->wf ? rt_alloc(WAVE_CHUNK, 3 * sizeof *w->wf_out) : NULL;
+        if (!w->wf_out) {
+            rt_wavefront_free(w->wf);
+            w->wf = NULL;
+        }
+    }
     for (;;) {
         if (job->cancel && atomic_load(job->cancel))
             break;
@@ -317,8 +430,12 @@ static void resolve_image(rt_render_job *job)
     }
 }
 
-static void free_job(rt_render_job *job, worker *workers)
+static void free_job(rt_render_job *job, worker *workers, int nthreads)
 {
+    for (int i = 0; workers && i < nthreads; i++) {
+        rt_wavefront_free(workers[i].wf);
+        free(workers[i].wf_out);
+    }
     free(job->tile_finished);
     free(job->sum);
     free(job->good);
@@ -401,7 +518,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     worker *workers = rt_alloc((size_t)nthreads, sizeof *workers);
     if (!job.tile_finished || !workers || (job.passes && (!job.sum || !job.good)) ||
         (job.aov && (!job.aov_sum || !job.lum_sq))) {
-        free_job(&job, workers);
+        free_job(&job, workers, nthreads);
         return rt_fail(err, RT_ERR_NOMEM, "out of memory setting up %d render threads for a %dx%d image", nthreads,
                        fb->width, fb->height);
     }
@@ -424,11 +541,13 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     rt_render_state state;
     rt_result sr = rt_render_state_prepare(&state, scene, tree, integrator->prepare, err);
     if (sr != RT_OK) {
-        free_job(&job, workers);
+        free_job(&job, workers, nthreads);
         return sr;
     }
     job.state = &state;
     job.radiance = integrator->radiance;
+    job.wavefront = integrator->wavefront;
+    job.batch_size = opt.batch_size > 0 ? opt.batch_size : 0;
     pthread_mutex_init(&job.lock, NULL);
     pthread_condattr_t ca;
     pthread_condattr_init(&ca);
@@ -529,7 +648,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     }
     pthread_cond_destroy(&job.done);
     pthread_mutex_destroy(&job.lock);
-    free_job(&job, workers);
+    free_job(&job, workers, nthreads);
     rt_render_state_free(&state);
     if (stats)
         *stats = st;

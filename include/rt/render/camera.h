@@ -11,11 +11,15 @@
  *   rt_camera_frame cf;
  *   rt_camera_frame_init(&cf, &scene.camera, width, height);
  *   rt_ray r = rt_camera_ray(&cf, x + 0.5f, y + 0.5f, lens_sample);
+ *   // sample s of spp of pixel (x, y) as rt_render takes it, and the path's random numbers:
+ *   rt_rng rng;
+ *   rt_ray r = rt_camera_pixel_sample(&cf, width, seed, spp, x, y, s, &rng);
  */
 #ifndef RT_CAMERA_H
 #define RT_CAMERA_H
 
 #include "rt/accel/intersect.h"
+#include "rt/render/sampling.h"
 #include "rt/scene/scene.h"
 
 typedef struct rt_camera_frame {
@@ -29,5 +33,14 @@ typedef struct rt_camera_frame {
  * the view direction, fov outside (0, 180)). */
 bool rt_camera_frame_init(rt_camera_frame *cf, const rt_camera *cam, int width, int height);
 rt_ray rt_camera_ray(const rt_camera_frame *cf, float film_x, float film_y, rt_vec2 lens_sample);
+
+/* Sample s of spp of pixel (x, y) of an image `width` pixels wide: the film
+ * position and lens point by correlated multi-jittering (a pattern per
+ * pixel and seed; the pixel centre when spp is 1), and in *rng the sample's
+ * own random stream, rt_rng_for_sample(seed, y * width + x, s). A pure
+ * function of its arguments: the tile loop and the wavefront tracer both
+ * take their samples here. */
+rt_ray rt_camera_pixel_sample(const rt_camera_frame *cf, int width, uint32_t seed, uint32_t spp, int x, int y,
+                              uint32_t s, rt_rng *rng);
 
 #endif

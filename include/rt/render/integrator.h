@@ -17,7 +17,10 @@
  *          rt/render/whitted.h; the model is specified in docs/shading.md).
  * path     physically based path tracing of glTF materials with
  *          next-event estimation and MIS (pathtrace.c, rt/render/pathtrace.h,
- *          docs/path-tracer.md).
+ *          docs/path-tracer.md), rendered as a wavefront of paths in
+ *          batches (wavefront.c, rt/render/wavefront.h).
+ * path_scalar  the same path tracer one path at a time: the reference
+ *          the wavefront is tested against (the same bytes).
  *
  * Adding one: a file with its radiance function (and a header declaring
  * it), and one line in the table in integrator.c. Its name then works in
@@ -41,6 +44,7 @@ typedef struct rt_integrator_info {
     rt_radiance_fn radiance;
     unsigned prepare;        /* RT_PREPARE_* bits (rt/render/render_state.h): what the render state must hold */
     int pass_samples;        /* rt_render's default: samples per pixel a pass; 0 = tile by tile */
+    bool wavefront;          /* rt_render traces batches of paths (rt/render/wavefront.h), same radiance */
 } rt_integrator_info;
 
 /* Every name in table order, NULL-terminated: the words of the `integrator`

@@ -54,6 +54,12 @@ rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, r
  * surfaces let 1 - alpha through. */
 float rt_shadow_visibility(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist);
 
+/* The shadow ray both use (one ray; past its first hit they walk on from
+ * it): from sf's surface, offset to the side of wi, to just short of dist.
+ * When the render state's shadows_need_shading is false, visibility is
+ * exactly !rt_kdtree_occluded of this ray (the wavefront tracer batches them). */
+rt_ray rt_shadow_ray(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist);
+
 /* ------------------------------------------------------------ light table */
 
 typedef struct rt_light_table {

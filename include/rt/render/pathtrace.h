@@ -25,12 +25,87 @@
 #ifndef RT_PATHTRACE_H
 #define RT_PATHTRACE_H
 
+#include "rt/render/bsdf.h"
 #include "rt/render/light.h"
+#include "rt/render/medium.h"
 #include "rt/render/sampling.h"
 
 #define RT_PATH_HARD_LIMIT 1024 /* bounces when max_depth is 0 (unlimited): a guard, never reached in practice */
+#define RT_PATH_LAYERS 257      /* surfaces a path segment may step past (alpha cut-outs) plus one */
 
+/* The scalar path tracer (integrator `path_scalar`, and the reference the
+ * wavefront `path` is tested against): one path at a time. */
 rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng);
+
+/* ---- the steps of one path, shared by rt_radiance_path and the wavefront
+ * tracer (rt/render/wavefront.h), so both run the same arithmetic in the
+ * same order and draw the same random numbers:
+ *
+ *   rt_path_state ps;
+ *   if (!rt_path_start(ctx, ray, &ps)) return 0;
+ *   loop: trace ps.r (the alpha walk, rt_trace_surface, with rng);
+ *         miss: rt_path_miss(ctx, &ps), stop; too deep: stop;
+ *         switch (rt_path_vertex_begin(ctx, &ps, &sf, &b, &wo)): STOP: stop; PASS: loop;
+ *         records from rt_path_nee_light (each light in order), rt_path_nee_env,
+ *         rt_path_nee_emitter; sum = rt_path_nee_add(sum, &rec, visibility) in that order;
+ *         ps.L = rt_path_add_finite(ps.L, ps.beta * sum);
+ *         if (!rt_path_vertex_end(ctx, &ps, &sf, &b, wo, rng)) stop;
+ *   L = finite(ps.L) ? ps.L : 0
+ */
+typedef struct rt_path_state {
+    rt_ray r;          /* the ray to trace next (unit direction) */
+    rt_vec3 L, beta;   /* radiance so far, throughput */
+    bool prev_delta;   /* the last scattering was a delta lobe (or the camera): no MIS */
+    float prev_pdf;    /* BSDF pdf of the ray just traced */
+    rt_vec3 prev_p;    /* where it left from */
+    int bounces;
+    rt_medium_stack media; /* the dielectrics it is inside (rt/render/medium.h) */
+    int skips;         /* false intersections it may still pass */
+} rt_path_state;
+
+/* What rt_path_vertex_begin found at a surface. */
+typedef enum rt_path_vertex {
+    RT_VERTEX_STOP = 0, /* the path ends here (emission added) */
+    RT_VERTEX_SHADE,    /* shade it: light sampling, then rt_path_vertex_end */
+    RT_VERTEX_PASS      /* a false intersection of nested media: ps->r goes straight on, trace it again */
+} rt_path_vertex;
+
+/* One light sample at a vertex, before its shadow ray: it adds
+ * fl cos vis w / pdf (fl = f x radiance) when the shadow ray from the
+ * vertex along wi over dist has visibility vis. */
+typedef struct rt_nee_record {
+    rt_vec3 fl;
+    float cos, w, pdf;
+    rt_vec3 wi;
+    float dist;
+} rt_nee_record;
+
+static inline rt_vec3 rt_path_add_finite(rt_vec3 acc, rt_vec3 c)
+{
+    return rt_finite3(c) ? rt_add(acc, rt_vmax(c, rt_v3s(0.0f))) : acc;
+}
+
+/* false for a degenerate camera ray (radiance 0). */
+bool rt_path_start(const rt_trace_ctx *ctx, const rt_ray *ray, rt_path_state *ps);
+/* ps.r left the scene: the environment, MIS-weighted. */
+void rt_path_miss(const rt_trace_ctx *ctx, rt_path_state *ps);
+/* At a surface ps.r reached: the medium's absorption, a false intersection
+ * passed (RT_VERTEX_PASS), emission (MIS), then the BSDF *b with the index
+ * ratio of the media on both sides and local *wo (RT_VERTEX_SHADE). */
+rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, rt_bsdf *b,
+                                    rt_vec3 *wo);
+/* Light i, the environment image, one emitter of the table: each draws its
+ * random numbers and fills *rec when it can contribute. */
+bool rt_path_nee_light(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
+                       size_t i, rt_nee_record *rec);
+bool rt_path_nee_env(const rt_trace_ctx *ctx, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng, rt_nee_record *rec);
+bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
+                         rt_nee_record *rec);
+rt_vec3 rt_path_nee_add(rt_vec3 sum, const rt_nee_record *rec, float vis);
+/* BSDF sampling, Russian roulette, the next ray in ps->r; false when the
+ * path ends. */
+bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
+                        rt_vec3 wo, rt_rng *rng);
 
 /* Power heuristic with exponent 2 (Veach 1997, ch. 9): a^2 / (a^2 + b^2). */
 static inline float rt_mis_power(float a, float b)

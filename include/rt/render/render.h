@@ -120,6 +120,7 @@ typedef struct rt_render_options {
     rt_render_progress_fn progress; /* NULL = no reports; called from the calling thread */
     void *progress_user;       /* handed to progress */
     struct rt_aov_buffers *aov; /* NULL = no AOVs; else the images to fill (rt/render/aov.h) */
+    int batch_size;            /* wavefront integrators: paths in flight per worker; 0 = RT_WAVEFRONT_BATCH (same image for any) */
     rt_render_region region;   /* only these pixels (fb is their size); zero = the whole image */
     int sample_begin, sample_end; /* only samples [begin, end) of settings.samples; 0, 0 = all */
     rt_render_accum *accum;    /* NULL, or sums and counts to continue and fill (a part, a resume) */

@@ -96,7 +96,7 @@ static inline rt_vec2 rt_cmj_sample(uint32_t s, uint32_t n, uint32_t p)
     float jy = rt_cmj_randfloat(s, p * 0x711ad6a5u);
     float x = ((float)(s % m) + ((float)sy + jx) / (float)k) / (float)m;
     float y = ((float)(s / m) + ((float)sx + jy) / (float)m) / (float)k;
-    return rt_v2(fminf(x, 0x1.fffffep-1f), fminf(y, 0x1.fffffep-1f));
+    return rt_v2(rt_fminf(x, 0x1.fffffep-1f), rt_fminf(y, 0x1.fffffep-1f));
 }
 
 /* Cosine-weighted direction about +z from a point in [0,1)^2 (Malley's
@@ -112,8 +112,10 @@ static inline rt_vec3 rt_sample_cosine_hemisphere(rt_vec2 u)
     } else {
         r = b; phi = (RT_PI / 2.0f) - (RT_PI / 4.0f) * (a / b);
     }
-    float x = r * cosf(phi), y = r * sinf(phi);
-    float z = sqrtf(fmaxf(0.0f, 1.0f - x * x - y * y));
+    float sn, cs;
+    rt_sincosf(phi, &sn, &cs);
+    float x = r * cs, y = r * sn;
+    float z = sqrtf(rt_fmaxf(0.0f, 1.0f - x * x - y * y));
     return rt_v3(x, y, z);
 }
 

@@ -54,7 +54,8 @@ typedef struct rt_camera {
 typedef enum rt_integrator {
     RT_INTEGRATOR_DIRECT = 0, /* direct light, Lambert: the foundation slice */
     RT_INTEGRATOR_WHITTED,    /* Phong, mirrors, glass, diffuse bounces */
-    RT_INTEGRATOR_PATH,       /* physically based path tracer */
+    RT_INTEGRATOR_PATH,       /* physically based path tracer (wavefront) */
+    RT_INTEGRATOR_PATH_SCALAR, /* the same, one path at a time (the reference) */
 } rt_integrator;
 
 /* Render settings. rt_settings_default() gives the documented defaults; the

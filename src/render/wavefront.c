@@ -1,0 +1,412 @@
+/* wavefront.c - the wavefront path tracer (rt/render/wavefront.h): a batch
+ * of paths in structure-of-arrays form, advanced one bounce at a time by a
+ * fixed sequence of stages over the whole batch:
+ *
+ *   refill    free lanes take the next camera samples of the work
+ *   trace     closest hits for every live path (rt_kdtree_intersect_batch),
+ *             repeated for the lanes whose hit an alpha cut-out removes
+ *   shade     surface records, then per path the steps of
+ *             rt/render/pathtrace.h (emission and MIS, the BSDF, one
+ *             light-sampling record per light / environment / emitter, BSDF
+ *             sampling, Russian roulette), lanes grouped by material kind
+ *   shadow    the records' shadow rays as one batch (rt_kdtree_occluded_batch)
+ *   resolve   each path adds its light samples, in their order
+ *   retire    finished paths write their radiance; survivors stay, in order
+ *
+ * The structure is pbrt-v4's wavefront integrator (Pharr, Jakob, Humphreys,
+ * "Physically Based Rendering", 4th ed., ch. 15: work queues of ray, shadow
+ * and material items in structure-of-arrays; per-path random state so the
+ * image does not depend on the packing) and Laine, Karras, Aila 2013,
+ * "Megakernels Considered Harmful: Wavefront Path Tracing on GPUs" (HPG).
+ *
+ * Determinism: a path's random numbers come only from its own PCG stream,
+ * seeded by (seed, pixel, sample) and carried in its lane, drawn in the order
+ * rt_radiance_path draws them; shading runs the same functions; a vertex's
+ * light samples are summed in the same order after their shadow rays come
+ * back. So every radiance equals rt_radiance_path's bit for bit, for any
+ * batch size, lane assignment and split of the work (tests/test_wavefront.c).
+ * Shadow rays are batched when no material needs shading on them (the render
+ * state's shadows_need_shading); otherwise each vertex walks its shadow rays
+ * at once through rt_shadow_visibility, as the scalar tracer does.
+ */
+#include "rt/render/wavefront.h"
+
+#include <stdlib.h>
+
+#include "rt/accel/kdtree_batch.h"
+#include "rt/base/alloc.h"
+#include "rt/render/pathtrace.h"
+
+enum lane_status {
+    LANE_TRACE,   /* ray to trace */
+    LANE_SURFACE, /* a kept surface in sf */
+    LANE_MISS,    /* left the scene */
+    LANE_DEEP,    /* every layer cut away */
+    LANE_LIVE,    /* shaded, next ray set */
+    LANE_DONE,    /* finished: radiance final after its light samples */
+};
+
+enum { KIND_BUCKETS = 8 }; /* material kinds (rt_bsdf_model) sorted apart; more fold into the last */
+/* light-sampling records a batch holds at most (about 80 bytes each with
+ * their shadow rays): the batch shrinks in scenes with many lights */
+#define MAX_RECORDS ((size_t)1 << 18)
+
+struct rt_wavefront {
+    size_t batch;        /* lanes */
+    size_t rec_per_path; /* light samples a vertex can make: lights + environment + emitter */
+    /* the path's ray (unit direction) and its hit */
+    float *ox, *oy, *oz, *dx, *dy, *dz, *tmin, *tmax;
+    float *ht, *hu, *hv;
+    uint32_t *hprim;
+    /* the path */
+    float *Lr, *Lg, *Lb, *br, *bg, *bb;
+    float *prev_pdf, *ppx, *ppy, *ppz;
+    uint8_t *prev_delta, *status, *nee;
+    int32_t *bounces, *layers, *skips;
+    rt_medium_stack *media; /* the dielectrics each path is inside */
+    uint64_t *rng_state, *rng_inc;
+    uint32_t *out;       /* index of the sample in the work */
+    /* this bounce's light samples: the lane's first record, how many, the
+     * throughput they are weighted by */
+    uint32_t *rec_first, *rec_count;
+    float *nbr, *nbg, *nbb;
+    rt_surface *sf;
+    /* records of this bounce: the sample, its visibility, its shadow ray */
+    rt_nee_record *rec;
+    float *vis;
+    float *sox, *soy, *soz, *sdx, *sdy, *sdz, *stmin, *stmax;
+    uint8_t *blocked;
+    uint32_t *pending;   /* records whose shadow ray is to trace */
+    /* lane lists */
+    uint32_t *active, *queue, *queue2, *order, *free_lanes;
+};
+
+static void *grab(size_t n, size_t size, bool *ok)
+{
+    void *p = rt_alloc(n, size);
+    if (!p)
+        *ok = false;
+    return p;
+}
+
+rt_wavefront *rt_wavefront_new(size_t batch, const rt_render_state *state)
+{
+    rt_wavefront *wf = rt_alloc(1, sizeof *wf);
+    if (!wf)
+        return NULL;
+    size_t B = batch ? batch : RT_WAVEFRONT_BATCH;
+    if (B > ((size_t)1 << 24))
+        B = (size_t)1 << 24;
+    size_t K = state->scene->light_count + 2;
+    if (B * K > MAX_RECORDS) /* many lights: fewer paths, not gigabytes of light samples */
+        B = MAX_RECORDS / K > 0 ? MAX_RECORDS / K : 1;
+    size_t R = B * K;
+    wf->batch = B;
+    wf->rec_per_path = K;
+    bool ok = true;
+    float **fl[] = {&wf->ox, &wf->oy, &wf->oz, &wf->dx, &wf->dy, &wf->dz, &wf->tmin, &wf->tmax, &wf->ht,
+                    &wf->hu, &wf->hv, &wf->Lr, &wf->Lg, &wf->Lb, &wf->br, &wf->bg, &wf->bb, &wf->prev_pdf,
+                    &wf->ppx, &wf->ppy, &wf->ppz, &wf->nbr, &wf->nbg, &wf->nbb};
+    for (size_t i = 0; i < sizeof fl / sizeof fl[0]; i++)
+        *fl[i] = grab(B, sizeof(float), &ok);
+    uint32_t **u32[] = {&wf->hprim, &wf->out, &wf->rec_first, &wf->rec_count, &wf->active,
+                        &wf->queue, &wf->queue2, &wf->order, &wf->free_lanes};
+    for (size_t i = 0; i < sizeof u32 / sizeof u32[0]; i++)
+        *u32[i] = grab(B, sizeof(uint32_t), &ok);
+    wf->prev_delta = grab(B, 1, &ok);
+    wf->status = grab(B, 1, &ok);
+    wf->nee = grab(B, 1, &ok);
+    wf->bounces = grab(B, sizeof(int32_t), &ok);
+    wf->layers = grab(B, sizeof(int32_t), &ok);
+    wf->skips = grab(B, sizeof(int32_t), &ok);
+    wf->media = grab(B, sizeof(rt_medium_stack), &ok);
+    wf->rng_state = grab(B, sizeof(uint64_t), &ok);
+    wf->rng_inc = grab(B, sizeof(uint64_t), &ok);
+    wf->sf = grab(B, sizeof(rt_surface), &ok);
+    wf->rec = grab(R, sizeof(rt_nee_record), &ok);
+    float **sfl[] = {&wf->vis, &wf->sox, &wf->soy, &wf->soz, &wf->sdx, &wf->sdy, &wf->sdz, &wf->stmin, &wf->stmax};
+    for (size_t i = 0; i < sizeof sfl / sizeof sfl[0]; i++)
+        *sfl[i] = grab(R, sizeof(float), &ok);
+    wf->blocked = grab(R, 1, &ok);
+    wf->pending = grab(R, sizeof(uint32_t), &ok);
+    if (!ok) {
+        rt_wavefront_free(wf);
+        return NULL;
+    }
+    return wf;
+}
+
+void rt_wavefront_free(rt_wavefront *wf)
+{
+    if (!wf)
+        return;
+    void *all[] = {wf->ox, wf->oy, wf->oz, wf->dx, wf->dy, wf->dz, wf->tmin, wf->tmax, wf->ht, wf->hu, wf->hv,
+                   wf->hprim, wf->Lr, wf->Lg, wf->Lb, wf->br, wf->bg, wf->bb, wf->prev_pdf, wf->ppx, wf->ppy,
+                   wf->ppz, wf->prev_delta, wf->status, wf->nee, wf->bounces, wf->layers, wf->rng_state,
+                   wf->rng_inc, wf->out, wf->rec_first, wf->rec_count, wf->nbr, wf->nbg, wf->nbb, wf->sf,
+                   wf->rec, wf->vis, wf->sox, wf->soy, wf->soz, wf->sdx, wf->sdy, wf->sdz, wf->stmin,
+                   wf->stmax, wf->blocked, wf->pending, wf->active, wf->queue, wf->queue2, wf->order,
+                   wf->free_lanes, wf->skips, wf->media};
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+        free(all[i]);
+    free(wf);
+}
+
+/* ------------------------------------------------------------ lane <-> path */
+
+static inline void load_path(const rt_wavefront *wf, uint32_t i, rt_path_state *ps, rt_rng *rng)
+{
+    ps->r = rt_ray_make(rt_v3(wf->ox[i], wf->oy[i], wf->oz[i]), rt_v3(wf->dx[i], wf->dy[i], wf->dz[i]),
+                        wf->tmin[i], wf->tmax[i]);
+    ps->L = rt_v3(wf->Lr[i], wf->Lg[i], wf->Lb[i]);
+    ps->beta = rt_v3(wf->br[i], wf->bg[i], wf->bb[i]);
+    ps->prev_delta = wf->prev_delta[i] != 0;
+    ps->prev_pdf = wf->prev_pdf[i];
+    ps->prev_p = rt_v3(wf->ppx[i], wf->ppy[i], wf->ppz[i]);
+    ps->bounces = wf->bounces[i];
+    ps->media = wf->media[i];
+    ps->skips = wf->skips[i];
+    rng->state = wf->rng_state[i];
+    rng->inc = wf->rng_inc[i];
+}
+
+static inline void store_path(rt_wavefront *wf, uint32_t i, const rt_path_state *ps, const rt_rng *rng)
+{
+    wf->ox[i] = ps->r.org.x, wf->oy[i] = ps->r.org.y, wf->oz[i] = ps->r.org.z;
+    wf->dx[i] = ps->r.dir.x, wf->dy[i] = ps->r.dir.y, wf->dz[i] = ps->r.dir.z;
+    wf->tmin[i] = ps->r.tmin, wf->tmax[i] = ps->r.tmax;
+    wf->Lr[i] = ps->L.x, wf->Lg[i] = ps->L.y, wf->Lb[i] = ps->L.z;
+    wf->br[i] = ps->beta.x, wf->bg[i] = ps->beta.y, wf->bb[i] = ps->beta.z;
+    wf->prev_delta[i] = ps->prev_delta;
+    wf->prev_pdf[i] = ps->prev_pdf;
+    wf->ppx[i] = ps->prev_p.x, wf->ppy[i] = ps->prev_p.y, wf->ppz[i] = ps->prev_p.z;
+    wf->bounces[i] = ps->bounces;
+    wf->media[i] = ps->media;
+    wf->skips[i] = ps->skips;
+    wf->rng_state[i] = rng->state;
+    wf->rng_inc[i] = rng->inc;
+}
+
+static inline void put_out(float *out, uint32_t k, rt_vec3 L)
+{
+    out[3 * (size_t)k] = L.x;
+    out[3 * (size_t)k + 1] = L.y;
+    out[3 * (size_t)k + 2] = L.z;
+}
+
+/* ------------------------------------------------------------ stages */
+
+/* Camera sample k of the work into lane i; false (radiance 0 written) for
+ * a degenerate camera ray. */
+static bool start_path(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_wavefront_work *wk, uint32_t i,
+                       uint32_t k, float *out)
+{
+    uint32_t n = wk->s1 - wk->s0;
+    uint32_t px = wk->first + k / n, s = wk->s0 + k % n;
+    uint32_t w = (uint32_t)(wk->x1 - wk->x0);
+    int x = wk->x0 + (int)(px % w), y = wk->y0 + (int)(px / w);
+    rt_rng rng;
+    rt_ray ray = rt_camera_pixel_sample(wk->camera, wk->width, wk->seed, wk->spp, x, y, s, &rng);
+    rt_path_state ps;
+    if (!rt_path_start(ctx, &ray, &ps)) {
+        put_out(out, k, rt_v3s(0.0f));
+        return false;
+    }
+    store_path(wf, i, &ps, &rng);
+    wf->out[i] = k;
+    wf->status[i] = LANE_TRACE;
+    return true;
+}
+
+/* Closest kept surface for every lane of the active list: the alpha walk
+ * of rt_trace_surface, one batch of rays per layer. */
+static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_active)
+{
+    const rt_kdtree *tree = ctx->state->tree;
+    rt_ray_batch rb = {wf->ox, wf->oy, wf->oz, wf->dx, wf->dy, wf->dz, wf->tmin, wf->tmax};
+    rt_hit_batch hb = {wf->ht, wf->hu, wf->hv, wf->hprim};
+    uint32_t *q = wf->queue, *q2 = wf->queue2;
+    size_t n = n_active;
+    for (size_t k = 0; k < n; k++) {
+        q[k] = wf->active[k];
+        wf->layers[q[k]] = RT_PATH_LAYERS;
+    }
+    while (n > 0) {
+        if (ctx->ray_count)
+            *ctx->ray_count += n;
+        rt_kdtree_intersect_batch(tree, &rb, q, n, &hb);
+        size_t n2 = 0;
+        for (size_t k = 0; k < n; k++) {
+            uint32_t i = q[k];
+            wf->layers[i]--;
+            if (wf->hprim[i] == RT_NONE) {
+                wf->status[i] = LANE_MISS;
+                continue;
+            }
+            rt_hit h = {wf->ht[i], wf->hu[i], wf->hv[i], wf->hprim[i]};
+            rt_ray r = rt_ray_make(rt_v3(wf->ox[i], wf->oy[i], wf->oz[i]), rt_v3(wf->dx[i], wf->dy[i], wf->dz[i]),
+                                   wf->tmin[i], wf->tmax[i]);
+            rt_surface *sf = &wf->sf[i];
+            rt_surface_at(ctx, &r, &h, sf);
+            float coverage;
+            bool cut = rt_surface_cut_away(ctx, sf, &coverage);
+            if (!cut && coverage < 1.0f) { /* stochastic alpha blending, from the path's stream */
+                rt_rng rng = {wf->rng_state[i], wf->rng_inc[i]};
+                if (rt_rng_float(&rng) >= coverage)
+                    cut = true;
+                wf->rng_state[i] = rng.state;
+            }
+            wf->tmin[i] = h.t;
+            if (!cut)
+                wf->status[i] = LANE_SURFACE;
+            else if (wf->layers[i] <= 0)
+                wf->status[i] = LANE_DEEP;
+            else
+                q2[n2++] = i;
+        }
+        uint32_t *t = q;
+        q = q2;
+        q2 = t;
+        n = n2;
+    }
+}
+
+/* One light-sampling record made at lane i's vertex: its visibility now
+ * (shadows that need shading) or its shadow ray queued for the batch. */
+static void add_record(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_surface *sf, uint32_t r, size_t *n_pending)
+{
+    const rt_nee_record *rec = &wf->rec[r];
+    if (ctx->state->shadows_need_shading) {
+        wf->vis[r] = rt_shadow_visibility(ctx, sf, rec->wi, rec->dist);
+        return;
+    }
+    rt_ray sr = rt_shadow_ray(ctx, sf, rec->wi, rec->dist);
+    wf->sox[r] = sr.org.x, wf->soy[r] = sr.org.y, wf->soz[r] = sr.org.z;
+    wf->sdx[r] = sr.dir.x, wf->sdy[r] = sr.dir.y, wf->sdz[r] = sr.dir.z;
+    wf->stmin[r] = sr.tmin, wf->stmax[r] = sr.tmax;
+    wf->pending[(*n_pending)++] = r;
+}
+
+/* One path at its vertex: the scalar tracer's loop body up to its shadow
+ * rays, then BSDF sampling (rt/render/pathtrace.h). */
+static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, size_t *n_rec, size_t *n_pending)
+{
+    rt_path_state ps;
+    rt_rng rng;
+    load_path(wf, i, &ps, &rng);
+    wf->nee[i] = 0;
+    uint8_t st = wf->status[i];
+    if (st != LANE_SURFACE) {
+        if (st == LANE_MISS)
+            rt_path_miss(ctx, &ps);
+        wf->status[i] = LANE_DONE;
+        store_path(wf, i, &ps, &rng);
+        return;
+    }
+    const rt_surface *sf = &wf->sf[i];
+    rt_bsdf b;
+    rt_vec3 wo;
+    rt_path_vertex v = rt_path_vertex_begin(ctx, &ps, sf, &b, &wo);
+    if (v != RT_VERTEX_SHADE) { /* the path ends, or passes a false intersection straight on */
+        wf->status[i] = v == RT_VERTEX_PASS ? LANE_LIVE : LANE_DONE;
+        store_path(wf, i, &ps, &rng);
+        return;
+    }
+    size_t first = *n_rec;
+    const rt_scene *s = ctx->state->scene;
+    for (size_t l = 0; l < s->light_count; l++)
+        if (rt_path_nee_light(ctx, sf, &b, wo, &rng, l, &wf->rec[*n_rec]))
+            add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
+    if (rt_path_nee_env(ctx, &b, wo, &rng, &wf->rec[*n_rec]))
+        add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
+    if (rt_path_nee_emitter(ctx, sf, &b, wo, &rng, &wf->rec[*n_rec]))
+        add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
+    wf->nee[i] = 1;
+    wf->rec_first[i] = (uint32_t)first;
+    wf->rec_count[i] = (uint32_t)(*n_rec - first);
+    wf->nbr[i] = ps.beta.x, wf->nbg[i] = ps.beta.y, wf->nbb[i] = ps.beta.z;
+    wf->status[i] = rt_path_vertex_end(ctx, &ps, sf, &b, wo, &rng) ? LANE_LIVE : LANE_DONE;
+    store_path(wf, i, &ps, &rng);
+}
+
+/* The active lanes in shading order: surfaces grouped by material kind
+ * (a stable counting sort), the rest first. */
+static void shading_order(rt_wavefront *wf, const rt_scene *s, size_t n)
+{
+    size_t count[KIND_BUCKETS + 2] = {0};
+    for (size_t k = 0; k < n; k++) {
+        uint32_t i = wf->active[k];
+        size_t key = 0;
+        if (wf->status[i] == LANE_SURFACE) {
+            size_t kind = (size_t)s->materials[wf->sf[i].material].bsdf;
+            key = 1 + (kind < KIND_BUCKETS ? kind : KIND_BUCKETS - 1);
+        }
+        wf->queue[k] = (uint32_t)key;
+        count[key + 1]++;
+    }
+    for (size_t b = 1; b < KIND_BUCKETS + 2; b++)
+        count[b] += count[b - 1];
+    for (size_t k = 0; k < n; k++)
+        wf->order[count[wf->queue[k]]++] = wf->active[k];
+}
+
+void rt_wavefront_radiance(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_wavefront_work *wk, float *out)
+{
+    const rt_scene *s = ctx->state->scene;
+    const uint64_t total = (uint64_t)wk->count * (uint64_t)(wk->s1 - wk->s0);
+    uint64_t next = 0;
+    size_t n_active = 0, n_free = wf->batch;
+    for (size_t k = 0; k < wf->batch; k++)
+        wf->free_lanes[k] = (uint32_t)(wf->batch - 1 - k);
+    rt_ray_batch srb = {wf->sox, wf->soy, wf->soz, wf->sdx, wf->sdy, wf->sdz, wf->stmin, wf->stmax};
+    for (;;) {
+        /* refill: free lanes take the next samples, in order */
+        while (n_free > 0 && next < total) {
+            uint32_t i = wf->free_lanes[n_free - 1];
+            if (start_path(wf, ctx, wk, i, (uint32_t)next++, out)) {
+                wf->active[n_active++] = i;
+                n_free--;
+            }
+        }
+        if (n_active == 0)
+            break;
+        trace_stage(wf, ctx, n_active);
+        /* shade, grouped by material kind */
+        shading_order(wf, s, n_active);
+        size_t n_rec = 0, n_pending = 0;
+        for (size_t k = 0; k < n_active; k++)
+            shade_lane(wf, ctx, wf->order[k], &n_rec, &n_pending);
+        /* shadow rays, one batch */
+        if (n_pending > 0) {
+            if (ctx->ray_count)
+                *ctx->ray_count += n_pending;
+            rt_kdtree_occluded_batch(ctx->state->tree, &srb, wf->pending, n_pending, wf->blocked);
+            for (size_t k = 0; k < n_pending; k++) {
+                uint32_t r = wf->pending[k];
+                wf->vis[r] = wf->blocked[r] ? 0.0f : 1.0f;
+            }
+        }
+        /* resolve the light samples, retire finished paths, keep the rest in order */
+        size_t kept = 0;
+        for (size_t k = 0; k < n_active; k++) {
+            uint32_t i = wf->active[k];
+            if (wf->nee[i]) {
+                rt_vec3 sum = rt_v3s(0.0f);
+                for (uint32_t r = wf->rec_first[i], e = r + wf->rec_count[i]; r < e; r++)
+                    sum = rt_path_nee_add(sum, &wf->rec[r], wf->vis[r]);
+                rt_vec3 L = rt_path_add_finite(rt_v3(wf->Lr[i], wf->Lg[i], wf->Lb[i]),
+                                               rt_mul(rt_v3(wf->nbr[i], wf->nbg[i], wf->nbb[i]), sum));
+                wf->Lr[i] = L.x, wf->Lg[i] = L.y, wf->Lb[i] = L.z;
+            }
+            if (wf->status[i] == LANE_DONE) {
+                rt_vec3 L = rt_v3(wf->Lr[i], wf->Lg[i], wf->Lb[i]);
+                put_out(out, wf->out[i], rt_finite3(L) ? L : rt_v3s(0.0f));
+                wf->free_lanes[n_free++] = i;
+            } else {
+                wf->status[i] = LANE_TRACE;
+                wf->active[kept++] = i;
+            }
+        }
+        n_active = kept;
+    }
+}
