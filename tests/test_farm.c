@@ -485,7 +485,7 @@ static void test_merge_refusals(void **state)
     (void)state;
     const char *scene = scene_path;
     for (int i = 0; i < 3; i++) {
-        char part[8], name[16];
+        char part[32], name[32];
         snprintf(part, sizeof part, "%d/3", i);
         snprintf(name, sizeof name, "g%d.exr", i);
         RUN_OK("-q", "--part", part, "-o", in_dir(name), scene);
@@ -569,7 +569,7 @@ static void test_part_bands(void **state)
     for (int n = 1; n <= 30; n += 29) {
         int next = 0;
         for (int i = 0; i < n; i++) {
-            char part[16];
+            char part[32];
             snprintf(part, sizeof part, "%d/%d", i, n);
             RUN_OK("-q", "-s", "1", "--part", part, "-o", in_dir("band.exr"), scene);
             size_t sz;
