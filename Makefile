@@ -100,22 +100,22 @@ $(BUILD)/librt.a: $(LIB_OBJ)
 $(RT): $(DRV_OBJ) $(BUILD)/librt.a
 	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS) $(SDL2_LIBS)
 
-$(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+$(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests -o $@ $< $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # the corpus replay test links the fuzz harness too
-$(BUILD)/tests/test_corpus: tests/test_corpus.c tests/fuzz/harness.c tests/fuzz/harness.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+$(BUILD)/tests/test_corpus: tests/test_corpus.c tests/fuzz/harness.c tests/fuzz/harness.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests -o $@ tests/test_corpus.c tests/fuzz/harness.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # rt compare's driver code is tested in-process
-$(BUILD)/tests/test_compare: tests/test_compare.c src/driver/compare.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+$(BUILD)/tests/test_compare: tests/test_compare.c src/driver/compare.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests -o $@ tests/test_compare.c src/driver/compare.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # rt convert's driver code is tested in-process too
-$(BUILD)/tests/test_hdr: tests/test_hdr.c src/driver/convert.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+$(BUILD)/tests/test_hdr: tests/test_hdr.c src/driver/convert.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests -o $@ tests/test_hdr.c src/driver/convert.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
@@ -123,7 +123,7 @@ $(BUILD)/tests/test_hdr: tests/test_hdr.c src/driver/convert.c src/driver/comman
 TEST_BIN += $(BUILD)/tests/test_kdtree_scalar
 # (only the traversal is compiled again, with RT_KD_SCALAR; its two functions
 # take the place of the library's, and the build and packing come from librt.a)
-$(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c src/accel/kdtree_trace.c src/accel/kdtree_internal.h $(BUILD)/librt.a tests/test_util.h | $(DEPS_OK)
+$(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c src/accel/kdtree_trace.c src/accel/kdtree_internal.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -DRT_KD_SCALAR -Itests -o $@ tests/test_kdtree.c src/accel/kdtree_trace.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 

@@ -15,6 +15,7 @@
  *     image means within 1.5% and RMSE within the scalar's own noise.
  */
 #include "test_util.h"
+#include "test_scenes.h"
 
 #include <math.h>
 
@@ -129,24 +130,7 @@ static void test_batch_traversal_matches_single_rays(void **state)
 /* ------------------------------------------------------------ wavefront */
 
 static const char *every_material =
-    "integrator path\nresolution 24 16\nsamples 6\nbackground 0.2 0.3 0.4\n"
-    "camera position 0 1.5 6 look_at 0 0.8 0 fov 40\n"
-    "texture checks checker 0.9 0.9 0.9  0.1 0.1 0.1 scale 4\n"
-    "material floor texture checks roughness 0.6\n"
-    "material metal color 0.9 0.6 0.2 metallic 1 roughness 0.05\n"
-    "material rough color 0.9 0.9 0.9 metallic 1 roughness 1\n"
-    "material plastic color 0.2 0.4 0.9 roughness 0.3\n"
-    "material glass color 1 1 1 transmission 1 ior 1.5 roughness 0\n"
-    "material veil color 1 0 0 alpha 0.5 alpha_mode blend\n"
-    "material cut color 0 1 0 alpha 0.2 alpha_mode mask\n"
-    "material lamp color 0 0 0 emission 3 3 2 double_sided false\n"
-    "material flat color 1 1 1 unlit true\n"
-    "quad -5 0 5  10 0 0  0 0 -10  floor\n"
-    "sphere -1.5 0.5 0 0.5 metal\nsphere -0.5 0.5 0 0.5 rough\nsphere 0.5 0.5 0 0.5 plastic\n"
-    "sphere 1.5 0.5 0 0.5 glass\nquad -2 0 1  4 0 0  0 2 0  veil\nquad -2 1.2 1.5  4 0 0  0 0.5 0  cut\n"
-    "triangle -1 2 -1  1 2 -1  0 2.5 -1  lamp\nsphere 0 2.2 -2 0.2 flat\n"
-    "light point 0 3 2  1 1 1  5\nlight spot 2 3 0  0 -1 0  1 1 1  10  10 30\n"
-    "light directional -1 -1 -1  0.5 0.5 0.5  1\nlight area -1 2.9 -1  2 0 0  0 0 2  2 2 2  1\n";
+    "integrator path\nresolution 24 16\nsamples 6\nbackground 0.2 0.3 0.4\n" TEST_EVERY_MATERIAL_SCENE;
 
 typedef struct fixture {
     rt_scene s;
