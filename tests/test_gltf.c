@@ -48,23 +48,6 @@ static const char *tmp_path(const char *name)
 
 static void write_text(const char *name, const char *text) { test_write_file(tmp_path(name), text, strlen(text)); }
 
-static char *base64(const void *data, size_t n)
-{
-    static const char al[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    const uint8_t *p = data;
-    char *out = malloc(n / 3 * 4 + 8);
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t w = (uint32_t)p[i] << 16 | (i + 1 < n ? (uint32_t)p[i + 1] << 8 : 0) | (i + 2 < n ? p[i + 2] : 0);
-        out[o++] = al[w >> 18 & 63];
-        out[o++] = al[w >> 12 & 63];
-        out[o++] = i + 1 < n ? al[w >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? al[w & 63] : '=';
-    }
-    out[o] = 0;
-    return out;
-}
-
 /* Loads a file into a fresh scene; returns the result, keeps the error. */
 static rt_result load(const char *path, rt_scene *s, rt_gltf_stats *st, rt_error *err)
 {
@@ -369,7 +352,7 @@ static void test_sample_features(void **state)
 /* A tiny glTF with one buffer given as base64 and the rest of the JSON. */
 static void write_gltf(const char *name, const void *bin, size_t n, const char *rest)
 {
-    char *b64 = base64(bin, n);
+    char *b64 = test_base64(bin, n);
     size_t cap = strlen(b64) + strlen(rest) + 512;
     char *text = malloc(cap);
     snprintf(text, cap,

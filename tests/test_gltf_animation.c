@@ -52,23 +52,6 @@ static void test_curves(void **state)
 
 /* ------------------------------------------------------ written files */
 
-static char *b64(const void *data, size_t n)
-{
-    static const char al[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    const uint8_t *p = data;
-    char *out = malloc(4 * ((n + 2) / 3) + 1);
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t w = (uint32_t)p[i] << 16 | (i + 1 < n ? (uint32_t)p[i + 1] << 8 : 0) | (i + 2 < n ? p[i + 2] : 0);
-        out[o++] = al[w >> 18 & 63];
-        out[o++] = al[w >> 12 & 63];
-        out[o++] = i + 1 < n ? al[w >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? al[w & 63] : '=';
-    }
-    out[o] = 0;
-    return out;
-}
-
 /* One buffer of floats: the triangle (0,0,0) (1,0,0) (0,1,0) at 0, then
  * `extra` floats. Views and accessors are written by the caller. */
 static char dir[64];
@@ -82,7 +65,7 @@ static const char *path_of(const char *name)
 
 static void write_gltf(const char *name, const float *data, size_t nfloats, const char *body)
 {
-    char *enc = b64(data, nfloats * sizeof(float));
+    char *enc = test_base64(data, nfloats * sizeof(float));
     size_t cap = strlen(enc) + strlen(body) + 512;
     char *json = malloc(cap);
     snprintf(json, cap,

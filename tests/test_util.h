@@ -77,6 +77,25 @@ static inline void test_remove_dir(const char *dir)
     rmdir(dir);
 }
 
+/* Standard base64 (RFC 4648) of n bytes, for data: URIs in written glTF
+ * files; the caller frees it. */
+static inline char *test_base64(const void *data, size_t n)
+{
+    static const char al[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const uint8_t *p = data;
+    char *out = malloc(4 * ((n + 2) / 3) + 1);
+    size_t o = 0;
+    for (size_t i = 0; i < n; i += 3) {
+        uint32_t w = (uint32_t)p[i] << 16 | (i + 1 < n ? (uint32_t)p[i + 1] << 8 : 0) | (i + 2 < n ? p[i + 2] : 0);
+        out[o++] = al[w >> 18 & 63];
+        out[o++] = al[w >> 12 & 63];
+        out[o++] = i + 1 < n ? al[w >> 6 & 63] : '=';
+        out[o++] = i + 2 < n ? al[w & 63] : '=';
+    }
+    out[o] = 0;
+    return out;
+}
+
 /* A small deterministic PRNG for test data (xorshift64*). */
 typedef struct test_rng { uint64_t s; } test_rng;
 static inline uint64_t test_rng_next(test_rng *r)
