@@ -28,7 +28,9 @@ host=\$1
 shift
 [ "\${1:-}" = -- ] && shift
 mkdir -p "$work/hosts/\$host"
-cd "$work/hosts/\$host" && HOME=\$PWD exec sh -c "\$*"
+# sshd gives the remote command the user's HOME and login SHELL (GNU
+# parallel's wrapper runs the command through \$SHELL): here, the host's home
+cd "$work/hosts/\$host" && HOME=\$PWD SHELL=/bin/sh exec sh -c "\$*"
 FAKE
 chmod +x "$work/ssh"
 

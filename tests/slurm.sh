@@ -18,6 +18,9 @@
 # (default ./rt), RT_SLURM_PARTS (default 3), RT_SLURM_TIMEOUT (seconds for
 # the jobs, default 300).
 set -eu
+# Slurm's daemons live in sbin, which a user's or a CI runner's PATH may lack
+PATH=$PATH:/usr/local/sbin:/usr/sbin:/sbin
+export PATH
 . tests/launch-common.sh
 launch_setup test-slurm
 parts=${RT_SLURM_PARTS:-3}
