@@ -15,7 +15,10 @@
 #include "rt/accel/kdtree.h"
 #include "rt/io/framebuffer.h"
 #include "rt/io/scene_parse.h"
+#include "rt/render/bsdf.h"
 #include "rt/render/render.h"
+#include "rt/render/render_state.h"
+#include "rt/render/surface.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/validate.h"
 
@@ -407,6 +410,50 @@ static void test_extended_flag(void **state)
     rt_scene_free(&s);
 }
 
+/* KHR_materials_clearcoat: the coat takes no texture from the material
+ * below it, so a base normal map tilts the base's normal but not the
+ * coat's, which keeps the interpolated normal (or follows its own map). */
+static void test_coat_ignores_base_normal_map(void **state)
+{
+    (void)state;
+    rt_scene s;
+    /* a constant normal map tilting the normal by atan(0.6 / 0.4) towards +u */
+    load_text(&s, "coat.txt",
+              "texture tilt constant 0.8 0.5 0.7\n"
+              "texture flat constant 0.5 0.5 1\n"
+              "material bumpy clearcoat 1 normal_map tilt\n"
+              "material both clearcoat 1 normal_map tilt clearcoat_normal_map flat\n"
+              "material coat_map clearcoat 1 normal_map flat clearcoat_normal_map tilt\n"
+              "quad -1 -1 0  2 0 0  0 2 0  bumpy\n"
+              "quad -1 -1 1  2 0 0  0 2 0  both\n"
+              "quad -1 -1 2  2 0 0  0 2 0  coat_map\n");
+    rt_error err = {0};
+    assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
+    rt_render_state rs;
+    assert_int_equal(rt_render_state_prepare(&rs, &s, NULL, 0, &err), RT_OK);
+    rt_trace_ctx ctx;
+    rt_trace_ctx_init(&ctx, &rs);
+    rt_vec3 tilted = rt_normalize(rt_v3(0.6f, 0.0f, 0.4f));
+    for (uint32_t q = 0; q < 3; q++) {
+        rt_vec3 p = rt_v3(0.1f, 0.2f, (float)q);
+        rt_vec3 dir = rt_normalize(rt_v3(0.1f, 0.05f, -1.0f));
+        rt_ray r = rt_ray_make(rt_sub(p, rt_scale(dir, 3.0f)), dir, 0.0f, INFINITY);
+        rt_hit h = {3.0f, 0.55f, 0.6f, q}; /* quads are the only primitives: ids 0, 1, 2 */
+        rt_surface sf;
+        rt_surface_at(&ctx, &r, &h, &sf);
+        rt_bsdf b;
+        rt_bsdf_from_surface(&ctx, &sf, &b);
+        assert_true(b.layered && b.clearcoat == 1.0f);
+        rt_vec3 coat = rt_bsdf_to_world(&b, b.cc_n), base = b.n;
+        rt_vec3 want_base = q == 2 ? rt_v3(0, 0, 1) : tilted, want_coat = q == 2 ? tilted : rt_v3(0, 0, 1);
+        if (rt_length(rt_sub(base, want_base)) > 1e-5f || rt_length(rt_sub(coat, want_coat)) > 1e-5f)
+            fail_msg("quad %u: base normal (%g %g %g), coat normal (%g %g %g)", q, (double)base.x, (double)base.y,
+                     (double)base.z, (double)coat.x, (double)coat.y, (double)coat.z);
+    }
+    rt_render_state_free(&rs);
+    rt_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -414,6 +461,7 @@ int main(void)
         cmocka_unit_test(test_render_matches_gltf),
         cmocka_unit_test(test_bad_values),
         cmocka_unit_test(test_extended_flag),
+        cmocka_unit_test(test_coat_ignores_base_normal_map),
     };
     return cmocka_run_group_tests_name("scene_ext", tests, setup_tmp, teardown_tmp);
 }

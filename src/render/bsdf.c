@@ -465,12 +465,32 @@ static void set_ext_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, 
     rt_vec3 bt = rt_cross(b->n, t);
     if (have_t && rt_dot(bt, sf->b) < 0.0f)
         bt = rt_neg(bt); /* keep the UV handedness */
-    if (e.clearcoat > 0.0f && have_t) {
-        rt_vec4 c = ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_NORMAL, false, &has);
-        if (has) {
-            rt_vec3 v = normal_texel(c, m->clearcoat_normal_scale);
-            rt_vec3 w = rt_add(rt_add(rt_scale(t, v.x), rt_scale(bt, v.y)), rt_scale(b->n, v.z));
-            e.clearcoat_normal = rt_bsdf_to_local(b, w);
+    /* the coat's normal: its own map, else the surface's normal without the
+     * base's normal map (KHR_materials_clearcoat: the coat inherits no
+     * texture of the material below it), in the frame of that normal */
+    if (e.clearcoat > 0.0f) {
+        rt_vec3 cn = b->n, ct = t, cbt = bt;
+        bool have_ct = have_t;
+        if (m->normal_tex.texture != RT_NONE && rt_dot(sf->n_unmapped, sf->wo) > 1e-4f &&
+            rt_finite3(sf->n_unmapped)) {
+            cn = sf->n_unmapped;
+            ct = rt_sub(sf->t, rt_scale(cn, rt_dot(sf->t, cn)));
+            float cl2 = rt_length2(ct);
+            have_ct = cl2 > 1e-12f && isfinite(cl2);
+            if (have_ct)
+                ct = rt_scale(ct, 1.0f / sqrtf(cl2));
+            cbt = rt_cross(cn, ct);
+            if (have_ct && rt_dot(cbt, sf->b) < 0.0f)
+                cbt = rt_neg(cbt);
+            e.clearcoat_normal = rt_bsdf_to_local(b, cn);
+        }
+        if (have_ct) {
+            rt_vec4 c = ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_NORMAL, false, &has);
+            if (has) {
+                rt_vec3 v = normal_texel(c, m->clearcoat_normal_scale);
+                rt_vec3 w = rt_add(rt_add(rt_scale(ct, v.x), rt_scale(cbt, v.y)), rt_scale(cn, v.z));
+                e.clearcoat_normal = rt_bsdf_to_local(b, w);
+            }
         }
     }
     e.spec_weight *= ext_sample(s, sf, m, RT_XTEX_SPECULAR, false, &has).w;

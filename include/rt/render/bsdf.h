@@ -98,7 +98,7 @@ typedef struct rt_bsdf {
     float clearcoat;       /* KHR_materials_clearcoat weight c */
     float cc_alpha;        /* the coat's GGX alpha (floored) */
     bool cc_delta;         /* coat roughness 0: a mirror coat */
-    rt_vec3 cc_t, cc_b, cc_n; /* the coat's frame in the local frame (cc_n = (0,0,1) without a coat normal map) */
+    rt_vec3 cc_t, cc_b, cc_n; /* the coat's frame in the local frame (cc_n = (0,0,1) when the coat shares the shading normal) */
     rt_vec3 sheen;         /* KHR_materials_sheen colour (0: no sheen) */
     float sheen_alpha;     /* its alpha (rt_sheen_alpha) */
     float iridescence;     /* KHR_materials_iridescence factor */
