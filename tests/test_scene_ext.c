@@ -5,8 +5,9 @@
  * a row of quads with clearcoat, sheen, specular colour and iridescence
  * written as scene-text triangles path traces to the same bytes as the
  * same quads as a glTF model in the same scene; out-of-range values and
- * extension keys on another bsdf are refused naming file:line:column; and
- * a material without extension keys keeps the core BSDF (not `extended`).
+ * extension keys on another bsdf are refused naming file:line:column; a
+ * material without extension keys keeps the core BSDF (not `extended`);
+ * a coat ignores the base's normal map; scenes/pbr-extensions.txt loads.
  */
 #include "test_util.h"
 
@@ -454,6 +455,25 @@ static void test_coat_ignores_base_normal_map(void **state)
     rt_scene_free(&s);
 }
 
+/* scenes/pbr-extensions.txt, the material grid of the README: every
+ * sphere but the two references (plain paint, bare velvet) and the floor
+ * takes the layered path. */
+static void test_shipped_scene(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_error err = {0};
+    assert_int_equal(rt_scene_parse_file(&s, "scenes/pbr-extensions.txt", &err), RT_OK);
+    size_t extended = 0;
+    for (size_t i = 0; i < s.material_count; i++)
+        extended += s.materials[i].extended;
+    assert_int_equal(s.spheres.count, 15);
+    assert_int_equal(extended, 13);
+    assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
+    rt_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -462,6 +482,7 @@ int main(void)
         cmocka_unit_test(test_bad_values),
         cmocka_unit_test(test_extended_flag),
         cmocka_unit_test(test_coat_ignores_base_normal_map),
+        cmocka_unit_test(test_shipped_scene),
     };
     return cmocka_run_group_tests_name("scene_ext", tests, setup_tmp, teardown_tmp);
 }
