@@ -924,21 +924,13 @@ static bool mat_key_is_ext(const mat_key *mk)
            mk->offset < offsetof(rt_material, extended);
 }
 
-/* A texture slot that holds a colour (sRGB): a missing image there shows
- * the missing-texture checker; in a data slot it is left out. */
+/* A texture slot that holds a colour: a missing image there shows the
+ * missing-texture checker; in a data slot it is left out. The extensions'
+ * colour maps are tints of a layer and count as data, as in the glTF
+ * loader (docs/gltf.md). */
 static bool mat_key_is_colour_slot(const mat_key *mk)
 {
-    static const size_t colour[] = {
-        offsetof(rt_material, base_color_tex),
-        offsetof(rt_material, emissive_tex),
-        offsetof(rt_material, ext_tex) + RT_XTEX_SPECULAR_COLOR * sizeof(rt_texture_slot),
-        offsetof(rt_material, ext_tex) + RT_XTEX_SHEEN_COLOR * sizeof(rt_texture_slot),
-        offsetof(rt_material, ext_tex) + RT_XTEX_DIFFUSE_TRANSMISSION_COLOR * sizeof(rt_texture_slot),
-    };
-    for (size_t i = 0; i < sizeof colour / sizeof *colour; i++)
-        if (mk->offset == colour[i])
-            return true;
-    return false;
+    return mk->offset == offsetof(rt_material, base_color_tex) || mk->offset == offsetof(rt_material, emissive_tex);
 }
 
 const char *rt_scene_material_key(size_t i)
