@@ -16,6 +16,13 @@
  * before it is used; `camera gltf N` is resolved after the last statement,
  * when every model's cameras are known.
  *
+ * Material keys: one table (mat_keys). The keys of the glTF PBR-next
+ * extensions are the KHR_materials_* properties in snake_case with the
+ * extensions' schema ranges (Khronos glTF extension registry: clearcoat,
+ * specular, sheen, anisotropy, iridescence, dispersion,
+ * diffuse_transmission), so a material written with them is the one the
+ * glTF loader makes from the same JSON.
+ *
  * Numbers: decimal only ([+-]digits[.digits][e[+-]digits], number.h),
  * finite, and within float range; the whole token must be used, so `1.0x`,
  * `nan`, `inf` and `0x10` are all rejected.
