@@ -390,8 +390,9 @@ void rt_bsdf_set_eta(rt_bsdf *b, float eta)
     eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
     float r0 = (eta - 1.0f) / (eta + 1.0f);
     b->f0 = r0 * r0;
+    bool changed = eta != b->eta;
     b->eta = eta;
-    if (b->ms && b->radiance_eta2)
+    if (changed && b->ms && b->radiance_eta2)
         dielectric_compensate(b); /* E and the split depend on eta */
 }
 
@@ -423,14 +424,16 @@ static void dielectric_compensate(rt_bsdf *b)
     b->ms_x = x;
     b->ms_refl = refl;
     b->ms_trans = trans;
+    b->ms_cell[0] = rt_ggx_dielectric_cell_of(alpha, eta);
+    b->ms_cell[1] = rt_ggx_dielectric_cell_of(alpha, 1.0f / eta);
 }
 
 float rt_bsdf_ms_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi)
 {
     if (!b->ms || !b->radiance_eta2 || !(wo.z > 0.0f) || !(wi.z < 0.0f))
         return 0.0f;
-    return b->ms_trans * (1.0f - rt_ggx_dielectric_albedo(wo.z, b->ms_alpha, b->eta)) *
-           (1.0f - rt_ggx_dielectric_albedo(-wi.z, b->ms_alpha, 1.0f / b->eta));
+    return b->ms_trans * (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[0], wo.z)) *
+           (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[1], -wi.z));
 }
 
 float rt_fresnel_diffuse_reflectance(float eta)
@@ -693,7 +696,7 @@ static void lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_
     *p_specular = ws / sum;
     *p_transmit = wt / sum;
     if (b->ms) { /* rough glass: single scattering keeps E(mu_o), the lobe the rest */
-        float pm = 1.0f - rt_ggx_dielectric_albedo(wo.z, b->ms_alpha, b->eta);
+        float pm = 1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[0], wo.z);
         pm = isfinite(pm) ? rt_clampf(pm, 0.0f, 0.95f) : 0.0f;
         *p_diffuse = pm * (1.0f - b->ms_x);
         *p_ms_transmit = pm * b->ms_x;
@@ -764,8 +767,8 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
                 p += ps * pv;
         }
         if (b->ms) /* rough glass: the reflected multiple-scattering lobe, sampled as diffuse */
-            f = rt_add(f, rt_v3s(b->ms_refl * (1.0f - rt_ggx_dielectric_albedo(wo.z, b->ms_alpha, b->eta)) *
-                                 (1.0f - rt_ggx_dielectric_albedo(wi.z, b->ms_alpha, b->eta))));
+            f = rt_add(f, rt_v3s(b->ms_refl * (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[0], wo.z)) *
+                                 (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[0], wi.z))));
     }
     *pdf = p;
     return f;

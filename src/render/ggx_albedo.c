@@ -52,15 +52,10 @@ rt_vec3 rt_fresnel_conductor_avg(rt_vec3 eta, rt_vec3 k)
 
 /* The dielectric tables' coordinates: side (0: eta < 1), the r row and
  * its weight, the alpha row and its weight. */
-typedef struct dielectric_cell {
-    int side, k, j;
-    float fk, fj;
-} dielectric_cell;
-
-static dielectric_cell dielectric_cell_of(float alpha, float eta)
+rt_ggx_dielectric_cell rt_ggx_dielectric_cell_of(float alpha, float eta)
 {
     enum { N = RT_GGX_ALBEDO_N, NR = RT_GGX_DIELECTRIC_NR };
-    dielectric_cell c;
+    rt_ggx_dielectric_cell c;
     eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
     c.side = eta >= 1.0f;
     float ir2 = c.side ? 1.0f / (eta * eta) : eta * eta; /* 1 / r^2, rows uniform in it */
@@ -86,8 +81,14 @@ static float bilerp(const float *r0, const float *r1, int i, float f, float g)
 
 float rt_ggx_dielectric_albedo(float mu, float alpha, float eta)
 {
+    rt_ggx_dielectric_cell c = rt_ggx_dielectric_cell_of(alpha, eta);
+    return rt_ggx_dielectric_albedo_at(&c, mu);
+}
+
+float rt_ggx_dielectric_albedo_at(const rt_ggx_dielectric_cell *cp, float mu)
+{
     enum { N = RT_GGX_ALBEDO_N };
-    dielectric_cell c = dielectric_cell_of(alpha, eta);
+    const rt_ggx_dielectric_cell c = *cp;
     float x = rt_clampf(isfinite(mu) ? mu : 1.0f, 0.0f, 1.0f) * N - 0.5f;
     x = rt_clampf(x, 0.0f, (float)(N - 1));
     int i = (int)x;
@@ -102,7 +103,7 @@ float rt_ggx_dielectric_albedo(float mu, float alpha, float eta)
 
 float rt_ggx_dielectric_albedo_avg(float alpha, float eta)
 {
-    dielectric_cell c = dielectric_cell_of(alpha, eta);
+    rt_ggx_dielectric_cell c = rt_ggx_dielectric_cell_of(alpha, eta);
     return bilerp(rt_ggx_dielectric_avg_table[c.side][c.k], rt_ggx_dielectric_avg_table[c.side][c.k + 1], c.j, c.fj,
                   c.fk);
 }
@@ -110,7 +111,7 @@ float rt_ggx_dielectric_albedo_avg(float alpha, float eta)
 float rt_ggx_dielectric_ms_transmit(float alpha, float eta)
 {
     eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
-    dielectric_cell c = dielectric_cell_of(alpha, eta);
+    rt_ggx_dielectric_cell c = rt_ggx_dielectric_cell_of(alpha, eta);
     float m = bilerp(rt_ggx_dielectric_ms_table[c.k], rt_ggx_dielectric_ms_table[c.k + 1], c.j, c.fj, c.fk);
     return c.side ? m / (eta * eta) : m;
 }

@@ -62,6 +62,7 @@
 
 #include <stdbool.h>
 
+#include "rt/render/ggx_albedo.h"
 #include "rt/render/surface.h"
 
 #define RT_BSDF_MIN_ALPHA 1e-4f /* GGX alpha floor for roughness > 0 (roughness 0 is a delta interface) */
@@ -88,6 +89,7 @@ typedef struct rt_bsdf {
     float ms_x;       /* dielectric: the share of the lost energy at wo that crosses the interface */
     float ms_refl;    /* dielectric: f_ms,R = ms_refl (1 - E_o(mu_o)) (1 - E_o(mu_i)) */
     float ms_trans;   /* dielectric: f_ms,T = ms_trans (1 - E_o(mu_o)) (1 - E_t(|mu_i|)) (flux; x eta^2 for radiance) */
+    rt_ggx_dielectric_cell ms_cell[2]; /* dielectric: E's table cells from wo's side (o) and the other (t) */
     float transmission; /* T */
     float eta;        /* index ratio across the surface along a transmitted ray: n_incident / n_transmitted */
     bool thin;        /* glTF transmission without a volume (thickness 0, thin-walled): light goes straight

@@ -50,6 +50,15 @@ rt_vec3 rt_fresnel_conductor_avg(rt_vec3 eta, rt_vec3 k);
  * energy reflected and transmitted (flux, without the eta^2 of radiance),
  * 1 for a smooth interface. */
 float rt_ggx_dielectric_albedo(float mu, float alpha, float eta);
+/* The same in two steps, for many lookups at one alpha and eta: the
+ * table cell (side, index row and alpha row with their weights), then E
+ * at mu in it (bit for bit rt_ggx_dielectric_albedo). */
+typedef struct rt_ggx_dielectric_cell {
+    int side, k, j;
+    float fk, fj;
+} rt_ggx_dielectric_cell;
+rt_ggx_dielectric_cell rt_ggx_dielectric_cell_of(float alpha, float eta);
+float rt_ggx_dielectric_albedo_at(const rt_ggx_dielectric_cell *c, float mu);
 /* E_avg(alpha, eta) = 2 int E(mu, alpha, eta) mu dmu. */
 float rt_ggx_dielectric_albedo_avg(float alpha, float eta);
 /* The multiple-scattering flux that crosses the interface under uniform
