@@ -26,6 +26,7 @@
  *     priority below the glass's the ray passes untouched.
  */
 #include "test_util.h"
+#include "test_fixture.h"
 
 #include <math.h>
 
@@ -37,30 +38,11 @@
 #include "rt/render/whitted.h"
 #include "rt/scene/scene.h"
 
-typedef struct fixture {
-    rt_scene s;
-    rt_kdtree tree;
-    rt_render_state rs;
-    rt_trace_ctx ctx;
-} fixture;
+typedef test_fixture fixture; /* test_fixture.h */
 
-static void load(fixture *f, const char *text)
-{
-    rt_error err;
-    rt_scene_init(&f->s);
-    if (rt_scene_parse_string(&f->s, text, strlen(text), "test", NULL, &err) != RT_OK)
-        fail_msg("parse: %s", err.message);
-    assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
-    assert_int_equal(rt_render_state_prepare(&f->rs, &f->s, &f->tree, 0, &err), RT_OK);
-    rt_trace_ctx_init(&f->ctx, &f->rs);
-}
+static void load(fixture *f, const char *text) { test_fixture_load(f, text, 0); }
 
-static void unload(fixture *f)
-{
-    rt_render_state_free(&f->rs);
-    rt_kdtree_free(&f->tree);
-    rt_scene_free(&f->s);
-}
+static void unload(fixture *f) { test_fixture_free(f); }
 
 static rt_vec3 radiance(const fixture *f, rt_vec3 org, rt_vec3 dir, uint32_t i)
 {
