@@ -446,15 +446,16 @@ static rt_vec3 normal_texel(rt_vec4 c, float scale)
 }
 
 /* The extensions' factors x textures at a hit (KHR_materials_*), and the
- * anisotropy direction as the frame's x. */
+ * anisotropy direction as the frame's x. The factors come from the
+ * material (rt_bsdf_ext_of_material), so its defaults are the only ones. */
 static void set_ext_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_material *m, rt_bsdf *b)
 {
     const rt_scene *s = ctx->state->scene;
     rt_bsdf_ext e;
     bool has;
-    rt_bsdf_ext_default(&e);
-    e.clearcoat = m->clearcoat * ext_sample(s, sf, m, RT_XTEX_CLEARCOAT, false, &has).x;
-    e.clearcoat_roughness = m->clearcoat_roughness * ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_ROUGHNESS, false, &has).y;
+    rt_bsdf_ext_of_material(m, &e);
+    e.clearcoat *= ext_sample(s, sf, m, RT_XTEX_CLEARCOAT, false, &has).x;
+    e.clearcoat_roughness *= ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_ROUGHNESS, false, &has).y;
     /* the tangent frame before the coat's map: sf's (t, b, n) made orthonormal about b->n */
     rt_vec3 t = rt_sub(sf->t, rt_scale(b->n, rt_dot(sf->t, b->n)));
     float tl2 = rt_length2(t);
@@ -464,35 +465,53 @@ static void set_ext_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, 
     rt_vec3 bt = rt_cross(b->n, t);
     if (have_t && rt_dot(bt, sf->b) < 0.0f)
         bt = rt_neg(bt); /* keep the UV handedness */
-    if (e.clearcoat > 0.0f && have_t) {
-        rt_vec4 c = ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_NORMAL, false, &has);
-        if (has) {
-            rt_vec3 v = normal_texel(c, m->clearcoat_normal_scale);
-            rt_vec3 w = rt_add(rt_add(rt_scale(t, v.x), rt_scale(bt, v.y)), rt_scale(b->n, v.z));
-            e.clearcoat_normal = rt_bsdf_to_local(b, w);
+    /* the coat's normal: its own map, else the surface's normal without the
+     * base's normal map (KHR_materials_clearcoat: the coat inherits no
+     * texture of the material below it), in the frame of that normal */
+    if (e.clearcoat > 0.0f) {
+        rt_vec3 cn = b->n, ct = t, cbt = bt;
+        bool have_ct = have_t;
+        if (m->normal_tex.texture != RT_NONE && rt_dot(sf->n_unmapped, sf->wo) > 1e-4f &&
+            rt_finite3(sf->n_unmapped)) {
+            cn = sf->n_unmapped;
+            ct = rt_sub(sf->t, rt_scale(cn, rt_dot(sf->t, cn)));
+            float cl2 = rt_length2(ct);
+            have_ct = cl2 > 1e-12f && isfinite(cl2);
+            if (have_ct)
+                ct = rt_scale(ct, 1.0f / sqrtf(cl2));
+            cbt = rt_cross(cn, ct);
+            if (have_ct && rt_dot(cbt, sf->b) < 0.0f)
+                cbt = rt_neg(cbt);
+            e.clearcoat_normal = rt_bsdf_to_local(b, cn);
+        }
+        if (have_ct) {
+            rt_vec4 c = ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_NORMAL, false, &has);
+            if (has) {
+                rt_vec3 v = normal_texel(c, m->clearcoat_normal_scale);
+                rt_vec3 w = rt_add(rt_add(rt_scale(ct, v.x), rt_scale(cbt, v.y)), rt_scale(cn, v.z));
+                e.clearcoat_normal = rt_bsdf_to_local(b, w);
+            }
         }
     }
-    rt_vec4 sp = ext_sample(s, sf, m, RT_XTEX_SPECULAR, false, &has);
-    e.spec_weight = m->specular_weight * sp.w;
+    e.spec_weight *= ext_sample(s, sf, m, RT_XTEX_SPECULAR, false, &has).w;
     rt_vec4 sc = ext_sample(s, sf, m, RT_XTEX_SPECULAR_COLOR, true, &has);
-    e.spec_color = rt_mul(m->specular_color, rt_v3(sc.x, sc.y, sc.z));
+    e.spec_color = rt_mul(e.spec_color, rt_v3(sc.x, sc.y, sc.z));
     rt_vec4 sh = ext_sample(s, sf, m, RT_XTEX_SHEEN_COLOR, true, &has);
-    e.sheen_color = rt_mul(m->sheen_color, rt_v3(sh.x, sh.y, sh.z));
-    e.sheen_roughness = m->sheen_roughness * ext_sample(s, sf, m, RT_XTEX_SHEEN_ROUGHNESS, false, &has).w;
-    e.iridescence = m->iridescence * ext_sample(s, sf, m, RT_XTEX_IRIDESCENCE, false, &has).x;
+    e.sheen_color = rt_mul(e.sheen_color, rt_v3(sh.x, sh.y, sh.z));
+    e.sheen_roughness *= ext_sample(s, sf, m, RT_XTEX_SHEEN_ROUGHNESS, false, &has).w;
+    e.iridescence *= ext_sample(s, sf, m, RT_XTEX_IRIDESCENCE, false, &has).x;
     rt_vec4 th = ext_sample(s, sf, m, RT_XTEX_IRIDESCENCE_THICKNESS, false, &has);
-    e.iridescence_ior = m->iridescence_ior;
-    e.iridescence_thickness = has ? m->iridescence_thickness_min +
-                                        (m->iridescence_thickness_max - m->iridescence_thickness_min) * th.y
-                                  : m->iridescence_thickness_max;
-    e.diffuse_transmission = m->diffuse_transmission * ext_sample(s, sf, m, RT_XTEX_DIFFUSE_TRANSMISSION, false, &has).w;
+    if (has)
+        e.iridescence_thickness = m->iridescence_thickness_min +
+                                  (m->iridescence_thickness_max - m->iridescence_thickness_min) * th.y;
+    e.diffuse_transmission *= ext_sample(s, sf, m, RT_XTEX_DIFFUSE_TRANSMISSION, false, &has).w;
     rt_vec4 dc = ext_sample(s, sf, m, RT_XTEX_DIFFUSE_TRANSMISSION_COLOR, true, &has);
-    e.diffuse_transmission_color = rt_mul(m->diffuse_transmission_color, rt_v3(dc.x, dc.y, dc.z));
-    e.dispersion = m->thin_walled ? 0.0f : m->dispersion; /* a thin wall does not bend light */
+    e.diffuse_transmission_color = rt_mul(e.diffuse_transmission_color, rt_v3(dc.x, dc.y, dc.z));
     /* anisotropy: direction (cos r, sin r) in the tangent frame, or the
      * texture's (2 RG - 1) rotated by r; strength x texture B */
     rt_vec4 an = ext_sample(s, sf, m, RT_XTEX_ANISOTROPY, false, &has);
-    e.anisotropy = m->anisotropy * (has ? an.z : 1.0f);
+    if (has)
+        e.anisotropy *= an.z;
     if (e.anisotropy > 0.0f && have_t) {
         float dx = has ? 2.0f * an.x - 1.0f : 1.0f, dy = has ? 2.0f * an.y - 1.0f : 0.0f;
         float cr = cosf(m->anisotropy_rotation), sr = sinf(m->anisotropy_rotation);
@@ -757,22 +776,29 @@ static bool thin_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, rt_vec3 c, fl
  * shading uses wo only). Diffuse transmission (dt) and the refraction lobe
  * are sampled only (delta samples), as transmission is. */
 
+void rt_bsdf_ext_of_material(const rt_material *m, rt_bsdf_ext *e)
+{
+    e->spec_weight = m->specular_weight;
+    e->spec_color = m->specular_color;
+    e->clearcoat = m->clearcoat;
+    e->clearcoat_roughness = m->clearcoat_roughness;
+    e->clearcoat_normal = rt_v3(0.0f, 0.0f, 1.0f); /* the shading normal: a coat without a map of its own */
+    e->sheen_color = m->sheen_color;
+    e->sheen_roughness = m->sheen_roughness;
+    e->anisotropy = m->anisotropy;
+    e->iridescence = m->iridescence;
+    e->iridescence_ior = m->iridescence_ior;
+    e->iridescence_thickness = m->iridescence_thickness_max; /* without a thickness texture: the maximum */
+    e->diffuse_transmission = m->diffuse_transmission;
+    e->diffuse_transmission_color = m->diffuse_transmission_color;
+    e->dispersion = m->thin_walled ? 0.0f : m->dispersion; /* a thin wall does not bend light */
+}
+
 void rt_bsdf_ext_default(rt_bsdf_ext *e)
 {
-    e->spec_weight = 1.0f;
-    e->spec_color = rt_v3s(1.0f);
-    e->clearcoat = 0.0f;
-    e->clearcoat_roughness = 0.0f;
-    e->clearcoat_normal = rt_v3(0.0f, 0.0f, 1.0f);
-    e->sheen_color = rt_v3s(0.0f);
-    e->sheen_roughness = 0.0f;
-    e->anisotropy = 0.0f;
-    e->iridescence = 0.0f;
-    e->iridescence_ior = 1.3f;
-    e->iridescence_thickness = 400.0f;
-    e->diffuse_transmission = 0.0f;
-    e->diffuse_transmission_color = rt_v3s(1.0f);
-    e->dispersion = 0.0f;
+    rt_material m;
+    rt_material_default(&m, NULL);
+    rt_bsdf_ext_of_material(&m, e);
 }
 
 /* KHR_materials_dispersion: the index at wavelength lambda (nm) from the

@@ -35,7 +35,8 @@
  * glTF extensions (docs/gltf.md, "Material mapping"): a clearcoat c adds
  * a mirror of weight c F_coat(n.v) (Schlick, F0 = 0.04) over the rest,
  * i.e. R becomes R + (1 - R) c F_coat; KHR_materials_specular scales ks at
- * load; sheen, anisotropy, iridescence and diffuse transmission are
+ * load (the glTF loader and the scene parser's specular_factor and
+ * specular_color keys alike); sheen, anisotropy, iridescence and diffuse transmission are
  * path-tracer effects this model leaves out.
  *
  * Recursion: reflection/refraction up to settings.max_bounce events; a

@@ -98,7 +98,7 @@ typedef struct rt_bsdf {
     float clearcoat;       /* KHR_materials_clearcoat weight c */
     float cc_alpha;        /* the coat's GGX alpha (floored) */
     bool cc_delta;         /* coat roughness 0: a mirror coat */
-    rt_vec3 cc_t, cc_b, cc_n; /* the coat's frame in the local frame (cc_n = (0,0,1) without a coat normal map) */
+    rt_vec3 cc_t, cc_b, cc_n; /* the coat's frame in the local frame (cc_n = (0,0,1) when the coat shares the shading normal) */
     rt_vec3 sheen;         /* KHR_materials_sheen colour (0: no sheen) */
     float sheen_alpha;     /* its alpha (rt_sheen_alpha) */
     float iridescence;     /* KHR_materials_iridescence factor */
@@ -174,8 +174,11 @@ void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float
  * rt_bsdf_from_surface calls it when the scene's energy_compensation is on. */
 void rt_bsdf_compensate(rt_bsdf *b);
 
-/* The glTF PBR-next extensions' parameters at a point (rt_bsdf_set_ext);
- * rt_bsdf_ext_default gives the values that leave the core BSDF. */
+/* The glTF PBR-next extensions' parameters at a point (rt_bsdf_set_ext).
+ * rt_bsdf_ext_of_material takes a material's factors (no textures: the
+ * path tracer multiplies those in at a hit); rt_bsdf_ext_default is that
+ * of rt_material_default()'s material, the values that leave the core
+ * BSDF, so the defaults live in one place (scene.c). */
 typedef struct rt_bsdf_ext {
     float spec_weight;          /* KHR_materials_specular: specularFactor */
     rt_vec3 spec_color;         /* specularColorFactor */
@@ -189,6 +192,7 @@ typedef struct rt_bsdf_ext {
     rt_vec3 diffuse_transmission_color;
     float dispersion;           /* KHR_materials_dispersion: 20 / Abbe number (needs transmission) */
 } rt_bsdf_ext;
+void rt_bsdf_ext_of_material(const rt_material *m, rt_bsdf_ext *e);
 void rt_bsdf_ext_default(rt_bsdf_ext *e);
 /* Puts the extensions' layers over a glTF BSDF from rt_bsdf_make or
  * rt_bsdf_from_surface (anything else is left as it is); with the default
