@@ -100,7 +100,7 @@ $(BUILD)/librt.a: $(LIB_OBJ)
 $(RT): $(DRV_OBJ) $(BUILD)/librt.a
 	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS) $(SDL2_LIBS)
 
-$(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
+$(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h tests/test_fixture.h tests/test_bsdf_check.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests -o $@ $< $(BUILD)/librt.a $(LDLIBS) -lcmocka
 

@@ -8,6 +8,7 @@
  * directions matches the pdf rt_bsdf_eval reports; every value is finite
  * at grazing and degenerate directions. */
 #include "test_util.h"
+#include "test_bsdf_check.h"
 
 #include <complex.h>
 #include <math.h>
@@ -15,12 +16,6 @@
 #include "rt/render/bsdf.h"
 #include "rt/render/ggx_albedo.h"
 #include "rt/render/sampling.h"
-
-static rt_vec3 dir_from(float cos_t, float phi)
-{
-    float s = sqrtf(fmaxf(0.0f, 1.0f - cos_t * cos_t));
-    return rt_v3(s * cosf(phi), s * sinf(phi), cos_t);
-}
 
 /* A uniformly distributed direction on the upper hemisphere. */
 static rt_vec3 uniform_hemi(test_rng *r)
@@ -245,63 +240,11 @@ static void test_ggx_tiny_alpha_precision(void **state)
 }
 
 /* The density rt_bsdf_sample_dir draws from integrates (over the sphere)
- * to the probability that it succeeds with a non-delta sample, and a histogram of its directions
- * over 16 x 16 cells in (cos theta, phi) matches the pdf integrated over
- * each cell. */
-static void pdf_histogram(const rt_bsdf *bp, rt_vec3 wo, uint64_t seed, const char *label)
+ * to the probability that it succeeds, and a histogram of its directions
+ * matches the pdf integrated over each cell (test_bsdf_check.h). */
+static void pdf_histogram(const rt_bsdf *b, rt_vec3 wo, uint64_t seed, const char *label)
 {
-    enum { NT = 16, NP = 16, N = 400000 };
-    static double hist[NT][NP], expect[NT][NP];
-    const rt_bsdf b = *bp;
-    memset(hist, 0, sizeof hist);
-    memset(expect, 0, sizeof expect);
-    rt_rng rng = rt_rng_seed(seed, 99);
-    int ok = 0;
-    for (int i = 0; i < N; i++) {
-        rt_bsdf_sample s;
-        float ul = rt_rng_float(&rng);
-        rt_vec2 u = rt_v2(rt_rng_float(&rng), rt_rng_float(&rng));
-        if (!rt_bsdf_sample_dir(&b, wo, u, ul, &s) || s.delta)
-            continue; /* delta samples (refraction) are outside the evaluated density */
-        ok++;
-        /* the sample's pdf is the evaluated pdf */
-        float pe;
-        rt_bsdf_eval(&b, wo, s.wi, &pe);
-        assert_true(fabsf(pe - s.pdf) <= 1e-4f * s.pdf);
-        int it = (int)(s.wi.z * NT), ip = (int)((atan2f(s.wi.y, s.wi.x) + RT_PI) / (2.0f * RT_PI) * NP);
-        it = it < 0 ? 0 : (it >= NT ? NT - 1 : it);
-        ip = ip < 0 ? 0 : (ip >= NP ? NP - 1 : ip);
-        hist[it][ip] += 1.0 / N;
-    }
-    /* pdf integrated over each cell, 24 x 24 midpoints per cell */
-    double total = 0.0;
-    const int sub = 24;
-    for (int it = 0; it < NT; it++)
-        for (int ip = 0; ip < NP; ip++) {
-            double acc = 0.0;
-            for (int a = 0; a < sub; a++)
-                for (int bb = 0; bb < sub; bb++) {
-                    float ct = ((float)it + ((float)a + 0.5f) / sub) / NT;
-                    float ph = ((float)ip + ((float)bb + 0.5f) / sub) / NP * 2.0f * RT_PI - RT_PI;
-                    float pdf;
-                    rt_bsdf_eval(&b, wo, dir_from(ct, ph), &pdf);
-                    acc += pdf;
-                }
-            double cell = (1.0 / NT) * (2.0 * 3.14159265358979323846 / NP); /* solid angle of the cell */
-            expect[it][ip] = acc / (sub * sub) * cell;
-            total += expect[it][ip];
-        }
-    double p_ok = (double)ok / N;
-    assert_true(fabs(total - p_ok) < 0.01);
-    assert_true(total <= 1.0 + 0.01);
-    for (int it = 0; it < NT; it++)
-        for (int ip = 0; ip < NP; ip++) {
-            double e = expect[it][ip], h = hist[it][ip];
-            /* 5 standard deviations of a binomial count, plus the quadrature error */
-            double tol = 5.0 * sqrt(e / N) + 0.02 * e + 2e-5;
-            if (fabs(h - e) > tol)
-                fail_msg("%s cell (%d,%d): histogram %.5f, pdf %.5f", label, it, ip, h, e);
-        }
+    test_pdf_histogram(b, wo, rt_rng_seed(seed, 99), 400000, label);
 }
 
 /* pdf_histogram over the glTF cases. */

@@ -19,6 +19,7 @@
  *     box-averaged over 8x8 blocks: image means within 1%, RMSE bounded.
  */
 #include "test_util.h"
+#include "test_fixture.h"
 #include "test_scenes.h"
 
 #include <math.h>
@@ -34,31 +35,14 @@
 #include "rt/io/scene_parse.h"
 #include "rt/scene/texture.h"
 
-typedef struct fixture {
-    rt_scene s;
-    rt_kdtree tree;
-    rt_render_state rs;
-    rt_trace_ctx ctx;
-} fixture;
+typedef test_fixture fixture; /* test_fixture.h */
 
 static void load(fixture *f, const char *text, bool table)
 {
-    rt_error err;
-    rt_scene_init(&f->s);
-    if (rt_scene_parse_string(&f->s, text, strlen(text), "test", NULL, &err) != RT_OK)
-        fail_msg("parse: %s", err.message);
-    assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
-    assert_int_equal(rt_render_state_prepare(&f->rs, &f->s, &f->tree, table ? RT_PREPARE_LIGHT_TABLE : 0, &err),
-                     RT_OK);
-    rt_trace_ctx_init(&f->ctx, &f->rs);
+    test_fixture_load(f, text, table ? RT_PREPARE_LIGHT_TABLE : 0);
 }
 
-static void unload(fixture *f)
-{
-    rt_render_state_free(&f->rs);
-    rt_kdtree_free(&f->tree);
-    rt_scene_free(&f->s);
-}
+static void unload(fixture *f) { test_fixture_free(f); }
 
 static rt_vec3 radiance(const fixture *f, rt_vec3 org, rt_vec3 dir, uint32_t i)
 {
@@ -533,15 +517,9 @@ static void add_env(rt_scene *s, int w, int h, float sky, float sun, int si, int
 
 static void load_env(fixture *f, const char *text, float sky, float sun, bool table)
 {
-    rt_error err;
-    rt_scene_init(&f->s);
-    if (rt_scene_parse_string(&f->s, text, strlen(text), "test", NULL, &err) != RT_OK)
-        fail_msg("parse: %s", err.message);
+    test_fixture_parse(f, text);
     add_env(&f->s, 64, 32, sky, sun, 40, 8);
-    assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
-    assert_int_equal(rt_render_state_prepare(&f->rs, &f->s, &f->tree, table ? RT_PREPARE_LIGHT_TABLE : 0, &err),
-                     RT_OK);
-    rt_trace_ctx_init(&f->ctx, &f->rs);
+    test_fixture_build(f, table ? RT_PREPARE_LIGHT_TABLE : 0);
 }
 
 /* The environment's sampling density integrates to 1 over the sphere. */
