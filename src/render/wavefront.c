@@ -207,7 +207,7 @@ static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_acti
             }
             rt_hit h = {wf->ht[i], wf->hu[i], wf->hv[i], wf->hprim[i]};
             rt_surface *sf = &wf->sf[i];
-            rt_surface_at(ctx, &wf->ps[i].r, &h, sf);
+            rt_surface_at_shading(ctx, &wf->ps[i].r, &h, sf);
             float coverage;
             bool cut = rt_surface_cut_away(ctx, sf, &coverage);
             if (!cut && coverage < 1.0f && rt_rng_float(&wf->rng[i]) >= coverage)
