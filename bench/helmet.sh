@@ -8,7 +8,9 @@
 # build/bench/helmet-sun.txt (the model from SHARED, that sky, a directional
 # sun, integrator path), then renders it RUNS times with each binary in
 # turn and prints, per run, the load average, the render time, the rays
-# traced (camera, bounce and shadow rays) and rays per second of render time.
+# traced (camera, bounce and shadow rays), rays per second of render time,
+# and the CPU seconds of the whole run (loading and the kd-tree included):
+# on a shared machine the CPU figure is the steadier one.
 # Environment: SHARED (default ../shared), RUNS (3), THREADS (1), RES (128), SPP (16).
 set -eu
 SHARED=${SHARED:-../shared}
@@ -65,11 +67,18 @@ resolution $RES $RES
 samples $SPP
 SCENE
 echo "bench-helmet: $dir/helmet-sun.txt, ${RES}x$RES, $SPP spp, $THREADS thread(s), $RUNS interleaved runs"
-printf '%-28s %4s %6s %9s %10s %9s\n' binary run load render_s rays Mrays/s
+printf '%-28s %4s %6s %9s %10s %9s %7s\n' binary run load render_s rays Mrays/s cpu_s
+cpu_file="$dir/times.txt"
+cpu_now() { # user + system CPU seconds of this shell's children so far (`times` run here, not in a subshell)
+    times > "$cpu_file"
+    cpu=$(tail -n 1 "$cpu_file" | awk '{ s = 0; for (i = 1; i <= NF; i++) { split($i, a, "m"); s += a[1] * 60 + a[2] } print s }')
+}
 run=1
 while [ "$run" -le "$RUNS" ]; do
     for bin in "$@"; do
         load=$(cut -d' ' -f1 /proc/loadavg)
+        cpu_now
+        c0=$cpu
         line=$("$bin" -v -t "$THREADS" -o "$dir/helmet-sun.pfm" "$dir/helmet-sun.txt" 2>&1 | grep 'rt: render:' || true)
         if [ -z "$line" ]; then
             echo "bench-helmet: $bin failed" >&2
@@ -77,8 +86,10 @@ while [ "$run" -le "$RUNS" ]; do
         fi
         secs=$(echo "$line" | sed -n 's/.*render: \([0-9.]*\) s on.*/\1/p')
         rays=$(echo "$line" | sed -n 's/.* camera rays, \([0-9]*\) rays,.*/\1/p')
-        printf '%-28s %4d %6s %9s %10s %9.3f\n' "$bin" "$run" "$load" "$secs" "$rays" \
-            "$(echo "$rays / $secs / 1000000" | bc -l)"
+        cpu_now
+        c1=$cpu
+        printf '%-28s %4d %6s %9s %10s %9.3f %7.2f\n' "$bin" "$run" "$load" "$secs" "$rays" \
+            "$(echo "$rays / $secs / 1000000" | bc -l)" "$(echo "$c1 - $c0" | bc -l)"
     done
     run=$((run + 1))
 done
