@@ -9,6 +9,7 @@
 #   make denoiser     Intel Open Image Denoise for --denoise: the pyoidn wheel in build/oidn-venv
 #   make bench-render rt's path tracer against Mitsuba 3 (sets it up in build/mitsuba-venv)
 #   make bench-denoise --denoise at 4/16/64 spp against raw 256 and 1024 spp
+#   make bench-helmet  path tracer rays/s on DamagedHelmet under a sky and a sun (RT_BINS: several builds)
 #   make install      rt, the library and its headers, and a pkg-config file
 #                     (PREFIX=/usr/local, DESTDIR for staging); make test-install checks it
 #   make test-slurm   the Slurm launcher (examples/slurm) on a real Slurm started here (root)
@@ -58,7 +59,7 @@ DEPS_OK  := $(BUILD)/.deps-ok
 
 
 .PHONY: test-slurm test-kubernetes test-parallel test-launchers
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build bench-render bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build bench-render bench-helmet bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -170,6 +171,11 @@ bench-compare: bench/rtbench
 RT_BINS ?= ./$(RT)
 bench-render: $(RT)
 	@SHARED=$(SHARED) sh bench/render.sh $(RT_BINS)
+
+# The path tracer's rays per second, shading included, on DamagedHelmet under an environment map and
+# a sun (bench/helmet.sh; RUNS, THREADS, RES, SPP); RT_BINS="./rt other/rt" runs builds interleaved.
+bench-helmet: $(RT)
+	@SHARED=$(SHARED) sh bench/helmet.sh $(RT_BINS)
 
 # --denoise on the shared Cornell box: 4/16/64 spp denoised against raw 256 and 1024 spp (docs/hdr.md).
 bench-denoise: $(RT) denoiser
