@@ -805,7 +805,7 @@ static void test_errors_syntax(void **state)
         rt_scene_free(&s);
     }
     expect_error("camera position 0 0 5 look_at 0 0 0 zoom 3\n", RT_ERR_PARSE, "1:37",
-                 "expected a camera key (position|look_at|up|fov|aperture|focus), got 'zoom'");
+                 "expected a camera key (position|look_at|up|fov|aperture|focus|shutter), got 'zoom'");
     expect_error("light laser 0 0 0\n", RT_ERR_PARSE, "1:7",
                  "expected a light kind (point|directional|spot|area), got 'laser'");
     expect_error("light point 0 0 0 1 1 1\n", RT_ERR_PARSE, "1:24",
