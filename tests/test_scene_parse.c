@@ -552,6 +552,11 @@ static void test_camera_values(void **state)
     assert_float_equal(s.camera.vfov_deg, 30, 0);
     assert_float_equal(s.camera.aperture, 0.1, 1e-7);
     assert_float_equal(s.camera.focus_distance, 7.5, 0);
+    assert_true(s.camera.shutter_open == 0 && s.camera.shutter_close == 0); /* no motion blur */
+    rt_scene_free(&s);
+    expect_ok("camera position 0 0 5 look_at 0 0 0 shutter -0.01 0.02\n", &s);
+    assert_float_equal(s.camera.shutter_open, -0.01, 1e-9);
+    assert_float_equal(s.camera.shutter_close, 0.02, 1e-9);
     rt_scene_free(&s);
 
     /* up, fov, aperture and focus have defaults */
