@@ -475,6 +475,11 @@ static void test_motion_blur(void **state)
     RUN_OK("-q", "--part", "1/2", "--spp-range", "100:256", "-o", in_dir("bp1b.exr"), in_dir("blur.txt"));
     RUN_OK("merge", in_dir("bp0.exr"), in_dir("bp1a.exr"), in_dir("bp1b.exr"), "-o", in_dir("bm.pfm"));
     assert_same_bytes(in_dir("bm.pfm"), in_dir("blur.pfm"));
+    /* stopped between slices (a slice is one pass), kept as a part, resumed: the same bytes */
+    RUN_OK("-q", "--time-limit", "0.000001", "--part-out", in_dir("bstop.exr"), "-o", in_dir("bstop.pfm"),
+           in_dir("blur.txt"));
+    RUN_OK("-q", "--resume", in_dir("bstop.exr"), "-o", in_dir("bres.pfm"), in_dir("blur.txt"));
+    assert_same_bytes(in_dir("bres.pfm"), in_dir("blur.pfm"));
     /* a part of another shutter is of another render */
     write_motion_scene("blur2.txt", "shutter 0 0.5", "motion_steps 16", "");
     RUN_OK("-q", "--part", "1/2", "-o", in_dir("bp1x.exr"), in_dir("blur2.txt"));

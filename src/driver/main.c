@@ -576,6 +576,13 @@ static rt_result render_slices(const rt_scene *scene, const rt_kdtree *tree, con
         memset(&st, 0, sizeof st);
         ro->sample_begin = b;
         ro->sample_end = e;
+        /* tiles would leave a stopped slice with some pixels further on than
+         * others, which the sums of a part (or --resume) cannot say: a slice
+         * is rendered in passes (the same bytes), one pass of all its
+         * samples where tiles were asked for */
+        int pass = a->pass_samples ? a->pass_samples : rt_integrator_info_of(scene->settings.integrator)->pass_samples;
+        if (pass <= 0)
+            ro->pass_samples = e - b;
         if (a->time_limit > 0.0) { /* what is left of it */
             ro->time_limit = a->time_limit - (rt_now_seconds() - t0);
             if (ro->time_limit <= 0.0)
@@ -600,7 +607,10 @@ static rt_result render_slices(const rt_scene *scene, const rt_kdtree *tree, con
         rs->time_limited = st.time_limited;
         rs->partial = st.partial && done_to == pj->s_begin; /* nothing whole yet */
         done_to = reached;
-        if (r == RT_OK && st.time_limited)
+        if (r == RT_OK && !st.time_limited && a->time_limit > 0.0 && k + 1 < slices &&
+            rt_now_seconds() - t0 >= a->time_limit) /* a slice is a pass: stop after the one that crossed it */
+            rs->time_limited = true;
+        if (r == RT_OK && rs->time_limited)
             break;
     }
     rs->samples_done = done_to - pj->s_begin;
