@@ -498,6 +498,20 @@ static int write_result(const args *a, const rt_settings *set, const part_job *p
     return status;
 }
 
+/* prepare() for the same input at another time (a motion slice): its
+ * warnings were the first load's, so they are not said again (-v keeps
+ * its lines). */
+static rt_result prepare_again(rt_scene *scene, const args *a, char *output, size_t size, bool *animated,
+                               rt_error *err)
+{
+    rt_log_level level = rt_log_get_level();
+    if (level == RT_LOG_NORMAL)
+        rt_log_set_level(RT_LOG_QUIET);
+    rt_result r = prepare(scene, a, output, size, animated, err);
+    rt_log_set_level(level);
+    return r;
+}
+
 /* A motion slice's scene starts with slice 0's decoded images, shared (the
  * loaders find an image by its name before decoding it, so the slice's
  * textures point at the same images, at the same indices): a slice costs
@@ -560,7 +574,7 @@ static rt_result render_slices(const rt_scene *scene, const rt_kdtree *tree, con
                 r = rt_fail(err, RT_ERR_NOMEM, "out of memory for the images of motion slice %d", k + 1);
                 break;
             }
-            if ((r = prepare(&sk, &ak, out, sizeof out, &animated, err)) != RT_OK) {
+            if ((r = prepare_again(&sk, &ak, out, sizeof out, &animated, err)) != RT_OK) {
                 free_slice(&sk, scene->image_count);
                 break;
             }
@@ -847,7 +861,7 @@ static int render_one(rt_scene *scene, const args *a, double t_start)
         rt_scene s0; /* loaded again at slice 0's time, keeping the decoded images */
         rt_scene_init(&s0);
         size_t n = scene->image_count;
-        if (!lend_images(&s0, scene) || prepare(&s0, &a0, output, sizeof output, &animated, &err) != RT_OK) {
+        if (!lend_images(&s0, scene) || prepare_again(&s0, &a0, output, sizeof output, &animated, &err) != RT_OK) {
             if (s0.image_count < n)
                 rt_fail(&err, RT_ERR_NOMEM, "out of memory for the images of motion slice 1");
             free_slice(&s0, n);
