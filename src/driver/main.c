@@ -870,8 +870,12 @@ static int render_one(rt_scene *scene, const args *a, double t_start)
             progress_view_free(&view);
             return 2;
         }
-        free_slice(scene, n); /* the images are s0's now */
-        *scene = s0;
+        if (animated) {
+            free_slice(scene, n); /* the images are s0's now */
+            *scene = s0;
+        } else { /* nothing follows the time: the scene as first loaded, unblurred */
+            free_slice(&s0, n);
+        }
         if (animated && slices > 1 && (a->aovs & ((1u << AOV_VARIANCE) | (1u << AOV_SPP)))) {
             progress_clear(&view);
             fprintf(stderr, "rt: --aov variance and spp are not kept over the slices of a motion-blurred render "
