@@ -100,7 +100,7 @@ $(BUILD)/librt.a: $(LIB_OBJ)
 $(RT): $(DRV_OBJ) $(BUILD)/librt.a
 	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS) $(SDL2_LIBS)
 
-$(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
+$(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h tests/test_fixture.h tests/test_bsdf_check.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests -o $@ $< $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
@@ -183,11 +183,15 @@ bench-build: bench/buildscale
 	@./bench/buildscale $$(sed -n 's#^| [A-Za-z0-9_]* | `\([^`]*\)`.*#$(SHARED)/\1#p' $(SHARED)/bench/MANIFEST.md 2>/dev/null)
 
 # Regenerates the committed GGX albedo tables of the energy compensation
-# (src/render/ggx_albedo_table.c) from tools/ggx_albedo.c; about 15 s of CPU.
+# (src/render/ggx_albedo_table.c for conductors,
+# src/render/ggx_albedo_dielectric_table.c for rough glass) from
+# tools/ggx_albedo.c; about 15 s of CPU each.
 ggx-albedo-table:
 	@mkdir -p $(BUILD)
 	$(CC) -std=c11 -O2 -D_DEFAULT_SOURCE -o $(BUILD)/ggx_albedo tools/ggx_albedo.c -lm
 	$(BUILD)/ggx_albedo > src/render/ggx_albedo_table.c.tmp && mv src/render/ggx_albedo_table.c.tmp src/render/ggx_albedo_table.c
+	$(BUILD)/ggx_albedo dielectric > src/render/ggx_albedo_dielectric_table.c.tmp && \
+	    mv src/render/ggx_albedo_dielectric_table.c.tmp src/render/ggx_albedo_dielectric_table.c
 
 SCENES := $(wildcard scenes/*.txt)
 scenes: $(RT)

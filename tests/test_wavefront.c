@@ -15,6 +15,7 @@
  *     image means within 1.5% and RMSE within the scalar's own noise.
  */
 #include "test_util.h"
+#include "test_fixture.h"
 #include "test_scenes.h"
 
 #include <math.h>
@@ -132,23 +133,9 @@ static void test_batch_traversal_matches_single_rays(void **state)
 static const char *every_material =
     "integrator path\nresolution 24 16\nsamples 6\nbackground 0.2 0.3 0.4\n" TEST_EVERY_MATERIAL_SCENE;
 
-typedef struct fixture {
-    rt_scene s;
-    rt_kdtree tree;
-    rt_render_state rs;
-    rt_trace_ctx ctx;
-} fixture;
+typedef test_fixture fixture; /* test_fixture.h */
 
-static void load_text(fixture *f, const char *text)
-{
-    rt_error err;
-    rt_scene_init(&f->s);
-    if (rt_scene_parse_string(&f->s, text, strlen(text), "test", NULL, &err) != RT_OK)
-        fail_msg("parse: %s", err.message);
-    assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
-    assert_int_equal(rt_render_state_prepare(&f->rs, &f->s, &f->tree, RT_PREPARE_LIGHT_TABLE, &err), RT_OK);
-    rt_trace_ctx_init(&f->ctx, &f->rs);
-}
+static void load_text(fixture *f, const char *text) { test_fixture_load(f, text, RT_PREPARE_LIGHT_TABLE); }
 
 static void load_cornell(fixture *f, int res)
 {
@@ -162,12 +149,7 @@ static void load_cornell(fixture *f, int res)
     f->s.settings.width = f->s.settings.height = res;
 }
 
-static void unload(fixture *f)
-{
-    rt_render_state_free(&f->rs);
-    rt_kdtree_free(&f->tree);
-    rt_scene_free(&f->s);
-}
+static void unload(fixture *f) { test_fixture_free(f); }
 
 /* Every sample of rows [y0, y1) of the image through the wavefront with
  * the given batch size and pixels per work unit, against rt_radiance_path. */

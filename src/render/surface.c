@@ -168,6 +168,7 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
 
     rt_vec3 tt = orthonormal_tangent(n, t);
     rt_vec3 bb = rt_scale(rt_cross(n, tt), w);
+    rt_vec3 n_unmapped = n;
     /* normal map, in the frame of the front face */
     const rt_material *m = &s->materials[sf->material];
     if (m->normal_tex.texture != RT_NONE) {
@@ -190,11 +191,13 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
     if (!sf->front) {
         ng = rt_neg(ng);
         n = rt_neg(n);
+        n_unmapped = rt_neg(n_unmapped);
         tt = rt_neg(tt);
         bb = rt_neg(bb);
     }
     sf->ng = ng;
     sf->n = n;
+    sf->n_unmapped = n_unmapped;
     sf->t = tt;
     sf->b = bb;
 }

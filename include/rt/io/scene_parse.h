@@ -46,6 +46,10 @@ typedef struct rt_scene_parse_options {
 rt_result rt_scene_parse_string_with(rt_scene *s, const char *text, size_t len, const char *name, const char *dir,
                                      const rt_scene_parse_options *options, rt_error *err);
 
+/* The material keys of the format (`color`, `clearcoat`, ...), by index:
+ * NULL past the last (for the docs test and tools). */
+const char *rt_scene_material_key(size_t i);
+
 /* The built-in default scene (a Cornell box with a sphere), in the same format. */
 extern const char rt_default_scene_text[];
 

@@ -28,6 +28,9 @@ typedef struct rt_surface {
     rt_vec3 p;            /* hit point */
     rt_vec3 ng;           /* geometric normal facing the ray */
     rt_vec3 n;            /* shading normal, same side as ng */
+    rt_vec3 n_unmapped;   /* the shading normal before the material's normal map (the
+                           * interpolated one), same side: a clearcoat's normal when
+                           * the coat has no normal map of its own */
     rt_vec3 t, b;         /* shading tangent frame (t, b, n); b = cross(n, t) * sign */
     rt_vec2 uv0, uv1;     /* rt convention: (0,0) top-left of a texture */
     rt_vec4 vertex_color;
