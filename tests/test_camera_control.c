@@ -199,6 +199,10 @@ static void test_camera_line_round_trip(void **state)
         }
         if (i % 7 == 0)
             c.up = rt_v3(0.0f, -0.0f, 1.0f);
+        if (i % 5 == 0) { /* an open shutter: motion blur */
+            c.shutter_open = uniform(&st, -0.1f, 0.0f);
+            c.shutter_close = uniform(&st, 0.001f, 0.1f);
+        }
         if (!(rt_length(rt_cross(rt_normalize(rt_sub(c.look_at, c.position)), rt_normalize(c.up))) > 1e-6f) ||
             !(rt_length2(rt_sub(c.look_at, c.position)) > 0.0f))
             continue;
@@ -219,6 +223,8 @@ static void test_camera_line_round_trip(void **state)
         assert_memory_equal(&s.camera.vfov_deg, &c.vfov_deg, sizeof(float));
         assert_memory_equal(&s.camera.aperture, &c.aperture, sizeof(float));
         assert_memory_equal(&s.camera.focus_distance, &c.focus_distance, sizeof(float));
+        assert_memory_equal(&s.camera.shutter_open, &c.shutter_open, sizeof(float));
+        assert_memory_equal(&s.camera.shutter_close, &c.shutter_close, sizeof(float));
         rt_scene_free(&s);
     }
     /* a short buffer: the length it would need, a cut (terminated) string */

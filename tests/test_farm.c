@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 
 #include "rt/io/framebuffer.h"
+#include "rt/io/image_read.h"
 
 static char dir[256];
 static char err_text[16384];
@@ -307,8 +308,10 @@ static void test_aov_parts(void **state)
     assert_int_equal(access(in_dir("x.pfm"), F_OK), -1);
 }
 
-/* --frames A:B: one file a frame, named from the pattern; no animation
- * yet, so each is the single render; bad patterns are refused up front. */
+/* --frames A:B: one file a frame, named from the pattern; a scene without
+ * animation gives the single render each frame; an animated glTF, given
+ * directly or on a scene file's model line, is posed at each frame's time;
+ * bad patterns are refused up front. */
 static void test_frames(void **state)
 {
     (void)state;
@@ -349,10 +352,161 @@ static void test_frames(void **state)
         RUN_OK("-q", "-r", "48x36", "-s", "2", "--frames", "1:2", "--part", "1/2", "-o", pattern, model);
         assert_int_equal(RUN("merge", in_dir("tp.0.exr"), in_dir("tp.1.exr"), "-o", in_dir("tp.png")), 2);
         assert_non_null(strstr(err_text, "not a part of the same render"));
+        /* a scene file around an animated model: its model line is posed at each frame's time */
+        char text[8000], fox[6200];
+        const char *rel = test_shared_path("assets/gltf/Fox/glTF-Binary/Fox.glb"); /* the scene is elsewhere */
+        char cwd[2048] = "";
+        assert_true(rel[0] == '/' || getcwd(cwd, sizeof cwd) != NULL);
+        snprintf(fox, sizeof fox, "%s%s%s", rel[0] == '/' ? "" : cwd, rel[0] == '/' ? "" : "/", rel);
+        snprintf(text, sizeof text,
+                 "resolution 48 36\nsamples 2\ncamera position 90 60 200 look_at 0 35 0 up 0 1 0 fov 40\n"
+                 "light directional -0.4 -1 -0.6 1 1 1 2\nmodel \"%s\" animation Run\n",
+                 fox);
+        FILE *f = fopen(in_dir("fox.txt"), "wb");
+        assert_non_null(f);
+        fputs(text, f);
+        fclose(f);
+        snprintf(pattern, sizeof pattern, "%s/fox.%%d.png", dir);
+        RUN_OK("-q", "--frames", "0:3", "--fps", "4", "-o", pattern, in_dir("fox.txt"));
+        RUN_OK("-q", "--frame-time", "0.5", "-o", in_dir("fox-t.png"), in_dir("fox.txt"));
+        assert_same_bytes(in_dir("fox.2.png"), in_dir("fox-t.png"));
+        f0 = slurp(in_dir("fox.0.png"), &n0), f2 = slurp(in_dir("fox.2.png"), &n2);
+        assert_true(n0 != n2 || memcmp(f0, f2, n0) != 0); /* the fox ran */
+        free(f0);
+        free(f2);
+        snprintf(pattern, sizeof pattern, "%s/foxp.%%d.exr", dir);
+        RUN_OK("-q", "--frames", "0:2", "--part", "0/2", "-o", pattern, in_dir("fox.txt"));
+        RUN_OK("-q", "--frames", "1:2", "--part", "1/2", "-o", pattern, in_dir("fox.txt"));
+        assert_int_equal(RUN("merge", in_dir("foxp.0.exr"), in_dir("foxp.1.exr"), "-o", in_dir("foxp.png")), 2);
+        assert_non_null(strstr(err_text, "frame_time"));
     }
     assert_int_equal(RUN("-q", "--frames", "0:2", "--frame-time", "1", "-o", pattern, scene), 2);
     assert_int_equal(RUN("-q", "--frames", "2:2", "-o", pattern, scene), 2);
     assert_int_equal(RUN("-q", "--frames", "0:2", "--fps", "0", "-o", pattern, scene), 2);
+}
+
+/* A scene file (name in dir) around the moving quad, with `camera_extra`
+ * on its camera line, `extra` lines after it and `model_extra` on the
+ * model line. */
+static void write_motion_scene(const char *name, const char *camera_extra, const char *extra, const char *model_extra)
+{
+    char text[2048];
+    /* 16 x 4 pixels over x in [-8, 8] at z = 0: tan(fov / 2) = 2 / 10 */
+    snprintf(text, sizeof text,
+             "resolution 16 4\nsamples 256\nintegrator direct\nbackground 1 1 1\n"
+             "camera position 0 0 10 look_at 0 0 0 up 0 1 0 fov 22.6198649 %s\n%s\nmodel quad.gltf %s\n",
+             camera_extra, extra, model_extra);
+    test_write_file(in_dir(name), text, strlen(text));
+}
+
+/* The mean of pixel column x of a float image. */
+static double column_mean(const char *path, int x)
+{
+    rt_framebuffer fb;
+    rt_error err;
+    assert_int_equal(rt_image_read(path, &fb, &err), RT_OK);
+    double sum = 0;
+    int h = fb.height;
+    for (int y = 0; y < h; y++)
+        sum += fb.rgb[3 * ((size_t)y * (size_t)fb.width + (size_t)x)];
+    rt_framebuffer_free(&fb);
+    return sum / h;
+}
+
+/* Motion blur (docs/gltf.md): a black quad 2 wide, as tall as the image,
+ * moves at 8 units/s from x = -4 to 4 during the shutter [0, 1] before a
+ * white background. Every point of the pixel column x in [0, 1] is covered
+ * for 2 / 8 = 1/4 of the shutter, so the column's value is 1 - 1/4: the
+ * coverage fraction equals the time overlap (16 slices put exactly 4
+ * midpoints in any quarter of the shutter; measured: 0.75 to float
+ * precision), and every other column its own overlap integrated over the
+ * column (1 - 1/16 at x in [-4, -3], ...). Columns the quad never reaches
+ * stay 1 exactly. K = 1 is the
+ * pose at the shutter's midpoint; the image is the same for any thread,
+ * tile, pass and part split; a pose fixed by `time` is not sliced. */
+static void test_motion_blur(void **state)
+{
+    (void)state;
+    /* the quad: two triangles facing +z; its translation over [0, 1] */
+    const float data[] = {0, -10, 0, 2, -10, 0, 2, 10, 0, 0, -10, 0, 2, 10, 0, 0, 10, 0, 0, 1, -4, 0, 0, 4, 0, 0};
+    char *enc = test_base64(data, sizeof data);
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,"
+             "\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":72},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":8},"
+             "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":24}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\","
+             "\"min\":[0,-10,0],\"max\":[2,10,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":2,"
+             "\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},{\"bufferView\":2,\"componentType\":5126,\"count\":2,"
+             "\"type\":\"VEC3\"}],"
+             "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"metallicFactor\":0}}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+             "\"animations\":[{\"samplers\":[{\"input\":1,\"output\":2}],"
+             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]}",
+             sizeof data, enc);
+    free(enc);
+    test_write_file(in_dir("quad.gltf"), json, strlen(json));
+    write_motion_scene("blur.txt", "shutter 0 1", "motion_steps 16", "");
+    RUN_OK("-q", "-o", in_dir("blur.pfm"), in_dir("blur.txt"));
+    for (int x = 0; x < 16; x++) { /* every column against its time overlap, integrated over the column */
+        double want = 0;
+        for (int i = 0; i < 10000; i++) {
+            double px = x - 8 + (i + 0.5) / 10000, t0 = (px + 2) / 8, t1 = (px + 4) / 8; /* covered in [t0, t1] */
+            t0 = t0 > 0 ? t0 : 0;
+            t1 = t1 < 1 ? t1 : 1;
+            want += t1 > t0 ? (t1 - t0) / 10000 : 0;
+        }
+        double got = column_mean(in_dir("blur.pfm"), x);
+        if (fabs(got - (1 - want)) > 0.01)
+            fail_msg("column %d: %g, expected 1 - %g", x, got, want);
+    }
+    assert_true(fabs(column_mean(in_dir("blur.pfm"), 8) - 0.75) < 1e-3); /* a quarter of the shutter */
+    assert_true(column_mean(in_dir("blur.pfm"), 0) == 1.0);
+    assert_true(column_mean(in_dir("blur.pfm"), 15) == 1.0);
+    /* any split of the work: the same bytes */
+    RUN_OK("-q", "-t", "1", "--passes", "0", "--tile", "3", "-o", in_dir("blur-t1.pfm"), in_dir("blur.txt"));
+    assert_same_bytes(in_dir("blur-t1.pfm"), in_dir("blur.pfm"));
+    RUN_OK("-q", "-t", "2", "--passes", "5", "-o", in_dir("blur-p5.pfm"), in_dir("blur.txt"));
+    assert_same_bytes(in_dir("blur-p5.pfm"), in_dir("blur.pfm"));
+    RUN_OK("-q", "--part", "0/2", "-o", in_dir("bp0.exr"), in_dir("blur.txt"));
+    RUN_OK("-q", "--part", "1/2", "--spp-range", "0:100", "-o", in_dir("bp1a.exr"), in_dir("blur.txt"));
+    RUN_OK("-q", "--part", "1/2", "--spp-range", "100:256", "-o", in_dir("bp1b.exr"), in_dir("blur.txt"));
+    RUN_OK("merge", in_dir("bp0.exr"), in_dir("bp1a.exr"), in_dir("bp1b.exr"), "-o", in_dir("bm.pfm"));
+    assert_same_bytes(in_dir("bm.pfm"), in_dir("blur.pfm"));
+    /* stopped between slices (a slice is one pass), kept as a part, resumed: the same bytes */
+    RUN_OK("-q", "--time-limit", "0.000001", "--part-out", in_dir("bstop.exr"), "-o", in_dir("bstop.pfm"),
+           in_dir("blur.txt"));
+    RUN_OK("-q", "--resume", in_dir("bstop.exr"), "-o", in_dir("bres.pfm"), in_dir("blur.txt"));
+    assert_same_bytes(in_dir("bres.pfm"), in_dir("blur.pfm"));
+    /* a part of another shutter is of another render */
+    write_motion_scene("blur2.txt", "shutter 0 0.5", "motion_steps 16", "");
+    RUN_OK("-q", "--part", "1/2", "-o", in_dir("bp1x.exr"), in_dir("blur2.txt"));
+    assert_int_equal(RUN("merge", in_dir("bp0.exr"), in_dir("bp1x.exr"), "-o", in_dir("x.pfm")), 2);
+    /* K = 1: the pose at the shutter's midpoint, as an unblurred render at that time */
+    write_motion_scene("k1.txt", "shutter 0.25 0.75", "motion_steps 1", "");
+    write_motion_scene("still.txt", "", "", "");
+    RUN_OK("-q", "-o", in_dir("k1.pfm"), in_dir("k1.txt"));
+    RUN_OK("-q", "--frame-time", "0.5", "-o", in_dir("mid.pfm"), in_dir("still.txt"));
+    assert_same_bytes(in_dir("k1.pfm"), in_dir("mid.pfm"));
+    assert_true(column_mean(in_dir("mid.pfm"), 8) == 0.0); /* the quad over x in [0, 2] at t = 0.5 */
+    RUN_OK("-q", "--frame-time", "0.25", "-o", in_dir("open.pfm"), in_dir("still.txt"));
+    assert_true(column_mean(in_dir("open.pfm"), 8) == 1.0); /* and over [-2, 0] at 0.25 */
+    RUN_OK("-q", "--frame-time", "0.25", "-o", in_dir("k1b.pfm"), in_dir("k1.txt")); /* the frame time shifts it */
+    assert_true(column_mean(in_dir("k1b.pfm"), 10) == 0.0 && column_mean(in_dir("k1b.pfm"), 8) == 1.0); /* [2, 4] */
+    /* a pose fixed by `time` does not follow the shutter: no slices, the unblurred image */
+    write_motion_scene("fixed.txt", "shutter 0 1", "motion_steps 16", "time 0.5");
+    write_motion_scene("fixed0.txt", "", "", "time 0.5");
+    RUN_OK("-v", "-o", in_dir("fixed.pfm"), in_dir("fixed.txt"));
+    assert_null(strstr(err_text, "motion: slice"));
+    RUN_OK("-q", "-o", in_dir("fixed0.pfm"), in_dir("fixed0.txt"));
+    assert_same_bytes(in_dir("fixed.pfm"), in_dir("fixed0.pfm"));
+    /* a shutter that closes before it opens */
+    write_motion_scene("bad.txt", "shutter 1 0", "", "");
+    assert_int_equal(RUN("-q", "-o", in_dir("x.pfm"), in_dir("bad.txt")), 2);
+    assert_non_null(strstr(err_text, "bad.txt:5:"));
+    assert_non_null(strstr(err_text, "closes (0 s) before it opens (1 s)"));
 }
 
 /* The samples [0, k] a sidecar says its part holds. */
@@ -601,6 +755,7 @@ int main(void)
         cmocka_unit_test(test_merge_refusals),
         cmocka_unit_test(test_aov_parts),
         cmocka_unit_test(test_frames),
+        cmocka_unit_test(test_motion_blur),
         cmocka_unit_test(test_part_bands),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -2,13 +2,17 @@
  * keyframe curves against closed forms, and small files written here (a
  * triangle translated, rotated, skinned and morphed) whose posed vertices
  * are known exactly; broken animation data refused with a clear message;
- * the shared Fox (skinned, 3 animations) posed at two times. */
+ * the shared Fox (skinned, 3 animations) posed at two times; scene-file
+ * `model` lines posed by the frame time and their own time, time_offset
+ * and animation options. */
 #include "test_util.h"
 
 #include <math.h>
 
 #include "rt/io/gltf.h"
 #include "rt/io/gltf_animation.h"
+#include "rt/io/load.h"
+#include "rt/io/scene_parse.h"
 #include "rt/scene/scene.h"
 
 #define PI_F 3.14159265358979f
@@ -305,11 +309,114 @@ static void test_fox(void **state)
     assert_true(ha > 0.7f * hr && ha < 1.3f * hr);
 }
 
+/* Vertex 1 of the scene text `text` (one model line) parsed with the
+ * frame time t (posed = false: none) and the driver's animation anim;
+ * returns the parse result. */
+static rt_result scene_vertex(const char *text, bool posed, float t, int anim, float *x, rt_error *err)
+{
+    rt_scene s;
+    rt_scene_init(&s);
+    memset(err, 0, sizeof *err);
+    rt_scene_parse_options o = {.use_time = posed, .time = t, .animation = anim};
+    char name[128];
+    snprintf(name, sizeof name, "%s/scene.txt", dir);
+    rt_result r = rt_scene_parse_string_with(&s, text, strlen(text), name, NULL, &o, err);
+    *x = r == RT_OK && s.vertices.count > 1 ? s.vertices.position[1].x : -99.0f;
+    rt_scene_free(&s);
+    return r;
+}
+
+/* `model` lines of a scene file: the frame time poses them; `time` fixes a
+ * line's pose, `time_offset` shifts it, `animation` picks by name or index;
+ * no frame time and no option = the static pose, as before. Two animations
+ * of the triangle's translation over [0, 2]: "slide" to x + 2, "back" to x - 2. */
+static void test_scene_model_lines(void **state)
+{
+    (void)state;
+    assert_true(test_make_dir(dir, sizeof dir, "anim"));
+    const float data[] = {TRI, 0, 2, 0, 0, 0, 2, 0, 0, 0, 0, 0, -2, 0, 0};
+    write_gltf("two.gltf", data, sizeof data / sizeof *data,
+               "\"bufferViews\":[" TRI_VIEWS ",{\"buffer\":0,\"byteOffset\":44,\"byteLength\":24},"
+               "{\"buffer\":0,\"byteOffset\":68,\"byteLength\":24}],"
+               "\"accessors\":[" TRI_ACCESSORS ",{\"bufferView\":2,\"componentType\":5126,\"count\":2,"
+               "\"type\":\"VEC3\"},{\"bufferView\":3,\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"}],"
+               "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+               "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+               "\"animations\":[{\"name\":\"slide\",\"samplers\":[{\"input\":1,\"output\":2}],"
+               "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]},"
+               "{\"name\":\"back\",\"samplers\":[{\"input\":1,\"output\":3}],"
+               "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]");
+    const float still[] = {TRI};
+    write_gltf("still.gltf", still, 9,
+               "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+               "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+               "\"min\":[0,0,0],\"max\":[1,1,0]}],"
+               "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+               "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]");
+    rt_error err;
+    float x;
+    /* the frame time (and the driver's animation) pose a plain line */
+    assert_int_equal(scene_vertex("model two.gltf\n", false, 0, 0, &x, &err), RT_OK);
+    assert_float_equal(x, 1.0f, 0); /* no frame time: the static pose */
+    assert_int_equal(scene_vertex("model two.gltf\n", true, 0.5f, 0, &x, &err), RT_OK);
+    assert_float_equal(x, 1.5f, 1e-6);
+    assert_int_equal(scene_vertex("model two.gltf\n", true, 0.5f, 1, &x, &err), RT_OK);
+    assert_float_equal(x, 0.5f, 1e-6);
+    /* time fixes the pose whatever the frame; time_offset adds to it (frame time 0 without one) */
+    assert_int_equal(scene_vertex("model two.gltf time 1\n", true, 0.5f, 0, &x, &err), RT_OK);
+    assert_float_equal(x, 2.0f, 1e-6);
+    assert_int_equal(scene_vertex("model two.gltf time 1\n", false, 0, 0, &x, &err), RT_OK);
+    assert_float_equal(x, 2.0f, 1e-6);
+    assert_int_equal(scene_vertex("model two.gltf time_offset 0.25\n", true, 0.5f, 0, &x, &err), RT_OK);
+    assert_float_equal(x, 1.75f, 1e-6);
+    assert_int_equal(scene_vertex("model two.gltf time_offset 0.25\n", false, 0, 0, &x, &err), RT_OK);
+    assert_float_equal(x, 1.25f, 1e-6);
+    /* animation by name or index, over the driver's */
+    assert_int_equal(scene_vertex("model two.gltf animation back\n", true, 0.5f, 0, &x, &err), RT_OK);
+    assert_float_equal(x, 0.5f, 1e-6);
+    assert_int_equal(scene_vertex("model two.gltf animation 0 translate 1 0 0\n", true, 0.5f, 1, &x, &err), RT_OK);
+    assert_float_equal(x, 2.5f, 1e-6);
+    assert_int_equal(scene_vertex("model two.gltf animation \"slide\" time 2\n", false, 0, 1, &x, &err), RT_OK);
+    assert_float_equal(x, 3.0f, 1e-6);
+    /* the driver's animation index passes over a model without animations */
+    assert_int_equal(scene_vertex("model still.gltf\n", true, 0.5f, 1, &x, &err), RT_OK);
+    assert_float_equal(x, 1.0f, 0);
+    /* errors name the scene file, line and column */
+    assert_int_equal(scene_vertex("\nmodel two.gltf animation run\n", true, 0.5f, 0, &x, &err), RT_ERR_INVALID);
+    assert_non_null(strstr(err.message, "scene.txt:2:7: "));
+    assert_non_null(strstr(err.message, "no animation named 'run' (the file has 'slide', 'back')"));
+    assert_int_equal(scene_vertex("model two.gltf animation 2\n", true, 0.5f, 0, &x, &err), RT_ERR_INVALID);
+    assert_non_null(strstr(err.message, "animation 2 requested, the file has 2"));
+    assert_int_equal(scene_vertex("model still.gltf animation 1\n", false, 0, 0, &x, &err), RT_ERR_INVALID);
+    assert_non_null(strstr(err.message, "the file has none"));
+    assert_int_equal(scene_vertex("model two.gltf time 1 time_offset 2\n", true, 0, 0, &x, &err), RT_ERR_INVALID);
+    assert_non_null(strstr(err.message, "scene.txt:1:23: give 'time'"));
+    assert_int_equal(scene_vertex("model two.gltf time soon\n", true, 0, 0, &x, &err), RT_ERR_PARSE);
+    assert_non_null(strstr(err.message, "scene.txt:1:21: expected a number for the model's animation time"));
+    assert_int_equal(scene_vertex("model two.gltf animation -1\n", true, 0, 0, &x, &err), RT_ERR_INVALID);
+    assert_int_equal(scene_vertex("model two.gltf time_offset 1 time_offset 1\n", true, 0, 0, &x, &err),
+                     RT_ERR_INVALID);
+    assert_non_null(strstr(err.message, "'time_offset' is given twice"));
+    assert_int_equal(scene_vertex("model two.gltf animation\n", true, 0, 0, &x, &err), RT_ERR_PARSE);
+    /* rt_load passes its time to a scene file's model lines */
+    char path[128];
+    snprintf(path, sizeof path, "%s/scene.txt", dir);
+    test_write_file(path, "model two.gltf\n", 15);
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_load_options lo = {.use_time = true, .time = 1.0f};
+    assert_int_equal(rt_load(&s, path, &lo, NULL, &err), RT_OK);
+    assert_float_equal(s.vertices.position[1].x, 2.0f, 1e-6);
+    rt_scene_free(&s);
+    test_remove_dir(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_curves), cmocka_unit_test(test_node_animation), cmocka_unit_test(test_skin),
         cmocka_unit_test(test_morph),  cmocka_unit_test(test_broken_animation), cmocka_unit_test(test_fox),
+        cmocka_unit_test(test_scene_model_lines),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -590,6 +590,11 @@ static void test_camera_values(void **state)
     assert_float_equal(s.camera.vfov_deg, 30, 0);
     assert_float_equal(s.camera.aperture, 0.1, 1e-7);
     assert_float_equal(s.camera.focus_distance, 7.5, 0);
+    assert_true(s.camera.shutter_open == 0 && s.camera.shutter_close == 0); /* no motion blur */
+    rt_scene_free(&s);
+    expect_ok("camera position 0 0 5 look_at 0 0 0 shutter -0.01 0.02\n", &s);
+    assert_float_equal(s.camera.shutter_open, -0.01, 1e-9);
+    assert_float_equal(s.camera.shutter_close, 0.02, 1e-9);
     rt_scene_free(&s);
 
     /* up, fov, aperture and focus have defaults */
@@ -843,7 +848,7 @@ static void test_errors_syntax(void **state)
         rt_scene_free(&s);
     }
     expect_error("camera position 0 0 5 look_at 0 0 0 zoom 3\n", RT_ERR_PARSE, "1:37",
-                 "expected a camera key (position|look_at|up|fov|aperture|focus), got 'zoom'");
+                 "expected a camera key (position|look_at|up|fov|aperture|focus|shutter), got 'zoom'");
     expect_error("light laser 0 0 0\n", RT_ERR_PARSE, "1:7",
                  "expected a light kind (point|directional|spot|area), got 'laser'");
     expect_error("light point 0 0 0 1 1 1\n", RT_ERR_PARSE, "1:24",

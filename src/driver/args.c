@@ -109,7 +109,8 @@ static const flag flags[] = {
     {NULL, "--up", "X,Y,Z", FLAG_UP, NULL, "camera up direction"},
     {NULL, "--fov", "DEG", FLAG_FOV, NULL, "vertical field of view in degrees, between 0 and 180"},
     {NULL, "--frame-time", "SECONDS", FLAG_FRAME_TIME, NULL,
-     "pose an animated glTF at this time: its animation, skins and morph targets (default: the file's static pose)"},
+     "pose an animated glTF (given directly or on a scene's model lines) at this time: its animation, skins and "
+     "morph targets (default: the file's static pose)"},
     {NULL, "--animation", "N", FLAG_ANIMATION, NULL, "which glTF animation --frame-time plays (default 0, the first)"},
     {NULL, "--tile", "N", FLAG_TILE, NULL, "tile size in pixels (default 32)"},
     {NULL, "--preview", "SECONDS", FLAG_PREVIEW, NULL,
@@ -140,7 +141,8 @@ static const flag flags[] = {
     {NULL, "--part-out", "FILE", FLAG_PART_OUT, NULL,
      "also write the render as a part FILE (.exr or .pfm, with FILE.json), e.g. to --resume it after a stop"},
     {NULL, "--frames", "A:B", FLAG_FRAMES, NULL,
-     "render frames A .. B-1 of an animated glTF (--animation N), each on its own at time frame / fps; -o names "
+     "render frames A .. B-1 of an animated glTF or scene (--animation N), each on its own at time frame / fps; "
+     "-o names "
      "them with %04d (out.%04d.png)"},
     {NULL, "--fps", "F", FLAG_FPS, NULL, "frames per second for --frames (default 24)"},
     {"-h", "--help", NULL, FLAG_HELP, NULL, "this text"},

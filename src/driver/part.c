@@ -68,6 +68,9 @@ static void settings_text(const rt_scene *scene, char *buf, size_t size)
     line(buf, size, "camera.fov %a", (double)c->vfov_deg);
     line(buf, size, "camera.aperture %a", (double)c->aperture);
     line(buf, size, "camera.focus_distance %a", (double)c->focus_distance);
+    if (c->shutter_close > c->shutter_open) /* motion blur: the shutter and its slices change pixels */
+        line(buf, size, "camera.shutter %a %a motion_steps %d", (double)c->shutter_open, (double)c->shutter_close,
+             s->motion_steps);
 }
 
 /* Component q of the AOV a layer holds (name: albedo, normal, position, depth). */
@@ -279,6 +282,23 @@ rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, cons
     }
     memset(pj->accum.sum, 0, n * 3 * sizeof(float));
     memset(pj->accum.good, 0, n * sizeof(uint32_t));
+    return RT_OK;
+}
+
+rt_result part_job_accum(part_job *pj, bool aov, rt_error *err)
+{
+    size_t n = (size_t)(pj->region.x1 - pj->region.x0) * (size_t)(pj->region.y1 - pj->region.y0);
+    pj->accum.sum = rt_alloc(n, 3 * sizeof(float));
+    pj->accum.good = rt_alloc(n, sizeof(uint32_t));
+    pj->accum.aov_sum = aov ? rt_alloc(n, sizeof *pj->accum.aov_sum) : NULL;
+    if (!pj->accum.sum || !pj->accum.good || (aov && !pj->accum.aov_sum)) {
+        part_job_free(pj);
+        return rt_fail(err, RT_ERR_NOMEM, "out of memory for the sums of a %zu-pixel motion-blurred render", n);
+    }
+    memset(pj->accum.sum, 0, n * 3 * sizeof(float));
+    memset(pj->accum.good, 0, n * sizeof(uint32_t));
+    if (aov)
+        memset(pj->accum.aov_sum, 0, n * sizeof *pj->accum.aov_sum);
     return RT_OK;
 }
 

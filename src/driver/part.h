@@ -39,6 +39,10 @@ rt_result part_identity(const rt_scene *scene, const char *input, rt_part_info *
  * them against the scene, allocates the sums. */
 rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, const rt_kdtree *tree, rt_error *err);
 void part_job_free(part_job *pj);
+/* Zeroed sums (and AOV sums when aov) for a render that is not a part but
+ * is made of several rt_render calls into the same sums (motion blur's
+ * slices); need_accum stays false. */
+rt_result part_job_accum(part_job *pj, bool aov, rt_error *err);
 
 /* Writes the sums as a part at path covering samples [part_begin, s_begin +
  * samples_done). */

@@ -208,6 +208,7 @@ typedef struct gl_doc {
     gl_channel *channels;   size_t channel_count, channel_cap;
     gl_asampler *asamplers; size_t asampler_count, asampler_cap;
     bool posed;             /* rt_gltf_options.use_time: animation, skins and morphs applied */
+    bool animated;          /* posed by an animation that has channels */
     rt_mat4 *skin_scratch;  size_t skin_scratch_cap; /* per-vertex skin matrices of one primitive */
     size_t decoded_bytes;   /* meshopt and Draco output so far (GL_MAX_DECODED) */
     uint32_t default_scene; /* RT_NONE = absent */
@@ -2503,13 +2504,18 @@ static rt_result pose_channel(gl_doc *d, uint32_t anim, uint32_t c, float t)
     return RT_OK;
 }
 
+static rt_result pose_named(gl_doc *d, const rt_gltf_options *opt);
+static rt_result pose_animation(gl_doc *d, uint32_t a, float time);
+
 /* rt_gltf_options.use_time: the chosen animation's channels at the time,
  * before the world matrices are made. */
 static rt_result pose_nodes(gl_doc *d, const rt_gltf_options *opt)
 {
     d->posed = true;
+    if (opt->animation_name)
+        return pose_named(d, opt);
     if (d->anim_count == 0) {
-        if (opt->animation > 0)
+        if (opt->animation > 0 && !opt->animation_optional)
             return rt_fail(d->err, RT_ERR_INVALID, "%s: animation %d requested, the file has none", d->path,
                            opt->animation);
         return RT_OK; /* skins and morph weights still pose the meshes */
@@ -2517,9 +2523,39 @@ static rt_result pose_nodes(gl_doc *d, const rt_gltf_options *opt)
     if (opt->animation < 0 || (size_t)opt->animation >= d->anim_count)
         return rt_fail(d->err, RT_ERR_INVALID, "%s: animation %d requested, the file has %zu (0 to %zu)", d->path,
                        opt->animation, d->anim_count, d->anim_count - 1);
-    uint32_t a = (uint32_t)opt->animation;
+    return pose_animation(d, (uint32_t)opt->animation, opt->time);
+}
+
+/* The animation named opt->animation_name (the first of that name); an
+ * unknown name is an error listing the file's names. */
+static rt_result pose_named(gl_doc *d, const rt_gltf_options *opt)
+{
+    char names[512] = "", name[128];
+    for (uint32_t a = 0; a < d->anim_count; a++) {
+        int t = rt_json_get(&d->j, d->anims[a].tok, "name");
+        if (t < 0 || rt_json_string(&d->j, t, name, sizeof name) < 0)
+            snprintf(name, sizeof name, "(%u, unnamed)", a);
+        else if (strcmp(name, opt->animation_name) == 0)
+            return pose_animation(d, a, opt->time);
+        size_t n = strlen(names);
+        if (n + strlen(name) + 8 < sizeof names)
+            snprintf(names + n, sizeof names - n, "%s'%s'", n ? ", " : "", name);
+        else if (n + 5 < sizeof names && !strstr(names, "..."))
+            snprintf(names + n, sizeof names - n, ", ...");
+    }
+    if (d->anim_count == 0)
+        return rt_fail(d->err, RT_ERR_INVALID, "%s: animation '%s' requested, the file has none", d->path,
+                       opt->animation_name);
+    return rt_fail(d->err, RT_ERR_INVALID, "%s: no animation named '%s' (the file has %s)", d->path,
+                   opt->animation_name, names);
+}
+
+/* Every channel of animation a at time t. */
+static rt_result pose_animation(gl_doc *d, uint32_t a, float time)
+{
+    d->animated = d->anims[a].channel_count > 0;
     for (uint32_t c = 0; c < d->anims[a].channel_count; c++)
-        TRY(pose_channel(d, a, c, opt->time));
+        TRY(pose_channel(d, a, c, time));
     return RT_OK;
 }
 
@@ -2961,6 +2997,7 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
 {
     if (opt && opt->use_time)
         TRY(pose_nodes(d, opt));
+    st->animated = d->animated;
     TRY(collect_visits(d, opt));
     rt_mat4 top = opt && opt->use_transform ? opt->transform : rt_mat4_identity();
     st->nodes = d->visit_count;

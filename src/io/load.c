@@ -148,6 +148,7 @@ static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const ch
         info->meshes = gs.meshes;
         info->primitives = gs.primitives;
         info->nodes = gs.nodes;
+        info->animated = gs.animated;
         if (r == RT_OK && opt->for_render) {
             if (!add_default_lighting(s))
                 r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", name);
@@ -179,7 +180,9 @@ static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const ch
     case RT_LOAD_SCENE:
         break;
     }
-    return rt_scene_parse_string(s, bytes, size, name, NULL, err);
+    rt_scene_parse_options po = {
+        .use_time = opt->use_time, .time = opt->time, .animation = opt->animation, .animated = &info->animated};
+    return rt_scene_parse_string_with(s, bytes, size, name, NULL, &po, err);
 }
 
 /* Marks the scene, loads, adds tangents for rendering, and rolls back on

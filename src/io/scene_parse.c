@@ -83,6 +83,7 @@ typedef struct parser {
     const char *name; /* file name for messages */
     const char *dir;  /* directory relative paths resolve against ("" = the current one) */
     rt_error *err;
+    rt_scene_parse_options pose; /* the frame time model lines are posed at */
 
     /* the current statement */
     tok *toks;
@@ -697,14 +698,14 @@ static rt_result st_camera(parser *p, const tok *kw)
     rt_camera c = {0};
     c.up = rt_v3(0, 1, 0);
     c.vfov_deg = 40.0f;
-    enum { K_POSITION, K_LOOK_AT, K_UP, K_FOV, K_APERTURE, K_FOCUS, K_COUNT };
-    static const char *const keys[K_COUNT] = {"position", "look_at", "up", "fov", "aperture", "focus"};
+    enum { K_POSITION, K_LOOK_AT, K_UP, K_FOV, K_APERTURE, K_FOCUS, K_SHUTTER, K_COUNT };
+    static const char *const keys[K_COUNT] = {"position", "look_at", "up", "fov", "aperture", "focus", "shutter"};
     const tok *seen[K_COUNT] = {0};
     while (peek(p)) {
         const tok *key = peek(p);
         int k = 0;
-        if ((r = get_choice(p, "a camera key", keys, K_COUNT, "position|look_at|up|fov|aperture|focus", &k)) !=
-            RT_OK)
+        if ((r = get_choice(p, "a camera key", keys, K_COUNT, "position|look_at|up|fov|aperture|focus|shutter",
+                            &k)) != RT_OK)
             return r;
         if (seen[k])
             return perr(p, RT_ERR_INVALID, key, "camera key '%s' is given twice (first at column %d)", keys[k],
@@ -723,6 +724,15 @@ static rt_result st_camera(parser *p, const tok *kw)
             }
             break;
         case K_APERTURE: r = get_float_in(p, "the camera aperture", 0.0f, FLT_MAX, &c.aperture); break;
+        case K_SHUTTER:
+            if ((r = get_float_in(p, "the shutter's opening time in seconds", -1e7f, 1e7f, &c.shutter_open)) ==
+                    RT_OK &&
+                (r = get_float_in(p, "the shutter's closing time in seconds", -1e7f, 1e7f, &c.shutter_close)) ==
+                    RT_OK &&
+                c.shutter_close < c.shutter_open)
+                r = perr(p, RT_ERR_INVALID, prev(p), "the shutter closes (%g s) before it opens (%g s)",
+                         (double)c.shutter_close, (double)c.shutter_open);
+            break;
         default: r = get_float_in(p, "the camera focus distance", 0.0f, FLT_MAX, &c.focus_distance); break;
         }
         if (r != RT_OK)
@@ -1373,6 +1383,71 @@ static rt_result st_mesh(parser *p, const tok *kw)
     return RT_OK;
 }
 
+/* The pose options of a `model` line: `time T`, `time_offset T`,
+ * `animation NAME|INDEX`; *taken tells whether one was read. */
+typedef struct model_pose {
+    const tok *time_tok, *offset_tok, *anim_tok;
+    float time, offset;
+} model_pose;
+
+static rt_result get_pose_option(parser *p, model_pose *m, bool *taken)
+{
+    const tok *key = peek(p);
+    rt_result r = RT_OK;
+    *taken = false;
+    if (!key || key->quoted)
+        return RT_OK;
+    if (strcmp(key->s, "time") == 0 || strcmp(key->s, "time_offset") == 0) {
+        bool fixed = key->s[4] == 0;
+        const tok **slot = fixed ? &m->time_tok : &m->offset_tok;
+        if (*slot)
+            return perr(p, RT_ERR_INVALID, key, "'%s' is given twice", key->s);
+        if (fixed ? m->offset_tok != NULL : m->time_tok != NULL)
+            return perr(p, RT_ERR_INVALID, key,
+                        "give 'time' (a fixed pose) or 'time_offset' (the frame time plus an offset), not both");
+        p->pos++;
+        *slot = key;
+        r = get_float_in(p, fixed ? "the model's animation time in seconds" : "the model's time offset in seconds",
+                         -1e7f, 1e7f, fixed ? &m->time : &m->offset);
+    } else if (strcmp(key->s, "animation") == 0) {
+        if (m->anim_tok)
+            return perr(p, RT_ERR_INVALID, key, "'animation' is given twice");
+        p->pos++;
+        r = get_word(p, "an animation name or index", &m->anim_tok);
+    } else {
+        return RT_OK;
+    }
+    *taken = r == RT_OK;
+    return r;
+}
+
+/* A model line's pose into the loader's options: posed when the render
+ * has a frame time or the line gives any pose option (the frame time is
+ * then 0 when the render has none); `time` fixes the pose, `time_offset`
+ * adds to the frame time. */
+static rt_result apply_pose(parser *p, const model_pose *m, rt_gltf_options *opt)
+{
+    opt->use_time = p->pose.use_time || m->time_tok || m->offset_tok || m->anim_tok;
+    if (!opt->use_time)
+        return RT_OK;
+    float frame = p->pose.use_time ? p->pose.time : 0.0f;
+    opt->time = m->time_tok ? m->time : frame + (m->offset_tok ? m->offset : 0.0f);
+    opt->animation = p->pose.animation;
+    opt->animation_optional = true;
+    if (m->anim_tok) {
+        long long n = 0;
+        opt->animation_optional = false;
+        if (!m->anim_tok->quoted && rt_parse_int(m->anim_tok->s, &n) == RT_NUMBER_OK) {
+            if (n < 0 || n > INT_MAX)
+                return perr(p, RT_ERR_INVALID, m->anim_tok, "an animation index counts from 0, got %s", m->anim_tok->s);
+            opt->animation = (int)n;
+        } else {
+            opt->animation_name = m->anim_tok->s;
+        }
+    }
+    return RT_OK;
+}
+
 static rt_result st_model(parser *p, const tok *kw)
 {
     const tok *file = NULL;
@@ -1381,11 +1456,14 @@ static rt_result st_model(parser *p, const tok *kw)
     if ((r = get_word(p, "a glTF file (.gltf or .glb)", &file)) != RT_OK)
         return r;
     xform x = {0};
+    model_pose pose = {0};
     rt_gltf_options opt = {0};
     const tok *scene_tok = NULL;
     while (peek(p)) {
         bool taken = false;
         if ((r = get_xform_option(p, &x, "model", &taken)) != RT_OK)
+            return r;
+        if (!taken && (r = get_pose_option(p, &pose, &taken)) != RT_OK)
             return r;
         if (taken)
             continue;
@@ -1401,12 +1479,16 @@ static rt_result st_model(parser *p, const tok *kw)
             opt.scene_index = (int)n;
             opt.use_scene_index = true;
         } else {
-            return perr(p, RT_ERR_PARSE, t, "expected a model option (translate, rotate, scale, scene), got %s",
+            return perr(p, RT_ERR_PARSE, t,
+                        "expected a model option (translate, rotate, scale, scene, time, time_offset, animation), "
+                        "got %s",
                         show(t, b, sizeof b));
         }
     }
     char path[MAX_PATH_LEN];
     if ((r = resolve_path(p, file, path, sizeof path)) != RT_OK)
+        return r;
+    if ((r = apply_pose(p, &pose, &opt)) != RT_OK)
         return r;
     opt.use_transform = x.translate_tok || x.rotate_tok || x.scale_tok;
     opt.transform = opt.use_transform ? xform_matrix(&x) : rt_mat4_identity();
@@ -1416,8 +1498,10 @@ static rt_result st_model(parser *p, const tok *kw)
     r = rt_gltf_load(p->s, path, &opt, &stats, &inner);
     if (r != RT_OK)
         return loader_err(p, file, r, &inner);
-    rt_info("%s:%d: model %s: %zu triangles, %zu materials, %zu cameras", p->name, kw->line, path, stats.triangles,
-            stats.materials, stats.cameras);
+    if (stats.animated && !pose.time_tok && p->pose.animated) /* its pose follows the frame time */
+        *p->pose.animated = true;
+    rt_info("%s:%d: model %s: %zu triangles, %zu materials, %zu cameras%s", p->name, kw->line, path, stats.triangles,
+            stats.materials, stats.cameras, opt.use_time ? ", posed" : "");
     return RT_OK;
 }
 
@@ -1733,6 +1817,12 @@ static rt_result finish(parser *p)
 rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const char *name, const char *dir,
                                 rt_error *err)
 {
+    return rt_scene_parse_string_with(s, text, len, name, dir, NULL, err);
+}
+
+rt_result rt_scene_parse_string_with(rt_scene *s, const char *text, size_t len, const char *name, const char *dir,
+                                     const rt_scene_parse_options *options, rt_error *err)
+{
     if (!name)
         name = "<scene>";
     if (!s || (!text && len > 0))
@@ -1760,6 +1850,8 @@ rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const
     p.dir = dir;
     p.err = err;
     p.default_material = RT_NONE;
+    if (options)
+        p.pose = *options;
     /* a UTF-8 byte order mark is not part of the first statement */
     size_t skip = len >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0 ? 3 : 0;
     rt_scene_mark mark = rt_scene_mark_of(s); /* a failed parse leaves the scene as it was */

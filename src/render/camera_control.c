@@ -136,5 +136,8 @@ int rt_camera_format(const rt_camera *c, char *buf, size_t size)
     if (n >= 0 && c->focus_distance > 0.0f)
         n += snprintf(size > (size_t)n ? buf + n : NULL, size > (size_t)n ? size - (size_t)n : 0, " focus %.9g",
                       (double)c->focus_distance);
+    if (n >= 0 && c->shutter_close > c->shutter_open)
+        n += snprintf(size > (size_t)n ? buf + n : NULL, size > (size_t)n ? size - (size_t)n : 0,
+                      " shutter %.9g %.9g", (double)c->shutter_open, (double)c->shutter_close);
     return n;
 }

@@ -26,6 +26,9 @@ typedef struct rt_gltf_options {
     bool use_time;         /* pose at `time`: the animation's channels, skins and morph weights */
     float time;            /* seconds on the animation's clock (clamped to its keys) */
     int animation;         /* which animation, when use_time (0 = the first) */
+    const char *animation_name; /* when use_time: the animation with this `name` instead (NULL = by index) */
+    bool animation_optional; /* a file without animations ignores `animation` (the scene format's model
+                              * lines take the driver's --animation so) instead of failing */
 } rt_gltf_options;
 
 /* What one load added. meshes/primitives count instances (a mesh used by
@@ -36,6 +39,7 @@ typedef struct rt_gltf_options {
 typedef struct rt_gltf_stats {
     size_t triangles, meshes, primitives, materials, textures, images, cameras, lights, nodes;
     rt_box bounds;         /* world bounds of the vertices the loaded triangles use */
+    bool animated;         /* posed by an animation with channels: another time may give another pose */
 } rt_gltf_stats;
 
 /* Appends the chosen scene of the glTF at path (read with rt_read_file) to

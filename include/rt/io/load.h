@@ -59,6 +59,7 @@ typedef struct rt_load_info {
     size_t meshes;      /* glTF: mesh instances; a mesh file: 1; a scene file: 0 */
     size_t primitives;  /* glTF: triangle primitives (instances); a mesh file: 1; a scene file: 0 */
     size_t nodes;       /* glTF: nodes of the chosen scene; otherwise 0 */
+    bool animated;      /* posed by an animation (a glTF, or a scene file's model line): another time may differ */
 } rt_load_info;
 
 /* Appends the input at path (NULL = the built-in scene) to s. options and

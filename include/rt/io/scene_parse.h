@@ -13,6 +13,7 @@
 #ifndef RT_SCENE_PARSE_H
 #define RT_SCENE_PARSE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "rt/base/error.h"
@@ -26,6 +27,24 @@ rt_result rt_scene_parse_file(rt_scene *s, const char *path, rt_error *err);
  * the directory of `name` when dir is NULL ("" = the current directory). */
 rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const char *name, const char *dir,
                                 rt_error *err);
+
+/* The time at which `model` lines pose their glTF animations (the driver's
+ * --frame-time / --frames and --animation): zero = no frame time, so a
+ * model line without `time`, `time_offset` or `animation` loads the static
+ * pose, as before; a line's own options override (docs/scene-format.md,
+ * section 6). */
+typedef struct rt_scene_parse_options {
+    bool use_time;   /* the render has a frame time */
+    float time;      /* its seconds */
+    int animation;   /* the animation a line without `animation` plays (a model without animations ignores it) */
+    bool *animated;  /* out, may be NULL: set true when a model line's pose follows the frame time (an animation
+                      * with channels, no fixed `time`), so that another time may give another pose */
+} rt_scene_parse_options;
+
+/* rt_scene_parse_string with model lines posed at options' time (NULL =
+ * none); the reader rt_load uses. */
+rt_result rt_scene_parse_string_with(rt_scene *s, const char *text, size_t len, const char *name, const char *dir,
+                                     const rt_scene_parse_options *options, rt_error *err);
 
 /* The material keys of the format (`color`, `clearcoat`, ...), by index:
  * NULL past the last (for the docs test and tools). */

@@ -45,6 +45,7 @@ typedef struct rt_camera {
     float aperture;       /* lens diameter; 0 = pinhole */
     float focus_distance; /* 0 = distance from position to look_at */
     float aspect_ratio;   /* width / height the camera was made for (glTF); 0 = none, follow the image */
+    float shutter_open, shutter_close; /* seconds from the frame time; equal = no motion blur (the default 0 0) */
 } rt_camera;
 
 /* Which integrator renders: a line of the integrator table
@@ -67,6 +68,7 @@ typedef struct rt_settings {
     int max_bounce;       /* mirror/refraction recursion depth */
     int max_depth;        /* path: most scattering events a path may have; 0 = unlimited (Russian roulette ends paths) */
     int rr_depth;         /* path: Russian roulette from this many bounces on; 0 = adaptive (once the throughput is below 1) */
+    int motion_steps;     /* time slices over an open camera shutter: each posed, its own kd-tree (docs/gltf.md) */
     int energy_compensation; /* path: 1 = Kulla-Conty multiple-scattering lobe on rough conductors (default 0, off) */
     int diffuse_bounces;  /* levels of indirect diffuse light (whitted) */
     int diffuse_rays;     /* cosine-distributed rays per diffuse level */
