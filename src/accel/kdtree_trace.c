@@ -684,11 +684,17 @@ KD_INLINE int wide_step_avx2(const rt_kdtree_wide *w, const kd_ray *r, bool par,
     __m256i ref = _mm256_load_si256((const __m256i *)(const void *)w->child);
     __m256 ok = _mm256_andnot_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(ref, _mm256_set1_epi32(-1))),
                                  _mm256_cmp_ps(l, h, _CMP_LE_OQ));
+    /* one valid cell (or none): nothing to order or push */
+    unsigned okm = (unsigned)_mm256_movemask_ps(ok);
+    if ((okm & (okm - 1u)) == 0) {
+        if (!okm)
+            return -1;
+        out->l = l, out->h = h, out->cell = (unsigned)__builtin_ctz(okm);
+        return 0;
+    }
     /* key order, farthest first: the nearest valid cell is the top bit */
     __m256i cell = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128((long long)order));
     unsigned mask = (unsigned)_mm256_movemask_ps(_mm256_permutevar8x32_ps(ok, cell));
-    if (!mask)
-        return -1;
     unsigned lane = 31u - (unsigned)__builtin_clz(mask), rest = mask ^ (1u << lane);
     out->l = l, out->h = h, out->cell = (unsigned)(order >> (8 * lane)) & 7u;
     __m256i idx = _mm256_permutevar8x32_epi32(
