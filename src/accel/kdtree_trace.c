@@ -399,18 +399,19 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, c
     uint32_t i = 0;
 #ifdef KD_SIMD
     if (n >= KD_SIMD_MIN) {
-        uint32_t T = tree->other_base;
-        while (i < n && (p[i] & RT_KD_PAYLOAD) < T) {
-            uint32_t m = n - i < 8 ? n - i : 8;
-            while ((p[i + m - 1] & RT_KD_PAYLOAD) >= T)
-                m--;
-            if (tri8(tree, p + i, m, ray, tr, best, hit)) {
+        /* the triangles: ids below other_base, which come first (one
+         * test for a leaf of triangles only, instead of one a group) */
+        uint32_t T = tree->other_base, nt = n;
+        while (nt > 0 && (p[nt - 1] & RT_KD_PAYLOAD) >= T)
+            nt--;
+        for (; i < nt; i += 8) {
+            if (tri8(tree, p + i, nt - i < 8 ? nt - i : 8, ray, tr, best, hit)) {
                 found = true;
                 if (any)
                     return true;
             }
-            i += m;
         }
+        i = nt; /* then the spheres and quads, one by one */
     }
 #endif
     for (; i < n; i++)
