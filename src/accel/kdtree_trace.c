@@ -10,7 +10,10 @@
  * interval through it (the parent interval cut by the near or far side of
  * its three planes), all 8 at once in AVX2 lanes; the cells' front-to-back
  * order depends only on the direction signs along the 7 planes' axes, so two
- * 128-entry tables give it. The nearest valid cell is entered, the others
+ * 128-entry tables give it. A step with one valid cell (most of them:
+ * 48-73% on the benchmark sets, the descent to a surface ray's origin)
+ * enters it before any of that ordering. Otherwise the nearest valid cell
+ * is entered, the others
  * pushed farthest first (compacted by a permute from a 256-entry table);
  * a cell is popped only if it starts before the closest hit so far. The
  * nearest cell is taken through a switch on the cell number, not by indexing
@@ -55,7 +58,10 @@
  * them (always_inline, flatten), intersect.h's tests included: keep new
  * traversal helpers here, not in another file, or they lose that.
  *
- * Measured and not kept (docs/performance.md has the numbers): the 8-wide
+ * Measured and not kept (docs/performance.md has the numbers): a start
+ * shortcut that walks down from the root plane by plane in scalar code
+ * while only one cell can be entered (exact, but as costly per node as the
+ * 8-lane step, +8% instructions); the 8-wide
  * test from 2 or 5 triangles instead of 3; prefetching the cell on top of
  * the stack (-12% on DamagedHelmet diffuse); the leaf test out of line.
  */
@@ -399,18 +405,19 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, c
     uint32_t i = 0;
 #ifdef KD_SIMD
     if (n >= KD_SIMD_MIN) {
-        uint32_t T = tree->other_base;
-        while (i < n && (p[i] & RT_KD_PAYLOAD) < T) {
-            uint32_t m = n - i < 8 ? n - i : 8;
-            while ((p[i + m - 1] & RT_KD_PAYLOAD) >= T)
-                m--;
-            if (tri8(tree, p + i, m, ray, tr, best, hit)) {
+        /* the triangles: ids below other_base, which come first (one
+         * test for a leaf of triangles only, instead of one a group) */
+        uint32_t T = tree->other_base, nt = n;
+        while (nt > 0 && (p[nt - 1] & RT_KD_PAYLOAD) >= T)
+            nt--;
+        for (; i < nt; i += 8) {
+            if (tri8(tree, p + i, nt - i < 8 ? nt - i : 8, ray, tr, best, hit)) {
                 found = true;
                 if (any)
                     return true;
             }
-            i += m;
         }
+        i = nt; /* then the spheres and quads, one by one */
     }
 #endif
     for (; i < n; i++)
@@ -684,11 +691,17 @@ KD_INLINE int wide_step_avx2(const rt_kdtree_wide *w, const kd_ray *r, bool par,
     __m256i ref = _mm256_load_si256((const __m256i *)(const void *)w->child);
     __m256 ok = _mm256_andnot_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(ref, _mm256_set1_epi32(-1))),
                                  _mm256_cmp_ps(l, h, _CMP_LE_OQ));
+    /* one valid cell (or none): nothing to order or push */
+    unsigned okm = (unsigned)_mm256_movemask_ps(ok);
+    if ((okm & (okm - 1u)) == 0) {
+        if (!okm)
+            return -1;
+        out->l = l, out->h = h, out->cell = (unsigned)__builtin_ctz(okm);
+        return 0;
+    }
     /* key order, farthest first: the nearest valid cell is the top bit */
     __m256i cell = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128((long long)order));
     unsigned mask = (unsigned)_mm256_movemask_ps(_mm256_permutevar8x32_ps(ok, cell));
-    if (!mask)
-        return -1;
     unsigned lane = 31u - (unsigned)__builtin_clz(mask), rest = mask ^ (1u << lane);
     out->l = l, out->h = h, out->cell = (unsigned)(order >> (8 * lane)) & 7u;
     __m256i idx = _mm256_permutevar8x32_epi32(
