@@ -21,7 +21,8 @@
  *
  * Determinism: a path's random numbers come only from its own PCG stream,
  * seeded by (seed, pixel, sample) and carried in its lane, drawn in the order
- * rt_radiance_path draws them; shading runs the same functions; a vertex's
+ * rt_radiance_path draws them, and from the sampler (rt/render/sampler.h),
+ * a function of the sample (key and index, in the lane) and the bounce; shading runs the same functions; a vertex's
  * light samples are summed in the same order after their shadow rays come
  * back. So every radiance equals rt_radiance_path's bit for bit, for any
  * batch size, lane assignment and split of the work (tests/test_wavefront.c).
@@ -65,6 +66,7 @@ struct rt_wavefront {
     int32_t *bounces, *layers, *skips;
     rt_medium_stack *media; /* the dielectrics each path is inside */
     uint64_t *rng_state, *rng_inc;
+    uint32_t *rng_key, *rng_index; /* the sample, for the sampler (rt/render/sampler.h) */
     uint32_t *out;       /* index of the sample in the work */
     /* this bounce's light samples: the lane's first record, how many, the
      * throughput they are weighted by */
@@ -110,7 +112,7 @@ rt_wavefront *rt_wavefront_new(size_t batch, const rt_render_state *state)
     for (size_t i = 0; i < sizeof fl / sizeof fl[0]; i++)
         *fl[i] = grab(B, sizeof(float), &ok);
     uint32_t **u32[] = {&wf->hprim, &wf->out, &wf->rec_first, &wf->rec_count, &wf->active,
-                        &wf->queue, &wf->queue2, &wf->order, &wf->free_lanes};
+                        &wf->queue, &wf->queue2, &wf->order, &wf->free_lanes, &wf->rng_key, &wf->rng_index};
     for (size_t i = 0; i < sizeof u32 / sizeof u32[0]; i++)
         *u32[i] = grab(B, sizeof(uint32_t), &ok);
     wf->prev_delta = grab(B, 1, &ok);
@@ -146,7 +148,7 @@ void rt_wavefront_free(rt_wavefront *wf)
                    wf->rng_inc, wf->out, wf->rec_first, wf->rec_count, wf->nbr, wf->nbg, wf->nbb, wf->sf,
                    wf->rec, wf->vis, wf->sox, wf->soy, wf->soz, wf->sdx, wf->sdy, wf->sdz, wf->stmin,
                    wf->stmax, wf->blocked, wf->pending, wf->active, wf->queue, wf->queue2, wf->order,
-                   wf->free_lanes, wf->skips, wf->media};
+                   wf->free_lanes, wf->skips, wf->media, wf->rng_key, wf->rng_index};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]);
     free(wf);
@@ -168,6 +170,8 @@ static inline void load_path(const rt_wavefront *wf, uint32_t i, rt_path_state *
     ps->skips = wf->skips[i];
     rng->state = wf->rng_state[i];
     rng->inc = wf->rng_inc[i];
+    rng->key = wf->rng_key[i];
+    rng->index = wf->rng_index[i];
 }
 
 static inline void store_path(rt_wavefront *wf, uint32_t i, const rt_path_state *ps, const rt_rng *rng)
@@ -185,6 +189,8 @@ static inline void store_path(rt_wavefront *wf, uint32_t i, const rt_path_state 
     wf->skips[i] = ps->skips;
     wf->rng_state[i] = rng->state;
     wf->rng_inc[i] = rng->inc;
+    wf->rng_key[i] = rng->key;
+    wf->rng_index[i] = rng->index;
 }
 
 static inline void put_out(float *out, uint32_t k, rt_vec3 L)
@@ -251,7 +257,7 @@ static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_acti
             float coverage;
             bool cut = rt_surface_cut_away(ctx, sf, &coverage);
             if (!cut && coverage < 1.0f) { /* stochastic alpha blending, from the path's stream */
-                rt_rng rng = {wf->rng_state[i], wf->rng_inc[i]};
+                rt_rng rng = {wf->rng_state[i], wf->rng_inc[i], wf->rng_key[i], wf->rng_index[i]};
                 if (rt_rng_float(&rng) >= coverage)
                     cut = true;
                 wf->rng_state[i] = rng.state;
@@ -315,11 +321,11 @@ static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, si
     size_t first = *n_rec;
     const rt_scene *s = ctx->state->scene;
     for (size_t l = 0; l < s->light_count; l++)
-        if (rt_path_nee_light(ctx, sf, &b, wo, &rng, l, &wf->rec[*n_rec]))
+        if (rt_path_nee_light(ctx, &ps, sf, &b, wo, &rng, l, &wf->rec[*n_rec]))
             add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
-    if (rt_path_nee_env(ctx, &b, wo, &rng, &wf->rec[*n_rec]))
+    if (rt_path_nee_env(ctx, &ps, &b, wo, &rng, &wf->rec[*n_rec]))
         add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
-    if (rt_path_nee_emitter(ctx, sf, &b, wo, &rng, &wf->rec[*n_rec]))
+    if (rt_path_nee_emitter(ctx, &ps, sf, &b, wo, &rng, &wf->rec[*n_rec]))
         add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
     wf->nee[i] = 1;
     wf->rec_first[i] = (uint32_t)first;

@@ -28,6 +28,8 @@ _Static_assert(sizeof(rt_integrator) == sizeof(int), "enum settings are stored a
 #define FIELD_SIZE(f) sizeof(((rt_settings *)0)->f)
 
 static const char *const onoff_words[] = {"off", "on", NULL};
+/* in rt_sampler_kind order (rt/scene/scene.h) */
+static const char *const sampler_words[] = {"independent", "cmj", "sobol", NULL};
 
 /* Table order is the order of --help and of the scene parser's "did you mean" search. */
 const rt_setting rt_settings_table[] = {
@@ -46,6 +48,9 @@ const rt_setting rt_settings_table[] = {
     {.name = "rr_depth", .args = "N", .type = RT_SETTING_INT, .field = FIELD(rr_depth), .min = 0, .max = 1024,
      .defaults = {3}, .what = "rr_depth",
      .help = "path: Russian roulette from this many bounces on; 0 = adaptive (once the throughput is below 1)"},
+    {.name = "sampler", .args = "NAME", .type = RT_SETTING_ENUM, .field = FIELD(sampler),
+     .defaults = {RT_SAMPLER_INDEPENDENT}, .words = sampler_words, .what = "a sampler",
+     .help = "path: the random numbers of light, BSDF and roulette decisions: a stream per sample, or stratified over the pixel's samples (cmj, sobol)"},
     {.name = "energy_compensation", .args = "MODE", .type = RT_SETTING_ENUM, .field = FIELD(energy_compensation),
      .defaults = {0}, .words = onoff_words, .what = "energy_compensation",
      .help = "path: restore the energy rough conductors lose to multiple scattering (Kulla-Conty 2017)"},
