@@ -142,8 +142,8 @@ static inline float rt_sampler_1d(rt_sampler_kind kind, uint32_t key, uint32_t i
         float x = ((float)s + rt_cmj_randfloat(index, p * 0x2a6f7e53u)) / (float)spp;
         return rt_fminf(x, 0x1.fffffep-1f);
     }
-    uint32_t seed = rt_sampler_hash(key, dim);
-    return rt_sampler_owen(rt_sobol_shuffle(index, spp, seed), seed * 0x2c1b3c6du + 0x297a2d39u);
+    uint32_t seed = rt_sampler_hash(key, dim); /* the shuffle's; the scramble's is hashed apart from it */
+    return rt_sampler_owen(rt_sobol_shuffle(index, spp, seed), rt_sampler_hash(seed, 0x68e31da4u));
 }
 
 static inline rt_vec2 rt_sampler_2d(rt_sampler_kind kind, uint32_t key, uint32_t index, uint32_t spp, uint32_t dim)
@@ -162,7 +162,10 @@ static inline rt_vec2 rt_sampler_2d(rt_sampler_kind kind, uint32_t key, uint32_t
     y ^= (y >> 4) & 0x0f0f0f0fu;
     y ^= (y >> 8) & 0x00ff00ffu;
     y ^= (y >> 16) & 0x0000ffffu;
-    return rt_sampler_owen2(j, seed * 0x2c1b3c6du + 0x297a2d39u, y, seed * 0x6c8e9cf5u + 0x3c6ef372u);
+    /* three independent seeds: the LK hash's low output bits (the top bits
+     * of a value) depend on the seed's low bits only, so seeds that differ
+     * by a multiply-add would scramble x and y alike */
+    return rt_sampler_owen2(j, rt_sampler_hash(seed, 0x68e31da4u), y, rt_sampler_hash(seed, 0xb5297a4du));
 }
 
 /* The path's value in dimension dim: the sampler's, or the next PCG draws. */
