@@ -9,6 +9,7 @@
 #   make denoiser     Intel Open Image Denoise for --denoise: the pyoidn wheel in build/oidn-venv
 #   make bench-render rt's path tracer against Mitsuba 3 (sets it up in build/mitsuba-venv)
 #   make bench-denoise --denoise at 4/16/64 spp against raw 256 and 1024 spp
+#   make bench-helmet  path tracer rays/s on DamagedHelmet under a sky and a sun (RT_BINS: several builds)
 #   make install      rt, the library and its headers, and a pkg-config file
 #                     (PREFIX=/usr/local, DESTDIR for staging); make test-install checks it
 #   make test-slurm   the Slurm launcher (examples/slurm) on a real Slurm started here (root)
@@ -58,7 +59,7 @@ DEPS_OK  := $(BUILD)/.deps-ok
 
 
 .PHONY: test-slurm test-kubernetes test-parallel test-launchers
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build bench-render bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build bench-render bench-helmet bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -100,7 +101,7 @@ $(BUILD)/librt.a: $(LIB_OBJ)
 $(RT): $(DRV_OBJ) $(BUILD)/librt.a
 	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS) $(SDL2_LIBS)
 
-$(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
+$(BUILD)/tests/%: tests/%.c $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h tests/test_fixture.h tests/test_bsdf_check.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests -o $@ $< $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
@@ -171,6 +172,11 @@ RT_BINS ?= ./$(RT)
 bench-render: $(RT)
 	@SHARED=$(SHARED) sh bench/render.sh $(RT_BINS)
 
+# The path tracer's rays per second, shading included, on DamagedHelmet under an environment map and
+# a sun (bench/helmet.sh; RUNS, THREADS, RES, SPP); RT_BINS="./rt other/rt" runs builds interleaved.
+bench-helmet: $(RT)
+	@SHARED=$(SHARED) sh bench/helmet.sh $(RT_BINS)
+
 # --denoise on the shared Cornell box: 4/16/64 spp denoised against raw 256 and 1024 spp (docs/hdr.md).
 bench-denoise: $(RT) denoiser
 	@SHARED=$(SHARED) sh bench/denoise.sh ./$(RT)
@@ -183,11 +189,15 @@ bench-build: bench/buildscale
 	@./bench/buildscale $$(sed -n 's#^| [A-Za-z0-9_]* | `\([^`]*\)`.*#$(SHARED)/\1#p' $(SHARED)/bench/MANIFEST.md 2>/dev/null)
 
 # Regenerates the committed GGX albedo tables of the energy compensation
-# (src/render/ggx_albedo_table.c) from tools/ggx_albedo.c; about 15 s of CPU.
+# (src/render/ggx_albedo_table.c for conductors,
+# src/render/ggx_albedo_dielectric_table.c for rough glass) from
+# tools/ggx_albedo.c; about 15 s of CPU each.
 ggx-albedo-table:
 	@mkdir -p $(BUILD)
 	$(CC) -std=c11 -O2 -D_DEFAULT_SOURCE -o $(BUILD)/ggx_albedo tools/ggx_albedo.c -lm
 	$(BUILD)/ggx_albedo > src/render/ggx_albedo_table.c.tmp && mv src/render/ggx_albedo_table.c.tmp src/render/ggx_albedo_table.c
+	$(BUILD)/ggx_albedo dielectric > src/render/ggx_albedo_dielectric_table.c.tmp && \
+	    mv src/render/ggx_albedo_dielectric_table.c.tmp src/render/ggx_albedo_dielectric_table.c
 
 SCENES := $(wildcard scenes/*.txt)
 scenes: $(RT)

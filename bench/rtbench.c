@@ -23,8 +23,9 @@
  * instruction counts under callgrind. --packets W H traces the set (a
  * primary set: one ray per pixel, row by row, N pixels wide, default 640)
  * in tiles of W x H pixels (W H = 4 2 or 4 4; at most 64 rays), 8 rays at a
- * time with rt_kdtree_intersect8 (kdtree_packet.h); the answers must be
- * the same. Exit 2 on bad arguments or files.
+ * time with rt_kdtree_intersect8 (kdtree_packet.h), or with --occluded
+ * rt_kdtree_occluded8; the answers must be the same. Exit 2 on bad
+ * arguments or files.
  */
 #include <pthread.h>
 #include <stdatomic.h>
@@ -73,6 +74,12 @@ static void trace_tile(const job *j, const size_t *idx, size_t n)
         rt_hit h[8];
         for (int i = 0; i < m; i++)
             r[i] = j->rays->rays[idx[g + (size_t)i]];
+        if (j->occluded) { /* hit/miss only: 0 for a hit */
+            unsigned hit = rt_kdtree_occluded8(j->tree, r, m);
+            for (int i = 0; i < m; i++)
+                j->t_out[idx[g + (size_t)i]] = (hit >> i & 1) ? 0.0f : INFINITY;
+            continue;
+        }
         unsigned hit = rt_kdtree_intersect8(j->tree, r, m, h);
         for (int i = 0; i < m; i++)
             j->t_out[idx[g + (size_t)i]] = (hit >> i & 1) ? h[i].t : INFINITY;
@@ -175,7 +182,7 @@ int main(int argc, char **argv)
             return usage();
     }
     if (!model || !rays_path || threads < 1 || threads > 256 || runs < 1 || runs > 1000 || build_threads < 0 ||
-        build_threads > 64 || limit < 0 || image_width < 1 || (pw && (occluded || limit)))
+        build_threads > 64 || limit < 0 || image_width < 1 || (pw && limit))
         return usage();
     rt_log_set_level(RT_LOG_QUIET);
 

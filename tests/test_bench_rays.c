@@ -17,7 +17,9 @@
  * watertight triangle test closed those cracks, and every full set now
  * agrees ray for ray. On the primary sets, 4x2 tiles spread over the image
  * also go through the packet traversal (kdtree_packet.h), whose t must be
- * the single ray's bit for bit.
+ * the single ray's bit for bit, and through its any-hit query: each ray cut
+ * exactly at its hit (tmax = t: not occluded, one ulp more: occluded), and
+ * shadow rays from the hit points to a light, as the single query answers.
  *
  * Cost: all three models, including the 1M-triangle one (its build is about
  * 1-2 s on two cores). It stays in because it is the model that tests the
@@ -123,6 +125,28 @@ static void check_set(const rt_kdtree *tree, const char *model, const char *kind
                     if (hit)
                         assert_true(h.t == ph[k].t);
                 }
+                /* rt_kdtree_occluded8: the same rays cut at their hit (open
+                 * at tmax: not occluded; one ulp later: occluded), then
+                 * shadow rays from the hit points to a light above the
+                 * model, each as the single any-hit query says */
+                rt_ray sr[8];
+                for (int k = 0; k < 8; k++) {
+                    sr[k] = pr[k];
+                    if (m >> k & 1)
+                        sr[k].tmax = k % 2 ? ph[k].t : nextafterf(ph[k].t, INFINITY);
+                }
+                unsigned o = rt_kdtree_occluded8(tree, sr, 8);
+                for (int k = 0; k < 8; k++)
+                    assert_int_equal(o >> k & 1, (m >> k & 1) ? k % 2 == 0 : 0);
+                rt_vec3 light = rt_add(rt_scale(rt_add(tree->bounds.lo, tree->bounds.hi), 0.5f),
+                                       rt_v3(0.3f * diag, diag, 0.2f * diag));
+                for (int k = 0; k < 8; k++) {
+                    rt_vec3 p = (m >> k & 1) ? rt_add(pr[k].org, rt_scale(pr[k].dir, ph[k].t)) : pr[k].org;
+                    sr[k] = rt_ray_make(p, rt_sub(light, p), 1e-4f, 1.0f);
+                }
+                o = rt_kdtree_occluded8(tree, sr, 8);
+                for (int k = 0; k < 8; k++)
+                    assert_int_equal(o >> k & 1, rt_kdtree_occluded(tree, &sr[k]));
                 tiles++;
             }
         assert_true(tiles > 2000);

@@ -8,6 +8,7 @@
  * directions matches the pdf rt_bsdf_eval reports; every value is finite
  * at grazing and degenerate directions. */
 #include "test_util.h"
+#include "test_bsdf_check.h"
 
 #include <complex.h>
 #include <math.h>
@@ -15,12 +16,6 @@
 #include "rt/render/bsdf.h"
 #include "rt/render/ggx_albedo.h"
 #include "rt/render/sampling.h"
-
-static rt_vec3 dir_from(float cos_t, float phi)
-{
-    float s = sqrtf(fmaxf(0.0f, 1.0f - cos_t * cos_t));
-    return rt_v3(s * cosf(phi), s * sinf(phi), cos_t);
-}
 
 /* A uniformly distributed direction on the upper hemisphere. */
 static rt_vec3 uniform_hemi(test_rng *r)
@@ -246,62 +241,10 @@ static void test_ggx_tiny_alpha_precision(void **state)
 
 /* The density rt_bsdf_sample_dir draws from integrates (over the sphere)
  * to the probability that it succeeds, and a histogram of its directions
- * over 16 x 16 cells in (cos theta, phi) matches the pdf integrated over
- * each cell. */
-static void pdf_histogram(const rt_bsdf *bp, rt_vec3 wo, uint64_t seed, const char *label)
+ * matches the pdf integrated over each cell (test_bsdf_check.h). */
+static void pdf_histogram(const rt_bsdf *b, rt_vec3 wo, uint64_t seed, const char *label)
 {
-    enum { NT = 16, NP = 16, N = 400000 };
-    static double hist[NT][NP], expect[NT][NP];
-    const rt_bsdf b = *bp;
-    memset(hist, 0, sizeof hist);
-    memset(expect, 0, sizeof expect);
-    rt_rng rng = rt_rng_seed(seed, 99);
-    int ok = 0;
-    for (int i = 0; i < N; i++) {
-        rt_bsdf_sample s;
-        float ul = rt_rng_float(&rng);
-        rt_vec2 u = rt_v2(rt_rng_float(&rng), rt_rng_float(&rng));
-        if (!rt_bsdf_sample_dir(&b, wo, u, ul, &s))
-            continue;
-        ok++;
-        /* the sample's pdf is the evaluated pdf */
-        float pe;
-        rt_bsdf_eval(&b, wo, s.wi, &pe);
-        assert_true(fabsf(pe - s.pdf) <= 1e-4f * s.pdf);
-        int it = (int)(s.wi.z * NT), ip = (int)((atan2f(s.wi.y, s.wi.x) + RT_PI) / (2.0f * RT_PI) * NP);
-        it = it < 0 ? 0 : (it >= NT ? NT - 1 : it);
-        ip = ip < 0 ? 0 : (ip >= NP ? NP - 1 : ip);
-        hist[it][ip] += 1.0 / N;
-    }
-    /* pdf integrated over each cell, 24 x 24 midpoints per cell */
-    double total = 0.0;
-    const int sub = 24;
-    for (int it = 0; it < NT; it++)
-        for (int ip = 0; ip < NP; ip++) {
-            double acc = 0.0;
-            for (int a = 0; a < sub; a++)
-                for (int bb = 0; bb < sub; bb++) {
-                    float ct = ((float)it + ((float)a + 0.5f) / sub) / NT;
-                    float ph = ((float)ip + ((float)bb + 0.5f) / sub) / NP * 2.0f * RT_PI - RT_PI;
-                    float pdf;
-                    rt_bsdf_eval(&b, wo, dir_from(ct, ph), &pdf);
-                    acc += pdf;
-                }
-            double cell = (1.0 / NT) * (2.0 * 3.14159265358979323846 / NP); /* solid angle of the cell */
-            expect[it][ip] = acc / (sub * sub) * cell;
-            total += expect[it][ip];
-        }
-    double p_ok = (double)ok / N;
-    assert_true(fabs(total - p_ok) < 0.01);
-    assert_true(total <= 1.0 + 0.01);
-    for (int it = 0; it < NT; it++)
-        for (int ip = 0; ip < NP; ip++) {
-            double e = expect[it][ip], h = hist[it][ip];
-            /* 5 standard deviations of a binomial count, plus the quadrature error */
-            double tol = 5.0 * sqrt(e / N) + 0.02 * e + 2e-5;
-            if (fabs(h - e) > tol)
-                fail_msg("%s cell (%d,%d): histogram %.5f, pdf %.5f", label, it, ip, h, e);
-        }
+    test_pdf_histogram(b, wo, rt_rng_seed(seed, 99), 400000, label);
 }
 
 /* pdf_histogram over the glTF cases. */
@@ -856,6 +799,161 @@ static void test_plastic_bsdf(void **state)
     pdf_histogram(&b, dir_from(0.6f, 0.4f), 300, "rough plastic");
 }
 
+/* Energy compensation of rough glass (Kulla and Conty 2017, dielectric
+ * tables; docs/shading.md, section 14):
+ *   - the committed E(mu, alpha, eta) against an independent estimate with
+ *     rt's float code (VNDF grid, exact Fresnel, reflection and refraction
+ *     weights F G2 / G1 and (1 - F) G2 / G1), both sides, on and off the
+ *     table's rows; E_avg against the lookups integrated;
+ *   - the energy by sampling (flux: refraction's eta^2 taken out): the
+ *     table's E without the lobe, 1 with it, from both sides;
+ *   - the reflected lobe is symmetric, the transmitted one obeys
+ *     n_o^2 f(wo, wi) = n_t^2 f(wi, wo) seen from the other side;
+ *   - the mixture pdf against a histogram, and the transmitted lobe's
+ *     samples cosine-distributed below with weight f pi eta^2 / p. */
+static void test_dielectric_compensation(void **state)
+{
+    (void)state;
+    const float pts[][3] = {{0.2f, 0.3f, 1.0f / 1.5f}, {0.55f, 0.6f, 1.5f}, {0.9f, 0.9f, 1.33f},
+                            {0.35f, 1.0f, 1.0f / 1.33f}, {0.7f, 0.15f, 1.5f}, {0.05f, 0.5f, 1.0f / 2.4f}};
+    for (int k = 0; k < 6; k++) {
+        float mu = pts[k][0], alpha = pts[k][1], eta = pts[k][2];
+        rt_vec3 wo = dir_from(mu, 0.0f);
+        enum { S = 300 };
+        double sum = 0.0;
+        for (int i = 0; i < S; i++) {
+            for (int j = 0; j < S; j++) {
+                rt_vec3 h = rt_ggx_sample_vndf(wo, alpha, rt_v2(((float)i + 0.5f) / S, ((float)j + 0.5f) / S));
+                float c = rt_dot(wo, h);
+                if (!(c > 0.0f))
+                    continue;
+                float F = rt_fresnel_exact(c, eta), g1 = rt_ggx_g1(wo, alpha);
+                rt_vec3 wr = rt_sub(rt_scale(h, 2.0f * c), wo);
+                if (wr.z > 0.0f)
+                    sum += F * rt_ggx_g2(wo, wr, alpha) / g1;
+                float s2 = eta * eta * (1.0f - c * c);
+                if (s2 < 1.0f) {
+                    rt_vec3 wt = rt_add(rt_scale(wo, -eta), rt_scale(h, eta * c - sqrtf(1.0f - s2)));
+                    if (wt.z < 0.0f)
+                        sum += (1.0f - F) * rt_ggx_g2(wo, rt_normalize(wt), alpha) / g1;
+                }
+            }
+        }
+        double want = sum / (S * S), got = rt_ggx_dielectric_albedo(mu, alpha, eta);
+        if (fabs(got - want) > 0.005)
+            fail_msg("E(%.2f, %.2f, %.3f): table %.5f, estimate %.5f", (double)mu, (double)alpha, (double)eta, got,
+                     want);
+        double avg = 0.0;
+        for (int i = 0; i < 1000; i++) {
+            float m = ((float)i + 0.5f) / 1000.0f;
+            avg += 2.0 * m * rt_ggx_dielectric_albedo(m, alpha, eta) / 1000.0;
+        }
+        if (fabs(avg - rt_ggx_dielectric_albedo_avg(alpha, eta)) > 0.005)
+            fail_msg("E_avg(%.2f, %.3f): table %.5f, lookups integrated %.5f", (double)alpha, (double)eta,
+                     (double)rt_ggx_dielectric_albedo_avg(alpha, eta), avg);
+    }
+    /* a smooth interface loses nothing; the multiple-scattering flux obeys
+     * n_o^2 T_o = n_t^2 T_t */
+    assert_true(fabsf(rt_ggx_dielectric_albedo(0.3f, 0.0f, 1.5f) - 1.0f) < 1e-5f);
+    assert_true(fabsf(rt_ggx_dielectric_ms_transmit(0.7f, 1.0f / 1.4f) / (1.4f * 1.4f) -
+                      rt_ggx_dielectric_ms_transmit(0.7f, 1.4f)) < 1e-6f);
+
+    const float etas[] = {1.0f / 1.5f, 1.5f, 1.0f / 1.33f, 1.33f}, alphas[] = {0.1f, 0.5f, 1.0f},
+                mus[] = {0.2f, 0.5f, 0.9f};
+    for (int e = 0; e < 4; e++) {
+        for (int a = 0; a < 3; a++) {
+            for (int m = 0; m < 3; m++) {
+                rt_vec3 wo = dir_from(mus[m], 0.4f);
+                double alb[2];
+                for (int comp = 0; comp < 2; comp++) {
+                    rt_bsdf b;
+                    rt_bsdf_make_dielectric(&b, rt_v3(0, 0, 1), etas[e], alphas[a]);
+                    if (comp)
+                        rt_bsdf_compensate(&b);
+                    assert_true(b.ms == (comp == 1));
+                    double sum = 0.0;
+                    const int n = 1 << 17;
+                    for (int i = 0; i < n; i++) {
+                        rt_bsdf_sample s;
+                        if (rt_bsdf_sample_dir(&b, wo, rt_cmj_sample((uint32_t)i, n, 11),
+                                               rt_cmj_randfloat((uint32_t)i, 5), &s))
+                            sum += s.wi.z < 0.0f ? s.weight.y / ((double)etas[e] * etas[e]) : s.weight.y;
+                    }
+                    alb[comp] = sum / n;
+                }
+                double E = rt_ggx_dielectric_albedo(mus[m], alphas[a], etas[e]);
+                fprintf(stderr, "rough glass eta %.3f alpha %.1f mu %.1f: energy %.4f (table E %.4f), compensated %.4f\n",
+                        (double)etas[e], (double)alphas[a], (double)mus[m], alb[0], E, alb[1]);
+                if (fabs(alb[0] - E) > 0.01)
+                    fail_msg("eta %.3f alpha %.1f mu %.1f: single scattering %.4f, table E %.4f", (double)etas[e],
+                             (double)alphas[a], (double)mus[m], alb[0], E);
+                if (fabs(alb[1] - 1.0) > 0.02)
+                    fail_msg("eta %.3f alpha %.1f mu %.1f: compensated %.4f", (double)etas[e], (double)alphas[a],
+                             (double)mus[m], alb[1]);
+            }
+        }
+    }
+
+    for (int e = 0; e < 4; e++) {
+        rt_bsdf b, back;
+        rt_bsdf_make_dielectric(&b, rt_v3(0, 0, 1), etas[e], 0.6f);
+        rt_bsdf_compensate(&b);
+        rt_bsdf_make_dielectric(&back, rt_v3(0, 0, 1), 1.0f / etas[e], 0.6f);
+        rt_bsdf_compensate(&back);
+        assert_true(b.ms && back.ms && b.ms_x > 0.0f && b.ms_x <= 1.0f);
+        test_rng r = {(uint64_t)e + 70};
+        for (int i = 0; i < 1000; i++) {
+            rt_vec3 wo = uniform_hemi(&r), wi = uniform_hemi(&r);
+            float f1 = rt_bsdf_eval(&b, wo, wi, NULL).y, f2 = rt_bsdf_eval(&b, wi, wo, NULL).y;
+            assert_true(fabsf(f1 - f2) <= 1e-4f * fmaxf(f1, 1e-3f));
+            rt_vec3 below = rt_v3(wi.x, wi.y, -wi.z), wo_below = rt_v3(wo.x, wo.y, -wo.z);
+            float t1 = rt_bsdf_ms_transmit(&b, wo, below), t2 = rt_bsdf_ms_transmit(&back, wi, wo_below);
+            assert_true(t1 > 0.0f);
+            if (fabsf(t1 * etas[e] * etas[e] - t2) > 1e-4f * t2)
+                fail_msg("eta %.3f: n_o^2 f_T %.6g, n_t^2 f_T back %.6g", (double)etas[e],
+                         (double)(t1 * etas[e] * etas[e]), (double)t2);
+        }
+        char label[48];
+        snprintf(label, sizeof label, "compensated glass eta %.3f", (double)etas[e]);
+        pdf_histogram(&b, dir_from(0.6f, 0.4f), (uint64_t)(400 + e), label);
+        /* the transmitted lobe alone: cosine-distributed below, weight f pi eta^2 / p */
+        rt_vec3 wo = dir_from(0.6f, 0.4f);
+        float pd, ps, pt;
+        rt_bsdf_lobe_probs(&b, wo, &pd, &ps, &pt);
+        enum { NB = 10, NS = 100000 };
+        double hist[NB] = {0};
+        float ptm = b.ms_x * rt_clampf(1.0f - rt_ggx_dielectric_albedo(0.6f, 0.6f, etas[e]), 0.0f, 0.95f);
+        rt_rng rng = rt_rng_seed(e, 8);
+        for (int i = 0; i < NS; i++) {
+            rt_bsdf_sample s;
+            float ul = 1.0f - ptm * (0.999f * rt_rng_float(&rng) + 0.0005f); /* in the lobe's share */
+            assert_true(rt_bsdf_sample_dir(&b, wo, rt_v2(rt_rng_float(&rng), rt_rng_float(&rng)), ul, &s));
+            assert_true(s.delta && s.wi.z < 0.0f);
+            float want = rt_bsdf_ms_transmit(&b, wo, s.wi) * RT_PI * etas[e] * etas[e] / ptm;
+            assert_true(fabsf(s.weight.y - want) <= 1e-4f * want);
+            int bin = (int)(-s.wi.z * NB);
+            hist[bin < NB ? bin : NB - 1] += 1.0 / NS;
+        }
+        for (int i = 0; i < NB; i++) {
+            double p = ((i + 1.0) * (i + 1.0) - (double)i * i) / (NB * NB); /* cos theta^2 uniform */
+            if (fabs(hist[i] - p) > 5.0 * sqrt(p / NS) + 1e-4)
+                fail_msg("eta %.3f: transmitted lobe, cos bin %d: %.5f, want %.5f", (double)etas[e], i, hist[i], p);
+        }
+    }
+    /* nested media: re-aiming at another index recomputes the lobe */
+    rt_bsdf b, c;
+    rt_bsdf_make_dielectric(&b, rt_v3(0, 0, 1), 1.0f / 1.5f, 0.5f);
+    rt_bsdf_compensate(&b);
+    rt_bsdf_set_eta(&b, 1.33f / 1.5f);
+    rt_bsdf_make_dielectric(&c, rt_v3(0, 0, 1), 1.33f / 1.5f, 0.5f);
+    rt_bsdf_compensate(&c);
+    assert_true(b.ms && b.ms_x == c.ms_x && b.ms_refl == c.ms_refl && b.ms_trans == c.ms_trans);
+    /* smooth glass has nothing to compensate */
+    rt_bsdf_make_dielectric(&b, rt_v3(0, 0, 1), 1.0f / 1.5f, 0.0f);
+    rt_bsdf_compensate(&b);
+    assert_false(b.ms);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -877,6 +975,7 @@ int main(void)
         cmocka_unit_test(test_energy_compensation),
         cmocka_unit_test(test_ggx_albedo_table),
         cmocka_unit_test(test_dielectric_bsdf),
+        cmocka_unit_test(test_dielectric_compensation),
         cmocka_unit_test(test_plastic_bsdf),
     };
     return cmocka_run_group_tests_name("bsdf", tests, NULL, NULL);

@@ -10,6 +10,7 @@
  * the density rt_bsdf_eval reports (mean weight = quadrature of f cos;
  * a histogram of the sampled directions against the pdf). */
 #include "test_util.h"
+#include "test_bsdf_check.h"
 
 #include <math.h>
 
@@ -18,12 +19,6 @@
 #include "rt/render/bsdf_iridescence.h"
 #include "rt/render/bsdf_sheen.h"
 #include "rt/render/sampling.h"
-
-static rt_vec3 dir_from(float cos_t, float phi)
-{
-    float s = sqrtf(fmaxf(0.0f, 1.0f - cos_t * cos_t));
-    return rt_v3(s * cosf(phi), s * sinf(phi), cos_t);
-}
 
 static rt_vec3 uniform_hemi(test_rng *r) { return dir_from(test_rng_float(r), 2.0f * RT_PI * test_rng_float(r)); }
 
@@ -382,51 +377,11 @@ static void test_thin_walled(void **state)
     assert_true(mx / n * -wo.x > 0.0 && my / n * -wo.y > 0.0);
 }
 
-/* A histogram of sampled directions over 16 x 16 cells in (cos theta, phi)
- * against the pdf rt_bsdf_eval reports integrated over each cell. */
+/* A histogram of sampled directions against the pdf rt_bsdf_eval reports
+ * (test_bsdf_check.h). */
 static void pdf_histogram(const rt_bsdf *b, rt_vec3 wo, uint64_t seed, const char *label)
 {
-    enum { NT = 16, NP = 16, N = 200000 };
-    static double hist[NT][NP];
-    memset(hist, 0, sizeof hist);
-    rt_rng rng = rt_rng_seed(seed, 7);
-    int ok = 0;
-    for (int i = 0; i < N; i++) {
-        rt_bsdf_sample s;
-        float ul = rt_rng_float(&rng);
-        rt_vec2 u = rt_v2(rt_rng_float(&rng), rt_rng_float(&rng));
-        if (!rt_bsdf_sample_dir(b, wo, u, ul, &s) || s.delta)
-            continue;
-        ok++;
-        float pe;
-        rt_bsdf_eval(b, wo, s.wi, &pe);
-        assert_true(fabsf(pe - s.pdf) <= 1e-4f * s.pdf);
-        int it = (int)(s.wi.z * NT), ip = (int)((atan2f(s.wi.y, s.wi.x) + RT_PI) / (2.0f * RT_PI) * NP);
-        it = it < 0 ? 0 : (it >= NT ? NT - 1 : it);
-        ip = ip < 0 ? 0 : (ip >= NP ? NP - 1 : ip);
-        hist[it][ip] += 1.0 / N;
-    }
-    double total = 0.0;
-    const int sub = 16;
-    for (int it = 0; it < NT; it++)
-        for (int ip = 0; ip < NP; ip++) {
-            double acc = 0.0;
-            for (int a = 0; a < sub; a++)
-                for (int c = 0; c < sub; c++) {
-                    float ct = ((float)it + ((float)a + 0.5f) / sub) / NT;
-                    float ph = ((float)ip + ((float)c + 0.5f) / sub) / NP * 2.0f * RT_PI - RT_PI;
-                    float pdf;
-                    rt_bsdf_eval(b, wo, dir_from(ct, ph), &pdf);
-                    acc += pdf;
-                }
-            double e = acc / (sub * sub) * (1.0 / NT) * (2.0 * 3.14159265358979323846 / NP);
-            total += e;
-            double tol = 5.0 * sqrt(e / N) + 0.03 * e + 3e-5;
-            if (fabs(hist[it][ip] - e) > tol)
-                fail_msg("%s cell (%d,%d): histogram %.5f, pdf %.5f", label, it, ip, hist[it][ip], e);
-        }
-    if (fabs(total - (double)ok / N) > 0.01)
-        fail_msg("%s: pdf integrates to %.4f, samples succeed %.4f", label, total, (double)ok / N);
+    test_pdf_histogram(b, wo, rt_rng_seed(seed, 7), 200000, label);
 }
 
 static void test_layered_pdf_histogram(void **state)

@@ -449,6 +449,56 @@ static void test_denoise_missing_library(void **state)
     free(msg);
 }
 
+/* --denoise-quality and -t reach OIDN: its filter runs in the quality
+ * asked for (the flag over RT_OIDN_QUALITY) on the device's numThreads as
+ * OIDN reports it back (the -v line); bad words are refused before any
+ * work. */
+static void test_denoise_quality_and_threads(void **state)
+{
+    (void)state;
+    rt_denoise_quality q = RT_DENOISE_DEFAULT;
+    assert_true(rt_denoise_quality_parse("fast", &q) && q == RT_DENOISE_FAST);
+    assert_true(rt_denoise_quality_parse("balanced", &q) && q == RT_DENOISE_BALANCED);
+    assert_true(rt_denoise_quality_parse("high", &q) && q == RT_DENOISE_HIGH);
+    assert_false(rt_denoise_quality_parse("High", &q) || rt_denoise_quality_parse("", &q));
+    assert_int_equal(q, RT_DENOISE_HIGH);
+    char args[512];
+    snprintf(args, sizeof args, "--denoise --denoise-quality ultra -o %s", tmp("never.png"));
+    assert_int_equal(run_rt(NULL, args, NULL), 2);
+    snprintf(args, sizeof args, "--denoise-quality high -o %s", tmp("never.png")); /* without --denoise */
+    assert_int_equal(run_rt(NULL, args, NULL), 2);
+    assert_int_equal(access(tmp("never.png"), F_OK), -1);
+
+    char where[4096];
+    rt_error err = {0};
+    if (rt_denoise_find(where, sizeof where, &err) != RT_OK) {
+        fprintf(stderr, "note: %s; skipping the denoiser runs\n", err.message);
+        skip();
+    }
+    const char *common = "-v -r 24x24 -s 2 --integrator path --denoise";
+    snprintf(args, sizeof args, "%s -t 1 --denoise-quality fast -o %s", common, tmp("fast.pfm"));
+    assert_int_equal(run_rt("RT_OIDN_QUALITY=high", args, tmp("fast.txt")), 0);
+    snprintf(args, sizeof args, "%s -t 2 -o %s", common, tmp("high.pfm"));
+    assert_int_equal(run_rt("RT_OIDN_QUALITY=high", args, tmp("high.txt")), 0);
+    char *msg;
+    size_t size;
+    assert_int_equal(rt_read_file(tmp("fast.txt"), 0, &msg, &size, &err), RT_OK);
+    if (!strstr(msg, "OIDN RT filter, fast quality, 1 thread,"))
+        fail_msg("-t 1 --denoise-quality fast: %s", msg);
+    free(msg);
+    assert_int_equal(rt_read_file(tmp("high.txt"), 0, &msg, &size, &err), RT_OK);
+    if (!strstr(msg, "OIDN RT filter, high quality, 2 threads,"))
+        fail_msg("-t 2 with RT_OIDN_QUALITY=high: %s", msg);
+    free(msg);
+    /* the same render, two networks: two images */
+    rt_framebuffer fast, high;
+    assert_int_equal(rt_image_read(tmp("fast.pfm"), &fast, &err), RT_OK);
+    assert_int_equal(rt_image_read(tmp("high.pfm"), &high, &err), RT_OK);
+    assert_true(memcmp(fast.rgb, high.rgb, (size_t)24 * 24 * 3 * sizeof(float)) != 0);
+    rt_framebuffer_free(&fast);
+    rt_framebuffer_free(&high);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -456,7 +506,7 @@ int main(void)
         cmocka_unit_test(test_exr_layers),           cmocka_unit_test(test_exr_texture_and_limits),
         cmocka_unit_test(test_tonemap_curves),       cmocka_unit_test(test_convert),
         cmocka_unit_test(test_denoise_cornell),      cmocka_unit_test(test_denoise_missing_library),
-        cmocka_unit_test(test_aovs),
+        cmocka_unit_test(test_aovs),                 cmocka_unit_test(test_denoise_quality_and_threads),
     };
     return cmocka_run_group_tests_name("hdr", tests, setup, teardown);
 }

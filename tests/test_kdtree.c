@@ -946,6 +946,128 @@ static void test_packets(void **state)
     }
 }
 
+/* One packet of n shadow rays through rt_kdtree_occluded8: each ray's bit
+ * is the single-ray rt_kdtree_occluded and brute force's any-hit. */
+static void check_packet_occluded(const rt_scene *s, const rt_kdtree *tree, const rt_ray *rays, int n, check_stats *cs)
+{
+    unsigned mask = rt_kdtree_occluded8(tree, rays, n);
+    assert_true(mask >> n == 0);
+    for (int i = 0; i < n; i++) {
+        bool pa = mask >> i & 1, sa = rt_kdtree_occluded(tree, &rays[i]), ba = ref_any(s, &rays[i]);
+        if (pa != ba || sa != ba)
+            fprintf(stderr, "shadow ray %d of %d: packet %d single %d brute %d (tmin %.9g tmax %.9g)\n", i, n, pa, sa,
+                    ba, (double)rays[i].tmin, (double)rays[i].tmax);
+        assert_int_equal(pa, ba);
+        assert_int_equal(sa, ba);
+        cs->rays++;
+        cs->hits += pa;
+    }
+}
+
+static void test_packets_occluded(void **state)
+{
+    (void)state;
+    /* rt_kdtree_occluded8 against single rays and brute force: shadow rays
+     * from the hit points of coherent 4x2 tiles to one point light (the
+     * packet path when the points lie on one side of the light), from
+     * scattered points to one light (mixed signs: single rays), random
+     * rays with random intervals, rays whose segment ends exactly on a
+     * triangle (tmax = the t of that hit: not occluded by it; one ulp
+     * more: occluded), the odd rays of test_packets, and n from 1 to 8 */
+    for (int sc = 0; sc < 2; sc++) {
+        rt_scene s;
+        rt_scene_init(&s);
+        test_rng r = {900 + (uint64_t)sc};
+        if (sc == 0) {
+            random_soup(&s, &r, 3000, 0.05f);
+        } else {
+            for (int i = 0; i < 40; i++) {
+                rt_vec3 lo = rt_v3((float)(int)(test_rng_next(&r) % 8), (float)(int)(test_rng_next(&r) % 8),
+                                   (float)(int)(test_rng_next(&r) % 8));
+                add_box_tris(&s, lo, rt_add(lo, rt_v3(1.0f + (float)(int)(test_rng_next(&r) % 2), 1.0f, 1.0f)));
+            }
+        }
+        rt_kdtree tree;
+        build_ok(&tree, &s);
+        check_stats cs = {0, 0, 0};
+        size_t ends = 0;
+        float span = sc == 0 ? 1.0f : 9.0f;
+        for (int cam = 0; cam < 40; cam++) {
+            rt_vec3 eye = rt_add(rnd3(&r, -0.5f * span, 1.5f * span), rt_v3(0, 0, -span));
+            rt_vec3 at = rnd3(&r, 0.3f * span, 0.7f * span);
+            rt_vec3 fw = rt_normalize(rt_sub(at, eye)), rx = rt_normalize(rt_cross(fw, rt_v3(0.3f, 1.0f, 0.1f))),
+                    uy = rt_cross(rx, fw);
+            rt_vec3 light = rnd3(&r, -0.5f * span, 1.5f * span);
+            float pix = cam % 2 ? 1e-3f : 2e-2f;
+            for (int tile = 0; tile < 30; tile++) {
+                float x0 = rnd(&r, -0.5f, 0.5f), y0 = rnd(&r, -0.5f, 0.5f);
+                rt_ray rays[8];
+                int n = 8, expect[8] = {-1, -1, -1, -1, -1, -1, -1, -1}; /* known answers: 0, 1 (-1: not known) */
+                for (int i = 0; i < 8; i++) { /* a tile's hit points (or points along its rays) to the light */
+                    rt_vec3 d = rt_add(fw, rt_add(rt_scale(rx, x0 + pix * (float)(i % 4)), rt_scale(uy, y0 + pix * (float)(i / 4))));
+                    rt_ray pr = rt_ray_make(eye, d, 0.0f, INFINITY);
+                    rt_hit h;
+                    float t = rt_kdtree_intersect(&tree, &pr, &h) ? h.t : span;
+                    rt_vec3 p = rt_add(eye, rt_scale(d, t));
+                    rays[i] = rt_ray_make(p, rt_sub(light, p), 1e-4f, 1.0f);
+                }
+                switch (tile % 10) {
+                case 1: n = 1 + (int)(test_rng_next(&r) % 7); break;
+                case 2: rays[3].dir.x = 0.0f; break;                 /* parallel to an axis */
+                case 3: rays[5].tmin = rays[5].tmax = 0.5f; break;  /* an empty interval */
+                case 4: rays[0].org.y = NAN; break;                  /* hits nothing */
+                case 5: /* random rays, random intervals */
+                    for (int i = 0; i < 8; i++) {
+                        rays[i] = random_ray(&r, -0.2f * span, 1.2f * span);
+                        rays[i].tmin = rnd(&r, 0.0f, 0.5f) * span;
+                        rays[i].tmax = rays[i].tmin + rnd(&r, 0.0f, 2.0f) * span;
+                    }
+                    break;
+                case 6: /* scattered points to the light: mixed signs */
+                    for (int i = 0; i < 8; i++) {
+                        rt_vec3 p = rnd3(&r, -0.2f * span, 1.2f * span);
+                        rays[i] = rt_ray_make(p, rt_sub(light, p), 0.0f, 1.0f);
+                    }
+                    break;
+                case 7: case 8: { /* segments that end exactly on their first hit: from near the light to
+                                   * points of one triangle, or from those points back towards the light */
+                    uint32_t tri = (uint32_t)(test_rng_next(&r) % s.triangles.count);
+                    rt_vec3 a = rt_tri_vertex(&s, tri, 0), b = rt_tri_vertex(&s, tri, 1), c = rt_tri_vertex(&s, tri, 2);
+                    rt_vec3 o = rt_add(light, rnd3(&r, -0.01f * span, 0.01f * span));
+                    for (int i = 0; i < 8; i++) {
+                        float u = rnd(&r, 0.05f, 0.45f), v = rnd(&r, 0.05f, 0.45f);
+                        rt_vec3 q = rt_add(a, rt_add(rt_scale(rt_sub(b, a), u), rt_scale(rt_sub(c, a), v)));
+                        rays[i] = tile % 10 == 7 ? rt_ray_make(o, rt_sub(q, o), 0.0f, INFINITY)
+                                                 : rt_ray_make(q, rt_sub(o, q), 1e-4f, INFINITY);
+                        rt_hit hb;
+                        expect[i] = -1;
+                        if (!ref_closest(&s, &rays[i], &hb)) {
+                            rays[i].tmax = 1.0f;
+                            continue;
+                        }
+                        /* open at tmax: the hit at exactly tmax does not count, one ulp later it does */
+                        rays[i].tmax = i % 2 ? hb.t : nextafterf(hb.t, INFINITY);
+                        expect[i] = i % 2 == 0;
+                        ends++;
+                    }
+                    break;
+                }
+                default: break;
+                }
+                check_packet_occluded(&s, &tree, rays, n, &cs);
+                for (int i = 0; i < n; i++)
+                    if (expect[i] >= 0)
+                        assert_int_equal(rt_kdtree_occluded(&tree, &rays[i]), expect[i]);
+            }
+        }
+        report(__func__, &cs);
+        assert_true(cs.hits > cs.rays / 10 && cs.hits < cs.rays - cs.rays / 10);
+        assert_true(ends > 100);
+        rt_kdtree_free(&tree);
+        rt_scene_free(&s);
+    }
+}
+
 static void test_threads_safe_reads(void **state)
 {
     (void)state;
@@ -1064,6 +1186,7 @@ int main(void)
         cmocka_unit_test(test_chaos),
         cmocka_unit_test(test_edge_rays),
         cmocka_unit_test(test_packets),
+        cmocka_unit_test(test_packets_occluded),
         cmocka_unit_test(test_threads_safe_reads),
         cmocka_unit_test(test_parallel_build_identical),
     };

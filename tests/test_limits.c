@@ -25,6 +25,7 @@
 #include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"
 #include "rt/io/mesh_io.h"
+#include "rt/render/limits.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
 #include "rt/io/scene_parse.h"
@@ -226,6 +227,46 @@ static void test_kdtree_primitive_cap(void **state)
     assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_ERR_LIMIT);
     expect_message(&err, "1073741824 primitives", "at most");
     s.triangles.count = 0;
+    rt_scene_free(&s);
+}
+
+/* What rt_render_check_limits refuses before a render (the driver calls
+ * it; test_cli.c checks the command line's messages): the primitive
+ * count, a settings value out of its table's range, a whitted gather tree
+ * over RT_MAX_DIFFUSE_TREE rays, a degenerate camera the input gave (an
+ * automatic one only warns). */
+static void test_render_limits(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    s.camera.position = rt_v3(0, 0, 5);
+    s.camera.look_at = rt_v3(0, 0, 0);
+    rt_error err = {0};
+    assert_int_equal(rt_render_check_limits(&s, "ok.txt", true, &err), RT_OK);
+    s.triangles.count = (size_t)1 << 30; /* the count alone (no arrays behind it) */
+    assert_int_equal(rt_render_check_limits(&s, "big.glb", true, &err), RT_ERR_LIMIT);
+    expect_message(&err, "big.glb: 1073741824 primitives", "over the limit");
+    s.triangles.count = 0;
+    s.settings.samples = -3;
+    assert_int_equal(rt_render_check_limits(&s, "bad.txt", true, &err), RT_ERR_LIMIT);
+    expect_message(&err, "bad.txt: ", "samples");
+    rt_settings_default(&s.settings);
+    s.settings.integrator = RT_INTEGRATOR_WHITTED;
+    s.settings.diffuse_bounces = 3;
+    s.settings.diffuse_rays = 256; /* 256^3 = 2^24: just allowed */
+    assert_int_equal(rt_render_check_limits(&s, "tree.txt", true, &err), RT_OK);
+    s.settings.diffuse_rays = 257;
+    assert_int_equal(rt_render_check_limits(&s, "tree.txt", true, &err), RT_ERR_LIMIT);
+    expect_message(&err, "tree.txt: diffuse_rays 257 with diffuse_bounces 3", "rays per camera sample");
+    rt_settings_default(&s.settings);
+    s.camera.look_at = s.camera.position;
+    assert_int_equal(rt_render_check_limits(&s, "cam.txt", true, &err), RT_ERR_INVALID);
+    expect_message(&err, "cam.txt: the camera is degenerate", NULL);
+    rt_log_level was = rt_log_get_level();
+    rt_log_set_level(RT_LOG_QUIET); /* the automatic camera's warning */
+    assert_int_equal(rt_render_check_limits(&s, "auto.glb", false, &err), RT_OK);
+    rt_log_set_level(was);
     rt_scene_free(&s);
 }
 
@@ -469,6 +510,7 @@ int main(void)
         cmocka_unit_test(test_image_header_limits),
         cmocka_unit_test(test_memory_budget_makes_clean_errors),
         cmocka_unit_test(test_kdtree_primitive_cap),
+        cmocka_unit_test(test_render_limits),
         cmocka_unit_test(test_scene_numbers_and_caps),
         cmocka_unit_test(test_mesh_numbers),
         cmocka_unit_test(test_same_image_any_threads_and_tiles),

@@ -18,9 +18,15 @@
  *     (index-matched) chords, against exp(-sum sigma_i d_i);
  *   - ten nested absorbing shells (more than the stack holds) along a
  *     diameter: overflow and underflow together still give the exact
- *     transmittance.
+ *     transmittance;
+ *   - `whitted` under the same rules: the water ball in the glass ball
+ *     reflects exactly the Fresnel reflectance between 1.5 and 1.333 (its
+ *     refracted light is cut by a black transmission colour, so the image
+ *     is that reflectance, deterministically), and with the water's
+ *     priority below the glass's the ray passes untouched.
  */
 #include "test_util.h"
+#include "test_fixture.h"
 
 #include <math.h>
 
@@ -29,32 +35,14 @@
 #include "rt/render/bsdf.h"
 #include "rt/render/medium.h"
 #include "rt/render/pathtrace.h"
+#include "rt/render/whitted.h"
 #include "rt/scene/scene.h"
 
-typedef struct fixture {
-    rt_scene s;
-    rt_kdtree tree;
-    rt_render_state rs;
-    rt_trace_ctx ctx;
-} fixture;
+typedef test_fixture fixture; /* test_fixture.h */
 
-static void load(fixture *f, const char *text)
-{
-    rt_error err;
-    rt_scene_init(&f->s);
-    if (rt_scene_parse_string(&f->s, text, strlen(text), "test", NULL, &err) != RT_OK)
-        fail_msg("parse: %s", err.message);
-    assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
-    assert_int_equal(rt_render_state_prepare(&f->rs, &f->s, &f->tree, 0, &err), RT_OK);
-    rt_trace_ctx_init(&f->ctx, &f->rs);
-}
+static void load(fixture *f, const char *text) { test_fixture_load(f, text, 0); }
 
-static void unload(fixture *f)
-{
-    rt_render_state_free(&f->rs);
-    rt_kdtree_free(&f->tree);
-    rt_scene_free(&f->s);
-}
+static void unload(fixture *f) { test_fixture_free(f); }
 
 static rt_vec3 radiance(const fixture *f, rt_vec3 org, rt_vec3 dir, uint32_t i)
 {
@@ -269,6 +257,47 @@ static void test_overflow_underflow_exact(void **state)
     unload(&f);
 }
 
+/* The glass of water for `whitted`: every transmissive material is a
+ * medium of its stack, under the path tracer's priority rules. */
+static void test_whitted_glass_of_water(void **state)
+{
+    (void)state;
+    fixture f;
+    load(&f, "integrator whitted\nmax_bounce 8\nbackground 1 1 1\n"
+             "material glass bsdf dielectric ior 1.5 exterior_ior 1.5 priority 1\n"
+             "material water bsdf dielectric ior 1.333 priority 2 transmission_color 0 0 0\n"
+             "sphere 0 0 0 2 glass\nsphere 0 0 0 1 water\n");
+    const float sines[] = {0.0f, 0.5f, 0.8f, 0.87f, 0.95f};
+    for (int k = 0; k < 5; k++) {
+        double c = sqrt(1.0 - (double)sines[k] * sines[k]);
+        double want = fresnel_d(c, 1.5, 1.333), air = fresnel_d(c, 1.0, 1.333);
+        rt_rng rng = rt_rng_for_sample(29, (uint32_t)k, 0);
+        rt_ray r = rt_ray_make(rt_v3(sines[k], 0, 5), rt_v3(0, 0, -1), 0.0f, INFINITY);
+        rt_vec3 L = rt_radiance_whitted(&f.ctx, &r, &rng);
+        fprintf(stderr, "whitted, water in glass, sin %.2f: %.5f, Fresnel 1.5/1.333 %.5f (water in air %.5f)\n",
+                (double)sines[k], (double)L.y, want, air);
+        if (fabs(L.y - want) > 2e-4 || fabs(L.x - L.y) > 1e-6 || fabs(L.z - L.y) > 1e-6)
+            fail_msg("sin %.2f: reflectance %.5f, want %.5f", (double)sines[k], (double)L.y, want);
+        assert_true(k == 4 || fabs(L.y - air) > 0.01); /* not the water-air interface */
+    }
+    unload(&f);
+    /* the water's priority below the glass's: its surface is false, the
+     * clear glass fills the ball and the ray passes untouched */
+    load(&f, "integrator whitted\nmax_bounce 8\nbackground 1 1 1\n"
+             "material glass bsdf dielectric ior 1.5 exterior_ior 1.5 priority 2\n"
+             "material water bsdf dielectric ior 1.333 priority 1 transmission_color 0 0 0\n"
+             "sphere 0 0 0 2 glass\nsphere 0 0 0 1 water\n");
+    for (uint32_t i = 0; i < 16; i++) {
+        rt_rng rng = rt_rng_for_sample(29, i, 0);
+        rt_ray r = rt_ray_make(rt_v3(0.06f * (float)i, 0.01f, 5), rt_v3(0, 0, -1), 0.0f, INFINITY);
+        rt_vec3 L = rt_radiance_whitted(&f.ctx, &r, &rng);
+        if (fabsf(L.x - 1.0f) > 1e-5f || fabsf(L.y - 1.0f) > 1e-5f || fabsf(L.z - 1.0f) > 1e-5f)
+            fail_msg("x %.2f: %.6f %.6f %.6f, want the background 1 untouched", 0.06 * i, (double)L.x,
+                     (double)L.y, (double)L.z);
+    }
+    unload(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -276,6 +305,7 @@ int main(void)
         cmocka_unit_test(test_glass_of_water_fresnel),
         cmocka_unit_test(test_absorption_where_each_medium_is),
         cmocka_unit_test(test_overflow_underflow_exact),
+        cmocka_unit_test(test_whitted_glass_of_water),
     };
     return cmocka_run_group_tests_name("medium", tests, NULL, NULL);
 }

@@ -482,6 +482,44 @@ static void test_settings_text_form(void **state)
     rt_scene_free(&s);
 }
 
+/* docs/scene-format.md's materials table (section 5) has a row for every
+ * material key the parser knows: a row whose first cell names it
+ * (`KEY ...` or `KEY`, maybe after another key of the same row). */
+static void test_material_keys_in_docs(void **state)
+{
+    (void)state;
+    FILE *f = fopen("docs/scene-format.md", "rb");
+    assert_non_null(f);
+    static char doc[1 << 17];
+    size_t n = fread(doc, 1, sizeof doc - 1, f);
+    fclose(f);
+    doc[n] = '\0';
+    char *sec = strstr(doc, "\n## 5. Materials\n");
+    assert_non_null(sec);
+    char *end = strstr(sec + 1, "\n## ");
+    if (end)
+        *end = '\0';
+    int missing = 0;
+    for (size_t i = 0; rt_scene_material_key(i); i++) {
+        const char *key = rt_scene_material_key(i);
+        bool found = false;
+        for (const char *row = strstr(sec, "\n| `"); row && !found; row = strstr(row + 1, "\n| `")) {
+            const char *cell_end = strstr(row + 3, " |");
+            char a[96], b[96];
+            snprintf(a, sizeof a, "`%s ", key);
+            snprintf(b, sizeof b, "`%s`", key);
+            const char *x = strstr(row, a), *y = strstr(row, b);
+            found = (x && x < cell_end) || (y && y < cell_end);
+        }
+        if (!found) {
+            print_error("docs/scene-format.md section 5 has no row for material key `%s`\n", key);
+            missing++;
+        }
+    }
+    assert_true(rt_scene_material_key(0) != NULL);
+    assert_int_equal(missing, 0);
+}
+
 /* docs/scene-format.md's settings table lists every setting of the table,
  * written as `name words`, with the table's default and allowed values. */
 static void test_settings_table_in_docs(void **state)
@@ -1288,6 +1326,7 @@ int main(void)
         cmocka_unit_test(test_settings_table_defaults),
         cmocka_unit_test(test_settings_text_form),
         cmocka_unit_test(test_settings_table_in_docs),
+        cmocka_unit_test(test_material_keys_in_docs),
         cmocka_unit_test(test_camera_values),
         cmocka_unit_test(test_material_values),
         cmocka_unit_test(test_primitive_values),

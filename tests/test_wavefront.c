@@ -1,7 +1,8 @@
 /* test_wavefront.c - the batch traversal and the wavefront path tracer:
  *   - rt_kdtree_intersect_batch / rt_kdtree_occluded_batch against the
  *     single-ray calls, bit for bit, over triangles, spheres and quads, for
- *     random rays traced in a shuffled subset of lanes;
+ *     random rays traced in a shuffled subset of lanes, and for fans of
+ *     rays from one point (which the batch traces as packets);
  *   - the wavefront tracer against the scalar one (rt_radiance_path), sample
  *     by sample, bit for bit, for batch sizes from 1 to 4096 and work split
  *     every way, on a scene of every material kind (alpha blending and
@@ -15,6 +16,7 @@
  *     image means within 1.5% and RMSE within the scalar's own noise.
  */
 #include "test_util.h"
+#include "test_fixture.h"
 #include "test_scenes.h"
 
 #include <math.h>
@@ -127,28 +129,69 @@ static void test_batch_traversal_matches_single_rays(void **state)
     rt_scene_free(&s);
 }
 
+/* Camera-like rays: runs of 1 to 12 rays from one eye point in a narrow
+ * fan (the wavefront's camera rays, which the batch traces as 8-ray
+ * packets), some fans straddling an axis (mixed direction signs), through
+ * the soup: every answer bit for bit a single ray's. */
+static void test_batch_packets_match_single_rays(void **state)
+{
+    (void)state;
+    rt_scene s;
+    soup_scene(&s);
+    rt_kdtree tree;
+    rt_error err;
+    assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
+    enum { N = 4096 };
+    static float ox[N], oy[N], oz[N], dx[N], dy[N], dz[N], tmin[N], tmax[N], t[N], u[N], v[N];
+    static uint32_t prim[N];
+    test_rng r = {777};
+    int i = 0, runs = 0;
+    while (i < N) {
+        int len = 1 + (int)(test_rng_next(&r) % 12);
+        rt_vec3 eye = rt_v3(rnd(&r, -1.0f, 2.0f), rnd(&r, -1.0f, 2.0f), -1.5f);
+        rt_vec3 at = rt_v3(rnd(&r, 0.2f, 0.8f), rnd(&r, 0.2f, 0.8f), 0.5f);
+        float spread = runs % 5 == 0 ? 0.3f : 0.01f; /* wide fans cross axes */
+        for (int k = 0; k < len && i < N; k++, i++) {
+            rt_vec3 d = rt_sub(rt_add(at, rt_v3(rnd(&r, -spread, spread), rnd(&r, -spread, spread), 0.0f)), eye);
+            ox[i] = eye.x, oy[i] = eye.y, oz[i] = eye.z;
+            dx[i] = d.x, dy[i] = d.y, dz[i] = d.z;
+            tmin[i] = 0.0f;
+            tmax[i] = k == 3 ? 1.0f : INFINITY;
+        }
+        runs++;
+    }
+    rt_ray_batch rb = {ox, oy, oz, dx, dy, dz, tmin, tmax};
+    rt_hit_batch hb = {t, u, v, prim};
+    size_t hits = rt_kdtree_intersect_batch(&tree, &rb, NULL, N, &hb);
+    size_t want = 0;
+    for (int k = 0; k < N; k++) {
+        rt_ray ray = rt_ray_make(rt_v3(ox[k], oy[k], oz[k]), rt_v3(dx[k], dy[k], dz[k]), tmin[k], tmax[k]);
+        rt_hit h;
+        if (rt_kdtree_intersect(&tree, &ray, &h)) {
+            want++;
+            assert_int_equal(prim[k], h.prim);
+            assert_memory_equal(&t[k], &h.t, sizeof h.t);
+            assert_memory_equal(&u[k], &h.u, sizeof h.u);
+            assert_memory_equal(&v[k], &h.v, sizeof h.v);
+        } else {
+            assert_int_equal(prim[k], RT_NONE);
+        }
+    }
+    assert_int_equal(hits, want);
+    fprintf(stderr, "%d fans, %zu of %d rays hit\n", runs, hits, N);
+    assert_true(hits > N / 10 && hits < N);
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
 /* ------------------------------------------------------------ wavefront */
 
 static const char *every_material =
     "integrator path\nresolution 24 16\nsamples 6\nbackground 0.2 0.3 0.4\n" TEST_EVERY_MATERIAL_SCENE;
 
-typedef struct fixture {
-    rt_scene s;
-    rt_kdtree tree;
-    rt_render_state rs;
-    rt_trace_ctx ctx;
-} fixture;
+typedef test_fixture fixture; /* test_fixture.h */
 
-static void load_text(fixture *f, const char *text)
-{
-    rt_error err;
-    rt_scene_init(&f->s);
-    if (rt_scene_parse_string(&f->s, text, strlen(text), "test", NULL, &err) != RT_OK)
-        fail_msg("parse: %s", err.message);
-    assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
-    assert_int_equal(rt_render_state_prepare(&f->rs, &f->s, &f->tree, RT_PREPARE_LIGHT_TABLE, &err), RT_OK);
-    rt_trace_ctx_init(&f->ctx, &f->rs);
-}
+static void load_text(fixture *f, const char *text) { test_fixture_load(f, text, RT_PREPARE_LIGHT_TABLE); }
 
 static void load_cornell(fixture *f, int res)
 {
@@ -162,12 +205,7 @@ static void load_cornell(fixture *f, int res)
     f->s.settings.width = f->s.settings.height = res;
 }
 
-static void unload(fixture *f)
-{
-    rt_render_state_free(&f->rs);
-    rt_kdtree_free(&f->tree);
-    rt_scene_free(&f->s);
-}
+static void unload(fixture *f) { test_fixture_free(f); }
 
 /* Every sample of rows [y0, y1) of the image through the wavefront with
  * the given batch size and pixels per work unit, against rt_radiance_path. */
@@ -408,6 +446,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_batch_traversal_matches_single_rays),
+        cmocka_unit_test(test_batch_packets_match_single_rays),
         cmocka_unit_test(test_wavefront_equals_scalar),
         cmocka_unit_test(test_render_bytes_any_split),
         cmocka_unit_test(test_cornell_reference_wavefront),

@@ -13,8 +13,9 @@
  *                   end flag, then the triangles it is the first to use);
  *   kdtree_trace.c  rt_kdtree_intersect and rt_kdtree_occluded over those
  *                   arrays (the AVX2 step and the portable one);
- *   kdtree_packet.c rt_kdtree_intersect8: up to 8 coherent rays through
- *                   the same arrays at once (the leaves by kdtree_trace.c).
+ *   kdtree_packet.c rt_kdtree_intersect8 and rt_kdtree_occluded8: up to 8
+ *                   coherent rays through the same arrays at once (one
+ *                   walk for both; the leaves by kdtree_trace.c).
  *
  * Only the build and packing use rt_kdtree_node; the traversal reads
  * nothing but rt_kdtree and this file's KD_MAX_DEPTH and KD_IDS_PAD.
@@ -103,9 +104,9 @@ typedef struct kd_ray {
  * set-up repeats ray_setup's operations for 8 rays in lanes): the
  * primitives of one leaf reference (RT_KD_ONE or RT_KD_LEAF) tested on
  * (ray->tmin, *best), as the single-ray traversal tests them; hit->prim is
- * the tree's primitive id. */
+ * the tree's primitive id. any: stop at the first hit (occlusion). */
 bool rt_kd_leaf_hit(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr, float *best,
-                    rt_hit *hit);
+                    rt_hit *hit, bool any);
 /* One primitive (a tree id, as in a leaf list) for one ray, the same way. */
 bool rt_kd_prim_hit(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
                     rt_hit *hit);

@@ -44,11 +44,12 @@
 #define KD_PACKET_SIMD 1
 #endif
 
-static unsigned single_rays(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits)
+/* The packet as single rays: closest hits into hits, or (any) occlusion. */
+static unsigned single_rays(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, bool any)
 {
     unsigned mask = 0;
     for (int i = 0; i < n; i++)
-        if (rt_kdtree_intersect(tree, &rays[i], &hits[i]))
+        if (any ? rt_kdtree_occluded(tree, &rays[i]) : rt_kdtree_intersect(tree, &rays[i], &hits[i]))
             mask |= 1u << i;
     return mask;
 }
@@ -144,16 +145,23 @@ typedef struct kd_pentry {
     uint32_t ref;
 } kd_pentry;
 
-unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits)
+#if defined(__GNUC__)
+#define KD_PINLINE static inline __attribute__((always_inline))
+#else
+#define KD_PINLINE static inline
+#endif
+
+/* The one packet walk of both entry points; any = occlusion: a ray is done
+ * at its first hit (its lane leaves the active mask and its closest-so-far
+ * becomes -inf, so no cell is entered or popped for it), and hits is not
+ * written. n is 1..8. */
+KD_PINLINE unsigned packet_walk(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, bool any)
 {
-    if (n < 1)
-        return 0;
-    if (n > 8)
-        n = 8;
     if (tree->root == RT_KD_EMPTY || rt_box_is_empty(tree->bounds))
         return 0;
-    for (int i = 0; i < n; i++)
-        hits[i].prim = RT_NONE;
+    if (!any)
+        for (int i = 0; i < n; i++)
+            hits[i].prim = RT_NONE;
     /* kdtree_trace.c's ray set-up (ray_accept and the AVX2 ray_setup), the
      * same operations with the 8 rays in lanes: rt_ray is 8 floats, so the
      * rays come in by an 8x8 transpose (lanes past n repeat ray 0, idle) */
@@ -209,12 +217,12 @@ unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, 
     if (!active)
         return 0;
     if ((unsigned)_mm256_movemask_ps(par) & active)
-        return single_rays(tree, rays, n, hits); /* a ray parallel to an axis */
+        return single_rays(tree, rays, n, hits, any); /* a ray parallel to an axis */
     int neg[3];
     for (int k = 0; k < 3; k++) {
         unsigned nm = (unsigned)_mm256_movemask_ps(negm[k]) & active;
         if (nm && nm != active)
-            return single_rays(tree, rays, n, hits); /* the cells' order differs */
+            return single_rays(tree, rays, n, hits, any); /* the cells' order differs */
         neg[k] = nm != 0;
     }
     /* idle lanes: an empty interval, no hit to improve */
@@ -316,6 +324,8 @@ unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, 
                                 found |= 1u << i;
                         }
                     }
+                    if (any && !(m &= ~found)) /* occlusion: the rays that hit are done */
+                        break;
                     if (ref >= RT_KD_ONE || (*p & RT_KD_LAST))
                         break;
                 }
@@ -323,9 +333,16 @@ unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, 
                 while (m) {
                     int i = __builtin_ctz(m);
                     m &= m - 1;
-                    if (rt_kd_leaf_hit(tree, ref, &rays[i], &tr[i], &best[i], &h[i]))
+                    if (rt_kd_leaf_hit(tree, ref, &rays[i], &tr[i], &best[i], &h[i], any))
                         found |= 1u << i;
                 }
+            }
+            if (any && (found & active)) {
+                active &= ~found;
+                if (!active)
+                    goto done;
+                for (unsigned d = found; d; d &= d - 1)
+                    best[__builtin_ctz(d)] = -INFINITY;
             }
             BEST = _mm256_load_ps(best);
         }
@@ -340,6 +357,8 @@ unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, 
         ref = stack[sp].ref, L = stack[sp].lo, H = stack[sp].hi;
     }
 done:
+    if (any)
+        return found;
     for (int i = 0; i < n; i++)
         if (found >> i & 1) {
             hits[i] = h[i];
@@ -347,9 +366,24 @@ done:
         }
     return found;
 }
+
+unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits)
+{
+    return n < 1 ? 0 : packet_walk(tree, rays, n > 8 ? 8 : n, hits, false);
+}
+
+unsigned rt_kdtree_occluded8(const rt_kdtree *tree, const rt_ray *rays, int n)
+{
+    return n < 1 ? 0 : packet_walk(tree, rays, n > 8 ? 8 : n, NULL, true);
+}
 #else
 unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits)
 {
-    return single_rays(tree, rays, n > 8 ? 8 : n, hits);
+    return n < 1 ? 0 : single_rays(tree, rays, n > 8 ? 8 : n, hits, false);
+}
+
+unsigned rt_kdtree_occluded8(const rt_kdtree *tree, const rt_ray *rays, int n)
+{
+    return n < 1 ? 0 : single_rays(tree, rays, n > 8 ? 8 : n, NULL, true);
 }
 #endif

@@ -807,12 +807,12 @@ KD_FLATTEN bool rt_kdtree_occluded(const rt_kdtree *tree, const rt_ray *ray)
 /* For the packet traversal (kdtree_packet.c): one leaf, or one primitive,
  * for one ray, out of line. */
 KD_FLATTEN bool rt_kd_leaf_hit(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr, float *best,
-                               rt_hit *hit)
+                               rt_hit *hit, bool any)
 {
     if (ref >= RT_KD_ONE)
         return test_prim(tree, ref & RT_KD_PAYLOAD, ray, tr, best, hit);
     const uint32_t *p = tree->prim_ids + (ref & RT_KD_PAYLOAD);
-    return test_leaf(tree, p, leaf_length(p), ray, tr, best, hit, false);
+    return test_leaf(tree, p, leaf_length(p), ray, tr, best, hit, any);
 }
 
 KD_FLATTEN bool rt_kd_prim_hit(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,

@@ -10,15 +10,21 @@ static rt_log_level log_level = RT_LOG_NORMAL;
 void rt_log_set_level(rt_log_level level) { log_level = level; }
 rt_log_level rt_log_get_level(void) { return log_level; }
 
+/* One line on stderr: the prefix, the message, a newline. */
+static void vline(const char *prefix, const char *fmt, va_list ap)
+{
+    fputs(prefix, stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+}
+
 void rt_warn(const char *fmt, ...)
 {
     if (log_level < RT_LOG_NORMAL)
         return;
     va_list ap;
     va_start(ap, fmt);
-    fputs("rt: warning: ", stderr);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    vline("rt: warning: ", fmt, ap);
     va_end(ap);
 }
 
@@ -28,8 +34,6 @@ void rt_info(const char *fmt, ...)
         return;
     va_list ap;
     va_start(ap, fmt);
-    fputs("rt: ", stderr);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    vline("rt: ", fmt, ap);
     va_end(ap);
 }

@@ -17,6 +17,7 @@
 
 #include "rt/base/log.h"
 #include "rt/base/number.h"
+#include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
 #include "rt/render/render.h"
 #include "tev.h"
@@ -48,6 +49,7 @@ typedef enum flag_kind {
     FLAG_TONEMAP,
     FLAG_HALF,
     FLAG_DENOISE,
+    FLAG_DENOISE_QUALITY,
     FLAG_AOV,
     FLAG_CROP,
     FLAG_PART,
@@ -81,7 +83,10 @@ static const flag flags[] = {
     {NULL, "--tonemap", "NAME", FLAG_TONEMAP, NULL, "tone curve for 8-bit output: clamp (default), filmic, aces or agx"},
     {NULL, "--half", NULL, FLAG_HALF, NULL, "EXR output in 16-bit half floats (default 32-bit float)"},
     {NULL, "--denoise", NULL, FLAG_DENOISE, NULL,
-     "denoise the render with Intel Open Image Denoise (install it with 'make denoiser')"},
+     "denoise the render with Intel Open Image Denoise (install it with 'make denoiser'), on -t threads"},
+    {NULL, "--denoise-quality", "NAME", FLAG_DENOISE_QUALITY, NULL,
+     "the denoiser's quality with --denoise: fast, balanced (default) or high (the same as RT_OIDN_QUALITY=NAME; "
+     "the flag wins)"},
     {NULL, "--aov", "LIST", FLAG_AOV, NULL,
      "extra images, comma-separated: albedo, normal, depth, position, variance, spp; layers of an .exr output, "
      "else files NAME.albedo.pfm ..."},
@@ -549,6 +554,10 @@ int args_parse(args *a, int argc, char **argv)
         case FLAG_DENOISE:
             a->denoise = true;
             break;
+        case FLAG_DENOISE_QUALITY:
+            if (!rt_denoise_quality_parse(value, &a->denoise_quality))
+                return fail_usage("%s wants %s, got '%s'", name, RT_DENOISE_QUALITY_NAMES, value);
+            break;
         case FLAG_AOV: {
             const char *s = value;
             while (*s) {
@@ -660,6 +669,8 @@ int args_parse(args *a, int argc, char **argv)
             break;
         }
     }
+    if (a->denoise_quality != RT_DENOISE_DEFAULT && !a->denoise)
+        return fail_usage("--denoise-quality goes with --denoise (rt --denoise --denoise-quality high ...)");
     if (a->part_count && a->has_crop)
         return fail_usage("--part and --crop both choose the region; give one of them");
     if (a->has_frames && a->posed && a->frame_time != 0.0f)

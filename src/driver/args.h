@@ -24,6 +24,7 @@
 #include "memory_budget.h"
 #include "rt/base/error.h"
 #include "rt/base/log.h"
+#include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/settings.h"
@@ -73,6 +74,7 @@ typedef struct args {
     rt_tonemap tonemap;     /* --tonemap: the curve for 8-bit output */
     bool half;              /* --half: EXR in half floats */
     bool denoise;           /* --denoise: Intel Open Image Denoise on the render */
+    rt_denoise_quality denoise_quality; /* --denoise-quality; RT_DENOISE_DEFAULT: RT_OIDN_QUALITY, else balanced */
     unsigned aovs;          /* --aov: bit k for aov_names[k] */
     /* parts of a render spread over machines (docs/farm.md) */
     bool has_crop;          /* --crop X0 Y0 X1 Y1 */

@@ -40,6 +40,7 @@
 #include "rt/io/framebuffer.h"
 #include "rt/io/load.h"
 #include "rt/render/integrator.h"
+#include "rt/render/limits.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/settings.h"
@@ -49,19 +50,14 @@
 #include "commands.h"
 #include "memory_budget.h"
 #include "frames.h"
+#include "info.h"
+#include "input.h"
 #include "output.h"
 #include "part.h"
 #include "progress.h"
 #include "tev.h"
 #include "viewer.h"
 #include "window.h"
-
-/* The kd-tree's primitive ids are the 30 payload bits of its references
- * (RT_KD_PAYLOAD, rt/accel/kdtree.h), one value kept free. */
-#define MAX_PRIMITIVES ((size_t)RT_KD_PAYLOAD - 1)
-/* whitted: rays a camera sample may spawn through diffuse gathering
- * (diffuse_rays ^ diffuse_bounces); more is a render that never ends. */
-#define MAX_DIFFUSE_TREE ((double)(1 << 24))
 
 /* What the signal handler shares with the render: the first signal's
  * number, the render's cancel flag (raised by the first signal, and by
@@ -83,213 +79,6 @@ static void on_signal(int sig)
         signal(sig, SIG_DFL);
         raise(sig);
     }
-}
-
-/* Prints an error; out-of-memory errors also say which budget ran out and
- * how to raise it. */
-static void report(const rt_error *err, const memory_budget *budget)
-{
-    fprintf(stderr, "rt: %s\n", err->message);
-    if (err->code != RT_ERR_NOMEM)
-        return;
-    if (budget->enforced) {
-        char sz[32];
-        memory_budget_format(budget->bytes, sz, sizeof sz);
-        fprintf(stderr,
-                "rt: the memory budget of %s (%s) ran out; raise it with --max-memory SIZE (e.g. --max-memory 16G, or "
-                "'none' for no limit)\n",
-                sz, budget->from_flag ? "--max-memory" : "the default, 75% of physical memory");
-    } else {
-        fprintf(stderr, "rt: the machine's memory ran out (no --max-memory budget was in force)\n");
-    }
-}
-
-/* Output name: -o, else the scene's `output`, else the input's base name
- * with .png, in the current directory. */
-static void default_output(const rt_scene *s, const char *input, char *out, size_t size)
-{
-    if (s && s->settings.output[0]) {
-        snprintf(out, size, "%s", s->settings.output);
-        return;
-    }
-    if (!input || strcmp(input, "-") == 0) {
-        snprintf(out, size, "out.png");
-        return;
-    }
-    const char *base = strrchr(input, '/');
-    base = base ? base + 1 : input;
-    const char *dot = strrchr(base, '.');
-    int len = dot && dot != base ? (int)(dot - base) : (int)strlen(base);
-    snprintf(out, size, "%.*s.png", len, base);
-}
-
-/* Caps on what a loaded scene may ask for, checked before any large
- * allocation of the render: the primitive count the kd-tree can index, a
- * diffuse-gather tree that would never finish, a usable camera, and every
- * setting in the range of the settings table (flags and the parser check
- * them as they read them; this catches what loaders set). */
-static rt_result check_limits(rt_scene *s, const char *name, bool camera_from_input, rt_error *err)
-{
-    size_t prims = rt_scene_prim_count(s);
-    if (prims > MAX_PRIMITIVES)
-        return rt_fail(err, RT_ERR_LIMIT, "%s: %zu primitives (triangles %zu, spheres %zu, quads %zu), over the limit of %zu",
-                       name, prims, s->triangles.count, s->spheres.count, s->quads.count, MAX_PRIMITIVES);
-    const rt_settings *set = &s->settings;
-    rt_setting_problem pb;
-    if (rt_settings_check(set, &pb) != RT_OK)
-        return rt_fail(err, RT_ERR_LIMIT, "%s: %s", name, pb.message);
-    if (set->integrator == RT_INTEGRATOR_WHITTED && set->diffuse_bounces > 0 && set->diffuse_rays > 1) {
-        double rays = 1.0;
-        for (int i = 0; i < set->diffuse_bounces && rays <= MAX_DIFFUSE_TREE; i++)
-            rays *= (double)set->diffuse_rays;
-        if (rays > MAX_DIFFUSE_TREE)
-            return rt_fail(err, RT_ERR_LIMIT,
-                           "%s: diffuse_rays %d with diffuse_bounces %d would trace over %.0f rays per camera sample "
-                           "(diffuse_rays ^ diffuse_bounces); lower one of them",
-                           name, set->diffuse_rays, set->diffuse_bounces, MAX_DIFFUSE_TREE);
-    }
-    rt_camera_frame cf;
-    if (!rt_camera_frame_init(&cf, &s->camera, set->width, set->height)) {
-        if (camera_from_input)
-            return rt_fail(err, RT_ERR_INVALID,
-                           "%s: the camera is degenerate (position equal to look_at, up parallel to the view, a field of "
-                           "view outside 0..180 degrees, or a value that is not finite)",
-                           name);
-        rt_warn("%s: could not frame the model automatically (its bounds are empty or not finite); looking down -z",
-                name);
-    }
-    return RT_OK;
-}
-
-/* The input as rt_load takes it: a path, NULL for the built-in scene, or
- * "-" for standard input, read whole and loaded from memory as "<stdin>"
- * (scene text, or glTF or a mesh by its content; relative paths in it
- * resolve against the current directory). */
-static rt_result load_input(rt_scene *s, const char *input, const rt_load_options *lo, rt_load_info *info,
-                            rt_error *err)
-{
-    if (!input || strcmp(input, "-") != 0)
-        return rt_load(s, input, lo, info, err);
-    memset(info, 0, sizeof *info);
-    if (isatty(0))
-        return rt_fail(err, RT_ERR_IO,
-                       "-: standard input is a terminal; pipe a scene in (rt - < scene.txt, or cat model.glb | rt -)");
-    char *bytes;
-    size_t size;
-    rt_error inner = {0};
-    if (rt_read_file("/dev/stdin", 0, &bytes, &size, &inner) != RT_OK) {
-        const char *what = strncmp(inner.message, "/dev/stdin: ", 12) == 0 ? inner.message + 12 : inner.message;
-        return rt_fail(err, inner.code, "<stdin>: %s", what);
-    }
-    rt_result r = rt_load_memory(s, bytes, size, "<stdin>", lo, info, err);
-    free(bytes);
-    return r;
-}
-
-/* The name messages use for an input. */
-static const char *input_name(const char *input)
-{
-    return !input ? "<built-in scene>" : strcmp(input, "-") == 0 ? "<stdin>" : input;
-}
-
-static void print_vec(const char *key, rt_vec3 v) { printf("%s: %.9g %.9g %.9g\n", key, v.x, v.y, v.z); }
-
-/* --info for one input: one `key: value` line per figure, for people and
- * scripts. The counts are the file's own (loaded as it is); the settings
- * and camera are what `rt FILE` would render with, before any flag. */
-static int print_info(const char *path, const args *a)
-{
-    const memory_budget *budget = &a->budget;
-    rt_scene s;
-    rt_scene_init(&s);
-    rt_error err = {0};
-    rt_load_info info;
-    rt_load_options lo = {.use_time = a->posed, .time = a->frame_time, .animation = a->animation};
-    rt_result r = load_input(&s, path, &lo, &info, &err);
-    if (r != RT_OK) {
-        report(&err, budget);
-        rt_scene_free(&s);
-        return 2;
-    }
-    rt_box b = rt_scene_bounds(&s);
-    printf("file: %s\n", input_name(path));
-    printf("format: %s\n", rt_load_kind_name(info.kind));
-    printf("triangles: %zu\n", s.triangles.count);
-    printf("vertices: %zu\n", s.vertices.count);
-    printf("spheres: %zu\n", s.spheres.count);
-    printf("quads: %zu\n", s.quads.count);
-    if (rt_box_is_empty(b))
-        printf("bounds: none\n");
-    else
-        printf("bounds: %.9g %.9g %.9g %.9g %.9g %.9g\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
-    if (info.kind != RT_LOAD_SCENE) {
-        printf("meshes: %zu\n", info.meshes);
-        printf("primitives: %zu\n", info.primitives);
-    }
-    if (info.kind == RT_LOAD_GLTF)
-        printf("nodes: %zu\n", info.nodes);
-    printf("materials: %zu\n", s.material_count);
-    printf("textures: %zu\n", s.texture_count);
-    printf("images: %zu\n", s.image_count);
-    for (size_t i = 0; i < s.image_count; i++)
-        printf("image.%zu: %dx%d %s\n", i, s.images[i].width, s.images[i].height, s.images[i].name);
-    printf("cameras: %zu\n", s.camera_count);
-    printf("lights: %zu\n", s.light_count);
-
-    /* how it would render */
-    rt_settings set = s.settings;
-    if (info.kind != RT_LOAD_SCENE)
-        rt_load_model_settings(&set);
-    const rt_camera *cam = NULL;
-    if (s.camera_set) {
-        printf("camera: scene file\n");
-        cam = &s.camera;
-    } else if (info.kind == RT_LOAD_GLTF && s.camera_count) {
-        printf("camera: gltf camera 0\n");
-        cam = &s.cameras[0];
-        if (cam->aspect_ratio > 0.0f) { /* the width follows the camera's aspect ratio */
-            double w = (double)set.height * cam->aspect_ratio + 0.5;
-            set.width = w < 1.0 ? 1 : (w > (double)RT_MAX_IMAGE_SIDE ? RT_MAX_IMAGE_SIDE : (int)w);
-        }
-    } else {
-        printf("camera: auto (framed to the bounds)\n");
-    }
-    if (cam) {
-        print_vec("camera.position", cam->position);
-        print_vec("camera.look_at", cam->look_at);
-        print_vec("camera.up", cam->up);
-        printf("camera.fov: %.9g\n", cam->vfov_deg);
-    }
-    s.settings = set;
-    char output[1024];
-    default_output(&s, path, output, sizeof output);
-    printf("resolution: %dx%d\n", set.width, set.height);
-    printf("samples: %d\n", set.samples);
-    printf("integrator: %s\n", rt_integrator_name(set.integrator));
-    printf("output: %s\n", output);
-    printf("load_ms: %.3f\n", info.load_ms);
-    rt_scene_free(&s);
-    return 0;
-}
-
-/* --info FILE [FILE...]: one block each, a blank line between; exit 2 when
- * any of them failed to load (the others are still reported). */
-static int print_infos(const args *a)
-{
-    int status = print_info(a->info_path, a);
-    const char *rest[ARGS_MAX_INPUTS + 1];
-    size_t n = 0;
-    if (a->input)
-        rest[n++] = a->input;
-    for (size_t i = 0; i < a->more_input_count; i++)
-        rest[n++] = a->more_inputs[i];
-    for (size_t i = 0; i < n; i++) {
-        printf("\n");
-        fflush(stdout);
-        if (print_info(rest[i], a) != 0)
-            status = 2;
-    }
-    return status;
 }
 
 /* --look-from, --look-at, --up, --fov over the file's or the framed camera;
@@ -355,11 +144,11 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
         return r;
     if (!a->output && !args_sets(a, "output") && a->input && strcmp(a->input, "-") != 0 &&
         !rt_load_is_scene_name(a->input)) {
-        default_output(NULL, a->input, output, size);
+        input_default_output(NULL, a->input, output, size);
         if ((r = rt_output_check(output, err)) != RT_OK)
             return r;
     }
-    if ((r = load_input(scene, a->input, &lo, &info, err)) != RT_OK)
+    if ((r = input_load(scene, a->input, &lo, &info, err)) != RT_OK)
         return r;
     if ((r = rt_scene_validate(scene, err)) != RT_OK) { /* from here on the tables are trusted */
         rt_error inner = *err;
@@ -385,22 +174,20 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     }
     /* a glTF camera made for another aspect ratio: keep the height, fit the width */
     if (!args_sets(a, "resolution") && a->input && info.kind == RT_LOAD_GLTF && scene->camera_set &&
-        scene->camera.aspect_ratio > 0.0f) {
-        double w = (double)set->height * scene->camera.aspect_ratio + 0.5;
-        set->width = w < 1.0 ? 1 : (w > (double)RT_MAX_IMAGE_SIDE ? RT_MAX_IMAGE_SIDE : (int)w);
-    }
+        scene->camera.aspect_ratio > 0.0f)
+        set->width = input_width_for_aspect(set->height, scene->camera.aspect_ratio);
     bool camera_from_input = scene->camera_set;
     if (!scene->camera_set)
         rt_scene_frame_camera(scene);
     if ((r = apply_pose_flags(scene, a, err)) != RT_OK)
         return r;
-    if ((r = check_limits(scene, input_name(a->input), camera_from_input, err)) != RT_OK)
+    if ((r = rt_render_check_limits(scene, input_name(a->input), camera_from_input, err)) != RT_OK)
         return r;
 
     if (a->output)
         snprintf(output, size, "%s", a->output);
     else
-        default_output(scene, a->input, output, size);
+        input_default_output(scene, a->input, output, size);
     if ((r = rt_output_check(output, err)) != RT_OK ||
         (r = rt_output_check_size(output, set->width, set->height, err)) != RT_OK)
         return r;
@@ -431,7 +218,7 @@ static int write_result(const args *a, const rt_settings *set, const part_job *p
     int status = 0;
     if (r != RT_OK && r != RT_ERR_INTERRUPTED) {
         progress_clear(view);
-        report(err, &a->budget);
+        memory_budget_report(err, &a->budget);
         return 2;
     }
     int sig = atomic_load(&interrupted);
@@ -453,7 +240,7 @@ static int write_result(const args *a, const rt_settings *set, const part_job *p
                     rs.passes ? "pass" : "tile", reason ? reason : "?", output,
                     rs.passes ? "" : " (a tiled part keeps nothing when stopped: render parts in --passes N)");
         } else if (part_job_write(pj, output, rs.samples_done, &write_temp, err) != RT_OK) {
-            report(err, &a->budget);
+            memory_budget_report(err, &a->budget);
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
             fprintf(stderr, "rt: wrote %s and %s.json: part [%d, %d) x [%d, %d) of %dx%d, samples %d:%d of %d%s; "
@@ -475,7 +262,7 @@ static int write_result(const args *a, const rt_settings *set, const part_job *p
             fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s left as it was\n",
                     rs.passes ? "pass" : "tile", reason ? reason : "?", output);
         } else if (output_write(a, set, fb, aov, target, &write_temp, err) != RT_OK) {
-            report(err, &a->budget);
+            memory_budget_report(err, &a->budget);
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
             fprintf(stderr, "rt: wrote %s: %dx%d, %s; %.2f s (render %.2f s)%s%s%s\n", target, fb->width, fb->height,
@@ -487,7 +274,7 @@ static int write_result(const args *a, const rt_settings *set, const part_job *p
         if (rs.partial)
             fprintf(stderr, "rt: %s: no part written: no %s finished\n", a->part_out, rs.passes ? "pass" : "tile");
         else if (part_job_write(pj, a->part_out, rs.samples_done, &write_temp, err) != RT_OK) {
-            report(err, &a->budget);
+            memory_budget_report(err, &a->budget);
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL || stopped)
             fprintf(stderr, "rt: wrote %s and %s.json: samples %d:%d of %d\n", a->part_out, a->part_out,
@@ -511,7 +298,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     progress_phase(view, "kd-tree", prims);
     if (rt_kdtree_build(&tree, scene, NULL, &err) != RT_OK) {
         progress_clear(view);
-        report(&err, &a->budget);
+        memory_budget_report(&err, &a->budget);
         return 2;
     }
     rt_info("kd-tree: built in %.1f ms: %zu nodes, %zu leaves (%zu empty), %zu references, depth %d; "
@@ -522,7 +309,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     part_job pj;
     if (part_job_init(&pj, a, scene, &tree, &err) != RT_OK) {
         progress_clear(view);
-        report(&err, &a->budget);
+        memory_budget_report(&err, &a->budget);
         rt_kdtree_free(&tree);
         return 2;
     }
@@ -552,7 +339,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     rt_framebuffer fb;
     if (rt_framebuffer_init(&fb, pj.region.x1 - pj.region.x0, pj.region.y1 - pj.region.y0, &err) != RT_OK) {
         progress_clear(view);
-        report(&err, &a->budget);
+        memory_budget_report(&err, &a->budget);
         part_job_free(&pj);
         rt_kdtree_free(&tree);
         return 2;
@@ -561,7 +348,7 @@ static int render_and_write(const rt_scene *scene, const args *a, const char *ou
     output_aovs aov;
     if (output_aovs_init(&aov, a, fb.width, fb.height, &err) != RT_OK) {
         progress_clear(view);
-        report(&err, &a->budget);
+        memory_budget_report(&err, &a->budget);
         rt_framebuffer_free(&fb);
         part_job_free(&pj);
         rt_kdtree_free(&tree);
@@ -695,7 +482,7 @@ static int render_one(rt_scene *scene, const args *a, double t_start)
     progress_phase(&view, "load", a->input ? a->input : "the built-in scene");
     if (prepare(scene, a, output, sizeof output, &err) != RT_OK) {
         progress_clear(&view);
-        report(&err, &a->budget);
+        memory_budget_report(&err, &a->budget);
         progress_view_free(&view);
         return 2;
     }
@@ -720,7 +507,7 @@ int main(int argc, char **argv)
     rt_log_set_level(a.log_level);
     memory_budget_apply(&a.budget);
     if (a.info_path)
-        return print_infos(&a);
+        return info_print(&a);
 
     rt_error err = {0};
     if (output_check(&a, &err) != RT_OK) {
@@ -732,7 +519,7 @@ int main(int argc, char **argv)
     char part_default[1100];
     if (args_output_is_part(&a) && !a.output) { /* a part goes to NAME.part.exr */
         char name[1024];
-        default_output(NULL, a.input, name, sizeof name);
+        input_default_output(NULL, a.input, name, sizeof name);
         rt_path_tagged(name, "part", ".exr", part_default, sizeof part_default);
         a.output = part_default;
     }

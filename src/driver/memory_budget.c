@@ -128,3 +128,20 @@ void memory_budget_apply(memory_budget *b)
         rt_info("memory budget: none%s", RT_SANITIZED && b->bytes ? " (not enforced in sanitizer builds)" : "");
     }
 }
+
+void memory_budget_report(const rt_error *err, const memory_budget *b)
+{
+    fprintf(stderr, "rt: %s\n", err->message);
+    if (err->code != RT_ERR_NOMEM)
+        return;
+    if (b->enforced) {
+        char sz[32];
+        memory_budget_format(b->bytes, sz, sizeof sz);
+        fprintf(stderr,
+                "rt: the memory budget of %s (%s) ran out; raise it with --max-memory SIZE (e.g. --max-memory 16G, or "
+                "'none' for no limit)\n",
+                sz, b->from_flag ? "--max-memory" : "the default, 75% of physical memory");
+    } else {
+        fprintf(stderr, "rt: the machine's memory ran out (no --max-memory budget was in force)\n");
+    }
+}

@@ -9,12 +9,15 @@
  *   if (!memory_budget_parse("4G", &b.bytes)) ... refuse the flag ...
  *   memory_budget_apply(&b);          // once, before loading; logs the budget with -v
  *   ... b.enforced says whether it took ...
+ *   memory_budget_report(&err, &b);   // "rt: MESSAGE", and for out of memory which budget ran out
  */
 #ifndef RT_DRIVER_MEMORY_BUDGET_H
 #define RT_DRIVER_MEMORY_BUDGET_H
 
 #include <stdbool.h>
 #include <stddef.h>
+
+#include "rt/base/error.h"
 
 typedef struct memory_budget {
     unsigned long long bytes; /* 0 = none */
@@ -31,5 +34,8 @@ bool memory_budget_parse(const char *s, unsigned long long *out);
 void memory_budget_format(unsigned long long bytes, char *buf, size_t size);
 /* Caps the data segment at b->bytes (not in sanitizer builds) and says so with -v. */
 void memory_budget_apply(memory_budget *b);
+/* Prints an error on stderr; out-of-memory errors also say which budget
+ * ran out and how to raise it. */
+void memory_budget_report(const rt_error *err, const memory_budget *b);
 
 #endif

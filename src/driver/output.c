@@ -123,7 +123,8 @@ rt_result output_write(const args *a, const rt_settings *set, rt_framebuffer *fb
         double t0 = rt_now_seconds();
         rt_denoise_input in = {.width = fb->width, .height = fb->height, .color = fb->rgb,
                                .albedo = aov->buf.albedo, .normal = aov->buf.normal,
-                               .prefilter_aux = aov->noisy_aux};
+                               .prefilter_aux = aov->noisy_aux, .quality = a->denoise_quality,
+                               .threads = a->threads};
         r = rt_denoise_image(&in, err);
         if (r != RT_OK)
             goto done;

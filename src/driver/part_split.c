@@ -29,6 +29,15 @@
 
 #define MAX_BLOCKS 4096
 
+/* Where a cut between bands goes: at row `want`, but after the previous
+ * cut (every band at least one row) and leaving a row for each of the
+ * `left` cuts still to come, this one included. */
+static int place_cut(int want, int prev, int rows, int left)
+{
+    int cut = want < prev + 1 ? prev + 1 : want;
+    return cut > rows - left ? rows - left : cut;
+}
+
 rt_result part_split(const rt_scene *scene, const rt_kdtree *tree, int index, int count, rt_render_region *band,
                      rt_error *err)
 {
@@ -91,11 +100,7 @@ rt_result part_split(const rt_scene *scene, const rt_kdtree *tree, int index, in
         run += row_cost[y / B];
         /* the cut after row y once the running cost reaches k/N of the total */
         while (k < count && run * (uint64_t)count >= total * (uint64_t)k) {
-            int cut = y + 1;
-            if (cut < cut_prev + 1)
-                cut = cut_prev + 1;
-            if (cut > H - (count - k))
-                cut = H - (count - k);
+            int cut = place_cut(y + 1, cut_prev, H, count - k);
             if (k == index)
                 start = cut;
             if (k == index + 1)
@@ -106,9 +111,7 @@ rt_result part_split(const rt_scene *scene, const rt_kdtree *tree, int index, in
     }
     /* cuts the running cost never reached (a zero total): the last rows, one each */
     for (; k < count; k++) {
-        int cut = cut_prev + 1;
-        if (cut > H - (count - k))
-            cut = H - (count - k);
+        int cut = place_cut(cut_prev + 1, cut_prev, H, count - k);
         if (k == index)
             start = cut;
         if (k == index + 1)

@@ -2,8 +2,9 @@
  *
  * The few C API entry points rt calls are declared here from OIDN's
  * documented API (Open Image Denoise API, doc/api.md of OIDN 2.x): devices
- * (oidnNewDevice, oidnSetDeviceInt "numThreads", oidnCommitDevice,
- * oidnGetDeviceError, oidnReleaseDevice) and filters (oidnNewFilter "RT",
+ * (oidnNewDevice, oidnSetDeviceInt / oidnGetDeviceInt "numThreads" (the
+ * CPU device's worker threads), oidnCommitDevice, oidnGetDeviceError,
+ * oidnReleaseDevice) and filters (oidnNewFilter "RT",
  * oidnSetSharedFilterImage with OIDN_FORMAT_FLOAT3 = 3, oidnSetFilterBool
  * "hdr" / "cleanAux", oidnSetFilterInt "quality" with OIDN_QUALITY_FAST = 4,
  * BALANCED = 5, HIGH = 6, oidnCommitFilter, oidnExecuteFilter,
@@ -45,6 +46,7 @@
 #include <unistd.h>
 
 #include "rt/base/clock.h"
+#include "rt/base/cpu.h"
 #include "rt/base/log.h"
 
 #define OIDN_SONAME "libOpenImageDenoise.so.2"
@@ -67,6 +69,7 @@ typedef struct oidn_api {
     void (*set_filter_bool)(void *filter, const char *name, bool value);
     void (*set_filter_int)(void *filter, const char *name, int value);
     void (*set_device_int)(void *device, const char *name, int value);
+    int (*get_device_int)(void *device, const char *name);
     void (*commit_filter)(void *filter);
     void (*execute_filter)(void *filter);
     void (*release_filter)(void *filter);
@@ -180,7 +183,9 @@ static rt_result load(oidn_api *api, char *where, size_t size, rt_error *err)
               BIND(lib, api, release_device, "oidnReleaseDevice") && BIND(lib, api, new_filter, "oidnNewFilter") &&
               BIND(lib, api, set_shared_filter_image, "oidnSetSharedFilterImage") &&
               BIND(lib, api, set_filter_bool, "oidnSetFilterBool") &&
-              BIND(lib, api, set_filter_int, "oidnSetFilterInt") && BIND(lib, api, set_device_int, "oidnSetDeviceInt") &&              BIND(lib, api, commit_filter, "oidnCommitFilter") && BIND(lib, api, execute_filter, "oidnExecuteFilter") &&
+              BIND(lib, api, set_filter_int, "oidnSetFilterInt") && BIND(lib, api, set_device_int, "oidnSetDeviceInt") &&
+              BIND(lib, api, get_device_int, "oidnGetDeviceInt") && BIND(lib, api, commit_filter, "oidnCommitFilter") &&
+              BIND(lib, api, execute_filter, "oidnExecuteFilter") &&
               BIND(lib, api, release_filter, "oidnReleaseFilter");
     if (!ok)
         return rt_fail(err, RT_ERR_IO, "--denoise: the Open Image Denoise library lacks the OIDN 2 C API (%s)",
@@ -233,19 +238,24 @@ static int oidn_quality(rt_denoise_quality q)
 
 static const char *const quality_names[] = {"balanced", "fast", "balanced", "high"};
 
+bool rt_denoise_quality_parse(const char *name, rt_denoise_quality *out)
+{
+    for (int k = RT_DENOISE_FAST; k <= RT_DENOISE_HIGH; k++)
+        if (name && strcmp(name, quality_names[k]) == 0) {
+            *out = (rt_denoise_quality)k;
+            return true;
+        }
+    return false;
+}
+
 /* in->quality, else RT_OIDN_QUALITY (fast, balanced, high), else balanced. */
 static rt_result pick_quality(const rt_denoise_input *in, rt_denoise_quality *q, rt_error *err)
 {
     *q = in->quality >= RT_DENOISE_FAST && in->quality <= RT_DENOISE_HIGH ? in->quality : RT_DENOISE_BALANCED;
     const char *env = getenv("RT_OIDN_QUALITY");
-    if (in->quality != RT_DENOISE_DEFAULT || !env || !env[0])
+    if (in->quality != RT_DENOISE_DEFAULT || !env || !env[0] || rt_denoise_quality_parse(env, q))
         return RT_OK;
-    for (int k = RT_DENOISE_FAST; k <= RT_DENOISE_HIGH; k++)
-        if (strcmp(env, quality_names[k]) == 0) {
-            *q = (rt_denoise_quality)k;
-            return RT_OK;
-        }
-    return rt_fail(err, RT_ERR_IO, "--denoise: RT_OIDN_QUALITY=%s is not fast, balanced or high", env);
+    return rt_fail(err, RT_ERR_IO, "--denoise: RT_OIDN_QUALITY=%s is not " RT_DENOISE_QUALITY_NAMES, env);
 }
 
 /* One RT filter, in place on `image` fed as its `input` ("color", or
@@ -312,10 +322,10 @@ rt_result rt_denoise_image(const rt_denoise_input *in, rt_error *err)
         free(aux);
         return rt_fail(err, RT_ERR_IO, "denoise: Open Image Denoise has no CPU device");
     }
-    if (in->threads > 0)
-        api.set_device_int(device, "numThreads", in->threads);
+    api.set_device_int(device, "numThreads", in->threads > 0 ? in->threads : rt_cpu_count());
     api.commit_device(device);
     r = device_error(&api, device, "starting the CPU device", err);
+    const int threads = r == RT_OK ? api.get_device_int(device, "numThreads") : 0; /* as OIDN took it */
     double t2 = rt_now_seconds(), cpu_ms = 0.0;
     if (r == RT_OK && aux) { /* OIDN's recipe for noisy aux: each denoised by its own filter first */
         r = run_filter(&api, device, "albedo", aux, NULL, NULL, quality, w, h, &cpu_ms, err);
@@ -335,8 +345,9 @@ rt_result rt_denoise_image(const rt_denoise_input *in, rt_error *err)
     double t4 = rt_now_seconds();
     api.release_device(device);
     free(aux);
-    rt_info("denoise: OIDN RT filter, %s quality%s: load %.1f ms, device %.1f ms, filter %.1f ms (CPU %.1f ms), "
-            "release %.1f ms", quality_names[quality], albedo ? (normal ? ", albedo and normal" : ", albedo") : "",
+    rt_info("denoise: OIDN RT filter, %s quality, %d thread%s%s: load %.1f ms, device %.1f ms, filter %.1f ms "
+            "(CPU %.1f ms), release %.1f ms", quality_names[quality], threads, threads == 1 ? "" : "s",
+            albedo ? (normal ? ", albedo and normal" : ", albedo") : "",
             1e3 * (t1 - t0), 1e3 * (t2 - t1), 1e3 * (t4 - t3), cpu_ms, 1e3 * (rt_now_seconds() - t4));
     return r;
 }

@@ -72,6 +72,38 @@ static bool word_at(const char *p, const char *end, const char *w)
     return true;
 }
 
+/* A decimal mantissa as it is read: at most 19 significant digits in m,
+ * exp10 the power of ten that scales it. */
+typedef struct decimal {
+    uint64_t m;
+    int digits; /* significant digits kept in m */
+    long exp10;
+    bool any, inexact;
+} decimal;
+
+/* The run of digits at p into d: integer digits past the 19th raise
+ * exp10, kept fraction digits lower it; a dropped digit other than 0 makes
+ * d inexact. Returns the first byte after the run. */
+static inline const char *take_digits(const char *p, const char *end, bool fraction, decimal *d)
+{
+    for (; p < end && is_digit(*p); p++) {
+        d->any = true;
+        if (d->digits < 19) {
+            d->m = d->m * 10 + (uint64_t)(*p - '0');
+            if (d->m)
+                d->digits++;
+            if (fraction)
+                d->exp10--;
+        } else {
+            if (!fraction)
+                d->exp10++;
+            if (*p != '0')
+                d->inexact = true;
+        }
+    }
+    return p;
+}
+
 const char *rt_mesh_parse_float(const char *p, const char *end, float *out, bool *nonfinite)
 {
     const char *start = p;
@@ -85,40 +117,15 @@ const char *rt_mesh_parse_float(const char *p, const char *end, float *out, bool
         *nonfinite = true;
         return NULL;
     }
-    uint64_t m = 0;
-    int digits = 0;     /* significant digits kept in m */
-    long exp10 = 0;
-    bool any = false, inexact = false;
-    while (p < end && is_digit(*p)) {
-        any = true;
-        if (digits < 19) {
-            m = m * 10 + (uint64_t)(*p - '0');
-            if (m)
-                digits++;
-        } else {
-            exp10++;
-            if (*p != '0')
-                inexact = true;
-        }
-        p++;
-    }
-    if (p < end && *p == '.') {
-        p++;
-        while (p < end && is_digit(*p)) {
-            any = true;
-            if (digits < 19) {
-                m = m * 10 + (uint64_t)(*p - '0');
-                if (m)
-                    digits++;
-                exp10--;
-            } else if (*p != '0') {
-                inexact = true;
-            }
-            p++;
-        }
-    }
-    if (!any)
+    decimal dec = {0, 0, 0, false, false};
+    p = take_digits(p, end, false, &dec);
+    if (p < end && *p == '.')
+        p = take_digits(p + 1, end, true, &dec);
+    if (!dec.any)
         return NULL;
+    uint64_t m = dec.m;
+    long exp10 = dec.exp10;
+    bool inexact = dec.inexact;
     if (p < end && (*p == 'e' || *p == 'E')) {
         const char *q = p + 1;
         bool eneg = false;

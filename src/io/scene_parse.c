@@ -16,6 +16,13 @@
  * before it is used; `camera gltf N` is resolved after the last statement,
  * when every model's cameras are known.
  *
+ * Material keys: one table (mat_keys). The keys of the glTF PBR-next
+ * extensions are the KHR_materials_* properties in snake_case with the
+ * extensions' schema ranges (Khronos glTF extension registry: clearcoat,
+ * specular, sheen, anisotropy, iridescence, dispersion,
+ * diffuse_transmission), so a material written with them is the one the
+ * glTF loader makes from the same JSON.
+ *
  * Numbers: decimal only ([+-]digits[.digits][e[+-]digits], number.h),
  * finite, and within float range; the whole token must be used, so `1.0x`,
  * `nan`, `inf` and `0x10` are all rejected.
@@ -282,6 +289,22 @@ static rt_result get_int(parser *p, const char *what, long long lo, long long hi
         return perr(p, RT_ERR_INVALID, t, "%s must be between %lld and %lld, got %s", what, lo, hi,
                     show(t, b, sizeof b));
     *out = v;
+    return RT_OK;
+}
+
+/* An RGB colour, each component in [0, hi]. */
+static rt_result get_color_in(parser *p, const char *what, float hi, rt_vec3 *out)
+{
+    static const char *comp[3] = {"red", "green", "blue"};
+    float v[3];
+    for (int i = 0; i < 3; i++) {
+        char w[256];
+        snprintf(w, sizeof w, "%s (%s)", what, comp[i]);
+        rt_result r = get_float_in(p, w, 0.0f, hi, &v[i]);
+        if (r != RT_OK)
+            return r;
+    }
+    *out = rt_v3(v[0], v[1], v[2]);
     return RT_OK;
 }
 
@@ -808,6 +831,8 @@ typedef enum mat_kind {
     MK_METAL,    /* a named metal: sets eta and k */
     MK_GGX,      /* GGX alpha, isotropic (one value: alpha_u = alpha_v) or two values (offset 1) */
     MK_SMITH,
+    MK_COLOR01,    /* an RGB colour with each component in [0, 1] */
+    MK_THICKNESS,  /* iridescence_thickness MIN MAX: two numbers >= 0 */
 } mat_kind;
 
 typedef struct mat_key {
@@ -819,6 +844,7 @@ typedef struct mat_key {
 } mat_key;
 
 #define MOFF(f) offsetof(rt_material, f)
+#define XTEX(k) (offsetof(rt_material, ext_tex) + (size_t)(k) * sizeof(rt_texture_slot))
 static const mat_key mat_keys[] = {
     {"color", "base_color", MK_COLOR, MOFF(color), 0, 0},
     {"alpha", NULL, MK_FLOAT, MOFF(alpha), 0, 1},
@@ -851,6 +877,7 @@ static const mat_key mat_keys[] = {
     {"priority", NULL, MK_INT, MOFF(priority), 0, 1000},
     {"absorption", NULL, MK_COLOR, MOFF(absorption), 0, 0},
     {"thickness", NULL, MK_FLOAT, MOFF(thickness), 0, FLT_MAX},
+    {"thin_walled", NULL, MK_BOOL, MOFF(thin_walled), 0, 0},
     {"attenuation_color", NULL, MK_COLOR, MOFF(attenuation_color), 0, 0},
     {"attenuation_distance", NULL, MK_DISTANCE, MOFF(attenuation_distance), 0, 0},
     {"texture", "base_color_texture", MK_TEXTURE, MOFF(base_color_tex), 0, 0},
@@ -859,11 +886,64 @@ static const mat_key mat_keys[] = {
     {"occlusion_map", "occlusion_texture", MK_TEXTURE, MOFF(occlusion_tex), 0, 0},
     {"emission_map", "emission_texture", MK_TEXTURE, MOFF(emissive_tex), 0, 0},
     {"transmission_map", "transmission_texture", MK_TEXTURE, MOFF(transmission_tex), 0, 0},
+    /* the glTF PBR-next extensions (KHR_materials_*), named after their
+     * properties; ranges are the extensions' schemas' (as gltf.c checks) */
+    {"clearcoat", NULL, MK_FLOAT, MOFF(clearcoat), 0, 1},
+    {"clearcoat_roughness", NULL, MK_FLOAT, MOFF(clearcoat_roughness), 0, 1},
+    {"clearcoat_normal_scale", NULL, MK_FLOAT, MOFF(clearcoat_normal_scale), -FLT_MAX, FLT_MAX},
+    {"clearcoat_map", "clearcoat_texture", MK_TEXTURE, XTEX(RT_XTEX_CLEARCOAT), 0, 0},
+    {"clearcoat_roughness_map", "clearcoat_roughness_texture", MK_TEXTURE, XTEX(RT_XTEX_CLEARCOAT_ROUGHNESS), 0, 0},
+    {"clearcoat_normal_map", "clearcoat_normal_texture", MK_TEXTURE, XTEX(RT_XTEX_CLEARCOAT_NORMAL), 0, 0},
+    {"specular_factor", NULL, MK_FLOAT, MOFF(specular_weight), 0, 1},
+    {"specular_color", NULL, MK_COLOR, MOFF(specular_color), 0, 0},
+    {"specular_map", "specular_texture", MK_TEXTURE, XTEX(RT_XTEX_SPECULAR), 0, 0},
+    {"specular_color_map", "specular_color_texture", MK_TEXTURE, XTEX(RT_XTEX_SPECULAR_COLOR), 0, 0},
+    {"sheen_color", NULL, MK_COLOR01, MOFF(sheen_color), 0, 0},
+    {"sheen_roughness", NULL, MK_FLOAT, MOFF(sheen_roughness), 0, 1},
+    {"sheen_color_map", "sheen_color_texture", MK_TEXTURE, XTEX(RT_XTEX_SHEEN_COLOR), 0, 0},
+    {"sheen_roughness_map", "sheen_roughness_texture", MK_TEXTURE, XTEX(RT_XTEX_SHEEN_ROUGHNESS), 0, 0},
+    {"anisotropy_strength", NULL, MK_FLOAT, MOFF(anisotropy), 0, 1},
+    {"anisotropy_rotation", NULL, MK_FLOAT, MOFF(anisotropy_rotation), -FLT_MAX, FLT_MAX},
+    {"anisotropy_map", "anisotropy_texture", MK_TEXTURE, XTEX(RT_XTEX_ANISOTROPY), 0, 0},
+    {"iridescence", NULL, MK_FLOAT, MOFF(iridescence), 0, 1},
+    {"iridescence_ior", NULL, MK_FLOAT, MOFF(iridescence_ior), 1, FLT_MAX},
+    {"iridescence_thickness", NULL, MK_THICKNESS, MOFF(iridescence_thickness_min), 0, FLT_MAX},
+    {"iridescence_map", "iridescence_texture", MK_TEXTURE, XTEX(RT_XTEX_IRIDESCENCE), 0, 0},
+    {"iridescence_thickness_map", "iridescence_thickness_texture", MK_TEXTURE, XTEX(RT_XTEX_IRIDESCENCE_THICKNESS), 0, 0},
+    {"dispersion", NULL, MK_FLOAT, MOFF(dispersion), 0, FLT_MAX},
+    {"diffuse_transmission", NULL, MK_FLOAT, MOFF(diffuse_transmission), 0, 1},
+    {"diffuse_transmission_color", NULL, MK_COLOR01, MOFF(diffuse_transmission_color), 0, 0},
+    {"diffuse_transmission_map", "diffuse_transmission_texture", MK_TEXTURE, XTEX(RT_XTEX_DIFFUSE_TRANSMISSION), 0, 0},
+    {"diffuse_transmission_color_map", "diffuse_transmission_color_texture", MK_TEXTURE,
+     XTEX(RT_XTEX_DIFFUSE_TRANSMISSION_COLOR), 0, 0},
     {"uv_scale", NULL, MK_UV, 0, 0, 0},
     {"uv_offset", NULL, MK_UV, 1, 0, 0},
 };
 #undef MOFF
+#undef XTEX
 #define MAT_KEY_COUNT (sizeof mat_keys / sizeof *mat_keys)
+
+/* A key of the glTF extensions: its field lies among the extension fields
+ * of rt_material (clearcoat .. ext_tex). */
+static bool mat_key_is_ext(const mat_key *mk)
+{
+    return mk->kind != MK_UV && mk->offset >= offsetof(rt_material, clearcoat) &&
+           mk->offset < offsetof(rt_material, extended);
+}
+
+/* A texture slot that holds a colour: a missing image there shows the
+ * missing-texture checker; in a data slot it is left out. The extensions'
+ * colour maps are tints of a layer and count as data, as in the glTF
+ * loader (docs/gltf.md). */
+static bool mat_key_is_colour_slot(const mat_key *mk)
+{
+    return mk->offset == offsetof(rt_material, base_color_tex) || mk->offset == offsetof(rt_material, emissive_tex);
+}
+
+const char *rt_scene_material_key(size_t i)
+{
+    return i < MAT_KEY_COUNT ? mat_keys[i].key : NULL;
+}
 
 static size_t mat_key_index(const char *key)
 {
@@ -929,6 +1009,17 @@ static rt_result st_material(parser *p, const tok *kw)
             break;
         }
         case MK_COLOR: r = get_color(p, what, (rt_vec3 *)field); break;
+        case MK_COLOR01: r = get_color_in(p, what, 1.0f, (rt_vec3 *)field); break;
+        case MK_THICKNESS: {
+            char w[128];
+            snprintf(w, sizeof w, "%s (minimum, nm)", what);
+            r = get_float_in(p, w, 0.0f, FLT_MAX, &m.iridescence_thickness_min);
+            if (r == RT_OK) {
+                snprintf(w, sizeof w, "%s (maximum, nm)", what);
+                r = get_float_in(p, w, 0.0f, FLT_MAX, &m.iridescence_thickness_max);
+            }
+            break;
+        }
         case MK_BOOL: r = get_bool(p, what, (bool *)field); break;
         case MK_ALPHA_MODE: {
             static const char *const modes[] = {"opaque", "mask", "blend"};
@@ -994,8 +1085,7 @@ static rt_result st_material(parser *p, const tok *kw)
             rt_texture_slot *slot = field;
             r = get_texture_ref(p, what, &slot->texture);
             /* a missing image: the checker for colour, nothing for data */
-            bool colour = mk->offset == offsetof(rt_material, base_color_tex) || mk->offset == offsetof(rt_material, emissive_tex);
-            if (r == RT_OK && !colour && is_missing(p, slot->texture))
+            if (r == RT_OK && !mat_key_is_colour_slot(mk) && is_missing(p, slot->texture))
                 slot->texture = RT_NONE;
             break;
         }
@@ -1025,6 +1115,9 @@ static rt_result st_material(parser *p, const tok *kw)
                        (mk->kind == MK_INT && mk->offset == offsetof(rt_material, priority));
         if (!seen[i])
             continue;
+        if (mat_key_is_ext(mk) && m.bsdf != RT_BSDF_GLTF)
+            return perr(p, RT_ERR_INVALID, seen[i],
+                        "material key '%s' (a glTF material extension) needs 'bsdf gltf', the default", mk->key);
         if (absorbs && m.bsdf != RT_BSDF_DIELECTRIC)
             return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf dielectric'", mk->key);
         if (exterior && m.bsdf != RT_BSDF_DIELECTRIC && m.bsdf != RT_BSDF_PLASTIC)
@@ -1056,14 +1149,26 @@ static rt_result st_material(parser *p, const tok *kw)
     if ((m.bsdf == RT_BSDF_DIELECTRIC || m.bsdf == RT_BSDF_CONDUCTOR || m.bsdf == RT_BSDF_PLASTIC) &&
         !seen[mat_key_index("roughness")])
         m.roughness = 0.0f;
+    /* whitted: KHR_materials_specular scales the Phong specular weight by
+     * what it does to the dielectric's F0 (as the glTF loader's mapping
+     * does, docs/gltf.md), unless `specular` itself is given */
+    if ((seen[mat_key_index("specular_factor")] || seen[mat_key_index("specular_color")]) &&
+        !seen[mat_key_index("specular")]) {
+        rt_vec3 sc = rt_vmin(m.specular_color, rt_v3s(25.0f)); /* F0 = min(0.04 specular_color, 1) */
+        m.specular *= m.specular_weight * (sc.x + sc.y + sc.z) / 3.0f;
+    }
     /* uv_scale / uv_offset apply to every slot: uv' = uv * scale + offset */
-    rt_texture_slot *slots[] = {&m.base_color_tex, &m.metal_rough_tex, &m.normal_tex,
-                                &m.occlusion_tex, &m.emissive_tex, &m.transmission_tex};
+    rt_texture_slot *slots[6 + RT_XTEX_COUNT] = {&m.base_color_tex, &m.metal_rough_tex, &m.normal_tex,
+                                                 &m.occlusion_tex,  &m.emissive_tex,    &m.transmission_tex};
+    for (int i = 0; i < RT_XTEX_COUNT; i++)
+        slots[6 + i] = &m.ext_tex[i];
     for (size_t i = 0; i < sizeof slots / sizeof *slots; i++) {
         float *t = slots[i]->uv_transform;
         t[0] = uv[0]; t[1] = 0; t[2] = uv[2];
         t[3] = 0; t[4] = uv[1]; t[5] = uv[3];
     }
+    /* the extensions' keys: the path tracer layers them as the glTF loader's */
+    m.extended = rt_material_extended(&m);
     uint32_t id = rt_scene_add_material(p->s, &m);
     if (id == RT_NONE || !name_add(&p->materials, name->s, id, name->line))
         return nomem(p, name);

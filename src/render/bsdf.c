@@ -30,7 +30,12 @@
  *   (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - E_avg)) restores the energy
  *   single scattering loses with F = 1, times F_avg^2 E_avg / (1 - F_avg
  *   (1 - E_avg)) for the Fresnel-weighted sum over the extra bounces; E
- *   and E_avg from rt/render/ggx_albedo.h.
+ *   and E_avg from rt/render/ggx_albedo.h. For rough glass the same
+ *   course's dielectric extension: E(mu, alpha, eta) of reflection and
+ *   refraction together from both sides, the lobe split between
+ *   reflection and transmission so that the transmitted part obeys the
+ *   reciprocity of refraction, n_o^2 f(wo, wi) = n_t^2 f(wi, wo)
+ *   (Veach 1997, 5.2), derived in docs/shading.md, section 14.
  * - Cosine sampling of the diffuse lobe (rt/sampling.h).
  * - Choosing one lobe by its estimated weight and returning the mixture pdf
  *   is one-sample MIS over the lobes with the balance heuristic (Veach 1997,
@@ -325,8 +330,14 @@ void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float
     set_conductor(b, eta, k, alpha_x, alpha_y, smith);
 }
 
+static void dielectric_compensate(rt_bsdf *b);
+
 void rt_bsdf_compensate(rt_bsdf *b)
 {
+    if (b->radiance_eta2) {
+        dielectric_compensate(b);
+        return;
+    }
     if (!b->conductor || b->delta || b->separable)
         return;
     float alpha = sqrtf(b->alpha * b->alpha_y);
@@ -379,7 +390,50 @@ void rt_bsdf_set_eta(rt_bsdf *b, float eta)
     eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
     float r0 = (eta - 1.0f) / (eta + 1.0f);
     b->f0 = r0 * r0;
+    bool changed = eta != b->eta;
     b->eta = eta;
+    if (changed && b->ms && b->radiance_eta2)
+        dielectric_compensate(b); /* E and the split depend on eta */
+}
+
+/* Kulla and Conty's lobe for rough glass, from the side o of wo to either
+ * side (t the other one), in flux form (docs/shading.md, section 14):
+ *   f_R = (1 - x_o) (1 - E_o(mu_o)) (1 - E_o(mu_i)) / (pi (1 - Eavg_o))
+ *   f_T = T_o (1 - E_o(mu_o)) (1 - E_t(mu_i)) / (pi (1 - Eavg_o) (1 - Eavg_t))
+ * with T_o = rt_ggx_dielectric_ms_transmit and x_o = T_o / (1 - Eavg_o):
+ * together they integrate to 1 - E_o(mu_o), the energy single scattering
+ * loses, f_R is symmetric and n_o^2 T_o = n_t^2 T_t makes f_T reciprocal
+ * across the interface. */
+static void dielectric_compensate(rt_bsdf *b)
+{
+    b->ms = false;
+    if (b->delta || !b->radiance_eta2)
+        return;
+    float alpha = b->alpha, eta = b->eta;
+    float lo = 1.0f - rt_ggx_dielectric_albedo_avg(alpha, eta);
+    float lt = 1.0f - rt_ggx_dielectric_albedo_avg(alpha, 1.0f / eta);
+    if (!(lo > 1e-5f) || !(lt > 1e-5f))
+        return; /* a near-mirror interface loses nothing */
+    float t = rt_ggx_dielectric_ms_transmit(alpha, eta);
+    float x = rt_clampf(t / lo, 0.0f, 1.0f);
+    float refl = (1.0f - x) / (RT_PI * lo), trans = x / (RT_PI * lt);
+    if (!isfinite(refl) || !isfinite(trans))
+        return;
+    b->ms = true;
+    b->ms_alpha = alpha;
+    b->ms_x = x;
+    b->ms_refl = refl;
+    b->ms_trans = trans;
+    b->ms_cell[0] = rt_ggx_dielectric_cell_of(alpha, eta);
+    b->ms_cell[1] = rt_ggx_dielectric_cell_of(alpha, 1.0f / eta);
+}
+
+float rt_bsdf_ms_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi)
+{
+    if (!b->ms || !b->radiance_eta2 || !(wo.z > 0.0f) || !(wi.z < 0.0f))
+        return 0.0f;
+    return b->ms_trans * (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[0], wo.z)) *
+           (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[1], -wi.z));
 }
 
 float rt_fresnel_diffuse_reflectance(float eta)
@@ -446,15 +500,16 @@ static rt_vec3 normal_texel(rt_vec4 c, float scale)
 }
 
 /* The extensions' factors x textures at a hit (KHR_materials_*), and the
- * anisotropy direction as the frame's x. */
+ * anisotropy direction as the frame's x. The factors come from the
+ * material (rt_bsdf_ext_of_material), so its defaults are the only ones. */
 static void set_ext_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_material *m, rt_bsdf *b)
 {
     const rt_scene *s = ctx->state->scene;
     rt_bsdf_ext e;
     bool has;
-    rt_bsdf_ext_default(&e);
-    e.clearcoat = m->clearcoat * ext_sample(s, sf, m, RT_XTEX_CLEARCOAT, false, &has).x;
-    e.clearcoat_roughness = m->clearcoat_roughness * ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_ROUGHNESS, false, &has).y;
+    rt_bsdf_ext_of_material(m, &e);
+    e.clearcoat *= ext_sample(s, sf, m, RT_XTEX_CLEARCOAT, false, &has).x;
+    e.clearcoat_roughness *= ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_ROUGHNESS, false, &has).y;
     /* the tangent frame before the coat's map: sf's (t, b, n) made orthonormal about b->n */
     rt_vec3 t = rt_sub(sf->t, rt_scale(b->n, rt_dot(sf->t, b->n)));
     float tl2 = rt_length2(t);
@@ -464,35 +519,53 @@ static void set_ext_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, 
     rt_vec3 bt = rt_cross(b->n, t);
     if (have_t && rt_dot(bt, sf->b) < 0.0f)
         bt = rt_neg(bt); /* keep the UV handedness */
-    if (e.clearcoat > 0.0f && have_t) {
-        rt_vec4 c = ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_NORMAL, false, &has);
-        if (has) {
-            rt_vec3 v = normal_texel(c, m->clearcoat_normal_scale);
-            rt_vec3 w = rt_add(rt_add(rt_scale(t, v.x), rt_scale(bt, v.y)), rt_scale(b->n, v.z));
-            e.clearcoat_normal = rt_bsdf_to_local(b, w);
+    /* the coat's normal: its own map, else the surface's normal without the
+     * base's normal map (KHR_materials_clearcoat: the coat inherits no
+     * texture of the material below it), in the frame of that normal */
+    if (e.clearcoat > 0.0f) {
+        rt_vec3 cn = b->n, ct = t, cbt = bt;
+        bool have_ct = have_t;
+        if (m->normal_tex.texture != RT_NONE && rt_dot(sf->n_unmapped, sf->wo) > 1e-4f &&
+            rt_finite3(sf->n_unmapped)) {
+            cn = sf->n_unmapped;
+            ct = rt_sub(sf->t, rt_scale(cn, rt_dot(sf->t, cn)));
+            float cl2 = rt_length2(ct);
+            have_ct = cl2 > 1e-12f && isfinite(cl2);
+            if (have_ct)
+                ct = rt_scale(ct, 1.0f / sqrtf(cl2));
+            cbt = rt_cross(cn, ct);
+            if (have_ct && rt_dot(cbt, sf->b) < 0.0f)
+                cbt = rt_neg(cbt);
+            e.clearcoat_normal = rt_bsdf_to_local(b, cn);
+        }
+        if (have_ct) {
+            rt_vec4 c = ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_NORMAL, false, &has);
+            if (has) {
+                rt_vec3 v = normal_texel(c, m->clearcoat_normal_scale);
+                rt_vec3 w = rt_add(rt_add(rt_scale(ct, v.x), rt_scale(cbt, v.y)), rt_scale(cn, v.z));
+                e.clearcoat_normal = rt_bsdf_to_local(b, w);
+            }
         }
     }
-    rt_vec4 sp = ext_sample(s, sf, m, RT_XTEX_SPECULAR, false, &has);
-    e.spec_weight = m->specular_weight * sp.w;
+    e.spec_weight *= ext_sample(s, sf, m, RT_XTEX_SPECULAR, false, &has).w;
     rt_vec4 sc = ext_sample(s, sf, m, RT_XTEX_SPECULAR_COLOR, true, &has);
-    e.spec_color = rt_mul(m->specular_color, rt_v3(sc.x, sc.y, sc.z));
+    e.spec_color = rt_mul(e.spec_color, rt_v3(sc.x, sc.y, sc.z));
     rt_vec4 sh = ext_sample(s, sf, m, RT_XTEX_SHEEN_COLOR, true, &has);
-    e.sheen_color = rt_mul(m->sheen_color, rt_v3(sh.x, sh.y, sh.z));
-    e.sheen_roughness = m->sheen_roughness * ext_sample(s, sf, m, RT_XTEX_SHEEN_ROUGHNESS, false, &has).w;
-    e.iridescence = m->iridescence * ext_sample(s, sf, m, RT_XTEX_IRIDESCENCE, false, &has).x;
+    e.sheen_color = rt_mul(e.sheen_color, rt_v3(sh.x, sh.y, sh.z));
+    e.sheen_roughness *= ext_sample(s, sf, m, RT_XTEX_SHEEN_ROUGHNESS, false, &has).w;
+    e.iridescence *= ext_sample(s, sf, m, RT_XTEX_IRIDESCENCE, false, &has).x;
     rt_vec4 th = ext_sample(s, sf, m, RT_XTEX_IRIDESCENCE_THICKNESS, false, &has);
-    e.iridescence_ior = m->iridescence_ior;
-    e.iridescence_thickness = has ? m->iridescence_thickness_min +
-                                        (m->iridescence_thickness_max - m->iridescence_thickness_min) * th.y
-                                  : m->iridescence_thickness_max;
-    e.diffuse_transmission = m->diffuse_transmission * ext_sample(s, sf, m, RT_XTEX_DIFFUSE_TRANSMISSION, false, &has).w;
+    if (has)
+        e.iridescence_thickness = m->iridescence_thickness_min +
+                                  (m->iridescence_thickness_max - m->iridescence_thickness_min) * th.y;
+    e.diffuse_transmission *= ext_sample(s, sf, m, RT_XTEX_DIFFUSE_TRANSMISSION, false, &has).w;
     rt_vec4 dc = ext_sample(s, sf, m, RT_XTEX_DIFFUSE_TRANSMISSION_COLOR, true, &has);
-    e.diffuse_transmission_color = rt_mul(m->diffuse_transmission_color, rt_v3(dc.x, dc.y, dc.z));
-    e.dispersion = m->thin_walled ? 0.0f : m->dispersion; /* a thin wall does not bend light */
+    e.diffuse_transmission_color = rt_mul(e.diffuse_transmission_color, rt_v3(dc.x, dc.y, dc.z));
     /* anisotropy: direction (cos r, sin r) in the tangent frame, or the
      * texture's (2 RG - 1) rotated by r; strength x texture B */
     rt_vec4 an = ext_sample(s, sf, m, RT_XTEX_ANISOTROPY, false, &has);
-    e.anisotropy = m->anisotropy * (has ? an.z : 1.0f);
+    if (has)
+        e.anisotropy *= an.z;
     if (e.anisotropy > 0.0f && have_t) {
         float dx = has ? 2.0f * an.x - 1.0f : 1.0f, dy = has ? 2.0f * an.y - 1.0f : 0.0f;
         float cr = cosf(m->anisotropy_rotation), sr = sinf(m->anisotropy_rotation);
@@ -548,6 +621,8 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
         float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
         rt_bsdf_make_dielectric(b, n, sf->front ? eta : 1.0f / eta, alpha);
         set_frame(b, n, sf->ng);
+        if (s->settings.energy_compensation)
+            rt_bsdf_compensate(b);
         return;
     }
     if (m->bsdf == RT_BSDF_PLASTIC) { /* opaque: the same from either side */
@@ -586,9 +661,13 @@ typedef struct layered_probs {
 static layered_probs layered_lobe_probs(const rt_bsdf *b, rt_vec3 wo);
 static rt_vec3 layered_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, const layered_probs *p, float *pdf);
 
-void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit)
+/* The lobe probabilities, with a compensated dielectric's transmitted
+ * multiple-scattering lobe apart (*p_ms_transmit; its reflected lobe is
+ * the diffuse one). */
+static void lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit,
+                       float *p_ms_transmit)
 {
-    *p_diffuse = *p_specular = *p_transmit = 0.0f;
+    *p_diffuse = *p_specular = *p_transmit = *p_ms_transmit = 0.0f;
     if (b->layered) {
         layered_probs p = layered_lobe_probs(b, wo);
         *p_diffuse = p.d;
@@ -635,6 +714,21 @@ void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p
     *p_diffuse = wd / sum;
     *p_specular = ws / sum;
     *p_transmit = wt / sum;
+    if (b->ms) { /* rough glass: single scattering keeps E(mu_o), the lobe the rest */
+        float pm = 1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[0], wo.z);
+        pm = isfinite(pm) ? rt_clampf(pm, 0.0f, 0.95f) : 0.0f;
+        *p_diffuse = pm * (1.0f - b->ms_x);
+        *p_ms_transmit = pm * b->ms_x;
+        *p_specular *= 1.0f - pm;
+        *p_transmit *= 1.0f - pm;
+    }
+}
+
+void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit)
+{
+    float ptm;
+    lobe_probs(b, wo, p_diffuse, p_specular, p_transmit, &ptm);
+    *p_transmit += ptm;
 }
 
 /* f and pdf of the non-delta lobes, given lobe probabilities. */
@@ -691,6 +785,9 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
             if (isfinite(pv))
                 p += ps * pv;
         }
+        if (b->ms) /* rough glass: the reflected multiple-scattering lobe, sampled as diffuse */
+            f = rt_add(f, rt_v3s(b->ms_refl * (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[0], wo.z)) *
+                                 (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[0], wi.z))));
     }
     *pdf = p;
     return f;
@@ -757,22 +854,29 @@ static bool thin_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, rt_vec3 c, fl
  * shading uses wo only). Diffuse transmission (dt) and the refraction lobe
  * are sampled only (delta samples), as transmission is. */
 
+void rt_bsdf_ext_of_material(const rt_material *m, rt_bsdf_ext *e)
+{
+    e->spec_weight = m->specular_weight;
+    e->spec_color = m->specular_color;
+    e->clearcoat = m->clearcoat;
+    e->clearcoat_roughness = m->clearcoat_roughness;
+    e->clearcoat_normal = rt_v3(0.0f, 0.0f, 1.0f); /* the shading normal: a coat without a map of its own */
+    e->sheen_color = m->sheen_color;
+    e->sheen_roughness = m->sheen_roughness;
+    e->anisotropy = m->anisotropy;
+    e->iridescence = m->iridescence;
+    e->iridescence_ior = m->iridescence_ior;
+    e->iridescence_thickness = m->iridescence_thickness_max; /* without a thickness texture: the maximum */
+    e->diffuse_transmission = m->diffuse_transmission;
+    e->diffuse_transmission_color = m->diffuse_transmission_color;
+    e->dispersion = m->thin_walled ? 0.0f : m->dispersion; /* a thin wall does not bend light */
+}
+
 void rt_bsdf_ext_default(rt_bsdf_ext *e)
 {
-    e->spec_weight = 1.0f;
-    e->spec_color = rt_v3s(1.0f);
-    e->clearcoat = 0.0f;
-    e->clearcoat_roughness = 0.0f;
-    e->clearcoat_normal = rt_v3(0.0f, 0.0f, 1.0f);
-    e->sheen_color = rt_v3s(0.0f);
-    e->sheen_roughness = 0.0f;
-    e->anisotropy = 0.0f;
-    e->iridescence = 0.0f;
-    e->iridescence_ior = 1.3f;
-    e->iridescence_thickness = 400.0f;
-    e->diffuse_transmission = 0.0f;
-    e->diffuse_transmission_color = rt_v3s(1.0f);
-    e->dispersion = 0.0f;
+    rt_material m;
+    rt_material_default(&m, NULL);
+    rt_bsdf_ext_of_material(&m, e);
 }
 
 /* KHR_materials_dispersion: the index at wavelength lambda (nm) from the
@@ -1057,10 +1161,18 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
         return false;
     if (b->layered)
         return layered_sample(b, wo, u, ulobe, s);
-    float pd, ps, pt;
-    rt_bsdf_lobe_probs(b, wo, &pd, &ps, &pt);
-    if (!(pd + ps + pt > 0.0f))
+    float pd, ps, pt, ptm;
+    lobe_probs(b, wo, &pd, &ps, &pt, &ptm);
+    if (!(pd + ps + pt + ptm > 0.0f))
         return false;
+    if (ptm > 0.0f && ulobe >= pd + ps + pt) {
+        /* rough glass: the transmitted multiple-scattering lobe, by the
+         * cosine below the surface; sampled only, as refraction is */
+        rt_vec3 c = rt_sample_cosine_hemisphere(u);
+        rt_vec3 wi = rt_v3(c.x, c.y, -c.z);
+        float f = rt_bsdf_ms_transmit(b, wo, wi);
+        return c.z > 0.0f && delta_sample(s, wi, rt_v3s(f * RT_PI * b->eta * b->eta / ptm));
+    }
     if (pt > 0.0f && ulobe >= pd + ps && b->thin)
         return thin_transmit(b, wo, u, b->diffuse, 1.0f / pt, s);
     if (pt > 0.0f && ulobe >= pd + ps) {

@@ -21,6 +21,20 @@
 #include "rt/base/alloc.h"
 #include "rt/render/environment.h"
 
+/* The unit direction and the distance from p to the point q on a light,
+ * into ls, and their squared distance; false when they coincide. */
+static bool toward(rt_vec3 p, rt_vec3 q, rt_light_sample *ls, float *d2)
+{
+    rt_vec3 d = rt_sub(q, p);
+    *d2 = rt_length2(d);
+    if (!(*d2 > 0.0f))
+        return false;
+    float dist = sqrtf(*d2);
+    ls->wi = rt_scale(d, 1.0f / dist);
+    ls->dist = dist;
+    return true;
+}
+
 bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, rt_vec2 u, rt_light_sample *ls)
 {
     (void)ctx;
@@ -28,13 +42,10 @@ bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, r
     switch (l->kind) {
     case RT_LIGHT_POINT:
     case RT_LIGHT_SPOT: {
-        rt_vec3 d = rt_sub(l->position, p);
-        float d2 = rt_length2(d);
-        if (!(d2 > 0.0f))
+        float d2;
+        if (!toward(p, l->position, ls, &d2))
             return false;
-        float dist = sqrtf(d2);
-        ls->wi = rt_scale(d, 1.0f / dist);
-        ls->dist = dist;
+        const float dist = ls->dist;
         float atten = 1.0f / d2;
         if (l->kind == RT_LIGHT_SPOT) {
             float cd = rt_dot(rt_normalize(l->direction), rt_neg(ls->wi));
@@ -65,13 +76,9 @@ bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, r
             return false;
         nl = rt_scale(nl, 1.0f / area);
         rt_vec3 q = rt_add(l->position, rt_add(rt_scale(l->edge_u, u.x), rt_scale(l->edge_v, u.y)));
-        rt_vec3 d = rt_sub(q, p);
-        float d2 = rt_length2(d);
-        if (!(d2 > 0.0f))
+        float d2;
+        if (!toward(p, q, ls, &d2))
             return false;
-        float dist = sqrtf(d2);
-        ls->wi = rt_scale(d, 1.0f / dist);
-        ls->dist = dist;
         float cos_l = -rt_dot(nl, ls->wi);
         if (!(cos_l > 0.0f))
             return false; /* behind the one-sided emitter */

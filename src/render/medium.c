@@ -67,8 +67,11 @@ rt_vec3 rt_medium_transmittance(const rt_material *mats, uint32_t medium, float 
 
 bool rt_medium_false_hit(const rt_medium_stack *st, const rt_material *mats, uint32_t mat, bool front)
 {
-    if (!rt_medium_is_medium(&mats[mat]))
-        return false;
+    return rt_medium_is_medium(&mats[mat]) && rt_medium_stack_false_hit(st, mats, mat, front);
+}
+
+bool rt_medium_stack_false_hit(const rt_medium_stack *st, const rt_material *mats, uint32_t mat, bool front)
+{
     if (front) {
         int t = top_of(st, mats, -1);
         return t >= 0 && mats[mat].priority < mats[st->material[t]].priority;
@@ -87,8 +90,12 @@ float rt_medium_outside_ior(const rt_medium_stack *st, const rt_material *mats, 
 
 void rt_medium_cross(rt_medium_stack *st, const rt_material *mats, uint32_t mat, bool front)
 {
-    if (!rt_medium_is_medium(&mats[mat]))
-        return;
+    if (rt_medium_is_medium(&mats[mat]))
+        rt_medium_stack_cross(st, mat, front);
+}
+
+void rt_medium_stack_cross(rt_medium_stack *st, uint32_t mat, bool front)
+{
     if (front) {
         if (st->depth >= RT_MEDIUM_STACK_MAX) { /* overflow: drop the outermost */
             for (int i = 1; i < RT_MEDIUM_STACK_MAX; i++)

@@ -72,15 +72,36 @@ static rt_vec2 slot_uv(const rt_surface *sf, const rt_texture_slot *slot)
     return rt_texture_slot_uv(slot, slot->texcoord == 1 ? sf->uv1 : sf->uv0);
 }
 
-void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf)
+bool rt_surface_material_reads_frame(const rt_material *m)
+{
+    return m->normal_tex.texture != RT_NONE || m->bsdf == RT_BSDF_CONDUCTOR || m->extended;
+}
+
+#if defined(__GNUC__)
+#define SURFACE_INLINE static inline __attribute__((always_inline)) /* one copy per caller, `frame` folded */
+#else
+#define SURFACE_INLINE static inline
+#endif
+
+/* The record; the tangent frame (t, b) only when `frame` is true or the
+ * material reads it (else zero). */
+SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf,
+                              bool frame)
 {
     const rt_scene *s = ctx->state->scene;
     uint32_t i;
-    rt_vec3 ng, n, t;
+    rt_vec3 ng, n, t = rt_v3s(0.0f);
     float w = 1.0f;
     sf->vertex_color = rt_v4(1, 1, 1, 1);
     sf->prim = hit->prim;
-    switch (rt_prim_kind_of(s, hit->prim, &i)) {
+    rt_prim_kind kind = rt_prim_kind_of(s, hit->prim, &i);
+    sf->material = kind == RT_PRIM_TRIANGLE ? s->triangles.material[i]
+                   : kind == RT_PRIM_SPHERE ? s->spheres.material[i]
+                                            : s->quads.material[i];
+    RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
+    const rt_material *m = &s->materials[sf->material];
+    frame = frame || rt_surface_material_reads_frame(m);
+    switch (kind) {
     case RT_PRIM_TRIANGLE: {
         const uint32_t *idx = &s->triangles.index[3 * (size_t)i];
         const rt_vertices *vx = &s->vertices;
@@ -125,12 +146,12 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
             sf->vertex_color = rt_v4(c0.x * bw + c1.x * bu + c2.x * bv, c0.y * bw + c1.y * bu + c2.y * bv,
                                      c0.z * bw + c1.z * bu + c2.z * bv, c0.w * bw + c1.w * bu + c2.w * bv);
         }
-        if (flags & RT_TRI_TANGENT) {
+        if (frame && (flags & RT_TRI_TANGENT)) {
             rt_vec4 q0 = vx->tangent[idx[0]], q1 = vx->tangent[idx[1]], q2 = vx->tangent[idx[2]];
             t = rt_v3(q0.x * bw + q1.x * bu + q2.x * bv, q0.y * bw + q1.y * bu + q2.y * bv,
                       q0.z * bw + q1.z * bu + q2.z * bv);
             w = q0.w < 0.0f ? -1.0f : 1.0f;
-        } else {
+        } else if (frame) {
             tangent_from_uv(e1, e2, rt_v2(t1.x - t0.x, t1.y - t0.y), rt_v2(t2.x - t0.x, t2.y - t0.y), ng, &t, &w);
         }
         break;
@@ -161,15 +182,16 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
         break;
     }
     }
-    sf->material = rt_prim_material(s, hit->prim);
-    RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
     sf->wo = rt_neg(rt_normalize(ray->dir));
     sf->front = rt_dot(ng, ray->dir) < 0.0f;
 
-    rt_vec3 tt = orthonormal_tangent(n, t);
-    rt_vec3 bb = rt_scale(rt_cross(n, tt), w);
+    rt_vec3 tt = rt_v3s(0.0f), bb = rt_v3s(0.0f);
+    if (frame) {
+        tt = orthonormal_tangent(n, t);
+        bb = rt_scale(rt_cross(n, tt), w);
+    }
+    rt_vec3 n_unmapped = n;
     /* normal map, in the frame of the front face */
-    const rt_material *m = &s->materials[sf->material];
     if (m->normal_tex.texture != RT_NONE) {
         RT_DCHECK(m->normal_tex.texture < s->texture_count);
         const rt_texture *tx = &s->textures[m->normal_tex.texture];
@@ -190,13 +212,25 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
     if (!sf->front) {
         ng = rt_neg(ng);
         n = rt_neg(n);
+        n_unmapped = rt_neg(n_unmapped);
         tt = rt_neg(tt);
         bb = rt_neg(bb);
     }
     sf->ng = ng;
     sf->n = n;
+    sf->n_unmapped = n_unmapped;
     sf->t = tt;
     sf->b = bb;
+}
+
+void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf)
+{
+    surface_at(ctx, ray, hit, sf, true);
+}
+
+void rt_surface_at_shading(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf)
+{
+    surface_at(ctx, ray, hit, sf, false);
 }
 
 rt_vec4 rt_surface_base_color(const rt_trace_ctx *ctx, const rt_surface *sf)

@@ -1,6 +1,9 @@
 /* wavefront.c - the wavefront path tracer (rt/render/wavefront.h): a batch
- * of paths in structure-of-arrays form, advanced one bounce at a time by a
- * fixed sequence of stages over the whole batch:
+ * of paths, advanced one bounce at a time by a fixed sequence of stages
+ * over the whole batch. Each lane's rt_path_state and random stream are
+ * read and written in place by the steps of rt/render/pathtrace.h (no copy
+ * in and out); the rays to trace, their hits and the shadow rays are
+ * gathered into structure-of-arrays form for the batch traversal:
  *
  *   refill    free lanes take the next camera samples of the work
  *   trace     closest hits for every live path (rt_kdtree_intersect_batch),
@@ -22,7 +25,8 @@
  * Determinism: a path's random numbers come only from its own PCG stream,
  * seeded by (seed, pixel, sample) and carried in its lane, drawn in the order
  * rt_radiance_path draws them, and from the sampler (rt/render/sampler.h),
- * a function of the sample (key and index, in the lane) and the bounce; shading runs the same functions; a vertex's
+ * a function of the sample (key and index, in the lane's rt_rng) and the
+ * bounce; shading runs the same functions; a vertex's
  * light samples are summed in the same order after their shadow rays come
  * back. So every radiance equals rt_radiance_path's bit for bit, for any
  * batch size, lane assignment and split of the work (tests/test_wavefront.c).
@@ -55,19 +59,17 @@ enum { KIND_BUCKETS = 8 }; /* material kinds (rt_bsdf_model) sorted apart; more 
 struct rt_wavefront {
     size_t batch;        /* lanes */
     size_t rec_per_path; /* light samples a vertex can make: lights + environment + emitter */
-    /* the path's ray (unit direction) and its hit */
+    /* each lane's path and random stream, read and written in place by the
+     * steps of rt/render/pathtrace.h */
+    rt_path_state *ps;
+    rt_rng *rng;
+    uint8_t *status, *nee;
+    int32_t *layers;
+    uint32_t *out;       /* index of the sample in the work */
+    /* the rays to trace, gathered from the paths, and their hits */
     float *ox, *oy, *oz, *dx, *dy, *dz, *tmin, *tmax;
     float *ht, *hu, *hv;
     uint32_t *hprim;
-    /* the path */
-    float *Lr, *Lg, *Lb, *br, *bg, *bb;
-    float *prev_pdf, *ppx, *ppy, *ppz;
-    uint8_t *prev_delta, *status, *nee;
-    int32_t *bounces, *layers, *skips;
-    rt_medium_stack *media; /* the dielectrics each path is inside */
-    uint64_t *rng_state, *rng_inc;
-    uint32_t *rng_key, *rng_index; /* the sample, for the sampler (rt/render/sampler.h) */
-    uint32_t *out;       /* index of the sample in the work */
     /* this bounce's light samples: the lane's first record, how many, the
      * throughput they are weighted by */
     uint32_t *rec_first, *rec_count;
@@ -107,23 +109,18 @@ rt_wavefront *rt_wavefront_new(size_t batch, const rt_render_state *state)
     wf->rec_per_path = K;
     bool ok = true;
     float **fl[] = {&wf->ox, &wf->oy, &wf->oz, &wf->dx, &wf->dy, &wf->dz, &wf->tmin, &wf->tmax, &wf->ht,
-                    &wf->hu, &wf->hv, &wf->Lr, &wf->Lg, &wf->Lb, &wf->br, &wf->bg, &wf->bb, &wf->prev_pdf,
-                    &wf->ppx, &wf->ppy, &wf->ppz, &wf->nbr, &wf->nbg, &wf->nbb};
+                    &wf->hu, &wf->hv, &wf->nbr, &wf->nbg, &wf->nbb};
     for (size_t i = 0; i < sizeof fl / sizeof fl[0]; i++)
         *fl[i] = grab(B, sizeof(float), &ok);
     uint32_t **u32[] = {&wf->hprim, &wf->out, &wf->rec_first, &wf->rec_count, &wf->active,
-                        &wf->queue, &wf->queue2, &wf->order, &wf->free_lanes, &wf->rng_key, &wf->rng_index};
+                        &wf->queue, &wf->queue2, &wf->order, &wf->free_lanes};
     for (size_t i = 0; i < sizeof u32 / sizeof u32[0]; i++)
         *u32[i] = grab(B, sizeof(uint32_t), &ok);
-    wf->prev_delta = grab(B, 1, &ok);
+    wf->ps = grab(B, sizeof(rt_path_state), &ok);
+    wf->rng = grab(B, sizeof(rt_rng), &ok);
     wf->status = grab(B, 1, &ok);
     wf->nee = grab(B, 1, &ok);
-    wf->bounces = grab(B, sizeof(int32_t), &ok);
     wf->layers = grab(B, sizeof(int32_t), &ok);
-    wf->skips = grab(B, sizeof(int32_t), &ok);
-    wf->media = grab(B, sizeof(rt_medium_stack), &ok);
-    wf->rng_state = grab(B, sizeof(uint64_t), &ok);
-    wf->rng_inc = grab(B, sizeof(uint64_t), &ok);
     wf->sf = grab(B, sizeof(rt_surface), &ok);
     wf->rec = grab(R, sizeof(rt_nee_record), &ok);
     float **sfl[] = {&wf->vis, &wf->sox, &wf->soy, &wf->soz, &wf->sdx, &wf->sdy, &wf->sdz, &wf->stmin, &wf->stmax};
@@ -142,55 +139,14 @@ void rt_wavefront_free(rt_wavefront *wf)
 {
     if (!wf)
         return;
-    void *all[] = {wf->ox, wf->oy, wf->oz, wf->dx, wf->dy, wf->dz, wf->tmin, wf->tmax, wf->ht, wf->hu, wf->hv,
-                   wf->hprim, wf->Lr, wf->Lg, wf->Lb, wf->br, wf->bg, wf->bb, wf->prev_pdf, wf->ppx, wf->ppy,
-                   wf->ppz, wf->prev_delta, wf->status, wf->nee, wf->bounces, wf->layers, wf->rng_state,
-                   wf->rng_inc, wf->out, wf->rec_first, wf->rec_count, wf->nbr, wf->nbg, wf->nbb, wf->sf,
-                   wf->rec, wf->vis, wf->sox, wf->soy, wf->soz, wf->sdx, wf->sdy, wf->sdz, wf->stmin,
-                   wf->stmax, wf->blocked, wf->pending, wf->active, wf->queue, wf->queue2, wf->order,
-                   wf->free_lanes, wf->skips, wf->media, wf->rng_key, wf->rng_index};
+    void *all[] = {wf->ps, wf->rng, wf->ox, wf->oy, wf->oz, wf->dx, wf->dy, wf->dz, wf->tmin, wf->tmax, wf->ht,
+                   wf->hu, wf->hv, wf->hprim, wf->status, wf->nee, wf->layers, wf->out, wf->rec_first,
+                   wf->rec_count, wf->nbr, wf->nbg, wf->nbb, wf->sf, wf->rec, wf->vis, wf->sox, wf->soy,
+                   wf->soz, wf->sdx, wf->sdy, wf->sdz, wf->stmin, wf->stmax, wf->blocked, wf->pending,
+                   wf->active, wf->queue, wf->queue2, wf->order, wf->free_lanes};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]);
     free(wf);
-}
-
-/* ------------------------------------------------------------ lane <-> path */
-
-static inline void load_path(const rt_wavefront *wf, uint32_t i, rt_path_state *ps, rt_rng *rng)
-{
-    ps->r = rt_ray_make(rt_v3(wf->ox[i], wf->oy[i], wf->oz[i]), rt_v3(wf->dx[i], wf->dy[i], wf->dz[i]),
-                        wf->tmin[i], wf->tmax[i]);
-    ps->L = rt_v3(wf->Lr[i], wf->Lg[i], wf->Lb[i]);
-    ps->beta = rt_v3(wf->br[i], wf->bg[i], wf->bb[i]);
-    ps->prev_delta = wf->prev_delta[i] != 0;
-    ps->prev_pdf = wf->prev_pdf[i];
-    ps->prev_p = rt_v3(wf->ppx[i], wf->ppy[i], wf->ppz[i]);
-    ps->bounces = wf->bounces[i];
-    ps->media = wf->media[i];
-    ps->skips = wf->skips[i];
-    rng->state = wf->rng_state[i];
-    rng->inc = wf->rng_inc[i];
-    rng->key = wf->rng_key[i];
-    rng->index = wf->rng_index[i];
-}
-
-static inline void store_path(rt_wavefront *wf, uint32_t i, const rt_path_state *ps, const rt_rng *rng)
-{
-    wf->ox[i] = ps->r.org.x, wf->oy[i] = ps->r.org.y, wf->oz[i] = ps->r.org.z;
-    wf->dx[i] = ps->r.dir.x, wf->dy[i] = ps->r.dir.y, wf->dz[i] = ps->r.dir.z;
-    wf->tmin[i] = ps->r.tmin, wf->tmax[i] = ps->r.tmax;
-    wf->Lr[i] = ps->L.x, wf->Lg[i] = ps->L.y, wf->Lb[i] = ps->L.z;
-    wf->br[i] = ps->beta.x, wf->bg[i] = ps->beta.y, wf->bb[i] = ps->beta.z;
-    wf->prev_delta[i] = ps->prev_delta;
-    wf->prev_pdf[i] = ps->prev_pdf;
-    wf->ppx[i] = ps->prev_p.x, wf->ppy[i] = ps->prev_p.y, wf->ppz[i] = ps->prev_p.z;
-    wf->bounces[i] = ps->bounces;
-    wf->media[i] = ps->media;
-    wf->skips[i] = ps->skips;
-    wf->rng_state[i] = rng->state;
-    wf->rng_inc[i] = rng->inc;
-    wf->rng_key[i] = rng->key;
-    wf->rng_index[i] = rng->index;
 }
 
 static inline void put_out(float *out, uint32_t k, rt_vec3 L)
@@ -211,14 +167,11 @@ static bool start_path(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_wavef
     uint32_t px = wk->first + k / n, s = wk->s0 + k % n;
     uint32_t w = (uint32_t)(wk->x1 - wk->x0);
     int x = wk->x0 + (int)(px % w), y = wk->y0 + (int)(px / w);
-    rt_rng rng;
-    rt_ray ray = rt_camera_pixel_sample(wk->camera, wk->width, wk->seed, wk->spp, x, y, s, &rng);
-    rt_path_state ps;
-    if (!rt_path_start(ctx, &ray, &ps)) {
+    rt_ray ray = rt_camera_pixel_sample(wk->camera, wk->width, wk->seed, wk->spp, x, y, s, &wf->rng[i]);
+    if (!rt_path_start(ctx, &ray, &wf->ps[i])) {
         put_out(out, k, rt_v3s(0.0f));
         return false;
     }
-    store_path(wf, i, &ps, &rng);
     wf->out[i] = k;
     wf->status[i] = LANE_TRACE;
     return true;
@@ -233,9 +186,14 @@ static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_acti
     rt_hit_batch hb = {wf->ht, wf->hu, wf->hv, wf->hprim};
     uint32_t *q = wf->queue, *q2 = wf->queue2;
     size_t n = n_active;
-    for (size_t k = 0; k < n; k++) {
-        q[k] = wf->active[k];
-        wf->layers[q[k]] = RT_PATH_LAYERS;
+    for (size_t k = 0; k < n; k++) { /* the rays, gathered */
+        uint32_t i = wf->active[k];
+        const rt_ray *r = &wf->ps[i].r;
+        q[k] = i;
+        wf->layers[i] = RT_PATH_LAYERS;
+        wf->ox[i] = r->org.x, wf->oy[i] = r->org.y, wf->oz[i] = r->org.z;
+        wf->dx[i] = r->dir.x, wf->dy[i] = r->dir.y, wf->dz[i] = r->dir.z;
+        wf->tmin[i] = r->tmin, wf->tmax[i] = r->tmax;
     }
     while (n > 0) {
         if (ctx->ray_count)
@@ -250,19 +208,13 @@ static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_acti
                 continue;
             }
             rt_hit h = {wf->ht[i], wf->hu[i], wf->hv[i], wf->hprim[i]};
-            rt_ray r = rt_ray_make(rt_v3(wf->ox[i], wf->oy[i], wf->oz[i]), rt_v3(wf->dx[i], wf->dy[i], wf->dz[i]),
-                                   wf->tmin[i], wf->tmax[i]);
             rt_surface *sf = &wf->sf[i];
-            rt_surface_at(ctx, &r, &h, sf);
+            rt_surface_at_shading(ctx, &wf->ps[i].r, &h, sf);
             float coverage;
             bool cut = rt_surface_cut_away(ctx, sf, &coverage);
-            if (!cut && coverage < 1.0f) { /* stochastic alpha blending, from the path's stream */
-                rt_rng rng = {wf->rng_state[i], wf->rng_inc[i], wf->rng_key[i], wf->rng_index[i]};
-                if (rt_rng_float(&rng) >= coverage)
-                    cut = true;
-                wf->rng_state[i] = rng.state;
-            }
-            wf->tmin[i] = h.t;
+            if (!cut && coverage < 1.0f && rt_rng_float(&wf->rng[i]) >= coverage)
+                cut = true; /* stochastic alpha blending, from the path's stream */
+            wf->tmin[i] = wf->ps[i].r.tmin = h.t;
             if (!cut)
                 wf->status[i] = LANE_SURFACE;
             else if (wf->layers[i] <= 0)
@@ -297,42 +249,38 @@ static void add_record(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_surfa
  * rays, then BSDF sampling (rt/render/pathtrace.h). */
 static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, size_t *n_rec, size_t *n_pending)
 {
-    rt_path_state ps;
-    rt_rng rng;
-    load_path(wf, i, &ps, &rng);
+    rt_path_state *ps = &wf->ps[i];
+    rt_rng *rng = &wf->rng[i];
     wf->nee[i] = 0;
     uint8_t st = wf->status[i];
     if (st != LANE_SURFACE) {
         if (st == LANE_MISS)
-            rt_path_miss(ctx, &ps);
+            rt_path_miss(ctx, ps);
         wf->status[i] = LANE_DONE;
-        store_path(wf, i, &ps, &rng);
         return;
     }
     const rt_surface *sf = &wf->sf[i];
     rt_bsdf b;
     rt_vec3 wo;
-    rt_path_vertex v = rt_path_vertex_begin(ctx, &ps, sf, &b, &wo);
+    rt_path_vertex v = rt_path_vertex_begin(ctx, ps, sf, &b, &wo);
     if (v != RT_VERTEX_SHADE) { /* the path ends, or passes a false intersection straight on */
         wf->status[i] = v == RT_VERTEX_PASS ? LANE_LIVE : LANE_DONE;
-        store_path(wf, i, &ps, &rng);
         return;
     }
     size_t first = *n_rec;
     const rt_scene *s = ctx->state->scene;
     for (size_t l = 0; l < s->light_count; l++)
-        if (rt_path_nee_light(ctx, &ps, sf, &b, wo, &rng, l, &wf->rec[*n_rec]))
+        if (rt_path_nee_light(ctx, ps, sf, &b, wo, rng, l, &wf->rec[*n_rec]))
             add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
-    if (rt_path_nee_env(ctx, &ps, &b, wo, &rng, &wf->rec[*n_rec]))
+    if (rt_path_nee_env(ctx, ps, &b, wo, rng, &wf->rec[*n_rec]))
         add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
-    if (rt_path_nee_emitter(ctx, &ps, sf, &b, wo, &rng, &wf->rec[*n_rec]))
+    if (rt_path_nee_emitter(ctx, ps, sf, &b, wo, rng, &wf->rec[*n_rec]))
         add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
     wf->nee[i] = 1;
     wf->rec_first[i] = (uint32_t)first;
     wf->rec_count[i] = (uint32_t)(*n_rec - first);
-    wf->nbr[i] = ps.beta.x, wf->nbg[i] = ps.beta.y, wf->nbb[i] = ps.beta.z;
-    wf->status[i] = rt_path_vertex_end(ctx, &ps, sf, &b, wo, &rng) ? LANE_LIVE : LANE_DONE;
-    store_path(wf, i, &ps, &rng);
+    wf->nbr[i] = ps->beta.x, wf->nbg[i] = ps->beta.y, wf->nbb[i] = ps->beta.z;
+    wf->status[i] = rt_path_vertex_end(ctx, ps, sf, &b, wo, rng) ? LANE_LIVE : LANE_DONE;
 }
 
 /* The active lanes in shading order: surfaces grouped by material kind
@@ -400,12 +348,10 @@ void rt_wavefront_radiance(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_w
                 rt_vec3 sum = rt_v3s(0.0f);
                 for (uint32_t r = wf->rec_first[i], e = r + wf->rec_count[i]; r < e; r++)
                     sum = rt_path_nee_add(sum, &wf->rec[r], wf->vis[r]);
-                rt_vec3 L = rt_path_add_finite(rt_v3(wf->Lr[i], wf->Lg[i], wf->Lb[i]),
-                                               rt_mul(rt_v3(wf->nbr[i], wf->nbg[i], wf->nbb[i]), sum));
-                wf->Lr[i] = L.x, wf->Lg[i] = L.y, wf->Lb[i] = L.z;
+                wf->ps[i].L = rt_path_add_finite(wf->ps[i].L, rt_mul(rt_v3(wf->nbr[i], wf->nbg[i], wf->nbb[i]), sum));
             }
             if (wf->status[i] == LANE_DONE) {
-                rt_vec3 L = rt_v3(wf->Lr[i], wf->Lg[i], wf->Lb[i]);
+                rt_vec3 L = wf->ps[i].L;
                 put_out(out, wf->out[i], rt_finite3(L) ? L : rt_v3s(0.0f));
                 wf->free_lanes[n_free++] = i;
             } else {

@@ -24,13 +24,19 @@
  *
  * Refraction: exact unpolarised Fresnel (rt_fresnel_dielectric), Snell's
  * law, total internal reflection. Rays carry a stack of the media they are
- * in (rt_medium_stack), so the index on each side of an interface is known
- * even for nested media (a glass ball in water: 1.33 -> 1.5, not 1 -> 1.5).
+ * in (rt_medium_stack) under the path tracer's rules (medium.c: Schmidt and
+ * Budge 2002, "Simple Nested Dielectrics in Ray Traced Images", JGT 7(1)),
+ * every transmissive material being a medium: the current medium is the
+ * highest `priority` one, a surface inside a higher-priority medium is a
+ * false intersection the ray passes straight through, and a true one
+ * refracts between the two media's indices (a glass ball in water: 1.33 ->
+ * 1.5, not 1 -> 1.5; outside everything, the object's exterior_ior).
  *
  * glTF extensions (docs/gltf.md, "Material mapping"): a clearcoat c adds
  * a mirror of weight c F_coat(n.v) (Schlick, F0 = 0.04) over the rest,
  * i.e. R becomes R + (1 - R) c F_coat; KHR_materials_specular scales ks at
- * load; sheen, anisotropy, iridescence and diffuse transmission are
+ * load (the glTF loader and the scene parser's specular_factor and
+ * specular_color keys alike); sheen, anisotropy, iridescence and diffuse transmission are
  * path-tracer effects this model leaves out.
  *
  * Recursion: reflection/refraction up to settings.max_bounce events; a
@@ -108,32 +114,14 @@ bool rt_refract(rt_vec3 d, rt_vec3 n, float n1, float n2, rt_vec3 *t)
 
 float rt_medium_ior(const rt_scene *s, const rt_medium_stack *m)
 {
-    if (!m || m->depth <= 0)
-        return 1.0f;
-    uint32_t mat = m->material[m->depth - 1];
-    RT_DCHECK(mat < s->material_count);
-    return s->materials[mat].ior;
+    uint32_t mat = m && m->depth > 0 ? rt_medium_current(m, s->materials) : RT_NONE;
+    RT_DCHECK(mat == RT_NONE || mat < s->material_count);
+    return mat == RT_NONE ? 1.0f : s->materials[mat].ior;
 }
 
-static void medium_push(rt_medium_stack *m, uint32_t mat)
-{
-    if (m->depth < RT_MEDIUM_STACK_MAX)
-        m->material[m->depth++] = mat;
-}
-
-/* Removes the innermost occurrence of mat; false when it was not there. */
-static bool medium_remove(rt_medium_stack *m, uint32_t mat)
-{
-    for (int i = m->depth - 1; i >= 0; i--) {
-        if (m->material[i] != mat)
-            continue;
-        for (int j = i; j + 1 < m->depth; j++)
-            m->material[j] = m->material[j + 1];
-        m->depth--;
-        return true;
-    }
-    return false;
-}
+/* whitted's media: every transmissive surface (the path tracer's are the
+ * bsdf dielectric ones, which the parser makes transmissive) */
+static bool is_medium(const rt_material *m) { return m->transmission > 0.0f; }
 
 /* ------------------------------------------------------------ integrator */
 
@@ -218,6 +206,14 @@ static rt_vec3 shade(wctx *w, const rt_surface *sf, const rt_medium_stack *med, 
     const rt_scene *s = ctx->state->scene;
     RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
     const rt_material *m = &s->materials[sf->material];
+    if (is_medium(m) && rt_medium_stack_false_hit(med, s->materials, sf->material, sf->front)) {
+        /* an interface inside a higher-priority medium: straight on */
+        rt_medium_stack inner = *med;
+        rt_medium_stack_cross(&inner, sf->material, sf->front);
+        rt_vec3 d = rt_neg(sf->wo);
+        rt_ray r = rt_ray_make(rt_surface_spawn(ctx, sf, d), d, 0.0f, INFINITY);
+        return trace(w, r, &inner, depth, level, weight, diffuse_ray);
+    }
     rt_vec4 b4 = rt_surface_base_color(ctx, sf);
     rt_vec3 base = rt_v3(b4.x, b4.y, b4.z);
     /* after a diffuse bounce, a sampled light's own quad is not seen: its
@@ -274,16 +270,11 @@ static rt_vec3 shade(wctx *w, const rt_surface *sf, const rt_medium_stack *med, 
     rt_vec3 w_trans = rt_v3s(0), tdir = d;
     rt_medium_stack inner = *med;
     if (T > 0.0f) {
-        float n1, n2;
-        if (sf->front) { /* entering the material's volume */
-            n1 = rt_medium_ior(s, med);
-            n2 = m->ior;
-            medium_push(&inner, sf->material);
-        } else {         /* leaving it */
-            n1 = m->ior;
-            medium_remove(&inner, sf->material);
-            n2 = rt_medium_ior(s, &inner);
-        }
+        /* entering: from the current medium into the material; leaving:
+         * from it into the medium beyond (rt/render/medium.h) */
+        float beyond = rt_medium_outside_ior(med, s->materials, sf->material, sf->front);
+        float n1 = sf->front ? beyond : m->ior, n2 = sf->front ? m->ior : beyond;
+        rt_medium_stack_cross(&inner, sf->material, sf->front);
         matched = n1 == n2;
         float cos_i = rt_clampf(rt_dot(sf->wo, ns), 0.0f, 1.0f);
         rt_fresnel fr = rt_fresnel_dielectric(cos_i, n1, n2);

@@ -1,6 +1,5 @@
-/* texture.c - images decoded once (stb_image behind our own size checks,
- * OpenEXR through rt/io/exr.h, WebP through rt/io/webp.h),
- * textures as image + sampler or a procedural pattern, and lookups.
+/* texture.c - images decoded once (by rt/io/image_decode.h) and cached by
+ * name, textures as image + sampler or a procedural pattern, and lookups.
  *
  * Lookups follow the glTF conventions, which are rt's internal ones: UV (0,0)
  * is the top-left corner of the image (row 0 as stored), u grows to the
@@ -20,11 +19,8 @@
 
 #include <sys/stat.h>
 
-#include <stb/stb_image.h>
-
 #include "rt/base/file.h"
-#include "rt/io/exr.h"
-#include "rt/io/webp.h"
+#include "rt/io/image_decode.h"
 
 /* sRGB 8-bit code -> linear value, from the IEC 61966-2-1 formula. */
 static const float srgb_table[256] = {
@@ -78,123 +74,6 @@ float rt_linear_to_srgb(float c)
 
 /* ------------------------------------------------------------- loading */
 
-/* PNG pixel data is a zlib stream whose decoded length the header fixes
- * exactly (PNG spec, sections 7 and 8: one filter byte per scanline, per
- * Adam7 pass when interlaced). stb_image grows its output buffer without
- * bound while inflating, so a small file whose stream never ends (or runs
- * on past the pixels) could take gigabytes. Before handing a PNG to stb we
- * therefore (1) refuse a declared size that deflate's 1032:1 maximum ratio
- * cannot produce from the bytes present, and (2) inflate the stream once
- * into a buffer of exactly the declared size, which stb's fixed-buffer
- * decoder refuses to overrun. Non-PNG data returns RT_OK untouched. */
-static uint32_t be32(const unsigned char *p)
-{
-    return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | (uint32_t)p[3];
-}
-
-static uint64_t png_rows_bytes(uint64_t w, uint64_t h, uint64_t bits_per_pixel)
-{
-    if (w == 0 || h == 0)
-        return 0;
-    return h * (1 + (w * bits_per_pixel + 7) / 8);
-}
-
-static rt_result png_precheck(const unsigned char *p, size_t size, const char *name, rt_error *err)
-{
-    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    if (size < 8 || memcmp(p, sig, 8) != 0)
-        return RT_OK;
-    uint32_t w = 0, h = 0;
-    int depth = 0, color = -1, interlace = 0;
-    bool iphone = false, ihdr = false;
-    size_t idat_len = 0, off = 8;
-    /* pass 1: header fields and the total IDAT length */
-    while (off + 12 <= size) {
-        uint32_t len = be32(p + off);
-        const unsigned char *type = p + off + 4;
-        if (len > size - off - 12)
-            break; /* truncated chunk: stb reports it */
-        const unsigned char *d = p + off + 8;
-        if (memcmp(type, "CgBI", 4) == 0)
-            iphone = true;
-        else if (memcmp(type, "IHDR", 4) == 0 && len >= 13 && !ihdr) {
-            ihdr = true;
-            w = be32(d);
-            h = be32(d + 4);
-            depth = d[8];
-            color = d[9];
-            interlace = d[12];
-        } else if (memcmp(type, "IDAT", 4) == 0)
-            idat_len += len;
-        else if (memcmp(type, "IEND", 4) == 0)
-            break;
-        off += 12 + (size_t)len;
-    }
-    if (!ihdr || idat_len == 0 || w == 0 || h == 0 || w > RT_MAX_IMAGE_DIM || h > RT_MAX_IMAGE_DIM)
-        return RT_OK; /* stb (or our size check) rejects these with its own reason */
-    int channels = color == 0 ? 1 : color == 2 ? 3 : color == 3 ? 1 : color == 4 ? 2 : color == 6 ? 4 : 0;
-    if (!channels || (depth != 1 && depth != 2 && depth != 4 && depth != 8 && depth != 16) || interlace > 1)
-        return RT_OK;
-    uint64_t bpp = (uint64_t)channels * (uint64_t)depth, need = 0;
-    if (!interlace) {
-        need = png_rows_bytes(w, h, bpp);
-    } else { /* Adam7: origin and step of each pass */
-        static const int x0[7] = {0, 4, 0, 2, 0, 1, 0}, y0[7] = {0, 0, 4, 0, 2, 0, 1};
-        static const int dx[7] = {8, 8, 4, 4, 2, 2, 1}, dy[7] = {8, 8, 8, 4, 4, 2, 2};
-        for (int k = 0; k < 7; k++) {
-            uint64_t pw = w > (uint32_t)x0[k] ? (w - (uint32_t)x0[k] + (uint32_t)dx[k] - 1) / (uint32_t)dx[k] : 0;
-            uint64_t ph = h > (uint32_t)y0[k] ? (h - (uint32_t)y0[k] + (uint32_t)dy[k] - 1) / (uint32_t)dy[k] : 0;
-            need += png_rows_bytes(pw, ph, bpp);
-        }
-    }
-    /* deflate emits at most 258 bytes per 2 bits (a ratio under 1032:1) */
-    if (need > (uint64_t)idat_len * 1032u + 1024u)
-        return rt_fail(err, RT_ERR_INVALID,
-                       "%s: PNG declares %ux%u pixels but holds only %zu bytes of compressed data, too few for them",
-                       name, w, h, idat_len);
-    if (need > (uint64_t)INT32_MAX || idat_len > (size_t)INT32_MAX)
-        return rt_fail(err, RT_ERR_LIMIT, "%s: PNG pixel data is over 2 GiB", name);
-    /* pass 2: the stream in one piece, inflated into a buffer of its exact size */
-    unsigned char *z = malloc(idat_len);
-    unsigned char *out = malloc((size_t)need);
-    if (!z || !out) {
-        free(z);
-        free(out);
-        return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory checking the PNG data (%zu bytes)", name, (size_t)need);
-    }
-    size_t zn = 0;
-    for (off = 8; off + 12 <= size;) {
-        uint32_t len = be32(p + off);
-        if (len > size - off - 12)
-            break;
-        if (memcmp(p + off + 4, "IDAT", 4) == 0) {
-            memcpy(z + zn, p + off + 8, len);
-            zn += len;
-        } else if (memcmp(p + off + 4, "IEND", 4) == 0)
-            break;
-        off += 12 + (size_t)len;
-    }
-    int got = iphone ? stbi_zlib_decode_noheader_buffer((char *)out, (int)need, (const char *)z, (int)zn)
-                     : stbi_zlib_decode_buffer((char *)out, (int)need, (const char *)z, (int)zn);
-    free(z);
-    free(out);
-    if (got < 0 || (uint64_t)got != need)
-        return rt_fail(err, RT_ERR_INVALID,
-                       "%s: PNG pixel data does not inflate to the %llu bytes its %ux%u header declares", name,
-                       (unsigned long long)need, w, h);
-    return RT_OK;
-}
-
-/* stb reports a failed allocation as "outofmem": that is RT_ERR_NOMEM (the
- * driver then names the memory budget), anything else is a bad image. */
-static rt_result decode_failed(const char *name, rt_error *err)
-{
-    const char *why = stbi_failure_reason();
-    if (why && strcmp(why, "outofmem") == 0)
-        return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory decoding the image", name);
-    return rt_fail(err, RT_ERR_INVALID, "%s: cannot decode image (%s)", name, why ? why : "unknown reason");
-}
-
 static uint32_t find_image(const rt_scene *s, const char *name)
 {
     for (size_t i = 0; i < s->image_count; i++)
@@ -211,84 +90,12 @@ rt_result rt_image_load_memory(rt_scene *s, const void *data, size_t size, const
         *image = cached;
         return RT_OK;
     }
-    if (size == 0 || size > (size_t)INT32_MAX)
-        return rt_fail(err, RT_ERR_INVALID, "%s: image data is %s", name, size ? "over 2 GiB" : "empty");
-    const stbi_uc *bytes = data;
-    int w = 0, h = 0, comp = 0;
-    /* stb refuses PNGs over 2^30 bytes of pixels as "unknown image type":
-     * read the size from the IHDR chunk ourselves to say what is wrong */
-    static const unsigned char png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    if (size >= 24 && memcmp(bytes, png_sig, 8) == 0 && memcmp(bytes + 12, "IHDR", 4) == 0) {
-        uint32_t pw = be32(bytes + 16), ph = be32(bytes + 20);
-        if (pw > RT_MAX_IMAGE_DIM || ph > RT_MAX_IMAGE_DIM || (uint64_t)pw * ph > RT_MAX_IMAGE_PIXELS)
-            return rt_fail(err, RT_ERR_LIMIT, "%s: image is %ux%u, over the limit of %dx%d and %u pixels", name, pw, ph,
-                           RT_MAX_IMAGE_DIM, RT_MAX_IMAGE_DIM, (unsigned)RT_MAX_IMAGE_PIXELS);
-    }
-    if (rt_exr_is(bytes, size)) { /* linear float, like HDR: 16 bytes a texel */
-        rt_image img;
-        memset(&img, 0, sizeof img);
-        snprintf(img.name, sizeof img.name, "%s", name);
-        rt_result r = rt_exr_decode(bytes, size, name, RT_MAX_IMAGE_DIM, RT_MAX_IMAGE_PIXELS / 4, &img.rgbaf,
-                                    &img.width, &img.height, err);
-        if (r != RT_OK)
-            return r;
-        uint32_t idx = rt_scene_add_image(s, &img);
-        if (idx == RT_NONE) {
-            free(img.rgbaf);
-            return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", name);
-        }
-        *image = idx;
-        return RT_OK;
-    }
-    if (rt_webp_is(bytes, size)) { /* 8-bit RGBA like PNG */
-        rt_image img;
-        memset(&img, 0, sizeof img);
-        snprintf(img.name, sizeof img.name, "%s", name);
-        rt_result r = rt_webp_decode(bytes, size, name, RT_MAX_IMAGE_DIM, RT_MAX_IMAGE_PIXELS, &img.rgba8, &img.width,
-                                     &img.height, err);
-        if (r != RT_OK)
-            return r;
-        uint32_t idx = rt_scene_add_image(s, &img);
-        if (idx == RT_NONE) {
-            free(img.rgba8);
-            return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", name);
-        }
-        *image = idx;
-        return RT_OK;
-    }
-    if (!stbi_info_from_memory(bytes, (int)size, &w, &h, &comp))
-        return rt_fail(err, RT_ERR_INVALID, "%s: not a readable image (%s)", name, stbi_failure_reason());
-    if (w <= 0 || h <= 0 || w > RT_MAX_IMAGE_DIM || h > RT_MAX_IMAGE_DIM ||
-        (uint64_t)w * (uint64_t)h > RT_MAX_IMAGE_PIXELS)
-        return rt_fail(err, RT_ERR_LIMIT, "%s: image is %dx%d, over the limit of %dx%d and %u pixels", name, w, h,
-                       RT_MAX_IMAGE_DIM, RT_MAX_IMAGE_DIM, (unsigned)RT_MAX_IMAGE_PIXELS);
-    bool hdr = stbi_is_hdr_from_memory(bytes, (int)size);
-    if (hdr && (uint64_t)w * (uint64_t)h > RT_MAX_IMAGE_PIXELS / 4) /* float RGBA: 16 bytes a texel */
-        return rt_fail(err, RT_ERR_LIMIT, "%s: HDR image is %dx%d, over the limit of %u pixels for float images", name,
-                       w, h, (unsigned)(RT_MAX_IMAGE_PIXELS / 4));
-    rt_result pr = png_precheck(bytes, size, name, err);
-    if (pr != RT_OK)
-        return pr;
+    static const rt_image_limits lim = {RT_MAX_IMAGE_DIM, RT_MAX_IMAGE_PIXELS, RT_MAX_IMAGE_PIXELS / 4};
     rt_image img;
-    memset(&img, 0, sizeof img);
+    rt_result r = rt_image_decode(data, size, name, &lim, &img, err);
+    if (r != RT_OK)
+        return r;
     snprintf(img.name, sizeof img.name, "%s", name);
-    int lw = 0, lh = 0, lc = 0;
-    if (hdr) {
-        img.rgbaf = stbi_loadf_from_memory(bytes, (int)size, &lw, &lh, &lc, 4);
-        if (!img.rgbaf)
-            return decode_failed(name, err);
-    } else {
-        img.rgba8 = stbi_load_from_memory(bytes, (int)size, &lw, &lh, &lc, 4);
-        if (!img.rgba8)
-            return decode_failed(name, err);
-    }
-    if (lw != w || lh != h) {
-        free(img.rgba8);
-        free(img.rgbaf);
-        return rt_fail(err, RT_ERR_INVALID, "%s: image size changed while decoding", name);
-    }
-    img.width = w;
-    img.height = h;
     uint32_t idx = rt_scene_add_image(s, &img);
     if (idx == RT_NONE) {
         free(img.rgba8);

@@ -11,7 +11,10 @@
  * `lanes` lists which entries of the arrays to trace (the live paths of a
  * batch, in any order); results go to the same entry. Every result is
  * bit-for-bit what rt_kdtree_intersect / rt_kdtree_occluded (rt/accel/kdtree.h)
- * return for the same ray, whatever the batch's size and order.
+ * return for the same ray, whatever the batch's size and order. Runs of
+ * consecutive rays in the list that share one origin (a pinhole camera's
+ * rays, listed pixel by pixel) are traced 8 at a time as packets
+ * (rt/accel/kdtree_packet.h): list coherent rays next to each other.
  */
 #ifndef RT_KDTREE_BATCH_H
 #define RT_KDTREE_BATCH_H

@@ -1,6 +1,6 @@
-/* rt/accel/kdtree_packet.h - closest hits of up to 8 coherent rays at once
- * (a 4x2 tile of primary rays, or shadow rays towards one light) through
- * the kd-tree of kdtree.h.
+/* rt/accel/kdtree_packet.h - closest hits, or occlusion, of up to 8
+ * coherent rays at once (a 4x2 tile of primary rays, or shadow rays from
+ * many points towards one light) through the kd-tree of kdtree.h.
  *
  *   rt_ray rays[8];   // e.g. the primary rays of a 4x2 pixel tile
  *   rt_hit hits[8];
@@ -8,10 +8,16 @@
  *   // bit i set: hits[i] is what rt_kdtree_intersect(&tree, &rays[i], ...)
  *   // gives (the same t bits; either primitive when two tie); else a miss
  *
+ *   rt_ray shadow[8]; // from 8 shading points to one light, each with its
+ *                     // own tmin and tmax (the segment to the light)
+ *   unsigned blocked = rt_kdtree_occluded8(&tree, shadow, 8);
+ *   // bit i set exactly when rt_kdtree_occluded(&tree, &shadow[i])
+ *
  * The rays share the walk down the tree: one step through a wide node
  * computes the 8 rays' intervals in every cell at once, a cell is
  * entered when any ray crosses it, and a leaf's triangles are tested
- * against all the rays that reach it at once. Packets whose rays run in different
+ * against all the rays that reach it at once; for occlusion a ray drops
+ * out of the packet at its first hit. Packets whose rays run in different
  * directions along some axis (the cells' order would differ), or with a
  * ray parallel to an axis, are traced as single rays. A 4x4 tile is two
  * calls.
@@ -21,7 +27,9 @@
 
 #include "rt/accel/kdtree.h"
 
-/* n rays (1..8); returns the mask of rays that hit. */
+/* n rays (1..8; more are ignored); returns the mask of rays that hit. */
 unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits);
+/* n rays (1..8); returns the mask of rays with any hit in (tmin, tmax). */
+unsigned rt_kdtree_occluded8(const rt_kdtree *tree, const rt_ray *rays, int n);
 
 #endif

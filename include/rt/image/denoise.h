@@ -13,6 +13,8 @@
  *   if (rt_denoise_find(where, sizeof where, &err) != RT_OK)
  *       ... err.message is one line saying how to install it ...
  *   rt_denoise_input in = {.width = w, .height = h, .color = rgb, .albedo = albedo, .normal = normal};
+ *   rt_denoise_quality_parse("high", &in.quality);   // false for a word that is not a quality
+ *   in.threads = 4;                                  // OIDN's numThreads; 0: rt_cpu_count()
  *   rt_denoise_image(&in, &err);   // rgb denoised in place
  *
  * With -v it prints one line timing its steps (load, device, filter setup,
@@ -28,7 +30,8 @@
 
 /* OIDN's quality modes (its "quality" filter parameter). RT_DENOISE_DEFAULT
  * is RT_OIDN_QUALITY from the environment (fast, balanced or high), else
- * balanced: measured in docs/hdr.md against fast and high. */
+ * balanced: measured in docs/hdr.md against fast and high. Any other value
+ * is the caller's choice and wins over RT_OIDN_QUALITY. */
 typedef enum rt_denoise_quality {
     RT_DENOISE_DEFAULT = 0, /* = RT_DENOISE_BALANCED */
     RT_DENOISE_FAST,
@@ -43,9 +46,16 @@ typedef struct rt_denoise_input {
     const float *albedo; /* optional (NULL): first non-specular hit's albedo, noise-free but for edges */
     const float *normal; /* optional, with albedo: its shading normal */
     rt_denoise_quality quality;
-    int threads;        /* OIDN's worker threads; 0: one per core */
+    int threads;        /* OIDN's worker threads (its numThreads); 0: rt_cpu_count(), the CPUs of the affinity mask */
     bool prefilter_aux; /* albedo and normal are noisy (depth of field): denoise them first */
 } rt_denoise_input;
+
+/* The words of the qualities, for messages and --help. */
+#define RT_DENOISE_QUALITY_NAMES "fast, balanced or high"
+
+/* "fast", "balanced" or "high" into *out; false (and *out untouched) for
+ * anything else. */
+bool rt_denoise_quality_parse(const char *name, rt_denoise_quality *out);
 
 /* The one-line hint printed when the library is missing. */
 #define RT_DENOISE_INSTALL_HINT "run 'make denoiser' (installs the pyoidn wheel into build/oidn-venv) or set RT_OIDN_LIBRARY"

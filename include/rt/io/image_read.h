@@ -1,7 +1,8 @@
 /* rt/io/image_read.h - reading a whole image file into a framebuffer of
- * linear RGB floats, whatever its format: OpenEXR (exr.h), PFM, Radiance HDR,
- * and 8-bit images (PNG, JPEG...: sRGB-decoded to linear). The format is
- * found from the file's first bytes, not its name. For `rt compare` and
+ * linear RGB floats, whatever its format: PFM, and everything
+ * rt_image_decode reads (image_decode.h: OpenEXR, Radiance HDR, and 8-bit
+ * images, PNG, JPEG, WebP...: sRGB-decoded to linear). The format is found
+ * from the file's first bytes, not its name. For `rt compare` and
  * `rt convert`; scene textures load through rt/scene/texture.h instead.
  *
  *   rt_framebuffer fb;

@@ -27,6 +27,10 @@ rt_result rt_scene_parse_file(rt_scene *s, const char *path, rt_error *err);
 rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const char *name, const char *dir,
                                 rt_error *err);
 
+/* The material keys of the format (`color`, `clearcoat`, ...), by index:
+ * NULL past the last (for the docs test and tools). */
+const char *rt_scene_material_key(size_t i);
+
 /* The built-in default scene (a Cornell box with a sphere), in the same format. */
 extern const char rt_default_scene_text[];
 

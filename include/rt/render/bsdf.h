@@ -62,6 +62,7 @@
 
 #include <stdbool.h>
 
+#include "rt/render/ggx_albedo.h"
 #include "rt/render/surface.h"
 
 #define RT_BSDF_MIN_ALPHA 1e-4f /* GGX alpha floor for roughness > 0 (roughness 0 is a delta interface) */
@@ -82,9 +83,13 @@ typedef struct rt_bsdf {
     bool radiance_eta2; /* dielectric: refraction scales radiance by eta^2 (n_wo / n_wi)^2 */
     bool plastic;     /* coat over Lambert: diffuse = R / (1 - R Fdr_in) / eta_in^2, times (1 - Fo)(1 - Fi) / pi */
     rt_vec3 eta_c, k_c; /* conductor: complex index relative to the outside */
-    bool ms;          /* conductor: Kulla-Conty multiple-scattering lobe (rt_bsdf_compensate) */
+    bool ms;          /* conductor or dielectric: Kulla-Conty multiple-scattering lobe (rt_bsdf_compensate) */
     float ms_alpha;   /* its table alpha, sqrt(alpha alpha_y) */
-    rt_vec3 ms_scale; /* F_ms / (pi (1 - E_avg)): f_ms = ms_scale (1 - E(mu_o)) (1 - E(mu_i)) */
+    rt_vec3 ms_scale; /* conductor: F_ms / (pi (1 - E_avg)): f_ms = ms_scale (1 - E(mu_o)) (1 - E(mu_i)) */
+    float ms_x;       /* dielectric: the share of the lost energy at wo that crosses the interface */
+    float ms_refl;    /* dielectric: f_ms,R = ms_refl (1 - E_o(mu_o)) (1 - E_o(mu_i)) */
+    float ms_trans;   /* dielectric: f_ms,T = ms_trans (1 - E_o(mu_o)) (1 - E_t(|mu_i|)) (flux; x eta^2 for radiance) */
+    rt_ggx_dielectric_cell ms_cell[2]; /* dielectric: E's table cells from wo's side (o) and the other (t) */
     float transmission; /* T */
     float eta;        /* index ratio across the surface along a transmitted ray: n_incident / n_transmitted */
     bool thin;        /* glTF transmission without a volume (thickness 0, thin-walled): light goes straight
@@ -98,7 +103,7 @@ typedef struct rt_bsdf {
     float clearcoat;       /* KHR_materials_clearcoat weight c */
     float cc_alpha;        /* the coat's GGX alpha (floored) */
     bool cc_delta;         /* coat roughness 0: a mirror coat */
-    rt_vec3 cc_t, cc_b, cc_n; /* the coat's frame in the local frame (cc_n = (0,0,1) without a coat normal map) */
+    rt_vec3 cc_t, cc_b, cc_n; /* the coat's frame in the local frame (cc_n = (0,0,1) when the coat shares the shading normal) */
     rt_vec3 sheen;         /* KHR_materials_sheen colour (0: no sheen) */
     float sheen_alpha;     /* its alpha (rt_sheen_alpha) */
     float iridescence;     /* KHR_materials_iridescence factor */
@@ -171,11 +176,25 @@ void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float
  * F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)) per channel, with the
  * tables of rt/render/ggx_albedo.h at alpha = sqrt(alpha_x alpha_y).
  * Sampled by the cosine with the probability of its share of the albedo.
+ * To a rough dielectric (rt_bsdf_make_dielectric) it adds the same lobe
+ * with E from the dielectric tables, split between a reflected lobe and
+ * a transmitted one (docs/shading.md, section 14): the reflected part is
+ * evaluated (light-sampled, MIS) with the cosine-sampled pdf, the
+ * transmitted part is sampled only, as the refraction is;
+ * rt_bsdf_set_eta recomputes it for another medium beyond.
  * rt_bsdf_from_surface calls it when the scene's energy_compensation is on. */
 void rt_bsdf_compensate(rt_bsdf *b);
+/* A compensated dielectric's transmitted multiple-scattering lobe f_ms,T
+ * (flux form, without the eta^2 of radiance) from wo (above) to wi
+ * (below the surface); 0 without compensation. For tests: n_o^2 f(wo, wi)
+ * = n_t^2 f(wi, wo) seen from the other side. */
+float rt_bsdf_ms_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi);
 
-/* The glTF PBR-next extensions' parameters at a point (rt_bsdf_set_ext);
- * rt_bsdf_ext_default gives the values that leave the core BSDF. */
+/* The glTF PBR-next extensions' parameters at a point (rt_bsdf_set_ext).
+ * rt_bsdf_ext_of_material takes a material's factors (no textures: the
+ * path tracer multiplies those in at a hit); rt_bsdf_ext_default is that
+ * of rt_material_default()'s material, the values that leave the core
+ * BSDF, so the defaults live in one place (scene.c). */
 typedef struct rt_bsdf_ext {
     float spec_weight;          /* KHR_materials_specular: specularFactor */
     rt_vec3 spec_color;         /* specularColorFactor */
@@ -189,6 +208,7 @@ typedef struct rt_bsdf_ext {
     rt_vec3 diffuse_transmission_color;
     float dispersion;           /* KHR_materials_dispersion: 20 / Abbe number (needs transmission) */
 } rt_bsdf_ext;
+void rt_bsdf_ext_of_material(const rt_material *m, rt_bsdf_ext *e);
 void rt_bsdf_ext_default(rt_bsdf_ext *e);
 /* Puts the extensions' layers over a glTF BSDF from rt_bsdf_make or
  * rt_bsdf_from_surface (anything else is left as it is); with the default

@@ -24,7 +24,8 @@
  *   rt_medium_cross(&media, mats, sf.material, sf.front);
  *
  * Rules (docs/shading.md, "Nested media"):
- * - Only `bsdf dielectric` materials are media here; every other surface
+ * - Only `bsdf dielectric` materials are media here (`whitted` counts every
+ *   transmissive material, through rt_medium_stack_*); every other surface
  *   is a plain boundary (a glTF KHR_materials_volume object keeps its own
  *   rule: a segment ending on its back ran inside it).
  * - The current medium is the entry of highest `priority` (ties: the one
@@ -57,9 +58,9 @@
 #define RT_MEDIUM_STACK_MAX 8 /* nesting depth: a liquid in a glass with ice in it is 3 */
 
 /* The media a path is inside, oldest first. The `whitted` integrator
- * carries the same struct with its own, priority-free rules
- * (rt/render/whitted.h: every transmissive surface, the top is the
- * medium, overflow keeps the outer levels). */
+ * carries the same struct under the same rules, with its own idea of a
+ * medium (every transmissive surface: rt/render/whitted.h), through the
+ * rt_medium_stack_* functions below. */
 typedef struct rt_medium_stack {
     int depth;                              /* entries in use, 0..RT_MEDIUM_STACK_MAX */
     uint32_t material[RT_MEDIUM_STACK_MAX]; /* entered media (material ids), oldest first */
@@ -89,5 +90,11 @@ float rt_medium_outside_ior(const rt_medium_stack *st, const rt_material *mats, 
  * entry (back). Overflow drops the oldest entry; removing an absent
  * medium changes nothing. Non-media are ignored. */
 void rt_medium_cross(rt_medium_stack *st, const rt_material *mats, uint32_t mat, bool front);
+
+/* rt_medium_false_hit and rt_medium_cross for a caller that decides
+ * itself which materials are media: `mat` is taken to be one (the
+ * functions above are these, for bsdf dielectric materials only). */
+bool rt_medium_stack_false_hit(const rt_medium_stack *st, const rt_material *mats, uint32_t mat, bool front);
+void rt_medium_stack_cross(rt_medium_stack *st, uint32_t mat, bool front);
 
 #endif

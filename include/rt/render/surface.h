@@ -4,7 +4,8 @@
  * Plain functions over the scene's tables (no virtual materials):
  *
  *   rt_surface sf;
- *   rt_surface_at(&ctx, &ray, &hit, &sf);          // point, normals, uv, material
+ *   rt_surface_at(&ctx, &ray, &hit, &sf);          // point, normals, tangent frame, uv, material
+ *   rt_surface_at_shading(&ctx, &ray, &hit, &sf);  // the same, the frame only where the material reads it
  *   // or: the first surface along a ray that its alpha does not cut away
  *   int layers = 32;
  *   float coverage;
@@ -28,6 +29,9 @@ typedef struct rt_surface {
     rt_vec3 p;            /* hit point */
     rt_vec3 ng;           /* geometric normal facing the ray */
     rt_vec3 n;            /* shading normal, same side as ng */
+    rt_vec3 n_unmapped;   /* the shading normal before the material's normal map (the
+                           * interpolated one), same side: a clearcoat's normal when
+                           * the coat has no normal map of its own */
     rt_vec3 t, b;         /* shading tangent frame (t, b, n); b = cross(n, t) * sign */
     rt_vec2 uv0, uv1;     /* rt convention: (0,0) top-left of a texture */
     rt_vec4 vertex_color;
@@ -51,6 +55,14 @@ static inline uint32_t rt_prim_material(const rt_scene *s, uint32_t prim)
 }
 
 void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf);
+/* The same record without the tangent frame (sf->t, sf->b zero) unless the
+ * material reads it (rt_surface_material_reads_frame): for the path tracer,
+ * whose BSDF builds its own frame about the shading normal, so a hit builds
+ * one frame, not two. Every other field is rt_surface_at's, bit for bit. */
+void rt_surface_at_shading(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf);
+/* Whether rt_bsdf_from_surface or the record itself reads the tangent
+ * frame: a normal map, a conductor (anisotropy), the glTF extensions. */
+bool rt_surface_material_reads_frame(const rt_material *m);
 
 /* Base colour (linear RGB, alpha) = factor x texture x vertex colour. */
 rt_vec4 rt_surface_base_color(const rt_trace_ctx *ctx, const rt_surface *sf);

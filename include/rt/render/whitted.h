@@ -40,11 +40,11 @@ rt_fresnel rt_fresnel_dielectric(float cos_i, float n1, float n2);
 bool rt_refract(rt_vec3 d, rt_vec3 n, float n1, float n2, rt_vec3 *t);
 
 /* The media a ray is inside (rt_medium_stack of rt/render/medium.h),
- * innermost last, as material indices: whitted's rules, without
- * priorities: entering a transmissive surface from its front pushes its
- * material, leaving it removes it. The index of refraction a ray travels
- * in is that of the top material, 1 (vacuum/air) when empty. Deeper
- * nesting than the capacity keeps the outer levels. */
+ * oldest first, as material indices, under the path tracer's rules
+ * (priorities, false intersections, overflow drops the outermost), every
+ * transmissive material being a medium. The index of refraction a ray
+ * travels in is the current medium's (highest priority, ties: the last
+ * entered), 1 (vacuum/air) when empty. */
 float rt_medium_ior(const rt_scene *s, const rt_medium_stack *m);
 
 rt_vec3 rt_radiance_whitted(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng);

@@ -1,10 +1,10 @@
 /* rt/texture.h - images (decoded once, cached by name) and texture lookups.
  *
- * Images are decoded with stb_image (PNG, JPEG, HDR, and the rest of what it
- * reads), OpenEXR (rt/io/exr.h) and libwebp (rt/io/webp.h), chosen by
- * content, behind our own checks: a header whose size is over the limit is
- * refused before any pixel memory is allocated. Loading the same file twice
- * returns the same image index.
+ * Images are decoded by rt_image_decode (rt/io/image_decode.h: OpenEXR,
+ * WebP, and PNG, JPEG, HDR and the rest of what stb_image reads, chosen by
+ * content) within RT_MAX_IMAGE_DIM and RT_MAX_IMAGE_PIXELS: a header whose
+ * size is over the limit is refused before any pixel memory is allocated.
+ * Loading the same file twice returns the same image index.
  *
  *   uint32_t img;
  *   if (rt_image_load_file(&scene, "wood.png", &img, &err) != RT_OK) ...

@@ -1,0 +1,69 @@
+/* test_fixture.h - a scene ready to trace, as the integrator tests set it
+ * up: the scene tables, their kd-tree, the render state and a trace
+ * context over them. Include after test_util.h.
+ *
+ *   test_fixture f;
+ *   test_fixture_load(&f, "integrator path\nsphere 0 0 0 1 m\n...", RT_PREPARE_LIGHT_TABLE);
+ *   rt_vec3 L = rt_radiance_path(&f.ctx, &ray, &rng);
+ *   test_fixture_free(&f);
+ *
+ * Or in two steps, to change the scene between parsing and building:
+ *
+ *   test_fixture_parse(&f, text);
+ *   ... add an environment map to f.s ...
+ *   test_fixture_build(&f, RT_PREPARE_LIGHT_TABLE);
+ *
+ * A scene text that does not parse fails the test with the parser's
+ * message.
+ */
+#ifndef RT_TEST_FIXTURE_H
+#define RT_TEST_FIXTURE_H
+
+#include <string.h>
+
+#include "rt/accel/kdtree.h"
+#include "rt/io/scene_parse.h"
+#include "rt/render/render_state.h"
+#include "rt/render/surface.h"
+#include "rt/scene/scene.h"
+
+typedef struct test_fixture {
+    rt_scene s;
+    rt_kdtree tree;
+    rt_render_state rs;
+    rt_trace_ctx ctx;
+} test_fixture;
+
+/* Parses `text` as a scene file into a fresh f->s. */
+static inline void test_fixture_parse(test_fixture *f, const char *text)
+{
+    rt_error err;
+    rt_scene_init(&f->s);
+    if (rt_scene_parse_string(&f->s, text, strlen(text), "test", NULL, &err) != RT_OK)
+        fail_msg("parse: %s", err.message);
+}
+
+/* The kd-tree of f->s, its render state (RT_PREPARE_* bits) and the trace
+ * context. */
+static inline void test_fixture_build(test_fixture *f, unsigned prepare)
+{
+    rt_error err;
+    assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
+    assert_int_equal(rt_render_state_prepare(&f->rs, &f->s, &f->tree, prepare, &err), RT_OK);
+    rt_trace_ctx_init(&f->ctx, &f->rs);
+}
+
+static inline void test_fixture_load(test_fixture *f, const char *text, unsigned prepare)
+{
+    test_fixture_parse(f, text);
+    test_fixture_build(f, prepare);
+}
+
+static inline void test_fixture_free(test_fixture *f)
+{
+    rt_render_state_free(&f->rs);
+    rt_kdtree_free(&f->tree);
+    rt_scene_free(&f->s);
+}
+
+#endif
