@@ -169,7 +169,10 @@ static void test_glass_of_water_fresnel(void **state)
                 (double)sines[k], mean, want, air);
         if (fabs(mean - want) > 5.0 * sigma + 1e-4)
             fail_msg("sin %.2f: reflectance %.5f, want %.5f", (double)sines[k], mean, want);
-        assert_true(k == 4 || fabs(mean - air) > 10.0 * sigma); /* not the water-air interface */
+        /* not the water-air interface: nearer the glass-water value (at sin
+         * 0.8 the two are 9.2 sigma apart, so "10 sigma from air" failed
+         * for an exact mean and passed only by the noise) */
+        assert_true(k == 4 || fabs(mean - air) > 0.5 * fabs(want - air));
     }
     unload(&f);
     /* the water's priority below the glass's: its surface is false, the

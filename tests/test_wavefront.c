@@ -270,8 +270,12 @@ static void test_wavefront_equals_scalar(void **state)
     load_text(&f, every_material);
     assert_true(f.rs.shadows_need_shading);
     const size_t batches[] = {1, 7, 256, 4096};
-    for (size_t b = 0; b < 4; b++)
-        check_against_scalar(&f, batches[b], b == 1 ? 5 : 48, 0, 16, 6);
+    for (int smp = RT_SAMPLER_INDEPENDENT; smp <= RT_SAMPLER_SOBOL; smp++) { /* each sampler (rt/render/sampler.h) */
+        f.s.settings.sampler = smp;
+        for (size_t b = 0; b < 4; b++)
+            if (smp == RT_SAMPLER_INDEPENDENT || b % 2 == 1)
+                check_against_scalar(&f, batches[b], b == 1 ? 5 : 48, 0, 16, 6);
+    }
     unload(&f);
     /* 300 lights: the batch shrinks to keep its light samples bounded */
     static char many[300 * 64 + 512];
@@ -314,21 +318,24 @@ static void test_render_bytes_any_split(void **state)
     (void)state;
     fixture f;
     load_text(&f, every_material);
-    rt_framebuffer ref;
-    render_with(&f, RT_INTEGRATOR_PATH_SCALAR, 1, 8, -1, 0, &ref);
-    size_t n = (size_t)ref.width * (size_t)ref.height * 3 * sizeof(float);
-    struct { int threads, tile, passes, batch; } runs[] = {
-        {1, 8, -1, 0}, {3, 8, -1, 0}, {3, 5, 2, 3}, {2, 64, 1, 4096}, {1, 16, 4, 100}, {3, 7, -1, 1},
-    };
-    for (size_t k = 0; k < sizeof runs / sizeof runs[0]; k++) {
-        rt_framebuffer fb;
-        render_with(&f, RT_INTEGRATOR_PATH, runs[k].threads, runs[k].tile, runs[k].passes, runs[k].batch, &fb);
-        if (memcmp(fb.rgb, ref.rgb, n) != 0)
-            fail_msg("run %zu (threads %d, tile %d, passes %d, batch %d) differs from path_scalar", k,
-                     runs[k].threads, runs[k].tile, runs[k].passes, runs[k].batch);
-        rt_framebuffer_free(&fb);
+    for (int smp = RT_SAMPLER_INDEPENDENT; smp <= RT_SAMPLER_SOBOL; smp++) { /* each sampler */
+        f.s.settings.sampler = smp;
+        rt_framebuffer ref;
+        render_with(&f, RT_INTEGRATOR_PATH_SCALAR, 1, 8, -1, 0, &ref);
+        size_t n = (size_t)ref.width * (size_t)ref.height * 3 * sizeof(float);
+        struct { int threads, tile, passes, batch; } runs[] = {
+            {1, 8, -1, 0}, {3, 8, -1, 0}, {3, 5, 2, 3}, {2, 64, 1, 4096}, {1, 16, 4, 100}, {3, 7, -1, 1},
+        };
+        for (size_t k = 0; k < sizeof runs / sizeof runs[0]; k++) {
+            rt_framebuffer fb;
+            render_with(&f, RT_INTEGRATOR_PATH, runs[k].threads, runs[k].tile, runs[k].passes, runs[k].batch, &fb);
+            if (memcmp(fb.rgb, ref.rgb, n) != 0)
+                fail_msg("sampler %d, run %zu (threads %d, tile %d, passes %d, batch %d) differs from path_scalar",
+                         smp, k, runs[k].threads, runs[k].tile, runs[k].passes, runs[k].batch);
+            rt_framebuffer_free(&fb);
+        }
+        rt_framebuffer_free(&ref);
     }
-    rt_framebuffer_free(&ref);
     unload(&f);
 }
 

@@ -47,6 +47,7 @@ static void settings_text(const rt_scene *scene, char *buf, size_t size)
     line(buf, size, "max_bounce %d", s->max_bounce);
     line(buf, size, "max_depth %d", s->max_depth);
     line(buf, size, "rr_depth %d", s->rr_depth);
+    line(buf, size, "sampler %d", s->sampler);
     line(buf, size, "diffuse_bounces %d", s->diffuse_bounces);
     line(buf, size, "diffuse_rays %d", s->diffuse_rays);
     line(buf, size, "shadow_samples %d", s->shadow_samples);

@@ -47,12 +47,48 @@
  * light through glass arrives by BSDF sampling. Alpha blending on camera
  * and bounce rays is stochastic: the surface is kept with probability alpha.
  * All random numbers come from the rng handed in, so images do not depend
- * on the thread count; every contribution is checked finite.
+ * on the thread count; every contribution is checked finite. The light,
+ * BSDF and roulette decisions take their numbers from the scene's sampler
+ * (settings.sampler, rt/render/sampler.h: stratified over the pixel's
+ * samples, or the rng's stream for `independent`), in dimensions fixed by
+ * the bounce and the decision (path_dim); alpha blending draws from the
+ * rng's stream.
  */
 #include "rt/render/pathtrace.h"
 
 #include "rt/render/environment.h"
 #include "rt/render/medium.h"
+#include "rt/render/sampler.h"
+
+/* The sampler dimensions of a vertex: a fixed layout per bounce (the
+ * vertex after `bounces` scatterings uses dims bounces * stride + slot),
+ * so every sample of a pixel takes each decision from the same stratified
+ * dimension, whatever its path did before, and the wavefront needs no
+ * per-lane counter. */
+enum { DIM_BSDF, DIM_LOBE_RR, DIM_ENV, DIM_EMIT_PICK, DIM_EMIT, DIM_LIGHT0 };
+
+static inline uint32_t path_dim(const rt_trace_ctx *ctx, const rt_path_state *ps, uint32_t slot)
+{
+    uint32_t stride = DIM_LIGHT0 + (uint32_t)ctx->state->scene->light_count;
+    return (uint32_t)ps->bounces * stride + slot;
+}
+
+static inline float path_1d(const rt_trace_ctx *ctx, const rt_path_state *ps, rt_rng *rng, uint32_t slot)
+{
+    const rt_settings *st = &ctx->state->scene->settings;
+    return rt_sample_1d((rt_sampler_kind)st->sampler, (uint32_t)st->samples, rng, path_dim(ctx, ps, slot));
+}
+
+static inline rt_vec2 path_2d_at(const rt_trace_ctx *ctx, rt_rng *rng, uint32_t dim)
+{
+    const rt_settings *st = &ctx->state->scene->settings;
+    return rt_sample_2d((rt_sampler_kind)st->sampler, (uint32_t)st->samples, rng, dim);
+}
+
+static inline rt_vec2 path_2d(const rt_trace_ctx *ctx, const rt_path_state *ps, rt_rng *rng, uint32_t slot)
+{
+    return path_2d_at(ctx, rng, path_dim(ctx, ps, slot));
+}
 
 /* One light-sampling term, f cos vis w / pdf times the radiance; zero when
  * the shadow ray is blocked (vis 0). */
@@ -85,11 +121,11 @@ static bool light_table_record(const rt_trace_ctx *ctx, const rt_bsdf *b, rt_vec
     return true;
 }
 
-bool rt_path_nee_light(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
-                       size_t i, rt_nee_record *rec)
+bool rt_path_nee_light(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
+                       rt_vec3 wo, rt_rng *rng, size_t i, rt_nee_record *rec)
 {
     const rt_light *l = &ctx->state->scene->lights[i];
-    rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
+    rt_vec2 u = path_2d(ctx, ps, rng, DIM_LIGHT0 + (uint32_t)i);
     rt_light_sample ls;
     if (!rt_light_sample_at(ctx, l, sf->p, u, &ls))
         return false;
@@ -114,12 +150,13 @@ bool rt_path_nee_light(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_b
     return true;
 }
 
-bool rt_path_nee_env(const rt_trace_ctx *ctx, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng, rt_nee_record *rec)
+bool rt_path_nee_env(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
+                     rt_nee_record *rec)
 {
     const rt_light_table *t = ctx->state->light_table;
     if (!(t && t->env_w > 0))
         return false;
-    rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
+    rt_vec2 u = path_2d(ctx, ps, rng, DIM_ENV);
     rt_vec3 d;
     float pdf_l;
     if (rt_light_table_sample_env(t, u, &d, &pdf_l) && rt_dot(d, b->ng) > 0.0f)
@@ -127,15 +164,15 @@ bool rt_path_nee_env(const rt_trace_ctx *ctx, const rt_bsdf *b, rt_vec3 wo, rt_r
     return false;
 }
 
-bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
-                         rt_nee_record *rec)
+bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
+                         rt_vec3 wo, rt_rng *rng, rt_nee_record *rec)
 {
     const rt_scene *s = ctx->state->scene;
     const rt_light_table *t = ctx->state->light_table;
     if (!(t && t->count))
         return false;
-    float ul = rt_rng_float(rng);
-    rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
+    float ul = path_1d(ctx, ps, rng, DIM_EMIT_PICK);
+    rt_vec2 u = path_2d(ctx, ps, rng, DIM_EMIT);
     size_t k = rt_light_table_pick(t, ul);
     uint32_t prim = t->prim[k], local;
     rt_hit h;
@@ -287,8 +324,23 @@ bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_sur
 {
     int rr_depth = ctx->state->scene->settings.rr_depth;
     /* continue the path by sampling the BSDF */
-    float ulobe = rt_rng_float(rng);
-    rt_vec2 u = rt_v2(rt_rng_float(rng), rt_rng_float(rng));
+    /* the lobe choice and the roulette share a 2D dimension, computed
+     * once and only when read: a Lambertian BSDF (one lobe) ignores ulobe
+     * and most paths end before the roulette. `independent` draws both from
+     * the stream, in call order. */
+    bool stratified = ctx->state->scene->settings.sampler != RT_SAMPLER_INDEPENDENT;
+    uint32_t lr_dim = path_dim(ctx, ps, DIM_LOBE_RR);
+    rt_vec2 ulr = rt_v2(0.0f, 0.0f);
+    bool have_lr = false;
+    float ulobe = 0.0f;
+    if (!stratified) {
+        ulobe = rt_rng_float(rng);
+    } else if (b->layered || !b->lambert) {
+        ulr = path_2d_at(ctx, rng, lr_dim);
+        have_lr = true;
+        ulobe = ulr.x;
+    }
+    rt_vec2 u = path_2d(ctx, ps, rng, DIM_BSDF);
     rt_bsdf_sample bs;
     if (!rt_bsdf_sample_dir(b, wo, u, ulobe, &bs))
         return false;
@@ -308,7 +360,9 @@ bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_sur
     ps->bounces++;
     if (rr_depth == 0 ? rt_max3(beta) < 1.0f : ps->bounces >= rr_depth) {
         float q = rr_depth == 0 ? rt_max3(beta) : rt_fminf(rt_max3(beta), 0.95f);
-        if (rt_rng_float(rng) >= q)
+        if (stratified && !have_lr)
+            ulr = path_2d_at(ctx, rng, lr_dim);
+        if ((stratified ? ulr.y : rt_rng_float(rng)) >= q)
             return false;
         ps->beta = rt_scale(beta, 1.0f / q);
     }
@@ -344,11 +398,11 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         rt_vec3 sum = rt_v3s(0.0f);
         rt_nee_record rec;
         for (size_t i = 0; i < s->light_count; i++)
-            if (rt_path_nee_light(ctx, &sf, &b, wo, rng, i, &rec))
+            if (rt_path_nee_light(ctx, &ps, &sf, &b, wo, rng, i, &rec))
                 sum = rt_path_nee_add(sum, &rec, rt_shadow_visibility(ctx, &sf, rec.wi, rec.dist));
-        if (rt_path_nee_env(ctx, &b, wo, rng, &rec))
+        if (rt_path_nee_env(ctx, &ps, &b, wo, rng, &rec))
             sum = rt_path_nee_add(sum, &rec, rt_shadow_visibility(ctx, &sf, rec.wi, rec.dist));
-        if (rt_path_nee_emitter(ctx, &sf, &b, wo, rng, &rec))
+        if (rt_path_nee_emitter(ctx, &ps, &sf, &b, wo, rng, &rec))
             sum = rt_path_nee_add(sum, &rec, rt_shadow_visibility(ctx, &sf, rec.wi, rec.dist));
         ps.L = rt_path_add_finite(ps.L, rt_mul(ps.beta, sum));
         if (!rt_path_vertex_end(ctx, &ps, &sf, &b, wo, rng))

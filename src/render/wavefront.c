@@ -24,7 +24,9 @@
  *
  * Determinism: a path's random numbers come only from its own PCG stream,
  * seeded by (seed, pixel, sample) and carried in its lane, drawn in the order
- * rt_radiance_path draws them; shading runs the same functions; a vertex's
+ * rt_radiance_path draws them, and from the sampler (rt/render/sampler.h),
+ * a function of the sample (key and index, in the lane's rt_rng) and the
+ * bounce; shading runs the same functions; a vertex's
  * light samples are summed in the same order after their shadow rays come
  * back. So every radiance equals rt_radiance_path's bit for bit, for any
  * batch size, lane assignment and split of the work (tests/test_wavefront.c).
@@ -268,11 +270,11 @@ static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, si
     size_t first = *n_rec;
     const rt_scene *s = ctx->state->scene;
     for (size_t l = 0; l < s->light_count; l++)
-        if (rt_path_nee_light(ctx, sf, &b, wo, rng, l, &wf->rec[*n_rec]))
+        if (rt_path_nee_light(ctx, ps, sf, &b, wo, rng, l, &wf->rec[*n_rec]))
             add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
-    if (rt_path_nee_env(ctx, &b, wo, rng, &wf->rec[*n_rec]))
+    if (rt_path_nee_env(ctx, ps, &b, wo, rng, &wf->rec[*n_rec]))
         add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
-    if (rt_path_nee_emitter(ctx, sf, &b, wo, rng, &wf->rec[*n_rec]))
+    if (rt_path_nee_emitter(ctx, ps, sf, &b, wo, rng, &wf->rec[*n_rec]))
         add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
     wf->nee[i] = 1;
     wf->rec_first[i] = (uint32_t)first;

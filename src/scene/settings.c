@@ -28,6 +28,8 @@ _Static_assert(sizeof(rt_integrator) == sizeof(int), "enum settings are stored a
 #define FIELD_SIZE(f) sizeof(((rt_settings *)0)->f)
 
 static const char *const onoff_words[] = {"off", "on", NULL};
+/* in rt_sampler_kind order (rt/scene/scene.h) */
+static const char *const sampler_words[] = {"independent", "cmj", "sobol", NULL};
 
 /* Table order is the order of --help and of the scene parser's "did you mean" search. */
 const rt_setting rt_settings_table[] = {
@@ -44,11 +46,14 @@ const rt_setting rt_settings_table[] = {
     {.name = "max_depth", .args = "N", .type = RT_SETTING_INT, .field = FIELD(max_depth), .min = 0, .max = 1024,
      .defaults = {0}, .what = "max_depth", .help = "path: the most scattering events a path may have; 0 = no cap"},
     {.name = "rr_depth", .args = "N", .type = RT_SETTING_INT, .field = FIELD(rr_depth), .min = 0, .max = 1024,
-     .defaults = {3}, .what = "rr_depth",
+     .defaults = {5}, .what = "rr_depth",
      .help = "path: Russian roulette from this many bounces on; 0 = adaptive (once the throughput is below 1)"},
     {.name = "motion_steps", .args = "K", .type = RT_SETTING_INT, .field = FIELD(motion_steps), .min = 1,
      .max = 256, .defaults = {8}, .what = "motion_steps",
      .help = "motion blur: poses (each with its own kd-tree) over the camera's shutter when models are animated"},
+    {.name = "sampler", .args = "NAME", .type = RT_SETTING_ENUM, .field = FIELD(sampler),
+     .defaults = {RT_SAMPLER_SOBOL}, .words = sampler_words, .what = "a sampler",
+     .help = "path: the random numbers of light, BSDF and roulette decisions: a stream per sample, or stratified over the pixel's samples (cmj, sobol)"},
     {.name = "energy_compensation", .args = "MODE", .type = RT_SETTING_ENUM, .field = FIELD(energy_compensation),
      .defaults = {0}, .words = onoff_words, .what = "energy_compensation",
      .help = "path: restore the energy rough conductors lose to multiple scattering (Kulla-Conty 2017)"},

@@ -46,7 +46,7 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
  *   loop: trace ps.r (the alpha walk, rt_trace_surface, with rng);
  *         miss: rt_path_miss(ctx, &ps), stop; too deep: stop;
  *         switch (rt_path_vertex_begin(ctx, &ps, &sf, &b, &wo)): STOP: stop; PASS: loop;
- *         records from rt_path_nee_light (each light in order), rt_path_nee_env,
+ *         records from rt_path_nee_light (each light in order; all take &ps), rt_path_nee_env,
  *         rt_path_nee_emitter; sum = rt_path_nee_add(sum, &rec, visibility) in that order;
  *         ps.L = rt_path_add_finite(ps.L, ps.beta * sum);
  *         if (!rt_path_vertex_end(ctx, &ps, &sf, &b, wo, rng)) stop;
@@ -94,13 +94,15 @@ void rt_path_miss(const rt_trace_ctx *ctx, rt_path_state *ps);
  * ratio of the media on both sides and local *wo (RT_VERTEX_SHADE). */
 rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, rt_bsdf *b,
                                     rt_vec3 *wo);
-/* Light i, the environment image, one emitter of the table: each draws its
- * random numbers and fills *rec when it can contribute. */
-bool rt_path_nee_light(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
-                       size_t i, rt_nee_record *rec);
-bool rt_path_nee_env(const rt_trace_ctx *ctx, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng, rt_nee_record *rec);
-bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
-                         rt_nee_record *rec);
+/* Light i, the environment image, one emitter of the table at the path's
+ * current vertex (ps: its bounce picks the sampler dimensions): each draws
+ * its random numbers and fills *rec when it can contribute. */
+bool rt_path_nee_light(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
+                       rt_vec3 wo, rt_rng *rng, size_t i, rt_nee_record *rec);
+bool rt_path_nee_env(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
+                     rt_nee_record *rec);
+bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
+                         rt_vec3 wo, rt_rng *rng, rt_nee_record *rec);
 rt_vec3 rt_path_nee_add(rt_vec3 sum, const rt_nee_record *rec, float vis);
 /* BSDF sampling, Russian roulette, the next ray in ps->r; false when the
  * path ends. */

@@ -6,6 +6,7 @@
  * the same pixels of the full image.
  *
  *   rt_rng rng = rt_rng_for_sample(seed, pixel_index, sample_index);
+ *   (rng.key, rng.index: the sample, for the stratified samplers of rt/render/sampler.h)
  *   float u = rt_rng_float(&rng);
  *   rt_vec2 p = rt_cmj_sample(sample_index, samples, pattern);  // stratified 2D point
  *
@@ -23,7 +24,13 @@
 
 #include "rt/base/vec.h"
 
-typedef struct rt_rng { uint64_t state, inc; } rt_rng;
+/* A PCG stream, and the sample it belongs to for the stratified samplers
+ * (rt/render/sampler.h): key = a hash of (seed, pixel), index = the
+ * sample's global index in its pixel (both 0 for rt_rng_seed streams). */
+typedef struct rt_rng {
+    uint64_t state, inc;
+    uint32_t key, index;
+} rt_rng;
 
 static inline uint64_t rt_mix64(uint64_t z)
 {
@@ -50,13 +57,17 @@ static inline rt_rng rt_rng_seed(uint64_t a, uint64_t b)
     rt_rng r;
     r.state = rt_mix64(a);
     r.inc = (rt_mix64(b ^ 0x5851f42d4c957f2dull) << 1u) | 1u;
+    r.key = r.index = 0;
     rt_rng_u32(&r);
     return r;
 }
 
 static inline rt_rng rt_rng_for_sample(uint32_t seed, uint64_t pixel, uint32_t sample)
 {
-    return rt_rng_seed(pixel * 0x9e3779b97f4a7c15ull ^ seed, ((uint64_t)seed << 32) | sample);
+    rt_rng r = rt_rng_seed(pixel * 0x9e3779b97f4a7c15ull ^ seed, ((uint64_t)seed << 32) | sample);
+    r.key = (uint32_t)rt_mix64(pixel ^ ((uint64_t)seed << 40) ^ 0x2545f4914f6cdd1dull);
+    r.index = sample;
+    return r;
 }
 
 /* Kensler's hash-based permutation of [0, l) indexed by i, for pattern p. */

@@ -59,6 +59,14 @@ typedef enum rt_integrator {
     RT_INTEGRATOR_PATH_SCALAR, /* the same, one path at a time (the reference) */
 } rt_integrator;
 
+/* Where a path's random numbers come from (rt/render/sampler.h); the
+ * values are the words of the `sampler` setting, in order. */
+typedef enum rt_sampler_kind {
+    RT_SAMPLER_INDEPENDENT = 0, /* a PCG stream per sample (pixel and lens stratified only) */
+    RT_SAMPLER_CMJ,             /* padded correlated multi-jittering over the spp */
+    RT_SAMPLER_SOBOL,           /* padded Owen-scrambled Sobol */
+} rt_sampler_kind;
+
 /* Render settings. rt_settings_default() gives the documented defaults; the
  * table of them (names, ranges, defaults, help) is rt/scene/settings.h. */
 typedef struct rt_settings {
@@ -69,6 +77,7 @@ typedef struct rt_settings {
     int max_depth;        /* path: most scattering events a path may have; 0 = unlimited (Russian roulette ends paths) */
     int rr_depth;         /* path: Russian roulette from this many bounces on; 0 = adaptive (once the throughput is below 1) */
     int motion_steps;     /* time slices over an open camera shutter: each posed, its own kd-tree (docs/gltf.md) */
+    int sampler;          /* path: an rt_sampler_kind */
     int energy_compensation; /* path: 1 = Kulla-Conty multiple-scattering lobe on rough conductors (default 0, off) */
     int diffuse_bounces;  /* levels of indirect diffuse light (whitted) */
     int diffuse_rays;     /* cosine-distributed rays per diffuse level */
