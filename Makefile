@@ -7,6 +7,7 @@
 #   make profile      ./rt-profile: optimised, with symbols and frame pointers (for perf)
 #   make scenes       render every scene in scenes/ into docs/images/
 #   make denoiser     Intel Open Image Denoise for --denoise: the pyoidn wheel in build/oidn-venv
+#   make bench-packets rt's packets and Embree's on the same pixel tiles (also run by bench-compare)
 #   make bench-render rt's path tracer against Mitsuba 3 (sets it up in build/mitsuba-venv)
 #   make bench-denoise --denoise at 4/16/64 spp against raw 256 and 1024 spp
 #   make install      rt, the library and its headers, and a pkg-config file
@@ -58,7 +59,7 @@ DEPS_OK  := $(BUILD)/.deps-ok
 
 
 .PHONY: test-slurm test-kubernetes test-parallel test-launchers
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build bench-render bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-packets bench-build bench-render bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -161,9 +162,15 @@ bench/rtbench: bench/rtbench.c $(BUILD)/librt.a | $(DEPS_OK)
 bench: bench/rtbench
 	@SHARED=$(SHARED) sh bench/run.sh
 
-# rt and Embree side by side on the same rays, as ratios (installs Embree 3 on first use).
+# rt and Embree side by side on the same rays, as ratios (installs Embree 3 on first use);
+# then the packets on the same tiles (bench-packets).
 bench-compare: bench/rtbench
 	@SHARED=$(SHARED) sh bench/compare.sh
+	@SHARED=$(SHARED) python3 bench/packets.py
+
+# rt's 8- and 16-ray packets and Embree's rtcIntersect8/16 on the same 4x2 and 4x4 tiles of the primary sets.
+bench-packets: bench/rtbench
+	@SHARED=$(SHARED) python3 bench/packets.py
 
 # rt's path tracer against Mitsuba 3 on the shared Cornell box (sets up Mitsuba in build/mitsuba-venv
 # and Debian's libllvm19 on first use); RT_BINS="./rt other/rt" compares rt builds too.

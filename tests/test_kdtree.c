@@ -853,14 +853,14 @@ static void test_edge_rays(void **state)
     }
 }
 
-/* One packet of n rays through rt_kdtree_intersect8 against brute force:
- * the same hit or miss, the same t bits, the same primitive or one that
- * ties at exactly that t. */
+/* One packet of n rays through rt_kdtree_intersect8 (n <= 8) or
+ * rt_kdtree_intersect16 against brute force: the same hit or miss, the
+ * same t bits, the same primitive or one that ties at exactly that t. */
 static void check_packet(const rt_scene *s, const rt_kdtree *tree, const rt_ray *rays, int n, check_stats *cs)
 {
-    rt_hit h[8];
+    rt_hit h[16];
     memset(h, 0x55, sizeof h);
-    unsigned mask = rt_kdtree_intersect8(tree, rays, n, h);
+    unsigned mask = n > 8 ? rt_kdtree_intersect16(tree, rays, n, h) : rt_kdtree_intersect8(tree, rays, n, h);
     assert_true(mask >> n == 0);
     for (int i = 0; i < n; i++) {
         rt_hit b;
@@ -920,23 +920,24 @@ static void test_packets(void **state)
             float pix = cam % 2 ? 1e-3f : 2e-2f; /* tight tiles, and wider ones that straddle edges */
             for (int tile = 0; tile < 30; tile++) {
                 float x0 = rnd(&r, -0.5f, 0.5f), y0 = rnd(&r, -0.5f, 0.5f);
-                rt_ray rays[8];
-                for (int i = 0; i < 8; i++) {
+                rt_ray rays[16];
+                for (int i = 0; i < 16; i++) {
                     rt_vec3 d = rt_add(fw, rt_add(rt_scale(rx, x0 + pix * (float)(i % 4)), rt_scale(uy, y0 + pix * (float)(i / 4))));
                     rays[i] = rt_ray_make(eye, d, 0.0f, INFINITY);
                 }
                 int n = 8;
                 switch (tile % 10) {
-                case 1: n = 1 + (int)(test_rng_next(&r) % 7); break;
-                case 2: rays[3].dir.x = 0.0f; break;                 /* parallel to an axis */
+                case 1: n = 1 + (int)(test_rng_next(&r) % 15); break;
+                case 2: rays[3 + 8 * (tile / 10 & 1)].dir.x = 0.0f; break;               /* parallel to an axis */
                 case 3: rays[5].tmin = rays[5].tmax = 1.0f; break;  /* an empty interval */
                 case 4: rays[0].org.y = NAN; break;                  /* hits nothing */
-                case 5: for (int i = 0; i < 8; i++) rays[i] = random_ray(&r, -0.2f * span, 1.2f * span); break;
+                case 5: for (int i = 0; i < 16; i++) rays[i] = random_ray(&r, -0.2f * span, 1.2f * span); break;
                 case 6: rays[2].tmax = rnd(&r, 0.5f, 2.0f) * span; rays[6].tmin = 0.5f * span; break;
-                case 7: rays[7].dir = rt_neg(rays[7].dir); break;   /* one ray the other way */
+                case 7: rays[7 + 8 * (tile / 10 & 1)].dir = rt_neg(rays[7 + 8 * (tile / 10 & 1)].dir); break; /* one ray the other way */
                 default: break;
                 }
-                check_packet(&s, &tree, rays, n, &cs);
+                check_packet(&s, &tree, rays, n < 8 ? n : 8, &cs); /* 4x2 */
+                check_packet(&s, &tree, rays, n == 8 ? 16 : n, &cs); /* 4x4 (n > 8: 16 lanes) */
             }
         }
         report(__func__, &cs);
@@ -946,11 +947,12 @@ static void test_packets(void **state)
     }
 }
 
-/* One packet of n shadow rays through rt_kdtree_occluded8: each ray's bit
- * is the single-ray rt_kdtree_occluded and brute force's any-hit. */
+/* One packet of n shadow rays through rt_kdtree_occluded8 (n <= 8) or
+ * rt_kdtree_occluded16: each ray's bit is the single-ray
+ * rt_kdtree_occluded and brute force's any-hit. */
 static void check_packet_occluded(const rt_scene *s, const rt_kdtree *tree, const rt_ray *rays, int n, check_stats *cs)
 {
-    unsigned mask = rt_kdtree_occluded8(tree, rays, n);
+    unsigned mask = n > 8 ? rt_kdtree_occluded16(tree, rays, n) : rt_kdtree_occluded8(tree, rays, n);
     assert_true(mask >> n == 0);
     for (int i = 0; i < n; i++) {
         bool pa = mask >> i & 1, sa = rt_kdtree_occluded(tree, &rays[i]), ba = ref_any(s, &rays[i]);
@@ -1001,9 +1003,11 @@ static void test_packets_occluded(void **state)
             float pix = cam % 2 ? 1e-3f : 2e-2f;
             for (int tile = 0; tile < 30; tile++) {
                 float x0 = rnd(&r, -0.5f, 0.5f), y0 = rnd(&r, -0.5f, 0.5f);
-                rt_ray rays[8];
-                int n = 8, expect[8] = {-1, -1, -1, -1, -1, -1, -1, -1}; /* known answers: 0, 1 (-1: not known) */
-                for (int i = 0; i < 8; i++) { /* a tile's hit points (or points along its rays) to the light */
+                rt_ray rays[16];
+                int n = 8, expect[16]; /* known answers: 0, 1 (-1: not known) */
+                for (int i = 0; i < 16; i++)
+                    expect[i] = -1;
+                for (int i = 0; i < 16; i++) { /* a tile's hit points (or points along its rays) to the light */
                     rt_vec3 d = rt_add(fw, rt_add(rt_scale(rx, x0 + pix * (float)(i % 4)), rt_scale(uy, y0 + pix * (float)(i / 4))));
                     rt_ray pr = rt_ray_make(eye, d, 0.0f, INFINITY);
                     rt_hit h;
@@ -1012,19 +1016,19 @@ static void test_packets_occluded(void **state)
                     rays[i] = rt_ray_make(p, rt_sub(light, p), 1e-4f, 1.0f);
                 }
                 switch (tile % 10) {
-                case 1: n = 1 + (int)(test_rng_next(&r) % 7); break;
-                case 2: rays[3].dir.x = 0.0f; break;                 /* parallel to an axis */
+                case 1: n = 1 + (int)(test_rng_next(&r) % 15); break;
+                case 2: rays[3 + 8 * (tile / 10 & 1)].dir.x = 0.0f; break;               /* parallel to an axis */
                 case 3: rays[5].tmin = rays[5].tmax = 0.5f; break;  /* an empty interval */
                 case 4: rays[0].org.y = NAN; break;                  /* hits nothing */
                 case 5: /* random rays, random intervals */
-                    for (int i = 0; i < 8; i++) {
+                    for (int i = 0; i < 16; i++) {
                         rays[i] = random_ray(&r, -0.2f * span, 1.2f * span);
                         rays[i].tmin = rnd(&r, 0.0f, 0.5f) * span;
                         rays[i].tmax = rays[i].tmin + rnd(&r, 0.0f, 2.0f) * span;
                     }
                     break;
                 case 6: /* scattered points to the light: mixed signs */
-                    for (int i = 0; i < 8; i++) {
+                    for (int i = 0; i < 16; i++) {
                         rt_vec3 p = rnd3(&r, -0.2f * span, 1.2f * span);
                         rays[i] = rt_ray_make(p, rt_sub(light, p), 0.0f, 1.0f);
                     }
@@ -1034,7 +1038,7 @@ static void test_packets_occluded(void **state)
                     uint32_t tri = (uint32_t)(test_rng_next(&r) % s.triangles.count);
                     rt_vec3 a = rt_tri_vertex(&s, tri, 0), b = rt_tri_vertex(&s, tri, 1), c = rt_tri_vertex(&s, tri, 2);
                     rt_vec3 o = rt_add(light, rnd3(&r, -0.01f * span, 0.01f * span));
-                    for (int i = 0; i < 8; i++) {
+                    for (int i = 0; i < 16; i++) {
                         float u = rnd(&r, 0.05f, 0.45f), v = rnd(&r, 0.05f, 0.45f);
                         rt_vec3 q = rt_add(a, rt_add(rt_scale(rt_sub(b, a), u), rt_scale(rt_sub(c, a), v)));
                         rays[i] = tile % 10 == 7 ? rt_ray_make(o, rt_sub(q, o), 0.0f, INFINITY)
@@ -1054,8 +1058,9 @@ static void test_packets_occluded(void **state)
                 }
                 default: break;
                 }
-                check_packet_occluded(&s, &tree, rays, n, &cs);
-                for (int i = 0; i < n; i++)
+                check_packet_occluded(&s, &tree, rays, n < 8 ? n : 8, &cs);
+                check_packet_occluded(&s, &tree, rays, n == 8 ? 16 : n, &cs);
+                for (int i = 0; i < 16; i++)
                     if (expect[i] >= 0)
                         assert_int_equal(rt_kdtree_occluded(&tree, &rays[i]), expect[i]);
             }

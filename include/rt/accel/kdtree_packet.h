@@ -31,5 +31,10 @@
 unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits);
 /* n rays (1..8); returns the mask of rays with any hit in (tmin, tmax). */
 unsigned rt_kdtree_occluded8(const rt_kdtree *tree, const rt_ray *rays, int n);
+/* The same for n = 1..16 rays (a 4x4 tile) in one walk: two 8-lane halves
+ * share each node step and leaf; rays that cannot share it go as two
+ * packets of 8. */
+unsigned rt_kdtree_intersect16(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits);
+unsigned rt_kdtree_occluded16(const rt_kdtree *tree, const rt_ray *rays, int n);
 
 #endif
