@@ -21,9 +21,12 @@
 # points the tests at the shared assets (default ../shared).
 
 CC      ?= cc
-# -march=native: the kd-tree's AVX2 traversal and the compiler's vector code
-# for this machine. A binary for other machines of a farm: PORTABLE=1 (x86-64
-# baseline, the kd-tree's portable step; same images, slower traversal).
+# -march=native: the compiler's vector code for this machine. A binary for
+# other machines of a farm: PORTABLE=1 (x86-64 baseline; the kd-tree's AVX2
+# kernels are compiled in either way and used when the CPU has AVX2 and FMA,
+# else its portable step: same images). -ffp-contract=off: no multiply-adds
+# fused by the compiler (GCC's -std=c11 default; clang's is on), so code
+# compiled with FMA available (native, the AVX2 kernels) rounds as baseline.
 ifeq ($(PORTABLE),1)
 OPT     ?= -O2
 BUILD   ?= build-portable
@@ -36,7 +39,7 @@ ifeq ($(WERROR),1)
 WARN    += -Werror
 endif
 CFLAGS  ?=
-CFLAGS  += -std=c11 $(WARN) $(OPT) -Iinclude -D_POSIX_C_SOURCE=200809L -MMD -MP
+CFLAGS  += -std=c11 -ffp-contract=off $(WARN) $(OPT) -Iinclude -D_POSIX_C_SOURCE=200809L -MMD -MP
 # C++ only for src/io/draco.cc, the wrapper over libdraco (rt/io/draco.h)
 CXX     ?= c++
 CXXFLAGS ?=
@@ -122,11 +125,11 @@ $(BUILD)/tests/test_hdr: tests/test_hdr.c src/driver/convert.c src/driver/comman
 
 # the kd-tree's portable path (no AVX2), tested on machines that have AVX2 too
 TEST_BIN += $(BUILD)/tests/test_kdtree_scalar
-# (only the traversal is compiled again, with RT_KD_SCALAR; its two functions
-# take the place of the library's, and the build and packing come from librt.a)
-$(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c src/accel/kdtree_trace.c src/accel/kdtree_internal.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
+# (the same tests with RT_KD_SCALAR: their trees are built with params.portable,
+# so their rays take the portable traversal that librt.a has beside the AVX2 one)
+$(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -DRT_KD_SCALAR -Itests -o $@ tests/test_kdtree.c src/accel/kdtree_trace.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+	$(CC) $(CFLAGS) -DRT_KD_SCALAR -Itests -o $@ tests/test_kdtree.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # --denoise loads Intel Open Image Denoise at run time (src/image/denoise.c);
 # Debian has no package, so the pyoidn wheel (which ships the library and its

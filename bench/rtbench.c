@@ -2,7 +2,7 @@
  * checked against Embree's reference hits.
  *
  *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
- *           [--build-threads N] [--occluded] [--limit N]
+ *           [--build-threads N] [--occluded] [--portable] [--limit N]
  *           [--packets W H [--image-width N] [--lanes 8|16]]
  *
  * Loads the model with rt_load, as `rt` does (a glTF: every triangle of
@@ -18,7 +18,8 @@
  * go through the any-hit query (shadow rays) instead, and a mismatch is a
  * ray whose hit/miss differs from the reference. Exits 1 when more than
  * 0.01% of the rays disagree with the reference: speed bought with wrong
- * answers does not count. --limit N keeps N rays spread evenly over the set
+ * answers does not count. --portable: the portable traversal even when
+ * the CPU has AVX2 (traversal: says which one ran). --limit N keeps N rays spread evenly over the set
  * (every count/N-th, with its reference hit): a fixed small subset for
  * instruction counts under callgrind. --packets W H traces the set (a
  * primary set: one ray per pixel, row by row, N pixels wide, default 640)
@@ -143,7 +144,7 @@ static int cmp_double(const void *a, const void *b)
 static int usage(void)
 {
     fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K] [--build-threads N] "
-                    "[--occluded] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]]\n");
+                    "[--occluded] [--portable] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]]\n");
     return 2;
 }
 
@@ -153,7 +154,7 @@ int main(int argc, char **argv)
     int threads = 1, runs = 5, build_threads = 0;
     long limit = 0;
     int pw = 0, ph = 0, image_width = 640, lanes = 0;
-    bool occluded = false;
+    bool occluded = false, portable = false;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--ref") == 0 && i + 1 < argc)
             hits_path = argv[++i];
@@ -179,6 +180,8 @@ int main(int argc, char **argv)
         }
         else if (strcmp(argv[i], "--occluded") == 0)
             occluded = true;
+        else if (strcmp(argv[i], "--portable") == 0)
+            portable = true;
         else if (argv[i][0] == '-')
             return usage();
         else if (!model)
@@ -222,6 +225,7 @@ int main(int argc, char **argv)
     rt_kdtree_params params;
     memset(&params, 0, sizeof params);
     params.threads = build_threads;
+    params.portable = portable;
     if (rt_kdtree_build(&tree, &scene, &params, &err) != RT_OK) {
         fprintf(stderr, "rtbench: %s\n", err.message);
         return 2;
@@ -277,6 +281,7 @@ int main(int argc, char **argv)
     printf("wide_nodes: %zu\n", tree.stats.wide_nodes);
     printf("bytes_per_triangle: %.1f\n",
            scene.triangles.count ? (double)tree.stats.bytes / (double)scene.triangles.count : 0.0);
+    printf("traversal: %s\n", tree.isa == RT_KD_ISA_AVX2 ? "avx2" : "portable");
     printf("threads: %d\n", threads);
     printf("rays: %zu\n", rs.count);
     printf("query: %s\n", occluded ? "occluded" : "closest");

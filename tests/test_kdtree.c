@@ -20,6 +20,15 @@
 
 /* ------------------------------------------------------------ helpers */
 
+/* test_kdtree_scalar is this file with RT_KD_SCALAR: every tree it builds
+ * takes the portable traversal (params.portable), on any CPU; test_kdtree's
+ * trees take what the CPU allows (the AVX2 kernels on this machine). */
+#ifdef RT_KD_SCALAR
+#define TEST_PORTABLE 1
+#else
+#define TEST_PORTABLE 0
+#endif
+
 static uint32_t add_tri(rt_scene *s, rt_vec3 a, rt_vec3 b, rt_vec3 c)
 {
     uint32_t v = rt_scene_add_vertices(s, 3);
@@ -322,7 +331,15 @@ static void check_random_rays(const rt_scene *s, const rt_kdtree *tree, uint64_t
 static void build_ok(rt_kdtree *tree, const rt_scene *s)
 {
     rt_error err = {0};
-    rt_result res = rt_kdtree_build(tree, s, NULL, &err);
+    rt_kdtree_params p = {0};
+    p.portable = TEST_PORTABLE;
+    rt_result res = rt_kdtree_build(tree, s, &p, &err);
+#ifdef RT_KD_SCALAR
+    assert_int_equal(tree->isa, RT_KD_ISA_PORTABLE);
+#elif defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) /* any build: the AVX2 kernels */
+        assert_int_equal(tree->isa, RT_KD_ISA_AVX2);
+#endif
     if (res != RT_OK)
         fprintf(stderr, "build failed: %s\n", err.message);
     assert_int_equal(res, RT_OK);
@@ -411,9 +428,9 @@ static void test_params(void **state)
     test_rng r = {77};
     random_soup(&s, &r, 1000, 0.05f);
     rt_kdtree_params p[3] = {
-        {1.0f, 80.0f, 0.5f, 0, 0}, /* pbrt's costs: deep trees */
-        {1.0f, 1.0f, 0.0f, 0, 0},
-        {10.0f, 1.0f, 0.0f, 3, 0}, /* shallow */
+        {1.0f, 80.0f, 0.5f, 0, 0, TEST_PORTABLE}, /* pbrt's costs: deep trees */
+        {1.0f, 1.0f, 0.0f, 0, 0, TEST_PORTABLE},
+        {10.0f, 1.0f, 0.0f, 3, 0, TEST_PORTABLE}, /* shallow */
     };
     for (int i = 0; i < 3; i++) {
         rt_kdtree tree;
@@ -445,7 +462,7 @@ static void test_deepest_tree(void **state)
             rt_vec3 c = rt_v3(axis == 0 ? d : 0.1f * d, axis == 1 ? d : 0.1f * d, axis == 2 ? d : 0.1f * d);
             add_tri(&s, c, rt_add(c, rt_v3(e, 0, 0)), rt_add(c, rt_v3(0, e, e)));
         }
-    rt_kdtree_params p = {1.0f, 80.0f, 0.5f, 60, 1};
+    rt_kdtree_params p = {1.0f, 80.0f, 0.5f, 60, 1, TEST_PORTABLE};
     rt_kdtree tree;
     rt_error err = {0};
     assert_int_equal(rt_kdtree_build(&tree, &s, &p, &err), RT_OK);
@@ -1149,6 +1166,7 @@ static void test_parallel_build_identical(void **state)
     rt_kdtree_params p1 = {0}, p3 = {0};
     p1.threads = 1;
     p3.threads = 3;
+    p1.portable = p3.portable = TEST_PORTABLE;
     rt_kdtree a, b;
     rt_error err = {0};
     assert_int_equal(rt_kdtree_build(&a, &s, &p1, &err), RT_OK);

@@ -30,8 +30,10 @@
  * instructions with the leaves ray by ray and a set-up per ray, -26% with
  * tri_rays, -41% with the set-up in lanes.
  *
- * Without AVX2 (and under RT_KD_SCALAR) the packet is traced as single
- * rays.
+ * The walk is an AVX2 kernel (compiled for AVX2 and FMA whatever the
+ * build's flags, kdtree_internal.h); a tree whose rays take the portable
+ * traversal (no AVX2 on the CPU, or params.portable) traces a packet as
+ * single rays.
  */
 #include "rt/accel/kdtree_packet.h"
 
@@ -39,9 +41,8 @@
 
 #include "kdtree_internal.h"
 
-#if defined(__AVX2__) && defined(__GNUC__) && !defined(RT_KD_SCALAR)
+#ifdef KD_HAVE_AVX2
 #include <immintrin.h>
-#define KD_PACKET_SIMD 1
 #endif
 
 /* The packet as single rays: closest hits into hits, or (any) occlusion. */
@@ -54,7 +55,8 @@ static unsigned single_rays(const rt_kdtree *tree, const rt_ray *rays, int n, rt
     return mask;
 }
 
-#ifdef KD_PACKET_SIMD
+#ifdef KD_HAVE_AVX2
+KD_AVX2_BEGIN
 #define KD_PSTACK 192 /* as kdtree_trace.c's stack: 7 pushes a wide level */
 _Static_assert(7 * ((KD_MAX_DEPTH + 2) / 3) + 1 <= KD_PSTACK, "packet traversal stack");
 
@@ -103,7 +105,7 @@ static inline void tri_rays(const rt_kdtree *tree, uint32_t id, unsigned m, cons
     while (zm) { /* an edge function rounded to zero: the reference decides */
         int i = __builtin_ctz(zm);
         zm &= zm - 1;
-        if (rt_kd_prim_hit(tree, id, &rays[i], &tr[i], &best[i], &h[i]))
+        if (rt_kd_prim_hit_avx2(tree, id, &rays[i], &tr[i], &best[i], &h[i]))
             *found |= 1u << i;
     }
     if (!live)
@@ -353,7 +355,7 @@ KD_PINLINE bool packet_walk(const rt_kdtree *tree, const rt_ray *rays, int n, rt
             }
             for (unsigned s = m & ~vec; s; s &= s - 1) {
                 int i = __builtin_ctz(s);
-                if (rt_kd_leaf_hit(tree, ref, &rays[i], &tr[i], &best[i], &h[i], any))
+                if (rt_kd_leaf_hit_avx2(tree, ref, &rays[i], &tr[i], &best[i], &h[i], any))
                     found |= 1u << i;
             }
             if (vec) {
@@ -372,7 +374,7 @@ KD_PINLINE bool packet_walk(const rt_kdtree *tree, const rt_ray *rays, int n, rt
                     } else {
                         for (unsigned s = vec; s; s &= s - 1) {
                             int i = __builtin_ctz(s);
-                            if (rt_kd_prim_hit(tree, id, &rays[i], &tr[i], &best[i], &h[i]))
+                            if (rt_kd_prim_hit_avx2(tree, id, &rays[i], &tr[i], &best[i], &h[i]))
                                 found |= 1u << i;
                         }
                     }
@@ -419,13 +421,47 @@ done:
     return true;
 }
 
+/* The four kernels: the walk with its constants. */
+static bool intersect8_avx2(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, unsigned *mask)
+{
+    return packet_walk(tree, rays, n, hits, false, 1, mask);
+}
+
+static bool occluded8_avx2(const rt_kdtree *tree, const rt_ray *rays, int n, unsigned *mask)
+{
+    return packet_walk(tree, rays, n, NULL, true, 1, mask);
+}
+
+static bool intersect16_avx2(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, unsigned *mask)
+{
+    return packet_walk(tree, rays, n, hits, false, 2, mask);
+}
+
+static bool occluded16_avx2(const rt_kdtree *tree, const rt_ray *rays, int n, unsigned *mask)
+{
+    return packet_walk(tree, rays, n, NULL, true, 2, mask);
+}
+KD_AVX2_END
+#define KD_PACKETS(tree) ((tree)->isa == RT_KD_ISA_AVX2)
+#else
+#define KD_PACKETS(tree) false
+#define intersect8_avx2(tree, rays, n, hits, mask) ((void)(mask), false)
+#define occluded8_avx2(tree, rays, n, mask) ((void)(mask), false)
+#define intersect16_avx2(tree, rays, n, hits, mask) ((void)(mask), false)
+#define occluded16_avx2(tree, rays, n, mask) ((void)(mask), false)
+#endif
+
+/* The entry points, compiled for the build's target: the kernels when the
+ * tree's rays take the AVX2 traversal and the rays can share the walk. */
 unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits)
 {
     unsigned mask;
     if (n < 1)
         return 0;
     n = n > 8 ? 8 : n;
-    return packet_walk(tree, rays, n, hits, false, 1, &mask) ? mask : single_rays(tree, rays, n, hits, false);
+    if (KD_PACKETS(tree) && intersect8_avx2(tree, rays, n, hits, &mask))
+        return mask;
+    return single_rays(tree, rays, n, hits, false);
 }
 
 unsigned rt_kdtree_occluded8(const rt_kdtree *tree, const rt_ray *rays, int n)
@@ -434,7 +470,9 @@ unsigned rt_kdtree_occluded8(const rt_kdtree *tree, const rt_ray *rays, int n)
     if (n < 1)
         return 0;
     n = n > 8 ? 8 : n;
-    return packet_walk(tree, rays, n, NULL, true, 1, &mask) ? mask : single_rays(tree, rays, n, NULL, true);
+    if (KD_PACKETS(tree) && occluded8_avx2(tree, rays, n, &mask))
+        return mask;
+    return single_rays(tree, rays, n, NULL, true);
 }
 
 /* 16 rays: one walk when they share it, else as two packets of 8 (each of
@@ -445,7 +483,7 @@ unsigned rt_kdtree_intersect16(const rt_kdtree *tree, const rt_ray *rays, int n,
     if (n <= 8)
         return rt_kdtree_intersect8(tree, rays, n, hits);
     n = n > 16 ? 16 : n;
-    if (packet_walk(tree, rays, n, hits, false, 2, &mask))
+    if (KD_PACKETS(tree) && intersect16_avx2(tree, rays, n, hits, &mask))
         return mask;
     return rt_kdtree_intersect8(tree, rays, 8, hits) | rt_kdtree_intersect8(tree, rays + 8, n - 8, hits + 8) << 8;
 }
@@ -456,28 +494,7 @@ unsigned rt_kdtree_occluded16(const rt_kdtree *tree, const rt_ray *rays, int n)
     if (n <= 8)
         return rt_kdtree_occluded8(tree, rays, n);
     n = n > 16 ? 16 : n;
-    if (packet_walk(tree, rays, n, NULL, true, 2, &mask))
+    if (KD_PACKETS(tree) && occluded16_avx2(tree, rays, n, &mask))
         return mask;
     return rt_kdtree_occluded8(tree, rays, 8) | rt_kdtree_occluded8(tree, rays + 8, n - 8) << 8;
 }
-#else
-unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits)
-{
-    return n < 1 ? 0 : single_rays(tree, rays, n > 8 ? 8 : n, hits, false);
-}
-
-unsigned rt_kdtree_occluded8(const rt_kdtree *tree, const rt_ray *rays, int n)
-{
-    return n < 1 ? 0 : single_rays(tree, rays, n > 8 ? 8 : n, NULL, true);
-}
-
-unsigned rt_kdtree_intersect16(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits)
-{
-    return n < 1 ? 0 : single_rays(tree, rays, n > 16 ? 16 : n, hits, false);
-}
-
-unsigned rt_kdtree_occluded16(const rt_kdtree *tree, const rt_ray *rays, int n)
-{
-    return n < 1 ? 0 : single_rays(tree, rays, n > 16 ? 16 : n, NULL, true);
-}
-#endif
