@@ -7,6 +7,7 @@
 #   make profile      ./rt-profile: optimised, with symbols and frame pointers (for perf)
 #   make scenes       render every scene in scenes/ into docs/images/
 #   make denoiser     Intel Open Image Denoise for --denoise: the pyoidn wheel in build/oidn-venv
+#   make bench-packets rt's packets and Embree's on the same pixel tiles (also run by bench-compare)
 #   make bench-render rt's path tracer against Mitsuba 3 (sets it up in build/mitsuba-venv)
 #   make bench-denoise --denoise at 4/16/64 spp against raw 256 and 1024 spp
 #   make bench-helmet  path tracer rays/s on DamagedHelmet under a sky and a sun (RT_BINS: several builds)
@@ -21,9 +22,12 @@
 # points the tests at the shared assets (default ../shared).
 
 CC      ?= cc
-# -march=native: the kd-tree's AVX2 traversal and the compiler's vector code
-# for this machine. A binary for other machines of a farm: PORTABLE=1 (x86-64
-# baseline, the kd-tree's portable step; same images, slower traversal).
+# -march=native: the compiler's vector code for this machine. A binary for
+# other machines of a farm: PORTABLE=1 (x86-64 baseline; the kd-tree's AVX2
+# kernels are compiled in either way and used when the CPU has AVX2 and FMA,
+# else its portable step: same images). -ffp-contract=off: no multiply-adds
+# fused by the compiler (GCC's -std=c11 default; clang's is on), so code
+# compiled with FMA available (native, the AVX2 kernels) rounds as baseline.
 ifeq ($(PORTABLE),1)
 OPT     ?= -O2
 BUILD   ?= build-portable
@@ -36,7 +40,7 @@ ifeq ($(WERROR),1)
 WARN    += -Werror
 endif
 CFLAGS  ?=
-CFLAGS  += -std=c11 $(WARN) $(OPT) -Iinclude -D_POSIX_C_SOURCE=200809L -MMD -MP
+CFLAGS  += -std=c11 -ffp-contract=off $(WARN) $(OPT) -Iinclude -D_POSIX_C_SOURCE=200809L -MMD -MP
 # C++ only for src/io/draco.cc, the wrapper over libdraco (rt/io/draco.h)
 CXX     ?= c++
 CXXFLAGS ?=
@@ -59,7 +63,7 @@ DEPS_OK  := $(BUILD)/.deps-ok
 
 
 .PHONY: test-slurm test-kubernetes test-parallel test-launchers
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-build bench-render bench-helmet bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
+.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-packets bench-build bench-render bench-helmet bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -122,11 +126,11 @@ $(BUILD)/tests/test_hdr: tests/test_hdr.c src/driver/convert.c src/driver/comman
 
 # the kd-tree's portable path (no AVX2), tested on machines that have AVX2 too
 TEST_BIN += $(BUILD)/tests/test_kdtree_scalar
-# (only the traversal is compiled again, with RT_KD_SCALAR; its two functions
-# take the place of the library's, and the build and packing come from librt.a)
-$(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c src/accel/kdtree_trace.c src/accel/kdtree_internal.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
+# (the same tests with RT_KD_SCALAR: their trees are built with params.portable,
+# so their rays take the portable traversal that librt.a has beside the AVX2 one)
+$(BUILD)/tests/test_kdtree_scalar: tests/test_kdtree.c $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -DRT_KD_SCALAR -Itests -o $@ tests/test_kdtree.c src/accel/kdtree_trace.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+	$(CC) $(CFLAGS) -DRT_KD_SCALAR -Itests -o $@ tests/test_kdtree.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # --denoise loads Intel Open Image Denoise at run time (src/image/denoise.c);
 # Debian has no package, so the pyoidn wheel (which ships the library and its
@@ -162,9 +166,15 @@ bench/rtbench: bench/rtbench.c $(BUILD)/librt.a | $(DEPS_OK)
 bench: bench/rtbench
 	@SHARED=$(SHARED) sh bench/run.sh
 
-# rt and Embree side by side on the same rays, as ratios (installs Embree 3 on first use).
+# rt and Embree side by side on the same rays, as ratios (installs Embree 3 on first use);
+# then the packets on the same tiles (bench-packets).
 bench-compare: bench/rtbench
 	@SHARED=$(SHARED) sh bench/compare.sh
+	@SHARED=$(SHARED) python3 bench/packets.py
+
+# rt's 8- and 16-ray packets and Embree's rtcIntersect8/16 on the same 4x2 and 4x4 tiles of the primary sets.
+bench-packets: bench/rtbench
+	@SHARED=$(SHARED) python3 bench/packets.py
 
 # rt's path tracer against Mitsuba 3 on the shared Cornell box (sets up Mitsuba in build/mitsuba-venv
 # and Debian's libllvm19 on first use); RT_BINS="./rt other/rt" compares rt builds too.

@@ -2,8 +2,8 @@
  * checked against Embree's reference hits.
  *
  *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
- *           [--build-threads N] [--occluded] [--limit N]
- *           [--packets W H [--image-width N]]
+ *           [--build-threads N] [--occluded] [--portable] [--limit N]
+ *           [--packets W H [--image-width N] [--lanes 8|16]]
  *
  * Loads the model with rt_load, as `rt` does (a glTF: every triangle of
  * the default scene in world space, as ../shared/bench/FORMAT.md defines;
@@ -18,14 +18,16 @@
  * go through the any-hit query (shadow rays) instead, and a mismatch is a
  * ray whose hit/miss differs from the reference. Exits 1 when more than
  * 0.01% of the rays disagree with the reference: speed bought with wrong
- * answers does not count. --limit N keeps N rays spread evenly over the set
+ * answers does not count. --portable: the portable traversal even when
+ * the CPU has AVX2 (traversal: says which one ran). --limit N keeps N rays spread evenly over the set
  * (every count/N-th, with its reference hit): a fixed small subset for
  * instruction counts under callgrind. --packets W H traces the set (a
  * primary set: one ray per pixel, row by row, N pixels wide, default 640)
- * in tiles of W x H pixels (W H = 4 2 or 4 4; at most 64 rays), 8 rays at a
- * time with rt_kdtree_intersect8 (kdtree_packet.h), or with --occluded
- * rt_kdtree_occluded8; the answers must be the same. Exit 2 on bad
- * arguments or files.
+ * in tiles of W x H pixels (W H = 4 2 or 4 4; at most 64 rays), 16 rays at
+ * a time with rt_kdtree_intersect16 (kdtree_packet.h) when a tile has 16
+ * or more, else 8 with rt_kdtree_intersect8 (--lanes 8|16 chooses), or
+ * with --occluded the any-hit calls; the answers must be the same. Exit 2
+ * on bad arguments or files.
  */
 #include <pthread.h>
 #include <stdatomic.h>
@@ -62,25 +64,26 @@ typedef struct job {
     bool occluded;
     const size_t *order; /* packets: ray indices tile by tile, pack rays a tile (NULL: single rays) */
     size_t pack;
+    int lanes; /* packets: rays a call, 8 or 16 */
     atomic_size_t next;
 } job;
 
-/* The rays of one tile, 8 at a time. */
+/* The rays of one tile, j->lanes (8 or 16) at a time. */
 static void trace_tile(const job *j, const size_t *idx, size_t n)
 {
-    for (size_t g = 0; g < n; g += 8) {
-        int m = n - g < 8 ? (int)(n - g) : 8;
-        rt_ray r[8];
-        rt_hit h[8];
+    for (size_t g = 0; g < n; g += (size_t)j->lanes) {
+        int m = n - g < (size_t)j->lanes ? (int)(n - g) : j->lanes;
+        rt_ray r[16];
+        rt_hit h[16];
         for (int i = 0; i < m; i++)
             r[i] = j->rays->rays[idx[g + (size_t)i]];
         if (j->occluded) { /* hit/miss only: 0 for a hit */
-            unsigned hit = rt_kdtree_occluded8(j->tree, r, m);
+            unsigned hit = m > 8 ? rt_kdtree_occluded16(j->tree, r, m) : rt_kdtree_occluded8(j->tree, r, m);
             for (int i = 0; i < m; i++)
                 j->t_out[idx[g + (size_t)i]] = (hit >> i & 1) ? 0.0f : INFINITY;
             continue;
         }
-        unsigned hit = rt_kdtree_intersect8(j->tree, r, m, h);
+        unsigned hit = m > 8 ? rt_kdtree_intersect16(j->tree, r, m, h) : rt_kdtree_intersect8(j->tree, r, m, h);
         for (int i = 0; i < m; i++)
             j->t_out[idx[g + (size_t)i]] = (hit >> i & 1) ? h[i].t : INFINITY;
     }
@@ -114,9 +117,9 @@ static void *trace_worker(void *arg)
 
 /* Wall seconds of one pass; *cpu gets the CPU seconds of all threads. */
 static double trace_all(const rt_kdtree *tree, const rt_rayset *rays, float *t_out, int threads, bool occluded,
-                        const size_t *order, size_t pack, double *cpu)
+                        const size_t *order, size_t pack, int lanes, double *cpu)
 {
-    job j = {tree, rays, t_out, occluded, order, pack, 0};
+    job j = {tree, rays, t_out, occluded, order, pack, lanes, 0};
     atomic_init(&j.next, 0);
     pthread_t th[256];
     double c0 = cpu_s(), t0 = now_s();
@@ -141,7 +144,7 @@ static int cmp_double(const void *a, const void *b)
 static int usage(void)
 {
     fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K] [--build-threads N] "
-                    "[--occluded] [--limit N] [--packets W H [--image-width N]]\n");
+                    "[--occluded] [--portable] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]]\n");
     return 2;
 }
 
@@ -150,8 +153,8 @@ int main(int argc, char **argv)
     const char *model = NULL, *rays_path = NULL, *hits_path = NULL;
     int threads = 1, runs = 5, build_threads = 0;
     long limit = 0;
-    int pw = 0, ph = 0, image_width = 640;
-    bool occluded = false;
+    int pw = 0, ph = 0, image_width = 640, lanes = 0;
+    bool occluded = false, portable = false;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--ref") == 0 && i + 1 < argc)
             hits_path = argv[++i];
@@ -170,8 +173,15 @@ int main(int argc, char **argv)
                 return usage();
         } else if (strcmp(argv[i], "--image-width") == 0 && i + 1 < argc)
             image_width = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--lanes") == 0 && i + 1 < argc) {
+            lanes = atoi(argv[++i]);
+            if (lanes != 8 && lanes != 16)
+                return usage();
+        }
         else if (strcmp(argv[i], "--occluded") == 0)
             occluded = true;
+        else if (strcmp(argv[i], "--portable") == 0)
+            portable = true;
         else if (argv[i][0] == '-')
             return usage();
         else if (!model)
@@ -182,8 +192,10 @@ int main(int argc, char **argv)
             return usage();
     }
     if (!model || !rays_path || threads < 1 || threads > 256 || runs < 1 || runs > 1000 || build_threads < 0 ||
-        build_threads > 64 || limit < 0 || image_width < 1 || (pw && limit))
+        build_threads > 64 || limit < 0 || image_width < 1 || (pw && limit) || (lanes && !pw))
         return usage();
+    if (pw && !lanes) /* 16-ray calls for tiles of 16 rays or more */
+        lanes = pw * ph >= 16 ? 16 : 8;
     rt_log_set_level(RT_LOG_QUIET);
 
     rt_error err = {0};
@@ -213,6 +225,7 @@ int main(int argc, char **argv)
     rt_kdtree_params params;
     memset(&params, 0, sizeof params);
     params.threads = build_threads;
+    params.portable = portable;
     if (rt_kdtree_build(&tree, &scene, &params, &err) != RT_OK) {
         fprintf(stderr, "rtbench: %s\n", err.message);
         return 2;
@@ -243,7 +256,7 @@ int main(int argc, char **argv)
         return 2;
     }
     for (int r = 0; r < runs; r++)
-        times[r] = trace_all(&tree, &rs, t_out, threads, occluded, order, (size_t)pw * (size_t)ph, &cpus[r]);
+        times[r] = trace_all(&tree, &rs, t_out, threads, occluded, order, (size_t)pw * (size_t)ph, lanes, &cpus[r]);
     qsort(times, (size_t)runs, sizeof(double), cmp_double);
     qsort(cpus, (size_t)runs, sizeof(double), cmp_double);
     double median = runs % 2 ? times[runs / 2] : 0.5 * (times[runs / 2 - 1] + times[runs / 2]);
@@ -268,11 +281,12 @@ int main(int argc, char **argv)
     printf("wide_nodes: %zu\n", tree.stats.wide_nodes);
     printf("bytes_per_triangle: %.1f\n",
            scene.triangles.count ? (double)tree.stats.bytes / (double)scene.triangles.count : 0.0);
+    printf("traversal: %s\n", tree.isa == RT_KD_ISA_AVX2 ? "avx2" : "portable");
     printf("threads: %d\n", threads);
     printf("rays: %zu\n", rs.count);
     printf("query: %s\n", occluded ? "occluded" : "closest");
     if (pw)
-        printf("packets: %dx%d tiles, 8 rays a call\n", pw, ph);
+        printf("packets: %dx%d tiles, %d rays a call\n", pw, ph, lanes);
     printf("mrays_per_s: %.3f\n", median > 0 ? 1e-6 * (double)rs.count / median : 0.0);
     printf("mrays_per_s_best: %.3f\n", times[0] > 0 ? 1e-6 * (double)rs.count / times[0] : 0.0);
     printf("cpu_mrays_per_s: %.3f\n", cpu_median > 0 ? 1e-6 * (double)rs.count / cpu_median : 0.0);

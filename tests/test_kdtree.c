@@ -20,6 +20,15 @@
 
 /* ------------------------------------------------------------ helpers */
 
+/* test_kdtree_scalar is this file with RT_KD_SCALAR: every tree it builds
+ * takes the portable traversal (params.portable), on any CPU; test_kdtree's
+ * trees take what the CPU allows (the AVX2 kernels on this machine). */
+#ifdef RT_KD_SCALAR
+#define TEST_PORTABLE 1
+#else
+#define TEST_PORTABLE 0
+#endif
+
 static uint32_t add_tri(rt_scene *s, rt_vec3 a, rt_vec3 b, rt_vec3 c)
 {
     uint32_t v = rt_scene_add_vertices(s, 3);
@@ -322,7 +331,15 @@ static void check_random_rays(const rt_scene *s, const rt_kdtree *tree, uint64_t
 static void build_ok(rt_kdtree *tree, const rt_scene *s)
 {
     rt_error err = {0};
-    rt_result res = rt_kdtree_build(tree, s, NULL, &err);
+    rt_kdtree_params p = {0};
+    p.portable = TEST_PORTABLE;
+    rt_result res = rt_kdtree_build(tree, s, &p, &err);
+#ifdef RT_KD_SCALAR
+    assert_int_equal(tree->isa, RT_KD_ISA_PORTABLE);
+#elif defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) /* any build: the AVX2 kernels */
+        assert_int_equal(tree->isa, RT_KD_ISA_AVX2);
+#endif
     if (res != RT_OK)
         fprintf(stderr, "build failed: %s\n", err.message);
     assert_int_equal(res, RT_OK);
@@ -411,9 +428,9 @@ static void test_params(void **state)
     test_rng r = {77};
     random_soup(&s, &r, 1000, 0.05f);
     rt_kdtree_params p[3] = {
-        {1.0f, 80.0f, 0.5f, 0, 0}, /* pbrt's costs: deep trees */
-        {1.0f, 1.0f, 0.0f, 0, 0},
-        {10.0f, 1.0f, 0.0f, 3, 0}, /* shallow */
+        {1.0f, 80.0f, 0.5f, 0, 0, TEST_PORTABLE}, /* pbrt's costs: deep trees */
+        {1.0f, 1.0f, 0.0f, 0, 0, TEST_PORTABLE},
+        {10.0f, 1.0f, 0.0f, 3, 0, TEST_PORTABLE}, /* shallow */
     };
     for (int i = 0; i < 3; i++) {
         rt_kdtree tree;
@@ -445,7 +462,7 @@ static void test_deepest_tree(void **state)
             rt_vec3 c = rt_v3(axis == 0 ? d : 0.1f * d, axis == 1 ? d : 0.1f * d, axis == 2 ? d : 0.1f * d);
             add_tri(&s, c, rt_add(c, rt_v3(e, 0, 0)), rt_add(c, rt_v3(0, e, e)));
         }
-    rt_kdtree_params p = {1.0f, 80.0f, 0.5f, 60, 1};
+    rt_kdtree_params p = {1.0f, 80.0f, 0.5f, 60, 1, TEST_PORTABLE};
     rt_kdtree tree;
     rt_error err = {0};
     assert_int_equal(rt_kdtree_build(&tree, &s, &p, &err), RT_OK);
@@ -853,14 +870,14 @@ static void test_edge_rays(void **state)
     }
 }
 
-/* One packet of n rays through rt_kdtree_intersect8 against brute force:
- * the same hit or miss, the same t bits, the same primitive or one that
- * ties at exactly that t. */
+/* One packet of n rays through rt_kdtree_intersect8 (n <= 8) or
+ * rt_kdtree_intersect16 against brute force: the same hit or miss, the
+ * same t bits, the same primitive or one that ties at exactly that t. */
 static void check_packet(const rt_scene *s, const rt_kdtree *tree, const rt_ray *rays, int n, check_stats *cs)
 {
-    rt_hit h[8];
+    rt_hit h[16];
     memset(h, 0x55, sizeof h);
-    unsigned mask = rt_kdtree_intersect8(tree, rays, n, h);
+    unsigned mask = n > 8 ? rt_kdtree_intersect16(tree, rays, n, h) : rt_kdtree_intersect8(tree, rays, n, h);
     assert_true(mask >> n == 0);
     for (int i = 0; i < n; i++) {
         rt_hit b;
@@ -920,23 +937,24 @@ static void test_packets(void **state)
             float pix = cam % 2 ? 1e-3f : 2e-2f; /* tight tiles, and wider ones that straddle edges */
             for (int tile = 0; tile < 30; tile++) {
                 float x0 = rnd(&r, -0.5f, 0.5f), y0 = rnd(&r, -0.5f, 0.5f);
-                rt_ray rays[8];
-                for (int i = 0; i < 8; i++) {
+                rt_ray rays[16];
+                for (int i = 0; i < 16; i++) {
                     rt_vec3 d = rt_add(fw, rt_add(rt_scale(rx, x0 + pix * (float)(i % 4)), rt_scale(uy, y0 + pix * (float)(i / 4))));
                     rays[i] = rt_ray_make(eye, d, 0.0f, INFINITY);
                 }
                 int n = 8;
                 switch (tile % 10) {
-                case 1: n = 1 + (int)(test_rng_next(&r) % 7); break;
-                case 2: rays[3].dir.x = 0.0f; break;                 /* parallel to an axis */
+                case 1: n = 1 + (int)(test_rng_next(&r) % 15); break;
+                case 2: rays[3 + 8 * (tile / 10 & 1)].dir.x = 0.0f; break;               /* parallel to an axis */
                 case 3: rays[5].tmin = rays[5].tmax = 1.0f; break;  /* an empty interval */
                 case 4: rays[0].org.y = NAN; break;                  /* hits nothing */
-                case 5: for (int i = 0; i < 8; i++) rays[i] = random_ray(&r, -0.2f * span, 1.2f * span); break;
+                case 5: for (int i = 0; i < 16; i++) rays[i] = random_ray(&r, -0.2f * span, 1.2f * span); break;
                 case 6: rays[2].tmax = rnd(&r, 0.5f, 2.0f) * span; rays[6].tmin = 0.5f * span; break;
-                case 7: rays[7].dir = rt_neg(rays[7].dir); break;   /* one ray the other way */
+                case 7: rays[7 + 8 * (tile / 10 & 1)].dir = rt_neg(rays[7 + 8 * (tile / 10 & 1)].dir); break; /* one ray the other way */
                 default: break;
                 }
-                check_packet(&s, &tree, rays, n, &cs);
+                check_packet(&s, &tree, rays, n < 8 ? n : 8, &cs); /* 4x2 */
+                check_packet(&s, &tree, rays, n == 8 ? 16 : n, &cs); /* 4x4 (n > 8: 16 lanes) */
             }
         }
         report(__func__, &cs);
@@ -946,11 +964,12 @@ static void test_packets(void **state)
     }
 }
 
-/* One packet of n shadow rays through rt_kdtree_occluded8: each ray's bit
- * is the single-ray rt_kdtree_occluded and brute force's any-hit. */
+/* One packet of n shadow rays through rt_kdtree_occluded8 (n <= 8) or
+ * rt_kdtree_occluded16: each ray's bit is the single-ray
+ * rt_kdtree_occluded and brute force's any-hit. */
 static void check_packet_occluded(const rt_scene *s, const rt_kdtree *tree, const rt_ray *rays, int n, check_stats *cs)
 {
-    unsigned mask = rt_kdtree_occluded8(tree, rays, n);
+    unsigned mask = n > 8 ? rt_kdtree_occluded16(tree, rays, n) : rt_kdtree_occluded8(tree, rays, n);
     assert_true(mask >> n == 0);
     for (int i = 0; i < n; i++) {
         bool pa = mask >> i & 1, sa = rt_kdtree_occluded(tree, &rays[i]), ba = ref_any(s, &rays[i]);
@@ -1001,9 +1020,11 @@ static void test_packets_occluded(void **state)
             float pix = cam % 2 ? 1e-3f : 2e-2f;
             for (int tile = 0; tile < 30; tile++) {
                 float x0 = rnd(&r, -0.5f, 0.5f), y0 = rnd(&r, -0.5f, 0.5f);
-                rt_ray rays[8];
-                int n = 8, expect[8] = {-1, -1, -1, -1, -1, -1, -1, -1}; /* known answers: 0, 1 (-1: not known) */
-                for (int i = 0; i < 8; i++) { /* a tile's hit points (or points along its rays) to the light */
+                rt_ray rays[16];
+                int n = 8, expect[16]; /* known answers: 0, 1 (-1: not known) */
+                for (int i = 0; i < 16; i++)
+                    expect[i] = -1;
+                for (int i = 0; i < 16; i++) { /* a tile's hit points (or points along its rays) to the light */
                     rt_vec3 d = rt_add(fw, rt_add(rt_scale(rx, x0 + pix * (float)(i % 4)), rt_scale(uy, y0 + pix * (float)(i / 4))));
                     rt_ray pr = rt_ray_make(eye, d, 0.0f, INFINITY);
                     rt_hit h;
@@ -1012,19 +1033,19 @@ static void test_packets_occluded(void **state)
                     rays[i] = rt_ray_make(p, rt_sub(light, p), 1e-4f, 1.0f);
                 }
                 switch (tile % 10) {
-                case 1: n = 1 + (int)(test_rng_next(&r) % 7); break;
-                case 2: rays[3].dir.x = 0.0f; break;                 /* parallel to an axis */
+                case 1: n = 1 + (int)(test_rng_next(&r) % 15); break;
+                case 2: rays[3 + 8 * (tile / 10 & 1)].dir.x = 0.0f; break;               /* parallel to an axis */
                 case 3: rays[5].tmin = rays[5].tmax = 0.5f; break;  /* an empty interval */
                 case 4: rays[0].org.y = NAN; break;                  /* hits nothing */
                 case 5: /* random rays, random intervals */
-                    for (int i = 0; i < 8; i++) {
+                    for (int i = 0; i < 16; i++) {
                         rays[i] = random_ray(&r, -0.2f * span, 1.2f * span);
                         rays[i].tmin = rnd(&r, 0.0f, 0.5f) * span;
                         rays[i].tmax = rays[i].tmin + rnd(&r, 0.0f, 2.0f) * span;
                     }
                     break;
                 case 6: /* scattered points to the light: mixed signs */
-                    for (int i = 0; i < 8; i++) {
+                    for (int i = 0; i < 16; i++) {
                         rt_vec3 p = rnd3(&r, -0.2f * span, 1.2f * span);
                         rays[i] = rt_ray_make(p, rt_sub(light, p), 0.0f, 1.0f);
                     }
@@ -1034,7 +1055,7 @@ static void test_packets_occluded(void **state)
                     uint32_t tri = (uint32_t)(test_rng_next(&r) % s.triangles.count);
                     rt_vec3 a = rt_tri_vertex(&s, tri, 0), b = rt_tri_vertex(&s, tri, 1), c = rt_tri_vertex(&s, tri, 2);
                     rt_vec3 o = rt_add(light, rnd3(&r, -0.01f * span, 0.01f * span));
-                    for (int i = 0; i < 8; i++) {
+                    for (int i = 0; i < 16; i++) {
                         float u = rnd(&r, 0.05f, 0.45f), v = rnd(&r, 0.05f, 0.45f);
                         rt_vec3 q = rt_add(a, rt_add(rt_scale(rt_sub(b, a), u), rt_scale(rt_sub(c, a), v)));
                         rays[i] = tile % 10 == 7 ? rt_ray_make(o, rt_sub(q, o), 0.0f, INFINITY)
@@ -1054,8 +1075,9 @@ static void test_packets_occluded(void **state)
                 }
                 default: break;
                 }
-                check_packet_occluded(&s, &tree, rays, n, &cs);
-                for (int i = 0; i < n; i++)
+                check_packet_occluded(&s, &tree, rays, n < 8 ? n : 8, &cs);
+                check_packet_occluded(&s, &tree, rays, n == 8 ? 16 : n, &cs);
+                for (int i = 0; i < 16; i++)
                     if (expect[i] >= 0)
                         assert_int_equal(rt_kdtree_occluded(&tree, &rays[i]), expect[i]);
             }
@@ -1144,6 +1166,7 @@ static void test_parallel_build_identical(void **state)
     rt_kdtree_params p1 = {0}, p3 = {0};
     p1.threads = 1;
     p3.threads = 3;
+    p1.portable = p3.portable = TEST_PORTABLE;
     rt_kdtree a, b;
     rt_error err = {0};
     assert_int_equal(rt_kdtree_build(&a, &s, &p1, &err), RT_OK);

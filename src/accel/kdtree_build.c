@@ -794,6 +794,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     double t0 = 1e3 * rt_now_seconds();
     memset(tree, 0, sizeof *tree);
     tree->scene = scene;
+    tree->isa = params && params->portable ? RT_KD_ISA_PORTABLE : rt_kd_isa_best(); /* once a tree */
     tree->bounds = rt_box_empty();
     size_t T = scene->triangles.count, S = scene->spheres.count, Q = scene->quads.count, N = T + S + Q;
     if (N >= (size_t)PRIM_MASK)

@@ -12,7 +12,9 @@
  *                   levels each, and leaf blocks (a leaf's id list with an
  *                   end flag, then the triangles it is the first to use);
  *   kdtree_trace.c  rt_kdtree_intersect and rt_kdtree_occluded over those
- *                   arrays (the AVX2 step and the portable one);
+ *                   arrays (the AVX2 step and the portable one), compiled
+ *                   twice: as itself (AVX2) and by kdtree_trace_portable.c
+ *                   (no SIMD; the choice between them, once a tree);
  *   kdtree_packet.c rt_kdtree_intersect8 and rt_kdtree_occluded8: up to 8
  *                   coherent rays through the same arrays at once (one
  *                   walk for both; the leaves by kdtree_trace.c).
@@ -100,15 +102,48 @@ typedef struct kd_ray {
     rt_tri_ray tr; /* the watertight triangle test's shear (intersect.h) */
 } kd_ray;
 
-/* kdtree_trace.c's single-ray leaf test, for kdtree_packet.c (whose ray
- * set-up repeats ray_setup's operations for 8 rays in lanes): the
- * primitives of one leaf reference (RT_KD_ONE or RT_KD_LEAF) tested on
+/* Runtime AVX2 dispatch. On x86 with GCC or clang the AVX2 kernels (the
+ * single-ray traversal of kdtree_trace.c, the packets of kdtree_packet.c)
+ * are compiled for AVX2 and FMA between KD_AVX2_BEGIN and KD_AVX2_END
+ * whatever the build's flags, so a PORTABLE=1 build (the x86-64 baseline)
+ * has them too; kdtree_trace_portable.c compiles kdtree_trace.c a second
+ * time without SIMD. rt_kdtree_build picks one for the tree's life
+ * (rt_kdtree.isa: rt_kd_isa_best, the CPU's); rt_kdtree_intersect and
+ * rt_kdtree_occluded branch on it once a ray. Only these kernels are
+ * dispatched: everything else is compiled for the build's target. Both
+ * give the reference's bits (-std=c11 contracts nothing into FMAs, and
+ * the Makefile says -ffp-contract=off for any compiler). */
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define KD_HAVE_AVX2 1
+#if defined(__clang__)
+#define KD_AVX2_BEGIN _Pragma("clang attribute push (__attribute__((target(\"avx2,fma\"))), apply_to = function)")
+#define KD_AVX2_END _Pragma("clang attribute pop")
+#else
+#define KD_AVX2_BEGIN _Pragma("GCC push_options") _Pragma("GCC target(\"avx2,fma\")")
+#define KD_AVX2_END _Pragma("GCC pop_options")
+#endif
+#endif
+
+/* The traversal a tree can use on this CPU: RT_KD_ISA_AVX2 when the
+ * kernels are compiled in and the CPU has AVX2 and FMA. */
+rt_kd_isa rt_kd_isa_best(void);
+
+/* kdtree_trace.c's entry points, once per variant (_avx2: the AVX2 pass,
+ * _portable: kdtree_trace_portable.c's); kdtree.h's functions call one. */
+bool rt_kd_intersect_avx2(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit);
+bool rt_kd_occluded_avx2(const rt_kdtree *tree, const rt_ray *ray);
+bool rt_kd_intersect_portable(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit);
+bool rt_kd_occluded_portable(const rt_kdtree *tree, const rt_ray *ray);
+
+/* kdtree_trace.c's single-ray leaf test (AVX2 pass), for kdtree_packet.c
+ * (whose ray set-up repeats ray_setup's operations for 8 rays in lanes):
+ * the primitives of one leaf reference (RT_KD_ONE or RT_KD_LEAF) tested on
  * (ray->tmin, *best), as the single-ray traversal tests them; hit->prim is
  * the tree's primitive id. any: stop at the first hit (occlusion). */
-bool rt_kd_leaf_hit(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr, float *best,
-                    rt_hit *hit, bool any);
+bool rt_kd_leaf_hit_avx2(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr, float *best,
+                         rt_hit *hit, bool any);
 /* One primitive (a tree id, as in a leaf list) for one ray, the same way. */
-bool rt_kd_prim_hit(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
-                    rt_hit *hit);
+bool rt_kd_prim_hit_avx2(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
+                         rt_hit *hit);
 
 #endif

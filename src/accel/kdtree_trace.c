@@ -35,8 +35,11 @@
  * NaN of the slab formula; such rays (rare) run a copy of the loop with
  * that case, the others a copy without it. Empty leaves are not stored
  * (their cells' references are "empty"), so no step is spent on them.
- * Without AVX2 (or with RT_KD_SCALAR, with which the Makefile compiles this
- * file again for test_kdtree_scalar) the same step runs as plain loops.
+ * This file is compiled twice (kdtree_internal.h, "Runtime AVX2
+ * dispatch"): as itself, the AVX2 kernels (built for AVX2 and FMA whatever
+ * the build's flags, names ending _avx2), and by kdtree_trace_portable.c
+ * with KD_PORTABLE, where the same step runs as plain loops (_portable);
+ * the tree says which one its rays take.
  *
  * Leaves with 3 or more triangles are tested 8 at a time with AVX2 (when
  * compiled for it): the same IEEE operations per lane as the scalar
@@ -72,9 +75,14 @@
 
 #include "rt/accel/intersect.h"
 
-#if defined(__AVX2__) && defined(__GNUC__) && !defined(RT_KD_SCALAR) /* RT_KD_SCALAR: the portable code, for tests */
+#if defined(KD_PORTABLE) || defined(KD_HAVE_AVX2) /* else: only the portable pass, nothing here */
+#ifdef KD_PORTABLE
+#define KD_NAME(f) f##_portable
+#else
 #include <immintrin.h>
 #define KD_SIMD 1
+#define KD_NAME(f) f##_avx2
+KD_AVX2_BEGIN
 #endif
 
 /* -------------------------------------------------------------- the ray */
@@ -800,7 +808,7 @@ KD_INLINE bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, b
     return traverse_ray(tree, ray, hit, any, true, &r);
 }
 
-KD_FLATTEN bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit)
+KD_FLATTEN bool KD_NAME(rt_kd_intersect)(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit)
 {
     hit->prim = RT_NONE;
     if (traverse(tree, ray, hit, false)) {
@@ -811,16 +819,17 @@ KD_FLATTEN bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt
     return false;
 }
 
-KD_FLATTEN bool rt_kdtree_occluded(const rt_kdtree *tree, const rt_ray *ray)
+KD_FLATTEN bool KD_NAME(rt_kd_occluded)(const rt_kdtree *tree, const rt_ray *ray)
 {
     rt_hit h;
     return traverse(tree, ray, &h, true);
 }
 
+#ifdef KD_SIMD
 /* For the packet traversal (kdtree_packet.c): one leaf, or one primitive,
  * for one ray, out of line. */
-KD_FLATTEN bool rt_kd_leaf_hit(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr, float *best,
-                               rt_hit *hit, bool any)
+KD_FLATTEN bool rt_kd_leaf_hit_avx2(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr,
+                                    float *best, rt_hit *hit, bool any)
 {
     if (ref >= RT_KD_ONE)
         return test_prim(tree, ref & RT_KD_PAYLOAD, ray, tr, best, hit);
@@ -828,8 +837,13 @@ KD_FLATTEN bool rt_kd_leaf_hit(const rt_kdtree *tree, uint32_t ref, const rt_ray
     return test_leaf(tree, p, leaf_length(p), ray, tr, best, hit, any);
 }
 
-KD_FLATTEN bool rt_kd_prim_hit(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
-                               rt_hit *hit)
+KD_FLATTEN bool rt_kd_prim_hit_avx2(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr,
+                                    float *best, rt_hit *hit)
 {
     return test_prim(tree, id, ray, tr, best, hit);
 }
+KD_AVX2_END
+#endif
+#else
+typedef int kd_trace_no_avx2; /* (ISO C wants something in a file) */
+#endif

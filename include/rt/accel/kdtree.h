@@ -55,7 +55,13 @@ typedef struct rt_kdtree_params {
     float empty_bonus;    /* fraction (0..1) by which a split with an empty side is cheaper (default 0.2) */
     int max_depth;        /* 0 = 8 + 1.3 log2(N) (pbrt's rule) */
     int threads;          /* build threads; 0 = one per online CPU (same tree for any count) */
+    int portable;         /* 1: the portable traversal even when the CPU has AVX2 (tests; same answers) */
 } rt_kdtree_params;
+
+/* The traversal kernels a tree uses, chosen once by the build from the CPU
+ * (AVX2 and FMA, when compiled in: on x86 with GCC or clang, PORTABLE=1
+ * builds included) and params->portable. */
+typedef enum rt_kd_isa { RT_KD_ISA_PORTABLE = 0, RT_KD_ISA_AVX2 = 1 } rt_kd_isa;
 
 typedef struct rt_kdtree_stats {
     size_t nodes, leaves, empty_leaves; /* of the binary tree */
@@ -104,6 +110,7 @@ typedef struct rt_kdtree {
     size_t triangle_count, sphere_count, quad_count; /* at build time */
     float scale; /* largest absolute coordinate of bounds (traversal epsilon) */
     const rt_scene *scene;
+    rt_kd_isa isa;        /* the traversal kernels this tree uses */
     rt_box bounds;
     int max_depth;
     rt_kdtree_stats stats;

@@ -19,8 +19,10 @@
  * against all the rays that reach it at once; for occlusion a ray drops
  * out of the packet at its first hit. Packets whose rays run in different
  * directions along some axis (the cells' order would differ), or with a
- * ray parallel to an axis, are traced as single rays. A 4x4 tile is two
- * calls.
+ * ray parallel to an axis, are traced as single rays. A 4x4 tile is one
+ * call of rt_kdtree_intersect16 (two 8-lane halves sharing the walk).
+ * Packets go through the AVX2 kernels when the tree's rays do
+ * (rt_kdtree.isa), else as single rays.
  */
 #ifndef RT_KDTREE_PACKET_H
 #define RT_KDTREE_PACKET_H
@@ -31,5 +33,10 @@
 unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits);
 /* n rays (1..8); returns the mask of rays with any hit in (tmin, tmax). */
 unsigned rt_kdtree_occluded8(const rt_kdtree *tree, const rt_ray *rays, int n);
+/* The same for n = 1..16 rays (a 4x4 tile) in one walk: two 8-lane halves
+ * share each node step and leaf; rays that cannot share it go as two
+ * packets of 8. */
+unsigned rt_kdtree_intersect16(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits);
+unsigned rt_kdtree_occluded16(const rt_kdtree *tree, const rt_ray *rays, int n);
 
 #endif
