@@ -5,6 +5,7 @@
  * correlated multi-jittered positions (Kensler 2013, rt/render/sampling.h). */
 #include "rt/render/camera.h"
 
+#include "rt/render/sampler.h"
 #include "rt/render/sampling.h"
 
 bool rt_camera_frame_init(rt_camera_frame *cf, const rt_camera *cam, int width, int height)
@@ -33,6 +34,7 @@ bool rt_camera_frame_init(rt_camera_frame *cf, const rt_camera *cam, int width, 
     cf->focus_distance = cam->focus_distance > 0.0f ? cam->focus_distance : dist;
     cf->inv_width = 1.0f / (float)(width > 0 ? width : 1);
     cf->inv_height = 1.0f / (float)(height > 0 ? height : 1);
+    cf->sampler = RT_SAMPLER_CMJ;
     return ok;
 }
 
@@ -56,6 +58,13 @@ rt_ray rt_camera_pixel_sample(const rt_camera_frame *cf, int width, uint32_t see
                               uint32_t s, rt_rng *rng)
 {
     uint64_t pixel = (uint64_t)y * (uint64_t)width + (uint64_t)x;
+    if (cf->sampler == RT_SAMPLER_SOBOL) {
+        *rng = rt_rng_for_sample(seed, pixel, s);
+        rt_vec2 j = spp > 1 ? rt_sampler_2d(RT_SAMPLER_SOBOL, rng->key, s, spp, RT_SAMPLER_DIM_FILM) : rt_v2(0.5f, 0.5f);
+        rt_vec2 lens = cf->lens_radius > 0.0f ? rt_sampler_2d(RT_SAMPLER_SOBOL, rng->key, s, spp, RT_SAMPLER_DIM_LENS)
+                                              : rt_v2(0.5f, 0.5f);
+        return rt_camera_ray(cf, (float)x + j.x, (float)y + j.y, lens);
+    }
     uint32_t pattern = (uint32_t)rt_mix64(pixel ^ ((uint64_t)seed << 40));
     rt_vec2 j = spp > 1 ? rt_cmj_sample(s, spp, pattern) : rt_v2(0.5f, 0.5f);
     /* a pinhole camera reads no lens point: skip its pattern (half the CMJ work) */

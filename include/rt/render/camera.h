@@ -27,6 +27,7 @@ typedef struct rt_camera_frame {
     float tan_half, aspect;
     float lens_radius, focus_distance;
     float inv_width, inv_height;
+    rt_sampler_kind sampler; /* RT_SAMPLER_SOBOL: film and lens from the Sobol sampler (rt_camera_frame_init: CMJ) */
 } rt_camera_frame;
 
 /* false when the camera is degenerate (look_at == position, up parallel to
@@ -36,7 +37,12 @@ rt_ray rt_camera_ray(const rt_camera_frame *cf, float film_x, float film_y, rt_v
 
 /* Sample s of spp of pixel (x, y) of an image `width` pixels wide: the film
  * position and lens point by correlated multi-jittering (a pattern per
- * pixel and seed; the pixel centre when spp is 1), and in *rng the sample's
+ * pixel and seed), or, when cf->sampler is RT_SAMPLER_SOBOL (the path
+ * tracer's default), from the padded Owen-scrambled Sobol sampler
+ * (rt/render/sampler.h) in dimensions of their own, so that every
+ * power-of-two prefix of a pixel's samples (a pass, a --time-limit stop, a
+ * motion-blur slice) covers the pixel evenly: CMJ puts the first samples of
+ * a pixel in its top rows. The pixel centre when spp is 1. In *rng the sample's
  * own random stream, rt_rng_for_sample(seed, y * width + x, s). A pure
  * function of its arguments: the tile loop and the wavefront tracer both
  * take their samples here. */

@@ -60,6 +60,11 @@
 #include "rt/render/sampling.h"
 #include "rt/scene/scene.h"
 
+/* The camera's dimensions (rt_camera_pixel_sample), apart from the path's
+ * (bounce x (5 + lights) + slot): the film position and the lens point. */
+#define RT_SAMPLER_DIM_FILM 0xfffffff0u
+#define RT_SAMPLER_DIM_LENS 0xfffffff1u
+
 static inline uint32_t rt_sampler_hash(uint32_t a, uint32_t b)
 {
     uint32_t h = a ^ (b * 0x9e3779b9u + 0x7f4a7c15u);
