@@ -328,17 +328,7 @@ static rt_result get_vec3(parser *p, const char *what, rt_vec3 *out)
 /* An RGB colour, each component >= 0. */
 static rt_result get_color(parser *p, const char *what, rt_vec3 *out)
 {
-    static const char *comp[3] = {"red", "green", "blue"};
-    float v[3];
-    for (int i = 0; i < 3; i++) {
-        char w[256];
-        snprintf(w, sizeof w, "%s (%s)", what, comp[i]);
-        rt_result r = get_float_in(p, w, 0.0f, FLT_MAX, &v[i]);
-        if (r != RT_OK)
-            return r;
-    }
-    *out = rt_v3(v[0], v[1], v[2]);
-    return RT_OK;
+    return get_color_in(p, what, FLT_MAX, out);
 }
 
 /* One of a list of words; `choices` is "a|b|c" for the message. */

@@ -1066,6 +1066,23 @@ static rt_vec3 layered_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, const laye
     return rt_finite3(f) ? f : rt_v3s(0.0f);
 }
 
+/* A sampled direction wi (unit, above the surface) whose BSDF value f and
+ * pdf the sampler's mixture evaluated: the sample's weight f cos / pdf, or
+ * false when the pdf or the weight is unusable. The end of both samplers. */
+static inline bool finish_sample(rt_vec3 wi, rt_vec3 f, float pdf, rt_bsdf_sample *s)
+{
+    if (!(pdf > 0.0f) || !isfinite(pdf))
+        return false;
+    rt_vec3 w = rt_scale(f, wi.z / pdf);
+    if (!rt_finite3(w))
+        return false;
+    s->wi = wi;
+    s->weight = w;
+    s->pdf = pdf;
+    s->delta = false;
+    return true;
+}
+
 static bool layered_sample(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
 {
     layered_probs p = layered_lobe_probs(b, wo);
@@ -1143,16 +1160,7 @@ static bool layered_sample(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe,
     wi = rt_normalize(wi);
     float pdf;
     rt_vec3 f = layered_eval(b, wo, wi, &p, &pdf);
-    if (!(pdf > 0.0f) || !isfinite(pdf))
-        return false;
-    rt_vec3 w = rt_scale(f, wi.z / pdf);
-    if (!rt_finite3(w))
-        return false;
-    s->wi = wi;
-    s->weight = w;
-    s->pdf = pdf;
-    s->delta = false;
-    return true;
+    return finish_sample(wi, f, pdf, s);
 }
 
 bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
@@ -1217,14 +1225,5 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
     wi = rt_normalize(wi);
     float pdf;
     rt_vec3 f = eval_lobes(b, wo, wi, pd, ps, &pdf);
-    if (!(pdf > 0.0f) || !isfinite(pdf))
-        return false;
-    rt_vec3 w = rt_scale(f, wi.z / pdf);
-    if (!rt_finite3(w))
-        return false;
-    s->wi = wi;
-    s->weight = w;
-    s->pdf = pdf;
-    s->delta = false;
-    return true;
+    return finish_sample(wi, f, pdf, s);
 }
