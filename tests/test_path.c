@@ -716,13 +716,9 @@ static void test_cornell_reference(void **state)
 static void test_cornell_emissive_triangles(void **state)
 {
     (void)state;
-    const char *ref_path = test_shared_path("reference/cornell/reference.pfm");
-    rt_error err;
     rt_framebuffer ref;
-    if (rt_pfm_read(ref_path, &ref, &err) != RT_OK) {
-        fprintf(stderr, "note: %s not readable (set RT_SHARED); skipping\n", ref_path);
+    if (!test_read_cornell_reference(&ref))
         return;
-    }
     FILE *fp = fopen("scenes/cornell-reference.txt", "rb");
     assert_non_null(fp);
     static char text[16384];

@@ -207,13 +207,10 @@ static void render(fixture *f, rt_integrator in, rt_sampler_kind kind, rt_render
 static void test_cornell_mse_stratified(void **state)
 {
     (void)state;
-    const char *ref_path = test_shared_path("reference/cornell/reference.pfm");
     rt_error err;
     rt_framebuffer ref;
-    if (rt_pfm_read(ref_path, &ref, &err) != RT_OK) {
-        fprintf(stderr, "note: %s not readable (set RT_SHARED); skipping\n", ref_path);
+    if (!test_read_cornell_reference(&ref))
         return;
-    }
     fixture f;
     rt_scene_init(&f.s);
     if (rt_scene_parse_file(&f.s, "scenes/cornell-reference.txt", &err) != RT_OK)
@@ -256,13 +253,10 @@ static void test_cornell_mse_stratified(void **state)
 static void test_prefix_covers_pixel(void **state)
 {
     (void)state;
-    const char *ref_path = test_shared_path("reference/cornell/reference.pfm");
     rt_error err;
     rt_framebuffer ref;
-    if (rt_pfm_read(ref_path, &ref, &err) != RT_OK) {
-        fprintf(stderr, "note: %s not readable (set RT_SHARED); skipping\n", ref_path);
+    if (!test_read_cornell_reference(&ref))
         return;
-    }
     fixture f;
     rt_scene_init(&f.s);
     if (rt_scene_parse_file(&f.s, "scenes/cornell-reference.txt", &err) != RT_OK)

@@ -21,6 +21,8 @@
 
 #include <cmocka.h>
 
+#include "rt/io/framebuffer.h"
+
 /* Path of a file under the shared directory, in a static buffer (one at a time). */
 static inline const char *test_shared_path(const char *rel)
 {
@@ -28,6 +30,19 @@ static inline const char *test_shared_path(const char *rel)
     const char *root = getenv("RT_SHARED");
     snprintf(buf, sizeof buf, "%s/%s", root && *root ? root : "../shared", rel);
     return buf;
+}
+
+/* The shared Mitsuba reference of the Cornell box (512x512) into *ref;
+ * false, with a note that the test is skipped, when it cannot be read. */
+static inline bool test_read_cornell_reference(rt_framebuffer *ref)
+{
+    const char *path = test_shared_path("reference/cornell/reference.pfm");
+    rt_error err;
+    if (rt_pfm_read(path, ref, &err) != RT_OK) {
+        fprintf(stderr, "note: %s not readable (set RT_SHARED); skipping\n", path);
+        return false;
+    }
+    return true;
 }
 
 /* True when the shared assets exist; otherwise prints why the test is skipped. */

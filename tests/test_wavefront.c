@@ -371,13 +371,9 @@ static double block_rmse(const rt_framebuffer *img, const rt_framebuffer *ref, d
 static void test_cornell_reference_wavefront(void **state)
 {
     (void)state;
-    const char *ref_path = test_shared_path("reference/cornell/reference.pfm");
-    rt_error err;
     rt_framebuffer ref;
-    if (rt_pfm_read(ref_path, &ref, &err) != RT_OK) {
-        fprintf(stderr, "note: %s not readable (set RT_SHARED); skipping\n", ref_path);
+    if (!test_read_cornell_reference(&ref))
         return;
-    }
     fixture f;
     load_cornell(&f, 64);
     f.s.settings.samples = 32;
