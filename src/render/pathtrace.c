@@ -65,8 +65,11 @@
  * so every sample of a pixel takes each decision from the same stratified
  * dimension, whatever its path did before, and the wavefront needs no
  * per-lane counter. With the Sobol sampler and AVX2, the first read of a
- * bounce computes its first RT_SOBOL_BLOCK dimensions at once into the
- * path's cache (rt/render/sobol_block.h: the same bits as one at a time). */
+ * bounce computes its first RT_SOBOL_BLOCK (8) dimensions at once into the
+ * path's cache (rt/render/sobol_block.h: the same bits as one at a time),
+ * which the bounce's other reads find there; with more than 3 lights the
+ * lights past the third fill blocks of 8 of their own in turn (then the
+ * first block is computed again for the environment, emitter and BSDF). */
 enum { DIM_BSDF, DIM_LOBE_RR, DIM_ENV, DIM_EMIT_PICK, DIM_EMIT, DIM_LIGHT0 };
 
 static inline uint32_t path_stride(const rt_trace_ctx *ctx)
@@ -84,8 +87,10 @@ static inline rt_vec2 path_2d_of(const rt_trace_ctx *ctx, rt_path_state *ps, rt_
 {
     const rt_settings *st = &ctx->state->scene->settings;
     uint32_t dim0 = (uint32_t)bounce * path_stride(ctx);
-    if (st->sampler == RT_SAMPLER_SOBOL && slot < RT_SOBOL_BLOCK && rt_sobol_cache_usable())
-        return rt_sobol_cache_2d(&ps->sobol, rng->key, rng->index, (uint32_t)st->samples, dim0, slot);
+    if (st->sampler == RT_SAMPLER_SOBOL && rt_sobol_cache_usable()) {
+        uint32_t first = slot - slot % RT_SOBOL_BLOCK; /* past 8 slots (3 lights), the block of 8 it falls in */
+        return rt_sobol_cache_2d(&ps->sobol, rng->key, rng->index, (uint32_t)st->samples, dim0 + first, slot - first);
+    }
     return rt_sample_2d((rt_sampler_kind)st->sampler, (uint32_t)st->samples, rng, dim0 + slot);
 }
 
@@ -99,7 +104,7 @@ static inline rt_vec2 path_2d(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng
 static inline float path_1d(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, uint32_t slot)
 {
     const rt_settings *st = &ctx->state->scene->settings;
-    if (st->sampler == RT_SAMPLER_SOBOL && slot < RT_SOBOL_BLOCK && rt_sobol_cache_usable())
+    if (st->sampler == RT_SAMPLER_SOBOL && rt_sobol_cache_usable())
         return path_2d(ctx, ps, rng, slot).x;
     return rt_sample_1d((rt_sampler_kind)st->sampler, (uint32_t)st->samples, rng, path_dim(ctx, ps, slot));
 }
