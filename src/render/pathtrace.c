@@ -64,9 +64,9 @@
  * vertex after `bounces` scatterings uses dims bounces * stride + slot),
  * so every sample of a pixel takes each decision from the same stratified
  * dimension, whatever its path did before, and the wavefront needs no
- * per-lane counter. With the Sobol sampler and AVX2, the first read of a
- * bounce computes its first RT_SOBOL_BLOCK (8) dimensions at once into the
- * path's cache (rt/render/sobol_block.h: the same bits as one at a time),
+ * per-lane counter. With a stratified sampler and AVX2, the first read of a
+ * bounce computes its first RT_SAMPLER_BLOCK (8) dimensions at once into
+ * the path's cache (rt/render/sampler_block.h: the same bits as one at a time),
  * which the bounce's other reads find there; with more than 3 lights the
  * lights past the third fill blocks of 8 of their own in turn (then the
  * first block is computed again for the environment, emitter and BSDF). */
@@ -86,12 +86,14 @@ static inline uint32_t path_dim(const rt_trace_ctx *ctx, const rt_path_state *ps
 static inline rt_vec2 path_2d_of(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, int bounce, uint32_t slot)
 {
     const rt_settings *st = &ctx->state->scene->settings;
+    rt_sampler_kind kind = (rt_sampler_kind)st->sampler;
     uint32_t dim0 = (uint32_t)bounce * path_stride(ctx);
-    if (st->sampler == RT_SAMPLER_SOBOL && rt_sobol_cache_usable()) {
-        uint32_t first = slot - slot % RT_SOBOL_BLOCK; /* past 8 slots (3 lights), the block of 8 it falls in */
-        return rt_sobol_cache_2d(&ps->sobol, rng->key, rng->index, (uint32_t)st->samples, dim0 + first, slot - first);
+    if (kind != RT_SAMPLER_INDEPENDENT && rt_sampler_block_usable()) {
+        uint32_t first = slot - slot % RT_SAMPLER_BLOCK; /* past 8 slots (3 lights), the block of 8 it falls in */
+        return rt_sampler_cache_2d(&ps->samples, kind, rng->key, rng->index, (uint32_t)st->samples, dim0 + first,
+                                   slot - first);
     }
-    return rt_sample_2d((rt_sampler_kind)st->sampler, (uint32_t)st->samples, rng, dim0 + slot);
+    return rt_sample_2d(kind, (uint32_t)st->samples, rng, dim0 + slot);
 }
 
 static inline rt_vec2 path_2d(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, uint32_t slot)
@@ -104,7 +106,7 @@ static inline rt_vec2 path_2d(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng
 static inline float path_1d(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, uint32_t slot)
 {
     const rt_settings *st = &ctx->state->scene->settings;
-    if (st->sampler == RT_SAMPLER_SOBOL && rt_sobol_cache_usable())
+    if (st->sampler == RT_SAMPLER_SOBOL && rt_sampler_block_usable())
         return path_2d(ctx, ps, rng, slot).x;
     return rt_sample_1d((rt_sampler_kind)st->sampler, (uint32_t)st->samples, rng, path_dim(ctx, ps, slot));
 }
@@ -266,7 +268,7 @@ bool rt_path_start(const rt_trace_ctx *ctx, const rt_ray *ray, rt_path_state *ps
     ps->bounces = 0;
     rt_medium_stack_init(&ps->media);
     ps->skips = RT_PATH_HARD_LIMIT;
-    rt_sobol_cache_clear(&ps->sobol); /* a new sample: the cache holds none of its values */
+    rt_sampler_cache_clear(&ps->samples); /* a new sample: the cache holds none of its values */
     return true;
 }
 

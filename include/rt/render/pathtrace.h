@@ -29,7 +29,7 @@
 #include "rt/render/light.h"
 #include "rt/render/medium.h"
 #include "rt/render/sampling.h"
-#include "rt/render/sobol_block.h"
+#include "rt/render/sampler_block.h"
 
 #define RT_PATH_HARD_LIMIT 1024 /* bounces when max_depth is 0 (unlimited): a guard, never reached in practice */
 #define RT_PATH_LAYERS 257      /* surfaces a path segment may step past (alpha cut-outs) plus one */
@@ -62,7 +62,7 @@ typedef struct rt_path_state {
     int bounces;
     rt_medium_stack media; /* the dielectrics it is inside (rt/render/medium.h) */
     int skips;         /* false intersections it may still pass */
-    rt_sobol_cache sobol; /* the Sobol sampler's values of the current bounce (rt/render/sobol_block.h) */
+    rt_sampler_cache samples; /* the stratified sampler's values of the current bounce (rt/render/sampler_block.h) */
 } rt_path_state;
 
 /* What rt_path_vertex_begin found at a surface. */

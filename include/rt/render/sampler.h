@@ -34,8 +34,8 @@
  * rt_sampler_1d / rt_sampler_2d are the stratified values themselves (no
  * rng), for tests and callers with their own keys. All inline: a path takes
  * three or four values a bounce, and a call costs a tenth of the work.
- * The path tracer and the camera read RT_SAMPLER_SOBOL through
- * rt/render/sobol_block.h when the CPU has AVX2: eight dimensions of a
+ * The path tracer (and the camera, for Sobol) read them through
+ * rt/render/sampler_block.h when the CPU has AVX2: eight dimensions of a
  * sample at once in vector lanes, the same bits as these functions.
  *
  * Padding: pbrt-v4 (Pharr, Jakob, Humphreys, 4th ed.), section 8.5; Kollig
