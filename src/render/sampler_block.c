@@ -69,6 +69,9 @@ typedef struct block_consts {
     uint8_t bswap[32], rev_lo[32], rev_hi[32];  /* byte swap; 4-bit reversal of a nibble, into the low or high nibble */
     uint32_t m1[8], m2[8], m4[8], m8[8], m16[8]; /* the generator matrix's masks; m4 also the low nibble of each byte */
     float unit[8];                              /* 2^-24 */
+    /* CMJ: the permutation's multipliers, the hash-to-float's, the pattern multipliers */
+    uint32_t perm[6][8], rf1[8], rf2[8], rf3[8], pat_perm[8], pat_x[8], pat_y[8], pat_jx[8], pat_jy[8];
+    float top[8];                               /* 0x1.fffffep-1, the largest float below 1 */
 } block_consts;
 
 #define H(c) ((c) * 0x9e3779b9u + 0x7f4a7c15u)
@@ -82,6 +85,10 @@ static const block_consts block_k = {
     KB(0x00, 0x80, 0x40, 0xc0, 0x20, 0xa0, 0x60, 0xe0, 0x10, 0x90, 0x50, 0xd0, 0x30, 0xb0, 0x70, 0xf0),
     K8(0x55555555u), K8(0x33333333u), K8(0x0f0f0f0fu), K8(0x00ff00ffu), K8(0x0000ffffu),
     K8(1.0f / 16777216.0f),
+    {K8(0xe170893du), K8(0x0929eb3fu), K8(0x6935fa69u), K8(0x74dcb303u), K8(0x9e501cc3u), K8(0xc860a3dfu)},
+    K8(0xb36534e5u), K8(0x93fc4795u), K8(0xdf6e307fu),
+    K8(0x8ee9b46bu), K8(0xa511e9b3u), K8(0x63d83595u), K8(0xa399d265u), K8(0x711ad6a5u),
+    K8(0x1.fffffep-1f),
 };
 #undef H
 
@@ -170,8 +177,8 @@ static inline __m128i quot4(__m128i x, __m256d l)
 
 static inline __m256i quot(__m256i x, uint32_t l) /* x / l */
 {
-    if (l == 1)
-        return x;
+    if ((l & (l - 1)) == 0) /* a power of two (1 included): a shift */
+        return _mm256_srli_epi32(x, __builtin_ctz(l));
     __m256d ld = _mm256_set1_pd((double)l);
     __m128i lo = quot4(_mm256_castsi256_si128(x), ld), hi = quot4(_mm256_extracti128_si256(x, 1), ld);
     return _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
@@ -179,34 +186,36 @@ static inline __m256i quot(__m256i x, uint32_t l) /* x / l */
 
 static inline __m256i rem(__m256i x, uint32_t l, __m256i q) /* x % l, given q = x / l */
 {
+    if ((l & (l - 1)) == 0)
+        return _mm256_and_si256(x, S1(l - 1));
     return _mm256_sub_epi32(x, _mm256_mullo_epi32(q, S1(l)));
 }
 
-static inline __m256i cmj_permute(__m256i i, uint32_t l, __m256i p) /* rt_cmj_permute */
+static inline __m256i cmj_permute(const block_consts *k, __m256i i, uint32_t l, __m256i p) /* rt_cmj_permute */
 {
     uint32_t ws = l - 1;
     ws |= ws >> 1; ws |= ws >> 2; ws |= ws >> 4; ws |= ws >> 8; ws |= ws >> 16;
     __m256i w = S1(ws), lv = S1(l);
     __m256i p16 = _mm256_srli_epi32(p, 16), p8 = _mm256_srli_epi32(p, 8), p23 = _mm256_srli_epi32(p, 23);
-    __m256i p27 = _mm256_or_si256(_mm256_srli_epi32(p, 27), S1(1));
+    __m256i p27 = _mm256_or_si256(_mm256_srli_epi32(p, 27), LD(one));
     __m256i active = _mm256_set1_epi32(-1);
     do { /* every lane the first time, then the lanes still >= l */
         __m256i v = _mm256_xor_si256(i, p);
-        v = _mm256_mullo_epi32(v, S1(0xe170893du));
+        v = _mm256_mullo_epi32(v, LD(perm[0]));
         v = _mm256_xor_si256(v, p16);
         v = xor_and_shift(v, w, 4);
         v = _mm256_xor_si256(v, p8);
-        v = _mm256_mullo_epi32(v, S1(0x0929eb3fu));
+        v = _mm256_mullo_epi32(v, LD(perm[1]));
         v = _mm256_xor_si256(v, p23);
         v = xor_and_shift(v, w, 1);
         v = _mm256_mullo_epi32(v, p27);
-        v = _mm256_mullo_epi32(v, S1(0x6935fa69u));
+        v = _mm256_mullo_epi32(v, LD(perm[2]));
         v = xor_and_shift(v, w, 11);
-        v = _mm256_mullo_epi32(v, S1(0x74dcb303u));
+        v = _mm256_mullo_epi32(v, LD(perm[3]));
         v = xor_and_shift(v, w, 2);
-        v = _mm256_mullo_epi32(v, S1(0x9e501cc3u));
+        v = _mm256_mullo_epi32(v, LD(perm[4]));
         v = xor_and_shift(v, w, 2);
-        v = _mm256_mullo_epi32(v, S1(0xc860a3dfu));
+        v = _mm256_mullo_epi32(v, LD(perm[5]));
         v = _mm256_and_si256(v, w);
         v = _mm256_xor_si256(v, _mm256_srli_epi32(v, 5));
         i = _mm256_blendv_epi8(i, v, active);
@@ -216,19 +225,19 @@ static inline __m256i cmj_permute(__m256i i, uint32_t l, __m256i p) /* rt_cmj_pe
     return rem(x, l, quot(x, l));
 }
 
-static inline __m256 cmj_randfloat(__m256i i, __m256i p) /* rt_cmj_randfloat */
+static inline __m256 cmj_randfloat(const block_consts *k, __m256i i, __m256i p) /* rt_cmj_randfloat */
 {
     i = _mm256_xor_si256(i, p);
     i = _mm256_xor_si256(i, _mm256_srli_epi32(i, 17));
     i = _mm256_xor_si256(i, _mm256_srli_epi32(i, 10));
-    i = _mm256_mullo_epi32(i, S1(0xb36534e5u));
+    i = _mm256_mullo_epi32(i, LD(rf1));
     i = _mm256_xor_si256(i, _mm256_srli_epi32(i, 12));
     i = _mm256_xor_si256(i, _mm256_srli_epi32(i, 21));
-    i = _mm256_mullo_epi32(i, S1(0x93fc4795u));
-    i = _mm256_xor_si256(i, S1(0xdf6e307fu));
+    i = _mm256_mullo_epi32(i, LD(rf2));
+    i = _mm256_xor_si256(i, LD(rf3));
     i = _mm256_xor_si256(i, _mm256_srli_epi32(i, 17));
-    i = _mm256_mullo_epi32(i, _mm256_or_si256(_mm256_srli_epi32(p, 18), S1(1)));
-    return _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srli_epi32(i, 8)), _mm256_set1_ps(1.0f / 16777216.0f));
+    i = _mm256_mullo_epi32(i, _mm256_or_si256(_mm256_srli_epi32(p, 18), LD(one)));
+    return _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_srli_epi32(i, 8)), _mm256_loadu_ps(k->unit));
 }
 
 BLOCK_OPAQUE static void cmj_block_avx2(const block_consts *k, uint32_t key, uint32_t index, uint32_t spp,
@@ -243,19 +252,19 @@ BLOCK_OPAQUE static void cmj_block_avx2(const block_consts *k, uint32_t key, uin
         p = mix32(k, _mm256_xor_si256(p, S1((index / spp) * 0x9e3779b9u + 0x7f4a7c15u)));
         index %= spp;
     }
-    __m256i s = cmj_permute(S1(index), spp, _mm256_mullo_epi32(p, S1(0x8ee9b46bu)));
+    __m256i s = cmj_permute(k, S1(index), spp, _mm256_mullo_epi32(p, LD(pat_perm)));
     /* rt_cmj_sample(s, spp, p) */
     uint32_t m, rows;
     rt_cmj_grid(spp, &m, &rows);
     __m256i sdm = quot(s, m), smm = rem(s, m, sdm);
-    __m256i sx = cmj_permute(smm, m, _mm256_mullo_epi32(p, S1(0xa511e9b3u)));
-    __m256i sy = cmj_permute(sdm, rows, _mm256_mullo_epi32(p, S1(0x63d83595u)));
-    __m256 jx = cmj_randfloat(s, _mm256_mullo_epi32(p, S1(0xa399d265u)));
-    __m256 jy = cmj_randfloat(s, _mm256_mullo_epi32(p, S1(0x711ad6a5u)));
+    __m256i sx = cmj_permute(k, smm, m, _mm256_mullo_epi32(p, LD(pat_x)));
+    __m256i sy = cmj_permute(k, sdm, rows, _mm256_mullo_epi32(p, LD(pat_y)));
+    __m256 jx = cmj_randfloat(k, s, _mm256_mullo_epi32(p, LD(pat_jx)));
+    __m256 jy = cmj_randfloat(k, s, _mm256_mullo_epi32(p, LD(pat_jy)));
     __m256 fm = _mm256_set1_ps((float)m), fk = _mm256_set1_ps((float)rows);
     __m256 vx = _mm256_add_ps(_mm256_cvtepi32_ps(smm), _mm256_div_ps(_mm256_add_ps(_mm256_cvtepi32_ps(sy), jx), fk));
     __m256 vy = _mm256_add_ps(_mm256_cvtepi32_ps(sdm), _mm256_div_ps(_mm256_add_ps(_mm256_cvtepi32_ps(sx), jy), fm));
-    const __m256 top = _mm256_set1_ps(0x1.fffffep-1f); /* rt_fminf: no NaN here */
+    const __m256 top = _mm256_loadu_ps(k->top); /* rt_fminf: no NaN here */
     _mm256_storeu_ps(x, _mm256_min_ps(_mm256_div_ps(vx, fm), top));
     _mm256_storeu_ps(y, _mm256_min_ps(_mm256_div_ps(vy, fk), top));
 }
