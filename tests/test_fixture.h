@@ -1,6 +1,7 @@
 /* test_fixture.h - a scene ready to trace, as the integrator tests set it
  * up: the scene tables, their kd-tree, the render state and a trace
- * context over them. Include after test_util.h.
+ * context over them; and for scenes built in code, the camera and a whole
+ * render. Include after test_util.h.
  *
  *   test_fixture f;
  *   test_fixture_load(&f, "integrator path\nsphere 0 0 0 1 m\n...", RT_PREPARE_LIGHT_TABLE);
@@ -23,9 +24,11 @@
 
 #include "rt/accel/kdtree.h"
 #include "rt/io/scene_parse.h"
+#include "rt/render/render.h"
 #include "rt/render/render_state.h"
 #include "rt/render/surface.h"
 #include "rt/scene/scene.h"
+#include "rt/scene/validate.h"
 
 typedef struct test_fixture {
     rt_scene s;
@@ -64,6 +67,37 @@ static inline void test_fixture_free(test_fixture *f)
     rt_render_state_free(&f->rs);
     rt_kdtree_free(&f->tree);
     rt_scene_free(&f->s);
+}
+
+/* The camera of a scene built in code: from `from` towards `at`, `up` up,
+ * a vertical field of view of fov_deg degrees. */
+static inline void test_scene_look(rt_scene *s, rt_vec3 from, rt_vec3 at, rt_vec3 up, float fov_deg)
+{
+    s->camera.position = from;
+    s->camera.look_at = at;
+    s->camera.up = up;
+    s->camera.vfov_deg = fov_deg;
+    s->camera_set = true;
+}
+
+/* Renders a scene built in code (validated here, with a kd-tree of its
+ * own) at its settings on `threads` threads in tiles of `tile` pixels (0:
+ * the default) into a new *fb; no sample may be bad. */
+static inline void test_render_scene(rt_scene *s, int threads, int tile, rt_framebuffer *fb)
+{
+    rt_error err = {0};
+    assert_int_equal(rt_scene_validate(s, &err), RT_OK);
+    rt_kdtree tree;
+    assert_int_equal(rt_kdtree_build(&tree, s, NULL, &err), RT_OK);
+    assert_int_equal(rt_framebuffer_init(fb, s->settings.width, s->settings.height, &err), RT_OK);
+    rt_render_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.threads = threads;
+    opt.tile_size = tile;
+    rt_render_stats st;
+    assert_int_equal(rt_render(s, &tree, &opt, fb, &st, &err), RT_OK);
+    assert_int_equal(st.bad_samples, 0);
+    rt_kdtree_free(&tree);
 }
 
 #endif
