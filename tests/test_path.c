@@ -675,21 +675,8 @@ static void test_cornell_reference(void **state)
     rt_render_stats st;
     render_fixture(&f, 0, &img, &st);
     assert_true(st.bad_samples == 0);
-    double se = 0.0, mine[3] = {0, 0, 0}, theirs[3] = {0, 0, 0};
-    for (int y = 0; y < 64; y++)
-        for (int x = 0; x < 64; x++)
-            for (int c = 0; c < 3; c++) {
-                double r = 0.0;
-                for (int j = 0; j < 8; j++)
-                    for (int i = 0; i < 8; i++)
-                        r += ref.rgb[3 * ((size_t)(8 * y + j) * 512 + (size_t)(8 * x + i)) + (size_t)c];
-                r /= 64.0;
-                double v = img.rgb[3 * ((size_t)y * 64 + (size_t)x) + (size_t)c];
-                se += (v - r) * (v - r);
-                mine[c] += v / 4096.0;
-                theirs[c] += r / 4096.0;
-            }
-    double rmse = sqrt(se / (64.0 * 64.0 * 3.0));
+    double mine[3], theirs[3];
+    double rmse = test_cornell_block_rmse(&img, &ref, mine, theirs);
     fprintf(stderr, "cornell-reference 64x64 @ 256 spp: RMSE %.5f, means (%.5f %.5f %.5f) vs (%.5f %.5f %.5f)\n", rmse,
             mine[0], mine[1], mine[2], theirs[0], theirs[1], theirs[2]);
     /* the reference's published means */

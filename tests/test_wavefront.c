@@ -339,29 +339,6 @@ static void test_render_bytes_any_split(void **state)
     unload(&f);
 }
 
-/* RMSE of a 64x64 image against the 512x512 reference box-averaged over
- * 8x8 blocks, and the image means of both. */
-static double block_rmse(const rt_framebuffer *img, const rt_framebuffer *ref, double mine[3], double theirs[3])
-{
-    double se = 0.0;
-    for (int c = 0; c < 3; c++)
-        mine[c] = theirs[c] = 0.0;
-    for (int y = 0; y < 64; y++)
-        for (int x = 0; x < 64; x++)
-            for (int c = 0; c < 3; c++) {
-                double r = 0.0;
-                for (int j = 0; j < 8; j++)
-                    for (int i = 0; i < 8; i++)
-                        r += ref->rgb[3 * ((size_t)(8 * y + j) * 512 + (size_t)(8 * x + i)) + (size_t)c];
-                r /= 64.0;
-                double v = img->rgb[3 * ((size_t)y * 64 + (size_t)x) + (size_t)c];
-                se += (v - r) * (v - r);
-                mine[c] += v / 4096.0;
-                theirs[c] += r / 4096.0;
-            }
-    return sqrt(se / (64.0 * 64.0 * 3.0));
-}
-
 /* scenes/cornell-reference.txt at 64x64 (each pixel an 8x8 block of the
  * 512x512 reference) and 32 spp: `path` and `path_scalar` give the same
  * bytes; the image means are within 1.5% of the reference's (their noise at
@@ -383,12 +360,12 @@ static void test_cornell_reference_wavefront(void **state)
     assert_memory_equal(img.rgb, scalar.rgb, 64 * 64 * 3 * sizeof(float));
     rt_framebuffer_free(&scalar);
     double mine[3], theirs[3], m2[3], t2[3];
-    double rmse = block_rmse(&img, &ref, mine, theirs);
+    double rmse = test_cornell_block_rmse(&img, &ref, mine, theirs);
     double noise = 0.0;
     for (uint32_t k = 1; k <= 2; k++) {
         f.s.settings.seed += k;
         render_with(&f, RT_INTEGRATOR_PATH_SCALAR, 2, 32, 0, 0, &scalar);
-        double e = block_rmse(&scalar, &ref, m2, t2);
+        double e = test_cornell_block_rmse(&scalar, &ref, m2, t2);
         noise = e > noise ? e : noise;
         rt_framebuffer_free(&scalar);
     }
