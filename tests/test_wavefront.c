@@ -55,6 +55,31 @@ static void soup_scene(rt_scene *s)
     }
 }
 
+/* Ray i of a batch, as a single ray. */
+static rt_ray batch_ray(const rt_ray_batch *rb, int i)
+{
+    return rt_ray_make(rt_v3(rb->ox[i], rb->oy[i], rb->oz[i]), rt_v3(rb->dx[i], rb->dy[i], rb->dz[i]), rb->tmin[i],
+                       rb->tmax[i]);
+}
+
+/* Entry i of a batch's closest hits is the single ray's
+ * rt_kdtree_intersect: the same primitive (RT_NONE for a miss) and the
+ * same bits of t, u and v. Returns whether the ray hit. */
+static bool assert_batch_hit_is_single(const rt_kdtree *tree, const rt_ray_batch *rb, const rt_hit_batch *hb, int i)
+{
+    rt_ray ray = batch_ray(rb, i);
+    rt_hit h;
+    if (!rt_kdtree_intersect(tree, &ray, &h)) {
+        assert_int_equal(hb->prim[i], RT_NONE);
+        return false;
+    }
+    assert_int_equal(hb->prim[i], h.prim);
+    assert_memory_equal(&hb->t[i], &h.t, sizeof h.t);
+    assert_memory_equal(&hb->u[i], &h.u, sizeof h.u);
+    assert_memory_equal(&hb->v[i], &h.v, sizeof h.v);
+    return true;
+}
+
 static void test_batch_traversal_matches_single_rays(void **state)
 {
     (void)state;
@@ -100,17 +125,8 @@ static void test_batch_traversal_matches_single_rays(void **state)
             assert_int_equal(blocked[i], 7);
             continue;
         }
-        rt_ray ray = rt_ray_make(rt_v3(ox[i], oy[i], oz[i]), rt_v3(dx[i], dy[i], dz[i]), tmin[i], tmax[i]);
-        rt_hit h;
-        if (rt_kdtree_intersect(&tree, &ray, &h)) {
-            want_hits++;
-            assert_int_equal(prim[i], h.prim);
-            assert_memory_equal(&t[i], &h.t, sizeof h.t);
-            assert_memory_equal(&u[i], &h.u, sizeof h.u);
-            assert_memory_equal(&v[i], &h.v, sizeof h.v);
-        } else {
-            assert_int_equal(prim[i], RT_NONE);
-        }
+        want_hits += assert_batch_hit_is_single(&tree, &rb, &hb, i);
+        rt_ray ray = batch_ray(&rb, i);
         bool occ = rt_kdtree_occluded(&tree, &ray);
         want_blocks += occ;
         assert_int_equal(blocked[i], occ ? 1 : 0);
@@ -164,19 +180,8 @@ static void test_batch_packets_match_single_rays(void **state)
     rt_hit_batch hb = {t, u, v, prim};
     size_t hits = rt_kdtree_intersect_batch(&tree, &rb, NULL, N, &hb);
     size_t want = 0;
-    for (int k = 0; k < N; k++) {
-        rt_ray ray = rt_ray_make(rt_v3(ox[k], oy[k], oz[k]), rt_v3(dx[k], dy[k], dz[k]), tmin[k], tmax[k]);
-        rt_hit h;
-        if (rt_kdtree_intersect(&tree, &ray, &h)) {
-            want++;
-            assert_int_equal(prim[k], h.prim);
-            assert_memory_equal(&t[k], &h.t, sizeof h.t);
-            assert_memory_equal(&u[k], &h.u, sizeof h.u);
-            assert_memory_equal(&v[k], &h.v, sizeof h.v);
-        } else {
-            assert_int_equal(prim[k], RT_NONE);
-        }
-    }
+    for (int k = 0; k < N; k++)
+        want += assert_batch_hit_is_single(&tree, &rb, &hb, k);
     assert_int_equal(hits, want);
     fprintf(stderr, "%d fans, %zu of %d rays hit\n", runs, hits, N);
     assert_true(hits > N / 10 && hits < N);
