@@ -77,6 +77,20 @@ static inline double test_cornell_block_rmse(const rt_framebuffer *img, const rt
     return sqrt(se / (64.0 * 64.0 * 3.0));
 }
 
+/* A load of the file `name` that must have failed with `code` and a
+ * message naming the file and containing `what`; what it got is shown when
+ * it did not. */
+static inline void test_expect_failure(rt_result r, const rt_error *err, rt_result code, const char *name,
+                                       const char *what)
+{
+    if (r != code || !strstr(err->message, name) || !strstr(err->message, what))
+        fprintf(stderr, "%s: got %s \"%s\", wanted %s containing \"%s\"\n", name, rt_result_name(r), err->message,
+                rt_result_name(code), what);
+    assert_int_equal(r, code);
+    assert_non_null(strstr(err->message, name));
+    assert_non_null(strstr(err->message, what));
+}
+
 /* True when the shared assets exist; otherwise prints why the test is skipped. */
 static inline int test_have_shared(void)
 {
