@@ -6,6 +6,7 @@
  *   test_fixture f;
  *   test_fixture_load(&f, "integrator path\nsphere 0 0 0 1 m\n...", RT_PREPARE_LIGHT_TABLE);
  *   rt_vec3 L = rt_radiance_path(&f.ctx, &ray, &rng);
+ *   rt_vec3 L2 = test_fixture_path_radiance(&f, seed, org, dir, i);  (checked finite, >= 0)
  *   test_fixture_free(&f);
  *
  * Or in two steps, to change the scene between parsing and building:
@@ -24,6 +25,7 @@
 
 #include "rt/accel/kdtree.h"
 #include "rt/io/scene_parse.h"
+#include "rt/render/pathtrace.h"
 #include "rt/render/render.h"
 #include "rt/render/render_state.h"
 #include "rt/render/surface.h"
@@ -60,6 +62,19 @@ static inline void test_fixture_load(test_fixture *f, const char *text, unsigned
 {
     test_fixture_parse(f, text);
     test_fixture_build(f, prepare);
+}
+
+/* The path tracer's radiance along the ray from org towards dir
+ * (normalised here) with the random stream of pixel i, sample 0, of
+ * `seed`; asserted finite and non-negative. */
+static inline rt_vec3 test_fixture_path_radiance(const test_fixture *f, uint32_t seed, rt_vec3 org, rt_vec3 dir,
+                                                 uint32_t i)
+{
+    rt_rng rng = rt_rng_for_sample(seed, i, 0);
+    rt_ray r = rt_ray_make(org, rt_normalize(dir), 0.0f, INFINITY);
+    rt_vec3 L = rt_radiance_path(&f->ctx, &r, &rng);
+    assert_true(rt_finite3(L) && L.x >= 0.0f && L.y >= 0.0f && L.z >= 0.0f);
+    return L;
 }
 
 static inline void test_fixture_free(test_fixture *f)
