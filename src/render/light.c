@@ -1,9 +1,15 @@
 /* light.c - light arriving at a surface point: sampling the scene's
  * lights, shadow transmittance, and the path tracer's table of emitters.
  *
- * Area lights are sampled uniformly by area and converted to solid angle
- * (pdf = d^2 / (A cos theta_l)); spot cones use glTF's smooth falloff
- * (KHR_lights_punctual) and its recommended range window.
+ * Area lights that are rectangles are sampled uniformly by the solid angle
+ * they subtend (Urena, Fajardo and King 2013, rt/render/spherical.h; pdf
+ * 1 / solid angle) when that solid angle is within pbrt-v4's range
+ * (3e-4 to 6.22 sr); other parallelograms, and rectangles outside the
+ * range, are sampled uniformly by area and converted to solid angle (pdf =
+ * d^2 / (A cos theta_l)). Emissive triangles of the table likewise (Arvo
+ * 1995, spherical triangles; rt_light_table_tri_solid). Spot cones use
+ * glTF's smooth falloff (KHR_lights_punctual) and its recommended range
+ * window.
  *
  * The light table (pbrt-v3, Pharr, Jakob, Humphreys, ch. 14.2 and 14.5):
  * emissive primitives are picked in proportion to their power (area x
@@ -20,6 +26,7 @@
 
 #include "rt/base/alloc.h"
 #include "rt/render/environment.h"
+#include "rt/render/spherical.h"
 
 /* The unit direction and the distance from p to the point q on a light,
  * into ls, and their squared distance; false when they coincide. */
@@ -33,6 +40,34 @@ static bool toward(rt_vec3 p, rt_vec3 q, rt_light_sample *ls, float *d2)
     ls->wi = rt_scale(d, 1.0f / dist);
     ls->dist = dist;
     return true;
+}
+
+/* Area light l set up for solid-angle sampling from p: true when it is a
+ * rectangle (edges perpendicular to 1e-5), p is in front of it and its
+ * solid angle from p is in the range where that is used. */
+static bool area_light_solid(const rt_light *l, rt_vec3 p, rt_sph_rect *r)
+{
+    float lu = rt_length2(l->edge_u), lv = rt_length2(l->edge_v), uv = rt_dot(l->edge_u, l->edge_v);
+    if (!(uv * uv <= 1e-10f * lu * lv))
+        return false;
+    if (!(rt_dot(rt_sub(p, l->position), rt_cross(l->edge_u, l->edge_v)) > 0.0f))
+        return false; /* behind the one-sided emitter (area sampling says so) */
+    return rt_sph_rect_init(r, l->position, l->edge_u, l->edge_v, p) && rt_sph_in_range(r->S);
+}
+
+/* The solid-angle pdf of uniform area sampling of area light l towards
+ * unit direction d at distance dist; 0 from behind. */
+static float area_light_area_pdf(const rt_light *l, rt_vec3 d, float dist)
+{
+    rt_vec3 nl = rt_cross(l->edge_u, l->edge_v);
+    float area = rt_length(nl);
+    if (!(area > 0.0f))
+        return 0.0f;
+    float cos_l = -rt_dot(nl, d) / area;
+    if (!(cos_l > 0.0f))
+        return 0.0f;
+    float p = dist * dist / (area * cos_l);
+    return isfinite(p) ? p : 0.0f;
 }
 
 bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, rt_vec2 u, rt_light_sample *ls)
@@ -75,6 +110,17 @@ bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, r
         if (!(area > 0.0f))
             return false;
         nl = rt_scale(nl, 1.0f / area);
+        rt_sph_rect sr;
+        if (area_light_solid(l, p, &sr)) { /* uniform in solid angle: radiance x S */
+            float dist;
+            ls->wi = rt_sph_rect_sample(&sr, u, &dist);
+            ls->dist = dist;
+            if (!(dist > 0.0f && isfinite(dist)) || !(-rt_dot(nl, ls->wi) > 0.0f))
+                return false;
+            ls->li = rt_scale(power, sr.S);
+            ls->pdf = 1.0f / sr.S;
+            return true;
+        }
         rt_vec3 q = rt_add(l->position, rt_add(rt_scale(l->edge_u, u.x), rt_scale(l->edge_v, u.y)));
         float d2;
         if (!toward(p, q, ls, &d2))
@@ -83,6 +129,7 @@ bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, r
         if (!(cos_l > 0.0f))
             return false; /* behind the one-sided emitter */
         ls->li = rt_scale(power, area * cos_l / d2);
+        ls->pdf = area_light_area_pdf(l, ls->wi, ls->dist);
         return true;
     }
     }
@@ -203,6 +250,7 @@ void rt_light_table_free(rt_light_table *t)
     free(t->cdf);
     free(t->area);
     free(t->prim_pdf);
+    free(t->prim_sel);
     free(t->quad_light);
     free(t->env_row_cdf);
     free(t->env_col_cdf);
@@ -348,8 +396,9 @@ rt_result rt_light_table_build(rt_light_table *t, const rt_scene *s, rt_error *e
     t->prim_count = np;
     t->quad_count = nq;
     t->prim_pdf = rt_alloc(np ? np : 1, sizeof *t->prim_pdf);
+    t->prim_sel = rt_alloc(np ? np : 1, sizeof *t->prim_sel);
     t->quad_light = rt_alloc(nq ? nq : 1, sizeof *t->quad_light);
-    if (!t->prim_pdf || !t->quad_light)
+    if (!t->prim_pdf || !t->prim_sel || !t->quad_light)
         goto nomem;
     for (size_t q = 0; q < nq; q++)
         t->quad_light[q] = RT_NONE;
@@ -405,6 +454,7 @@ rt_result rt_light_table_build(rt_light_table *t, const rt_scene *s, rt_error *e
         acc += w[i];
         t->cdf[i] = (float)(acc / total);
         t->prim_pdf[t->prim[i]] = (float)(w[i] / total / (double)t->area[i]);
+        t->prim_sel[t->prim[i]] = (float)(w[i] / total);
     }
     t->cdf[k - 1] = 1.0f;
     free(w);
@@ -432,15 +482,19 @@ uint32_t rt_area_light_of_prim(const rt_scene *s, const rt_light_table *t, uint3
     return RT_NONE;
 }
 
-float rt_area_light_pdf(const rt_light *l, rt_vec3 d, float dist)
+float rt_area_light_pdf(const rt_light *l, rt_vec3 p, rt_vec3 d, float dist)
 {
-    rt_vec3 nl = rt_cross(l->edge_u, l->edge_v);
-    float area = rt_length(nl);
-    if (!(area > 0.0f))
-        return 0.0f;
-    float cos_l = -rt_dot(nl, d) / area;
-    if (!(cos_l > 0.0f))
-        return 0.0f;
-    float p = dist * dist / (area * cos_l);
-    return isfinite(p) ? p : 0.0f;
+    rt_sph_rect sr;
+    if (area_light_solid(l, p, &sr))
+        return -rt_dot(rt_cross(l->edge_u, l->edge_v), d) > 0.0f ? 1.0f / sr.S : 0.0f;
+    return area_light_area_pdf(l, d, dist);
+}
+
+bool rt_light_table_tri_solid(const rt_scene *s, uint32_t prim, rt_vec3 p, rt_sph_tri *st)
+{
+    uint32_t i;
+    if (rt_prim_kind_of(s, prim, &i) != RT_PRIM_TRIANGLE)
+        return false;
+    return rt_sph_tri_init(st, rt_tri_vertex(s, i, 0), rt_tri_vertex(s, i, 1), rt_tri_vertex(s, i, 2), p) &&
+           rt_sph_in_range(st->S);
 }
