@@ -9,10 +9,12 @@
  *     uniform in solid angle: the fraction landing in each of several
  *     sub-polygons equals its share of the solid angle within 4 sigma;
  *   - the irradiance estimate from a uniformly emitting rectangle (an area
- *     light through rt_light_sample_at) and a triangle matches Lambert's
- *     polygon formula E = L/2 sum_i angle(v_i, v_i+1) n . unit(v_i x v_i+1)
- *     within 4 sigma, and its variance is below uniform area sampling's at
- *     a point close to the light;
+ *     light through rt_light_sample_at: three points that see it large and
+ *     sample it by solid angle, one that sees it small and samples it by
+ *     area) and a triangle matches Lambert's polygon formula
+ *     E = L/2 sum_i angle(v_i, v_i+1) n . unit(v_i x v_i+1) within 4 sigma,
+ *     and its variance is below half of uniform area sampling's at a point
+ *     close to the light (measured 42x and 20x lower standard deviations);
  *   - the light sample's pdf is rt_area_light_pdf's, bit for bit (what MIS
  *     weighs BSDF hits on the light with), with solid-angle sampling and
  *     with the area fallback (a rectangle too small in solid angle, a

@@ -208,7 +208,7 @@ bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_path_state *ps, const
     case RT_PRIM_TRIANGLE: {
         rt_vec3 a = rt_tri_vertex(s, local, 0), bb = rt_tri_vertex(s, local, 1), c = rt_tri_vertex(s, local, 2);
         rt_sph_tri st;
-        if (rt_light_table_tri_solid(s, prim, sf->p, &st)) {
+        if (rt_tri_solid(a, bb, c, t->prim_sel[prim] / t->prim_pdf[prim], sf->p, &st)) {
             solid = st.S;
             if (!tri_barycentric(a, bb, c, sf->p, rt_sph_tri_sample(&st, u), &h.u, &h.v))
                 return false;
@@ -330,7 +330,10 @@ rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, 
                 rt_sph_tri st;
                 float cos_l = fabsf(rt_dot(sf->ng, ps->r.dir));
                 float pa = t->prim_pdf[sf->prim];
-                if (rt_light_table_tri_solid(s, sf->prim, ps->prev_p, &st))
+                uint32_t ti;
+                if (rt_prim_kind_of(s, sf->prim, &ti) == RT_PRIM_TRIANGLE &&
+                    rt_tri_solid(rt_tri_vertex(s, ti, 0), rt_tri_vertex(s, ti, 1), rt_tri_vertex(s, ti, 2),
+                                 t->prim_sel[sf->prim] / pa, ps->prev_p, &st))
                     pdf_l = t->prim_sel[sf->prim] / st.S;
                 else
                     pdf_l = cos_l > 0.0f ? pa * d2 / cos_l : 0.0f;

@@ -66,14 +66,30 @@ static inline bool dunit(dvec a, dvec *out)
 
 /* ------------------------------------------------------------ rectangles */
 
+/* The interior angle of the spherical rectangle at a vertex (x, y, z0)
+ * is the argument of (c, h |v|) with c = +-x y (the paper's -n_i . n_i+1
+ * times the lengths of both normals, h = -z0): its four angles are
+ * multiplied as complex numbers, so that S = arg(z0 z1 z2 z3) (g sums to
+ * S + 2 pi) costs one atan2, and k = 2 pi - arg(z2 z3) enters the sampler
+ * only through its cosine and sine. */
+typedef struct cplx {
+    double re, im;
+} cplx;
+
+static inline cplx cmul(cplx a, cplx b)
+{
+    cplx r = {a.re * b.re - a.im * b.im, a.re * b.im + a.im * b.re};
+    return r;
+}
+
 bool rt_sph_rect_init(rt_sph_rect *r, rt_vec3 corner, rt_vec3 ex, rt_vec3 ey, rt_vec3 o)
 {
     r->S = 0.0f;
     dvec ux = dv(ex), uy = dv(ey);
     double exl = dlen(ux), eyl = dlen(uy);
-    dvec x, y;
-    if (!dunit(ux, &x) || !dunit(uy, &y))
+    if (!(exl > 0.0 && eyl > 0.0))
         return false;
+    dvec x = dscale(ux, 1.0 / exl), y = dscale(uy, 1.0 / eyl);
     dvec z = dcross(x, y);
     dvec d = dsub(dv(corner), dv(o));
     double z0 = ddot(d, z);
@@ -81,19 +97,21 @@ bool rt_sph_rect_init(rt_sph_rect *r, rt_vec3 corner, rt_vec3 ex, rt_vec3 ey, rt
         z = dscale(z, -1.0);
         z0 = -z0;
     }
-    if (!(z0 < 0.0))
+    if (!(z0 < 0.0) || !isfinite(z0))
         return false; /* o in the plane */
     double x0 = ddot(d, x), y0 = ddot(d, y), x1 = x0 + exl, y1 = y0 + eyl;
-    dvec n[4];
-    dvec m0 = {0.0, z0, -y0}, m1 = {-z0, 0.0, x1}, m2 = {0.0, -z0, y1}, m3 = {z0, 0.0, -x0};
-    if (!dunit(m0, &n[0]) || !dunit(m1, &n[1]) || !dunit(m2, &n[2]) || !dunit(m3, &n[3]))
-        return false;
-    double g[4];
-    for (int i = 0; i < 4; i++)
-        g[i] = acos(dclamp(-ddot(n[i], n[(i + 1) & 3]), -1.0, 1.0));
-    r->k = 2.0 * PI_D - g[2] - g[3];
-    double S = g[0] + g[1] - r->k;
-    if (!(S > 0.0) || !isfinite(S))
+    double h = -z0, h2 = z0 * z0;
+    /* the angles at v10, v11, v01, v00 (the paper's g0 .. g3) */
+    cplx g0 = {x1 * y0, h * sqrt(x1 * x1 + y0 * y0 + h2)};
+    cplx g1 = {-x1 * y1, h * sqrt(x1 * x1 + y1 * y1 + h2)};
+    cplx g2 = {x0 * y1, h * sqrt(x0 * x0 + y1 * y1 + h2)};
+    cplx g3 = {-x0 * y0, h * sqrt(x0 * x0 + y0 * y0 + h2)};
+    cplx g23 = cmul(g2, g3), all = cmul(cmul(g0, g1), g23);
+    double S = atan2(all.im, all.re); /* g0 + g1 + g2 + g3 - 2 pi, in (0, 2 pi) */
+    if (S <= 0.0)
+        S += 2.0 * PI_D;
+    double l23 = sqrt(g23.re * g23.re + g23.im * g23.im);
+    if (!(S > 0.0) || !isfinite(S) || !(l23 > 0.0) || !isfinite(l23))
         return false;
     r->x = fv(x);
     r->y = fv(y);
@@ -103,40 +121,46 @@ bool rt_sph_rect_init(rt_sph_rect *r, rt_vec3 corner, rt_vec3 ex, rt_vec3 ey, rt
     r->z0 = z0;
     r->x1 = x1;
     r->y1 = y1;
-    r->b0 = n[0].z;
-    r->b1 = n[2].z;
+    r->b0 = -y0 / sqrt(h2 + y0 * y0); /* n0.z */
+    r->b1 = y1 / sqrt(h2 + y1 * y1);  /* n2.z */
+    r->cos_k = g23.re / l23;          /* k = 2 pi - arg(g2 g3) */
+    r->sin_k = -g23.im / l23;
     r->S = (float)S;
     return true;
 }
 
 rt_vec3 rt_sph_rect_sample(const rt_sph_rect *r, rt_vec2 u, float *dist)
 {
-    double S = r->S, z0 = r->z0, b0 = r->b0;
-    /* the x coordinate of the vertical line that sweeps solid angle u.x S */
-    double au = (double)u.x * S + r->k;
-    double fu = (cos(au) * b0 - r->b1) / sin(au);
+    double z0 = r->z0, b0 = r->b0;
+    /* the x coordinate of the vertical line that sweeps solid angle u.x S:
+     * au = u.x S + k, through the sum formulas */
+    double us = (double)u.x * (double)r->S, cs = cos(us), sn = sin(us);
+    double cos_au = r->cos_k * cs - r->sin_k * sn, sin_au = r->sin_k * cs + r->cos_k * sn;
+    double fu = (cos_au * b0 - r->b1) / sin_au;
     double cu = 1.0 / sqrt(fu * fu + b0 * b0);
     cu = dclamp(fu > 0.0 ? cu : -cu, -1.0, 1.0);
     double xu = -(cu * z0) / sqrt(fmax(1e-300, 1.0 - cu * cu));
     xu = isfinite(xu) ? dclamp(xu, r->x0, r->x1) : (cu > 0.0 ? r->x1 : r->x0);
     /* along it, uniform in h = y / |(xu, y, z0)| */
-    double dd = sqrt(xu * xu + z0 * z0);
-    double h0 = r->y0 / sqrt(dd * dd + r->y0 * r->y0), h1 = r->y1 / sqrt(dd * dd + r->y1 * r->y1);
+    double dd2 = xu * xu + z0 * z0, dd = sqrt(dd2);
+    double h0 = r->y0 / sqrt(dd2 + r->y0 * r->y0), h1 = r->y1 / sqrt(dd2 + r->y1 * r->y1);
     double hv = h0 + (double)u.y * (h1 - h0), hv2 = hv * hv;
     double yv = hv2 < 1.0 - 1e-12 ? hv * dd / sqrt(1.0 - hv2) : r->y1;
     yv = dclamp(yv, r->y0, r->y1);
     dvec w = dadd(dadd(dscale(dv(r->x), xu), dscale(dv(r->y), yv)), dscale(dv(r->z), z0));
-    double l = dlen(w);
+    double l = sqrt(dd2 + yv * yv);
     *dist = (float)l;
     return fv(dscale(w, 1.0 / l));
 }
 
 /* ------------------------------------------------------------ triangles */
 
-/* The angle between unit-length-free vectors a and b, in [0, pi]. */
-static double angle_between(dvec a, dvec b)
+/* The angle between vectors a and b as the complex number (cos, sin)
+ * times |a| |b|. */
+static inline cplx angle_between(dvec a, dvec b)
 {
-    return atan2(dlen(dcross(a, b)), ddot(a, b));
+    cplx r = {ddot(a, b), dlen(dcross(a, b))};
+    return r;
 }
 
 bool rt_sph_tri_init(rt_sph_tri *t, rt_vec3 a, rt_vec3 b, rt_vec3 c, rt_vec3 p)
@@ -146,23 +170,24 @@ bool rt_sph_tri_init(rt_sph_tri *t, rt_vec3 a, rt_vec3 b, rt_vec3 c, rt_vec3 p)
     if (!dunit(dsub(dv(a), dp), &A) || !dunit(dsub(dv(b), dp), &B) || !dunit(dsub(dv(c), dp), &C))
         return false;
     dvec nab = dcross(A, B), nbc = dcross(B, C), nca = dcross(C, A);
-    if (!(dlen(nab) > 0.0 && dlen(nbc) > 0.0 && dlen(nca) > 0.0))
-        return false;
-    /* interior angles: between the planes through each vertex's two edges */
-    double alpha = angle_between(nab, dscale(nca, -1.0));
-    double beta = angle_between(nbc, dscale(nab, -1.0));
-    double gamma = angle_between(nca, dscale(nbc, -1.0));
-    double area = alpha + beta + gamma - PI_D;
-    if (!(area > 0.0) || !isfinite(area))
+    /* interior angles: between the planes through each vertex's two edges;
+     * their sum minus pi is the argument of minus their product */
+    cplx za = angle_between(nab, dscale(nca, -1.0));
+    cplx zb = angle_between(nbc, dscale(nab, -1.0));
+    cplx zc = angle_between(nca, dscale(nbc, -1.0));
+    cplx prod = cmul(cmul(za, zb), zc);
+    double la = sqrt(za.re * za.re + za.im * za.im);
+    double area = atan2(-prod.im, -prod.re);
+    if (area <= 0.0)
+        area += 2.0 * PI_D;
+    if (!(la > 0.0) || !isfinite(la) || !(area > 0.0) || !isfinite(area) || !(prod.re != 0.0 || prod.im != 0.0))
         return false;
     t->a[0] = A.x, t->a[1] = A.y, t->a[2] = A.z;
     t->b[0] = B.x, t->b[1] = B.y, t->b[2] = B.z;
     t->c[0] = C.x, t->c[1] = C.y, t->c[2] = C.z;
-    t->alpha = alpha;
-    t->cos_alpha = cos(alpha);
-    t->sin_alpha = sin(alpha);
+    t->cos_alpha = za.re / la;
+    t->sin_alpha = za.im / la;
     t->cos_c = dclamp(ddot(A, B), -1.0, 1.0);
-    t->area = area;
     t->S = (float)area;
     return true;
 }
@@ -170,9 +195,10 @@ bool rt_sph_tri_init(rt_sph_tri *t, rt_vec3 a, rt_vec3 b, rt_vec3 c, rt_vec3 p)
 rt_vec3 rt_sph_tri_sample(const rt_sph_tri *t, rt_vec2 u)
 {
     dvec A = {t->a[0], t->a[1], t->a[2]}, B = {t->b[0], t->b[1], t->b[2]}, C = {t->c[0], t->c[1], t->c[2]};
-    /* C' on the arc AC such that A B C' has area u.x x area */
-    double ap = (double)u.x * t->area;
-    double s = sin(ap - t->alpha), c = cos(ap - t->alpha);
+    /* C' on the arc AC such that A B C' has area u.x x area; s, c: the
+     * sine and cosine of (u.x area - alpha) by the difference formulas */
+    double ap = (double)u.x * (double)t->S, sa = sin(ap), ca = cos(ap);
+    double s = sa * t->cos_alpha - ca * t->sin_alpha, c = ca * t->cos_alpha + sa * t->sin_alpha;
     double uu = c - t->cos_alpha, vv = s + t->sin_alpha * t->cos_c;
     double q = ((vv * c - uu * s) * t->cos_alpha - vv) / ((vv * s + uu * c) * t->sin_alpha);
     q = isfinite(q) ? dclamp(q, -1.0, 1.0) : 1.0;

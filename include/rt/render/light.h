@@ -13,9 +13,10 @@
  * glTF's smooth falloff, glTF's range window) and directional lights are
  * deltas; area lights (a one-sided parallelogram) that are rectangles are
  * sampled uniformly by the solid angle they subtend (pdf 1 / solid angle,
- * rt/render/spherical.h) when it lies between 3e-4 and 6.22 sr, otherwise
- * uniformly by area and converted to solid angle (pdf = d^2 / (A cos
- * theta_l)). The table's emissive triangles likewise (rt_light_table_tri_solid).
+ * rt/render/spherical.h) from points that see them large (estimated 0.1 sr
+ * or more; exactly between 3e-4 and 6.22 sr), otherwise uniformly by area
+ * and converted to solid angle (pdf = d^2 / (A cos theta_l)). The table's
+ * emissive triangles likewise (rt_tri_solid).
  *
  * The light table is per scene and read-only while rendering: built once
  * before the render threads start (the render state does it for
@@ -102,11 +103,14 @@ bool rt_light_table_sample_env(const rt_light_table *t, rt_vec2 u, rt_vec3 *d, f
  * unit direction d (0 without an environment image). */
 float rt_light_table_env_pdf(const rt_light_table *t, rt_vec3 d);
 
-/* Table emitter prim seen from p, set up in *st for solid-angle sampling:
- * true when it is a triangle whose solid angle from p is in the range
- * where that is used (its pdf is then prim_sel[prim] / st->S), false when
- * it is sampled uniformly by area (pdf prim_pdf[prim] d^2 / cos theta_l). */
-bool rt_light_table_tri_solid(const rt_scene *s, uint32_t prim, rt_vec3 p, rt_sph_tri *st);
+/* Triangle (a, b, c) of the table, of the given area (the table's
+ * prim_sel[prim] / prim_pdf[prim], so that the sampler and MIS decide
+ * alike), seen from p, set up in *st for solid-angle sampling: true when p
+ * sees it large (area / d^2 from its centroid at least 0.1) and its solid
+ * angle from p is in the range where that is used (its pdf is then
+ * prim_sel[prim] / st->S), false when it is sampled uniformly by area (pdf
+ * prim_pdf[prim] d^2 / cos theta_l). */
+bool rt_tri_solid(rt_vec3 a, rt_vec3 b, rt_vec3 c, float area, rt_vec3 p, rt_sph_tri *st);
 
 /* The area light whose visible quad primitive `prim` is, or RT_NONE; from
  * the table when given (NULL: a search of the lights). */

@@ -43,7 +43,7 @@ static inline bool rt_sph_in_range(float solid_angle)
 typedef struct rt_sph_rect {
     rt_vec3 x, y, z;
     double x0, y0, z0, x1, y1;
-    double b0, b1, k;
+    double b0, b1, cos_k, sin_k;
     float S; /* the solid angle, sr */
 } rt_sph_rect;
 
@@ -61,9 +61,8 @@ rt_vec3 rt_sph_rect_sample(const rt_sph_rect *r, rt_vec2 u, float *dist);
  * vertices and its angles. */
 typedef struct rt_sph_tri {
     double a[3], b[3], c[3];     /* unit directions to the vertices */
-    double alpha, cos_alpha, sin_alpha, cos_c; /* angle at a; cos of the side ab */
-    double area;                 /* alpha + beta + gamma - pi */
-    float S;                     /* the solid angle, sr (area in float) */
+    double cos_alpha, sin_alpha, cos_c; /* of the angle at a; cos of the side ab */
+    float S;                     /* the solid angle alpha + beta + gamma - pi, sr */
 } rt_sph_tri;
 
 /* Sets up triangle (a, b, c) seen from p. False when p lies in its plane
