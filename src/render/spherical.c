@@ -26,7 +26,7 @@
  *   C' = q A + sqrt(1 - q^2) unit(C - (C.A) A)
  *   z = 1 - u2 (1 - C'.B),  P = z B + sqrt(1 - z^2) unit(C' - (C'.B) B)
  * The interior angles come from the normals of the planes through p and
- * each edge, as in pbrt-v4 (Pharr, Jakob, Humphreys, 4th ed., 6.5.4). All in
+ * each edge, as in pbrt-v4 (Pharr, Jakob, Humphreys, 4th ed.). All in
  * double precision; the renderer falls back to area sampling outside
  * pbrt-v4's range of solid angles (rt_sph_in_range).
  */

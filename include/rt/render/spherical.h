@@ -4,14 +4,14 @@
  * (whose solid-angle pdf d^2 / (A cos theta_l) blows up close to it).
  *
  *   rt_sph_rect r;                       // rectangle corner + edges ex, ey (perpendicular)
- *   if (rt_sph_rect_init(&r, corner, ex, ey, p) && r.S > ...) {
+ *   if (rt_sph_rect_init(&r, corner, ex, ey, p) && rt_sph_in_range(r.S)) {
  *       float dist;
  *       rt_vec3 wi = rt_sph_rect_sample(&r, u, &dist);   // unit direction, distance to the rectangle
  *       ... pdf = 1 / r.S ...
  *   }
  *
  *   rt_sph_tri t;
- *   if (rt_sph_tri_init(&t, a, b, c, p)) {   // t.S = solid angle of triangle abc from p
+ *   if (rt_sph_tri_init(&t, a, b, c, p) && rt_sph_in_range(t.S)) {   // t.S: its solid angle from p
  *       rt_vec3 wi = rt_sph_tri_sample(&t, u);   // unit direction from p into the triangle
  *   }
  *
