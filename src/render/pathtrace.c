@@ -7,11 +7,15 @@
  *   - emission seen along the ray is added, beta Le, weighted by MIS
  *     against light sampling when the emitter could have been light-sampled
  *     from the previous vertex;
- *   - next-event estimation: every rt_light is sampled once (area lights
- *     uniformly by area, pdf d^2 / (A cos theta_l); point, spot and
- *     directional lights are deltas, weight 1), and, with a light table
- *     (rt/render/light.h), one emissive primitive chosen in proportion to
- *     its power (area x mean emitted radiance) and a uniform point on it,
+ *   - next-event estimation: every rt_light is sampled once (rectangular
+ *     area lights uniformly in solid angle, pdf 1 / solid angle, others
+ *     uniformly by area, pdf d^2 / (A cos theta_l), rt/render/light.h;
+ *     point, spot and directional lights are deltas, weight 1), and, with
+ *     a light table (rt/render/light.h), one emissive primitive chosen in
+ *     proportion to its power (area x mean emitted radiance) and a
+ *     direction uniform in its solid angle (triangles, Arvo 1995) or a
+ *     uniform point on it (quads, spheres, triangles too small or too
+ *     large in solid angle),
  *     and one direction of the environment image drawn in proportion to
  *     luminance x sin(theta) (piecewise constant over its
  *     latitude-longitude cells, pbrt-v3 14.2.4);
@@ -159,7 +163,7 @@ bool rt_path_nee_light(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surf
         return false;
     float w = 1.0f;
     if (l->kind == RT_LIGHT_AREA && l->quad != RT_NONE)
-        w = rt_mis_power(rt_area_light_pdf(l, ls.wi, ls.dist), pdf_b);
+        w = rt_mis_power(ls.pdf, pdf_b);
     if (!(w > 0.0f))
         return false;
     rec->fl = rt_mul(f, ls.li);
@@ -185,6 +189,27 @@ bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *
     return false;
 }
 
+/* Barycentric weights (of vertices 1 and 2) of where the ray from p along
+ * w meets the plane of triangle (a, b, c), clamped onto the triangle; false
+ * when w runs parallel to it. */
+static bool tri_barycentric(rt_vec3 a, rt_vec3 b, rt_vec3 c, rt_vec3 p, rt_vec3 w, float *u, float *v)
+{
+    rt_vec3 e1 = rt_sub(b, a), e2 = rt_sub(c, a), pv = rt_cross(w, e2);
+    float det = rt_dot(e1, pv);
+    if (!(fabsf(det) > 0.0f))
+        return false;
+    rt_vec3 tv = rt_sub(p, a), qv = rt_cross(tv, e1);
+    float bu = rt_clampf(rt_dot(tv, pv) / det, 0.0f, 1.0f), bv = rt_clampf(rt_dot(w, qv) / det, 0.0f, 1.0f);
+    if (bu + bv > 1.0f) {
+        float k = 1.0f / (bu + bv);
+        bu *= k;
+        bv *= k;
+    }
+    *u = bu;
+    *v = bv;
+    return isfinite(bu) && isfinite(bv);
+}
+
 bool rt_path_nee_emitter(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                          rt_vec3 wo, rt_rng *rng, rt_nee_record *rec)
 {
@@ -199,12 +224,20 @@ bool rt_path_nee_emitter(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_su
     rt_hit h;
     h.prim = prim;
     rt_vec3 q;
+    float solid = 0.0f; /* the solid angle when sampled by it, else 0 (by area) */
     switch (rt_prim_kind_of(s, prim, &local)) {
     case RT_PRIM_TRIANGLE: {
-        float su = sqrtf(u.x);
-        h.u = u.y * su;        /* weight of vertex 1 */
-        h.v = 1.0f - su;       /* weight of vertex 2 */
         rt_vec3 a = rt_tri_vertex(s, local, 0), bb = rt_tri_vertex(s, local, 1), c = rt_tri_vertex(s, local, 2);
+        rt_sph_tri st;
+        if (rt_tri_solid(a, bb, c, t->prim_sel[prim] / t->prim_pdf[prim], sf->p, &st)) {
+            solid = st.S;
+            if (!tri_barycentric(a, bb, c, sf->p, rt_sph_tri_sample(&st, u), &h.u, &h.v))
+                return false;
+        } else {
+            float su = sqrtf(u.x);
+            h.u = u.y * su;        /* weight of vertex 1 */
+            h.v = 1.0f - su;       /* weight of vertex 2 */
+        }
         q = rt_add(rt_add(rt_scale(a, 1.0f - h.u - h.v), rt_scale(bb, h.u)), rt_scale(c, h.v));
         break;
     }
@@ -241,7 +274,7 @@ bool rt_path_nee_emitter(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_su
     rt_surface_at_shading(ctx, &r, &h, &se);
     float cos_l = fabsf(rt_dot(se.ng, wdir));
     rt_vec3 Le = rt_surface_emission(ctx, &se);
-    float pdf_l = t->prim_pdf[prim] * d2 / cos_l;
+    float pdf_l = solid > 0.0f ? t->prim_sel[prim] / solid : t->prim_pdf[prim] * d2 / cos_l;
     if (rt_max3(Le) > 0.0f && cos_l > 0.0f && pdf_l > 0.0f && isfinite(pdf_l) && rt_dot(wdir, b->ng) > 0.0f)
         return light_table_record(ctx, b, wo, wdir, &Le, pdf_l, dist, rec);
     return false;
@@ -311,12 +344,21 @@ rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, 
         if (!ps->prev_delta) {
             float d2 = rt_length2(rt_sub(sf->p, ps->prev_p));
             float pdf_l = 0.0f;
+            const rt_light_table *t = ctx->state->light_table;
             if (light != RT_NONE) {
-                pdf_l = rt_area_light_pdf(&s->lights[light], ps->r.dir, sqrtf(d2));
-            } else if (ctx->state->light_table && sf->prim < ctx->state->light_table->prim_count) {
+                pdf_l = rt_area_light_pdf(&s->lights[light], ps->prev_p, ps->r.dir, sqrtf(d2));
+            } else if (t && sf->prim < t->prim_count && t->prim_pdf[sf->prim] > 0.0f) {
+                /* the density rt_path_nee_emitter drew from at prev_p */
+                rt_sph_tri st;
                 float cos_l = fabsf(rt_dot(sf->ng, ps->r.dir));
-                float pa = ctx->state->light_table->prim_pdf[sf->prim];
-                pdf_l = (pa > 0.0f && cos_l > 0.0f) ? pa * d2 / cos_l : 0.0f;
+                float pa = t->prim_pdf[sf->prim];
+                uint32_t ti;
+                if (rt_prim_kind_of(s, sf->prim, &ti) == RT_PRIM_TRIANGLE &&
+                    rt_tri_solid(rt_tri_vertex(s, ti, 0), rt_tri_vertex(s, ti, 1), rt_tri_vertex(s, ti, 2),
+                                 t->prim_sel[sf->prim] / pa, ps->prev_p, &st))
+                    pdf_l = t->prim_sel[sf->prim] / st.S;
+                else
+                    pdf_l = cos_l > 0.0f ? pa * d2 / cos_l : 0.0f;
             }
             if (pdf_l > 0.0f && isfinite(pdf_l))
                 w = rt_mis_power(ps->prev_pdf, pdf_l);

@@ -11,8 +11,12 @@
  *
  * Light kinds: point and spot lights (intensity / d^2, spot cones with
  * glTF's smooth falloff, glTF's range window) and directional lights are
- * deltas; area lights (a one-sided parallelogram) are sampled uniformly by
- * area and converted to solid angle (pdf = d^2 / (A cos theta_l)).
+ * deltas; area lights (a one-sided parallelogram) that are rectangles are
+ * sampled uniformly by the solid angle they subtend (pdf 1 / solid angle,
+ * rt/render/spherical.h) from points that see them large (estimated 0.1 sr
+ * or more; exactly between 3e-4 and 6.22 sr), otherwise uniformly by area
+ * and converted to solid angle (pdf = d^2 / (A cos theta_l)). The table's
+ * emissive triangles likewise (rt_tri_solid).
  *
  * The light table is per scene and read-only while rendering: built once
  * before the render threads start (the render state does it for
@@ -27,12 +31,14 @@
 #define RT_LIGHT_H
 
 #include "rt/base/error.h"
+#include "rt/render/spherical.h"
 #include "rt/render/surface.h"
 
 typedef struct rt_light_sample {
     rt_vec3 wi;       /* unit direction from the point to the light */
     float dist;       /* distance to the sampled light point, INFINITY for directional */
     rt_vec3 li;       /* incident radiance divided by the sampling pdf (solid angle) */
+    float pdf;        /* that pdf for area lights (rt_area_light_pdf's value); unset for deltas */
 } rt_light_sample;
 
 /* Samples light l as seen from point p with a 2D sample u. False when the
@@ -40,10 +46,11 @@ typedef struct rt_light_sample {
  * spot cone). */
 bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, rt_vec2 u, rt_light_sample *ls);
 
-/* Solid-angle pdf with which rt_light_sample_at samples area light l
- * towards unit direction d from a point at distance dist; 0 when seen
- * from behind. */
-float rt_area_light_pdf(const rt_light *l, rt_vec3 d, float dist);
+/* Solid-angle pdf with which rt_light_sample_at samples area light l from
+ * point p towards unit direction d (the light at distance dist); 0 when
+ * seen from behind. The same bits as rt_light_sample.pdf of a sample from
+ * p in direction d. */
+float rt_area_light_pdf(const rt_light *l, rt_vec3 p, rt_vec3 d, float dist);
 
 /* Fraction of light arriving along wi from distance dist: 0 when blocked,
  * 1 when clear, and in between through transmissive or alpha-blended
@@ -69,6 +76,7 @@ typedef struct rt_light_table {
     float *area;          /* their areas */
     size_t prim_count;    /* primitive ids covered by prim_pdf */
     float *prim_pdf;      /* per primitive id: selection probability / area (0 = not in the table) */
+    float *prim_sel;      /* per primitive id: selection probability (0 = not in the table) */
     size_t quad_count;
     uint32_t *quad_light; /* per quad: index of the area light it is the visible quad of, or RT_NONE */
     /* environment image, importance-sampled by luminance x sin(theta) over
@@ -94,6 +102,15 @@ bool rt_light_table_sample_env(const rt_light_table *t, rt_vec2 u, rt_vec3 *d, f
 /* Solid-angle pdf with which the table samples the environment towards
  * unit direction d (0 without an environment image). */
 float rt_light_table_env_pdf(const rt_light_table *t, rt_vec3 d);
+
+/* Triangle (a, b, c) of the table, of the given area (the table's
+ * prim_sel[prim] / prim_pdf[prim], so that the sampler and MIS decide
+ * alike), seen from p, set up in *st for solid-angle sampling: true when p
+ * sees it large (area / d^2 from its centroid at least 0.1) and its solid
+ * angle from p is in the range where that is used (its pdf is then
+ * prim_sel[prim] / st->S), false when it is sampled uniformly by area (pdf
+ * prim_pdf[prim] d^2 / cos theta_l). */
+bool rt_tri_solid(rt_vec3 a, rt_vec3 b, rt_vec3 c, float area, rt_vec3 p, rt_sph_tri *st);
 
 /* The area light whose visible quad primitive `prim` is, or RT_NONE; from
  * the table when given (NULL: a search of the lights). */
