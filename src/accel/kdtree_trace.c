@@ -41,8 +41,8 @@
  * with KD_PORTABLE, where the same step runs as plain loops (_portable);
  * the tree says which one its rays take.
  *
- * Leaves with 3 or more triangles are tested 8 at a time with AVX2 (when
- * compiled for it): the same IEEE operations per lane as the scalar
+ * A leaf's triangles are tested 8 at a time with AVX2 (when compiled for
+ * it): the same IEEE operations per lane as the scalar
  * watertight test of intersect.h (Woop, Benthin and Wald 2013; its shear
  * is made once per ray, in kd_ray), so the same bits (tests check it). Its
  * three edge functions need no divide, so a group whose lanes all have
@@ -52,10 +52,15 @@
  * the scalar reference (which recomputes it in double), so the rare case
  * costs no code in the vector path. The vertex columns are taken in the
  * ray's axis order by one branch on a per-ray constant (three inlined
- * copies of the test). The eight triangles are loaded with one unaligned
- * 8-float load each and an 8x8 transpose, plus one gather for the ninth
- * float: nine gathers were the hottest instructions in the profile
- * (+10-30% rays/s without them).
+ * copies of the test). A leaf list's triangles are loaded with one
+ * unaligned 8-float load each and an 8x8 transpose, plus one gather for the
+ * ninth float: nine gathers were the hottest instructions in the profile
+ * (+10-30% rays/s without them); the list itself is read 8 ids at a time,
+ * its end and its last triangle found from the loaded ids (no length loop).
+ * A tree whose leaves hold their triangles (rt_kdtree.soa: small scenes)
+ * has them in groups of 8 already in columns: nine loads, no ids, no
+ * transpose (Cornell box: -3% of the instructions of a ray with the same
+ * tree, docs/performance.md).
  *
  * Everything the two entry points use is in this file and inlined into
  * them (always_inline, flatten), intersect.h's tests included: keep new
@@ -64,8 +69,7 @@
  * Measured and not kept (docs/performance.md has the numbers): a start
  * shortcut that walks down from the root plane by plane in scalar code
  * while only one cell can be entered (exact, but as costly per node as the
- * 8-lane step, +8% instructions); the 8-wide
- * test from 2 or 5 triangles instead of 3; prefetching the cell on top of
+ * 8-lane step, +8% instructions); prefetching the cell on top of
  * the stack (-12% on DamagedHelmet diffuse); the leaf test out of line.
  */
 #include "kdtree_internal.h"
@@ -248,7 +252,6 @@ KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, 
 }
 
 #ifdef KD_SIMD
-#define KD_SIMD_MIN 3 /* leaves with at least this many triangles go 8 at a time */
 
 /* The watertight test of intersect.h on 8 triangles whose vertex
  * coordinates come permuted to the ray's (kx, ky, kz) (see tri8): the very
@@ -306,39 +309,18 @@ KD_INLINE int tri8_core(__m256 ax, __m256 ay, __m256 az, __m256 bx, __m256 by, _
     return !_mm256_testz_ps(m, m);
 }
 
-/* Up to 8 triangles (ids, all triangles) at once with the watertight test
- * (tri8_core), bit for bit the reference's; the closest valid lane wins,
- * on a tie the first, like the scalar loop. */
-KD_INLINE bool tri8(const rt_kdtree *tree, const uint32_t *ids, uint32_t n, const rt_ray *ray, const rt_tri_ray *tr,
-                    float *best, rt_hit *hit)
+/* The test of tri8 and tri8_group on the triangles' 9 vertex columns:
+ * lanes of live (the first n) take part; the closest valid lane wins, on
+ * a tie the first, like the scalar loop. A triangle's tree id is ids[k]
+ * (a list's; the reference then tests it from its record) or, with ids
+ * NULL, gid + k (an SoA group's lane k: the reference tests the lane's
+ * vertices). */
+KD_INLINE bool tri8_cols(const rt_kdtree *tree, __m256 v0x, __m256 v0y, __m256 v0z, __m256 v1x, __m256 v1y,
+                         __m256 v1z, __m256 v2x, __m256 v2y, __m256 v2z, __m256i live, uint32_t n,
+                         const uint32_t *ids, uint32_t gid, const rt_ray *ray, const rt_tri_ray *tr, float *best,
+                         rt_hit *hit)
 {
     RT_NO_FP_CONTRACT
-    const float *tri = tree->tri;
-    __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)n), lane);
-    __m256i id = _mm256_maskload_epi32((const int *)ids, live);
-    id = _mm256_and_si256(_mm256_blendv_epi8(_mm256_set1_epi32((int)ids[0]), id, live),
-                          _mm256_set1_epi32((int)RT_KD_PAYLOAD)); /* the last id carries RT_KD_LAST */
-    __m256i base = id; /* ids are the records' offsets */
-    /* floats 0-7 of each triangle: one unaligned load per lane and an 8x8
-     * transpose (cheaper than eight gathers); float 8 by one gather */
-    uint32_t off[8];
-    _mm256_storeu_si256((__m256i *)off, base);
-    __m256 r0 = _mm256_loadu_ps(tri + off[0]), r1 = _mm256_loadu_ps(tri + off[1]), r2 = _mm256_loadu_ps(tri + off[2]),
-           r3 = _mm256_loadu_ps(tri + off[3]), r4 = _mm256_loadu_ps(tri + off[4]), r5 = _mm256_loadu_ps(tri + off[5]),
-           r6 = _mm256_loadu_ps(tri + off[6]), r7 = _mm256_loadu_ps(tri + off[7]);
-    __m256 v2z = _mm256_i32gather_ps(tri + 8, base, 4);
-    __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1), t2 = _mm256_unpacklo_ps(r2, r3),
-           t3 = _mm256_unpackhi_ps(r2, r3), t4 = _mm256_unpacklo_ps(r4, r5), t5 = _mm256_unpackhi_ps(r4, r5),
-           t6 = _mm256_unpacklo_ps(r6, r7), t7 = _mm256_unpackhi_ps(r6, r7);
-    __m256 s0 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)), s1 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)),
-           s2 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)), s3 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2)),
-           s4 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(1, 0, 1, 0)), s5 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(3, 2, 3, 2)),
-           s6 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(1, 0, 1, 0)), s7 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(3, 2, 3, 2));
-    __m256 v0x = _mm256_permute2f128_ps(s0, s4, 0x20), v0y = _mm256_permute2f128_ps(s1, s5, 0x20),
-           v0z = _mm256_permute2f128_ps(s2, s6, 0x20), v1x = _mm256_permute2f128_ps(s3, s7, 0x20),
-           v1y = _mm256_permute2f128_ps(s0, s4, 0x31), v1z = _mm256_permute2f128_ps(s1, s5, 0x31),
-           v2x = _mm256_permute2f128_ps(s2, s6, 0x31), v2y = _mm256_permute2f128_ps(s3, s7, 0x31);
     __m256 ok = _mm256_castsi256_ps(live), t, u, v, adet;
     int res;
     /* the columns in the ray's axis order: three inlined copies, one
@@ -353,8 +335,24 @@ KD_INLINE bool tri8(const rt_kdtree *tree, const uint32_t *ids, uint32_t n, cons
         if (res == 0)
             return false;
         bool found = false; /* an edge function rounded to zero: the reference decides, in order */
-        for (uint32_t i = 0; i < n; i++)
-            found |= test_prim(tree, ids[i] & RT_KD_PAYLOAD, ray, tr, best, hit);
+        if (ids) {
+            for (uint32_t i = 0; i < n; i++)
+                found |= test_prim(tree, ids[i] & RT_KD_PAYLOAD, ray, tr, best, hit);
+            return found;
+        }
+        float c[9][8];
+        _mm256_storeu_ps(c[0], v0x), _mm256_storeu_ps(c[1], v0y), _mm256_storeu_ps(c[2], v0z);
+        _mm256_storeu_ps(c[3], v1x), _mm256_storeu_ps(c[4], v1y), _mm256_storeu_ps(c[5], v1z);
+        _mm256_storeu_ps(c[6], v2x), _mm256_storeu_ps(c[7], v2y), _mm256_storeu_ps(c[8], v2z);
+        for (uint32_t i = 0; i < n; i++) {
+            float tt, uu, vv;
+            if (rt_intersect_triangle_ray(tr, rt_v3(c[0][i], c[1][i], c[2][i]), rt_v3(c[3][i], c[4][i], c[5][i]),
+                                          rt_v3(c[6][i], c[7][i], c[8][i]), ray->tmin, *best, &tt, &uu, &vv)) {
+                *best = tt;
+                hit->t = tt, hit->u = uu, hit->v = vv, hit->prim = gid + i;
+                found = true;
+            }
+        }
         return found;
     }
     /* intersect.h's guard against determinants that are rounding noise */
@@ -382,59 +380,163 @@ KD_INLINE bool tri8(const rt_kdtree *tree, const uint32_t *ids, uint32_t n, cons
     hit->t = tl[k];
     hit->u = ul[k];
     hit->v = vl[k];
-    hit->prim = ids[k] & RT_KD_PAYLOAD;
+    hit->prim = ids ? ids[k] & RT_KD_PAYLOAD : gid + (uint32_t)k;
     return true;
+}
+
+/* The first n (1-8) triangles of a group of 8 ids at once with the
+ * watertight test (tri8_core), bit for bit the reference's; the closest
+ * valid lane wins, on a tie the first, like the scalar loop. id: the 8 ids
+ * without their flags (test_leaf loaded them). */
+KD_INLINE bool tri8(const rt_kdtree *tree, const uint32_t *ids, __m256i id, uint32_t n, const rt_ray *ray,
+                    const rt_tri_ray *tr, float *best, rt_hit *hit)
+{
+    RT_NO_FP_CONTRACT
+    const float *tri = tree->tri;
+    __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)n), lane);
+    /* idle lanes repeat the first triangle (a record that exists) */
+    __m256i base = _mm256_blendv_epi8(_mm256_permutevar8x32_epi32(id, _mm256_setzero_si256()), id, live);
+    /* floats 0-7 of each triangle: one unaligned load per lane and an 8x8
+     * transpose (cheaper than eight gathers); float 8 by one gather */
+    uint32_t off[8];
+    _mm256_storeu_si256((__m256i *)off, base);
+    __m256 r0 = _mm256_loadu_ps(tri + off[0]), r1 = _mm256_loadu_ps(tri + off[1]), r2 = _mm256_loadu_ps(tri + off[2]),
+           r3 = _mm256_loadu_ps(tri + off[3]), r4 = _mm256_loadu_ps(tri + off[4]), r5 = _mm256_loadu_ps(tri + off[5]),
+           r6 = _mm256_loadu_ps(tri + off[6]), r7 = _mm256_loadu_ps(tri + off[7]);
+    __m256 v2z = _mm256_i32gather_ps(tri + 8, base, 4);
+    __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1), t2 = _mm256_unpacklo_ps(r2, r3),
+           t3 = _mm256_unpackhi_ps(r2, r3), t4 = _mm256_unpacklo_ps(r4, r5), t5 = _mm256_unpackhi_ps(r4, r5),
+           t6 = _mm256_unpacklo_ps(r6, r7), t7 = _mm256_unpackhi_ps(r6, r7);
+    __m256 s0 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)), s1 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)),
+           s2 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)), s3 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2)),
+           s4 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(1, 0, 1, 0)), s5 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(3, 2, 3, 2)),
+           s6 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(1, 0, 1, 0)), s7 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(3, 2, 3, 2));
+    __m256 v0x = _mm256_permute2f128_ps(s0, s4, 0x20), v0y = _mm256_permute2f128_ps(s1, s5, 0x20),
+           v0z = _mm256_permute2f128_ps(s2, s6, 0x20), v1x = _mm256_permute2f128_ps(s3, s7, 0x20),
+           v1y = _mm256_permute2f128_ps(s0, s4, 0x31), v1z = _mm256_permute2f128_ps(s1, s5, 0x31),
+           v2x = _mm256_permute2f128_ps(s2, s6, 0x31), v2y = _mm256_permute2f128_ps(s3, s7, 0x31);
+    return tri8_cols(tree, v0x, v0y, v0z, v1x, v1y, v1z, v2x, v2y, v2z, live, n, ids, 0, ray, tr, best, hit);
+}
+
+/* The first n (1-8) triangles of an SoA group g (rt_kdtree.soa: rows of
+ * v0.x ... v2.z, 8 lanes each) at once: no ids to load, no transpose. */
+KD_INLINE bool tri8_group(const rt_kdtree *tree, const float *g, uint32_t n, const rt_ray *ray, const rt_tri_ray *tr,
+                          float *best, rt_hit *hit)
+{
+    __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)n), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    return tri8_cols(tree, _mm256_loadu_ps(g), _mm256_loadu_ps(g + 8), _mm256_loadu_ps(g + 16),
+                     _mm256_loadu_ps(g + 24), _mm256_loadu_ps(g + 32), _mm256_loadu_ps(g + 40),
+                     _mm256_loadu_ps(g + 48), _mm256_loadu_ps(g + 56), _mm256_loadu_ps(g + 64), live, n, NULL,
+                     (uint32_t)(g - tree->tri) + 63u, ray, tr, best, hit);
 }
 #endif
 
-/* The length of a leaf list: up to its id with RT_KD_LAST (the lists are
- * followed by KD_IDS_PAD such ids, so 8 can always be loaded). */
+#ifndef KD_SIMD
+/* The length of a leaf list: up to its id with RT_KD_LAST. */
 KD_INLINE uint32_t leaf_length(const uint32_t *p)
 {
     uint32_t n = 0;
-#ifdef KD_SIMD
-    for (;; n += 8) {
-        unsigned m = (unsigned)_mm256_movemask_ps(_mm256_loadu_ps((const float *)(const void *)(p + n)));
-        if (m)
-            return n + (uint32_t)__builtin_ctz(m) + 1;
-    }
-#else
     while (!(p[n] & RT_KD_LAST))
         n++;
     return n + 1;
-#endif
 }
+#endif
 
-/* All primitives of a multi-primitive leaf (ids ascending: triangles first). */
-KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, const rt_ray *ray, const rt_tri_ray *tr,
-                         float *best, rt_hit *hit, bool any)
+/* All primitives of a leaf block b of a tree with soa set (kdtree.h): its
+ * triangles group by group, 8 at a time (AVX2) or one by one in lane
+ * order (portable: the same order, hence the same hit), then its spheres
+ * and quads. */
+KD_INLINE bool test_block(const rt_kdtree *tree, const uint32_t *b, const rt_ray *ray, const rt_tri_ray *tr,
+                          float *best, rt_hit *hit, bool any)
 {
     bool found = false;
-    uint32_t i = 0;
+    uint32_t nt = b[0] & ~RT_KD_LAST;
+    const float *g = (const float *)(const void *)(b + 1);
+    for (uint32_t i = 0; i < nt; i += 8, g += RT_KD_GROUP) {
+        uint32_t n = nt - i < 8 ? nt - i : 8;
 #ifdef KD_SIMD
-    if (n >= KD_SIMD_MIN) {
-        /* the triangles: ids below other_base, which come first (one
-         * test for a leaf of triangles only, instead of one a group) */
-        uint32_t T = tree->other_base, nt = n;
-        while (nt > 0 && (p[nt - 1] & RT_KD_PAYLOAD) >= T)
-            nt--;
-        for (; i < nt; i += 8) {
-            if (tri8(tree, p + i, nt - i < 8 ? nt - i : 8, ray, tr, best, hit)) {
+        if (tri8_group(tree, g, n, ray, tr, best, hit)) {
+            found = true;
+            if (any)
+                return true;
+        }
+#else
+        for (uint32_t k = 0; k < n; k++) {
+            float t, u, v;
+            if (rt_intersect_triangle_ray(tr, rt_v3(g[k], g[8 + k], g[16 + k]), rt_v3(g[24 + k], g[32 + k], g[40 + k]),
+                                          rt_v3(g[48 + k], g[56 + k], g[64 + k]), ray->tmin, *best, &t, &u, &v)) {
+                *best = t;
+                hit->t = t, hit->u = u, hit->v = v, hit->prim = (uint32_t)(g - tree->tri) + 63u + k;
                 found = true;
                 if (any)
                     return true;
             }
         }
-        i = nt; /* then the spheres and quads, one by one */
-    }
 #endif
-    for (; i < n; i++)
+    }
+    if (b[0] & RT_KD_LAST)
+        for (const uint32_t *q = (const uint32_t *)(const void *)g;; q++) {
+            if (test_prim(tree, *q & RT_KD_PAYLOAD, ray, tr, best, hit)) {
+                found = true;
+                if (any)
+                    return true;
+            }
+            if (*q & RT_KD_LAST)
+                break;
+        }
+    return found;
+}
+
+/* All primitives of a multi-primitive leaf list p (ids ascending:
+ * triangles first, then spheres and quads; the last id flagged
+ * RT_KD_LAST). The AVX2 pass reads the list 8 ids at a time (the blocks
+ * are followed by KD_IDS_PAD flagged ids, so 8 can always be loaded): the
+ * flag's lane ends the list and the ids below other_base are the group's
+ * triangles, tested together by tri8, so finding the list's length and
+ * its last triangle costs no loop; the spheres and quads after them go one
+ * by one. The same primitives in the same order as one by one. */
+KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, const rt_ray *ray, const rt_tri_ray *tr,
+                         float *best, rt_hit *hit, bool any)
+{
+    if (tree->soa)
+        return test_block(tree, p, ray, tr, best, hit, any);
+    bool found = false;
+#ifdef KD_SIMD
+    const __m256i payload = _mm256_set1_epi32((int)RT_KD_PAYLOAD);
+    const __m256i other = _mm256_set1_epi32((int)tree->other_base - 1); /* ids < 2^30: signed compares */
+    for (;; p += 8) {
+        __m256i raw = _mm256_loadu_si256((const __m256i *)(const void *)p);
+        unsigned end = (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(raw));
+        unsigned n = end ? (unsigned)__builtin_ctz(end) + 1u : 8u; /* ids of this group */
+        __m256i id = _mm256_and_si256(raw, payload);
+        unsigned rest = (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(id, other))) &
+                        ((2u << (n - 1u)) - 1u); /* spheres and quads: the last lanes */
+        unsigned nt = rest ? (unsigned)__builtin_ctz(rest) : n;
+        if (nt > 0 && tri8(tree, p, id, nt, ray, tr, best, hit)) {
+            found = true;
+            if (any)
+                return true;
+        }
+        for (unsigned i = nt; i < n; i++)
+            if (test_prim(tree, p[i] & RT_KD_PAYLOAD, ray, tr, best, hit)) {
+                found = true;
+                if (any)
+                    return true;
+            }
+        if (end)
+            return found;
+    }
+#else
+    uint32_t n = leaf_length(p);
+    for (uint32_t i = 0; i < n; i++)
         if (test_prim(tree, p[i] & RT_KD_PAYLOAD, ray, tr, best, hit)) {
             found = true;
             if (any)
                 return true;
         }
     return found;
+#endif
 }
 
 /* ------------------------------------------------------ the wide step */
@@ -776,7 +878,7 @@ KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hi
             }
         } else {
             const uint32_t *p = ids + (ref & RT_KD_PAYLOAD);
-            if (test_leaf(tree, p, leaf_length(p), ray, &r->tr, &best, hit, any)) {
+            if (test_leaf(tree, p, ray, &r->tr, &best, hit, any)) {
                 found = true;
                 if (any)
                     return true;
@@ -834,7 +936,7 @@ KD_FLATTEN bool rt_kd_leaf_hit_avx2(const rt_kdtree *tree, uint32_t ref, const r
     if (ref >= RT_KD_ONE)
         return test_prim(tree, ref & RT_KD_PAYLOAD, ray, tr, best, hit);
     const uint32_t *p = tree->prim_ids + (ref & RT_KD_PAYLOAD);
-    return test_leaf(tree, p, leaf_length(p), ray, tr, best, hit, any);
+    return test_leaf(tree, p, ray, tr, best, hit, any);
 }
 
 KD_FLATTEN bool rt_kd_prim_hit_avx2(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr,
