@@ -29,10 +29,6 @@
 #define TEST_PORTABLE 0
 #endif
 
-/* The leaf layout every tree here is built with (rt_kdtree_params.leaves):
- * main runs the tests once for each. */
-static int test_leaves = RT_KD_LEAVES_AUTO;
-
 static uint32_t add_tri(rt_scene *s, rt_vec3 a, rt_vec3 b, rt_vec3 c)
 {
     uint32_t v = rt_scene_add_vertices(s, 3);
@@ -211,37 +207,6 @@ static void walk_ref(walk_state *w, uint32_t ref)
     if (ref >= RT_KD_ONE) {
         c = 1;
         ids = &one;
-        assert_true(!tree->soa || one >= tree->other_base); /* a lone triangle is a block */
-    } else if (tree->soa) {
-        /* a block: header, groups of 8 triangles as rows, then the others */
-        assert_true(one < tree->prim_id_count);
-        uint32_t nt = tree->prim_ids[one] & ~RT_KD_LAST;
-        size_t groups = (nt + 7) / 8, at = one + 1 + RT_KD_GROUP * groups;
-        c = nt;
-        if (tree->prim_ids[one] & RT_KD_LAST) {
-            do {
-                assert_true(at + c - nt < tree->prim_id_count);
-            } while (!(tree->prim_ids[at + c++ - nt] & RT_KD_LAST));
-        }
-        assert_true(c >= 1 && at + c - nt <= tree->prim_id_count);
-        w->leaf_ids = realloc(w->leaf_ids, c * sizeof *w->leaf_ids);
-        assert_non_null(w->leaf_ids);
-        for (uint32_t j = 0; j < nt; j++) {
-            uint32_t g = one + 1 + RT_KD_GROUP * (j / 8), k = j % 8;
-            w->leaf_ids[j] = g + 63 + k;
-            /* the lane's vertices are its scene triangle's */
-            uint32_t t = tree->prim_ids[g + 72 + k];
-            assert_true(t < w->s->triangles.count);
-            for (int v = 0; v < 3; v++) {
-                rt_vec3 pv = w->s->vertices.position[w->s->triangles.index[3 * t + (size_t)v]];
-                assert_true(tree->tri[g + 8 * (3 * v) + k] == pv.x);
-                assert_true(tree->tri[g + 8 * (3 * v + 1) + k] == pv.y);
-                assert_true(tree->tri[g + 8 * (3 * v + 2) + k] == pv.z);
-            }
-        }
-        for (size_t j = nt; j < c; j++)
-            w->leaf_ids[j] = tree->prim_ids[at + j - nt] & RT_KD_PAYLOAD;
-        ids = w->leaf_ids;
     } else {
         assert_true(one < tree->prim_id_count);
         c = 1;
@@ -263,7 +228,7 @@ static void walk_ref(walk_state *w, uint32_t ref)
             assert_true(ids[j - 1] < ids[j]);
         /* a triangle is its record's offset in the leaf blocks, the record
          * carries the scene's id; spheres and quads come above other_base */
-        if (ids[j] < tree->other_base && !tree->soa) {
+        if (ids[j] < tree->other_base) {
             assert_true(ids[j] + RT_KD_TRI <= tree->prim_id_count);
             if (ref < RT_KD_ONE) /* not inside the leaf's own id list */
                 assert_true(ids[j] >= one + c || ids[j] + RT_KD_TRI <= one);
@@ -368,10 +333,7 @@ static void build_ok(rt_kdtree *tree, const rt_scene *s)
     rt_error err = {0};
     rt_kdtree_params p = {0};
     p.portable = TEST_PORTABLE;
-    p.leaves = test_leaves;
     rt_result res = rt_kdtree_build(tree, s, &p, &err);
-    if (test_leaves != RT_KD_LEAVES_AUTO)
-        assert_int_equal(tree->soa, test_leaves == RT_KD_LEAVES_SOA);
 #ifdef RT_KD_SCALAR
     assert_int_equal(tree->isa, RT_KD_ISA_PORTABLE);
 #elif defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
@@ -466,14 +428,13 @@ static void test_params(void **state)
     test_rng r = {77};
     random_soup(&s, &r, 1000, 0.05f);
     rt_kdtree_params p[3] = {
-        {1.0f, 80.0f, 0.5f, 0, 0, TEST_PORTABLE, 0}, /* pbrt's costs: deep trees */
-        {1.0f, 1.0f, 0.0f, 0, 0, TEST_PORTABLE, 0},
-        {10.0f, 1.0f, 0.0f, 3, 0, TEST_PORTABLE, 0}, /* shallow */
+        {1.0f, 80.0f, 0.5f, 0, 0, TEST_PORTABLE}, /* pbrt's costs: deep trees */
+        {1.0f, 1.0f, 0.0f, 0, 0, TEST_PORTABLE},
+        {10.0f, 1.0f, 0.0f, 3, 0, TEST_PORTABLE}, /* shallow */
     };
     for (int i = 0; i < 3; i++) {
         rt_kdtree tree;
         rt_error err = {0};
-        p[i].leaves = test_leaves;
         assert_int_equal(rt_kdtree_build(&tree, &s, &p[i], &err), RT_OK);
         check_tree(&s, &tree);
         if (i == 2)
@@ -501,8 +462,7 @@ static void test_deepest_tree(void **state)
             rt_vec3 c = rt_v3(axis == 0 ? d : 0.1f * d, axis == 1 ? d : 0.1f * d, axis == 2 ? d : 0.1f * d);
             add_tri(&s, c, rt_add(c, rt_v3(e, 0, 0)), rt_add(c, rt_v3(0, e, e)));
         }
-    rt_kdtree_params p = {1.0f, 80.0f, 0.5f, 60, 1, TEST_PORTABLE, 0};
-    p.leaves = test_leaves;
+    rt_kdtree_params p = {1.0f, 80.0f, 0.5f, 60, 1, TEST_PORTABLE};
     rt_kdtree tree;
     rt_error err = {0};
     assert_int_equal(rt_kdtree_build(&tree, &s, &p, &err), RT_OK);
@@ -1253,12 +1213,5 @@ int main(void)
         cmocka_unit_test(test_threads_safe_reads),
         cmocka_unit_test(test_parallel_build_identical),
     };
-    /* the leaf layout the build picks (small scenes: SoA blocks), then
-     * each layout forced */
-    int fails = cmocka_run_group_tests_name("kdtree", tests, NULL, NULL);
-    test_leaves = RT_KD_LEAVES_LISTS;
-    fails += cmocka_run_group_tests_name("kdtree, leaf lists", tests, NULL, NULL);
-    test_leaves = RT_KD_LEAVES_SOA;
-    fails += cmocka_run_group_tests_name("kdtree, SoA leaf blocks", tests, NULL, NULL);
-    return fails;
+    return cmocka_run_group_tests_name("kdtree", tests, NULL, NULL);
 }

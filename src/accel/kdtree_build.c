@@ -978,7 +978,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     c.side = NULL;
     c.strad = NULL;
     rt_kd_binary bin = {c.nodes, c.node_count, c.ids, c.id_count};
-    if (!rt_kd_pack_wide(tree, &bin, params ? params->leaves : RT_KD_LEAVES_AUTO, &c.limit))
+    if (!rt_kd_pack_wide(tree, &bin, &c.limit))
         goto oom;
     c.st.nodes = c.node_count;
     c.st.wide_nodes = tree->wide_count;

@@ -10,8 +10,7 @@
  *   kdtree_pack.c   rt_kd_pack_wide, which makes the arrays of rt_kdtree
  *                   that the traversal reads: 64-byte wide nodes of three
  *                   levels each, and leaf blocks (a leaf's id list with an
- *                   end flag, then the triangles it is the first to use;
- *                   or, in small scenes, all its triangles in SoA groups);
+ *                   end flag, then the triangles it is the first to use);
  *   kdtree_trace.c  rt_kdtree_intersect and rt_kdtree_occluded over those
  *                   arrays (the AVX2 step and the portable one), compiled
  *                   twice: as itself (AVX2) and by kdtree_trace_portable.c
@@ -83,9 +82,8 @@ typedef struct rt_kd_binary {
  * (tree->prim_ids, tree->tri: the same array), replacing tree->tri (9
  * floats a triangle in scene order, as the build made them). false: out of
  * memory, or with *limit set, more wide nodes or block words than a child
- * reference can address (tree->tri is then unchanged). leaves: the layout
- * asked for (RT_KD_LEAVES_*); tree->soa says which one it made. */
-bool rt_kd_pack_wide(rt_kdtree *tree, const rt_kd_binary *bin, int leaves, bool *limit);
+ * reference can address (tree->tri is then unchanged). */
+bool rt_kd_pack_wide(rt_kdtree *tree, const rt_kd_binary *bin, bool *limit);
 
 /* The ray as the wide step of kdtree_trace.c reads it: per axis (lanes 0-2
  * of 8, which the AVX2 step loads whole and permutes by axis; the SSE

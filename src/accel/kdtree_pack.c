@@ -25,14 +25,6 @@
  * 2 MB go on transparent huge pages (madvise): +5-15% there, the TLB no
  * longer misses on every node.
  *
- * Leaves that hold their triangles (rt_kdtree.soa, kdtree.h): when the
- * whole tree then stays within 64 bytes a triangle (small scenes: the
- * Cornell box), every leaf is instead a block of its own triangles, 8 to a
- * group in structure-of-arrays rows (widen_block), so the 8-wide test
- * loads nine rows and needs no id list, transpose or gather. A triangle in
- * k leaves is then stored k times: on the benchmark models that is 146
- * bytes a triangle (DamagedHelmet), over the bound, so they keep lists.
- *
  * Wide nodes: for tracing, the binary tree is then packed three levels at a
  * time into 64-byte, cache-line-aligned nodes (rt_kdtree_wide: 7 planes, 8
  * cells, a reference per cell to a wide node, a leaf or nothing; missing
@@ -102,11 +94,6 @@ typedef struct kd_widen {
     uint32_t *where;    /* per scene triangle: its record's offset in blk, or KD_NO_NODE */
     const float *tri9;  /* the build's triangles, 9 floats each in scene order */
     uint32_t T, other;  /* triangle count; first id of spheres and quads */
-    bool soa;           /* leaves as blocks of SoA groups (rt_kdtree.soa) */
-    uint32_t rank;      /* soa: the next first-use rank (kept in where) */
-    uint32_t *tmp;      /* soa: one leaf's triangles (their ranks) */
-    uint32_t *rank_tri; /* soa: the scene triangle of each rank */
-    size_t tmp_cap;
     bool oom, limit;
 } kd_widen;
 
@@ -128,62 +115,10 @@ static uint32_t block_id(kd_widen *x, uint32_t p)
     return x->where[p];
 }
 
-/* A leaf as a block that holds its triangles (rt_kdtree.soa; the layout
- * is described at rt_kdtree_wide in kdtree.h): the header, the triangles
- * 8 to a group as rows of v0.x ... v2.z and a row of scene ids, then the
- * spheres' and quads' ids. The triangles come in the order a leaf list
- * would hold them (first use in depth-first order), so ties between
- * triangles resolve as with lists. A lone sphere or quad stays RT_KD_ONE. */
-static uint32_t widen_block(kd_widen *x, const rt_kdtree_node *nd)
-{
-    uint32_t n = nd->b >> 2;
-    if (n == 0)
-        return RT_KD_EMPTY;
-    const uint32_t *p = n == 1 ? &nd->a : x->bids + nd->a;
-    if (n == 1 && p[0] >= x->T)
-        return RT_KD_ONE | (x->other + (p[0] - x->T));
-    if (!rt_grow((void **)&x->tmp, &x->tmp_cap, n, sizeof *x->tmp)) {
-        x->oom = true;
-        return RT_KD_EMPTY;
-    }
-    uint32_t nt = 0;
-    for (uint32_t j = 0; j < n; j++)
-        if (p[j] < x->T) {
-            if (x->where[p[j]] == KD_NO_NODE) {
-                x->rank_tri[x->rank] = p[j];
-                x->where[p[j]] = x->rank++;
-            }
-            x->tmp[nt++] = x->where[p[j]];
-        }
-    kd_sort_ids(x->tmp, nt); /* by first use, as a list's record offsets */
-    uint32_t off = (uint32_t)x->in;
-    uint32_t *b = x->blk + off;
-    b[0] = nt | (nt < n ? RT_KD_LAST : 0u);
-    uint32_t *g = b + 1;
-    for (uint32_t i = 0; i < nt; i += 8, g += RT_KD_GROUP) {
-        for (uint32_t k = 0; k < 8; k++) {
-            uint32_t t = x->rank_tri[x->tmp[i + (i + k < nt ? k : 0)]];
-            for (int r = 0; r < 9; r++)
-                memcpy(&g[8 * r + k], &x->tri9[9 * (size_t)t + (size_t)r], sizeof *g);
-            g[72 + k] = t;
-        }
-    }
-    uint32_t m = 0;
-    for (uint32_t j = 0; j < n; j++) /* ascending scene ids: ascending tree ids */
-        if (p[j] >= x->T)
-            g[m++] = x->other + (p[j] - x->T);
-    if (m)
-        g[m - 1] |= RT_KD_LAST;
-    x->in = (size_t)(g + m - x->blk);
-    return RT_KD_LEAF | off;
-}
-
 /* A leaf's reference: one primitive, or a block (the id list, then the
  * records of the triangles first used here). */
 static uint32_t widen_leaf(kd_widen *x, const rt_kdtree_node *nd)
 {
-    if (x->soa)
-        return widen_block(x, nd);
     uint32_t n = nd->b >> 2;
     if (n == 0)
         return RT_KD_EMPTY;
@@ -272,29 +207,7 @@ static uint32_t widen_rec(kd_widen *x, uint32_t top)
     return (uint32_t)me;
 }
 
-/* The words of the leaf blocks in the soa layout (widen_block), and the
- * binary tree's interior nodes (each wide node holds at least one). */
-static size_t soa_words(const rt_kd_binary *bin, uint32_t T, size_t *interior)
-{
-    size_t words = 0;
-    *interior = 0;
-    for (size_t i = 0; i < bin->node_count; i++) {
-        const rt_kdtree_node *nd = &bin->nodes[i];
-        if ((nd->b & 3u) != KD_LEAF_TAG) {
-            (*interior)++;
-            continue;
-        }
-        uint32_t n = nd->b >> 2, nt = 0;
-        const uint32_t *p = n == 1 ? &nd->a : bin->ids + nd->a;
-        for (uint32_t j = 0; j < n; j++)
-            nt += p[j] < T;
-        if (n > 1 || nt == 1)
-            words += 1 + (size_t)RT_KD_GROUP * ((nt + 7) / 8) + (n - nt);
-    }
-    return words;
-}
-
-bool rt_kd_pack_wide(rt_kdtree *tree, const rt_kd_binary *bin, int leaves, bool *limit)
+bool rt_kd_pack_wide(rt_kdtree *tree, const rt_kd_binary *bin, bool *limit)
 {
     kd_widen x;
     memset(&x, 0, sizeof x);
@@ -324,24 +237,9 @@ bool rt_kd_pack_wide(rt_kdtree *tree, const rt_kd_binary *bin, int leaves, bool 
             }
     }
     memset(x.where, 0xff, (x.T ? x.T : 1) * sizeof *x.where);
-    /* leaves that hold their triangles when the tree then stays within 64
-     * bytes a triangle (wide nodes counted at one per interior node, an
-     * upper bound), or when asked */
-    size_t interior, sw = soa_words(bin, x.T, &interior);
-    x.soa = leaves == RT_KD_LEAVES_SOA ||
-            (leaves == RT_KD_LEAVES_AUTO && x.T > 0 && 4 * sw + 64 * interior <= 64 * (size_t)x.T);
-    if (x.soa) {
-        words = sw;
-        x.rank_tri = malloc((x.T ? x.T : 1) * sizeof *x.rank_tri);
-        if (!x.rank_tri) {
-            free(x.where);
-            return false;
-        }
-    }
     size_t others = tree->sphere_count + tree->quad_count;
     if (words + others > RT_KD_PAYLOAD) {
         free(x.where);
-        free(x.rank_tri);
         *limit = true;
         return false;
     }
@@ -350,13 +248,10 @@ bool rt_kd_pack_wide(rt_kdtree *tree, const rt_kd_binary *bin, int leaves, bool 
     x.blk = alloc_hot((words + KD_IDS_PAD) * sizeof *x.blk);
     if (!x.blk) {
         free(x.where);
-        free(x.rank_tri);
         return false;
     }
     tree->root = bin->node_count ? widen_rec(&x, 0) : RT_KD_EMPTY;
     free(x.where);
-    free(x.rank_tri);
-    free(x.tmp);
     for (size_t i = 0; i < KD_IDS_PAD; i++)
         x.blk[words + i] = RT_KD_LAST;
     rt_kdtree_wide *w = NULL;
@@ -375,6 +270,5 @@ bool rt_kd_pack_wide(rt_kdtree *tree, const rt_kd_binary *bin, int leaves, bool 
     tree->tri = (float *)(void *)x.blk;
     tree->prim_id_count = words;
     tree->other_base = x.other;
-    tree->soa = x.soa;
     return true;
 }

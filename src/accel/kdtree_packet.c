@@ -21,10 +21,8 @@
  * their closest hit. A leaf that two or more rays reach is tested
  * primitive by primitive with the rays in the lanes (tri_rays: the
  * watertight test of intersect.h, each lane with its own ray's shear, the
- * vertices broadcast), when the rays share the shear's axis kz and the
- * leaf is a list; else (and in a tree whose leaves hold their triangles in
- * SoA groups, rt_kdtree.soa) ray by ray with the single-ray leaf test
- * (kdtree_trace.c's rt_kd_leaf_hit).
+ * vertices broadcast), when the rays share the shear's axis kz; else ray by
+ * ray with the single-ray leaf test (kdtree_trace.c's rt_kd_leaf_hit).
  * Either way each ray gets the reference's bits, so its single-ray hit and
  * brute force's (test_packets checks it). The 8 rays are set up together
  * too (kdtree_trace.c's ray set-up, the same operations with the rays in
@@ -358,7 +356,7 @@ KD_PINLINE bool packet_walk(const rt_kdtree *tree, const rt_ray *rays, int n, rt
             for (int k = 0; k < K; k++) {
                 unsigned mk = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(L[k], _mm256_min_ps(H[k], BEST[k]), _CMP_LE_OQ)) &
                               (active >> (8 * k) & 0xffu);
-                if (across[k] && !tree->soa && mk & (mk - 1))
+                if (across[k] && mk & (mk - 1))
                     vec |= mk << (8 * k);
                 m |= mk << (8 * k);
             }

@@ -52,15 +52,12 @@
  * the scalar reference (which recomputes it in double), so the rare case
  * costs no code in the vector path. The vertex columns are taken in the
  * ray's axis order by one branch on a per-ray constant (three inlined
- * copies of the test). A leaf list's triangles are loaded with one
- * unaligned 8-float load each and an 8x8 transpose, plus one gather for the
- * ninth float: nine gathers were the hottest instructions in the profile
- * (+10-30% rays/s without them); the list itself is read 8 ids at a time,
- * its end and its last triangle found from the loaded ids (no length loop).
- * A tree whose leaves hold their triangles (rt_kdtree.soa: small scenes)
- * has them in groups of 8 already in columns: nine loads, no ids, no
- * transpose (Cornell box: -3% of the instructions of a ray with the same
- * tree, docs/performance.md).
+ * copies of the test). The eight triangles are loaded with one unaligned
+ * 8-float load each and an 8x8 transpose, plus one gather for the ninth
+ * float: nine gathers were the hottest instructions in the profile
+ * (+10-30% rays/s without them). The list itself is read 8 ids at a time,
+ * its end and its last triangle found from the loaded ids (no length loop;
+ * groups of 1-2 triangles too: the scalar test costs more).
  *
  * Everything the two entry points use is in this file and inlined into
  * them (always_inline, flatten), intersect.h's tests included: keep new
@@ -70,7 +67,10 @@
  * shortcut that walks down from the root plane by plane in scalar code
  * while only one cell can be entered (exact, but as costly per node as the
  * 8-lane step, +8% instructions); prefetching the cell on top of
- * the stack (-12% on DamagedHelmet diffuse); the leaf test out of line.
+ * the stack (-12% on DamagedHelmet diffuse); the leaf test out of line;
+ * leaves that hold their triangles in SoA groups (no ids, no transpose:
+ * -3% on the Cornell box but 146 bytes a triangle on DamagedHelmet, and
+ * +1.4% on the list trees for carrying both layouts).
  */
 #include "kdtree_internal.h"
 
@@ -309,81 +309,6 @@ KD_INLINE int tri8_core(__m256 ax, __m256 ay, __m256 az, __m256 bx, __m256 by, _
     return !_mm256_testz_ps(m, m);
 }
 
-/* The test of tri8 and tri8_group on the triangles' 9 vertex columns:
- * lanes of live (the first n) take part; the closest valid lane wins, on
- * a tie the first, like the scalar loop. A triangle's tree id is ids[k]
- * (a list's; the reference then tests it from its record) or, with ids
- * NULL, gid + k (an SoA group's lane k: the reference tests the lane's
- * vertices). */
-KD_INLINE bool tri8_cols(const rt_kdtree *tree, __m256 v0x, __m256 v0y, __m256 v0z, __m256 v1x, __m256 v1y,
-                         __m256 v1z, __m256 v2x, __m256 v2y, __m256 v2z, __m256i live, uint32_t n,
-                         const uint32_t *ids, uint32_t gid, const rt_ray *ray, const rt_tri_ray *tr, float *best,
-                         rt_hit *hit)
-{
-    RT_NO_FP_CONTRACT
-    __m256 ok = _mm256_castsi256_ps(live), t, u, v, adet;
-    int res;
-    /* the columns in the ray's axis order: three inlined copies, one
-     * branch on a per-ray constant */
-    if (tr->kz == 2)
-        res = tri8_core(v0x, v0y, v0z, v1x, v1y, v1z, v2x, v2y, v2z, ray, tr, *best, &ok, &t, &u, &v, &adet);
-    else if (tr->kz == 1)
-        res = tri8_core(v0z, v0x, v0y, v1z, v1x, v1y, v2z, v2x, v2y, ray, tr, *best, &ok, &t, &u, &v, &adet);
-    else
-        res = tri8_core(v0y, v0z, v0x, v1y, v1z, v1x, v2y, v2z, v2x, ray, tr, *best, &ok, &t, &u, &v, &adet);
-    if (res <= 0) {
-        if (res == 0)
-            return false;
-        bool found = false; /* an edge function rounded to zero: the reference decides, in order */
-        if (ids) {
-            for (uint32_t i = 0; i < n; i++)
-                found |= test_prim(tree, ids[i] & RT_KD_PAYLOAD, ray, tr, best, hit);
-            return found;
-        }
-        float c[9][8];
-        _mm256_storeu_ps(c[0], v0x), _mm256_storeu_ps(c[1], v0y), _mm256_storeu_ps(c[2], v0z);
-        _mm256_storeu_ps(c[3], v1x), _mm256_storeu_ps(c[4], v1y), _mm256_storeu_ps(c[5], v1z);
-        _mm256_storeu_ps(c[6], v2x), _mm256_storeu_ps(c[7], v2y), _mm256_storeu_ps(c[8], v2z);
-        for (uint32_t i = 0; i < n; i++) {
-            float tt, uu, vv;
-            if (rt_intersect_triangle_ray(tr, rt_v3(c[0][i], c[1][i], c[2][i]), rt_v3(c[3][i], c[4][i], c[5][i]),
-                                          rt_v3(c[6][i], c[7][i], c[8][i]), ray->tmin, *best, &tt, &uu, &vv)) {
-                *best = tt;
-                hit->t = tt, hit->u = uu, hit->v = vv, hit->prim = gid + i;
-                found = true;
-            }
-        }
-        return found;
-    }
-    /* intersect.h's guard against determinants that are rounding noise */
-    __m256 absmask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-    __m256 e1x = _mm256_sub_ps(v1x, v0x), e1y = _mm256_sub_ps(v1y, v0y), e1z = _mm256_sub_ps(v1z, v0z);
-    __m256 e2x = _mm256_sub_ps(v2x, v0x), e2y = _mm256_sub_ps(v2y, v0y), e2z = _mm256_sub_ps(v2z, v0z);
-    __m256 a1 = _mm256_add_ps(_mm256_add_ps(_mm256_and_ps(e1x, absmask), _mm256_and_ps(e1y, absmask)),
-                              _mm256_and_ps(e1z, absmask));
-    __m256 a2 = _mm256_add_ps(_mm256_add_ps(_mm256_and_ps(e2x, absmask), _mm256_and_ps(e2y, absmask)),
-                              _mm256_and_ps(e2z, absmask));
-    __m256 lhs = _mm256_div_ps(_mm256_div_ps(_mm256_mul_ps(adet, _mm256_set1_ps(tr->adz)), a1), a2);
-    ok = _mm256_and_ps(ok, _mm256_cmp_ps(lhs, _mm256_set1_ps(0x1p-16f * tr->ad), _CMP_GT_OQ));
-    int mask = _mm256_movemask_ps(ok);
-    if (!mask)
-        return false;
-    float tl[8], ul[8], vl[8];
-    _mm256_storeu_ps(tl, t);
-    _mm256_storeu_ps(ul, u);
-    _mm256_storeu_ps(vl, v);
-    int k = __builtin_ctz((unsigned)mask);
-    for (int i = k + 1; i < 8; i++)
-        if ((mask >> i) & 1 && tl[i] < tl[k])
-            k = i;
-    *best = tl[k];
-    hit->t = tl[k];
-    hit->u = ul[k];
-    hit->v = vl[k];
-    hit->prim = ids ? ids[k] & RT_KD_PAYLOAD : gid + (uint32_t)k;
-    return true;
-}
-
 /* The first n (1-8) triangles of a group of 8 ids at once with the
  * watertight test (tri8_core), bit for bit the reference's; the closest
  * valid lane wins, on a tie the first, like the scalar loop. id: the 8 ids
@@ -416,19 +341,51 @@ KD_INLINE bool tri8(const rt_kdtree *tree, const uint32_t *ids, __m256i id, uint
            v0z = _mm256_permute2f128_ps(s2, s6, 0x20), v1x = _mm256_permute2f128_ps(s3, s7, 0x20),
            v1y = _mm256_permute2f128_ps(s0, s4, 0x31), v1z = _mm256_permute2f128_ps(s1, s5, 0x31),
            v2x = _mm256_permute2f128_ps(s2, s6, 0x31), v2y = _mm256_permute2f128_ps(s3, s7, 0x31);
-    return tri8_cols(tree, v0x, v0y, v0z, v1x, v1y, v1z, v2x, v2y, v2z, live, n, ids, 0, ray, tr, best, hit);
-}
-
-/* The first n (1-8) triangles of an SoA group g (rt_kdtree.soa: rows of
- * v0.x ... v2.z, 8 lanes each) at once: no ids to load, no transpose. */
-KD_INLINE bool tri8_group(const rt_kdtree *tree, const float *g, uint32_t n, const rt_ray *ray, const rt_tri_ray *tr,
-                          float *best, rt_hit *hit)
-{
-    __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)n), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-    return tri8_cols(tree, _mm256_loadu_ps(g), _mm256_loadu_ps(g + 8), _mm256_loadu_ps(g + 16),
-                     _mm256_loadu_ps(g + 24), _mm256_loadu_ps(g + 32), _mm256_loadu_ps(g + 40),
-                     _mm256_loadu_ps(g + 48), _mm256_loadu_ps(g + 56), _mm256_loadu_ps(g + 64), live, n, NULL,
-                     (uint32_t)(g - tree->tri) + 63u, ray, tr, best, hit);
+    __m256 ok = _mm256_castsi256_ps(live), t, u, v, adet;
+    int res;
+    /* the columns in the ray's axis order: three inlined copies, one
+     * branch on a per-ray constant */
+    if (tr->kz == 2)
+        res = tri8_core(v0x, v0y, v0z, v1x, v1y, v1z, v2x, v2y, v2z, ray, tr, *best, &ok, &t, &u, &v, &adet);
+    else if (tr->kz == 1)
+        res = tri8_core(v0z, v0x, v0y, v1z, v1x, v1y, v2z, v2x, v2y, ray, tr, *best, &ok, &t, &u, &v, &adet);
+    else
+        res = tri8_core(v0y, v0z, v0x, v1y, v1z, v1x, v2y, v2z, v2x, ray, tr, *best, &ok, &t, &u, &v, &adet);
+    if (res <= 0) {
+        if (res == 0)
+            return false;
+        bool found = false; /* an edge function rounded to zero: the reference decides, in order */
+        for (uint32_t i = 0; i < n; i++)
+            found |= test_prim(tree, ids[i] & RT_KD_PAYLOAD, ray, tr, best, hit);
+        return found;
+    }
+    /* intersect.h's guard against determinants that are rounding noise */
+    __m256 absmask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    __m256 e1x = _mm256_sub_ps(v1x, v0x), e1y = _mm256_sub_ps(v1y, v0y), e1z = _mm256_sub_ps(v1z, v0z);
+    __m256 e2x = _mm256_sub_ps(v2x, v0x), e2y = _mm256_sub_ps(v2y, v0y), e2z = _mm256_sub_ps(v2z, v0z);
+    __m256 a1 = _mm256_add_ps(_mm256_add_ps(_mm256_and_ps(e1x, absmask), _mm256_and_ps(e1y, absmask)),
+                              _mm256_and_ps(e1z, absmask));
+    __m256 a2 = _mm256_add_ps(_mm256_add_ps(_mm256_and_ps(e2x, absmask), _mm256_and_ps(e2y, absmask)),
+                              _mm256_and_ps(e2z, absmask));
+    __m256 lhs = _mm256_div_ps(_mm256_div_ps(_mm256_mul_ps(adet, _mm256_set1_ps(tr->adz)), a1), a2);
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(lhs, _mm256_set1_ps(0x1p-16f * tr->ad), _CMP_GT_OQ));
+    int mask = _mm256_movemask_ps(ok);
+    if (!mask)
+        return false;
+    float tl[8], ul[8], vl[8];
+    _mm256_storeu_ps(tl, t);
+    _mm256_storeu_ps(ul, u);
+    _mm256_storeu_ps(vl, v);
+    int k = __builtin_ctz((unsigned)mask);
+    for (int i = k + 1; i < 8; i++)
+        if ((mask >> i) & 1 && tl[i] < tl[k])
+            k = i;
+    *best = tl[k];
+    hit->t = tl[k];
+    hit->u = ul[k];
+    hit->v = vl[k];
+    hit->prim = ids[k] & RT_KD_PAYLOAD;
+    return true;
 }
 #endif
 
@@ -443,51 +400,6 @@ KD_INLINE uint32_t leaf_length(const uint32_t *p)
 }
 #endif
 
-/* All primitives of a leaf block b of a tree with soa set (kdtree.h): its
- * triangles group by group, 8 at a time (AVX2) or one by one in lane
- * order (portable: the same order, hence the same hit), then its spheres
- * and quads. */
-KD_INLINE bool test_block(const rt_kdtree *tree, const uint32_t *b, const rt_ray *ray, const rt_tri_ray *tr,
-                          float *best, rt_hit *hit, bool any)
-{
-    bool found = false;
-    uint32_t nt = b[0] & ~RT_KD_LAST;
-    const float *g = (const float *)(const void *)(b + 1);
-    for (uint32_t i = 0; i < nt; i += 8, g += RT_KD_GROUP) {
-        uint32_t n = nt - i < 8 ? nt - i : 8;
-#ifdef KD_SIMD
-        if (tri8_group(tree, g, n, ray, tr, best, hit)) {
-            found = true;
-            if (any)
-                return true;
-        }
-#else
-        for (uint32_t k = 0; k < n; k++) {
-            float t, u, v;
-            if (rt_intersect_triangle_ray(tr, rt_v3(g[k], g[8 + k], g[16 + k]), rt_v3(g[24 + k], g[32 + k], g[40 + k]),
-                                          rt_v3(g[48 + k], g[56 + k], g[64 + k]), ray->tmin, *best, &t, &u, &v)) {
-                *best = t;
-                hit->t = t, hit->u = u, hit->v = v, hit->prim = (uint32_t)(g - tree->tri) + 63u + k;
-                found = true;
-                if (any)
-                    return true;
-            }
-        }
-#endif
-    }
-    if (b[0] & RT_KD_LAST)
-        for (const uint32_t *q = (const uint32_t *)(const void *)g;; q++) {
-            if (test_prim(tree, *q & RT_KD_PAYLOAD, ray, tr, best, hit)) {
-                found = true;
-                if (any)
-                    return true;
-            }
-            if (*q & RT_KD_LAST)
-                break;
-        }
-    return found;
-}
-
 /* All primitives of a multi-primitive leaf list p (ids ascending:
  * triangles first, then spheres and quads; the last id flagged
  * RT_KD_LAST). The AVX2 pass reads the list 8 ids at a time (the blocks
@@ -499,8 +411,6 @@ KD_INLINE bool test_block(const rt_kdtree *tree, const uint32_t *b, const rt_ray
 KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, const rt_ray *ray, const rt_tri_ray *tr,
                          float *best, rt_hit *hit, bool any)
 {
-    if (tree->soa)
-        return test_block(tree, p, ray, tr, best, hit, any);
     bool found = false;
 #ifdef KD_SIMD
     const __m256i payload = _mm256_set1_epi32((int)RT_KD_PAYLOAD);

@@ -23,9 +23,7 @@
  * RT_KD_TRI words) of the triangles no earlier leaf used, so a leaf's list
  * and most of its triangles sit in the same or adjacent cache lines; a
  * triangle's id is the offset of its record in that array (hits report
- * scene ids). When the tree fits in 64 bytes a triangle that way (small
- * scenes), a leaf's block instead holds all its triangles, 8 to a group in
- * structure-of-arrays form (rt_kdtree.soa). The build, this packing and the traversal are described,
+ * scene ids). The build, this packing and the traversal are described,
  * with their sources, at the top of src/accel/kdtree_build.c,
  * kdtree_pack.c and kdtree_trace.c.
  *
@@ -58,16 +56,7 @@ typedef struct rt_kdtree_params {
     int max_depth;        /* 0 = 8 + 1.3 log2(N) (pbrt's rule) */
     int threads;          /* build threads; 0 = one per online CPU (same tree for any count) */
     int portable;         /* 1: the portable traversal even when the CPU has AVX2 (tests; same answers) */
-    int leaves;           /* leaf layout: RT_KD_LEAVES_AUTO (0), _LISTS or _SOA (tests; same answers) */
 } rt_kdtree_params;
-
-/* How leaves hold their triangles (rt_kdtree.soa). LISTS: a leaf is a list
- * of ids, each triangle's record stored once (in the block of the first
- * leaf that uses it). SOA: a leaf holds its triangles, 8 to a group in
- * structure-of-arrays form (no id list, no transpose; a triangle in k
- * leaves is stored k times). AUTO: SOA when the whole tree then stays
- * within 64 bytes a triangle (small scenes), else LISTS. */
-enum { RT_KD_LEAVES_AUTO = 0, RT_KD_LEAVES_LISTS = 1, RT_KD_LEAVES_SOA = 2 };
 
 /* The traversal kernels a tree uses, chosen once by the build from the CPU
  * (AVX2 and FMA, when compiled in: on x86 with GCC or clang, PORTABLE=1
@@ -93,15 +82,7 @@ typedef struct rt_kdtree_stats {
  * RT_KD_LEAF | offset into prim_ids of a list of primitive ids (ascending,
  * the last with RT_KD_LAST set). A primitive id below other_base is the
  * offset of a triangle's record in the same array, an id above it a sphere
- * or quad (scene id = id - other_base + triangle_count).
- * In a tree with soa set, a leaf reference RT_KD_LEAF | offset is instead a
- * block: a header word (the triangle count nt, RT_KD_LAST set when spheres
- * or quads follow), ceil(nt / 8) groups of RT_KD_GROUP words (v0.x, v0.y,
- * v0.z, v1.x, ..., v2.z as rows of 8 floats, then a row of the 8 scene
- * triangle ids; lanes past nt repeat lane 0), then the spheres' and quads'
- * ids (the last with RT_KD_LAST); one-triangle leaves are blocks too. The
- * tree id of lane k of a group at offset g is g + 63 + k, so the word 9
- * after it is the scene id, as for a record. */
+ * or quad (scene id = id - other_base + triangle_count). */
 typedef struct rt_kdtree_wide {
     float split[7];
     uint32_t axes;      /* axis of plane p in bits 2p, 2p+1 */
@@ -113,7 +94,6 @@ typedef struct rt_kdtree_wide {
 #define RT_KD_PAYLOAD 0x3fffffffu
 #define RT_KD_LAST 0x80000000u
 #define RT_KD_TRI 10
-#define RT_KD_GROUP 80
 
 typedef struct rt_kdtree {
     rt_kdtree_wide *wide; /* 64-byte aligned */
@@ -131,7 +111,6 @@ typedef struct rt_kdtree {
     float scale; /* largest absolute coordinate of bounds (traversal epsilon) */
     const rt_scene *scene;
     rt_kd_isa isa;        /* the traversal kernels this tree uses */
-    bool soa;             /* leaves are blocks of triangles in SoA groups (see rt_kdtree_wide) */
     rt_box bounds;
     int max_depth;
     rt_kdtree_stats stats;
