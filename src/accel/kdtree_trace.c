@@ -105,7 +105,7 @@ static inline bool ray_accept(const rt_kdtree *tree, const rt_ray *ray, kd_ray *
         return false;
     float omax = fmaxf(fabsf(ray->org.x), fmaxf(fabsf(ray->org.y), fabsf(ray->org.z)));
     r->mp = (tree->scale + omax) * 0x1p-18f;
-    r->tr = rt_tri_ray_make(ray->org, ray->dir);
+    rt_tri_ray_init(&r->tr, ray->org, ray->dir);
     return true;
 }
 
@@ -135,7 +135,7 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
     __m128 om = _mm_max_ps(ao, _mm_shuffle_ps(ao, ao, _MM_SHUFFLE(1, 0, 3, 2)));
     om = _mm_max_ps(om, _mm_shuffle_ps(om, om, _MM_SHUFFLE(2, 3, 0, 1)));
     r->mp = (tree->scale + _mm_cvtss_f32(om)) * 0x1p-18f;
-    r->tr = rt_tri_ray_make(ray->org, ray->dir);
+    rt_tri_ray_init(&r->tr, ray->org, ray->dir);
     __m128 mp = _mm_set1_ps(r->mp);
     __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), d);
     __m128 ma = _mm_mul_ps(mp, _mm_andnot_ps(_mm_set1_ps(-0.0f), inv));
@@ -218,6 +218,16 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
 #define KD_FLATTEN
 #endif
 
+/* A quad, out of line: rare in meshes, and the traversal's flattened code
+ * stays as it is without it. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static bool quad_hit(const rt_quad_prep *q, const rt_ray *ray, float best, float *t, float *u, float *v)
+{
+    return rt_intersect_quad_prepared(ray->org, ray->dir, q, ray->tmin, best, t, u, v);
+}
+
 /* Tests one primitive with the reference functions on (tmin, *best). */
 KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
                          rt_hit *hit)
@@ -236,11 +246,7 @@ KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, 
             return false;
         u = v = 0.0f;
     } else {
-        const rt_quads *q = &tree->scene->quads;
-        size_t i = id - tree->other_base - tree->sphere_count;
-        if (!rt_intersect_quad(ray->org, ray->dir, rt_v3(q->px[i], q->py[i], q->pz[i]),
-                               rt_v3(q->ux[i], q->uy[i], q->uz[i]), rt_v3(q->vx[i], q->vy[i], q->vz[i]), ray->tmin,
-                               *best, &t, &u, &v))
+        if (!quad_hit(&tree->quads[id - tree->other_base - tree->sphere_count], ray, *best, &t, &u, &v))
             return false;
     }
     *best = t;
