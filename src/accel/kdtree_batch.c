@@ -32,16 +32,25 @@ static inline unsigned dir_signs(const rt_ray_batch *rb, uint32_t i)
     return (unsigned)signbit(rb->dx[i]) | (unsigned)signbit(rb->dy[i]) << 1 | (unsigned)signbit(rb->dz[i]) << 2;
 }
 
+static inline bool same_origin(const rt_ray_batch *rb, uint32_t i, uint32_t l)
+{
+    return rb->ox[l] == rb->ox[i] && rb->oy[l] == rb->oy[i] && rb->oz[l] == rb->oz[i];
+}
+
 /* How many rays from position k of the list (at most 8) share ray k's
- * origin and direction signs. */
+ * origin and direction signs. Secondary rays (a path's bounce, each from
+ * its own surface point) end the run at the first comparison, before any
+ * direction sign is computed. */
 static inline int coherent_run(const rt_ray_batch *rb, const uint32_t *lanes, size_t k, size_t n)
 {
     uint32_t i = lanes ? lanes[k] : (uint32_t)k;
+    if (k + 1 >= n || !same_origin(rb, i, lanes ? lanes[k + 1] : (uint32_t)(k + 1)))
+        return 1;
     unsigned sg = dir_signs(rb, i);
     int m = 1;
     for (size_t j = k + 1; j < n && m < 8; j++, m++) {
         uint32_t l = lanes ? lanes[j] : (uint32_t)j;
-        if (!(rb->ox[l] == rb->ox[i] && rb->oy[l] == rb->oy[i] && rb->oz[l] == rb->oz[i]) || dir_signs(rb, l) != sg)
+        if (!same_origin(rb, i, l) || dir_signs(rb, l) != sg)
             break;
     }
     return m;

@@ -980,9 +980,27 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     rt_kd_binary bin = {c.nodes, c.node_count, c.ids, c.id_count};
     if (!rt_kd_pack_wide(tree, &bin, &c.limit))
         goto oom;
+    /* the quads' tests without their ray-independent part (cross product,
+     * lengths, the degeneracy guard): the same bits */
+    if (Q > 0) {
+        tree->quads = malloc(Q * sizeof *tree->quads);
+        if (!tree->quads) {
+            free(tree->wide);
+            free(tree->prim_ids);
+            tree->wide = NULL;
+            tree->prim_ids = NULL;
+            tree->tri = NULL;
+            goto oom;
+        }
+        const rt_quads *q = &scene->quads;
+        for (size_t i = 0; i < Q; i++)
+            tree->quads[i] = rt_quad_prepare(rt_v3(q->px[i], q->py[i], q->pz[i]), rt_v3(q->ux[i], q->uy[i], q->uz[i]),
+                                             rt_v3(q->vx[i], q->vy[i], q->vz[i]));
+    }
     c.st.nodes = c.node_count;
     c.st.wide_nodes = tree->wide_count;
-    c.st.bytes = tree->wide_count * sizeof *tree->wide + tree->prim_id_count * sizeof *tree->prim_ids;
+    c.st.bytes = tree->wide_count * sizeof *tree->wide + tree->prim_id_count * sizeof *tree->prim_ids +
+                 Q * sizeof *tree->quads;
     free(c.nodes);
     free(c.ids);
     c.st.build_ms = 1e3 * rt_now_seconds() - t0;
@@ -1011,5 +1029,6 @@ void rt_kdtree_free(rt_kdtree *tree)
         return;
     free(tree->wide);
     free(tree->prim_ids); /* tree->tri is the same array */
+    free(tree->quads);
     memset(tree, 0, sizeof *tree);
 }

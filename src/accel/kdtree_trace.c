@@ -41,8 +41,8 @@
  * with KD_PORTABLE, where the same step runs as plain loops (_portable);
  * the tree says which one its rays take.
  *
- * Leaves with 3 or more triangles are tested 8 at a time with AVX2 (when
- * compiled for it): the same IEEE operations per lane as the scalar
+ * A leaf's triangles are tested 8 at a time with AVX2 (when compiled for
+ * it): the same IEEE operations per lane as the scalar
  * watertight test of intersect.h (Woop, Benthin and Wald 2013; its shear
  * is made once per ray, in kd_ray), so the same bits (tests check it). Its
  * three edge functions need no divide, so a group whose lanes all have
@@ -55,7 +55,9 @@
  * copies of the test). The eight triangles are loaded with one unaligned
  * 8-float load each and an 8x8 transpose, plus one gather for the ninth
  * float: nine gathers were the hottest instructions in the profile
- * (+10-30% rays/s without them).
+ * (+10-30% rays/s without them). The list itself is read 8 ids at a time,
+ * its end and its last triangle found from the loaded ids (no length loop;
+ * groups of 1-2 triangles too: the scalar test costs more).
  *
  * Everything the two entry points use is in this file and inlined into
  * them (always_inline, flatten), intersect.h's tests included: keep new
@@ -64,9 +66,11 @@
  * Measured and not kept (docs/performance.md has the numbers): a start
  * shortcut that walks down from the root plane by plane in scalar code
  * while only one cell can be entered (exact, but as costly per node as the
- * 8-lane step, +8% instructions); the 8-wide
- * test from 2 or 5 triangles instead of 3; prefetching the cell on top of
- * the stack (-12% on DamagedHelmet diffuse); the leaf test out of line.
+ * 8-lane step, +8% instructions); prefetching the cell on top of
+ * the stack (-12% on DamagedHelmet diffuse); the leaf test out of line;
+ * leaves that hold their triangles in SoA groups (no ids, no transpose:
+ * -3% on the Cornell box but 146 bytes a triangle on DamagedHelmet, and
+ * +1.4% on the list trees for carrying both layouts).
  */
 #include "kdtree_internal.h"
 
@@ -101,7 +105,7 @@ static inline bool ray_accept(const rt_kdtree *tree, const rt_ray *ray, kd_ray *
         return false;
     float omax = fmaxf(fabsf(ray->org.x), fmaxf(fabsf(ray->org.y), fabsf(ray->org.z)));
     r->mp = (tree->scale + omax) * 0x1p-18f;
-    r->tr = rt_tri_ray_make(ray->org, ray->dir);
+    rt_tri_ray_init(&r->tr, ray->org, ray->dir);
     return true;
 }
 
@@ -131,7 +135,7 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
     __m128 om = _mm_max_ps(ao, _mm_shuffle_ps(ao, ao, _MM_SHUFFLE(1, 0, 3, 2)));
     om = _mm_max_ps(om, _mm_shuffle_ps(om, om, _MM_SHUFFLE(2, 3, 0, 1)));
     r->mp = (tree->scale + _mm_cvtss_f32(om)) * 0x1p-18f;
-    r->tr = rt_tri_ray_make(ray->org, ray->dir);
+    rt_tri_ray_init(&r->tr, ray->org, ray->dir);
     __m128 mp = _mm_set1_ps(r->mp);
     __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), d);
     __m128 ma = _mm_mul_ps(mp, _mm_andnot_ps(_mm_set1_ps(-0.0f), inv));
@@ -214,6 +218,16 @@ static inline bool ray_setup(const rt_kdtree *tree, const rt_ray *ray, kd_ray *r
 #define KD_FLATTEN
 #endif
 
+/* A quad, out of line: rare in meshes, and the traversal's flattened code
+ * stays as it is without it. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static bool quad_hit(const rt_quad_prep *q, const rt_ray *ray, float best, float *t, float *u, float *v)
+{
+    return rt_intersect_quad_prepared(ray->org, ray->dir, q, ray->tmin, best, t, u, v);
+}
+
 /* Tests one primitive with the reference functions on (tmin, *best). */
 KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
                          rt_hit *hit)
@@ -232,11 +246,7 @@ KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, 
             return false;
         u = v = 0.0f;
     } else {
-        const rt_quads *q = &tree->scene->quads;
-        size_t i = id - tree->other_base - tree->sphere_count;
-        if (!rt_intersect_quad(ray->org, ray->dir, rt_v3(q->px[i], q->py[i], q->pz[i]),
-                               rt_v3(q->ux[i], q->uy[i], q->uz[i]), rt_v3(q->vx[i], q->vy[i], q->vz[i]), ray->tmin,
-                               *best, &t, &u, &v))
+        if (!quad_hit(&tree->quads[id - tree->other_base - tree->sphere_count], ray, *best, &t, &u, &v))
             return false;
     }
     *best = t;
@@ -248,7 +258,6 @@ KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, 
 }
 
 #ifdef KD_SIMD
-#define KD_SIMD_MIN 3 /* leaves with at least this many triangles go 8 at a time */
 
 /* The watertight test of intersect.h on 8 triangles whose vertex
  * coordinates come permuted to the ray's (kx, ky, kz) (see tri8): the very
@@ -306,20 +315,19 @@ KD_INLINE int tri8_core(__m256 ax, __m256 ay, __m256 az, __m256 bx, __m256 by, _
     return !_mm256_testz_ps(m, m);
 }
 
-/* Up to 8 triangles (ids, all triangles) at once with the watertight test
- * (tri8_core), bit for bit the reference's; the closest valid lane wins,
- * on a tie the first, like the scalar loop. */
-KD_INLINE bool tri8(const rt_kdtree *tree, const uint32_t *ids, uint32_t n, const rt_ray *ray, const rt_tri_ray *tr,
-                    float *best, rt_hit *hit)
+/* The first n (1-8) triangles of a group of 8 ids at once with the
+ * watertight test (tri8_core), bit for bit the reference's; the closest
+ * valid lane wins, on a tie the first, like the scalar loop. id: the 8 ids
+ * without their flags (test_leaf loaded them). */
+KD_INLINE bool tri8(const rt_kdtree *tree, const uint32_t *ids, __m256i id, uint32_t n, const rt_ray *ray,
+                    const rt_tri_ray *tr, float *best, rt_hit *hit)
 {
     RT_NO_FP_CONTRACT
     const float *tri = tree->tri;
     __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     __m256i live = _mm256_cmpgt_epi32(_mm256_set1_epi32((int)n), lane);
-    __m256i id = _mm256_maskload_epi32((const int *)ids, live);
-    id = _mm256_and_si256(_mm256_blendv_epi8(_mm256_set1_epi32((int)ids[0]), id, live),
-                          _mm256_set1_epi32((int)RT_KD_PAYLOAD)); /* the last id carries RT_KD_LAST */
-    __m256i base = id; /* ids are the records' offsets */
+    /* idle lanes repeat the first triangle (a record that exists) */
+    __m256i base = _mm256_blendv_epi8(_mm256_permutevar8x32_epi32(id, _mm256_setzero_si256()), id, live);
     /* floats 0-7 of each triangle: one unaligned load per lane and an 8x8
      * transpose (cheaper than eight gathers); float 8 by one gather */
     uint32_t off[8];
@@ -387,54 +395,64 @@ KD_INLINE bool tri8(const rt_kdtree *tree, const uint32_t *ids, uint32_t n, cons
 }
 #endif
 
-/* The length of a leaf list: up to its id with RT_KD_LAST (the lists are
- * followed by KD_IDS_PAD such ids, so 8 can always be loaded). */
+#ifndef KD_SIMD
+/* The length of a leaf list: up to its id with RT_KD_LAST. */
 KD_INLINE uint32_t leaf_length(const uint32_t *p)
 {
     uint32_t n = 0;
-#ifdef KD_SIMD
-    for (;; n += 8) {
-        unsigned m = (unsigned)_mm256_movemask_ps(_mm256_loadu_ps((const float *)(const void *)(p + n)));
-        if (m)
-            return n + (uint32_t)__builtin_ctz(m) + 1;
-    }
-#else
     while (!(p[n] & RT_KD_LAST))
         n++;
     return n + 1;
-#endif
 }
+#endif
 
-/* All primitives of a multi-primitive leaf (ids ascending: triangles first). */
-KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, const rt_ray *ray, const rt_tri_ray *tr,
+/* All primitives of a multi-primitive leaf list p (ids ascending:
+ * triangles first, then spheres and quads; the last id flagged
+ * RT_KD_LAST). The AVX2 pass reads the list 8 ids at a time (the blocks
+ * are followed by KD_IDS_PAD flagged ids, so 8 can always be loaded): the
+ * flag's lane ends the list and the ids below other_base are the group's
+ * triangles, tested together by tri8, so finding the list's length and
+ * its last triangle costs no loop; the spheres and quads after them go one
+ * by one. The same primitives in the same order as one by one. */
+KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, const rt_ray *ray, const rt_tri_ray *tr,
                          float *best, rt_hit *hit, bool any)
 {
     bool found = false;
-    uint32_t i = 0;
 #ifdef KD_SIMD
-    if (n >= KD_SIMD_MIN) {
-        /* the triangles: ids below other_base, which come first (one
-         * test for a leaf of triangles only, instead of one a group) */
-        uint32_t T = tree->other_base, nt = n;
-        while (nt > 0 && (p[nt - 1] & RT_KD_PAYLOAD) >= T)
-            nt--;
-        for (; i < nt; i += 8) {
-            if (tri8(tree, p + i, nt - i < 8 ? nt - i : 8, ray, tr, best, hit)) {
+    const __m256i payload = _mm256_set1_epi32((int)RT_KD_PAYLOAD);
+    const __m256i other = _mm256_set1_epi32((int)tree->other_base - 1); /* ids < 2^30: signed compares */
+    for (;; p += 8) {
+        __m256i raw = _mm256_loadu_si256((const __m256i *)(const void *)p);
+        unsigned end = (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(raw));
+        unsigned n = end ? (unsigned)__builtin_ctz(end) + 1u : 8u; /* ids of this group */
+        __m256i id = _mm256_and_si256(raw, payload);
+        unsigned rest = (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(id, other))) &
+                        ((2u << (n - 1u)) - 1u); /* spheres and quads: the last lanes */
+        unsigned nt = rest ? (unsigned)__builtin_ctz(rest) : n;
+        if (nt > 0 && tri8(tree, p, id, nt, ray, tr, best, hit)) {
+            found = true;
+            if (any)
+                return true;
+        }
+        for (unsigned i = nt; i < n; i++)
+            if (test_prim(tree, p[i] & RT_KD_PAYLOAD, ray, tr, best, hit)) {
                 found = true;
                 if (any)
                     return true;
             }
-        }
-        i = nt; /* then the spheres and quads, one by one */
+        if (end)
+            return found;
     }
-#endif
-    for (; i < n; i++)
+#else
+    uint32_t n = leaf_length(p);
+    for (uint32_t i = 0; i < n; i++)
         if (test_prim(tree, p[i] & RT_KD_PAYLOAD, ray, tr, best, hit)) {
             found = true;
             if (any)
                 return true;
         }
     return found;
+#endif
 }
 
 /* ------------------------------------------------------ the wide step */
@@ -776,7 +794,7 @@ KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hi
             }
         } else {
             const uint32_t *p = ids + (ref & RT_KD_PAYLOAD);
-            if (test_leaf(tree, p, leaf_length(p), ray, &r->tr, &best, hit, any)) {
+            if (test_leaf(tree, p, ray, &r->tr, &best, hit, any)) {
                 found = true;
                 if (any)
                     return true;
@@ -834,7 +852,7 @@ KD_FLATTEN bool rt_kd_leaf_hit_avx2(const rt_kdtree *tree, uint32_t ref, const r
     if (ref >= RT_KD_ONE)
         return test_prim(tree, ref & RT_KD_PAYLOAD, ray, tr, best, hit);
     const uint32_t *p = tree->prim_ids + (ref & RT_KD_PAYLOAD);
-    return test_leaf(tree, p, leaf_length(p), ray, tr, best, hit, any);
+    return test_leaf(tree, p, ray, tr, best, hit, any);
 }
 
 KD_FLATTEN bool rt_kd_prim_hit_avx2(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr,

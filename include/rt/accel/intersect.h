@@ -10,6 +10,8 @@
  *   if (rt_intersect_triangle(r.org, r.dir, v0, v1, v2, r.tmin, r.tmax, &t, &u, &v)) ...
  *   rt_tri_ray tr = rt_tri_ray_make(r.org, r.dir);   // once per ray, then per triangle:
  *   if (rt_intersect_triangle_ray(&tr, v0, v1, v2, r.tmin, r.tmax, &t, &u, &v)) ...
+ *   rt_quad_prep q = rt_quad_prepare(p, eu, ev);     // once per quad, then per ray:
+ *   if (rt_intersect_quad_prepared(r.org, r.dir, &q, r.tmin, r.tmax, &t, &u, &v)) ...
  *
  * Triangle: watertight, Woop, Benthin and Wald (2013), "Watertight
  * Ray/Triangle Intersection", JCGT 2(1): the vertices are moved to the
@@ -27,7 +29,10 @@
  * rounding noise and the computed hit could lie anywhere on the ray.
  * Sphere: the numerically robust quadratic of Haines et al., "Precision
  * Improvements for Ray/Sphere Intersection", Ray Tracing Gems ch. 7.
- * Quad (parallelogram p + s*u + t*v): plane hit, then (s, t) by projection.
+ * Quad (parallelogram p + s*u + t*v): plane hit, then (s, t) by projection;
+ * rt_intersect_quad is rt_quad_prepare (the normal and the degeneracy
+ * guard, which do not depend on the ray: the kd-tree keeps them) followed
+ * by rt_intersect_quad_prepared, so both give the same bits.
  */
 #ifndef RT_INTERSECT_H
 #define RT_INTERSECT_H
@@ -53,7 +58,8 @@ typedef struct rt_tri_ray {
 
 static inline float rt__axis(rt_vec3 a, int k) { return k == 0 ? a.x : k == 1 ? a.y : a.z; }
 
-static inline rt_tri_ray rt_tri_ray_make(rt_vec3 org, rt_vec3 dir)
+/* The same, written in place (the kd-tree's ray set-up: no copy). */
+static inline void rt_tri_ray_init(rt_tri_ray *rp, rt_vec3 org, rt_vec3 dir)
 {
     RT_NO_FP_CONTRACT
     rt_tri_ray r;
@@ -71,6 +77,13 @@ static inline rt_tri_ray rt_tri_ray_make(rt_vec3 org, rt_vec3 dir)
     r.okz = rt__axis(org, r.kz);
     r.adz = fabsf(rt__axis(dir, r.kz));
     r.ad = ax + ay + az;
+    *rp = r;
+}
+
+static inline rt_tri_ray rt_tri_ray_make(rt_vec3 org, rt_vec3 dir)
+{
+    rt_tri_ray r;
+    rt_tri_ray_init(&r, org, dir);
     return r;
 }
 
@@ -155,34 +168,67 @@ static inline bool rt_intersect_sphere(rt_vec3 org, rt_vec3 dir, rt_vec3 center,
     return false;
 }
 
-static inline bool rt_intersect_quad(rt_vec3 org, rt_vec3 dir, rt_vec3 p, rt_vec3 eu, rt_vec3 ev, float tmin,
-                                     float tmax, float *t_out, float *s_out, float *r_out)
+/* A quad (parallelogram p + s eu + r ev, s and r in [0, 1]) prepared for
+ * rt_intersect_quad_prepared: what the test computes from the quad alone,
+ * made once (the kd-tree keeps one per quad). */
+typedef struct rt_quad_prep {
+    rt_vec3 p, eu, ev;
+    rt_vec3 n;   /* eu x ev */
+    float nn;    /* n . n */
+    float nd;    /* |n.x| + |n.y| + |n.z| */
+    bool usable; /* n . n > 0 and not degenerate by the guard below */
+} rt_quad_prep;
+
+static inline rt_quad_prep rt_quad_prepare(rt_vec3 p, rt_vec3 eu, rt_vec3 ev)
 {
     RT_NO_FP_CONTRACT
-    rt_vec3 n = rt_cross(eu, ev);
-    float nn = rt_dot(n, n);
-    float denom = rt_dot(n, dir);
-    if (denom == 0.0f || !(nn > 0.0f))
+    rt_quad_prep q;
+    q.p = p, q.eu = eu, q.ev = ev;
+    q.n = rt_cross(eu, ev);
+    q.nn = rt_dot(q.n, q.n);
+    q.nd = fabsf(q.n.x) + fabsf(q.n.y) + fabsf(q.n.z);
+    /* edges (nearly) parallel make the numbers below rounding noise */
+    q.usable = q.nn > 0.0f && q.nn / rt_dot(eu, eu) / rt_dot(ev, ev) > 0x1p-32f;
+    return q;
+}
+
+/* The quad against a ray: t in (tmin, tmax), (s, r) the hit's parameters. */
+static inline bool rt_intersect_quad_prepared(rt_vec3 org, rt_vec3 dir, const rt_quad_prep *q, float tmin,
+                                              float tmax, float *t_out, float *s_out, float *r_out)
+{
+    RT_NO_FP_CONTRACT
+    if (!q->usable)
         return false;
-    float t = rt_dot(n, rt_sub(p, org)) / denom;
+    rt_vec3 n = q->n;
+    float denom = rt_dot(n, dir);
+    if (denom == 0.0f)
+        return false;
+    float t = rt_dot(n, rt_sub(q->p, org)) / denom;
     if (!(t > tmin && t < tmax))
         return false;
-    rt_vec3 w = rt_sub(rt_madd(org, dir, t), p);
-    float s = rt_dot(n, rt_cross(w, ev)) / nn;
+    rt_vec3 w = rt_sub(rt_madd(org, dir, t), q->p);
+    float s = rt_dot(n, rt_cross(w, q->ev)) / q->nn;
     if (s < 0.0f || s > 1.0f)
         return false;
-    float r = rt_dot(n, rt_cross(eu, w)) / nn;
+    float r = rt_dot(n, rt_cross(q->eu, w)) / q->nn;
     if (r < 0.0f || r > 1.0f)
         return false;
-    /* as for triangles: edges (nearly) parallel, or a grazing ray, make the
-     * numbers above rounding noise; such hits do not count */
-    float nd = fabsf(n.x) + fabsf(n.y) + fabsf(n.z), ad = fabsf(dir.x) + fabsf(dir.y) + fabsf(dir.z);
-    if (!(nn / rt_dot(eu, eu) / rt_dot(ev, ev) > 0x1p-32f) || !(fabsf(denom) / nd > 0x1p-16f * ad))
+    /* as for triangles: a grazing ray makes the numbers above rounding
+     * noise; such hits do not count */
+    float ad = fabsf(dir.x) + fabsf(dir.y) + fabsf(dir.z);
+    if (!(fabsf(denom) / q->nd > 0x1p-16f * ad))
         return false;
     *t_out = t;
     *s_out = s;
     *r_out = r;
     return true;
+}
+
+static inline bool rt_intersect_quad(rt_vec3 org, rt_vec3 dir, rt_vec3 p, rt_vec3 eu, rt_vec3 ev, float tmin,
+                                     float tmax, float *t_out, float *s_out, float *r_out)
+{
+    rt_quad_prep q = rt_quad_prepare(p, eu, ev);
+    return rt_intersect_quad_prepared(org, dir, &q, tmin, tmax, t_out, s_out, r_out);
 }
 
 #endif

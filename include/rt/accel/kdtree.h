@@ -34,8 +34,9 @@
  * coordinates, a zero edge, a zero-area quad, a non-finite sphere) are left
  * out of the tree.
  *
- * The tree keeps a pointer to the scene (for spheres and quads): the scene
- * must outlive it and must not gain primitives after the build.
+ * The tree keeps a pointer to the scene (for spheres) and each quad's
+ * prepared test (rt_quad_prep): the scene must outlive it and must not
+ * gain or move primitives after the build.
  */
 #ifndef RT_KDTREE_H
 #define RT_KDTREE_H
@@ -45,6 +46,7 @@
 #include <string.h>
 
 #include "rt/base/error.h"
+#include "rt/accel/intersect.h"
 #include "rt/accel/ray.h"
 #include "rt/scene/scene.h"
 
@@ -70,7 +72,7 @@ typedef struct rt_kdtree_stats {
     size_t max_leaf_prims;
     int depth;
     double build_ms;
-    size_t bytes;         /* wide nodes + leaf blocks (ids and triangles) */
+    size_t bytes;         /* wide nodes + leaf blocks (ids and triangles) + prepared quads */
 } rt_kdtree_stats;
 
 /* Three levels of the binary tree: planes in breadth-first order (0 the top
@@ -108,6 +110,7 @@ typedef struct rt_kdtree {
     float *tri;
     uint32_t other_base;  /* primitive ids >= this are spheres and quads */
     size_t triangle_count, sphere_count, quad_count; /* at build time */
+    rt_quad_prep *quads;  /* per scene quad: its test's ray-independent part (quad_count) */
     float scale; /* largest absolute coordinate of bounds (traversal epsilon) */
     const rt_scene *scene;
     rt_kd_isa isa;        /* the traversal kernels this tree uses */
