@@ -217,7 +217,7 @@ bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_path_state *ps, const
     h.t = dist;
     rt_ray r = rt_ray_make(sf->p, wdir, 0.0f, INFINITY);
     rt_surface se;
-    rt_surface_at_shading(ctx, &r, &h, &se);
+    rt_surface_at_emitter(ctx, &r, &h, &se); /* its ng and emission */
     float cos_l = fabsf(rt_dot(se.ng, wdir));
     rt_vec3 Le = rt_surface_emission(ctx, &se);
     float pdf_l = t->prim_pdf[prim] * d2 / cos_l;

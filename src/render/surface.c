@@ -83,11 +83,18 @@ bool rt_surface_material_reads_frame(const rt_material *m)
 #define SURFACE_INLINE static inline
 #endif
 
-/* The record; the tangent frame (t, b) only when `frame` is true or the
+/* What a caller needs of the record: everything (rt_surface_at), the
+ * frame only where the material reads it (rt_surface_at_shading), or what
+ * emission reads (rt_surface_at_emitter: no shading normal, normal map,
+ * tangent frame or vertex colour). */
+typedef enum surface_need { NEED_ALL, NEED_SHADING, NEED_EMISSION } surface_need;
+
+/* The record; the tangent frame (t, b) only when `need` is NEED_ALL or the
  * material reads it (else zero). */
 SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf,
-                              bool frame)
+                              surface_need need)
 {
+    bool emission_only = need == NEED_EMISSION;
     const rt_scene *s = ctx->state->scene;
     uint32_t i;
     rt_vec3 ng, n, t = rt_v3s(0.0f);
@@ -100,7 +107,7 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
                                             : s->quads.material[i];
     RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
     const rt_material *m = &s->materials[sf->material];
-    frame = frame || rt_surface_material_reads_frame(m);
+    bool frame = need == NEED_ALL || (!emission_only && rt_surface_material_reads_frame(m));
     switch (kind) {
     case RT_PRIM_TRIANGLE: {
         const uint32_t *idx = &s->triangles.index[3 * (size_t)i];
@@ -120,7 +127,7 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
                 ng = rt_neg(ng);
         }
         n = ng;
-        if (flags & RT_TRI_SMOOTH) {
+        if ((flags & RT_TRI_SMOOTH) && !emission_only) {
             rt_vec3 ni = rt_add(rt_add(rt_scale(vx->normal[idx[0]], bw), rt_scale(vx->normal[idx[1]], bu)),
                                 rt_scale(vx->normal[idx[2]], bv));
             if (rt_length2(ni) > 1e-20f && rt_finite3(ni))
@@ -141,7 +148,7 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
         }
         RT_DCHECK(!(flags & RT_TRI_COLOR) || vx->color);
         RT_DCHECK(!(flags & RT_TRI_TANGENT) || vx->tangent);
-        if (flags & RT_TRI_COLOR) {
+        if ((flags & RT_TRI_COLOR) && !emission_only) {
             rt_vec4 c0 = vx->color[idx[0]], c1 = vx->color[idx[1]], c2 = vx->color[idx[2]];
             sf->vertex_color = rt_v4(c0.x * bw + c1.x * bu + c2.x * bv, c0.y * bw + c1.y * bu + c2.y * bv,
                                      c0.z * bw + c1.z * bu + c2.z * bv, c0.w * bw + c1.w * bu + c2.w * bv);
@@ -192,7 +199,7 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
     }
     rt_vec3 n_unmapped = n;
     /* normal map, in the frame of the front face */
-    if (m->normal_tex.texture != RT_NONE) {
+    if (m->normal_tex.texture != RT_NONE && !emission_only) {
         RT_DCHECK(m->normal_tex.texture < s->texture_count);
         const rt_texture *tx = &s->textures[m->normal_tex.texture];
         bool unorm8 = tx->kind == RT_TEX_IMAGE && s->images[tx->image].rgba8;
@@ -225,12 +232,17 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
 
 void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf)
 {
-    surface_at(ctx, ray, hit, sf, true);
+    surface_at(ctx, ray, hit, sf, NEED_ALL);
 }
 
 void rt_surface_at_shading(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf)
 {
-    surface_at(ctx, ray, hit, sf, false);
+    surface_at(ctx, ray, hit, sf, NEED_SHADING);
+}
+
+void rt_surface_at_emitter(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf)
+{
+    surface_at(ctx, ray, hit, sf, NEED_EMISSION);
 }
 
 rt_vec4 rt_surface_base_color(const rt_trace_ctx *ctx, const rt_surface *sf)

@@ -6,6 +6,7 @@
  *   rt_surface sf;
  *   rt_surface_at(&ctx, &ray, &hit, &sf);          // point, normals, tangent frame, uv, material
  *   rt_surface_at_shading(&ctx, &ray, &hit, &sf);  // the same, the frame only where the material reads it
+ *   rt_surface_at_emitter(&ctx, &ray, &hit, &sf);  // what rt_surface_emission reads, no more
  *   // or: the first surface along a ray that its alpha does not cut away
  *   int layers = 32;
  *   float coverage;
@@ -60,6 +61,11 @@ void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit
  * whose BSDF builds its own frame about the shading normal, so a hit builds
  * one frame, not two. Every other field is rt_surface_at's, bit for bit. */
 void rt_surface_at_shading(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf);
+/* Only what rt_surface_emission reads, for a point sampled on an emitter:
+ * p, ng, front, wo, uv0, uv1, material and prim are rt_surface_at's, bit
+ * for bit; n = n_unmapped = ng (no interpolated or mapped normal), t = b =
+ * 0, vertex_color (1, 1, 1, 1). */
+void rt_surface_at_emitter(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf);
 /* Whether rt_bsdf_from_surface or the record itself reads the tangent
  * frame: a normal map, a conductor (anisotropy), the glTF extensions. */
 bool rt_surface_material_reads_frame(const rt_material *m);
