@@ -269,6 +269,7 @@ static inline void set_lambert(rt_bsdf *b, rt_vec3 base)
     if (!rt_finite3(base))
         base = rt_v3s(0.0f);
     b->lambert = true;
+    b->wo_z = NAN;
     b->layered = false;
     b->thin = false;
     b->conductor = false;
@@ -303,6 +304,7 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
     if (!(ior > 0.0f) || !isfinite(ior))
         ior = 1.5f;
     b->lambert = false;
+    b->wo_z = NAN;
     b->layered = false;
     b->thin = false;
     b->conductor = false;
@@ -353,6 +355,7 @@ static void dielectric_compensate(rt_bsdf *b);
 
 void rt_bsdf_compensate(rt_bsdf *b)
 {
+    b->wo_z = NAN;
     if (b->radiance_eta2) {
         dielectric_compensate(b);
         return;
@@ -406,6 +409,7 @@ void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha)
 
 void rt_bsdf_set_eta(rt_bsdf *b, float eta)
 {
+    b->wo_z = NAN;
     eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
     float r0 = (eta - 1.0f) / (eta + 1.0f);
     b->f0 = r0 * r0;
@@ -748,6 +752,26 @@ static void lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_
     }
 }
 
+/* lobe_probs, from rt_bsdf_set_wo's cache when it holds this wo (the core
+ * BSDF's probabilities depend on wo only through wo.z). */
+static inline void lobe_probs_at(const rt_bsdf *b, rt_vec3 wo, float *pd, float *ps, float *pt, float *ptm)
+{
+    if (wo.z == b->wo_z && !b->layered) {
+        *pd = b->p_d, *ps = b->p_s, *pt = b->p_t, *ptm = b->p_tm;
+        return;
+    }
+    lobe_probs(b, wo, pd, ps, pt, ptm);
+}
+
+void rt_bsdf_set_wo(rt_bsdf *b, rt_vec3 wo)
+{
+    b->wo_z = NAN;
+    if (b->layered || b->lambert || !(wo.z > 0.0f))
+        return; /* layered: probabilities of the whole wo; Lambert: nothing to cache */
+    lobe_probs(b, wo, &b->p_d, &b->p_s, &b->p_t, &b->p_tm);
+    b->wo_z = wo.z;
+}
+
 void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit)
 {
     float ptm;
@@ -836,8 +860,8 @@ rt_vec3 rt_bsdf_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float *pdf)
         layered_probs p = layered_lobe_probs(b, wo);
         return layered_eval(b, wo, wi, &p, pdf ? pdf : &dummy_l);
     }
-    float pd, ps, pt, dummy;
-    rt_bsdf_lobe_probs(b, wo, &pd, &ps, &pt);
+    float pd, ps, pt, ptm, dummy;
+    lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
     return eval_lobes(b, wo, wi, pd, ps, pdf ? pdf : &dummy);
 }
 
@@ -929,6 +953,7 @@ static float clamp01(float x) { return isfinite(x) ? rt_clampf(x, 0.0f, 1.0f) : 
 
 void rt_bsdf_set_ext(rt_bsdf *b, const rt_bsdf_ext *e)
 {
+    b->wo_z = NAN;
     if (b->lambert || b->conductor || b->plastic || b->radiance_eta2)
         return; /* the extensions extend the glTF BSDF only */
     b->spec_weight = clamp01(e->spec_weight);
@@ -1217,7 +1242,7 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
     if (b->layered)
         return layered_sample(b, wo, u, ulobe, s);
     float pd, ps, pt, ptm;
-    lobe_probs(b, wo, &pd, &ps, &pt, &ptm);
+    lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
     if (!(pd + ps + pt + ptm > 0.0f))
         return false;
     if (ptm > 0.0f && ulobe >= pd + ps + pt) {

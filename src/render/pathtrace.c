@@ -316,6 +316,8 @@ rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, 
         rt_bsdf_set_eta(b, sf->front ? eta : 1.0f / eta);
     }
     *wo = rt_bsdf_to_local(b, sf->wo);
+    if (!b->lambert) /* (Lambert has nothing to cache) */
+        rt_bsdf_set_wo(b, *wo); /* the light samples and the next direction share wo */
     return wo->z > 0.0f ? RT_VERTEX_SHADE : RT_VERTEX_STOP;
 }
 
