@@ -90,15 +90,6 @@ static inline rt_vec2 path_2d(const rt_trace_ctx *ctx, const rt_path_state *ps, 
     return path_2d_at(ctx, rng, path_dim(ctx, ps, slot));
 }
 
-/* One light-sampling term, f cos vis w / pdf times the radiance; zero when
- * the shadow ray is blocked (vis 0). */
-rt_vec3 rt_path_nee_add(rt_vec3 sum, const rt_nee_record *rec, float vis)
-{
-    if (!(vis > 0.0f))
-        return sum;
-    return rt_path_add_finite(sum, rt_scale(rec->fl, rec->cos * vis * rec->w / rec->pdf));
-}
-
 /* A record for a light from the light table in direction d (world, above
  * the geometric surface) with light-sampling density pdf_l, weighted against
  * BSDF sampling by the power heuristic; the radiance is *Le or, for Le NULL,
@@ -153,9 +144,9 @@ bool rt_path_nee_light(const rt_trace_ctx *ctx, const rt_path_state *ps, const r
 bool rt_path_nee_env(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
                      rt_nee_record *rec)
 {
-    const rt_light_table *t = ctx->state->light_table;
-    if (!(t && t->env_w > 0))
+    if (!rt_path_samples_env(ctx))
         return false;
+    const rt_light_table *t = ctx->state->light_table;
     rt_vec2 u = path_2d(ctx, ps, rng, DIM_ENV);
     rt_vec3 d;
     float pdf_l;
@@ -167,10 +158,10 @@ bool rt_path_nee_env(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_
 bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                          rt_vec3 wo, rt_rng *rng, rt_nee_record *rec)
 {
+    if (!rt_path_samples_emitters(ctx))
+        return false;
     const rt_scene *s = ctx->state->scene;
     const rt_light_table *t = ctx->state->light_table;
-    if (!(t && t->count))
-        return false;
     float ul = path_1d(ctx, ps, rng, DIM_EMIT_PICK);
     rt_vec2 u = path_2d(ctx, ps, rng, DIM_EMIT);
     size_t k = rt_light_table_pick(t, ul);
