@@ -241,6 +241,33 @@ static void test_surface_record_variants(void **state)
         }
     rt_render_state_free(&rs);
     rt_scene_free(&s);
+
+    /* without a texture the shading record leaves the UVs out (zero), and
+     * only them */
+    rt_scene_init(&s);
+    rt_material plain;
+    rt_material_default(&plain, "plain");
+    m = rt_scene_add_material(&s, &plain);
+    add_square_mesh(&s, &xf, m, false);
+    rt_scene_add_sphere(&s, rt_v3(5, 0, 0), 1.5f, m);
+    assert_int_equal(rt_render_state_prepare(&rs, &s, NULL, 0, &err), RT_OK);
+    rt_trace_ctx_init(&ctx, &rs);
+    assert_int_equal(rs.material_needs[m] & RT_MATERIAL_TEXTURED, 0);
+    for (uint32_t prim = 0; prim < 3; prim++) {
+        rt_ray r = rt_ray_make(rt_v3(0.1f, 0.2f, 3.0f), rt_normalize(dirs[0]), 0.0f, INFINITY);
+        rt_hit h = {2.5f, 0.3f, 0.45f, prim};
+        rt_surface a, sh;
+        rt_surface_at(&ctx, &r, &h, &a);
+        rt_surface_at_shading(&ctx, &r, &h, &sh);
+        assert_true(a.uv0.x != 0.0f || a.uv0.y != 0.0f);
+        assert_true(sh.uv0.x == 0.0f && sh.uv0.y == 0.0f && sh.uv1.x == 0.0f && sh.uv1.y == 0.0f);
+        /* every other field as the full record's (no frame: the material does not read it) */
+        assert_true(same3(sh.p, a.p) && same3(sh.ng, a.ng) && same3(sh.n, a.n) && same3(sh.n_unmapped, a.n_unmapped));
+        assert_true(same3(sh.wo, a.wo) && sh.front == a.front && sh.material == a.material && sh.prim == a.prim);
+        assert_true(memcmp(&sh.vertex_color, &a.vertex_color, sizeof a.vertex_color) == 0);
+    }
+    rt_render_state_free(&rs);
+    rt_scene_free(&s);
 }
 
 /* UV conventions: sphere longitude/latitude, quad (s, 1 - t), triangles

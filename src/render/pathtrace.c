@@ -271,7 +271,8 @@ rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, 
         return RT_VERTEX_PASS;
     }
     /* emission, MIS-weighted when it could have been light-sampled */
-    rt_vec3 Le = rt_surface_emission(ctx, sf);
+    rt_vec3 Le = (ctx->state->material_needs[sf->material] & RT_MATERIAL_EMITS) ? rt_surface_emission(ctx, sf)
+                                                                                 : rt_v3s(0.0f);
     /* area lights' quads have emissive materials: look only those up */
     bool emissive = rt_max3(rt_scale(m->emission, m->emission_strength)) > 0.0f;
     uint32_t light = emissive ? rt_area_light_of_prim(s, ctx->state->light_table, sf->prim) : RT_NONE;

@@ -77,6 +77,25 @@ bool rt_surface_material_reads_frame(const rt_material *m)
     return m->normal_tex.texture != RT_NONE || m->bsdf == RT_BSDF_CONDUCTOR || m->extended;
 }
 
+uint8_t rt_material_needs(const rt_material *m)
+{
+    const rt_texture_slot *slots[] = {&m->base_color_tex, &m->metal_rough_tex, &m->normal_tex,
+                                      &m->occlusion_tex,  &m->emissive_tex,    &m->transmission_tex};
+    bool textured = false;
+    for (size_t k = 0; k < sizeof slots / sizeof slots[0]; k++)
+        textured = textured || slots[k]->texture != RT_NONE;
+    for (size_t k = 0; k < RT_XTEX_COUNT; k++)
+        textured = textured || m->ext_tex[k].texture != RT_NONE;
+    uint8_t needs = 0;
+    if (textured)
+        needs |= RT_MATERIAL_TEXTURED;
+    if (rt_surface_material_reads_frame(m))
+        needs |= RT_MATERIAL_FRAME;
+    if (m->emission.x > 0.0f || m->emission.y > 0.0f || m->emission.z > 0.0f) /* rt_surface_emission's test */
+        needs |= RT_MATERIAL_EMITS;
+    return needs;
+}
+
 #if defined(__GNUC__)
 #define SURFACE_INLINE static inline __attribute__((always_inline)) /* one copy per caller, `frame` folded */
 #else
@@ -107,7 +126,9 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
                                             : s->quads.material[i];
     RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
     const rt_material *m = &s->materials[sf->material];
-    bool frame = need == NEED_ALL || (!emission_only && rt_surface_material_reads_frame(m));
+    uint8_t needs = ctx->state->material_needs[sf->material];
+    bool frame = need == NEED_ALL || (!emission_only && (needs & RT_MATERIAL_FRAME));
+    bool uv = need == NEED_ALL || (needs & RT_MATERIAL_TEXTURED);
     switch (kind) {
     case RT_PRIM_TRIANGLE: {
         const uint32_t *idx = &s->triangles.index[3 * (size_t)i];
@@ -133,18 +154,22 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
             if (rt_length2(ni) > 1e-20f && rt_finite3(ni))
                 n = rt_normalize(ni);
         }
-        rt_vec2 t0 = vx->uv0[idx[0]], t1 = vx->uv0[idx[1]], t2 = vx->uv0[idx[2]];
-        if (flags & RT_TRI_UV) {
-            sf->uv0 = rt_v2(t0.x * bw + t1.x * bu + t2.x * bv, t0.y * bw + t1.y * bu + t2.y * bv);
+        rt_vec2 t0 = rt_v2(0, 0), t1 = rt_v2(1, 0), t2 = rt_v2(0, 1);
+        if (uv || frame) { /* (a frame from the UVs reads them too) */
+            if (flags & RT_TRI_UV) {
+                t0 = vx->uv0[idx[0]], t1 = vx->uv0[idx[1]], t2 = vx->uv0[idx[2]];
+                sf->uv0 = rt_v2(t0.x * bw + t1.x * bu + t2.x * bv, t0.y * bw + t1.y * bu + t2.y * bv);
+            } else {
+                sf->uv0 = rt_v2(bu, bv);
+            }
+            if (vx->uv1) {
+                rt_vec2 s0 = vx->uv1[idx[0]], s1 = vx->uv1[idx[1]], s2 = vx->uv1[idx[2]];
+                sf->uv1 = rt_v2(s0.x * bw + s1.x * bu + s2.x * bv, s0.y * bw + s1.y * bu + s2.y * bv);
+            } else {
+                sf->uv1 = sf->uv0;
+            }
         } else {
-            t0 = rt_v2(0, 0), t1 = rt_v2(1, 0), t2 = rt_v2(0, 1);
-            sf->uv0 = rt_v2(bu, bv);
-        }
-        if (vx->uv1) {
-            rt_vec2 s0 = vx->uv1[idx[0]], s1 = vx->uv1[idx[1]], s2 = vx->uv1[idx[2]];
-            sf->uv1 = rt_v2(s0.x * bw + s1.x * bu + s2.x * bv, s0.y * bw + s1.y * bu + s2.y * bv);
-        } else {
-            sf->uv1 = sf->uv0;
+            sf->uv0 = sf->uv1 = rt_v2(0, 0); /* no texture reads them */
         }
         RT_DCHECK(!(flags & RT_TRI_COLOR) || vx->color);
         RT_DCHECK(!(flags & RT_TRI_TANGENT) || vx->tangent);
@@ -171,7 +196,7 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
         sf->p = rt_madd(c, d, fabsf(r));
         ng = r < 0.0f ? rt_neg(d) : d;
         n = ng;
-        sf->uv0 = sf->uv1 = rt_latlong_from_dir(d);
+        sf->uv0 = sf->uv1 = uv ? rt_latlong_from_dir(d) : rt_v2(0, 0);
         t = rt_v3(d.z, 0.0f, -d.x); /* dP/du; zero at the poles, fixed by orthonormal_tangent */
         break;
     }
