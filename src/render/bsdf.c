@@ -617,8 +617,13 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
         n = sf->ng;
     set_frame(b, n, sf->ng);
     if (m->bsdf == RT_BSDF_LAMBERT) { /* base colour x texture x vertex colour, nothing else */
-        rt_vec4 c = rt_surface_base_color(ctx, sf);
-        set_lambert(b, rt_v3(c.x, c.y, c.z));
+        if (m->base_color_tex.texture == RT_NONE) { /* rt_surface_base_color's arithmetic, inline */
+            rt_vec4 v = sf->vertex_color;
+            set_lambert(b, rt_v3(m->color.x * v.x, m->color.y * v.y, m->color.z * v.z));
+        } else {
+            rt_vec4 c = rt_surface_base_color(ctx, sf);
+            set_lambert(b, rt_v3(c.x, c.y, c.z));
+        }
         return;
     }
     if (m->bsdf == RT_BSDF_CONDUCTOR) {

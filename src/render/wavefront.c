@@ -182,6 +182,7 @@ static bool start_path(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_wavef
 static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_active)
 {
     const rt_kdtree *tree = ctx->state->tree;
+    const rt_material *materials = ctx->state->scene->materials;
     rt_ray_batch rb = {wf->ox, wf->oy, wf->oz, wf->dx, wf->dy, wf->dz, wf->tmin, wf->tmax};
     rt_hit_batch hb = {wf->ht, wf->hu, wf->hv, wf->hprim};
     uint32_t *q = wf->queue, *q2 = wf->queue2;
@@ -210,10 +211,13 @@ static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_acti
             rt_hit h = {wf->ht[i], wf->hu[i], wf->hv[i], wf->hprim[i]};
             rt_surface *sf = &wf->sf[i];
             rt_surface_at_shading(ctx, &wf->ps[i].r, &h, sf);
-            float coverage;
-            bool cut = rt_surface_cut_away(ctx, sf, &coverage);
-            if (!cut && coverage < 1.0f && rt_rng_float(&wf->rng[i]) >= coverage)
-                cut = true; /* stochastic alpha blending, from the path's stream */
+            bool cut = false;
+            if (materials[sf->material].alpha_mode != RT_ALPHA_OPAQUE) { /* (opaque: never cut, coverage 1) */
+                float coverage;
+                cut = rt_surface_cut_away(ctx, sf, &coverage);
+                if (!cut && coverage < 1.0f && rt_rng_float(&wf->rng[i]) >= coverage)
+                    cut = true; /* stochastic alpha blending, from the path's stream */
+            }
             wf->tmin[i] = wf->ps[i].r.tmin = h.t;
             if (!cut)
                 wf->status[i] = LANE_SURFACE;
