@@ -5,7 +5,8 @@
  * world-space direction on a rotated mesh, a sphere and a quad; and the
  * Khronos NormalTangentTest / NormalTangentMirrorTest models (shared
  * assets) show every normal-mapped dome as a dome; the shading and emitter
- * records agree with the full one in every field they promise. */
+ * records agree with the full one in every field they promise, and in
+ * where secondary rays start. */
 #include "test_util.h"
 
 #include <math.h>
@@ -234,6 +235,13 @@ static void test_surface_record_variants(void **state)
                 assert_true(memcmp(&v[k]->uv0, &a.uv0, sizeof a.uv0) == 0);
                 assert_true(memcmp(&v[k]->uv1, &a.uv1, sizeof a.uv1) == 0);
                 assert_true(v[k]->front == a.front && v[k]->material == a.material && v[k]->prim == a.prim);
+            }
+            /* the shading record's spawn origin, kept for ng's side, is the one computed on demand */
+            assert_true(sh.p_out_set && !a.p_out_set);
+            for (int side = -1; side <= 1; side += 2) {
+                rt_vec3 dir = rt_normalize(rt_add(rt_scale(a.ng, (float)side), rt_v3(0.2f, 0.1f, -0.3f)));
+                rt_vec3 o1 = rt_surface_spawn(&ctx, &sh, dir), o2 = rt_surface_spawn(&ctx, &a, dir);
+                assert_true(same3(o1, o2));
             }
             assert_true(same3(em.n, em.ng) && same3(em.n_unmapped, em.ng));
             assert_true(rt_length2(em.t) == 0.0f && rt_length2(em.b) == 0.0f); /* -0 from behind */

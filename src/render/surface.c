@@ -102,6 +102,14 @@ uint8_t rt_material_needs(const rt_material *m)
 #define SURFACE_INLINE static inline
 #endif
 
+/* A secondary ray's origin leaving p on the side of unit normal `side`. */
+static inline rt_vec3 spawn_origin(const rt_trace_ctx *ctx, rt_vec3 p, rt_vec3 side)
+{
+    rt_vec3 o = rt_offset_ray_origin(p, side, ctx->state->scale);
+    float extra = ctx->state->scene->settings.ray_offset;
+    return extra > 0.0f ? rt_madd(o, side, extra) : o;
+}
+
 /* What a caller needs of the record: everything (rt_surface_at), the
  * frame only where the material reads it (rt_surface_at_shading), or what
  * emission reads (rt_surface_at_emitter: no shading normal, normal map,
@@ -253,6 +261,9 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
     sf->n_unmapped = n_unmapped;
     sf->t = tt;
     sf->b = bb;
+    sf->p_out_set = need == NEED_SHADING;
+    if (sf->p_out_set)
+        sf->p_out = spawn_origin(ctx, sf->p, ng);
 }
 
 void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf)
@@ -318,10 +329,10 @@ bool rt_surface_cut_away(const rt_trace_ctx *ctx, const rt_surface *sf, float *c
 
 rt_vec3 rt_surface_spawn(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 d)
 {
-    rt_vec3 side = rt_dot(d, sf->ng) >= 0.0f ? sf->ng : rt_neg(sf->ng);
-    rt_vec3 o = rt_offset_ray_origin(sf->p, side, ctx->state->scale);
-    float extra = ctx->state->scene->settings.ray_offset;
-    return extra > 0.0f ? rt_madd(o, side, extra) : o;
+    bool out = rt_dot(d, sf->ng) >= 0.0f;
+    if (out && sf->p_out_set)
+        return sf->p_out; /* computed once for the record */
+    return spawn_origin(ctx, sf->p, out ? sf->ng : rt_neg(sf->ng));
 }
 rt_surface_walk rt_trace_surface(const rt_trace_ctx *ctx, rt_ray *r, int *layers_left, rt_rng *blend_rng,
                                  rt_surface *sf, float *coverage)

@@ -40,6 +40,8 @@ typedef struct rt_surface {
     bool front;
     uint32_t material;
     uint32_t prim;
+    bool p_out_set;       /* p_out holds rt_surface_spawn's origin for directions on ng's side */
+    rt_vec3 p_out;        /* (rt_surface_at_shading sets it: a shaded hit's bounce and shadow rays mostly leave there) */
 } rt_surface;
 
 /* The material of primitive `prim` (an id of the scene's one primitive id
