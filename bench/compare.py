@@ -9,36 +9,20 @@ high-quality build, and rt's bytes per triangle. The machines are shared and
 noisy, so only ratios from one run mean much.
 Environment: SHARED (default ../shared), RUNS (default 5).
 """
-import json, os, re, subprocess, sys
+import json, os, subprocess, sys
 
-shared = os.environ.get("SHARED", "../shared")
-runs = os.environ.get("RUNS", "5")
-embree_dir = os.path.join(shared, "bench", "embree")
-build = os.environ.get("BUILD_EMBREE", "/tmp/rt-embree")
-manifest = open(os.path.join(shared, "bench", "MANIFEST.md")).read()
-models = re.findall(r"^\| (\w+) \| `([^`]+)` \|", manifest, re.M)
-if not models:
-    sys.exit("bench-compare: no models in the manifest")
+import common
+from common import shared, runs, embree_dir, build, loadavg
 
-if subprocess.call(["sh", "-c", "echo '#include <embree3/rtcore.h>' | cc -E -x c - >/dev/null 2>&1"]) != 0:
-    print("bench-compare: installing Embree 3 and the converter's Python packages (make -C %s deps)" % embree_dir,
-          file=sys.stderr)
-    subprocess.check_call(["make", "-C", embree_dir, "deps"])
+manifest, models = common.bench_models("bench-compare")
+common.ensure_embree("bench-compare")
+
 
 def rtbench(glb, model, kind, threads, extra=()):
-    out = subprocess.run(["./bench/rtbench", os.path.join(shared, glb),
-                          os.path.join(shared, "bench", model, "%s.%s.rays" % (model, kind)),
-                          "--ref", os.path.join(shared, "bench", model, "%s.%s.hits" % (model, kind)),
-                          "-t", str(threads), "--runs", runs] + list(extra), capture_output=True, text=True)
-    d = dict(line.split(": ", 1) for line in out.stdout.splitlines() if ": " in line)
-    d["status"] = out.returncode
-    return d
-
-def loadavg():
-    try:
-        return " ".join(open("/proc/loadavg").read().split()[:3])
-    except OSError:
-        return "?"
+    return common.rtbench([os.path.join(shared, glb),
+                           os.path.join(shared, "bench", model, "%s.%s.rays" % (model, kind)),
+                           "--ref", os.path.join(shared, "bench", model, "%s.%s.hits" % (model, kind)),
+                           "-t", str(threads), "--runs", runs] + list(extra))
 
 print("load average at start: " + loadavg())
 print("%-28s %-8s %3s %10s %10s %7s %11s" % ("model", "kind", "thr", "rt Mray/s", "Embree", "ratio", "mismatches"))

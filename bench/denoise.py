@@ -22,10 +22,11 @@ denoised renders the same way (dn-N.pfm, dn-N.json). Environment: SHARED (defaul
 "x,y,w,h" of the 16-spp images written as PNGs for docs/images, default
 none).
 """
-import json, os, re, resource, subprocess, sys
+import json, os, re, subprocess, sys
+
+from common import shared, loadavg, children_cpu, rt_compare
 
 here = os.path.dirname(os.path.abspath(__file__))
-shared = os.environ.get("SHARED", "../shared")
 threads = os.environ.get("THREADS", "2")
 den_spps = [int(s) for s in os.environ.get("DENOISED_SPP", "4 16 64").split()]
 raw_spps = [int(s) for s in os.environ.get("RAW_SPP", "256 1024").split()]
@@ -39,18 +40,6 @@ for path in (rt, reference):
     if not os.path.exists(path):
         sys.exit("bench-denoise: no %s (SHARED=dir for the shared material, the rt binary as argument)" % path)
 os.makedirs(out_dir, exist_ok=True)
-
-
-def loadavg():
-    try:
-        return " ".join(open("/proc/loadavg").read().split()[:3])
-    except OSError:
-        return "?"
-
-
-def children_cpu():
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
 
 
 def run(args):
@@ -68,10 +57,9 @@ def seconds(pattern, text):
 
 
 def compare(image):
-    p = subprocess.run([rt, "compare", image, reference], capture_output=True, text=True)
-    d = dict(line.split(": ", 1) for line in p.stdout.splitlines() if ": " in line)
-    if p.returncode != 0 or "RMSE" not in d:
-        sys.exit("bench-denoise: rt compare %s: %s" % (image, p.stderr.strip()))
+    d, err = rt_compare(rt, image, reference)
+    if d is None:
+        sys.exit("bench-denoise: rt compare %s: %s" % (image, err))
     return {k: float(d[k].split()[0]) for k in ("RMSE", "relMSE", "LDR-FLIP")}
 
 

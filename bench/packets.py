@@ -20,19 +20,11 @@ Environment: SHARED (default ../shared), RUNS (default 5), BUILD_EMBREE
 """
 import json, os, re, subprocess, sys
 
-shared = os.environ.get("SHARED", "../shared")
-runs = os.environ.get("RUNS", "5")
-embree_dir = os.path.join(shared, "bench", "embree")
-build = os.environ.get("BUILD_EMBREE", "/tmp/rt-embree")
-manifest = open(os.path.join(shared, "bench", "MANIFEST.md")).read()
-models = re.findall(r"^\| (\w+) \| `([^`]+)` \|", manifest, re.M)
-if not models:
-    sys.exit("bench-packets: no models in the manifest")
+import common
+from common import shared, runs, embree_dir, build, loadavg
 
-if subprocess.call(["sh", "-c", "echo '#include <embree3/rtcore.h>' | cc -E -x c - >/dev/null 2>&1"]) != 0:
-    print("bench-packets: installing Embree 3 and the converter's Python packages (make -C %s deps)" % embree_dir,
-          file=sys.stderr)
-    subprocess.check_call(["make", "-C", embree_dir, "deps"])
+manifest, models = common.bench_models("bench-packets")
+common.ensure_embree("bench-packets")
 subprocess.check_call(["make", "-s", "-C", embree_dir, "BUILD=" + build], stdout=subprocess.DEVNULL)
 
 
@@ -46,12 +38,10 @@ def image_size(model):
 def rtbench(glb, model, threads, tw, th):
     w, _ = image_size(model)
     rays = os.path.join(shared, "bench", model, model + ".primary")
-    out = subprocess.run(["./bench/rtbench", os.path.join(shared, glb), rays + ".rays", "--ref", rays + ".hits",
-                          "-t", str(threads), "--runs", runs, "--packets", str(tw), str(th),
-                          "--image-width", str(w)], capture_output=True, text=True)
-    d = dict(line.split(": ", 1) for line in out.stdout.splitlines() if ": " in line)
-    if out.returncode != 0:
-        print(out.stderr, file=sys.stderr, end="")
+    d = common.rtbench([os.path.join(shared, glb), rays + ".rays", "--ref", rays + ".hits", "-t", str(threads),
+                        "--runs", runs, "--packets", str(tw), str(th), "--image-width", str(w)])
+    if d["status"] != 0:
+        print(d["stderr"], file=sys.stderr, end="")
     return d
 
 
@@ -68,13 +58,6 @@ def embree(model, glb):
         print(out.stderr, file=sys.stderr)
         sys.exit("bench-packets: the Embree anchor failed for " + model)
     return json.loads(out.stdout)["results"]
-
-
-def loadavg():
-    try:
-        return " ".join(open("/proc/loadavg").read().split()[:3])
-    except OSError:
-        return "?"
 
 
 print("load average at start: " + loadavg())

@@ -23,10 +23,11 @@ scalar_rgb"), SCALAR_SPP (the sample counts at which scalar variants run,
 default 16: they are slow), MITSUBA_PYTHON (default
 build/mitsuba-venv/bin/python), OUT (the images, default build/bench-render).
 """
-import json, os, re, resource, subprocess, sys, time
+import json, os, re, subprocess, sys, time
+
+from common import shared, loadavg, children_cpu, rt_compare
 
 here = os.path.dirname(os.path.abspath(__file__))
-shared = os.environ.get("SHARED", "../shared")
 spps = [int(s) for s in os.environ.get("SPP", "16 64").split()]
 threads_list = [int(t) for t in os.environ.get("THREADS", "1 2").split()]
 res = int(os.environ.get("RES", "512"))
@@ -52,27 +53,14 @@ for path in [scene_xml, reference] + rts:
 os.makedirs(out_dir, exist_ok=True)
 
 
-def loadavg():
-    try:
-        return " ".join(open("/proc/loadavg").read().split()[:3])
-    except OSError:
-        return "?"
-
-
 def rmse(image):
     """RMSE against the shared reference, None at another resolution."""
     if res != 512:
         return None
-    out = subprocess.run([rts[0], "compare", image, reference], capture_output=True, text=True)
-    m = re.search(r"^RMSE: (\S+)", out.stdout, re.M)
-    if not m:
-        fail("rt compare %s: %s" % (image, out.stderr.strip()))
-    return float(m.group(1))
-
-
-def children_cpu():
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
+    d, err = rt_compare(rts[0], image, reference)
+    if d is None:
+        fail("rt compare %s: %s" % (image, err))
+    return float(d["RMSE"].split()[0])
 
 
 def run_rt(binary, spp, threads, tag):

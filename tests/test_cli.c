@@ -579,27 +579,29 @@ static void test_bad_scene_files(void **state)
 {
     (void)state;
     const char *o = out_png;
-    write_text("kw.txt", "resolution 16 16\nbogus 1 2\n");
-    REFUSE(o, "kw.txt:2:1: ", "unknown keyword 'bogus'", path_in("kw.txt"), "-o", o);
-    write_text("nan.txt", "resolution 16 16\ncamera position 0 1 nan look_at 0 0 0\n");
-    REFUSE(o, "nan.txt:2:21: ", "'nan'", path_in("nan.txt"), "-o", o);
-    write_text("inf.txt", "resolution 16 16\ncamera position 0 1 2 look_at 0 0 0 fov inf\n");
-    REFUSE(o, "inf.txt:2:", "'inf'", path_in("inf.txt"), "-o", o);
-    write_text("cam.txt", "resolution 16 16\ncamera position 0 0 0 look_at 0 0 0\n");
-    REFUSE(o, "cam.txt:2:", "look_at point equals its position", path_in("cam.txt"), "-o", o);
-    write_text("spp.txt", "samples 2000000\n");
-    REFUSE(o, "spp.txt:1:9: ", "between 1 and 1048576", path_in("spp.txt"), "-o", o);
-    write_text("res.txt", "resolution 40000 10\n");
-    REFUSE(o, "res.txt:1:12: ", "between 1 and 32768", path_in("res.txt"), "-o", o);
-    write_text("depth.txt", "max_bounce 1000\n");
-    REFUSE(o, "depth.txt:1:12: ", "max_bounce must be between 0 and 256", path_in("depth.txt"), "-o", o);
-    write_text("tree.txt", "resolution 8 8\nintegrator whitted\ndiffuse_rays 1000\ndiffuse_bounces 5\n");
-    REFUSE(o, "tree.txt: ", "rays per camera sample", path_in("tree.txt"), "-o", o);
-    write_text("badnum.txt", "resolution 16 16x\n");
-    REFUSE(o, "badnum.txt:1:", NULL, path_in("badnum.txt"), "-o", o);
-    REFUSE(o, "missing.txt: cannot open", NULL, path_in("missing.txt"), "-o", o);
-    write_text("mesh.txt", "mesh missing.obj\n");
-    REFUSE(o, "missing.obj", NULL, path_in("mesh.txt"), "-o", o);
+    /* file, its text (NULL: no such file), the message's two fragments */
+    static const struct {
+        const char *file, *text, *msg1, *msg2;
+    } bad[] = {
+        {"kw.txt", "resolution 16 16\nbogus 1 2\n", "kw.txt:2:1: ", "unknown keyword 'bogus'"},
+        {"nan.txt", "resolution 16 16\ncamera position 0 1 nan look_at 0 0 0\n", "nan.txt:2:21: ", "'nan'"},
+        {"inf.txt", "resolution 16 16\ncamera position 0 1 2 look_at 0 0 0 fov inf\n", "inf.txt:2:", "'inf'"},
+        {"cam.txt", "resolution 16 16\ncamera position 0 0 0 look_at 0 0 0\n", "cam.txt:2:",
+         "look_at point equals its position"},
+        {"spp.txt", "samples 2000000\n", "spp.txt:1:9: ", "between 1 and 1048576"},
+        {"res.txt", "resolution 40000 10\n", "res.txt:1:12: ", "between 1 and 32768"},
+        {"depth.txt", "max_bounce 1000\n", "depth.txt:1:12: ", "max_bounce must be between 0 and 256"},
+        {"tree.txt", "resolution 8 8\nintegrator whitted\ndiffuse_rays 1000\ndiffuse_bounces 5\n", "tree.txt: ",
+         "rays per camera sample"},
+        {"badnum.txt", "resolution 16 16x\n", "badnum.txt:1:", NULL},
+        {"missing.txt", NULL, "missing.txt: cannot open", NULL},
+        {"mesh.txt", "mesh missing.obj\n", "missing.obj", NULL},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        if (bad[i].text)
+            write_text(bad[i].file, bad[i].text);
+        REFUSE(o, bad[i].msg1, bad[i].msg2, path_in(bad[i].file), "-o", o);
+    }
     /* the scene's own output line is protected the same way */
     char own[700];
     snprintf(own, sizeof own, "output \"%s\"\nbogus\n", o);
@@ -1063,6 +1065,20 @@ static const char *slow_scene(void)
     return path_in("slow.txt");
 }
 
+/* slow_scene with its camera line replaced by the first line of `printed`
+ * (a `camera` line the window printed), as moved.txt; its path. */
+static const char *slow_scene_with_camera(char *printed)
+{
+    static char moved[4096];
+    *strchr(printed, '\n') = 0;
+    snprintf(moved, sizeof moved,
+             "resolution 64 64\nbackground 0.5 0.6 0.7\n%s\n"
+             "material glow color 0.5 0.5 0.5 emission 1 0.5 0.25\nsphere 0 0 0 1 glow\n",
+             printed);
+    write_text("moved.txt", moved);
+    return path_in("moved.txt");
+}
+
 /* Runs rt with args, sends `sig` after 0.7 s, and waits. */
 static void run_and_signal(const char *const *args, int sig, run_result *r)
 {
@@ -1320,8 +1336,9 @@ static void tev_view_free(tev_view *v)
         free(v->plane[c]);
 }
 
-/* A loopback TCP socket on a free port, bound (listening when `listening`). */
-static int tev_socket(int *port, bool listening)
+/* A loopback TCP socket on a free port, bound (listening when `listening`);
+ * its "127.0.0.1:PORT" for --display-server in address. */
+static int tev_socket(char address[64], bool listening)
 {
     int fd = socket(AF_INET, SOCK_STREAM, 0);
     assert_true(fd >= 0);
@@ -1333,7 +1350,7 @@ static int tev_socket(int *port, bool listening)
     assert_int_equal(bind(fd, (struct sockaddr *)&a, sizeof a), 0);
     socklen_t len = sizeof a;
     assert_int_equal(getsockname(fd, (struct sockaddr *)&a, &len), 0);
-    *port = ntohs(a.sin_port);
+    snprintf(address, 64, "127.0.0.1:%d", ntohs(a.sin_port));
     if (listening)
         assert_int_equal(listen(fd, 4), 0);
     return fd;
@@ -1531,6 +1548,26 @@ static void assert_tev_layer(const tev_view *v, const char *layer, int channels,
     rt_framebuffer_free(&fb);
 }
 
+/* Runs rt with args, which point it at the tev stand-in `listener`, reads
+ * everything rt sends into *v until rt closes the connection, closes the
+ * listener; rt must exit 0. */
+static void run_showing_tev(const char *const *args, int listener, tev_view *v)
+{
+    double t0 = now_s();
+    pid_t pid = spawn(args);
+    int fd = tev_accept(listener);
+    memset(v, 0, sizeof *v);
+    while (tev_read_packet(fd, v))
+        ;
+    close(fd);
+    close(listener);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    wait_for(pid, t0, 120.0, r);
+    assert_int_equal(r->status, 0);
+    free(r);
+}
+
 /* --display-server with a tev stand-in listening: tiled and in passes, the
  * image tev ends up showing is the written one, bit for bit. */
 static void test_display_server(void **state)
@@ -1538,31 +1575,17 @@ static void test_display_server(void **state)
     (void)state;
     const char *modes[2] = {"0", "2"};
     for (int m = 0; m < 2; m++) {
-        int port;
-        int listener = tev_socket(&port, true);
         char address[64];
-        snprintf(address, sizeof address, "127.0.0.1:%d", port);
+        int listener = tev_socket(address, true);
         const char *pfm = path_in("tev.pfm");
         const char *const args[] = {"-q", "-r", "40x24", "-s", "6", "--tile", "8", "--integrator", "path", "--passes",
                                     modes[m], "--display-server", address, "-o", pfm, slow_scene(), NULL};
-        double t0 = now_s();
-        pid_t pid = spawn(args);
-        int fd = tev_accept(listener);
         tev_view v;
-        memset(&v, 0, sizeof v);
-        while (tev_read_packet(fd, &v))
-            ;
-        close(fd);
-        close(listener);
-        run_result *r = malloc(sizeof *r);
-        assert_non_null(r);
-        wait_for(pid, t0, 120.0, r);
-        assert_int_equal(r->status, 0);
+        run_showing_tev(args, listener, &v);
         assert_int_equal(v.creates, 1);
         assert_true(v.updates >= 1);
         assert_tev_shows(&v, pfm, "tev.pfm");
         tev_view_free(&v);
-        free(r);
         unlink(pfm);
     }
 }
@@ -1578,27 +1601,14 @@ static void test_display_server_aovs(void **state)
     static const char *const want[] = {"R", "G", "B", "albedo.R", "albedo.G", "albedo.B", "normal.R", "normal.G",
                                        "normal.B", "depth.Y", "spp.Y"};
     for (int m = 0; m < 2; m++) {
-        int port;
-        int listener = tev_socket(&port, true);
         char address[64];
-        snprintf(address, sizeof address, "127.0.0.1:%d", port);
+        int listener = tev_socket(address, true);
         const char *pfm = path_in("tevaov.pfm");
         const char *const args[] = {"-q", "-r", "40x24", "-s", "6", "--tile", "8", "--integrator", "path",
                                     "--passes", modes[m], "--aov", "albedo,normal,depth,spp", "--display-server",
                                     address, "-o", pfm, slow_scene(), NULL};
-        double t0 = now_s();
-        pid_t pid = spawn(args);
-        int fd = tev_accept(listener);
         tev_view v;
-        memset(&v, 0, sizeof v);
-        while (tev_read_packet(fd, &v))
-            ;
-        close(fd);
-        close(listener);
-        run_result *r = malloc(sizeof *r);
-        assert_non_null(r);
-        wait_for(pid, t0, 120.0, r);
-        assert_int_equal(r->status, 0);
+        run_showing_tev(args, listener, &v);
         assert_int_equal(v.creates, 1);
         assert_true(v.updates >= 1);
         assert_int_equal(v.nch, (int)(sizeof want / sizeof want[0]));
@@ -1610,7 +1620,6 @@ static void test_display_server_aovs(void **state)
         assert_tev_layer(&v, "depth", 1, path_in("tevaov.depth.pfm"));
         assert_tev_layer(&v, "spp", 1, path_in("tevaov.spp.pfm"));
         tev_view_free(&v);
-        free(r);
         unlink(pfm);
         unlink(path_in("tevaov.albedo.pfm"));
         unlink(path_in("tevaov.normal.pfm"));
@@ -1624,10 +1633,8 @@ static void test_display_server_aovs(void **state)
 static void test_display_server_absent(void **state)
 {
     (void)state;
-    int port;
-    int bound = tev_socket(&port, false); /* bound, not listening: connections are refused */
     char address[64];
-    snprintf(address, sizeof address, "127.0.0.1:%d", port);
+    int bound = tev_socket(address, false); /* bound, not listening: connections are refused */
     const char *pfm = path_in("absent.pfm");
     run_result *r = malloc(sizeof *r);
     assert_non_null(r);
@@ -1652,10 +1659,8 @@ static void test_display_server_absent(void **state)
 static void test_display_server_reconnects(void **state)
 {
     (void)state;
-    int port;
-    int listener = tev_socket(&port, true);
     char address[64];
-    snprintf(address, sizeof address, "127.0.0.1:%d", port);
+    int listener = tev_socket(address, true);
     const char *pfm = path_in("again.pfm");
     const char *const args[] = {"-q", "-s", "100000", "-t", "2", "--integrator", "path", "--display-server", address,
                                 "-o", pfm, slow_scene(), NULL};
@@ -1746,6 +1751,43 @@ static pid_t start_xvfb(int *display)
     return pid;
 }
 
+/* Saves DISPLAY into saved and unsets it, so that a --window test sees no
+ * display but the Xvfb it starts. */
+static void save_display(char saved[256])
+{
+    const char *display = getenv("DISPLAY");
+    saved[0] = '\0';
+    if (display)
+        snprintf(saved, 256, "%s", display);
+    unsetenv("DISPLAY");
+}
+
+/* Puts back the DISPLAY save_display saved (unset if there was none). */
+static void restore_display(const char saved[256])
+{
+    if (saved[0])
+        setenv("DISPLAY", saved, 1);
+    else
+        unsetenv("DISPLAY");
+}
+
+/* For a --window test, DISPLAY saved: starts Xvfb and returns its display
+ * number. When rt has no window (built without SDL2; asked with a tiny
+ * --window render to png) or there is no Xvfb, puts DISPLAY back, frees r
+ * and skips the test. */
+static int window_xvfb_or_skip(run_result *r, const char *png, const char saved[256])
+{
+    run_args(r, (const char *const[]){"-q", "-r", "8x8", "-s", "1", "--window", "-o", png, NULL});
+    int dpy = -1;
+    pid_t xvfb = strstr(r->err, "built without SDL2") ? -1 : start_xvfb(&dpy);
+    if (xvfb < 0) {
+        restore_display(saved);
+        free(r);
+        skip(); /* no SDL2 or no Xvfb */
+    }
+    return dpy;
+}
+
 /* --window under Xvfb: the window shows the rendered image, the PNG's very
  * bytes (read back from the window through RT_WINDOW_SCREENSHOT). Without
  * a display --window is refused with a clear message and exit 2. */
@@ -1755,11 +1797,8 @@ static void test_window(void **state)
     run_result *r = malloc(sizeof *r);
     assert_non_null(r);
     const char *png = path_in("win.png"), *shot = path_in("win.ppm");
-    const char *display = getenv("DISPLAY");
-    char saved[256] = "";
-    if (display)
-        snprintf(saved, sizeof saved, "%s", display);
-    unsetenv("DISPLAY");
+    char saved[256];
+    save_display(saved);
     put_precious(png);
     run_args(r, (const char *const[]){"-q", "-r", "8x8", "-s", "1", "--window", "-o", png, NULL});
     assert_int_equal(r->status, 2);
@@ -1789,10 +1828,7 @@ static void test_window(void **state)
                                       "-o", png, slow_scene(), NULL});
     unsetenv("RT_WINDOW_SCREENSHOT");
     unsetenv("LSAN_OPTIONS");
-    if (saved[0])
-        setenv("DISPLAY", saved, 1);
-    else
-        unsetenv("DISPLAY");
+    restore_display(saved);
     stop_xvfb();
     if (r->status != 0) {
         static char msg[sizeof r->err];
@@ -1858,26 +1894,15 @@ static void test_window_camera(void **state)
     run_result *r = malloc(sizeof *r);
     assert_non_null(r);
     const char *png = path_in("cam.png"), *out = path_in("cam.out");
-    const char *display = getenv("DISPLAY");
-    char saved[256] = "";
-    if (display)
-        snprintf(saved, sizeof saved, "%s", display);
-    unsetenv("DISPLAY");
-    run_args(r, (const char *const[]){"-q", "-r", "8x8", "-s", "1", "--window", "-o", png, NULL});
-    int dpy = -1;
-    pid_t xvfb = strstr(r->err, "built without SDL2") ? -1 : start_xvfb(&dpy);
-    if (xvfb < 0) {
-        if (saved[0])
-            setenv("DISPLAY", saved, 1);
-        free(r);
-        skip(); /* no SDL2 or no Xvfb */
-    }
+    char saved[256];
+    save_display(saved);
+    int dpy = window_xvfb_or_skip(r, png, saved);
     const char *scene = slow_scene();
     /* 1. a drag, then P, then Esc */
     run_window_script(r, dpy, "wait done; drag left 20 12 30 14; wait done; key P; key Escape", out,
                       (const char *const[]){"-v", "-r", "40x24", "-s", "8", "--integrator", "path", "--passes", "2",
                                             "--window", "-o", png, scene, NULL});
-    static char printed[2048], moved[4096];
+    static char printed[2048];
     read_all(out, printed, sizeof printed);
     int status1 = r->status;
     bool restarted = strstr(r->err, "the camera moved; rendering again from sample 0") != NULL;
@@ -1898,8 +1923,7 @@ static void test_window_camera(void **state)
                       (const char *const[]){"-r", "40x24", "-s", "100000", "--integrator", "path", "--passes", "2",
                                             "--window", "-o", png3, scene, NULL});
     stop_xvfb();
-    if (saved[0])
-        setenv("DISPLAY", saved, 1);
+    restore_display(saved);
     assert_int_equal(status1, 0);
     assert_true(restarted);
     assert_int_equal(wrote1, 2); /* the first camera's image, then the moved one's */
@@ -1917,14 +1941,8 @@ static void test_window_camera(void **state)
     render_ok(orig, (const char *const[]){"-r", "40x24", "-s", "8", "--integrator", "path", scene, NULL});
     assert_false(same_file(orig, png));
     /* the printed line, pasted into the scene, renders the window's image */
-    *strchr(printed, '\n') = 0;
-    snprintf(moved, sizeof moved,
-             "resolution 64 64\nbackground 0.5 0.6 0.7\n%s\n"
-             "material glow color 0.5 0.5 0.5 emission 1 0.5 0.25\nsphere 0 0 0 1 glow\n",
-             printed);
-    write_text("moved.txt", moved);
-    render_ok(again, (const char *const[]){"-r", "40x24", "-s", "8", "--integrator", "path", path_in("moved.txt"),
-                                           NULL});
+    render_ok(again, (const char *const[]){"-r", "40x24", "-s", "8", "--integrator", "path",
+                                           slow_scene_with_camera(printed), NULL});
     assert_same_file(again, png);
     /* ] ] ] = +1 stop: the snapshot is what --exposure 1 writes */
     render_ok(again, (const char *const[]){"-r", "40x24", "-s", "8", "--integrator", "path", "--exposure", "1", scene,
@@ -2000,20 +2018,9 @@ static void test_window_inputs(void **state)
     run_result *r = malloc(sizeof *r);
     assert_non_null(r);
     const char *png = path_in("in.png"), *out = path_in("in.out");
-    const char *display = getenv("DISPLAY");
-    char saved[256] = "";
-    if (display)
-        snprintf(saved, sizeof saved, "%s", display);
-    unsetenv("DISPLAY");
-    run_args(r, (const char *const[]){"-q", "-r", "8x8", "-s", "1", "--window", "-o", png, NULL});
-    int dpy = -1;
-    pid_t xvfb = strstr(r->err, "built without SDL2") ? -1 : start_xvfb(&dpy);
-    if (xvfb < 0) {
-        if (saved[0])
-            setenv("DISPLAY", saved, 1);
-        free(r);
-        skip();
-    }
+    char saved[256];
+    save_display(saved);
+    int dpy = window_xvfb_or_skip(r, png, saved);
     const char *scene = slow_scene(); /* a sphere of radius 1 at the origin: diagonal 2 sqrt(3) */
     run_window_script(r, dpy,
                       "wait done; key P; drag right 20 12 25 12; key P; wheel 2; key P; key W; key P; key R; key P; "
@@ -2022,8 +2029,7 @@ static void test_window_inputs(void **state)
                       (const char *const[]){"-q", "-r", "40x24", "-s", "4", "--integrator", "path", "--window", "-o",
                                             png, scene, NULL});
     stop_xvfb();
-    if (saved[0])
-        setenv("DISPLAY", saved, 1);
+    restore_display(saved);
     if (r->status != 0)
         fail_msg("rt --window failed (%d): %s", r->status, r->err);
     static char text[8192];
@@ -2118,20 +2124,9 @@ static void test_window_camera_xdotool(void **state)
     run_result *r = malloc(sizeof *r);
     assert_non_null(r);
     const char *png = path_in("xdo.png"), *out = path_in("xdo.txt"), *err = path_in("stderr.txt");
-    const char *display = getenv("DISPLAY");
-    char saved[256] = "";
-    if (display)
-        snprintf(saved, sizeof saved, "%s", display);
-    unsetenv("DISPLAY");
-    run_args(r, (const char *const[]){"-q", "-r", "8x8", "-s", "1", "--window", "-o", png, NULL});
-    int dpy = -1;
-    pid_t xvfb = strstr(r->err, "built without SDL2") ? -1 : start_xvfb(&dpy);
-    if (xvfb < 0) {
-        if (saved[0])
-            setenv("DISPLAY", saved, 1);
-        free(r);
-        skip();
-    }
+    char saved[256];
+    save_display(saved);
+    int dpy = window_xvfb_or_skip(r, png, saved);
     const char *scene = slow_scene();
     char dname[32];
     snprintf(dname, sizeof dname, ":%d", dpy);
@@ -2142,11 +2137,8 @@ static void test_window_camera_xdotool(void **state)
                                                "--window", "-o", png, scene, NULL},
                          out);
     unsetenv("LSAN_OPTIONS");
-    if (saved[0])
-        setenv("DISPLAY", saved, 1);
-    else
-        unsetenv("DISPLAY");
-    static char wid[64], printed[2048], moved[4096];
+    restore_display(saved);
+    static char wid[64], printed[2048];
     bool ok = xdo(dpy, wid, sizeof wid, (const char *const[]){"search", "--sync", "--name", "^rt: ", NULL}) == 0;
     if (ok)
         *strchr(wid, '\n') = 0;
@@ -2172,15 +2164,9 @@ static void test_window_camera_xdotool(void **state)
     assert_int_equal(r->status, 0);
     read_all(out, printed, sizeof printed);
     assert_null(strstr(printed, "camera position 0 0 4 look_at 0 0 0 "));
-    *strchr(printed, '\n') = 0;
-    snprintf(moved, sizeof moved,
-             "resolution 64 64\nbackground 0.5 0.6 0.7\n%s\n"
-             "material glow color 0.5 0.5 0.5 emission 1 0.5 0.25\nsphere 0 0 0 1 glow\n",
-             printed);
-    write_text("moved.txt", moved);
     const char *again_png = path_in("xdo-again.png");
     render_ok(again_png, (const char *const[]){"-r", "40x24", "-s", "8", "--integrator", "path",
-                                               path_in("moved.txt"), NULL});
+                                               slow_scene_with_camera(printed), NULL});
     assert_same_file(again_png, png);
     unlink(png);
     unlink(again_png);

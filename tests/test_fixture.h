@@ -1,10 +1,12 @@
 /* test_fixture.h - a scene ready to trace, as the integrator tests set it
  * up: the scene tables, their kd-tree, the render state and a trace
- * context over them. Include after test_util.h.
+ * context over them; and for scenes built in code, the camera and a whole
+ * render. Include after test_util.h.
  *
  *   test_fixture f;
  *   test_fixture_load(&f, "integrator path\nsphere 0 0 0 1 m\n...", RT_PREPARE_LIGHT_TABLE);
  *   rt_vec3 L = rt_radiance_path(&f.ctx, &ray, &rng);
+ *   rt_vec3 L2 = test_fixture_path_radiance(&f, seed, org, dir, i);  (checked finite, >= 0)
  *   test_fixture_free(&f);
  *
  * Or in two steps, to change the scene between parsing and building:
@@ -23,9 +25,12 @@
 
 #include "rt/accel/kdtree.h"
 #include "rt/io/scene_parse.h"
+#include "rt/render/pathtrace.h"
+#include "rt/render/render.h"
 #include "rt/render/render_state.h"
 #include "rt/render/surface.h"
 #include "rt/scene/scene.h"
+#include "rt/scene/validate.h"
 
 typedef struct test_fixture {
     rt_scene s;
@@ -59,11 +64,55 @@ static inline void test_fixture_load(test_fixture *f, const char *text, unsigned
     test_fixture_build(f, prepare);
 }
 
+/* The path tracer's radiance along the ray from org towards dir
+ * (normalised here) with the random stream of pixel i, sample 0, of
+ * `seed`; asserted finite and non-negative. */
+static inline rt_vec3 test_fixture_path_radiance(const test_fixture *f, uint32_t seed, rt_vec3 org, rt_vec3 dir,
+                                                 uint32_t i)
+{
+    rt_rng rng = rt_rng_for_sample(seed, i, 0);
+    rt_ray r = rt_ray_make(org, rt_normalize(dir), 0.0f, INFINITY);
+    rt_vec3 L = rt_radiance_path(&f->ctx, &r, &rng);
+    assert_true(rt_finite3(L) && L.x >= 0.0f && L.y >= 0.0f && L.z >= 0.0f);
+    return L;
+}
+
 static inline void test_fixture_free(test_fixture *f)
 {
     rt_render_state_free(&f->rs);
     rt_kdtree_free(&f->tree);
     rt_scene_free(&f->s);
+}
+
+/* The camera of a scene built in code: from `from` towards `at`, `up` up,
+ * a vertical field of view of fov_deg degrees. */
+static inline void test_scene_look(rt_scene *s, rt_vec3 from, rt_vec3 at, rt_vec3 up, float fov_deg)
+{
+    s->camera.position = from;
+    s->camera.look_at = at;
+    s->camera.up = up;
+    s->camera.vfov_deg = fov_deg;
+    s->camera_set = true;
+}
+
+/* Renders a scene built in code (validated here, with a kd-tree of its
+ * own) at its settings on `threads` threads in tiles of `tile` pixels (0:
+ * the default) into a new *fb; no sample may be bad. */
+static inline void test_render_scene(rt_scene *s, int threads, int tile, rt_framebuffer *fb)
+{
+    rt_error err = {0};
+    assert_int_equal(rt_scene_validate(s, &err), RT_OK);
+    rt_kdtree tree;
+    assert_int_equal(rt_kdtree_build(&tree, s, NULL, &err), RT_OK);
+    assert_int_equal(rt_framebuffer_init(fb, s->settings.width, s->settings.height, &err), RT_OK);
+    rt_render_options opt;
+    memset(&opt, 0, sizeof opt);
+    opt.threads = threads;
+    opt.tile_size = tile;
+    rt_render_stats st;
+    assert_int_equal(rt_render(s, &tree, &opt, fb, &st, &err), RT_OK);
+    assert_int_equal(st.bad_samples, 0);
+    rt_kdtree_free(&tree);
 }
 
 #endif

@@ -160,6 +160,16 @@ static void test_node_animation(void **state)
     test_remove_dir(dir);
 }
 
+/* The skin tests' buffer views, accessors, mesh and two-joint skin: the
+ * triangle, JOINTS_0 as unsigned bytes, WEIGHTS_0 as floats. */
+#define SKIN_MESH                                                                                                      \
+    "\"bufferViews\":[" TRI_VIEWS ",{\"buffer\":0,\"byteOffset\":44,\"byteLength\":12},"                               \
+    "{\"buffer\":0,\"byteOffset\":56,\"byteLength\":48}],"                                                             \
+    "\"accessors\":[" TRI_ACCESSORS ",{\"bufferView\":2,\"componentType\":5121,\"count\":3,"                           \
+    "\"type\":\"VEC4\"},{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"}],"                     \
+    "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":2,\"WEIGHTS_0\":3}}]}],"                \
+    "\"skins\":[{\"joints\":[1,2]}],"
+
 /* Two joints at the origin; vertex 1 follows joint 1, rotated 90 degrees
  * about z (its rest rotation), vertex 2 half joint 0 and half joint 1. */
 static void test_skin(void **state)
@@ -178,12 +188,7 @@ static void test_skin(void **state)
     const float weights[12] = {1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0};
     memcpy(&data[14], weights, sizeof weights);
     write_gltf("skin.gltf", data, sizeof data / sizeof *data,
-               "\"bufferViews\":[" TRI_VIEWS ",{\"buffer\":0,\"byteOffset\":44,\"byteLength\":12},"
-               "{\"buffer\":0,\"byteOffset\":56,\"byteLength\":48}],"
-               "\"accessors\":[" TRI_ACCESSORS ",{\"bufferView\":2,\"componentType\":5121,\"count\":3,"
-               "\"type\":\"VEC4\"},{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"}],"
-               "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":2,\"WEIGHTS_0\":3}}]}],"
-               "\"skins\":[{\"joints\":[1,2]}],"
+               SKIN_MESH
                "\"nodes\":[{\"mesh\":0,\"skin\":0,\"translation\":[100,0,0]},{},"
                "{\"rotation\":[0,0,0.70710678,0.70710678]}],"
                "\"scenes\":[{\"nodes\":[0,1,2]}]");
@@ -201,12 +206,7 @@ static void test_skin(void **state)
     joints[4] = 7;
     memcpy(&data[11], joints, 12);
     write_gltf("badjoint.gltf", data, sizeof data / sizeof *data,
-               "\"bufferViews\":[" TRI_VIEWS ",{\"buffer\":0,\"byteOffset\":44,\"byteLength\":12},"
-               "{\"buffer\":0,\"byteOffset\":56,\"byteLength\":48}],"
-               "\"accessors\":[" TRI_ACCESSORS ",{\"bufferView\":2,\"componentType\":5121,\"count\":3,"
-               "\"type\":\"VEC4\"},{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"}],"
-               "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":2,\"WEIGHTS_0\":3}}]}],"
-               "\"skins\":[{\"joints\":[1,2]}],"
+               SKIN_MESH
                "\"nodes\":[{\"mesh\":0,\"skin\":0},{},{}],\"scenes\":[{\"nodes\":[0,1,2]}]");
     assert_int_equal(load_at("badjoint.gltf", true, 0.0f, 0, &s, &err), RT_ERR_INVALID);
     assert_non_null(strstr(err.message, "badjoint.gltf"));
@@ -355,49 +355,69 @@ static void test_scene_model_lines(void **state)
                "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]");
     rt_error err;
     float x;
-    /* the frame time (and the driver's animation) pose a plain line */
-    assert_int_equal(scene_vertex("model two.gltf\n", false, 0, 0, &x, &err), RT_OK);
-    assert_float_equal(x, 1.0f, 0); /* no frame time: the static pose */
-    assert_int_equal(scene_vertex("model two.gltf\n", true, 0.5f, 0, &x, &err), RT_OK);
-    assert_float_equal(x, 1.5f, 1e-6);
-    assert_int_equal(scene_vertex("model two.gltf\n", true, 0.5f, 1, &x, &err), RT_OK);
-    assert_float_equal(x, 0.5f, 1e-6);
-    /* time fixes the pose whatever the frame; time_offset adds to it (frame time 0 without one) */
-    assert_int_equal(scene_vertex("model two.gltf time 1\n", true, 0.5f, 0, &x, &err), RT_OK);
-    assert_float_equal(x, 2.0f, 1e-6);
-    assert_int_equal(scene_vertex("model two.gltf time 1\n", false, 0, 0, &x, &err), RT_OK);
-    assert_float_equal(x, 2.0f, 1e-6);
-    assert_int_equal(scene_vertex("model two.gltf time_offset 0.25\n", true, 0.5f, 0, &x, &err), RT_OK);
-    assert_float_equal(x, 1.75f, 1e-6);
-    assert_int_equal(scene_vertex("model two.gltf time_offset 0.25\n", false, 0, 0, &x, &err), RT_OK);
-    assert_float_equal(x, 1.25f, 1e-6);
-    /* animation by name or index, over the driver's */
-    assert_int_equal(scene_vertex("model two.gltf animation back\n", true, 0.5f, 0, &x, &err), RT_OK);
-    assert_float_equal(x, 0.5f, 1e-6);
-    assert_int_equal(scene_vertex("model two.gltf animation 0 translate 1 0 0\n", true, 0.5f, 1, &x, &err), RT_OK);
-    assert_float_equal(x, 2.5f, 1e-6);
-    assert_int_equal(scene_vertex("model two.gltf animation \"slide\" time 2\n", false, 0, 1, &x, &err), RT_OK);
-    assert_float_equal(x, 3.0f, 1e-6);
-    /* the driver's animation index passes over a model without animations */
-    assert_int_equal(scene_vertex("model still.gltf\n", true, 0.5f, 1, &x, &err), RT_OK);
-    assert_float_equal(x, 1.0f, 0);
-    /* errors name the scene file, line and column */
-    assert_int_equal(scene_vertex("\nmodel two.gltf animation run\n", true, 0.5f, 0, &x, &err), RT_ERR_INVALID);
-    assert_non_null(strstr(err.message, "scene.txt:2:7: "));
-    assert_non_null(strstr(err.message, "no animation named 'run' (the file has 'slide', 'back')"));
-    assert_int_equal(scene_vertex("model two.gltf animation 2\n", true, 0.5f, 0, &x, &err), RT_ERR_INVALID);
-    assert_non_null(strstr(err.message, "animation 2 requested, the file has 2"));
-    assert_int_equal(scene_vertex("model still.gltf animation 1\n", false, 0, 0, &x, &err), RT_ERR_INVALID);
-    assert_non_null(strstr(err.message, "the file has none"));
-    assert_int_equal(scene_vertex("model two.gltf time 1 time_offset 2\n", true, 0, 0, &x, &err), RT_ERR_INVALID);
-    assert_non_null(strstr(err.message, "scene.txt:1:23: give 'time'"));
-    assert_int_equal(scene_vertex("model two.gltf time soon\n", true, 0, 0, &x, &err), RT_ERR_PARSE);
-    assert_non_null(strstr(err.message, "scene.txt:1:21: expected a number for the model's animation time"));
-    assert_int_equal(scene_vertex("model two.gltf animation -1\n", true, 0, 0, &x, &err), RT_ERR_INVALID);
-    assert_int_equal(scene_vertex("model two.gltf time_offset 1 time_offset 1\n", true, 0, 0, &x, &err),
-                     RT_ERR_INVALID);
-    assert_non_null(strstr(err.message, "'time_offset' is given twice"));
-    assert_int_equal(scene_vertex("model two.gltf animation\n", true, 0, 0, &x, &err), RT_ERR_PARSE);
+    /* each line's pose of vertex 1 (x = 1 at rest): the line, whether a
+     * frame time is given and which (the driver's --frame-time), the
+     * driver's animation, the x it lands at and the tolerance */
+    static const struct {
+        const char *text;
+        bool posed;
+        float t;
+        int anim;
+        float x;
+        double tol;
+    } poses[] = {
+        /* the frame time (and the driver's animation) pose a plain line */
+        {"model two.gltf\n", false, 0, 0, 1.0f, 0}, /* no frame time: the static pose */
+        {"model two.gltf\n", true, 0.5f, 0, 1.5f, 1e-6},
+        {"model two.gltf\n", true, 0.5f, 1, 0.5f, 1e-6},
+        /* time fixes the pose whatever the frame; time_offset adds to it (frame time 0 without one) */
+        {"model two.gltf time 1\n", true, 0.5f, 0, 2.0f, 1e-6},
+        {"model two.gltf time 1\n", false, 0, 0, 2.0f, 1e-6},
+        {"model two.gltf time_offset 0.25\n", true, 0.5f, 0, 1.75f, 1e-6},
+        {"model two.gltf time_offset 0.25\n", false, 0, 0, 1.25f, 1e-6},
+        /* animation by name or index, over the driver's */
+        {"model two.gltf animation back\n", true, 0.5f, 0, 0.5f, 1e-6},
+        {"model two.gltf animation 0 translate 1 0 0\n", true, 0.5f, 1, 2.5f, 1e-6},
+        {"model two.gltf animation \"slide\" time 2\n", false, 0, 1, 3.0f, 1e-6},
+        /* the driver's animation index passes over a model without animations */
+        {"model still.gltf\n", true, 0.5f, 1, 1.0f, 0},
+    };
+    for (size_t i = 0; i < sizeof poses / sizeof poses[0]; i++) {
+        rt_result r = scene_vertex(poses[i].text, poses[i].posed, poses[i].t, poses[i].anim, &x, &err);
+        if (r != RT_OK)
+            print_error("%s%s\n", poses[i].text, err.message);
+        assert_int_equal(r, RT_OK);
+        assert_float_equal(x, poses[i].x, poses[i].tol);
+    }
+    /* errors name the scene file, line and column: the line, as above, the
+     * code and up to two parts of the message (NULL: not checked) */
+    static const struct {
+        const char *text;
+        bool posed;
+        float t;
+        int anim;
+        rt_result code;
+        const char *part1, *part2;
+    } bad[] = {
+        {"\nmodel two.gltf animation run\n", true, 0.5f, 0, RT_ERR_INVALID, "scene.txt:2:7: ",
+         "no animation named 'run' (the file has 'slide', 'back')"},
+        {"model two.gltf animation 2\n", true, 0.5f, 0, RT_ERR_INVALID, "animation 2 requested, the file has 2", NULL},
+        {"model still.gltf animation 1\n", false, 0, 0, RT_ERR_INVALID, "the file has none", NULL},
+        {"model two.gltf time 1 time_offset 2\n", true, 0, 0, RT_ERR_INVALID, "scene.txt:1:23: give 'time'", NULL},
+        {"model two.gltf time soon\n", true, 0, 0, RT_ERR_PARSE,
+         "scene.txt:1:21: expected a number for the model's animation time", NULL},
+        {"model two.gltf animation -1\n", true, 0, 0, RT_ERR_INVALID, NULL, NULL},
+        {"model two.gltf time_offset 1 time_offset 1\n", true, 0, 0, RT_ERR_INVALID, "'time_offset' is given twice",
+         NULL},
+        {"model two.gltf animation\n", true, 0, 0, RT_ERR_PARSE, NULL, NULL},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        assert_int_equal(scene_vertex(bad[i].text, bad[i].posed, bad[i].t, bad[i].anim, &x, &err), bad[i].code);
+        if (bad[i].part1)
+            assert_non_null(strstr(err.message, bad[i].part1));
+        if (bad[i].part2)
+            assert_non_null(strstr(err.message, bad[i].part2));
+    }
     /* rt_load passes its time to a scene file's model lines */
     char path[128];
     snprintf(path, sizeof path, "%s/scene.txt", dir);

@@ -216,12 +216,7 @@ static void expect_fail_memory(const uint8_t *data, size_t size, const char *nam
     rt_scene_init(&s);
     rt_error err = {0};
     rt_result r = rt_gltf_load_memory(&s, data, size, name, NULL, NULL, &err);
-    if (r != code || !strstr(err.message, name) || !strstr(err.message, what))
-        fprintf(stderr, "%s: got %s \"%s\", wanted %s containing \"%s\"\n", name, rt_result_name(r), err.message,
-                rt_result_name(code), what);
-    assert_int_equal(r, code);
-    assert_non_null(strstr(err.message, name));
-    assert_non_null(strstr(err.message, what));
+    test_expect_failure(r, &err, code, name, what);
     assert_int_equal(s.triangles.count, 0);
     rt_scene_free(&s);
 }

@@ -6,6 +6,7 @@
  * picture), and the shared Khronos sample models that use them, when
  * ../shared has them; KHR_materials_variants through rt_load_options. */
 #include "test_util.h"
+#include "test_fixture.h"
 
 #include <fcntl.h>
 #include <math.h>
@@ -177,19 +178,9 @@ static void render_file(const char *path, rt_framebuffer *fb)
     s.settings.height = H;
     s.settings.samples = 64;
     s.settings.integrator = RT_INTEGRATOR_PATH;
-    assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
-    rt_kdtree tree;
-    assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
-    assert_int_equal(rt_framebuffer_init(fb, W, H, &err), RT_OK);
-    rt_render_options opt;
-    memset(&opt, 0, sizeof opt);
-    opt.threads = 2;
-    rt_render_stats st;
-    assert_int_equal(rt_render(&s, &tree, &opt, fb, &st, &err), RT_OK);
-    assert_int_equal(st.bad_samples, 0);
+    test_render_scene(&s, 2, 0, fb);
     for (int i = 0; i < W * H * 3; i++)
         assert_true(isfinite(fb->rgb[i]) && fb->rgb[i] >= 0.0f);
-    rt_kdtree_free(&tree);
     rt_scene_free(&s);
 }
 

@@ -306,13 +306,8 @@ static bool reference_64(rt_framebuffer *out)
     assert_int_equal(rt_framebuffer_init(out, 64, 64, &err), RT_OK);
     for (int y = 0; y < 64; y++)
         for (int x = 0; x < 64; x++)
-            for (int c = 0; c < 3; c++) {
-                double r = 0.0;
-                for (int j = 0; j < 8; j++)
-                    for (int i = 0; i < 8; i++)
-                        r += ref.rgb[3 * ((size_t)(8 * y + j) * 512 + (size_t)(8 * x + i)) + (size_t)c];
-                out->rgb[3 * ((size_t)y * 64 + (size_t)x) + (size_t)c] = (float)(r / 64.0);
-            }
+            for (int c = 0; c < 3; c++)
+                out->rgb[3 * ((size_t)y * 64 + (size_t)x) + (size_t)c] = (float)test_cornell_block(&ref, x, y, c);
     rt_framebuffer_free(&ref);
     return true;
 }

@@ -904,6 +904,45 @@ static void check_packet(const rt_scene *s, const rt_kdtree *tree, const rt_ray 
     }
 }
 
+/* The two scenes of the packet tests: 0, a random soup; 1, integer boxes
+ * whose faces lie on split planes. */
+static void packet_scene(rt_scene *s, test_rng *r, int which)
+{
+    if (which == 0) {
+        random_soup(s, r, 3000, 0.05f);
+    } else {
+        for (int i = 0; i < 40; i++) {
+            rt_vec3 lo = rt_v3((float)(int)(test_rng_next(r) % 8), (float)(int)(test_rng_next(r) % 8),
+                               (float)(int)(test_rng_next(r) % 8));
+            add_box_tris(s, lo, rt_add(lo, rt_v3(1.0f + (float)(int)(test_rng_next(r) % 2), 1.0f, 1.0f)));
+        }
+    }
+}
+
+/* A random pinhole camera into a scene of size span, as the packet tests
+ * aim their 4x4 tiles of rays: the eye, the forward, right and up axes. */
+typedef struct tile_camera {
+    rt_vec3 eye, fw, rx, uy;
+} tile_camera;
+
+static tile_camera random_tile_camera(test_rng *r, float span)
+{
+    tile_camera c;
+    c.eye = rt_add(rnd3(r, -0.5f * span, 1.5f * span), rt_v3(0, 0, -span));
+    rt_vec3 at = rnd3(r, 0.3f * span, 0.7f * span);
+    c.fw = rt_normalize(rt_sub(at, c.eye));
+    c.rx = rt_normalize(rt_cross(c.fw, rt_v3(0.3f, 1.0f, 0.1f)));
+    c.uy = rt_cross(c.rx, c.fw);
+    return c;
+}
+
+/* The direction of ray i (row-major, 4 a row) of the tile whose first ray
+ * is at (x0, y0) on the image plane, its rays pix apart. */
+static rt_vec3 tile_dir(const tile_camera *c, float x0, float y0, float pix, int i)
+{
+    return rt_add(c->fw, rt_add(rt_scale(c->rx, x0 + pix * (float)(i % 4)), rt_scale(c->uy, y0 + pix * (float)(i / 4))));
+}
+
 static void test_packets(void **state)
 {
     (void)state;
@@ -916,31 +955,19 @@ static void test_packets(void **state)
         rt_scene s;
         rt_scene_init(&s);
         test_rng r = {700 + (uint64_t)sc};
-        if (sc == 0) {
-            random_soup(&s, &r, 3000, 0.05f);
-        } else {
-            for (int i = 0; i < 40; i++) {
-                rt_vec3 lo = rt_v3((float)(int)(test_rng_next(&r) % 8), (float)(int)(test_rng_next(&r) % 8),
-                                   (float)(int)(test_rng_next(&r) % 8));
-                add_box_tris(&s, lo, rt_add(lo, rt_v3(1.0f + (float)(int)(test_rng_next(&r) % 2), 1.0f, 1.0f)));
-            }
-        }
+        packet_scene(&s, &r, sc);
         rt_kdtree tree;
         build_ok(&tree, &s);
         check_stats cs = {0, 0, 0};
         float span = sc == 0 ? 1.0f : 9.0f;
         for (int cam = 0; cam < 40; cam++) {
-            rt_vec3 eye = rt_add(rnd3(&r, -0.5f * span, 1.5f * span), rt_v3(0, 0, -span));
-            rt_vec3 at = rnd3(&r, 0.3f * span, 0.7f * span);
-            rt_vec3 fw = rt_normalize(rt_sub(at, eye)), rx = rt_normalize(rt_cross(fw, rt_v3(0.3f, 1.0f, 0.1f))),
-                    uy = rt_cross(rx, fw);
+            tile_camera tc = random_tile_camera(&r, span);
             float pix = cam % 2 ? 1e-3f : 2e-2f; /* tight tiles, and wider ones that straddle edges */
             for (int tile = 0; tile < 30; tile++) {
                 float x0 = rnd(&r, -0.5f, 0.5f), y0 = rnd(&r, -0.5f, 0.5f);
                 rt_ray rays[16];
                 for (int i = 0; i < 16; i++) {
-                    rt_vec3 d = rt_add(fw, rt_add(rt_scale(rx, x0 + pix * (float)(i % 4)), rt_scale(uy, y0 + pix * (float)(i / 4))));
-                    rays[i] = rt_ray_make(eye, d, 0.0f, INFINITY);
+                    rays[i] = rt_ray_make(tc.eye, tile_dir(&tc, x0, y0, pix, i), 0.0f, INFINITY);
                 }
                 int n = 8;
                 switch (tile % 10) {
@@ -997,25 +1024,14 @@ static void test_packets_occluded(void **state)
         rt_scene s;
         rt_scene_init(&s);
         test_rng r = {900 + (uint64_t)sc};
-        if (sc == 0) {
-            random_soup(&s, &r, 3000, 0.05f);
-        } else {
-            for (int i = 0; i < 40; i++) {
-                rt_vec3 lo = rt_v3((float)(int)(test_rng_next(&r) % 8), (float)(int)(test_rng_next(&r) % 8),
-                                   (float)(int)(test_rng_next(&r) % 8));
-                add_box_tris(&s, lo, rt_add(lo, rt_v3(1.0f + (float)(int)(test_rng_next(&r) % 2), 1.0f, 1.0f)));
-            }
-        }
+        packet_scene(&s, &r, sc);
         rt_kdtree tree;
         build_ok(&tree, &s);
         check_stats cs = {0, 0, 0};
         size_t ends = 0;
         float span = sc == 0 ? 1.0f : 9.0f;
         for (int cam = 0; cam < 40; cam++) {
-            rt_vec3 eye = rt_add(rnd3(&r, -0.5f * span, 1.5f * span), rt_v3(0, 0, -span));
-            rt_vec3 at = rnd3(&r, 0.3f * span, 0.7f * span);
-            rt_vec3 fw = rt_normalize(rt_sub(at, eye)), rx = rt_normalize(rt_cross(fw, rt_v3(0.3f, 1.0f, 0.1f))),
-                    uy = rt_cross(rx, fw);
+            tile_camera tc = random_tile_camera(&r, span);
             rt_vec3 light = rnd3(&r, -0.5f * span, 1.5f * span);
             float pix = cam % 2 ? 1e-3f : 2e-2f;
             for (int tile = 0; tile < 30; tile++) {
@@ -1025,11 +1041,11 @@ static void test_packets_occluded(void **state)
                 for (int i = 0; i < 16; i++)
                     expect[i] = -1;
                 for (int i = 0; i < 16; i++) { /* a tile's hit points (or points along its rays) to the light */
-                    rt_vec3 d = rt_add(fw, rt_add(rt_scale(rx, x0 + pix * (float)(i % 4)), rt_scale(uy, y0 + pix * (float)(i / 4))));
-                    rt_ray pr = rt_ray_make(eye, d, 0.0f, INFINITY);
+                    rt_vec3 d = tile_dir(&tc, x0, y0, pix, i);
+                    rt_ray pr = rt_ray_make(tc.eye, d, 0.0f, INFINITY);
                     rt_hit h;
                     float t = rt_kdtree_intersect(&tree, &pr, &h) ? h.t : span;
-                    rt_vec3 p = rt_add(eye, rt_scale(d, t));
+                    rt_vec3 p = rt_add(tc.eye, rt_scale(d, t));
                     rays[i] = rt_ray_make(p, rt_sub(light, p), 1e-4f, 1.0f);
                 }
                 switch (tile % 10) {

@@ -44,13 +44,10 @@ static void load(fixture *f, const char *text) { test_fixture_load(f, text, 0); 
 
 static void unload(fixture *f) { test_fixture_free(f); }
 
+/* The path tracer's radiance (test_fixture_path_radiance) with this file's seed. */
 static rt_vec3 radiance(const fixture *f, rt_vec3 org, rt_vec3 dir, uint32_t i)
 {
-    rt_rng rng = rt_rng_for_sample(29, i, 0);
-    rt_ray r = rt_ray_make(org, rt_normalize(dir), 0.0f, INFINITY);
-    rt_vec3 L = rt_radiance_path(&f->ctx, &r, &rng);
-    assert_true(rt_finite3(L) && L.x >= 0.0f && L.y >= 0.0f && L.z >= 0.0f);
-    return L;
+    return test_fixture_path_radiance(f, 29, org, dir, i);
 }
 
 /* Exact unpolarised Fresnel reflectance in double precision, n1 -> n2. */

@@ -44,13 +44,69 @@ static void load(fixture *f, const char *text, bool table)
 
 static void unload(fixture *f) { test_fixture_free(f); }
 
+/* The path tracer's radiance (test_fixture_path_radiance) with this file's seed. */
 static rt_vec3 radiance(const fixture *f, rt_vec3 org, rt_vec3 dir, uint32_t i)
 {
-    rt_rng rng = rt_rng_for_sample(17, i, 0);
-    rt_ray r = rt_ray_make(org, rt_normalize(dir), 0.0f, INFINITY);
-    rt_vec3 L = rt_radiance_path(&f->ctx, &r, &rng);
-    assert_true(rt_finite3(L) && L.x >= 0.0f && L.y >= 0.0f && L.z >= 0.0f);
-    return L;
+    return test_fixture_path_radiance(f, 17, org, dir, i);
+}
+
+/* Channel c (0, 1, 2) of v. */
+static double channel(rt_vec3 v, int c) { return c == 0 ? v.x : c == 1 ? v.y : v.z; }
+
+/* The mean of channel c of the radiance along -z from n points (x, y, 5),
+ * x and y uniform in [-w/2, w/2] (the test stream seeded `seed`). */
+static double mean_over_square(const fixture *f, uint32_t n, uint64_t seed, float w, int c)
+{
+    double sum = 0.0;
+    test_rng tr = {seed};
+    for (uint32_t i = 0; i < n; i++) {
+        float x = w * test_rng_float(&tr) - 0.5f * w, y = w * test_rng_float(&tr) - 0.5f * w;
+        sum += channel(radiance(f, rt_v3(x, y, 5), rt_v3(0, 0, -1), i), c);
+    }
+    return sum / n;
+}
+
+/* The same from n points of [-1, 1]^2, of which only those with
+ * x^2 + y^2 <= 0.98 count: a unit sphere at the origin without its
+ * silhouette. *se (when not NULL): the standard error of the mean. */
+static double mean_over_sphere_disk(const fixture *f, uint32_t n, uint64_t seed, int c, double *se)
+{
+    double sum = 0.0, sum2 = 0.0;
+    test_rng tr = {seed};
+    uint32_t hits = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        float x = 2.0f * test_rng_float(&tr) - 1.0f, y = 2.0f * test_rng_float(&tr) - 1.0f;
+        if (x * x + y * y > 0.98f)
+            continue; /* the sphere only */
+        double L = channel(radiance(f, rt_v3(x, y, 5), rt_v3(0, 0, -1), i), c);
+        sum += L;
+        sum2 += L * L;
+        hits++;
+    }
+    double mean = sum / hits;
+    if (se)
+        *se = sqrt(fmax(0.0, sum2 / hits - mean * mean) / hits);
+    return mean;
+}
+
+/* Inside a closed sphere around the origin: the mean red radiance over n
+ * rays from (0.1, -0.2, 0.3) in random directions (the test stream seeded
+ * `seed`), and its standard error in *sd. */
+static double mean_inside_sphere(const fixture *f, uint32_t n, uint64_t seed, double *sd)
+{
+    double sum = 0.0, sum2 = 0.0;
+    test_rng tr = {seed};
+    for (uint32_t i = 0; i < n; i++) {
+        rt_vec3 dir = rt_v3(test_rng_float(&tr) - 0.5f, test_rng_float(&tr) - 0.5f, test_rng_float(&tr) - 0.5f);
+        if (rt_length2(dir) < 1e-6f)
+            dir = rt_v3(0, 0, 1);
+        double L = radiance(f, rt_v3(0.1f, -0.2f, 0.3f), dir, i).x;
+        sum += L;
+        sum2 += L * L;
+    }
+    double mean = sum / n;
+    *sd = sqrt(fmax(0.0, sum2 / n - mean * mean) / n);
+    return mean;
 }
 
 /* ------------------------------------------------------------- furnaces */
@@ -141,14 +197,7 @@ static void test_furnace_glass(void **state)
                  (double)rough[k]);
         fixture f;
         load(&f, text, false);
-        double sum = 0.0;
-        const uint32_t n = 20000;
-        test_rng tr = {21};
-        for (uint32_t i = 0; i < n; i++) {
-            float x = 1.4f * test_rng_float(&tr) - 0.7f, y = 1.4f * test_rng_float(&tr) - 0.7f;
-            sum += radiance(&f, rt_v3(x, y, 5), rt_v3(0, 0, -1), i).x;
-        }
-        double mean = sum / n;
+        double mean = mean_over_square(&f, 20000, 21, 1.4f, 0);
         fprintf(stderr, "glass furnace, roughness %.1f: %.4f\n", (double)rough[k], mean);
         /* smooth: Fresnel splits energy, nothing is lost; rough: single
          * scattering loses the refractions a microfacet sends back to the
@@ -178,18 +227,7 @@ static void test_furnace_energy_compensation(void **state)
                      on ? "on" : "off", (double)alphas[k]);
             fixture f;
             load(&f, text, false);
-            double sum = 0.0;
-            const uint32_t n = 20000;
-            test_rng tr = {33};
-            uint32_t hits = 0;
-            for (uint32_t i = 0; i < n; i++) {
-                float x = 2.0f * test_rng_float(&tr) - 1.0f, y = 2.0f * test_rng_float(&tr) - 1.0f;
-                if (x * x + y * y > 0.98f)
-                    continue; /* the sphere only */
-                sum += radiance(&f, rt_v3(x, y, 5), rt_v3(0, 0, -1), i).y;
-                hits++;
-            }
-            mean[on] = sum / hits;
+            mean[on] = mean_over_sphere_disk(&f, 20000, 33, 1, NULL);
             unload(&f);
         }
         fprintf(stderr, "white metal furnace, alpha %.1f: %.4f single scattering, %.4f compensated\n",
@@ -226,21 +264,7 @@ static void test_furnace_glass_compensation(void **state)
                          on ? "on" : "off", (double)iors[e], (double)alphas[k]);
                 fixture f;
                 load(&f, text, false);
-                double sum = 0.0, sum2 = 0.0;
-                const uint32_t n = on ? 400000 : 40000;
-                test_rng tr = {41};
-                uint32_t hits = 0;
-                for (uint32_t i = 0; i < n; i++) {
-                    float x = 2.0f * test_rng_float(&tr) - 1.0f, y = 2.0f * test_rng_float(&tr) - 1.0f;
-                    if (x * x + y * y > 0.98f)
-                        continue; /* the sphere only */
-                    double L = radiance(&f, rt_v3(x, y, 5), rt_v3(0, 0, -1), i).y;
-                    sum += L;
-                    sum2 += L * L;
-                    hits++;
-                }
-                mean[on] = sum / hits;
-                se[on] = sqrt(fmax(0.0, sum2 / hits - mean[on] * mean[on]) / hits);
+                mean[on] = mean_over_sphere_disk(&f, on ? 400000 : 40000, 41, 1, &se[on]);
                 unload(&f);
             }
             fprintf(stderr,
@@ -286,15 +310,9 @@ static void test_dielectric_closed_forms(void **state)
     (void)state;
     fixture f;
     load(&f, "integrator path\nbackground 1 1 1\nmaterial g bsdf dielectric ior 1.5\nsphere 0 0 0 1 g\n", false);
-    double sum = 0.0;
-    const uint32_t n = 20000;
-    test_rng tr = {5};
-    for (uint32_t i = 0; i < n; i++) {
-        float x = 1.4f * test_rng_float(&tr) - 0.7f, y = 1.4f * test_rng_float(&tr) - 0.7f;
-        sum += radiance(&f, rt_v3(x, y, 5), rt_v3(0, 0, -1), i).y;
-    }
-    fprintf(stderr, "dielectric furnace: %.4f\n", sum / n);
-    assert_true(fabs(sum / n - 1.0) < 0.01);
+    double mean = mean_over_square(&f, 20000, 5, 1.4f, 1);
+    fprintf(stderr, "dielectric furnace: %.4f\n", mean);
+    assert_true(fabs(mean - 1.0) < 0.01);
     unload(&f);
 
     load(&f, "integrator path\nbackground 1 1 1\n"
@@ -311,7 +329,8 @@ static void test_dielectric_closed_forms(void **state)
 
     load(&f, "integrator path\nbackground 0 0 0\nmaterial g bsdf dielectric ior 1.5\n"
              "material e color 0 0 0 bsdf lambert emission 1 1 1\nsphere 0 0 0 1 g\nsphere 0 0 0 0.5 e\n", false);
-    sum = 0.0;
+    double sum = 0.0;
+    const uint32_t n = 20000;
     for (uint32_t i = 0; i < n; i++)
         sum += radiance(&f, rt_v3(0, 0, 5), rt_v3(0, 0, -1), i).y;
     fprintf(stderr, "emitter in glass: %.4f (want 0.42667)\n", sum / n);
@@ -335,18 +354,7 @@ static void test_closed_furnace(void **state)
             load(&f, text, t == 1);
             assert_int_equal(f.rs.light_table ? f.rs.light_table->count : 0, t == 1 ? 1 : 0);
             double a = 0.6, want = depths[d] ? (1.0 - pow(a, depths[d] + 1)) / (1.0 - a) : 1.0 / (1.0 - a);
-            double sum = 0.0, sum2 = 0.0;
-            const uint32_t n = 40000;
-            test_rng tr = {9};
-            for (uint32_t i = 0; i < n; i++) {
-                rt_vec3 dir = rt_v3(test_rng_float(&tr) - 0.5f, test_rng_float(&tr) - 0.5f, test_rng_float(&tr) - 0.5f);
-                if (rt_length2(dir) < 1e-6f)
-                    dir = rt_v3(0, 0, 1);
-                rt_vec3 L = radiance(&f, rt_v3(0.1f, -0.2f, 0.3f), dir, i);
-                sum += L.x;
-                sum2 += (double)L.x * L.x;
-            }
-            double mean = sum / n, sd = sqrt(fmax(0.0, sum2 / n - mean * mean) / n);
+            double sd, mean = mean_inside_sphere(&f, 40000, 9, &sd);
             if (fabs(mean - want) > 4.0 * sd + 1e-3)
                 fail_msg("table %d max_depth %d: %.4f +- %.4f, want %.4f", t, depths[d], mean, sd, want);
             unload(&f);
@@ -370,18 +378,7 @@ static void test_rr_depth_unbiased(void **state)
         fixture f;
         load(&f, text, false);
         assert_int_equal(f.s.settings.rr_depth, rr[k]);
-        double sum = 0.0, sum2 = 0.0;
-        const uint32_t n = 40000;
-        test_rng tr = {13};
-        for (uint32_t i = 0; i < n; i++) {
-            rt_vec3 dir = rt_v3(test_rng_float(&tr) - 0.5f, test_rng_float(&tr) - 0.5f, test_rng_float(&tr) - 0.5f);
-            if (rt_length2(dir) < 1e-6f)
-                dir = rt_v3(0, 0, 1);
-            double L = radiance(&f, rt_v3(0.1f, -0.2f, 0.3f), dir, i).x;
-            sum += L;
-            sum2 += L * L;
-        }
-        double mean = sum / n, sd = sqrt(fmax(0.0, sum2 / n - mean * mean) / n);
+        double sd, mean = mean_inside_sphere(&f, 40000, 13, &sd);
         if (fabs(mean - 2.5) > 4.0 * sd + 1e-3)
             fail_msg("rr_depth %d: %.4f +- %.4f, want 2.5", rr[k], mean, sd);
         unload(&f);
@@ -655,16 +652,10 @@ static void test_every_material_finite_and_deterministic(void **state)
 static void test_cornell_reference(void **state)
 {
     (void)state;
-    const char *ref_path = test_shared_path("reference/cornell/reference.pfm");
-    FILE *probe = fopen(ref_path, "rb");
-    if (!probe) {
-        fprintf(stderr, "note: %s not found (set RT_SHARED); skipping the reference comparison\n", ref_path);
-        return;
-    }
-    fclose(probe);
-    rt_error err;
     rt_framebuffer ref;
-    assert_int_equal(rt_pfm_read(ref_path, &ref, &err), RT_OK);
+    if (!test_read_cornell_reference(&ref))
+        return;
+    rt_error err;
     assert_int_equal(ref.width, 512);
     assert_int_equal(ref.height, 512);
     fixture f;
@@ -681,21 +672,8 @@ static void test_cornell_reference(void **state)
     rt_render_stats st;
     render_fixture(&f, 0, &img, &st);
     assert_true(st.bad_samples == 0);
-    double se = 0.0, mine[3] = {0, 0, 0}, theirs[3] = {0, 0, 0};
-    for (int y = 0; y < 64; y++)
-        for (int x = 0; x < 64; x++)
-            for (int c = 0; c < 3; c++) {
-                double r = 0.0;
-                for (int j = 0; j < 8; j++)
-                    for (int i = 0; i < 8; i++)
-                        r += ref.rgb[3 * ((size_t)(8 * y + j) * 512 + (size_t)(8 * x + i)) + (size_t)c];
-                r /= 64.0;
-                double v = img.rgb[3 * ((size_t)y * 64 + (size_t)x) + (size_t)c];
-                se += (v - r) * (v - r);
-                mine[c] += v / 4096.0;
-                theirs[c] += r / 4096.0;
-            }
-    double rmse = sqrt(se / (64.0 * 64.0 * 3.0));
+    double mine[3], theirs[3];
+    double rmse = test_cornell_block_rmse(&img, &ref, mine, theirs);
     fprintf(stderr, "cornell-reference 64x64 @ 256 spp: RMSE %.5f, means (%.5f %.5f %.5f) vs (%.5f %.5f %.5f)\n", rmse,
             mine[0], mine[1], mine[2], theirs[0], theirs[1], theirs[2]);
     /* the reference's published means */

@@ -3,6 +3,7 @@
  * tiles, time limits and cancelled passes, progress reports, and image
  * output. */
 #include "test_util.h"
+#include "test_fixture.h"
 
 #include <math.h>
 #include <unistd.h>
@@ -20,23 +21,6 @@ static uint32_t add_lambert(rt_scene *s, const char *name, rt_vec3 albedo)
     rt_material_default(&m, name);
     m.color = albedo;
     return rt_scene_add_material(s, &m);
-}
-
-static void render_scene(rt_scene *s, int threads, int tile, rt_framebuffer *fb)
-{
-    rt_error err = {0};
-    assert_int_equal(rt_scene_validate(s, &err), RT_OK);
-    rt_kdtree tree;
-    assert_int_equal(rt_kdtree_build(&tree, s, NULL, &err), RT_OK);
-    assert_int_equal(rt_framebuffer_init(fb, s->settings.width, s->settings.height, &err), RT_OK);
-    rt_render_options opt;
-    memset(&opt, 0, sizeof opt);
-    opt.threads = threads;
-    opt.tile_size = tile;
-    rt_render_stats st;
-    assert_int_equal(rt_render(s, &tree, &opt, fb, &st, &err), RT_OK);
-    assert_int_equal(st.bad_samples, 0);
-    rt_kdtree_free(&tree);
 }
 
 /* A Lambertian plane under a point light: L = albedo / pi * I * cos / r^2,
@@ -61,13 +45,9 @@ static void test_lambert_plane_point_light(void **state)
     s.settings.width = 40;
     s.settings.height = 30;
     s.settings.samples = 1;
-    s.camera.position = rt_v3(0, 3, 1);
-    s.camera.look_at = rt_v3(0, 0, 0);
-    s.camera.up = rt_v3(0, 1, 0);
-    s.camera.vfov_deg = 50;
-    s.camera_set = true;
+    test_scene_look(&s, rt_v3(0, 3, 1), rt_v3(0, 0, 0), rt_v3(0, 1, 0), 50);
     rt_framebuffer fb;
-    render_scene(&s, 2, 8, &fb);
+    test_render_scene(&s, 2, 8, &fb);
 
     rt_camera_frame cf;
     rt_camera_frame_init(&cf, &s.camera, fb.width, fb.height);
@@ -128,11 +108,7 @@ static void build_busy_scene(rt_scene *s)
     s->settings.height = 23;
     s->settings.samples = 5;
     s->settings.shadow_samples = 4;
-    s->camera.position = rt_v3(0, 1.5f, 4);
-    s->camera.look_at = rt_v3(0, 0.5f, 0);
-    s->camera.up = rt_v3(0, 1, 0);
-    s->camera.vfov_deg = 45;
-    s->camera_set = true;
+    test_scene_look(s, rt_v3(0, 1.5f, 4), rt_v3(0, 0.5f, 0), rt_v3(0, 1, 0), 45);
 }
 
 static void test_same_image_any_thread_count(void **state)
@@ -141,9 +117,9 @@ static void test_same_image_any_thread_count(void **state)
     rt_scene s;
     build_busy_scene(&s);
     rt_framebuffer a, b, c;
-    render_scene(&s, 1, 32, &a);
-    render_scene(&s, 2, 32, &b);
-    render_scene(&s, 7, 5, &c); /* more threads than useful, odd tiles */
+    test_render_scene(&s, 1, 32, &a);
+    test_render_scene(&s, 2, 32, &b);
+    test_render_scene(&s, 7, 5, &c); /* more threads than useful, odd tiles */
     size_t n = (size_t)a.width * a.height * 3 * sizeof(float);
     assert_memory_equal(a.rgb, b.rgb, n);
     assert_memory_equal(a.rgb, c.rgb, n);
@@ -402,17 +378,14 @@ static void test_area_light_visible_one_sided(void **state)
     s.settings.width = 1;
     s.settings.height = 1;
     s.settings.samples = 1;
-    s.camera.position = rt_v3(0, 1.0f, 0.0f);
-    s.camera.look_at = rt_v3(0, 3, 0.0f);
-    s.camera.up = rt_v3(0, 0, 1);
-    s.camera.vfov_deg = 1;
+    test_scene_look(&s, rt_v3(0, 1.0f, 0.0f), rt_v3(0, 3, 0.0f), rt_v3(0, 0, 1), 1);
     rt_framebuffer fb;
-    render_scene(&s, 1, 32, &fb);
+    test_render_scene(&s, 1, 32, &fb);
     assert_float_equal(fb.rgb[0], 5.0f, 1e-5);
     rt_framebuffer_free(&fb);
     s.camera.position = rt_v3(0, 4.0f, 0.0f);
     s.camera.look_at = rt_v3(0, 0, 0.0f);
-    render_scene(&s, 1, 32, &fb);
+    test_render_scene(&s, 1, 32, &fb);
     assert_float_equal(fb.rgb[0], 0.0f, 1e-6); /* back of the emitter, lit from nowhere */
     rt_framebuffer_free(&fb);
     rt_scene_free(&s);

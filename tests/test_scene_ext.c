@@ -10,6 +10,7 @@
  * a coat ignores the base's normal map; scenes/pbr-extensions.txt loads.
  */
 #include "test_util.h"
+#include "test_fixture.h"
 
 #include <math.h>
 
@@ -220,23 +221,13 @@ static void quad_corners(int k, float v[4][3])
     memcpy(v, c, sizeof c);
 }
 
+/* Renders scene text (resolution RW x RH) written as file. */
 enum { RW = 64, RH = 24 };
 static void render_scene(const char *file, const char *text, rt_framebuffer *fb)
 {
     rt_scene s;
     load_text(&s, file, text);
-    rt_error err = {0};
-    assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
-    rt_kdtree tree;
-    assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
-    assert_int_equal(rt_framebuffer_init(fb, RW, RH, &err), RT_OK);
-    rt_render_options opt;
-    memset(&opt, 0, sizeof opt);
-    opt.threads = 2;
-    rt_render_stats st;
-    assert_int_equal(rt_render(&s, &tree, &opt, fb, &st, &err), RT_OK);
-    assert_int_equal(st.bad_samples, 0);
-    rt_kdtree_free(&tree);
+    test_render_scene(&s, 2, 0, fb);
     rt_scene_free(&s);
 }
 

@@ -63,6 +63,25 @@ static void expect_ok(const char *text, rt_scene *s)
     }
 }
 
+/* A parse that must succeed: its message is shown when it does not. */
+static void assert_parsed(rt_result r, const rt_error *err)
+{
+    if (r != RT_OK)
+        print_error("%s\n", err->message);
+    assert_int_equal(r, RT_OK);
+}
+
+/* Skips the test (freeing *s) when the parse needed a loader this build
+ * does not have. */
+static void skip_if_unsupported(rt_result r, rt_scene *s, const rt_error *err)
+{
+    if (r == RT_ERR_UNSUPPORTED) {
+        fprintf(stderr, "note: %s\n", err->message);
+        rt_scene_free(s);
+        skip();
+    }
+}
+
 static void assert_vec3(rt_vec3 v, float x, float y, float z)
 {
     assert_float_equal(v.x, x, 1e-5);
@@ -71,6 +90,31 @@ static void assert_vec3(rt_vec3 v, float x, float y, float z)
 }
 
 /* ------------------------------------------------------------ scenes */
+
+/* docs/scene-format.md, whole, in a static buffer (one at a time). */
+static char *read_scene_format_doc(void)
+{
+    FILE *f = fopen("docs/scene-format.md", "rb");
+    assert_non_null(f);
+    static char doc[1 << 17];
+    size_t n = fread(doc, 1, sizeof doc - 1, f);
+    fclose(f);
+    doc[n] = '\0';
+    return doc;
+}
+
+/* The section of docs/scene-format.md that starts at `heading`, up to the
+ * next "## " heading (read_scene_format_doc's buffer, cut there). */
+static const char *scene_format_doc_section(const char *heading)
+{
+    char *sec = strstr(read_scene_format_doc(), heading);
+    assert_non_null(sec);
+    char *end = strstr(sec + 1, "\n## ");
+    if (end)
+        *end = '\0';
+    return sec;
+}
+
 
 static void check_cornell(const rt_scene *s)
 {
@@ -115,9 +159,7 @@ static void test_default_scene(void **state)
     rt_scene_init(&s);
     rt_result r = rt_scene_parse_string(&s, rt_default_scene_text, strlen(rt_default_scene_text), "<default>", NULL,
                                         &err);
-    if (r != RT_OK)
-        print_error("%s\n", err.message);
-    assert_int_equal(r, RT_OK);
+    assert_parsed(r, &err);
     check_cornell(&s);
     assert_string_equal(s.settings.output, ""); /* the driver writes out.png */
     rt_scene_free(&s);
@@ -135,9 +177,7 @@ static void test_cornell_file_matches_default(void **state)
                                            NULL, &err),
                      RT_OK);
     rt_result r = rt_scene_parse_file(&b, "scenes/cornell.txt", &err);
-    if (r != RT_OK)
-        print_error("%s\n", err.message);
-    assert_int_equal(r, RT_OK);
+    assert_parsed(r, &err);
     check_cornell(&b);
     assert_string_equal(b.settings.output, "cornell.png");
     assert_int_equal(a.quads.count, b.quads.count);
@@ -180,9 +220,7 @@ static void test_all_scene_files(void **state)
         if (r == RT_ERR_UNSUPPORTED) {
             fprintf(stderr, "note: %s needs a loader that is not built yet: %s\n", path, err.message);
         } else {
-            if (r != RT_OK)
-                print_error("%s\n", err.message);
-            assert_int_equal(r, RT_OK);
+            assert_parsed(r, &err);
             assert_true(rt_scene_prim_count(&s) > 0);
             parsed++;
         }
@@ -199,9 +237,7 @@ static void test_spheres_scene(void **state)
     rt_error err;
     rt_scene_init(&s);
     rt_result r = rt_scene_parse_file(&s, "scenes/spheres.txt", &err);
-    if (r != RT_OK)
-        print_error("%s\n", err.message);
-    assert_int_equal(r, RT_OK);
+    assert_parsed(r, &err);
     assert_int_equal(s.spheres.count, 5);
     assert_int_equal(s.quads.count, 1);
     assert_int_equal(s.light_count, 2);
@@ -223,14 +259,8 @@ static void test_textures_scene(void **state)
     rt_error err;
     rt_scene_init(&s);
     rt_result r = rt_scene_parse_file(&s, "scenes/textures.txt", &err);
-    if (r == RT_ERR_UNSUPPORTED) {
-        fprintf(stderr, "note: %s\n", err.message);
-        rt_scene_free(&s);
-        skip();
-    }
-    if (r != RT_OK)
-        print_error("%s\n", err.message);
-    assert_int_equal(r, RT_OK);
+    skip_if_unsupported(r, &s, &err);
+    assert_parsed(r, &err);
     assert_int_equal(s.image_count, 2);     /* uvgrid.png once, bumps.png */
     assert_int_equal(s.camera_count, 1);    /* box.gltf's camera, not selected */
     assert_vec3(s.camera.position, 0, 2.4f, 6);
@@ -248,13 +278,7 @@ static void test_textures_scene(void **state)
 static void test_docs_example(void **state)
 {
     (void)state;
-    FILE *f = fopen("docs/scene-format.md", "rb");
-    assert_non_null(f);
-    static char doc[1 << 17];
-    size_t n = fread(doc, 1, sizeof doc - 1, f);
-    fclose(f);
-    doc[n] = '\0';
-    const char *sec = strstr(doc, "## 9. A complete example");
+    const char *sec = strstr(read_scene_format_doc(), "## 9. A complete example");
     assert_non_null(sec);
     const char *start = strstr(sec, "```\n");
     assert_non_null(start);
@@ -266,14 +290,8 @@ static void test_docs_example(void **state)
     rt_scene_init(&s);
     rt_result r = rt_scene_parse_string(&s, start, (size_t)(end - start), "docs/scene-format.md#example", "scenes",
                                         &err);
-    if (r == RT_ERR_UNSUPPORTED) {
-        fprintf(stderr, "note: %s\n", err.message);
-        rt_scene_free(&s);
-        skip();
-    }
-    if (r != RT_OK)
-        print_error("%s\n", err.message);
-    assert_int_equal(r, RT_OK);
+    skip_if_unsupported(r, &s, &err);
+    assert_parsed(r, &err);
     assert_int_equal(s.light_count, 4);
     assert_int_equal(s.spheres.count, 2);
     assert_int_equal(s.settings.integrator, RT_INTEGRATOR_WHITTED);
@@ -291,14 +309,8 @@ static void test_camera_gltf(void **state)
     rt_scene_init(&s);
     const char *text = "camera gltf 0\nmodel ../assets/box.gltf\n";
     rt_result r = rt_scene_parse_string(&s, text, strlen(text), "t.txt", "scenes", &err);
-    if (r == RT_ERR_UNSUPPORTED) {
-        fprintf(stderr, "note: %s\n", err.message);
-        rt_scene_free(&s);
-        skip();
-    }
-    if (r != RT_OK)
-        print_error("%s\n", err.message);
-    assert_int_equal(r, RT_OK);
+    skip_if_unsupported(r, &s, &err);
+    assert_parsed(r, &err);
     assert_int_equal(s.camera_count, 1);
     assert_true(s.camera_set);
     assert_memory_equal(&s.camera, &s.cameras[0], sizeof s.camera);
@@ -488,17 +500,7 @@ static void test_settings_text_form(void **state)
 static void test_material_keys_in_docs(void **state)
 {
     (void)state;
-    FILE *f = fopen("docs/scene-format.md", "rb");
-    assert_non_null(f);
-    static char doc[1 << 17];
-    size_t n = fread(doc, 1, sizeof doc - 1, f);
-    fclose(f);
-    doc[n] = '\0';
-    char *sec = strstr(doc, "\n## 5. Materials\n");
-    assert_non_null(sec);
-    char *end = strstr(sec + 1, "\n## ");
-    if (end)
-        *end = '\0';
+    const char *sec = scene_format_doc_section("\n## 5. Materials\n");
     int missing = 0;
     for (size_t i = 0; rt_scene_material_key(i); i++) {
         const char *key = rt_scene_material_key(i);
@@ -525,17 +527,7 @@ static void test_material_keys_in_docs(void **state)
 static void test_settings_table_in_docs(void **state)
 {
     (void)state;
-    FILE *f = fopen("docs/scene-format.md", "rb");
-    assert_non_null(f);
-    static char doc[1 << 17];
-    size_t n = fread(doc, 1, sizeof doc - 1, f);
-    fclose(f);
-    doc[n] = '\0';
-    char *sec = strstr(doc, "\n## 2. Settings\n");
-    assert_non_null(sec);
-    char *end = strstr(sec + 1, "\n## ");
-    if (end)
-        *end = '\0';
+    const char *sec = scene_format_doc_section("\n## 2. Settings\n");
     int missing = 0;
     for (size_t i = 0; i < rt_settings_count; i++) {
         const rt_setting *def = &rt_settings_table[i];
@@ -1177,9 +1169,7 @@ static void test_paths_relative_to_scene_file(void **state)
     rt_error err;
     rt_scene_init(&s);
     rt_result r = rt_scene_parse_file(&s, TMP_DIR "/sub/scene.txt", &err);
-    if (r != RT_OK)
-        print_error("%s\n", err.message);
-    assert_int_equal(r, RT_OK);
+    assert_parsed(r, &err);
     assert_int_equal(s.image_count, 1);
     assert_string_equal(s.images[0].name, TMP_DIR "/sub/tex.ppm");
     rt_scene_free(&s);
@@ -1216,9 +1206,7 @@ static void test_mesh_transform(void **state)
         rt_scene_free(&s);
         skip();
     }
-    if (r != RT_OK)
-        print_error("%s\n", err.message);
-    assert_int_equal(r, RT_OK);
+    assert_parsed(r, &err);
     assert_int_equal(s.triangles.count, 1);
     assert_int_equal(s.triangles.material[0], 0);
     /* by hand: scale (2,3,4); Rx 90: (x,y,z) -> (x,-z,y); Rz 90: (x,y,z) -> (-y,x,z); then translate.
@@ -1237,9 +1225,7 @@ static void test_mesh_transform(void **state)
 
     /* a uniform scale and a mesh without a material (gets a default one) */
     r = parse(&s, "mesh tri.off scale 2\n", &err);
-    if (r != RT_OK)
-        print_error("%s\n", err.message);
-    assert_int_equal(r, RT_OK);
+    assert_parsed(r, &err);
     assert_int_equal(s.triangles.count, 1);
     rt_box b = rt_scene_bounds(&s);
     assert_vec3(b.hi, 2, 2, 2);

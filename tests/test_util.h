@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <dirent.h>
+#include <math.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -43,6 +44,51 @@ static inline bool test_read_cornell_reference(rt_framebuffer *ref)
         return false;
     }
     return true;
+}
+
+/* The mean of channel c over the 8x8 block (x, y) of the 512x512 Cornell
+ * reference: what pixel (x, y) of a 64x64 render of the same camera covers. */
+static inline double test_cornell_block(const rt_framebuffer *ref, int x, int y, int c)
+{
+    double r = 0.0;
+    for (int j = 0; j < 8; j++)
+        for (int i = 0; i < 8; i++)
+            r += ref->rgb[3 * ((size_t)(8 * y + j) * 512 + (size_t)(8 * x + i)) + (size_t)c];
+    return r / 64.0;
+}
+
+/* RMSE of a 64x64 image against the Cornell reference box-averaged over
+ * 8x8 blocks (test_cornell_block), and the image means of both. */
+static inline double test_cornell_block_rmse(const rt_framebuffer *img, const rt_framebuffer *ref, double mine[3],
+                                             double theirs[3])
+{
+    double se = 0.0;
+    for (int c = 0; c < 3; c++)
+        mine[c] = theirs[c] = 0.0;
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++)
+            for (int c = 0; c < 3; c++) {
+                double r = test_cornell_block(ref, x, y, c);
+                double v = img->rgb[3 * ((size_t)y * 64 + (size_t)x) + (size_t)c];
+                se += (v - r) * (v - r);
+                mine[c] += v / 4096.0;
+                theirs[c] += r / 4096.0;
+            }
+    return sqrt(se / (64.0 * 64.0 * 3.0));
+}
+
+/* A load of the file `name` that must have failed with `code` and a
+ * message naming the file and containing `what`; what it got is shown when
+ * it did not. */
+static inline void test_expect_failure(rt_result r, const rt_error *err, rt_result code, const char *name,
+                                       const char *what)
+{
+    if (r != code || !strstr(err->message, name) || !strstr(err->message, what))
+        fprintf(stderr, "%s: got %s \"%s\", wanted %s containing \"%s\"\n", name, rt_result_name(r), err->message,
+                rt_result_name(code), what);
+    assert_int_equal(r, code);
+    assert_non_null(strstr(err->message, name));
+    assert_non_null(strstr(err->message, what));
 }
 
 /* True when the shared assets exist; otherwise prints why the test is skipped. */

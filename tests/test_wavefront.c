@@ -55,6 +55,31 @@ static void soup_scene(rt_scene *s)
     }
 }
 
+/* Ray i of a batch, as a single ray. */
+static rt_ray batch_ray(const rt_ray_batch *rb, int i)
+{
+    return rt_ray_make(rt_v3(rb->ox[i], rb->oy[i], rb->oz[i]), rt_v3(rb->dx[i], rb->dy[i], rb->dz[i]), rb->tmin[i],
+                       rb->tmax[i]);
+}
+
+/* Entry i of a batch's closest hits is the single ray's
+ * rt_kdtree_intersect: the same primitive (RT_NONE for a miss) and the
+ * same bits of t, u and v. Returns whether the ray hit. */
+static bool assert_batch_hit_is_single(const rt_kdtree *tree, const rt_ray_batch *rb, const rt_hit_batch *hb, int i)
+{
+    rt_ray ray = batch_ray(rb, i);
+    rt_hit h;
+    if (!rt_kdtree_intersect(tree, &ray, &h)) {
+        assert_int_equal(hb->prim[i], RT_NONE);
+        return false;
+    }
+    assert_int_equal(hb->prim[i], h.prim);
+    assert_memory_equal(&hb->t[i], &h.t, sizeof h.t);
+    assert_memory_equal(&hb->u[i], &h.u, sizeof h.u);
+    assert_memory_equal(&hb->v[i], &h.v, sizeof h.v);
+    return true;
+}
+
 static void test_batch_traversal_matches_single_rays(void **state)
 {
     (void)state;
@@ -100,17 +125,8 @@ static void test_batch_traversal_matches_single_rays(void **state)
             assert_int_equal(blocked[i], 7);
             continue;
         }
-        rt_ray ray = rt_ray_make(rt_v3(ox[i], oy[i], oz[i]), rt_v3(dx[i], dy[i], dz[i]), tmin[i], tmax[i]);
-        rt_hit h;
-        if (rt_kdtree_intersect(&tree, &ray, &h)) {
-            want_hits++;
-            assert_int_equal(prim[i], h.prim);
-            assert_memory_equal(&t[i], &h.t, sizeof h.t);
-            assert_memory_equal(&u[i], &h.u, sizeof h.u);
-            assert_memory_equal(&v[i], &h.v, sizeof h.v);
-        } else {
-            assert_int_equal(prim[i], RT_NONE);
-        }
+        want_hits += assert_batch_hit_is_single(&tree, &rb, &hb, i);
+        rt_ray ray = batch_ray(&rb, i);
         bool occ = rt_kdtree_occluded(&tree, &ray);
         want_blocks += occ;
         assert_int_equal(blocked[i], occ ? 1 : 0);
@@ -164,19 +180,8 @@ static void test_batch_packets_match_single_rays(void **state)
     rt_hit_batch hb = {t, u, v, prim};
     size_t hits = rt_kdtree_intersect_batch(&tree, &rb, NULL, N, &hb);
     size_t want = 0;
-    for (int k = 0; k < N; k++) {
-        rt_ray ray = rt_ray_make(rt_v3(ox[k], oy[k], oz[k]), rt_v3(dx[k], dy[k], dz[k]), tmin[k], tmax[k]);
-        rt_hit h;
-        if (rt_kdtree_intersect(&tree, &ray, &h)) {
-            want++;
-            assert_int_equal(prim[k], h.prim);
-            assert_memory_equal(&t[k], &h.t, sizeof h.t);
-            assert_memory_equal(&u[k], &h.u, sizeof h.u);
-            assert_memory_equal(&v[k], &h.v, sizeof h.v);
-        } else {
-            assert_int_equal(prim[k], RT_NONE);
-        }
-    }
+    for (int k = 0; k < N; k++)
+        want += assert_batch_hit_is_single(&tree, &rb, &hb, k);
     assert_int_equal(hits, want);
     fprintf(stderr, "%d fans, %zu of %d rays hit\n", runs, hits, N);
     assert_true(hits > N / 10 && hits < N);
@@ -339,29 +344,6 @@ static void test_render_bytes_any_split(void **state)
     unload(&f);
 }
 
-/* RMSE of a 64x64 image against the 512x512 reference box-averaged over
- * 8x8 blocks, and the image means of both. */
-static double block_rmse(const rt_framebuffer *img, const rt_framebuffer *ref, double mine[3], double theirs[3])
-{
-    double se = 0.0;
-    for (int c = 0; c < 3; c++)
-        mine[c] = theirs[c] = 0.0;
-    for (int y = 0; y < 64; y++)
-        for (int x = 0; x < 64; x++)
-            for (int c = 0; c < 3; c++) {
-                double r = 0.0;
-                for (int j = 0; j < 8; j++)
-                    for (int i = 0; i < 8; i++)
-                        r += ref->rgb[3 * ((size_t)(8 * y + j) * 512 + (size_t)(8 * x + i)) + (size_t)c];
-                r /= 64.0;
-                double v = img->rgb[3 * ((size_t)y * 64 + (size_t)x) + (size_t)c];
-                se += (v - r) * (v - r);
-                mine[c] += v / 4096.0;
-                theirs[c] += r / 4096.0;
-            }
-    return sqrt(se / (64.0 * 64.0 * 3.0));
-}
-
 /* scenes/cornell-reference.txt at 64x64 (each pixel an 8x8 block of the
  * 512x512 reference) and 32 spp: `path` and `path_scalar` give the same
  * bytes; the image means are within 1.5% of the reference's (their noise at
@@ -383,12 +365,12 @@ static void test_cornell_reference_wavefront(void **state)
     assert_memory_equal(img.rgb, scalar.rgb, 64 * 64 * 3 * sizeof(float));
     rt_framebuffer_free(&scalar);
     double mine[3], theirs[3], m2[3], t2[3];
-    double rmse = block_rmse(&img, &ref, mine, theirs);
+    double rmse = test_cornell_block_rmse(&img, &ref, mine, theirs);
     double noise = 0.0;
     for (uint32_t k = 1; k <= 2; k++) {
         f.s.settings.seed += k;
         render_with(&f, RT_INTEGRATOR_PATH_SCALAR, 2, 32, 0, 0, &scalar);
-        double e = block_rmse(&scalar, &ref, m2, t2);
+        double e = test_cornell_block_rmse(&scalar, &ref, m2, t2);
         noise = e > noise ? e : noise;
         rt_framebuffer_free(&scalar);
     }

@@ -5,6 +5,7 @@
  * fully transparent sphere, nested media, diffuse bounces in a furnace
  * and finiteness. */
 #include "test_util.h"
+#include "test_fixture.h"
 
 #include <math.h>
 
@@ -276,25 +277,14 @@ static void test_mirror_shows_wall(void **state)
     s.settings.width = 8;
     s.settings.height = 8;
     s.settings.samples = 4;
-    s.camera.position = rt_v3(0, 0, 2);
-    s.camera.look_at = rt_v3(0, 0, 0);
-    s.camera.up = rt_v3(0, 1, 0);
-    s.camera.vfov_deg = 30;
-    s.camera_set = true;
+    test_scene_look(&s, rt_v3(0, 0, 2), rt_v3(0, 0, 0), rt_v3(0, 1, 0), 30);
     built b;
     build(&b, &s);
     rt_vec3 L = radiance(&b, rt_v3(0.2f, 0.1f, 2), rt_v3(-0.1f, 0.05f, -1));
     assert_true(fabsf(L.x - R * C.x) < 1e-6f && fabsf(L.y - R * C.y) < 1e-6f && fabsf(L.z - R * C.z) < 1e-6f);
 
-    rt_error err = {0};
     rt_framebuffer fb;
-    assert_int_equal(rt_framebuffer_init(&fb, 8, 8, &err), RT_OK);
-    rt_render_options opt;
-    memset(&opt, 0, sizeof opt);
-    opt.threads = 2;
-    rt_render_stats st;
-    assert_int_equal(rt_render(&s, &b.tree, &opt, &fb, &st, &err), RT_OK);
-    assert_int_equal(st.bad_samples, 0);
+    test_render_scene(&s, 2, 0, &fb);
     for (int i = 0; i < 64; i++) {
         assert_true(fabsf(fb.rgb[3 * i] - R * C.x) < 1e-5f);
         assert_true(fabsf(fb.rgb[3 * i + 1] - R * C.y) < 1e-5f);

@@ -16,10 +16,9 @@
 #   parallel -q -S 1/ws1,1/ws2,1/: --bf scene.gltf --return '{2}' --cleanup --halt now,fail=1 \
 #       rt --frames {1}:{3} -o f.%04d.png scene.gltf ::: 0 1 ... :::+ f.0000.png f.0001.png ... :::+ 1 2 ...
 set -eu
-if [ $# -lt 3 ]; then
-    echo "frames.sh: usage: RT_HOSTS=host1,host2,: sh frames.sh A:B SCENE PATTERN [rt flags...]" >&2
-    exit 2
-fi
+# shellcheck source=checks.sh source-path=SCRIPTDIR
+. "$(dirname "$0")/checks.sh"
+need_args frames.sh $# 3 "RT_HOSTS=host1,host2,: sh frames.sh A:B SCENE PATTERN [rt flags...]"
 range=$1
 scene=$2
 pattern=$3
@@ -35,11 +34,8 @@ case $pattern in
     *) echo "frames.sh: PATTERN needs a %04d (or %d, %0Nd) for the frame number: '$pattern'" >&2; exit 2 ;;
 esac
 [ "$a" -lt "$b" ] || { echo "frames.sh: no frames in $range (A < B, B not rendered)" >&2; exit 2; }
-[ -r "$scene" ] || { echo "frames.sh: cannot read the scene $scene" >&2; exit 2; }
-if ! parallel --version 2>/dev/null | grep -q '^GNU parallel'; then
-    echo "frames.sh: GNU parallel is not installed (apt-get install parallel; moreutils' parallel is another program)" >&2
-    exit 2
-fi
+need_scene frames.sh "$scene"
+need_gnu_parallel frames.sh
 frames=""
 names=""
 nexts=""

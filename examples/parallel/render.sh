@@ -25,12 +25,12 @@
 # each to PARALLEL (the environment variable GNU parallel takes options from),
 # or keep the scene on a file system all hosts share. A failed part stops
 # the rest (--halt) and nothing is merged; the parts written stay, and
-# `rt --part I/N` renders a missing one by hand.
+# `rt --part I/N` renders a missing one by hand. The argument checks are
+# in checks.sh, beside this file.
 set -eu
-if [ $# -lt 3 ]; then
-    echo "render.sh: usage: RT_HOSTS=host1,host2,: sh render.sh N SCENE IMAGE [rt flags...]" >&2
-    exit 2
-fi
+# shellcheck source=checks.sh source-path=SCRIPTDIR
+. "$(dirname "$0")/checks.sh"
+need_args render.sh $# 3 "RT_HOSTS=host1,host2,: sh render.sh N SCENE IMAGE [rt flags...]"
 n=$1
 scene=$2
 image=$3
@@ -38,11 +38,8 @@ shift 3
 case $n in
     '' | *[!0-9]* | 0) echo "render.sh: N must be a number of parts >= 1, not '$n'" >&2; exit 2 ;;
 esac
-[ -r "$scene" ] || { echo "render.sh: cannot read the scene $scene" >&2; exit 2; }
-if ! parallel --version 2>/dev/null | grep -q '^GNU parallel'; then
-    echo "render.sh: GNU parallel is not installed (apt-get install parallel; moreutils' parallel is another program)" >&2
-    exit 2
-fi
+need_scene render.sh "$scene"
+need_gnu_parallel render.sh
 rt=${RT:-rt}
 stem=$(basename "${image%.*}")
 for f in "$stem".part.*; do

@@ -484,27 +484,37 @@ static int edit_distance(const char *a, const char *b)
     return d[n][m];
 }
 
+/* The candidate closest to a word, for "did you mean" hints: shown the
+ * candidates one at a time (near_miss_consider), it keeps the first of the
+ * closest within edit distance 2; best is NULL when none is that close. */
+typedef struct near_miss {
+    const char *word, *best;
+    int best_d;
+} near_miss;
+
+static near_miss near_miss_of(const char *word) { return (near_miss){word, NULL, 3}; }
+
+static void near_miss_consider(near_miss *n, const char *candidate)
+{
+    int d = edit_distance(n->word, candidate);
+    if (d < n->best_d)
+        n->best_d = d, n->best = candidate;
+}
+
 /* The defined name closest to `word` (edit distance under 3), for "did
  * you mean"; NULL when none is that close. Names the scene holds from other
  * loaders count too, except the internal "__" ones. */
 static const char *closest_name(const parser *p, const name_table *table, bool scene_materials, const char *word)
 {
-    const char *best = NULL;
-    int best_d = 3;
-    for (size_t i = 0; i < table->count; i++) {
-        int d = edit_distance(word, table->items[i].name);
-        if (d < best_d)
-            best_d = d, best = table->items[i].name;
-    }
+    near_miss n = near_miss_of(word);
+    for (size_t i = 0; i < table->count; i++)
+        near_miss_consider(&n, table->items[i].name);
     for (size_t i = 0; scene_materials && i < p->s->material_count; i++) {
         const char *name = p->s->materials[i].name;
-        if (strncmp(name, "__", 2) == 0)
-            continue;
-        int d = edit_distance(word, name);
-        if (d < best_d)
-            best_d = d, best = name;
+        if (strncmp(name, "__", 2) != 0)
+            near_miss_consider(&n, name);
     }
-    return best;
+    return n.best;
 }
 
 /* A material by name: those defined in this file first, then any other in
@@ -824,8 +834,6 @@ static rt_result st_texture(parser *p, const tok *kw)
 
 /* ------------------------------------------------------------ materials */
 
-static int edit_distance(const char *a, const char *b);
-
 typedef enum mat_kind {
     MK_FLOAT, MK_INT, MK_COLOR, MK_BOOL, MK_TEXTURE, MK_ALPHA_MODE, MK_DISTANCE, MK_UV, MK_BSDF,
     MK_METAL,    /* a named metal: sets eta and k */
@@ -975,16 +983,12 @@ static rt_result st_material(parser *p, const tok *kw)
                !(mat_keys[k].alias && strcmp(key->s, mat_keys[k].alias) == 0))
             k++;
         if (k == MAT_KEY_COUNT || key->quoted) {
-            const char *best = NULL;
-            int best_d = 3;
-            for (size_t i = 0; i < MAT_KEY_COUNT; i++) {
-                int d = edit_distance(key->s, mat_keys[i].key);
-                if (d < best_d)
-                    best_d = d, best = mat_keys[i].key;
-            }
-            if (best)
+            near_miss n = near_miss_of(key->s);
+            for (size_t i = 0; i < MAT_KEY_COUNT; i++)
+                near_miss_consider(&n, mat_keys[i].key);
+            if (n.best)
                 return perr(p, RT_ERR_PARSE, key, "expected a material key, got %s (did you mean '%s'?)",
-                            show(key, b, sizeof b), best);
+                            show(key, b, sizeof b), n.best);
             return perr(p, RT_ERR_PARSE, key,
                         "expected a material key (color, alpha, ambient, diffuse, specular, shininess, reflect, "
                         "transmission, ior, metallic, roughness, emission, texture, normal_map, ... see "
@@ -1642,20 +1646,13 @@ static rt_result run_statement(parser *p)
             if (strcmp(kw->s, keywords[i].word) == 0)
                 return keywords[i].fn(p, kw);
     }
-    const char *best = NULL;
-    int best_d = 3;
-    for (size_t i = 0; i < rt_settings_count; i++) {
-        int d = edit_distance(kw->s, rt_settings_table[i].name);
-        if (d < best_d)
-            best_d = d, best = rt_settings_table[i].name;
-    }
-    for (size_t i = 0; i < sizeof keywords / sizeof *keywords; i++) {
-        int d = edit_distance(kw->s, keywords[i].word);
-        if (d < best_d)
-            best_d = d, best = keywords[i].word;
-    }
-    if (best)
-        return perr(p, RT_ERR_PARSE, kw, "unknown keyword %s (did you mean '%s'?)", show(kw, b, sizeof b), best);
+    near_miss n = near_miss_of(kw->s);
+    for (size_t i = 0; i < rt_settings_count; i++)
+        near_miss_consider(&n, rt_settings_table[i].name);
+    for (size_t i = 0; i < sizeof keywords / sizeof *keywords; i++)
+        near_miss_consider(&n, keywords[i].word);
+    if (n.best)
+        return perr(p, RT_ERR_PARSE, kw, "unknown keyword %s (did you mean '%s'?)", show(kw, b, sizeof b), n.best);
     return perr(p, RT_ERR_PARSE, kw,
                 "unknown keyword %s (expected a setting, camera, texture, material, sphere, quad, triangle, mesh, "
                 "model or light)",
