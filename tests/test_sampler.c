@@ -10,6 +10,14 @@
  *     stratifies the 1D dimension;
  *   - every value is in [0, 1) and a pure function of its arguments, and
  *     two dimensions of one pixel are not the same pattern (padding);
+ *   - Sobol: rt_sampler_block (AVX2 lanes when the CPU has them), its
+ *     scalar path, the path's cache of it and rt_sampler_2d / rt_sampler_1d
+ *     give the bits of a reference written here from the definitions (bit
+ *     loops: the reversal, Sobol's generator matrix from its direction
+ *     numbers, Owen scrambling as the LK hash of the reversed value) over
+ *     many keys, indices, spp and dimensions; CMJ: the block and its cache
+ *     give rt_sampler_2d's bits (sampling.h's Kensler functions) over as
+ *     many, spp of every kind of grid and indices past the spp included;
  *   - the path tracer: `path` equals `path_scalar` byte for byte with each
  *     sampler (tests/test_wavefront.c covers the splits), and on the shared
  *     Cornell box at 16 spp each stratified sampler's image is closer to the
@@ -24,6 +32,7 @@
 #include "rt/io/scene_parse.h"
 #include "rt/render/render.h"
 #include "rt/render/sampler.h"
+#include "rt/render/sampler_block.h"
 #include "rt/scene/scene.h"
 
 static const uint32_t keys[] = {0u, 1u, 0x9e3779b9u, 0xdeadbeefu, 12345u};
@@ -89,6 +98,142 @@ static void test_sobol_nets(void **state)
             check_net(keys[a], dims[b], 100, 0, 64); /* spp not a power of two: its prefixes */
             check_net(keys[a], dims[b], 100, 64, 32);
             check_net(keys[a], dims[b], 16, 0, 16);
+        }
+}
+
+/* ---- a reference for the Sobol sampler, from its definitions */
+
+static uint32_t ref_hash(uint32_t a, uint32_t b) /* sampler.h's seed hash: murmur3's finaliser */
+{
+    uint32_t h = a ^ (b * 0x9e3779b9u + 0x7f4a7c15u);
+    h ^= h >> 16;
+    h *= 0x85ebca6bu;
+    h ^= h >> 13;
+    h *= 0xc2b2ae35u;
+    h ^= h >> 16;
+    return h;
+}
+
+static uint32_t ref_reverse(uint32_t x)
+{
+    uint32_t r = 0;
+    for (int b = 0; b < 32; b++)
+        if (x & (1u << b))
+            r |= 1u << (31 - b);
+    return r;
+}
+
+static uint32_t ref_lk(uint32_t x, uint32_t seed) /* Vegdahl 2021's hash */
+{
+    x ^= x * 0x3d20adeau;
+    x += seed;
+    x *= (seed >> 16) | 1u;
+    x ^= x * 0x05526c56u;
+    x ^= x * 0x53a22864u;
+    return x;
+}
+
+/* Owen scrambling of a 0.32 fixed-point value: the hash of its reversal. */
+static uint32_t ref_owen(uint32_t v, uint32_t seed) { return ref_reverse(ref_lk(ref_reverse(v), seed)); }
+
+static float ref_unit(uint32_t v) { return (float)(v >> 8) / 16777216.0f; }
+
+/* Sobol's second dimension at index j: the xor of the direction numbers
+ * V_i = m_(i+1) / 2^(i+1) of j's set bits, m_1 = 1, m_(k+1) = m_k xor 2 m_k. */
+static uint32_t ref_sobol_y(uint32_t j)
+{
+    uint32_t y = 0, m = 1;
+    for (int i = 0; i < 32; i++) {
+        if (j & (1u << i))
+            y ^= m << (31 - i); /* m_(i+1) < 2^(i+1): its bits as the fraction's top i+1 */
+        m ^= m << 1;
+    }
+    return y;
+}
+
+static rt_vec2 ref_sobol_2d(uint32_t key, uint32_t index, uint32_t spp, uint32_t dim)
+{
+    uint32_t seed = ref_hash(key, dim);
+    uint32_t mask = 1; /* the index bits that index spp samples: 2^k >= spp, at least one bit */
+    while (mask < spp - 1 && spp > 1 && mask != 0xffffffffu)
+        mask = mask << 1 | 1u;
+    /* the nested scramble of those bits: bit k flipped by a function of the
+     * bits above it, an Owen scramble of the index read as a fraction */
+    uint32_t j = (index & ~mask) | (ref_owen(index, seed) & mask);
+    uint32_t x = ref_reverse(j), y = ref_sobol_y(j);
+    return rt_v2(ref_unit(ref_owen(x, ref_hash(seed, 0x68e31da4u))), ref_unit(ref_owen(y, ref_hash(seed, 0xb5297a4du))));
+}
+
+static uint32_t lcg(uint32_t *s) { return *s = *s * 1664525u + 1013904223u; }
+
+static void test_sobol_block_matches_reference(void **state)
+{
+    (void)state;
+    const uint32_t spps[] = {0u, 1u, 2u, 3u, 4u, 16u, 17u, 100u, 1024u, 65537u, 0x80000000u, 0xffffffffu};
+    const uint32_t dim0s[] = {0u, 6u, 8u, 1000u, RT_SAMPLER_DIM_FILM, 0xfffffffcu /* wraps past 2^32 */};
+    if (!rt_sampler_block_simd())
+        print_message("(this CPU has no AVX2: rt_sampler_block checked on its scalar path only)\n");
+    uint32_t rs = 12345u;
+    size_t checked = 0;
+    for (size_t sp = 0; sp < sizeof spps / sizeof *spps; sp++)
+        for (uint32_t t = 0; t < 400; t++) {
+            uint32_t key = t < 5 ? keys[t] : lcg(&rs);
+            uint32_t index = t < 64 ? t : (t & 1 ? lcg(&rs) % 4096u : lcg(&rs));
+            uint32_t dim0 = t < 60 ? dim0s[t % 6] : lcg(&rs) % 200u * 7u;
+            float bx[RT_SAMPLER_BLOCK], by[RT_SAMPLER_BLOCK], sx[RT_SAMPLER_BLOCK], sy[RT_SAMPLER_BLOCK];
+            rt_sampler_block(RT_SAMPLER_SOBOL, key, index, spps[sp], dim0, bx, by);
+            rt_sampler_block_scalar(RT_SAMPLER_SOBOL, key, index, spps[sp], dim0, sx, sy);
+            rt_sampler_cache c;
+            rt_sampler_cache_clear(&c);
+            for (uint32_t k = 0; k < RT_SAMPLER_BLOCK; k++) {
+                uint32_t dim = dim0 + k;
+                rt_vec2 r = ref_sobol_2d(key, index, spps[sp], dim);
+                rt_vec2 v = rt_sampler_2d(RT_SAMPLER_SOBOL, key, index, spps[sp], dim);
+                float v1 = rt_sampler_1d(RT_SAMPLER_SOBOL, key, index, spps[sp], dim);
+                rt_vec2 cv = rt_sampler_cache_2d(&c, RT_SAMPLER_SOBOL, key, index, spps[sp], dim0, (k * 5u) % RT_SAMPLER_BLOCK);
+                rt_vec2 cr = ref_sobol_2d(key, index, spps[sp], dim0 + (k * 5u) % RT_SAMPLER_BLOCK);
+                if (!(r.x == v.x && r.y == v.y && r.x == v1 && r.x == bx[k] && r.y == by[k] && r.x == sx[k] &&
+                      r.y == sy[k] && cv.x == cr.x && cv.y == cr.y))
+                    fail_msg("key %#x index %u spp %u dim %#x: reference (%a, %a), rt_sampler_2d (%a, %a), 1d %a, "
+                             "block (%a, %a), scalar block (%a, %a), cache (%a, %a) for (%a, %a)",
+                             key, index, spps[sp], dim, (double)r.x, (double)r.y, (double)v.x, (double)v.y,
+                             (double)v1, (double)bx[k], (double)by[k], (double)sx[k], (double)sy[k], (double)cv.x,
+                             (double)cv.y, (double)cr.x, (double)cr.y);
+                checked++;
+            }
+            /* the cache refills for another block of the same sample */
+            rt_vec2 other = rt_sampler_cache_2d(&c, RT_SAMPLER_SOBOL, key, index, spps[sp], dim0 + 3u, 2);
+            rt_vec2 want = ref_sobol_2d(key, index, spps[sp], dim0 + 5u);
+            assert_true(other.x == want.x && other.y == want.y);
+        }
+    assert_true(checked == sizeof spps / sizeof *spps * 400u * RT_SAMPLER_BLOCK);
+}
+
+static void test_cmj_block_matches_scalar(void **state)
+{
+    (void)state;
+    /* squares, m x k grids with a short last row, primes, powers of two, large */
+    const uint32_t spps[] = {0u, 1u, 2u, 3u, 5u, 7u, 16u, 17u, 64u, 100u, 1000u, 1024u, 65537u, 1000000u, 0x80000000u};
+    uint32_t rs = 777u;
+    for (size_t sp = 0; sp < sizeof spps / sizeof *spps; sp++)
+        for (uint32_t t = 0; t < 400; t++) {
+            uint32_t n = spps[sp] ? spps[sp] : 1u;
+            uint32_t key = t < 5 ? keys[t] : lcg(&rs);
+            /* the spp's first round, later rounds (a fresh pattern), any index */
+            uint32_t index = t % 4 == 0 ? lcg(&rs) : t % 4 == 1 ? t % n : lcg(&rs) % (n < 4096u ? 3u * n : 12288u);
+            uint32_t dim0 = t < 60 ? (uint32_t[]){0u, 6u, 1000u, 0xfffffffcu}[t % 4] : lcg(&rs);
+            float bx[RT_SAMPLER_BLOCK], by[RT_SAMPLER_BLOCK];
+            rt_sampler_block(RT_SAMPLER_CMJ, key, index, spps[sp], dim0, bx, by);
+            rt_sampler_cache c;
+            rt_sampler_cache_clear(&c);
+            for (uint32_t k = 0; k < RT_SAMPLER_BLOCK; k++) {
+                rt_vec2 v = rt_sampler_2d(RT_SAMPLER_CMJ, key, index, spps[sp], dim0 + k);
+                rt_vec2 cv = rt_sampler_cache_2d(&c, RT_SAMPLER_CMJ, key, index, spps[sp], dim0, k);
+                if (!(v.x == bx[k] && v.y == by[k] && v.x == cv.x && v.y == cv.y))
+                    fail_msg("CMJ key %#x index %u spp %u dim %#x: rt_sampler_2d (%a, %a), block (%a, %a), cache (%a, %a)",
+                             key, index, spps[sp], dim0 + k, (double)v.x, (double)v.y, (double)bx[k], (double)by[k],
+                             (double)cv.x, (double)cv.y);
+            }
         }
 }
 
@@ -295,6 +440,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_values_in_unit_interval),
         cmocka_unit_test(test_sobol_nets),
+        cmocka_unit_test(test_sobol_block_matches_reference),
+        cmocka_unit_test(test_cmj_block_matches_scalar),
         cmocka_unit_test(test_cmj_strata),
         cmocka_unit_test(test_dimensions_decorrelated),
         cmocka_unit_test(test_cornell_mse_stratified),

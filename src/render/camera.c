@@ -2,11 +2,14 @@
  * exact convention). Thin lens: the origin is sampled on a disk of radius
  * aperture/2 around the eye and the ray aimed at the point the pinhole ray
  * reaches on the plane of focus (pbrt, section 6.2.3). Pixel samples:
- * correlated multi-jittered positions (Kensler 2013, rt/render/sampling.h). */
+ * correlated multi-jittered positions (Kensler 2013, rt/render/sampling.h),
+ * or for the path tracer its Sobol sampler's (rt/render/sampler.h; film and
+ * lens in one rt/render/sampler_block.h block when the CPU has AVX2). */
 #include "rt/render/camera.h"
 
 #include "rt/render/sampler.h"
 #include "rt/render/sampling.h"
+#include "rt/render/sampler_block.h"
 
 bool rt_camera_frame_init(rt_camera_frame *cf, const rt_camera *cam, int width, int height)
 {
@@ -60,9 +63,21 @@ rt_ray rt_camera_pixel_sample(const rt_camera_frame *cf, int width, uint32_t see
     uint64_t pixel = (uint64_t)y * (uint64_t)width + (uint64_t)x;
     if (cf->sampler == RT_SAMPLER_SOBOL) {
         *rng = rt_rng_for_sample(seed, pixel, s);
-        rt_vec2 j = spp > 1 ? rt_sampler_2d(RT_SAMPLER_SOBOL, rng->key, s, spp, RT_SAMPLER_DIM_FILM) : rt_v2(0.5f, 0.5f);
-        rt_vec2 lens = cf->lens_radius > 0.0f ? rt_sampler_2d(RT_SAMPLER_SOBOL, rng->key, s, spp, RT_SAMPLER_DIM_LENS)
-                                              : rt_v2(0.5f, 0.5f);
+        rt_vec2 j = rt_v2(0.5f, 0.5f), lens = rt_v2(0.5f, 0.5f);
+        if (rt_sampler_block_usable() && (spp > 1 || cf->lens_radius > 0.0f)) {
+            /* film and lens are consecutive dimensions: one block (in lanes) for both */
+            float bx[RT_SAMPLER_BLOCK], by[RT_SAMPLER_BLOCK];
+            rt_sampler_block(RT_SAMPLER_SOBOL, rng->key, s, spp, RT_SAMPLER_DIM_FILM, bx, by);
+            if (spp > 1)
+                j = rt_v2(bx[0], by[0]);
+            if (cf->lens_radius > 0.0f)
+                lens = rt_v2(bx[RT_SAMPLER_DIM_LENS - RT_SAMPLER_DIM_FILM], by[RT_SAMPLER_DIM_LENS - RT_SAMPLER_DIM_FILM]);
+        } else {
+            if (spp > 1)
+                j = rt_sampler_2d(RT_SAMPLER_SOBOL, rng->key, s, spp, RT_SAMPLER_DIM_FILM);
+            if (cf->lens_radius > 0.0f)
+                lens = rt_sampler_2d(RT_SAMPLER_SOBOL, rng->key, s, spp, RT_SAMPLER_DIM_LENS);
+        }
         return rt_camera_ray(cf, (float)x + j.x, (float)y + j.y, lens);
     }
     uint32_t pattern = (uint32_t)rt_mix64(pixel ^ ((uint64_t)seed << 40));

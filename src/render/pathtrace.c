@@ -64,30 +64,51 @@
  * vertex after `bounces` scatterings uses dims bounces * stride + slot),
  * so every sample of a pixel takes each decision from the same stratified
  * dimension, whatever its path did before, and the wavefront needs no
- * per-lane counter. */
+ * per-lane counter. With a stratified sampler and AVX2, the first read of a
+ * bounce computes its first RT_SAMPLER_BLOCK (8) dimensions at once into
+ * the path's cache (rt/render/sampler_block.h: the same bits as one at a time),
+ * which the bounce's other reads find there; with more than 3 lights the
+ * lights past the third fill blocks of 8 of their own in turn (then the
+ * first block is computed again for the environment, emitter and BSDF). */
 enum { DIM_BSDF, DIM_LOBE_RR, DIM_ENV, DIM_EMIT_PICK, DIM_EMIT, DIM_LIGHT0 };
+
+static inline uint32_t path_stride(const rt_trace_ctx *ctx)
+{
+    return DIM_LIGHT0 + (uint32_t)ctx->state->scene->light_count;
+}
 
 static inline uint32_t path_dim(const rt_trace_ctx *ctx, const rt_path_state *ps, uint32_t slot)
 {
-    uint32_t stride = DIM_LIGHT0 + (uint32_t)ctx->state->scene->light_count;
-    return (uint32_t)ps->bounces * stride + slot;
+    return (uint32_t)ps->bounces * path_stride(ctx) + slot;
 }
 
-static inline float path_1d(const rt_trace_ctx *ctx, const rt_path_state *ps, rt_rng *rng, uint32_t slot)
+/* The 2D value of slot `slot` of bounce `bounce`. */
+static inline rt_vec2 path_2d_of(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, int bounce, uint32_t slot)
 {
     const rt_settings *st = &ctx->state->scene->settings;
+    rt_sampler_kind kind = (rt_sampler_kind)st->sampler;
+    uint32_t dim0 = (uint32_t)bounce * path_stride(ctx);
+    if (kind != RT_SAMPLER_INDEPENDENT && rt_sampler_block_usable()) {
+        uint32_t first = slot - slot % RT_SAMPLER_BLOCK; /* past 8 slots (3 lights), the block of 8 it falls in */
+        return rt_sampler_cache_2d(&ps->samples, kind, rng->key, rng->index, (uint32_t)st->samples, dim0 + first,
+                                   slot - first);
+    }
+    return rt_sample_2d(kind, (uint32_t)st->samples, rng, dim0 + slot);
+}
+
+static inline rt_vec2 path_2d(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, uint32_t slot)
+{
+    return path_2d_of(ctx, ps, rng, ps->bounces, slot);
+}
+
+/* A 1D value: Sobol's is the x of the dimension's 2D value
+ * (rt_sampler_1d), so it reads the cache; CMJ's and the stream's are apart. */
+static inline float path_1d(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, uint32_t slot)
+{
+    const rt_settings *st = &ctx->state->scene->settings;
+    if (st->sampler == RT_SAMPLER_SOBOL && rt_sampler_block_usable())
+        return path_2d(ctx, ps, rng, slot).x;
     return rt_sample_1d((rt_sampler_kind)st->sampler, (uint32_t)st->samples, rng, path_dim(ctx, ps, slot));
-}
-
-static inline rt_vec2 path_2d_at(const rt_trace_ctx *ctx, rt_rng *rng, uint32_t dim)
-{
-    const rt_settings *st = &ctx->state->scene->settings;
-    return rt_sample_2d((rt_sampler_kind)st->sampler, (uint32_t)st->samples, rng, dim);
-}
-
-static inline rt_vec2 path_2d(const rt_trace_ctx *ctx, const rt_path_state *ps, rt_rng *rng, uint32_t slot)
-{
-    return path_2d_at(ctx, rng, path_dim(ctx, ps, slot));
 }
 
 /* A record for a light from the light table in direction d (world, above
@@ -112,7 +133,7 @@ static bool light_table_record(const rt_trace_ctx *ctx, const rt_bsdf *b, rt_vec
     return true;
 }
 
-bool rt_path_nee_light(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
+bool rt_path_nee_light(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                        rt_vec3 wo, rt_rng *rng, size_t i, rt_nee_record *rec)
 {
     const rt_light *l = &ctx->state->scene->lights[i];
@@ -141,7 +162,7 @@ bool rt_path_nee_light(const rt_trace_ctx *ctx, const rt_path_state *ps, const r
     return true;
 }
 
-bool rt_path_nee_env(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
+bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
                      rt_nee_record *rec)
 {
     if (!rt_path_samples_env(ctx))
@@ -155,7 +176,7 @@ bool rt_path_nee_env(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_
     return false;
 }
 
-bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
+bool rt_path_nee_emitter(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                          rt_vec3 wo, rt_rng *rng, rt_nee_record *rec)
 {
     if (!rt_path_samples_emitters(ctx))
@@ -238,6 +259,7 @@ bool rt_path_start(const rt_trace_ctx *ctx, const rt_ray *ray, rt_path_state *ps
     ps->bounces = 0;
     rt_medium_stack_init(&ps->media);
     ps->skips = RT_PATH_HARD_LIMIT;
+    rt_sampler_cache_clear(&ps->samples); /* a new sample: the cache holds none of its values */
     return true;
 }
 
@@ -323,14 +345,14 @@ bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_sur
      * and most paths end before the roulette. `independent` draws both from
      * the stream, in call order. */
     bool stratified = ctx->state->scene->settings.sampler != RT_SAMPLER_INDEPENDENT;
-    uint32_t lr_dim = path_dim(ctx, ps, DIM_LOBE_RR);
+    int lr_bounce = ps->bounces; /* the roulette reads it after ps->bounces++ */
     rt_vec2 ulr = rt_v2(0.0f, 0.0f);
     bool have_lr = false;
     float ulobe = 0.0f;
     if (!stratified) {
         ulobe = rt_rng_float(rng);
     } else if (b->layered || !b->lambert) {
-        ulr = path_2d_at(ctx, rng, lr_dim);
+        ulr = path_2d_of(ctx, ps, rng, lr_bounce, DIM_LOBE_RR);
         have_lr = true;
         ulobe = ulr.x;
     }
@@ -355,7 +377,7 @@ bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_sur
     if (rr_depth == 0 ? rt_max3(beta) < 1.0f : ps->bounces >= rr_depth) {
         float q = rr_depth == 0 ? rt_max3(beta) : rt_fminf(rt_max3(beta), 0.95f);
         if (stratified && !have_lr)
-            ulr = path_2d_at(ctx, rng, lr_dim);
+            ulr = path_2d_of(ctx, ps, rng, lr_bounce, DIM_LOBE_RR);
         if ((stratified ? ulr.y : rt_rng_float(rng)) >= q)
             return false;
         ps->beta = rt_scale(beta, 1.0f / q);

@@ -29,6 +29,7 @@
 #include "rt/render/light.h"
 #include "rt/render/medium.h"
 #include "rt/render/sampling.h"
+#include "rt/render/sampler_block.h"
 
 #define RT_PATH_HARD_LIMIT 1024 /* bounces when max_depth is 0 (unlimited): a guard, never reached in practice */
 #define RT_PATH_LAYERS 257      /* surfaces a path segment may step past (alpha cut-outs) plus one */
@@ -61,6 +62,7 @@ typedef struct rt_path_state {
     int bounces;
     rt_medium_stack media; /* the dielectrics it is inside (rt/render/medium.h) */
     int skips;         /* false intersections it may still pass */
+    rt_sampler_cache samples; /* the stratified sampler's values of the current bounce (rt/render/sampler_block.h) */
 } rt_path_state;
 
 /* What rt_path_vertex_begin found at a surface. */
@@ -95,13 +97,13 @@ void rt_path_miss(const rt_trace_ctx *ctx, rt_path_state *ps);
 rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, rt_bsdf *b,
                                     rt_vec3 *wo);
 /* Light i, the environment image, one emitter of the table at the path's
- * current vertex (ps: its bounce picks the sampler dimensions): each draws
+ * current vertex (ps: its bounce picks the sampler dimensions, its cache holds them): each draws
  * its random numbers and fills *rec when it can contribute. */
-bool rt_path_nee_light(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
+bool rt_path_nee_light(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                        rt_vec3 wo, rt_rng *rng, size_t i, rt_nee_record *rec);
-bool rt_path_nee_env(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
+bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
                      rt_nee_record *rec);
-bool rt_path_nee_emitter(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
+bool rt_path_nee_emitter(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                          rt_vec3 wo, rt_rng *rng, rt_nee_record *rec);
 /* One light-sampling term, f cos vis w / pdf times the radiance; zero when
  * the shadow ray is blocked (vis 0). */

@@ -34,6 +34,9 @@
  * rt_sampler_1d / rt_sampler_2d are the stratified values themselves (no
  * rng), for tests and callers with their own keys. All inline: a path takes
  * three or four values a bounce, and a call costs a tenth of the work.
+ * The path tracer (and the camera, for Sobol) read them through
+ * rt/render/sampler_block.h when the CPU has AVX2: eight dimensions of a
+ * sample at once in vector lanes, the same bits as these functions.
  *
  * Padding: pbrt-v4 (Pharr, Jakob, Humphreys, 4th ed.), section 8.5; Kollig
  * and Keller 2002, "Efficient Multidimensional Sampling". CMJ: Kensler

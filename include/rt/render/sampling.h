@@ -94,13 +94,21 @@ static inline float rt_cmj_randfloat(uint32_t i, uint32_t p)
     return (float)(i >> 8) * (1.0f / 16777216.0f);
 }
 
-/* Sample s of n (any n >= 1) of pattern p: a point in [0,1)^2. */
-static inline rt_vec2 rt_cmj_sample(uint32_t s, uint32_t n, uint32_t p)
+/* The grid of n samples: m columns, k rows, m*k >= n. */
+static inline void rt_cmj_grid(uint32_t n, uint32_t *m_out, uint32_t *k_out)
 {
     uint32_t m = (uint32_t)sqrtf((float)n);
     if (m == 0) m = 1;
     while (m * m > n) m--;
-    uint32_t k = (n + m - 1) / m; /* m columns, k rows; m*k >= n */
+    *m_out = m;
+    *k_out = (n + m - 1) / m;
+}
+
+/* Sample s of n (any n >= 1) of pattern p: a point in [0,1)^2. */
+static inline rt_vec2 rt_cmj_sample(uint32_t s, uint32_t n, uint32_t p)
+{
+    uint32_t m, k;
+    rt_cmj_grid(n, &m, &k);
     uint32_t sx = rt_cmj_permute(s % m, m, p * 0xa511e9b3u);
     uint32_t sy = rt_cmj_permute(s / m, k, p * 0x63d83595u);
     float jx = rt_cmj_randfloat(s, p * 0xa399d265u);
