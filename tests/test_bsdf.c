@@ -6,7 +6,8 @@
  * quadrature and importance sampling; the sampling density integrates to
  * the probability that sampling succeeds, and a histogram of sampled
  * directions matches the pdf rt_bsdf_eval reports; every value is finite
- * at grazing and degenerate directions. */
+ * at grazing and degenerate directions; rt_bsdf_set_wo's cache changes
+ * no bit of any result. */
 #include "test_util.h"
 #include "test_bsdf_check.h"
 
@@ -954,6 +955,69 @@ static void test_dielectric_compensation(void **state)
     assert_false(b.ms);
 }
 
+static bool same_bits(const void *a, const void *b, size_t n) { return memcmp(a, b, n) == 0; }
+
+/* rt_bsdf_set_wo caches what a vertex's evaluations share: eval and
+ * sample_dir give the same bits with and without it, for every kind of
+ * BSDF (glTF cases, transmission, rough and smooth glass, a compensated
+ * conductor and dielectric, plastic), and a change to the BSDF after it
+ * (rt_bsdf_set_eta) is not answered from a stale cache. */
+static void test_set_wo_same_bits(void **state)
+{
+    (void)state;
+    enum { KINDS = NCASES + 6 };
+    test_rng r = {77};
+    for (int k = 0; k < KINDS; k++) {
+        rt_bsdf b;
+        rt_vec3 n = rt_v3(0, 0, 1);
+        if (k < (int)NCASES)
+            make(&b, &cases[k]);
+        else if (k == NCASES)
+            rt_bsdf_make(&b, n, rt_v3(0.9f, 0.8f, 0.7f), 0.2f, 0.3f, 1.45f, 0.6f, false);
+        else if (k == NCASES + 1)
+            rt_bsdf_make_dielectric(&b, n, 1.0f / 1.5f, 0.3f);
+        else if (k == NCASES + 2)
+            rt_bsdf_make_dielectric(&b, n, 1.5f, 0.0f);
+        else if (k == NCASES + 3)
+            rt_bsdf_make_conductor(&b, n, rt_v3(0.2f, 0.9f, 1.1f), rt_v3(3.9f, 2.4f, 2.2f), 0.4f, 0.4f,
+                                   RT_SMITH_CORRELATED);
+        else if (k == NCASES + 4)
+            rt_bsdf_make_dielectric(&b, n, 1.0f / 1.33f, 0.5f);
+        else
+            rt_bsdf_make_plastic(&b, n, rt_v3(0.6f, 0.3f, 0.2f), 1.0f / 1.5f, 0.2f);
+        if (k == NCASES + 3 || k == NCASES + 4)
+            rt_bsdf_compensate(&b);
+        for (int j = 0; j < 20; j++) {
+            rt_vec3 wo = uniform_hemi(&r);
+            rt_bsdf c = b;
+            rt_bsdf_set_wo(&c, wo);
+            if (j == 19 && k >= (int)NCASES + 1 && k <= (int)NCASES + 2) {
+                rt_bsdf_set_eta(&b, 1.2f); /* after the cache: both must see the new eta */
+                rt_bsdf_set_eta(&c, 1.2f);
+            }
+            for (int i = 0; i < 20; i++) {
+                rt_vec3 wi = uniform_hemi(&r);
+                if (i & 1)
+                    wi.z = -wi.z;
+                float p0, p1;
+                rt_vec3 f0 = rt_bsdf_eval(&b, wo, wi, &p0), f1 = rt_bsdf_eval(&c, wo, wi, &p1);
+                assert_true(same_bits(&f0, &f1, sizeof f0) && same_bits(&p0, &p1, sizeof p0));
+                rt_vec2 u = rt_v2(test_rng_float(&r), test_rng_float(&r));
+                float ul = test_rng_float(&r);
+                rt_bsdf_sample s0, s1;
+                memset(&s0, 0, sizeof s0);
+                memset(&s1, 0, sizeof s1);
+                bool ok0 = rt_bsdf_sample_dir(&b, wo, u, ul, &s0), ok1 = rt_bsdf_sample_dir(&c, wo, u, ul, &s1);
+                assert_true(ok0 == ok1);
+                if (ok0)
+                    assert_true(same_bits(&s0.wi, &s1.wi, sizeof s0.wi) &&
+                                same_bits(&s0.weight, &s1.weight, sizeof s0.weight) &&
+                                same_bits(&s0.pdf, &s1.pdf, sizeof s0.pdf) && s0.delta == s1.delta);
+            }
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -977,6 +1041,7 @@ int main(void)
         cmocka_unit_test(test_dielectric_bsdf),
         cmocka_unit_test(test_dielectric_compensation),
         cmocka_unit_test(test_plastic_bsdf),
+        cmocka_unit_test(test_set_wo_same_bits),
     };
     return cmocka_run_group_tests_name("bsdf", tests, NULL, NULL);
 }

@@ -4,7 +4,9 @@
  * bit; a tilted map tilts the normal by the right angle towards the right
  * world-space direction on a rotated mesh, a sphere and a quad; and the
  * Khronos NormalTangentTest / NormalTangentMirrorTest models (shared
- * assets) show every normal-mapped dome as a dome. */
+ * assets) show every normal-mapped dome as a dome; the shading and emitter
+ * records agree with the full one in every field they promise, and in
+ * where secondary rays start. */
 #include "test_util.h"
 
 #include <math.h>
@@ -192,6 +194,88 @@ static void test_normal_map_sphere_and_quad(void **state)
         assert_true(near3(back.n, rt_neg(sf.n), 1e-6f));
         rt_scene_free(&s);
     }
+}
+
+static bool same3(rt_vec3 a, rt_vec3 b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+/* rt_surface_at_shading and rt_surface_at_emitter against rt_surface_at:
+ * the fields each promises, bit for bit, on smooth normal-mapped
+ * triangles (a tilted map, so n differs from ng), a sphere and a quad,
+ * from the front and from behind. */
+static void test_surface_record_variants(void **state)
+{
+    (void)state;
+    rt_scene s;
+    rt_scene_init(&s);
+    uint32_t m = material_with_normal_map(&s, normal_constant(&s, rt_normalize(rt_v3(0.3f, -0.2f, 1.0f))));
+    rt_mat4 xf = some_rotation();
+    add_square_mesh(&s, &xf, m, false);
+    rt_scene_add_sphere(&s, rt_v3(5, 0, 0), 1.5f, m);
+    rt_scene_add_quad(&s, rt_v3(-5, -1, 1), rt_v3(0, 0, -2), rt_v3(0, 3, 0), m);
+    rt_render_state rs;
+    rt_error err;
+    assert_int_equal(rt_render_state_prepare(&rs, &s, NULL, 0, &err), RT_OK);
+    rt_trace_ctx ctx;
+    rt_trace_ctx_init(&ctx, &rs);
+    const rt_vec3 dirs[2] = {{0.3f, -0.4f, -0.866f}, {-0.2f, 0.5f, 0.84f}};
+    for (uint32_t prim = 0; prim < 4; prim++)
+        for (int d = 0; d < 2; d++) {
+            rt_ray r = rt_ray_make(rt_v3(0.1f, 0.2f, 3.0f), rt_normalize(dirs[d]), 0.0f, INFINITY);
+            rt_hit h = {2.5f, 0.3f, 0.45f, prim};
+            rt_surface a, sh, em;
+            rt_surface_at(&ctx, &r, &h, &a);
+            rt_surface_at_shading(&ctx, &r, &h, &sh);
+            rt_surface_at_emitter(&ctx, &r, &h, &em);
+            /* the normal map reads the frame: the shading record is the full one */
+            assert_true(same3(sh.n, a.n) && same3(sh.t, a.t) && same3(sh.b, a.b));
+            assert_true(prim >= 2 || !same3(a.n, a.ng)); /* the map tilts the triangles' normal */
+            const rt_surface *v[2] = {&sh, &em};
+            for (int k = 0; k < 2; k++) {
+                assert_true(same3(v[k]->p, a.p) && same3(v[k]->ng, a.ng) && same3(v[k]->wo, a.wo));
+                assert_true(memcmp(&v[k]->uv0, &a.uv0, sizeof a.uv0) == 0);
+                assert_true(memcmp(&v[k]->uv1, &a.uv1, sizeof a.uv1) == 0);
+                assert_true(v[k]->front == a.front && v[k]->material == a.material && v[k]->prim == a.prim);
+            }
+            /* the shading record's spawn origin, kept for ng's side, is the one computed on demand */
+            assert_true(sh.p_out_set && !a.p_out_set);
+            for (int side = -1; side <= 1; side += 2) {
+                rt_vec3 dir = rt_normalize(rt_add(rt_scale(a.ng, (float)side), rt_v3(0.2f, 0.1f, -0.3f)));
+                rt_vec3 o1 = rt_surface_spawn(&ctx, &sh, dir), o2 = rt_surface_spawn(&ctx, &a, dir);
+                assert_true(same3(o1, o2));
+            }
+            assert_true(same3(em.n, em.ng) && same3(em.n_unmapped, em.ng));
+            assert_true(rt_length2(em.t) == 0.0f && rt_length2(em.b) == 0.0f); /* -0 from behind */
+            assert_true(em.vertex_color.x == 1.0f && em.vertex_color.w == 1.0f);
+        }
+    rt_render_state_free(&rs);
+    rt_scene_free(&s);
+
+    /* without a texture the shading record leaves the UVs out (zero), and
+     * only them */
+    rt_scene_init(&s);
+    rt_material plain;
+    rt_material_default(&plain, "plain");
+    m = rt_scene_add_material(&s, &plain);
+    add_square_mesh(&s, &xf, m, false);
+    rt_scene_add_sphere(&s, rt_v3(5, 0, 0), 1.5f, m);
+    assert_int_equal(rt_render_state_prepare(&rs, &s, NULL, 0, &err), RT_OK);
+    rt_trace_ctx_init(&ctx, &rs);
+    assert_int_equal(rs.material_needs[m] & RT_MATERIAL_TEXTURED, 0);
+    for (uint32_t prim = 0; prim < 3; prim++) {
+        rt_ray r = rt_ray_make(rt_v3(0.1f, 0.2f, 3.0f), rt_normalize(dirs[0]), 0.0f, INFINITY);
+        rt_hit h = {2.5f, 0.3f, 0.45f, prim};
+        rt_surface a, sh;
+        rt_surface_at(&ctx, &r, &h, &a);
+        rt_surface_at_shading(&ctx, &r, &h, &sh);
+        assert_true(a.uv0.x != 0.0f || a.uv0.y != 0.0f);
+        assert_true(sh.uv0.x == 0.0f && sh.uv0.y == 0.0f && sh.uv1.x == 0.0f && sh.uv1.y == 0.0f);
+        /* every other field as the full record's (no frame: the material does not read it) */
+        assert_true(same3(sh.p, a.p) && same3(sh.ng, a.ng) && same3(sh.n, a.n) && same3(sh.n_unmapped, a.n_unmapped));
+        assert_true(same3(sh.wo, a.wo) && sh.front == a.front && sh.material == a.material && sh.prim == a.prim);
+        assert_true(memcmp(&sh.vertex_color, &a.vertex_color, sizeof a.vertex_color) == 0);
+    }
+    rt_render_state_free(&rs);
+    rt_scene_free(&s);
 }
 
 /* UV conventions: sphere longitude/latitude, quad (s, 1 - t), triangles
@@ -531,6 +615,7 @@ int main(void)
         cmocka_unit_test(test_normal_map_rotated_mesh),
         cmocka_unit_test(test_normal_map_sphere_and_quad),
         cmocka_unit_test(test_uv_conventions),
+        cmocka_unit_test(test_surface_record_variants),
         cmocka_unit_test(test_flat_normal_map_is_exact),
         cmocka_unit_test(test_normal_map_8bit_extremes),
         cmocka_unit_test(test_generate_tangents),

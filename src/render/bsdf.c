@@ -261,18 +261,15 @@ static void set_frame(rt_bsdf *b, rt_vec3 n, rt_vec3 ng)
     rt_onb(n, &b->t, &b->b);
 }
 
-static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness, float ior, float transmission,
-                       bool lambert)
+/* The Lambert BSDF of albedo base (clamped to finite, non-negative):
+ * what set_params sets for lambert, without its other parameters. */
+static inline void set_lambert(rt_bsdf *b, rt_vec3 base)
 {
     base = rt_vmax(base, rt_v3s(0.0f));
     if (!rt_finite3(base))
         base = rt_v3s(0.0f);
-    metallic = isfinite(metallic) ? rt_clampf(metallic, 0.0f, 1.0f) : 0.0f;
-    roughness = isfinite(roughness) ? rt_clampf(roughness, 0.0f, 1.0f) : 1.0f;
-    transmission = isfinite(transmission) ? rt_clampf(transmission, 0.0f, 1.0f) : 0.0f;
-    if (!(ior > 0.0f) || !isfinite(ior))
-        ior = 1.5f;
-    b->lambert = lambert;
+    b->lambert = true;
+    b->wo_z = NAN;
     b->layered = false;
     b->thin = false;
     b->conductor = false;
@@ -281,17 +278,41 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
     b->radiance_eta2 = false;
     b->plastic = false;
     b->base = base;
+    b->alpha_y = 1.0f;
+    b->diffuse = base;
+    b->metallic = 0.0f;
+    b->f0 = 0.0f;
+    b->alpha = 1.0f;
+    b->delta = false;
+    b->transmission = 0.0f;
+    b->eta = 1.0f;
+}
+
+static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness, float ior, float transmission,
+                       bool lambert)
+{
     if (lambert) {
-        b->alpha_y = 1.0f;
-        b->diffuse = base;
-        b->metallic = 0.0f;
-        b->f0 = 0.0f;
-        b->alpha = 1.0f;
-        b->delta = false;
-        b->transmission = 0.0f;
-        b->eta = 1.0f;
+        set_lambert(b, base);
         return;
     }
+    base = rt_vmax(base, rt_v3s(0.0f));
+    if (!rt_finite3(base))
+        base = rt_v3s(0.0f);
+    metallic = isfinite(metallic) ? rt_clampf(metallic, 0.0f, 1.0f) : 0.0f;
+    roughness = isfinite(roughness) ? rt_clampf(roughness, 0.0f, 1.0f) : 1.0f;
+    transmission = isfinite(transmission) ? rt_clampf(transmission, 0.0f, 1.0f) : 0.0f;
+    if (!(ior > 0.0f) || !isfinite(ior))
+        ior = 1.5f;
+    b->lambert = false;
+    b->wo_z = NAN;
+    b->layered = false;
+    b->thin = false;
+    b->conductor = false;
+    b->ms = false;
+    b->separable = false;
+    b->radiance_eta2 = false;
+    b->plastic = false;
+    b->base = base;
     float r0 = (ior - 1.0f) / (ior + 1.0f);
     b->diffuse = rt_scale(base, 1.0f - metallic);
     b->metallic = metallic;
@@ -334,6 +355,7 @@ static void dielectric_compensate(rt_bsdf *b);
 
 void rt_bsdf_compensate(rt_bsdf *b)
 {
+    b->wo_z = NAN;
     if (b->radiance_eta2) {
         dielectric_compensate(b);
         return;
@@ -387,6 +409,7 @@ void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha)
 
 void rt_bsdf_set_eta(rt_bsdf *b, float eta)
 {
+    b->wo_z = NAN;
     eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
     float r0 = (eta - 1.0f) / (eta + 1.0f);
     b->f0 = r0 * r0;
@@ -593,6 +616,16 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
     if (!(rt_dot(n, sf->wo) > 1e-4f) || !rt_finite3(n))
         n = sf->ng;
     set_frame(b, n, sf->ng);
+    if (m->bsdf == RT_BSDF_LAMBERT) { /* base colour x texture x vertex colour, nothing else */
+        if (m->base_color_tex.texture == RT_NONE) { /* rt_surface_base_color's arithmetic, inline */
+            rt_vec4 v = sf->vertex_color;
+            set_lambert(b, rt_v3(m->color.x * v.x, m->color.y * v.y, m->color.z * v.z));
+        } else {
+            rt_vec4 c = rt_surface_base_color(ctx, sf);
+            set_lambert(b, rt_v3(c.x, c.y, c.z));
+        }
+        return;
+    }
     if (m->bsdf == RT_BSDF_CONDUCTOR) {
         float roughness = m->roughness;
         if (m->metal_rough_tex.texture != RT_NONE) {
@@ -634,18 +667,18 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
     }
     rt_vec4 b4 = rt_surface_base_color(ctx, sf);
     float metallic = m->metallic, roughness = m->roughness, transmission = m->transmission;
-    if (m->bsdf != RT_BSDF_LAMBERT && m->metal_rough_tex.texture != RT_NONE) {
+    if (m->metal_rough_tex.texture != RT_NONE) {
         rt_vec2 uv = rt_texture_slot_uv(&m->metal_rough_tex, m->metal_rough_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
         rt_vec4 mr = rt_texture_sample(s, m->metal_rough_tex.texture, uv, false);
         metallic *= mr.z;
         roughness *= mr.y;
     }
-    if (m->bsdf != RT_BSDF_LAMBERT && transmission > 0.0f && m->transmission_tex.texture != RT_NONE) {
+    if (transmission > 0.0f && m->transmission_tex.texture != RT_NONE) {
         rt_vec2 uv = rt_texture_slot_uv(&m->transmission_tex,
                                         m->transmission_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
         transmission *= rt_texture_sample(s, m->transmission_tex.texture, uv, false).x;
     }
-    set_params(b, rt_v3(b4.x, b4.y, b4.z), metallic, roughness, m->ior, transmission, m->bsdf == RT_BSDF_LAMBERT);
+    set_params(b, rt_v3(b4.x, b4.y, b4.z), metallic, roughness, m->ior, transmission, false);
     if (!sf->front)
         b->eta = 1.0f / b->eta; /* leaving the object through its back */
     /* a glTF material without a volume (KHR_materials_volume thickness 0) is thin-walled */
@@ -724,6 +757,26 @@ static void lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_
     }
 }
 
+/* lobe_probs, from rt_bsdf_set_wo's cache when it holds this wo (the core
+ * BSDF's probabilities depend on wo only through wo.z). */
+static inline void lobe_probs_at(const rt_bsdf *b, rt_vec3 wo, float *pd, float *ps, float *pt, float *ptm)
+{
+    if (wo.z == b->wo_z && !b->layered) {
+        *pd = b->p_d, *ps = b->p_s, *pt = b->p_t, *ptm = b->p_tm;
+        return;
+    }
+    lobe_probs(b, wo, pd, ps, pt, ptm);
+}
+
+void rt_bsdf_set_wo(rt_bsdf *b, rt_vec3 wo)
+{
+    b->wo_z = NAN;
+    if (b->layered || b->lambert || !(wo.z > 0.0f))
+        return; /* layered: probabilities of the whole wo; Lambert: nothing to cache */
+    lobe_probs(b, wo, &b->p_d, &b->p_s, &b->p_t, &b->p_tm);
+    b->wo_z = wo.z;
+}
+
 void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit)
 {
     float ptm;
@@ -793,15 +846,27 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
     return f;
 }
 
+/* Lambert's probability of its one lobe: 1, or 0 for a black surface
+ * (lobe_probs' value). */
+static inline float lambert_prob(const rt_bsdf *b) { return mean3(b->diffuse) > 0.0f ? 1.0f : 0.0f; }
+
 rt_vec3 rt_bsdf_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float *pdf)
 {
+    if (b->lambert) { /* eval_lobes' Lambert case, without the other lobes' bookkeeping */
+        float dummy_p, *p = pdf ? pdf : &dummy_p;
+        *p = 0.0f;
+        if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
+            return rt_v3s(0.0f);
+        *p = lambert_prob(b) * wi.z * RT_INV_PI;
+        return rt_scale(b->diffuse, RT_INV_PI);
+    }
     if (b->layered) {
         float dummy_l;
         layered_probs p = layered_lobe_probs(b, wo);
         return layered_eval(b, wo, wi, &p, pdf ? pdf : &dummy_l);
     }
-    float pd, ps, pt, dummy;
-    rt_bsdf_lobe_probs(b, wo, &pd, &ps, &pt);
+    float pd, ps, pt, ptm, dummy;
+    lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
     return eval_lobes(b, wo, wi, pd, ps, pdf ? pdf : &dummy);
 }
 
@@ -893,6 +958,7 @@ static float clamp01(float x) { return isfinite(x) ? rt_clampf(x, 0.0f, 1.0f) : 
 
 void rt_bsdf_set_ext(rt_bsdf *b, const rt_bsdf_ext *e)
 {
+    b->wo_z = NAN;
     if (b->lambert || b->conductor || b->plastic || b->radiance_eta2)
         return; /* the extensions extend the glTF BSDF only */
     b->spec_weight = clamp01(e->spec_weight);
@@ -1167,10 +1233,21 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
 {
     if (!(wo.z > 0.0f))
         return false;
+    if (b->lambert) { /* the general path's steps for one cosine lobe of probability 1 */
+        if (!(lambert_prob(b) > 0.0f))
+            return false;
+        rt_vec3 wi = rt_sample_cosine_hemisphere(u);
+        if (!(wi.z > 0.0f) || !rt_finite3(wi))
+            return false;
+        wi = rt_normalize(wi);
+        if (!(wi.z > 0.0f))
+            return false; /* eval_lobes' test */
+        return finish_sample(wi, rt_scale(b->diffuse, RT_INV_PI), 1.0f * wi.z * RT_INV_PI, s);
+    }
     if (b->layered)
         return layered_sample(b, wo, u, ulobe, s);
     float pd, ps, pt, ptm;
-    lobe_probs(b, wo, &pd, &ps, &pt, &ptm);
+    lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
     if (!(pd + ps + pt + ptm > 0.0f))
         return false;
     if (ptm > 0.0f && ulobe >= pd + ps + pt) {

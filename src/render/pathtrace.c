@@ -115,15 +115,6 @@ static inline float path_1d(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *
     return rt_sample_1d((rt_sampler_kind)st->sampler, (uint32_t)st->samples, rng, path_dim(ctx, ps, slot));
 }
 
-/* One light-sampling term, f cos vis w / pdf times the radiance; zero when
- * the shadow ray is blocked (vis 0). */
-rt_vec3 rt_path_nee_add(rt_vec3 sum, const rt_nee_record *rec, float vis)
-{
-    if (!(vis > 0.0f))
-        return sum;
-    return rt_path_add_finite(sum, rt_scale(rec->fl, rec->cos * vis * rec->w / rec->pdf));
-}
-
 /* A record for a light from the light table in direction d (world, above
  * the geometric surface) with light-sampling density pdf_l, weighted against
  * BSDF sampling by the power heuristic; the radiance is *Le or, for Le NULL,
@@ -178,9 +169,9 @@ bool rt_path_nee_light(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surf
 bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
                      rt_nee_record *rec)
 {
-    const rt_light_table *t = ctx->state->light_table;
-    if (!(t && t->env_w > 0))
+    if (!rt_path_samples_env(ctx))
         return false;
+    const rt_light_table *t = ctx->state->light_table;
     rt_vec2 u = path_2d(ctx, ps, rng, DIM_ENV);
     rt_vec3 d;
     float pdf_l;
@@ -213,10 +204,10 @@ static bool tri_barycentric(rt_vec3 a, rt_vec3 b, rt_vec3 c, rt_vec3 p, rt_vec3 
 bool rt_path_nee_emitter(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                          rt_vec3 wo, rt_rng *rng, rt_nee_record *rec)
 {
+    if (!rt_path_samples_emitters(ctx))
+        return false;
     const rt_scene *s = ctx->state->scene;
     const rt_light_table *t = ctx->state->light_table;
-    if (!(t && t->count))
-        return false;
     float ul = path_1d(ctx, ps, rng, DIM_EMIT_PICK);
     rt_vec2 u = path_2d(ctx, ps, rng, DIM_EMIT);
     size_t k = rt_light_table_pick(t, ul);
@@ -271,7 +262,7 @@ bool rt_path_nee_emitter(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_su
     h.t = dist;
     rt_ray r = rt_ray_make(sf->p, wdir, 0.0f, INFINITY);
     rt_surface se;
-    rt_surface_at_shading(ctx, &r, &h, &se);
+    rt_surface_at_emitter(ctx, &r, &h, &se); /* its ng and emission */
     float cos_l = fabsf(rt_dot(se.ng, wdir));
     rt_vec3 Le = rt_surface_emission(ctx, &se);
     float pdf_l = solid > 0.0f ? t->prim_sel[prim] / solid : t->prim_pdf[prim] * d2 / cos_l;
@@ -335,7 +326,8 @@ rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, 
         return RT_VERTEX_PASS;
     }
     /* emission, MIS-weighted when it could have been light-sampled */
-    rt_vec3 Le = rt_surface_emission(ctx, sf);
+    rt_vec3 Le = (ctx->state->material_needs[sf->material] & RT_MATERIAL_EMITS) ? rt_surface_emission(ctx, sf)
+                                                                                 : rt_v3s(0.0f);
     /* area lights' quads have emissive materials: look only those up */
     bool emissive = rt_max3(rt_scale(m->emission, m->emission_strength)) > 0.0f;
     uint32_t light = emissive ? rt_area_light_of_prim(s, ctx->state->light_table, sf->prim) : RT_NONE;
@@ -380,6 +372,8 @@ rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, 
         rt_bsdf_set_eta(b, sf->front ? eta : 1.0f / eta);
     }
     *wo = rt_bsdf_to_local(b, sf->wo);
+    if (!b->lambert) /* (Lambert has nothing to cache) */
+        rt_bsdf_set_wo(b, *wo); /* the light samples and the next direction share wo */
     return wo->z > 0.0f ? RT_VERTEX_SHADE : RT_VERTEX_STOP;
 }
 

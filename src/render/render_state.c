@@ -3,8 +3,9 @@
  * offsets (Waechter and Binder, Ray Tracing Gems ch. 6, via
  * rt_offset_ray_origin), whether shadow rays must look at the surfaces
  * they cross, the whitted integrator's ambient radiance (docs/shading.md),
- * and the light table when the integrator samples emitters; and the
- * counted closest-hit query.
+ * the light table when the integrator samples emitters, and what each
+ * material needs of a surface record (rt_material_needs); and the counted
+ * closest-hit query.
  */
 #include "rt/render/render_state.h"
 
@@ -14,6 +15,7 @@
 #include "rt/base/alloc.h"
 #include "rt/render/environment.h"
 #include "rt/render/light.h"
+#include "rt/render/surface.h"
 
 /* The whitted integrator's ambient radiance: the scene's ambient_light when
  * given, else the mean radiance of the environment over the sphere. */
@@ -36,10 +38,14 @@ rt_result rt_render_state_prepare(rt_render_state *rs, const rt_scene *scene, co
                                       rt_v3(fabsf(b.hi.x), fabsf(b.hi.y), fabsf(b.hi.z)))), 0.0f);
     }
     rs->scale = (isfinite(scale) && scale > 1e-30f) ? scale : 1.0f;
+    rs->material_needs = rt_alloc(scene->material_count + 1, 1);
+    if (!rs->material_needs)
+        return rt_fail(err, RT_ERR_NOMEM, "out of memory preparing the render");
     for (size_t i = 0; i < scene->material_count; i++) {
         const rt_material *m = &scene->materials[i];
         if (m->transmission > 0.0f || m->alpha_mode != RT_ALPHA_OPAQUE)
             rs->shadows_need_shading = true;
+        rs->material_needs[i] = rt_material_needs(m);
     }
     rs->ambient = ambient_radiance(scene);
     if (prepare & RT_PREPARE_LIGHT_TABLE) {
@@ -50,6 +56,8 @@ rt_result rt_render_state_prepare(rt_render_state *rs, const rt_scene *scene, co
         if (r != RT_OK) {
             free(rs->light_table);
             rs->light_table = NULL;
+            free(rs->material_needs);
+            rs->material_needs = NULL;
             return r;
         }
     }
@@ -62,6 +70,7 @@ void rt_render_state_free(rt_render_state *rs)
         return;
     rt_light_table_free(rs->light_table);
     free(rs->light_table);
+    free(rs->material_needs);
     memset(rs, 0, sizeof *rs);
 }
 

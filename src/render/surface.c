@@ -77,17 +77,51 @@ bool rt_surface_material_reads_frame(const rt_material *m)
     return m->normal_tex.texture != RT_NONE || m->bsdf == RT_BSDF_CONDUCTOR || m->extended;
 }
 
+uint8_t rt_material_needs(const rt_material *m)
+{
+    const rt_texture_slot *slots[] = {&m->base_color_tex, &m->metal_rough_tex, &m->normal_tex,
+                                      &m->occlusion_tex,  &m->emissive_tex,    &m->transmission_tex};
+    bool textured = false;
+    for (size_t k = 0; k < sizeof slots / sizeof slots[0]; k++)
+        textured = textured || slots[k]->texture != RT_NONE;
+    for (size_t k = 0; k < RT_XTEX_COUNT; k++)
+        textured = textured || m->ext_tex[k].texture != RT_NONE;
+    uint8_t needs = 0;
+    if (textured)
+        needs |= RT_MATERIAL_TEXTURED;
+    if (rt_surface_material_reads_frame(m))
+        needs |= RT_MATERIAL_FRAME;
+    if (m->emission.x > 0.0f || m->emission.y > 0.0f || m->emission.z > 0.0f) /* rt_surface_emission's test */
+        needs |= RT_MATERIAL_EMITS;
+    return needs;
+}
+
 #if defined(__GNUC__)
 #define SURFACE_INLINE static inline __attribute__((always_inline)) /* one copy per caller, `frame` folded */
 #else
 #define SURFACE_INLINE static inline
 #endif
 
-/* The record; the tangent frame (t, b) only when `frame` is true or the
+/* A secondary ray's origin leaving p on the side of unit normal `side`. */
+static inline rt_vec3 spawn_origin(const rt_trace_ctx *ctx, rt_vec3 p, rt_vec3 side)
+{
+    rt_vec3 o = rt_offset_ray_origin(p, side, ctx->state->scale);
+    float extra = ctx->state->scene->settings.ray_offset;
+    return extra > 0.0f ? rt_madd(o, side, extra) : o;
+}
+
+/* What a caller needs of the record: everything (rt_surface_at), the
+ * frame only where the material reads it (rt_surface_at_shading), or what
+ * emission reads (rt_surface_at_emitter: no shading normal, normal map,
+ * tangent frame or vertex colour). */
+typedef enum surface_need { NEED_ALL, NEED_SHADING, NEED_EMISSION } surface_need;
+
+/* The record; the tangent frame (t, b) only when `need` is NEED_ALL or the
  * material reads it (else zero). */
 SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf,
-                              bool frame)
+                              surface_need need)
 {
+    bool emission_only = need == NEED_EMISSION;
     const rt_scene *s = ctx->state->scene;
     uint32_t i;
     rt_vec3 ng, n, t = rt_v3s(0.0f);
@@ -100,7 +134,9 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
                                             : s->quads.material[i];
     RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
     const rt_material *m = &s->materials[sf->material];
-    frame = frame || rt_surface_material_reads_frame(m);
+    uint8_t needs = ctx->state->material_needs[sf->material];
+    bool frame = need == NEED_ALL || (!emission_only && (needs & RT_MATERIAL_FRAME));
+    bool uv = need == NEED_ALL || (needs & RT_MATERIAL_TEXTURED);
     switch (kind) {
     case RT_PRIM_TRIANGLE: {
         const uint32_t *idx = &s->triangles.index[3 * (size_t)i];
@@ -120,28 +156,32 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
                 ng = rt_neg(ng);
         }
         n = ng;
-        if (flags & RT_TRI_SMOOTH) {
+        if ((flags & RT_TRI_SMOOTH) && !emission_only) {
             rt_vec3 ni = rt_add(rt_add(rt_scale(vx->normal[idx[0]], bw), rt_scale(vx->normal[idx[1]], bu)),
                                 rt_scale(vx->normal[idx[2]], bv));
             if (rt_length2(ni) > 1e-20f && rt_finite3(ni))
                 n = rt_normalize(ni);
         }
-        rt_vec2 t0 = vx->uv0[idx[0]], t1 = vx->uv0[idx[1]], t2 = vx->uv0[idx[2]];
-        if (flags & RT_TRI_UV) {
-            sf->uv0 = rt_v2(t0.x * bw + t1.x * bu + t2.x * bv, t0.y * bw + t1.y * bu + t2.y * bv);
+        rt_vec2 t0 = rt_v2(0, 0), t1 = rt_v2(1, 0), t2 = rt_v2(0, 1);
+        if (uv || frame) { /* (a frame from the UVs reads them too) */
+            if (flags & RT_TRI_UV) {
+                t0 = vx->uv0[idx[0]], t1 = vx->uv0[idx[1]], t2 = vx->uv0[idx[2]];
+                sf->uv0 = rt_v2(t0.x * bw + t1.x * bu + t2.x * bv, t0.y * bw + t1.y * bu + t2.y * bv);
+            } else {
+                sf->uv0 = rt_v2(bu, bv);
+            }
+            if (vx->uv1) {
+                rt_vec2 s0 = vx->uv1[idx[0]], s1 = vx->uv1[idx[1]], s2 = vx->uv1[idx[2]];
+                sf->uv1 = rt_v2(s0.x * bw + s1.x * bu + s2.x * bv, s0.y * bw + s1.y * bu + s2.y * bv);
+            } else {
+                sf->uv1 = sf->uv0;
+            }
         } else {
-            t0 = rt_v2(0, 0), t1 = rt_v2(1, 0), t2 = rt_v2(0, 1);
-            sf->uv0 = rt_v2(bu, bv);
-        }
-        if (vx->uv1) {
-            rt_vec2 s0 = vx->uv1[idx[0]], s1 = vx->uv1[idx[1]], s2 = vx->uv1[idx[2]];
-            sf->uv1 = rt_v2(s0.x * bw + s1.x * bu + s2.x * bv, s0.y * bw + s1.y * bu + s2.y * bv);
-        } else {
-            sf->uv1 = sf->uv0;
+            sf->uv0 = sf->uv1 = rt_v2(0, 0); /* no texture reads them */
         }
         RT_DCHECK(!(flags & RT_TRI_COLOR) || vx->color);
         RT_DCHECK(!(flags & RT_TRI_TANGENT) || vx->tangent);
-        if (flags & RT_TRI_COLOR) {
+        if ((flags & RT_TRI_COLOR) && !emission_only) {
             rt_vec4 c0 = vx->color[idx[0]], c1 = vx->color[idx[1]], c2 = vx->color[idx[2]];
             sf->vertex_color = rt_v4(c0.x * bw + c1.x * bu + c2.x * bv, c0.y * bw + c1.y * bu + c2.y * bv,
                                      c0.z * bw + c1.z * bu + c2.z * bv, c0.w * bw + c1.w * bu + c2.w * bv);
@@ -164,7 +204,7 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
         sf->p = rt_madd(c, d, fabsf(r));
         ng = r < 0.0f ? rt_neg(d) : d;
         n = ng;
-        sf->uv0 = sf->uv1 = rt_latlong_from_dir(d);
+        sf->uv0 = sf->uv1 = uv ? rt_latlong_from_dir(d) : rt_v2(0, 0);
         t = rt_v3(d.z, 0.0f, -d.x); /* dP/du; zero at the poles, fixed by orthonormal_tangent */
         break;
     }
@@ -192,7 +232,7 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
     }
     rt_vec3 n_unmapped = n;
     /* normal map, in the frame of the front face */
-    if (m->normal_tex.texture != RT_NONE) {
+    if (m->normal_tex.texture != RT_NONE && !emission_only) {
         RT_DCHECK(m->normal_tex.texture < s->texture_count);
         const rt_texture *tx = &s->textures[m->normal_tex.texture];
         bool unorm8 = tx->kind == RT_TEX_IMAGE && s->images[tx->image].rgba8;
@@ -221,16 +261,24 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
     sf->n_unmapped = n_unmapped;
     sf->t = tt;
     sf->b = bb;
+    sf->p_out_set = need == NEED_SHADING;
+    if (sf->p_out_set)
+        sf->p_out = spawn_origin(ctx, sf->p, ng);
 }
 
 void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf)
 {
-    surface_at(ctx, ray, hit, sf, true);
+    surface_at(ctx, ray, hit, sf, NEED_ALL);
 }
 
 void rt_surface_at_shading(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf)
 {
-    surface_at(ctx, ray, hit, sf, false);
+    surface_at(ctx, ray, hit, sf, NEED_SHADING);
+}
+
+void rt_surface_at_emitter(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf)
+{
+    surface_at(ctx, ray, hit, sf, NEED_EMISSION);
 }
 
 rt_vec4 rt_surface_base_color(const rt_trace_ctx *ctx, const rt_surface *sf)
@@ -281,10 +329,10 @@ bool rt_surface_cut_away(const rt_trace_ctx *ctx, const rt_surface *sf, float *c
 
 rt_vec3 rt_surface_spawn(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 d)
 {
-    rt_vec3 side = rt_dot(d, sf->ng) >= 0.0f ? sf->ng : rt_neg(sf->ng);
-    rt_vec3 o = rt_offset_ray_origin(sf->p, side, ctx->state->scale);
-    float extra = ctx->state->scene->settings.ray_offset;
-    return extra > 0.0f ? rt_madd(o, side, extra) : o;
+    bool out = rt_dot(d, sf->ng) >= 0.0f;
+    if (out && sf->p_out_set)
+        return sf->p_out; /* computed once for the record */
+    return spawn_origin(ctx, sf->p, out ? sf->ng : rt_neg(sf->ng));
 }
 rt_surface_walk rt_trace_surface(const rt_trace_ctx *ctx, rt_ray *r, int *layers_left, rt_rng *blend_rng,
                                  rt_surface *sf, float *coverage)

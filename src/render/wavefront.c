@@ -182,6 +182,7 @@ static bool start_path(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_wavef
 static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_active)
 {
     const rt_kdtree *tree = ctx->state->tree;
+    const rt_material *materials = ctx->state->scene->materials;
     rt_ray_batch rb = {wf->ox, wf->oy, wf->oz, wf->dx, wf->dy, wf->dz, wf->tmin, wf->tmax};
     rt_hit_batch hb = {wf->ht, wf->hu, wf->hv, wf->hprim};
     uint32_t *q = wf->queue, *q2 = wf->queue2;
@@ -210,10 +211,13 @@ static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_acti
             rt_hit h = {wf->ht[i], wf->hu[i], wf->hv[i], wf->hprim[i]};
             rt_surface *sf = &wf->sf[i];
             rt_surface_at_shading(ctx, &wf->ps[i].r, &h, sf);
-            float coverage;
-            bool cut = rt_surface_cut_away(ctx, sf, &coverage);
-            if (!cut && coverage < 1.0f && rt_rng_float(&wf->rng[i]) >= coverage)
-                cut = true; /* stochastic alpha blending, from the path's stream */
+            bool cut = false;
+            if (materials[sf->material].alpha_mode != RT_ALPHA_OPAQUE) { /* (opaque: never cut, coverage 1) */
+                float coverage;
+                cut = rt_surface_cut_away(ctx, sf, &coverage);
+                if (!cut && coverage < 1.0f && rt_rng_float(&wf->rng[i]) >= coverage)
+                    cut = true; /* stochastic alpha blending, from the path's stream */
+            }
             wf->tmin[i] = wf->ps[i].r.tmin = h.t;
             if (!cut)
                 wf->status[i] = LANE_SURFACE;
@@ -247,7 +251,8 @@ static void add_record(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_surfa
 
 /* One path at its vertex: the scalar tracer's loop body up to its shadow
  * rays, then BSDF sampling (rt/render/pathtrace.h). */
-static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, size_t *n_rec, size_t *n_pending)
+static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, size_t *n_rec, size_t *n_pending,
+                       bool env, bool emitters)
 {
     rt_path_state *ps = &wf->ps[i];
     rt_rng *rng = &wf->rng[i];
@@ -267,18 +272,20 @@ static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, si
         wf->status[i] = v == RT_VERTEX_PASS ? LANE_LIVE : LANE_DONE;
         return;
     }
-    size_t first = *n_rec;
-    const rt_scene *s = ctx->state->scene;
-    for (size_t l = 0; l < s->light_count; l++)
-        if (rt_path_nee_light(ctx, ps, sf, &b, wo, rng, l, &wf->rec[*n_rec]))
-            add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
-    if (rt_path_nee_env(ctx, ps, &b, wo, rng, &wf->rec[*n_rec]))
-        add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
-    if (rt_path_nee_emitter(ctx, ps, sf, &b, wo, rng, &wf->rec[*n_rec]))
-        add_record(wf, ctx, sf, (uint32_t)(*n_rec)++, n_pending);
+    size_t first = *n_rec, n = first;
+    const size_t lights = ctx->state->scene->light_count;
+    for (size_t l = 0; l < lights; l++)
+        if (rt_path_nee_light(ctx, ps, sf, &b, wo, rng, l, &wf->rec[n]))
+            add_record(wf, ctx, sf, (uint32_t)n++, n_pending);
+    /* (skipped when they could make nothing: they would draw nothing) */
+    if (env && rt_path_nee_env(ctx, ps, &b, wo, rng, &wf->rec[n]))
+        add_record(wf, ctx, sf, (uint32_t)n++, n_pending);
+    if (emitters && rt_path_nee_emitter(ctx, ps, sf, &b, wo, rng, &wf->rec[n]))
+        add_record(wf, ctx, sf, (uint32_t)n++, n_pending);
+    *n_rec = n;
     wf->nee[i] = 1;
     wf->rec_first[i] = (uint32_t)first;
-    wf->rec_count[i] = (uint32_t)(*n_rec - first);
+    wf->rec_count[i] = (uint32_t)(n - first);
     wf->nbr[i] = ps->beta.x, wf->nbg[i] = ps->beta.y, wf->nbb[i] = ps->beta.z;
     wf->status[i] = rt_path_vertex_end(ctx, ps, sf, &b, wo, rng) ? LANE_LIVE : LANE_DONE;
 }
@@ -313,6 +320,7 @@ void rt_wavefront_radiance(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_w
     for (size_t k = 0; k < wf->batch; k++)
         wf->free_lanes[k] = (uint32_t)(wf->batch - 1 - k);
     rt_ray_batch srb = {wf->sox, wf->soy, wf->soz, wf->sdx, wf->sdy, wf->sdz, wf->stmin, wf->stmax};
+    const bool env = rt_path_samples_env(ctx), emitters = rt_path_samples_emitters(ctx);
     for (;;) {
         /* refill: free lanes take the next samples, in order */
         while (n_free > 0 && next < total) {
@@ -329,7 +337,7 @@ void rt_wavefront_radiance(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_w
         shading_order(wf, s, n_active);
         size_t n_rec = 0, n_pending = 0;
         for (size_t k = 0; k < n_active; k++)
-            shade_lane(wf, ctx, wf->order[k], &n_rec, &n_pending);
+            shade_lane(wf, ctx, wf->order[k], &n_rec, &n_pending, env, emitters);
         /* shadow rays, one batch */
         if (n_pending > 0) {
             if (ctx->ray_count)

@@ -112,6 +112,10 @@ typedef struct rt_bsdf {
     rt_vec3 dt_color;      /* its colour */
     bool dispersive;       /* KHR_materials_dispersion: refraction picks one channel's eta */
     rt_vec3 eta_rgb;       /* eta per channel (Cauchy through the Abbe number, at 656.3, 587.6, 486.1 nm) */
+    /* rt_bsdf_set_wo's cache for the core BSDF (not layered): the lobe
+     * probabilities at cos theta_o = wo_z (NaN: nothing cached) */
+    float wo_z;
+    float p_d, p_s, p_t, p_tm;
 } rt_bsdf;
 
 typedef struct rt_bsdf_sample {
@@ -214,6 +218,13 @@ void rt_bsdf_ext_default(rt_bsdf_ext *e);
  * rt_bsdf_from_surface (anything else is left as it is); with the default
  * parameters b stays the core BSDF. */
 void rt_bsdf_set_ext(rt_bsdf *b, const rt_bsdf_ext *e);
+
+/* Computes once what rt_bsdf_eval and rt_bsdf_sample_dir need at this wo
+ * whatever wi is (the lobe probabilities), for a vertex that evaluates
+ * several light samples and draws one direction from one wo: call it after
+ * the last change to b (rt_bsdf_set_eta, rt_bsdf_compensate, rt_bsdf_set_ext
+ * forget it). The results are the same, bit for bit, with or without it. */
+void rt_bsdf_set_wo(rt_bsdf *b, rt_vec3 wo);
 
 static inline rt_vec3 rt_bsdf_to_local(const rt_bsdf *b, rt_vec3 w)
 {

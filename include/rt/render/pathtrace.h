@@ -105,7 +105,27 @@ bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *
                      rt_nee_record *rec);
 bool rt_path_nee_emitter(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                          rt_vec3 wo, rt_rng *rng, rt_nee_record *rec);
-rt_vec3 rt_path_nee_add(rt_vec3 sum, const rt_nee_record *rec, float vis);
+/* One light-sampling term, f cos vis w / pdf times the radiance; zero when
+ * the shadow ray is blocked (vis 0). */
+static inline rt_vec3 rt_path_nee_add(rt_vec3 sum, const rt_nee_record *rec, float vis)
+{
+    if (!(vis > 0.0f))
+        return sum;
+    return rt_path_add_finite(sum, rt_scale(rec->fl, rec->cos * vis * rec->w / rec->pdf));
+}
+/* Whether rt_path_nee_env / rt_path_nee_emitter can make a record in this
+ * render (a light table with an environment / with emitters): when not,
+ * they return false at once, drawing nothing, so a caller may skip them. */
+static inline bool rt_path_samples_env(const rt_trace_ctx *ctx)
+{
+    const rt_light_table *t = ctx->state->light_table;
+    return t && t->env_w > 0;
+}
+static inline bool rt_path_samples_emitters(const rt_trace_ctx *ctx)
+{
+    const rt_light_table *t = ctx->state->light_table;
+    return t && t->count;
+}
 /* BSDF sampling, Russian roulette, the next ray in ps->r; false when the
  * path ends. */
 bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,

@@ -6,6 +6,7 @@
  *   rt_surface sf;
  *   rt_surface_at(&ctx, &ray, &hit, &sf);          // point, normals, tangent frame, uv, material
  *   rt_surface_at_shading(&ctx, &ray, &hit, &sf);  // the same, the frame only where the material reads it
+ *   rt_surface_at_emitter(&ctx, &ray, &hit, &sf);  // what rt_surface_emission reads, no more
  *   // or: the first surface along a ray that its alpha does not cut away
  *   int layers = 32;
  *   float coverage;
@@ -39,6 +40,8 @@ typedef struct rt_surface {
     bool front;
     uint32_t material;
     uint32_t prim;
+    bool p_out_set;       /* p_out holds rt_surface_spawn's origin for directions on ng's side */
+    rt_vec3 p_out;        /* (rt_surface_at_shading sets it: a shaded hit's bounce and shadow rays mostly leave there) */
 } rt_surface;
 
 /* The material of primitive `prim` (an id of the scene's one primitive id
@@ -56,13 +59,23 @@ static inline uint32_t rt_prim_material(const rt_scene *s, uint32_t prim)
 
 void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf);
 /* The same record without the tangent frame (sf->t, sf->b zero) unless the
- * material reads it (rt_surface_material_reads_frame): for the path tracer,
- * whose BSDF builds its own frame about the shading normal, so a hit builds
- * one frame, not two. Every other field is rt_surface_at's, bit for bit. */
+ * material reads it (rt_surface_material_reads_frame), and without UVs
+ * (uv0, uv1 zero) when it has no texture: for the path tracer, whose BSDF
+ * builds its own frame about the shading normal, so a hit builds one
+ * frame, not two. Every other field is rt_surface_at's, bit for bit. */
 void rt_surface_at_shading(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf);
+/* Only what rt_surface_emission reads, for a point sampled on an emitter:
+ * p, ng, front, wo, material and prim are rt_surface_at's, bit for bit,
+ * and uv0, uv1 too when the material has a texture (else zero); n =
+ * n_unmapped = ng (no interpolated or mapped normal), t = b = 0,
+ * vertex_color (1, 1, 1, 1). */
+void rt_surface_at_emitter(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf);
 /* Whether rt_bsdf_from_surface or the record itself reads the tangent
  * frame: a normal map, a conductor (anisotropy), the glTF extensions. */
 bool rt_surface_material_reads_frame(const rt_material *m);
+/* The RT_MATERIAL_* bits of m (rt/render/render_state.h), which
+ * rt_render_state_prepare keeps per material. */
+uint8_t rt_material_needs(const rt_material *m);
 
 /* Base colour (linear RGB, alpha) = factor x texture x vertex colour. */
 rt_vec4 rt_surface_base_color(const rt_trace_ctx *ctx, const rt_surface *sf);
