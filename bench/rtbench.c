@@ -11,8 +11,7 @@
  * default one per core), traces every ray for the closest hit K times and
  * prints `key: value` lines: triangles, load_ms, build_ms, nodes and leaves
  * (of the binary tree the build makes), wide_nodes (the 64-byte nodes of
- * up to 7 planes that the traversal reads), planes_per_wide_node, shapes
- * (the distinct treelet shapes of those nodes), bytes_per_triangle, mrays_per_s (median of K runs, wall clock),
+ * three levels that the traversal reads), bytes_per_triangle, mrays_per_s (median of K runs, wall clock),
  * mrays_per_s_best (the fastest run), cpu_mrays_per_s (rays per CPU-second
  * of the median run, summed over threads: on a shared, loaded machine this
  * is the steadier figure), hits, mismatches. With --occluded the same rays
@@ -280,8 +279,6 @@ int main(int argc, char **argv)
     printf("nodes: %zu\n", tree.stats.nodes);
     printf("leaves: %zu\n", tree.stats.leaves);
     printf("wide_nodes: %zu\n", tree.stats.wide_nodes);
-    printf("planes_per_wide_node: %.2f\n", tree.stats.wide_nodes ? (double)tree.stats.wide_planes / (double)tree.stats.wide_nodes : 0.0);
-    printf("shapes: %zu\n", tree.shape_count);
     printf("bytes_per_triangle: %.1f\n",
            scene.triangles.count ? (double)tree.stats.bytes / (double)scene.triangles.count : 0.0);
     printf("traversal: %s\n", tree.isa == RT_KD_ISA_AVX2 ? "avx2" : "portable");

@@ -982,11 +982,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
         goto oom;
     c.st.nodes = c.node_count;
     c.st.wide_nodes = tree->wide_count;
-    for (size_t i = 0; i < tree->wide_count; i++) /* a node's planes: its cells - 1 */
-        for (int k = 1; k < 8; k++)
-            c.st.wide_planes += tree->shapes[tree->wide[i].axes >> RT_KD_SHAPE_SHIFT].cell[k] != RT_KD_NO_LINK;
-    c.st.bytes = tree->wide_count * sizeof *tree->wide + tree->shape_count * sizeof *tree->shapes +
-                 tree->prim_id_count * sizeof *tree->prim_ids;
+    c.st.bytes = tree->wide_count * sizeof *tree->wide + tree->prim_id_count * sizeof *tree->prim_ids;
     free(c.nodes);
     free(c.ids);
     c.st.build_ms = 1e3 * rt_now_seconds() - t0;
@@ -1014,7 +1010,6 @@ void rt_kdtree_free(rt_kdtree *tree)
     if (!tree)
         return;
     free(tree->wide);
-    free(tree->shapes);
     free(tree->prim_ids); /* tree->tri is the same array */
     memset(tree, 0, sizeof *tree);
 }

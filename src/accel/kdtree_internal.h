@@ -8,9 +8,8 @@
  *                   8-byte rt_kdtree_node and leaf id lists (rt_kd_binary,
  *                   which lives only during the build); then it calls
  *   kdtree_pack.c   rt_kd_pack_wide, which makes the arrays of rt_kdtree
- *                   that the traversal reads: 64-byte wide nodes of up to
- *                   7 planes in a treelet of free shape (with the tree's
- *                   table of shapes), and leaf blocks (a leaf's id list with an
+ *                   that the traversal reads: 64-byte wide nodes of three
+ *                   levels each, and leaf blocks (a leaf's id list with an
  *                   end flag, then the triangles it is the first to use);
  *   kdtree_trace.c  rt_kdtree_intersect and rt_kdtree_occluded over those
  *                   arrays (the AVX2 step and the portable one), compiled

@@ -10,7 +10,7 @@
  * the 8 rays (not the 8 cells, as in the single-ray step). In a wide node
  * the 7 planes give each ray its t = (split - o) / d (one vector operation
  * a plane), and each cell each ray's interval: the parent interval cut by
- * the planes on the cell's path (its shape's parent links), widened by the ray's ma exactly as
+ * the cell's three planes, widened by the ray's ma exactly as
  * kdtree_trace.c's step does, so every ray crosses the cells its single
  * traversal crosses, with the same intervals. The cells' front-to-back
  * order depends only on the direction signs along the planes' axes, which
@@ -64,7 +64,8 @@ static unsigned single_rays(const rt_kdtree *tree, const rt_ray *rays, int n, rt
 
 #ifdef KD_HAVE_AVX2
 KD_AVX2_BEGIN
-#define KD_PSTACK (7 * KD_MAX_DEPTH + 1) /* as kdtree_trace.c's stack: up to 7 pushes a wide node, at least a level each */
+#define KD_PSTACK 192 /* as kdtree_trace.c's stack: 7 pushes a wide level */
+_Static_assert(7 * ((KD_MAX_DEPTH + 2) / 3) + 1 <= KD_PSTACK, "packet traversal stack");
 
 /* The packet's rays for the triangle test, one ray a lane: the shear of
  * each (rt_tri_ray), when all share the axis kz. */
@@ -302,7 +303,6 @@ KD_PINLINE bool packet_walk(const rt_kdtree *tree, const rt_ray *rays, int n, rt
     for (;;) {
         while (ref < RT_KD_LEAF) {
             const rt_kdtree_wide *w = &tree->wide[ref];
-            const rt_kdtree_shape *sh = &tree->shapes[w->axes >> RT_KD_SHAPE_SHIFT];
             __m256 lo[7][KD_PMAX], hi[7][KD_PMAX], hcap[KD_PMAX];
             int ng[7];
             for (int p = 0; p < 7; p++) {
@@ -317,42 +317,28 @@ KD_PINLINE bool packet_walk(const rt_kdtree *tree, const rt_ray *rays, int n, rt
             }
             for (int k = 0; k < K; k++)
                 hcap[k] = _mm256_min_ps(H[k], BEST[k]);
-            /* the cells' keys (kdtree_trace.c's wide step: the far bits of
-             * each cell's path), then back to front, as its portable step:
-             * the last cell found is the nearest */
-            unsigned key[8], left = 0;
-            for (unsigned c = 0; c < 8; c++) {
-                if (w->child[c] == RT_KD_EMPTY)
-                    continue;
-                unsigned kc = 0;
-                for (uint32_t e = sh->cell[c]; (e & 7u) != 7u; e = sh->plane[e & 7u])
-                    kc |= ((e >> 3 & 1u) ^ (unsigned)ng[e & 7u]) << (e >> 8);
-                key[c] = kc;
-                left |= 1u << c;
-            }
+            /* back to front, as kdtree_trace.c's portable step: the last
+             * cell found is the nearest */
             int pushed = 0;
-            while (left) {
-                unsigned c = (unsigned)__builtin_ctz(left);
-                for (unsigned mm = left & (left - 1); mm; mm &= mm - 1)
-                    if (key[__builtin_ctz(mm)] > key[c])
-                        c = (unsigned)__builtin_ctz(mm);
-                left &= ~(1u << c);
+            for (unsigned key = 8; key-- > 0;) {
+                unsigned f0 = key >> 2 & 1u, f1 = key >> 1 & 1u, f2 = key & 1u;
+                unsigned b0 = f0 ^ (unsigned)ng[0], p1 = 1 + b0, b1 = f1 ^ (unsigned)ng[p1], p2 = 3 + 2 * b0 + b1,
+                         b2 = f2 ^ (unsigned)ng[p2];
+                uint32_t cref = w->child[4 * b0 + 2 * b1 + b2];
+                if (cref == RT_KD_EMPTY)
+                    continue;
                 unsigned cross = 0;
                 for (int k = 0; k < K; k++) {
                     __m256 l = L[k], hh = hcap[k];
-                    for (uint32_t e = sh->cell[c]; (e & 7u) != 7u; e = sh->plane[e & 7u]) {
-                        unsigned pl = e & 7u;
-                        if ((e >> 3 & 1u) ^ (unsigned)ng[pl])
-                            l = _mm256_max_ps(lo[pl][k], l);
-                        else
-                            hh = _mm256_min_ps(hi[pl][k], hh);
-                    }
+                    if (f0) l = _mm256_max_ps(lo[0][k], l); else hh = _mm256_min_ps(hi[0][k], hh);
+                    if (f1) l = _mm256_max_ps(lo[p1][k], l); else hh = _mm256_min_ps(hi[p1][k], hh);
+                    if (f2) l = _mm256_max_ps(lo[p2][k], l); else hh = _mm256_min_ps(hi[p2][k], hh);
                     cross |= (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(l, hh, _CMP_LE_OQ));
                     slo[sp * K + k] = l, shi[sp * K + k] = hh;
                 }
                 if (!cross)
                     continue;
-                sref[sp++] = w->child[c];
+                sref[sp++] = cref;
                 pushed++;
             }
             if (!pushed)

@@ -5,20 +5,16 @@
  * was the first to use; a triangle's id is its record's offset).
  *
  * Traversal: the recursive ray segment algorithm (Havran's thesis, "TA_B^rec",
- * and pbrt's KdTreeAccel) with a fixed stack, up to 7 planes per step. A
- * wide node holds a treelet of free shape (kdtree_pack.c); each plane gives
- * t = (split - o) / d, each cell the ray's t interval through it (the parent
- * interval cut by the near or far side of every plane on its path), all 8
- * at once in AVX2 lanes: the planes' own cuts, their paths from the top
- * plane by two rounds of doubling over the shape's parent links (pointer
- * jumping, Wyllie 1979: max and min are associative and idempotent), then
- * each cell's own cut and its parent's path. The front-to-back order is the
- * order of per-cell keys, the far bits along each cell's path (the same
- * doubling, with OR). A step with one valid cell (most of them: 43-70% on
- * the benchmark sets, the descent to a surface ray's origin) enters it
- * before any keys are made; with two, one compare orders them; otherwise
- * the nearest valid cell is entered and the others pushed farthest first
- * (smallest key first by phminposuw);
+ * and pbrt's KdTreeAccel) with a fixed stack, three levels per step. In a
+ * wide node, each plane gives t = (split - o) / d, each cell the ray's t
+ * interval through it (the parent interval cut by the near or far side of
+ * its three planes), all 8 at once in AVX2 lanes; the cells' front-to-back
+ * order depends only on the direction signs along the 7 planes' axes, so two
+ * 128-entry tables give it. A step with one valid cell (most of them:
+ * 48-73% on the benchmark sets, the descent to a surface ray's origin)
+ * enters it before any of that ordering. Otherwise the nearest valid cell
+ * is entered, the others
+ * pushed farthest first (compacted by a permute from a 256-entry table);
  * a cell is popped only if it starts before the closest hit so far. The
  * nearest cell is taken through a switch on the cell number, not by indexing
  * the node with it: when the branch is predicted (coherent rays), the next
@@ -65,12 +61,8 @@
  * them (always_inline, flatten), intersect.h's tests included: keep new
  * traversal helpers here, not in another file, or they lose that.
  *
- * Measured and not kept (docs/performance.md has the numbers): the cells'
- * intervals a depth at a time (a permute of each cell's plane at that depth:
- * 10 operations a depth, up to 7 depths; +20% instructions against the
- * fixed three-level nodes, where doubling costs +3%); treelets of depth 7
- * (three doubling rounds: the 1% fewer steps do not pay for the round); a
- * start shortcut that walks down from the root plane by plane in scalar code
+ * Measured and not kept (docs/performance.md has the numbers): a start
+ * shortcut that walks down from the root plane by plane in scalar code
  * while only one cell can be entered (exact, but as costly per node as the
  * 8-lane step, +8% instructions); the 8-wide
  * test from 2 or 5 triangles instead of 3; prefetching the cell on top of
@@ -448,28 +440,26 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, uint32_t n, c
 /* ------------------------------------------------------ the wide step */
 
 /* One step through a wide node w for the ray's interval [tn, tf]: which of
- * its cells the ray crosses (non-empty t interval, non-empty child), in
+ * the 8 cells the ray crosses (non-empty t interval, non-empty child), in
  * front-to-back order. The nearest is returned in *near_cell with its
  * interval, the others are pushed farthest first (so the next nearest ends
  * on top of the stack); returns how many were pushed, or -1 when the ray
  * crosses no non-empty cell.
  *
- * A cell's path (up its shape's parent links, kdtree.h) gives its planes;
- * at each, the cell lies on the side the ray enters first (near) or second
- * (far: its side is the above one, unless the ray runs towards -axis,
- * neg). Its t interval is [tn, tf] cut by [lo, inf) for each plane it lies
- * beyond and (-inf, hi] for each it lies before, lo/hi = t(plane) -/+ ma:
- * the binary traversal's intervals, so the same leaves in the same order.
- * Its key, the far bits of its path (the edge into depth d sets bit 7 - d),
- * orders the cells front to back: two cells first differ at the plane that
- * separates them, where the near one has 0. */
-#define KD_ROUNDS 2 /* doubling rounds: 2^2 >= 4, the deepest plane's depth (kdtree_pack.c) */
-#define KD_WSTACK (7 * KD_MAX_DEPTH + 8) /* up to 7 pushes a wide node, each at least one level deep, + 8 for the full-width store */
+ * Order: a cell's key k = k0 k1 k2 (bit 2 = level 0) says on which side of
+ * its plane at each level it lies, 0 = the side the ray enters first (the
+ * below side unless the ray runs towards -axis: neg). Cell c = 4 b0 + 2 b1
+ * + b2 with b = k ^ neg at each level, its planes 0, 1 + b0, 3 + 2 b0 + b1;
+ * ascending keys are front to back. The cell's t interval is [tn, tf] cut
+ * by [lo, inf) for each plane it lies beyond and (-inf, hi] for each it lies
+ * before, lo/hi = t(plane) -/+ ma: the binary traversal's intervals, so the
+ * same leaves in the same order. */
+#define KD_WSTACK 192 /* 7 net pushes per wide level, KD_MAX_DEPTH / 3 levels, + 8 for the full-width store */
+_Static_assert(7 * ((KD_MAX_DEPTH + 2) / 3) + 8 <= KD_WSTACK, "wide traversal stack");
 
 #ifndef KD_SIMD /* the portable step (the AVX2 one below does the same, 8 cells at once) */
-KD_INLINE int wide_step_scalar(const rt_kdtree_wide *w, const rt_kdtree_shape *sh, const kd_ray *r, bool par,
-                               float tn, float tf, uint32_t *sref, float *slo, float *shi, unsigned *near_cell,
-                               float *near_tn, float *near_tf)
+KD_INLINE int wide_step_scalar(const rt_kdtree_wide *w, const kd_ray *r, bool par, float tn, float tf, uint32_t *sref,
+                               float *slo, float *shi, unsigned *near_cell, float *near_tn, float *near_tf)
 {
     float lo[7], hi[7];
     int neg[7];
@@ -487,70 +477,193 @@ KD_INLINE int wide_step_scalar(const rt_kdtree_wide *w, const rt_kdtree_shape *s
             neg[p] = r->neg[k];
         }
     }
-    float cl[8], ch[8];
-    unsigned key[8], live = 0;
-    for (unsigned c = 0; c < 8; c++) {
-        if (w->child[c] == RT_KD_EMPTY)
-            continue;
-        float l = tn, h = tf;
-        unsigned k = 0;
-        for (uint32_t e = sh->cell[c]; (e & 7u) != 7u; e = sh->plane[e & 7u]) { /* up the parent links */
-            unsigned p = e & 7u, far = (e >> 3 & 1u) ^ (unsigned)(neg[p] & 1);
-            if (far)
-                l = lo[p] > l ? lo[p] : l;
-            else
-                h = hi[p] < h ? hi[p] : h;
-            k |= far << (e >> 8);
-        }
-        if (!(l <= h))
-            continue;
-        cl[c] = l, ch[c] = h, key[c] = k;
-        live |= 1u << c;
-    }
     /* back to front: the entries come out farthest first, and the last one
      * (the nearest) is returned instead of pushed */
     int n = 0;
-    while (live) {
-        unsigned c = 8;
-        for (unsigned j = 0; j < 8; j++)
-            if (live >> j & 1u && (c == 8 || key[j] > key[c]))
-                c = j;
-        live &= ~(1u << c);
-        sref[n] = w->child[c], slo[n] = cl[c], shi[n] = ch[c];
+    for (unsigned key = 8; key-- > 0;) {
+        unsigned f0 = key >> 2 & 1u, f1 = key >> 1 & 1u, f2 = key & 1u;
+        unsigned b0 = f0 ^ (unsigned)(neg[0] & 1), p1 = 1 + b0, b1 = f1 ^ (unsigned)(neg[p1] & 1),
+                 p2 = 3 + 2 * b0 + b1, b2 = f2 ^ (unsigned)(neg[p2] & 1);
+        float l = tn, h = tf;
+        if (f0) l = lo[0] > l ? lo[0] : l; else h = hi[0] < h ? hi[0] : h;
+        if (f1) l = lo[p1] > l ? lo[p1] : l; else h = hi[p1] < h ? hi[p1] : h;
+        if (f2) l = lo[p2] > l ? lo[p2] : l; else h = hi[p2] < h ? hi[p2] : h;
+        unsigned cell = 4 * b0 + 2 * b1 + b2;
+        uint32_t ref = w->child[cell];
+        if (ref == RT_KD_EMPTY || !(l <= h))
+            continue;
+        sref[n] = ref, slo[n] = l, shi[n] = h;
         n++;
-        *near_cell = c, *near_tn = cl[c], *near_tf = ch[c];
+        *near_cell = cell, *near_tn = l, *near_tf = h;
     }
     return n - 1; /* -1: none */
 }
 #endif
 
 #ifdef KD_SIMD
-/* The same as wide_step_scalar, eight cells at once (lane c = cell c), so
- * the caller can read the nearest cell's interval from a fixed lane once it
- * has branched on the cell: only that branch waits for the choice of the
- * nearest cell, the data does not. The planes' lo and hi are in lanes 0-6
- * (lane 7: -inf and +inf, what "no parent" reads). Each plane's own cut
- * (its edge from its parent) takes one permute by its parent link; two
- * rounds of doubling (lane p takes its ancestor's value, then the ancestor
- * link jumps twice as far) give each plane the cuts of its whole path from
- * the top, as the pack keeps planes within depth 4; a cell is its own cut
- * and its parent's path. Keys, only when two or more cells are valid, are
- * made the same way with OR. */
+/* Byte i of entry m: the lane of the i-th set bit of m (compaction by a
+ * permute, as AVX2 has no compress instruction). This table and the two
+ * below are printed by tools/kd_tables.py. */
+static const uint64_t kd_compress[256] = {
+    0x0000000000000000ull, 0x0000000000000000ull, 0x0000000000000001ull, 0x0000000000000100ull,
+    0x0000000000000002ull, 0x0000000000000200ull, 0x0000000000000201ull, 0x0000000000020100ull,
+    0x0000000000000003ull, 0x0000000000000300ull, 0x0000000000000301ull, 0x0000000000030100ull,
+    0x0000000000000302ull, 0x0000000000030200ull, 0x0000000000030201ull, 0x0000000003020100ull,
+    0x0000000000000004ull, 0x0000000000000400ull, 0x0000000000000401ull, 0x0000000000040100ull,
+    0x0000000000000402ull, 0x0000000000040200ull, 0x0000000000040201ull, 0x0000000004020100ull,
+    0x0000000000000403ull, 0x0000000000040300ull, 0x0000000000040301ull, 0x0000000004030100ull,
+    0x0000000000040302ull, 0x0000000004030200ull, 0x0000000004030201ull, 0x0000000403020100ull,
+    0x0000000000000005ull, 0x0000000000000500ull, 0x0000000000000501ull, 0x0000000000050100ull,
+    0x0000000000000502ull, 0x0000000000050200ull, 0x0000000000050201ull, 0x0000000005020100ull,
+    0x0000000000000503ull, 0x0000000000050300ull, 0x0000000000050301ull, 0x0000000005030100ull,
+    0x0000000000050302ull, 0x0000000005030200ull, 0x0000000005030201ull, 0x0000000503020100ull,
+    0x0000000000000504ull, 0x0000000000050400ull, 0x0000000000050401ull, 0x0000000005040100ull,
+    0x0000000000050402ull, 0x0000000005040200ull, 0x0000000005040201ull, 0x0000000504020100ull,
+    0x0000000000050403ull, 0x0000000005040300ull, 0x0000000005040301ull, 0x0000000504030100ull,
+    0x0000000005040302ull, 0x0000000504030200ull, 0x0000000504030201ull, 0x0000050403020100ull,
+    0x0000000000000006ull, 0x0000000000000600ull, 0x0000000000000601ull, 0x0000000000060100ull,
+    0x0000000000000602ull, 0x0000000000060200ull, 0x0000000000060201ull, 0x0000000006020100ull,
+    0x0000000000000603ull, 0x0000000000060300ull, 0x0000000000060301ull, 0x0000000006030100ull,
+    0x0000000000060302ull, 0x0000000006030200ull, 0x0000000006030201ull, 0x0000000603020100ull,
+    0x0000000000000604ull, 0x0000000000060400ull, 0x0000000000060401ull, 0x0000000006040100ull,
+    0x0000000000060402ull, 0x0000000006040200ull, 0x0000000006040201ull, 0x0000000604020100ull,
+    0x0000000000060403ull, 0x0000000006040300ull, 0x0000000006040301ull, 0x0000000604030100ull,
+    0x0000000006040302ull, 0x0000000604030200ull, 0x0000000604030201ull, 0x0000060403020100ull,
+    0x0000000000000605ull, 0x0000000000060500ull, 0x0000000000060501ull, 0x0000000006050100ull,
+    0x0000000000060502ull, 0x0000000006050200ull, 0x0000000006050201ull, 0x0000000605020100ull,
+    0x0000000000060503ull, 0x0000000006050300ull, 0x0000000006050301ull, 0x0000000605030100ull,
+    0x0000000006050302ull, 0x0000000605030200ull, 0x0000000605030201ull, 0x0000060503020100ull,
+    0x0000000000060504ull, 0x0000000006050400ull, 0x0000000006050401ull, 0x0000000605040100ull,
+    0x0000000006050402ull, 0x0000000605040200ull, 0x0000000605040201ull, 0x0000060504020100ull,
+    0x0000000006050403ull, 0x0000000605040300ull, 0x0000000605040301ull, 0x0000060504030100ull,
+    0x0000000605040302ull, 0x0000060504030200ull, 0x0000060504030201ull, 0x0006050403020100ull,
+    0x0000000000000007ull, 0x0000000000000700ull, 0x0000000000000701ull, 0x0000000000070100ull,
+    0x0000000000000702ull, 0x0000000000070200ull, 0x0000000000070201ull, 0x0000000007020100ull,
+    0x0000000000000703ull, 0x0000000000070300ull, 0x0000000000070301ull, 0x0000000007030100ull,
+    0x0000000000070302ull, 0x0000000007030200ull, 0x0000000007030201ull, 0x0000000703020100ull,
+    0x0000000000000704ull, 0x0000000000070400ull, 0x0000000000070401ull, 0x0000000007040100ull,
+    0x0000000000070402ull, 0x0000000007040200ull, 0x0000000007040201ull, 0x0000000704020100ull,
+    0x0000000000070403ull, 0x0000000007040300ull, 0x0000000007040301ull, 0x0000000704030100ull,
+    0x0000000007040302ull, 0x0000000704030200ull, 0x0000000704030201ull, 0x0000070403020100ull,
+    0x0000000000000705ull, 0x0000000000070500ull, 0x0000000000070501ull, 0x0000000007050100ull,
+    0x0000000000070502ull, 0x0000000007050200ull, 0x0000000007050201ull, 0x0000000705020100ull,
+    0x0000000000070503ull, 0x0000000007050300ull, 0x0000000007050301ull, 0x0000000705030100ull,
+    0x0000000007050302ull, 0x0000000705030200ull, 0x0000000705030201ull, 0x0000070503020100ull,
+    0x0000000000070504ull, 0x0000000007050400ull, 0x0000000007050401ull, 0x0000000705040100ull,
+    0x0000000007050402ull, 0x0000000705040200ull, 0x0000000705040201ull, 0x0000070504020100ull,
+    0x0000000007050403ull, 0x0000000705040300ull, 0x0000000705040301ull, 0x0000070504030100ull,
+    0x0000000705040302ull, 0x0000070504030200ull, 0x0000070504030201ull, 0x0007050403020100ull,
+    0x0000000000000706ull, 0x0000000000070600ull, 0x0000000000070601ull, 0x0000000007060100ull,
+    0x0000000000070602ull, 0x0000000007060200ull, 0x0000000007060201ull, 0x0000000706020100ull,
+    0x0000000000070603ull, 0x0000000007060300ull, 0x0000000007060301ull, 0x0000000706030100ull,
+    0x0000000007060302ull, 0x0000000706030200ull, 0x0000000706030201ull, 0x0000070603020100ull,
+    0x0000000000070604ull, 0x0000000007060400ull, 0x0000000007060401ull, 0x0000000706040100ull,
+    0x0000000007060402ull, 0x0000000706040200ull, 0x0000000706040201ull, 0x0000070604020100ull,
+    0x0000000007060403ull, 0x0000000706040300ull, 0x0000000706040301ull, 0x0000070604030100ull,
+    0x0000000706040302ull, 0x0000070604030200ull, 0x0000070604030201ull, 0x0007060403020100ull,
+    0x0000000000070605ull, 0x0000000007060500ull, 0x0000000007060501ull, 0x0000000706050100ull,
+    0x0000000007060502ull, 0x0000000706050200ull, 0x0000000706050201ull, 0x0000070605020100ull,
+    0x0000000007060503ull, 0x0000000706050300ull, 0x0000000706050301ull, 0x0000070605030100ull,
+    0x0000000706050302ull, 0x0000070605030200ull, 0x0000070605030201ull, 0x0007060503020100ull,
+    0x0000000007060504ull, 0x0000000706050400ull, 0x0000000706050401ull, 0x0000070605040100ull,
+    0x0000000706050402ull, 0x0000070605040200ull, 0x0000070605040201ull, 0x0007060504020100ull,
+    0x0000000706050403ull, 0x0000070605040300ull, 0x0000070605040301ull, 0x0007060504030100ull,
+    0x0000070605040302ull, 0x0007060504030200ull, 0x0007060504030201ull, 0x0706050403020100ull,
+};
+
+/* The front-to-back order of a node's cells depends only on which of its 7
+ * planes the ray crosses towards -axis (7 bits nb): byte L of
+ * kd_cell_of_key[nb] is the cell with key 7 - L, byte c of
+ * kd_key_of_cell[nb] the key of cell c (keys as in wide_step_scalar). */
+static const uint64_t kd_cell_of_key[128] = {
+    0x0001020304050607ull, 0x0405060700010203ull, 0x0203000104050607ull, 0x0405060702030001ull,
+    0x0001020306070405ull, 0x0607040500010203ull, 0x0203000106070405ull, 0x0607040502030001ull,
+    0x0100020304050607ull, 0x0405060701000203ull, 0x0203010004050607ull, 0x0405060702030100ull,
+    0x0100020306070405ull, 0x0607040501000203ull, 0x0203010006070405ull, 0x0607040502030100ull,
+    0x0001030204050607ull, 0x0405060700010302ull, 0x0302000104050607ull, 0x0405060703020001ull,
+    0x0001030206070405ull, 0x0607040500010302ull, 0x0302000106070405ull, 0x0607040503020001ull,
+    0x0100030204050607ull, 0x0405060701000302ull, 0x0302010004050607ull, 0x0405060703020100ull,
+    0x0100030206070405ull, 0x0607040501000302ull, 0x0302010006070405ull, 0x0607040503020100ull,
+    0x0001020305040607ull, 0x0504060700010203ull, 0x0203000105040607ull, 0x0504060702030001ull,
+    0x0001020306070504ull, 0x0607050400010203ull, 0x0203000106070504ull, 0x0607050402030001ull,
+    0x0100020305040607ull, 0x0504060701000203ull, 0x0203010005040607ull, 0x0504060702030100ull,
+    0x0100020306070504ull, 0x0607050401000203ull, 0x0203010006070504ull, 0x0607050402030100ull,
+    0x0001030205040607ull, 0x0504060700010302ull, 0x0302000105040607ull, 0x0504060703020001ull,
+    0x0001030206070504ull, 0x0607050400010302ull, 0x0302000106070504ull, 0x0607050403020001ull,
+    0x0100030205040607ull, 0x0504060701000302ull, 0x0302010005040607ull, 0x0504060703020100ull,
+    0x0100030206070504ull, 0x0607050401000302ull, 0x0302010006070504ull, 0x0607050403020100ull,
+    0x0001020304050706ull, 0x0405070600010203ull, 0x0203000104050706ull, 0x0405070602030001ull,
+    0x0001020307060405ull, 0x0706040500010203ull, 0x0203000107060405ull, 0x0706040502030001ull,
+    0x0100020304050706ull, 0x0405070601000203ull, 0x0203010004050706ull, 0x0405070602030100ull,
+    0x0100020307060405ull, 0x0706040501000203ull, 0x0203010007060405ull, 0x0706040502030100ull,
+    0x0001030204050706ull, 0x0405070600010302ull, 0x0302000104050706ull, 0x0405070603020001ull,
+    0x0001030207060405ull, 0x0706040500010302ull, 0x0302000107060405ull, 0x0706040503020001ull,
+    0x0100030204050706ull, 0x0405070601000302ull, 0x0302010004050706ull, 0x0405070603020100ull,
+    0x0100030207060405ull, 0x0706040501000302ull, 0x0302010007060405ull, 0x0706040503020100ull,
+    0x0001020305040706ull, 0x0504070600010203ull, 0x0203000105040706ull, 0x0504070602030001ull,
+    0x0001020307060504ull, 0x0706050400010203ull, 0x0203000107060504ull, 0x0706050402030001ull,
+    0x0100020305040706ull, 0x0504070601000203ull, 0x0203010005040706ull, 0x0504070602030100ull,
+    0x0100020307060504ull, 0x0706050401000203ull, 0x0203010007060504ull, 0x0706050402030100ull,
+    0x0001030205040706ull, 0x0504070600010302ull, 0x0302000105040706ull, 0x0504070603020001ull,
+    0x0001030207060504ull, 0x0706050400010302ull, 0x0302000107060504ull, 0x0706050403020001ull,
+    0x0100030205040706ull, 0x0504070601000302ull, 0x0302010005040706ull, 0x0504070603020100ull,
+    0x0100030207060504ull, 0x0706050401000302ull, 0x0302010007060504ull, 0x0706050403020100ull,
+};
+static const uint64_t kd_key_of_cell[128] = {
+    0x0706050403020100ull, 0x0302010007060504ull, 0x0706050401000302ull, 0x0302010005040706ull,
+    0x0504070603020100ull, 0x0100030207060504ull, 0x0504070601000302ull, 0x0100030205040706ull,
+    0x0706050403020001ull, 0x0302010007060405ull, 0x0706050401000203ull, 0x0302010005040607ull,
+    0x0504070603020001ull, 0x0100030207060405ull, 0x0504070601000203ull, 0x0100030205040607ull,
+    0x0706050402030100ull, 0x0302010006070504ull, 0x0706050400010302ull, 0x0302010004050706ull,
+    0x0504070602030100ull, 0x0100030206070504ull, 0x0504070600010302ull, 0x0100030204050706ull,
+    0x0706050402030001ull, 0x0302010006070405ull, 0x0706050400010203ull, 0x0302010004050607ull,
+    0x0504070602030001ull, 0x0100030206070405ull, 0x0504070600010203ull, 0x0100030204050607ull,
+    0x0706040503020100ull, 0x0302000107060504ull, 0x0706040501000302ull, 0x0302000105040706ull,
+    0x0504060703020100ull, 0x0100020307060504ull, 0x0504060701000302ull, 0x0100020305040706ull,
+    0x0706040503020001ull, 0x0302000107060405ull, 0x0706040501000203ull, 0x0302000105040607ull,
+    0x0504060703020001ull, 0x0100020307060405ull, 0x0504060701000203ull, 0x0100020305040607ull,
+    0x0706040502030100ull, 0x0302000106070504ull, 0x0706040500010302ull, 0x0302000104050706ull,
+    0x0504060702030100ull, 0x0100020306070504ull, 0x0504060700010302ull, 0x0100020304050706ull,
+    0x0706040502030001ull, 0x0302000106070405ull, 0x0706040500010203ull, 0x0302000104050607ull,
+    0x0504060702030001ull, 0x0100020306070405ull, 0x0504060700010203ull, 0x0100020304050607ull,
+    0x0607050403020100ull, 0x0203010007060504ull, 0x0607050401000302ull, 0x0203010005040706ull,
+    0x0405070603020100ull, 0x0001030207060504ull, 0x0405070601000302ull, 0x0001030205040706ull,
+    0x0607050403020001ull, 0x0203010007060405ull, 0x0607050401000203ull, 0x0203010005040607ull,
+    0x0405070603020001ull, 0x0001030207060405ull, 0x0405070601000203ull, 0x0001030205040607ull,
+    0x0607050402030100ull, 0x0203010006070504ull, 0x0607050400010302ull, 0x0203010004050706ull,
+    0x0405070602030100ull, 0x0001030206070504ull, 0x0405070600010302ull, 0x0001030204050706ull,
+    0x0607050402030001ull, 0x0203010006070405ull, 0x0607050400010203ull, 0x0203010004050607ull,
+    0x0405070602030001ull, 0x0001030206070405ull, 0x0405070600010203ull, 0x0001030204050607ull,
+    0x0607040503020100ull, 0x0203000107060504ull, 0x0607040501000302ull, 0x0203000105040706ull,
+    0x0405060703020100ull, 0x0001020307060504ull, 0x0405060701000302ull, 0x0001020305040706ull,
+    0x0607040503020001ull, 0x0203000107060405ull, 0x0607040501000203ull, 0x0203000105040607ull,
+    0x0405060703020001ull, 0x0001020307060405ull, 0x0405060701000203ull, 0x0001020305040607ull,
+    0x0607040502030100ull, 0x0203000106070504ull, 0x0607040500010302ull, 0x0203000104050706ull,
+    0x0405060702030100ull, 0x0001020306070504ull, 0x0405060700010302ull, 0x0001020304050706ull,
+    0x0607040502030001ull, 0x0203000106070405ull, 0x0607040500010203ull, 0x0203000104050607ull,
+    0x0405060702030001ull, 0x0001020306070405ull, 0x0405060700010203ull, 0x0001020304050607ull,
+};
+
+/* The same as wide_step_scalar, eight cells at once. Lanes are cells here
+ * (lane c = cell c, whose planes 0, 1 + c/4 and 3 + c/2 are the same for
+ * every node), so the caller can read the nearest cell's interval from a
+ * fixed lane once it has branched on the cell: only that branch waits for
+ * the choice of the nearest cell, the data does not. The pushes go in key
+ * order (see wide_step_scalar) through the key -> cell permutation. */
 typedef struct kd_step {
     __m256 l, h;   /* per cell: its t interval */
     unsigned cell; /* the nearest valid cell */
 } kd_step;
 
-KD_INLINE int wide_step_avx2(const rt_kdtree_wide *w, const rt_kdtree_shape *shapes, const kd_ray *r, bool par,
-                             float tn, float tf, uint32_t *sref, float *slo, float *shi, kd_step *out)
+KD_INLINE int wide_step_avx2(const rt_kdtree_wide *w, const kd_ray *r, bool par, float tn, float tf, uint32_t *sref,
+                             float *slo, float *shi, kd_step *out)
 {
-    const __m256i three = _mm256_set1_epi32(3);
+    const __m256i three = _mm256_set1_epi32(3), zero = _mm256_setzero_si256();
     const __m256 ninf = _mm256_set1_ps(-INFINITY), pinf = _mm256_set1_ps(INFINITY);
     __m256 split = _mm256_load_ps((const float *)(const void *)w); /* lane 7: the axes, unused */
     __m256i axis = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32((int)w->axes),
                                                       _mm256_setr_epi32(0, 2, 4, 6, 8, 10, 12, 0)),
                                     three);
-    const rt_kdtree_shape *sh = &shapes[w->axes >> RT_KD_SHAPE_SHIFT];
     __m256 o = _mm256_permutevar8x32_ps(_mm256_load_ps(r->o), axis);
     __m256 inv = _mm256_permutevar8x32_ps(_mm256_load_ps(r->inv), axis);
     __m256 ma = _mm256_permutevar8x32_ps(_mm256_load_ps(r->ma), axis);
@@ -567,80 +680,44 @@ KD_INLINE int wide_step_avx2(const rt_kdtree_wide *w, const rt_kdtree_shape *sha
         hi = _mm256_blendv_ps(hi, phi, pm);
         neg = _mm256_andnot_si256(_mm256_castps_si256(pm), neg);
     }
-    lo = _mm256_blend_ps(lo, ninf, 0x80);
-    hi = _mm256_blend_ps(hi, pinf, 0x80);
-    /* the cells' intervals and keys, a depth at a time */
-    /* the planes' own intervals (their edges' cuts), then by doubling over
-     * the parent links each plane's whole path from the top plane */
-    const __m256i pe = _mm256_load_si256((const __m256i *)(const void *)sh->plane),
-                  ce = _mm256_load_si256((const __m256i *)(const void *)sh->cell);
-    /* sign bit: the side ^ the parent plane's neg = far */
-    __m256 pf = _mm256_castsi256_ps(_mm256_xor_si256(_mm256_slli_epi32(pe, 28), _mm256_permutevar8x32_epi32(neg, pe)));
-    __m256 pl = _mm256_blendv_ps(ninf, _mm256_permutevar8x32_ps(lo, pe), pf);
-    __m256 ph = _mm256_blendv_ps(_mm256_permutevar8x32_ps(hi, pe), pinf, pf);
-    __m256i anc = pe;
-    for (int k = 0; k < KD_ROUNDS; k++) {
-        pl = _mm256_max_ps(pl, _mm256_permutevar8x32_ps(pl, anc));
-        ph = _mm256_min_ps(ph, _mm256_permutevar8x32_ps(ph, anc));
-        anc = _mm256_permutevar8x32_epi32(anc, anc);
-    }
-    /* the cells: their own edge and their parent plane's path */
-    __m256 cf = _mm256_castsi256_ps(_mm256_xor_si256(_mm256_slli_epi32(ce, 28), _mm256_permutevar8x32_epi32(neg, ce)));
-    __m256 l = _mm256_max_ps(_mm256_max_ps(_mm256_blendv_ps(ninf, _mm256_permutevar8x32_ps(lo, ce), cf),
-                                           _mm256_permutevar8x32_ps(pl, ce)),
-                             _mm256_set1_ps(tn));
-    __m256 h = _mm256_min_ps(_mm256_min_ps(_mm256_blendv_ps(_mm256_permutevar8x32_ps(hi, ce), pinf, cf),
-                                           _mm256_permutevar8x32_ps(ph, ce)),
-                             _mm256_set1_ps(tf));
+    /* cell order: the planes of cell c (0, 1 + c/4, 3 + c/2), and the key
+     * bits that say on which side of each the cell is for this ray */
+    const __m256i q1 = _mm256_setr_epi32(1, 1, 1, 1, 2, 2, 2, 2), q2 = _mm256_setr_epi32(3, 3, 4, 4, 5, 5, 6, 6);
+    unsigned nb = (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(neg)) & 0x7fu;
+    uint64_t order = kd_cell_of_key[nb];
+    __m256i key = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128((long long)kd_key_of_cell[nb]));
+    /* blendv reads the sign bit: key bit 2, 1, 0 = far side at level 0, 1, 2 */
+    __m256 m0 = _mm256_castsi256_ps(_mm256_slli_epi32(key, 29)), m1 = _mm256_castsi256_ps(_mm256_slli_epi32(key, 30)),
+           m2 = _mm256_castsi256_ps(_mm256_slli_epi32(key, 31));
+    __m256 x = _mm256_max_ps(_mm256_blendv_ps(ninf, _mm256_permutevar8x32_ps(lo, zero), m0),
+                             _mm256_max_ps(_mm256_blendv_ps(ninf, _mm256_permutevar8x32_ps(lo, q1), m1),
+                                           _mm256_blendv_ps(ninf, _mm256_permutevar8x32_ps(lo, q2), m2)));
+    __m256 y = _mm256_min_ps(_mm256_blendv_ps(_mm256_permutevar8x32_ps(hi, zero), pinf, m0),
+                             _mm256_min_ps(_mm256_blendv_ps(_mm256_permutevar8x32_ps(hi, q1), pinf, m1),
+                                           _mm256_blendv_ps(_mm256_permutevar8x32_ps(hi, q2), pinf, m2)));
+    __m256 l = _mm256_max_ps(x, _mm256_set1_ps(tn)), h = _mm256_min_ps(y, _mm256_set1_ps(tf));
     __m256i ref = _mm256_load_si256((const __m256i *)(const void *)w->child);
     __m256 ok = _mm256_andnot_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(ref, _mm256_set1_epi32(-1))),
                                  _mm256_cmp_ps(l, h, _CMP_LE_OQ));
     /* one valid cell (or none): nothing to order or push */
     unsigned okm = (unsigned)_mm256_movemask_ps(ok);
-    out->l = l, out->h = h;
     if ((okm & (okm - 1u)) == 0) {
         if (!okm)
             return -1;
-        out->cell = (unsigned)__builtin_ctz(okm);
+        out->l = l, out->h = h, out->cell = (unsigned)__builtin_ctz(okm);
         return 0;
     }
-    /* the keys (the far bits again, only here: most steps have one cell) */
-    __m256i pk = _mm256_sllv_epi32(_mm256_srli_epi32(_mm256_castps_si256(pf), 31), _mm256_srli_epi32(pe, 8));
-    anc = pe;
-    for (int k = 0; k < KD_ROUNDS; k++) {
-        pk = _mm256_or_si256(pk, _mm256_permutevar8x32_epi32(pk, anc));
-        anc = _mm256_permutevar8x32_epi32(anc, anc);
-    }
-    __m256i key = _mm256_or_si256(_mm256_sllv_epi32(_mm256_srli_epi32(_mm256_castps_si256(cf), 31), _mm256_srli_epi32(ce, 8)),
-                                  _mm256_permutevar8x32_epi32(pk, ce));
-    _Alignas(32) float lb[8], hb[8];
-    _mm256_store_ps(lb, l);
-    _mm256_store_ps(hb, h);
-    unsigned rest = okm & (okm - 1u);
-    if ((rest & (rest - 1u)) == 0) { /* two cells (most multi-cell steps): one compare */
-        _Alignas(32) uint32_t kb[8];
-        _mm256_store_si256((__m256i *)(void *)kb, key);
-        unsigned a = (unsigned)__builtin_ctz(okm), b = (unsigned)__builtin_ctz(rest);
-        unsigned nearc = kb[a] < kb[b] ? a : b, farc = a ^ b ^ nearc;
-        out->cell = nearc;
-        sref[0] = w->child[farc], slo[0] = lb[farc], shi[0] = hb[farc];
-        return 1;
-    }
-    /* more: key << 3 | cell in 16-bit lanes for the valid cells (0xffff
-     * for the others), the smallest first */
-    __m256i v = _mm256_or_si256(_mm256_slli_epi32(key, 3), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-    v = _mm256_blendv_epi8(_mm256_set1_epi32(0xffff), v, _mm256_castps_si256(ok));
-    __m128i v16 = _mm_packus_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
-    __m128i mn = _mm_minpos_epu16(v16);
-    out->cell = (unsigned)_mm_cvtsi128_si32(mn) & 7u;
-    int n = __builtin_popcount(okm) - 1;
-    for (int j = n - 1; j >= 0; j--) { /* the next nearest goes on top */
-        v16 = _mm_or_si128(v16, _mm_cmpeq_epi16(v16, _mm_broadcastw_epi16(mn)));
-        mn = _mm_minpos_epu16(v16);
-        unsigned c = (unsigned)_mm_cvtsi128_si32(mn) & 7u;
-        sref[j] = w->child[c], slo[j] = lb[c], shi[j] = hb[c];
-    }
-    return n;
+    /* key order, farthest first: the nearest valid cell is the top bit */
+    __m256i cell = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128((long long)order));
+    unsigned mask = (unsigned)_mm256_movemask_ps(_mm256_permutevar8x32_ps(ok, cell));
+    unsigned lane = 31u - (unsigned)__builtin_clz(mask), rest = mask ^ (1u << lane);
+    out->l = l, out->h = h, out->cell = (unsigned)(order >> (8 * lane)) & 7u;
+    __m256i idx = _mm256_permutevar8x32_epi32(
+        cell, _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(const void *)&kd_compress[rest])));
+    _mm256_storeu_si256((__m256i *)(void *)sref, _mm256_permutevar8x32_epi32(ref, idx));
+    _mm256_storeu_ps(slo, _mm256_permutevar8x32_ps(l, idx));
+    _mm256_storeu_ps(shi, _mm256_permutevar8x32_ps(h, idx));
+    return __builtin_popcount(rest);
 }
 
 /* The nearest cell's child and interval: a branch per cell (see above). */
@@ -657,7 +734,6 @@ KD_INLINE int wide_step_avx2(const rt_kdtree_wide *w, const rt_kdtree_shape *sha
 KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, bool any, bool par, const kd_ray *r)
 {
     const rt_kdtree_wide *wide = tree->wide;
-    const rt_kdtree_shape *shapes = tree->shapes;
     const uint32_t *ids = tree->prim_ids;
     uint32_t sref[KD_WSTACK];
     float slo[KD_WSTACK], shi[KD_WSTACK];
@@ -670,7 +746,7 @@ KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hi
             const rt_kdtree_wide *w = &wide[ref];
 #ifdef KD_SIMD
             kd_step st;
-            int n = wide_step_avx2(w, shapes, r, par, tn, tf < best ? tf : best, sref + sp, slo + sp, shi + sp, &st);
+            int n = wide_step_avx2(w, r, par, tn, tf < best ? tf : best, sref + sp, slo + sp, shi + sp, &st);
             if (n < 0)
                 goto pop;
             sp += n;
@@ -684,8 +760,8 @@ KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hi
             }
 #else
             unsigned cell = 0; /* set whenever the step returns >= 0 */
-            int n = wide_step_scalar(w, &shapes[w->axes >> RT_KD_SHAPE_SHIFT], r, par, tn, tf < best ? tf : best,
-                                     sref + sp, slo + sp, shi + sp, &cell, &tn, &tf);
+            int n = wide_step_scalar(w, r, par, tn, tf < best ? tf : best, sref + sp, slo + sp, shi + sp, &cell, &tn,
+                                     &tf);
             if (n < 0)
                 goto pop;
             sp += n;

@@ -14,11 +14,10 @@
  *
  * Layout: the build makes 8-byte nodes in one array (the below child is the
  * next node) and leaf primitive lists in a second array; for tracing,
- * up to 7 interior nodes of that binary tree (a treelet of free shape,
- * chosen by surface area) are then packed into one 64-byte,
+ * every three levels of that binary tree are then packed into one 64-byte,
  * cache-line-aligned rt_kdtree_wide (7 split planes, 8 cells), so a ray
- * resolves several levels with one memory access and one SIMD step instead
- * of dependent branches. The planes and cells are exactly the binary
+ * resolves three levels with one memory access and one SIMD step instead of
+ * three dependent branches. The planes and cells are exactly the binary
  * tree's. Leaves and triangles share one array of leaf blocks: a block is
  * the leaf's id list followed by the records (v0, v1, v2 and the scene id,
  * RT_KD_TRI words) of the triangles no earlier leaf used, so a leaf's list
@@ -66,44 +65,29 @@ typedef enum rt_kd_isa { RT_KD_ISA_PORTABLE = 0, RT_KD_ISA_AVX2 = 1 } rt_kd_isa;
 
 typedef struct rt_kdtree_stats {
     size_t nodes, leaves, empty_leaves; /* of the binary tree */
-    size_t wide_nodes;    /* 64-byte nodes of up to 7 planes each, which the traversal reads */
-    size_t wide_planes;   /* planes those nodes hold (of 7 each) */
+    size_t wide_nodes;    /* 64-byte nodes of 3 levels each, which the traversal reads */
     size_t prim_refs;     /* primitive ids stored in leaves (with duplicates) */
     size_t max_leaf_prims;
     int depth;
     double build_ms;
-    size_t bytes;         /* wide nodes + shape table + leaf blocks (ids and triangles) */
+    size_t bytes;         /* wide nodes + leaf blocks (ids and triangles) */
 } rt_kdtree_stats;
 
-/* A wide node: up to 7 planes of the binary tree in a free treelet shape
- * (any subtree of up to 7 interior nodes, chosen by the pack), numbered in
- * preorder (0 the top node); its up to 8 cells are the treelet's external
- * positions in depth-first order, below side first. The shape is an index
- * into the tree's shape table (rt_kdtree.shapes), which gives each cell's
- * path: the plane and side at each depth. A plane the shape does not use
- * is +inf on x (never read). A child reference is another wide node
- * (< RT_KD_LEAF), RT_KD_EMPTY, RT_KD_ONE | primitive id, or RT_KD_LEAF |
- * offset into prim_ids of a list of primitive ids (ascending, the last with
- * RT_KD_LAST set). A primitive id below other_base is the offset of a
- * triangle's record in the same array, an id above it a sphere or quad
- * (scene id = id - other_base + triangle_count). */
+/* Three levels of the binary tree: planes in breadth-first order (0 the top
+ * node, 1 and 2 its below and above children, 3-6 theirs: plane p's children
+ * are 2p+1 and 2p+2), cells c = 4 b0 + 2 b1 + b2 with b = 0 for the below
+ * side at each level. A plane that does not exist (a leaf above level 3)
+ * is +inf on x, which keeps the whole cell below it. A child reference is
+ * another wide node (< RT_KD_LEAF), RT_KD_EMPTY, RT_KD_ONE | primitive id, or
+ * RT_KD_LEAF | offset into prim_ids of a list of primitive ids (ascending,
+ * the last with RT_KD_LAST set). A primitive id below other_base is the
+ * offset of a triangle's record in the same array, an id above it a sphere
+ * or quad (scene id = id - other_base + triangle_count). */
 typedef struct rt_kdtree_wide {
     float split[7];
-    uint32_t axes;      /* axis of plane p in bits 2p, 2p+1; the shape's index from bit RT_KD_SHAPE_SHIFT */
+    uint32_t axes;      /* axis of plane p in bits 2p, 2p+1 */
     uint32_t child[8];
 } rt_kdtree_wide;
-#define RT_KD_SHAPE_SHIFT 14
-
-/* A treelet shape, as parent links: for plane p (lanes 0-6) and for cell c,
- * its parent plane (bits 0-2), its side of that plane (bit 3: above) and
- * the bit its edge sets in the cell order's key (bits 8-15: 7 - its
- * depth); RT_KD_NO_LINK for the top plane, lane 7 of plane[], and the
- * planes and cells the shape does not have. 64 bytes. */
-typedef struct rt_kdtree_shape {
-    _Alignas(64) uint32_t plane[8];
-    uint32_t cell[8];
-} rt_kdtree_shape;
-#define RT_KD_NO_LINK (7u | 32u << 8) /* plane 7 (none); a key shift of 32 sets no bit */
 #define RT_KD_EMPTY 0xffffffffu
 #define RT_KD_LEAF 0x80000000u
 #define RT_KD_ONE 0xc0000000u
@@ -114,8 +98,6 @@ typedef struct rt_kdtree_shape {
 typedef struct rt_kdtree {
     rt_kdtree_wide *wide; /* 64-byte aligned */
     size_t wide_count;
-    rt_kdtree_shape *shapes; /* the wide nodes' shapes (32-byte aligned), in order of first use */
-    size_t shape_count;
     uint32_t root;        /* a child reference: the whole tree */
     /* the leaf blocks: tri and prim_ids are the same array (64-byte aligned,
      * prim_id_count words, then KD_IDS_PAD words of padding), read as floats
