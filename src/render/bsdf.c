@@ -261,14 +261,18 @@ static void set_frame(rt_bsdf *b, rt_vec3 n, rt_vec3 ng)
     rt_onb(n, &b->t, &b->b);
 }
 
-/* The Lambert BSDF of albedo base (clamped to finite, non-negative):
- * what set_params sets for lambert, without its other parameters. */
-static inline void set_lambert(rt_bsdf *b, rt_vec3 base)
+/* An albedo clamped to finite, non-negative values. */
+static inline rt_vec3 clean_base(rt_vec3 base)
 {
     base = rt_vmax(base, rt_v3s(0.0f));
-    if (!rt_finite3(base))
-        base = rt_v3s(0.0f);
-    b->lambert = true;
+    return rt_finite3(base) ? base : rt_v3s(0.0f);
+}
+
+/* The core BSDF's kind flags: Lambert or the metallic-roughness lobes,
+ * nothing layered or special, no cached wo (rt_bsdf_set_wo). */
+static inline void set_kind(rt_bsdf *b, bool lambert)
+{
+    b->lambert = lambert;
     b->wo_z = NAN;
     b->layered = false;
     b->thin = false;
@@ -277,6 +281,14 @@ static inline void set_lambert(rt_bsdf *b, rt_vec3 base)
     b->separable = false;
     b->radiance_eta2 = false;
     b->plastic = false;
+}
+
+/* The Lambert BSDF of albedo base (clamped to finite, non-negative):
+ * what set_params sets for lambert, without its other parameters. */
+static inline void set_lambert(rt_bsdf *b, rt_vec3 base)
+{
+    base = clean_base(base);
+    set_kind(b, true);
     b->base = base;
     b->alpha_y = 1.0f;
     b->diffuse = base;
@@ -295,23 +307,13 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
         set_lambert(b, base);
         return;
     }
-    base = rt_vmax(base, rt_v3s(0.0f));
-    if (!rt_finite3(base))
-        base = rt_v3s(0.0f);
+    base = clean_base(base);
     metallic = isfinite(metallic) ? rt_clampf(metallic, 0.0f, 1.0f) : 0.0f;
     roughness = isfinite(roughness) ? rt_clampf(roughness, 0.0f, 1.0f) : 1.0f;
     transmission = isfinite(transmission) ? rt_clampf(transmission, 0.0f, 1.0f) : 0.0f;
     if (!(ior > 0.0f) || !isfinite(ior))
         ior = 1.5f;
-    b->lambert = false;
-    b->wo_z = NAN;
-    b->layered = false;
-    b->thin = false;
-    b->conductor = false;
-    b->ms = false;
-    b->separable = false;
-    b->radiance_eta2 = false;
-    b->plastic = false;
+    set_kind(b, false);
     b->base = base;
     float r0 = (ior - 1.0f) / (ior + 1.0f);
     b->diffuse = rt_scale(base, 1.0f - metallic);
