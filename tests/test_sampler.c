@@ -326,7 +326,28 @@ static double crop_mse(const rt_framebuffer *img, const rt_framebuffer *ref, rt_
     return se / ((double)(r.x1 - r.x0) * (double)(r.y1 - r.y0) * 3.0);
 }
 
-static void render(fixture *f, rt_integrator in, rt_sampler_kind kind, rt_render_region region, rt_framebuffer *fb)
+/* The shared Cornell box (scenes/cornell-reference.txt) at seed 0 and its
+ * kd-tree. */
+static void cornell_fixture(fixture *f)
+{
+    rt_error err;
+    rt_scene_init(&f->s);
+    if (rt_scene_parse_file(&f->s, "scenes/cornell-reference.txt", &err) != RT_OK)
+        fail_msg("%s", err.message);
+    f->s.settings.seed = 0;
+    assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
+}
+
+static void fixture_free(fixture *f)
+{
+    rt_kdtree_free(&f->tree);
+    rt_scene_free(&f->s);
+}
+
+/* Renders region with the integrator and sampler given: all the scene's
+ * samples when sample_end is 0, else samples 0 .. sample_end - 1. */
+static void render(fixture *f, rt_integrator in, rt_sampler_kind kind, rt_render_region region, int sample_end,
+                   rt_framebuffer *fb)
 {
     rt_error err;
     f->s.settings.integrator = in;
@@ -336,6 +357,7 @@ static void render(fixture *f, rt_integrator in, rt_sampler_kind kind, rt_render
     memset(&opt, 0, sizeof opt);
     opt.threads = 2;
     opt.region = region;
+    opt.sample_end = sample_end;
     rt_render_stats st;
     assert_int_equal(rt_render(&f->s, &f->tree, &opt, fb, &st, &err), RT_OK);
     assert_int_equal(st.bad_samples, 0);
@@ -352,28 +374,23 @@ static void render(fixture *f, rt_integrator in, rt_sampler_kind kind, rt_render
 static void test_cornell_mse_stratified(void **state)
 {
     (void)state;
-    rt_error err;
     rt_framebuffer ref;
     if (!test_read_cornell_reference(&ref))
         return;
     fixture f;
-    rt_scene_init(&f.s);
-    if (rt_scene_parse_file(&f.s, "scenes/cornell-reference.txt", &err) != RT_OK)
-        fail_msg("%s", err.message);
+    cornell_fixture(&f);
     f.s.settings.samples = 16;
-    f.s.settings.seed = 0;
-    assert_int_equal(rt_kdtree_build(&f.tree, &f.s, NULL, &err), RT_OK);
     const rt_sampler_kind kinds[] = {RT_SAMPLER_INDEPENDENT, RT_SAMPLER_CMJ, RT_SAMPLER_SOBOL};
     double mse[3];
     const rt_render_region crop = {192, 192, 320, 320}, corner = {192, 192, 224, 224};
     for (int k = 0; k < 3; k++) {
         rt_framebuffer img;
-        render(&f, RT_INTEGRATOR_PATH, kinds[k], crop, &img);
+        render(&f, RT_INTEGRATOR_PATH, kinds[k], crop, 0, &img);
         mse[k] = crop_mse(&img, &ref, crop);
         rt_framebuffer_free(&img);
         rt_framebuffer small, scalar;
-        render(&f, RT_INTEGRATOR_PATH, kinds[k], corner, &small);
-        render(&f, RT_INTEGRATOR_PATH_SCALAR, kinds[k], corner, &scalar);
+        render(&f, RT_INTEGRATOR_PATH, kinds[k], corner, 0, &small);
+        render(&f, RT_INTEGRATOR_PATH_SCALAR, kinds[k], corner, 0, &scalar);
         assert_memory_equal(small.rgb, scalar.rgb, (size_t)32 * 32 * 3 * sizeof(float));
         rt_framebuffer_free(&small);
         rt_framebuffer_free(&scalar);
@@ -383,8 +400,7 @@ static void test_cornell_mse_stratified(void **state)
     assert_true(mse[1] < 0.85 * mse[0]);
     assert_true(mse[2] < 0.85 * mse[0]);
     rt_framebuffer_free(&ref);
-    rt_kdtree_free(&f.tree);
-    rt_scene_free(&f.s);
+    fixture_free(&f);
 }
 
 /* A stopped render is the prefix of each pixel's samples: samples 0..15 of
@@ -398,32 +414,17 @@ static void test_cornell_mse_stratified(void **state)
 static void test_prefix_covers_pixel(void **state)
 {
     (void)state;
-    rt_error err;
     rt_framebuffer ref;
     if (!test_read_cornell_reference(&ref))
         return;
     fixture f;
-    rt_scene_init(&f.s);
-    if (rt_scene_parse_file(&f.s, "scenes/cornell-reference.txt", &err) != RT_OK)
-        fail_msg("%s", err.message);
-    f.s.settings.seed = 0;
-    assert_int_equal(rt_kdtree_build(&f.tree, &f.s, NULL, &err), RT_OK);
+    cornell_fixture(&f);
     const rt_render_region crop = {192, 192, 320, 320};
     double mse[2];
     for (int k = 0; k < 2; k++) {
         f.s.settings.samples = k == 0 ? 16 : 64;
-        f.s.settings.integrator = RT_INTEGRATOR_PATH;
-        f.s.settings.sampler = RT_SAMPLER_SOBOL;
         rt_framebuffer img;
-        assert_int_equal(rt_framebuffer_init(&img, 128, 128, &err), RT_OK);
-        rt_render_options opt;
-        memset(&opt, 0, sizeof opt);
-        opt.threads = 2;
-        opt.region = crop;
-        opt.sample_begin = 0;
-        opt.sample_end = 16;
-        rt_render_stats st;
-        assert_int_equal(rt_render(&f.s, &f.tree, &opt, &img, &st, &err), RT_OK);
+        render(&f, RT_INTEGRATOR_PATH, RT_SAMPLER_SOBOL, crop, 16, &img);
         mse[k] = crop_mse(&img, &ref, crop);
         rt_framebuffer_free(&img);
     }
@@ -431,8 +432,7 @@ static void test_prefix_covers_pixel(void **state)
             mse[1] / mse[0]);
     assert_true(mse[1] < 1.3 * mse[0]);
     rt_framebuffer_free(&ref);
-    rt_kdtree_free(&f.tree);
-    rt_scene_free(&f.s);
+    fixture_free(&f);
 }
 
 int main(void)
