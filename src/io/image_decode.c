@@ -2,7 +2,8 @@
  * (rt/io/image_decode.h), chosen by the first bytes: OpenEXR (exr.c),
  * WebP (webp.c), then stb_image (PNG, JPEG, Radiance HDR, BMP, TGA, ...)
  * behind size checks made on the header before any pixel allocation
- * (stbi_info, and PNG's IHDR read directly).
+ * (stbi_info, and PNG's IHDR read directly) and, for Radiance HDR, a walk
+ * over its scanlines (radiance.c) that stb's reader would otherwise trust.
  *
  * Sources: the PNG specification (ISO/IEC 15948, sections 5, 7 and 8:
  * chunks, scanline filter bytes, Adam7 interlacing) for the declared size
@@ -19,6 +20,7 @@
 #include <stb/stb_image.h>
 
 #include "rt/io/exr.h"
+#include "rt/io/radiance.h"
 #include "rt/io/webp.h"
 
 /* PNG pixel data is a zlib stream whose decoded length the header fixes
@@ -178,6 +180,9 @@ rt_result rt_image_decode(const void *data, size_t size, const char *name, const
     if (hdr && (uint64_t)w * (uint64_t)h > lim->max_float_pixels)
         return rt_fail(err, RT_ERR_LIMIT, "%s: HDR image is %dx%d, over the limit of %llu pixels for float images",
                        name, w, h, (unsigned long long)lim->max_float_pixels);
+    /* stb's HDR reader loops for ever on a run of 0 (a cut file reads as one) */
+    if (hdr && rt_radiance_check(bytes, size, name, err) != RT_OK)
+        return RT_ERR_INVALID;
     rt_result pr = png_precheck(bytes, size, name, lim->max_side, err);
     if (pr != RT_OK)
         return pr;
