@@ -1,5 +1,5 @@
 /* image_read.c - one reader for every image format rt writes (and 8-bit
- * ones): the first bytes decide. PFM by "PF" (rt_pfm_read; Paul Debevec's
+ * ones): the first bytes decide. PFM by "PF" or "Pf" (rt_pfm_read, pfm.c; Paul Debevec's
  * format note); everything else through rt_image_decode (image_decode.c:
  * OpenEXR, Radiance HDR, WebP, PNG, JPEG, ... behind its size checks),
  * 8-bit values decoded with the sRGB transfer function (IEC 61966-2-1) so
@@ -26,7 +26,7 @@ rt_result rt_image_read(const char *path, rt_framebuffer *fb, rt_error *err)
     rt_result r = rt_read_file(path, (size_t)INT32_MAX, &bytes, &size, err);
     if (r != RT_OK)
         return r;
-    if (size >= 2 && bytes[0] == 'P' && bytes[1] == 'F') {
+    if (size >= 2 && bytes[0] == 'P' && (bytes[1] == 'F' || bytes[1] == 'f')) { /* colour or grey PFM */
         free(bytes);
         return rt_pfm_read(path, fb, err);
     }

@@ -87,7 +87,10 @@ rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *pat
 /* Writes bytes to path the same atomic way (a part's sidecar, docs/farm.md). */
 rt_result rt_file_write_atomic(const char *path, const void *bytes, size_t size, rt_write_temp *temp, rt_error *err);
 
-/* Reads a PFM (for tests and comparisons against references). */
+/* Reads a PFM file (src/io/pfm.c): colour ("PF") or grey ("Pf", copied to
+ * R, G and B), either byte order. The header is checked against the file's
+ * size before any pixel memory is taken; every message names the file, and
+ * the byte where it goes wrong. */
 rt_result rt_pfm_read(const char *path, rt_framebuffer *fb, rt_error *err);
 
 #endif
