@@ -12,6 +12,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "rt/base/file.h"
 #include "rt/image/compare.h"
 #include "rt/image/flip.h"
 #include "rt/io/framebuffer.h"
@@ -653,6 +654,25 @@ static void test_rt_compare(void **state)
     res = run_compare("--help", NULL);
     assert_int_equal(res.status, 0);
     assert_non_null(strstr(res.out, "usage: rt compare"));
+
+    /* an error map over an image being compared (by another name too) is
+     * refused before any work: the image stays as it was */
+    char *before, *after;
+    size_t nb, na;
+    assert_int_equal(rt_read_file(cand, 0, &before, &nb, &err), RT_OK);
+    char cand_again[300];
+    snprintf(cand_again, sizeof cand_again, "%s/./cand.pfm", dir);
+    res = run_compare(cand, ref, "--error-map", cand_again, NULL);
+    assert_int_equal(res.status, 2);
+    assert_non_null(strstr(res.errs, "is the image"));
+    res = run_compare(cand, ref, "--hdr-error-map", ref, NULL);
+    assert_int_equal(res.status, 2);
+    res = run_compare(cand, ref, "--error-map", map, "--hdr-error-map", map, NULL);
+    assert_int_equal(res.status, 2);
+    assert_int_equal(rt_read_file(cand, 0, &after, &na, &err), RT_OK);
+    assert_true(na == nb && memcmp(before, after, nb) == 0);
+    free(before);
+    free(after);
 
     const char *files[] = {cand, ref, small, nan_img, map, hdr_map};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)

@@ -200,3 +200,9 @@ bool rt_path_tagged(const char *path, const char *tag, const char *new_ext, char
     int n = snprintf(out, size, "%.*s.%s%s", (int)(dot - path), path, tag, new_ext ? new_ext : dot);
     return n >= 0 && (size_t)n < size;
 }
+
+bool rt_same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    return a && b && stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}

@@ -35,7 +35,7 @@ static const char usage[] =
     "  --max-flip X          fail when LDR-FLIP > X\n"
     "  --max-hdr-flip X      fail when HDR-FLIP > X\n"
     "  --error-map FILE      write the LDR-FLIP error map: .png in FLIP's magma colours,\n"
-    "                        .pfm or .hdr as the raw error in [0,1]\n"
+    "                        .pfm, .hdr or .exr as the raw error in [0,1]\n"
     "  --hdr-error-map FILE  the same for HDR-FLIP\n"
     "  --ppd N               pixels per degree of visual angle (default 67.02: 0.7 m\n"
     "                        from a 0.7 m wide 3840-pixel monitor)\n"
@@ -259,11 +259,25 @@ int rt_cmd_compare_to(int argc, char **argv, FILE *out, FILE *errs)
     /* outputs are checked before any work, as rt does for renders */
     rt_error err = {0};
     const char *outputs[2] = {a.error_map, a.hdr_error_map};
-    for (int i = 0; i < 2; i++)
+    for (int i = 0; i < 2; i++) {
         if (outputs[i] && rt_output_check(outputs[i], &err) != RT_OK) {
             fprintf(errs, "rt: compare: %s\n", err.message);
             return 2;
         }
+        /* an error map over an image being compared would replace it */
+        const char *input = rt_same_file(outputs[i], a.candidate) ? a.candidate
+                            : rt_same_file(outputs[i], a.reference) ? a.reference
+                                                                    : NULL;
+        if (input) {
+            fprintf(errs, "rt: compare: the error map %s is the image %s; write it to another file\n", outputs[i],
+                    input);
+            return 2;
+        }
+    }
+    if (a.error_map && a.hdr_error_map && strcmp(a.error_map, a.hdr_error_map) == 0) {
+        fprintf(errs, "rt: compare: --error-map and --hdr-error-map both name %s\n", a.error_map);
+        return 2;
+    }
 
     rt_framebuffer cand = {0}, ref = {0};
     int status = 2;

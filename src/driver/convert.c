@@ -9,6 +9,7 @@
 #include <stdbool.h>
 #include <string.h>
 
+#include "rt/base/file.h"
 #include "rt/base/number.h"
 #include "rt/image/tonemap.h"
 #include "rt/io/framebuffer.h"
@@ -25,7 +26,7 @@ static const char usage[] =
     "  --tonemap NAME   8-bit output: clamp (default), filmic, aces or agx\n"
     "  --half           EXR output in 16-bit half floats\n"
     "\n"
-    "exit status: 0 written, 2 bad input (flags, unreadable IN, unwritable OUT)\n";
+    "exit status: 0 written, 2 bad input (flags, unreadable IN, unwritable OUT, OUT the same file as IN)\n";
 
 int rt_cmd_convert_to(int argc, char **argv, FILE *out, FILE *errs)
 {
@@ -80,6 +81,10 @@ int rt_cmd_convert_to(int argc, char **argv, FILE *out, FILE *errs)
     rt_image_format fmt;
     if (rt_output_format(dst, &fmt, &err) != RT_OK || rt_output_check(dst, &err) != RT_OK) {
         fprintf(errs, "rt: convert: %s\n", err.message);
+        return 2;
+    }
+    if (rt_same_file(in, dst)) { /* the write is atomic, but the input would be gone */
+        fprintf(errs, "rt: convert: %s is the input %s; write to another file\n", dst, in);
         return 2;
     }
     if (fmt != RT_FORMAT_PNG && (ev_given || tm_given)) {

@@ -45,6 +45,11 @@
  * "path: ". On failure *bytes is NULL and *size 0. */
 rt_result rt_read_file(const char *path, size_t max_size, char **bytes, size_t *size, rt_error *err);
 
+/* True when both paths exist and are the same file (device and inode: a
+ * hard link, a symbolic link or "./x" for "x" count), so that a command
+ * can refuse to write its output over one of its inputs. */
+bool rt_same_file(const char *a, const char *b);
+
 /* True when the last component of path ends in ext (".obj"), ignoring ASCII
  * case. */
 bool rt_path_has_ext(const char *path, const char *ext);
