@@ -38,6 +38,7 @@
 
 #include <dlfcn.h>
 #include <glob.h>
+#include <pwd.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -115,6 +116,52 @@ static void *try_glob(const char *pattern, char *where, size_t size)
 #endif
 #endif
 
+/* Appends one pattern line to out (dropped when it does not fit). */
+static void add_pattern(char *out, size_t size, const char *prefix, const char *middle, const char *wheel_at)
+{
+    size_t used = strlen(out);
+    int n = snprintf(out + used, size - used, "%s%s%s/" OIDN_WHEEL_LIB "\n", prefix, middle, wheel_at);
+    if (n < 0 || (size_t)n >= size - used)
+        out[used] = 0;
+}
+
+void rt_denoise_wheel_patterns(char *out, size_t size)
+{
+    if (!size)
+        return;
+    out[0] = 0;
+    static const char *const venv_lib = "/lib/python3*";
+    /* build/oidn-venv beside the binary, or up to two folders above it */
+    char exe[4096];
+    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n > 0) {
+        exe[n] = 0;
+        char *slash = strrchr(exe, '/');
+        if (slash)
+            *slash = 0;
+        static const char *const ups[] = {"/build/oidn-venv", "/../build/oidn-venv", "/../../build/oidn-venv"};
+        for (int i = 0; i < 3; i++)
+            add_pattern(out, size, exe, ups[i], venv_lib);
+    }
+    add_pattern(out, size, "", "build/oidn-venv", venv_lib); /* under the current directory */
+    const char *venv = getenv("VIRTUAL_ENV");
+    if (venv && venv[0])
+        add_pattern(out, size, venv, "", venv_lib);
+    /* the user site, as Python finds it: PYTHONUSERBASE, else ~/.local (HOME, else the password entry) */
+    const char *base = getenv("PYTHONUSERBASE");
+    if (base && base[0]) {
+        add_pattern(out, size, base, "", venv_lib);
+        return;
+    }
+    const char *home = getenv("HOME");
+    if (!home || !home[0]) {
+        const struct passwd *pw = getpwuid(getuid());
+        home = pw ? pw->pw_dir : NULL;
+    }
+    if (home && home[0])
+        add_pattern(out, size, home, "/.local", venv_lib);
+}
+
 static void *open_library(char *where, size_t size, rt_error *err)
 {
     const char *env = getenv("RT_OIDN_LIBRARY");
@@ -139,33 +186,12 @@ static void *open_library(char *where, size_t size, rt_error *err)
         return lib;
     }
     void *lib = try_open(OIDN_SONAME, where, size);
-    char pattern[4400];
-    /* build/oidn-venv beside the binary, or up to two folders above it */
-    char exe[4096];
-    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (!lib && n > 0) {
-        exe[n] = 0;
-        char *slash = strrchr(exe, '/');
-        if (slash)
-            *slash = 0;
-        static const char *const ups[] = {"", "/..", "/../.."};
-        for (int i = 0; i < 3 && !lib; i++) {
-            snprintf(pattern, sizeof pattern, "%s%s/build/oidn-venv/lib/python3*/" OIDN_WHEEL_LIB, exe, ups[i]);
-            lib = try_glob(pattern, where, size);
-        }
-    }
-    if (!lib) {
-        snprintf(pattern, sizeof pattern, "build/oidn-venv/lib/python3*/" OIDN_WHEEL_LIB);
-        lib = try_glob(pattern, where, size);
-    }
-    const char *venv = getenv("VIRTUAL_ENV"), *home = getenv("HOME");
-    if (!lib && venv && venv[0]) {
-        snprintf(pattern, sizeof pattern, "%s/lib/python3*/" OIDN_WHEEL_LIB, venv);
-        lib = try_glob(pattern, where, size);
-    }
-    if (!lib && home && home[0]) {
-        snprintf(pattern, sizeof pattern, "%s/.local/lib/python3*/" OIDN_WHEEL_LIB, home);
-        lib = try_glob(pattern, where, size);
+    char patterns[8 * 4400];
+    rt_denoise_wheel_patterns(patterns, sizeof patterns);
+    for (char *line = patterns, *next; !lib && *line; line = next) {
+        next = strchr(line, '\n');
+        *next++ = 0;
+        lib = try_glob(line, where, size);
     }
     if (!lib)
         rt_fail(err, RT_ERR_IO, "--denoise needs Intel Open Image Denoise (" OIDN_SONAME "), not found: "

@@ -6,8 +6,9 @@
  * build/oidn-venv. rt looks for the library, in order: the file named by
  * RT_OIDN_LIBRARY; the system's libOpenImageDenoise.so.2; the wheel under
  * build/oidn-venv beside the rt binary (or one or two folders up, for the
- * test binaries), under $VIRTUAL_ENV, and under the Python user site
- * (~/.local/lib/python3.X/site-packages). Nothing but --denoise needs it.
+ * test binaries) or the current directory, under $VIRTUAL_ENV, and under
+ * the Python user site ($PYTHONUSERBASE or ~/.local, then
+ * lib/python3.X/site-packages). Nothing but --denoise needs it.
  *
  *   char where[4096];
  *   if (rt_denoise_find(where, sizeof where, &err) != RT_OK)
@@ -58,7 +59,18 @@ typedef struct rt_denoise_input {
 bool rt_denoise_quality_parse(const char *name, rt_denoise_quality *out);
 
 /* The one-line hint printed when the library is missing. */
-#define RT_DENOISE_INSTALL_HINT "run 'make denoiser' (installs the pyoidn wheel into build/oidn-venv) or set RT_OIDN_LIBRARY"
+#define RT_DENOISE_INSTALL_HINT                                                                                        \
+    "run 'make denoiser' in rt's source tree (the pyoidn wheel into build/oidn-venv), or 'pip install "                \
+    "pyoidn==2.5.1.0' in a virtual environment or with --user, or set RT_OIDN_LIBRARY to the library"
+
+/* Where the pyoidn wheel's library is looked for after RT_OIDN_LIBRARY and
+ * the system's loader, in order, as glob(3) patterns, one a line, into out:
+ * build/oidn-venv beside the rt binary (or one or two folders up), under
+ * the current directory, under $VIRTUAL_ENV, then the Python user site
+ * ($PYTHONUSERBASE, else ~/.local), each as
+ * PREFIX/lib/python3.X/site-packages/pyoidn/oidn/lib/libOpenImageDenoise.so.2
+ * (any python3.X). */
+void rt_denoise_wheel_patterns(char *out, size_t size);
 
 /* Finds and loads the library; `where` receives the path that loaded.
  * RT_ERR_IO with a one-line message when it cannot be found or
