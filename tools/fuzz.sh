@@ -12,7 +12,7 @@
 set -eu
 SECONDS_EACH=${FUZZ_SECONDS:-60}
 SHARED=${SHARED:-../shared}
-TARGETS=${FUZZ_TARGETS:-"scene gltf glb gltf_bin obj ply off image exr meshopt draco part"}
+TARGETS=${FUZZ_TARGETS:-"scene gltf glb gltf_bin obj ply off image exr meshopt draco part image_file"}
 B=build-fuzz
 
 if ! command -v clang >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then

@@ -100,3 +100,42 @@ for p in sorted(glob.glob("tests/corpus/glb/compressed-*.glb")):
                 v = doc["bufferViews"][dr["bufferView"]]
                 put("draco", "%s-view%d" % (base, dr["bufferView"]),
                     bin_[v.get("byteOffset", 0):v.get("byteOffset", 0) + v["byteLength"]])
+
+# float images for image (textures, environment maps) and image_file (what
+# rt compare and rt convert read, PFM too): small Radiance HDR files, run-length
+# encoded (16 wide) and flat (4 wide), PFM in both byte orders and grey
+def rgbe_pixels(w, h):
+    return [[(16 + 7 * x + 3 * y) % 256, (40 + 5 * x) % 256, (90 + 11 * y) % 256, 128 + (x + y) % 3]
+            for y in range(h) for x in range(w)]
+
+def radiance(w, h, rle):
+    out = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n" % (h, w)
+    px = rgbe_pixels(w, h)
+    for y in range(h):
+        row = px[y * w:(y + 1) * w]
+        if not rle:
+            out += b"".join(bytes(p) for p in row)
+            continue
+        out += bytes([2, 2, w >> 8, w & 255])
+        for c in range(4):
+            vals = [p[c] for p in row]
+            if c == 3:  # the exponents as one run
+                out += bytes([128 + w, vals[0]]) if len(set(vals)) == 1 else bytes([w]) + bytes(vals)
+            else:       # the mantissas as one dump
+                out += bytes([w]) + bytes(vals)
+    return out
+
+def pfm(w, h, grey, big):
+    ch = 1 if grey else 3
+    vals = [((i * 37) % 101) / 17.0 for i in range(w * h * ch)]
+    head = b"%s\n%d %d\n%s\n" % (b"Pf" if grey else b"PF", w, h, b"1.0" if big else b"-1.0")
+    return head + struct.pack(("%s%df" % (">" if big else "<", len(vals))), *vals)
+
+for target in ("image", "image_file"):
+    put(target, "rle-16x4.hdr", radiance(16, 4, True))
+    put(target, "flat-4x3.hdr", radiance(4, 3, False))
+put("image_file", "rgb-le-5x3.pfm", pfm(5, 3, False, False))
+put("image_file", "rgb-be-3x2.pfm", pfm(3, 2, False, True))
+put("image_file", "grey-4x2.pfm", pfm(4, 2, True, False))
+for p in sorted(glob.glob("tests/corpus/exr/*.exr")):
+    put("image_file", os.path.basename(p), open(p, "rb").read())

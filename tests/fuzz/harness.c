@@ -11,20 +11,22 @@
 
 #include "rt/io/draco.h"
 #include "rt/io/exr.h"
+#include "rt/io/framebuffer.h"
+#include "rt/io/image_read.h"
 #include "rt/io/load.h"
 #include "rt/io/meshopt.h"
 #include "rt/io/part.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/texture.h"
 
-const char *const rt_fuzz_targets[] = {"scene", "gltf",  "glb", "gltf_bin", "obj",   "ply",  "off",
-                                       "image", "exr",   "meshopt", "draco", "part", NULL};
+const char *const rt_fuzz_targets[] = {"scene", "gltf",    "glb",   "gltf_bin", "obj",        "ply",  "off",
+                                       "image", "exr",     "meshopt", "draco", "part", "image_file", NULL};
 
 static char dir[64];
 
 static void remove_temp_dir(void)
 {
-    static const char *const files[] = {"buffer.bin", "m.mtl", "p.exr", "p.exr.json", NULL};
+    static const char *const files[] = {"buffer.bin", "m.mtl", "p.exr", "p.exr.json", "fuzz.img", NULL};
     char path[256];
     for (int i = 0; files[i]; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, files[i]);
@@ -158,6 +160,13 @@ int rt_fuzz_run(const char *target, const uint8_t *data, size_t size)
         uint32_t img;
         rt_image_load_memory(&s, data, size, "fuzz.img", &img, &err);
         rt_scene_free(&s);
+    } else if (strcmp(target, "image_file") == 0) {
+        /* an image file as rt compare and rt convert read it: PFM too */
+        write_temp("fuzz.img", data, size, path, sizeof path);
+        rt_framebuffer fb;
+        rt_error err;
+        if (rt_image_read(path, &fb, &err) == RT_OK)
+            rt_framebuffer_free(&fb);
     } else if (strcmp(target, "part") == 0) {
         /* u32 length, the sidecar (its "@HASH@" replaced by the image's
          * FNV-1a, so the fuzzer gets past the hash check), the image */

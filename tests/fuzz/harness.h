@@ -13,8 +13,10 @@
  * u16 count in the first five bytes), draco (a Draco mesh stream, its
  * indices and attributes read back) and part (u32 sidecar length, a
  * part's JSON sidecar, then its EXR image, read by rt_part_read; "@HASH@"
- * in the sidecar becomes the image's hash).
- * Every target but image, exr, meshopt, draco and part loads through rt_load_memory, as `rt` loads a file
+ * in the sidecar becomes the image's hash), image_file (any bytes as an
+ * image file through rt_image_read, as rt compare and rt convert read it:
+ * PFM besides what image reads).
+ * Every target but image, exr, meshopt, draco, part and image_file loads through rt_load_memory, as `rt` loads a file
  * of that kind (fuzz.txt, fuzz.gltf, fuzz.obj, ...): the content picks the
  * reader before the name does.
  */
