@@ -1,9 +1,13 @@
 /* test_hdr.c - the HDR workflow: OpenEXR out and in (float exact, half to
- * half precision, layers, textures, size limits, broken files), the tone
- * curves at points worked out from their formulas, `rt convert` (round
- * trips, refused flag combinations, exit codes), and --denoise: the 64x64
- * Cornell render gets closer to the shared Mitsuba reference, and a missing
- * library is one clear error before any rendering. */
+ * half precision, layers, textures, size limits, broken files), Radiance
+ * HDR and PFM files cut or lying about their size (an error naming the
+ * file and the byte, never a hang or a huge allocation), the tone curves
+ * at points worked out from their formulas, `rt convert` (round trips,
+ * refused flag combinations, OUT over IN, exit codes), AOVs (the same bytes
+ * for any threads, tiles and passes; through mirrors and glass), and
+ * --denoise: the 64x64 Cornell render gets closer to the shared Mitsuba
+ * reference, the noisy image is kept with --aov, the library's search
+ * order, and a missing library is one clear error before any rendering. */
 #include "test_util.h"
 
 #include <math.h>
@@ -188,6 +192,143 @@ static void test_exr_texture_and_limits(void **state)
     rt_framebuffer_free(&a);
 }
 
+/* Writes bytes[0 .. n) to the test folder's `name`; its path. */
+static const char *put(const char *name, const void *bytes, size_t n)
+{
+    const char *path = tmp(name);
+    test_write_file(path, bytes, n);
+    return path;
+}
+
+/* rt_image_read must refuse bytes[0 .. n) as `name`, with a message naming
+ * it and containing `what` (when given). */
+static void expect_refused(const char *name, const void *bytes, size_t n, const char *what)
+{
+    rt_framebuffer fb;
+    rt_error err = {0};
+    const char *path = put(name, bytes, n);
+    if (rt_image_read(path, &fb, &err) == RT_OK)
+        fail_msg("%s (%zu bytes) was read", name, n);
+    if (!strstr(err.message, name) || (what && !strstr(err.message, what)))
+        fail_msg("%s (%zu bytes): '%s' (wanted '%s')", name, n, err.message, what ? what : "");
+}
+
+/* Radiance HDR: stb_image's reader loops for ever on a file cut inside a
+ * run-length scanline (it reads zeros past the end: runs of length 0), and
+ * leaves flat pixels past the end unset. Every cut is an error naming the
+ * file and the byte; environment maps (the texture path) too. An alarm
+ * turns a hang into a failure. */
+static void test_radiance_checked(void **state)
+{
+    (void)state;
+    alarm(120);
+    rt_framebuffer a, b;
+    assert_int_equal(rt_framebuffer_init(&a, 19, 5, NULL), RT_OK);
+    for (size_t i = 0; i < 19 * 5 * 3; i++)
+        a.rgb[i] = (float)(i % 23) * 0.37f + 0.01f;
+    rt_error err = {0};
+    assert_int_equal(rt_framebuffer_write(&a, tmp("rle.hdr"), 1.0f, &err), RT_OK); /* 19 wide: run-length scanlines */
+    assert_int_equal(rt_image_read(tmp("rle.hdr"), &b, &err), RT_OK);
+    for (size_t i = 0; i < 19 * 5 * 3; i++) /* RGBE: 8-bit mantissas on a shared exponent */
+        assert_near(b.rgb[i], a.rgb[i], 0.01 * fmax(fmax(a.rgb[i - i % 3], a.rgb[i - i % 3 + 1]), a.rgb[i - i % 3 + 2]));
+    rt_framebuffer_free(&b);
+    char *bytes;
+    size_t size;
+    assert_int_equal(rt_read_file(tmp("rle.hdr"), 0, &bytes, &size, &err), RT_OK);
+    const char *res = strstr(bytes, "+X 19\n");
+    assert_non_null(res);
+    const size_t data_at = (size_t)(res - bytes) + 6;
+    for (size_t cut = 0; cut < size; cut++)
+        expect_refused("cut.hdr", bytes, cut, cut > data_at ? "Radiance HDR data ends at byte" : NULL);
+    /* an environment map cut short: the scene's texture loader says so */
+    put("sky.hdr", bytes, size - 7);
+    rt_scene sc;
+    rt_scene_init(&sc);
+    uint32_t img;
+    assert_int_equal(rt_image_load_file(&sc, tmp("sky.hdr"), &img, &err), RT_ERR_INVALID);
+    assert_non_null(strstr(err.message, "sky.hdr"));
+    rt_scene_free(&sc);
+    /* a run of length 0 */
+    char *bad = malloc(size);
+    assert_non_null(bad);
+    memcpy(bad, bytes, size);
+    assert_true(bad[data_at] == 2 && bad[data_at + 1] == 2);
+    bad[data_at + 4] = 0;
+    expect_refused("zero.hdr", bad, size, "run of length 0");
+    /* a flat scanline after run-length ones (stb would start over at the second pixel) */
+    memcpy(bad, bytes, size);
+    size_t second = data_at + 4;
+    for (int c = 0; c < 4; c++) /* past scanline 0's four components */
+        for (int x = 0; x < 19;) {
+            unsigned char count = (unsigned char)bad[second];
+            x += count > 128 ? count - 128 : count;
+            second += count > 128 ? 2 : 1 + count;
+        }
+    bad[second] = 1;
+    expect_refused("mixed.hdr", bad, size, "flat after run-length");
+    free(bad);
+    free(bytes);
+    /* flat data (under 8 pixels wide), cut */
+    rt_framebuffer f4;
+    assert_int_equal(rt_framebuffer_init(&f4, 4, 3, NULL), RT_OK);
+    for (size_t i = 0; i < 4 * 3 * 3; i++)
+        f4.rgb[i] = 0.5f;
+    assert_int_equal(rt_framebuffer_write(&f4, tmp("flat.hdr"), 1.0f, &err), RT_OK);
+    assert_int_equal(rt_image_read(tmp("flat.hdr"), &b, &err), RT_OK);
+    assert_near(b.rgb[0], 0.5, 0);
+    rt_framebuffer_free(&b);
+    assert_int_equal(rt_read_file(tmp("flat.hdr"), 0, &bytes, &size, &err), RT_OK);
+    expect_refused("flat-cut.hdr", bytes, size - 1, "flat pixels");
+    free(bytes);
+    rt_framebuffer_free(&f4);
+    rt_framebuffer_free(&a);
+    alarm(0);
+}
+
+/* PFM: the header is parsed by hand and checked against the file's size
+ * before any pixel memory (a 65536x65536 header on a small file is one
+ * error, not 48 GiB); every message names the file and a byte; grey ("Pf")
+ * and big-endian files read. */
+static void test_pfm_checked(void **state)
+{
+    (void)state;
+    rt_framebuffer a, b;
+    fill(&a, 7, 3);
+    rt_error err = {0};
+    assert_int_equal(rt_framebuffer_write(&a, tmp("p.pfm"), 1.0f, &err), RT_OK);
+    char *bytes;
+    size_t size;
+    assert_int_equal(rt_read_file(tmp("p.pfm"), 0, &bytes, &size, &err), RT_OK);
+    const size_t data_at = size - 7 * 3 * 12;
+    for (size_t cut = 0; cut < size; cut++)
+        expect_refused("cut.pfm", bytes, cut, cut >= data_at ? "PFM data ends at byte" : NULL);
+    free(bytes);
+    static const char huge[] = "PF\n65536 65536\n-1.0\n\0\0\0\0\0\0\0\0\0\0\0\0";
+    expect_refused("huge.pfm", huge, sizeof huge - 1, "needs 51539607552 bytes");
+    expect_refused("wide.pfm", "PF\n65537 1\n-1.0\n", 17, "PFM width at byte 3 is over 65536");
+    expect_refused("zero.pfm", "PF\n4 0\n-1.0\n", 12, "PFM height at byte 5 is 0");
+    expect_refused("neg.pfm", "PF\n-4 1\n-1.0\n", 13, "expected the width");
+    expect_refused("nan.pfm", "PF\n1 1\nnan\n\0\0\0\0\0\0\0\0\0\0\0\0", 23, "expected the scale");
+    /* grey, little-endian: 0.5 and 1 copied to R, G and B */
+    static const unsigned char grey[] = {'P', 'f', '\n', '2', ' ', '1', '\n', '-', '1', '\n', 0, 0, 0, 0x3f, 0, 0, 0x80, 0x3f};
+    assert_int_equal(rt_image_read(put("g.pfm", grey, sizeof grey), &b, &err), RT_OK);
+    assert_int_equal(b.width, 2);
+    for (int c = 0; c < 3; c++) {
+        assert_near(b.rgb[c], 0.5, 0);
+        assert_near(b.rgb[3 + c], 1.0, 0);
+    }
+    rt_framebuffer_free(&b);
+    /* colour, big-endian (a positive scale), two rows: the bottom one first */
+    static const unsigned char be[] = {'P', 'F', '\n', '1', ' ', '2', '\n', '1', '.', '0', '\n',
+                                       0x3f, 0x80, 0, 0, 0x40, 0, 0, 0, 0x40, 0x40, 0, 0,  /* bottom: 1 2 3 */
+                                       0x3e, 0x80, 0, 0, 0, 0, 0, 0, 0xbf, 0x80, 0, 0}; /* top: 0.25 0 -1 */
+    assert_int_equal(rt_image_read(put("be.pfm", be, sizeof be), &b, &err), RT_OK);
+    static const float want[6] = {0.25f, 0.0f, -1.0f, 1.0f, 2.0f, 3.0f};
+    assert_memory_equal(b.rgb, want, sizeof want);
+    rt_framebuffer_free(&b);
+    rt_framebuffer_free(&a);
+}
+
 static void test_tonemap_curves(void **state)
 {
     (void)state;
@@ -276,6 +417,17 @@ static void test_convert(void **state)
     assert_int_equal(run_convert(tmp("missing.exr"), tmp("x.png"), NULL, NULL), 2);
     assert_int_equal(run_convert(tmp("c.exr"), NULL, NULL, NULL), 2);
     assert_int_equal(access(tmp("x.pfm"), F_OK), -1);
+    /* OUT the same file as IN (by any name) is refused: the input stays */
+    char *before, *after;
+    size_t nb, na;
+    assert_int_equal(rt_read_file(tmp("c.exr"), 0, &before, &nb, &err), RT_OK);
+    char again[300];
+    snprintf(again, sizeof again, "%s/./c.exr", dir);
+    assert_int_equal(run_convert(tmp("c.exr"), again, "--half", NULL), 2);
+    assert_int_equal(rt_read_file(tmp("c.exr"), 0, &after, &na, &err), RT_OK);
+    assert_true(na == nb && memcmp(before, after, nb) == 0);
+    free(before);
+    free(after);
     /* a broken input leaves an existing output as it was */
     test_write_file(tmp("bad.exr"), "\x76\x2f\x31\x01garbage", 11);
     assert_int_equal(run_convert(tmp("bad.exr"), tmp("c2.pfm"), NULL, NULL), 2);
@@ -397,15 +549,24 @@ static void test_aovs(void **state)
     snprintf(args, sizeof args, "%s -t 3 --tile 7 --aov albedo,normal,depth,position,variance,spp -o %s", common,
              tmp("a3.pfm"));
     assert_int_equal(run_rt(NULL, args, NULL), 0);
+    /* tile by tile, and in passes of 3 samples: the same bytes again */
+    snprintf(args, sizeof args, "%s -t 2 --passes 0 --tile 5 --aov albedo,normal,depth,position,variance,spp -o %s",
+             common, tmp("at.pfm"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
+    snprintf(args, sizeof args, "%s -t 2 --passes 3 --aov albedo,normal,depth,position,variance,spp -o %s", common,
+             tmp("ap.pfm"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
     assert_true(same_file(tmp("plain.pfm"), tmp("a1.pfm")));
     static const char *const names[] = {"albedo", "normal", "depth", "position", "variance", "spp"};
-    for (int k = 0; k < 6; k++) {
-        char p1[128], p3[128];
-        snprintf(p1, sizeof p1, "a1.%s.pfm", names[k]);
-        snprintf(p3, sizeof p3, "a3.%s.pfm", names[k]);
-        if (!same_file(tmp(p1), tmp(p3)))
-            fail_msg("the %s AOV differs between 1 and 3 threads", names[k]);
-    }
+    static const char *const others[] = {"a3", "at", "ap"};
+    for (int k = 0; k < 6; k++)
+        for (int o = 0; o < 3; o++) {
+            char p1[128], p3[128];
+            snprintf(p1, sizeof p1, "a1.%s.pfm", names[k]);
+            snprintf(p3, sizeof p3, "%s.%s.pfm", others[o], names[k]);
+            if (!same_file(tmp(p1), tmp(p3)))
+                fail_msg("the %s AOV differs between 1 thread and %s", names[k], p3);
+        }
     rt_framebuffer alb, nrm, spp;
     rt_error err;
     assert_int_equal(rt_image_read(tmp("a1.albedo.pfm"), &alb, &err), RT_OK);
@@ -426,6 +587,63 @@ static void test_aovs(void **state)
     assert_int_equal(run_rt(NULL, args, NULL), 2);
 }
 
+/* AOVs through perfect mirrors and glass, as OIDN wants them: a camera
+ * facing a smooth silver mirror (bsdf conductor, then a glTF metal of
+ * roughness 0) sees the red wall behind it: the wall's albedo and normal
+ * (facing the ray, -z), while depth and position stay the mirror's; through
+ * a slab of smooth glass, the green wall behind it. */
+static void test_aovs_through_mirror_and_glass(void **state)
+{
+    (void)state;
+    static const char *const scenes[3] = {
+        "material m bsdf conductor metal Ag ggx_alpha 0\n"
+        "quad -5 -5 0  10 0 0  0 10 0  m\n"
+        "quad -5 -5 4  0 10 0  10 0 0  red\n",
+        "material m color 1 1 1 metallic 1 roughness 0\n"
+        "quad -5 -5 0  10 0 0  0 10 0  m\n"
+        "quad -5 -5 4  0 10 0  10 0 0  red\n",
+        "material glass bsdf dielectric ior 1.5\n"
+        "quad -5 -5 0.1  10 0 0  0 10 0  glass\n"
+        "quad -5 -5 -0.1  0 10 0  10 0 0  glass\n"
+        "quad -5 -5 -2  10 0 0  0 10 0  green\n",
+    };
+    static const float albedo[3][3] = {{0.65f, 0.05f, 0.05f}, {0.65f, 0.05f, 0.05f}, {0.12f, 0.45f, 0.15f}};
+    static const float normal_z[3] = {-1.0f, -1.0f, 1.0f}, depth[3] = {2.0f, 2.0f, 1.9f};
+    for (int k = 0; k < 3; k++) {
+        char text[1024], name[32], args[600], scene[256], out[256];
+        snprintf(text, sizeof text,
+                 "resolution 8 8\nsamples 2\nintegrator path\n"
+                 "camera position 0 0 2 look_at 0 0 0 up 0 1 0 fov 10\n"
+                 "material red color 0.65 0.05 0.05 bsdf lambert\n"
+                 "material green color 0.12 0.45 0.15 bsdf lambert\n"
+                 "light point 0 0 1 1 1 1 10\n%s",
+                 scenes[k]);
+        snprintf(name, sizeof name, "specular%d.txt", k);
+        snprintf(scene, sizeof scene, "%s", put(name, text, strlen(text)));
+        snprintf(name, sizeof name, "specular%d.pfm", k);
+        snprintf(out, sizeof out, "%s", tmp(name));
+        snprintf(args, sizeof args, "-q --aov albedo,normal,depth -o %s %s", out, scene);
+        assert_int_equal(run_rt(NULL, args, NULL), 0);
+        rt_framebuffer a, n, d;
+        rt_error err;
+        snprintf(name, sizeof name, "specular%d.albedo.pfm", k);
+        assert_int_equal(rt_image_read(tmp(name), &a, &err), RT_OK);
+        snprintf(name, sizeof name, "specular%d.normal.pfm", k);
+        assert_int_equal(rt_image_read(tmp(name), &n, &err), RT_OK);
+        snprintf(name, sizeof name, "specular%d.depth.pfm", k);
+        assert_int_equal(rt_image_read(tmp(name), &d, &err), RT_OK);
+        for (size_t i = 0; i < 64; i++) {
+            for (int c = 0; c < 3; c++)
+                assert_near(a.rgb[3 * i + (size_t)c], albedo[k][c], 1e-6);
+            assert_near(n.rgb[3 * i + 2], normal_z[k], 1e-5);
+            assert_near(d.rgb[3 * i], depth[k], 0.02); /* the first hit (a view 10 degrees wide: 1.0076x at the corners) */
+        }
+        rt_framebuffer_free(&a);
+        rt_framebuffer_free(&n);
+        rt_framebuffer_free(&d);
+    }
+}
+
 static void test_denoise_missing_library(void **state)
 {
     (void)state;
@@ -442,6 +660,80 @@ static void test_denoise_missing_library(void **state)
     assert_non_null(strchr(msg, '\n'));
     assert_null(strchr(msg, '\n') + 1 < msg + size ? strchr(strchr(msg, '\n') + 1, '\n') : NULL);
     free(msg);
+}
+
+/* Where the wheel is looked for, in order: build/oidn-venv near the binary
+ * and under the current directory, $VIRTUAL_ENV, then the Python user site:
+ * $PYTHONUSERBASE when set (where 'pip install --user' puts it then), else
+ * ~/.local. */
+static void test_denoise_search_order(void **state)
+{
+    (void)state;
+    const char *keep[3] = {getenv("VIRTUAL_ENV"), getenv("PYTHONUSERBASE"), getenv("HOME")};
+    char saved[3][1024];
+    for (int i = 0; i < 3; i++)
+        snprintf(saved[i], sizeof saved[i], "%s", keep[i] ? keep[i] : "");
+    setenv("VIRTUAL_ENV", "/venv", 1);
+    setenv("PYTHONUSERBASE", "/userbase", 1);
+    setenv("HOME", "/home/someone", 1);
+    char list[16384];
+    rt_denoise_wheel_patterns(list, sizeof list);
+    const char *wheel = "/lib/python3*/site-packages/pyoidn/oidn/lib/libOpenImageDenoise.so.2\n";
+    char venv[256], user[256];
+    snprintf(venv, sizeof venv, "/venv%s", wheel);
+    snprintf(user, sizeof user, "/userbase%s", wheel);
+    const char *cwd = strstr(list, "\nbuild/oidn-venv/lib/python3*/"), *v = strstr(list, venv), *u = strstr(list, user);
+    if (!cwd || !v || !u || !(cwd < v && v < u) || strstr(list, "/home/someone"))
+        fail_msg("search order:\n%s", list);
+    unsetenv("PYTHONUSERBASE");
+    rt_denoise_wheel_patterns(list, sizeof list);
+    if (!strstr(list, "/home/someone/.local/lib/python3*/site-packages/pyoidn/oidn/lib/libOpenImageDenoise.so.2\n"))
+        fail_msg("without PYTHONUSERBASE:\n%s", list);
+    static const char *const names[3] = {"VIRTUAL_ENV", "PYTHONUSERBASE", "HOME"};
+    for (int i = 0; i < 3; i++) {
+        if (keep[i])
+            setenv(names[i], saved[i], 1);
+        else
+            unsetenv(names[i]);
+    }
+}
+
+/* --denoise with --aov keeps the noisy image beside the denoised one: the
+ * same bytes as a render without --denoise, as NAME.noisy.pfm or as the
+ * EXR's noisy layer. */
+static void test_denoise_keeps_noisy(void **state)
+{
+    (void)state;
+    char where[4096];
+    rt_error err = {0};
+    if (rt_denoise_find(where, sizeof where, &err) != RT_OK) {
+        fprintf(stderr, "note: %s; skipping the denoiser runs\n", err.message);
+        skip();
+    }
+    const char *common = "-q -r 20x16 -s 2 --integrator path";
+    char args[512];
+    snprintf(args, sizeof args, "%s -o %s", common, tmp("raw.pfm"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
+    snprintf(args, sizeof args, "%s --denoise --aov albedo -o %s", common, tmp("den.pfm"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
+    assert_true(same_file(tmp("raw.pfm"), tmp("den.noisy.pfm")));
+    assert_false(same_file(tmp("raw.pfm"), tmp("den.pfm")));
+    assert_int_equal(access(tmp("den.albedo.pfm"), F_OK), 0);
+    snprintf(args, sizeof args, "%s --denoise --aov normal -o %s", common, tmp("den.exr"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
+    char *bytes;
+    size_t size;
+    assert_int_equal(rt_read_file(tmp("den.exr"), 0, &bytes, &size, &err), RT_OK);
+    static const char *const noisy[3] = {"noisy.R", "noisy.G", "noisy.B"};
+    float *px = NULL;
+    int w, h;
+    assert_int_equal(rt_exr_decode_channels(bytes, size, "den.exr", 64, 4096, noisy, 3, &px, &w, &h, &err), RT_OK);
+    rt_framebuffer raw;
+    assert_int_equal(rt_image_read(tmp("raw.pfm"), &raw, &err), RT_OK);
+    assert_memory_equal(px, raw.rgb, (size_t)20 * 16 * 3 * sizeof(float));
+    rt_framebuffer_free(&raw);
+    free(px);
+    free(bytes);
 }
 
 /* --denoise-quality and -t reach OIDN: its filter runs in the quality
@@ -499,9 +791,12 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_exr_float_round_trip), cmocka_unit_test(test_exr_half_round_trip),
         cmocka_unit_test(test_exr_layers),           cmocka_unit_test(test_exr_texture_and_limits),
+        cmocka_unit_test(test_radiance_checked),     cmocka_unit_test(test_pfm_checked),
         cmocka_unit_test(test_tonemap_curves),       cmocka_unit_test(test_convert),
         cmocka_unit_test(test_denoise_cornell),      cmocka_unit_test(test_denoise_missing_library),
-        cmocka_unit_test(test_aovs),                 cmocka_unit_test(test_denoise_quality_and_threads),
+        cmocka_unit_test(test_aovs),                 cmocka_unit_test(test_aovs_through_mirror_and_glass),
+        cmocka_unit_test(test_denoise_quality_and_threads), cmocka_unit_test(test_denoise_search_order),
+        cmocka_unit_test(test_denoise_keeps_noisy),
     };
     return cmocka_run_group_tests_name("hdr", tests, setup, teardown);
 }
