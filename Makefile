@@ -7,6 +7,7 @@
 #   make profile      ./rt-profile: optimised, with symbols and frame pointers (for perf)
 #   make scenes       render every scene in scenes/ into docs/images/
 #   make denoiser     Intel Open Image Denoise for --denoise: the pyoidn wheel in build/oidn-venv
+#   make reference    the path tracer against the shared Mitsuba reference, through rt compare (SPP=64)
 #   make bench-packets rt's packets and Embree's on the same pixel tiles (also run by bench-compare)
 #   make bench-render rt's path tracer against Mitsuba 3 (sets it up in build/mitsuba-venv)
 #   make bench-denoise --denoise at 4/16/64 spp against raw 256 and 1024 spp
@@ -63,7 +64,7 @@ DEPS_OK  := $(BUILD)/.deps-ok
 
 
 .PHONY: test-slurm test-kubernetes test-parallel test-launchers
-.PHONY: all test asan tsan profile scenes clean deps bench bench-compare bench-packets bench-build bench-render bench-helmet bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
+.PHONY: all test asan tsan profile scenes clean deps reference bench bench-compare bench-packets bench-build bench-render bench-helmet bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -186,6 +187,11 @@ bench-render: $(RT)
 # a sun (bench/helmet.sh; RUNS, THREADS, RES, SPP); RT_BINS="./rt other/rt" runs builds interleaved.
 bench-helmet: $(RT)
 	@SHARED=$(SHARED) sh bench/helmet.sh $(RT_BINS)
+
+# The path tracer against the shared Mitsuba reference through rt compare (docs/path-tracer.md, section 6):
+# SPP (default 64) samples at 512x512; fails when the RMSE is over what noise explains.
+reference: $(RT)
+	@SHARED=$(SHARED) RT=./$(RT) sh tools/reference.sh
 
 # --denoise on the shared Cornell box: 4/16/64 spp denoised against raw 256 and 1024 spp (docs/hdr.md).
 bench-denoise: $(RT) denoiser
