@@ -534,6 +534,52 @@ static bool same_file(const char *a, const char *b)
     return same;
 }
 
+/* The float outputs hold the radiance as rendered whatever the exposure
+ * (--exposure in stops and the scene's exposure factor), all three alike:
+ * PFM byte for byte, EXR value for value, Radiance HDR to its 8-bit
+ * mantissas; only the 8-bit PNG is scaled. */
+static void test_float_outputs_ignore_exposure(void **state)
+{
+    (void)state;
+    const char *common = "-q -r 24x16 -s 2 --integrator path";
+    char args[512];
+    snprintf(args, sizeof args, "%s -o %s", common, tmp("lin.pfm"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
+    static const char *const ext[4] = {"pfm", "exr", "hdr", "png"};
+    for (int k = 0; k < 4; k++) {
+        snprintf(args, sizeof args, "%s --exposure 2 --set exposure=1.5 -o %s/exp.%s", common, dir, ext[k]);
+        assert_int_equal(run_rt(NULL, args, NULL), 0);
+    }
+    snprintf(args, sizeof args, "%s -o %s", common, tmp("lin.png"));
+    assert_int_equal(run_rt(NULL, args, NULL), 0);
+    assert_true(same_file(tmp("lin.pfm"), tmp("exp.pfm")));
+    rt_framebuffer lin, e;
+    rt_error err;
+    assert_int_equal(rt_image_read(tmp("lin.pfm"), &lin, &err), RT_OK);
+    assert_int_equal(rt_image_read(tmp("exp.exr"), &e, &err), RT_OK);
+    assert_memory_equal(lin.rgb, e.rgb, (size_t)24 * 16 * 3 * sizeof(float));
+    rt_framebuffer_free(&e);
+    assert_int_equal(rt_image_read(tmp("exp.hdr"), &e, &err), RT_OK);
+    for (size_t i = 0; i < (size_t)24 * 16 * 3; i++) {
+        const float *px = lin.rgb + (i - i % 3);
+        assert_near(e.rgb[i], lin.rgb[i], fmax(fmax(px[0], px[1]), px[2]) / 128.0 + 1e-30);
+    }
+    rt_framebuffer_free(&e);
+    /* the PNG is 6x brighter (1.5 x 2^2) before the curve: brighter on average */
+    rt_framebuffer p1, p6;
+    assert_int_equal(rt_image_read(tmp("lin.png"), &p1, &err), RT_OK);
+    assert_int_equal(rt_image_read(tmp("exp.png"), &p6, &err), RT_OK);
+    double s1 = 0.0, s6 = 0.0;
+    for (size_t i = 0; i < (size_t)24 * 16 * 3; i++) {
+        s1 += p1.rgb[i];
+        s6 += p6.rgb[i];
+    }
+    assert_true(s6 > 2.0 * s1);
+    rt_framebuffer_free(&p1);
+    rt_framebuffer_free(&p6);
+    rt_framebuffer_free(&lin);
+}
+
 /* AOVs: the beauty image is the same with them as without; every AOV is
  * bit-identical for 1 and 3 threads and other tile sizes; the values are
  * the scene's (the Cornell box's white floor: albedo 0.73 + 0.04, normal +y). */
@@ -792,6 +838,7 @@ int main(void)
         cmocka_unit_test(test_exr_float_round_trip), cmocka_unit_test(test_exr_half_round_trip),
         cmocka_unit_test(test_exr_layers),           cmocka_unit_test(test_exr_texture_and_limits),
         cmocka_unit_test(test_radiance_checked),     cmocka_unit_test(test_pfm_checked),
+        cmocka_unit_test(test_float_outputs_ignore_exposure),
         cmocka_unit_test(test_tonemap_curves),       cmocka_unit_test(test_convert),
         cmocka_unit_test(test_denoise_cornell),      cmocka_unit_test(test_denoise_missing_library),
         cmocka_unit_test(test_aovs),                 cmocka_unit_test(test_aovs_through_mirror_and_glass),
