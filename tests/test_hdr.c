@@ -553,6 +553,17 @@ static void test_float_outputs_ignore_exposure(void **state)
     snprintf(args, sizeof args, "%s -o %s", common, tmp("lin.png"));
     assert_int_equal(run_rt(NULL, args, NULL), 0);
     assert_true(same_file(tmp("lin.pfm"), tmp("exp.pfm")));
+    /* said, not silently ignored (rt convert and rt merge refuse them) */
+    snprintf(args, sizeof args, "-r 8x8 -s 1 --tonemap agx --half -o %s", tmp("said.pfm"));
+    assert_int_equal(run_rt(NULL, args, tmp("said.txt")), 0);
+    char *said;
+    size_t said_size;
+    rt_error said_err;
+    assert_int_equal(rt_read_file(tmp("said.txt"), 0, &said, &said_size, &said_err), RT_OK);
+    if (!strstr(said, "said.pfm holds the linear radiance: --exposure and --tonemap shape 8-bit output") ||
+        !strstr(said, "said.pfm: --half is for .exr output; ignored"))
+        fail_msg("rt said: %s", said);
+    free(said);
     rt_framebuffer lin, e;
     rt_error err;
     assert_int_equal(rt_image_read(tmp("lin.pfm"), &lin, &err), RT_OK);

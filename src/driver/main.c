@@ -193,6 +193,14 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
     if ((r = rt_output_check(output, err)) != RT_OK ||
         (r = rt_output_check_size(output, set->width, set->height, err)) != RT_OK)
         return r;
+    /* rt convert and rt merge refuse these; a render keeps them for the window */
+    rt_image_format fmt = RT_FORMAT_PNG;
+    rt_output_format(output, &fmt, NULL);
+    if (fmt != RT_FORMAT_PNG && (a->exposure_ev != 0.0f || a->tonemap != RT_TONEMAP_CLAMP))
+        rt_warn("%s holds the linear radiance: --exposure and --tonemap shape 8-bit output (.png)%s", output,
+                a->window ? " and the window" : " only");
+    if (fmt != RT_FORMAT_EXR && a->half)
+        rt_warn("%s: --half is for .exr output; ignored", output);
     if (!a->input && a->log_level >= RT_LOG_NORMAL)
         fprintf(stderr, "rt: no input given; rendering the built-in Cornell box to %s (rt --help for usage)\n",
                 output);
