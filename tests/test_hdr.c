@@ -285,6 +285,24 @@ static void test_radiance_checked(void **state)
     alarm(0);
 }
 
+/* Binary PNM: stb_image does not check that the pixels are there, so a
+ * 12-byte header declaring 664x55372 read as 147 MB of uninitialised
+ * pixels (found by the image_file fuzz target); a whole file still reads. */
+static void test_pnm_checked(void **state)
+{
+    (void)state;
+    expect_refused("lying.pgm", "P5 664 55372 ", 13, "PNM data ends at byte 13, but its 664x55372 header needs 36767008");
+    expect_refused("short16.pgm", "P5 2 1 65535 \1\2\3", 16, "needs 4 bytes of pixels from byte 13");
+    static const char ppm[] = "P6\n# a comment\n2 1\n255\n\xff\x00\x00\x00\x00\xff";
+    rt_framebuffer fb;
+    rt_error err = {0};
+    assert_int_equal(rt_image_read(put("ok.ppm", ppm, sizeof ppm - 1), &fb, &err), RT_OK);
+    assert_int_equal(fb.width, 2);
+    assert_near(fb.rgb[0], 1.0, 0);
+    assert_near(fb.rgb[5], 1.0, 0);
+    rt_framebuffer_free(&fb);
+}
+
 /* PFM: the header is parsed by hand and checked against the file's size
  * before any pixel memory (a 65536x65536 header on a small file is one
  * error, not 48 GiB); every message names the file and a byte; grey ("Pf")
@@ -849,6 +867,7 @@ int main(void)
         cmocka_unit_test(test_exr_float_round_trip), cmocka_unit_test(test_exr_half_round_trip),
         cmocka_unit_test(test_exr_layers),           cmocka_unit_test(test_exr_texture_and_limits),
         cmocka_unit_test(test_radiance_checked),     cmocka_unit_test(test_pfm_checked),
+        cmocka_unit_test(test_pnm_checked),
         cmocka_unit_test(test_float_outputs_ignore_exposure),
         cmocka_unit_test(test_tonemap_curves),       cmocka_unit_test(test_convert),
         cmocka_unit_test(test_denoise_cornell),      cmocka_unit_test(test_denoise_missing_library),

@@ -3,7 +3,8 @@
  * WebP (webp.c), then stb_image (PNG, JPEG, Radiance HDR, BMP, TGA, ...)
  * behind size checks made on the header before any pixel allocation
  * (stbi_info, and PNG's IHDR read directly) and, for Radiance HDR, a walk
- * over its scanlines (radiance.c) that stb's reader would otherwise trust.
+ * over its scanlines (radiance.c) that stb's reader would otherwise trust;
+ * binary PNM must hold the pixels its header declares.
  *
  * Sources: the PNG specification (ISO/IEC 15948, sections 5, 7 and 8:
  * chunks, scanline filter bytes, Adam7 interlacing) for the declared size
@@ -130,6 +131,52 @@ static rt_result png_precheck(const unsigned char *p, size_t size, const char *n
     return RT_OK;
 }
 
+/* Binary PNM (P5 grey, P6 RGB): stb_image 2.27 reads the pixels without
+ * checking they are there (stbi__pnm_load ignores stbi__getn's result), so
+ * a 12-byte file declaring 664x55372 became 147 MB of uninitialised
+ * pixels, seconds of work for a fuzzer. The header is read as stb reads
+ * it (white space and # comments between the width, the height and the
+ * largest value, then one byte) to find where the pixels start, and the
+ * bytes they need (two a sample past a largest value of 255) must be
+ * there. */
+static int pnm_next(const unsigned char *p, size_t size, size_t *at)
+{
+    return *at < size ? p[(*at)++] : 0; /* stb's get8: 0 at the end, which stays there */
+}
+
+static bool pnm_space(int c) { return c == ' ' || c == '\t' || c == '\n' || c == '\v' || c == '\f' || c == '\r'; }
+
+static rt_result pnm_precheck(const unsigned char *p, size_t size, const char *name, rt_error *err)
+{
+    if (size < 2 || p[0] != 'P' || (p[1] != '5' && p[1] != '6'))
+        return RT_OK;
+    size_t at = 2;
+    int c = pnm_next(p, size, &at);
+    uint64_t v[3] = {0, 0, 0}; /* width, height, largest value */
+    for (int k = 0; k < 3; k++) {
+        for (;;) {
+            while (at < size && pnm_space(c))
+                c = pnm_next(p, size, &at);
+            if (c != '#')
+                break;
+            while (at < size && c != '\n' && c != '\r')
+                c = pnm_next(p, size, &at);
+        }
+        while (c >= '0' && c <= '9') {
+            if (v[k] < ((uint64_t)1 << 32))
+                v[k] = v[k] * 10 + (uint64_t)(c - '0');
+            c = pnm_next(p, size, &at);
+        }
+    }
+    const uint64_t need = v[0] * v[1] * (p[1] == '6' ? 3u : 1u) * (v[2] > 255 ? 2u : 1u);
+    if ((uint64_t)(size - at) < need)
+        return rt_fail(err, RT_ERR_INVALID,
+                       "%s: PNM data ends at byte %zu, but its %llux%llu header needs %llu bytes of pixels from byte "
+                       "%zu",
+                       name, size, (unsigned long long)v[0], (unsigned long long)v[1], (unsigned long long)need, at);
+    return RT_OK;
+}
+
 /* stb reports a failed allocation as "outofmem": that is RT_ERR_NOMEM (the
  * driver then names the memory budget), anything else is a bad image. */
 static rt_result decode_failed(const char *name, rt_error *err)
@@ -182,6 +229,8 @@ rt_result rt_image_decode(const void *data, size_t size, const char *name, const
                        name, w, h, (unsigned long long)lim->max_float_pixels);
     /* stb's HDR reader loops for ever on a run of 0 (a cut file reads as one) */
     if (hdr && rt_radiance_check(bytes, size, name, err) != RT_OK)
+        return RT_ERR_INVALID;
+    if (pnm_precheck(bytes, size, name, err) != RT_OK)
         return RT_ERR_INVALID;
     rt_result pr = png_precheck(bytes, size, name, lim->max_side, err);
     if (pr != RT_OK)
