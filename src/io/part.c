@@ -463,7 +463,7 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
     size_t n = (size_t)rw * (size_t)rh;
     float *px = NULL, *cpx = NULL, *bpx[RT_PART_MAX_BLOCKS] = {NULL};
     /* EXR channels: R, G, B, count.Y, then each block's, then each layer's */
-    static char names_buf[4 + 3 * (RT_PART_MAX_BLOCKS + RT_PART_MAX_LAYERS)][40];
+    char names_buf[4 + 3 * (RT_PART_MAX_BLOCKS + RT_PART_MAX_LAYERS)][40];
     const char *names[4 + 3 * (RT_PART_MAX_BLOCKS + RT_PART_MAX_LAYERS)] = {"R", "G", "B", "count.Y"};
     int nc = 4;
     for (int k = 0; k < nb; k++)
@@ -487,8 +487,10 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
         char bpath[4200];
         int cw = 0, ch = 0;
         const char *file = k < 0 ? cpath : bpath;
-        if (k >= 0 && !block_path(image, info->block_first + k, bpath, sizeof bpath))
-            return rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
+        if (k >= 0 && !block_path(image, info->block_first + k, bpath, sizeof bpath)) {
+            r = rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
+            break;
+        }
         r = read_image(file, k < 0 ? count_hash : block_hash[k], false, NULL, 0, k < 0 ? &cpx : &bpx[k], &cw, &ch,
                        err);
         if (r == RT_OK && (cw != rw || ch != rh))
