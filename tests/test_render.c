@@ -226,6 +226,17 @@ static rt_result render_with(rt_scene *s, const rt_render_options *opt, rt_frame
     return r;
 }
 
+/* The reference the pass tests compare with: the scene tiled, one thread,
+ * 32-pixel tiles (opt is left holding those options). */
+static void render_tiled_reference(rt_scene *s, rt_render_options *opt, rt_framebuffer *ref, rt_render_stats *st)
+{
+    memset(opt, 0, sizeof *opt);
+    opt->threads = 1;
+    opt->tile_size = 32;
+    opt->pass_samples = -1;
+    assert_int_equal(render_with(s, opt, ref, st), RT_OK);
+}
+
 /* Passes of any size give the bytes of the tiled render, for 1, 2 and 3
  * threads and several tile sizes, with every integrator; the path
  * tracer's default is passes. 13 samples: passes of 1, 2, 4, 5 and 13 split
@@ -242,13 +253,9 @@ static void test_passes_same_bytes_as_tiles(void **state)
     for (size_t k = 0; k < sizeof integrators / sizeof *integrators; k++) {
         s.settings.integrator = integrators[k];
         rt_render_options opt;
-        memset(&opt, 0, sizeof opt);
-        opt.threads = 1;
-        opt.tile_size = 32;
-        opt.pass_samples = -1;
         rt_framebuffer ref;
         rt_render_stats st;
-        assert_int_equal(render_with(&s, &opt, &ref, &st), RT_OK);
+        render_tiled_reference(&s, &opt, &ref, &st);
         assert_false(st.passes);
         assert_int_equal(st.samples_done, 13);
         size_t n = (size_t)ref.width * ref.height * 3 * sizeof(float);
@@ -292,13 +299,9 @@ static void test_passes_same_bytes_above_a_block(void **state)
     for (size_t k = 0; k < sizeof integrators / sizeof *integrators; k++) {
         s.settings.integrator = integrators[k];
         rt_render_options opt;
-        memset(&opt, 0, sizeof opt);
-        opt.threads = 1;
-        opt.tile_size = 32;
-        opt.pass_samples = -1;
         rt_framebuffer ref;
         rt_render_stats st;
-        assert_int_equal(render_with(&s, &opt, &ref, &st), RT_OK);
+        render_tiled_reference(&s, &opt, &ref, &st);
         size_t n = (size_t)ref.width * ref.height * 3 * sizeof(float);
         for (size_t p = 0; p < sizeof pass_sizes / sizeof *pass_sizes; p++) {
             opt.threads = 1 + (int)(p % 2);
