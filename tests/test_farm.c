@@ -839,6 +839,11 @@ static void test_aligned_ranges_same_bytes(void **state)
     RUN_OK("-q", "-r", "16x12", "-s", "192", "--spp-range", "100:192", "-o", in_dir("u1.exr"), scene);
     MERGE(in_dir("mu.pfm"), in_dir("u0.exr"), in_dir("u1.exr"));
     assert_within_summation_bound(in_dir("mu.pfm"), in_dir("s192.pfm"), 192);
+    /* a PFM part's block file damaged: refused, naming it, nothing written */
+    copy(in_dir("a1.block.2.pfm"), in_dir("a1.block.2.pfm"), 100);
+    assert_int_equal(RUN("merge", in_dir("a0.exr"), in_dir("a1.pfm"), "-o", in_dir("bad.pfm")), 2);
+    assert_non_null(strstr(err_text, "a1.block.2.pfm: the image's bytes do not match"));
+    assert_int_equal(access(in_dir("bad.pfm"), F_OK), -1);
 }
 
 /* --resume stopped inside a block (70 of 200 samples) is exact; so is a
@@ -864,6 +869,15 @@ static void test_resume_inside_a_block(void **state)
     RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "0:64", "-o", in_dir("k0.exr"), scene);
     MERGE(in_dir("mk.pfm"), in_dir("k0.exr"), in_dir("k2.exr"));
     assert_same_bytes(in_dir("mk.pfm"), in_dir("s200.pfm"));
+    /* ... also when a time limit stopped it, wherever */
+    RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "64:200", "--passes", "1", "--time-limit", "0.001", "-o",
+           in_dir("kt.exr"), scene);
+    int k = sidecar_end(in_dir("kt.exr.json"));
+    assert_true(k > 64 && k <= 200);
+    if (k < 200)
+        RUN_OK("-q", "-r", "16x12", "-s", "200", "--resume", in_dir("kt.exr"), "-o", in_dir("kt.exr"), scene);
+    MERGE(in_dir("mkt.pfm"), in_dir("kt.exr"), in_dir("k0.exr"));
+    assert_same_bytes(in_dir("mkt.pfm"), in_dir("s200.pfm"));
 }
 
 /* A range from a block edge longer than the 64 blocks a part keeps apart
