@@ -509,6 +509,9 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     if (fb->width != reg.x1 - reg.x0 || fb->height != reg.y1 - reg.y0 || !fb->rgb)
         return rt_fail(err, RT_ERR_INVALID, "framebuffer is %dx%d but the region rendered is %dx%d", fb->width,
                        fb->height, reg.x1 - reg.x0, reg.y1 - reg.y0);
+    if (opt.accum && (!opt.accum->sum || !opt.accum->block || !opt.accum->good ||
+                      (opt.accum->kept && (opt.accum->kept_first < 0 || opt.accum->kept_count < 0))))
+        return rt_fail(err, RT_ERR_INVALID, "the caller's sums (opt.accum) need sum, block and good arrays");
     const rt_integrator_info *integrator = rt_integrator_info_of(set->integrator);
     if (!integrator)
         return rt_fail(err, RT_ERR_INVALID, "integrator %d is not one of the %zu rt knows", (int)set->integrator,
