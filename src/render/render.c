@@ -9,7 +9,7 @@
  * rest. settings.clamp, when set, caps a sample's luminance.
  *
  * A pixel's sum is kept in blocks of RT_SAMPLE_BLOCK (64) samples by sample
- * index (rt/render/render.h): the float sum of the current block's good
+ * index (rt/render/sample_block.h): the float sum of the current block's good
  * samples in sample order, and the fold of the blocks before it, which
  * takes the block in when a sample index crosses a block edge; the pixel is
  * (fold + block) * (1 / good). Up to 64 samples that is 0 + b_0: the plain
