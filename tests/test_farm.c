@@ -1,6 +1,7 @@
 /* test_farm.c - parts of a render and `rt merge` as a user runs them
  * (docs/farm.md): region parts (--part I/N, --crop) merge into exactly the
- * bytes of a single render, PNG and float; sample ranges merge within the
+ * bytes of a single render, PNG and float; sample ranges that start on
+ * block edges (multiples of 64) too; other sample ranges merge within the
  * float summation bound docs/farm.md states; --resume continues a part
  * (also one a --time-limit stopped) to exactly the single render's bytes;
  * merge refuses parts that do not make one image, naming the part, with
@@ -743,6 +744,186 @@ static void test_part_bands(void **state)
     }
 }
 
+
+/* The sidecar's "blocks": [first, count]. */
+static void sidecar_blocks(const char *json, int *first, int *count)
+{
+    size_t n;
+    char *t = slurp(json, &n);
+    const char *s = strstr(t, "\"blocks\": [");
+    assert_non_null(s);
+    assert_int_equal(sscanf(s, "\"blocks\": [%d, %d]", first, count), 2);
+    free(t);
+}
+
+/* Merges the NULL-terminated parts into out; asserts it worked. */
+static void merge_to(const char *out, const char *const *parts)
+{
+    const char *args[32] = {"merge"};
+    int na = 1;
+    for (int i = 0; parts[i]; i++)
+        args[na++] = parts[i];
+    args[na++] = "-o";
+    args[na++] = out;
+    args[na] = NULL;
+    if (run(args) != 0)
+        fail_msg("merge failed: %s", err_text);
+}
+
+#define MERGE(out, ...) merge_to(out, (const char *const[]){__VA_ARGS__, NULL})
+
+/* Sample ranges whose edges are multiples of 64 (the sample blocks of
+ * rt/render/sample_block.h) merge into exactly the single render's bytes:
+ * 2 and 3 ranges, EXR and PFM parts, tiles and passes, 1 and 2 threads,
+ * alone and with region parts; the integrator one path at a time (direct)
+ * and as a wavefront (path). Before sums were kept in blocks these
+ * differed in the last bits (a float sum cannot be regrouped). */
+static void test_aligned_ranges_same_bytes(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    /* 192 spp: 0:64 + 64:192 */
+    RUN_OK("-q", "-r", "16x12", "-s", "192", "-o", in_dir("s192.pfm"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "192", "-o", in_dir("s192.png"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "192", "-t", "2", "--spp-range", "0:64", "-o", in_dir("a0.exr"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "192", "-t", "1", "--passes", "0", "--spp-range", "64:192", "-o",
+           in_dir("a1.pfm"), scene);
+    int first = -1, count = -1;
+    sidecar_blocks(in_dir("a1.pfm.json"), &first, &count);
+    assert_int_equal(first, 1); /* blocks 1 and 2 kept apart */
+    assert_int_equal(count, 2);
+    assert_int_equal(access(in_dir("a1.block.2.pfm"), F_OK), 0);
+    MERGE(in_dir("m2.pfm"), in_dir("a1.pfm"), in_dir("a0.exr"));
+    assert_same_bytes(in_dir("m2.pfm"), in_dir("s192.pfm"));
+    MERGE(in_dir("m2.png"), in_dir("a0.exr"), in_dir("a1.pfm"));
+    assert_same_bytes(in_dir("m2.png"), in_dir("s192.png"));
+    /* 320 spp: 0:128 + 128:192 + 192:320 */
+    RUN_OK("-q", "-r", "16x12", "-s", "320", "-o", in_dir("s320.pfm"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "320", "-o", in_dir("s320.png"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "320", "-t", "1", "--passes", "0", "--tile", "5", "--spp-range", "0:128", "-o",
+           in_dir("b0.exr"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "320", "-t", "2", "--passes", "7", "--spp-range", "128:192", "-o",
+           in_dir("b1.pfm"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "320", "-t", "2", "--spp-range", "192:320", "-o", in_dir("b2.exr"), scene);
+    MERGE(in_dir("m3.pfm"), in_dir("b2.exr"), in_dir("b0.exr"), in_dir("b1.pfm"));
+    assert_same_bytes(in_dir("m3.pfm"), in_dir("s320.pfm"));
+    MERGE(in_dir("m3.png"), in_dir("b0.exr"), in_dir("b1.pfm"), in_dir("b2.exr"));
+    assert_same_bytes(in_dir("m3.png"), in_dir("s320.png"));
+    /* regions and ranges together: part 0 whole, part 1 in 2 ranges, part 2 in 3 */
+    RUN_OK("-q", "-r", "16x12", "-s", "192", "--part", "0/3", "-o", in_dir("q0.exr"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "192", "--part", "1/3", "--spp-range", "0:64", "-o", in_dir("q1a.pfm"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "192", "--part", "1/3", "--spp-range", "64:192", "--passes", "0", "-o",
+           in_dir("q1b.exr"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "192", "--part", "2/3", "--spp-range", "0:128", "-t", "1", "-o",
+           in_dir("q2a.exr"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "192", "--part", "2/3", "--spp-range", "128:192", "-o", in_dir("q2b.exr"),
+           scene);
+    MERGE(in_dir("mq.pfm"), in_dir("q2b.exr"), in_dir("q1b.exr"), in_dir("q0.exr"), in_dir("q1a.pfm"),
+          in_dir("q2a.exr"));
+    assert_same_bytes(in_dir("mq.pfm"), in_dir("s192.pfm"));
+    MERGE(in_dir("mq.png"), in_dir("q0.exr"), in_dir("q1a.pfm"), in_dir("q1b.exr"), in_dir("q2a.exr"),
+          in_dir("q2b.exr"));
+    assert_same_bytes(in_dir("mq.png"), in_dir("s192.png"));
+    /* one path at a time (direct: tiles) */
+    RUN_OK("-q", "-r", "16x12", "-s", "130", "--integrator", "direct", "-o", in_dir("d.pfm"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "130", "--integrator", "direct", "--spp-range", "0:64", "-t", "1", "-o",
+           in_dir("d0.exr"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "130", "--integrator", "direct", "--spp-range", "64:128", "--passes", "3", "-o",
+           in_dir("d1.exr"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "130", "--integrator", "direct", "--spp-range", "128:130", "-o",
+           in_dir("d2.pfm"), scene);
+    MERGE(in_dir("md.pfm"), in_dir("d0.exr"), in_dir("d1.exr"), in_dir("d2.pfm"));
+    assert_same_bytes(in_dir("md.pfm"), in_dir("d.pfm"));
+    /* a range off the block edges still merges, within the bound */
+    RUN_OK("-q", "-r", "16x12", "-s", "192", "--spp-range", "0:100", "-o", in_dir("u0.exr"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "192", "--spp-range", "100:192", "-o", in_dir("u1.exr"), scene);
+    MERGE(in_dir("mu.pfm"), in_dir("u0.exr"), in_dir("u1.exr"));
+    assert_within_summation_bound(in_dir("mu.pfm"), in_dir("s192.pfm"), 192);
+    /* a PFM part's block file damaged: refused, naming it, nothing written */
+    copy(in_dir("a1.block.2.pfm"), in_dir("a1.block.2.pfm"), 100);
+    assert_int_equal(RUN("merge", in_dir("a0.exr"), in_dir("a1.pfm"), "-o", in_dir("bad.pfm")), 2);
+    assert_non_null(strstr(err_text, "a1.block.2.pfm: the image's bytes do not match"));
+    assert_int_equal(access(in_dir("bad.pfm"), F_OK), -1);
+}
+
+/* --resume stopped inside a block (70 of 200 samples) is exact; so is a
+ * part from a block edge resumed and merged after the range before it. */
+static void test_resume_inside_a_block(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    RUN_OK("-q", "-r", "16x12", "-s", "200", "-o", in_dir("s200.pfm"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "0:70", "-o", in_dir("r70.exr"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "200", "--resume", in_dir("r70.exr"), "-o", in_dir("r.pfm"), scene);
+    assert_same_bytes(in_dir("r.pfm"), in_dir("s200.pfm"));
+    RUN_OK("-q", "-r", "16x12", "-s", "200", "--resume", in_dir("r70.exr"), "--passes", "0", "-o", in_dir("rt.pfm"),
+           scene);
+    assert_same_bytes(in_dir("rt.pfm"), in_dir("s200.pfm"));
+    /* samples 64:100, resumed to 64:200, after 0:64 */
+    RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "64:100", "-o", in_dir("k.pfm"), scene);
+    RUN_OK("-q", "-r", "16x12", "-s", "200", "--resume", in_dir("k.pfm"), "-o", in_dir("k2.exr"), scene);
+    int first = -1, count = -1;
+    sidecar_blocks(in_dir("k2.exr.json"), &first, &count);
+    assert_int_equal(first, 1);
+    assert_int_equal(count, 3);
+    RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "0:64", "-o", in_dir("k0.exr"), scene);
+    MERGE(in_dir("mk.pfm"), in_dir("k0.exr"), in_dir("k2.exr"));
+    assert_same_bytes(in_dir("mk.pfm"), in_dir("s200.pfm"));
+    /* ... also when a time limit stopped it, wherever */
+    RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "64:200", "--passes", "1", "--time-limit", "0.001", "-o",
+           in_dir("kt.exr"), scene);
+    int k = sidecar_end(in_dir("kt.exr.json"));
+    assert_true(k > 64 && k <= 200);
+    if (k < 200)
+        RUN_OK("-q", "-r", "16x12", "-s", "200", "--resume", in_dir("kt.exr"), "-o", in_dir("kt.exr"), scene);
+    MERGE(in_dir("mkt.pfm"), in_dir("kt.exr"), in_dir("k0.exr"));
+    assert_same_bytes(in_dir("mkt.pfm"), in_dir("s200.pfm"));
+}
+
+/* A range from a block edge longer than the 64 blocks a part keeps apart
+ * says so and merges within the bound. */
+static void test_too_many_blocks(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    RUN_OK("-q", "-r", "3x2", "-s", "4224", "-o", in_dir("big.pfm"), scene); /* 66 blocks */
+    RUN_OK("-q", "-r", "3x2", "-s", "4224", "--spp-range", "0:64", "-o", in_dir("big0.exr"), scene);
+    assert_int_equal(RUN("-r", "3x2", "-s", "4224", "--spp-range", "64:4224", "-o", in_dir("big1.exr"), scene), 0);
+    assert_non_null(strstr(err_text, "keeps at most 64 apart"));
+    int first = -1, count = -1;
+    sidecar_blocks(in_dir("big1.exr.json"), &first, &count);
+    assert_int_equal(first, 65); /* only the last block apart, after the part's own fold */
+    assert_int_equal(count, 1);
+    MERGE(in_dir("bigm.pfm"), in_dir("big0.exr"), in_dir("big1.exr"));
+    assert_within_summation_bound(in_dir("bigm.pfm"), in_dir("big.pfm"), 4224);
+}
+
+/* A part written by an rt before sample blocks (format 1) is refused by
+ * merge and --resume, naming the file and the format. */
+static void test_old_format_refused(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    RUN_OK("-q", "--spp-range", "0:8", "-o", in_dir("old.exr"), scene);
+    size_t n;
+    char *t = slurp(in_dir("old.exr.json"), &n);
+    char *s = strstr(t, "\"rt_part\": 2");
+    assert_non_null(s);
+    s[11] = '1';
+    test_write_file(in_dir("old.exr.json"), t, n);
+    free(t);
+    test_write_file(in_dir("keep.png"), precious, sizeof precious - 1);
+    assert_int_equal(RUN("merge", in_dir("old.exr"), "-o", in_dir("keep.png")), 2);
+    assert_non_null(strstr(err_text, "old.exr.json: part format 1, this rt reads format 2"));
+    assert_int_equal(RUN("-q", "--resume", in_dir("old.exr"), "-o", in_dir("keep.png"), scene), 2);
+    assert_non_null(strstr(err_text, "old.exr.json: part format 1"));
+    size_t m;
+    char *k = slurp(in_dir("keep.png"), &m);
+    assert_int_equal(m, sizeof precious - 1);
+    assert_memory_equal(k, precious, m);
+    free(k);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -757,6 +938,10 @@ int main(void)
         cmocka_unit_test(test_frames),
         cmocka_unit_test(test_motion_blur),
         cmocka_unit_test(test_part_bands),
+        cmocka_unit_test(test_aligned_ranges_same_bytes),
+        cmocka_unit_test(test_resume_inside_a_block),
+        cmocka_unit_test(test_too_many_blocks),
+        cmocka_unit_test(test_old_format_refused),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

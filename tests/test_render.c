@@ -226,6 +226,17 @@ static rt_result render_with(rt_scene *s, const rt_render_options *opt, rt_frame
     return r;
 }
 
+/* The reference the pass tests compare with: the scene tiled, one thread,
+ * 32-pixel tiles (opt is left holding those options). */
+static void render_tiled_reference(rt_scene *s, rt_render_options *opt, rt_framebuffer *ref, rt_render_stats *st)
+{
+    memset(opt, 0, sizeof *opt);
+    opt->threads = 1;
+    opt->tile_size = 32;
+    opt->pass_samples = -1;
+    assert_int_equal(render_with(s, opt, ref, st), RT_OK);
+}
+
 /* Passes of any size give the bytes of the tiled render, for 1, 2 and 3
  * threads and several tile sizes, with every integrator; the path
  * tracer's default is passes. 13 samples: passes of 1, 2, 4, 5 and 13 split
@@ -242,13 +253,9 @@ static void test_passes_same_bytes_as_tiles(void **state)
     for (size_t k = 0; k < sizeof integrators / sizeof *integrators; k++) {
         s.settings.integrator = integrators[k];
         rt_render_options opt;
-        memset(&opt, 0, sizeof opt);
-        opt.threads = 1;
-        opt.tile_size = 32;
-        opt.pass_samples = -1;
         rt_framebuffer ref;
         rt_render_stats st;
-        assert_int_equal(render_with(&s, &opt, &ref, &st), RT_OK);
+        render_tiled_reference(&s, &opt, &ref, &st);
         assert_false(st.passes);
         assert_int_equal(st.samples_done, 13);
         size_t n = (size_t)ref.width * ref.height * 3 * sizeof(float);
@@ -272,6 +279,41 @@ static void test_passes_same_bytes_as_tiles(void **state)
                 assert_memory_equal(ref.rgb, fb.rgb, n);
                 rt_framebuffer_free(&fb);
             }
+        rt_framebuffer_free(&ref);
+    }
+    rt_scene_free(&s);
+}
+
+/* Above 64 samples a pixel's sum folds its blocks of 64 (render.h): passes
+ * of sizes that cross block edges anywhere, threads and tiles still give
+ * the tiled render's bytes, for the wavefront (path), one path at a time
+ * (path_scalar) and the tiled direct integrator. */
+static void test_passes_same_bytes_above_a_block(void **state)
+{
+    (void)state;
+    rt_scene s;
+    build_busy_scene(&s);
+    s.settings.samples = 130;
+    const rt_integrator integrators[] = {RT_INTEGRATOR_PATH, RT_INTEGRATOR_PATH_SCALAR, RT_INTEGRATOR_DIRECT};
+    const int pass_sizes[] = {1, 7, 64, 100, 130};
+    for (size_t k = 0; k < sizeof integrators / sizeof *integrators; k++) {
+        s.settings.integrator = integrators[k];
+        rt_render_options opt;
+        rt_framebuffer ref;
+        rt_render_stats st;
+        render_tiled_reference(&s, &opt, &ref, &st);
+        size_t n = (size_t)ref.width * ref.height * 3 * sizeof(float);
+        for (size_t p = 0; p < sizeof pass_sizes / sizeof *pass_sizes; p++) {
+            opt.threads = 1 + (int)(p % 2);
+            opt.tile_size = p % 2 ? 5 : 16;
+            opt.pass_samples = pass_sizes[p];
+            rt_framebuffer fb;
+            assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
+            assert_true(st.passes);
+            assert_int_equal(st.samples_done, 130);
+            assert_memory_equal(ref.rgb, fb.rgb, n);
+            rt_framebuffer_free(&fb);
+        }
         rt_framebuffer_free(&ref);
     }
     rt_scene_free(&s);
@@ -433,6 +475,7 @@ int main(void)
         cmocka_unit_test(test_same_image_any_thread_count),
         cmocka_unit_test(test_progress_reports),
         cmocka_unit_test(test_passes_same_bytes_as_tiles),
+        cmocka_unit_test(test_passes_same_bytes_above_a_block),
         cmocka_unit_test(test_time_limit),
         cmocka_unit_test(test_pass_progress_and_cancel),
         cmocka_unit_test(test_area_light_visible_one_sided),

@@ -4,9 +4,12 @@
  * Every part must be of the same render as the first (part_mismatch: rt
  * version, scene hash, size, samples, seed, settings). Parts with the same
  * region are sample ranges of it: sorted by their first sample they must
- * cover 0 .. spp exactly once, and their float sums are added in that order
- * (equal to a single render's sum up to float summation order; one range
- * is the render's own sum, exactly). The regions must tile the image
+ * cover 0 .. spp exactly once, and their sums are folded in that order as
+ * the render folds its sample blocks (rt/render/sample_block.h): 0 plus
+ * each part's fold, then each block it keeps apart. That is a single
+ * render's sum exactly when every range starts at a block edge (or 0) and
+ * keeps its blocks apart; else equal to it up to float summation order
+ * (docs/farm.md states the bound). The regions must tile the image
  * exactly once. A pixel is then resolved as in src/render/render.c, sum *
  * (1 / count), so region parts give a single render's bytes exactly, and
  * written through the same atomic writer with the same exposure (the
@@ -135,24 +138,22 @@ static int assemble(const merge_state *m, float *sum, uint32_t *good, float *con
                 }
                 owner[px] = idx[0];
                 size_t local = (size_t)(y - r->y0) * (size_t)rw + (size_t)(x - r->x0);
-                float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+                size_t np = (size_t)rw * (size_t)(r->y1 - r->y0);
+                /* the render's fold: 0 + each part's fold, then its blocks, in sample order */
+                float f[3] = {0.0f, 0.0f, 0.0f};
                 uint32_t c = 0;
                 for (int k = 0; k < n; k++) {
                     const rt_part *q = &P[idx[k]];
-                    if (k == 0) {
-                        s0 = q->sum[3 * local];
-                        s1 = q->sum[3 * local + 1];
-                        s2 = q->sum[3 * local + 2];
-                    } else {
-                        s0 += q->sum[3 * local];
-                        s1 += q->sum[3 * local + 1];
-                        s2 += q->sum[3 * local + 2];
+                    for (int ch = 0; ch < 3; ch++) {
+                        f[ch] += q->sum[3 * local + (size_t)ch];
+                        for (int b = 0; b < q->info.block_count; b++)
+                            f[ch] += q->blocks[((size_t)b * np + local) * 3 + (size_t)ch];
                     }
                     c += q->good[local];
                 }
-                sum[3 * px] = s0;
-                sum[3 * px + 1] = s1;
-                sum[3 * px + 2] = s2;
+                sum[3 * px] = f[0];
+                sum[3 * px + 1] = f[1];
+                sum[3 * px + 2] = f[2];
                 good[px] = c;
                 for (int l = 0; l < first->layer_count; l++) {
                     size_t ch = (size_t)first->layer_channels[l];

@@ -185,6 +185,54 @@ const char *part_mismatch(const rt_part_info *a, const rt_part_info *b, char *bu
     return buf;
 }
 
+/* Zeroed sums, block sums and counts (and AOV sums when aov) for n pixels. */
+static rt_result alloc_sums(part_job *pj, size_t n, bool aov, rt_error *err)
+{
+    pj->accum.sum = rt_alloc(n, 3 * sizeof(float));
+    pj->accum.block = rt_alloc(n, 3 * sizeof(float));
+    pj->accum.good = rt_alloc(n, sizeof(uint32_t));
+    pj->accum.aov_sum = aov ? rt_alloc(n, sizeof *pj->accum.aov_sum) : NULL;
+    if (!pj->accum.sum || !pj->accum.block || !pj->accum.good || (aov && !pj->accum.aov_sum)) {
+        part_job_free(pj);
+        return rt_fail(err, RT_ERR_NOMEM, "out of memory for the sums of %zu pixels", n);
+    }
+    memset(pj->accum.sum, 0, n * 3 * sizeof(float));
+    memset(pj->accum.block, 0, n * 3 * sizeof(float));
+    memset(pj->accum.good, 0, n * sizeof(uint32_t));
+    if (aov)
+        memset(pj->accum.aov_sum, 0, n * sizeof *pj->accum.aov_sum);
+    return RT_OK;
+}
+
+/* A part from a block edge past sample 0 keeps each block's sum apart (so
+ * a merge folds them in after the parts before it, exactly), when its
+ * blocks up to the render's last sample are at most RT_PART_MAX_BLOCKS;
+ * the render keeps the finished ones in accum.kept (n pixels each), the
+ * last stays in accum.block. Else the part keeps its fold and last block,
+ * and merges within the bound (docs/farm.md). */
+static rt_result keep_blocks(part_job *pj, size_t n, rt_error *err)
+{
+    int first = pj->part_begin / RT_SAMPLE_BLOCK, last = (pj->s_end - 1) / RT_SAMPLE_BLOCK;
+    pj->keep_blocks = pj->part_begin > 0 && pj->part_begin % RT_SAMPLE_BLOCK == 0 && last - first < RT_PART_MAX_BLOCKS;
+    if (pj->part_begin > 0 && pj->part_begin % RT_SAMPLE_BLOCK == 0 && !pj->keep_blocks)
+        rt_warn("samples %d:%d span %d blocks of %d; a part keeps at most %d apart, so this one merges within the "
+                "float summation bound, not to the exact bytes (split it into ranges of at most %d samples)",
+                pj->part_begin, pj->s_end, last - first + 1, RT_SAMPLE_BLOCK, RT_PART_MAX_BLOCKS,
+                RT_PART_MAX_BLOCKS * RT_SAMPLE_BLOCK);
+    if (!pj->keep_blocks || last == first)
+        return RT_OK;
+    pj->accum.kept = rt_alloc(n * (size_t)(last - first), 3 * sizeof(float));
+    if (!pj->accum.kept) {
+        part_job_free(pj);
+        return rt_fail(err, RT_ERR_NOMEM, "out of memory for %d block sums of %zu pixels", last - first, n);
+    }
+    pj->accum.kept_first = first;
+    pj->accum.kept_count = last - first;
+    return RT_OK;
+}
+
+static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_error *err);
+
 rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, const rt_kdtree *tree, rt_error *err)
 {
     memset(pj, 0, sizeof *pj);
@@ -234,83 +282,91 @@ rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, cons
         }
     size_t n = (size_t)(pj->region.x1 - pj->region.x0) * (size_t)(pj->region.y1 - pj->region.y0);
     pj->need_accum = true;
-    if (a->resume) {
-        rt_part p;
-        if ((r = rt_part_read(a->resume, &p, err)) != RT_OK)
-            return r;
-        char why[1024];
-        if (part_mismatch(&p.info, &pj->info, why, sizeof why)) {
-            r = rt_fail(err, RT_ERR_INVALID, "--resume %s: the part is of another render: %s", a->resume, why);
-            rt_part_free(&p);
-            return r;
-        }
-        if (p.info.s_end >= s->samples) {
-            r = rt_fail(err, RT_ERR_INVALID, "--resume %s: the part already holds samples %d:%d, all there are",
-                        a->resume, p.info.s_begin, p.info.s_end);
-            rt_part_free(&p);
-            return r;
-        }
-        pj->region = (rt_render_region){p.info.x0, p.info.y0, p.info.x1, p.info.y1};
-        pj->part_begin = p.info.s_begin;
-        pj->s_begin = p.info.s_end;
-        pj->s_end = s->samples;
-        pj->accum.sum = p.sum;
-        pj->accum.good = p.good;
-        p.sum = NULL;
-        p.good = NULL;
-        if (pj->info.layer_count) {
-            size_t np = (size_t)(p.info.x1 - p.info.x0) * (size_t)(p.info.y1 - p.info.y0);
-            pj->accum.aov_sum = rt_alloc(np, sizeof *pj->accum.aov_sum);
-            if (!pj->accum.aov_sum) {
-                rt_part_free(&p);
-                return rt_fail(err, RT_ERR_NOMEM, "out of memory for the AOV sums of %s", a->resume);
-            }
-            layers_to_aov(&p.info, (const float *const *)p.layer, pj->accum.aov_sum, np);
-        }
+    if (a->resume)
+        return resume(pj, a, s, err);
+    if ((r = alloc_sums(pj, n, pj->info.layer_count > 0, err)) != RT_OK)
+        return r;
+    return keep_blocks(pj, n, err);
+}
+
+/* part_job_init for --resume: the region, samples and sums of the part. */
+static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_error *err)
+{
+    rt_result r;
+    rt_part p;
+    if ((r = rt_part_read(a->resume, &p, err)) != RT_OK)
+        return r;
+    char why[1024];
+    if (part_mismatch(&p.info, &pj->info, why, sizeof why)) {
+        r = rt_fail(err, RT_ERR_INVALID, "--resume %s: the part is of another render: %s", a->resume, why);
         rt_part_free(&p);
-        bool whole = pj->region.x0 == 0 && pj->region.y0 == 0 && pj->region.x1 == s->width &&
-                     pj->region.y1 == s->height && pj->part_begin == 0;
-        pj->to_part = !whole;
-        return RT_OK;
+        return r;
     }
-    pj->accum.sum = rt_alloc(n, 3 * sizeof(float));
-    pj->accum.good = rt_alloc(n, sizeof(uint32_t));
-    if (pj->info.layer_count)
-        pj->accum.aov_sum = rt_alloc(n, sizeof *pj->accum.aov_sum);
-    if (!pj->accum.sum || !pj->accum.good || (pj->info.layer_count && !pj->accum.aov_sum)) {
+    if (p.info.s_end >= s->samples) {
+        r = rt_fail(err, RT_ERR_INVALID, "--resume %s: the part already holds samples %d:%d, all there are",
+                    a->resume, p.info.s_begin, p.info.s_end);
+        rt_part_free(&p);
+        return r;
+    }
+    pj->region = (rt_render_region){p.info.x0, p.info.y0, p.info.x1, p.info.y1};
+    pj->part_begin = p.info.s_begin;
+    pj->s_begin = p.info.s_end;
+    pj->s_end = s->samples;
+    size_t np = (size_t)(p.info.x1 - p.info.x0) * (size_t)(p.info.y1 - p.info.y0);
+    /* the render's state: the fold of every block but the last (the
+     * part's kept blocks folded in as the render folded them), the last */
+    pj->accum.sum = p.sum;
+    pj->accum.good = p.good;
+    p.sum = NULL;
+    p.good = NULL;
+    int nb = p.info.block_count;
+    for (size_t i = 0; i < 3 * np; i++)
+        for (int k = 0; k + 1 < nb; k++)
+            pj->accum.sum[i] += p.blocks[(size_t)k * 3 * np + i];
+    pj->accum.block = rt_alloc(np, 3 * sizeof(float));
+    if (!pj->accum.block) {
+        rt_part_free(&p);
         part_job_free(pj);
-        return rt_fail(err, RT_ERR_NOMEM, "out of memory for the sums of a %zu-pixel part", n);
+        return rt_fail(err, RT_ERR_NOMEM, "out of memory for the sums of %s", a->resume);
     }
-    memset(pj->accum.sum, 0, n * 3 * sizeof(float));
-    memset(pj->accum.good, 0, n * sizeof(uint32_t));
+    memcpy(pj->accum.block, p.blocks + (size_t)(nb - 1) * 3 * np, np * 3 * sizeof(float));
+    bool kept = p.info.s_begin > 0 && (long long)p.info.block_first * RT_SAMPLE_BLOCK == p.info.s_begin;
+    r = RT_OK;
+    if (kept && (r = keep_blocks(pj, np, err)) == RT_OK && pj->keep_blocks && nb > 1)
+        memcpy(pj->accum.kept, p.blocks, (size_t)(nb - 1) * np * 3 * sizeof(float));
+    if (r != RT_OK) {
+        rt_part_free(&p);
+        return r;
+    }
+    if (pj->info.layer_count) {
+        pj->accum.aov_sum = rt_alloc(np, sizeof *pj->accum.aov_sum);
+        if (!pj->accum.aov_sum) {
+            rt_part_free(&p);
+            return rt_fail(err, RT_ERR_NOMEM, "out of memory for the AOV sums of %s", a->resume);
+        }
+        layers_to_aov(&p.info, (const float *const *)p.layer, pj->accum.aov_sum, np);
+    }
+    rt_part_free(&p);
+    bool whole = pj->region.x0 == 0 && pj->region.y0 == 0 && pj->region.x1 == s->width &&
+                 pj->region.y1 == s->height && pj->part_begin == 0;
+    pj->to_part = !whole;
     return RT_OK;
 }
 
 rt_result part_job_accum(part_job *pj, bool aov, rt_error *err)
 {
     size_t n = (size_t)(pj->region.x1 - pj->region.x0) * (size_t)(pj->region.y1 - pj->region.y0);
-    pj->accum.sum = rt_alloc(n, 3 * sizeof(float));
-    pj->accum.good = rt_alloc(n, sizeof(uint32_t));
-    pj->accum.aov_sum = aov ? rt_alloc(n, sizeof *pj->accum.aov_sum) : NULL;
-    if (!pj->accum.sum || !pj->accum.good || (aov && !pj->accum.aov_sum)) {
-        part_job_free(pj);
-        return rt_fail(err, RT_ERR_NOMEM, "out of memory for the sums of a %zu-pixel motion-blurred render", n);
-    }
-    memset(pj->accum.sum, 0, n * 3 * sizeof(float));
-    memset(pj->accum.good, 0, n * sizeof(uint32_t));
-    if (aov)
-        memset(pj->accum.aov_sum, 0, n * sizeof *pj->accum.aov_sum);
-    return RT_OK;
+    return alloc_sums(pj, n, aov, err);
 }
 
 void part_job_free(part_job *pj)
 {
     free(pj->accum.sum);
+    free(pj->accum.block);
     free(pj->accum.good);
+    free(pj->accum.kept);
     free(pj->accum.aov_sum);
-    pj->accum.sum = NULL;
-    pj->accum.good = NULL;
-    pj->accum.aov_sum = NULL;
+    memset(&pj->accum, 0, sizeof pj->accum);
 }
 
 rt_result part_job_write(const part_job *pj, const char *path, int samples_done, rt_write_temp *temp, rt_error *err)
@@ -325,13 +381,32 @@ rt_result part_job_write(const part_job *pj, const char *path, int samples_done,
     size_t n = (size_t)(info.x1 - info.x0) * (size_t)(info.y1 - info.y0);
     float *layers[RT_PART_MAX_LAYERS] = {NULL};
     rt_result r = RT_OK;
+    /* the blocks: kept apart, each (the fold written is then 0), or the last one after the fold */
+    const float *blocks[RT_PART_MAX_BLOCKS];
+    const float *fold = pj->accum.sum;
+    float *zeros = NULL;
+    info.block_first = (info.s_end - 1) / RT_SAMPLE_BLOCK;
+    info.block_count = 1;
+    if (pj->keep_blocks) {
+        info.block_first = info.s_begin / RT_SAMPLE_BLOCK;
+        info.block_count = (info.s_end - 1) / RT_SAMPLE_BLOCK - info.block_first + 1;
+        for (int k = 0; k + 1 < info.block_count; k++)
+            blocks[k] = pj->accum.kept + (size_t)k * n * 3;
+        if (!(zeros = rt_alloc(n, 3 * sizeof(float))))
+            r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the part's sums", path);
+        else
+            memset(zeros, 0, n * 3 * sizeof(float));
+        fold = zeros;
+    }
+    blocks[info.block_count - 1] = pj->accum.block;
     for (int k = 0; k < info.layer_count && r == RT_OK; k++)
         if (!(layers[k] = rt_alloc(n, (size_t)info.layer_channels[k] * sizeof(float))))
             r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the AOV layers", path);
     if (r == RT_OK) {
         aov_to_layers(&info, pj->accum.aov_sum, layers, n);
-        r = rt_part_write(path, &info, pj->accum.sum, pj->accum.good, (const float *const *)layers, temp, err);
+        r = rt_part_write(path, &info, fold, blocks, pj->accum.good, (const float *const *)layers, temp, err);
     }
+    free(zeros);
     for (int k = 0; k < info.layer_count; k++)
         free(layers[k]);
     return r;

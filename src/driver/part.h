@@ -27,7 +27,8 @@ typedef struct part_job {
     int s_begin, s_end;      /* the samples this run adds */
     int part_begin;          /* the first sample the sums hold (--resume: the part's; else s_begin) */
     bool need_accum;         /* sums kept: a part output, --part-out or --resume */
-    rt_render_accum accum;   /* region-sized; zeros, or the resumed part's sums */
+    bool keep_blocks;        /* the part keeps each sample block apart (part_begin a block edge past 0) */
+    rt_render_accum accum;   /* region-sized; zeros, or the resumed part's sums (and kept blocks) */
     rt_part_info info;       /* what the parts written are parts of (with the AOV layers) */
 } part_job;
 

@@ -98,7 +98,7 @@ static rt_result exr_failed(rt_error *err, rt_result kind, const char *name, con
 
 /* ------------------------------------------------------------ writing */
 
-#define MAX_CHANNELS 64
+#define MAX_CHANNELS 256
 
 typedef struct out_channel {
     char name[64];

@@ -1,7 +1,8 @@
 /* part.c - a part's image and JSON sidecar out and in (rt/io/part.h,
  * docs/farm.md). The image holds the exact float sums and counts the render
- * kept (not their ratio), so a merge can resolve pixels with the very
- * operations of a single render. Integrity: the sidecar carries FNV-1a 64
+ * kept (not their ratio): the fold of the first sample blocks and the sums
+ * of the blocks kept apart (rt/render/sample_block.h), so a merge can fold
+ * and resolve pixels with the very operations of a single render. Integrity: the sidecar carries FNV-1a 64
  * hashes (Fowler, Noll, Vo; the parameters of the IETF draft
  * draft-eastlake-fnv) of the image files, of the scene's bytes and of the
  * settings text; reading checks the ones it can. JSON (RFC 8259) through
@@ -44,6 +45,24 @@ bool rt_part_sidecar_path(const char *path, char *out, size_t size)
 static bool count_path(const char *path, char *out, size_t size)
 {
     return rt_path_tagged(path, "count", NULL, out, size);
+}
+
+/* Block j's name: the EXR layer "block.J", and a PFM part's file NAME.block.J.pfm. */
+static void block_name(int j, char *out, size_t size) { snprintf(out, size, "block.%d", j); }
+
+static bool block_path(const char *path, int j, char *out, size_t size)
+{
+    char tag[32];
+    block_name(j, tag, sizeof tag);
+    return rt_path_tagged(path, tag, NULL, out, size);
+}
+
+bool rt_part_blocks_ok(int s_begin, int s_end, int first, int count)
+{
+    int last = (s_end - 1) / RT_SAMPLE_BLOCK;
+    if (count < 1 || count > RT_PART_MAX_BLOCKS || first < 0 || first + count - 1 != last)
+        return false;
+    return count == 1 || (long long)first * RT_SAMPLE_BLOCK == s_begin;
 }
 
 static rt_result hash_file(const char *path, uint64_t *h, rt_error *err)
@@ -111,10 +130,10 @@ static void put_string(text *t, const char *s)
     put(t, "\"");
 }
 
-rt_result rt_part_write(const char *path, const rt_part_info *info, const float *sum, const uint32_t *good,
-                        const float *const *layers, rt_write_temp *temp, rt_error *err)
+rt_result rt_part_write(const char *path, const rt_part_info *info, const float *sum, const float *const *blocks,
+                        const uint32_t *good, const float *const *layers, rt_write_temp *temp, rt_error *err)
 {
-    char side[4200], cpath[4200];
+    char side[4200], cpath[4200], bpath[4200];
     if (!rt_part_path_ok(path))
         return rt_fail(err, RT_ERR_INVALID, "%s: a part is written as .exr or .pfm", path);
     if (!rt_part_sidecar_path(path, side, sizeof side) || !count_path(path, cpath, sizeof cpath))
@@ -122,6 +141,12 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
     if (info->layer_count < 0 || info->layer_count > RT_PART_MAX_LAYERS ||
         (info->layer_count > 0 && !rt_path_has_ext(path, ".exr")))
         return rt_fail(err, RT_ERR_INVALID, "%s: a part with AOVs is written as .exr", path);
+    int bfirst = info->block_first, bcount = info->block_count;
+    if (!rt_part_blocks_ok(info->s_begin, info->s_end, bfirst, bcount))
+        return rt_fail(err, RT_ERR_INVALID, "%s: samples %d:%d cannot keep blocks %d..%d apart", path, info->s_begin,
+                       info->s_end, bfirst, bfirst + bcount - 1);
+    if (!block_path(path, bfirst + bcount - 1, bpath, sizeof bpath))
+        return rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
     int w = info->x1 - info->x0, h = info->y1 - info->y0;
     size_t n = (size_t)w * (size_t)h;
     float *counts = rt_alloc(n, sizeof(float));
@@ -132,12 +157,18 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
     rt_framebuffer fb = {w, h, (float *)sum};
     bool exr = rt_path_has_ext(path, ".exr");
     rt_result r = RT_OK;
-    uint64_t image_hash = 0, count_hash = 0;
+    uint64_t image_hash = 0, count_hash = 0, block_hash[RT_PART_MAX_BLOCKS] = {0};
+    char bname[RT_PART_MAX_BLOCKS][24];
+    for (int k = 0; k < bcount; k++)
+        block_name(bfirst + k, bname[k], sizeof bname[k]);
     if (exr) {
-        rt_image_layer layer[1 + RT_PART_MAX_LAYERS] = {{"count", 1, counts}};
+        rt_image_layer layer[1 + RT_PART_MAX_BLOCKS + RT_PART_MAX_LAYERS] = {{"count", 1, counts}};
+        int nl = 1;
+        for (int k = 0; k < bcount; k++)
+            layer[nl++] = (rt_image_layer){bname[k], 3, blocks[k]};
         for (int k = 0; k < info->layer_count; k++)
-            layer[1 + k] = (rt_image_layer){info->layer_name[k], info->layer_channels[k], layers[k]};
-        rt_image_options opt = {.layers = layer, .layer_count = 1 + info->layer_count};
+            layer[nl++] = (rt_image_layer){info->layer_name[k], info->layer_channels[k], layers[k]};
+        rt_image_options opt = {.layers = layer, .layer_count = nl};
         r = rt_framebuffer_write_tracked(&fb, path, &opt, temp, err);
     } else {
         float *grey = rt_alloc(n, 3 * sizeof(float));
@@ -152,9 +183,16 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
         r = rt_framebuffer_write_tracked(&cfb, cpath, &opt, temp, err);
         free(grey);
         if (r == RT_OK)
-            r = rt_framebuffer_write_tracked(&fb, path, &opt, temp, err);
-        if (r == RT_OK)
             r = hash_file(cpath, &count_hash, err);
+        for (int k = 0; k < bcount && r == RT_OK; k++) {
+            rt_framebuffer bfb = {w, h, (float *)blocks[k]};
+            block_path(path, bfirst + k, bpath, sizeof bpath);
+            r = rt_framebuffer_write_tracked(&bfb, bpath, &opt, temp, err);
+            if (r == RT_OK)
+                r = hash_file(bpath, &block_hash[k], err);
+        }
+        if (r == RT_OK)
+            r = rt_framebuffer_write_tracked(&fb, path, &opt, temp, err);
     }
     free(counts);
     if (r == RT_OK)
@@ -171,7 +209,10 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
     if (!exr) {
         put(&t, "  \"count_image\": ");
         put_string(&t, rt_path_basename(cpath));
-        put(&t, ",\n  \"count_fnv1a64\": \"%016" PRIx64 "\",\n", count_hash);
+        put(&t, ",\n  \"count_fnv1a64\": \"%016" PRIx64 "\",\n  \"block_fnv1a64\": [", count_hash);
+        for (int k = 0; k < bcount; k++)
+            put(&t, "%s\"%016" PRIx64 "\"", k ? ", " : "", block_hash[k]);
+        put(&t, "],\n");
     }
     put(&t, "  \"scene\": ");
     put_string(&t, info->scene);
@@ -181,8 +222,8 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
     put_string(&t, info->settings);
     put(&t, ",\n  \"width\": %d,\n  \"height\": %d,\n  \"region\": [%d, %d, %d, %d],\n", info->width, info->height,
         info->x0, info->y0, info->x1, info->y1);
-    put(&t, "  \"spp\": %d,\n  \"samples\": [%d, %d],\n  \"seed\": %" PRIu32 ",\n", info->spp, info->s_begin,
-        info->s_end, info->seed);
+    put(&t, "  \"spp\": %d,\n  \"samples\": [%d, %d],\n  \"blocks\": [%d, %d],\n  \"seed\": %" PRIu32 ",\n",
+        info->spp, info->s_begin, info->s_end, bfirst, bcount, info->seed);
     put(&t, "  \"exposure\": \"%a\",\n  \"layers\": [", (double)info->exposure);
     for (int k = 0; k < info->layer_count; k++) {
         put(&t, "%s[", k ? ", " : "");
@@ -256,7 +297,7 @@ static bool float_text(const char *s, float *out)
 
 /* The sidecar's fields into info; the image hashes into the rest. */
 static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *image_hash, uint64_t *count_hash,
-                              bool *has_count, rt_error *err)
+                              uint64_t *block_hash, bool *has_count, rt_error *err)
 {
     char *bytes;
     size_t size;
@@ -271,14 +312,16 @@ static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *im
     }
     memset(info, 0, sizeof *info);
     long long fmt, w, h, spp, seed;
-    int reg[4], smp[2];
+    int reg[4], smp[2], blk[2] = {0, 0};
     char expo[64];
     uint64_t settings_hash = 0;
     *has_count = rt_json_get(&j, 0, "count_fnv1a64") >= 0;
     if (!get_int(&j, 0, "rt_part", 1, 1000, &fmt))
         r = bad(err, side, "not a part sidecar (no \"rt_part\" format number)");
     else if (fmt != RT_PART_FORMAT)
-        r = rt_fail(err, RT_ERR_INVALID, "%s: part format %lld, this rt reads format %d", side, fmt, RT_PART_FORMAT);
+        r = rt_fail(err, RT_ERR_INVALID,
+                    "%s: part format %lld, this rt reads format %d only%s", side, fmt, RT_PART_FORMAT,
+                    fmt < RT_PART_FORMAT ? " (an older rt's part, before sums in sample blocks: render it again)" : "");
     else if (!get_string(&j, 0, "rt_version", info->version, sizeof info->version))
         r = bad(err, side, "\"rt_version\" missing or not a string");
     else if (!get_hash(&j, 0, "image_fnv1a64", image_hash))
@@ -304,10 +347,25 @@ static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *im
         r = bad(err, side, "\"spp\" must be an integer from 1 to 1048576");
     else if (!get_ints(&j, 0, "samples", 2, 0, 1 << 20, smp) || smp[0] >= smp[1] || smp[1] > spp)
         r = bad(err, side, "\"samples\" must be [begin, end] with begin < end <= spp");
+    else if (!get_ints(&j, 0, "blocks", 2, 0, 1 << 20, blk))
+        r = bad(err, side, "\"blocks\" must be [first, count]");
+    else if (!rt_part_blocks_ok(smp[0], smp[1], blk[0], blk[1]))
+        r = bad(err, side, "\"blocks\" [first, count] must end with the block of the last sample and be that one "
+                           "block, or every block from the first sample on, at most 64");
     else if (!get_int(&j, 0, "seed", 0, UINT32_MAX, &seed))
         r = bad(err, side, "\"seed\" must be an integer from 0 to 4294967295");
     else if (!get_string(&j, 0, "exposure", expo, sizeof expo) || !float_text(expo, &info->exposure))
         r = bad(err, side, "\"exposure\" missing or not a number");
+    int bi = r == RT_OK && *has_count ? rt_json_get(&j, 0, "block_fnv1a64") : -1;
+    if (r == RT_OK && *has_count) {
+        if (bi < 0 || j.tok[bi].type != RT_JSON_ARRAY || j.tok[bi].size != blk[1])
+            r = bad(err, side, "\"block_fnv1a64\" must list a hash for each block");
+        for (int k = 0, e = bi + 1; r == RT_OK && k < blk[1]; k++, e = rt_json_skip(&j, e)) {
+            char hex[32], *end;
+            if (rt_json_string(&j, e, hex, sizeof hex) != 16 || (block_hash[k] = strtoull(hex, &end, 16), *end != 0))
+                r = bad(err, side, "\"block_fnv1a64\" entries must be 16 hex digits");
+        }
+    }
     int li = r == RT_OK ? rt_json_get(&j, 0, "layers") : -1;
     if (r == RT_OK && li >= 0) {
         if (j.tok[li].type != RT_JSON_ARRAY || j.tok[li].size > RT_PART_MAX_LAYERS)
@@ -333,6 +391,8 @@ static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *im
         info->spp = (int)spp;
         info->s_begin = smp[0];
         info->s_end = smp[1];
+        info->block_first = blk[0];
+        info->block_count = blk[1];
         info->seed = (uint32_t)seed;
     }
     rt_json_free(&j);
@@ -388,45 +448,60 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
                        path);
     if (!rt_part_sidecar_path(image, side, sizeof side) || !count_path(image, cpath, sizeof cpath))
         return rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
-    uint64_t image_hash = 0, count_hash = 0;
+    uint64_t image_hash = 0, count_hash = 0, block_hash[RT_PART_MAX_BLOCKS] = {0};
     bool has_count = false;
     rt_part_info *info = &part->info;
-    rt_result r = read_sidecar(side, info, &image_hash, &count_hash, &has_count, err);
+    rt_result r = read_sidecar(side, info, &image_hash, &count_hash, block_hash, &has_count, err);
     if (r != RT_OK)
         return r;
     bool exr = rt_path_has_ext(image, ".exr");
     if (!exr && !has_count)
         return rt_fail(err, RT_ERR_INVALID, "%s: a .pfm part's sidecar must name \"count_fnv1a64\"", side);
-    int rw = info->x1 - info->x0, rh = info->y1 - info->y0, w = 0, h = 0;
+    if (!exr && info->layer_count)
+        return rt_fail(err, RT_ERR_INVALID, "%s: a .pfm part cannot have layers", side);
+    int rw = info->x1 - info->x0, rh = info->y1 - info->y0, w = 0, h = 0, nb = info->block_count;
     size_t n = (size_t)rw * (size_t)rh;
-    float *px = NULL, *cpx = NULL;
-    /* the channels: R, G, B, count.Y, then each layer's */
-    char names_buf[4 + 3 * RT_PART_MAX_LAYERS][24];
-    const char *names[4 + 3 * RT_PART_MAX_LAYERS] = {"R", "G", "B", "count.Y"};
+    float *px = NULL, *cpx = NULL, *bpx[RT_PART_MAX_BLOCKS] = {NULL};
+    /* EXR channels: R, G, B, count.Y, then each block's, then each layer's */
+    char names_buf[4 + 3 * (RT_PART_MAX_BLOCKS + RT_PART_MAX_LAYERS)][40];
+    const char *names[4 + 3 * (RT_PART_MAX_BLOCKS + RT_PART_MAX_LAYERS)] = {"R", "G", "B", "count.Y"};
     int nc = 4;
+    for (int k = 0; k < nb; k++)
+        for (int c = 0; c < 3; c++, nc++) {
+            snprintf(names_buf[nc], sizeof names_buf[nc], "block.%d.%c", info->block_first + k, "RGB"[c]);
+            names[nc] = names_buf[nc];
+        }
+    int layers_at = nc;
     for (int k = 0; k < info->layer_count; k++)
         for (int c = 0; c < info->layer_channels[k]; c++, nc++) {
             snprintf(names_buf[nc], sizeof names_buf[nc], "%s.%s", info->layer_name[k],
                      info->layer_channels[k] == 1 ? "Y" : c == 0 ? "R" : c == 1 ? "G" : "B");
             names[nc] = names_buf[nc];
         }
-    if (!exr && info->layer_count)
-        return rt_fail(err, RT_ERR_INVALID, "%s: a .pfm part cannot have layers", side);
     r = read_image(image, image_hash, exr, names, nc, &px, &w, &h, err);
     if (r == RT_OK && (w != rw || h != rh))
         r = rt_fail(err, RT_ERR_INVALID, "%s: the image is %dx%d but its sidecar's region is %dx%d", image, w, h, rw,
                     rh);
-    int cw = 0, ch = 0;
-    if (r == RT_OK && !exr) {
-        r = read_image(cpath, count_hash, false, NULL, 0, &cpx, &cw, &ch, err);
+    /* a .pfm part's counts and blocks beside it */
+    for (int k = -1; r == RT_OK && !exr && k < nb; k++) {
+        char bpath[4200];
+        int cw = 0, ch = 0;
+        const char *file = k < 0 ? cpath : bpath;
+        if (k >= 0 && !block_path(image, info->block_first + k, bpath, sizeof bpath)) {
+            r = rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
+            break;
+        }
+        r = read_image(file, k < 0 ? count_hash : block_hash[k], false, NULL, 0, k < 0 ? &cpx : &bpx[k], &cw, &ch,
+                       err);
         if (r == RT_OK && (cw != rw || ch != rh))
-            r = rt_fail(err, RT_ERR_INVALID, "%s: the image is %dx%d but its sidecar's region is %dx%d", cpath, cw,
+            r = rt_fail(err, RT_ERR_INVALID, "%s: the image is %dx%d but its sidecar's region is %dx%d", file, cw,
                         ch, rw, rh);
     }
     if (r == RT_OK) {
         part->sum = rt_alloc(n, 3 * sizeof(float));
+        part->blocks = rt_alloc(n * (size_t)nb, 3 * sizeof(float));
         part->good = rt_alloc(n, sizeof(uint32_t));
-        bool ok = part->sum && part->good;
+        bool ok = part->sum && part->blocks && part->good;
         for (int k = 0; k < info->layer_count; k++) {
             part->layer[k] = rt_alloc(n, (size_t)info->layer_channels[k] * sizeof(float));
             ok = ok && part->layer[k];
@@ -438,8 +513,14 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
     for (size_t i = 0; i < n && r == RT_OK; i++) {
         const float *s = exr ? px + (size_t)nc * i : px + 3 * i;
         float c = exr ? s[3] : cpx[3 * i];
-        if (!(c >= 0.0f && c <= most && c == floorf(c)) || !(s[0] >= 0.0f) || !(s[1] >= 0.0f) || !(s[2] >= 0.0f) ||
-            !isfinite(s[0]) || !isfinite(s[1]) || !isfinite(s[2])) {
+        float v[3 * (1 + RT_PART_MAX_BLOCKS)]; /* the fold, then each block */
+        for (int k = 0; k <= nb; k++)
+            for (int q = 0; q < 3; q++)
+                v[3 * k + q] = k == 0 ? s[q] : exr ? s[4 + 3 * (k - 1) + q] : bpx[k - 1][3 * i + (size_t)q];
+        bool sums_ok = true;
+        for (int q = 0; q < 3 * (1 + nb); q++)
+            sums_ok = sums_ok && v[q] >= 0.0f && isfinite(v[q]);
+        if (!(c >= 0.0f && c <= most && c == floorf(c)) || !sums_ok) {
             r = rt_fail(err, RT_ERR_INVALID,
                         "%s: pixel (%zu, %zu) of the part holds a sum or count no render makes (sums are finite and "
                         ">= 0, counts whole numbers up to %d)",
@@ -447,24 +528,26 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
                         info->s_end - info->s_begin);
             break;
         }
-        part->sum[3 * i] = s[0];
-        part->sum[3 * i + 1] = s[1];
-        part->sum[3 * i + 2] = s[2];
+        memcpy(part->sum + 3 * i, v, 3 * sizeof(float));
+        for (int k = 0; k < nb; k++)
+            memcpy(part->blocks + ((size_t)k * n + i) * 3, v + 3 * (k + 1), 3 * sizeof(float));
         part->good[i] = (uint32_t)c;
-        for (int k = 0, at = 4; k < info->layer_count; at += info->layer_channels[k], k++)
+        for (int k = 0, at = layers_at; k < info->layer_count; at += info->layer_channels[k], k++)
             for (int q = 0; q < info->layer_channels[k]; q++) {
-                float v = s[at + q];
-                if (!isfinite(v)) {
+                float lv = s[at + q];
+                if (!isfinite(lv)) {
                     r = rt_fail(err, RT_ERR_INVALID, "%s: layer %s of pixel (%zu, %zu) is not finite", image,
                                 info->layer_name[k], i % (size_t)rw + (size_t)info->x0,
                                 i / (size_t)rw + (size_t)info->y0);
                     break;
                 }
-                part->layer[k][(size_t)info->layer_channels[k] * i + (size_t)q] = v;
+                part->layer[k][(size_t)info->layer_channels[k] * i + (size_t)q] = lv;
             }
     }
     free(px);
     free(cpx);
+    for (int k = 0; k < nb; k++)
+        free(bpx[k]);
     if (r != RT_OK)
         rt_part_free(part);
     return r;
@@ -473,8 +556,10 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
 void rt_part_free(rt_part *part)
 {
     free(part->sum);
+    free(part->blocks);
     free(part->good);
     part->sum = NULL;
+    part->blocks = NULL;
     part->good = NULL;
     for (int k = 0; k < RT_PART_MAX_LAYERS; k++) {
         free(part->layer[k]);

@@ -8,10 +8,18 @@
  * dropped and counted (it shows a bug, not light); the pixel averages the
  * rest. settings.clamp, when set, caps a sample's luminance.
  *
- * Passes keep per pixel the float sum of its good samples and their count;
+ * A pixel's sum is kept in blocks of RT_SAMPLE_BLOCK (64) samples by sample
+ * index (rt/render/sample_block.h): the float sum of the current block's good
+ * samples in sample order, and the fold of the blocks before it, which
+ * takes the block in when a sample index crosses a block edge; the pixel is
+ * (fold + block) * (1 / good). Up to 64 samples that is 0 + b_0: the plain
+ * sequential sum, bit for bit; above, the blocks let a range of samples
+ * rendered elsewhere be folded in at its place (docs/farm.md).
+ *
+ * Passes keep per pixel the fold, the block sum and the count (28 bytes);
  * a pass adds its samples in sample order with the same operations the tile
- * loop uses (add_samples below serves both), and the image is resolved as
- * sum * (1 / good) after each pass, so a pass split cannot change a bit.
+ * loop uses (add_sample below serves both, and the wavefront path), and the
+ * image is resolved after each pass, so a pass split cannot change a bit.
  * (The build's -std=c11 keeps GCC from contracting a*b+c into an FMA.)
  * Workers are started for each pass and joined at its end: the join is the
  * barrier that keeps two passes off one pixel, and a start costs far less
@@ -46,7 +54,8 @@ struct rt_render_job {
     bool passes;                  /* pass mode: accumulate into sum/good */
     uint32_t s0, s1;              /* passes: this pass's samples [s0, s1) */
     rt_render_accum *accum;       /* NULL, or the caller's sums and counts, continued */
-    float *sum;                   /* passes: per pixel, RGB sum of the good samples so far */
+    float *sum;                   /* passes: per pixel, RGB fold of the finished blocks (pixel_sum.fold) */
+    float *block;                 /* passes: per pixel, RGB sum of the current block's good samples */
     uint32_t *good;               /* passes: per pixel, how many samples were good */
     int samples_done;             /* passes: samples in fb (read by progress reports) */
     double deadline;              /* tiles: take no tile after this time; 0 = none */
@@ -107,15 +116,43 @@ static void aov_store(rt_aov_buffers *aov, size_t pixel, const rt_aov_sample *s,
     }
 }
 
+/* A pixel's running sum: the fold of its finished sample blocks, the sum of
+ * the current block's good samples, and how many samples were good. */
+typedef struct pixel_sum {
+    rt_vec3 fold, block;
+    uint32_t good;
+} pixel_sum;
+
+/* Sample s starts a block: the block so far goes into the fold (and, for
+ * the caller's kept blocks, into its plane). Up to the first edge the fold
+ * is 0 + 0. */
+static void fold_block(const rt_render_job *job, size_t local, uint32_t s, pixel_sum *p)
+{
+    const rt_render_accum *acc = job->accum;
+    if (acc && acc->kept) {
+        int64_t j = (int64_t)(s / RT_SAMPLE_BLOCK) - 1 - acc->kept_first; /* the block that ended, as a plane */
+        if (j >= 0 && j < acc->kept_count) {
+            float *k = acc->kept + ((size_t)j * (size_t)job->rw * (size_t)job->rh + local) * 3;
+            k[0] = p->block.x;
+            k[1] = p->block.y;
+            k[2] = p->block.z;
+        }
+    }
+    p->fold = rt_add(p->fold, p->block);
+    p->block = rt_v3s(0);
+}
+
 /* Adds radiance sample L, sample s of pixel (x, y) of the whole image
- * (`local`: its index in the region's buffers), to *sum and *good: the one
- * place a pixel's arithmetic happens, for tiles and passes, one path at a
- * time or a wavefront, alike; samples come in sample order. */
+ * (`local`: its index in the region's buffers), to *p: the one place a
+ * pixel's arithmetic happens, for tiles and passes, one path at a time or
+ * a wavefront, alike; samples come in sample order. */
 static inline void add_sample(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, size_t local,
-                              uint32_t s, rt_vec3 L, rt_vec3 *sum, uint32_t *good)
+                              uint32_t s, rt_vec3 L, pixel_sum *p)
 {
     const rt_settings *st = &job->scene->settings;
     uint64_t pixel = (uint64_t)y * (uint64_t)job->width + (uint64_t)x;
+    if (s % RT_SAMPLE_BLOCK == 0)
+        fold_block(job, local, s, p);
     if (!rt_finite3(L) || L.x < 0.0f || L.y < 0.0f || L.z < 0.0f) {
         w->bad_samples++;
         return;
@@ -125,8 +162,8 @@ static inline void add_sample(const rt_render_job *job, worker *w, rt_trace_ctx 
         if (lum > st->clamp)
             L = rt_scale(L, st->clamp / lum);
     }
-    *sum = rt_add(*sum, L);
-    (*good)++;
+    p->block = rt_add(p->block, L);
+    p->good++;
     if (job->aov) { /* own random numbers: the image stays as it was */
         rt_rng unused;
         rt_ray ray = rt_camera_pixel_sample(&job->camera, job->width, st->seed, job->spp, x, y, s, &unused);
@@ -142,23 +179,28 @@ static inline void add_sample(const rt_render_job *job, worker *w, rt_trace_ctx 
     }
 }
 
-/* Adds samples [s0, s1) of pixel (x, y) to *sum_io and *good_io, in sample
- * order, one path at a time. */
+/* Adds samples [s0, s1) of pixel (x, y) to *p_io, in sample order, one
+ * path at a time. */
 static inline void add_samples(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, size_t local,
-                               uint32_t s0, uint32_t s1, rt_vec3 *sum_io, uint32_t *good_io)
+                               uint32_t s0, uint32_t s1, pixel_sum *p_io)
 {
     const rt_settings *st = &job->scene->settings;
-    rt_vec3 sum = *sum_io;
-    uint32_t good = *good_io;
+    pixel_sum p = *p_io;
     for (uint32_t s = s0; s < s1; s++) {
         rt_rng rng;
         rt_ray ray = rt_camera_pixel_sample(&job->camera, job->width, st->seed, job->spp, x, y, s, &rng);
         w->camera_rays++;
         rt_vec3 L = job->radiance(ctx, &ray, &rng);
-        add_sample(job, w, ctx, x, y, local, s, L, &sum, &good);
+        add_sample(job, w, ctx, x, y, local, s, L, &p);
     }
-    *sum_io = sum;
-    *good_io = good;
+    *p_io = p;
+}
+
+/* The pixel's sum: the fold with the current block taken in (the fold
+ * alone, exactly, when that block is still empty of samples). */
+static inline rt_vec3 pixel_total(const pixel_sum *p)
+{
+    return rt_add(p->fold, p->block);
 }
 
 /* The pixel value of a sum of `good` samples. */
@@ -177,44 +219,50 @@ static void tile_bounds(const rt_render_job *job, int tile, int *x0, int *y0, in
     *y1 = *y0 + job->tile_size < job->rh ? *y0 + job->tile_size : job->rh;
 }
 
+static inline rt_vec3 load3(const float *f) { return rt_v3(f[0], f[1], f[2]); }
+
+static inline void store3(float *f, rt_vec3 v)
+{
+    f[0] = v.x;
+    f[1] = v.y;
+    f[2] = v.z;
+}
+
 /* A pixel's running sum before its samples (`pixel`: its index in the
  * region): passes continue the accumulated one, tiles start from zero or
  * from the caller's sums. */
-static void pixel_begin(const rt_render_job *job, size_t pixel, rt_vec3 *sum, uint32_t *good)
+static void pixel_begin(const rt_render_job *job, size_t pixel, pixel_sum *p)
 {
-    const float *acc = NULL;
-    *sum = rt_v3s(0);
-    *good = 0;
+    p->fold = p->block = rt_v3s(0);
+    p->good = 0;
     if (job->passes) {
-        acc = job->sum + 3 * pixel;
-        *good = job->good[pixel];
+        p->fold = load3(job->sum + 3 * pixel);
+        p->block = load3(job->block + 3 * pixel);
+        p->good = job->good[pixel];
     } else if (job->accum) { /* continue the caller's sums */
-        acc = job->accum->sum + 3 * pixel;
-        *good = job->accum->good[pixel];
+        p->fold = load3(job->accum->sum + 3 * pixel);
+        p->block = load3(job->accum->block + 3 * pixel);
+        p->good = job->accum->good[pixel];
     }
-    if (acc)
-        *sum = rt_v3(acc[0], acc[1], acc[2]);
 }
 
-/* ... and after them: passes keep the sum, tiles write the pixel (and the
+/* ... and after them: passes keep the sums, tiles write the pixel (and the
  * caller's sums). */
-static void pixel_end(rt_render_job *job, size_t pixel, rt_vec3 sum, uint32_t good)
+static void pixel_end(rt_render_job *job, size_t pixel, const pixel_sum *p)
 {
     if (job->passes) {
-        float *acc = job->sum + 3 * pixel;
-        acc[0] = sum.x;
-        acc[1] = sum.y;
-        acc[2] = sum.z;
-        job->good[pixel] = good;
+        store3(job->sum + 3 * pixel, p->fold);
+        store3(job->block + 3 * pixel, p->block);
+        job->good[pixel] = p->good;
         return;
     }
     if (job->accum) {
-        float *acc = job->accum->sum + 3 * pixel;
-        acc[0] = sum.x;
-        acc[1] = sum.y;
-        acc[2] = sum.z;
-        job->accum->good[pixel] = good;
+        store3(job->accum->sum + 3 * pixel, p->fold);
+        store3(job->accum->block + 3 * pixel, p->block);
+        job->accum->good[pixel] = p->good;
     }
+    rt_vec3 sum = pixel_total(p);
+    uint32_t good = p->good;
     if (job->aov)
         aov_store(job->aov, pixel, &job->aov_sum[pixel], good, rt_luminance(sum), job->lum_sq[pixel]);
     sum = resolve(sum, good);
@@ -255,23 +303,20 @@ static bool render_tile_wavefront(rt_render_job *job, worker *w, rt_trace_ctx *c
             for (uint32_t i = 0; i < wk.count; i++) {
                 int x = x0 + (int)((p + i) % tw), y = y0 + (int)((p + i) / tw);
                 size_t pixel = (size_t)y * (size_t)job->rw + (size_t)x;
-                rt_vec3 sum;
-                uint32_t good;
-                pixel_begin(job, pixel, &sum, &good);
+                pixel_sum ps;
+                pixel_begin(job, pixel, &ps);
                 const float *o = w->wf_out + 3 * (size_t)i * ns;
                 for (uint32_t s = s0; s < s1; s++, o += 3)
-                    add_sample(job, w, ctx, x + job->rx0, y + job->ry0, pixel, s, rt_v3(o[0], o[1], o[2]), &sum,
-                               &good);
-                pixel_end(job, pixel, sum, good);
+                    add_sample(job, w, ctx, x + job->rx0, y + job->ry0, pixel, s, rt_v3(o[0], o[1], o[2]), &ps);
+                pixel_end(job, pixel, &ps);
             }
             continue;
         }
         /* one pixel, its samples in chunks */
         int x = x0 + (int)(p % tw), y = y0 + (int)(p / tw);
         size_t pixel = (size_t)y * (size_t)job->rw + (size_t)x;
-        rt_vec3 sum;
-        uint32_t good;
-        pixel_begin(job, pixel, &sum, &good);
+        pixel_sum ps;
+        pixel_begin(job, pixel, &ps);
         for (uint32_t sa = s0; sa < s1; sa += WAVE_CHUNK) {
             if (cancelled(job))
                 return false;
@@ -281,10 +326,9 @@ static bool render_tile_wavefront(rt_render_job *job, worker *w, rt_trace_ctx *c
             w->camera_rays += wk.s1 - wk.s0;
             const float *o = w->wf_out;
             for (uint32_t s = wk.s0; s < wk.s1; s++, o += 3)
-                add_sample(job, w, ctx, x + job->rx0, y + job->ry0, pixel, s, rt_v3(o[0], o[1], o[2]), &sum,
-                           &good);
+                add_sample(job, w, ctx, x + job->rx0, y + job->ry0, pixel, s, rt_v3(o[0], o[1], o[2]), &ps);
         }
-        pixel_end(job, pixel, sum, good);
+        pixel_end(job, pixel, &ps);
     }
     return true;
 }
@@ -305,11 +349,10 @@ static bool render_tile(rt_render_job *job, worker *w, rt_trace_ctx *ctx, int ti
             if (cancelled(job))
                 return false;
             size_t pixel = (size_t)y * (size_t)job->rw + (size_t)x;
-            rt_vec3 sum;
-            uint32_t good;
-            pixel_begin(job, pixel, &sum, &good);
-            add_samples(job, w, ctx, x + job->rx0, y + job->ry0, pixel, s0, s1, &sum, &good);
-            pixel_end(job, pixel, sum, good);
+            pixel_sum ps;
+            pixel_begin(job, pixel, &ps);
+            add_samples(job, w, ctx, x + job->rx0, y + job->ry0, pixel, s0, s1, &ps);
+            pixel_end(job, pixel, &ps);
         }
     }
     return true;
@@ -418,11 +461,11 @@ static void resolve_image(rt_render_job *job)
 {
     size_t n = (size_t)job->rw * (size_t)job->rh;
     for (size_t k = 0; k < n; k++) {
-        const float *acc = job->sum + 3 * k;
+        pixel_sum p = {load3(job->sum + 3 * k), load3(job->block + 3 * k), job->good[k]};
+        rt_vec3 sum = pixel_total(&p);
         if (job->aov)
-            aov_store(job->aov, k, &job->aov_sum[k], job->good[k], rt_luminance(rt_v3(acc[0], acc[1], acc[2])),
-                      job->lum_sq[k]);
-        rt_vec3 v = resolve(rt_v3(acc[0], acc[1], acc[2]), job->good[k]);
+            aov_store(job->aov, k, &job->aov_sum[k], p.good, rt_luminance(sum), job->lum_sq[k]);
+        rt_vec3 v = resolve(sum, p.good);
         float *px = job->fb->rgb + 3 * k;
         px[0] = v.x;
         px[1] = v.y;
@@ -438,6 +481,7 @@ static void free_job(rt_render_job *job, worker *workers, int nthreads)
     }
     free(job->tile_finished);
     free(job->sum);
+    free(job->block);
     free(job->good);
     free(job->aov_sum);
     free(job->lum_sq);
@@ -465,6 +509,9 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     if (fb->width != reg.x1 - reg.x0 || fb->height != reg.y1 - reg.y0 || !fb->rgb)
         return rt_fail(err, RT_ERR_INVALID, "framebuffer is %dx%d but the region rendered is %dx%d", fb->width,
                        fb->height, reg.x1 - reg.x0, reg.y1 - reg.y0);
+    if (opt.accum && (!opt.accum->sum || !opt.accum->block || !opt.accum->good ||
+                      (opt.accum->kept && (opt.accum->kept_first < 0 || opt.accum->kept_count < 0))))
+        return rt_fail(err, RT_ERR_INVALID, "the caller's sums (opt.accum) need sum, block and good arrays");
     const rt_integrator_info *integrator = rt_integrator_info_of(set->integrator);
     if (!integrator)
         return rt_fail(err, RT_ERR_INVALID, "integrator %d is not one of the %zu rt knows", (int)set->integrator,
@@ -507,6 +554,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     size_t npx = (size_t)fb->width * (size_t)fb->height;
     if (job.passes) {
         job.sum = rt_alloc(npx, 3 * sizeof *job.sum);
+        job.block = rt_alloc(npx, 3 * sizeof *job.block);
         job.good = rt_alloc(npx, sizeof *job.good);
     }
     job.aov = opt.aov;
@@ -518,7 +566,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     if (nthreads > 1024)
         nthreads = 1024;
     worker *workers = rt_alloc((size_t)nthreads, sizeof *workers);
-    if (!job.tile_finished || !workers || (job.passes && (!job.sum || !job.good)) ||
+    if (!job.tile_finished || !workers || (job.passes && (!job.sum || !job.block || !job.good)) ||
         (job.aov && (!job.aov_sum || !job.lum_sq))) {
         free_job(&job, workers, nthreads);
         return rt_fail(err, RT_ERR_NOMEM, "out of memory setting up %d render threads for a %dx%d image", nthreads,
@@ -532,9 +580,11 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     if (job.passes) {
         if (job.accum) { /* continue the caller's sums; they get them back after each whole pass */
             memcpy(job.sum, job.accum->sum, npx * 3 * sizeof *job.sum);
+            memcpy(job.block, job.accum->block, npx * 3 * sizeof *job.block);
             memcpy(job.good, job.accum->good, npx * sizeof *job.good);
         } else {
             memset(job.sum, 0, npx * 3 * sizeof *job.sum);
+            memset(job.block, 0, npx * 3 * sizeof *job.block);
             memset(job.good, 0, npx * sizeof *job.good);
         }
         memset(fb->rgb, 0, npx * 3 * sizeof *fb->rgb);
@@ -608,6 +658,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
             resolve_image(&job);
             if (job.accum) {
                 memcpy(job.accum->sum, job.sum, npx * 3 * sizeof *job.sum);
+                memcpy(job.accum->block, job.block, npx * 3 * sizeof *job.block);
                 memcpy(job.accum->good, job.good, npx * sizeof *job.good);
             }
             if (aov_accum)

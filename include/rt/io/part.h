@@ -2,9 +2,16 @@
  * a float image of a region's per-pixel SUMS of good samples and their
  * COUNTS, and its JSON sidecar saying what it is a part of.
  *
- * The image is `path` (.exr: R, G, B = the sums, count.Y = the counts, 32-bit
- * float, which holds every count up to 2^24 exactly; .pfm: the sums, and the
- * counts in path.count.pfm beside it). The sidecar is `path`.json: the
+ * A pixel's sum is a fold over blocks of RT_SAMPLE_BLOCK samples
+ * (rt/render/sample_block.h); a part keeps it as the fold of its first blocks
+ * (`sum`) and the sums of its last block or blocks kept apart (`blocks`,
+ * rt_part_blocks_ok says which), so a merge can fold the parts' blocks in
+ * sample order to the bits of a single render.
+ *
+ * The image is `path` (.exr: R, G, B = the fold, block.J.R/G/B = block J's
+ * sums, count.Y = the counts, 32-bit float, which holds every count up to
+ * 2^24 exactly; .pfm: the fold, the counts in path.count.pfm and block J in
+ * path.block.J.pfm beside it). The sidecar is `path`.json: the
  * scene's hash, the settings that affect pixels, the image size, the region,
  * the sample range, the seed, rt's version, and the FNV-1a hashes of the
  * image files, so a part whose image was replaced, truncated or corrupted is
@@ -12,11 +19,12 @@
  * first.
  *
  *   rt_part_info info = {...};                     // what the part is
- *   rt_part_write("p.exr", &info, sum, good, NULL, NULL, &err);   // layers: NULL when info.layer_count is 0
+ *   info.block_first = (info.s_end - 1) / RT_SAMPLE_BLOCK, info.block_count = 1;   // rt_part_blocks_ok
+ *   rt_part_write("p.exr", &info, fold, blocks, good, NULL, NULL, &err);   // layers: NULL when info.layer_count is 0
  *
  *   rt_part p;
  *   if (rt_part_read("p.exr", &p, &err) != RT_OK) ... err names the file and what is wrong ...
- *   ... p.info, p.sum (3 floats a pixel of the region), p.good ...
+ *   ... p.info, p.sum (3 floats a pixel of the region), p.blocks, p.good ...
  *   rt_part_free(&p);
  */
 #ifndef RT_PART_H
@@ -27,10 +35,12 @@
 
 #include "rt/base/error.h"
 #include "rt/io/framebuffer.h"
+#include "rt/render/sample_block.h"
 
-#define RT_PART_FORMAT 1            /* the sidecar's "rt_part" version */
+#define RT_PART_FORMAT 2            /* the sidecar's "rt_part" version (1: one plain sum, before sample blocks) */
 #define RT_PART_SETTINGS_MAX 8192   /* bytes of the settings text */
 #define RT_PART_MAX_LAYERS 4        /* extra sums a part may carry (AOVs) */
+#define RT_PART_MAX_BLOCKS 64       /* block sums a part keeps apart at most (4096 samples) */
 
 typedef struct rt_part_info {
     char version[32];          /* rt's version that rendered it */
@@ -43,6 +53,7 @@ typedef struct rt_part_info {
     int s_begin, s_end;        /* the samples summed: [s_begin, s_end) */
     uint32_t seed;
     float exposure;            /* the scene's exposure, for 8-bit output of a merge */
+    int block_first, block_count; /* the blocks kept apart (rt_part_blocks_ok) */
     int layer_count;           /* extra per-pixel sums (EXR parts only): "albedo", "depth" ... */
     char layer_name[RT_PART_MAX_LAYERS][16];
     int layer_channels[RT_PART_MAX_LAYERS]; /* 1 or 3 */
@@ -50,7 +61,8 @@ typedef struct rt_part_info {
 
 typedef struct rt_part {
     rt_part_info info;
-    float *sum;                /* 3 floats a pixel of the region, row-major */
+    float *sum;                /* 3 floats a pixel of the region, row-major: the fold before the blocks */
+    float *blocks;             /* info.block_count planes of 3 floats a pixel, block after block */
     uint32_t *good;            /* 1 a pixel */
     float *layer[RT_PART_MAX_LAYERS]; /* info.layer_channels[k] floats a pixel */
     char path[4096];           /* the image's path (messages) */
@@ -65,17 +77,28 @@ bool rt_part_path_ok(const char *path);
 /* The sidecar's path for a part image: path + ".json". false when it does not fit. */
 bool rt_part_sidecar_path(const char *path, char *out, size_t size);
 
-/* Writes the part's image(s), then its sidecar. sum, good and the
+/* Whether a part of samples [s_begin, s_end) may keep blocks [first,
+ * first + count) apart: the last is the block of sample s_end - 1, and
+ * either it is the only one (the part's `sum` folds the blocks before it:
+ * a part from sample 0, or one merged within the summation bound of
+ * docs/farm.md) or they are all of its blocks from s_begin, a block edge,
+ * on, at most RT_PART_MAX_BLOCKS (its `sum` is then 0, and a merge folds
+ * each block in at its place). */
+bool rt_part_blocks_ok(int s_begin, int s_end, int first, int count);
+
+/* Writes the part's image(s), then its sidecar. sum (the fold), the
+ * info->block_count planes of blocks, good and the
  * info->layer_count layers (EXR layers NAME.R/G/B or NAME.Y) are the
  * region's. temp (may be NULL) tracks the temporary file for a signal
  * handler. */
-rt_result rt_part_write(const char *path, const rt_part_info *info, const float *sum, const uint32_t *good,
-                        const float *const *layers, rt_write_temp *temp, rt_error *err);
+rt_result rt_part_write(const char *path, const rt_part_info *info, const float *sum, const float *const *blocks,
+                        const uint32_t *good, const float *const *layers, rt_write_temp *temp, rt_error *err);
 
 /* Reads a part: `path` is its image or its sidecar (NAME.json). Checks the
  * sidecar's fields and ranges, the image hashes, the image size against the
- * region, and that every sum is finite and non-negative and every count an
- * integer no larger than the sample range. */
+ * region, the blocks against the samples (rt_part_blocks_ok), and that every
+ * sum is finite and non-negative and every count an integer no larger than
+ * the sample range. A part of another format is refused, naming it. */
 rt_result rt_part_read(const char *path, rt_part *part, rt_error *err);
 void rt_part_free(rt_part *part);
 

@@ -21,13 +21,14 @@
  *   After each pass fb holds the whole image at the samples done so far, so
  *   stopping early (cancel, opt.time_limit) still leaves a complete image.
  *   Per pixel the samples are summed in sample order in the same float
- *   arithmetic as tiles (the sums and counts of good samples are kept
- *   between passes), so the final image is bit-identical to the tiled one.
+ *   arithmetic as tiles (the block sums, their fold and the counts of good
+ *   samples are kept between passes, 28 bytes a pixel), so the final image
+ *   is bit-identical to the tiled one.
  * The default is the integrator's (rt_integrator_info.pass_samples): passes
  * of 4 for `path`, which takes hundreds of samples and is worth watching
  * converge; tiles for `direct` and `whitted`, which are usually rendered
  * with a few samples (one pass would be the whole render) and then need no
- * accumulation buffer (16 bytes a pixel) and no sweep over the image each
+ * accumulation buffer (28 bytes a pixel) and no sweep over the image each
  * pass.
  *
  * Parts of an image (docs/farm.md): opt.region renders a rectangle of the
@@ -67,6 +68,7 @@
 #include "rt/base/error.h"
 #include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"
+#include "rt/render/sample_block.h" /* RT_SAMPLE_BLOCK: how a pixel's sum is kept */
 #include "rt/scene/scene.h"
 
 /* One tile of the image: its pixels [x0, x1) x [y0, y1), and whether
@@ -99,16 +101,27 @@ typedef struct rt_render_region {
     int x0, y0, x1, y1;
 } rt_render_region;
 
+
 /* The caller's per-pixel sums (parts, docs/farm.md): region-sized arrays the
  * render continues (zeros for a fresh start, a stored part's values to
  * resume it) and leaves holding the samples before it plus the ones it
  * added: on return, in pass mode, up to the last whole pass (also when
  * stopped); in tile mode, exact only when no tile is missing. */
 typedef struct rt_render_accum {
-    float *sum;     /* 3 floats a pixel: the RGB float sum of the good samples, in sample order */
+    float *sum;     /* 3 floats a pixel: the fold of the blocks before the current one (RT_SAMPLE_BLOCK) */
+    float *block;   /* 3 floats a pixel: the current block's float sum of its good samples, in sample order */
     uint32_t *good; /* 1 a pixel: how many samples were good */
+    /* NULL, or each finished block's sum kept apart as well (a part that
+     * starts inside the image's samples: a merge folds them in after the
+     * parts before it): blocks kept_first .. kept_first + kept_count - 1,
+     * one region-sized plane of 3 floats a pixel each, block after block.
+     * A pass cut short may leave later planes written: only the blocks the
+     * returned samples finished are meaningful. */
+    float *kept;
+    int kept_first, kept_count;
     struct rt_aov_sample *aov_sum; /* NULL, or with opt.aov: the sums of the good samples' albedo, normal,
-                                      position and depth (rt/render/aov.h), continued alike */
+                                      position and depth (rt/render/aov.h), continued alike (one plain sum:
+                                      not in blocks) */
 } rt_render_accum;
 
 typedef struct rt_render_options {
