@@ -157,7 +157,7 @@ static rt_result pnm_precheck(const unsigned char *p, size_t size, const char *n
         for (;;) {
             while (at < size && pnm_space(c))
                 c = pnm_next(p, size, &at);
-            if (c != '#')
+            if (at >= size || c != '#') /* as stb: the end stops it, a '#' there too */
                 break;
             while (at < size && c != '\n' && c != '\r')
                 c = pnm_next(p, size, &at);
