@@ -287,12 +287,15 @@ static void test_radiance_checked(void **state)
 
 /* Binary PNM: stb_image does not check that the pixels are there, so a
  * 12-byte header declaring 664x55372 read as 147 MB of uninitialised
- * pixels (found by the image_file fuzz target); a whole file still reads. */
+ * pixels (found by the image_file fuzz target), and a 38-byte TGA
+ * declaring 8224x8224 took 8 s and 1 GB; a whole file still reads. */
 static void test_pnm_checked(void **state)
 {
     (void)state;
     expect_refused("lying.pgm", "P5 664 55372 ", 13, "PNM data ends at byte 13, but its 664x55372 header needs 36767008");
     expect_refused("short16.pgm", "P5 2 1 65535 \1\2\3", 16, "needs 4 bytes of pixels from byte 13");
+    /* any format: more pixels than a byte can hold (an 18-byte TGA header declaring 8224x8224) */
+    expect_refused("lying.tga", "\0\0\2\0\0\0\0\0\0\0\0\0\x20\x20\x20\x20\x18\0", 18, "too few for any format");
     alarm(60); /* a header ending in a comment's '#' once looped for ever (the fuzzer's) */
     expect_refused("hash.pgm", "P53 65#", 7, NULL);
     alarm(0);

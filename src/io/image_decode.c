@@ -177,6 +177,13 @@ static rt_result pnm_precheck(const unsigned char *p, size_t size, const char *n
     return RT_OK;
 }
 
+/* The most pixels a byte of any format stb_image decodes can hold: a 1-bit
+ * PNG at deflate's 1032:1 (8 x 1032 = 8256). The others hold fewer: JPEG
+ * at least a bit per 8x8 block and component (512 for grey), GIF's 12-bit
+ * LZW codes at most 4096 pixels each (about 2730), TGA and PSD run lengths
+ * 128 pixels per 2 bytes (64), PNM, BMP and uncompressed TGA 1 or less. */
+#define PIXELS_PER_BYTE_MAX 8256u
+
 /* stb reports a failed allocation as "outofmem": that is RT_ERR_NOMEM (the
  * driver then names the memory budget), anything else is a bad image. */
 static rt_result decode_failed(const char *name, rt_error *err)
@@ -232,6 +239,14 @@ rt_result rt_image_decode(const void *data, size_t size, const char *name, const
         return RT_ERR_INVALID;
     if (pnm_precheck(bytes, size, name, err) != RT_OK)
         return RT_ERR_INVALID;
+    /* No format stb reads packs more than PIXELS_PER_BYTE_MAX pixels into a
+     * byte (see its definition); stb fills what a header declares past the
+     * data with zeros or leftovers, so a 38-byte run-length TGA declaring
+     * 8224x8224 took 8 s and 1 GB to read. */
+    if ((uint64_t)w * (uint64_t)h > PIXELS_PER_BYTE_MAX * (uint64_t)size + 65536u)
+        return rt_fail(err, RT_ERR_INVALID,
+                       "%s: image declares %dx%d pixels but is only %zu bytes long, too few for any format rt reads",
+                       name, w, h, size);
     rt_result pr = png_precheck(bytes, size, name, lim->max_side, err);
     if (pr != RT_OK)
         return pr;
