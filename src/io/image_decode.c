@@ -239,17 +239,18 @@ rt_result rt_image_decode(const void *data, size_t size, const char *name, const
         return RT_ERR_INVALID;
     if (pnm_precheck(bytes, size, name, err) != RT_OK)
         return RT_ERR_INVALID;
+    rt_result pr = png_precheck(bytes, size, name, lim->max_side, err);
+    if (pr != RT_OK)
+        return pr;
     /* No format stb reads packs more than PIXELS_PER_BYTE_MAX pixels into a
      * byte (see its definition); stb fills what a header declares past the
      * data with zeros or leftovers, so a 38-byte run-length TGA declaring
-     * 8224x8224 took 8 s and 1 GB to read. */
+     * 8224x8224 took 8 s and 1 GB to read. (After the PNG check, whose
+     * message is more precise.) */
     if ((uint64_t)w * (uint64_t)h > PIXELS_PER_BYTE_MAX * (uint64_t)size + 65536u)
         return rt_fail(err, RT_ERR_INVALID,
                        "%s: image declares %dx%d pixels but is only %zu bytes long, too few for any format rt reads",
                        name, w, h, size);
-    rt_result pr = png_precheck(bytes, size, name, lim->max_side, err);
-    if (pr != RT_OK)
-        return pr;
     int lw = 0, lh = 0, lc = 0;
     if (hdr) {
         img->rgbaf = stbi_loadf_from_memory(bytes, (int)size, &lw, &lh, &lc, 4);
