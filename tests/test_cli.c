@@ -41,6 +41,18 @@ static const char *rt_bin(void)
     return b && *b ? b : "./rt";
 }
 
+/* rt_bin() as an absolute path, for a child that changes directory or
+ * runs under another program. */
+static const char *rt_bin_absolute(void)
+{
+    static char bin[4096], cwd[3000];
+    if (rt_bin()[0] != '/' && getcwd(cwd, sizeof cwd))
+        snprintf(bin, sizeof bin, "%s/%s", cwd, rt_bin());
+    else
+        snprintf(bin, sizeof bin, "%s", rt_bin());
+    return bin;
+}
+
 static double now_s(void)
 {
     struct timespec ts;
@@ -104,12 +116,7 @@ static pid_t spawn_to(const char *const *args, const char *stdout_path)
 {
     const char *argv[64];
     int n = 0;
-    static char bin[4096], cwd[3000]; /* absolute, for a child that changes directory */
-    if (rt_bin()[0] != '/' && getcwd(cwd, sizeof cwd))
-        snprintf(bin, sizeof bin, "%s/%s", cwd, rt_bin());
-    else
-        snprintf(bin, sizeof bin, "%s", rt_bin());
-    argv[n++] = bin;
+    argv[n++] = rt_bin_absolute();
     for (int i = 0; args[i] && n < 63; i++)
         argv[n++] = args[i];
     argv[n] = NULL;
@@ -1102,12 +1109,7 @@ static int run_on_terminal(const char *const *args, char *out, size_t cap)
     assert_int_equal(unlockpt(master), 0);
     const char *slave = ptsname(master);
     assert_non_null(slave);
-    static char bin[4096], cwd[3000];
-    if (rt_bin()[0] != '/' && getcwd(cwd, sizeof cwd))
-        snprintf(bin, sizeof bin, "%s/%s", cwd, rt_bin());
-    else
-        snprintf(bin, sizeof bin, "%s", rt_bin());
-    const char *argv[64] = {bin};
+    const char *argv[64] = {rt_bin_absolute()};
     int n = 1;
     for (int i = 0; args[i] && n < 63; i++)
         argv[n++] = args[i];
@@ -1451,11 +1453,8 @@ static void test_write_renames_right_after_link(void **state)
     (void)state;
     if (access("/usr/bin/strace", X_OK) != 0)
         skip();
-    static char bin[4096], cwd[3000], log[16384];
-    if (rt_bin()[0] != '/' && getcwd(cwd, sizeof cwd))
-        snprintf(bin, sizeof bin, "%s/%s", cwd, rt_bin());
-    else
-        snprintf(bin, sizeof bin, "%s", rt_bin());
+    static char log[16384];
+    const char *bin = rt_bin_absolute();
     const char *outs[2] = {path_in("traced.pfm"), path_in("traced.png")};
     for (int k = 0; k < 2; k++) {
         const char *trace = path_in("strace.txt");
