@@ -1170,9 +1170,9 @@ static void test_progress_line_on_terminal(void **state)
     (void)state;
     static char out[1 << 16];
     const char *pfm = path_in("prog.pfm");
-    const char *modes[2] = {"4", "0"};
+    const char *modes[2] = {"4", "0"}, *spp[2] = {"120", "400"}; /* tiles: long enough for a report before the end */
     for (int m = 0; m < 2; m++) {
-        int status = run_on_terminal((const char *const[]){"-r", "48x48", "-s", "400", "-t", "1", "--integrator",
+        int status = run_on_terminal((const char *const[]){"-r", "48x48", "-s", spp[m], "-t", "1", "--integrator",
                                                            "path", "--passes", modes[m], "-o", pfm, slow_scene(),
                                                            NULL},
                                      out, sizeof out);
@@ -1182,19 +1182,19 @@ static void test_progress_line_on_terminal(void **state)
         assert_contains(out, "kd-tree (1 primitives) ...");
         assert_contains(out, "s, kd-tree ");
         assert_contains(out, "s, render [");
-        assert_contains(out, m == 0 ? "/400 spp" : "/4 tiles");
+        assert_contains(out, m == 0 ? "/120 spp" : "/4 tiles");
         assert_contains(out, "ETA");
         /* the last bar, complete, stays on screen above the wrote line */
-        const char *last = strstr(out, m == 0 ? "100.0% 400/400 spp" : "100.0% 4/4 tiles");
+        const char *last = strstr(out, m == 0 ? "100.0% 120/120 spp" : "100.0% 4/4 tiles");
         if (!last)
             fail_msg("no complete bar on the terminal:\n%s", out + (strlen(out) > 600 ? strlen(out) - 600 : 0));
         const char *wrote = strstr(last, "\nrt: wrote ");
         assert_non_null(wrote);
         double wall = -1, render = -1;
-        const char *semi = strstr(wrote, m == 0 ? "400 of 400 spp; " : "48x48, 400 of 400 spp; ");
+        const char *semi = strstr(wrote, m == 0 ? "120 of 120 spp; " : "48x48, 400 of 400 spp; ");
         assert_non_null(semi);
         assert_int_equal(sscanf(strchr(semi, ';') + 1, " %lf s (render %lf s)", &wall, &render), 2);
-        assert_true(render > 0.0 && wall >= render);
+        assert_true(render >= 0.0 && wall >= render);
     }
     run_result *r = malloc(sizeof *r);
     assert_non_null(r);
@@ -1469,6 +1469,7 @@ static void test_write_renames_right_after_link(void **state)
             dup2(null, 0);
             dup2(null, 1);
             dup2(null, 2);
+            setenv("LSAN_OPTIONS", "detect_leaks=0", 1); /* LeakSanitizer's ptrace cannot attach under strace */
             execl("/usr/bin/strace", "strace", "-f", "-qq", "-o", trace, "-e",
                   "trace=linkat,close,rename,renameat,renameat2", bin, "-q", "-r", "8x8", "-s", "1", "-t", "1", "-o",
                   outs[k], (char *)NULL);
