@@ -22,6 +22,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <stdbool.h>
+#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -1896,8 +1897,9 @@ static void test_display_server_reconnects(void **state)
 
 /* Starts Xvfb on a display number it picks itself (-displayfd); returns
  * its pid and the number, or -1 when there is no Xvfb. The pid is kept in
- * running_xvfb until stop_xvfb, so teardown stops an Xvfb that a failing
- * test left running. */
+ * running_xvfb until stop_xvfb, so teardown (or the next start) stops an
+ * Xvfb that a failing test left running; a test binary killed outright
+ * takes its Xvfb along (PR_SET_PDEATHSIG). */
 static pid_t running_xvfb = -1;
 
 static void stop_xvfb(void)
@@ -1916,9 +1918,13 @@ static pid_t start_xvfb(int *display)
         return -1;
     int fds[2];
     assert_int_equal(pipe(fds), 0);
+    pid_t parent = getpid();
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
+        /* ended with the test binary even when that is killed before its teardown */
+        if (prctl(PR_SET_PDEATHSIG, SIGTERM) != 0 || getppid() != parent)
+            _exit(127);
         close(fds[0]);
         char fd[16];
         snprintf(fd, sizeof fd, "%d", fds[1]);
