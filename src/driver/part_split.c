@@ -83,8 +83,10 @@ rt_result part_split(const rt_scene *scene, const rt_kdtree *tree, int index, in
                 uint64_t pixel = (uint64_t)y * (uint64_t)W + (uint64_t)x;
                 rt_ray ray = rt_camera_ray(&cam, (float)x + 0.5f, (float)y + 0.5f, rt_v2(0.5f, 0.5f));
                 rt_rng rng = rt_rng_for_sample(set->seed, pixel, 0);
-                rays++; /* the camera ray itself: an empty view still costs */
+                uint64_t at = rays;
                 (void)integ->radiance(&ctx, &ray, &rng);
+                if (rays == at)
+                    rays++; /* an integrator that traced nothing: the sample still costs */
             }
         row_cost[j] = rays - before;
     }
