@@ -553,6 +553,33 @@ static void test_time_limit_then_resume(void **state)
     }
 }
 
+/* The integrators that tile (whitted, direct) render in passes when the
+ * render keeps a part, so a stop keeps one there too; --passes 0 (tiles,
+ * asked for) says it keeps none. */
+static void test_time_limit_tiling_integrator(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    RUN_OK("-q", "-s", "64", "--integrator", "whitted", "-o", in_dir("wfull.pfm"), scene);
+    RUN_OK("-q", "-s", "64", "--integrator", "whitted", "--time-limit", "0.001", "--part-out", in_dir("wstop.exr"),
+           "-o", in_dir("wstopped.pfm"), scene);
+    int k = sidecar_end(in_dir("wstop.exr.json"));
+    assert_true(k >= 4 && k <= 64 && k % 4 == 0); /* whole passes of 4 */
+    if (k < 64) {
+        RUN_OK("-q", "-s", "64", "--integrator", "whitted", "--resume", in_dir("wstop.exr"), "-o",
+               in_dir("wresumed.pfm"), scene);
+        assert_same_bytes(in_dir("wresumed.pfm"), in_dir("wfull.pfm"));
+    }
+    RUN_OK("-q", "-s", "64", "--integrator", "direct", "--time-limit", "0.001", "--crop", "0", "0", "40", "15", "-o",
+           in_dir("dstop.exr"), scene);
+    k = sidecar_end(in_dir("dstop.exr.json"));
+    assert_true(k >= 4 && k <= 64 && k % 4 == 0);
+    if (RUN("-s", "64", "--integrator", "whitted", "--passes", "0", "--time-limit", "0.001", "--part-out",
+            in_dir("tstop.exr"), "-o", in_dir("tstopped.pfm"), scene) == 0 &&
+        access(in_dir("tstop.exr.json"), F_OK) != 0)
+        assert_non_null(strstr(err_text, "keeps no part"));
+}
+
 /* Ctrl-C in passes: the part holds the whole passes done (a pass cut short
  * is not in it), and resumed it is the straight render. When the signal
  * lands does not matter to the assertions. */
@@ -810,6 +837,7 @@ int main(void)
         cmocka_unit_test(test_sample_ranges),
         cmocka_unit_test(test_resume_exact),
         cmocka_unit_test(test_time_limit_then_resume),
+        cmocka_unit_test(test_time_limit_tiling_integrator),
         cmocka_unit_test(test_interrupt_then_resume),
         cmocka_unit_test(test_merge_refusals),
         cmocka_unit_test(test_aov_parts),
