@@ -672,8 +672,11 @@ static void test_merge_refusals(void **state)
         RUN_OK("-q", "--part", part, "-o", in_dir(name), scene);
     }
     /* a missing region, a part twice, overlapping regions */
-    REFUSE("in no part", in_dir("g0.exr"), in_dir("g2.exr"));
+    REFUSE("a part is missing: no part covers the region [0, 40) x [", in_dir("g0.exr"), in_dir("g2.exr"));
     REFUSE("given twice", in_dir("g0.exr"), in_dir("g1.exr"), in_dir("g1.exr"), in_dir("g2.exr"));
+    char other_name[700]; /* the same file by another name */
+    snprintf(other_name, sizeof other_name, "%s/./g1.exr", dir);
+    REFUSE("given twice (also as", in_dir("g0.exr"), in_dir("g1.exr"), other_name, in_dir("g2.exr"));
     RUN_OK("-q", "--crop", "0", "0", "40", "20", "-o", in_dir("top.exr"), scene);
     REFUSE("overlaps", in_dir("g0.exr"), in_dir("g1.exr"), in_dir("g2.exr"), in_dir("top.exr"));
     /* sample ranges: overlapping, missing */
@@ -719,6 +722,42 @@ static void test_merge_refusals(void **state)
     REFUSE("e.exr.json", in_dir("g0.exr"), in_dir("e.exr"), in_dir("g2.exr"));
     copy(in_dir("g1.exr"), in_dir("n.exr"), 0);
     REFUSE("n.exr.json", in_dir("g0.exr"), in_dir("n.exr"), in_dir("g2.exr"));
+    /* sidecars with a key twice or absurd numbers, and one whose region is
+     * not the image's size (the image's hash still matches), each named */
+    static const char *const edits[][3] = {
+        {"\"seed\": 7", "\"seed\": 7, \"seed\": 8", "key \"seed\" given twice"},
+        {"\"width\": 40", "\"width\": -40", "\"width\" and \"height\""},
+        {"\"height\": 30", "\"height\": 1e30", "\"width\" and \"height\""},
+        {"\"spp\": 16", "\"spp\": 1e30", "\"spp\" must be"},
+        {"\"samples\": [0, 16]", "\"samples\": [-16, 16]", "\"samples\" must be"},
+        {"\"region\": [0, ", "\"region\": [-1, ", "\"region\" must be"},
+        {", 40, ", ", 41, ", "\"region\" must be"},
+        {", 40, ", ", 39, ", "the image is 40x"},
+        {"\"seed\": 7", "\"seed\": 1e300", "\"seed\" must be"},
+    };
+    for (size_t e = 0; e < sizeof edits / sizeof edits[0]; e++) {
+        t = slurp(in_dir("g1.exr.json"), &n);
+        char *at = strstr(t, edits[e][0]), edited[16384];
+        assert_non_null(at);
+        snprintf(edited, sizeof edited, "%.*s%s%s", (int)(at - t), t, edits[e][1], at + strlen(edits[e][0]));
+        free(t);
+        test_write_file(in_dir("ed.exr.json"), edited, strlen(edited));
+        copy(in_dir("g1.exr"), in_dir("ed.exr"), 0);
+        REFUSE(edits[e][2], in_dir("g0.exr"), in_dir("ed.exr"), in_dir("g2.exr"));
+        assert_non_null(strstr(err_text, "ed.exr"));
+    }
+    /* PFM parts: a truncated image, a truncated or missing counts file */
+    RUN_OK("-q", "--part", "1/3", "-o", in_dir("q.pfm"), scene);
+    static const char *const pfm_cut[][2] = {{"q.pfm", "tq.pfm"}, {"q.count.pfm", "tq.count.pfm"}};
+    for (int c = 0; c < 2; c++) {
+        copy(in_dir("q.pfm"), in_dir("tq.pfm"), 0);
+        copy(in_dir("q.count.pfm"), in_dir("tq.count.pfm"), 0);
+        copy(in_dir("q.pfm.json"), in_dir("tq.pfm.json"), 0);
+        copy(in_dir(pfm_cut[c][0]), in_dir(pfm_cut[c][1]), 500);
+        REFUSE(pfm_cut[c][1], in_dir("g0.exr"), in_dir("tq.pfm"), in_dir("g2.exr"));
+    }
+    unlink(in_dir("tq.count.pfm"));
+    REFUSE("tq.count.pfm", in_dir("g0.exr"), in_dir("tq.pfm"), in_dir("g2.exr"));
     REFUSE("not a part", in_dir("g0.exr"), scene);
     /* the output over a part's own image or sidecar */
     assert_int_equal(RUN("merge", in_dir("g0.exr"), in_dir("g1.exr"), in_dir("g2.exr"), "-o", in_dir("g1.exr")), 2);
@@ -727,6 +766,8 @@ static void test_merge_refusals(void **state)
     /* flags */
     REFUSE(NULL, in_dir("g0.exr"), "--bogus");
     REFUSE("needs at least one PART", "--half");
+    assert_int_equal(RUN("merge", in_dir("g0.exr"), in_dir("g1.exr"), in_dir("g2.exr")), 2); /* no -o */
+    assert_non_null(strstr(err_text, "-o OUT"));
     /* a part must be a float image */
     assert_int_equal(RUN("-q", "--part", "0/3", "-o", in_dir("keep.png"), scene), 2);
     assert_non_null(strstr(err_text, ".exr or .pfm"));
