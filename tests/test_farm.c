@@ -554,6 +554,33 @@ static void test_time_limit_then_resume(void **state)
     }
 }
 
+/* The integrators that tile (whitted, direct) render in passes when the
+ * render keeps a part, so a stop keeps one there too; --passes 0 (tiles,
+ * asked for) says it keeps none. */
+static void test_time_limit_tiling_integrator(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    RUN_OK("-q", "-s", "64", "--integrator", "whitted", "-o", in_dir("wfull.pfm"), scene);
+    RUN_OK("-q", "-s", "64", "--integrator", "whitted", "--time-limit", "0.001", "--part-out", in_dir("wstop.exr"),
+           "-o", in_dir("wstopped.pfm"), scene);
+    int k = sidecar_end(in_dir("wstop.exr.json"));
+    assert_true(k >= 4 && k <= 64 && k % 4 == 0); /* whole passes of 4 */
+    if (k < 64) {
+        RUN_OK("-q", "-s", "64", "--integrator", "whitted", "--resume", in_dir("wstop.exr"), "-o",
+               in_dir("wresumed.pfm"), scene);
+        assert_same_bytes(in_dir("wresumed.pfm"), in_dir("wfull.pfm"));
+    }
+    RUN_OK("-q", "-s", "64", "--integrator", "direct", "--time-limit", "0.001", "--crop", "0", "0", "40", "15", "-o",
+           in_dir("dstop.exr"), scene);
+    k = sidecar_end(in_dir("dstop.exr.json"));
+    assert_true(k >= 4 && k <= 64 && k % 4 == 0);
+    if (RUN("-s", "64", "--integrator", "whitted", "--passes", "0", "--time-limit", "0.001", "--part-out",
+            in_dir("tstop.exr"), "-o", in_dir("tstopped.pfm"), scene) == 0 &&
+        access(in_dir("tstop.exr.json"), F_OK) != 0)
+        assert_non_null(strstr(err_text, "keeps no part"));
+}
+
 /* Ctrl-C in passes: the part holds the whole passes done (a pass cut short
  * is not in it), and resumed it is the straight render. When the signal
  * lands does not matter to the assertions. */
@@ -646,8 +673,11 @@ static void test_merge_refusals(void **state)
         RUN_OK("-q", "--part", part, "-o", in_dir(name), scene);
     }
     /* a missing region, a part twice, overlapping regions */
-    REFUSE("in no part", in_dir("g0.exr"), in_dir("g2.exr"));
+    REFUSE("a part is missing: no part covers the region [0, 40) x [", in_dir("g0.exr"), in_dir("g2.exr"));
     REFUSE("given twice", in_dir("g0.exr"), in_dir("g1.exr"), in_dir("g1.exr"), in_dir("g2.exr"));
+    char other_name[700]; /* the same file by another name */
+    snprintf(other_name, sizeof other_name, "%s/./g1.exr", dir);
+    REFUSE("given twice (also as", in_dir("g0.exr"), in_dir("g1.exr"), other_name, in_dir("g2.exr"));
     RUN_OK("-q", "--crop", "0", "0", "40", "20", "-o", in_dir("top.exr"), scene);
     REFUSE("overlaps", in_dir("g0.exr"), in_dir("g1.exr"), in_dir("g2.exr"), in_dir("top.exr"));
     /* sample ranges: overlapping, missing */
@@ -693,6 +723,42 @@ static void test_merge_refusals(void **state)
     REFUSE("e.exr.json", in_dir("g0.exr"), in_dir("e.exr"), in_dir("g2.exr"));
     copy(in_dir("g1.exr"), in_dir("n.exr"), 0);
     REFUSE("n.exr.json", in_dir("g0.exr"), in_dir("n.exr"), in_dir("g2.exr"));
+    /* sidecars with a key twice or absurd numbers, and one whose region is
+     * not the image's size (the image's hash still matches), each named */
+    static const char *const edits[][3] = {
+        {"\"seed\": 7", "\"seed\": 7, \"seed\": 8", "key \"seed\" given twice"},
+        {"\"width\": 40", "\"width\": -40", "\"width\" and \"height\""},
+        {"\"height\": 30", "\"height\": 1e30", "\"width\" and \"height\""},
+        {"\"spp\": 16", "\"spp\": 1e30", "\"spp\" must be"},
+        {"\"samples\": [0, 16]", "\"samples\": [-16, 16]", "\"samples\" must be"},
+        {"\"region\": [0, ", "\"region\": [-1, ", "\"region\" must be"},
+        {", 40, ", ", 41, ", "\"region\" must be"},
+        {", 40, ", ", 39, ", "the image is 40x"},
+        {"\"seed\": 7", "\"seed\": 1e300", "\"seed\" must be"},
+    };
+    for (size_t e = 0; e < sizeof edits / sizeof edits[0]; e++) {
+        t = slurp(in_dir("g1.exr.json"), &n);
+        char *at = strstr(t, edits[e][0]), edited[16384];
+        assert_non_null(at);
+        snprintf(edited, sizeof edited, "%.*s%s%s", (int)(at - t), t, edits[e][1], at + strlen(edits[e][0]));
+        free(t);
+        test_write_file(in_dir("ed.exr.json"), edited, strlen(edited));
+        copy(in_dir("g1.exr"), in_dir("ed.exr"), 0);
+        REFUSE(edits[e][2], in_dir("g0.exr"), in_dir("ed.exr"), in_dir("g2.exr"));
+        assert_non_null(strstr(err_text, "ed.exr"));
+    }
+    /* PFM parts: a truncated image, a truncated or missing counts file */
+    RUN_OK("-q", "--part", "1/3", "-o", in_dir("q.pfm"), scene);
+    static const char *const pfm_cut[][2] = {{"q.pfm", "tq.pfm"}, {"q.count.pfm", "tq.count.pfm"}};
+    for (int c = 0; c < 2; c++) {
+        copy(in_dir("q.pfm"), in_dir("tq.pfm"), 0);
+        copy(in_dir("q.count.pfm"), in_dir("tq.count.pfm"), 0);
+        copy(in_dir("q.pfm.json"), in_dir("tq.pfm.json"), 0);
+        copy(in_dir(pfm_cut[c][0]), in_dir(pfm_cut[c][1]), 500);
+        REFUSE(pfm_cut[c][1], in_dir("g0.exr"), in_dir("tq.pfm"), in_dir("g2.exr"));
+    }
+    unlink(in_dir("tq.count.pfm"));
+    REFUSE("tq.count.pfm", in_dir("g0.exr"), in_dir("tq.pfm"), in_dir("g2.exr"));
     REFUSE("not a part", in_dir("g0.exr"), scene);
     /* the output over a part's own image or sidecar */
     assert_int_equal(RUN("merge", in_dir("g0.exr"), in_dir("g1.exr"), in_dir("g2.exr"), "-o", in_dir("g1.exr")), 2);
@@ -701,6 +767,8 @@ static void test_merge_refusals(void **state)
     /* flags */
     REFUSE(NULL, in_dir("g0.exr"), "--bogus");
     REFUSE("needs at least one PART", "--half");
+    assert_int_equal(RUN("merge", in_dir("g0.exr"), in_dir("g1.exr"), in_dir("g2.exr")), 2); /* no -o */
+    assert_non_null(strstr(err_text, "-o OUT"));
     /* a part must be a float image */
     assert_int_equal(RUN("-q", "--part", "0/3", "-o", in_dir("keep.png"), scene), 2);
     assert_non_null(strstr(err_text, ".exr or .pfm"));
@@ -924,6 +992,38 @@ static void test_old_format_refused(void **state)
     free(k);
 }
 
+/* --part I/N balances cost, not area, and the cost is the one part_split.c
+ * defines: 1 a ray, 4 more for a ray that finds a surface. The upper half of
+ * this view is a lit wall (a camera ray that hits, 1 + 4, and its shadow
+ * ray, 1: 6 a pixel), the lower half empty (a camera ray that escapes: 1),
+ * so a column costs 32 x 6 + 32 = 224 and the cuts go where the running cost
+ * reaches 56, 112 and 168: after rows 9, 18 and 27 (equal area: 16 rows
+ * each; rays alone: 12, 24, 40). */
+static void test_part_bands_cost(void **state)
+{
+    (void)state;
+    static const char wall[] = "resolution 64 64\nsamples 4\nintegrator direct\n"
+                               "camera position 0 0 10 look_at 0 0 0 up 0 1 0 fov 40\n"
+                               "material white color 0.8 0.8 0.8\nquad -100 0 0  200 0 0  0 100 0  white\n"
+                               "light directional 0 0 -1  1 1 1  1\n";
+    test_write_file(in_dir("wall.txt"), wall, sizeof wall - 1);
+    static const int cuts[5] = {0, 10, 19, 28, 64};
+    for (int i = 0; i < 4; i++) {
+        char part[8];
+        snprintf(part, sizeof part, "%d/4", i);
+        RUN_OK("-q", "--part", part, "-o", in_dir("wb.exr"), in_dir("wall.txt"));
+        size_t sz;
+        char *t = slurp(in_dir("wb.exr.json"), &sz);
+        const char *s = strstr(t, "\"region\": [");
+        int reg[4];
+        assert_non_null(s);
+        assert_int_equal(sscanf(s, "\"region\": [%d, %d, %d, %d]", &reg[0], &reg[1], &reg[2], &reg[3]), 4);
+        free(t);
+        assert_int_equal(reg[1], cuts[i]);
+        assert_int_equal(reg[3], cuts[i + 1]);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -932,6 +1032,7 @@ int main(void)
         cmocka_unit_test(test_sample_ranges),
         cmocka_unit_test(test_resume_exact),
         cmocka_unit_test(test_time_limit_then_resume),
+        cmocka_unit_test(test_time_limit_tiling_integrator),
         cmocka_unit_test(test_interrupt_then_resume),
         cmocka_unit_test(test_merge_refusals),
         cmocka_unit_test(test_aov_parts),
@@ -942,6 +1043,7 @@ int main(void)
         cmocka_unit_test(test_resume_inside_a_block),
         cmocka_unit_test(test_too_many_blocks),
         cmocka_unit_test(test_old_format_refused),
+        cmocka_unit_test(test_part_bands_cost),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

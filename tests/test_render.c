@@ -238,8 +238,9 @@ static void render_tiled_reference(rt_scene *s, rt_render_options *opt, rt_frame
 }
 
 /* Passes of any size give the bytes of the tiled render, for 1, 2 and 3
- * threads and several tile sizes, with every integrator; the path
- * tracer's default is passes. 13 samples: passes of 1, 2, 4, 5 and 13 split
+ * threads and several tile sizes, with every integrator of the table
+ * (path_scalar, the one-path-at-a-time path tracer, too); the path
+ * tracers' default is passes. 13 samples: passes of 1, 2, 4, 5 and 13 split
  * it evenly and unevenly, and 32 is larger than the count. */
 static void test_passes_same_bytes_as_tiles(void **state)
 {
@@ -248,7 +249,8 @@ static void test_passes_same_bytes_as_tiles(void **state)
     build_busy_scene(&s);
     s.settings.samples = 13;
     s.settings.clamp = 3.0f; /* the clamp's arithmetic too */
-    const rt_integrator integrators[] = {RT_INTEGRATOR_PATH, RT_INTEGRATOR_DIRECT, RT_INTEGRATOR_WHITTED};
+    const rt_integrator integrators[] = {RT_INTEGRATOR_PATH, RT_INTEGRATOR_PATH_SCALAR, RT_INTEGRATOR_DIRECT,
+                                         RT_INTEGRATOR_WHITTED};
     const int pass_sizes[] = {1, 2, 4, 5, 13, 32, 0};
     for (size_t k = 0; k < sizeof integrators / sizeof *integrators; k++) {
         s.settings.integrator = integrators[k];
@@ -270,7 +272,8 @@ static void test_passes_same_bytes_as_tiles(void **state)
                 opt.pass_samples = pass_sizes[p];
                 rt_framebuffer fb;
                 assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
-                bool passes = pass_sizes[p] > 0 || integrators[k] == RT_INTEGRATOR_PATH;
+                bool passes = pass_sizes[p] > 0 || integrators[k] == RT_INTEGRATOR_PATH ||
+                              integrators[k] == RT_INTEGRATOR_PATH_SCALAR;
                 assert_int_equal(st.passes, passes);
                 assert_int_equal(st.samples_done, 13);
                 assert_false(st.partial || st.interrupted || st.time_limited);
@@ -321,34 +324,39 @@ static void test_passes_same_bytes_above_a_block(void **state)
 
 /* A time limit already over when the render starts: passes stop after the
  * first pass with the whole image at its samples (the pass that crosses the
- * budget is finished), tiles take no tile; both report it and return OK. */
+ * budget is finished), tiles take no tile; both report it and return OK.
+ * With every integrator of the table, in passes and in tiles. */
 static void test_time_limit(void **state)
 {
     (void)state;
     rt_scene s;
     build_busy_scene(&s);
     s.settings.samples = 64;
-    s.settings.integrator = RT_INTEGRATOR_PATH;
-    rt_render_options opt;
-    memset(&opt, 0, sizeof opt);
-    opt.threads = 2;
-    opt.pass_samples = 3;
-    opt.time_limit = 1e-9;
-    rt_framebuffer fb;
-    rt_render_stats st;
-    assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
-    assert_true(st.passes && st.time_limited && !st.interrupted && !st.partial);
-    assert_int_equal(st.samples_done, 3);
-    assert_int_equal(st.passes_done, 1);
-    assert_int_equal(st.camera_rays, 3 * (uint64_t)fb.width * (uint64_t)fb.height); /* every pixel, 3 samples */
-    rt_framebuffer_free(&fb);
+    const rt_integrator integrators[] = {RT_INTEGRATOR_PATH, RT_INTEGRATOR_PATH_SCALAR, RT_INTEGRATOR_DIRECT,
+                                         RT_INTEGRATOR_WHITTED};
+    for (size_t k = 0; k < sizeof integrators / sizeof *integrators; k++) {
+        s.settings.integrator = integrators[k];
+        rt_render_options opt;
+        memset(&opt, 0, sizeof opt);
+        opt.threads = 2;
+        opt.pass_samples = 3;
+        opt.time_limit = 1e-9;
+        rt_framebuffer fb;
+        rt_render_stats st;
+        assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
+        assert_true(st.passes && st.time_limited && !st.interrupted && !st.partial);
+        assert_int_equal(st.samples_done, 3);
+        assert_int_equal(st.passes_done, 1);
+        assert_int_equal(st.camera_rays, 3 * (uint64_t)fb.width * (uint64_t)fb.height); /* every pixel, 3 samples */
+        rt_framebuffer_free(&fb);
 
-    opt.pass_samples = -1;
-    assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
-    assert_true(!st.passes && st.time_limited && !st.interrupted && st.partial);
-    assert_true(st.tiles_done < st.tiles_total);
-    assert_int_equal(st.samples_done, 0);
-    rt_framebuffer_free(&fb);
+        opt.pass_samples = -1; /* tiles */
+        assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
+        assert_true(!st.passes && st.time_limited && !st.interrupted && st.partial);
+        assert_true(st.tiles_done < st.tiles_total);
+        assert_int_equal(st.samples_done, 0);
+        rt_framebuffer_free(&fb);
+    }
     rt_scene_free(&s);
 }
 

@@ -11,7 +11,8 @@
 #                  EXT_texture_webp
 # and, optionally (rt builds and runs without them; a failed install is only
 # reported): libsdl2-dev for --window, xvfb and xdotool for the tests that
-# open it and move its camera with real X input.
+# open it and move its camera with real X input, strace for the test that
+# the image writer renames right after it links (test_cli).
 #
 # With arguments PACKAGE:COMMAND or PACKAGE ..., it installs instead just
 # the packages whose COMMAND is not on the PATH (or in /usr/sbin), or which
@@ -80,13 +81,14 @@ install_optional() {
     pkg-config --exists sdl2 2>/dev/null || optional="$optional libsdl2-dev"
     [ -x /usr/bin/Xvfb ] || optional="$optional xvfb"
     command -v xdotool >/dev/null 2>&1 || optional="$optional xdotool"
+    [ -x /usr/bin/strace ] || optional="$optional strace" # test_write_renames_right_after_link
     [ -n "$optional" ] || return 0
     if [ "$(id -u)" -eq 0 ]; then
         S=""
     elif sudo -n true 2>/dev/null; then
         S="sudo -n"
     else
-        echo "rt: optional packages not installed:$optional (for --window and its tests)" >&2
+        echo "rt: optional packages not installed:$optional (for --window and its tests, strace for a test of the image writer)" >&2
         return 0
     fi
     echo "rt: installing optional packages:$optional" >&2

@@ -117,7 +117,7 @@ static const flag flags[] = {
      "live view: rewrite the output with the finished tiles every SECONDS"},
     {NULL, "--passes", "N", FLAG_PASSES, NULL,
      "render in passes of N samples per pixel over the whole image; 0 = tile by tile\n"
-     "(default: passes of 4 for path, tiles for direct and whitted)"},
+     "(default: passes of 4 for path and for parts, tiles for direct and whitted)"},
     {NULL, "--time-limit", "SECONDS", FLAG_TIME_LIMIT, NULL,
      "stop after the pass (tiles: the tiles in hand) that crosses SECONDS of rendering and write the image"},
     {NULL, "--display-server", "HOST:PORT", FLAG_DISPLAY_SERVER, NULL,

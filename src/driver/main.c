@@ -282,7 +282,9 @@ static int write_result(const args *a, const rt_settings *set, const part_job *p
     }
     if (status != 2 && a->part_out) {
         if (rs.partial)
-            fprintf(stderr, "rt: %s: no part written: no %s finished\n", a->part_out, rs.passes ? "pass" : "tile");
+            fprintf(stderr, "rt: %s: no part written: %s\n", a->part_out,
+                    rs.passes ? "no pass finished"
+                              : "a render in tiles keeps no part when stopped (--passes 0 asked for tiles)");
         else if (part_job_write(pj, a->part_out, rs.samples_done, &write_temp, err) != RT_OK) {
             memory_budget_report(err, &a->budget);
             status = 2;
@@ -333,6 +335,21 @@ static void free_slice(rt_scene *slice, size_t n)
  * given (posed at its time by render_one), the others loaded and built
  * here one at a time; a stop (Ctrl-C, --time-limit) ends the run at the
  * samples reached. *rs sums the slices' statistics. */
+/* Samples a pass for rt_render_options.pass_samples (0: the integrator's
+ * default; -1: tiles): --passes when given; else a render that keeps a part
+ * (a part output, --part-out, --resume) goes in passes of 4 even where the
+ * integrator would tile (direct, whitted), so that a stop by --time-limit,
+ * Ctrl-C or SIGTERM keeps the passes it finished (pixels are the same for
+ * any pass split). */
+static int pass_samples_for(const args *a, const part_job *pj, const rt_scene *scene)
+{
+    if (a->pass_samples)
+        return a->pass_samples;
+    if (pj->need_accum && rt_integrator_info_of(scene->settings.integrator)->pass_samples <= 0)
+        return 4;
+    return 0;
+}
+
 static rt_result render_slices(const rt_scene *scene, const rt_kdtree *tree, const args *a, int slices,
                                const part_job *pj, rt_render_options *ro, rt_framebuffer *fb, rt_render_stats *rs,
                                progress_view *view, rt_error *err)
@@ -389,7 +406,9 @@ static rt_result render_slices(const rt_scene *scene, const rt_kdtree *tree, con
          * others, which the sums of a part (or --resume) cannot say: a slice
          * is rendered in passes (the same bytes), one pass of all its
          * samples where tiles were asked for */
-        int pass = a->pass_samples ? a->pass_samples : rt_integrator_info_of(scene->settings.integrator)->pass_samples;
+        int pass = pass_samples_for(a, pj, scene);
+        if (pass == 0)
+            pass = rt_integrator_info_of(scene->settings.integrator)->pass_samples;
         if (pass <= 0)
             ro->pass_samples = e - b;
         if (a->time_limit > 0.0) { /* what is left of it */
@@ -540,7 +559,7 @@ static int render_and_write(const rt_scene *scene, const args *a, int slices, co
     memset(&ro, 0, sizeof ro);
     ro.threads = a->threads;
     ro.tile_size = a->tile;
-    ro.pass_samples = a->pass_samples;
+    ro.pass_samples = pass_samples_for(a, &pj, scene);
     ro.time_limit = a->time_limit;
     ro.cancel = &render_stop;
     ro.progress = view->bar || view->preview_path || view->tev || view->window ? progress_report : NULL;

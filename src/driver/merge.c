@@ -75,6 +75,34 @@ static void sort_group(int *idx, int n, const rt_part *parts)
         }
 }
 
+/* 2 when some pixel has no owner: the message names the box the missing
+ * pixels span (a missing band of --part I/N is that band), their number and
+ * the first; else 0. */
+static int report_gap(const int *owner, int W, int H, FILE *errs)
+{
+    int x0 = W, y0 = H, x1 = -1, y1 = -1;
+    size_t missing = 0, first = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++)
+            if (owner[(size_t)y * (size_t)W + (size_t)x] < 0) {
+                if (!missing++)
+                    first = (size_t)y * (size_t)W + (size_t)x;
+                x0 = x < x0 ? x : x0;
+                x1 = x > x1 ? x : x1;
+                y0 = y < y0 ? y : y0;
+                y1 = y > y1 ? y : y1;
+            }
+    if (!missing)
+        return 0;
+    size_t box = (size_t)(x1 + 1 - x0) * (size_t)(y1 + 1 - y0);
+    fprintf(errs,
+            "rt: merge: a part is missing: no part covers %s [%d, %d) x [%d, %d) of the %dx%d image (%zu pixel%s, the "
+            "first (%zu, %zu))\n",
+            missing == box ? "the region" : "pixels in", x0, x1 + 1, y0, y1 + 1, W, H, missing, missing == 1 ? "" : "s",
+            first % (size_t)W, first / (size_t)W);
+    return 2;
+}
+
 /* Checks that the parts fit together and sums them into sum/good and the
  * layers' sums (whole image); 0 or 2 (the message printed). */
 static int assemble(const merge_state *m, float *sum, uint32_t *good, float *const *layer, FILE *errs)
@@ -166,12 +194,8 @@ static int assemble(const merge_state *m, float *sum, uint32_t *good, float *con
                 }
             }
     }
-    for (size_t i = 0; i < (size_t)W * (size_t)H && status == 0; i++)
-        if (owner[i] < 0) {
-            fprintf(errs, "rt: merge: pixel (%zu, %zu) of the %dx%d image is in no part (a part is missing)\n",
-                    i % (size_t)W, i / (size_t)W, W, H);
-            status = 2;
-        }
+    if (status == 0)
+        status = report_gap(owner, W, H, errs);
     free(owner);
     free(idx);
     return status;
@@ -274,11 +298,18 @@ int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs)
             status = 2;
             break;
         }
-        for (int k = 0; k < i && status == 0; k++)
-            if (strcmp(m.parts[k].path, m.parts[i].path) == 0) {
-                fprintf(errs, "rt: merge: %s is given twice\n", m.parts[i].path);
+        for (int k = 0; k < i && status == 0; k++) { /* the same file, by the same name or another */
+            struct stat sk;
+            if (strcmp(m.parts[k].path, m.parts[i].path) == 0 ||
+                (stat(m.parts[k].path, &sk) == 0 && stat(m.parts[i].path, &sp) == 0 && sk.st_dev == sp.st_dev &&
+                 sk.st_ino == sp.st_ino)) {
+                if (strcmp(m.parts[k].path, m.parts[i].path) == 0)
+                    fprintf(errs, "rt: merge: %s is given twice\n", m.parts[i].path);
+                else
+                    fprintf(errs, "rt: merge: %s is given twice (also as %s)\n", m.parts[i].path, m.parts[k].path);
                 status = 2;
             }
+        }
         m.group[i] = -1;
         for (int k = 0; k < i && m.group[i] < 0; k++)
             if (same_region(&m.parts[k].info, &m.parts[i].info))

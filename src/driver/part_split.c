@@ -5,8 +5,11 @@
  * chosen so there are at most about 4096 blocks); in every block four
  * pixels (the centres of its quarters) trace one sample each with the
  * scene's own integrator (sample 0 of a 1-spp render, seeded as a render
- * is), and the block's cost is the number of rays they traced, counted by
- * the trace context. Rays, not seconds: the count is the same on every
+ * is), and the block's cost is what the rays they traced cost, counted by
+ * the trace context: 1 a ray, and HIT_COST more for a ray that found a
+ * surface (a shading; rays that escape the scene are cheap, so counting
+ * rays alone gives the band of an empty sky too little). Rays and hits,
+ * not seconds: the count is the same on every
  * machine and every run, so each machine of a farm computes the same
  * bands without talking to the others. A row costs what its block row
  * costs. The bands are then cut at the rows where the running cost crosses
@@ -28,6 +31,13 @@
 #include "rt/render/sampling.h"
 
 #define MAX_BLOCKS 4096
+/* What a ray that finds a surface costs on top of a ray (1): the surface's
+ * shading and the deeper walk through the tree to it. Measured (CPU time
+ * of the 4 parts, docs/farm.md): a sample of empty background ~0.14-0.16
+ * us, a sample that hits ~0.8-0.9 us with its shadow rays, 5.6-5.9 times;
+ * of 0, 2, 3, 4, 6 and 8, 4 kept the worst part nearest the mean over the
+ * five scenes measured (a dense corner wants more, a direct-lit floor less). */
+#define HIT_COST 4
 
 /* Where a cut between bands goes: at row `want`, but after the previous
  * cut (every band at least one row) and leaving a row for each of the
@@ -71,10 +81,11 @@ rt_result part_split(const rt_scene *scene, const rt_kdtree *tree, int index, in
     rt_camera_frame_init(&cam, &scene->camera, W, H);
     rt_trace_ctx ctx;
     rt_trace_ctx_init(&ctx, &state);
-    uint64_t rays = 0;
+    uint64_t rays = 0, hits = 0;
     ctx.ray_count = &rays;
+    ctx.hit_count = &hits;
     for (int j = 0; j < by; j++) {
-        uint64_t before = rays;
+        uint64_t before = rays + HIT_COST * hits;
         for (int i = 0; i < bx; i++)
             for (int q = 0; q < 4; q++) {
                 int x = i * B + (q & 1 ? 3 * B / 4 : B / 4), y = j * B + (q & 2 ? 3 * B / 4 : B / 4);
@@ -83,10 +94,12 @@ rt_result part_split(const rt_scene *scene, const rt_kdtree *tree, int index, in
                 uint64_t pixel = (uint64_t)y * (uint64_t)W + (uint64_t)x;
                 rt_ray ray = rt_camera_ray(&cam, (float)x + 0.5f, (float)y + 0.5f, rt_v2(0.5f, 0.5f));
                 rt_rng rng = rt_rng_for_sample(set->seed, pixel, 0);
-                rays++; /* the camera ray itself: an empty view still costs */
+                uint64_t at = rays;
                 (void)integ->radiance(&ctx, &ray, &rng);
+                if (rays == at)
+                    rays++; /* an integrator that traced nothing: the sample still costs */
             }
-        row_cost[j] = rays - before;
+        row_cost[j] = rays + HIT_COST * hits - before;
     }
     rt_render_state_free(&state);
     /* every image row costs its block row's cost */

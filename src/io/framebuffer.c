@@ -8,11 +8,15 @@
  *
  * Where Linux offers it, the temporary file has no name while it is
  * written (open(2) O_TMPFILE on the target's directory); only when it is
- * complete is it linked in under a temporary name (linkat(2) through
- * /proc/self/fd, as open(2) describes) and at once renamed over the
- * target. A process killed during the write (a second Ctrl-C, SIGKILL)
- * leaves no file behind. Elsewhere, or on a file system without O_TMPFILE,
- * a mkstemp(3) file is written and renamed as before. */
+ * complete (and closed, through a duplicate descriptor kept for this) is
+ * it linked in under a temporary name (linkat(2) through /proc/self/fd,
+ * as open(2) describes) and renamed over the target by the very next
+ * system call. A process killed during the write (a second Ctrl-C,
+ * SIGKILL) leaves no file behind; the one moment that can is a SIGKILL
+ * landing between those two calls, which leaves a complete image under
+ * .rt-tmp-PID-N (a handled signal removes it: rt_write_temp). Elsewhere,
+ * or on a file system without O_TMPFILE, a mkstemp(3) file is written and
+ * renamed as before. */
 #define _GNU_SOURCE /* O_TMPFILE */
 #include "rt/io/framebuffer.h"
 
@@ -162,14 +166,15 @@ static void discard_temp(temp_file *t)
     publish_name(t, NULL);
 }
 
-/* Gives a closed-over, complete temporary file a name beside the target:
- * an unnamed one is linked in now (a fresh name, retried if taken). */
-static bool name_temp(temp_file *t)
+/* Gives a complete temporary file a name beside the target: an unnamed
+ * one is linked in now through `fd`, an open descriptor of it (a fresh
+ * name, retried if taken). */
+static bool name_temp(temp_file *t, int fd)
 {
     if (!t->unnamed)
         return true;
     char proc[64];
-    snprintf(proc, sizeof proc, "/proc/self/fd/%d", fileno(t->f));
+    snprintf(proc, sizeof proc, "/proc/self/fd/%d", fd);
     for (int attempt = 0; attempt < 100; attempt++) {
         snprintf(t->name, sizeof t->name, "%s/.rt-tmp-%ld-%d", t->dir, (long)getpid(), attempt);
         publish_name(t, t->name);
@@ -339,24 +344,43 @@ static rt_result finish_temp(temp_file *t, const char *path, int ok, rt_error *e
         mode = 0666 & ~mask;
     }
     fchmod(fileno(f), mode);
-    if (!name_temp(t)) {
+    /* The file is closed before it gets a name, so that a failed close (a
+     * network file system reports write errors there) replaces nothing,
+     * and the name is renamed over path by the very next system call: a
+     * close between the two (ext4 may wait on the inode's writeback there)
+     * was a window of milliseconds where SIGKILL left the .rt-tmp name
+     * behind. An unnamed file is kept open for linkat by a duplicate of
+     * its descriptor, closed after the rename. */
+    int keep = -1;
+    if (t->unnamed && (keep = dup(fileno(f))) < 0) {
         saved = errno;
-        discard_temp(t);
-        return rt_fail(err, RT_ERR_IO, "%s: cannot link the finished image in: %s", path, strerror(saved));
-    }
-    if (fclose(f) != 0) {
-        saved = errno;
-        t->f = NULL;
         discard_temp(t);
         return rt_fail(err, RT_ERR_IO, "%s: write failed: %s", path, strerror(saved));
     }
     t->f = NULL;
+    if (fclose(f) != 0) {
+        saved = errno;
+        if (keep >= 0)
+            close(keep);
+        discard_temp(t);
+        return rt_fail(err, RT_ERR_IO, "%s: write failed: %s", path, strerror(saved));
+    }
+    if (!name_temp(t, keep)) {
+        saved = errno;
+        close(keep);
+        discard_temp(t);
+        return rt_fail(err, RT_ERR_IO, "%s: cannot link the finished image in: %s", path, strerror(saved));
+    }
     if (rename(t->name, path) != 0) {
         saved = errno;
+        if (keep >= 0)
+            close(keep);
         discard_temp(t);
         return rt_fail(err, RT_ERR_IO, "%s: cannot rename the finished image into place: %s", path, strerror(saved));
     }
     publish_name(t, NULL); /* renamed: nothing left to remove */
+    if (keep >= 0)
+        close(keep);
     return RT_OK;
 }
 

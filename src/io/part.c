@@ -310,6 +310,20 @@ static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *im
         free(bytes);
         return r;
     }
+    /* a key given twice: which one counts is anybody's guess (RFC 8259 4), so neither */
+    for (int a = 1, ka = 0; r == RT_OK && ka < j.tok[0].size && a < j.count; ka++, a = rt_json_skip(&j, a + 1))
+        for (int b = 1, kb = 0; kb < ka && b < a; kb++, b = rt_json_skip(&j, b + 1))
+            if (j.tok[a].end - j.tok[a].start == j.tok[b].end - j.tok[b].start &&
+                memcmp(bytes + j.tok[a].start, bytes + j.tok[b].start, (size_t)(j.tok[a].end - j.tok[a].start)) == 0) {
+                r = rt_fail(err, RT_ERR_INVALID, "%s: byte %d: key \"%.*s\" given twice", side, j.tok[a].start - 1,
+                            j.tok[a].end - j.tok[a].start, bytes + j.tok[a].start);
+                break;
+            }
+    if (r != RT_OK) {
+        rt_json_free(&j);
+        free(bytes);
+        return r;
+    }
     memset(info, 0, sizeof *info);
     long long fmt, w, h, spp, seed;
     int reg[4], smp[2], blk[2] = {0, 0};

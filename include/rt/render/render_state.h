@@ -63,6 +63,7 @@ void rt_render_state_free(rt_render_state *rs);
 typedef struct rt_trace_ctx {
     const rt_render_state *state;
     uint64_t *ray_count; /* rays this thread traced; NULL = not counted */
+    uint64_t *hit_count; /* of them, rays rt_trace found a hit for (a surface to shade); NULL = not counted */
 } rt_trace_ctx;
 
 void rt_trace_ctx_init(rt_trace_ctx *ctx, const rt_render_state *state);
