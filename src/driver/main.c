@@ -569,7 +569,8 @@ static int render_and_write(const rt_scene *scene, const args *a, int slices, co
     ro.sample_begin = pj.s_begin;
     ro.sample_end = pj.s_end;
     ro.accum = pj.need_accum ? &pj.accum : NULL;
-    aov.noisy_aux = scene->camera.aperture > 0.0f; /* depth of field blurs albedo and normal with noise */
+    /* depth of field and motion blur (an open shutter) blur albedo and normal with noise */
+    aov.noisy_aux = scene->camera.aperture > 0.0f || scene->camera.shutter_close > scene->camera.shutter_open;
     rt_render_stats rs;
     memset(&rs, 0, sizeof rs);
     /* --window: the scene at the window's camera; a camera move cancels the

@@ -20,7 +20,7 @@
 typedef struct output_aovs {
     rt_aov_buffers buf; /* the images the render fills */
     unsigned wanted;    /* bit k: aov_names[k] is written (--aov); --denoise adds albedo and normal unwritten */
-    bool noisy_aux;     /* set by the caller when the camera has an aperture: --denoise prefilters albedo and normal */
+    bool noisy_aux;     /* set by the caller when the camera has an aperture or an open shutter: --denoise prefilters albedo and normal */
 } output_aovs;
 
 /* Checks what the output options need before any rendering: with --denoise,

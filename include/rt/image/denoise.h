@@ -48,7 +48,7 @@ typedef struct rt_denoise_input {
     const float *normal; /* optional, with albedo: its shading normal */
     rt_denoise_quality quality;
     int threads;        /* OIDN's worker threads (its numThreads); 0: rt_cpu_count(), the CPUs of the affinity mask */
-    bool prefilter_aux; /* albedo and normal are noisy (depth of field): denoise them first */
+    bool prefilter_aux; /* albedo and normal are noisy (depth of field, motion blur): denoise them first */
 } rt_denoise_input;
 
 /* The words of the qualities, for messages and --help. */
