@@ -879,6 +879,23 @@ static void test_broken_data(void **state)
             expect_fail("deep.gltf", RT_ERR_LIMIT, "more than 1024 levels deep");
         }
     }
+    /* 100 000 nodes (2.4 MB): the JSON tokenizer once scanned back over every
+     * token at each '}', so this took minutes (30 000 nodes: 7.8 s); with
+     * parent links it is a fraction of a second and still the depth error */
+    {
+        const int len = 100000;
+        size_t cap = (size_t)len * 24 + 64;
+        char *nodes = malloc(cap);
+        size_t o = (size_t)snprintf(nodes, cap, "\"nodes\":[");
+        for (int i = 0; i < len; i++)
+            o += (size_t)snprintf(nodes + o, cap - o, i + 1 < len ? "{\"children\":[%d]}," : "{\"mesh\":0}", i + 1);
+        snprintf(nodes + o, cap - o, "],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]");
+        write_gltf("many-nodes.gltf", pos, sizeof pos, nodes);
+        free(nodes);
+        expect_fail("many-nodes.gltf", RT_ERR_LIMIT, "nodes[1025] is more than 1024 levels deep");
+    }
     write_gltf("range.gltf", pos, sizeof pos,
                "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
                "\"accessors\":[{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]");

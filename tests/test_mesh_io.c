@@ -840,6 +840,12 @@ static void test_ply_errors(void **state)
     load_fail(tpath("notply.ply"), RT_ERR_PARSE, "not a PLY file");
     write_text("badtype.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n");
     load_fail(tpath("badtype.ply"), RT_ERR_PARSE, "badtype.ply:4: unknown property type 'float128'");
+    /* a second 'x' used to be read silently (the later one won) */
+    write_text("dupx.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float x\n"
+                           "property float y\nproperty float z\nelement face 1\n"
+                           "property list uchar int vertex_indices\nend_header\n"
+                           "0 0 0 0\n1 1 0 0\n0 0 1 0\n3 0 1 2\n");
+    load_fail(tpath("dupx.ply"), RT_ERR_PARSE, "dupx.ply:5: property 'x' given twice in element 'vertex'");
 }
 
 static void test_ply_faces_first_and_crlf(void **state)

@@ -1001,6 +1001,19 @@ static void test_errors_values(void **state)
     expect_error("# no models\ncamera gltf 0\n", RT_ERR_INVALID, "2:13", "camera gltf 0: the loaded models have 0 cameras");
     expect_error("material m\nquad 0 0 0  1 0 0  2 0 0  m\n", RT_ERR_INVALID, "2:1", "degenerate quad");
     expect_error("material m\ntriangle 0 0 0  1 1 1  2 2 2  m\n", RT_ERR_INVALID, "2:1", "degenerate triangle");
+    /* sizes whose squares overflow a float: the triangle used to load with a
+     * zero normal (rt_normalize of an infinite length), the camera and the
+     * quad were blamed on the up vector and on parallel edges */
+    expect_error("material m\ntriangle 0 0 0  1e10 0 0  0 1e10 0  m\n", RT_ERR_INVALID, "2:1",
+                 "the triangle is too large: its normal overflows float arithmetic");
+    expect_error("material m\ntriangle 0 0 0  3e38 0 0  0 3e38 0  m\n", RT_ERR_INVALID, "2:1",
+                 "the triangle is too large");
+    expect_error("material m\nquad 0 0 0  1e10 0 0  0 1e10 0  m\n", RT_ERR_INVALID, "2:1",
+                 "the quad is too large: its normal overflows float arithmetic");
+    expect_error("camera position 3e38 0 5 look_at -3e38 0 0 up 0 1 0\n", RT_ERR_INVALID, "1:26",
+                 "the camera look_at point is too far from its position");
+    expect_error("camera position 1e20 0 0 look_at 0 0 0 up 0 1 0\n", RT_ERR_INVALID, "1:26",
+                 "the camera look_at point is too far from its position");
     expect_error("light directional 0 0 0  1 1 1  1\n", RT_ERR_INVALID, "1:19", "the directional light direction is zero");
     expect_error("light point 0 0 0  1 1 1  -5\n", RT_ERR_INVALID, "1:27", "the point light intensity must be >= 0");
     expect_error("light spot 0 0 0  0 -1 0  1 1 1  1  40 30\n", RT_ERR_INVALID, "1:37",

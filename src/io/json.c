@@ -7,7 +7,13 @@
  * Strict mode is on, so primitives must be followed by a delimiter and keys
  * must be strings. Tokens are copied into rt_json_tok so no other file needs
  * jsmn's header. See include/rt/json.h.
+ *
+ * JSMN_PARENT_LINKS: without it jsmn finds the container a '}' or ']'
+ * returns to by scanning back over every token so far, so a file of many
+ * small objects (100 000 nodes, accessors, ...) took time quadratic in its
+ * size (30 000 nodes: 7.8 s); with the links the step is one hop up.
  */
+#define JSMN_PARENT_LINKS
 #define JSMN_STRICT
 #define JSMN_STATIC
 #include <jsmn.h>

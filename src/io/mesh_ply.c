@@ -455,6 +455,12 @@ static bool parse_header(ply_reader *r, ply_file *pf)
                     pr.role = vertex_role(name, nl2);
             }
             copy_name(pr.name, sizeof pr.name, name, nl2);
+            /* "x" twice: which one is the position? (only properties rt
+             * reads are compared, so this stays cheap for wide headers) */
+            if (pr.role != R_SKIP)
+                for (size_t k = el->first_prop; k < pf->nprop; k++)
+                    if (pf->props[k].role == pr.role && strcmp(pf->props[k].name, pr.name) == 0)
+                        return fail_at(r, "property '%s' given twice in element '%s'", pr.name, el->name);
             if (pf->nprop >= 65536 || !rt_grow((void **)&pf->props, &pf->propcap, pf->nprop + 1, sizeof *pf->props))
                 return fail_at(r, "too many properties");
             pf->props[pf->nprop++] = pr;

@@ -745,6 +745,11 @@ static rt_result st_camera(parser *p, const tok *kw)
     rt_vec3 dir = rt_sub(c.look_at, c.position);
     if (!(rt_length2(dir) > 0.0f))
         return perr(p, RT_ERR_INVALID, seen[K_LOOK_AT], "the camera look_at point equals its position");
+    /* past ~1.8e19 the squared length overflows and the direction cannot
+     * be normalised: say so rather than blame the up vector */
+    if (!(rt_length2(dir) < FLT_MAX))
+        return perr(p, RT_ERR_INVALID, seen[K_LOOK_AT],
+                    "the camera look_at point is too far from its position (over 1e19 in float arithmetic)");
     if (!(rt_length2(c.up) > 0.0f))
         return perr(p, RT_ERR_INVALID, seen[K_UP], "the camera up vector is zero");
     if (!(rt_length(rt_cross(rt_normalize(dir), rt_normalize(c.up))) > 1e-6f))
@@ -1207,7 +1212,9 @@ static rt_result st_quad(parser *p, const tok *kw)
         (r = expect_end(p, "quad")) != RT_OK)
         return r;
     rt_vec3 n = rt_cross(u, v);
-    if (!(rt_length2(n) > 0.0f) || !rt_finite3(n))
+    if (!(rt_length2(n) < FLT_MAX))
+        return perr(p, RT_ERR_INVALID, kw, "the quad is too large: its normal overflows float arithmetic");
+    if (!(rt_length2(n) > 0.0f))
         return perr(p, RT_ERR_INVALID, kw, "degenerate quad: its edges are zero or parallel");
     if (rt_scene_add_quad(p->s, c, u, v, m) == RT_NONE)
         return nomem(p, kw);
@@ -1225,7 +1232,9 @@ static rt_result st_triangle(parser *p, const tok *kw)
         (r = get_material(p, "the triangle", &m)) != RT_OK || (r = expect_end(p, "triangle")) != RT_OK)
         return r;
     rt_vec3 n = rt_cross(rt_sub(b, a), rt_sub(c, a));
-    if (!(rt_length2(n) > 0.0f) || !rt_finite3(n))
+    if (!(rt_length2(n) < FLT_MAX))
+        return perr(p, RT_ERR_INVALID, kw, "the triangle is too large: its normal overflows float arithmetic");
+    if (!(rt_length2(n) > 0.0f))
         return perr(p, RT_ERR_INVALID, kw, "degenerate triangle: its vertices are collinear");
     n = rt_normalize(n);
     uint32_t v0 = rt_scene_add_vertices(p->s, 3);
