@@ -359,6 +359,22 @@ static void write_gltf(const char *name, const void *bin, size_t n, const char *
     free(b64);
 }
 
+/* write_gltf with a chain of `len` nodes, each the child of the one before,
+ * the last holding a one-triangle mesh of the buffer's 3 positions. */
+static void write_node_chain(const char *name, const void *bin, size_t n, int len)
+{
+    size_t cap = (size_t)len * 24 + 256;
+    char *nodes = malloc(cap);
+    size_t o = (size_t)snprintf(nodes, cap, "\"nodes\":[");
+    for (int i = 0; i < len; i++)
+        o += (size_t)snprintf(nodes + o, cap - o, i + 1 < len ? "{\"children\":[%d]}," : "{\"mesh\":0}", i + 1);
+    snprintf(nodes + o, cap - o, "],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]");
+    write_gltf(name, bin, n, nodes);
+    free(nodes);
+}
+
 static void assert_vec3(rt_vec3 a, float x, float y, float z)
 {
     assert_float_equal(a.x, x, 1e-5);
@@ -860,16 +876,7 @@ static void test_broken_data(void **state)
     expect_fail("color.gltf", RT_ERR_INVALID, "attributes.COLOR_0: accessor 1 has componentType 5121");
     /* a chain of 1025 nodes is fine (depth 1024), 1026 is over the limit */
     for (int len = 1025; len <= 1026; len++) {
-        size_t cap = (size_t)len * 24 + 64;
-        char *nodes = malloc(cap);
-        size_t o = (size_t)snprintf(nodes, cap, "\"nodes\":[");
-        for (int i = 0; i < len; i++)
-            o += (size_t)snprintf(nodes + o, cap - o, i + 1 < len ? "{\"children\":[%d]}," : "{\"mesh\":0}", i + 1);
-        snprintf(nodes + o, cap - o, "],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
-                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
-                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]");
-        write_gltf("deep.gltf", pos, sizeof pos, nodes);
-        free(nodes);
+        write_node_chain("deep.gltf", pos, sizeof pos, len);
         if (len == 1025) {
             assert_int_equal(load(tmp_path("deep.gltf"), &s, &st, &err), RT_OK);
             assert_int_equal(st.triangles, 1);
@@ -882,20 +889,8 @@ static void test_broken_data(void **state)
     /* 100 000 nodes (2.4 MB): the JSON tokenizer once scanned back over every
      * token at each '}', so this took minutes (30 000 nodes: 7.8 s); with
      * parent links it is a fraction of a second and still the depth error */
-    {
-        const int len = 100000;
-        size_t cap = (size_t)len * 24 + 64;
-        char *nodes = malloc(cap);
-        size_t o = (size_t)snprintf(nodes, cap, "\"nodes\":[");
-        for (int i = 0; i < len; i++)
-            o += (size_t)snprintf(nodes + o, cap - o, i + 1 < len ? "{\"children\":[%d]}," : "{\"mesh\":0}", i + 1);
-        snprintf(nodes + o, cap - o, "],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
-                 "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
-                 "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]");
-        write_gltf("many-nodes.gltf", pos, sizeof pos, nodes);
-        free(nodes);
-        expect_fail("many-nodes.gltf", RT_ERR_LIMIT, "nodes[1025] is more than 1024 levels deep");
-    }
+    write_node_chain("many-nodes.gltf", pos, sizeof pos, 100000);
+    expect_fail("many-nodes.gltf", RT_ERR_LIMIT, "nodes[1025] is more than 1024 levels deep");
     write_gltf("range.gltf", pos, sizeof pos,
                "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
                "\"accessors\":[{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]");
