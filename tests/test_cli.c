@@ -113,14 +113,20 @@ typedef struct run_result {
 static const char *stdin_path; /* the child's standard input when set, else /dev/null */
 static const char *child_dir;  /* the child's working directory when set */
 
+/* argv (cap entries) = program, then the NULL-terminated args, then NULL. */
+static void make_argv(const char **argv, int cap, const char *program, const char *const *args)
+{
+    int n = 0;
+    argv[n++] = program;
+    for (int i = 0; args[i] && n < cap - 1; i++)
+        argv[n++] = args[i];
+    argv[n] = NULL;
+}
+
 static pid_t spawn_to(const char *const *args, const char *stdout_path)
 {
     const char *argv[64];
-    int n = 0;
-    argv[n++] = rt_bin_absolute();
-    for (int i = 0; args[i] && n < 63; i++)
-        argv[n++] = args[i];
-    argv[n] = NULL;
+    make_argv(argv, 64, rt_bin_absolute(), args);
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
@@ -1110,11 +1116,8 @@ static int run_on_terminal(const char *const *args, char *out, size_t cap)
     assert_int_equal(unlockpt(master), 0);
     const char *slave = ptsname(master);
     assert_non_null(slave);
-    const char *argv[64] = {rt_bin_absolute()};
-    int n = 1;
-    for (int i = 0; args[i] && n < 63; i++)
-        argv[n++] = args[i];
-    argv[n] = NULL;
+    const char *argv[64];
+    make_argv(argv, 64, rt_bin_absolute(), args);
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
@@ -2270,11 +2273,7 @@ static int xdo(int dpy, char *out, size_t cap, const char *const *args)
 {
     const char *xout = path_in("xdo.out");
     const char *argv[32];
-    int n = 0;
-    argv[n++] = "xdotool";
-    for (int i = 0; args[i] && n < 31; i++)
-        argv[n++] = args[i];
-    argv[n] = NULL;
+    make_argv(argv, 32, "xdotool", args);
     pid_t pid = fork();
     assert_true(pid >= 0);
     if (pid == 0) {
