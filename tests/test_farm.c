@@ -1009,7 +1009,7 @@ static void test_part_bands_cost(void **state)
     test_write_file(in_dir("wall.txt"), wall, sizeof wall - 1);
     static const int cuts[5] = {0, 10, 19, 28, 64};
     for (int i = 0; i < 4; i++) {
-        char part[8];
+        char part[16];
         snprintf(part, sizeof part, "%d/4", i);
         RUN_OK("-q", "--part", part, "-o", in_dir("wb.exr"), in_dir("wall.txt"));
         size_t sz;
