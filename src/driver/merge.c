@@ -21,11 +21,11 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "output.h"
 #include "part.h"
 #include "rt/base/alloc.h"
+#include "rt/base/file.h"
 #include "rt/base/number.h"
 #include "rt/image/tonemap.h"
 #include "rt/io/framebuffer.h"
@@ -289,20 +289,15 @@ int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs)
             status = 2;
             break;
         }
-        struct stat so, sp;
         char side[4200];
         rt_part_sidecar_path(m.parts[i].path, side, sizeof side);
-        if (stat(dst, &so) == 0 && ((stat(m.parts[i].path, &sp) == 0 && so.st_dev == sp.st_dev && so.st_ino == sp.st_ino) ||
-                                    (stat(side, &sp) == 0 && so.st_dev == sp.st_dev && so.st_ino == sp.st_ino))) {
+        if (rt_same_file(dst, m.parts[i].path) || rt_same_file(dst, side)) {
             fprintf(errs, "rt: merge: %s: the output is one of the part's own files; write the image elsewhere\n", dst);
             status = 2;
             break;
         }
         for (int k = 0; k < i && status == 0; k++) { /* the same file, by the same name or another */
-            struct stat sk;
-            if (strcmp(m.parts[k].path, m.parts[i].path) == 0 ||
-                (stat(m.parts[k].path, &sk) == 0 && stat(m.parts[i].path, &sp) == 0 && sk.st_dev == sp.st_dev &&
-                 sk.st_ino == sp.st_ino)) {
+            if (strcmp(m.parts[k].path, m.parts[i].path) == 0 || rt_same_file(m.parts[k].path, m.parts[i].path)) {
                 if (strcmp(m.parts[k].path, m.parts[i].path) == 0)
                     fprintf(errs, "rt: merge: %s is given twice\n", m.parts[i].path);
                 else
