@@ -470,6 +470,7 @@ static int render_and_write(const rt_scene *scene, const args *a, int slices, co
 
     part_job pj;
     if (part_job_init(&pj, a, scene, &tree, &err) != RT_OK) {
+        part_job_free(&pj); /* whatever a failed --resume had taken from its part */
         progress_clear(view);
         memory_budget_report(&err, &a->budget);
         rt_kdtree_free(&tree);

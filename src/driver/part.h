@@ -37,7 +37,8 @@ typedef struct part_job {
 rt_result part_identity(const rt_scene *scene, const char *input, rt_part_info *info, rt_error *err);
 
 /* Plans the render from the flags (and the part --resume names), checks
- * them against the scene, allocates the sums. */
+ * them against the scene, allocates the sums. After a failure too, pj is
+ * released with part_job_free (which may be called again). */
 rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, const rt_kdtree *tree, rt_error *err);
 void part_job_free(part_job *pj);
 /* Zeroed sums (and AOV sums when aov) for a render that is not a part but
