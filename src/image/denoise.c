@@ -20,9 +20,10 @@
  * denoised image's relMSE and FLIP by under 1% and took two thirds of the
  * time (two more filters, OIDN 2.3+'s larger prefilter networks in high
  * quality). A camera with an aperture (depth of field) does make them noisy
- * where out of focus, and an open shutter (motion blur) where things move: rt_denoise_input.prefilter_aux then runs OIDN's
- * recipe, the albedo and normal each through an RT filter of its own (as
- * its `albedo` and `normal` inputs) before the beauty. The default quality
+ * where out of focus, and an open shutter (motion blur) where things move:
+ * rt_denoise_input.prefilter_aux then runs OIDN's recipe, the albedo and
+ * normal each through an RT filter of its own (as its `albedo` and `normal`
+ * inputs) before the beauty. The default quality
  * is OIDN's "balanced" (its pre-2.3 network): 2.4x less CPU time than
  * "high" on that image for a relMSE 1.35x higher, both ~60x below the
  * noisy image's.
