@@ -270,6 +270,21 @@ static void irradiance(const rt_light *l, rt_vec3 p, rt_vec3 n, int side, stats 
     }
 }
 
+/* Solid-angle sampling's irradiance at point k (sa) against Lambert's
+ * (want) within 4 sigma (jittered samples: the i.i.d. sigma is an upper
+ * bound), and, when `close`, its variance below half area sampling's (ar). */
+static void check_irradiance(const char *what, size_t k, const stats *sa, const stats *ar, double want, bool close)
+{
+    double sd = sqrt(stats_var(sa) / sa->n);
+    fprintf(stderr, "%s point %zu: E %.6f (Lambert %.6f), sd per sample: solid angle %.4g, area %.4g\n", what, k,
+            stats_mean(sa), want, sqrt(stats_var(sa)), sqrt(stats_var(ar)));
+    if (fabs(stats_mean(sa) - want) > 4 * sd + 1e-5 * want)
+        fail_msg("%s point %zu: irradiance %.6f, Lambert %.6f (sd %.6f)", what, k, stats_mean(sa), want, sd);
+    if (close && !(stats_var(sa) < 0.5 * stats_var(ar)))
+        fail_msg("%s point %zu, close by: solid-angle sampling's variance %.4g is not below area sampling's %.4g / 2",
+                 what, k, stats_var(sa), stats_var(ar));
+}
+
 static void test_rect_irradiance(void **state)
 {
     (void)state;
@@ -287,16 +302,7 @@ static void test_rect_irradiance(void **state)
     for (size_t k = 0; k < sizeof pts / sizeof pts[0]; k++) {
         stats sa = {0}, ar = {0};
         irradiance(&l, pts[k].p, pts[k].n, 100, &sa, &ar);
-        double want = lambert_irradiance(poly, 4, pts[k].p, pts[k].n);
-        /* jittered samples: the i.i.d. sigma is an upper bound */
-        double sd = sqrt(stats_var(&sa) / sa.n);
-        fprintf(stderr, "rect point %zu: E %.6f (Lambert %.6f), sd per sample: solid angle %.4g, area %.4g\n", k,
-                stats_mean(&sa), want, sqrt(stats_var(&sa)), sqrt(stats_var(&ar)));
-        if (fabs(stats_mean(&sa) - want) > 4 * sd + 1e-5 * want)
-            fail_msg("rect point %zu: irradiance %.6f, Lambert %.6f (sd %.6f)", k, stats_mean(&sa), want, sd);
-        if (k == 2 && !(stats_var(&sa) < 0.5 * stats_var(&ar)))
-            fail_msg("close to the light, solid-angle sampling's variance %.4g is not below area sampling's %.4g / 2",
-                     stats_var(&sa), stats_var(&ar));
+        check_irradiance("rect", k, &sa, &ar, lambert_irradiance(poly, 4, pts[k].p, pts[k].n), k == 2);
     }
 }
 
@@ -327,15 +333,7 @@ static void test_tri_irradiance(void **state)
             rt_vec3 w = rt_scale(d, 1.0f / sqrtf(d2));
             stats_add(&ar, 0.5 * A2 * fmax(0.0, rt_dot(pts[k].n, w)) * fabs(rt_dot(ng, w)) / d2);
         }
-        double want = lambert_irradiance(v, 3, pts[k].p, pts[k].n);
-        double sd = sqrt(stats_var(&sa) / sa.n);
-        fprintf(stderr, "triangle point %zu: E %.6f (Lambert %.6f), sd per sample: solid angle %.4g, area %.4g\n", k,
-                stats_mean(&sa), want, sqrt(stats_var(&sa)), sqrt(stats_var(&ar)));
-        if (fabs(stats_mean(&sa) - want) > 4 * sd + 1e-5 * want)
-            fail_msg("triangle point %zu: irradiance %.6f, Lambert %.6f (sd %.6f)", k, stats_mean(&sa), want, sd);
-        if (k == 1 && !(stats_var(&sa) < 0.5 * stats_var(&ar)))
-            fail_msg("close to the triangle, solid-angle sampling's variance %.4g is not below area sampling's %.4g / 2",
-                     stats_var(&sa), stats_var(&ar));
+        check_irradiance("triangle", k, &sa, &ar, lambert_irradiance(v, 3, pts[k].p, pts[k].n), k == 1);
     }
 }
 
