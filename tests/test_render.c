@@ -237,6 +237,19 @@ static void render_tiled_reference(rt_scene *s, rt_render_options *opt, rt_frame
     assert_int_equal(render_with(s, opt, ref, st), RT_OK);
 }
 
+/* Renders s with opt, asserts it completed with `samples` per pixel and
+ * gave ref's bytes; *st keeps its statistics. */
+static void assert_renders_like(rt_scene *s, const rt_render_options *opt, const rt_framebuffer *ref, int samples,
+                                rt_render_stats *st)
+{
+    rt_framebuffer fb;
+    assert_int_equal(render_with(s, opt, &fb, st), RT_OK);
+    assert_int_equal(st->samples_done, samples);
+    assert_false(st->partial || st->interrupted || st->time_limited);
+    assert_memory_equal(ref->rgb, fb.rgb, (size_t)ref->width * ref->height * 3 * sizeof(float));
+    rt_framebuffer_free(&fb);
+}
+
 /* Passes of any size give the bytes of the tiled render, for 1, 2 and 3
  * threads and several tile sizes, with every integrator of the table
  * (path_scalar, the one-path-at-a-time path tracer, too); the path
@@ -260,7 +273,6 @@ static void test_passes_same_bytes_as_tiles(void **state)
         render_tiled_reference(&s, &opt, &ref, &st);
         assert_false(st.passes);
         assert_int_equal(st.samples_done, 13);
-        size_t n = (size_t)ref.width * ref.height * 3 * sizeof(float);
         double sum = 0;
         for (size_t i = 0; i < (size_t)ref.width * ref.height * 3; i++)
             sum += ref.rgb[i];
@@ -270,17 +282,12 @@ static void test_passes_same_bytes_as_tiles(void **state)
                 opt.threads = threads;
                 opt.tile_size = threads == 3 ? 5 : 16 * threads;
                 opt.pass_samples = pass_sizes[p];
-                rt_framebuffer fb;
-                assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
+                assert_renders_like(&s, &opt, &ref, 13, &st);
                 bool passes = pass_sizes[p] > 0 || integrators[k] == RT_INTEGRATOR_PATH ||
                               integrators[k] == RT_INTEGRATOR_PATH_SCALAR;
                 assert_int_equal(st.passes, passes);
-                assert_int_equal(st.samples_done, 13);
-                assert_false(st.partial || st.interrupted || st.time_limited);
                 if (passes && pass_sizes[p] > 0)
                     assert_int_equal(st.passes_done, (13 + pass_sizes[p] - 1) / pass_sizes[p]);
-                assert_memory_equal(ref.rgb, fb.rgb, n);
-                rt_framebuffer_free(&fb);
             }
         rt_framebuffer_free(&ref);
     }
@@ -305,17 +312,12 @@ static void test_passes_same_bytes_above_a_block(void **state)
         rt_framebuffer ref;
         rt_render_stats st;
         render_tiled_reference(&s, &opt, &ref, &st);
-        size_t n = (size_t)ref.width * ref.height * 3 * sizeof(float);
         for (size_t p = 0; p < sizeof pass_sizes / sizeof *pass_sizes; p++) {
             opt.threads = 1 + (int)(p % 2);
             opt.tile_size = p % 2 ? 5 : 16;
             opt.pass_samples = pass_sizes[p];
-            rt_framebuffer fb;
-            assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
+            assert_renders_like(&s, &opt, &ref, 130, &st);
             assert_true(st.passes);
-            assert_int_equal(st.samples_done, 130);
-            assert_memory_equal(ref.rgb, fb.rgb, n);
-            rt_framebuffer_free(&fb);
         }
         rt_framebuffer_free(&ref);
     }
