@@ -29,11 +29,17 @@
  * full on BSDF hits.
  *
  * Russian roulette (Arvo and Kirk 1990) from settings.rr_depth bounces: the
- * path survives with q = min(max channel of beta, 0.95) and beta /= q, which
- * keeps the estimator unbiased; rr_depth 0 is adaptive (pbrt-v4's rule):
- * from the first bounce, whenever the max channel of beta has fallen below
- * 1, the path survives with q = that channel. settings.max_depth caps the scattering
- * events of a path (0 = no cap).
+ * path survives with q = min(w, 0.95) and beta /= q, which keeps the
+ * estimator unbiased; rr_depth 0 is adaptive (pbrt-v4's rule): from the
+ * first bounce, whenever w has fallen below 1, the path survives with
+ * q = w. The weight w is the max channel of beta times eta_scale, the
+ * product of (n_t / n_i)^2 over the refractions of a bsdf dielectric the
+ * path took (whose weights scale radiance by (n_i / n_t)^2, a change of
+ * units, not a loss): pbrt-v4's etaScale (Pharr, Jakob, Humphreys, 4th
+ * ed., 13.1.4) and Mitsuba 3's max(throughput) eta^2, so a path inside
+ * glass is judged as it will be once it leaves (issue 30). Thin-walled
+ * and glTF transmission leave radiance unscaled and eta_scale at 1.
+ * settings.max_depth caps the scattering events of a path (0 = no cap).
  *
  * Media (rt/render/medium.h): the path carries a stack of the dielectric
  * objects it is inside (Schmidt and Budge 2002's nested dielectrics). Each
@@ -286,6 +292,7 @@ bool rt_path_start(const rt_trace_ctx *ctx, const rt_ray *ray, rt_path_state *ps
     ps->r = r;
     ps->L = rt_v3s(0.0f);
     ps->beta = rt_v3s(1.0f);
+    ps->eta_scale = 1.0f;
     ps->prev_delta = true; /* the camera "samples" its ray: no MIS */
     ps->prev_pdf = 0.0f;   /* BSDF pdf of the ray just traced */
     ps->prev_p = r.org;
@@ -410,14 +417,17 @@ bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_sur
     ps->beta = beta;
     if (!rt_finite3(beta) || !(rt_max3(beta) > 0.0f))
         return false;
-    if (bs.wi.z < 0.0f) /* transmitted: into or out of the medium */
+    if (bs.wi.z < 0.0f) { /* transmitted: into or out of the medium */
         rt_medium_cross(&ps->media, ctx->state->scene->materials, sf->material, sf->front);
+        if (b->radiance_eta2 && !b->thin) /* the weight held (n_i / n_t)^2 = b->eta^2: undo it for the roulette */
+            ps->eta_scale /= b->eta * b->eta;
+    }
     ps->prev_delta = bs.delta;
     ps->prev_pdf = bs.pdf;
     ps->prev_p = sf->p;
     ps->bounces++;
-    if (rr_depth == 0 ? rt_max3(beta) < 1.0f : ps->bounces >= rr_depth) {
-        float q = rr_depth == 0 ? rt_max3(beta) : rt_fminf(rt_max3(beta), 0.95f);
+    float q = rt_path_rr_probability(ps, rr_depth);
+    if (q < 1.0f) {
         if (stratified && !have_lr)
             ulr = path_2d_of(ctx, ps, rng, lr_bounce, DIM_LOBE_RR);
         if ((stratified ? ulr.y : rt_rng_float(rng)) >= q)

@@ -59,7 +59,8 @@ enum { KIND_BUCKETS = 8 }; /* material kinds (rt_bsdf_model) sorted apart; more 
 struct rt_wavefront {
     size_t batch;        /* lanes */
     size_t rec_per_path; /* light samples a vertex can make: lights + environment + emitter */
-    /* each lane's path and random stream, read and written in place by the
+    /* each lane's path (throughput, eta_scale for the roulette, media
+     * stack, ...) and random stream, read and written in place by the
      * steps of rt/render/pathtrace.h */
     rt_path_state *ps;
     rt_rng *rng;

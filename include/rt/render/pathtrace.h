@@ -56,6 +56,9 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
 typedef struct rt_path_state {
     rt_ray r;          /* the ray to trace next (unit direction) */
     rt_vec3 L, beta;   /* radiance so far, throughput */
+    float eta_scale;   /* the product of (n_t / n_i)^2 over the refractions whose weight scaled beta by
+                        * (n_i / n_t)^2 (bsdf dielectric): beta * eta_scale is the throughput without
+                        * that change of units, what the roulette weighs (1 outside, pbrt-v4's etaScale) */
     bool prev_delta;   /* the last scattering was a delta lobe (or the camera): no MIS */
     float prev_pdf;    /* BSDF pdf of the ray just traced */
     rt_vec3 prev_p;    /* where it left from */
@@ -127,9 +130,25 @@ static inline bool rt_path_samples_emitters(const rt_trace_ctx *ctx)
     return t && t->count;
 }
 /* BSDF sampling, Russian roulette, the next ray in ps->r; false when the
- * path ends. */
+ * path ends. The roulette (rt_path_rr_probability) weighs max channel of
+ * beta x eta_scale: a path inside a dense dielectric is not killed for the
+ * 1 / eta^2 its radiance carries there. */
 bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                         rt_vec3 wo, rt_rng *rng);
+
+/* The probability that Russian roulette lets the path continue once its
+ * bounce ps->bounces is sampled (beta, eta_scale updated): 1 when the
+ * roulette does not play. It weighs w = max channel of beta x eta_scale
+ * (exactly max channel of beta when eta_scale is 1, as on every path that
+ * never refracted through a bsdf dielectric): min(w, 0.95) from rr_depth
+ * bounces on; for rr_depth 0 (adaptive), w whenever w is below 1. */
+static inline float rt_path_rr_probability(const rt_path_state *ps, int rr_depth)
+{
+    float w = rt_max3(ps->beta) * ps->eta_scale;
+    if (rr_depth == 0)
+        return w < 1.0f ? w : 1.0f;
+    return ps->bounces >= rr_depth ? rt_fminf(w, 0.95f) : 1.0f;
+}
 
 /* Power heuristic with exponent 2 (Veach 1997, ch. 9): a^2 / (a^2 + b^2). */
 static inline float rt_mis_power(float a, float b)
