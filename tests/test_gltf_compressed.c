@@ -121,8 +121,7 @@ static void test_decodes_like_original(void **state)
 static void test_meshopt_lossless_exact(void **state)
 {
     (void)state;
-    if (!test_have_shared())
-        skip();
+    test_require_shared();
     rt_scene s, o;
     rt_gltf_stats st, ost;
     rt_error err;

@@ -653,8 +653,7 @@ static void test_cornell_reference(void **state)
 {
     (void)state;
     rt_framebuffer ref;
-    if (!test_read_cornell_reference(&ref))
-        return;
+    test_require_cornell_reference(&ref);
     rt_error err;
     assert_int_equal(ref.width, 512);
     assert_int_equal(ref.height, 512);
@@ -695,8 +694,7 @@ static void test_cornell_emissive_triangles(void **state)
 {
     (void)state;
     rt_framebuffer ref;
-    if (!test_read_cornell_reference(&ref))
-        return;
+    test_require_cornell_reference(&ref);
     FILE *fp = fopen("scenes/cornell-reference.txt", "rb");
     assert_non_null(fp);
     static char text[16384];

@@ -354,8 +354,7 @@ static void test_cornell_reference_wavefront(void **state)
 {
     (void)state;
     rt_framebuffer ref;
-    if (!test_read_cornell_reference(&ref))
-        return;
+    test_require_cornell_reference(&ref);
     fixture f;
     load_cornell(&f, 64);
     f.s.settings.samples = 32;
