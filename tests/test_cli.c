@@ -1329,6 +1329,85 @@ static void test_time_limit(void **state)
     free(r);
 }
 
+/* Which 8x8 tiles of a 64x64 preview are finished: 1 where the tile holds
+ * rendered pixels, 0 where every pixel is --preview's dim grey (0.02); a
+ * tile that is partly grey fails. The count of finished tiles. */
+static int preview_tiles(const rt_framebuffer *fb, int finished[64])
+{
+    int n = 0;
+    for (int t = 0; t < 64; t++) {
+        int grey = 0;
+        for (int y = (t / 8) * 8; y < (t / 8) * 8 + 8; y++)
+            for (int x = (t % 8) * 8; x < (t % 8) * 8 + 8; x++) {
+                const float *p = fb->rgb + 3 * ((size_t)y * 64 + (size_t)x);
+                grey += p[0] == 0.02f && p[1] == 0.02f && p[2] == 0.02f;
+            }
+        if (grey != 0 && grey != 64)
+            fail_msg("preview tile %d is partly grey (%d of 64 pixels)", t, grey);
+        finished[t] = grey == 0;
+        n += finished[t];
+    }
+    return n;
+}
+
+/* --preview SECONDS rewrites the output while a tiled render runs: the
+ * finished tiles as rendered, the others dim grey. The output is watched
+ * until a preview shows a finished tile (tiles of 8192 samples a pixel: the
+ * render is far from done), then rt is interrupted: every tile that preview
+ * showed finished is, bit for bit, the tile NAME.partial.pfm keeps, and the
+ * preview is left as the output. */
+static void test_preview(void **state)
+{
+    (void)state;
+    const char *pfm = path_in("prev.pfm"), *partial = path_in("prev.partial.pfm");
+    put_precious(pfm);
+    unlink(partial);
+    const char *const args[] = {"-q", "--preview", "0.1", "--tile", "8", "-s", "8192", "-t", "2", "--integrator",
+                                "direct", "-o", pfm, slow_scene(), NULL};
+    double t0 = now_s();
+    pid_t pid = spawn(args);
+    rt_framebuffer prev;
+    rt_error err;
+    int finished[64], shown = 0;
+    while (shown == 0) {
+        if (now_s() - t0 > 60.0) {
+            kill(pid, SIGKILL);
+            waitpid(pid, NULL, 0);
+            fail_msg("no preview with a finished tile in %s within 60 s", pfm);
+        }
+        sleep_s(0.01);
+        if (rt_pfm_read(pfm, &prev, &err) != RT_OK)
+            continue; /* still the earlier file: no preview yet */
+        assert_int_equal(prev.width, 64);
+        shown = preview_tiles(&prev, finished);
+        if (shown == 0)
+            rt_framebuffer_free(&prev);
+    }
+    kill(pid, SIGINT);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    wait_for(pid, t0, 120.0, r);
+    assert_int_equal(r->status, 130);
+    free(r);
+    rt_framebuffer part, out;
+    assert_int_equal(rt_pfm_read(partial, &part, &err), RT_OK);
+    for (int t = 0; t < 64; t++)
+        for (int y = (t / 8) * 8; finished[t] && y < (t / 8) * 8 + 8; y++) {
+            size_t o = 3 * ((size_t)y * 64 + (size_t)(t % 8) * 8);
+            if (memcmp(prev.rgb + o, part.rgb + o, 8 * 3 * sizeof(float)) != 0)
+                fail_msg("tile %d: the preview's pixels are not the finished tile's", t);
+        }
+    assert_int_equal(rt_pfm_read(pfm, &out, &err), RT_OK); /* a preview, not the earlier file */
+    int last[64];
+    assert_true(preview_tiles(&out, last) >= shown);
+    rt_framebuffer_free(&out);
+    rt_framebuffer_free(&part);
+    rt_framebuffer_free(&prev);
+    assert_no_temp_files();
+    unlink(pfm);
+    unlink(partial);
+}
+
 /* The second Ctrl-C leaves at once, by the signal itself: the first is
  * sent once the progress bar shows the render running (a pixel of 2^20
  * samples, which takes seconds), the second as soon as the first has been
@@ -2398,6 +2477,7 @@ int main(void)
         cmocka_unit_test(test_sigint_writes_passes),
         cmocka_unit_test(test_sigterm_writes_passes),
         cmocka_unit_test(test_time_limit),
+        cmocka_unit_test(test_preview),
         cmocka_unit_test(test_progress_line_on_terminal),
         cmocka_unit_test(test_second_sigint_exits_at_once),
         cmocka_unit_test(test_killed_write_leaves_no_temp),

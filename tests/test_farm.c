@@ -394,6 +394,37 @@ static void test_frames_animated_gltf(void **state)
     assert_non_null(strstr(err_text, "frame_time"));
 }
 
+/* quad.gltf in the scratch directory: a black quad 2 wide, 20 tall, two
+ * triangles facing +z with its left edge at x = 0; animation 0 moves it by
+ * (-4, 0, 0) at t = 0 to (4, 0, 0) at t = 1, animation 1 holds it at
+ * (-6, 0, 0) over the same times. */
+static void write_moving_quad(void)
+{
+    const float data[] = {0, -10, 0, 2, -10, 0, 2, 10, 0, 0, -10, 0, 2, 10, 0, 0, 10, 0, 0, 1, -4, 0, 0, 4, 0, 0,
+                          -6, 0, 0, -6, 0, 0};
+    char *enc = test_base64(data, sizeof data);
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,"
+             "\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":72},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":8},"
+             "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":24},{\"buffer\":0,\"byteOffset\":104,\"byteLength\":24}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\","
+             "\"min\":[0,-10,0],\"max\":[2,10,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":2,"
+             "\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},{\"bufferView\":2,\"componentType\":5126,\"count\":2,"
+             "\"type\":\"VEC3\"},{\"bufferView\":3,\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"}],"
+             "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"metallicFactor\":0}}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+             "\"animations\":[{\"samplers\":[{\"input\":1,\"output\":2}],"
+             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]},"
+             "{\"samplers\":[{\"input\":1,\"output\":3}],"
+             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]}",
+             sizeof data, enc);
+    free(enc);
+    test_write_file(in_dir("quad.gltf"), json, strlen(json));
+}
+
 /* A scene file (name in dir) around the moving quad, with `camera_extra`
  * on its camera line, `extra` lines after it and `model_extra` on the
  * model line. */
@@ -436,27 +467,7 @@ static double column_mean(const char *path, int x)
 static void test_motion_blur(void **state)
 {
     (void)state;
-    /* the quad: two triangles facing +z; its translation over [0, 1] */
-    const float data[] = {0, -10, 0, 2, -10, 0, 2, 10, 0, 0, -10, 0, 2, 10, 0, 0, 10, 0, 0, 1, -4, 0, 0, 4, 0, 0};
-    char *enc = test_base64(data, sizeof data);
-    char json[4096];
-    snprintf(json, sizeof json,
-             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,"
-             "\"uri\":\"data:application/octet-stream;base64,%s\"}],"
-             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":72},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":8},"
-             "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":24}],"
-             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\","
-             "\"min\":[0,-10,0],\"max\":[2,10,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":2,"
-             "\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},{\"bufferView\":2,\"componentType\":5126,\"count\":2,"
-             "\"type\":\"VEC3\"}],"
-             "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"metallicFactor\":0}}],"
-             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
-             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
-             "\"animations\":[{\"samplers\":[{\"input\":1,\"output\":2}],"
-             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]}",
-             sizeof data, enc);
-    free(enc);
-    test_write_file(in_dir("quad.gltf"), json, strlen(json));
+    write_moving_quad();
     write_motion_scene("blur.txt", "shutter 0 1", "motion_steps 16", "");
     RUN_OK("-q", "-o", in_dir("blur.pfm"), in_dir("blur.txt"));
     for (int x = 0; x < 16; x++) { /* every column against its time overlap, integrated over the column */
@@ -516,6 +527,29 @@ static void test_motion_blur(void **state)
     assert_int_equal(RUN("-q", "-o", in_dir("x.pfm"), in_dir("bad.txt")), 2);
     assert_non_null(strstr(err_text, "bad.txt:5:"));
     assert_non_null(strstr(err_text, "closes (0 s) before it opens (1 s)"));
+}
+
+/* --animation N picks the glTF animation --frame-time plays: at t = 0.5
+ * animation 0 has the quad over x in [0, 2] (pixel column 8 black, column
+ * 2 white), animation 1 holds it over [-6, -4] (column 2 black, column 8
+ * white); animation 0 is the default; one the file does not have is
+ * refused, naming the count. */
+static void test_animation_index(void **state)
+{
+    (void)state;
+    write_moving_quad();
+    write_motion_scene("still.txt", "", "", "");
+    RUN_OK("-q", "--frame-time", "0.5", "-o", in_dir("anim-default.pfm"), in_dir("still.txt"));
+    RUN_OK("-q", "--frame-time", "0.5", "--animation", "0", "-o", in_dir("anim0.pfm"), in_dir("still.txt"));
+    RUN_OK("-q", "--frame-time", "0.5", "--animation", "1", "-o", in_dir("anim1.pfm"), in_dir("still.txt"));
+    assert_same_bytes(in_dir("anim-default.pfm"), in_dir("anim0.pfm"));
+    assert_true(column_mean(in_dir("anim0.pfm"), 8) == 0.0 && column_mean(in_dir("anim0.pfm"), 2) == 1.0);
+    assert_true(column_mean(in_dir("anim1.pfm"), 2) == 0.0 && column_mean(in_dir("anim1.pfm"), 8) == 1.0);
+    assert_int_equal(RUN("-q", "--frame-time", "0.5", "--animation", "2", "-o", in_dir("anim2.pfm"),
+                         in_dir("still.txt")),
+                     2);
+    assert_non_null(strstr(err_text, "quad.gltf: animation 2 requested, the file has 2 (0 to 1)"));
+    assert_int_equal(access(in_dir("anim2.pfm"), F_OK), -1);
 }
 
 /* The samples [0, k] a sidecar says its part holds. */
@@ -1011,6 +1045,7 @@ int main(void)
         cmocka_unit_test(test_aov_parts),
         cmocka_unit_test(test_frames),
         cmocka_unit_test(test_frames_animated_gltf),
+        cmocka_unit_test(test_animation_index),
         cmocka_unit_test(test_motion_blur),
         cmocka_unit_test(test_part_bands),
         cmocka_unit_test(test_aligned_ranges_same_bytes),
