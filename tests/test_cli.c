@@ -252,8 +252,7 @@ static void expect_refusal_v(const char *protect, const char *msg1, const char *
 static int setup(void **state)
 {
     (void)state;
-    snprintf(dir, sizeof dir, "/tmp/rt-test-cli-XXXXXX");
-    if (!mkdtemp(dir))
+    if (!test_make_dir(dir, sizeof dir, "cli"))
         return -1;
     snprintf(out_png, sizeof out_png, "%s/out.png", dir);
     if (access(rt_bin(), X_OK) != 0) {
@@ -269,19 +268,7 @@ static int teardown(void **state)
 {
     (void)state;
     stop_xvfb();
-    DIR *d = opendir(dir);
-    if (d) {
-        struct dirent *e;
-        while ((e = readdir(d))) {
-            if (e->d_name[0] == '.' && (e->d_name[1] == 0 || (e->d_name[1] == '.' && e->d_name[2] == 0)))
-                continue;
-            char p[600];
-            snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-            unlink(p);
-        }
-        closedir(d);
-    }
-    rmdir(dir);
+    test_remove_dir(dir);
     return 0;
 }
 

@@ -553,8 +553,8 @@ static void write_pfm(const char *path, const float *rgb, int w, int h)
 static void test_rt_compare(void **state)
 {
     (void)state;
-    char dir[] = "/tmp/rt_test_compare_XXXXXX";
-    assert_non_null(mkdtemp(dir));
+    char dir[64];
+    assert_true(test_make_dir(dir, sizeof dir, "compare"));
     char cand[256], ref[256], small[256], nan_img[256], map[256], hdr_map[256], missing[256];
     snprintf(cand, sizeof cand, "%s/cand.pfm", dir);
     snprintf(ref, sizeof ref, "%s/ref.pfm", dir);
@@ -676,10 +676,7 @@ static void test_rt_compare(void **state)
     free(before);
     free(after);
 
-    const char *files[] = {cand, ref, small, nan_img, map, hdr_map};
-    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
-        unlink(files[i]);
-    rmdir(dir);
+    test_remove_dir(dir);
     free(cq);
     free(rq);
     free(c);

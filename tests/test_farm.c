@@ -114,8 +114,7 @@ static void assert_same_bytes(const char *a, const char *b)
 static int setup(void **state)
 {
     (void)state;
-    snprintf(dir, sizeof dir, "/tmp/rt-test-farm-XXXXXX");
-    if (!mkdtemp(dir) || access(rt_bin(), X_OK) != 0)
+    if (!test_make_dir(dir, sizeof dir, "farm") || access(rt_bin(), X_OK) != 0)
         return -1;
     snprintf(scene_path, sizeof scene_path, "%s/scene.txt", dir);
     /* the glass Cornell box, small, path traced (passes; --integrator picks the others) */

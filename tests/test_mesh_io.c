@@ -1108,8 +1108,7 @@ static void test_shared_meshes(void **state)
 
 int main(void)
 {
-    snprintf(tmpdir, sizeof tmpdir, "/tmp/rt_test_mesh_io_XXXXXX");
-    if (!mkdtemp(tmpdir)) {
+    if (!test_make_dir(tmpdir, sizeof tmpdir, "mesh_io")) {
         perror("mkdtemp");
         return 1;
     }
@@ -1137,9 +1136,6 @@ int main(void)
         cmocka_unit_test(test_shared_meshes),
     };
     int failed = cmocka_run_group_tests_name("mesh_io", tests, NULL, NULL);
-    char cmd[320];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
-    if (system(cmd) != 0)
-        fprintf(stderr, "note: could not remove %s\n", tmpdir);
+    test_remove_dir(tmpdir);
     return failed;
 }

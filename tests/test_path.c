@@ -654,7 +654,10 @@ static void test_every_material_finite_and_deterministic(void **state)
     unload(&f);
 }
 
-/* The shared reference: scenes/cornell-reference.txt at 64x64 (the same
+/* The Cornell-reference test (the one: test_wavefront.c checks that
+ * path_scalar renders the same bytes as `path`, the wavefront, used here;
+ * test_sampler.c compares samplers' errors against the same reference).
+ * The shared reference: scenes/cornell-reference.txt at 64x64 (the same
  * camera, so each pixel covers an 8x8 block of the 512x512 reference) and
  * 256 samples per pixel, against the reference box-averaged over 8x8
  * blocks. The reference's own noise (RMSE 0.002 per 512x512 pixel at 8064

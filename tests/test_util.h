@@ -146,16 +146,18 @@ static inline void test_write_file(const char *path, const void *data, size_t si
     fclose(f);
 }
 
-/* A fresh scratch directory /tmp/rt_test_TAG_XXXXXX into dir (size >= 64);
- * false when it cannot be made. */
+/* The tests' one scratch-directory helper: a fresh directory
+ * /tmp/rt_test_TAG_XXXXXX into dir (size >= 64), made in a group setup or
+ * a test, and test_remove_dir in the teardown; false when it cannot be
+ * made. */
 static inline int test_make_dir(char *dir, size_t size, const char *tag)
 {
     snprintf(dir, size, "/tmp/rt_test_%s_XXXXXX", tag);
     return mkdtemp(dir) != NULL;
 }
 
-/* Removes a scratch directory made by test_make_dir with the files in it
- * (no subdirectories). */
+/* Removes a scratch directory made by test_make_dir with everything in it
+ * (subdirectories too; symbolic links are removed, not followed). */
 static inline void test_remove_dir(const char *dir)
 {
     DIR *d = opendir(dir);
@@ -164,8 +166,14 @@ static inline void test_remove_dir(const char *dir)
         char p[4200];
         while ((e = readdir(d)))
             if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) {
-                snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-                unlink(p);
+                int n = snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
+                struct stat st;
+                if (n < 0 || (size_t)n >= sizeof p)
+                    continue; /* no such name in a scratch directory */
+                if (lstat(p, &st) == 0 && S_ISDIR(st.st_mode))
+                    test_remove_dir(p);
+                else
+                    unlink(p);
             }
         closedir(d);
     }
