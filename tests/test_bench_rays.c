@@ -163,14 +163,11 @@ static void check_set(const rt_kdtree *tree, const char *model, const char *kind
 static void test_bench_rays(void **state)
 {
     (void)state;
-    if (!test_have_shared())
-        return;
+    test_require_shared();
     bench_model models[16];
     size_t n = read_manifest(models, 16);
-    if (n == 0) {
-        fprintf(stderr, "note: no bench manifest at %s; skipping\n", test_shared_path("bench/MANIFEST.md"));
-        return;
-    }
+    if (n == 0) /* the shared assets are there: their ray sets must be too */
+        fail_msg("no bench models in %s", test_shared_path("bench/MANIFEST.md"));
     for (size_t m = 0; m < n; m++) {
         rt_scene scene;
         rt_scene_init(&scene);

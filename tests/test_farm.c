@@ -7,7 +7,9 @@
  * merge refuses parts that do not make one image, naming the part, with
  * exit status 2 and nothing written. Runs ./rt (RT_BIN) in a scratch
  * directory. */
+#define _XOPEN_SOURCE 700 /* posix_openpt: a terminal for the progress bar */
 #include "test_util.h"
+#include "test_terminal.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -112,8 +114,7 @@ static void assert_same_bytes(const char *a, const char *b)
 static int setup(void **state)
 {
     (void)state;
-    snprintf(dir, sizeof dir, "/tmp/rt-test-farm-XXXXXX");
-    if (!mkdtemp(dir) || access(rt_bin(), X_OK) != 0)
+    if (!test_make_dir(dir, sizeof dir, "farm") || access(rt_bin(), X_OK) != 0)
         return -1;
     snprintf(scene_path, sizeof scene_path, "%s/scene.txt", dir);
     /* the glass Cornell box, small, path traced (passes; --integrator picks the others) */
@@ -310,9 +311,8 @@ static void test_aov_parts(void **state)
 }
 
 /* --frames A:B: one file a frame, named from the pattern; a scene without
- * animation gives the single render each frame; an animated glTF, given
- * directly or on a scene file's model line, is posed at each frame's time;
- * bad patterns are refused up front. */
+ * animation gives the single render each frame; bad patterns are refused
+ * up front. */
 static void test_frames(void **state)
 {
     (void)state;
@@ -333,57 +333,95 @@ static void test_frames(void **state)
         assert_int_equal(RUN("-q", "--frames", "0:2", "-o", in_dir(bad[i]), scene), 2);
         assert_non_null(strstr(err_text, "%0Nd"));
     }
-    /* an animated glTF: frame f is the model posed at f / fps, as --frame-time poses it */
-    if (test_have_shared()) {
-        const char *truck = test_shared_path("assets/gltf/CesiumMilkTruck/glTF-Binary/CesiumMilkTruck.glb");
-        static char model[4096];
-        snprintf(model, sizeof model, "%s", truck);
-        snprintf(pattern, sizeof pattern, "%s/truck.%%d.png", dir);
-        RUN_OK("-q", "-r", "48x36", "-s", "2", "--frames", "0:3", "--fps", "4", "-o", pattern, model);
-        RUN_OK("-q", "-r", "48x36", "-s", "2", "--frame-time", "0.5", "-o", in_dir("truck-t.png"), model);
-        assert_same_bytes(in_dir("truck.2.png"), in_dir("truck-t.png"));
-        size_t n0, n2;
-        char *f0 = slurp(in_dir("truck.0.png"), &n0), *f2 = slurp(in_dir("truck.2.png"), &n2);
-        assert_true(n0 != n2 || memcmp(f0, f2, n0) != 0); /* the truck moved */
-        free(f0);
-        free(f2);
-        /* parts of different frames are parts of different renders */
-        snprintf(pattern, sizeof pattern, "%s/tp.%%d.exr", dir);
-        RUN_OK("-q", "-r", "48x36", "-s", "2", "--frames", "0:2", "--part", "0/2", "-o", pattern, model);
-        RUN_OK("-q", "-r", "48x36", "-s", "2", "--frames", "1:2", "--part", "1/2", "-o", pattern, model);
-        assert_int_equal(RUN("merge", in_dir("tp.0.exr"), in_dir("tp.1.exr"), "-o", in_dir("tp.png")), 2);
-        assert_non_null(strstr(err_text, "not a part of the same render"));
-        /* a scene file around an animated model: its model line is posed at each frame's time */
-        char text[8000], fox[6200];
-        const char *rel = test_shared_path("assets/gltf/Fox/glTF-Binary/Fox.glb"); /* the scene is elsewhere */
-        char cwd[2048] = "";
-        assert_true(rel[0] == '/' || getcwd(cwd, sizeof cwd) != NULL);
-        snprintf(fox, sizeof fox, "%s%s%s", rel[0] == '/' ? "" : cwd, rel[0] == '/' ? "" : "/", rel);
-        snprintf(text, sizeof text,
-                 "resolution 48 36\nsamples 2\ncamera position 90 60 200 look_at 0 35 0 up 0 1 0 fov 40\n"
-                 "light directional -0.4 -1 -0.6 1 1 1 2\nmodel \"%s\" animation Run\n",
-                 fox);
-        FILE *f = fopen(in_dir("fox.txt"), "wb");
-        assert_non_null(f);
-        fputs(text, f);
-        fclose(f);
-        snprintf(pattern, sizeof pattern, "%s/fox.%%d.png", dir);
-        RUN_OK("-q", "--frames", "0:3", "--fps", "4", "-o", pattern, in_dir("fox.txt"));
-        RUN_OK("-q", "--frame-time", "0.5", "-o", in_dir("fox-t.png"), in_dir("fox.txt"));
-        assert_same_bytes(in_dir("fox.2.png"), in_dir("fox-t.png"));
-        f0 = slurp(in_dir("fox.0.png"), &n0), f2 = slurp(in_dir("fox.2.png"), &n2);
-        assert_true(n0 != n2 || memcmp(f0, f2, n0) != 0); /* the fox ran */
-        free(f0);
-        free(f2);
-        snprintf(pattern, sizeof pattern, "%s/foxp.%%d.exr", dir);
-        RUN_OK("-q", "--frames", "0:2", "--part", "0/2", "-o", pattern, in_dir("fox.txt"));
-        RUN_OK("-q", "--frames", "1:2", "--part", "1/2", "-o", pattern, in_dir("fox.txt"));
-        assert_int_equal(RUN("merge", in_dir("foxp.0.exr"), in_dir("foxp.1.exr"), "-o", in_dir("foxp.png")), 2);
-        assert_non_null(strstr(err_text, "frame_time"));
-    }
     assert_int_equal(RUN("-q", "--frames", "0:2", "--frame-time", "1", "-o", pattern, scene), 2);
     assert_int_equal(RUN("-q", "--frames", "2:2", "-o", pattern, scene), 2);
     assert_int_equal(RUN("-q", "--frames", "0:2", "--fps", "0", "-o", pattern, scene), 2);
+}
+
+/* --frames of an animated glTF: frame f is the model posed at f / fps, as
+ * --frame-time poses it, given directly or on a scene file's model line;
+ * parts of different frames are parts of different renders. */
+static void test_frames_animated_gltf(void **state)
+{
+    (void)state;
+    test_require_shared();
+    char pattern[600];
+    const char *truck = test_shared_path("assets/gltf/CesiumMilkTruck/glTF-Binary/CesiumMilkTruck.glb");
+    static char model[4096];
+    snprintf(model, sizeof model, "%s", truck);
+    snprintf(pattern, sizeof pattern, "%s/truck.%%d.png", dir);
+    RUN_OK("-q", "-r", "48x36", "-s", "2", "--frames", "0:3", "--fps", "4", "-o", pattern, model);
+    RUN_OK("-q", "-r", "48x36", "-s", "2", "--frame-time", "0.5", "-o", in_dir("truck-t.png"), model);
+    assert_same_bytes(in_dir("truck.2.png"), in_dir("truck-t.png"));
+    size_t n0, n2;
+    char *f0 = slurp(in_dir("truck.0.png"), &n0), *f2 = slurp(in_dir("truck.2.png"), &n2);
+    assert_true(n0 != n2 || memcmp(f0, f2, n0) != 0); /* the truck moved */
+    free(f0);
+    free(f2);
+    /* parts of different frames are parts of different renders */
+    snprintf(pattern, sizeof pattern, "%s/tp.%%d.exr", dir);
+    RUN_OK("-q", "-r", "48x36", "-s", "2", "--frames", "0:2", "--part", "0/2", "-o", pattern, model);
+    RUN_OK("-q", "-r", "48x36", "-s", "2", "--frames", "1:2", "--part", "1/2", "-o", pattern, model);
+    assert_int_equal(RUN("merge", in_dir("tp.0.exr"), in_dir("tp.1.exr"), "-o", in_dir("tp.png")), 2);
+    assert_non_null(strstr(err_text, "not a part of the same render"));
+    /* a scene file around an animated model: its model line is posed at each frame's time */
+    char text[8000], fox[6200];
+    const char *rel = test_shared_path("assets/gltf/Fox/glTF-Binary/Fox.glb"); /* the scene is elsewhere */
+    char cwd[2048] = "";
+    assert_true(rel[0] == '/' || getcwd(cwd, sizeof cwd) != NULL);
+    snprintf(fox, sizeof fox, "%s%s%s", rel[0] == '/' ? "" : cwd, rel[0] == '/' ? "" : "/", rel);
+    snprintf(text, sizeof text,
+             "resolution 48 36\nsamples 2\ncamera position 90 60 200 look_at 0 35 0 up 0 1 0 fov 40\n"
+             "light directional -0.4 -1 -0.6 1 1 1 2\nmodel \"%s\" animation Run\n",
+             fox);
+    FILE *f = fopen(in_dir("fox.txt"), "wb");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    snprintf(pattern, sizeof pattern, "%s/fox.%%d.png", dir);
+    RUN_OK("-q", "--frames", "0:3", "--fps", "4", "-o", pattern, in_dir("fox.txt"));
+    RUN_OK("-q", "--frame-time", "0.5", "-o", in_dir("fox-t.png"), in_dir("fox.txt"));
+    assert_same_bytes(in_dir("fox.2.png"), in_dir("fox-t.png"));
+    f0 = slurp(in_dir("fox.0.png"), &n0), f2 = slurp(in_dir("fox.2.png"), &n2);
+    assert_true(n0 != n2 || memcmp(f0, f2, n0) != 0); /* the fox ran */
+    free(f0);
+    free(f2);
+    snprintf(pattern, sizeof pattern, "%s/foxp.%%d.exr", dir);
+    RUN_OK("-q", "--frames", "0:2", "--part", "0/2", "-o", pattern, in_dir("fox.txt"));
+    RUN_OK("-q", "--frames", "1:2", "--part", "1/2", "-o", pattern, in_dir("fox.txt"));
+    assert_int_equal(RUN("merge", in_dir("foxp.0.exr"), in_dir("foxp.1.exr"), "-o", in_dir("foxp.png")), 2);
+    assert_non_null(strstr(err_text, "frame_time"));
+}
+
+/* quad.gltf in the scratch directory: a black quad 2 wide, 20 tall, two
+ * triangles facing +z with its left edge at x = 0; animation 0 moves it by
+ * (-4, 0, 0) at t = 0 to (4, 0, 0) at t = 1, animation 1 holds it at
+ * (-6, 0, 0) over the same times. */
+static void write_moving_quad(void)
+{
+    const float data[] = {0, -10, 0, 2, -10, 0, 2, 10, 0, 0, -10, 0, 2, 10, 0, 0, 10, 0, 0, 1, -4, 0, 0, 4, 0, 0,
+                          -6, 0, 0, -6, 0, 0};
+    char *enc = test_base64(data, sizeof data);
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,"
+             "\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":72},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":8},"
+             "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":24},{\"buffer\":0,\"byteOffset\":104,\"byteLength\":24}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\","
+             "\"min\":[0,-10,0],\"max\":[2,10,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":2,"
+             "\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},{\"bufferView\":2,\"componentType\":5126,\"count\":2,"
+             "\"type\":\"VEC3\"},{\"bufferView\":3,\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"}],"
+             "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"metallicFactor\":0}}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+             "\"animations\":[{\"samplers\":[{\"input\":1,\"output\":2}],"
+             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]},"
+             "{\"samplers\":[{\"input\":1,\"output\":3}],"
+             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]}",
+             sizeof data, enc);
+    free(enc);
+    test_write_file(in_dir("quad.gltf"), json, strlen(json));
 }
 
 /* A scene file (name in dir) around the moving quad, with `camera_extra`
@@ -428,27 +466,7 @@ static double column_mean(const char *path, int x)
 static void test_motion_blur(void **state)
 {
     (void)state;
-    /* the quad: two triangles facing +z; its translation over [0, 1] */
-    const float data[] = {0, -10, 0, 2, -10, 0, 2, 10, 0, 0, -10, 0, 2, 10, 0, 0, 10, 0, 0, 1, -4, 0, 0, 4, 0, 0};
-    char *enc = test_base64(data, sizeof data);
-    char json[4096];
-    snprintf(json, sizeof json,
-             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,"
-             "\"uri\":\"data:application/octet-stream;base64,%s\"}],"
-             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":72},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":8},"
-             "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":24}],"
-             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":6,\"type\":\"VEC3\","
-             "\"min\":[0,-10,0],\"max\":[2,10,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":2,"
-             "\"type\":\"SCALAR\",\"min\":[0],\"max\":[1]},{\"bufferView\":2,\"componentType\":5126,\"count\":2,"
-             "\"type\":\"VEC3\"}],"
-             "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"metallicFactor\":0}}],"
-             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
-             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
-             "\"animations\":[{\"samplers\":[{\"input\":1,\"output\":2}],"
-             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]}",
-             sizeof data, enc);
-    free(enc);
-    test_write_file(in_dir("quad.gltf"), json, strlen(json));
+    write_moving_quad();
     write_motion_scene("blur.txt", "shutter 0 1", "motion_steps 16", "");
     RUN_OK("-q", "-o", in_dir("blur.pfm"), in_dir("blur.txt"));
     for (int x = 0; x < 16; x++) { /* every column against its time overlap, integrated over the column */
@@ -510,6 +528,29 @@ static void test_motion_blur(void **state)
     assert_non_null(strstr(err_text, "closes (0 s) before it opens (1 s)"));
 }
 
+/* --animation N picks the glTF animation --frame-time plays: at t = 0.5
+ * animation 0 has the quad over x in [0, 2] (pixel column 8 black, column
+ * 2 white), animation 1 holds it over [-6, -4] (column 2 black, column 8
+ * white); animation 0 is the default; one the file does not have is
+ * refused, naming the count. */
+static void test_animation_index(void **state)
+{
+    (void)state;
+    write_moving_quad();
+    write_motion_scene("still.txt", "", "", "");
+    RUN_OK("-q", "--frame-time", "0.5", "-o", in_dir("anim-default.pfm"), in_dir("still.txt"));
+    RUN_OK("-q", "--frame-time", "0.5", "--animation", "0", "-o", in_dir("anim0.pfm"), in_dir("still.txt"));
+    RUN_OK("-q", "--frame-time", "0.5", "--animation", "1", "-o", in_dir("anim1.pfm"), in_dir("still.txt"));
+    assert_same_bytes(in_dir("anim-default.pfm"), in_dir("anim0.pfm"));
+    assert_true(column_mean(in_dir("anim0.pfm"), 8) == 0.0 && column_mean(in_dir("anim0.pfm"), 2) == 1.0);
+    assert_true(column_mean(in_dir("anim1.pfm"), 2) == 0.0 && column_mean(in_dir("anim1.pfm"), 8) == 1.0);
+    assert_int_equal(RUN("-q", "--frame-time", "0.5", "--animation", "2", "-o", in_dir("anim2.pfm"),
+                         in_dir("still.txt")),
+                     2);
+    assert_non_null(strstr(err_text, "quad.gltf: animation 2 requested, the file has 2 (0 to 1)"));
+    assert_int_equal(access(in_dir("anim2.pfm"), F_OK), -1);
+}
+
 /* The samples [0, k] a sidecar says its part holds. */
 static int sidecar_end(const char *json)
 {
@@ -523,35 +564,34 @@ static int sidecar_end(const char *json)
     return b;
 }
 
-/* A render stopped by a time limit leaves a part; resumed, or merged with
- * the rest of the samples, it is the straight render of all of them.
- * Where it stops does not matter to the assertions. */
+/* A time limit that is over before the first pass ends (1 us: less than
+ * starting a thread takes) stops a render in passes after exactly its
+ * first pass (the limit is checked between passes) and a tiled one before
+ * its first tile (a worker checks it before taking one): where it stops is
+ * known, so the test asserts that branch. */
+#define TIME_UP "0.000001"
+
+/* A render stopped by a time limit after its first pass leaves a part of
+ * it; resumed, or merged with the rest of the samples, it is the straight
+ * render of all of them. */
 static void test_time_limit_then_resume(void **state)
 {
     (void)state;
     const char *scene = scene_path;
     RUN_OK("-q", "-s", "64", "-o", in_dir("full64.pfm"), scene);
-    RUN_OK("-q", "-s", "64", "--passes", "1", "--time-limit", "0.001", "--part-out", in_dir("stop.exr"), "-o",
+    RUN_OK("-q", "-s", "64", "--passes", "1", "--time-limit", TIME_UP, "--part-out", in_dir("stop.exr"), "-o",
            in_dir("stopped.pfm"), scene);
-    int k = sidecar_end(in_dir("stop.exr.json"));
-    assert_true(k >= 1 && k <= 64);
-    if (k < 64) {
-        RUN_OK("-q", "-s", "64", "--resume", in_dir("stop.exr"), "-o", in_dir("resumed.pfm"), scene);
-        assert_same_bytes(in_dir("resumed.pfm"), in_dir("full64.pfm"));
-        char range[32];
-        snprintf(range, sizeof range, "%d:64", k);
-        RUN_OK("-q", "-s", "64", "--spp-range", range, "-o", in_dir("rest.exr"), scene);
-        RUN_OK("merge", in_dir("stop.exr"), in_dir("rest.exr"), "-o", in_dir("merged64.pfm"));
-        assert_within_summation_bound(in_dir("merged64.pfm"), in_dir("full64.pfm"), 64);
-    }
+    assert_int_equal(sidecar_end(in_dir("stop.exr.json")), 1);
+    RUN_OK("-q", "-s", "64", "--resume", in_dir("stop.exr"), "-o", in_dir("resumed.pfm"), scene);
+    assert_same_bytes(in_dir("resumed.pfm"), in_dir("full64.pfm"));
+    RUN_OK("-q", "-s", "64", "--spp-range", "1:64", "-o", in_dir("rest.exr"), scene);
+    RUN_OK("merge", in_dir("stop.exr"), in_dir("rest.exr"), "-o", in_dir("merged64.pfm"));
+    assert_within_summation_bound(in_dir("merged64.pfm"), in_dir("full64.pfm"), 64);
     /* a part render stopped the same way writes the part of the passes it finished */
-    RUN_OK("-q", "-s", "64", "--passes", "1", "--time-limit", "0.001", "--part", "0/1", "-o", in_dir("p.exr"), scene);
-    k = sidecar_end(in_dir("p.exr.json"));
-    assert_true(k >= 1 && k <= 64);
-    if (k < 64) {
-        RUN_OK("-q", "-s", "64", "--resume", in_dir("p.exr"), "-o", in_dir("p-resumed.pfm"), scene);
-        assert_same_bytes(in_dir("p-resumed.pfm"), in_dir("full64.pfm"));
-    }
+    RUN_OK("-q", "-s", "64", "--passes", "1", "--time-limit", TIME_UP, "--part", "0/1", "-o", in_dir("p.exr"), scene);
+    assert_int_equal(sidecar_end(in_dir("p.exr.json")), 1);
+    RUN_OK("-q", "-s", "64", "--resume", in_dir("p.exr"), "-o", in_dir("p-resumed.pfm"), scene);
+    assert_same_bytes(in_dir("p-resumed.pfm"), in_dir("full64.pfm"));
 }
 
 /* The integrators that tile (whitted, direct) render in passes when the
@@ -562,76 +602,44 @@ static void test_time_limit_tiling_integrator(void **state)
     (void)state;
     const char *scene = scene_path;
     RUN_OK("-q", "-s", "64", "--integrator", "whitted", "-o", in_dir("wfull.pfm"), scene);
-    RUN_OK("-q", "-s", "64", "--integrator", "whitted", "--time-limit", "0.001", "--part-out", in_dir("wstop.exr"),
+    RUN_OK("-q", "-s", "64", "--integrator", "whitted", "--time-limit", TIME_UP, "--part-out", in_dir("wstop.exr"),
            "-o", in_dir("wstopped.pfm"), scene);
-    int k = sidecar_end(in_dir("wstop.exr.json"));
-    assert_true(k >= 4 && k <= 64 && k % 4 == 0); /* whole passes of 4 */
-    if (k < 64) {
-        RUN_OK("-q", "-s", "64", "--integrator", "whitted", "--resume", in_dir("wstop.exr"), "-o",
-               in_dir("wresumed.pfm"), scene);
-        assert_same_bytes(in_dir("wresumed.pfm"), in_dir("wfull.pfm"));
-    }
-    RUN_OK("-q", "-s", "64", "--integrator", "direct", "--time-limit", "0.001", "--crop", "0", "0", "40", "15", "-o",
+    assert_int_equal(sidecar_end(in_dir("wstop.exr.json")), 4); /* the first whole pass of 4 */
+    RUN_OK("-q", "-s", "64", "--integrator", "whitted", "--resume", in_dir("wstop.exr"), "-o", in_dir("wresumed.pfm"),
+           scene);
+    assert_same_bytes(in_dir("wresumed.pfm"), in_dir("wfull.pfm"));
+    RUN_OK("-q", "-s", "64", "--integrator", "direct", "--time-limit", TIME_UP, "--crop", "0", "0", "40", "15", "-o",
            in_dir("dstop.exr"), scene);
-    k = sidecar_end(in_dir("dstop.exr.json"));
-    assert_true(k >= 4 && k <= 64 && k % 4 == 0);
-    if (RUN("-s", "64", "--integrator", "whitted", "--passes", "0", "--time-limit", "0.001", "--part-out",
-            in_dir("tstop.exr"), "-o", in_dir("tstopped.pfm"), scene) == 0 &&
-        access(in_dir("tstop.exr.json"), F_OK) != 0)
-        assert_non_null(strstr(err_text, "keeps no part"));
+    assert_int_equal(sidecar_end(in_dir("dstop.exr.json")), 4);
+    /* tiles, asked for: no tile is started, and rt says it keeps no part */
+    RUN_OK("-s", "64", "--integrator", "whitted", "--passes", "0", "--time-limit", TIME_UP, "--part-out",
+           in_dir("tstop.exr"), "-o", in_dir("tstopped.pfm"), scene);
+    assert_int_equal(access(in_dir("tstop.exr.json"), F_OK), -1);
+    assert_non_null(strstr(err_text, "keeps no part"));
 }
 
-/* Ctrl-C in passes: the part holds the whole passes done (a pass cut short
- * is not in it), and resumed it is the straight render. When the signal
- * lands does not matter to the assertions. */
+/* Ctrl-C in passes, sent once the progress bar shows the first of 64
+ * one-sample passes done: exit 130, the part holds the whole passes done
+ * (at least that one, a pass cut short is not in it), and resumed it is
+ * the straight render. */
 static void test_interrupt_then_resume(void **state)
 {
     (void)state;
     const char *scene = scene_path;
     RUN_OK("-q", "-s", "64", "-o", in_dir("full64i.pfm"), scene);
-    const char *argv[] = {rt_bin(), "-q", "-s", "64", "--passes", "1", "-t", "2", "--part-out", in_dir("int.exr"), "-o",
+    const char *argv[] = {rt_bin(), "-s", "64", "--passes", "1", "-t", "2", "--part-out", in_dir("int.exr"), "-o",
                           in_dir("int.pfm"), scene, NULL};
-    /* a signal before rt has set up its handler (a slow start under a
-     * sanitizer) kills it outright, writing nothing: then wait longer */
-    int st = 0, code = -1;
-    for (long ms = 150; ms <= 5000 && code < 0; ms *= 3) {
-        unlink(in_dir("int.exr.json"));
-        pid_t pid = fork();
-        assert_true(pid >= 0);
-        if (pid == 0) {
-            int nul = open("/dev/null", O_RDWR);
-            dup2(nul, 0);
-            dup2(nul, 1);
-            dup2(nul, 2);
-            execv(argv[0], (char *const *)argv);
-            _exit(127);
-        }
-        struct timespec ts = {ms / 1000, (ms % 1000) * 1000 * 1000};
-        nanosleep(&ts, NULL);
-        kill(pid, SIGINT);
-        while (waitpid(pid, &st, 0) < 0 && errno == EINTR)
-            ;
-        if (WIFSIGNALED(st)) {
-            assert_int_equal(WTERMSIG(st), SIGINT);
-            assert_int_equal(access(in_dir("int.exr.json"), F_OK), -1);
-            continue;
-        }
-        assert_true(WIFEXITED(st));
-        code = WEXITSTATUS(st);
-    }
-    if (code < 0)
-        return; /* never past its start-up in 5 s: nothing to check */
-    assert_true(code == 130 || code == 0);
-    if (access(in_dir("int.exr.json"), F_OK) != 0)
-        return; /* stopped before the first pass: nothing to resume */
+    static char out[1 << 16];
+    test_terminal_signal at = {.sig = SIGINT, .unit = " spp", .at_least = 1};
+    test_terminal_result r;
+    test_terminal_run(argv, &at, out, sizeof out, &r);
+    if (r.status != 130)
+        fail_msg("expected exit 130 after SIGINT at %d/64 spp, got %d (signal %d):\n%s", r.signalled_at, r.status,
+                 r.signal, out);
     int k = sidecar_end(in_dir("int.exr.json"));
-    assert_true(k >= 1 && k <= 64);
-    if (code == 0)
-        assert_int_equal(k, 64);
-    if (k < 64) {
-        RUN_OK("-q", "-s", "64", "--resume", in_dir("int.exr"), "-o", in_dir("int-resumed.pfm"), scene);
-        assert_same_bytes(in_dir("int-resumed.pfm"), in_dir("full64i.pfm"));
-    }
+    assert_true(k >= r.signalled_at && k < 64);
+    RUN_OK("-q", "-s", "64", "--resume", in_dir("int.exr"), "-o", in_dir("int-resumed.pfm"), scene);
+    assert_same_bytes(in_dir("int-resumed.pfm"), in_dir("full64i.pfm"));
 }
 
 static const char precious[] = "an earlier image the user keeps\n";
@@ -937,13 +945,11 @@ static void test_resume_inside_a_block(void **state)
     RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "0:64", "-o", in_dir("k0.exr"), scene);
     MERGE(in_dir("mk.pfm"), in_dir("k0.exr"), in_dir("k2.exr"));
     assert_same_bytes(in_dir("mk.pfm"), in_dir("s200.pfm"));
-    /* ... also when a time limit stopped it, wherever */
-    RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "64:200", "--passes", "1", "--time-limit", "0.001", "-o",
+    /* ... also when a time limit stopped it (after its first pass) */
+    RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "64:200", "--passes", "1", "--time-limit", TIME_UP, "-o",
            in_dir("kt.exr"), scene);
-    int k = sidecar_end(in_dir("kt.exr.json"));
-    assert_true(k > 64 && k <= 200);
-    if (k < 200)
-        RUN_OK("-q", "-r", "16x12", "-s", "200", "--resume", in_dir("kt.exr"), "-o", in_dir("kt.exr"), scene);
+    assert_int_equal(sidecar_end(in_dir("kt.exr.json")), 65);
+    RUN_OK("-q", "-r", "16x12", "-s", "200", "--resume", in_dir("kt.exr"), "-o", in_dir("kt.exr"), scene);
     MERGE(in_dir("mkt.pfm"), in_dir("kt.exr"), in_dir("k0.exr"));
     assert_same_bytes(in_dir("mkt.pfm"), in_dir("s200.pfm"));
 }
@@ -1037,6 +1043,8 @@ int main(void)
         cmocka_unit_test(test_merge_refusals),
         cmocka_unit_test(test_aov_parts),
         cmocka_unit_test(test_frames),
+        cmocka_unit_test(test_frames_animated_gltf),
+        cmocka_unit_test(test_animation_index),
         cmocka_unit_test(test_motion_blur),
         cmocka_unit_test(test_part_bands),
         cmocka_unit_test(test_aligned_ranges_same_bytes),

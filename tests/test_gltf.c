@@ -173,8 +173,7 @@ static int find_model(const char *dir, char *out, size_t cap)
 static void test_manifest_models(void **state)
 {
     (void)state;
-    if (!test_have_shared())
-        skip();
+    test_require_shared();
     static manifest_row rows[128];
     int n = read_manifest(rows, 128);
     assert_true(n >= 30); /* 33 glTF models + 2 meshes when this was written */
@@ -253,8 +252,7 @@ static void test_manifest_models(void **state)
 static void test_sample_features(void **state)
 {
     (void)state;
-    if (!test_have_shared())
-        skip();
+    test_require_shared();
     rt_scene s;
     rt_gltf_stats st;
     rt_error err;

@@ -286,8 +286,7 @@ static void test_broken_animation(void **state)
 static void test_fox(void **state)
 {
     (void)state;
-    if (!test_have_shared())
-        skip();
+    test_require_shared();
     const char *fox = test_shared_path("assets/gltf/Fox/glTF-Binary/Fox.glb");
     rt_gltf_stats a, b, rest;
     rt_scene s;

@@ -5,8 +5,9 @@
  * sample models by the standard tools (tools/gen_compressed_assets.sh:
  * gltfpack, gltf-transform). Each must decode to its original's triangle
  * count and bounds, within the quantization step where the tool quantized,
- * and its textures to the original's size and nearly its pixels. Originals
- * come from the shared assets (skipped with a note when absent; the
+ * and its textures to the original's size and nearly its pixels; every
+ * vertex keeps its normal and UV (within the quantization). Originals come
+ * from the shared assets (that test skips, saying so, without them; the
  * compressed files alone are still checked against the counts below).
  * The decoders are also checked on their own: a meshopt round trip through
  * the library's encoder, and broken streams refused with a clear error. */
@@ -69,10 +70,77 @@ static double image_diff(const rt_image *a, const rt_image *b)
     return sum / (double)n;
 }
 
+/* The UV of each vertex as its material's base colour texture sees it
+ * (through the KHR_texture_transform that quantizing tools add), in a new
+ * array of 2 floats a vertex. */
+static float *texture_uvs(const rt_scene *s)
+{
+    float *uv = calloc(2 * s->vertices.count + 1, sizeof *uv);
+    assert_non_null(uv);
+    for (size_t t = 0; t < s->triangles.count; t++) {
+        const float *m = s->materials[s->triangles.material[t]].base_color_tex.uv_transform;
+        for (int k = 0; k < 3; k++) {
+            uint32_t v = s->triangles.index[3 * t + (size_t)k];
+            rt_vec2 u = s->vertices.uv0[v];
+            uv[2 * v] = m[0] * u.x + m[1] * u.y + m[2];
+            uv[2 * v + 1] = m[3] * u.x + m[4] * u.y + m[5];
+        }
+    }
+    return uv;
+}
+
+/* Every vertex of a has one in b at the same place (within pos_tol) with
+ * the same normal (cosine >= 0.99: 8-bit normals are within 0.01) and, when
+ * `uv`, the same texture UV (within 0.005: 10 bits or more): the attributes
+ * survived. The closest vertex by all three counts (a cube's corner holds
+ * three vertices, one a face). */
+static void assert_vertices_in(const rt_scene *a, const rt_scene *b, double pos_tol, bool uv, const char *what)
+{
+    assert_non_null(a->vertices.normal);
+    assert_non_null(b->vertices.normal);
+    float *ua = texture_uvs(a), *ub = texture_uvs(b);
+    for (size_t i = 0; i < a->vertices.count; i++) {
+        rt_vec3 p = a->vertices.position[i], n = a->vertices.normal[i];
+        double best = INFINITY, dp = 0, cosn = 0, duv = 0;
+        for (size_t j = 0; j < b->vertices.count; j++) {
+            rt_vec3 q = b->vertices.position[j], m = b->vertices.normal[j];
+            double d = rt_length(rt_sub(p, q)), c = rt_dot(n, m), u = 0;
+            if (uv)
+                u = fabs(ua[2 * i] - ub[2 * j]) + fabs(ua[2 * i + 1] - ub[2 * j + 1]);
+            double score = d / (pos_tol + 1e-9) + 100.0 * (1.0 - c) + u / 0.005;
+            if (score < best)
+                best = score, dp = d, cosn = c, duv = u;
+        }
+        if (dp > pos_tol + 1e-6 || cosn < 0.99 || duv > 0.005)
+            fail_msg("%s: vertex %zu (%g %g %g): the nearest has position off by %g (tolerance %g), normal cosine %g, "
+                     "UV off by %g",
+                     what, i, p.x, p.y, p.z, dp, pos_tol, cosn, duv);
+    }
+    free(ua);
+    free(ub);
+}
+
+/* The compressed files alone decode to their originals' triangle counts. */
+static void test_decodes_counts(void **state)
+{
+    (void)state;
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        rt_scene s;
+        rt_gltf_stats st;
+        rt_error err;
+        rt_result r = load(corpus(cases[c].file), &s, &st, &err);
+        if (r != RT_OK)
+            fprintf(stderr, "%s: %s\n", cases[c].file, err.message);
+        assert_int_equal(r, RT_OK);
+        assert_int_equal(st.triangles, cases[c].triangles);
+        rt_scene_free(&s);
+    }
+}
+
 static void test_decodes_like_original(void **state)
 {
     (void)state;
-    bool shared = test_have_shared();
+    test_require_shared();
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
         rt_scene s, o;
         rt_gltf_stats st, ost;
@@ -82,7 +150,7 @@ static void test_decodes_like_original(void **state)
             fprintf(stderr, "%s: %s\n", cases[c].file, err.message);
         assert_int_equal(r, RT_OK);
         assert_int_equal(st.triangles, cases[c].triangles);
-        if (shared) {
+        {
             assert_int_equal(load(test_shared_path(cases[c].original), &o, &ost, &err), RT_OK);
             assert_int_equal(st.triangles, ost.triangles);
             double tol = cases[c].tolerance * extent(&ost.bounds);
@@ -111,6 +179,12 @@ static void test_decodes_like_original(void **state)
                     mo += o.vertices.color[v].x + o.vertices.color[v].y + o.vertices.color[v].z;
                 assert_true(fabs(ms / (double)s.vertices.count - mo / (double)o.vertices.count) < 0.02);
             }
+            /* normals and UVs, both ways */
+            bool uv = (o.triangles.flags[0] & RT_TRI_UV) != 0;
+            assert_int_equal((s.triangles.flags[0] & RT_TRI_UV) != 0, uv);
+            double pos_tol = fmax(cases[c].tolerance, 1e-6) * extent(&ost.bounds);
+            assert_vertices_in(&o, &s, pos_tol, uv, cases[c].file);
+            assert_vertices_in(&s, &o, pos_tol, uv, cases[c].file);
             rt_scene_free(&o);
         }
         rt_scene_free(&s);
@@ -121,8 +195,7 @@ static void test_decodes_like_original(void **state)
 static void test_meshopt_lossless_exact(void **state)
 {
     (void)state;
-    if (!test_have_shared())
-        skip();
+    test_require_shared();
     rt_scene s, o;
     rt_gltf_stats st, ost;
     rt_error err;
@@ -331,6 +404,8 @@ static void test_webp_limits(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_decodes_counts),
+        cmocka_unit_test(test_decodes_counts),
         cmocka_unit_test(test_decodes_like_original), cmocka_unit_test(test_meshopt_lossless_exact),
         cmocka_unit_test(test_meshopt_round_trip),    cmocka_unit_test(test_broken_streams),
         cmocka_unit_test(test_basisu_fallback),       cmocka_unit_test(test_webp_limits),

@@ -10,6 +10,7 @@
  * order, and a missing library is one clear error before any rendering. */
 #include "test_util.h"
 
+#include <glob.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -40,16 +41,14 @@ static char dir[64];
 static int setup(void **state)
 {
     (void)state;
-    snprintf(dir, sizeof dir, "/tmp/rt_test_hdr_XXXXXX");
-    return mkdtemp(dir) ? 0 : -1;
+    return test_make_dir(dir, sizeof dir, "hdr") ? 0 : -1;
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-    return system(cmd) == 0 ? 0 : -1;
+    test_remove_dir(dir);
+    return 0;
 }
 
 static const char *tmp(const char *name)
@@ -471,13 +470,38 @@ static int run_rt(const char *env, const char *args, const char *stderr_to)
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
-/* The 512x512 reference box-averaged to 64x64 (test_path.c's comparison). */
-static bool reference_64(rt_framebuffer *out)
+/* Skips the calling test, saying why, where --denoise cannot run: in a
+ * sanitizer build (denoise.c refuses there), or with no Open Image Denoise
+ * where `make denoiser` puts it (build/oidn-venv) and no RT_OIDN_LIBRARY.
+ * Where it is installed, rt must find it: that is not a reason to skip. */
+static void require_denoiser(void)
+{
+    test_skip_in_sanitizer_build("denoise.c refuses --denoise (OIDN's TBB dlopens with RTLD_DEEPBIND)");
+    const char *env = getenv("RT_OIDN_LIBRARY");
+    glob_t g;
+    bool installed = env && *env;
+    if (!installed && glob("build/oidn-venv/lib/python3*/site-packages/pyoidn/oidn/lib/libOpenImageDenoise.so.2", 0,
+                           NULL, &g) == 0) {
+        installed = true;
+        globfree(&g);
+    }
+    if (!installed) {
+        fprintf(stderr, "skip: no Open Image Denoise in build/oidn-venv (make denoiser) and no RT_OIDN_LIBRARY\n");
+        skip();
+    }
+    char where[4096];
+    rt_error err = {0};
+    if (rt_denoise_find(where, sizeof where, &err) != RT_OK)
+        fail_msg("Open Image Denoise is installed, but rt does not find it: %s", err.message);
+}
+
+/* The 512x512 reference box-averaged to 64x64 (test_path.c's comparison);
+ * skips the calling test without it. */
+static void reference_64(rt_framebuffer *out)
 {
     rt_framebuffer ref;
     rt_error err;
-    if (rt_pfm_read(test_shared_path("reference/cornell/reference.pfm"), &ref, &err) != RT_OK)
-        return false;
+    test_require_cornell_reference(&ref);
     assert_int_equal(ref.width, 512);
     assert_int_equal(rt_framebuffer_init(out, 64, 64, &err), RT_OK);
     for (int y = 0; y < 64; y++)
@@ -485,23 +509,15 @@ static bool reference_64(rt_framebuffer *out)
             for (int c = 0; c < 3; c++)
                 out->rgb[3 * ((size_t)y * 64 + (size_t)x) + (size_t)c] = (float)test_cornell_block(&ref, x, y, c);
     rt_framebuffer_free(&ref);
-    return true;
 }
 
 static void test_denoise_cornell(void **state)
 {
     (void)state;
-    char where[4096];
+    require_denoiser();
     rt_error err = {0};
-    if (rt_denoise_find(where, sizeof where, &err) != RT_OK) {
-        fprintf(stderr, "note: %s; skipping the denoiser test\n", err.message);
-        skip();
-    }
     rt_framebuffer ref;
-    if (!reference_64(&ref)) {
-        fprintf(stderr, "note: no shared reference (set RT_SHARED); skipping the denoiser test\n");
-        skip();
-    }
+    reference_64(&ref);
     char args[512];
     snprintf(args, sizeof args, "-q -r 64x64 -s 16 -o %s scenes/cornell-reference.txt", tmp("noisy.pfm"));
     assert_int_equal(run_rt(NULL, args, NULL), 0);
@@ -617,7 +633,13 @@ static void test_float_outputs_ignore_exposure(void **state)
 
 /* AOVs: the beauty image is the same with them as without; every AOV is
  * bit-identical for 1 and 3 threads and other tile sizes; the values are
- * the scene's (the Cornell box's white floor: albedo 0.73 + 0.04, normal +y). */
+ * the scene's, worked out here from it: the Cornell box's white floor has
+ * albedo 0.73 + 0.04 and normal +y; its position is where the ray through
+ * the pixel's centre from scenes/cornell.txt's camera (position 0 1 3.94,
+ * looking down -z, vertical fov 39.3) meets the plane y = 0 (the mean of
+ * the pixel's samples, within its footprint), its depth the distance from
+ * the camera to there; the variance of the pixel's mean is the samples'
+ * variance over their count, so 4x the samples give a quarter of it. */
 static void test_aovs(void **state)
 {
     (void)state;
@@ -657,9 +679,48 @@ static void test_aovs(void **state)
     assert_near(alb.rgb[px], 0.73 + 0.04, 1e-4); /* diffuse 0.73 + the dielectric's specular f0 0.04 */
     assert_near(nrm.rgb[px + 1], 1.0, 1e-3);
     assert_near(spp.rgb[px], 4.0, 0);
+    rt_framebuffer pos, dep;
+    assert_int_equal(rt_image_read(tmp("a1.position.pfm"), &pos, &err), RT_OK);
+    assert_int_equal(rt_image_read(tmp("a1.depth.pfm"), &dep, &err), RT_OK);
+    double t = tan(0.5 * 39.3 * 3.14159265358979 / 180.0);
+    double dx = ((24 + 0.5) / 48 * 2 - 1) * t * 48.0 / 40.0, dy = (1 - (38 + 0.5) / 40 * 2) * t; /* dz = -1 */
+    double hit = 1.0 / -dy;                                                                      /* y: 1 -> 0 */
+    double want[3] = {dx * hit, 0.0, 3.94 - hit};
+    double dist = sqrt((want[0]) * (want[0]) + 1.0 + (3.94 - want[2]) * (3.94 - want[2]));
+    fprintf(stderr, "floor pixel: position (%.4f %.4f %.4f), the ray through its centre meets y = 0 at (%.4f 0 %.4f); "
+                    "depth %.4f, distance %.4f\n",
+            pos.rgb[px], pos.rgb[px + 1], pos.rgb[px + 2], want[0], want[2], dep.rgb[px], dist);
+    assert_near(pos.rgb[px + 1], 0.0, 1e-5);
+    assert_near(pos.rgb[px], want[0], 0.01);
+    assert_near(pos.rgb[px + 2], want[2], 0.03); /* a pixel spans about 0.16 in z there */
+    double seen = sqrt((double)pos.rgb[px] * pos.rgb[px] + 1.0 + (3.94 - pos.rgb[px + 2]) * (3.94 - pos.rgb[px + 2]));
+    assert_near(dep.rgb[px], seen, 1e-3 * seen); /* depth: the distance to the mean position, to first order */
+    assert_near(dep.rgb[px], dist, 0.03);
+    rt_framebuffer_free(&pos);
+    rt_framebuffer_free(&dep);
     rt_framebuffer_free(&alb);
     rt_framebuffer_free(&nrm);
     rt_framebuffer_free(&spp);
+    /* variance over the floor's bottom-middle block at 16 and 64 samples */
+    double var[2];
+    for (int k = 0; k < 2; k++) {
+        snprintf(args, sizeof args, "-q -r 48x40 -s %d --integrator path --aov variance -o %s scenes/cornell.txt",
+                 k ? 64 : 16, tmp("v.pfm"));
+        assert_int_equal(run_rt(NULL, args, NULL), 0);
+        rt_framebuffer v;
+        assert_int_equal(rt_image_read(tmp("v.variance.pfm"), &v, &err), RT_OK);
+        var[k] = 0.0;
+        for (int y = 33; y < 38; y++) /* the floor (row 38 is its front edge) */
+            for (int x = 18; x < 30; x++) {
+                float a = v.rgb[3 * ((size_t)y * 48 + (size_t)x)];
+                assert_true(a > 0.0f); /* a lit diffuse floor under the path tracer is noisy */
+                var[k] += a / (5.0 * 12.0);
+            }
+        rt_framebuffer_free(&v);
+    }
+    fprintf(stderr, "floor variance of the mean: %.4g at 16 spp, %.4g at 64 (ratio %.2f, 4 expected)\n", var[0],
+            var[1], var[0] / var[1]);
+    assert_true(var[0] / var[1] > 3.0 && var[0] / var[1] < 5.3);
     /* EXR: one file with the layers */
     snprintf(args, sizeof args, "%s --aov albedo,depth -o %s", common, tmp("a.exr"));
     assert_int_equal(run_rt(NULL, args, NULL), 0);
@@ -785,12 +846,8 @@ static void test_denoise_search_order(void **state)
 static void test_denoise_keeps_noisy(void **state)
 {
     (void)state;
-    char where[4096];
+    require_denoiser();
     rt_error err = {0};
-    if (rt_denoise_find(where, sizeof where, &err) != RT_OK) {
-        fprintf(stderr, "note: %s; skipping the denoiser runs\n", err.message);
-        skip();
-    }
     const char *common = "-q -r 20x16 -s 2 --integrator path";
     char args[512];
     snprintf(args, sizeof args, "%s -o %s", common, tmp("raw.pfm"));
@@ -837,12 +894,8 @@ static void test_denoise_quality_and_threads(void **state)
     assert_int_equal(run_rt(NULL, args, NULL), 2);
     assert_int_equal(access(tmp("never.png"), F_OK), -1);
 
-    char where[4096];
+    require_denoiser();
     rt_error err = {0};
-    if (rt_denoise_find(where, sizeof where, &err) != RT_OK) {
-        fprintf(stderr, "note: %s; skipping the denoiser runs\n", err.message);
-        skip();
-    }
     const char *common = "-v -r 24x24 -s 2 --integrator path --denoise";
     snprintf(args, sizeof args, "%s -t 1 --denoise-quality fast -o %s", common, tmp("fast.pfm"));
     assert_int_equal(run_rt("RT_OIDN_QUALITY=high", args, tmp("fast.txt")), 0);

@@ -451,8 +451,8 @@ static void test_pfm_roundtrip_and_atomic_write(void **state)
     assert_int_equal(rt_framebuffer_init(&fb, 5, 3, &err), RT_OK);
     for (int i = 0; i < 45; i++)
         fb.rgb[i] = (float)i * 0.25f - 1.0f;
-    char dir[] = "/tmp/rt-test-XXXXXX";
-    assert_non_null(mkdtemp(dir));
+    char dir[64];
+    assert_true(test_make_dir(dir, sizeof dir, "render"));
     char path[256];
     snprintf(path, sizeof path, "%s/a.pfm", dir);
     assert_int_equal(rt_framebuffer_write(&fb, path, 1.0f, &err), RT_OK);
@@ -473,9 +473,7 @@ static void test_pfm_roundtrip_and_atomic_write(void **state)
     assert_int_equal(rt_output_check("/nonexistent-dir/x.png", &err), RT_ERR_IO);
     assert_non_null(strstr(err.message, "/nonexistent-dir/x.png"));
     rt_framebuffer_free(&fb);
-    char cmd[300];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    assert_int_equal(system(cmd), 0);
+    test_remove_dir(dir);
 }
 
 int main(void)

@@ -375,8 +375,7 @@ static void test_cornell_mse_stratified(void **state)
 {
     (void)state;
     rt_framebuffer ref;
-    if (!test_read_cornell_reference(&ref))
-        return;
+    test_require_cornell_reference(&ref);
     fixture f;
     cornell_fixture(&f);
     f.s.settings.samples = 16;
@@ -415,8 +414,7 @@ static void test_prefix_covers_pixel(void **state)
 {
     (void)state;
     rt_framebuffer ref;
-    if (!test_read_cornell_reference(&ref))
-        return;
+    test_require_cornell_reference(&ref);
     fixture f;
     cornell_fixture(&f);
     const rt_render_region crop = {192, 192, 320, 320};

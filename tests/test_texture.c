@@ -228,8 +228,8 @@ static void test_float_and_procedural(void **state)
 static void test_loader_and_cache(void **state)
 {
     (void)state;
-    char dir[] = "/tmp/rt_test_texture_XXXXXX";
-    assert_non_null(mkdtemp(dir));
+    char dir[64];
+    assert_true(test_make_dir(dir, sizeof dir, "texture"));
     char png[512], hdr[512], bad[512], scene[512];
     snprintf(png, sizeof png, "%s/tex.png", dir);
     snprintf(hdr, sizeof hdr, "%s/env.hdr", dir);
@@ -324,11 +324,7 @@ static void test_loader_and_cache(void **state)
     assert_true(s.material_count >= 3);
     rt_scene_free(&s);
 
-    unlink(png);
-    unlink(hdr);
-    unlink(bad);
-    unlink(scene);
-    rmdir(dir);
+    test_remove_dir(dir);
 }
 
 int main(void)

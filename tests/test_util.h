@@ -2,8 +2,12 @@
  *
  * Tests include <cmocka.h> through this header. Paths: the repository root is
  * the working directory (make test runs there); shared assets are found at
- * $RT_SHARED (default ../shared), and tests that need them skip with a clear
- * message when they are absent.
+ * $RT_SHARED (default ../shared). A test that cannot run calls skip() with
+ * the reason printed first (test_require_shared, test_require_cornell_reference,
+ * test_skip_in_sanitizer_build): cmocka lists it by name as SKIPPED, tests/run.sh
+ * counts it, and CI fails on any skip outside the sanitizer builds' named
+ * list (the Makefile's SANITIZER_SKIPS). Never `return` early from a test that
+ * checked nothing: that counts as a pass.
  */
 #ifndef RT_TEST_UTIL_H
 #define RT_TEST_UTIL_H
@@ -34,16 +38,15 @@ static inline const char *test_shared_path(const char *rel)
 }
 
 /* The shared Mitsuba reference of the Cornell box (512x512) into *ref;
- * false, with a note that the test is skipped, when it cannot be read. */
-static inline bool test_read_cornell_reference(rt_framebuffer *ref)
+ * the calling test is skipped, saying why, when it cannot be read. */
+static inline void test_require_cornell_reference(rt_framebuffer *ref)
 {
     const char *path = test_shared_path("reference/cornell/reference.pfm");
     rt_error err;
     if (rt_pfm_read(path, ref, &err) != RT_OK) {
-        fprintf(stderr, "note: %s not readable (set RT_SHARED); skipping\n", path);
-        return false;
+        fprintf(stderr, "skip: %s not readable (set RT_SHARED): %s\n", path, err.message);
+        skip();
     }
-    return true;
 }
 
 /* The mean of channel c over the 8x8 block (x, y) of the 512x512 Cornell
@@ -91,15 +94,46 @@ static inline void test_expect_failure(rt_result r, const rt_error *err, rt_resu
     assert_non_null(strstr(err->message, what));
 }
 
-/* True when the shared assets exist; otherwise prints why the test is skipped. */
+/* True when the shared assets exist (without saying anything). */
 static inline int test_have_shared(void)
 {
     struct stat st;
-    const char *p = test_shared_path("assets/MANIFEST.md");
-    if (stat(p, &st) == 0)
-        return 1;
-    fprintf(stderr, "note: shared assets not found at %s (set RT_SHARED); skipping\n", p);
-    return 0;
+    return stat(test_shared_path("assets/MANIFEST.md"), &st) == 0;
+}
+
+/* Skips the calling test, saying why, unless the shared assets are there. */
+static inline void test_require_shared(void)
+{
+    if (!test_have_shared()) {
+        fprintf(stderr, "skip: shared assets not found at %s (set RT_SHARED)\n",
+                test_shared_path("assets/MANIFEST.md"));
+        skip();
+    }
+}
+
+/* 1 in a build with AddressSanitizer or ThreadSanitizer (the tests are built
+ * with the same flags as rt and the library: make asan, make tsan). */
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define TEST_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define TEST_SANITIZED 1
+#endif
+#endif
+#ifndef TEST_SANITIZED
+#define TEST_SANITIZED 0
+#endif
+
+/* Skips the calling test in a sanitizer build, saying why: for the few
+ * tests a sanitizer runtime cannot run (each is named in the Makefile's
+ * SANITIZER_SKIPS, and any other skip there fails CI). Decided by how the
+ * test was built, never by what the code under test reports. */
+static inline void test_skip_in_sanitizer_build(const char *why)
+{
+    if (TEST_SANITIZED) {
+        fprintf(stderr, "skip: not in a sanitizer build: %s\n", why);
+        skip();
+    }
 }
 
 /* Writes `text` to a fresh temporary file and returns its path (static buffer per call site's copy). */
@@ -112,16 +146,18 @@ static inline void test_write_file(const char *path, const void *data, size_t si
     fclose(f);
 }
 
-/* A fresh scratch directory /tmp/rt_test_TAG_XXXXXX into dir (size >= 64);
- * false when it cannot be made. */
+/* The tests' one scratch-directory helper: a fresh directory
+ * /tmp/rt_test_TAG_XXXXXX into dir (size >= 64), made in a group setup or
+ * a test, and test_remove_dir in the teardown; false when it cannot be
+ * made. */
 static inline int test_make_dir(char *dir, size_t size, const char *tag)
 {
     snprintf(dir, size, "/tmp/rt_test_%s_XXXXXX", tag);
     return mkdtemp(dir) != NULL;
 }
 
-/* Removes a scratch directory made by test_make_dir with the files in it
- * (no subdirectories). */
+/* Removes a scratch directory made by test_make_dir with everything in it
+ * (subdirectories too; symbolic links are removed, not followed). */
 static inline void test_remove_dir(const char *dir)
 {
     DIR *d = opendir(dir);
@@ -130,8 +166,14 @@ static inline void test_remove_dir(const char *dir)
         char p[4200];
         while ((e = readdir(d)))
             if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) {
-                snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-                unlink(p);
+                int n = snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
+                struct stat st;
+                if (n < 0 || (size_t)n >= sizeof p)
+                    continue; /* no such name in a scratch directory */
+                if (lstat(p, &st) == 0 && S_ISDIR(st.st_mode))
+                    test_remove_dir(p);
+                else
+                    unlink(p);
             }
         closedir(d);
     }

@@ -13,6 +13,7 @@ holds, and writes the images as PFM files to --out for `rt compare`.
     python3 -m venv /tmp/flip && /tmp/flip/bin/pip install flip-evaluator==1.7 numpy
     /tmp/flip/bin/python tools/flip_reference.py            # the table in tests/test_compare.c
     /tmp/flip/bin/python tools/flip_reference.py CAND.pfm REF.pfm   # any two PFM images
+    /tmp/flip/bin/python tools/flip_reference.py --big   # test_flip_512_time's 512x512 LDR-FLIP
 
 With two PFM files (linear RGB, as rt writes them) it prints LDR-FLIP of the
 images clamped to [0, 1] and sRGB-encoded, and HDR-FLIP of the linear
@@ -169,6 +170,23 @@ def srgb_encode(img):
     return np.where(c <= 0.0031308, c * 12.92, 1.055 * np.power(c, 1.0 / 2.4) - 0.055).astype(np.float32)
 
 
+def big():
+    """test_flip_512_time's pair: a 16-pixel checkerboard over a ramp (the
+    reference) and a copy with PCG32(7, 1) noise of up to 1/4 added, clamped
+    to 1: 512x512, sRGB values."""
+    s = 512
+    rng = pcg32(7, 1)
+    r = np.zeros((s, s, 3), dtype=np.float32)
+    c = np.zeros((s, s, 3), dtype=np.float32)
+    for y in range(s):
+        for x in range(s):
+            v = np.float32((((x // 16 + y // 16) & 1) * 128 + x // 4) / 256.0)
+            for k in range(3):
+                r[y, x, k] = v
+                c[y, x, k] = min(np.float32(1.0), np.float32(v + np.float32((next(rng) >> 24) / 1024.0)))
+    return c, r
+
+
 def main():
     import flip_evaluator as flip
 
@@ -176,10 +194,17 @@ def main():
     ap.add_argument("images", nargs="*", help="CANDIDATE.pfm REFERENCE.pfm")
     ap.add_argument("--out", default="/tmp/rt-flip-pairs", help="where the procedural pairs are written as PFM")
     ap.add_argument("--ppd", type=float, default=0.0, help="pixels per degree (default: FLIP's 67.02)")
+    ap.add_argument("--big", action="store_true", help="the 512x512 pair of test_flip_512_time")
     a = ap.parse_args()
 
     def params(ppd):
         return {"ppd": ppd} if ppd > 0 else {}
+
+    if a.big:
+        c, r = big()
+        _, l, _ = flip.evaluate(r, c, "LDR", applyMagma=False, parameters=params(a.ppd))
+        print("512x512 LDR-FLIP: %.7f" % l)
+        return
 
     if a.images:
         if len(a.images) != 2:

@@ -8,12 +8,26 @@
 # build-fuzz/crashes/TARGET/: fix the bug, then keep the input in
 # tests/corpus/TARGET/ so make test replays it). Reproduce one input with
 # ./build-fuzz/fuzz_TARGET FILE.
-# Environment: FUZZ_SECONDS, FUZZ_TARGETS (space-separated subset), SHARED.
+# A run that fuzzed too little fails too: a target the harness does not
+# know (tests/fuzz/harness.c's rt_fuzz_targets), a target whose run reports
+# no execution count, or fewer executions than FUZZ_MIN_EXECS_PER_S (default
+# 10) times FUZZ_SECONDS.
+# Environment: FUZZ_SECONDS, FUZZ_TARGETS (space-separated subset), SHARED,
+# FUZZ_MIN_EXECS_PER_S.
 set -eu
 SECONDS_EACH=${FUZZ_SECONDS:-60}
 SHARED=${SHARED:-../shared}
-TARGETS=${FUZZ_TARGETS:-"scene gltf glb gltf_bin obj ply off image exr meshopt draco part image_file"}
+MIN_RATE=${FUZZ_MIN_EXECS_PER_S:-10}
+KNOWN=$(sed -n '/rt_fuzz_targets\[\] = {/,/};/p' tests/fuzz/harness.c | grep -o '"[a-z_]*"' | tr -d '"' | tr '\n' ' ')
+TARGETS=${FUZZ_TARGETS:-$KNOWN}
 B=build-fuzz
+for t in $TARGETS; do
+    case " $KNOWN " in
+        *" $t "*) ;;
+        *) echo "fuzz: unknown target '$t' (the harness has: $KNOWN)" >&2; exit 1 ;;
+    esac
+done
+[ -n "$(echo $TARGETS)" ] || { echo "fuzz: no targets" >&2; exit 1; }
 
 if ! command -v clang >/dev/null 2>&1 || ! ls /usr/lib/llvm-*/lib/clang/*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
     echo "fuzz: installing clang and its libFuzzer runtime (clang, libclang-rt-14-dev)" >&2
@@ -72,5 +86,14 @@ for t in $TARGETS; do
     crashes=$(find $B/crashes/$t -type f ! -name .started -newer "$stamp" | wc -l)
     printf '%-10s %12s %14s %8s\n' "$t" "${rate:-?}" "${execs:-?}" "$crashes" | tee -a "$summary"
     [ "$crashes" -eq 0 ] || { status=1; grep -m 3 -E 'ERROR|SUMMARY|runtime error' "$log" >&2 || true; }
+    floor=$((MIN_RATE * SECONDS_EACH))
+    if [ -z "$execs" ]; then
+        echo "fuzz: $t reported no execution count (see $log)" >&2
+        tail -n 3 "$log" >&2
+        status=1
+    elif [ "$execs" -lt "$floor" ]; then
+        echo "fuzz: $t ran $execs executions in $SECONDS_EACH s, under the floor of $floor ($MIN_RATE a second)" >&2
+        status=1
+    fi
 done
 exit $status
