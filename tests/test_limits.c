@@ -24,6 +24,7 @@
 #include "rt/io/gltf.h"
 #include "rt/io/framebuffer.h"
 #include "rt/accel/kdtree.h"
+#include "rt/io/image_load.h"
 #include "rt/io/mesh_io.h"
 #include "rt/render/limits.h"
 #include "rt/render/render.h"

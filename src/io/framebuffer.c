@@ -36,7 +36,6 @@
 #include "rt/base/alloc.h"
 #include "rt/image/tonemap.h"
 #include "rt/io/exr.h"
-#include "rt/scene/texture.h"
 
 rt_result rt_framebuffer_init(rt_framebuffer *fb, int width, int height, rt_error *err)
 {

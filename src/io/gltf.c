@@ -55,6 +55,7 @@
 #include "rt/io/base64.h"
 #include "rt/io/draco.h"
 #include "rt/io/gltf_animation.h"
+#include "rt/io/image_load.h"
 #include "rt/io/json.h"
 #include "rt/io/meshopt.h"
 #include "rt/scene/texture.h"

@@ -47,6 +47,7 @@
 #include "rt/base/log.h"
 #include "rt/base/number.h"
 #include "rt/io/gltf.h"
+#include "rt/io/image_load.h"
 #include "rt/io/mesh_io.h"
 #include "rt/scene/settings.h"
 #include "rt/scene/texture.h"
