@@ -22,7 +22,7 @@
 #include "rt/image/srgb.h"
 #include "rt/image/tonemap.h"
 #include "rt/io/exr.h"
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 #include "rt/io/image_load.h"
 #include "rt/io/image_read.h"
 #include "rt/scene/scene.h"

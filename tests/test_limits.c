@@ -22,7 +22,7 @@
 #include "rt/base/alloc.h"
 #include "rt/base/log.h"
 #include "rt/io/gltf.h"
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 #include "rt/accel/kdtree.h"
 #include "rt/io/image_load.h"
 #include "rt/io/mesh_io.h"

@@ -18,7 +18,7 @@
 #include "rt/image/compare.h"
 #include "rt/image/flip.h"
 #include "rt/image/srgb.h"
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 #include "rt/io/image_read.h"
 
 static const char usage[] =
