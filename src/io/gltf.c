@@ -242,13 +242,6 @@ static rt_result fail_at(gl_doc *d, int tok, rt_result code, const char *fmt, ..
     return rt_fail(d->err, code, "%s: %s", d->path, msg);
 }
 
-#define TRY(x)                      \
-    do {                            \
-        rt_result r_ = (x);         \
-        if (r_ != RT_OK)            \
-            return r_;              \
-    } while (0)
-
 /* ------------------------------------------------------- JSON helpers */
 
 static int jtype(const gl_doc *d, int t) { return t >= 0 && t < d->j.count ? d->j.tok[t].type : 0; }
@@ -274,15 +267,6 @@ static rt_result expect_array(gl_doc *d, int t, const char *where, const char *k
         return fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected an array", where, key);
     return RT_OK;
 }
-
-/* Iterates the keys of an object already checked by expect_object. */
-#define FOR_KEYS(d, obj, k, v)                                                                    \
-    for (int k##_n = 0, k = (obj) + 1, v = (obj) + 2; k##_n < (d)->j.tok[obj].size && v < (d)->j.count; \
-         k##_n++, k = rt_json_skip(&(d)->j, v), v = k + 1)
-/* Iterates the elements of an array. */
-#define FOR_ITEMS(d, arr, idx, e)                                                       \
-    for (int idx = 0, e = (arr) + 1; idx < (d)->j.tok[arr].size && e < (d)->j.count; \
-         idx++, e = rt_json_skip(&(d)->j, e))
 
 #define KEY(k, s) rt_json_key_is(&d->j, (k), (s))
 
@@ -322,8 +306,10 @@ static rt_result get_int(gl_doc *d, const char *where, const char *key, int t, i
 
 static rt_result get_float(gl_doc *d, const char *where, const char *key, int t, float *out)
 {
+    rt_result r;
     double v;
-    TRY(get_num(d, where, key, t, &v));
+    if ((r = get_num(d, where, key, t, &v)) != RT_OK)
+        return r;
     if (fabs(v) > FLT_MAX)
         return fail_at(d, t, RT_ERR_INVALID, "%s.%s: number out of float range", where, key);
     *out = (float)v;
@@ -332,9 +318,12 @@ static rt_result get_float(gl_doc *d, const char *where, const char *key, int t,
 
 static rt_result get_floats(gl_doc *d, const char *where, const char *key, int t, float *out, int n)
 {
+    rt_result r;
     if (jtype(d, t) != RT_JSON_ARRAY || jsize(d, t) != n)
         return fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected an array of %d numbers", where, key, n);
-    FOR_ITEMS(d, t, i, e) TRY(get_float(d, where, key, e, &out[i]));
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e))
+        if ((r = get_float(d, where, key, e, &out[i])) != RT_OK)
+            return r;
     return RT_OK;
 }
 
@@ -356,7 +345,9 @@ static rt_result get_string(gl_doc *d, const char *where, const char *key, int t
 /* Allocates one zeroed record per element of array token t. */
 static rt_result alloc_table(gl_doc *d, int t, const char *key, size_t elem, void **out, size_t *count)
 {
-    TRY(expect_array(d, t, "glTF", key));
+    rt_result r;
+    if ((r = expect_array(d, t, "glTF", key)) != RT_OK)
+        return r;
     if (*out)
         return fail_at(d, t, RT_ERR_INVALID, "%s appears twice", key);
     size_t n = (size_t)jsize(d, t);
@@ -469,21 +460,26 @@ static bool extension_supported(const gl_doc *d, int t)
 
 static rt_result check_extensions(gl_doc *d)
 {
+    rt_result r;
     char name[128];
     int req = rt_json_get(&d->j, 0, "extensionsRequired");
     if (req >= 0) {
-        TRY(expect_array(d, req, "glTF", "extensionsRequired"));
-        FOR_ITEMS(d, req, i, e) {
-            TRY(get_string(d, "glTF", "extensionsRequired", e, name, sizeof name));
+        if ((r = expect_array(d, req, "glTF", "extensionsRequired")) != RT_OK)
+            return r;
+        for (int i = 0, e = req + 1; i < d->j.tok[req].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
+            if ((r = get_string(d, "glTF", "extensionsRequired", e, name, sizeof name)) != RT_OK)
+                return r;
             if (!extension_supported(d, e))
                 return fail_at(d, e, RT_ERR_UNSUPPORTED, "required extension %s is not supported", name);
         }
     }
     int used = rt_json_get(&d->j, 0, "extensionsUsed");
     if (used >= 0) {
-        TRY(expect_array(d, used, "glTF", "extensionsUsed"));
-        FOR_ITEMS(d, used, i, e) {
-            TRY(get_string(d, "glTF", "extensionsUsed", e, name, sizeof name));
+        if ((r = expect_array(d, used, "glTF", "extensionsUsed")) != RT_OK)
+            return r;
+        for (int i = 0, e = used + 1; i < d->j.tok[used].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
+            if ((r = get_string(d, "glTF", "extensionsUsed", e, name, sizeof name)) != RT_OK)
+                return r;
             if (!extension_supported(d, e))
                 rt_warn("%s: extension %s is not supported; ignored", d->path, name);
         }
@@ -493,16 +489,20 @@ static rt_result check_extensions(gl_doc *d)
 
 static rt_result parse_asset(gl_doc *d, int t)
 {
-    TRY(expect_object(d, t, "asset"));
+    rt_result r;
+    if ((r = expect_object(d, t, "asset")) != RT_OK)
+        return r;
     int v = rt_json_get(&d->j, t, "version");
     char buf[32];
     if (v < 0)
         return fail_at(d, t, RT_ERR_INVALID, "asset.version is missing");
-    TRY(get_string(d, "asset", "version", v, buf, sizeof buf));
+    if ((r = get_string(d, "asset", "version", v, buf, sizeof buf)) != RT_OK)
+        return r;
     int minv = rt_json_get(&d->j, t, "minVersion");
     char mbuf[32];
     if (minv >= 0) {
-        TRY(get_string(d, "asset", "minVersion", minv, mbuf, sizeof mbuf));
+        if ((r = get_string(d, "asset", "minVersion", minv, mbuf, sizeof mbuf)) != RT_OK)
+            return r;
         if (strcmp(mbuf, "2.0") != 0)
             return fail_at(d, minv, RT_ERR_UNSUPPORTED, "asset.minVersion %s is not supported (only 2.0)", mbuf);
     } else if (buf[0] != '2' || buf[1] != '.') {
@@ -513,27 +513,34 @@ static rt_result parse_asset(gl_doc *d, int t)
 
 static rt_result parse_buffers(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "buffers", sizeof(gl_buffer), (void **)&d->buffers, &d->buffer_count));
-    FOR_ITEMS(d, t, i, e) {
+    rt_result r = RT_OK;
+    if ((r = alloc_table(d, t, "buffers", sizeof(gl_buffer), (void **)&d->buffers, &d->buffer_count)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "buffers[%d]", i);
         gl_buffer *b = &d->buffers[i];
         b->uri = -1;
         b->tok = e;
         b->byte_length = SIZE_MAX;
-        TRY(expect_object(d, e, where));
-        FOR_KEYS(d, e, k, v) {
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
+        for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
+             k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
             if (KEY(k, "uri")) {
                 if (jtype(d, v) != RT_JSON_STRING)
                     return fail_at(d, v, RT_ERR_INVALID, "%s.uri: expected a string", where);
                 b->uri = v;
             } else if (KEY(k, "byteLength")) {
-                TRY(get_size(d, where, "byteLength", v, &b->byte_length));
+                if ((r = get_size(d, where, "byteLength", v, &b->byte_length)) != RT_OK)
+                    return r;
             } else if (KEY(k, "extensions")) {
                 int mo = rt_json_get(&d->j, v, "EXT_meshopt_compression");
                 int fb = mo >= 0 ? rt_json_get(&d->j, mo, "fallback") : -1;
                 if (fb >= 0)
-                    TRY(get_bool(d, where, "extensions.EXT_meshopt_compression.fallback", fb, &b->fallback));
+                    r = get_bool(d, where, "extensions.EXT_meshopt_compression.fallback", fb, &b->fallback);
+                if (r != RT_OK)
+                    return r;
             }
         }
         if (b->byte_length == SIZE_MAX || b->byte_length == 0)
@@ -546,9 +553,11 @@ static rt_result parse_buffers(gl_doc *d, int t)
  * and how they decode (rt/io/meshopt.h). */
 static rt_result parse_meshopt_view(gl_doc *d, const char *view, int t, gl_view *bv)
 {
+    rt_result r = RT_OK;
     char where[96];
     snprintf(where, sizeof where, "%s.extensions.EXT_meshopt_compression", view);
-    TRY(expect_object(d, t, where));
+    if ((r = expect_object(d, t, where)) != RT_OK)
+        return r;
     bv->meshopt = true;
     bv->mo_tok = t;
     bv->mo_buffer = RT_NONE;
@@ -556,23 +565,28 @@ static rt_result parse_meshopt_view(gl_doc *d, const char *view, int t, gl_view 
     bv->mo_mode = -1;
     bv->mo_filter = RT_MESHOPT_FILTER_NONE;
     char name[32];
-    FOR_KEYS(d, t, k, v) {
-        if (KEY(k, "buffer")) TRY(get_index(d, where, "buffer", v, &bv->mo_buffer));
-        else if (KEY(k, "byteOffset")) TRY(get_size(d, where, "byteOffset", v, &bv->mo_offset));
-        else if (KEY(k, "byteLength")) TRY(get_size(d, where, "byteLength", v, &bv->mo_length));
-        else if (KEY(k, "byteStride")) TRY(get_size(d, where, "byteStride", v, &bv->mo_stride));
-        else if (KEY(k, "count")) TRY(get_size(d, where, "count", v, &bv->mo_count));
+    for (int k_n = 0, k = t + 1, v = t + 2; k_n < d->j.tok[t].size && v < d->j.count;
+         k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+        if (KEY(k, "buffer")) r = get_index(d, where, "buffer", v, &bv->mo_buffer);
+        else if (KEY(k, "byteOffset")) r = get_size(d, where, "byteOffset", v, &bv->mo_offset);
+        else if (KEY(k, "byteLength")) r = get_size(d, where, "byteLength", v, &bv->mo_length);
+        else if (KEY(k, "byteStride")) r = get_size(d, where, "byteStride", v, &bv->mo_stride);
+        else if (KEY(k, "count")) r = get_size(d, where, "count", v, &bv->mo_count);
         else if (KEY(k, "mode")) {
-            TRY(get_string(d, where, "mode", v, name, sizeof name));
+            if ((r = get_string(d, where, "mode", v, name, sizeof name)) != RT_OK)
+                return r;
             if ((bv->mo_mode = rt_meshopt_mode_from_name(name)) < 0)
                 return fail_at(d, v, RT_ERR_INVALID, "%s.mode \"%s\" is not ATTRIBUTES, TRIANGLES or INDICES", where,
                                name);
         } else if (KEY(k, "filter")) {
-            TRY(get_string(d, where, "filter", v, name, sizeof name));
+            if ((r = get_string(d, where, "filter", v, name, sizeof name)) != RT_OK)
+                return r;
             if ((bv->mo_filter = rt_meshopt_filter_from_name(name)) < 0)
                 return fail_at(d, v, RT_ERR_INVALID,
                                "%s.filter \"%s\" is not NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL", where, name);
         }
+        if (r != RT_OK)
+            return r;
     }
     if (bv->mo_buffer == RT_NONE || bv->mo_length == SIZE_MAX || bv->mo_stride == SIZE_MAX ||
         bv->mo_count == SIZE_MAX || bv->mo_mode < 0)
@@ -586,29 +600,38 @@ static rt_result parse_meshopt_view(gl_doc *d, const char *view, int t, gl_view 
 
 static rt_result parse_views(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "bufferViews", sizeof(gl_view), (void **)&d->views, &d->view_count));
-    FOR_ITEMS(d, t, i, e) {
+    rt_result r = RT_OK;
+    if ((r = alloc_table(d, t, "bufferViews", sizeof(gl_view), (void **)&d->views, &d->view_count)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "bufferViews[%d]", i);
         gl_view *bv = &d->views[i];
         bv->buffer = RT_NONE;
         bv->length = SIZE_MAX;
         bv->tok = e;
-        TRY(expect_object(d, e, where));
-        FOR_KEYS(d, e, k, v) {
-            if (KEY(k, "buffer")) TRY(get_index(d, where, "buffer", v, &bv->buffer));
-            else if (KEY(k, "byteOffset")) TRY(get_size(d, where, "byteOffset", v, &bv->offset));
-            else if (KEY(k, "byteLength")) TRY(get_size(d, where, "byteLength", v, &bv->length));
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
+        for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
+             k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+            if (KEY(k, "buffer")) r = get_index(d, where, "buffer", v, &bv->buffer);
+            else if (KEY(k, "byteOffset")) r = get_size(d, where, "byteOffset", v, &bv->offset);
+            else if (KEY(k, "byteLength")) r = get_size(d, where, "byteLength", v, &bv->length);
             else if (KEY(k, "byteStride")) {
-                TRY(get_size(d, where, "byteStride", v, &bv->stride));
+                if ((r = get_size(d, where, "byteStride", v, &bv->stride)) != RT_OK)
+                    return r;
                 if (bv->stride < 4 || bv->stride > 252 || bv->stride % 4)
                     return fail_at(d, v, RT_ERR_INVALID, "%s.byteStride %zu must be a multiple of 4 in [4, 252]",
                                    where, bv->stride);
             } else if (KEY(k, "extensions")) {
                 int mo = rt_json_get(&d->j, v, "EXT_meshopt_compression");
                 if (mo >= 0)
-                    TRY(parse_meshopt_view(d, where, mo, bv));
+                    r = parse_meshopt_view(d, where, mo, bv);
+                if (r != RT_OK)
+                    return r;
             }
+            if (r != RT_OK)
+                return r;
         }
         if (bv->buffer == RT_NONE)
             return fail_at(d, e, RT_ERR_INVALID, "%s: buffer is missing", where);
@@ -641,25 +664,33 @@ static size_t elem_size(const gl_accessor *a)
 
 static rt_result parse_sparse(gl_doc *d, const char *where, int t, gl_accessor *a)
 {
+    rt_result r = RT_OK;
     char w[80];
     snprintf(w, sizeof w, "%s.sparse", where);
-    TRY(expect_object(d, t, w));
+    if ((r = expect_object(d, t, w)) != RT_OK)
+        return r;
     bool have_count = false, have_idx = false, have_val = false;
     a->sp_idx_view = a->sp_val_view = RT_NONE;
-    FOR_KEYS(d, t, k, v) {
+    for (int k_n = 0, k = t + 1, v = t + 2; k_n < d->j.tok[t].size && v < d->j.count;
+         k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
         if (KEY(k, "count")) {
-            TRY(get_size(d, w, "count", v, &a->sparse_count));
+            if ((r = get_size(d, w, "count", v, &a->sparse_count)) != RT_OK)
+                return r;
             have_count = true;
         } else if (KEY(k, "indices")) {
             char wi[96];
             snprintf(wi, sizeof wi, "%s.indices", w);
-            TRY(expect_object(d, v, wi));
+            if ((r = expect_object(d, v, wi)) != RT_OK)
+                return r;
             have_idx = true;
             a->sp_idx_ctype = 0;
-            FOR_KEYS(d, v, k2, v2) {
-                if (KEY(k2, "bufferView")) TRY(get_index(d, wi, "bufferView", v2, &a->sp_idx_view));
-                else if (KEY(k2, "byteOffset")) TRY(get_size(d, wi, "byteOffset", v2, &a->sp_idx_offset));
-                else if (KEY(k2, "componentType")) TRY(get_int(d, wi, "componentType", v2, &a->sp_idx_ctype));
+            for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
+                 k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
+                if (KEY(k2, "bufferView")) r = get_index(d, wi, "bufferView", v2, &a->sp_idx_view);
+                else if (KEY(k2, "byteOffset")) r = get_size(d, wi, "byteOffset", v2, &a->sp_idx_offset);
+                else if (KEY(k2, "componentType")) r = get_int(d, wi, "componentType", v2, &a->sp_idx_ctype);
+                if (r != RT_OK)
+                    return r;
             }
             if (a->sp_idx_ctype != GL_UNSIGNED_BYTE && a->sp_idx_ctype != GL_UNSIGNED_SHORT &&
                 a->sp_idx_ctype != GL_UNSIGNED_INT)
@@ -667,11 +698,15 @@ static rt_result parse_sparse(gl_doc *d, const char *where, int t, gl_accessor *
         } else if (KEY(k, "values")) {
             char wv[96];
             snprintf(wv, sizeof wv, "%s.values", w);
-            TRY(expect_object(d, v, wv));
+            if ((r = expect_object(d, v, wv)) != RT_OK)
+                return r;
             have_val = true;
-            FOR_KEYS(d, v, k2, v2) {
-                if (KEY(k2, "bufferView")) TRY(get_index(d, wv, "bufferView", v2, &a->sp_val_view));
-                else if (KEY(k2, "byteOffset")) TRY(get_size(d, wv, "byteOffset", v2, &a->sp_val_offset));
+            for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
+                 k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
+                if (KEY(k2, "bufferView")) r = get_index(d, wv, "bufferView", v2, &a->sp_val_view);
+                else if (KEY(k2, "byteOffset")) r = get_size(d, wv, "byteOffset", v2, &a->sp_val_offset);
+                if (r != RT_OK)
+                    return r;
             }
         }
     }
@@ -685,25 +720,31 @@ static rt_result parse_sparse(gl_doc *d, const char *where, int t, gl_accessor *
 
 static rt_result parse_accessors(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "accessors", sizeof(gl_accessor), (void **)&d->accessors, &d->accessor_count));
-    FOR_ITEMS(d, t, i, e) {
+    rt_result r = RT_OK;
+    if ((r = alloc_table(d, t, "accessors", sizeof(gl_accessor), (void **)&d->accessors, &d->accessor_count)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "accessors[%d]", i);
         gl_accessor *a = &d->accessors[i];
         a->view = RT_NONE;
         a->count = SIZE_MAX;
         a->tok = e;
-        TRY(expect_object(d, e, where));
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
         int sparse = -1;
         char type[16] = "";
-        FOR_KEYS(d, e, k, v) {
-            if (KEY(k, "bufferView")) TRY(get_index(d, where, "bufferView", v, &a->view));
-            else if (KEY(k, "byteOffset")) TRY(get_size(d, where, "byteOffset", v, &a->offset));
-            else if (KEY(k, "componentType")) TRY(get_int(d, where, "componentType", v, &a->ctype));
-            else if (KEY(k, "normalized")) TRY(get_bool(d, where, "normalized", v, &a->normalized));
-            else if (KEY(k, "count")) TRY(get_size(d, where, "count", v, &a->count));
-            else if (KEY(k, "type")) TRY(get_string(d, where, "type", v, type, sizeof type));
+        for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
+             k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+            if (KEY(k, "bufferView")) r = get_index(d, where, "bufferView", v, &a->view);
+            else if (KEY(k, "byteOffset")) r = get_size(d, where, "byteOffset", v, &a->offset);
+            else if (KEY(k, "componentType")) r = get_int(d, where, "componentType", v, &a->ctype);
+            else if (KEY(k, "normalized")) r = get_bool(d, where, "normalized", v, &a->normalized);
+            else if (KEY(k, "count")) r = get_size(d, where, "count", v, &a->count);
+            else if (KEY(k, "type")) r = get_string(d, where, "type", v, type, sizeof type);
             else if (KEY(k, "sparse")) sparse = v;
+            if (r != RT_OK)
+                return r;
         }
         if (comp_size(a->ctype) == 0)
             return fail_at(d, e, RT_ERR_INVALID, "%s: componentType %d is not one of 5120 5121 5122 5123 5125 5126",
@@ -724,7 +765,9 @@ static rt_result parse_accessors(gl_doc *d, int t)
         if (a->normalized && (a->ctype == GL_FLOAT || a->ctype == GL_UNSIGNED_INT))
             return fail_at(d, e, RT_ERR_INVALID, "%s: normalized is not allowed for componentType %d", where, a->ctype);
         if (sparse >= 0)
-            TRY(parse_sparse(d, where, sparse, a));
+            r = parse_sparse(d, where, sparse, a);
+        if (r != RT_OK)
+            return r;
     }
     return RT_OK;
 }
@@ -733,24 +776,33 @@ static rt_result parse_accessors(gl_doc *d, int t)
  * compressed mesh and the unique ids of the attributes rt reads. */
 static rt_result parse_draco_prim(gl_doc *d, const char *prim, int t, gl_prim *pr)
 {
+    rt_result r = RT_OK;
     char where[128];
     snprintf(where, sizeof where, "%s.extensions.KHR_draco_mesh_compression", prim);
-    TRY(expect_object(d, t, where));
+    if ((r = expect_object(d, t, where)) != RT_OK)
+        return r;
     pr->draco_tok = t;
     int attrs = -1;
-    FOR_KEYS(d, t, k, v) {
-        if (KEY(k, "bufferView")) TRY(get_index(d, where, "bufferView", v, &pr->draco_view));
+    for (int k_n = 0, k = t + 1, v = t + 2; k_n < d->j.tok[t].size && v < d->j.count;
+         k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+        if (KEY(k, "bufferView")) r = get_index(d, where, "bufferView", v, &pr->draco_view);
         else if (KEY(k, "attributes")) attrs = v;
+        if (r != RT_OK)
+            return r;
     }
     if (pr->draco_view == RT_NONE || attrs < 0)
         return fail_at(d, t, RT_ERR_INVALID, "%s: needs bufferView and attributes", where);
     char wa[160];
     snprintf(wa, sizeof wa, "%s.attributes", where);
-    TRY(expect_object(d, attrs, wa));
-    FOR_KEYS(d, attrs, k2, v2) {
+    if ((r = expect_object(d, attrs, wa)) != RT_OK)
+        return r;
+    for (int k2_n = 0, k2 = attrs + 1, v2 = attrs + 2; k2_n < d->j.tok[attrs].size && v2 < d->j.count;
+         k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
         for (int a = 0; a < ATTR_COUNT; a++)
             if (KEY(k2, attr_names[a]))
-                TRY(get_index(d, wa, attr_names[a], v2, &pr->draco_id[a]));
+                r = get_index(d, wa, attr_names[a], v2, &pr->draco_id[a]);
+        if (r != RT_OK)
+            return r;
     }
     if (pr->draco_id[ATTR_POSITION] == RT_NONE)
         return fail_at(d, attrs, RT_ERR_INVALID, "%s: POSITION is missing", wa);
@@ -760,23 +812,29 @@ static rt_result parse_draco_prim(gl_doc *d, const char *prim, int t, gl_prim *p
 /* A primitive's morph targets: POSITION, NORMAL, TANGENT displacements. */
 static rt_result parse_targets(gl_doc *d, const char *prim, int t, gl_prim *pr)
 {
-    TRY(expect_array(d, t, prim, "targets"));
+    rt_result r = RT_OK;
+    if ((r = expect_array(d, t, prim, "targets")) != RT_OK)
+        return r;
     pr->first_target = (uint32_t)d->target_count;
     pr->target_count = (uint32_t)jsize(d, t);
     pr->targets = pr->target_count > 0;
     static const char *const names[3] = {"POSITION", "NORMAL", "TANGENT"};
-    FOR_ITEMS(d, t, i, e) {
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[96];
         snprintf(where, sizeof where, "%s.targets[%d]", prim, i);
-        TRY(expect_object(d, e, where));
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
         if (!rt_grow((void **)&d->targets, &d->target_cap, d->target_count + 1, sizeof(gl_target)))
             return fail_at(d, e, RT_ERR_NOMEM, "out of memory for morph targets");
         gl_target *g = &d->targets[d->target_count++];
         g->attr[0] = g->attr[1] = g->attr[2] = RT_NONE;
-        FOR_KEYS(d, e, k, v) {
+        for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
+             k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
             for (int a = 0; a < 3; a++)
                 if (KEY(k, names[a]))
-                    TRY(get_index(d, where, names[a], v, &g->attr[a]));
+                    r = get_index(d, where, names[a], v, &g->attr[a]);
+            if (r != RT_OK)
+                return r;
         }
     }
     return RT_OK;
@@ -784,17 +842,21 @@ static rt_result parse_targets(gl_doc *d, const char *prim, int t, gl_prim *pr)
 
 static rt_result parse_meshes(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "meshes", sizeof(gl_mesh), (void **)&d->meshes, &d->mesh_count));
+    rt_result r = RT_OK;
+    if ((r = alloc_table(d, t, "meshes", sizeof(gl_mesh), (void **)&d->meshes, &d->mesh_count)) != RT_OK)
+        return r;
     /* count primitives first so they live in one table */
     size_t total = 0;
-    FOR_ITEMS(d, t, i, e) {
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "meshes[%d]", i);
-        TRY(expect_object(d, e, where));
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
         int p = rt_json_get(&d->j, e, "primitives");
         if (p < 0)
             return fail_at(d, e, RT_ERR_INVALID, "%s: primitives is missing", where);
-        TRY(expect_array(d, p, where, "primitives"));
+        if ((r = expect_array(d, p, where, "primitives")) != RT_OK)
+            return r;
         if (jsize(d, p) == 0)
             return fail_at(d, p, RT_ERR_INVALID, "%s.primitives is empty", where);
         total += (size_t)jsize(d, p);
@@ -802,14 +864,14 @@ static rt_result parse_meshes(gl_doc *d, int t)
     d->prims = rt_alloc(total, sizeof(gl_prim));
     if (!d->prims)
         return fail_at(d, t, RT_ERR_NOMEM, "out of memory for %zu primitives", total);
-    FOR_ITEMS(d, t, i, e) {
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         gl_mesh *m = &d->meshes[i];
         m->tok = e;
         m->weights = rt_json_get(&d->j, e, "weights");
         int p = rt_json_get(&d->j, e, "primitives");
         m->first = (uint32_t)d->prim_count;
         m->count = (uint32_t)jsize(d, p);
-        FOR_ITEMS(d, p, pi, pe) {
+        for (int pi = 0, pe = p + 1; pi < d->j.tok[p].size && pe < d->j.count; pi++, pe = rt_json_skip(&d->j, pe)) {
             char where[64];
             snprintf(where, sizeof where, "meshes[%d].primitives[%d]", i, pi);
             gl_prim *pr = &d->prims[d->prim_count++];
@@ -820,49 +882,65 @@ static rt_result parse_meshes(gl_doc *d, int t)
             for (int a = 0; a < ATTR_COUNT; a++)
                 pr->attr[a] = pr->draco_id[a] = RT_NONE;
             pr->joints[0] = pr->joints[1] = pr->weights[0] = pr->weights[1] = RT_NONE;
-            TRY(expect_object(d, pe, where));
+            if ((r = expect_object(d, pe, where)) != RT_OK)
+                return r;
             bool have_attrs = false;
-            FOR_KEYS(d, pe, k, v) {
-                if (KEY(k, "indices")) TRY(get_index(d, where, "indices", v, &pr->indices));
-                else if (KEY(k, "material")) TRY(get_index(d, where, "material", v, &pr->material));
+            for (int k_n = 0, k = pe + 1, v = pe + 2; k_n < d->j.tok[pe].size && v < d->j.count;
+                 k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+                if (KEY(k, "indices")) r = get_index(d, where, "indices", v, &pr->indices);
+                else if (KEY(k, "material")) r = get_index(d, where, "material", v, &pr->material);
                 else if (KEY(k, "mode")) {
-                    TRY(get_int(d, where, "mode", v, &pr->mode));
+                    if ((r = get_int(d, where, "mode", v, &pr->mode)) != RT_OK)
+                        return r;
                     if (pr->mode < 0 || pr->mode > 6)
                         return fail_at(d, v, RT_ERR_INVALID, "%s.mode %d is not in [0, 6]", where, pr->mode);
                 } else if (KEY(k, "targets")) {
-                    TRY(parse_targets(d, where, v, pr));
+                    if ((r = parse_targets(d, where, v, pr)) != RT_OK)
+                        return r;
                 } else if (KEY(k, "extensions")) {
                     int dr = rt_json_get(&d->j, v, "KHR_draco_mesh_compression");
                     if (dr >= 0)
-                        TRY(parse_draco_prim(d, where, dr, pr));
+                        r = parse_draco_prim(d, where, dr, pr);
+                    if (r != RT_OK)
+                        return r;
                     /* KHR_materials_variants: the mappings are checked in apply_variant */
                     int x = rt_json_get(&d->j, v, "KHR_materials_variants");
                     if (jtype(d, v) == RT_JSON_OBJECT && x >= 0) {
                         char wx[128];
                         snprintf(wx, sizeof wx, "%s.extensions.KHR_materials_variants", where);
-                        TRY(expect_object(d, x, wx));
+                        if ((r = expect_object(d, x, wx)) != RT_OK)
+                            return r;
                         int mp = rt_json_get(&d->j, x, "mappings");
                         if (mp < 0)
                             return fail_at(d, x, RT_ERR_INVALID, "%s: mappings is missing", wx);
-                        TRY(expect_array(d, mp, wx, "mappings"));
+                        if ((r = expect_array(d, mp, wx, "mappings")) != RT_OK)
+                            return r;
                         pr->variants_tok = mp;
                     }
                 } else if (KEY(k, "attributes")) {
                     char wa[96];
                     snprintf(wa, sizeof wa, "%s.attributes", where);
-                    TRY(expect_object(d, v, wa));
+                    if ((r = expect_object(d, v, wa)) != RT_OK)
+                        return r;
                     have_attrs = true;
-                    FOR_KEYS(d, v, k2, v2) {
+                    for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
+                         k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
                         for (int a = 0; a < ATTR_COUNT; a++)
                             if (KEY(k2, attr_names[a]))
-                                TRY(get_index(d, wa, attr_names[a], v2, &pr->attr[a]));
+                                r = get_index(d, wa, attr_names[a], v2, &pr->attr[a]);
+                        if (r != RT_OK)
+                            return r;
                         static const char *const skin_attrs[4] = {"JOINTS_0", "JOINTS_1", "WEIGHTS_0", "WEIGHTS_1"};
                         for (int a = 0; a < 4; a++)
                             if (KEY(k2, skin_attrs[a]))
-                                TRY(get_index(d, wa, skin_attrs[a], v2,
-                                              a < 2 ? &pr->joints[a] : &pr->weights[a - 2]));
+                                r = get_index(d, wa, skin_attrs[a], v2,
+                                              a < 2 ? &pr->joints[a] : &pr->weights[a - 2]);
+                        if (r != RT_OK)
+                            return r;
                     }
                 }
+                if (r != RT_OK)
+                    return r;
             }
             if (!have_attrs)
                 return fail_at(d, pe, RT_ERR_INVALID, "%s: attributes is missing", where);
@@ -887,14 +965,17 @@ static rt_mat4 mat_from_gltf(const float *c)
  * their indices; read_index_list then fills it item by item. */
 static rt_result alloc_index_lists(gl_doc *d, int t, const char *table, const char *member, uint32_t **out)
 {
+    rt_result r;
     size_t total = 0;
-    FOR_ITEMS(d, t, i, e) {
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "%s[%d]", table, i);
-        TRY(expect_object(d, e, where));
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
         int a = rt_json_get(&d->j, e, member);
         if (a >= 0) {
-            TRY(expect_array(d, a, where, member));
+            if ((r = expect_array(d, a, where, member)) != RT_OK)
+                return r;
             total += (size_t)jsize(d, a);
         }
     }
@@ -908,12 +989,14 @@ static rt_result alloc_index_lists(gl_doc *d, int t, const char *table, const ch
 static rt_result read_index_list(gl_doc *d, int e, const char *where, const char *member, uint32_t *list, size_t *used,
                                  uint32_t *n)
 {
+    rt_result r;
     int a = rt_json_get(&d->j, e, member); /* the token the counting pass saw, even if the key is repeated */
     if (a < 0)
         return RT_OK;
-    FOR_ITEMS(d, a, i, x) {
+    for (int i = 0, x = a + 1; i < d->j.tok[a].size && x < d->j.count; i++, x = rt_json_skip(&d->j, x)) {
         uint32_t index;
-        TRY(get_index(d, where, member, x, &index));
+        if ((r = get_index(d, where, member, x, &index)) != RT_OK)
+            return r;
         list[(*used)++] = index;
         (*n)++;
     }
@@ -922,9 +1005,12 @@ static rt_result read_index_list(gl_doc *d, int e, const char *where, const char
 
 static rt_result parse_nodes(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "nodes", sizeof(gl_node), (void **)&d->nodes, &d->node_count));
-    TRY(alloc_index_lists(d, t, "nodes", "children", &d->children));
-    FOR_ITEMS(d, t, i, e) {
+    rt_result r = RT_OK;
+    if ((r = alloc_table(d, t, "nodes", sizeof(gl_node), (void **)&d->nodes, &d->node_count)) != RT_OK)
+        return r;
+    if ((r = alloc_index_lists(d, t, "nodes", "children", &d->children)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "nodes[%d]", i);
         gl_node *n = &d->nodes[i];
@@ -934,35 +1020,46 @@ static rt_result parse_nodes(gl_doc *d, int t)
         n->weights = -1;
         bool have_matrix = false, have_trs = false;
         float matrix[16], tr[3] = {0, 0, 0}, rot[4] = {0, 0, 0, 1}, sc[3] = {1, 1, 1};
-        FOR_KEYS(d, e, k, v) {
-            if (KEY(k, "mesh")) TRY(get_index(d, where, "mesh", v, &n->mesh));
-            else if (KEY(k, "camera")) TRY(get_index(d, where, "camera", v, &n->camera));
-            else if (KEY(k, "skin")) TRY(get_index(d, where, "skin", v, &n->skin));
+        for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
+             k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+            if (KEY(k, "mesh")) r = get_index(d, where, "mesh", v, &n->mesh);
+            else if (KEY(k, "camera")) r = get_index(d, where, "camera", v, &n->camera);
+            else if (KEY(k, "skin")) r = get_index(d, where, "skin", v, &n->skin);
             else if (KEY(k, "matrix")) {
-                TRY(get_floats(d, where, "matrix", v, matrix, 16));
+                if ((r = get_floats(d, where, "matrix", v, matrix, 16)) != RT_OK)
+                    return r;
                 have_matrix = true;
             } else if (KEY(k, "translation")) {
-                TRY(get_floats(d, where, "translation", v, tr, 3));
+                if ((r = get_floats(d, where, "translation", v, tr, 3)) != RT_OK)
+                    return r;
                 have_trs = true;
             } else if (KEY(k, "rotation")) {
-                TRY(get_floats(d, where, "rotation", v, rot, 4));
+                if ((r = get_floats(d, where, "rotation", v, rot, 4)) != RT_OK)
+                    return r;
                 have_trs = true;
             } else if (KEY(k, "scale")) {
-                TRY(get_floats(d, where, "scale", v, sc, 3));
+                if ((r = get_floats(d, where, "scale", v, sc, 3)) != RT_OK)
+                    return r;
                 have_trs = true;
             } else if (KEY(k, "weights")) {
                 n->weights = v;
             } else if (KEY(k, "extensions")) {
                 int l = rt_json_get(&d->j, v, "KHR_lights_punctual");
                 if (l >= 0) {
-                    TRY(expect_object(d, l, where));
+                    if ((r = expect_object(d, l, where)) != RT_OK)
+                        return r;
                     int li = rt_json_get(&d->j, l, "light");
                     if (li >= 0)
-                        TRY(get_index(d, where, "extensions.KHR_lights_punctual.light", li, &n->light));
+                        r = get_index(d, where, "extensions.KHR_lights_punctual.light", li, &n->light);
+                    if (r != RT_OK)
+                        return r;
                 }
             }
+            if (r != RT_OK)
+                return r;
         }
-        TRY(read_index_list(d, e, where, "children", d->children, &d->children_count, &n->child_count));
+        if ((r = read_index_list(d, e, where, "children", d->children, &d->children_count, &n->child_count)) != RT_OK)
+            return r;
         memcpy(n->tr, tr, sizeof tr);
         memcpy(n->sc, sc, sizeof sc);
         n->has_matrix = have_matrix;
@@ -990,15 +1087,19 @@ static rt_result parse_nodes(gl_doc *d, int t)
 
 static rt_result parse_scenes(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "scenes", sizeof(gl_scene), (void **)&d->scenes, &d->scene_count));
-    TRY(alloc_index_lists(d, t, "scenes", "nodes", &d->scene_nodes));
-    FOR_ITEMS(d, t, i, e) {
+    rt_result r;
+    if ((r = alloc_table(d, t, "scenes", sizeof(gl_scene), (void **)&d->scenes, &d->scene_count)) != RT_OK)
+        return r;
+    if ((r = alloc_index_lists(d, t, "scenes", "nodes", &d->scene_nodes)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "scenes[%d]", i);
         gl_scene *sc = &d->scenes[i];
         sc->tok = e;
         sc->first = (uint32_t)d->scene_nodes_count;
-        TRY(read_index_list(d, e, where, "nodes", d->scene_nodes, &d->scene_nodes_count, &sc->count));
+        if ((r = read_index_list(d, e, where, "nodes", d->scene_nodes, &d->scene_nodes_count, &sc->count)) != RT_OK)
+            return r;
     }
     return RT_OK;
 }
@@ -1007,28 +1108,35 @@ static rt_result parse_scenes(gl_doc *d, int t)
 static rt_result parse_texinfo(gl_doc *d, const char *where, const char *key, int t, rt_texture_slot *slot,
                                float *extra, const char *extra_key)
 {
+    rt_result r = RT_OK;
     char w[128];
     snprintf(w, sizeof w, "%s.%s", where, key);
-    TRY(expect_object(d, t, w));
+    if ((r = expect_object(d, t, w)) != RT_OK)
+        return r;
     uint32_t index = RT_NONE;
     int texcoord = 0;
-    FOR_KEYS(d, t, k, v) {
-        if (KEY(k, "index")) TRY(get_index(d, w, "index", v, &index));
-        else if (KEY(k, "texCoord")) TRY(get_int(d, w, "texCoord", v, &texcoord));
-        else if (extra_key && KEY(k, extra_key)) TRY(get_float(d, w, extra_key, v, extra));
+    for (int k_n = 0, k = t + 1, v = t + 2; k_n < d->j.tok[t].size && v < d->j.count;
+         k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+        if (KEY(k, "index")) r = get_index(d, w, "index", v, &index);
+        else if (KEY(k, "texCoord")) r = get_int(d, w, "texCoord", v, &texcoord);
+        else if (extra_key && KEY(k, extra_key)) r = get_float(d, w, extra_key, v, extra);
         else if (KEY(k, "extensions")) {
             int x = rt_json_get(&d->j, v, "KHR_texture_transform");
             if (x < 0)
                 continue;
             char wx[200];
             snprintf(wx, sizeof wx, "%s.extensions.KHR_texture_transform", w);
-            TRY(expect_object(d, x, wx));
+            if ((r = expect_object(d, x, wx)) != RT_OK)
+                return r;
             float off[2] = {0, 0}, scale[2] = {1, 1}, rot = 0;
-            FOR_KEYS(d, x, k2, v2) {
-                if (KEY(k2, "offset")) TRY(get_floats(d, wx, "offset", v2, off, 2));
-                else if (KEY(k2, "scale")) TRY(get_floats(d, wx, "scale", v2, scale, 2));
-                else if (KEY(k2, "rotation")) TRY(get_float(d, wx, "rotation", v2, &rot));
-                else if (KEY(k2, "texCoord")) TRY(get_int(d, wx, "texCoord", v2, &texcoord));
+            for (int k2_n = 0, k2 = x + 1, v2 = x + 2; k2_n < d->j.tok[x].size && v2 < d->j.count;
+                 k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
+                if (KEY(k2, "offset")) r = get_floats(d, wx, "offset", v2, off, 2);
+                else if (KEY(k2, "scale")) r = get_floats(d, wx, "scale", v2, scale, 2);
+                else if (KEY(k2, "rotation")) r = get_float(d, wx, "rotation", v2, &rot);
+                else if (KEY(k2, "texCoord")) r = get_int(d, wx, "texCoord", v2, &texcoord);
+                if (r != RT_OK)
+                    return r;
             }
             /* matrix = T(offset) * R(rotation) * S(scale) with R, row-major,
              * = [cos sin; -sin cos]: u' = u cos + v sin, v' = -u sin + v cos.
@@ -1045,6 +1153,8 @@ static rt_result parse_texinfo(gl_doc *d, const char *where, const char *key, in
             slot->uv_transform[4] = c * scale[1];
             slot->uv_transform[5] = off[1];
         }
+        if (r != RT_OK)
+            return r;
     }
     if (index == RT_NONE)
         return fail_at(d, t, RT_ERR_INVALID, "%s: index is missing", w);
@@ -1084,7 +1194,9 @@ static void derive_phong(rt_material *m)
 /* A factor of a material extension that must lie in [lo, hi]. */
 static rt_result get_ranged(gl_doc *d, const char *where, const char *key, int t, float lo, float hi, float *out)
 {
-    TRY(get_float(d, where, key, t, out));
+    rt_result r;
+    if ((r = get_float(d, where, key, t, out)) != RT_OK)
+        return r;
     if (!(*out >= lo && *out <= hi))
         return fail_at(d, t, RT_ERR_INVALID, "%s.%s %g is outside [%g, %g]", where, key, (double)*out, (double)lo,
                        (double)hi);
@@ -1095,8 +1207,10 @@ static rt_result get_ranged(gl_doc *d, const char *where, const char *key, int t
 static rt_result get_color_ranged(gl_doc *d, const char *where, const char *key, int t, float lo, float hi,
                                   rt_vec3 *out)
 {
+    rt_result r;
     float c[3];
-    TRY(get_floats(d, where, key, t, c, 3));
+    if ((r = get_floats(d, where, key, t, c, 3)) != RT_OK)
+        return r;
     for (int i = 0; i < 3; i++)
         if (!(c[i] >= lo && c[i] <= hi))
             return fail_at(d, t, RT_ERR_INVALID, "%s.%s component %d (%g) is outside [%g, %g]", where, key, i,
@@ -1111,99 +1225,127 @@ static rt_result get_color_ranged(gl_doc *d, const char *where, const char *key,
  * key. Ranges are the extensions' schemas'. */
 static rt_result parse_material_ext(gl_doc *d, const char *wx, int k2, int v2, rt_material *m, bool *known)
 {
+    rt_result r = RT_OK;
     char we[160];
     float big = 3.0e38f;
     *known = true;
     if (KEY(k2, "KHR_materials_clearcoat")) {
         snprintf(we, sizeof we, "%s.KHR_materials_clearcoat", wx);
-        TRY(expect_object(d, v2, we));
-        FOR_KEYS(d, v2, k3, v3) {
-            if (KEY(k3, "clearcoatFactor")) TRY(get_ranged(d, we, "clearcoatFactor", v3, 0, 1, &m->clearcoat));
+        if ((r = expect_object(d, v2, we)) != RT_OK)
+            return r;
+        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
+             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
+            if (KEY(k3, "clearcoatFactor")) r = get_ranged(d, we, "clearcoatFactor", v3, 0, 1, &m->clearcoat);
             else if (KEY(k3, "clearcoatRoughnessFactor"))
-                TRY(get_ranged(d, we, "clearcoatRoughnessFactor", v3, 0, 1, &m->clearcoat_roughness));
+                r = get_ranged(d, we, "clearcoatRoughnessFactor", v3, 0, 1, &m->clearcoat_roughness);
             else if (KEY(k3, "clearcoatTexture"))
-                TRY(parse_texinfo(d, we, "clearcoatTexture", v3, &m->ext_tex[RT_XTEX_CLEARCOAT], NULL, NULL));
+                r = parse_texinfo(d, we, "clearcoatTexture", v3, &m->ext_tex[RT_XTEX_CLEARCOAT], NULL, NULL);
             else if (KEY(k3, "clearcoatRoughnessTexture"))
-                TRY(parse_texinfo(d, we, "clearcoatRoughnessTexture", v3, &m->ext_tex[RT_XTEX_CLEARCOAT_ROUGHNESS],
-                                  NULL, NULL));
+                r = parse_texinfo(d, we, "clearcoatRoughnessTexture", v3, &m->ext_tex[RT_XTEX_CLEARCOAT_ROUGHNESS],
+                                  NULL, NULL);
             else if (KEY(k3, "clearcoatNormalTexture"))
-                TRY(parse_texinfo(d, we, "clearcoatNormalTexture", v3, &m->ext_tex[RT_XTEX_CLEARCOAT_NORMAL],
-                                  &m->clearcoat_normal_scale, "scale"));
+                r = parse_texinfo(d, we, "clearcoatNormalTexture", v3, &m->ext_tex[RT_XTEX_CLEARCOAT_NORMAL],
+                                  &m->clearcoat_normal_scale, "scale");
+            if (r != RT_OK)
+                return r;
         }
     } else if (KEY(k2, "KHR_materials_specular")) {
         snprintf(we, sizeof we, "%s.KHR_materials_specular", wx);
-        TRY(expect_object(d, v2, we));
-        FOR_KEYS(d, v2, k3, v3) {
-            if (KEY(k3, "specularFactor")) TRY(get_ranged(d, we, "specularFactor", v3, 0, 1, &m->specular_weight));
+        if ((r = expect_object(d, v2, we)) != RT_OK)
+            return r;
+        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
+             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
+            if (KEY(k3, "specularFactor")) r = get_ranged(d, we, "specularFactor", v3, 0, 1, &m->specular_weight);
             else if (KEY(k3, "specularColorFactor"))
-                TRY(get_color_ranged(d, we, "specularColorFactor", v3, 0, big, &m->specular_color));
+                r = get_color_ranged(d, we, "specularColorFactor", v3, 0, big, &m->specular_color);
             else if (KEY(k3, "specularTexture"))
-                TRY(parse_texinfo(d, we, "specularTexture", v3, &m->ext_tex[RT_XTEX_SPECULAR], NULL, NULL));
+                r = parse_texinfo(d, we, "specularTexture", v3, &m->ext_tex[RT_XTEX_SPECULAR], NULL, NULL);
             else if (KEY(k3, "specularColorTexture"))
-                TRY(parse_texinfo(d, we, "specularColorTexture", v3, &m->ext_tex[RT_XTEX_SPECULAR_COLOR], NULL,
-                                  NULL));
+                r = parse_texinfo(d, we, "specularColorTexture", v3, &m->ext_tex[RT_XTEX_SPECULAR_COLOR], NULL,
+                                  NULL);
+            if (r != RT_OK)
+                return r;
         }
     } else if (KEY(k2, "KHR_materials_sheen")) {
         snprintf(we, sizeof we, "%s.KHR_materials_sheen", wx);
-        TRY(expect_object(d, v2, we));
-        FOR_KEYS(d, v2, k3, v3) {
-            if (KEY(k3, "sheenColorFactor")) TRY(get_color_ranged(d, we, "sheenColorFactor", v3, 0, 1, &m->sheen_color));
+        if ((r = expect_object(d, v2, we)) != RT_OK)
+            return r;
+        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
+             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
+            if (KEY(k3, "sheenColorFactor")) r = get_color_ranged(d, we, "sheenColorFactor", v3, 0, 1, &m->sheen_color);
             else if (KEY(k3, "sheenRoughnessFactor"))
-                TRY(get_ranged(d, we, "sheenRoughnessFactor", v3, 0, 1, &m->sheen_roughness));
+                r = get_ranged(d, we, "sheenRoughnessFactor", v3, 0, 1, &m->sheen_roughness);
             else if (KEY(k3, "sheenColorTexture"))
-                TRY(parse_texinfo(d, we, "sheenColorTexture", v3, &m->ext_tex[RT_XTEX_SHEEN_COLOR], NULL, NULL));
+                r = parse_texinfo(d, we, "sheenColorTexture", v3, &m->ext_tex[RT_XTEX_SHEEN_COLOR], NULL, NULL);
             else if (KEY(k3, "sheenRoughnessTexture"))
-                TRY(parse_texinfo(d, we, "sheenRoughnessTexture", v3, &m->ext_tex[RT_XTEX_SHEEN_ROUGHNESS], NULL,
-                                  NULL));
+                r = parse_texinfo(d, we, "sheenRoughnessTexture", v3, &m->ext_tex[RT_XTEX_SHEEN_ROUGHNESS], NULL,
+                                  NULL);
+            if (r != RT_OK)
+                return r;
         }
     } else if (KEY(k2, "KHR_materials_anisotropy")) {
         snprintf(we, sizeof we, "%s.KHR_materials_anisotropy", wx);
-        TRY(expect_object(d, v2, we));
-        FOR_KEYS(d, v2, k3, v3) {
-            if (KEY(k3, "anisotropyStrength")) TRY(get_ranged(d, we, "anisotropyStrength", v3, 0, 1, &m->anisotropy));
+        if ((r = expect_object(d, v2, we)) != RT_OK)
+            return r;
+        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
+             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
+            if (KEY(k3, "anisotropyStrength")) r = get_ranged(d, we, "anisotropyStrength", v3, 0, 1, &m->anisotropy);
             else if (KEY(k3, "anisotropyRotation"))
-                TRY(get_ranged(d, we, "anisotropyRotation", v3, -big, big, &m->anisotropy_rotation));
+                r = get_ranged(d, we, "anisotropyRotation", v3, -big, big, &m->anisotropy_rotation);
             else if (KEY(k3, "anisotropyTexture"))
-                TRY(parse_texinfo(d, we, "anisotropyTexture", v3, &m->ext_tex[RT_XTEX_ANISOTROPY], NULL, NULL));
+                r = parse_texinfo(d, we, "anisotropyTexture", v3, &m->ext_tex[RT_XTEX_ANISOTROPY], NULL, NULL);
+            if (r != RT_OK)
+                return r;
         }
     } else if (KEY(k2, "KHR_materials_iridescence")) {
         snprintf(we, sizeof we, "%s.KHR_materials_iridescence", wx);
-        TRY(expect_object(d, v2, we));
-        FOR_KEYS(d, v2, k3, v3) {
-            if (KEY(k3, "iridescenceFactor")) TRY(get_ranged(d, we, "iridescenceFactor", v3, 0, 1, &m->iridescence));
+        if ((r = expect_object(d, v2, we)) != RT_OK)
+            return r;
+        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
+             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
+            if (KEY(k3, "iridescenceFactor")) r = get_ranged(d, we, "iridescenceFactor", v3, 0, 1, &m->iridescence);
             else if (KEY(k3, "iridescenceIor"))
-                TRY(get_ranged(d, we, "iridescenceIor", v3, 1, big, &m->iridescence_ior));
+                r = get_ranged(d, we, "iridescenceIor", v3, 1, big, &m->iridescence_ior);
             else if (KEY(k3, "iridescenceThicknessMinimum"))
-                TRY(get_ranged(d, we, "iridescenceThicknessMinimum", v3, 0, big, &m->iridescence_thickness_min));
+                r = get_ranged(d, we, "iridescenceThicknessMinimum", v3, 0, big, &m->iridescence_thickness_min);
             else if (KEY(k3, "iridescenceThicknessMaximum"))
-                TRY(get_ranged(d, we, "iridescenceThicknessMaximum", v3, 0, big, &m->iridescence_thickness_max));
+                r = get_ranged(d, we, "iridescenceThicknessMaximum", v3, 0, big, &m->iridescence_thickness_max);
             else if (KEY(k3, "iridescenceTexture"))
-                TRY(parse_texinfo(d, we, "iridescenceTexture", v3, &m->ext_tex[RT_XTEX_IRIDESCENCE], NULL, NULL));
+                r = parse_texinfo(d, we, "iridescenceTexture", v3, &m->ext_tex[RT_XTEX_IRIDESCENCE], NULL, NULL);
             else if (KEY(k3, "iridescenceThicknessTexture"))
-                TRY(parse_texinfo(d, we, "iridescenceThicknessTexture", v3,
-                                  &m->ext_tex[RT_XTEX_IRIDESCENCE_THICKNESS], NULL, NULL));
+                r = parse_texinfo(d, we, "iridescenceThicknessTexture", v3,
+                                  &m->ext_tex[RT_XTEX_IRIDESCENCE_THICKNESS], NULL, NULL);
+            if (r != RT_OK)
+                return r;
         }
     } else if (KEY(k2, "KHR_materials_dispersion")) {
         snprintf(we, sizeof we, "%s.KHR_materials_dispersion", wx);
-        TRY(expect_object(d, v2, we));
+        if ((r = expect_object(d, v2, we)) != RT_OK)
+            return r;
         int s = rt_json_get(&d->j, v2, "dispersion");
         if (s >= 0)
-            TRY(get_ranged(d, we, "dispersion", s, 0, big, &m->dispersion));
+            r = get_ranged(d, we, "dispersion", s, 0, big, &m->dispersion);
+        if (r != RT_OK)
+            return r;
     } else if (KEY(k2, "KHR_materials_diffuse_transmission")) {
         snprintf(we, sizeof we, "%s.KHR_materials_diffuse_transmission", wx);
-        TRY(expect_object(d, v2, we));
-        FOR_KEYS(d, v2, k3, v3) {
+        if ((r = expect_object(d, v2, we)) != RT_OK)
+            return r;
+        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
+             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
             if (KEY(k3, "diffuseTransmissionFactor"))
-                TRY(get_ranged(d, we, "diffuseTransmissionFactor", v3, 0, 1, &m->diffuse_transmission));
+                r = get_ranged(d, we, "diffuseTransmissionFactor", v3, 0, 1, &m->diffuse_transmission);
             else if (KEY(k3, "diffuseTransmissionColorFactor"))
-                TRY(get_color_ranged(d, we, "diffuseTransmissionColorFactor", v3, 0, 1,
-                                     &m->diffuse_transmission_color));
+                r = get_color_ranged(d, we, "diffuseTransmissionColorFactor", v3, 0, 1,
+                                     &m->diffuse_transmission_color);
             else if (KEY(k3, "diffuseTransmissionTexture"))
-                TRY(parse_texinfo(d, we, "diffuseTransmissionTexture", v3,
-                                  &m->ext_tex[RT_XTEX_DIFFUSE_TRANSMISSION], NULL, NULL));
+                r = parse_texinfo(d, we, "diffuseTransmissionTexture", v3,
+                                  &m->ext_tex[RT_XTEX_DIFFUSE_TRANSMISSION], NULL, NULL);
             else if (KEY(k3, "diffuseTransmissionColorTexture"))
-                TRY(parse_texinfo(d, we, "diffuseTransmissionColorTexture", v3,
-                                  &m->ext_tex[RT_XTEX_DIFFUSE_TRANSMISSION_COLOR], NULL, NULL));
+                r = parse_texinfo(d, we, "diffuseTransmissionColorTexture", v3,
+                                  &m->ext_tex[RT_XTEX_DIFFUSE_TRANSMISSION_COLOR], NULL, NULL);
+            if (r != RT_OK)
+                return r;
         }
     } else {
         *known = false;
@@ -1213,8 +1355,10 @@ static rt_result parse_material_ext(gl_doc *d, const char *wx, int k2, int v2, r
 
 static rt_result parse_materials(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "materials", sizeof(gl_material), (void **)&d->materials, &d->material_count));
-    FOR_ITEMS(d, t, i, e) {
+    rt_result r = RT_OK;
+    if ((r = alloc_table(d, t, "materials", sizeof(gl_material), (void **)&d->materials, &d->material_count)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "materials[%d]", i);
         gl_material *gm = &d->materials[i];
@@ -1228,42 +1372,54 @@ static rt_result parse_materials(gl_doc *d, int t)
         m->roughness = 1;
         m->double_sided = false;
         m->transmission_color = rt_v3s(1);
-        TRY(expect_object(d, e, where));
-        FOR_KEYS(d, e, k, v) {
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
+        for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
+             k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
             if (KEY(k, "name")) {
                 if (rt_json_string(&d->j, v, m->name, sizeof m->name) < 0) /* long names: keep the default */
                     snprintf(m->name, sizeof m->name, "%s", name);
             } else if (KEY(k, "pbrMetallicRoughness")) {
                 char wp[80];
                 snprintf(wp, sizeof wp, "%s.pbrMetallicRoughness", where);
-                TRY(expect_object(d, v, wp));
-                FOR_KEYS(d, v, k2, v2) {
+                if ((r = expect_object(d, v, wp)) != RT_OK)
+                    return r;
+                for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
+                     k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
                     if (KEY(k2, "baseColorFactor")) {
                         float c[4];
-                        TRY(get_floats(d, wp, "baseColorFactor", v2, c, 4));
+                        if ((r = get_floats(d, wp, "baseColorFactor", v2, c, 4)) != RT_OK)
+                            return r;
                         m->color = rt_v3(c[0], c[1], c[2]);
                         m->alpha = c[3];
-                    } else if (KEY(k2, "metallicFactor")) TRY(get_float(d, wp, "metallicFactor", v2, &m->metallic));
-                    else if (KEY(k2, "roughnessFactor")) TRY(get_float(d, wp, "roughnessFactor", v2, &m->roughness));
+                    } else if (KEY(k2, "metallicFactor")) r = get_float(d, wp, "metallicFactor", v2, &m->metallic);
+                    else if (KEY(k2, "roughnessFactor")) r = get_float(d, wp, "roughnessFactor", v2, &m->roughness);
                     else if (KEY(k2, "baseColorTexture"))
-                        TRY(parse_texinfo(d, wp, "baseColorTexture", v2, &m->base_color_tex, NULL, NULL));
+                        r = parse_texinfo(d, wp, "baseColorTexture", v2, &m->base_color_tex, NULL, NULL);
                     else if (KEY(k2, "metallicRoughnessTexture"))
-                        TRY(parse_texinfo(d, wp, "metallicRoughnessTexture", v2, &m->metal_rough_tex, NULL, NULL));
+                        r = parse_texinfo(d, wp, "metallicRoughnessTexture", v2, &m->metal_rough_tex, NULL, NULL);
+                    if (r != RT_OK)
+                        return r;
                 }
             } else if (KEY(k, "normalTexture")) {
-                TRY(parse_texinfo(d, where, "normalTexture", v, &m->normal_tex, &m->normal_scale, "scale"));
+                if ((r = parse_texinfo(d, where, "normalTexture", v, &m->normal_tex, &m->normal_scale, "scale")) != RT_OK)
+                    return r;
             } else if (KEY(k, "occlusionTexture")) {
-                TRY(parse_texinfo(d, where, "occlusionTexture", v, &m->occlusion_tex, &m->occlusion_strength,
-                                  "strength"));
+                if ((r = parse_texinfo(d, where, "occlusionTexture", v, &m->occlusion_tex, &m->occlusion_strength,
+                                       "strength")) != RT_OK)
+                    return r;
             } else if (KEY(k, "emissiveTexture")) {
-                TRY(parse_texinfo(d, where, "emissiveTexture", v, &m->emissive_tex, NULL, NULL));
+                if ((r = parse_texinfo(d, where, "emissiveTexture", v, &m->emissive_tex, NULL, NULL)) != RT_OK)
+                    return r;
             } else if (KEY(k, "emissiveFactor")) {
                 float c[3];
-                TRY(get_floats(d, where, "emissiveFactor", v, c, 3));
+                if ((r = get_floats(d, where, "emissiveFactor", v, c, 3)) != RT_OK)
+                    return r;
                 m->emission = rt_v3(c[0], c[1], c[2]);
             } else if (KEY(k, "alphaMode")) {
                 char mode[16];
-                TRY(get_string(d, where, "alphaMode", v, mode, sizeof mode));
+                if ((r = get_string(d, where, "alphaMode", v, mode, sizeof mode)) != RT_OK)
+                    return r;
                 if (strcmp(mode, "OPAQUE") == 0) m->alpha_mode = RT_ALPHA_OPAQUE;
                 else if (strcmp(mode, "MASK") == 0) m->alpha_mode = RT_ALPHA_MASK;
                 else if (strcmp(mode, "BLEND") == 0) m->alpha_mode = RT_ALPHA_BLEND;
@@ -1271,9 +1427,11 @@ static rt_result parse_materials(gl_doc *d, int t)
                     return fail_at(d, v, RT_ERR_INVALID, "%s.alphaMode \"%s\" is not OPAQUE, MASK or BLEND", where,
                                    mode);
             } else if (KEY(k, "alphaCutoff")) {
-                TRY(get_float(d, where, "alphaCutoff", v, &m->alpha_cutoff));
+                if ((r = get_float(d, where, "alphaCutoff", v, &m->alpha_cutoff)) != RT_OK)
+                    return r;
             } else if (KEY(k, "doubleSided")) {
-                TRY(get_bool(d, where, "doubleSided", v, &m->double_sided));
+                if ((r = get_bool(d, where, "doubleSided", v, &m->double_sided)) != RT_OK)
+                    return r;
             } else if (KEY(k, "extras")) {
                 /* extras are free-form: only an object with "bsdf": "lambertian"
                  * means something to rt (a pure Lambertian surface, as the
@@ -1285,46 +1443,64 @@ static rt_result parse_materials(gl_doc *d, int t)
             } else if (KEY(k, "extensions")) {
                 char wx[96];
                 snprintf(wx, sizeof wx, "%s.extensions", where);
-                TRY(expect_object(d, v, wx));
-                FOR_KEYS(d, v, k2, v2) {
+                if ((r = expect_object(d, v, wx)) != RT_OK)
+                    return r;
+                for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
+                     k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
                     char we[160];
                     bool known;
-                    TRY(parse_material_ext(d, wx, k2, v2, m, &known));
+                    if ((r = parse_material_ext(d, wx, k2, v2, m, &known)) != RT_OK)
+                        return r;
                     if (known)
                         continue;
                     if (KEY(k2, "KHR_materials_emissive_strength")) {
                         snprintf(we, sizeof we, "%s.KHR_materials_emissive_strength", wx);
-                        TRY(expect_object(d, v2, we));
+                        if ((r = expect_object(d, v2, we)) != RT_OK)
+                            return r;
                         int s = rt_json_get(&d->j, v2, "emissiveStrength");
                         if (s >= 0)
-                            TRY(get_float(d, we, "emissiveStrength", s, &m->emission_strength));
+                            r = get_float(d, we, "emissiveStrength", s, &m->emission_strength);
+                        if (r != RT_OK)
+                            return r;
                     } else if (KEY(k2, "KHR_materials_transmission")) {
                         snprintf(we, sizeof we, "%s.KHR_materials_transmission", wx);
-                        TRY(expect_object(d, v2, we));
-                        FOR_KEYS(d, v2, k3, v3) {
+                        if ((r = expect_object(d, v2, we)) != RT_OK)
+                            return r;
+                        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
+                             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
                             if (KEY(k3, "transmissionFactor"))
-                                TRY(get_float(d, we, "transmissionFactor", v3, &m->transmission));
+                                r = get_float(d, we, "transmissionFactor", v3, &m->transmission);
                             else if (KEY(k3, "transmissionTexture"))
-                                TRY(parse_texinfo(d, we, "transmissionTexture", v3, &m->transmission_tex, NULL, NULL));
+                                r = parse_texinfo(d, we, "transmissionTexture", v3, &m->transmission_tex, NULL, NULL);
+                            if (r != RT_OK)
+                                return r;
                         }
                     } else if (KEY(k2, "KHR_materials_ior")) {
                         snprintf(we, sizeof we, "%s.KHR_materials_ior", wx);
-                        TRY(expect_object(d, v2, we));
+                        if ((r = expect_object(d, v2, we)) != RT_OK)
+                            return r;
                         int s = rt_json_get(&d->j, v2, "ior");
                         if (s >= 0)
-                            TRY(get_float(d, we, "ior", s, &m->ior));
+                            r = get_float(d, we, "ior", s, &m->ior);
+                        if (r != RT_OK)
+                            return r;
                     } else if (KEY(k2, "KHR_materials_volume")) {
                         snprintf(we, sizeof we, "%s.KHR_materials_volume", wx);
-                        TRY(expect_object(d, v2, we));
-                        FOR_KEYS(d, v2, k3, v3) {
-                            if (KEY(k3, "thicknessFactor")) TRY(get_float(d, we, "thicknessFactor", v3, &m->thickness));
+                        if ((r = expect_object(d, v2, we)) != RT_OK)
+                            return r;
+                        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
+                             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
+                            if (KEY(k3, "thicknessFactor")) r = get_float(d, we, "thicknessFactor", v3, &m->thickness);
                             else if (KEY(k3, "attenuationDistance"))
-                                TRY(get_float(d, we, "attenuationDistance", v3, &m->attenuation_distance));
+                                r = get_float(d, we, "attenuationDistance", v3, &m->attenuation_distance);
                             else if (KEY(k3, "attenuationColor")) {
                                 float c[3];
-                                TRY(get_floats(d, we, "attenuationColor", v3, c, 3));
+                                if ((r = get_floats(d, we, "attenuationColor", v3, c, 3)) != RT_OK)
+                                    return r;
                                 m->attenuation_color = rt_v3(c[0], c[1], c[2]);
                             }
+                            if (r != RT_OK)
+                                return r;
                         }
                         if (!(m->attenuation_distance > 0))
                             return fail_at(d, v2, RT_ERR_INVALID, "%s.attenuationDistance must be positive", we);
@@ -1346,26 +1522,34 @@ static rt_result parse_materials(gl_doc *d, int t)
 
 static rt_result parse_textures(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "textures", sizeof(gl_texture), (void **)&d->textures, &d->texture_count));
-    FOR_ITEMS(d, t, i, e) {
+    rt_result r = RT_OK;
+    if ((r = alloc_table(d, t, "textures", sizeof(gl_texture), (void **)&d->textures, &d->texture_count)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "textures[%d]", i);
         gl_texture *tx = &d->textures[i];
         tx->tok = e;
         tx->source = tx->sampler = RT_NONE;
-        TRY(expect_object(d, e, where));
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
         uint32_t webp = RT_NONE;
-        FOR_KEYS(d, e, k, v) {
-            if (KEY(k, "source")) TRY(get_index(d, where, "source", v, &tx->source));
-            else if (KEY(k, "sampler")) TRY(get_index(d, where, "sampler", v, &tx->sampler));
+        for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
+             k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+            if (KEY(k, "source")) r = get_index(d, where, "source", v, &tx->source);
+            else if (KEY(k, "sampler")) r = get_index(d, where, "sampler", v, &tx->sampler);
             else if (KEY(k, "extensions")) {
                 int ew = rt_json_get(&d->j, v, "EXT_texture_webp");
                 int src = ew >= 0 ? rt_json_get(&d->j, ew, "source") : -1;
                 if (src >= 0)
-                    TRY(get_index(d, where, "extensions.EXT_texture_webp.source", src, &webp));
+                    r = get_index(d, where, "extensions.EXT_texture_webp.source", src, &webp);
+                if (r != RT_OK)
+                    return r;
                 tx->other_source = tx->other_source || rt_json_get(&d->j, v, "KHR_texture_basisu") >= 0 ||
                                    rt_json_get(&d->j, v, "MSFT_texture_dds") >= 0;
             }
+            if (r != RT_OK)
+                return r;
         }
         if (webp != RT_NONE) /* EXT_texture_webp: the WebP image replaces the fallback source */
             tx->source = webp;
@@ -1375,19 +1559,25 @@ static rt_result parse_textures(gl_doc *d, int t)
 
 static rt_result parse_samplers(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "samplers", sizeof(gl_sampler), (void **)&d->samplers, &d->sampler_count));
-    FOR_ITEMS(d, t, i, e) {
+    rt_result r = RT_OK;
+    if ((r = alloc_table(d, t, "samplers", sizeof(gl_sampler), (void **)&d->samplers, &d->sampler_count)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "samplers[%d]", i);
         gl_sampler *sm = &d->samplers[i];
         sm->tok = e;
         sm->wrap_s = sm->wrap_t = 10497;
-        TRY(expect_object(d, e, where));
-        FOR_KEYS(d, e, k, v) {
-            if (KEY(k, "magFilter")) TRY(get_int(d, where, "magFilter", v, &sm->mag));
-            else if (KEY(k, "minFilter")) TRY(get_int(d, where, "minFilter", v, &sm->min));
-            else if (KEY(k, "wrapS")) TRY(get_int(d, where, "wrapS", v, &sm->wrap_s));
-            else if (KEY(k, "wrapT")) TRY(get_int(d, where, "wrapT", v, &sm->wrap_t));
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
+        for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
+             k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+            if (KEY(k, "magFilter")) r = get_int(d, where, "magFilter", v, &sm->mag);
+            else if (KEY(k, "minFilter")) r = get_int(d, where, "minFilter", v, &sm->min);
+            else if (KEY(k, "wrapS")) r = get_int(d, where, "wrapS", v, &sm->wrap_s);
+            else if (KEY(k, "wrapT")) r = get_int(d, where, "wrapT", v, &sm->wrap_t);
+            if (r != RT_OK)
+                return r;
         }
         int w[2] = {sm->wrap_s, sm->wrap_t};
         for (int k = 0; k < 2; k++)
@@ -1401,22 +1591,27 @@ static rt_result parse_samplers(gl_doc *d, int t)
 
 static rt_result parse_images(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "images", sizeof(gl_image), (void **)&d->images, &d->image_count));
-    FOR_ITEMS(d, t, i, e) {
+    rt_result r;
+    if ((r = alloc_table(d, t, "images", sizeof(gl_image), (void **)&d->images, &d->image_count)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "images[%d]", i);
         gl_image *im = &d->images[i];
         im->tok = e;
         im->uri = -1;
         im->view = RT_NONE;
-        TRY(expect_object(d, e, where));
-        FOR_KEYS(d, e, k, v) {
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
+        for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
+             k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
             if (KEY(k, "uri")) {
                 if (jtype(d, v) != RT_JSON_STRING)
                     return fail_at(d, v, RT_ERR_INVALID, "%s.uri: expected a string", where);
                 im->uri = v;
             } else if (KEY(k, "bufferView")) {
-                TRY(get_index(d, where, "bufferView", v, &im->view));
+                if ((r = get_index(d, where, "bufferView", v, &im->view)) != RT_OK)
+                    return r;
             }
         }
         if ((im->uri < 0) == (im->view == RT_NONE))
@@ -1427,18 +1622,24 @@ static rt_result parse_images(gl_doc *d, int t)
 
 static rt_result parse_cameras(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "cameras", sizeof(gl_camera), (void **)&d->cameras, &d->camera_count));
-    FOR_ITEMS(d, t, i, e) {
+    rt_result r = RT_OK;
+    if ((r = alloc_table(d, t, "cameras", sizeof(gl_camera), (void **)&d->cameras, &d->camera_count)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "cameras[%d]", i);
         gl_camera *c = &d->cameras[i];
         c->tok = e;
-        TRY(expect_object(d, e, where));
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
         char type[16] = "";
         int persp = -1;
-        FOR_KEYS(d, e, k, v) {
-            if (KEY(k, "type")) TRY(get_string(d, where, "type", v, type, sizeof type));
+        for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
+             k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+            if (KEY(k, "type")) r = get_string(d, where, "type", v, type, sizeof type);
             else if (KEY(k, "perspective")) persp = v;
+            if (r != RT_OK)
+                return r;
         }
         if (strcmp(type, "perspective") == 0) {
             c->perspective = true;
@@ -1446,13 +1647,17 @@ static rt_result parse_cameras(gl_doc *d, int t)
                 return fail_at(d, e, RT_ERR_INVALID, "%s: perspective is missing", where);
             char wp[64];
             snprintf(wp, sizeof wp, "%s.perspective", where);
-            TRY(expect_object(d, persp, wp));
+            if ((r = expect_object(d, persp, wp)) != RT_OK)
+                return r;
             c->yfov = -1;
-            FOR_KEYS(d, persp, k, v) {
-                if (KEY(k, "yfov")) TRY(get_float(d, wp, "yfov", v, &c->yfov));
-                else if (KEY(k, "aspectRatio")) TRY(get_float(d, wp, "aspectRatio", v, &c->aspect));
-                else if (KEY(k, "znear")) TRY(get_float(d, wp, "znear", v, &c->znear));
-                else if (KEY(k, "zfar")) TRY(get_float(d, wp, "zfar", v, &c->zfar));
+            for (int k_n = 0, k = persp + 1, v = persp + 2; k_n < d->j.tok[persp].size && v < d->j.count;
+                 k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+                if (KEY(k, "yfov")) r = get_float(d, wp, "yfov", v, &c->yfov);
+                else if (KEY(k, "aspectRatio")) r = get_float(d, wp, "aspectRatio", v, &c->aspect);
+                else if (KEY(k, "znear")) r = get_float(d, wp, "znear", v, &c->znear);
+                else if (KEY(k, "zfar")) r = get_float(d, wp, "zfar", v, &c->zfar);
+                if (r != RT_OK)
+                    return r;
             }
             if (!(c->yfov > 0 && c->yfov < RT_PI))
                 return fail_at(d, persp, RT_ERR_INVALID, "%s.yfov must be in (0, pi)", wp);
@@ -1465,16 +1670,20 @@ static rt_result parse_cameras(gl_doc *d, int t)
 
 static rt_result parse_lights(gl_doc *d, int ext)
 {
-    TRY(expect_object(d, ext, "extensions"));
+    rt_result r = RT_OK;
+    if ((r = expect_object(d, ext, "extensions")) != RT_OK)
+        return r;
     int l = rt_json_get(&d->j, ext, "KHR_lights_punctual");
     if (l < 0)
         return RT_OK;
-    TRY(expect_object(d, l, "extensions.KHR_lights_punctual"));
+    if ((r = expect_object(d, l, "extensions.KHR_lights_punctual")) != RT_OK)
+        return r;
     int t = rt_json_get(&d->j, l, "lights");
     if (t < 0)
         return RT_OK;
-    TRY(alloc_table(d, t, "lights", sizeof(gl_light), (void **)&d->lights, &d->light_count));
-    FOR_ITEMS(d, t, i, e) {
+    if ((r = alloc_table(d, t, "lights", sizeof(gl_light), (void **)&d->lights, &d->light_count)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[64];
         snprintf(where, sizeof where, "KHR_lights_punctual.lights[%d]", i);
         gl_light *g = &d->lights[i];
@@ -1483,23 +1692,32 @@ static rt_result parse_lights(gl_doc *d, int ext)
         g->intensity = 1;
         g->inner = 0;
         g->outer = RT_PI / 4;
-        TRY(expect_object(d, e, where));
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
         char type[16] = "";
-        FOR_KEYS(d, e, k, v) {
-            if (KEY(k, "type")) TRY(get_string(d, where, "type", v, type, sizeof type));
+        for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
+             k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+            if (KEY(k, "type")) r = get_string(d, where, "type", v, type, sizeof type);
             else if (KEY(k, "color")) {
                 float c[3];
-                TRY(get_floats(d, where, "color", v, c, 3));
+                if ((r = get_floats(d, where, "color", v, c, 3)) != RT_OK)
+                    return r;
                 g->color = rt_v3(c[0], c[1], c[2]);
-            } else if (KEY(k, "intensity")) TRY(get_float(d, where, "intensity", v, &g->intensity));
-            else if (KEY(k, "range")) TRY(get_float(d, where, "range", v, &g->range));
+            } else if (KEY(k, "intensity")) r = get_float(d, where, "intensity", v, &g->intensity);
+            else if (KEY(k, "range")) r = get_float(d, where, "range", v, &g->range);
             else if (KEY(k, "spot")) {
-                TRY(expect_object(d, v, where));
-                FOR_KEYS(d, v, k2, v2) {
-                    if (KEY(k2, "innerConeAngle")) TRY(get_float(d, where, "spot.innerConeAngle", v2, &g->inner));
-                    else if (KEY(k2, "outerConeAngle")) TRY(get_float(d, where, "spot.outerConeAngle", v2, &g->outer));
+                if ((r = expect_object(d, v, where)) != RT_OK)
+                    return r;
+                for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
+                     k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
+                    if (KEY(k2, "innerConeAngle")) r = get_float(d, where, "spot.innerConeAngle", v2, &g->inner);
+                    else if (KEY(k2, "outerConeAngle")) r = get_float(d, where, "spot.outerConeAngle", v2, &g->outer);
+                    if (r != RT_OK)
+                        return r;
                 }
             }
+            if (r != RT_OK)
+                return r;
         }
         if (strcmp(type, "point") == 0) g->kind = RT_LIGHT_POINT;
         else if (strcmp(type, "spot") == 0) g->kind = RT_LIGHT_SPOT;
@@ -1515,29 +1733,38 @@ static rt_result parse_lights(gl_doc *d, int ext)
 
 static rt_result parse_skins(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "skins", sizeof(gl_skin), (void **)&d->skins, &d->skin_count));
-    FOR_ITEMS(d, t, i, e) {
+    rt_result r = RT_OK;
+    if ((r = alloc_table(d, t, "skins", sizeof(gl_skin), (void **)&d->skins, &d->skin_count)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "skins[%d]", i);
         gl_skin *sk = &d->skins[i];
         sk->tok = e;
         sk->ibm = RT_NONE;
-        TRY(expect_object(d, e, where));
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
         int joints = -1;
-        FOR_KEYS(d, e, k, v) {
-            if (KEY(k, "inverseBindMatrices")) TRY(get_index(d, where, "inverseBindMatrices", v, &sk->ibm));
+        for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
+             k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+            if (KEY(k, "inverseBindMatrices")) r = get_index(d, where, "inverseBindMatrices", v, &sk->ibm);
             else if (KEY(k, "joints")) joints = v;
+            if (r != RT_OK)
+                return r;
         }
         if (joints < 0)
             return fail_at(d, e, RT_ERR_INVALID, "%s: joints is missing", where);
-        TRY(expect_array(d, joints, where, "joints"));
+        if ((r = expect_array(d, joints, where, "joints")) != RT_OK)
+            return r;
         if (jsize(d, joints) == 0)
             return fail_at(d, joints, RT_ERR_INVALID, "%s.joints is empty", where);
         sk->first_joint = (uint32_t)d->skin_joints_count;
-        FOR_ITEMS(d, joints, j, je) {
+        for (int j = 0, je = joints + 1; j < d->j.tok[joints].size && je < d->j.count;
+             j++, je = rt_json_skip(&d->j, je)) {
             if (!rt_grow((void **)&d->skin_joints, &d->skin_joints_cap, d->skin_joints_count + 1, sizeof(uint32_t)))
                 return fail_at(d, je, RT_ERR_NOMEM, "out of memory for joints");
-            TRY(get_index(d, where, "joints", je, &d->skin_joints[d->skin_joints_count++]));
+            if ((r = get_index(d, where, "joints", je, &d->skin_joints[d->skin_joints_count++])) != RT_OK)
+                return r;
         }
         sk->joint_count = (uint32_t)(d->skin_joints_count - sk->first_joint);
     }
@@ -1546,35 +1773,44 @@ static rt_result parse_skins(gl_doc *d, int t)
 
 static rt_result parse_animations(gl_doc *d, int t)
 {
-    TRY(alloc_table(d, t, "animations", sizeof(gl_anim), (void **)&d->anims, &d->anim_count));
-    FOR_ITEMS(d, t, i, e) {
+    rt_result r = RT_OK;
+    if ((r = alloc_table(d, t, "animations", sizeof(gl_anim), (void **)&d->anims, &d->anim_count)) != RT_OK)
+        return r;
+    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e)) {
         char where[48];
         snprintf(where, sizeof where, "animations[%d]", i);
         gl_anim *an = &d->anims[i];
         an->tok = e;
-        TRY(expect_object(d, e, where));
+        if ((r = expect_object(d, e, where)) != RT_OK)
+            return r;
         int chans = rt_json_get(&d->j, e, "channels"), samps = rt_json_get(&d->j, e, "samplers");
         if (chans < 0 || samps < 0)
             return fail_at(d, e, RT_ERR_INVALID, "%s: needs channels and samplers", where);
-        TRY(expect_array(d, samps, where, "samplers"));
-        TRY(expect_array(d, chans, where, "channels"));
+        if ((r = expect_array(d, samps, where, "samplers")) != RT_OK)
+            return r;
+        if ((r = expect_array(d, chans, where, "channels")) != RT_OK)
+            return r;
         an->first_sampler = (uint32_t)d->asampler_count;
-        FOR_ITEMS(d, samps, j, se) {
+        for (int j = 0, se = samps + 1; j < d->j.tok[samps].size && se < d->j.count;
+             j++, se = rt_json_skip(&d->j, se)) {
             char w[80];
             snprintf(w, sizeof w, "%s.samplers[%d]", where, j);
-            TRY(expect_object(d, se, w));
+            if ((r = expect_object(d, se, w)) != RT_OK)
+                return r;
             if (!rt_grow((void **)&d->asamplers, &d->asampler_cap, d->asampler_count + 1, sizeof(gl_asampler)))
                 return fail_at(d, se, RT_ERR_NOMEM, "out of memory for animation samplers");
             gl_asampler *sa = &d->asamplers[d->asampler_count++];
             sa->input = sa->output = RT_NONE;
             sa->interp = RT_INTERP_LINEAR;
             sa->tok = se;
-            FOR_KEYS(d, se, k, v) {
-                if (KEY(k, "input")) TRY(get_index(d, w, "input", v, &sa->input));
-                else if (KEY(k, "output")) TRY(get_index(d, w, "output", v, &sa->output));
+            for (int k_n = 0, k = se + 1, v = se + 2; k_n < d->j.tok[se].size && v < d->j.count;
+                 k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+                if (KEY(k, "input")) r = get_index(d, w, "input", v, &sa->input);
+                else if (KEY(k, "output")) r = get_index(d, w, "output", v, &sa->output);
                 else if (KEY(k, "interpolation")) {
                     char name[32];
-                    TRY(get_string(d, w, "interpolation", v, name, sizeof name));
+                    if ((r = get_string(d, w, "interpolation", v, name, sizeof name)) != RT_OK)
+                        return r;
                     if (strcmp(name, "LINEAR") == 0) sa->interp = RT_INTERP_LINEAR;
                     else if (strcmp(name, "STEP") == 0) sa->interp = RT_INTERP_STEP;
                     else if (strcmp(name, "CUBICSPLINE") == 0) sa->interp = RT_INTERP_CUBICSPLINE;
@@ -1582,31 +1818,39 @@ static rt_result parse_animations(gl_doc *d, int t)
                         return fail_at(d, v, RT_ERR_INVALID,
                                        "%s.interpolation \"%s\" is not LINEAR, STEP or CUBICSPLINE", w, name);
                 }
+                if (r != RT_OK)
+                    return r;
             }
             if (sa->input == RT_NONE || sa->output == RT_NONE)
                 return fail_at(d, se, RT_ERR_INVALID, "%s: needs input and output", w);
         }
         an->sampler_count = (uint32_t)(d->asampler_count - an->first_sampler);
         an->first_channel = (uint32_t)d->channel_count;
-        FOR_ITEMS(d, chans, j, ce) {
+        for (int j = 0, ce = chans + 1; j < d->j.tok[chans].size && ce < d->j.count;
+             j++, ce = rt_json_skip(&d->j, ce)) {
             char w[80];
             snprintf(w, sizeof w, "%s.channels[%d]", where, j);
-            TRY(expect_object(d, ce, w));
+            if ((r = expect_object(d, ce, w)) != RT_OK)
+                return r;
             if (!rt_grow((void **)&d->channels, &d->channel_cap, d->channel_count + 1, sizeof(gl_channel)))
                 return fail_at(d, ce, RT_ERR_NOMEM, "out of memory for animation channels");
             gl_channel *ch = &d->channels[d->channel_count++];
             ch->sampler = ch->node = RT_NONE;
             ch->path = -1;
             ch->tok = ce;
-            FOR_KEYS(d, ce, k, v) {
-                if (KEY(k, "sampler")) TRY(get_index(d, w, "sampler", v, &ch->sampler));
+            for (int k_n = 0, k = ce + 1, v = ce + 2; k_n < d->j.tok[ce].size && v < d->j.count;
+                 k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+                if (KEY(k, "sampler")) r = get_index(d, w, "sampler", v, &ch->sampler);
                 else if (KEY(k, "target")) {
-                    TRY(expect_object(d, v, w));
-                    FOR_KEYS(d, v, k2, v2) {
-                        if (KEY(k2, "node")) TRY(get_index(d, w, "target.node", v2, &ch->node));
+                    if ((r = expect_object(d, v, w)) != RT_OK)
+                        return r;
+                    for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
+                         k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
+                        if (KEY(k2, "node")) r = get_index(d, w, "target.node", v2, &ch->node);
                         else if (KEY(k2, "path")) {
                             char name[32];
-                            TRY(get_string(d, w, "target.path", v2, name, sizeof name));
+                            if ((r = get_string(d, w, "target.path", v2, name, sizeof name)) != RT_OK)
+                                return r;
                             if (strcmp(name, "translation") == 0) ch->path = PATH_TRANSLATION;
                             else if (strcmp(name, "rotation") == 0) ch->path = PATH_ROTATION;
                             else if (strcmp(name, "scale") == 0) ch->path = PATH_SCALE;
@@ -1614,8 +1858,12 @@ static rt_result parse_animations(gl_doc *d, int t)
                             else
                                 ch->path = -2; /* "pointer" (KHR_animation_pointer) and others: not ours */
                         }
+                        if (r != RT_OK)
+                            return r;
                     }
                 }
+                if (r != RT_OK)
+                    return r;
             }
             if (ch->sampler == RT_NONE || ch->path == -1)
                 return fail_at(d, ce, RT_ERR_INVALID, "%s: needs sampler and target.path", w);
@@ -1630,39 +1878,52 @@ static rt_result parse_animations(gl_doc *d, int t)
 
 static rt_result parse_document(gl_doc *d)
 {
-    TRY(rt_json_parse(&d->j, d->json_text, d->json_len, d->path, d->json_base, d->err));
-    TRY(expect_object(d, 0, "glTF"));
-    TRY(check_extensions(d));
+    rt_result r = RT_OK;
+    if ((r = rt_json_parse(&d->j, d->json_text, d->json_len, d->path, d->json_base, d->err)) != RT_OK)
+        return r;
+    if ((r = expect_object(d, 0, "glTF")) != RT_OK)
+        return r;
+    if ((r = check_extensions(d)) != RT_OK)
+        return r;
     bool have_asset = false;
     d->default_scene = RT_NONE;
     d->variants_tok = -1;
-    FOR_KEYS(d, 0, k, v) {
-        if (KEY(k, "asset")) { TRY(parse_asset(d, v)); have_asset = true; }
-        else if (KEY(k, "buffers")) TRY(parse_buffers(d, v));
-        else if (KEY(k, "bufferViews")) TRY(parse_views(d, v));
-        else if (KEY(k, "accessors")) TRY(parse_accessors(d, v));
-        else if (KEY(k, "meshes")) TRY(parse_meshes(d, v));
-        else if (KEY(k, "nodes")) TRY(parse_nodes(d, v));
-        else if (KEY(k, "scenes")) TRY(parse_scenes(d, v));
-        else if (KEY(k, "scene")) TRY(get_index(d, "glTF", "scene", v, &d->default_scene));
-        else if (KEY(k, "materials")) TRY(parse_materials(d, v));
-        else if (KEY(k, "textures")) TRY(parse_textures(d, v));
-        else if (KEY(k, "samplers")) TRY(parse_samplers(d, v));
-        else if (KEY(k, "images")) TRY(parse_images(d, v));
-        else if (KEY(k, "cameras")) TRY(parse_cameras(d, v));
+    for (int k_n = 0, k = 1, v = 2; k_n < d->j.tok[0].size && v < d->j.count;
+         k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
+        if (KEY(k, "asset")) {
+            r = parse_asset(d, v);
+            have_asset = true;
+        }
+        else if (KEY(k, "buffers")) r = parse_buffers(d, v);
+        else if (KEY(k, "bufferViews")) r = parse_views(d, v);
+        else if (KEY(k, "accessors")) r = parse_accessors(d, v);
+        else if (KEY(k, "meshes")) r = parse_meshes(d, v);
+        else if (KEY(k, "nodes")) r = parse_nodes(d, v);
+        else if (KEY(k, "scenes")) r = parse_scenes(d, v);
+        else if (KEY(k, "scene")) r = get_index(d, "glTF", "scene", v, &d->default_scene);
+        else if (KEY(k, "materials")) r = parse_materials(d, v);
+        else if (KEY(k, "textures")) r = parse_textures(d, v);
+        else if (KEY(k, "samplers")) r = parse_samplers(d, v);
+        else if (KEY(k, "images")) r = parse_images(d, v);
+        else if (KEY(k, "cameras")) r = parse_cameras(d, v);
         else if (KEY(k, "extensions")) {
-            TRY(parse_lights(d, v));
+            if ((r = parse_lights(d, v)) != RT_OK)
+                return r;
             int x = rt_json_get(&d->j, v, "KHR_materials_variants");
             if (x >= 0) {
-                TRY(expect_object(d, x, "extensions.KHR_materials_variants"));
+                if ((r = expect_object(d, x, "extensions.KHR_materials_variants")) != RT_OK)
+                    return r;
                 d->variants_tok = rt_json_get(&d->j, x, "variants");
                 if (d->variants_tok < 0)
                     return fail_at(d, x, RT_ERR_INVALID, "extensions.KHR_materials_variants: variants is missing");
-                TRY(expect_array(d, d->variants_tok, "extensions.KHR_materials_variants", "variants"));
+                if ((r = expect_array(d, d->variants_tok, "extensions.KHR_materials_variants", "variants")) != RT_OK)
+                    return r;
             }
         }
-        else if (KEY(k, "skins")) TRY(parse_skins(d, v));
-        else if (KEY(k, "animations")) TRY(parse_animations(d, v));
+        else if (KEY(k, "skins")) r = parse_skins(d, v);
+        else if (KEY(k, "animations")) r = parse_animations(d, v);
+        if (r != RT_OK)
+            return r;
     }
     if (!have_asset)
         return fail_at(d, 0, RT_ERR_INVALID, "asset is missing (not a glTF file?)");
@@ -1671,15 +1932,22 @@ static rt_result parse_document(gl_doc *d)
 
 /* ---------------------------------------------------------- validation */
 
-#define CHECK_INDEX(idx, count, tok, table, ...)                                                            \
-    do {                                                                                                    \
-        if ((idx) != RT_NONE && (size_t)(idx) >= (count)) {                                                 \
-            char what_[160];                                                                                \
-            snprintf(what_, sizeof what_, __VA_ARGS__);                                                     \
-            return fail_at(d, tok, RT_ERR_INVALID, "%s %u is out of range (the file has %zu %s)", what_,    \
-                           (unsigned)(idx), (size_t)(count), table);                                        \
-        }                                                                                                   \
-    } while (0)
+/* An index into a table of `count` records: RT_NONE (absent) or in range.
+ * The message names the reference, "what" formatted from fmt. */
+static rt_result check_index(gl_doc *d, uint32_t idx, size_t count, int tok, const char *table, const char *fmt, ...)
+    RT_PRINTF(6, 7);
+static rt_result check_index(gl_doc *d, uint32_t idx, size_t count, int tok, const char *table, const char *fmt, ...)
+{
+    if (idx == RT_NONE || (size_t)idx < count)
+        return RT_OK;
+    char what[160];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    return fail_at(d, tok, RT_ERR_INVALID, "%s %u is out of range (the file has %zu %s)", what, (unsigned)idx, count,
+                   table);
+}
 
 /* Does [offset, offset + count * stride - stride + elem) fit in length? */
 static bool span_fits(size_t offset, size_t count, size_t stride, size_t elem, size_t length)
@@ -1709,6 +1977,7 @@ static const char *prim_name(const gl_doc *d, size_t p, char *buf, size_t cap)
  * without data has nothing to read. */
 static rt_result validate_meshopt_view(gl_doc *d, size_t i)
 {
+    rt_result r;
     gl_view *v = &d->views[i];
     const gl_buffer *b = &d->buffers[v->buffer];
     if (!v->meshopt) {
@@ -1718,8 +1987,9 @@ static rt_result validate_meshopt_view(gl_doc *d, size_t i)
                            v->buffer);
         return RT_OK;
     }
-    CHECK_INDEX(v->mo_buffer, d->buffer_count, v->mo_tok, "buffers",
-                "bufferViews[%zu].extensions.EXT_meshopt_compression.buffer", i);
+    if ((r = check_index(d, v->mo_buffer, d->buffer_count, v->mo_tok, "buffers",
+                              "bufferViews[%zu].extensions.EXT_meshopt_compression.buffer", i)) != RT_OK)
+        return r;
     const gl_buffer *src = &d->buffers[v->mo_buffer];
     if (src->fallback)
         return fail_at(d, v->mo_tok, RT_ERR_INVALID,
@@ -1740,19 +2010,22 @@ static rt_result validate_meshopt_view(gl_doc *d, size_t i)
  * accessors does not apply to them). */
 static rt_result validate_draco_prims(gl_doc *d)
 {
+    rt_result r;
     for (size_t p = 0; p < d->prim_count; p++) {
         gl_prim *pr = &d->prims[p];
         if (pr->draco_view == RT_NONE)
             continue;
         char name[64];
         prim_name(d, p, name, sizeof name);
-        CHECK_INDEX(pr->draco_view, d->view_count, pr->draco_tok, "bufferViews",
-                    "%s.extensions.KHR_draco_mesh_compression.bufferView", name);
+        if ((r = check_index(d, pr->draco_view, d->view_count, pr->draco_tok, "bufferViews",
+                                  "%s.extensions.KHR_draco_mesh_compression.bufferView", name)) != RT_OK)
+            return r;
         if (pr->mode != 4 || pr->indices == RT_NONE)
             return fail_at(d, pr->draco_tok, RT_ERR_UNSUPPORTED,
                            "%s: a KHR_draco_mesh_compression primitive must be indexed triangles (mode 4 with "
                            "indices)", name);
-        CHECK_INDEX(pr->indices, d->accessor_count, pr->tok, "accessors", "%s.indices", name);
+        if ((r = check_index(d, pr->indices, d->accessor_count, pr->tok, "accessors", "%s.indices", name)) != RT_OK)
+            return r;
         d->accessors[pr->indices].draco = true;
         for (int k = 0; k < ATTR_COUNT; k++) {
             if (pr->draco_id[k] == RT_NONE)
@@ -1762,8 +2035,9 @@ static rt_result validate_draco_prims(gl_doc *d)
                                "%s: KHR_draco_mesh_compression.attributes.%s has no accessor in the "
                                "primitive's attributes",
                                name, attr_names[k]);
-            CHECK_INDEX(pr->attr[k], d->accessor_count, pr->tok, "accessors", "%s.attributes.%s", name,
-                        attr_names[k]);
+            if ((r = check_index(d, pr->attr[k], d->accessor_count, pr->tok, "accessors", "%s.attributes.%s", name,
+                                      attr_names[k])) != RT_OK)
+                return r;
             d->accessors[pr->attr[k]].draco = true;
         }
     }
@@ -1772,22 +2046,27 @@ static rt_result validate_draco_prims(gl_doc *d)
 
 static rt_result validate(gl_doc *d)
 {
+    rt_result r;
     for (size_t i = 0; i < d->view_count; i++) {
         const gl_view *v = &d->views[i];
-        CHECK_INDEX(v->buffer, d->buffer_count, v->tok, "buffers", "bufferViews[%zu].buffer", i);
+        if ((r = check_index(d, v->buffer, d->buffer_count, v->tok, "buffers", "bufferViews[%zu].buffer", i)) != RT_OK)
+            return r;
         size_t blen = d->buffers[v->buffer].byte_length;
         if (!span_fits(v->offset, 1, 0, v->length, blen))
             return fail_at(d, v->tok, RT_ERR_INVALID,
                            "bufferViews[%zu]: byteOffset %zu + byteLength %zu runs past buffer %u (%zu bytes)", i,
                            v->offset, v->length, v->buffer, blen);
-        TRY(validate_meshopt_view(d, i));
+        if ((r = validate_meshopt_view(d, i)) != RT_OK)
+            return r;
     }
-    TRY(validate_draco_prims(d));
+    if ((r = validate_draco_prims(d)) != RT_OK)
+        return r;
     for (size_t i = 0; i < d->accessor_count; i++) {
         gl_accessor *a = &d->accessors[i];
         size_t es = elem_size(a);
         if (a->view != RT_NONE) {
-            CHECK_INDEX(a->view, d->view_count, a->tok, "bufferViews", "accessors[%zu].bufferView", i);
+            if ((r = check_index(d, a->view, d->view_count, a->tok, "bufferViews", "accessors[%zu].bufferView", i)) != RT_OK)
+                return r;
             const gl_view *v = &d->views[a->view];
             size_t stride = v->stride ? v->stride : es;
             if (stride < es)
@@ -1805,10 +2084,12 @@ static rt_result validate(gl_doc *d)
                            GL_MAX_ZEROS);
         }
         if (a->sparse_count) {
-            CHECK_INDEX(a->sp_idx_view, d->view_count, a->tok, "bufferViews",
-                        "accessors[%zu].sparse.indices.bufferView", i);
-            CHECK_INDEX(a->sp_val_view, d->view_count, a->tok, "bufferViews",
-                        "accessors[%zu].sparse.values.bufferView", i);
+            if ((r = check_index(d, a->sp_idx_view, d->view_count, a->tok, "bufferViews",
+                                      "accessors[%zu].sparse.indices.bufferView", i)) != RT_OK)
+                return r;
+            if ((r = check_index(d, a->sp_val_view, d->view_count, a->tok, "bufferViews",
+                                      "accessors[%zu].sparse.values.bufferView", i)) != RT_OK)
+                return r;
             size_t ics = comp_size(a->sp_idx_ctype);
             if (!span_fits(a->sp_idx_offset, a->sparse_count, ics, ics, d->views[a->sp_idx_view].length))
                 return fail_at(d, a->tok, RT_ERR_INVALID, "accessors[%zu].sparse.indices run past bufferView %u", i,
@@ -1821,10 +2102,12 @@ static rt_result validate(gl_doc *d)
     for (size_t m = 0; m < d->mesh_count; m++) {
         for (uint32_t p = 0; p < d->meshes[m].count; p++) {
             const gl_prim *pr = &d->prims[d->meshes[m].first + p];
-            CHECK_INDEX(pr->material, d->material_count, pr->tok, "materials",
-                        "meshes[%zu].primitives[%u].material", m, p);
-            CHECK_INDEX(pr->indices, d->accessor_count, pr->tok, "accessors",
-                        "meshes[%zu].primitives[%u].indices", m, p);
+            if ((r = check_index(d, pr->material, d->material_count, pr->tok, "materials",
+                                      "meshes[%zu].primitives[%u].material", m, p)) != RT_OK)
+                return r;
+            if ((r = check_index(d, pr->indices, d->accessor_count, pr->tok, "accessors",
+                                      "meshes[%zu].primitives[%u].indices", m, p)) != RT_OK)
+                return r;
             if (pr->indices != RT_NONE) {
                 const gl_accessor *a = &d->accessors[pr->indices];
                 if (a->ncomp != 1 || a->normalized ||
@@ -1837,9 +2120,10 @@ static rt_result validate(gl_doc *d)
             size_t count = 0;
             for (int k = 0; k < ATTR_COUNT; k++) {
                 uint32_t ai = pr->attr[k];
-                CHECK_INDEX(ai, d->accessor_count, pr->tok, "accessors",
-                            "meshes[%zu].primitives[%u].attributes.%s", m, p,
-                            attr_names[k]);
+                if ((r = check_index(d, ai, d->accessor_count, pr->tok, "accessors",
+                                          "meshes[%zu].primitives[%u].attributes.%s", m, p,
+                                          attr_names[k])) != RT_OK)
+                    return r;
                 if (ai == RT_NONE)
                     continue;
                 const gl_accessor *a = &d->accessors[ai];
@@ -1877,13 +2161,18 @@ static rt_result validate(gl_doc *d)
     }
     for (size_t i = 0; i < d->node_count; i++) {
         gl_node *n = &d->nodes[i];
-        CHECK_INDEX(n->mesh, d->mesh_count, n->tok, "meshes", "nodes[%zu].mesh", i);
-        CHECK_INDEX(n->camera, d->camera_count, n->tok, "cameras", "nodes[%zu].camera", i);
-        CHECK_INDEX(n->skin, d->skin_count, n->tok, "skins", "nodes[%zu].skin", i);
-        CHECK_INDEX(n->light, d->light_count, n->tok, "lights", "nodes[%zu].KHR_lights_punctual.light", i);
+        if ((r = check_index(d, n->mesh, d->mesh_count, n->tok, "meshes", "nodes[%zu].mesh", i)) != RT_OK)
+            return r;
+        if ((r = check_index(d, n->camera, d->camera_count, n->tok, "cameras", "nodes[%zu].camera", i)) != RT_OK)
+            return r;
+        if ((r = check_index(d, n->skin, d->skin_count, n->tok, "skins", "nodes[%zu].skin", i)) != RT_OK)
+            return r;
+        if ((r = check_index(d, n->light, d->light_count, n->tok, "lights", "nodes[%zu].KHR_lights_punctual.light", i)) != RT_OK)
+            return r;
         for (uint32_t c = 0; c < n->child_count; c++) {
             uint32_t ch = d->children[n->first_child + c];
-            CHECK_INDEX(ch, d->node_count, n->tok, "nodes", "nodes[%zu].children", i);
+            if ((r = check_index(d, ch, d->node_count, n->tok, "nodes", "nodes[%zu].children", i)) != RT_OK)
+                return r;
             if (d->nodes[ch].parent != RT_NONE)
                 return fail_at(d, n->tok, RT_ERR_INVALID, "nodes[%zu]: child %u already has parent node %u", i, ch,
                                d->nodes[ch].parent);
@@ -1904,7 +2193,7 @@ static rt_result validate(gl_doc *d)
         }
         for (size_t i = 0; i < d->node_count; i++)
             depth[i] = unknown;
-        rt_result r = RT_OK;
+        r = RT_OK;
         for (size_t i = 0; i < d->node_count && r == RT_OK; i++) {
             size_t len = 0;
             uint32_t n = (uint32_t)i;
@@ -1941,7 +2230,8 @@ static rt_result validate(gl_doc *d)
         }
         free(depth);
         free(path);
-        TRY(r);
+        if ((r = r) != RT_OK)
+            return r;
     }
     /* scene roots: in range, parentless, listed once (mark[n] = scene + 1) */
     uint32_t *mark = rt_alloc(d->node_count, sizeof(uint32_t));
@@ -1951,7 +2241,7 @@ static rt_result validate(gl_doc *d)
         const gl_scene *sc = &d->scenes[i];
         for (uint32_t k = 0; k < sc->count; k++) {
             uint32_t n = d->scene_nodes[sc->first + k];
-            rt_result r = RT_OK;
+            r = RT_OK;
             if (n >= d->node_count)
                 r = fail_at(d, sc->tok, RT_ERR_INVALID,
                             "scenes[%zu].nodes %u is out of range (the file has %zu nodes)", i, n, d->node_count);
@@ -1968,25 +2258,31 @@ static rt_result validate(gl_doc *d)
         }
     }
     free(mark);
-    CHECK_INDEX(d->default_scene, d->scene_count, -1, "scenes", "scene");
+    if ((r = check_index(d, d->default_scene, d->scene_count, -1, "scenes", "scene")) != RT_OK)
+        return r;
     for (size_t i = 0; i < d->material_count; i++) {
         const rt_material *m = &d->materials[i].m;
         const rt_texture_slot *slots[] = {&m->base_color_tex, &m->metal_rough_tex, &m->normal_tex,
                                           &m->occlusion_tex,  &m->emissive_tex,    &m->transmission_tex};
         for (size_t k = 0; k < sizeof slots / sizeof slots[0]; k++)
-            CHECK_INDEX(slots[k]->texture, d->texture_count, d->materials[i].tok, "textures",
-                        "materials[%zu]: texture", i);
+            if ((r = check_index(d, slots[k]->texture, d->texture_count, d->materials[i].tok, "textures",
+                                      "materials[%zu]: texture", i)) != RT_OK)
+                return r;
         for (int k = 0; k < RT_XTEX_COUNT; k++)
-            CHECK_INDEX(m->ext_tex[k].texture, d->texture_count, d->materials[i].tok, "textures",
-                        "materials[%zu].extensions: texture", i);
+            if ((r = check_index(d, m->ext_tex[k].texture, d->texture_count, d->materials[i].tok, "textures",
+                                      "materials[%zu].extensions: texture", i)) != RT_OK)
+                return r;
     }
     for (size_t i = 0; i < d->texture_count; i++) {
-        CHECK_INDEX(d->textures[i].source, d->image_count, d->textures[i].tok, "images", "textures[%zu].source", i);
-        CHECK_INDEX(d->textures[i].sampler, d->sampler_count, d->textures[i].tok, "samplers",
-                    "textures[%zu].sampler", i);
+        if ((r = check_index(d, d->textures[i].source, d->image_count, d->textures[i].tok, "images", "textures[%zu].source", i)) != RT_OK)
+            return r;
+        if ((r = check_index(d, d->textures[i].sampler, d->sampler_count, d->textures[i].tok, "samplers",
+                                  "textures[%zu].sampler", i)) != RT_OK)
+            return r;
     }
     for (size_t i = 0; i < d->image_count; i++)
-        CHECK_INDEX(d->images[i].view, d->view_count, d->images[i].tok, "bufferViews", "images[%zu].bufferView", i);
+        if ((r = check_index(d, d->images[i].view, d->view_count, d->images[i].tok, "bufferViews", "images[%zu].bufferView", i)) != RT_OK)
+            return r;
     return RT_OK;
 }
 
@@ -2081,6 +2377,7 @@ static rt_result token_string(gl_doc *d, int t, const char *what, char **out)
 
 static rt_result load_buffers(gl_doc *d)
 {
+    rt_result r;
     for (size_t i = 0; i < d->buffer_count; i++) {
         gl_buffer *b = &d->buffers[i];
         char what[48];
@@ -2095,8 +2392,8 @@ static rt_result load_buffers(gl_doc *d)
             have = d->bin_size;
         } else {
             char *uri;
-            TRY(token_string(d, b->uri, what, &uri));
-            rt_result r;
+            if ((r = token_string(d, b->uri, what, &uri)) != RT_OK)
+                return r;
             if (strncmp(uri, "data:", 5) == 0) {
                 r = decode_data_uri(d, b->uri, uri, strlen(uri), what, &b->owned, &have);
             } else {
@@ -2110,7 +2407,8 @@ static rt_result load_buffers(gl_doc *d)
                 free(path);
             }
             free(uri);
-            TRY(r);
+            if ((r = r) != RT_OK)
+                return r;
             b->data = b->owned;
         }
         if (have < b->byte_length)
@@ -2171,6 +2469,7 @@ static rt_result sparse_index(gl_doc *d, uint32_t ai, size_t k, size_t *prev, si
 /* Decodes accessor ai into out (count * ncomp floats), sparse applied. */
 static rt_result read_floats(gl_doc *d, uint32_t ai, float *out)
 {
+    rt_result r;
     const gl_accessor *a = &d->accessors[ai];
     size_t n = (size_t)a->ncomp, cs = comp_size(a->ctype), es = elem_size(a);
     if (a->view == RT_NONE) {
@@ -2194,7 +2493,8 @@ static rt_result read_floats(gl_doc *d, uint32_t ai, float *out)
         const uint8_t *vals = view_ptr(d, a->sp_val_view, a->sp_val_offset);
         size_t prev = 0, idx;
         for (size_t k = 0; k < a->sparse_count; k++) {
-            TRY(sparse_index(d, ai, k, &prev, &idx));
+            if ((r = sparse_index(d, ai, k, &prev, &idx)) != RT_OK)
+                return r;
             for (size_t c = 0; c < n; c++)
                 out[idx * n + c] = comp_float(vals + k * es + c * cs, a->ctype, a->normalized);
         }
@@ -2205,6 +2505,7 @@ static rt_result read_floats(gl_doc *d, uint32_t ai, float *out)
 /* Decodes an index accessor into out (count values), sparse applied. */
 static rt_result read_uints(gl_doc *d, uint32_t ai, uint32_t *out)
 {
+    rt_result r;
     const gl_accessor *a = &d->accessors[ai];
     size_t cs = comp_size(a->ctype);
     if (a->view == RT_NONE) {
@@ -2230,7 +2531,8 @@ static rt_result read_uints(gl_doc *d, uint32_t ai, uint32_t *out)
         const uint8_t *vals = view_ptr(d, a->sp_val_view, a->sp_val_offset);
         size_t prev = 0, idx;
         for (size_t k = 0; k < a->sparse_count; k++) {
-            TRY(sparse_index(d, ai, k, &prev, &idx));
+            if ((r = sparse_index(d, ai, k, &prev, &idx)) != RT_OK)
+                return r;
             out[idx] = comp_uint(vals + k * cs, a->ctype);
         }
     }
@@ -2253,11 +2555,13 @@ static rt_result decoded_budget(gl_doc *d, int tok, size_t bytes)
  * bytes, which view_ptr then reads in place of the (fallback) buffer. */
 static rt_result decode_meshopt_views(gl_doc *d)
 {
+    rt_result r;
     for (size_t i = 0; i < d->view_count; i++) {
         gl_view *v = &d->views[i];
         if (!v->meshopt)
             continue;
-        TRY(decoded_budget(d, v->mo_tok, v->length));
+        if ((r = decoded_budget(d, v->mo_tok, v->length)) != RT_OK)
+            return r;
         v->decoded = malloc(v->length);
         if (!v->decoded)
             return fail_at(d, v->mo_tok, RT_ERR_NOMEM, "out of memory for %zu decompressed bytes", v->length);
@@ -2307,6 +2611,7 @@ static rt_result fill_accessor(gl_doc *d, uint32_t ai, int tok, void *bytes, siz
  * its decoded mesh, checked against the counts its accessors declare. */
 static rt_result fill_from_draco(gl_doc *d, size_t p, const rt_draco_mesh *m)
 {
+    rt_result r;
     const gl_prim *pr = &d->prims[p];
     int tok = pr->draco_tok;
     char name[64];
@@ -2316,7 +2621,8 @@ static rt_result fill_from_draco(gl_doc *d, size_t p, const rt_draco_mesh *m)
         return fail_at(d, tok, RT_ERR_INVALID,
                        "%s: the Draco mesh has %zu triangles, the indices accessor %u has %zu indices",
                        prim_name(d, p, name, sizeof name), faces, pr->indices, nidx);
-    TRY(decoded_budget(d, tok, nidx * sizeof(uint32_t)));
+    if ((r = decoded_budget(d, tok, nidx * sizeof(uint32_t))) != RT_OK)
+        return r;
     uint32_t *idx = malloc((nidx ? nidx : 1) * sizeof *idx);
     if (!idx)
         return fail_at(d, tok, RT_ERR_NOMEM, "out of memory for %zu indices", nidx);
@@ -2328,7 +2634,8 @@ static rt_result fill_from_draco(gl_doc *d, size_t p, const rt_draco_mesh *m)
             return fail_at(d, tok, RT_ERR_INVALID, "%s: a Draco triangle names point %u of %zu",
                            prim_name(d, p, name, sizeof name), bad, points);
         }
-    TRY(fill_accessor(d, pr->indices, tok, idx, nidx * sizeof *idx, GL_UNSIGNED_INT));
+    if ((r = fill_accessor(d, pr->indices, tok, idx, nidx * sizeof *idx, GL_UNSIGNED_INT)) != RT_OK)
+        return r;
     for (int k = 0; k < ATTR_COUNT; k++) {
         if (pr->draco_id[k] == RT_NONE)
             continue;
@@ -2342,7 +2649,8 @@ static rt_result fill_from_draco(gl_doc *d, size_t p, const rt_draco_mesh *m)
             return fail_at(d, tok, RT_ERR_INVALID, "%s: %s is attribute %u, which the Draco mesh does "
                            "not have", prim_name(d, p, name, sizeof name), attr_names[k], pr->draco_id[k]);
         size_t n = points * (size_t)a->ncomp;
-        TRY(decoded_budget(d, tok, n * sizeof(float)));
+        if ((r = decoded_budget(d, tok, n * sizeof(float))) != RT_OK)
+            return r;
         float *vals = malloc((n ? n : 1) * sizeof *vals);
         if (!vals)
             return fail_at(d, tok, RT_ERR_NOMEM, "out of memory for %zu values", n);
@@ -2351,7 +2659,8 @@ static rt_result fill_from_draco(gl_doc *d, size_t p, const rt_draco_mesh *m)
             return fail_at(d, tok, RT_ERR_INVALID, "%s: Draco attribute %u (%s) cannot be read as "
                            "%d floats", prim_name(d, p, name, sizeof name), pr->draco_id[k], attr_names[k], a->ncomp);
         }
-        TRY(fill_accessor(d, ai, tok, vals, n * sizeof *vals, GL_FLOAT));
+        if ((r = fill_accessor(d, ai, tok, vals, n * sizeof *vals, GL_FLOAT)) != RT_OK)
+            return r;
     }
     return RT_OK;
 }
@@ -2370,7 +2679,8 @@ static rt_result decode_draco_prims(gl_doc *d)
                            prim_name(d, p, name, sizeof name), why);
         rt_result r = fill_from_draco(d, p, m);
         rt_draco_free(m);
-        TRY(r);
+        if ((r = r) != RT_OK)
+            return r;
     }
     return RT_OK;
 }
@@ -2441,6 +2751,7 @@ static uint32_t node_targets(const gl_doc *d, uint32_t node)
 /* One channel of the chosen animation applied to its node at time t. */
 static rt_result pose_channel(gl_doc *d, uint32_t anim, uint32_t c, float t)
 {
+    rt_result r;
     const gl_anim *an = &d->anims[anim];
     const gl_channel *ch = &d->channels[an->first_channel + c];
     if (ch->path < 0 || ch->node == RT_NONE)
@@ -2465,7 +2776,8 @@ static rt_result pose_channel(gl_doc *d, uint32_t anim, uint32_t c, float t)
     snprintf(w_in, sizeof w_in, "input of %s", what);
     snprintf(w_out, sizeof w_out, "output of %s", what);
     float *times = NULL, *values = NULL;
-    TRY(posing_floats(d, sa->input, 1, SIZE_MAX, w_in, &times));
+    if ((r = posing_floats(d, sa->input, 1, SIZE_MAX, w_in, &times)) != RT_OK)
+        return r;
     size_t keys = d->accessors[sa->input].count;
     for (size_t k = 1; k < keys; k++)
         if (!(times[k] > times[k - 1])) {
@@ -2476,8 +2788,8 @@ static rt_result pose_channel(gl_doc *d, uint32_t anim, uint32_t c, float t)
                            k, now, before);
         }
     size_t per = sa->interp == RT_INTERP_CUBICSPLINE ? 3 : 1;
-    rt_result r = ch->path == PATH_WEIGHTS ? posing_floats(d, sa->output, 1, keys * per * (size_t)ncomp, w_out, &values)
-                                           : posing_floats(d, sa->output, ncomp, keys * per, w_out, &values);
+    r = ch->path == PATH_WEIGHTS ? posing_floats(d, sa->output, 1, keys * per * (size_t)ncomp, w_out, &values)
+                                 : posing_floats(d, sa->output, ncomp, keys * per, w_out, &values);
     if (r != RT_OK) {
         free(times);
         return r;
@@ -2554,9 +2866,11 @@ static rt_result pose_named(gl_doc *d, const rt_gltf_options *opt)
 /* Every channel of animation a at time t. */
 static rt_result pose_animation(gl_doc *d, uint32_t a, float time)
 {
+    rt_result r;
     d->animated = d->anims[a].channel_count > 0;
     for (uint32_t c = 0; c < d->anims[a].channel_count; c++)
-        TRY(pose_channel(d, a, c, time));
+        if ((r = pose_channel(d, a, c, time)) != RT_OK)
+            return r;
     return RT_OK;
 }
 
@@ -2641,6 +2955,7 @@ static rt_result morph_weights(gl_doc *d, uint32_t node, uint32_t count, float *
 static rt_result apply_morph(gl_doc *d, const gl_prim *p, const float *w, int slot, float *f, size_t stride,
                              size_t vcount)
 {
+    rt_result r;
     static const char *const names[3] = {"POSITION", "NORMAL", "TANGENT"};
     for (uint32_t k = 0; k < p->target_count; k++) {
         uint32_t ai = d->targets[p->first_target + k].attr[slot];
@@ -2649,7 +2964,8 @@ static rt_result apply_morph(gl_doc *d, const gl_prim *p, const float *w, int sl
         char what[64];
         snprintf(what, sizeof what, "%s of morph target %u", names[slot], k);
         float *delta;
-        TRY(posing_floats(d, ai, 3, vcount, what, &delta));
+        if ((r = posing_floats(d, ai, 3, vcount, what, &delta)) != RT_OK)
+            return r;
         for (size_t i = 0; i < vcount; i++)
             for (size_t c = 0; c < 3; c++)
                 f[i * stride + c] += w[k] * delta[3 * i + c];
@@ -2679,8 +2995,9 @@ static rt_result skin_matrices(gl_doc *d, const gl_prim *p, uint32_t node, const
     char what[64];
     snprintf(what, sizeof what, "inverseBindMatrices of skins[%u]", d->nodes[node].skin);
     float *ibm = NULL;
-    if (sk->ibm != RT_NONE)
-        TRY(posing_floats(d, sk->ibm, 16, SIZE_MAX, what, &ibm));
+    rt_result r;
+    if (sk->ibm != RT_NONE && (r = posing_floats(d, sk->ibm, 16, SIZE_MAX, what, &ibm)) != RT_OK)
+        return r;
     if (ibm && d->accessors[sk->ibm].count < sk->joint_count) {
         free(ibm);
         return fail_at(d, sk->tok, RT_ERR_INVALID, "skins[%u]: %u joints but %zu inverseBindMatrices",
@@ -2702,7 +3019,7 @@ static rt_result skin_matrices(gl_doc *d, const gl_prim *p, uint32_t node, const
         jm[j] = rt_mat4_mul(node_world(d, jn, top), ibm ? mat_from_gltf(ibm + 16 * j) : rt_mat4_identity());
     }
     free(ibm);
-    rt_result r = RT_OK;
+    r = RT_OK;
     if (!rt_grow((void **)&d->skin_scratch, &d->skin_scratch_cap, vcount ? vcount : 1, sizeof(rt_mat4))) {
         free(jm);
         return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for skinning", d->path);
@@ -2753,6 +3070,7 @@ static rt_result skin_matrices(gl_doc *d, const gl_prim *p, uint32_t node, const
 static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t node, uint32_t pi, const rt_mat4 *M,
                                 const rt_mat4 *top, uint32_t material, size_t vbase)
 {
+    rt_result r = RT_OK;
     uint32_t mesh = d->nodes[node].mesh;
     const gl_prim *p = &d->prims[d->meshes[mesh].first + pi];
     const gl_accessor *pos = &d->accessors[p->attr[ATTR_POSITION]];
@@ -2766,15 +3084,22 @@ static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t node, uint32_t 
     if (morph) {
         if (p->target_count > 64)
             return fail_at(d, p->tok, RT_ERR_LIMIT, "meshes[%u].primitives[%u]: over 64 morph targets", mesh, pi);
-        TRY(morph_weights(d, node, p->target_count, mw));
+        if ((r = morph_weights(d, node, p->target_count, mw)) != RT_OK)
+            return r;
     }
     if (d->posed && d->nodes[node].skin != RT_NONE && p->joints[0] != RT_NONE && p->weights[0] != RT_NONE)
-        TRY(skin_matrices(d, p, node, M, top, vcount, &vm));
+        r = skin_matrices(d, p, node, M, top, vcount, &vm);
+    if (r != RT_OK)
+        return r;
 
-    TRY(scratch(d, ATTR_POSITION, vcount * 3, &f));
-    TRY(read_floats(d, p->attr[ATTR_POSITION], f));
+    if ((r = scratch(d, ATTR_POSITION, vcount * 3, &f)) != RT_OK)
+        return r;
+    if ((r = read_floats(d, p->attr[ATTR_POSITION], f)) != RT_OK)
+        return r;
     if (morph)
-        TRY(apply_morph(d, p, mw, 0, f, 3, vcount));
+        r = apply_morph(d, p, mw, 0, f, 3, vcount);
+    if (r != RT_OK)
+        return r;
     for (size_t i = 0; i < vcount; i++) {
         rt_vec3 q = rt_v3(f[3 * i], f[3 * i + 1], f[3 * i + 2]);
         if (!rt_finite3(q))
@@ -2789,10 +3114,14 @@ static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t node, uint32_t 
     bool have_n = p->attr[ATTR_NORMAL] != RT_NONE && rt_mat4_normal_matrix(M, &N);
     uint8_t flags = 0;
     if (have_n) {
-        TRY(scratch(d, ATTR_NORMAL, vcount * 3, &f));
-        TRY(read_floats(d, p->attr[ATTR_NORMAL], f));
+        if ((r = scratch(d, ATTR_NORMAL, vcount * 3, &f)) != RT_OK)
+            return r;
+        if ((r = read_floats(d, p->attr[ATTR_NORMAL], f)) != RT_OK)
+            return r;
         if (morph)
-            TRY(apply_morph(d, p, mw, 1, f, 3, vcount));
+            r = apply_morph(d, p, mw, 1, f, 3, vcount);
+        if (r != RT_OK)
+            return r;
         for (size_t i = 0; i < vcount; i++) {
             rt_vec3 n = rt_v3(f[3 * i], f[3 * i + 1], f[3 * i + 2]);
             rt_mat4 Ni;
@@ -2803,10 +3132,14 @@ static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t node, uint32_t 
         }
         flags |= RT_TRI_SMOOTH;
         if (p->attr[ATTR_TANGENT] != RT_NONE) {
-            TRY(scratch(d, ATTR_TANGENT, vcount * 4, &f));
-            TRY(read_floats(d, p->attr[ATTR_TANGENT], f));
+            if ((r = scratch(d, ATTR_TANGENT, vcount * 4, &f)) != RT_OK)
+                return r;
+            if ((r = read_floats(d, p->attr[ATTR_TANGENT], f)) != RT_OK)
+                return r;
             if (morph)
-                TRY(apply_morph(d, p, mw, 2, f, 4, vcount));
+                r = apply_morph(d, p, mw, 2, f, 4, vcount);
+            if (r != RT_OK)
+                return r;
             float sign = det < 0 ? -1.0f : 1.0f;
             for (size_t i = 0; i < vcount; i++) {
                 rt_vec3 t = rt_mat4_vector(vm ? &vm[i] : M, rt_v3(f[4 * i], f[4 * i + 1], f[4 * i + 2]));
@@ -2820,8 +3153,10 @@ static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t node, uint32_t 
     for (int k = ATTR_TEXCOORD_0; k <= ATTR_TEXCOORD_1; k++) {
         if (p->attr[k] == RT_NONE)
             continue;
-        TRY(scratch(d, k, vcount * 2, &f));
-        TRY(read_floats(d, p->attr[k], f));
+        if ((r = scratch(d, k, vcount * 2, &f)) != RT_OK)
+            return r;
+        if ((r = read_floats(d, p->attr[k], f)) != RT_OK)
+            return r;
         rt_vec2 *uv = k == ATTR_TEXCOORD_0 ? V->uv0 : V->uv1;
         for (size_t i = 0; i < vcount; i++)
             uv[vbase + i] = rt_v2(f[2 * i], f[2 * i + 1]);
@@ -2831,8 +3166,10 @@ static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t node, uint32_t 
     if (p->attr[ATTR_COLOR_0] != RT_NONE) {
         const gl_accessor *ca = &d->accessors[p->attr[ATTR_COLOR_0]];
         size_t nc = (size_t)ca->ncomp;
-        TRY(scratch(d, ATTR_COLOR_0, vcount * nc, &f));
-        TRY(read_floats(d, p->attr[ATTR_COLOR_0], f));
+        if ((r = scratch(d, ATTR_COLOR_0, vcount * nc, &f)) != RT_OK)
+            return r;
+        if ((r = read_floats(d, p->attr[ATTR_COLOR_0], f)) != RT_OK)
+            return r;
         for (size_t i = 0; i < vcount; i++)
             V->color[vbase + i] = rt_v4(f[nc * i], f[nc * i + 1], f[nc * i + 2], nc == 4 ? f[nc * i + 3] : 1.0f);
         flags |= RT_TRI_COLOR;
@@ -2845,7 +3182,8 @@ static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t node, uint32_t 
         icount = d->accessors[p->indices].count;
         if (!rt_grow((void **)&d->idx_scratch, &d->idx_cap, icount, sizeof(uint32_t)))
             return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu indices", d->path, icount);
-        TRY(read_uints(d, p->indices, d->idx_scratch));
+        if ((r = read_uints(d, p->indices, d->idx_scratch)) != RT_OK)
+            return r;
         idx = d->idx_scratch;
         for (size_t i = 0; i < icount; i++)
             if (idx[i] >= vcount)
@@ -2903,7 +3241,8 @@ static rt_result load_image(gl_doc *d, rt_scene *s, uint32_t ii, uint32_t *out, 
         r = rt_image_load_memory(s, view_ptr(d, im->view, 0), v->length, name, &img, &inner);
     } else {
         char *uri;
-        TRY(token_string(d, im->uri, what, &uri));
+        if ((r = token_string(d, im->uri, what, &uri)) != RT_OK)
+            return r;
         snprintf(label, sizeof label, "\"%.200s%s\"", uri, strlen(uri) > 200 ? "..." : "");
         if (strncmp(uri, "data:", 5) == 0) {
             uint8_t *bytes = NULL;
@@ -2952,6 +3291,7 @@ static rt_result load_image(gl_doc *d, rt_scene *s, uint32_t ii, uint32_t *out, 
 
 static rt_result load_textures(gl_doc *d, rt_scene *s, rt_gltf_stats *st)
 {
+    rt_result r;
     d->image_map = rt_alloc(d->image_count, sizeof(uint32_t));
     d->texture_map = rt_alloc(d->texture_count, sizeof(uint32_t));
     d->texture_missing = rt_alloc(d->texture_count, sizeof(bool));
@@ -2970,7 +3310,8 @@ static rt_result load_textures(gl_doc *d, rt_scene *s, rt_gltf_stats *st)
         }
         bool fresh = d->image_map[gt->source] == RT_NONE, missing;
         uint32_t img = RT_NONE;
-        TRY(load_image(d, s, gt->source, &img, &missing));
+        if ((r = load_image(d, s, gt->source, &img, &missing)) != RT_OK)
+            return r;
         if (fresh && !missing)
             st->images++;
         d->texture_missing[i] = missing;
@@ -2978,11 +3319,11 @@ static rt_result load_textures(gl_doc *d, rt_scene *s, rt_gltf_stats *st)
         if (gt->sampler != RT_NONE) {
             const gl_sampler *sm = &d->samplers[gt->sampler];
             int w[2] = {sm->wrap_s, sm->wrap_t};
-            rt_wrap r[2];
+            rt_wrap wrap[2];
             for (int k = 0; k < 2; k++)
-                r[k] = w[k] == 33071 ? RT_WRAP_CLAMP : w[k] == 33648 ? RT_WRAP_MIRROR : RT_WRAP_REPEAT;
-            tex.wrap_s = r[0];
-            tex.wrap_t = r[1];
+                wrap[k] = w[k] == 33071 ? RT_WRAP_CLAMP : w[k] == 33648 ? RT_WRAP_MIRROR : RT_WRAP_REPEAT;
+            tex.wrap_s = wrap[0];
+            tex.wrap_t = wrap[1];
             tex.filter = sm->mag == 9728 ? RT_FILTER_NEAREST : RT_FILTER_BILINEAR;
         }
         uint32_t ti = rt_scene_add_texture(s, &tex);
@@ -2996,10 +3337,14 @@ static rt_result load_textures(gl_doc *d, rt_scene *s, rt_gltf_stats *st)
 
 static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st)
 {
+    rt_result r = RT_OK;
     if (opt && opt->use_time)
-        TRY(pose_nodes(d, opt));
+        r = pose_nodes(d, opt);
+    if (r != RT_OK)
+        return r;
     st->animated = d->animated;
-    TRY(collect_visits(d, opt));
+    if ((r = collect_visits(d, opt)) != RT_OK)
+        return r;
     rt_mat4 top = opt && opt->use_transform ? opt->transform : rt_mat4_identity();
     st->nodes = d->visit_count;
 
@@ -3061,7 +3406,8 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
     if (s->vertices.count + verts >= RT_NONE || s->triangles.count + tris >= RT_NONE)
         return rt_fail(d->err, RT_ERR_LIMIT, "%s: the scene would exceed 2^32 vertices or triangles", d->path);
 
-    TRY(load_textures(d, s, st));
+    if ((r = load_textures(d, s, st)) != RT_OK)
+        return r;
 
     /* materials: one per glTF material (+ a default for primitives without one) */
     uint32_t mat_base = (uint32_t)s->material_count;
@@ -3121,7 +3467,8 @@ static rt_result flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_
             if (!is_triangles(p->mode) || p->attr[ATTR_POSITION] == RT_NONE)
                 continue;
             uint32_t mat = p->material == RT_NONE ? default_mat : mat_base + p->material;
-            TRY(emit_primitive(d, s, d->visits[v].node, k, &d->visits[v].world, &top, mat, vbase));
+            if ((r = emit_primitive(d, s, d->visits[v].node, k, &d->visits[v].world, &top, mat, vbase)) != RT_OK)
+                return r;
             vbase += d->accessors[p->attr[ATTR_POSITION]].count;
         }
     }
@@ -3214,19 +3561,23 @@ static void doc_free(gl_doc *d)
  * says (primitives without one keep their own). */
 static rt_result apply_variant(gl_doc *d, const rt_gltf_options *opt)
 {
+    rt_result r;
     const char *want = opt ? opt->variant : NULL;
     size_t count = d->variants_tok >= 0 ? (size_t)jsize(d, d->variants_tok) : 0;
     uint32_t chosen = RT_NONE;
     char names[512] = "";
     if (d->variants_tok >= 0) {
-        FOR_ITEMS(d, d->variants_tok, i, e) {
+        for (int i = 0, e = d->variants_tok + 1; i < d->j.tok[d->variants_tok].size && e < d->j.count;
+             i++, e = rt_json_skip(&d->j, e)) {
             char where[64], name[128];
             snprintf(where, sizeof where, "extensions.KHR_materials_variants.variants[%d]", i);
-            TRY(expect_object(d, e, where));
+            if ((r = expect_object(d, e, where)) != RT_OK)
+                return r;
             int n = rt_json_get(&d->j, e, "name");
             if (n < 0)
                 return fail_at(d, e, RT_ERR_INVALID, "%s: name is missing", where);
-            TRY(get_string(d, where, "name", n, name, sizeof name));
+            if ((r = get_string(d, where, "name", n, name, sizeof name)) != RT_OK)
+                return r;
             if (want && strcmp(want, name) == 0 && chosen == RT_NONE)
                 chosen = (uint32_t)i;
             size_t used = strlen(names);
@@ -3242,22 +3593,27 @@ static rt_result apply_variant(gl_doc *d, const rt_gltf_options *opt)
         if (pr->variants_tok < 0)
             continue;
         uint32_t material = pr->material;
-        FOR_ITEMS(d, pr->variants_tok, i, e) {
+        for (int i = 0, e = pr->variants_tok + 1; i < d->j.tok[pr->variants_tok].size && e < d->j.count;
+             i++, e = rt_json_skip(&d->j, e)) {
             char where[96];
             snprintf(where, sizeof where, "primitive %zu: KHR_materials_variants.mappings[%d]", p, i);
-            TRY(expect_object(d, e, where));
+            if ((r = expect_object(d, e, where)) != RT_OK)
+                return r;
             uint32_t m = RT_NONE;
             int mt = rt_json_get(&d->j, e, "material"), vt = rt_json_get(&d->j, e, "variants");
             if (mt < 0 || vt < 0)
                 return fail_at(d, e, RT_ERR_INVALID, "%s: material or variants is missing", where);
-            TRY(get_index(d, where, "material", mt, &m));
+            if ((r = get_index(d, where, "material", mt, &m)) != RT_OK)
+                return r;
             if (m >= d->material_count)
                 return fail_at(d, mt, RT_ERR_INVALID, "%s: material %u is out of range (the file has %zu materials)",
                                where, m, d->material_count);
-            TRY(expect_array(d, vt, where, "variants"));
-            FOR_ITEMS(d, vt, j, ve) {
+            if ((r = expect_array(d, vt, where, "variants")) != RT_OK)
+                return r;
+            for (int j = 0, ve = vt + 1; j < d->j.tok[vt].size && ve < d->j.count; j++, ve = rt_json_skip(&d->j, ve)) {
                 uint32_t v;
-                TRY(get_index(d, where, "variants", ve, &v));
+                if ((r = get_index(d, where, "variants", ve, &v)) != RT_OK)
+                    return r;
                 if (v >= count)
                     return fail_at(d, ve, RT_ERR_INVALID, "%s: variant %u is out of range (the file has %zu)", where,
                                    v, count);
@@ -3272,6 +3628,7 @@ static rt_result apply_variant(gl_doc *d, const rt_gltf_options *opt)
 
 static rt_result load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st)
 {
+    rt_result r;
     size_t dir_size = strlen(d->path) + 1;
     d->dir = malloc(dir_size);
     if (!d->dir)
@@ -3281,7 +3638,8 @@ static rt_result load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_glt
         return rt_fail(d->err, RT_ERR_LIMIT, "%s: file is over the limit of %zu bytes", d->path, GL_MAX_FILE);
     if (d->file_size >= 4 && memcmp(d->bytes, "glTF", 4) == 0) {
         d->glb = true;
-        TRY(split_glb(d));
+        if ((r = split_glb(d)) != RT_OK)
+            return r;
     } else {
         if (rt_path_has_ext(d->path, ".glb"))
             return rt_fail(d->err, RT_ERR_INVALID, "%s: byte 0: bad magic (expected \"glTF\" for a .glb file)",
@@ -3294,12 +3652,18 @@ static rt_result load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_glt
             d->json_base = 3;
         }
     }
-    TRY(parse_document(d));
-    TRY(apply_variant(d, opt));
-    TRY(validate(d));
-    TRY(load_buffers(d));
-    TRY(decode_meshopt_views(d));
-    TRY(decode_draco_prims(d));
+    if ((r = parse_document(d)) != RT_OK)
+        return r;
+    if ((r = apply_variant(d, opt)) != RT_OK)
+        return r;
+    if ((r = validate(d)) != RT_OK)
+        return r;
+    if ((r = load_buffers(d)) != RT_OK)
+        return r;
+    if ((r = decode_meshopt_views(d)) != RT_OK)
+        return r;
+    if ((r = decode_draco_prims(d)) != RT_OK)
+        return r;
     return flatten(d, s, opt, st);
 }
 
