@@ -129,7 +129,8 @@ static rt_result validate_draco_prims(gl_doc *d)
     return RT_OK;
 }
 
-rt_result gl_validate(gl_doc *d)
+/* Each bufferView within its buffer, a compressed view within its source. */
+static rt_result check_views(gl_doc *d)
 {
     rt_result r;
     for (size_t i = 0; i < d->view_count; i++) {
@@ -144,8 +145,14 @@ rt_result gl_validate(gl_doc *d)
         if ((r = gl_validate_meshopt_view(d, i)) != RT_OK)
             return r;
     }
-    if ((r = validate_draco_prims(d)) != RT_OK)
-        return r;
+    return RT_OK;
+}
+
+/* Each accessor within its bufferView (or under the zero-fill cap), its
+ * sparse indices and values within theirs. */
+static rt_result check_accessors(gl_doc *d)
+{
+    rt_result r;
     for (size_t i = 0; i < d->accessor_count; i++) {
         gl_accessor *a = &d->accessors[i];
         size_t es = gl_elem_size(a);
@@ -185,6 +192,14 @@ rt_result gl_validate(gl_doc *d)
                                   a->sp_val_view);
         }
     }
+    return RT_OK;
+}
+
+/* Each primitive's material, indices and attributes: in range, of the
+ * types the spec allows, the attributes of one count. */
+static rt_result check_primitives(gl_doc *d)
+{
+    rt_result r;
     for (size_t m = 0; m < d->mesh_count; m++) {
         for (uint32_t p = 0; p < d->meshes[m].count; p++) {
             const gl_prim *pr = &d->prims[d->meshes[m].first + p];
@@ -245,6 +260,13 @@ rt_result gl_validate(gl_doc *d)
             }
         }
     }
+    return RT_OK;
+}
+
+/* Each node's references in range; children linked to their one parent. */
+static rt_result check_nodes(gl_doc *d)
+{
+    rt_result r;
     for (size_t i = 0; i < d->node_count; i++) {
         gl_node *n = &d->nodes[i];
         if ((r = check_index(d, n->mesh, d->mesh_count, n->tok, "meshes", "nodes[%zu].mesh", i)) != RT_OK)
@@ -266,61 +288,67 @@ rt_result gl_validate(gl_doc *d)
             d->nodes[ch].parent = (uint32_t)i;
         }
     }
-    /* Each node has at most one parent now. Depths by walking up to a root
-     * or a node of known depth, memoised, so the whole pass is linear; a
-     * walk that meets its own path is a cycle. */
-    {
-        const uint32_t unknown = UINT32_MAX, on_path = UINT32_MAX - 1;
-        uint32_t *depth = rt_alloc(d->node_count, sizeof(uint32_t));
-        uint32_t *path = rt_alloc(GL_MAX_DEPTH + 2, sizeof(uint32_t));
-        if (!depth || !path) {
-            free(depth);
-            free(path);
-            return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
-        }
-        for (size_t i = 0; i < d->node_count; i++)
-            depth[i] = unknown;
-        r = RT_OK;
-        for (size_t i = 0; i < d->node_count && r == RT_OK; i++) {
-            size_t len = 0;
-            uint32_t n = (uint32_t)i;
-            while (depth[n] == unknown) {
-                if (len > GL_MAX_DEPTH) {
-                    r = gl_fail_at(d, d->nodes[i].tok, RT_ERR_LIMIT, "nodes[%zu] is more than %d levels deep", i,
-                                   GL_MAX_DEPTH);
-                    break;
-                }
-                depth[n] = on_path;
-                path[len++] = n;
-                uint32_t p = d->nodes[n].parent;
-                if (p == RT_NONE) {
-                    n = RT_NONE;
-                    break;
-                }
-                if (depth[p] == on_path) {
-                    r = gl_fail_at(d, d->nodes[p].tok, RT_ERR_INVALID, "nodes[%u] is its own ancestor (a cycle)", p);
-                    break;
-                }
-                n = p;
-            }
-            if (r != RT_OK)
-                break;
-            uint32_t base = n == RT_NONE ? 0 : depth[n] + 1;
-            for (size_t k = len; k-- > 0; base++) {
-                if (base > GL_MAX_DEPTH) {
-                    r = gl_fail_at(d, d->nodes[i].tok, RT_ERR_LIMIT, "nodes[%zu] is more than %d levels deep", i,
-                                   GL_MAX_DEPTH);
-                    break;
-                }
-                depth[path[k]] = base;
-            }
-        }
+    return RT_OK;
+}
+
+/* Each node has at most one parent (check_nodes). Depths by walking up to
+ * a root or a node of known depth, memoised, so the whole pass is linear;
+ * a walk that meets its own path is a cycle. */
+static rt_result check_depths(gl_doc *d)
+{
+    const uint32_t unknown = UINT32_MAX, on_path = UINT32_MAX - 1;
+    uint32_t *depth = rt_alloc(d->node_count, sizeof(uint32_t));
+    uint32_t *path = rt_alloc(GL_MAX_DEPTH + 2, sizeof(uint32_t));
+    if (!depth || !path) {
         free(depth);
         free(path);
-        if ((r = r) != RT_OK)
-            return r;
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
     }
-    /* scene roots: in range, parentless, listed once (mark[n] = scene + 1) */
+    for (size_t i = 0; i < d->node_count; i++)
+        depth[i] = unknown;
+    rt_result r = RT_OK;
+    for (size_t i = 0; i < d->node_count && r == RT_OK; i++) {
+        size_t len = 0;
+        uint32_t n = (uint32_t)i;
+        while (depth[n] == unknown) {
+            if (len > GL_MAX_DEPTH) {
+                r = gl_fail_at(d, d->nodes[i].tok, RT_ERR_LIMIT, "nodes[%zu] is more than %d levels deep", i,
+                               GL_MAX_DEPTH);
+                break;
+            }
+            depth[n] = on_path;
+            path[len++] = n;
+            uint32_t p = d->nodes[n].parent;
+            if (p == RT_NONE) {
+                n = RT_NONE;
+                break;
+            }
+            if (depth[p] == on_path) {
+                r = gl_fail_at(d, d->nodes[p].tok, RT_ERR_INVALID, "nodes[%u] is its own ancestor (a cycle)", p);
+                break;
+            }
+            n = p;
+        }
+        if (r != RT_OK)
+            break;
+        uint32_t base = n == RT_NONE ? 0 : depth[n] + 1;
+        for (size_t k = len; k-- > 0; base++) {
+            if (base > GL_MAX_DEPTH) {
+                r = gl_fail_at(d, d->nodes[i].tok, RT_ERR_LIMIT, "nodes[%zu] is more than %d levels deep", i,
+                               GL_MAX_DEPTH);
+                break;
+            }
+            depth[path[k]] = base;
+        }
+    }
+    free(depth);
+    free(path);
+    return r;
+}
+
+/* Scene roots: in range, parentless, listed once (mark[n] = scene + 1). */
+static rt_result check_scene_roots(gl_doc *d)
+{
     uint32_t *mark = rt_alloc(d->node_count, sizeof(uint32_t));
     if (!mark)
         return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory", d->path);
@@ -328,7 +356,7 @@ rt_result gl_validate(gl_doc *d)
         const gl_scene *sc = &d->scenes[i];
         for (uint32_t k = 0; k < sc->count; k++) {
             uint32_t n = d->scene_nodes[sc->first + k];
-            r = RT_OK;
+            rt_result r = RT_OK;
             if (n >= d->node_count)
                 r = gl_fail_at(d, sc->tok, RT_ERR_INVALID,
                                "scenes[%zu].nodes %u is out of range (the file has %zu nodes)", i, n, d->node_count);
@@ -345,8 +373,14 @@ rt_result gl_validate(gl_doc *d)
         }
     }
     free(mark);
-    if ((r = check_index(d, d->default_scene, d->scene_count, -1, "scenes", "scene")) != RT_OK)
-        return r;
+    return RT_OK;
+}
+
+/* Every texture a material names, every image a texture names, every
+ * bufferView an image names: in range. */
+static rt_result check_textures(gl_doc *d)
+{
+    rt_result r;
     for (size_t i = 0; i < d->material_count; i++) {
         const rt_material *m = &d->materials[i].m;
         const rt_texture_slot *slots[] = {&m->base_color_tex, &m->metal_rough_tex, &m->normal_tex,
@@ -373,4 +407,26 @@ rt_result gl_validate(gl_doc *d)
                              "images[%zu].bufferView", i)) != RT_OK)
             return r;
     return RT_OK;
+}
+
+rt_result gl_validate(gl_doc *d)
+{
+    rt_result r;
+    if ((r = check_views(d)) != RT_OK)
+        return r;
+    if ((r = validate_draco_prims(d)) != RT_OK)
+        return r;
+    if ((r = check_accessors(d)) != RT_OK)
+        return r;
+    if ((r = check_primitives(d)) != RT_OK)
+        return r;
+    if ((r = check_nodes(d)) != RT_OK)
+        return r;
+    if ((r = check_depths(d)) != RT_OK)
+        return r;
+    if ((r = check_scene_roots(d)) != RT_OK)
+        return r;
+    if ((r = check_index(d, d->default_scene, d->scene_count, -1, "scenes", "scene")) != RT_OK)
+        return r;
+    return check_textures(d);
 }

@@ -252,23 +252,19 @@ static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t node, uint32_t 
     return RT_OK;
 }
 
-rt_result gl_flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st)
-{
-    rt_result r = RT_OK;
-    if (opt && opt->use_time)
-        r = gl_pose_nodes(d, opt);
-    if (r != RT_OK)
-        return r;
-    st->animated = d->animated;
-    if ((r = collect_visits(d, opt)) != RT_OK)
-        return r;
-    rt_mat4 top = opt && opt->use_transform ? opt->transform : rt_mat4_identity();
-    st->nodes = d->visit_count;
+/* What the chosen scene will add: vertices and triangles (within the
+ * loader's limits), the vertex attributes it uses, whether a primitive
+ * lacks a material; skipped primitives are warned about once. */
+typedef struct gl_totals {
+    size_t verts, tris;
+    unsigned attrs;    /* RT_ATTR_* */
+    bool need_default; /* a primitive without a material */
+} gl_totals;
 
-    /* Count what the scene will hold, then reserve it all at once. */
-    size_t verts = 0, tris = 0, zeros = 0;
-    unsigned attrs = 0;
-    bool need_default = false, warned_modes = false, warned_skin = false, warned_pos = false;
+static rt_result count_geometry(gl_doc *d, rt_gltf_stats *st, gl_totals *t)
+{
+    size_t zeros = 0;
+    bool warned_modes = false, warned_skin = false, warned_pos = false;
     for (size_t v = 0; v < d->visit_count; v++) {
         const gl_node *n = &d->nodes[d->visits[v].node];
         if (n->skin != RT_NONE && !warned_skin && !d->posed) {
@@ -299,35 +295,36 @@ rt_result gl_flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf
                 continue;
             }
             const gl_accessor *pa = &d->accessors[p->attr[ATTR_POSITION]];
-            verts += pa->count;
+            t->verts += pa->count;
             if (pa->view == RT_NONE && (zeros += pa->count) > GL_MAX_ZEROS)
                 return rt_fail(d->err, RT_ERR_LIMIT,
                                "%s: over %zu vertices come from accessors without a bufferView (instancing "
                                "included); over the loader's limit",
                                d->path, GL_MAX_ZEROS);
-            tris += prim_triangles(d, p);
-            if (verts > GL_MAX_VERTICES || tris > GL_MAX_TRIANGLES)
+            t->tris += prim_triangles(d, p);
+            if (t->verts > GL_MAX_VERTICES || t->tris > GL_MAX_TRIANGLES)
                 return rt_fail(d->err, RT_ERR_LIMIT,
                                "%s: the scene has over %zu vertices or triangles (instancing included); over the "
                                "loader's limit",
                                d->path, GL_MAX_VERTICES);
             if (p->material == RT_NONE)
-                need_default = true;
-            if (p->attr[ATTR_TEXCOORD_1] != RT_NONE) attrs |= RT_ATTR_UV1;
-            if (p->attr[ATTR_TANGENT] != RT_NONE && p->attr[ATTR_NORMAL] != RT_NONE) attrs |= RT_ATTR_TANGENT;
-            if (p->attr[ATTR_COLOR_0] != RT_NONE) attrs |= RT_ATTR_COLOR;
+                t->need_default = true;
+            if (p->attr[ATTR_TEXCOORD_1] != RT_NONE) t->attrs |= RT_ATTR_UV1;
+            if (p->attr[ATTR_TANGENT] != RT_NONE && p->attr[ATTR_NORMAL] != RT_NONE) t->attrs |= RT_ATTR_TANGENT;
+            if (p->attr[ATTR_COLOR_0] != RT_NONE) t->attrs |= RT_ATTR_COLOR;
             st->primitives++;
         }
         st->meshes++;
     }
-    if (s->vertices.count + verts >= RT_NONE || s->triangles.count + tris >= RT_NONE)
-        return rt_fail(d->err, RT_ERR_LIMIT, "%s: the scene would exceed 2^32 vertices or triangles", d->path);
+    return RT_OK;
+}
 
-    if ((r = gl_load_textures(d, s, st)) != RT_OK)
-        return r;
-
-    /* materials: one per glTF material (+ a default for primitives without one) */
-    uint32_t mat_base = (uint32_t)s->material_count;
+/* Materials: one per glTF material, its texture slots mapped to the scene's
+ * textures (+ a default for primitives without one, when need_default). */
+static rt_result add_materials(gl_doc *d, rt_scene *s, rt_gltf_stats *st, bool need_default, uint32_t *mat_base,
+                               uint32_t *default_mat)
+{
+    *mat_base = (uint32_t)s->material_count;
     for (size_t i = 0; i < d->material_count; i++) {
         rt_material m = d->materials[i].m;
         rt_texture_slot *slots[] = {&m.base_color_tex, &m.metal_rough_tex, &m.normal_tex,
@@ -349,31 +346,37 @@ rt_result gl_flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf
             return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding materials", d->path);
         st->materials++;
     }
-    uint32_t default_mat = RT_NONE;
-    if (need_default) {
-        rt_material m;
-        rt_material_default(&m, "gltf_default");
-        m.color = rt_v3s(1);
-        m.metallic = 1;
-        m.roughness = 1;
-        m.double_sided = false;
-        m.transmission_color = m.color;
-        gl_derive_phong(&m);
-        default_mat = rt_scene_add_material(s, &m);
-        if (default_mat == RT_NONE)
-            return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding materials", d->path);
-        st->materials++;
-    }
+    *default_mat = RT_NONE;
+    if (!need_default)
+        return RT_OK;
+    rt_material m;
+    rt_material_default(&m, "gltf_default");
+    m.color = rt_v3s(1);
+    m.metallic = 1;
+    m.roughness = 1;
+    m.double_sided = false;
+    m.transmission_color = m.color;
+    gl_derive_phong(&m);
+    *default_mat = rt_scene_add_material(s, &m);
+    if (*default_mat == RT_NONE)
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding materials", d->path);
+    st->materials++;
+    return RT_OK;
+}
 
-    /* geometry */
-    if (attrs && !rt_scene_enable_attr(s, attrs))
+/* Every triangle primitive of every visited node into the scene's tables
+ * reserved at once, and the bounds of the vertices they use. */
+static rt_result add_geometry(gl_doc *d, rt_scene *s, rt_gltf_stats *st, const gl_totals *t, const rt_mat4 *top,
+                              uint32_t mat_base, uint32_t default_mat)
+{
+    if (t->attrs && !rt_scene_enable_attr(s, t->attrs))
         return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for vertex attributes", d->path);
     size_t tri_first = s->triangles.count;
-    if (!rt_scene_reserve_triangles(s, tris))
-        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu triangles", d->path, tris);
+    if (!rt_scene_reserve_triangles(s, t->tris))
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu triangles", d->path, t->tris);
     size_t vbase = s->vertices.count;
-    if (verts && rt_scene_add_vertices(s, verts) == RT_NONE)
-        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu vertices", d->path, verts);
+    if (t->verts && rt_scene_add_vertices(s, t->verts) == RT_NONE)
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu vertices", d->path, t->verts);
     for (size_t v = 0; v < d->visit_count; v++) {
         const gl_node *n = &d->nodes[d->visits[v].node];
         if (n->mesh == RT_NONE)
@@ -384,7 +387,8 @@ rt_result gl_flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf
             if (!is_triangles(p->mode) || p->attr[ATTR_POSITION] == RT_NONE)
                 continue;
             uint32_t mat = p->material == RT_NONE ? default_mat : mat_base + p->material;
-            if ((r = emit_primitive(d, s, d->visits[v].node, k, &d->visits[v].world, &top, mat, vbase)) != RT_OK)
+            rt_result r;
+            if ((r = emit_primitive(d, s, d->visits[v].node, k, &d->visits[v].world, top, mat, vbase)) != RT_OK)
                 return r;
             vbase += d->accessors[p->attr[ATTR_POSITION]].count;
         }
@@ -401,8 +405,13 @@ rt_result gl_flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf
         b.lo.z = q.z < b.lo.z ? q.z : b.lo.z; b.hi.z = q.z > b.hi.z ? q.z : b.hi.z;
     }
     st->bounds = b;
+    return RT_OK;
+}
 
-    /* cameras and lights */
+/* Perspective cameras and KHR_lights_punctual lights of the visited nodes,
+ * placed by their world matrices. */
+static rt_result add_cameras_and_lights(gl_doc *d, rt_scene *s, rt_gltf_stats *st)
+{
     bool warned_ortho = false;
     for (size_t v = 0; v < d->visit_count; v++) {
         const gl_node *n = &d->nodes[d->visits[v].node];
@@ -446,4 +455,32 @@ rt_result gl_flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf
         }
     }
     return RT_OK;
+}
+
+rt_result gl_flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st)
+{
+    rt_result r = RT_OK;
+    if (opt && opt->use_time)
+        r = gl_pose_nodes(d, opt);
+    if (r != RT_OK)
+        return r;
+    st->animated = d->animated;
+    if ((r = collect_visits(d, opt)) != RT_OK)
+        return r;
+    rt_mat4 top = opt && opt->use_transform ? opt->transform : rt_mat4_identity();
+    st->nodes = d->visit_count;
+
+    gl_totals t = {0};
+    if ((r = count_geometry(d, st, &t)) != RT_OK)
+        return r;
+    if (s->vertices.count + t.verts >= RT_NONE || s->triangles.count + t.tris >= RT_NONE)
+        return rt_fail(d->err, RT_ERR_LIMIT, "%s: the scene would exceed 2^32 vertices or triangles", d->path);
+    if ((r = gl_load_textures(d, s, st)) != RT_OK)
+        return r;
+    uint32_t mat_base, default_mat;
+    if ((r = add_materials(d, s, st, t.need_default, &mat_base, &default_mat)) != RT_OK)
+        return r;
+    if ((r = add_geometry(d, s, st, &t, &top, mat_base, default_mat)) != RT_OK)
+        return r;
+    return add_cameras_and_lights(d, s, st);
 }

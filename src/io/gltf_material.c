@@ -269,6 +269,120 @@ static rt_result parse_material_ext(gl_doc *d, const char *wx, int k2, int v2, r
     return RT_OK;
 }
 
+/* A material's pbrMetallicRoughness object (where: "materials[i]"). */
+static rt_result parse_pbr(gl_doc *d, const char *where, int v, rt_material *m)
+{
+    rt_result r = RT_OK;
+    char wp[80];
+    snprintf(wp, sizeof wp, "%s.pbrMetallicRoughness", where);
+    if ((r = gl_expect_object(d, v, wp)) != RT_OK)
+        return r;
+    for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
+         k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
+        if (KEY(k2, "baseColorFactor")) {
+            float c[4];
+            if ((r = gl_get_floats(d, wp, "baseColorFactor", v2, c, 4)) != RT_OK)
+                return r;
+            m->color = rt_v3(c[0], c[1], c[2]);
+            m->alpha = c[3];
+        } else if (KEY(k2, "metallicFactor")) r = gl_get_float(d, wp, "metallicFactor", v2, &m->metallic);
+        else if (KEY(k2, "roughnessFactor")) r = gl_get_float(d, wp, "roughnessFactor", v2, &m->roughness);
+        else if (KEY(k2, "baseColorTexture"))
+            r = parse_texinfo(d, wp, "baseColorTexture", v2, &m->base_color_tex, NULL, NULL);
+        else if (KEY(k2, "metallicRoughnessTexture"))
+            r = parse_texinfo(d, wp, "metallicRoughnessTexture", v2, &m->metal_rough_tex, NULL, NULL);
+        if (r != RT_OK)
+            return r;
+    }
+    return RT_OK;
+}
+
+/* The extensions glTF materials had first: KHR_materials_emissive_strength,
+ * transmission, ior, volume and unlit; any other key k2 is ignored. */
+static rt_result parse_core_ext(gl_doc *d, const char *wx, int k2, int v2, rt_material *m)
+{
+    rt_result r = RT_OK;
+    char we[160];
+    if (KEY(k2, "KHR_materials_emissive_strength")) {
+        snprintf(we, sizeof we, "%s.KHR_materials_emissive_strength", wx);
+        if ((r = gl_expect_object(d, v2, we)) != RT_OK)
+            return r;
+        int s = rt_json_get(&d->j, v2, "emissiveStrength");
+        if (s >= 0)
+            r = gl_get_float(d, we, "emissiveStrength", s, &m->emission_strength);
+        if (r != RT_OK)
+            return r;
+    } else if (KEY(k2, "KHR_materials_transmission")) {
+        snprintf(we, sizeof we, "%s.KHR_materials_transmission", wx);
+        if ((r = gl_expect_object(d, v2, we)) != RT_OK)
+            return r;
+        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
+             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
+            if (KEY(k3, "transmissionFactor"))
+                r = gl_get_float(d, we, "transmissionFactor", v3, &m->transmission);
+            else if (KEY(k3, "transmissionTexture"))
+                r = parse_texinfo(d, we, "transmissionTexture", v3, &m->transmission_tex, NULL, NULL);
+            if (r != RT_OK)
+                return r;
+        }
+    } else if (KEY(k2, "KHR_materials_ior")) {
+        snprintf(we, sizeof we, "%s.KHR_materials_ior", wx);
+        if ((r = gl_expect_object(d, v2, we)) != RT_OK)
+            return r;
+        int s = rt_json_get(&d->j, v2, "ior");
+        if (s >= 0)
+            r = gl_get_float(d, we, "ior", s, &m->ior);
+        if (r != RT_OK)
+            return r;
+    } else if (KEY(k2, "KHR_materials_volume")) {
+        snprintf(we, sizeof we, "%s.KHR_materials_volume", wx);
+        if ((r = gl_expect_object(d, v2, we)) != RT_OK)
+            return r;
+        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
+             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
+            if (KEY(k3, "thicknessFactor"))
+                r = gl_get_float(d, we, "thicknessFactor", v3, &m->thickness);
+            else if (KEY(k3, "attenuationDistance"))
+                r = gl_get_float(d, we, "attenuationDistance", v3, &m->attenuation_distance);
+            else if (KEY(k3, "attenuationColor")) {
+                float c[3];
+                if ((r = gl_get_floats(d, we, "attenuationColor", v3, c, 3)) != RT_OK)
+                    return r;
+                m->attenuation_color = rt_v3(c[0], c[1], c[2]);
+            }
+            if (r != RT_OK)
+                return r;
+        }
+        if (!(m->attenuation_distance > 0))
+            return gl_fail_at(d, v2, RT_ERR_INVALID, "%s.attenuationDistance must be positive", we);
+    } else if (KEY(k2, "KHR_materials_unlit")) {
+        m->unlit = true;
+    }
+    return RT_OK;
+}
+
+/* A material's extensions object: the newer extensions (parse_material_ext),
+ * then the first ones (parse_core_ext); others are ignored. */
+static rt_result parse_extensions(gl_doc *d, const char *where, int v, rt_material *m)
+{
+    rt_result r;
+    char wx[96];
+    snprintf(wx, sizeof wx, "%s.extensions", where);
+    if ((r = gl_expect_object(d, v, wx)) != RT_OK)
+        return r;
+    for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
+         k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
+        bool known;
+        if ((r = parse_material_ext(d, wx, k2, v2, m, &known)) != RT_OK)
+            return r;
+        if (known)
+            continue;
+        if ((r = parse_core_ext(d, wx, k2, v2, m)) != RT_OK)
+            return r;
+    }
+    return RT_OK;
+}
+
 rt_result gl_parse_materials(gl_doc *d, int t)
 {
     rt_result r = RT_OK;
@@ -297,27 +411,8 @@ rt_result gl_parse_materials(gl_doc *d, int t)
                 if (rt_json_string(&d->j, v, m->name, sizeof m->name) < 0) /* long names: keep the default */
                     snprintf(m->name, sizeof m->name, "%s", name);
             } else if (KEY(k, "pbrMetallicRoughness")) {
-                char wp[80];
-                snprintf(wp, sizeof wp, "%s.pbrMetallicRoughness", where);
-                if ((r = gl_expect_object(d, v, wp)) != RT_OK)
+                if ((r = parse_pbr(d, where, v, m)) != RT_OK)
                     return r;
-                for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
-                     k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
-                    if (KEY(k2, "baseColorFactor")) {
-                        float c[4];
-                        if ((r = gl_get_floats(d, wp, "baseColorFactor", v2, c, 4)) != RT_OK)
-                            return r;
-                        m->color = rt_v3(c[0], c[1], c[2]);
-                        m->alpha = c[3];
-                    } else if (KEY(k2, "metallicFactor")) r = gl_get_float(d, wp, "metallicFactor", v2, &m->metallic);
-                    else if (KEY(k2, "roughnessFactor")) r = gl_get_float(d, wp, "roughnessFactor", v2, &m->roughness);
-                    else if (KEY(k2, "baseColorTexture"))
-                        r = parse_texinfo(d, wp, "baseColorTexture", v2, &m->base_color_tex, NULL, NULL);
-                    else if (KEY(k2, "metallicRoughnessTexture"))
-                        r = parse_texinfo(d, wp, "metallicRoughnessTexture", v2, &m->metal_rough_tex, NULL, NULL);
-                    if (r != RT_OK)
-                        return r;
-                }
             } else if (KEY(k, "normalTexture")) {
                 if ((r = parse_texinfo(d, where, "normalTexture", v, &m->normal_tex, &m->normal_scale,
                                        "scale")) != RT_OK)
@@ -359,74 +454,8 @@ rt_result gl_parse_materials(gl_doc *d, int t)
                 if (b >= 0 && rt_json_string(&d->j, b, bsdf, sizeof bsdf) >= 0 && strcmp(bsdf, "lambertian") == 0)
                     m->bsdf = RT_BSDF_LAMBERT;
             } else if (KEY(k, "extensions")) {
-                char wx[96];
-                snprintf(wx, sizeof wx, "%s.extensions", where);
-                if ((r = gl_expect_object(d, v, wx)) != RT_OK)
+                if ((r = parse_extensions(d, where, v, m)) != RT_OK)
                     return r;
-                for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
-                     k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
-                    char we[160];
-                    bool known;
-                    if ((r = parse_material_ext(d, wx, k2, v2, m, &known)) != RT_OK)
-                        return r;
-                    if (known)
-                        continue;
-                    if (KEY(k2, "KHR_materials_emissive_strength")) {
-                        snprintf(we, sizeof we, "%s.KHR_materials_emissive_strength", wx);
-                        if ((r = gl_expect_object(d, v2, we)) != RT_OK)
-                            return r;
-                        int s = rt_json_get(&d->j, v2, "emissiveStrength");
-                        if (s >= 0)
-                            r = gl_get_float(d, we, "emissiveStrength", s, &m->emission_strength);
-                        if (r != RT_OK)
-                            return r;
-                    } else if (KEY(k2, "KHR_materials_transmission")) {
-                        snprintf(we, sizeof we, "%s.KHR_materials_transmission", wx);
-                        if ((r = gl_expect_object(d, v2, we)) != RT_OK)
-                            return r;
-                        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
-                             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
-                            if (KEY(k3, "transmissionFactor"))
-                                r = gl_get_float(d, we, "transmissionFactor", v3, &m->transmission);
-                            else if (KEY(k3, "transmissionTexture"))
-                                r = parse_texinfo(d, we, "transmissionTexture", v3, &m->transmission_tex, NULL, NULL);
-                            if (r != RT_OK)
-                                return r;
-                        }
-                    } else if (KEY(k2, "KHR_materials_ior")) {
-                        snprintf(we, sizeof we, "%s.KHR_materials_ior", wx);
-                        if ((r = gl_expect_object(d, v2, we)) != RT_OK)
-                            return r;
-                        int s = rt_json_get(&d->j, v2, "ior");
-                        if (s >= 0)
-                            r = gl_get_float(d, we, "ior", s, &m->ior);
-                        if (r != RT_OK)
-                            return r;
-                    } else if (KEY(k2, "KHR_materials_volume")) {
-                        snprintf(we, sizeof we, "%s.KHR_materials_volume", wx);
-                        if ((r = gl_expect_object(d, v2, we)) != RT_OK)
-                            return r;
-                        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
-                             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
-                            if (KEY(k3, "thicknessFactor")) r = gl_get_float(d, we, "thicknessFactor", v3,
-                                                                             &m->thickness);
-                            else if (KEY(k3, "attenuationDistance"))
-                                r = gl_get_float(d, we, "attenuationDistance", v3, &m->attenuation_distance);
-                            else if (KEY(k3, "attenuationColor")) {
-                                float c[3];
-                                if ((r = gl_get_floats(d, we, "attenuationColor", v3, c, 3)) != RT_OK)
-                                    return r;
-                                m->attenuation_color = rt_v3(c[0], c[1], c[2]);
-                            }
-                            if (r != RT_OK)
-                                return r;
-                        }
-                        if (!(m->attenuation_distance > 0))
-                            return gl_fail_at(d, v2, RT_ERR_INVALID, "%s.attenuationDistance must be positive", we);
-                    } else if (KEY(k2, "KHR_materials_unlit")) {
-                        m->unlit = true;
-                    }
-                }
             }
         }
         /* transmitted light is tinted by the base colour (KHR_materials_transmission) */
