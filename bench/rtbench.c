@@ -40,7 +40,7 @@
 #include "rt/io/load.h"
 #include "rt/accel/kdtree.h"
 #include "rt/accel/kdtree_packet.h"
-#include "rt/io/rayset.h"
+#include "rt/accel/rayset.h"
 #include "rt/scene/scene.h"
 
 static double now_s(void)

@@ -10,7 +10,7 @@
 #include <stdio.h>
 
 #include "rt/accel/kdtree.h"
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 #include "rt/io/load.h"
 #include "rt/render/render.h"
 #include "rt/scene/validate.h"

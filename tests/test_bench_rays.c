@@ -33,7 +33,7 @@
 #include "rt/io/load.h"
 #include "rt/accel/kdtree.h"
 #include "rt/accel/kdtree_packet.h"
-#include "rt/io/rayset.h"
+#include "rt/accel/rayset.h"
 #include "rt/scene/scene.h"
 
 #define RAYS_PER_SET 2500

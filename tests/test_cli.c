@@ -31,7 +31,8 @@
 
 #include <stb/stb_image.h>
 
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
+#include "rt/io/image_read.h"
 
 static char dir[256];     /* this run's scratch directory */
 static char out_png[512]; /* the "earlier image" every failing run must leave alone */
@@ -1422,7 +1423,7 @@ static void test_second_sigint_exits_at_once(void **state)
 
 /* An image write killed at any moment (a second Ctrl-C, SIGKILL) leaves no
  * temporary file: the file being written has no name until it is complete
- * (framebuffer.c). A child rewrites a 100 MB PFM in a loop and is killed
+ * (image_write.c). A child rewrites a 100 MB PFM in a loop and is killed
  * at ten different moments; the scratch directory is checked each time. */
 static void test_killed_write_leaves_no_temp(void **state)
 {

@@ -15,7 +15,8 @@
 #include "rt/base/file.h"
 #include "rt/image/compare.h"
 #include "rt/image/flip.h"
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
+#include "rt/io/image_read.h"
 
 #include "../src/driver/commands.h"
 

@@ -18,7 +18,7 @@
 #include <time.h>
 #include <sys/wait.h>
 
-#include "rt/io/framebuffer.h"
+#include "rt/image/framebuffer.h"
 #include "rt/io/image_read.h"
 
 static char dir[256];

@@ -13,7 +13,7 @@
 #include <unistd.h>
 
 #include "rt/accel/kdtree.h"
-#include "rt/io/framebuffer.h"
+#include "rt/image/framebuffer.h"
 #include "rt/io/gltf.h"
 #include "rt/io/load.h"
 #include "rt/render/render.h"

@@ -26,7 +26,7 @@
 
 #include "rt/render/bsdf.h"
 #include "rt/render/camera.h"
-#include "rt/io/framebuffer.h"
+#include "rt/image/framebuffer.h"
 #include "rt/render/integrator.h"
 #include "rt/accel/kdtree.h"
 #include "rt/render/ggx_albedo.h"

@@ -9,7 +9,8 @@
 #include <unistd.h>
 
 #include "rt/render/camera.h"
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
+#include "rt/io/image_read.h"
 #include "rt/accel/kdtree.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"

@@ -28,7 +28,7 @@
 #include <math.h>
 
 #include "rt/accel/kdtree.h"
-#include "rt/io/framebuffer.h"
+#include "rt/image/framebuffer.h"
 #include "rt/io/scene_parse.h"
 #include "rt/render/render.h"
 #include "rt/render/sampler.h"

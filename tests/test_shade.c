@@ -12,7 +12,7 @@
 #include <math.h>
 
 #include "rt/io/gltf.h"
-#include "rt/io/framebuffer.h"
+#include "rt/image/framebuffer.h"
 #include "rt/accel/kdtree.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"

@@ -9,7 +9,9 @@
 #include <math.h>
 #include <unistd.h>
 
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
+#include "rt/image/srgb.h"
+#include "rt/io/image_load.h"
 #include "rt/scene/scene.h"
 #include "rt/io/scene_parse.h"
 #include "rt/scene/texture.h"

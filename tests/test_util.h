@@ -14,6 +14,7 @@
 
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -26,7 +27,7 @@
 
 #include <cmocka.h>
 
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_read.h"
 
 /* Path of a file under the shared directory, in a static buffer (one at a time). */
 static inline const char *test_shared_path(const char *rel)

@@ -24,7 +24,7 @@
 
 #include "rt/accel/kdtree.h"
 #include "rt/accel/kdtree_batch.h"
-#include "rt/io/framebuffer.h"
+#include "rt/image/framebuffer.h"
 #include "rt/io/scene_parse.h"
 #include "rt/render/camera.h"
 #include "rt/render/pathtrace.h"

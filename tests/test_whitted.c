@@ -9,7 +9,7 @@
 
 #include <math.h>
 
-#include "rt/io/framebuffer.h"
+#include "rt/image/framebuffer.h"
 #include "rt/render/direct.h"
 #include "rt/accel/kdtree.h"
 #include "rt/render/render.h"

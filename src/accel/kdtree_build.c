@@ -491,8 +491,189 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
 static void *fork_worker(void *arg);
 static void free_forks(kd_build *c);
 
+/* Sides of the primitives of a split at best_key on the axis whose events
+ * are E[0..n) (a primitive's events come in the order START, END): left,
+ * right, or both; the straddlers go to c->strad. Returns their count. */
+static size_t classify(kd_build *c, const uint64_t *E, size_t n, uint32_t best_key, int best_side)
+{
+    uint8_t *side = c->side;
+    size_t ns = 0;
+    for (size_t i = 0; i < n; i++) {
+        uint64_t e = E[i];
+        uint32_t key = ev_key(e), p = ev_prim(e);
+        unsigned t = ev_type(e);
+        if (t == EV_START) {
+            side[p] = key >= best_key ? SIDE_RIGHT : SIDE_BOTH;
+        } else if (t == EV_END) {
+            if (key <= best_key)
+                side[p] = SIDE_LEFT;
+            else if (side[p] == SIDE_BOTH)
+                c->strad[ns++] = p;
+        } else {
+            side[p] = key < best_key || (key == best_key && best_side == SIDE_LEFT) ? SIDE_LEFT : SIDE_RIGHT;
+        }
+    }
+    return ns;
+}
+
+/* The new events of a split's straddling primitives, clipped to each child
+ * and sorted per axis, in one block (buf) that owns the six lists. */
+typedef struct kd_straddlers {
+    uint64_t *buf;
+    uint64_t *l[3], *r[3];
+    size_t lcnt[3], rcnt[3];
+    size_t npl, npr; /* straddlers kept on each side */
+} kd_straddlers;
+
+/* Fills *x for the ns straddlers in c->strad; false when out of memory. */
+static bool clip_straddlers(const kd_build *c, size_t ns, rt_box VL, rt_box VR, kd_straddlers *x)
+{
+    memset(x, 0, sizeof *x);
+    if (ns == 0)
+        return true;
+    x->buf = malloc(ns * 14 * sizeof *x->buf); /* 6 lists of 2 ns + sort scratch 2 ns */
+    if (!x->buf)
+        return false;
+    for (int d = 0; d < 3; d++) {
+        x->l[d] = x->buf + (size_t)d * 2 * ns;
+        x->r[d] = x->buf + (size_t)(3 + d) * 2 * ns;
+    }
+    for (size_t i = 0; i < ns; i++) {
+        uint32_t p = c->strad[i];
+        rt_box b;
+        if (prim_clip_bounds(c, p, VL, &b)) {
+            emit_events(b, p, x->l, x->lcnt);
+            x->npl++;
+        }
+        if (prim_clip_bounds(c, p, VR, &b)) {
+            emit_events(b, p, x->r, x->rcnt);
+            x->npr++;
+        }
+    }
+    uint64_t *scratch = x->buf + 12 * ns;
+    for (int d = 0; d < 3; d++) {
+        ev_sort(x->l[d], x->lcnt[d], scratch);
+        ev_sort(x->r[d], x->rcnt[d], scratch);
+    }
+    return true;
+}
+
+/* A split's two children: each one block of event lists (cnt[3] long) and
+ * its primitive count. */
+typedef struct kd_children {
+    uint64_t *lev, *rev;
+    size_t lc[3], rc[3];
+    size_t left_prims, right_prims;
+} kd_children;
+
+/* Filters the parent's lists into the children's blocks by c->side, merging
+ * the straddlers' new events in; sized for the worst case, shrunk
+ * afterwards. k: the split axis, whose events count the primitives. False
+ * when out of memory (nothing allocated then). */
+static bool split_events(const kd_build *c, uint64_t *const list[3], const size_t cnt[3], int k, size_t ns,
+                         const kd_straddlers *x, kd_children *ch)
+{
+    const uint8_t *side = c->side;
+    size_t total = cnt[0] + cnt[1] + cnt[2];
+    size_t lcap = total + x->lcnt[0] + x->lcnt[1] + x->lcnt[2], rcap = total + x->rcnt[0] + x->rcnt[1] + x->rcnt[2];
+    uint64_t *lev = malloc((lcap ? lcap : 1) * sizeof *lev);
+    uint64_t *rev = malloc((rcap ? rcap : 1) * sizeof *rev);
+    if (!lev || !rev) {
+        free(lev);
+        free(rev);
+        return false;
+    }
+    size_t lo = 0, ro = 0;
+    ch->left_prims = x->npl;
+    ch->right_prims = x->npr;
+    for (int d = 0; d < 3; d++) {
+        uint64_t *lp = lev + lo, *rp = rev + ro;
+        const uint64_t *src = list[d];
+        size_t a = 0, b = 0, m = cnt[d];
+        for (size_t i = 0; i < m; i++) {
+            uint64_t e = src[i];
+            uint8_t sd = side[ev_prim(e)];
+            lp[a] = e; /* branch-free: write both, advance one */
+            rp[b] = e;
+            a += sd == SIDE_LEFT;
+            b += sd == SIDE_RIGHT;
+        }
+        if (d == k) {
+            for (size_t i = 0; i < a; i++)
+                ch->left_prims += ev_type(lp[i]) != EV_END;
+            for (size_t i = 0; i < b; i++)
+                ch->right_prims += ev_type(rp[i]) != EV_END;
+        }
+        if (ns > 0) {
+            merge_back(lp, a, x->l[d], x->lcnt[d]);
+            merge_back(rp, b, x->r[d], x->rcnt[d]);
+        }
+        ch->lc[d] = a + x->lcnt[d];
+        ch->rc[d] = b + x->rcnt[d];
+        lo += ch->lc[d];
+        ro += ch->rc[d];
+    }
+    /* give back what the worst case did not need (shrinking cannot fail for good) */
+    uint64_t *t;
+    if (lo < lcap && (t = realloc(lev, (lo ? lo : 1) * sizeof *lev)) != NULL)
+        lev = t;
+    if (ro < rcap && (t = realloc(rev, (ro ? ro : 1) * sizeof *rev)) != NULL)
+        rev = t;
+    ch->lev = lev;
+    ch->rev = rev;
+    return true;
+}
+
+/* Builds the below child (VL) on a thread of its own as fork f, into its
+ * own arrays behind a placeholder node, while this thread builds the above
+ * child (VR); then makes `node` their parent. */
+static void build_forked(kd_build *c, kd_fork *f, uint32_t node, int k, float split, rt_box VL, rt_box VR,
+                         kd_children *ch, int depth)
+{
+    uint32_t ph = push_node(c);
+    if (c->oom) {
+        free(f);
+        free(ch->lev);
+        free(ch->rev);
+        return;
+    }
+    c->nodes[ph].a = (uint32_t)c->fork_count;
+    c->nodes[ph].b = TASK_MARK;
+    c->forks[c->fork_count++] = f;
+    kd_build *o = &f->out;
+    o->s = c->s;
+    o->T = c->T, o->S = c->S, o->Q = c->Q;
+    o->kt = c->kt, o->ki = c->ki, o->lambda = c->lambda;
+    o->max_depth = c->max_depth;
+    o->fork_depth = c->fork_depth, o->fork_min = c->fork_min, o->nprims_total = c->nprims_total;
+    f->V = VL;
+    f->ev = ch->lev;
+    memcpy(f->cnt, ch->lc, sizeof f->cnt);
+    f->nprims = ch->left_prims;
+    f->depth = depth + 1;
+    pthread_t th;
+    bool started = pthread_create(&th, NULL, fork_worker, f) == 0;
+    if (!started)
+        fork_worker(f);
+    uint32_t above = (uint32_t)c->node_count;
+    build_rec(c, VR, ch->rev, ch->rc, ch->right_prims, depth + 1);
+    if (started)
+        pthread_join(th, NULL);
+    if (f->out.oom) {
+        c->oom = true;
+        c->limit |= f->out.limit;
+    }
+    if (c->oom)
+        return;
+    bool below_empty = f->out.node_count == 1 && f->out.nodes[0].b == KD_LEAF_TAG;
+    set_interior(c, node, k, split, below_empty, above);
+}
+
 /* Builds the subtree of box V from its event lists (one block `ev`, lists of
- * cnt[0], cnt[1], cnt[2] events, owned and freed here) over nprims prims. */
+ * cnt[0], cnt[1], cnt[2] events, owned and freed here) over nprims prims:
+ * the best plane (find_plane) or a leaf, the primitives' sides, the
+ * straddlers clipped to each child, the children's lists, then the
+ * children, the below one on a thread of its own near the root. */
 static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t nprims, int depth)
 {
     uint32_t node = push_node(c);
@@ -511,175 +692,47 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
         free(ev);
         return;
     }
-
-    /* classify in one pass over axis k (events of a primitive come in the
-     * order START, END): left, right, or both (a straddler) */
-    uint8_t *side = c->side;
-    const uint64_t *E = list[k];
-    size_t n = cnt[k], ns = 0;
     if (!rt_grow((void **)&c->strad, &c->strad_cap, nprims, sizeof *c->strad)) {
         c->oom = true;
         free(ev);
         return;
     }
-    for (size_t i = 0; i < n; i++) {
-        uint64_t e = E[i];
-        uint32_t key = ev_key(e), p = ev_prim(e);
-        unsigned t = ev_type(e);
-        if (t == EV_START) {
-            side[p] = key >= best_key ? SIDE_RIGHT : SIDE_BOTH;
-        } else if (t == EV_END) {
-            if (key <= best_key)
-                side[p] = SIDE_LEFT;
-            else if (side[p] == SIDE_BOTH)
-                c->strad[ns++] = p;
-        } else {
-            side[p] = key < best_key || (key == best_key && best_side == SIDE_LEFT) ? SIDE_LEFT : SIDE_RIGHT;
-        }
-    }
+    size_t ns = classify(c, list[k], cnt[k], best_key, best_side);
 
     float split = o2f(best_key);
     rt_box VL = V, VR = V;
     box_hi(&VL)[k] = split;
     box_lo(&VR)[k] = split;
 
-    /* new events of the straddling primitives, clipped to each child */
-    uint64_t *nbuf = NULL;
-    uint64_t *nl_list[3] = {NULL, NULL, NULL}, *nr_list[3] = {NULL, NULL, NULL};
-    size_t nl_cnt[3] = {0, 0, 0}, nr_cnt[3] = {0, 0, 0};
-    size_t npl = 0, npr = 0; /* straddlers kept on each side */
-    if (ns > 0) {
-        nbuf = malloc(ns * 14 * sizeof *nbuf); /* 6 lists of 2 ns + sort scratch 2 ns */
-        if (!nbuf) {
-            c->oom = true;
-            free(ev);
-            return;
-        }
-        for (int d = 0; d < 3; d++) {
-            nl_list[d] = nbuf + (size_t)d * 2 * ns;
-            nr_list[d] = nbuf + (size_t)(3 + d) * 2 * ns;
-        }
-        for (size_t i = 0; i < ns; i++) {
-            uint32_t p = c->strad[i];
-            rt_box b;
-            if (prim_clip_bounds(c, p, VL, &b)) {
-                emit_events(b, p, nl_list, nl_cnt);
-                npl++;
-            }
-            if (prim_clip_bounds(c, p, VR, &b)) {
-                emit_events(b, p, nr_list, nr_cnt);
-                npr++;
-            }
-        }
-        uint64_t *scratch = nbuf + 12 * ns;
-        for (int d = 0; d < 3; d++) {
-            ev_sort(nl_list[d], nl_cnt[d], scratch);
-            ev_sort(nr_list[d], nr_cnt[d], scratch);
-        }
-    }
-
-    /* filter the parent lists into the children's blocks, merging the new
-     * events in; sized for the worst case, shrunk afterwards */
-    size_t total = cnt[0] + cnt[1] + cnt[2];
-    size_t lcap = total + nl_cnt[0] + nl_cnt[1] + nl_cnt[2], rcap = total + nr_cnt[0] + nr_cnt[1] + nr_cnt[2];
-    uint64_t *lev = malloc((lcap ? lcap : 1) * sizeof *lev);
-    uint64_t *rev = malloc((rcap ? rcap : 1) * sizeof *rev);
-    if (!lev || !rev) {
-        free(lev);
-        free(rev);
-        free(nbuf);
+    kd_straddlers x;
+    if (!clip_straddlers(c, ns, VL, VR, &x)) {
+        c->oom = true;
         free(ev);
+        return;
+    }
+    kd_children ch;
+    bool ok = split_events(c, list, cnt, k, ns, &x, &ch);
+    free(x.buf);
+    free(ev);
+    if (!ok) {
         c->oom = true;
         return;
     }
-    size_t lc[3], rc[3], lo = 0, ro = 0;
-    size_t left_prims = npl, right_prims = npr;
-    for (int d = 0; d < 3; d++) {
-        uint64_t *lp = lev + lo, *rp = rev + ro;
-        const uint64_t *src = list[d];
-        size_t a = 0, b = 0, m = cnt[d];
-        for (size_t i = 0; i < m; i++) {
-            uint64_t e = src[i];
-            uint8_t sd = side[ev_prim(e)];
-            lp[a] = e; /* branch-free: write both, advance one */
-            rp[b] = e;
-            a += sd == SIDE_LEFT;
-            b += sd == SIDE_RIGHT;
-        }
-        if (d == k) {
-            for (size_t i = 0; i < a; i++)
-                left_prims += ev_type(lp[i]) != EV_END;
-            for (size_t i = 0; i < b; i++)
-                right_prims += ev_type(rp[i]) != EV_END;
-        }
-        if (ns > 0) {
-            merge_back(lp, a, nl_list[d], nl_cnt[d]);
-            merge_back(rp, b, nr_list[d], nr_cnt[d]);
-        }
-        lc[d] = a + nl_cnt[d];
-        rc[d] = b + nr_cnt[d];
-        lo += lc[d];
-        ro += rc[d];
-    }
-    free(nbuf);
-    free(ev);
-    /* give back what the worst case did not need (shrinking cannot fail for good) */
-    uint64_t *t;
-    if (lo < lcap && (t = realloc(lev, (lo ? lo : 1) * sizeof *lev)) != NULL)
-        lev = t;
-    if (ro < rcap && (t = realloc(rev, (ro ? ro : 1) * sizeof *rev)) != NULL)
-        rev = t;
 
     kd_fork *f = NULL;
-    if (depth < c->fork_depth && left_prims >= c->fork_min &&
+    if (depth < c->fork_depth && ch.left_prims >= c->fork_min &&
         rt_grow((void **)&c->forks, &c->fork_cap, c->fork_count + 1, sizeof *c->forks) &&
         (f = calloc(1, sizeof *f)) != NULL) {
-        uint32_t ph = push_node(c);
-        if (c->oom) {
-            free(f);
-            free(lev);
-            free(rev);
-            return;
-        }
-        c->nodes[ph].a = (uint32_t)c->fork_count;
-        c->nodes[ph].b = TASK_MARK;
-        c->forks[c->fork_count++] = f;
-        kd_build *o = &f->out;
-        o->s = c->s;
-        o->T = c->T, o->S = c->S, o->Q = c->Q;
-        o->kt = c->kt, o->ki = c->ki, o->lambda = c->lambda;
-        o->max_depth = c->max_depth;
-        o->fork_depth = c->fork_depth, o->fork_min = c->fork_min, o->nprims_total = c->nprims_total;
-        f->V = VL;
-        f->ev = lev;
-        memcpy(f->cnt, lc, sizeof f->cnt);
-        f->nprims = left_prims;
-        f->depth = depth + 1;
-        pthread_t th;
-        bool started = pthread_create(&th, NULL, fork_worker, f) == 0;
-        if (!started)
-            fork_worker(f);
-        uint32_t above = (uint32_t)c->node_count;
-        build_rec(c, VR, rev, rc, right_prims, depth + 1);
-        if (started)
-            pthread_join(th, NULL);
-        if (f->out.oom) {
-            c->oom = true;
-            c->limit |= f->out.limit;
-        }
-        if (c->oom)
-            return;
-        bool below_empty = f->out.node_count == 1 && f->out.nodes[0].b == KD_LEAF_TAG;
-        set_interior(c, node, k, split, below_empty, above);
+        build_forked(c, f, node, k, split, VL, VR, &ch, depth);
         return;
     }
-    build_rec(c, VL, lev, lc, left_prims, depth + 1);
+    build_rec(c, VL, ch.lev, ch.lc, ch.left_prims, depth + 1);
     if (c->oom) {
-        free(rev);
+        free(ch.rev);
         return;
     }
     uint32_t above = (uint32_t)c->node_count;
-    build_rec(c, VR, rev, rc, right_prims, depth + 1);
+    build_rec(c, VR, ch.rev, ch.rc, ch.right_prims, depth + 1);
     if (c->oom)
         return;
     set_interior(c, node, k, split, c->nodes[node + 1].b == KD_LEAF_TAG, above);
@@ -789,6 +842,184 @@ static void *sort_worker(void *arg)
 /* Bounds of every primitive (and the triangles' records), the root's three
  * sorted event lists, the recursive build (forked near the root), the forks
  * stitched into one depth-first array, then kdtree_pack.c. */
+/* The cost model and the other parameters of a build (params may be NULL;
+ * 0 fields take the defaults); returns the threads to build with. */
+static int init_build(kd_build *c, const rt_scene *scene, const rt_kdtree_params *params)
+{
+    memset(c, 0, sizeof *c);
+    c->s = scene;
+    c->T = (uint32_t)scene->triangles.count;
+    c->S = (uint32_t)scene->spheres.count;
+    c->Q = (uint32_t)scene->quads.count;
+    c->kt = params && params->traversal_cost > 0.0f ? params->traversal_cost : 4.0;
+    c->ki = params && params->intersect_cost > 0.0f ? params->intersect_cost : 1.0;
+    double eb = params && params->empty_bonus > 0.0f ? params->empty_bonus : 0.2;
+    if (eb > 1.0)
+        eb = 1.0;
+    c->lambda = 1.0 - eb;
+    int threads = params && params->threads > 0 ? params->threads : rt_cpu_count();
+    if (threads < 1)
+        threads = 1;
+    if (threads > 64)
+        threads = 64;
+    return threads;
+}
+
+/* Primitive i's box as the splits will clip it, and whether it can be hit
+ * at all (finite, not degenerate); a triangle's vertices are copied to
+ * tree->tri (zeros for one that cannot be hit). Spheres and quads are
+ * bounded by clipping against all of space; a triangle's box is its
+ * vertices' (the same numbers, without the clipping passes that a million
+ * triangles would pay for nothing). */
+static bool prim_bounds(const kd_build *c, rt_kdtree *tree, size_t i, rt_box *out)
+{
+    const rt_box everywhere = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
+    const rt_scene *scene = c->s;
+    size_t T = c->T, S = c->S, nverts = scene->vertices.count;
+    rt_box b = rt_box_empty();
+    bool ok = true;
+    if (i < T) {
+        const uint32_t *ix = scene->triangles.index + 3 * i;
+        float *dst = tree->tri + 9 * i;
+        memset(dst, 0, 9 * sizeof *dst);
+        if (ix[0] >= nverts || ix[1] >= nverts || ix[2] >= nverts) {
+            ok = false;
+        } else {
+            rt_vec3 a = scene->vertices.position[ix[0]], bb = scene->vertices.position[ix[1]],
+                    cc = scene->vertices.position[ix[2]];
+            rt_vec3 e1 = rt_sub(bb, a), e2 = rt_sub(cc, a);
+            ok = rt_finite3(a) && rt_finite3(bb) && rt_finite3(cc) && rt_finite3(e1) && rt_finite3(e2) &&
+                 (e1.x != 0.0f || e1.y != 0.0f || e1.z != 0.0f) && (e2.x != 0.0f || e2.y != 0.0f || e2.z != 0.0f);
+            if (ok) {
+                dst[0] = a.x, dst[1] = a.y, dst[2] = a.z;
+                dst[3] = bb.x, dst[4] = bb.y, dst[5] = bb.z;
+                dst[6] = cc.x, dst[7] = cc.y, dst[8] = cc.z;
+                b = rt_box_point(rt_box_point(rt_box_point(b, a), bb), cc);
+            }
+        }
+    } else if (i < T + S) {
+        size_t j = i - T;
+        const rt_spheres *sp = &scene->spheres;
+        ok = isfinite(sp->cx[j]) && isfinite(sp->cy[j]) && isfinite(sp->cz[j]) && isfinite(sp->radius[j]) &&
+             prim_clip_bounds(c, (uint32_t)i, everywhere, &b);
+    } else {
+        size_t j = i - T - S;
+        const rt_quads *q = &scene->quads;
+        rt_vec3 p = rt_v3(q->px[j], q->py[j], q->pz[j]), u = rt_v3(q->ux[j], q->uy[j], q->uz[j]),
+                v = rt_v3(q->vx[j], q->vy[j], q->vz[j]);
+        rt_vec3 nrm = rt_cross(u, v);
+        ok = rt_finite3(p) && rt_finite3(u) && rt_finite3(v) && rt_dot(nrm, nrm) > 0.0f &&
+             prim_clip_bounds(c, (uint32_t)i, everywhere, &b);
+    }
+    if (ok && !finite_box(b))
+        ok = false;
+    *out = b;
+    return ok;
+}
+
+/* Every primitive's box into pb (empty for one that can never be hit) and
+ * the tree's bounds; returns how many can be hit. */
+static size_t bound_prims(const kd_build *c, rt_kdtree *tree, rt_box *pb, size_t N)
+{
+    size_t nvalid = 0;
+    for (size_t i = 0; i < N; i++) {
+        rt_box b;
+        bool ok = prim_bounds(c, tree, i, &b);
+        pb[i] = b;
+        if (ok) {
+            nvalid++;
+            tree->bounds = rt_box_union(tree->bounds, b);
+        } else {
+            pb[i] = rt_box_empty();
+        }
+    }
+    if (nvalid < N)
+        rt_info("kdtree: %zu of %zu primitives can never be hit (non-finite or degenerate) and are left out", N - nvalid,
+                N);
+    return nvalid;
+}
+
+/* Sorts the three event lists (y and z on a helper thread when threads > 1
+ * and there are enough) and compacts them into one block at list[0];
+ * false when out of memory. */
+static bool sort_events(uint64_t *list[3], const size_t cnt[3], size_t nvalid, int threads)
+{
+    uint64_t *ev = list[0];
+    uint64_t *tmp = malloc((nvalid ? 2 * nvalid : 1) * sizeof *tmp);
+    if (!tmp)
+        return false;
+    /* the three axes sort independently: y and z on a helper thread */
+    kd_sort_job job = {{list[1], list[2]}, {cnt[1], cnt[2]}, NULL};
+    pthread_t th;
+    bool started = false;
+    if (threads > 1 && nvalid >= KD_FORK_MIN_PRIMS && (job.tmp = malloc(2 * nvalid * sizeof *job.tmp)) != NULL)
+        started = pthread_create(&th, NULL, sort_worker, &job) == 0;
+    ev_sort(list[0], cnt[0], tmp);
+    if (started) {
+        pthread_join(th, NULL);
+    } else {
+        ev_sort(list[1], cnt[1], tmp);
+        ev_sort(list[2], cnt[2], tmp);
+    }
+    free(job.tmp);
+    free(tmp);
+    /* compact the three lists into one block */
+    memmove(ev + cnt[0], list[1], cnt[1] * sizeof *ev);
+    memmove(ev + cnt[0] + cnt[1], list[2], cnt[2] * sizeof *ev);
+    return true;
+}
+
+/* The forked subtrees in place of their placeholders, depth first, in one
+ * array of nodes and one of ids; false when out of memory or over the node
+ * format (then c->limit). */
+static bool stitch_forks(kd_build *c)
+{
+    size_t nn = 0, ni = 0;
+    sum_forks(c, &nn, &ni, &c->st, true);
+    if (nn >= ((size_t)1 << KD_INDEX_BITS) || ni > KD_MAX_IDS) {
+        c->limit = true;
+        return false;
+    }
+    rt_kdtree_node *nodes = malloc(nn * sizeof *nodes);
+    uint32_t *ids = malloc((ni ? ni : 1) * sizeof *ids);
+    if (!nodes || !ids) {
+        free(nodes);
+        free(ids);
+        return false;
+    }
+    size_t on = 0, oi = 0;
+    stitch(c, 0, nodes, &on, ids, &oi);
+    free_forks(c);
+    free(c->nodes);
+    free(c->ids);
+    c->nodes = nodes;
+    c->ids = ids;
+    c->node_count = on;
+    c->id_count = oi;
+    return true;
+}
+
+/* The quads' tests without their ray-independent part (cross product,
+ * lengths, the degeneracy guard): the same bits. False when out of memory
+ * (the packed tree is freed then). */
+static bool prepare_quads(rt_kdtree *tree, const rt_scene *scene, size_t Q)
+{
+    tree->quads = malloc(Q * sizeof *tree->quads);
+    if (!tree->quads) {
+        free(tree->wide);
+        free(tree->prim_ids);
+        tree->wide = NULL;
+        tree->prim_ids = NULL;
+        tree->tri = NULL;
+        return false;
+    }
+    const rt_quads *q = &scene->quads;
+    for (size_t i = 0; i < Q; i++)
+        tree->quads[i] = rt_quad_prepare(rt_v3(q->px[i], q->py[i], q->pz[i]), rt_v3(q->ux[i], q->uy[i], q->uz[i]),
+                                         rt_v3(q->vx[i], q->vy[i], q->vz[i]));
+    return true;
+}
+
 rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
 {
     double t0 = 1e3 * rt_now_seconds();
@@ -804,24 +1035,8 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     tree->quad_count = Q;
 
     kd_build c;
-    memset(&c, 0, sizeof c);
-    c.s = scene;
-    c.T = (uint32_t)T;
-    c.S = (uint32_t)S;
-    c.Q = (uint32_t)Q;
-    c.kt = params && params->traversal_cost > 0.0f ? params->traversal_cost : 4.0;
-    c.ki = params && params->intersect_cost > 0.0f ? params->intersect_cost : 1.0;
-    double eb = params && params->empty_bonus > 0.0f ? params->empty_bonus : 0.2;
-    if (eb > 1.0)
-        eb = 1.0;
-    c.lambda = 1.0 - eb;
-    int threads = params && params->threads > 0 ? params->threads : rt_cpu_count();
-    if (threads < 1)
-        threads = 1;
-    if (threads > 64)
-        threads = 64;
-
-    uint64_t *ev = NULL, *tmp = NULL;
+    int threads = init_build(&c, scene, params);
+    uint64_t *ev = NULL;
     if (T > 0) {
         tree->tri = malloc(T * 9 * sizeof *tree->tri);
         if (!tree->tri)
@@ -832,66 +1047,11 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     if (!ev || !c.side)
         goto oom;
 
-    /* valid primitives and their bounds: first a count, then the events.
-     * Spheres and quads are bounded as the splits will clip them, here
-     * against all of space; a triangle's box is its vertices' (the same
-     * numbers, without the clipping passes that a million triangles would
-     * pay for nothing). */
-    const rt_box everywhere = {{-INFINITY, -INFINITY, -INFINITY}, {INFINITY, INFINITY, INFINITY}};
-    size_t nvalid = 0;
+    /* valid primitives and their bounds: first a count, then the events */
     rt_box *pb = malloc((N ? N : 1) * sizeof *pb);
     if (!pb)
         goto oom;
-    size_t nverts = scene->vertices.count;
-    for (size_t i = 0; i < N; i++) {
-        rt_box b = rt_box_empty();
-        bool ok = true;
-        if (i < T) {
-            const uint32_t *ix = scene->triangles.index + 3 * i;
-            float *dst = tree->tri + 9 * i;
-            memset(dst, 0, 9 * sizeof *dst);
-            if (ix[0] >= nverts || ix[1] >= nverts || ix[2] >= nverts) {
-                ok = false;
-            } else {
-                rt_vec3 a = scene->vertices.position[ix[0]], bb = scene->vertices.position[ix[1]],
-                        cc = scene->vertices.position[ix[2]];
-                rt_vec3 e1 = rt_sub(bb, a), e2 = rt_sub(cc, a);
-                ok = rt_finite3(a) && rt_finite3(bb) && rt_finite3(cc) && rt_finite3(e1) && rt_finite3(e2) &&
-                     (e1.x != 0.0f || e1.y != 0.0f || e1.z != 0.0f) && (e2.x != 0.0f || e2.y != 0.0f || e2.z != 0.0f);
-                if (ok) {
-                    dst[0] = a.x, dst[1] = a.y, dst[2] = a.z;
-                    dst[3] = bb.x, dst[4] = bb.y, dst[5] = bb.z;
-                    dst[6] = cc.x, dst[7] = cc.y, dst[8] = cc.z;
-                    b = rt_box_point(rt_box_point(rt_box_point(b, a), bb), cc);
-                }
-            }
-        } else if (i < T + S) {
-            size_t j = i - T;
-            const rt_spheres *sp = &scene->spheres;
-            ok = isfinite(sp->cx[j]) && isfinite(sp->cy[j]) && isfinite(sp->cz[j]) && isfinite(sp->radius[j]) &&
-                 prim_clip_bounds(&c, (uint32_t)i, everywhere, &b);
-        } else {
-            size_t j = i - T - S;
-            const rt_quads *q = &scene->quads;
-            rt_vec3 p = rt_v3(q->px[j], q->py[j], q->pz[j]), u = rt_v3(q->ux[j], q->uy[j], q->uz[j]),
-                    v = rt_v3(q->vx[j], q->vy[j], q->vz[j]);
-            rt_vec3 nrm = rt_cross(u, v);
-            ok = rt_finite3(p) && rt_finite3(u) && rt_finite3(v) && rt_dot(nrm, nrm) > 0.0f &&
-                 prim_clip_bounds(&c, (uint32_t)i, everywhere, &b);
-        }
-        if (ok && !finite_box(b))
-            ok = false;
-        pb[i] = b;
-        if (ok) {
-            nvalid++;
-            tree->bounds = rt_box_union(tree->bounds, b);
-        } else {
-            pb[i] = rt_box_empty();
-        }
-    }
-    if (nvalid < N)
-        rt_info("kdtree: %zu of %zu primitives can never be hit (non-finite or degenerate) and are left out", N - nvalid,
-                N);
+    size_t nvalid = bound_prims(&c, tree, pb, N);
 
     size_t cnt[3] = {0, 0, 0};
     uint64_t *list[3] = {ev, ev + 2 * nvalid, ev + 4 * nvalid};
@@ -899,30 +1059,8 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
         if (!rt_box_is_empty(pb[i]))
             emit_events(pb[i], (uint32_t)i, list, cnt);
     free(pb);
-    tmp = malloc((nvalid ? 2 * nvalid : 1) * sizeof *tmp);
-    if (!tmp)
+    if (!sort_events(list, cnt, nvalid, threads))
         goto oom;
-    {
-        /* the three axes sort independently: y and z on a helper thread */
-        kd_sort_job job = {{list[1], list[2]}, {cnt[1], cnt[2]}, NULL};
-        pthread_t th;
-        bool started = false;
-        if (threads > 1 && nvalid >= KD_FORK_MIN_PRIMS && (job.tmp = malloc(2 * nvalid * sizeof *job.tmp)) != NULL)
-            started = pthread_create(&th, NULL, sort_worker, &job) == 0;
-        ev_sort(list[0], cnt[0], tmp);
-        if (started) {
-            pthread_join(th, NULL);
-        } else {
-            ev_sort(list[1], cnt[1], tmp);
-            ev_sort(list[2], cnt[2], tmp);
-        }
-        free(job.tmp);
-    }
-    free(tmp);
-    tmp = NULL;
-    /* compact the three lists into one block */
-    memmove(ev + cnt[0], list[1], cnt[1] * sizeof *ev);
-    memmove(ev + cnt[0] + cnt[1], list[2], cnt[2] * sizeof *ev);
 
     if (nvalid > 0) {
         const float *lo = &tree->bounds.lo.x, *hi = &tree->bounds.hi.x;
@@ -949,30 +1087,8 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     ev = NULL;
     if (c.oom)
         goto oom;
-    if (c.fork_count > 0) {
-        size_t nn = 0, ni = 0;
-        sum_forks(&c, &nn, &ni, &c.st, true);
-        if (nn >= ((size_t)1 << KD_INDEX_BITS) || ni > KD_MAX_IDS) {
-            c.limit = true;
-            goto oom;
-        }
-        rt_kdtree_node *nodes = malloc(nn * sizeof *nodes);
-        uint32_t *ids = malloc((ni ? ni : 1) * sizeof *ids);
-        if (!nodes || !ids) {
-            free(nodes);
-            free(ids);
-            goto oom;
-        }
-        size_t on = 0, oi = 0;
-        stitch(&c, 0, nodes, &on, ids, &oi);
-        free_forks(&c);
-        free(c.nodes);
-        free(c.ids);
-        c.nodes = nodes;
-        c.ids = ids;
-        c.node_count = on;
-        c.id_count = oi;
-    }
+    if (c.fork_count > 0 && !stitch_forks(&c))
+        goto oom;
     free(c.side);
     free(c.strad);
     c.side = NULL;
@@ -980,23 +1096,8 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     rt_kd_binary bin = {c.nodes, c.node_count, c.ids, c.id_count};
     if (!rt_kd_pack_wide(tree, &bin, &c.limit))
         goto oom;
-    /* the quads' tests without their ray-independent part (cross product,
-     * lengths, the degeneracy guard): the same bits */
-    if (Q > 0) {
-        tree->quads = malloc(Q * sizeof *tree->quads);
-        if (!tree->quads) {
-            free(tree->wide);
-            free(tree->prim_ids);
-            tree->wide = NULL;
-            tree->prim_ids = NULL;
-            tree->tri = NULL;
-            goto oom;
-        }
-        const rt_quads *q = &scene->quads;
-        for (size_t i = 0; i < Q; i++)
-            tree->quads[i] = rt_quad_prepare(rt_v3(q->px[i], q->py[i], q->pz[i]), rt_v3(q->ux[i], q->uy[i], q->uz[i]),
-                                             rt_v3(q->vx[i], q->vy[i], q->vz[i]));
-    }
+    if (Q > 0 && !prepare_quads(tree, scene, Q))
+        goto oom;
     c.st.nodes = c.node_count;
     c.st.wide_nodes = tree->wide_count;
     c.st.bytes = tree->wide_count * sizeof *tree->wide + tree->prim_id_count * sizeof *tree->prim_ids +
@@ -1010,7 +1111,6 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
 oom:
     free_forks(&c);
     free(ev);
-    free(tmp);
     free(c.side);
     free(c.strad);
     free(c.nodes);

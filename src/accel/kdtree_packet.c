@@ -157,6 +157,224 @@ static inline void tri_rays(const rt_kdtree *tree, uint32_t id, unsigned m, cons
 
 #define KD_PMAX 2 /* halves of 8 lanes: packets of 8 or 16 rays */
 
+/* Eight rt_ray records (8 floats each) in, one vector a field out, the
+ * rays in lanes: ox oy oz dx dy dz tmin tmax (an 8x8 transpose). */
+KD_PINLINE void transpose8(__m256 R[8])
+{
+    __m256 t0 = _mm256_unpacklo_ps(R[0], R[1]), t1 = _mm256_unpackhi_ps(R[0], R[1]),
+           t2 = _mm256_unpacklo_ps(R[2], R[3]), t3 = _mm256_unpackhi_ps(R[2], R[3]),
+           t4 = _mm256_unpacklo_ps(R[4], R[5]), t5 = _mm256_unpackhi_ps(R[4], R[5]),
+           t6 = _mm256_unpacklo_ps(R[6], R[7]), t7 = _mm256_unpackhi_ps(R[6], R[7]);
+    __m256 s0 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)), s1 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)),
+           s2 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)), s3 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2)),
+           s4 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(1, 0, 1, 0)), s5 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(3, 2, 3, 2)),
+           s6 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(1, 0, 1, 0)), s7 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(3, 2, 3, 2));
+    R[0] = _mm256_permute2f128_ps(s0, s4, 0x20), R[1] = _mm256_permute2f128_ps(s1, s5, 0x20);
+    R[2] = _mm256_permute2f128_ps(s2, s6, 0x20), R[3] = _mm256_permute2f128_ps(s3, s7, 0x20);
+    R[4] = _mm256_permute2f128_ps(s0, s4, 0x31), R[5] = _mm256_permute2f128_ps(s1, s5, 0x31);
+    R[6] = _mm256_permute2f128_ps(s2, s6, 0x31), R[7] = _mm256_permute2f128_ps(s3, s7, 0x31);
+}
+
+/* kdtree_trace.c's ray set-up (ray_accept and the AVX2 ray_setup), the
+ * same operations with the rays of half k in lanes (lanes past n repeat the
+ * half's first ray, idle): origin O, reciprocal direction INV, the offset
+ * MA per axis, and the interval [*TN, *TF] within the tree's bounds.
+ * Returns the half's accepted rays as bits of the packet; adds the rays
+ * parallel to an axis to *parm and the negative directions to negbits. */
+KD_PINLINE unsigned setup_half(const rt_kdtree *tree, const rt_ray *rays, int n, int k, __m256 O[3], __m256 INV[3],
+                               __m256 MA[3], __m256 *TN, __m256 *TF, __m256 *TMAX, unsigned *parm,
+                               unsigned negbits[3])
+{
+    const __m256 inf = _mm256_set1_ps(INFINITY), sign = _mm256_set1_ps(-0.0f), zero = _mm256_setzero_ps();
+    const rt_ray *rk = rays + 8 * k;
+    int nk = n - 8 * k < 8 ? n - 8 * k : 8;
+    __m256 R[8];
+    for (int i = 0; i < 8; i++)
+        R[i] = _mm256_loadu_ps((const float *)(const void *)&rk[i < nk ? i : 0]);
+    transpose8(R);
+    __m256 ok = _mm256_cmp_ps(R[6], R[7], _CMP_LT_OQ);
+    __m256 dz = _mm256_and_ps(_mm256_cmp_ps(R[3], zero, _CMP_EQ_OQ),
+                              _mm256_and_ps(_mm256_cmp_ps(R[4], zero, _CMP_EQ_OQ), _mm256_cmp_ps(R[5], zero, _CMP_EQ_OQ)));
+    ok = _mm256_andnot_ps(dz, ok);
+    for (int a = 0; a < 6; a++)
+        ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_andnot_ps(sign, R[a]), inf, _CMP_LT_OQ));
+    __m256 om = _mm256_max_ps(_mm256_max_ps(_mm256_andnot_ps(sign, R[0]), _mm256_andnot_ps(sign, R[1])),
+                              _mm256_andnot_ps(sign, R[2]));
+    __m256 mp = _mm256_mul_ps(_mm256_add_ps(_mm256_set1_ps(tree->scale), om), _mm256_set1_ps(0x1p-18f));
+    const float *blo = &tree->bounds.lo.x, *bhi = &tree->bounds.hi.x;
+    __m256 A = _mm256_set1_ps(-INFINITY), B = inf, par = zero;
+    for (int a = 0; a < 3; a++) {
+        __m256 lo = _mm256_set1_ps(blo[a]), hi = _mm256_set1_ps(bhi[a]);
+        O[a] = R[a];
+        INV[a] = _mm256_div_ps(_mm256_set1_ps(1.0f), R[3 + a]);
+        MA[a] = _mm256_mul_ps(mp, _mm256_andnot_ps(sign, INV[a]));
+        __m256 pk = _mm256_cmp_ps(MA[a], inf, _CMP_NLT_UQ);
+        __m256 out = _mm256_or_ps(_mm256_cmp_ps(O[a], _mm256_sub_ps(lo, mp), _CMP_LT_OQ),
+                                  _mm256_cmp_ps(O[a], _mm256_add_ps(hi, mp), _CMP_GT_OQ));
+        ok = _mm256_andnot_ps(_mm256_and_ps(pk, out), ok);
+        __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(lo, O[a]), INV[a]), t1 = _mm256_mul_ps(_mm256_sub_ps(hi, O[a]), INV[a]);
+        __m256 ta = _mm256_sub_ps(_mm256_min_ps(t1, t0), MA[a]), tb = _mm256_add_ps(_mm256_max_ps(t0, t1), MA[a]);
+        A = _mm256_max_ps(A, _mm256_blendv_ps(ta, _mm256_set1_ps(-INFINITY), pk));
+        B = _mm256_min_ps(B, _mm256_blendv_ps(tb, inf, pk));
+        par = _mm256_or_ps(par, pk);
+        negbits[a] |= (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(INV[a], zero, _CMP_NGT_UQ)) << (8 * k);
+    }
+    *TN = _mm256_max_ps(R[6], A), *TF = _mm256_min_ps(R[7], B), *TMAX = R[7];
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(*TN, *TF, _CMP_LE_OQ));
+    *parm |= (unsigned)_mm256_movemask_ps(par) << (8 * k);
+    return ((unsigned)_mm256_movemask_ps(ok) & ((1u << nk) - 1u)) << (8 * k);
+}
+
+/* Half k once the packet is accepted: its idle lanes get an empty interval
+ * and no hit to improve (*BEST, and best in memory), and its rays' shears
+ * go into *P for the triangle test across rays. Returns whether that test
+ * applies: some ray is active and all share the shear's axis kz. */
+KD_PINLINE bool prepare_half(const rt_ray *rays, const rt_tri_ray *tr, unsigned active, int k, __m256 O[3],
+                             __m256 INV[3], __m256 MA[3], __m256 *TN, __m256 *TF, __m256 TMAX, __m256 *BEST,
+                             float *best, kd_pray *P)
+{
+    const __m256 inf = _mm256_set1_ps(INFINITY);
+    unsigned ak = active >> (8 * k) & 0xffu;
+    __m256 idle = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+        _mm256_and_si256(_mm256_set1_epi32((int)ak), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
+        _mm256_setzero_si256()));
+    for (int a = 0; a < 3; a++) {
+        O[a] = _mm256_andnot_ps(idle, O[a]);
+        INV[a] = _mm256_andnot_ps(idle, INV[a]);
+        MA[a] = _mm256_andnot_ps(idle, MA[a]);
+    }
+    *TN = _mm256_blendv_ps(*TN, inf, idle);
+    *TF = _mm256_blendv_ps(*TF, _mm256_set1_ps(-INFINITY), idle);
+    *BEST = _mm256_blendv_ps(TMAX, _mm256_set1_ps(-INFINITY), idle);
+    _mm256_store_ps(best + 8 * k, *BEST);
+    if (!ak)
+        return false;
+    bool across = true;
+    _Alignas(32) float q[9][8];
+    int first = 8 * k + __builtin_ctz(ak);
+    P->kx = tr[first].kx, P->ky = tr[first].ky, P->kz = tr[first].kz;
+    for (int j = 0; j < 8; j++) {
+        int i = ak >> j & 1 ? 8 * k + j : first;
+        const rt_tri_ray *t = &tr[i];
+        if (t->kz != P->kz)
+            across = false;
+        q[0][j] = t->okx, q[1][j] = t->oky, q[2][j] = t->okz, q[3][j] = t->sx, q[4][j] = t->sy, q[5][j] = t->sz;
+        q[6][j] = t->adz, q[7][j] = t->ad, q[8][j] = rays[i].tmin;
+    }
+    P->ox = _mm256_load_ps(q[0]), P->oy = _mm256_load_ps(q[1]), P->oz = _mm256_load_ps(q[2]);
+    P->sx = _mm256_load_ps(q[3]), P->sy = _mm256_load_ps(q[4]), P->sz = _mm256_load_ps(q[5]);
+    P->adz = _mm256_load_ps(q[6]), P->ad = _mm256_load_ps(q[7]), P->tmin = _mm256_load_ps(q[8]);
+    return across;
+}
+
+/* The stack of the walk: a child reference with each half's per-ray
+ * interval. */
+typedef struct kd_pstack {
+    uint32_t ref[KD_PSTACK];
+    __m256 lo[KD_PSTACK * KD_PMAX], hi[KD_PSTACK * KD_PMAX];
+    int sp;
+} kd_pstack;
+
+/* Wide node w for the packet: each plane's t for every ray (widened by its
+ * ma), then the 8 cells back to front, as kdtree_trace.c's portable step,
+ * each cut from the rays' intervals [L, min(H, BEST)] by its three planes
+ * and pushed with them when some ray crosses it, so the last pushed is the
+ * nearest. Returns how many were pushed. */
+KD_PINLINE int push_cells(const rt_kdtree_wide *w, int K, const int neg[3], __m256 (*O)[3], __m256 (*INV)[3],
+                          __m256 (*MA)[3], const __m256 *L, const __m256 *H, const __m256 *BEST, kd_pstack *S)
+{
+    __m256 lo[7][KD_PMAX], hi[7][KD_PMAX], hcap[KD_PMAX];
+    int ng[7];
+    for (int p = 0; p < 7; p++) {
+        unsigned a = (w->axes >> (2 * p)) & 3u;
+        __m256 s = _mm256_set1_ps(w->split[p]);
+        for (int k = 0; k < K; k++) {
+            __m256 t = _mm256_mul_ps(_mm256_sub_ps(s, O[k][a]), INV[k][a]);
+            lo[p][k] = _mm256_sub_ps(t, MA[k][a]);
+            hi[p][k] = _mm256_add_ps(t, MA[k][a]);
+        }
+        ng[p] = neg[a];
+    }
+    for (int k = 0; k < K; k++)
+        hcap[k] = _mm256_min_ps(H[k], BEST[k]);
+    int pushed = 0, sp = S->sp;
+    for (unsigned key = 8; key-- > 0;) {
+        unsigned f0 = key >> 2 & 1u, f1 = key >> 1 & 1u, f2 = key & 1u;
+        unsigned b0 = f0 ^ (unsigned)ng[0], p1 = 1 + b0, b1 = f1 ^ (unsigned)ng[p1], p2 = 3 + 2 * b0 + b1,
+                 b2 = f2 ^ (unsigned)ng[p2];
+        uint32_t cref = w->child[4 * b0 + 2 * b1 + b2];
+        if (cref == RT_KD_EMPTY)
+            continue;
+        unsigned cross = 0;
+        for (int k = 0; k < K; k++) {
+            __m256 l = L[k], hh = hcap[k];
+            if (f0) l = _mm256_max_ps(lo[0][k], l); else hh = _mm256_min_ps(hi[0][k], hh);
+            if (f1) l = _mm256_max_ps(lo[p1][k], l); else hh = _mm256_min_ps(hi[p1][k], hh);
+            if (f2) l = _mm256_max_ps(lo[p2][k], l); else hh = _mm256_min_ps(hi[p2][k], hh);
+            cross |= (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(l, hh, _CMP_LE_OQ));
+            S->lo[sp * K + k] = l, S->hi[sp * K + k] = hh;
+        }
+        if (!cross)
+            continue;
+        S->ref[sp++] = cref;
+        pushed++;
+    }
+    S->sp = sp;
+    return pushed;
+}
+
+/* Leaf ref for each active ray whose interval [L, min(H, BEST)] crosses
+ * its cell: the halves with two or more such rays sharing kz (across)
+ * primitive by primitive with the rays in lanes (vec), the other rays one
+ * by one; with any, a ray that hits is done. Returns found with the rays
+ * that hit added. */
+KD_PINLINE unsigned leaf_rays(const rt_kdtree *tree, uint32_t ref, int K, bool any, unsigned active,
+                              const bool *across, const kd_pray *P, const __m256 *L, const __m256 *H,
+                              const __m256 *BEST, const rt_ray *rays, const rt_tri_ray *tr, float *best, rt_hit *h,
+                              unsigned found)
+{
+    unsigned m = 0, vec = 0;
+    for (int k = 0; k < K; k++) {
+        unsigned mk = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(L[k], _mm256_min_ps(H[k], BEST[k]), _CMP_LE_OQ)) &
+                      (active >> (8 * k) & 0xffu);
+        if (across[k] && mk & (mk - 1))
+            vec |= mk << (8 * k);
+        m |= mk << (8 * k);
+    }
+    for (unsigned s = m & ~vec; s; s &= s - 1) {
+        int i = __builtin_ctz(s);
+        if (rt_kd_leaf_hit_avx2(tree, ref, &rays[i], &tr[i], &best[i], &h[i], any))
+            found |= 1u << i;
+    }
+    if (!vec)
+        return found;
+    uint32_t one = ref & RT_KD_PAYLOAD;
+    const uint32_t *p = ref >= RT_KD_ONE ? &one : tree->prim_ids + (ref & RT_KD_PAYLOAD);
+    for (;; p++) {
+        uint32_t id = *p & RT_KD_PAYLOAD;
+        if (id < tree->other_base) {
+            for (int k = 0; k < K; k++) {
+                unsigned vk = vec >> (8 * k) & 0xffu, fk = 0;
+                if (vk) {
+                    tri_rays(tree, id, vk, &P[k], rays + 8 * k, tr + 8 * k, best + 8 * k, h + 8 * k, &fk);
+                    found |= fk << (8 * k);
+                }
+            }
+        } else {
+            for (unsigned s = vec; s; s &= s - 1) {
+                int i = __builtin_ctz(s);
+                if (rt_kd_prim_hit_avx2(tree, id, &rays[i], &tr[i], &best[i], &h[i]))
+                    found |= 1u << i;
+            }
+        }
+        if (any && !(vec &= ~found)) /* occlusion: the rays that hit are done */
+            break;
+        if (ref >= RT_KD_ONE || (*p & RT_KD_LAST))
+            break;
+    }
+    return found;
+}
+
 /* The one packet walk of every entry point: K halves of 8 rays in AVX2
  * lanes (K = 1 or 2, a constant at each call, n rays with 8 (K - 1) < n <=
  * 8 K); any = occlusion: a ray is done at its first hit (its lane leaves
@@ -174,67 +392,10 @@ KD_PINLINE bool packet_walk(const rt_kdtree *tree, const rt_ray *rays, int n, rt
             hits[i].prim = RT_NONE;
     if (tree->root == RT_KD_EMPTY || rt_box_is_empty(tree->bounds))
         return true;
-    const __m256 inf = _mm256_set1_ps(INFINITY), sign = _mm256_set1_ps(-0.0f), zero = _mm256_setzero_ps();
     __m256 O[KD_PMAX][3], INV[KD_PMAX][3], MA[KD_PMAX][3], TN[KD_PMAX], TF[KD_PMAX], TMAX[KD_PMAX];
     unsigned active = 0, parm = 0, negbits[3] = {0, 0, 0};
-    for (int k = 0; k < K; k++) {
-        /* kdtree_trace.c's ray set-up (ray_accept and the AVX2 ray_setup),
-         * the same operations with 8 rays in lanes: rt_ray is 8 floats, so
-         * the rays come in by an 8x8 transpose (lanes past n repeat the
-         * half's first ray, idle) */
-        const rt_ray *rk = rays + 8 * k;
-        int nk = n - 8 * k < 8 ? n - 8 * k : 8;
-        __m256 R[8];
-        for (int i = 0; i < 8; i++)
-            R[i] = _mm256_loadu_ps((const float *)(const void *)&rk[i < nk ? i : 0]);
-        {
-            __m256 t0 = _mm256_unpacklo_ps(R[0], R[1]), t1 = _mm256_unpackhi_ps(R[0], R[1]),
-                   t2 = _mm256_unpacklo_ps(R[2], R[3]), t3 = _mm256_unpackhi_ps(R[2], R[3]),
-                   t4 = _mm256_unpacklo_ps(R[4], R[5]), t5 = _mm256_unpackhi_ps(R[4], R[5]),
-                   t6 = _mm256_unpacklo_ps(R[6], R[7]), t7 = _mm256_unpackhi_ps(R[6], R[7]);
-            __m256 s0 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)), s1 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)),
-                   s2 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)), s3 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2)),
-                   s4 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(1, 0, 1, 0)), s5 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(3, 2, 3, 2)),
-                   s6 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(1, 0, 1, 0)), s7 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(3, 2, 3, 2));
-            R[0] = _mm256_permute2f128_ps(s0, s4, 0x20), R[1] = _mm256_permute2f128_ps(s1, s5, 0x20);
-            R[2] = _mm256_permute2f128_ps(s2, s6, 0x20), R[3] = _mm256_permute2f128_ps(s3, s7, 0x20);
-            R[4] = _mm256_permute2f128_ps(s0, s4, 0x31), R[5] = _mm256_permute2f128_ps(s1, s5, 0x31);
-            R[6] = _mm256_permute2f128_ps(s2, s6, 0x31), R[7] = _mm256_permute2f128_ps(s3, s7, 0x31);
-        }
-        /* R: ox oy oz dx dy dz tmin tmax */
-        __m256 ok = _mm256_cmp_ps(R[6], R[7], _CMP_LT_OQ);
-        __m256 dz = _mm256_and_ps(_mm256_cmp_ps(R[3], zero, _CMP_EQ_OQ),
-                                  _mm256_and_ps(_mm256_cmp_ps(R[4], zero, _CMP_EQ_OQ), _mm256_cmp_ps(R[5], zero, _CMP_EQ_OQ)));
-        ok = _mm256_andnot_ps(dz, ok);
-        for (int a = 0; a < 6; a++)
-            ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_andnot_ps(sign, R[a]), inf, _CMP_LT_OQ));
-        __m256 om = _mm256_max_ps(_mm256_max_ps(_mm256_andnot_ps(sign, R[0]), _mm256_andnot_ps(sign, R[1])),
-                                  _mm256_andnot_ps(sign, R[2]));
-        __m256 mp = _mm256_mul_ps(_mm256_add_ps(_mm256_set1_ps(tree->scale), om), _mm256_set1_ps(0x1p-18f));
-        const float *blo = &tree->bounds.lo.x, *bhi = &tree->bounds.hi.x;
-        __m256 A = _mm256_set1_ps(-INFINITY), B = inf, par = zero;
-        for (int a = 0; a < 3; a++) {
-            __m256 lo = _mm256_set1_ps(blo[a]), hi = _mm256_set1_ps(bhi[a]);
-            O[k][a] = R[a];
-            INV[k][a] = _mm256_div_ps(_mm256_set1_ps(1.0f), R[3 + a]);
-            MA[k][a] = _mm256_mul_ps(mp, _mm256_andnot_ps(sign, INV[k][a]));
-            __m256 pk = _mm256_cmp_ps(MA[k][a], inf, _CMP_NLT_UQ);
-            __m256 out = _mm256_or_ps(_mm256_cmp_ps(O[k][a], _mm256_sub_ps(lo, mp), _CMP_LT_OQ),
-                                      _mm256_cmp_ps(O[k][a], _mm256_add_ps(hi, mp), _CMP_GT_OQ));
-            ok = _mm256_andnot_ps(_mm256_and_ps(pk, out), ok);
-            __m256 t0 = _mm256_mul_ps(_mm256_sub_ps(lo, O[k][a]), INV[k][a]),
-                   t1 = _mm256_mul_ps(_mm256_sub_ps(hi, O[k][a]), INV[k][a]);
-            __m256 ta = _mm256_sub_ps(_mm256_min_ps(t1, t0), MA[k][a]), tb = _mm256_add_ps(_mm256_max_ps(t0, t1), MA[k][a]);
-            A = _mm256_max_ps(A, _mm256_blendv_ps(ta, _mm256_set1_ps(-INFINITY), pk));
-            B = _mm256_min_ps(B, _mm256_blendv_ps(tb, inf, pk));
-            par = _mm256_or_ps(par, pk);
-            negbits[a] |= (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(INV[k][a], zero, _CMP_NGT_UQ)) << (8 * k);
-        }
-        TN[k] = _mm256_max_ps(R[6], A), TF[k] = _mm256_min_ps(R[7], B), TMAX[k] = R[7];
-        ok = _mm256_and_ps(ok, _mm256_cmp_ps(TN[k], TF[k], _CMP_LE_OQ));
-        active |= ((unsigned)_mm256_movemask_ps(ok) & ((1u << nk) - 1u)) << (8 * k);
-        parm |= (unsigned)_mm256_movemask_ps(par) << (8 * k);
-    }
+    for (int k = 0; k < K; k++)
+        active |= setup_half(tree, rays, n, k, O[k], INV[k], MA[k], &TN[k], &TF[k], &TMAX[k], &parm, negbits);
     if (!active)
         return true;
     if (parm & active)
@@ -254,168 +415,52 @@ KD_PINLINE bool packet_walk(const rt_kdtree *tree, const rt_ray *rays, int n, rt
     kd_pray P[KD_PMAX];
     bool across[KD_PMAX];
     __m256 BEST[KD_PMAX];
-    for (int k = 0; k < K; k++) {
-        /* idle lanes: an empty interval, no hit to improve */
-        unsigned ak = active >> (8 * k) & 0xffu;
-        __m256 idle = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
-            _mm256_and_si256(_mm256_set1_epi32((int)ak), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
-            _mm256_setzero_si256()));
-        for (int a = 0; a < 3; a++) {
-            O[k][a] = _mm256_andnot_ps(idle, O[k][a]);
-            INV[k][a] = _mm256_andnot_ps(idle, INV[k][a]);
-            MA[k][a] = _mm256_andnot_ps(idle, MA[k][a]);
-        }
-        TN[k] = _mm256_blendv_ps(TN[k], inf, idle);
-        TF[k] = _mm256_blendv_ps(TF[k], _mm256_set1_ps(-INFINITY), idle);
-        BEST[k] = _mm256_blendv_ps(TMAX[k], _mm256_set1_ps(-INFINITY), idle);
-        _mm256_store_ps(best + 8 * k, BEST[k]);
-        /* the triangle test across rays, when the half's rays share the
-         * shear's axes */
-        across[k] = ak != 0;
-        if (!ak)
-            continue;
-        _Alignas(32) float q[9][8];
-        int first = 8 * k + __builtin_ctz(ak);
-        P[k].kx = tr[first].kx, P[k].ky = tr[first].ky, P[k].kz = tr[first].kz;
-        for (int j = 0; j < 8; j++) {
-            int i = ak >> j & 1 ? 8 * k + j : first;
-            const rt_tri_ray *t = &tr[i];
-            if (t->kz != P[k].kz)
-                across[k] = false;
-            q[0][j] = t->okx, q[1][j] = t->oky, q[2][j] = t->okz, q[3][j] = t->sx, q[4][j] = t->sy, q[5][j] = t->sz;
-            q[6][j] = t->adz, q[7][j] = t->ad, q[8][j] = rays[i].tmin;
-        }
-        P[k].ox = _mm256_load_ps(q[0]), P[k].oy = _mm256_load_ps(q[1]), P[k].oz = _mm256_load_ps(q[2]);
-        P[k].sx = _mm256_load_ps(q[3]), P[k].sy = _mm256_load_ps(q[4]), P[k].sz = _mm256_load_ps(q[5]);
-        P[k].adz = _mm256_load_ps(q[6]), P[k].ad = _mm256_load_ps(q[7]), P[k].tmin = _mm256_load_ps(q[8]);
-    }
+    for (int k = 0; k < K; k++)
+        across[k] = prepare_half(rays, tr, active, k, O[k], INV[k], MA[k], &TN[k], &TF[k], TMAX[k], &BEST[k], best,
+                                 &P[k]);
     rt_hit h[8 * KD_PMAX];
     unsigned found = 0;
 
-    /* the stack: a child reference with each half's per-ray interval */
-    uint32_t sref[KD_PSTACK];
-    __m256 slo[KD_PSTACK * KD_PMAX], shi[KD_PSTACK * KD_PMAX];
-    int sp = 0;
+    kd_pstack S;
+    S.sp = 0;
     uint32_t ref = tree->root;
     __m256 L[KD_PMAX], H[KD_PMAX];
     for (int k = 0; k < K; k++)
         L[k] = TN[k], H[k] = TF[k];
     for (;;) {
         while (ref < RT_KD_LEAF) {
-            const rt_kdtree_wide *w = &tree->wide[ref];
-            __m256 lo[7][KD_PMAX], hi[7][KD_PMAX], hcap[KD_PMAX];
-            int ng[7];
-            for (int p = 0; p < 7; p++) {
-                unsigned a = (w->axes >> (2 * p)) & 3u;
-                __m256 s = _mm256_set1_ps(w->split[p]);
-                for (int k = 0; k < K; k++) {
-                    __m256 t = _mm256_mul_ps(_mm256_sub_ps(s, O[k][a]), INV[k][a]);
-                    lo[p][k] = _mm256_sub_ps(t, MA[k][a]);
-                    hi[p][k] = _mm256_add_ps(t, MA[k][a]);
-                }
-                ng[p] = neg[a];
-            }
-            for (int k = 0; k < K; k++)
-                hcap[k] = _mm256_min_ps(H[k], BEST[k]);
-            /* back to front, as kdtree_trace.c's portable step: the last
-             * cell found is the nearest */
-            int pushed = 0;
-            for (unsigned key = 8; key-- > 0;) {
-                unsigned f0 = key >> 2 & 1u, f1 = key >> 1 & 1u, f2 = key & 1u;
-                unsigned b0 = f0 ^ (unsigned)ng[0], p1 = 1 + b0, b1 = f1 ^ (unsigned)ng[p1], p2 = 3 + 2 * b0 + b1,
-                         b2 = f2 ^ (unsigned)ng[p2];
-                uint32_t cref = w->child[4 * b0 + 2 * b1 + b2];
-                if (cref == RT_KD_EMPTY)
-                    continue;
-                unsigned cross = 0;
-                for (int k = 0; k < K; k++) {
-                    __m256 l = L[k], hh = hcap[k];
-                    if (f0) l = _mm256_max_ps(lo[0][k], l); else hh = _mm256_min_ps(hi[0][k], hh);
-                    if (f1) l = _mm256_max_ps(lo[p1][k], l); else hh = _mm256_min_ps(hi[p1][k], hh);
-                    if (f2) l = _mm256_max_ps(lo[p2][k], l); else hh = _mm256_min_ps(hi[p2][k], hh);
-                    cross |= (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(l, hh, _CMP_LE_OQ));
-                    slo[sp * K + k] = l, shi[sp * K + k] = hh;
-                }
-                if (!cross)
-                    continue;
-                sref[sp++] = cref;
-                pushed++;
-            }
-            if (!pushed)
+            if (!push_cells(&tree->wide[ref], K, neg, O, INV, MA, L, H, BEST, &S))
                 goto pop;
-            sp--; /* the nearest: enter it */
-            ref = sref[sp];
+            S.sp--; /* the nearest: enter it */
+            ref = S.ref[S.sp];
             for (int k = 0; k < K; k++)
-                L[k] = slo[sp * K + k], H[k] = shi[sp * K + k];
+                L[k] = S.lo[S.sp * K + k], H[k] = S.hi[S.sp * K + k];
         }
-        {
-            /* a leaf: each ray that crosses its cell; the halves with two or
-             * more such rays sharing kz primitive by primitive, rays in
-             * lanes (vec), the other rays one by one */
-            unsigned m = 0, vec = 0;
-            for (int k = 0; k < K; k++) {
-                unsigned mk = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(L[k], _mm256_min_ps(H[k], BEST[k]), _CMP_LE_OQ)) &
-                              (active >> (8 * k) & 0xffu);
-                if (across[k] && mk & (mk - 1))
-                    vec |= mk << (8 * k);
-                m |= mk << (8 * k);
-            }
-            for (unsigned s = m & ~vec; s; s &= s - 1) {
-                int i = __builtin_ctz(s);
-                if (rt_kd_leaf_hit_avx2(tree, ref, &rays[i], &tr[i], &best[i], &h[i], any))
-                    found |= 1u << i;
-            }
-            if (vec) {
-                uint32_t one = ref & RT_KD_PAYLOAD;
-                const uint32_t *p = ref >= RT_KD_ONE ? &one : tree->prim_ids + (ref & RT_KD_PAYLOAD);
-                for (;; p++) {
-                    uint32_t id = *p & RT_KD_PAYLOAD;
-                    if (id < tree->other_base) {
-                        for (int k = 0; k < K; k++) {
-                            unsigned vk = vec >> (8 * k) & 0xffu, fk = 0;
-                            if (vk) {
-                                tri_rays(tree, id, vk, &P[k], rays + 8 * k, tr + 8 * k, best + 8 * k, h + 8 * k, &fk);
-                                found |= fk << (8 * k);
-                            }
-                        }
-                    } else {
-                        for (unsigned s = vec; s; s &= s - 1) {
-                            int i = __builtin_ctz(s);
-                            if (rt_kd_prim_hit_avx2(tree, id, &rays[i], &tr[i], &best[i], &h[i]))
-                                found |= 1u << i;
-                        }
-                    }
-                    if (any && !(vec &= ~found)) /* occlusion: the rays that hit are done */
-                        break;
-                    if (ref >= RT_KD_ONE || (*p & RT_KD_LAST))
-                        break;
-                }
-            }
-            unsigned done = found & active;
-            if (any && done) {
-                active &= ~done;
-                if (!active)
-                    goto done;
-                for (; done; done &= done - 1)
-                    best[__builtin_ctz(done)] = -INFINITY;
-            }
-            for (int k = 0; k < K; k++)
-                BEST[k] = _mm256_load_ps(best + 8 * k);
+        found = leaf_rays(tree, ref, K, any, active, across, P, L, H, BEST, rays, tr, best, h, found);
+        unsigned done = found & active;
+        if (any && done) {
+            active &= ~done;
+            if (!active)
+                goto done;
+            for (; done; done &= done - 1)
+                best[__builtin_ctz(done)] = -INFINITY;
         }
+        for (int k = 0; k < K; k++)
+            BEST[k] = _mm256_load_ps(best + 8 * k);
     pop:
         for (;;) { /* the next cell that some ray crosses before its closest hit */
-            if (sp == 0)
+            if (S.sp == 0)
                 goto done;
-            sp--;
+            S.sp--;
             unsigned c = 0;
             for (int k = 0; k < K; k++)
-                c |= (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(slo[sp * K + k], BEST[k], _CMP_LE_OQ)) << (8 * k);
+                c |= (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(S.lo[S.sp * K + k], BEST[k], _CMP_LE_OQ)) << (8 * k);
             if (c & active)
                 break;
         }
-        ref = sref[sp];
+        ref = S.ref[S.sp];
         for (int k = 0; k < K; k++)
-            L[k] = slo[sp * K + k], H[k] = shi[sp * K + k];
+            L[k] = S.lo[S.sp * K + k], H[k] = S.hi[S.sp * K + k];
     }
 done:
     *mask = found;

@@ -17,9 +17,9 @@
 #include "rt/base/file.h"
 #include "rt/image/compare.h"
 #include "rt/image/flip.h"
-#include "rt/io/framebuffer.h"
+#include "rt/image/srgb.h"
+#include "rt/io/image_write.h"
 #include "rt/io/image_read.h"
-#include "rt/scene/texture.h"
 
 static const char usage[] =
     "usage: rt compare CANDIDATE REFERENCE [options]\n"

@@ -1,7 +1,7 @@
 /* convert.c - `rt convert IN OUT [--exposure EV] [--tonemap NAME] [--half]`:
  * an image from one format to another. IN is read whatever its format
  * (rt/io/image_read.h: EXR, PFM, HDR, PNG...); OUT's extension picks the
- * writer, as for renders (rt/io/framebuffer.h). Exposure and the tone curve
+ * writer, as for renders (rt/io/image_write.h). Exposure and the tone curve
  * (rt/image/tonemap.h) shape 8-bit output; the float formats stay linear, so
  * asking for them with a float OUT is refused rather than ignored. */
 #include "commands.h"
@@ -12,7 +12,7 @@
 #include "rt/base/file.h"
 #include "rt/base/number.h"
 #include "rt/image/tonemap.h"
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 #include "rt/io/image_read.h"
 
 static const char usage[] =

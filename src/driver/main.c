@@ -37,7 +37,7 @@
 #include "rt/render/camera.h"
 #include "rt/image/tonemap.h"
 #include "rt/accel/kdtree.h"
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 #include "rt/io/load.h"
 #include "rt/render/integrator.h"
 #include "rt/render/limits.h"

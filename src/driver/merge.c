@@ -28,7 +28,7 @@
 #include "rt/base/file.h"
 #include "rt/base/number.h"
 #include "rt/image/tonemap.h"
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 #include "rt/io/part.h"
 
 static const char usage[] =

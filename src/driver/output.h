@@ -1,7 +1,7 @@
 /* output.h - what rt does with a finished render (driver-private): the AOV
  * images (--aov), the denoiser (--denoise, fed the albedo and normal AOVs),
  * exposure and tone curve for 8-bit output, half EXR, then the atomic write
- * (rt/io/framebuffer.h).
+ * (rt/io/image_write.h).
  *
  *   if (output_check(&a, &err) != RT_OK) ...     // before rendering: --denoise has its library
  *   output_aovs aov;
@@ -14,7 +14,7 @@
 #define RT_DRIVER_OUTPUT_H
 
 #include "args.h"
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 #include "rt/render/aov.h"
 
 typedef struct output_aovs {

@@ -31,7 +31,7 @@
 
 #include <stdbool.h>
 
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 #include "rt/render/render.h"
 
 #include "tev.h"

@@ -26,7 +26,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 
 #define TEV_MAX_LAYERS 8
 

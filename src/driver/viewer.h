@@ -19,7 +19,7 @@
 #include <stdatomic.h>
 #include <stdbool.h>
 
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 #include "rt/render/render.h"
 
 #include "window.h"

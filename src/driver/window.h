@@ -45,7 +45,7 @@
 #include <stddef.h>
 
 #include "rt/image/tonemap.h"
-#include "rt/io/framebuffer.h"
+#include "rt/image/framebuffer.h"
 #include "rt/scene/scene.h"
 
 /* What the user asked for since the driver last looked. */

@@ -19,7 +19,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "rt/scene/texture.h"
+#include "rt/image/srgb.h"
 
 static const char *const names[] = {"clamp", "filmic", "aces", "agx"};
 

@@ -251,6 +251,92 @@ static exr_result_t decode_chunk(exr_context_t ctx, const exr_chunk_info_t *cinf
 /* The decoder both entry points share: channels `channels` (all required
  * when `required`, else the RGBA/Y rules of rt_exr_decode) into
  * n floats a pixel. */
+/* The channel list against what the caller asked for: the required
+ * channels all present, or (not required) some of R, G, B or Y; no channel
+ * read is subsampled. *has_rgb, *has_y: which colour channels there are. */
+static rt_result check_channels(const exr_attr_chlist_t *chl, const char *name, const char *const *channels,
+                                int nchan, bool required, bool *has_rgb, bool *has_y, rt_error *err)
+{
+    *has_rgb = *has_y = false;
+    int found = 0;
+    for (int c = 0; c < chl->num_channels; c++) {
+        const exr_attr_chlist_entry_t *e = &chl->entries[c];
+        const char *n = e->name.str;
+        bool used = required ? false
+                             : strcmp(n, "R") == 0 || strcmp(n, "G") == 0 || strcmp(n, "B") == 0 ||
+                                   strcmp(n, "A") == 0 || strcmp(n, "Y") == 0;
+        for (int k = 0; k < nchan && required; k++)
+            if (strcmp(n, channels[k]) == 0) {
+                used = true;
+                found++;
+            }
+        if (used && (e->x_sampling != 1 || e->y_sampling != 1))
+            return rt_fail(err, RT_ERR_INVALID, "%s: EXR channel %s is subsampled (%dx%d), which rt does not read",
+                           name, n, e->x_sampling, e->y_sampling);
+        *has_rgb |= strcmp(n, "R") == 0 || strcmp(n, "G") == 0 || strcmp(n, "B") == 0;
+        *has_y |= strcmp(n, "Y") == 0;
+    }
+    if (required && found < nchan) {
+        char list[256] = "";
+        for (int k = 0; k < nchan; k++) {
+            strncat(list, k ? ", " : "", sizeof list - strlen(list) - 1);
+            strncat(list, channels[k], sizeof list - strlen(list) - 1);
+        }
+        return rt_fail(err, RT_ERR_INVALID, "%s: EXR part 0 lacks some of the channels %s", name, list);
+    }
+    if (!required && !*has_rgb && !*has_y)
+        return rt_fail(err, RT_ERR_INVALID, "%s: EXR part 0 has no R, G, B or Y channel", name);
+    return RT_OK;
+}
+
+/* Every chunk of part 0, scanline or tiled, decoded into rgba (w x h,
+ * wc->count floats a pixel); a chunk outside the data window fails. */
+static exr_result_t decode_pixels(exr_context_t ctx, exr_storage_t storage, const exr_attr_box2i_t *dw, int w, int h,
+                                  float *rgba, const want_channels *wc)
+{
+    exr_result_t rv = EXR_ERR_SUCCESS;
+    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
+    bool started = false;
+    if (storage == EXR_STORAGE_SCANLINE) {
+        int32_t lines = 1;
+        exr_get_scanlines_per_chunk(ctx, 0, &lines);
+        for (int64_t y = dw->min.y; y <= dw->max.y && rv == EXR_ERR_SUCCESS; y += lines) {
+            exr_chunk_info_t cinfo;
+            rv = exr_read_scanline_chunk_info(ctx, 0, (int)y, &cinfo);
+            if (rv != EXR_ERR_SUCCESS)
+                break;
+            int64_t y0 = (int64_t)cinfo.start_y - dw->min.y;
+            if (y0 < 0 || y0 + cinfo.height > h || cinfo.width != w) {
+                rv = EXR_ERR_BAD_CHUNK_LEADER;
+                break;
+            }
+            rv = decode_chunk(ctx, &cinfo, &dec, &started, rgba, w, 0, (int)y0, wc);
+        }
+    } else {
+        int32_t tw = 0, th = 0;
+        rv = exr_get_tile_sizes(ctx, 0, 0, 0, &tw, &th);
+        if (rv == EXR_ERR_SUCCESS && (tw <= 0 || th <= 0))
+            rv = EXR_ERR_INVALID_ATTR;
+        for (int ty = 0; rv == EXR_ERR_SUCCESS && (int64_t)ty * th < h; ty++) {
+            for (int tx = 0; rv == EXR_ERR_SUCCESS && (int64_t)tx * tw < w; tx++) {
+                exr_chunk_info_t cinfo;
+                rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &cinfo);
+                if (rv != EXR_ERR_SUCCESS)
+                    break;
+                int64_t x0 = (int64_t)tx * tw, y0 = (int64_t)ty * th;
+                if (x0 + cinfo.width > w || y0 + cinfo.height > h) {
+                    rv = EXR_ERR_BAD_CHUNK_LEADER;
+                    break;
+                }
+                rv = decode_chunk(ctx, &cinfo, &dec, &started, rgba, w, (int)x0, (int)y0, wc);
+            }
+        }
+    }
+    if (started)
+        exr_decoding_destroy(ctx, &dec);
+    return rv;
+}
+
 static rt_result decode(const void *data, size_t size, const char *name, int max_dim, uint64_t max_pixels,
                         const char *const *channels, int nchan, bool required, float **rgba_out, int *width,
                         int *height, rt_error *err)
@@ -301,40 +387,9 @@ static rt_result decode(const void *data, size_t size, const char *name, int max
                          name, (long long)w64, (long long)h64, max_dim, max_dim, (unsigned long long)max_pixels);
         goto done;
     }
-    bool has_rgb = false, has_y = false;
-    int found = 0;
-    for (int c = 0; c < chl->num_channels; c++) {
-        const exr_attr_chlist_entry_t *e = &chl->entries[c];
-        const char *n = e->name.str;
-        bool used = required ? false
-                             : strcmp(n, "R") == 0 || strcmp(n, "G") == 0 || strcmp(n, "B") == 0 ||
-                                   strcmp(n, "A") == 0 || strcmp(n, "Y") == 0;
-        for (int k = 0; k < nchan && required; k++)
-            if (strcmp(n, channels[k]) == 0) {
-                used = true;
-                found++;
-            }
-        if (used && (e->x_sampling != 1 || e->y_sampling != 1)) {
-            result = rt_fail(err, RT_ERR_INVALID, "%s: EXR channel %s is subsampled (%dx%d), which rt does not read",
-                             name, n, e->x_sampling, e->y_sampling);
-            goto done;
-        }
-        has_rgb |= strcmp(n, "R") == 0 || strcmp(n, "G") == 0 || strcmp(n, "B") == 0;
-        has_y |= strcmp(n, "Y") == 0;
-    }
-    if (required && found < nchan) {
-        char list[256] = "";
-        for (int k = 0; k < nchan; k++) {
-            strncat(list, k ? ", " : "", sizeof list - strlen(list) - 1);
-            strncat(list, channels[k], sizeof list - strlen(list) - 1);
-        }
-        result = rt_fail(err, RT_ERR_INVALID, "%s: EXR part 0 lacks some of the channels %s", name, list);
+    bool has_rgb, has_y;
+    if ((result = check_channels(chl, name, channels, nchan, required, &has_rgb, &has_y, err)) != RT_OK)
         goto done;
-    }
-    if (!required && !has_rgb && !has_y) {
-        result = rt_fail(err, RT_ERR_INVALID, "%s: EXR part 0 has no R, G, B or Y channel", name);
-        goto done;
-    }
     int w = (int)w64, h = (int)h64;
     rgba = rt_alloc((size_t)w * (size_t)h, (size_t)nchan * sizeof(float));
     if (!rgba) {
@@ -346,45 +401,7 @@ static rt_result decode(const void *data, size_t size, const char *name, int max
     bool grey = !required && has_y && !has_rgb;
     static const char *const grey_names[4] = {"Y", "-", "-", "-"};
     want_channels wc = {grey ? grey_names : channels, nchan};
-    exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
-    bool started = false;
-    if (storage == EXR_STORAGE_SCANLINE) {
-        int32_t lines = 1;
-        exr_get_scanlines_per_chunk(ctx, 0, &lines);
-        for (int64_t y = dw.min.y; y <= dw.max.y && rv == EXR_ERR_SUCCESS; y += lines) {
-            exr_chunk_info_t cinfo;
-            rv = exr_read_scanline_chunk_info(ctx, 0, (int)y, &cinfo);
-            if (rv != EXR_ERR_SUCCESS)
-                break;
-            int64_t y0 = (int64_t)cinfo.start_y - dw.min.y;
-            if (y0 < 0 || y0 + cinfo.height > h || cinfo.width != w) {
-                rv = EXR_ERR_BAD_CHUNK_LEADER;
-                break;
-            }
-            rv = decode_chunk(ctx, &cinfo, &dec, &started, rgba, w, 0, (int)y0, &wc);
-        }
-    } else {
-        int32_t tw = 0, th = 0;
-        rv = exr_get_tile_sizes(ctx, 0, 0, 0, &tw, &th);
-        if (rv == EXR_ERR_SUCCESS && (tw <= 0 || th <= 0))
-            rv = EXR_ERR_INVALID_ATTR;
-        for (int ty = 0; rv == EXR_ERR_SUCCESS && (int64_t)ty * th < h; ty++) {
-            for (int tx = 0; rv == EXR_ERR_SUCCESS && (int64_t)tx * tw < w; tx++) {
-                exr_chunk_info_t cinfo;
-                rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &cinfo);
-                if (rv != EXR_ERR_SUCCESS)
-                    break;
-                int64_t x0 = (int64_t)tx * tw, y0 = (int64_t)ty * th;
-                if (x0 + cinfo.width > w || y0 + cinfo.height > h) {
-                    rv = EXR_ERR_BAD_CHUNK_LEADER;
-                    break;
-                }
-                rv = decode_chunk(ctx, &cinfo, &dec, &started, rgba, w, (int)x0, (int)y0, &wc);
-            }
-        }
-    }
-    if (started)
-        exr_decoding_destroy(ctx, &dec);
+    rv = decode_pixels(ctx, storage, &dw, w, h, rgba, &wc);
     if (rv != EXR_ERR_SUCCESS) {
         result = exr_failed(err, RT_ERR_INVALID, name, "cannot decode the EXR pixels", &s, rv);
         goto done;

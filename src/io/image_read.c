@@ -11,8 +11,8 @@
 #include <string.h>
 
 #include "rt/base/file.h"
+#include "rt/image/srgb.h"
 #include "rt/io/image_decode.h"
-#include "rt/scene/texture.h"
 
 #define READ_MAX_DIM 65536
 #define READ_MAX_PIXELS ((uint64_t)1 << 28)

@@ -48,6 +48,7 @@
 #include "rt/base/alloc.h"
 #include "rt/base/file.h"
 #include "rt/base/log.h"
+#include "rt/io/image_load.h"
 #include "rt/scene/texture.h"
 
 #define OBJ_NAME_MAX 128

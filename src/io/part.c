@@ -19,6 +19,7 @@
 #include "rt/base/alloc.h"
 #include "rt/base/file.h"
 #include "rt/io/exr.h"
+#include "rt/io/image_read.h"
 #include "rt/io/json.h"
 
 #define SIDECAR_MAX_BYTES (1u << 20)

@@ -1,4 +1,4 @@
-/* pfm.c - reading PFM files (rt_pfm_read, rt/io/framebuffer.h).
+/* pfm.c - reading PFM files (rt_pfm_read, rt/io/image_read.h).
  *
  * The format (Paul Debevec's "PFM Portable Float Map" note, as Netpbm and
  * pbrt read it): "PF" (RGB) or "Pf" (grey), white space, the width, white
@@ -11,7 +11,7 @@
  * here) and the pixel bytes it declares are checked against the file's size
  * before any pixel memory is allocated, so a header claiming 65536x65536
  * (48 GiB) on a small file is one clear error, not an allocation. */
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_read.h"
 
 #include <errno.h>
 #include <math.h>

@@ -47,6 +47,7 @@
 #include "rt/base/log.h"
 #include "rt/base/number.h"
 #include "rt/io/gltf.h"
+#include "rt/io/image_load.h"
 #include "rt/io/mesh_io.h"
 #include "rt/scene/settings.h"
 #include "rt/scene/texture.h"
@@ -967,152 +968,154 @@ static size_t mat_key_index(const char *key)
     return i;
 }
 
-static rt_result st_material(parser *p, const tok *kw)
+/* `metal NAME`: a named conductor's complex IOR (rt_metals) into m. */
+static rt_result get_metal(parser *p, const char *what, rt_material *m)
 {
-    (void)kw;
-    const tok *name = NULL;
     rt_result r;
-    char b[80];
-    if ((r = get_word(p, "a material name", &name)) != RT_OK ||
-        (r = check_new_name(p, name, &p->materials, "material")) != RT_OK)
-        return r;
-    rt_material m;
-    rt_material_default(&m, name->s);
-    const tok *seen[MAT_KEY_COUNT] = {0};
-    float uv[4] = {1, 1, 0, 0}; /* scale u, v; offset u, v */
-    while (peek(p)) {
-        const tok *key = peek(p);
-        p->pos++;
-        size_t k = 0;
-        while (k < MAT_KEY_COUNT && strcmp(key->s, mat_keys[k].key) != 0 &&
-               !(mat_keys[k].alias && strcmp(key->s, mat_keys[k].alias) == 0))
-            k++;
-        if (k == MAT_KEY_COUNT || key->quoted) {
-            near_miss n = near_miss_of(key->s);
-            for (size_t i = 0; i < MAT_KEY_COUNT; i++)
-                near_miss_consider(&n, mat_keys[i].key);
-            if (n.best)
-                return perr(p, RT_ERR_PARSE, key, "expected a material key, got %s (did you mean '%s'?)",
-                            show(key, b, sizeof b), n.best);
-            return perr(p, RT_ERR_PARSE, key,
-                        "expected a material key (color, alpha, ambient, diffuse, specular, shininess, reflect, "
-                        "transmission, ior, metallic, roughness, emission, texture, normal_map, ... see "
-                        "docs/scene-format.md), got %s",
-                        show(key, b, sizeof b));
-        }
-        if (seen[k])
-            return perr(p, RT_ERR_INVALID, key, "material key '%s' is given twice (first at column %d)",
-                        mat_keys[k].key, seen[k]->col);
-        seen[k] = key;
-        const mat_key *mk = &mat_keys[k];
-        char what[96];
-        snprintf(what, sizeof what, "material %s", mk->key);
-        void *field = (char *)&m + mk->offset;
-        switch (mk->kind) {
-        case MK_FLOAT: r = get_float_in(p, what, mk->lo, mk->hi, (float *)field); break;
-        case MK_INT: {
-            long long v = 0;
-            r = get_int(p, what, (long long)mk->lo, (long long)mk->hi, &v);
-            if (r == RT_OK)
-                *(int *)field = (int)v;
-            break;
-        }
-        case MK_COLOR: r = get_color(p, what, (rt_vec3 *)field); break;
-        case MK_COLOR01: r = get_color_in(p, what, 1.0f, (rt_vec3 *)field); break;
-        case MK_THICKNESS: {
-            char w[128];
-            snprintf(w, sizeof w, "%s (minimum, nm)", what);
-            r = get_float_in(p, w, 0.0f, FLT_MAX, &m.iridescence_thickness_min);
-            if (r == RT_OK) {
-                snprintf(w, sizeof w, "%s (maximum, nm)", what);
-                r = get_float_in(p, w, 0.0f, FLT_MAX, &m.iridescence_thickness_max);
-            }
-            break;
-        }
-        case MK_BOOL: r = get_bool(p, what, (bool *)field); break;
-        case MK_ALPHA_MODE: {
-            static const char *const modes[] = {"opaque", "mask", "blend"};
-            static const rt_alpha_mode values[] = {RT_ALPHA_OPAQUE, RT_ALPHA_MASK, RT_ALPHA_BLEND};
-            int i = 0;
-            r = get_choice(p, what, modes, 3, "opaque|mask|blend", &i);
-            if (r == RT_OK)
-                *(rt_alpha_mode *)field = values[i];
-            break;
-        }
-        case MK_BSDF: {
-            static const char *const models[] = {"gltf", "lambert", "conductor", "dielectric", "plastic"};
-            static const rt_bsdf_model values[] = {RT_BSDF_GLTF, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR,
-                                                   RT_BSDF_DIELECTRIC, RT_BSDF_PLASTIC};
-            int i = 0;
-            r = get_choice(p, what, models, 5, "gltf|lambert|conductor|dielectric|plastic", &i);
-            if (r == RT_OK)
-                *(rt_bsdf_model *)field = values[i];
-            break;
-        }
-        case MK_METAL: {
-            const char *names[16];
-            char choices[128] = "";
-            RT_DCHECK(rt_metal_count <= 16);
-            for (size_t i = 0; i < rt_metal_count; i++) {
-                names[i] = rt_metals[i].name;
-                snprintf(choices + strlen(choices), sizeof choices - strlen(choices), "%s%s", i ? "|" : "",
-                         rt_metals[i].name);
-            }
-            int i = 0;
-            r = get_choice(p, what, names, (int)rt_metal_count, choices, &i);
-            if (r == RT_OK) {
-                m.eta = rt_metals[i].eta;
-                m.k = rt_metals[i].k;
-            }
-            break;
-        }
-        case MK_GGX:
-            r = get_float_in(p, what, 0.0f, 1.0f, &m.alpha_u);
-            if (r == RT_OK && mk->offset == 1)
-                r = get_float_in(p, what, 0.0f, 1.0f, &m.alpha_v);
-            else if (r == RT_OK)
-                m.alpha_v = m.alpha_u;
-            break;
-        case MK_SMITH: {
-            static const char *const terms[] = {"correlated", "separable"};
-            static const rt_smith values[] = {RT_SMITH_CORRELATED, RT_SMITH_SEPARABLE};
-            int i = 0;
-            r = get_choice(p, what, terms, 2, "correlated|separable", &i);
-            if (r == RT_OK)
-                *(rt_smith *)field = values[i];
-            break;
-        }
-        case MK_DISTANCE:
-            if (peek_is(p, "inf")) {
-                p->pos++;
-                *(float *)field = INFINITY;
-            } else {
-                r = get_float_above(p, what, 0.0f, (float *)field);
-            }
-            break;
-        case MK_TEXTURE: {
-            rt_texture_slot *slot = field;
-            r = get_texture_ref(p, what, &slot->texture);
-            /* a missing image: the checker for colour, nothing for data */
-            if (r == RT_OK && !mat_key_is_colour_slot(mk) && is_missing(p, slot->texture))
-                slot->texture = RT_NONE;
-            break;
-        }
-        case MK_UV: {
-            float *pair = &uv[mk->offset * 2];
-            char w[256];
-            snprintf(w, sizeof w, "%s (u)", what);
-            r = get_float(p, w, &pair[0]);
-            if (r == RT_OK) {
-                snprintf(w, sizeof w, "%s (v)", what);
-                r = get_float(p, w, &pair[1]);
-            }
-            break;
-        }
-        }
-        if (r != RT_OK)
-            return r;
+    const char *names[16];
+    char choices[128] = "";
+    RT_DCHECK(rt_metal_count <= 16);
+    for (size_t i = 0; i < rt_metal_count; i++) {
+        names[i] = rt_metals[i].name;
+        snprintf(choices + strlen(choices), sizeof choices - strlen(choices), "%s%s", i ? "|" : "",
+                 rt_metals[i].name);
     }
+    int i = 0;
+    r = get_choice(p, what, names, (int)rt_metal_count, choices, &i);
+    if (r == RT_OK) {
+        m->eta = rt_metals[i].eta;
+        m->k = rt_metals[i].k;
+    }
+    return r;
+}
+
+/* The material key `key` names: its index in mat_keys, or the error
+ * naming the nearest key. */
+static rt_result find_mat_key(parser *p, const tok *key, size_t *index)
+{
+    char b[80];
+    size_t k = 0;
+    while (k < MAT_KEY_COUNT && strcmp(key->s, mat_keys[k].key) != 0 &&
+           !(mat_keys[k].alias && strcmp(key->s, mat_keys[k].alias) == 0))
+        k++;
+    if (k == MAT_KEY_COUNT || key->quoted) {
+        near_miss n = near_miss_of(key->s);
+        for (size_t i = 0; i < MAT_KEY_COUNT; i++)
+            near_miss_consider(&n, mat_keys[i].key);
+        if (n.best)
+            return perr(p, RT_ERR_PARSE, key, "expected a material key, got %s (did you mean '%s'?)",
+                        show(key, b, sizeof b), n.best);
+        return perr(p, RT_ERR_PARSE, key,
+                    "expected a material key (color, alpha, ambient, diffuse, specular, shininess, reflect, "
+                    "transmission, ior, metallic, roughness, emission, texture, normal_map, ... see "
+                    "docs/scene-format.md), got %s",
+                    show(key, b, sizeof b));
+    }
+    *index = k;
+    return RT_OK;
+}
+
+/* The value of material key mk, read into m (uv: the uv_scale and
+ * uv_offset pairs, which apply to every slot once all keys are read). */
+static rt_result read_mat_value(parser *p, const mat_key *mk, rt_material *m, float uv[4])
+{
+    rt_result r = RT_OK;
+    char what[96];
+    snprintf(what, sizeof what, "material %s", mk->key);
+    void *field = (char *)m + mk->offset;
+    switch (mk->kind) {
+    case MK_FLOAT: r = get_float_in(p, what, mk->lo, mk->hi, (float *)field); break;
+    case MK_INT: {
+        long long v = 0;
+        r = get_int(p, what, (long long)mk->lo, (long long)mk->hi, &v);
+        if (r == RT_OK)
+            *(int *)field = (int)v;
+        break;
+    }
+    case MK_COLOR: r = get_color(p, what, (rt_vec3 *)field); break;
+    case MK_COLOR01: r = get_color_in(p, what, 1.0f, (rt_vec3 *)field); break;
+    case MK_THICKNESS: {
+        char w[128];
+        snprintf(w, sizeof w, "%s (minimum, nm)", what);
+        r = get_float_in(p, w, 0.0f, FLT_MAX, &m->iridescence_thickness_min);
+        if (r == RT_OK) {
+            snprintf(w, sizeof w, "%s (maximum, nm)", what);
+            r = get_float_in(p, w, 0.0f, FLT_MAX, &m->iridescence_thickness_max);
+        }
+        break;
+    }
+    case MK_BOOL: r = get_bool(p, what, (bool *)field); break;
+    case MK_ALPHA_MODE: {
+        static const char *const modes[] = {"opaque", "mask", "blend"};
+        static const rt_alpha_mode values[] = {RT_ALPHA_OPAQUE, RT_ALPHA_MASK, RT_ALPHA_BLEND};
+        int i = 0;
+        r = get_choice(p, what, modes, 3, "opaque|mask|blend", &i);
+        if (r == RT_OK)
+            *(rt_alpha_mode *)field = values[i];
+        break;
+    }
+    case MK_BSDF: {
+        static const char *const models[] = {"gltf", "lambert", "conductor", "dielectric", "plastic"};
+        static const rt_bsdf_model values[] = {RT_BSDF_GLTF, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR,
+                                               RT_BSDF_DIELECTRIC, RT_BSDF_PLASTIC};
+        int i = 0;
+        r = get_choice(p, what, models, 5, "gltf|lambert|conductor|dielectric|plastic", &i);
+        if (r == RT_OK)
+            *(rt_bsdf_model *)field = values[i];
+        break;
+    }
+    case MK_METAL: r = get_metal(p, what, m); break;
+    case MK_GGX:
+        r = get_float_in(p, what, 0.0f, 1.0f, &m->alpha_u);
+        if (r == RT_OK && mk->offset == 1)
+            r = get_float_in(p, what, 0.0f, 1.0f, &m->alpha_v);
+        else if (r == RT_OK)
+            m->alpha_v = m->alpha_u;
+        break;
+    case MK_SMITH: {
+        static const char *const terms[] = {"correlated", "separable"};
+        static const rt_smith values[] = {RT_SMITH_CORRELATED, RT_SMITH_SEPARABLE};
+        int i = 0;
+        r = get_choice(p, what, terms, 2, "correlated|separable", &i);
+        if (r == RT_OK)
+            *(rt_smith *)field = values[i];
+        break;
+    }
+    case MK_DISTANCE:
+        if (peek_is(p, "inf")) {
+            p->pos++;
+            *(float *)field = INFINITY;
+        } else {
+            r = get_float_above(p, what, 0.0f, (float *)field);
+        }
+        break;
+    case MK_TEXTURE: {
+        rt_texture_slot *slot = field;
+        r = get_texture_ref(p, what, &slot->texture);
+        /* a missing image: the checker for colour, nothing for data */
+        if (r == RT_OK && !mat_key_is_colour_slot(mk) && is_missing(p, slot->texture))
+            slot->texture = RT_NONE;
+        break;
+    }
+    case MK_UV: {
+        float *pair = &uv[mk->offset * 2];
+        char w[256];
+        snprintf(w, sizeof w, "%s (u)", what);
+        r = get_float(p, w, &pair[0]);
+        if (r == RT_OK) {
+            snprintf(w, sizeof w, "%s (v)", what);
+            r = get_float(p, w, &pair[1]);
+        }
+        break;
+    }
+    }
+    return r;
+}
+
+/* The keys that need a particular bsdf, and the pairs given either one way
+ * or the other (seen: the token of each key given, NULL if not). */
+static rt_result check_mat_keys(parser *p, const rt_material *m, const tok *const *seen)
+{
     /* the conductor's keys: only with bsdf conductor, one way each */
     const tok *k_metal = NULL, *k_eta = NULL, *k_alpha = NULL, *k_alpha_uv = NULL;
     for (size_t i = 0; i < MAT_KEY_COUNT; i++) {
@@ -1124,18 +1127,18 @@ static rt_result st_material(parser *p, const tok *kw)
                        (mk->kind == MK_INT && mk->offset == offsetof(rt_material, priority));
         if (!seen[i])
             continue;
-        if (mat_key_is_ext(mk) && m.bsdf != RT_BSDF_GLTF)
+        if (mat_key_is_ext(mk) && m->bsdf != RT_BSDF_GLTF)
             return perr(p, RT_ERR_INVALID, seen[i],
                         "material key '%s' (a glTF material extension) needs 'bsdf gltf', the default", mk->key);
-        if (absorbs && m.bsdf != RT_BSDF_DIELECTRIC)
+        if (absorbs && m->bsdf != RT_BSDF_DIELECTRIC)
             return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf dielectric'", mk->key);
-        if (exterior && m.bsdf != RT_BSDF_DIELECTRIC && m.bsdf != RT_BSDF_PLASTIC)
+        if (exterior && m->bsdf != RT_BSDF_DIELECTRIC && m->bsdf != RT_BSDF_PLASTIC)
             return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf dielectric' or 'bsdf plastic'",
                         mk->key);
         if (!(complex_ior || mk->kind == MK_METAL || mk->kind == MK_GGX || mk->kind == MK_SMITH))
             continue;
         bool any = mk->kind == MK_GGX && mk->offset == 0; /* ggx_alpha: conductor, dielectric or plastic */
-        if (m.bsdf != RT_BSDF_CONDUCTOR && !(any && (m.bsdf == RT_BSDF_DIELECTRIC || m.bsdf == RT_BSDF_PLASTIC)))
+        if (m->bsdf != RT_BSDF_CONDUCTOR && !(any && (m->bsdf == RT_BSDF_DIELECTRIC || m->bsdf == RT_BSDF_PLASTIC)))
             return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf conductor'%s", mk->key,
                         any ? ", 'bsdf dielectric' or 'bsdf plastic'" : "");
         if (mk->kind == MK_METAL)
@@ -1150,34 +1153,71 @@ static rt_result st_material(parser *p, const tok *kw)
                     k_eta->s);
     if (k_alpha && k_alpha_uv)
         return perr(p, RT_ERR_INVALID, k_alpha_uv, "give either 'ggx_alpha' or 'ggx_alpha_uv', not both");
+    return RT_OK;
+}
+
+/* The defaults that depend on the bsdf and on which keys were given, the
+ * UV transform on every slot, and what the path tracer layers. */
+static void finish_material(rt_material *m, const tok *const *seen, const float uv[4])
+{
     /* glass transmits: whitted refracts it, shadow rays treat it as glass */
-    if (m.bsdf == RT_BSDF_DIELECTRIC && !seen[mat_key_index("transmission")])
-        m.transmission = 1.0f;
+    if (m->bsdf == RT_BSDF_DIELECTRIC && !seen[mat_key_index("transmission")])
+        m->transmission = 1.0f;
     /* conductors and dielectrics are smooth unless given a roughness (as in
      * pbrt-v4 and Mitsuba 3), not glTF's rough default */
-    if ((m.bsdf == RT_BSDF_DIELECTRIC || m.bsdf == RT_BSDF_CONDUCTOR || m.bsdf == RT_BSDF_PLASTIC) &&
+    if ((m->bsdf == RT_BSDF_DIELECTRIC || m->bsdf == RT_BSDF_CONDUCTOR || m->bsdf == RT_BSDF_PLASTIC) &&
         !seen[mat_key_index("roughness")])
-        m.roughness = 0.0f;
+        m->roughness = 0.0f;
     /* whitted: KHR_materials_specular scales the Phong specular weight by
      * what it does to the dielectric's F0 (as the glTF loader's mapping
      * does, docs/gltf.md), unless `specular` itself is given */
     if ((seen[mat_key_index("specular_factor")] || seen[mat_key_index("specular_color")]) &&
         !seen[mat_key_index("specular")]) {
-        rt_vec3 sc = rt_vmin(m.specular_color, rt_v3s(25.0f)); /* F0 = min(0.04 specular_color, 1) */
-        m.specular *= m.specular_weight * (sc.x + sc.y + sc.z) / 3.0f;
+        rt_vec3 sc = rt_vmin(m->specular_color, rt_v3s(25.0f)); /* F0 = min(0.04 specular_color, 1) */
+        m->specular *= m->specular_weight * (sc.x + sc.y + sc.z) / 3.0f;
     }
     /* uv_scale / uv_offset apply to every slot: uv' = uv * scale + offset */
-    rt_texture_slot *slots[6 + RT_XTEX_COUNT] = {&m.base_color_tex, &m.metal_rough_tex, &m.normal_tex,
-                                                 &m.occlusion_tex,  &m.emissive_tex,    &m.transmission_tex};
+    rt_texture_slot *slots[6 + RT_XTEX_COUNT] = {&m->base_color_tex, &m->metal_rough_tex, &m->normal_tex,
+                                                 &m->occlusion_tex,  &m->emissive_tex,    &m->transmission_tex};
     for (int i = 0; i < RT_XTEX_COUNT; i++)
-        slots[6 + i] = &m.ext_tex[i];
+        slots[6 + i] = &m->ext_tex[i];
     for (size_t i = 0; i < sizeof slots / sizeof *slots; i++) {
         float *t = slots[i]->uv_transform;
         t[0] = uv[0]; t[1] = 0; t[2] = uv[2];
         t[3] = 0; t[4] = uv[1]; t[5] = uv[3];
     }
     /* the extensions' keys: the path tracer layers them as the glTF loader's */
-    m.extended = rt_material_extended(&m);
+    m->extended = rt_material_extended(m);
+}
+
+static rt_result st_material(parser *p, const tok *kw)
+{
+    (void)kw;
+    const tok *name = NULL;
+    rt_result r;
+    if ((r = get_word(p, "a material name", &name)) != RT_OK ||
+        (r = check_new_name(p, name, &p->materials, "material")) != RT_OK)
+        return r;
+    rt_material m;
+    rt_material_default(&m, name->s);
+    const tok *seen[MAT_KEY_COUNT] = {0};
+    float uv[4] = {1, 1, 0, 0}; /* scale u, v; offset u, v */
+    while (peek(p)) {
+        const tok *key = peek(p);
+        p->pos++;
+        size_t k = 0;
+        if ((r = find_mat_key(p, key, &k)) != RT_OK)
+            return r;
+        if (seen[k])
+            return perr(p, RT_ERR_INVALID, key, "material key '%s' is given twice (first at column %d)",
+                        mat_keys[k].key, seen[k]->col);
+        seen[k] = key;
+        if ((r = read_mat_value(p, &mat_keys[k], &m, uv)) != RT_OK)
+            return r;
+    }
+    if ((r = check_mat_keys(p, &m, seen)) != RT_OK)
+        return r;
+    finish_material(&m, seen, uv);
     uint32_t id = rt_scene_add_material(p->s, &m);
     if (id == RT_NONE || !name_add(&p->materials, name->s, id, name->line))
         return nomem(p, name);

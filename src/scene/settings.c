@@ -17,6 +17,7 @@
 
 #include "rt/base/file.h"
 #include "rt/base/number.h"
+#include "rt/io/image_load.h"
 #include "rt/render/integrator.h"
 #include "rt/scene/texture.h"
 

@@ -11,7 +11,8 @@
 
 #include "rt/io/draco.h"
 #include "rt/io/exr.h"
-#include "rt/io/framebuffer.h"
+#include "rt/image/framebuffer.h"
+#include "rt/io/image_load.h"
 #include "rt/io/image_read.h"
 #include "rt/io/load.h"
 #include "rt/io/meshopt.h"

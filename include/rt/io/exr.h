@@ -5,7 +5,7 @@
  * float or, with half = true, 16-bit half channels. The beauty image is the
  * channels R, G, B; each extra layer NAME adds NAME.R, NAME.G, NAME.B (three
  * components) or NAME.Y (one), the multi-layer naming every EXR viewer reads.
- * The bytes go to an open FILE (framebuffer.c hands it the temporary file
+ * The bytes go to an open FILE (image_write.c hands it the temporary file
  * that is renamed into place once complete).
  *
  *   rt_exr_layer layers[2] = {{NULL, 3, fb.rgb}, {"albedo", 3, albedo}};

@@ -14,7 +14,7 @@
  *   free(img.rgba8); free(img.rgbaf);
  *
  * Textures go through rt_image_load_file / rt_image_load_memory
- * (rt/scene/texture.h: decoded once, cached by name); `rt compare` and
+ * (rt/io/image_load.h: decoded once, cached by name); `rt compare` and
  * `rt convert` through rt_image_read (rt/io/image_read.h).
  */
 #ifndef RT_IMAGE_DECODE_H

@@ -15,7 +15,7 @@
  * scene's hash, the settings that affect pixels, the image size, the region,
  * the sample range, the seed, rt's version, and the FNV-1a hashes of the
  * image files, so a part whose image was replaced, truncated or corrupted is
- * refused. Both are written atomically (rt/io/framebuffer.h), the image
+ * refused. Both are written atomically (rt/io/image_write.h), the image
  * first.
  *
  *   rt_part_info info = {...};                     // what the part is
@@ -34,7 +34,7 @@
 #include <stdint.h>
 
 #include "rt/base/error.h"
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 #include "rt/render/sample_block.h"
 
 #define RT_PART_FORMAT 2            /* the sidecar's "rt_part" version (1: one plain sum, before sample blocks) */

@@ -66,7 +66,7 @@
 
 #include "rt/base/cpu.h" /* rt_cpu_count: the default thread count */
 #include "rt/base/error.h"
-#include "rt/io/framebuffer.h"
+#include "rt/image/framebuffer.h"
 #include "rt/accel/kdtree.h"
 #include "rt/render/sample_block.h" /* RT_SAMPLE_BLOCK: how a pixel's sum is kept */
 #include "rt/scene/scene.h"

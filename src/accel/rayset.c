@@ -1,6 +1,6 @@
 /* rayset.c - reading the shared .rays / .hits benchmark files, with every
  * count checked against the file size before anything is allocated. */
-#include "rt/io/rayset.h"
+#include "rt/accel/rayset.h"
 
 #include "rt/base/alloc.h"
 

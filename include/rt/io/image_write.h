@@ -1,6 +1,7 @@
-/* rt/io/framebuffer.h - the framebuffer and writing it out: PNG (8-bit sRGB), PFM
- * (linear float), Radiance HDR and OpenEXR (float or half, with extra layers
- * such as AOVs), chosen by the file extension. The float formats (PFM, HDR,
+/* rt/io/image_write.h - writing a framebuffer (rt/image/framebuffer.h) to
+ * a file: PNG (8-bit sRGB), PFM (linear float), Radiance HDR and OpenEXR
+ * (float or half, with extra layers such as AOVs), chosen by the file
+ * extension. The float formats (PFM, HDR,
  * EXR) always hold linear radiance as rendered: exposure and the tone curve
  * apply to PNG alone.
  *
@@ -19,19 +20,15 @@
  *   rt_image_options opt = {.exposure = 2.0f, .tonemap = RT_TONEMAP_AGX};
  *   rt_framebuffer_write_with(&fb, "out.png", &opt, &err);   // or .half, .layers for EXR
  */
-#ifndef RT_FRAMEBUFFER_H
-#define RT_FRAMEBUFFER_H
+#ifndef RT_IMAGE_WRITE_H
+#define RT_IMAGE_WRITE_H
 
 #include <signal.h>
 #include <stdbool.h>
 
 #include "rt/base/error.h"
+#include "rt/image/framebuffer.h"
 #include "rt/image/tonemap.h"
-
-typedef struct rt_framebuffer {
-    int width, height;
-    float *rgb; /* 3 floats a pixel, row-major, row 0 at the top */
-} rt_framebuffer;
 
 typedef enum rt_image_format { RT_FORMAT_PNG = 0, RT_FORMAT_PFM, RT_FORMAT_HDR, RT_FORMAT_EXR } rt_image_format;
 
@@ -52,9 +49,6 @@ typedef struct rt_image_options {
     const rt_image_layer *layers; /* EXR: extra layers (at most RT_MAX_IMAGE_LAYERS) */
     int layer_count;
 } rt_image_options;
-
-rt_result rt_framebuffer_init(rt_framebuffer *fb, int width, int height, rt_error *err);
-void rt_framebuffer_free(rt_framebuffer *fb);
 
 /* The format for a path's extension (.png, .pfm, .hdr, .exr; case-insensitive). */
 rt_result rt_output_format(const char *path, rt_image_format *format, rt_error *err);
@@ -77,7 +71,7 @@ rt_result rt_framebuffer_write_with(const rt_framebuffer *fb, const char *path, 
  * write under way, and the handler may unlink(path) (async-signal-safe;
  * a name not yet or no longer there is harmless). */
 typedef struct rt_write_temp {
-    char path[4300]; /* as long as any temporary name framebuffer.c makes */
+    char path[4300]; /* as long as any temporary name image_write.c makes */
     volatile sig_atomic_t active;
 } rt_write_temp;
 /* rt_framebuffer_write_with that keeps *temp up to date (temp may be NULL). */
@@ -86,11 +80,5 @@ rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *pat
 
 /* Writes bytes to path the same atomic way (a part's sidecar, docs/farm.md). */
 rt_result rt_file_write_atomic(const char *path, const void *bytes, size_t size, rt_write_temp *temp, rt_error *err);
-
-/* Reads a PFM file (src/io/pfm.c): colour ("PF") or grey ("Pf", copied to
- * R, G and B), either byte order. The header is checked against the file's
- * size before any pixel memory is taken; every message names the file, and
- * the byte where it goes wrong. */
-rt_result rt_pfm_read(const char *path, rt_framebuffer *fb, rt_error *err);
 
 #endif

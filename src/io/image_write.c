@@ -1,4 +1,4 @@
-/* framebuffer.c - framebuffer output: PNG (stb_image_write, 8-bit sRGB after
+/* image_write.c - framebuffer output (rt/io/image_write.h): PNG (stb_image_write, 8-bit sRGB after
  * exposure and a tone curve, rt/image/tonemap.h), PFM (little-endian float
  * RGB, bottom scanline first, as the format defines), Radiance HDR
  * (stb_image_write) and OpenEXR (exr.c, with extra layers), all written to a
@@ -18,7 +18,7 @@
  * or on a file system without O_TMPFILE, a mkstemp(3) file is written and
  * renamed as before. */
 #define _GNU_SOURCE /* O_TMPFILE */
-#include "rt/io/framebuffer.h"
+#include "rt/io/image_write.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -36,28 +36,6 @@
 #include "rt/base/alloc.h"
 #include "rt/image/tonemap.h"
 #include "rt/io/exr.h"
-#include "rt/scene/texture.h"
-
-rt_result rt_framebuffer_init(rt_framebuffer *fb, int width, int height, rt_error *err)
-{
-    fb->width = fb->height = 0;
-    fb->rgb = NULL;
-    if (width <= 0 || height <= 0 || width > 65536 || height > 65536)
-        return rt_fail(err, RT_ERR_LIMIT, "image size %dx%d is out of range (1..65536 a side)", width, height);
-    fb->rgb = rt_alloc((size_t)width * (size_t)height, 3 * sizeof(float));
-    if (!fb->rgb)
-        return rt_fail(err, RT_ERR_NOMEM, "out of memory for a %dx%d image", width, height);
-    fb->width = width;
-    fb->height = height;
-    return RT_OK;
-}
-
-void rt_framebuffer_free(rt_framebuffer *fb)
-{
-    free(fb->rgb);
-    fb->rgb = NULL;
-    fb->width = fb->height = 0;
-}
 
 rt_result rt_output_format(const char *path, rt_image_format *format, rt_error *err)
 {

@@ -1,4 +1,5 @@
-/* rt/rayset.h - the shared benchmark ray files (.rays, .hits).
+/* rt/accel/rayset.h - the shared benchmark ray files (.rays, .hits): rays
+ * for the kd-tree and the distances a reference tracer found along them.
  *
  * Format (../shared/bench/FORMAT.md), little-endian:
  *   .rays  "RTRAYS01", u64 N, N x float32[8] = ox oy oz dx dy dz tmin tmax
@@ -12,11 +13,12 @@
 #ifndef RT_RAYSET_H
 #define RT_RAYSET_H
 
+#include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "rt/accel/ray.h"
 #include "rt/base/error.h"
-#include "rt/accel/intersect.h"
 
 typedef struct rt_rayset {
     rt_ray *rays;
