@@ -1,5 +1,6 @@
 /* bsdf.c - Lambert, the glTF metallic-roughness BSDF and the conductor
- * for the path tracer: evaluation, pdf and importance sampling (see rt/render/bsdf.h).
+ * for the path tracer: evaluation, pdf and importance sampling (see rt/render/bsdf.h),
+ * built from the GGX and Fresnel terms of rt/render/microfacet.h.
  *
  * Sources:
  * - The BRDF: glTF 2.0 specification, appendix B "BRDF Implementation",
@@ -53,185 +54,13 @@
  */
 #include "rt/render/bsdf.h"
 
-#include "rt/render/ggx_albedo.h"
 #include "rt/render/bsdf_clearcoat.h"
 #include "rt/render/bsdf_iridescence.h"
 #include "rt/render/bsdf_sheen.h"
+#include "rt/render/ggx_albedo.h"
+#include "rt/render/microfacet.h"
 #include "rt/render/sampling.h"
 #include "rt/scene/texture.h"
-
-/* Both evaluated from the tangent components: sin^2 = x^2 + y^2 is exact
- * near the normal, where 1 - cos^2 (and the textbook k = cos^2 (a^2 - 1)
- * + 1) cancels to nothing in single precision once alpha^2 falls below
- * the float epsilon. D = a^2 / (pi (a^2 cos^2 + sin^2)^2) then keeps full
- * relative precision down to alpha 1e-4 and below (a peak of 3e7). */
-float rt_ggx_d(rt_vec3 h, float alpha)
-{
-    if (!(h.z > 0.0f))
-        return 0.0f;
-    float a2 = alpha * alpha;
-    float s2 = h.x * h.x + h.y * h.y;
-    float k = a2 * (h.z * h.z) + s2;
-    float d = a2 / (RT_PI * k * k);
-    return isfinite(d) ? d : 0.0f;
-}
-
-float rt_ggx_lambda(rt_vec3 w, float alpha)
-{
-    float c2 = w.z * w.z;
-    float s2 = w.x * w.x + w.y * w.y;
-    if (!(c2 > 0.0f))
-        return INFINITY;
-    float t2 = alpha * alpha * s2 / c2; /* alpha^2 tan^2 theta */
-    /* sqrt(1 + t2) - 1 without cancellation for small t2 */
-    return 0.5f * t2 / (sqrtf(1.0f + t2) + 1.0f);
-}
-
-float rt_ggx_g1(rt_vec3 w, float alpha)
-{
-    float l = rt_ggx_lambda(w, alpha);
-    return isfinite(l) ? 1.0f / (1.0f + l) : 0.0f;
-}
-
-float rt_ggx_g2(rt_vec3 wo, rt_vec3 wi, float alpha)
-{
-    float lo = rt_ggx_lambda(wo, alpha), li = rt_ggx_lambda(wi, alpha);
-    if (!isfinite(lo) || !isfinite(li))
-        return 0.0f;
-    return 1.0f / (1.0f + lo + li);
-}
-
-static rt_vec3 vndf_xy(rt_vec3 wo, float ax, float ay, rt_vec2 u)
-{
-    /* stretch the view direction to the hemisphere configuration */
-    rt_vec3 vh = rt_normalize(rt_v3(ax * wo.x, ay * wo.y, wo.z));
-    float lensq = vh.x * vh.x + vh.y * vh.y;
-    rt_vec3 t1 = lensq > 1e-14f ? rt_scale(rt_v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(lensq)) : rt_v3(1, 0, 0);
-    rt_vec3 t2 = rt_cross(vh, t1);
-    /* a point on the projected area of the hemisphere */
-    float r = sqrtf(u.x), phi = 2.0f * RT_PI * u.y;
-    float sn, cs;
-    rt_sincosf(phi, &sn, &cs);
-    float p1 = r * cs, p2 = r * sn;
-    float s = 0.5f * (1.0f + vh.z);
-    p2 = (1.0f - s) * sqrtf(rt_fmaxf(0.0f, 1.0f - p1 * p1)) + s * p2;
-    rt_vec3 nh = rt_add(rt_add(rt_scale(t1, p1), rt_scale(t2, p2)),
-                        rt_scale(vh, sqrtf(rt_fmaxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));
-    /* unstretch */
-    rt_vec3 ne = rt_v3(ax * nh.x, ay * nh.y, rt_fmaxf(1e-7f, nh.z));
-    return rt_normalize(ne);
-}
-
-rt_vec3 rt_ggx_sample_vndf(rt_vec3 wo, float alpha, rt_vec2 u) { return vndf_xy(wo, alpha, alpha, u); }
-
-/* Anisotropic GGX (alpha ax along x, ay along y; Heitz 2014, eq. 85 and
- * 86): D = 1 / (pi ax ay ((x/ax)^2 + (y/ay)^2 + z^2)^2), Lambda with
- * alpha^2 tan^2 = (ax^2 x^2 + ay^2 y^2) / z^2; the isotropic forms when
- * ax = ay. */
-static float d_xy(rt_vec3 h, float ax, float ay)
-{
-    if (ax == ay)
-        return rt_ggx_d(h, ax);
-    if (!(h.z > 0.0f))
-        return 0.0f;
-    float x = h.x / ax, y = h.y / ay;
-    float k = x * x + y * y + h.z * h.z;
-    float d = 1.0f / (RT_PI * ax * ay * k * k);
-    return isfinite(d) ? d : 0.0f;
-}
-
-static float lambda_xy(rt_vec3 w, float ax, float ay)
-{
-    if (ax == ay)
-        return rt_ggx_lambda(w, ax);
-    float c2 = w.z * w.z;
-    if (!(c2 > 0.0f))
-        return INFINITY;
-    float t2 = (ax * ax * w.x * w.x + ay * ay * w.y * w.y) / c2;
-    return 0.5f * t2 / (sqrtf(1.0f + t2) + 1.0f);
-}
-
-static float g1_xy(rt_vec3 w, float ax, float ay)
-{
-    float l = lambda_xy(w, ax, ay);
-    return isfinite(l) ? 1.0f / (1.0f + l) : 0.0f;
-}
-
-/* Smith G2: height-correlated 1 / (1 + L(wo) + L(wi)) (Heitz 2014, eq.
- * 99), or separable G1(wo) G1(wi) (eq. 98, as older renderers use). */
-static float g2_xy(rt_vec3 wo, rt_vec3 wi, float ax, float ay, bool separable)
-{
-    float lo = lambda_xy(wo, ax, ay), li = lambda_xy(wi, ax, ay);
-    if (!isfinite(lo) || !isfinite(li))
-        return 0.0f;
-    return separable ? 1.0f / ((1.0f + lo) * (1.0f + li)) : 1.0f / (1.0f + lo + li);
-}
-
-float rt_ggx_reflect_pdf(rt_vec3 wo, rt_vec3 wi, float alpha)
-{
-    if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
-        return 0.0f;
-    rt_vec3 h = rt_add(wo, wi);
-    float l2 = rt_length2(h);
-    if (!(l2 > 1e-20f))
-        return 0.0f;
-    h = rt_scale(h, 1.0f / sqrtf(l2));
-    float p = rt_ggx_g1(wo, alpha) * rt_ggx_d(h, alpha) / (4.0f * wo.z);
-    return isfinite(p) ? p : 0.0f;
-}
-
-/* Exact unpolarised Fresnel reflectance of a conductor, eta + i k relative
- * to the outside, one channel (the closed form of pbrt-v3, 8.2.1, after
- * Born and Wolf 14.2). */
-static float fresnel_conductor1(float c, float eta, float k)
-{
-    c = rt_clampf(c, 0.0f, 1.0f);
-    float c2 = c * c, s2 = 1.0f - c2;
-    float eta2 = eta * eta, k2 = k * k;
-    float t0 = eta2 - k2 - s2;
-    float a2b2 = sqrtf(rt_fmaxf(0.0f, t0 * t0 + 4.0f * eta2 * k2));
-    float t1 = a2b2 + c2;
-    float a = sqrtf(rt_fmaxf(0.0f, 0.5f * (a2b2 + t0)));
-    float t2 = 2.0f * c * a;
-    float rs = (t1 - t2) / (t1 + t2);
-    float t3 = c2 * a2b2 + s2 * s2;
-    float t4 = t2 * s2;
-    float rp = rs * (t3 - t4) / (t3 + t4);
-    float f = 0.5f * (rs + rp);
-    return isfinite(f) ? rt_clampf(f, 0.0f, 1.0f) : 1.0f;
-}
-
-rt_vec3 rt_fresnel_conductor(float cos_i, rt_vec3 eta, rt_vec3 k)
-{
-    return rt_v3(fresnel_conductor1(cos_i, eta.x, k.x), fresnel_conductor1(cos_i, eta.y, k.y),
-                 fresnel_conductor1(cos_i, eta.z, k.z));
-}
-
-static inline float schlick_weight(float c)
-{
-    float x = 1.0f - rt_clampf(c, 0.0f, 1.0f);
-    float x2 = x * x;
-    return x2 * x2 * x;
-}
-
-static inline rt_vec3 schlick(rt_vec3 f0, float c)
-{
-    float w = schlick_weight(c);
-    return rt_add(f0, rt_scale(rt_sub(rt_v3s(1.0f), f0), w));
-}
-
-float rt_fresnel_exact(float cos_i, float eta)
-{
-    float ci = rt_clampf(cos_i, 0.0f, 1.0f);
-    float sin2_t = eta * eta * (1.0f - ci * ci);
-    if (!(sin2_t < 1.0f))
-        return 1.0f; /* total internal reflection (or a NaN input) */
-    float ct = sqrtf(1.0f - sin2_t);
-    float rs = (eta * ci - ct) / (eta * ci + ct);
-    float rp = (ci - eta * ct) / (ci + eta * ct);
-    float f = 0.5f * (rs * rs + rp * rp);
-    return isfinite(f) ? rt_clampf(f, 0.0f, 1.0f) : 1.0f;
-}
 
 /* The dielectric Fresnel Fd at a (micro)facet seen at cosine c from wo:
  * the exact equations for a transmissive surface (glass: reflection and
@@ -241,7 +70,7 @@ static inline float fresnel_dielectric(const rt_bsdf *b, float c)
 {
     if (b->transmission > 0.0f || b->plastic)
         return rt_fresnel_exact(c, b->eta);
-    return b->f0 + (1.0f - b->f0) * schlick_weight(c);
+    return b->f0 + (1.0f - b->f0) * rt_schlick_weight(c);
 }
 
 static inline float mean3(rt_vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
@@ -250,7 +79,7 @@ static inline float mean3(rt_vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f);
  * conductor_fresnel (Schlick on the base colour) and the dielectric's Fd. */
 static inline rt_vec3 fresnel_specular(const rt_bsdf *b, float c, float fd)
 {
-    rt_vec3 fm = b->metallic > 0.0f ? schlick(b->base, c) : rt_v3s(0.0f);
+    rt_vec3 fm = b->metallic > 0.0f ? rt_fresnel_schlick(b->base, c) : rt_v3s(0.0f);
     return rt_lerp3(rt_v3s(fd), fm, b->metallic);
 }
 
@@ -459,24 +288,6 @@ float rt_bsdf_ms_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi)
         return 0.0f;
     return b->ms_trans * (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[0], wo.z)) *
            (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[1], -wi.z));
-}
-
-float rt_fresnel_diffuse_reflectance(float eta)
-{
-    /* seen from the denser side: by reciprocity what does not reflect
-     * inside is what enters from outside, shrunk by the solid angle ratio,
-     * Fdr(eta) = 1 - (1 - Fdr(1 / eta)) / eta^2 (no kink to integrate) */
-    if (eta > 1.0f)
-        return 1.0f - (1.0f - rt_fresnel_diffuse_reflectance(1.0f / eta)) / (eta * eta);
-    /* integral of F(c) 2c dc, midpoint rule (F is smooth from outside:
-     * 64 points are within 2e-5) */
-    enum { N = 64 };
-    float sum = 0.0f;
-    for (int i = 0; i < N; i++) {
-        float c = ((float)i + 0.5f) / N;
-        sum += rt_fresnel_exact(c, eta) * 2.0f * c;
-    }
-    return sum / N;
 }
 
 void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alpha)
@@ -806,9 +617,9 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
     float voh = rt_dot(wo, h);
     if (b->conductor) {
         /* F(wo.h) D G2 / (4 cos_o cos_i), VNDF pdf G1(wo) D / (4 cos_o) */
-        float D = d_xy(h, b->alpha, b->alpha_y);
-        float spec = D * g2_xy(wo, wi, b->alpha, b->alpha_y, b->separable) / (4.0f * wo.z * wi.z);
-        float pv = g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
+        float D = rt_ggx_d_xy(h, b->alpha, b->alpha_y);
+        float spec = D * rt_ggx_g2_xy(wo, wi, b->alpha, b->alpha_y, b->separable) / (4.0f * wo.z * wi.z);
+        float pv = rt_ggx_g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
         if (!isfinite(spec) || !isfinite(pv))
             return rt_v3s(0.0f);
         *pdf = ps * pv;
@@ -907,10 +718,10 @@ static bool thin_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, rt_vec3 c, fl
  * The glTF material with the PBR-next extensions, as the extensions
  * define its layers (docs/shading.md, "Extension layering"):
  *
- *   Fd   = spec_weight schlick(min(F0 spec_color, 1), v.h)      KHR_materials_specular
+ *   Fd   = spec_weight rt_fresnel_schlick(min(F0 spec_color, 1), v.h)      KHR_materials_specular
  *          (the exact Fresnel times spec_color for a transmissive surface),
  *          mixed with the thin film's Fresnel by the iridescence factor
- *   Fm   = schlick(B, v.h), mixed with the film's Fresnel the same way
+ *   Fm   = rt_fresnel_schlick(B, v.h), mixed with the film's Fresnel the same way
  *   base = (1 - m)(1 - max3(Fd)) ((1 - T)(1 - dt) B / pi + ...) + lerp(Fd, Fm, m) D V
  *          with D, V anisotropic GGX (alpha along t = mix(alpha, 1, s^2))
  *   sheen_layer = sheen f_sheen + base (1 - max3(sheen) max(E(wo), E(wi)))
@@ -1027,8 +838,8 @@ static rt_vec3 layered_fresnel(const rt_bsdf *b, float c, float *fd_max)
     if (b->transmission > 0.0f)
         fd = rt_vmin(rt_scale(b->spec_color, rt_fresnel_exact(c, b->eta)), rt_v3s(1.0f));
     else
-        fd = schlick(f0, c);
-    rt_vec3 fm = b->metallic > 0.0f ? schlick(b->base, c) : rt_v3s(0.0f);
+        fd = rt_fresnel_schlick(f0, c);
+    rt_vec3 fm = b->metallic > 0.0f ? rt_fresnel_schlick(b->base, c) : rt_v3s(0.0f);
     if (b->iridescence > 0.0f) {
         rt_vec3 fi = rt_iridescence_fresnel(1.0f, b->irid_ior, f0, b->irid_thickness, c);
         fd = rt_lerp3(fd, rt_vmin(fi, rt_v3s(1.0f)), b->iridescence);
@@ -1105,11 +916,11 @@ static rt_vec3 layered_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, const laye
     rt_vec3 f = rt_scale(b->diffuse, tdiff * RT_INV_PI);
     float pr = p->d * wi.z * RT_INV_PI;
     if (!b->delta) {
-        float D = d_xy(h, b->alpha, b->alpha_y);
-        float spec = D * g2_xy(wo, wi, b->alpha, b->alpha_y, false) / (4.0f * wo.z * wi.z);
+        float D = rt_ggx_d_xy(h, b->alpha, b->alpha_y);
+        float spec = D * rt_ggx_g2_xy(wo, wi, b->alpha, b->alpha_y, false) / (4.0f * wo.z * wi.z);
         if (isfinite(spec))
             f = rt_add(f, rt_scale(F, spec));
-        float pv = g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
+        float pv = rt_ggx_g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
         if (p->s > 0.0f && isfinite(pv))
             pr += p->s * pv;
     }
@@ -1217,7 +1028,7 @@ static bool layered_sample(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe,
     if (ulobe < p.d || (b->delta && ulobe < p.d + p.s)) {
         wi = rt_sample_cosine_hemisphere(u);
     } else if (ulobe < p.d + p.s) {
-        rt_vec3 h = vndf_xy(wo, b->alpha, b->alpha_y, u);
+        rt_vec3 h = rt_ggx_sample_vndf_xy(wo, b->alpha, b->alpha_y, u);
         wi = rt_sub(rt_scale(h, 2.0f * rt_dot(wo, h)), wo);
     } else {
         rt_vec3 wc = rt_clearcoat_sample(co, b->cc_alpha, u);
@@ -1296,7 +1107,7 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
     if (ulobe < pd || b->lambert || b->delta || !(ps > 0.0f)) {
         wi = rt_sample_cosine_hemisphere(u);
     } else {
-        rt_vec3 h = vndf_xy(wo, b->alpha, b->alpha_y, u);
+        rt_vec3 h = rt_ggx_sample_vndf_xy(wo, b->alpha, b->alpha_y, u);
         wi = rt_sub(rt_scale(h, 2.0f * rt_dot(wo, h)), wo);
     }
     if (!(wi.z > 0.0f) || !rt_finite3(wi))

@@ -10,7 +10,7 @@
  */
 #include "rt/render/ggx_albedo.h"
 
-#include "rt/render/bsdf.h"
+#include "rt/render/microfacet.h"
 
 float rt_ggx_albedo(float mu, float alpha)
 {

@@ -63,6 +63,7 @@
 #include <stdbool.h>
 
 #include "rt/render/ggx_albedo.h"
+#include "rt/render/microfacet.h"
 #include "rt/render/surface.h"
 
 #define RT_BSDF_MIN_ALPHA 1e-4f /* GGX alpha floor for roughness > 0 (roughness 0 is a delta interface) */
@@ -125,30 +126,12 @@ typedef struct rt_bsdf_sample {
     bool delta;       /* transmission or a mirror reflection: sampled only, never light-sampled, so no MIS */
 } rt_bsdf_sample;
 
-/* Exact unpolarised Fresnel reflectance of a smooth dielectric interface
- * (Born and Wolf, Principles of Optics, 1.5.2) at incident cosine cos_i,
- * eta = n_incident / n_transmitted; 1 past the critical angle. */
-float rt_fresnel_exact(float cos_i, float eta);
-/* Exact unpolarised Fresnel reflectance of a conductor of complex index
- * eta + i k (per channel, relative to the outside) at incident cosine cos_i. */
-rt_vec3 rt_fresnel_conductor(float cos_i, rt_vec3 eta, rt_vec3 k);
-
 /* Absorption coefficient inside a material (Beer-Lambert: transmittance
  * exp(-sigma d) over a distance d travelled inside): a dielectric's
  * `absorption` plus, for a dielectric or a glTF volume (thickness > 0,
  * transmission > 0), -ln(attenuation_color) / attenuation_distance. Zero
  * when nothing absorbs. */
 rt_vec3 rt_material_absorption(const rt_material *m);
-
-/* GGX building blocks, local frame (z = normal). */
-float rt_ggx_d(rt_vec3 h, float alpha);              /* D(h), 0 below the surface; h unit, stable to alpha 1e-4 */
-float rt_ggx_lambda(rt_vec3 w, float alpha);         /* Smith Lambda(w) */
-float rt_ggx_g1(rt_vec3 w, float alpha);             /* 1 / (1 + Lambda) */
-float rt_ggx_g2(rt_vec3 wo, rt_vec3 wi, float alpha); /* height-correlated 1 / (1 + L(wo) + L(wi)) */
-/* A visible normal for wo (wo.z > 0) from u in [0,1)^2 (Heitz 2018). */
-rt_vec3 rt_ggx_sample_vndf(rt_vec3 wo, float alpha, rt_vec2 u);
-/* pdf of reflecting wo into wi by VNDF sampling: G1(wo) D(h) / (4 wo.z). */
-float rt_ggx_reflect_pdf(rt_vec3 wo, rt_vec3 wi, float alpha);
 
 /* Builds the BSDF of a hit: material factors x textures (base colour,
  * metallic-roughness, transmission), frame from the shading normal (the
@@ -165,10 +148,6 @@ void rt_bsdf_set_eta(rt_bsdf *b, float eta);
 /* A plastic (bsdf plastic): Lambertian reflectance R under a dielectric
  * coat, eta = n_outside / n_coat, coat GGX alpha (0: smooth). */
 void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alpha);
-/* Hemispherical (cosine-weighted) average of the exact Fresnel reflectance
- * at an interface of index ratio eta = n_incident / n_transmitted:
- * the internal diffuse reflectance for eta > 1. */
-float rt_fresnel_diffuse_reflectance(float eta);
 /* A conductor (bsdf conductor) the same way: GGX alphas along x and y of
  * the frame (both 0: a delta mirror). */
 void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float alpha_x, float alpha_y,
