@@ -18,6 +18,7 @@
 #include "rt/render/bsdf_clearcoat.h"
 #include "rt/render/bsdf_iridescence.h"
 #include "rt/render/bsdf_sheen.h"
+#include "rt/render/material_eval.h"
 #include "rt/render/sampling.h"
 
 static rt_vec3 uniform_hemi(test_rng *r) { return dir_from(test_rng_float(r), 2.0f * RT_PI * test_rng_float(r)); }

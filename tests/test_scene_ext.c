@@ -17,7 +17,7 @@
 #include "rt/accel/kdtree.h"
 #include "rt/io/framebuffer.h"
 #include "rt/io/scene_parse.h"
-#include "rt/render/bsdf.h"
+#include "rt/render/material_eval.h"
 #include "rt/render/render.h"
 #include "rt/render/render_state.h"
 #include "rt/render/surface.h"

@@ -11,7 +11,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "rt/render/bsdf.h"
+#include "rt/render/material_eval.h"
 #include "rt/render/surface.h"
 #include "rt/render/whitted.h"
 

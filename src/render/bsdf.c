@@ -60,7 +60,6 @@
 #include "rt/render/ggx_albedo.h"
 #include "rt/render/microfacet.h"
 #include "rt/render/sampling.h"
-#include "rt/scene/texture.h"
 
 /* The dielectric Fresnel Fd at a (micro)facet seen at cosine c from wo:
  * the exact equations for a transmissive surface (glass: reflection and
@@ -83,7 +82,7 @@ static inline rt_vec3 fresnel_specular(const rt_bsdf *b, float c, float fd)
     return rt_lerp3(rt_v3s(fd), fm, b->metallic);
 }
 
-static void set_frame(rt_bsdf *b, rt_vec3 n, rt_vec3 ng)
+void rt_bsdf_set_frame(rt_bsdf *b, rt_vec3 n, rt_vec3 ng)
 {
     b->n = n;
     b->ng = ng;
@@ -114,7 +113,7 @@ static inline void set_kind(rt_bsdf *b, bool lambert)
 
 /* The Lambert BSDF of albedo base (clamped to finite, non-negative):
  * what set_params sets for lambert, without its other parameters. */
-static inline void set_lambert(rt_bsdf *b, rt_vec3 base)
+void rt_bsdf_set_lambert(rt_bsdf *b, rt_vec3 base)
 {
     base = clean_base(base);
     set_kind(b, true);
@@ -133,7 +132,7 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
                        bool lambert)
 {
     if (lambert) {
-        set_lambert(b, base);
+        rt_bsdf_set_lambert(b, base);
         return;
     }
     base = clean_base(base);
@@ -157,11 +156,16 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
 void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float roughness, float ior,
                   float transmission, bool lambert)
 {
-    set_frame(b, n, n);
+    rt_bsdf_set_frame(b, n, n);
     set_params(b, base, metallic, roughness, ior, transmission, lambert);
 }
 
-static void set_conductor(rt_bsdf *b, rt_vec3 eta, rt_vec3 k, float ax, float ay, rt_smith smith)
+void rt_bsdf_set_gltf(rt_bsdf *b, rt_vec3 base, float metallic, float roughness, float ior, float transmission)
+{
+    set_params(b, base, metallic, roughness, ior, transmission, false);
+}
+
+void rt_bsdf_set_conductor(rt_bsdf *b, rt_vec3 eta, rt_vec3 k, float ax, float ay, bool separable)
 {
     set_params(b, rt_v3s(0.0f), 0.0f, 1.0f, 1.5f, 0.0f, false);
     b->conductor = true;
@@ -172,14 +176,14 @@ static void set_conductor(rt_bsdf *b, rt_vec3 eta, rt_vec3 k, float ax, float ay
     b->delta = ax == 0.0f && ay == 0.0f;
     b->alpha = rt_fmaxf(ax, RT_BSDF_MIN_ALPHA);
     b->alpha_y = rt_fmaxf(ay, RT_BSDF_MIN_ALPHA);
-    b->separable = smith == RT_SMITH_SEPARABLE;
+    b->separable = separable;
 }
 
 void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float alpha_x, float alpha_y,
-                            rt_smith smith)
+                            bool separable)
 {
-    set_frame(b, n, n);
-    set_conductor(b, eta, k, alpha_x, alpha_y, smith);
+    rt_bsdf_set_frame(b, n, n);
+    rt_bsdf_set_conductor(b, eta, k, alpha_x, alpha_y, separable);
 }
 
 static void dielectric_compensate(rt_bsdf *b);
@@ -208,25 +212,9 @@ void rt_bsdf_compensate(rt_bsdf *b)
     b->ms_scale = scale;
 }
 
-rt_vec3 rt_material_absorption(const rt_material *m)
-{
-    rt_vec3 sigma = rt_v3s(0.0f);
-    if (m->bsdf == RT_BSDF_DIELECTRIC)
-        sigma = m->absorption;
-    bool volume = m->bsdf == RT_BSDF_DIELECTRIC ||
-                  (m->bsdf == RT_BSDF_GLTF && m->thickness > 0.0f &&
-                   (m->transmission > 0.0f || m->diffuse_transmission > 0.0f));
-    if (volume && isfinite(m->attenuation_distance) && m->attenuation_distance > 0.0f) {
-        rt_vec3 c = rt_vmax(m->attenuation_color, rt_v3s(1e-6f));
-        rt_vec3 a = rt_v3(-logf(rt_fminf(c.x, 1.0f)), -logf(rt_fminf(c.y, 1.0f)), -logf(rt_fminf(c.z, 1.0f)));
-        sigma = rt_add(sigma, rt_scale(a, 1.0f / m->attenuation_distance));
-    }
-    return rt_finite3(sigma) ? rt_vmax(sigma, rt_v3s(0.0f)) : rt_v3s(0.0f);
-}
-
 void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha)
 {
-    set_frame(b, n, n);
+    rt_bsdf_set_frame(b, n, n);
     set_params(b, rt_v3s(1.0f), 0.0f, 1.0f, 1.5f, 1.0f, false);
     eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
     float r0 = (eta - 1.0f) / (eta + 1.0f);
@@ -292,7 +280,7 @@ float rt_bsdf_ms_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi)
 
 void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alpha)
 {
-    set_frame(b, n, n);
+    rt_bsdf_set_frame(b, n, n);
     set_params(b, R, 0.0f, 1.0f, 1.5f, 0.0f, false);
     eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
     float r0 = (eta - 1.0f) / (eta + 1.0f);
@@ -314,190 +302,6 @@ void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alp
     b->diffuse = rt_scale(b->diffuse, inv_eta2);
     if (!rt_finite3(b->diffuse))
         b->diffuse = rt_v3s(0.0f);
-}
-
-static rt_vec4 ext_sample(const rt_scene *s, const rt_surface *sf, const rt_material *m, rt_ext_slot k, bool srgb,
-                          bool *present)
-{
-    const rt_texture_slot *slot = &m->ext_tex[k];
-    *present = slot->texture != RT_NONE;
-    if (!*present)
-        return rt_v4(1.0f, 1.0f, 1.0f, 1.0f);
-    rt_vec2 uv = rt_texture_slot_uv(slot, slot->texcoord == 1 ? sf->uv1 : sf->uv0);
-    return rt_texture_sample(s, slot->texture, uv, srgb);
-}
-
-/* A tangent-space normal map's texel as a unit vector (2c - 1, scaled in x, y). */
-static rt_vec3 normal_texel(rt_vec4 c, float scale)
-{
-    rt_vec3 v = rt_v3((2.0f * c.x - 1.0f) * scale, (2.0f * c.y - 1.0f) * scale, 2.0f * c.z - 1.0f);
-    float l2 = rt_length2(v);
-    return l2 > 1e-12f && isfinite(l2) ? rt_scale(v, 1.0f / sqrtf(l2)) : rt_v3(0.0f, 0.0f, 1.0f);
-}
-
-/* The extensions' factors x textures at a hit (KHR_materials_*), and the
- * anisotropy direction as the frame's x. The factors come from the
- * material (rt_bsdf_ext_of_material), so its defaults are the only ones. */
-static void set_ext_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_material *m, rt_bsdf *b)
-{
-    const rt_scene *s = ctx->state->scene;
-    rt_bsdf_ext e;
-    bool has;
-    rt_bsdf_ext_of_material(m, &e);
-    e.clearcoat *= ext_sample(s, sf, m, RT_XTEX_CLEARCOAT, false, &has).x;
-    e.clearcoat_roughness *= ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_ROUGHNESS, false, &has).y;
-    /* the tangent frame before the coat's map: sf's (t, b, n) made orthonormal about b->n */
-    rt_vec3 t = rt_sub(sf->t, rt_scale(b->n, rt_dot(sf->t, b->n)));
-    float tl2 = rt_length2(t);
-    bool have_t = tl2 > 1e-12f && isfinite(tl2);
-    if (have_t)
-        t = rt_scale(t, 1.0f / sqrtf(tl2));
-    rt_vec3 bt = rt_cross(b->n, t);
-    if (have_t && rt_dot(bt, sf->b) < 0.0f)
-        bt = rt_neg(bt); /* keep the UV handedness */
-    /* the coat's normal: its own map, else the surface's normal without the
-     * base's normal map (KHR_materials_clearcoat: the coat inherits no
-     * texture of the material below it), in the frame of that normal */
-    if (e.clearcoat > 0.0f) {
-        rt_vec3 cn = b->n, ct = t, cbt = bt;
-        bool have_ct = have_t;
-        if (m->normal_tex.texture != RT_NONE && rt_dot(sf->n_unmapped, sf->wo) > 1e-4f &&
-            rt_finite3(sf->n_unmapped)) {
-            cn = sf->n_unmapped;
-            ct = rt_sub(sf->t, rt_scale(cn, rt_dot(sf->t, cn)));
-            float cl2 = rt_length2(ct);
-            have_ct = cl2 > 1e-12f && isfinite(cl2);
-            if (have_ct)
-                ct = rt_scale(ct, 1.0f / sqrtf(cl2));
-            cbt = rt_cross(cn, ct);
-            if (have_ct && rt_dot(cbt, sf->b) < 0.0f)
-                cbt = rt_neg(cbt);
-            e.clearcoat_normal = rt_bsdf_to_local(b, cn);
-        }
-        if (have_ct) {
-            rt_vec4 c = ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_NORMAL, false, &has);
-            if (has) {
-                rt_vec3 v = normal_texel(c, m->clearcoat_normal_scale);
-                rt_vec3 w = rt_add(rt_add(rt_scale(ct, v.x), rt_scale(cbt, v.y)), rt_scale(cn, v.z));
-                e.clearcoat_normal = rt_bsdf_to_local(b, w);
-            }
-        }
-    }
-    e.spec_weight *= ext_sample(s, sf, m, RT_XTEX_SPECULAR, false, &has).w;
-    rt_vec4 sc = ext_sample(s, sf, m, RT_XTEX_SPECULAR_COLOR, true, &has);
-    e.spec_color = rt_mul(e.spec_color, rt_v3(sc.x, sc.y, sc.z));
-    rt_vec4 sh = ext_sample(s, sf, m, RT_XTEX_SHEEN_COLOR, true, &has);
-    e.sheen_color = rt_mul(e.sheen_color, rt_v3(sh.x, sh.y, sh.z));
-    e.sheen_roughness *= ext_sample(s, sf, m, RT_XTEX_SHEEN_ROUGHNESS, false, &has).w;
-    e.iridescence *= ext_sample(s, sf, m, RT_XTEX_IRIDESCENCE, false, &has).x;
-    rt_vec4 th = ext_sample(s, sf, m, RT_XTEX_IRIDESCENCE_THICKNESS, false, &has);
-    if (has)
-        e.iridescence_thickness = m->iridescence_thickness_min +
-                                  (m->iridescence_thickness_max - m->iridescence_thickness_min) * th.y;
-    e.diffuse_transmission *= ext_sample(s, sf, m, RT_XTEX_DIFFUSE_TRANSMISSION, false, &has).w;
-    rt_vec4 dc = ext_sample(s, sf, m, RT_XTEX_DIFFUSE_TRANSMISSION_COLOR, true, &has);
-    e.diffuse_transmission_color = rt_mul(e.diffuse_transmission_color, rt_v3(dc.x, dc.y, dc.z));
-    /* anisotropy: direction (cos r, sin r) in the tangent frame, or the
-     * texture's (2 RG - 1) rotated by r; strength x texture B */
-    rt_vec4 an = ext_sample(s, sf, m, RT_XTEX_ANISOTROPY, false, &has);
-    if (has)
-        e.anisotropy *= an.z;
-    if (e.anisotropy > 0.0f && have_t) {
-        float dx = has ? 2.0f * an.x - 1.0f : 1.0f, dy = has ? 2.0f * an.y - 1.0f : 0.0f;
-        float cr = cosf(m->anisotropy_rotation), sr = sinf(m->anisotropy_rotation);
-        float x = cr * dx - sr * dy, y = sr * dx + cr * dy;
-        rt_vec3 dir = rt_add(rt_scale(t, x), rt_scale(bt, y));
-        float l2 = rt_length2(dir);
-        if (l2 > 1e-12f && isfinite(l2)) {
-            rt_vec3 cn = rt_bsdf_to_world(b, e.clearcoat_normal); /* keep the coat's normal in world space */
-            b->t = rt_scale(dir, 1.0f / sqrtf(l2));
-            b->b = rt_cross(b->n, b->t);
-            e.clearcoat_normal = rt_bsdf_to_local(b, cn);
-        }
-    }
-    rt_bsdf_set_ext(b, &e);
-}
-
-void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
-{
-    const rt_scene *s = ctx->state->scene;
-    RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
-    const rt_material *m = &s->materials[sf->material];
-    /* frame: the shading normal, unless wo is not above it (normal maps,
-     * interpolated normals at silhouettes); then the geometric normal */
-    rt_vec3 n = sf->n;
-    if (!(rt_dot(n, sf->wo) > 1e-4f) || !rt_finite3(n))
-        n = sf->ng;
-    set_frame(b, n, sf->ng);
-    if (m->bsdf == RT_BSDF_LAMBERT) { /* base colour x texture x vertex colour, nothing else */
-        if (m->base_color_tex.texture == RT_NONE) { /* rt_surface_base_color's arithmetic, inline */
-            rt_vec4 v = sf->vertex_color;
-            set_lambert(b, rt_v3(m->color.x * v.x, m->color.y * v.y, m->color.z * v.z));
-        } else {
-            rt_vec4 c = rt_surface_base_color(ctx, sf);
-            set_lambert(b, rt_v3(c.x, c.y, c.z));
-        }
-        return;
-    }
-    if (m->bsdf == RT_BSDF_CONDUCTOR) {
-        float roughness = m->roughness;
-        if (m->metal_rough_tex.texture != RT_NONE) {
-            rt_vec2 uv = rt_texture_slot_uv(&m->metal_rough_tex,
-                                            m->metal_rough_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
-            roughness *= rt_texture_sample(s, m->metal_rough_tex.texture, uv, false).y;
-        }
-        float ax = m->alpha_u >= 0.0f ? m->alpha_u : roughness * roughness;
-        float ay = m->alpha_v >= 0.0f ? m->alpha_v : roughness * roughness;
-        if (ax != ay) { /* anisotropic: x along the surface tangent */
-            rt_vec3 t = rt_sub(sf->t, rt_scale(n, rt_dot(sf->t, n)));
-            float l2 = rt_length2(t);
-            if (l2 > 1e-12f && isfinite(l2)) {
-                b->t = rt_scale(t, 1.0f / sqrtf(l2));
-                b->b = rt_cross(n, b->t);
-            }
-        }
-        set_conductor(b, m->eta, m->k, ax, ay, m->smith);
-        if (s->settings.energy_compensation)
-            rt_bsdf_compensate(b);
-        return;
-    }
-    if (m->bsdf == RT_BSDF_DIELECTRIC) {
-        /* eta = n_wo / n_wi: exterior over interior entering the front */
-        float eta = m->exterior_ior / m->ior;
-        float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
-        rt_bsdf_make_dielectric(b, n, sf->front ? eta : 1.0f / eta, alpha);
-        set_frame(b, n, sf->ng);
-        if (s->settings.energy_compensation)
-            rt_bsdf_compensate(b);
-        return;
-    }
-    if (m->bsdf == RT_BSDF_PLASTIC) { /* opaque: the same from either side */
-        rt_vec4 c = rt_surface_base_color(ctx, sf);
-        float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
-        rt_bsdf_make_plastic(b, n, rt_v3(c.x, c.y, c.z), m->exterior_ior / m->ior, alpha);
-        set_frame(b, n, sf->ng);
-        return;
-    }
-    rt_vec4 b4 = rt_surface_base_color(ctx, sf);
-    float metallic = m->metallic, roughness = m->roughness, transmission = m->transmission;
-    if (m->metal_rough_tex.texture != RT_NONE) {
-        rt_vec2 uv = rt_texture_slot_uv(&m->metal_rough_tex, m->metal_rough_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
-        rt_vec4 mr = rt_texture_sample(s, m->metal_rough_tex.texture, uv, false);
-        metallic *= mr.z;
-        roughness *= mr.y;
-    }
-    if (transmission > 0.0f && m->transmission_tex.texture != RT_NONE) {
-        rt_vec2 uv = rt_texture_slot_uv(&m->transmission_tex,
-                                        m->transmission_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
-        transmission *= rt_texture_sample(s, m->transmission_tex.texture, uv, false).x;
-    }
-    set_params(b, rt_v3(b4.x, b4.y, b4.z), metallic, roughness, m->ior, transmission, false);
-    if (!sf->front)
-        b->eta = 1.0f / b->eta; /* leaving the object through its back */
-    /* a glTF material without a volume (KHR_materials_volume thickness 0) is thin-walled */
-    b->thin = m->bsdf == RT_BSDF_GLTF && b->transmission > 0.0f && m->thin_walled;
-    if (m->extended && m->bsdf == RT_BSDF_GLTF)
-        set_ext_from_surface(ctx, sf, m, b);
 }
 
 /* Lobe probabilities of the layered glTF BSDF (the extensions' section below). */
@@ -731,31 +535,6 @@ static bool thin_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, rt_vec3 c, fl
  * directions, so f stays reciprocal (the extensions' non-normative
  * shading uses wo only). Diffuse transmission (dt) and the refraction lobe
  * are sampled only (delta samples), as transmission is. */
-
-void rt_bsdf_ext_of_material(const rt_material *m, rt_bsdf_ext *e)
-{
-    e->spec_weight = m->specular_weight;
-    e->spec_color = m->specular_color;
-    e->clearcoat = m->clearcoat;
-    e->clearcoat_roughness = m->clearcoat_roughness;
-    e->clearcoat_normal = rt_v3(0.0f, 0.0f, 1.0f); /* the shading normal: a coat without a map of its own */
-    e->sheen_color = m->sheen_color;
-    e->sheen_roughness = m->sheen_roughness;
-    e->anisotropy = m->anisotropy;
-    e->iridescence = m->iridescence;
-    e->iridescence_ior = m->iridescence_ior;
-    e->iridescence_thickness = m->iridescence_thickness_max; /* without a thickness texture: the maximum */
-    e->diffuse_transmission = m->diffuse_transmission;
-    e->diffuse_transmission_color = m->diffuse_transmission_color;
-    e->dispersion = m->thin_walled ? 0.0f : m->dispersion; /* a thin wall does not bend light */
-}
-
-void rt_bsdf_ext_default(rt_bsdf_ext *e)
-{
-    rt_material m;
-    rt_material_default(&m, NULL);
-    rt_bsdf_ext_of_material(&m, e);
-}
 
 /* KHR_materials_dispersion: the index at wavelength lambda (nm) from the
  * index n_d at 587.6 nm and the Abbe number V = 20 / dispersion, Cauchy's

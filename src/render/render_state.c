@@ -15,6 +15,7 @@
 #include "rt/base/alloc.h"
 #include "rt/render/environment.h"
 #include "rt/render/light.h"
+#include "rt/render/material_eval.h"
 #include "rt/render/surface.h"
 
 /* The whitted integrator's ambient radiance: the scene's ambient_light when

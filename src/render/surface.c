@@ -72,30 +72,6 @@ static rt_vec2 slot_uv(const rt_surface *sf, const rt_texture_slot *slot)
     return rt_texture_slot_uv(slot, slot->texcoord == 1 ? sf->uv1 : sf->uv0);
 }
 
-bool rt_surface_material_reads_frame(const rt_material *m)
-{
-    return m->normal_tex.texture != RT_NONE || m->bsdf == RT_BSDF_CONDUCTOR || m->extended;
-}
-
-uint8_t rt_material_needs(const rt_material *m)
-{
-    const rt_texture_slot *slots[] = {&m->base_color_tex, &m->metal_rough_tex, &m->normal_tex,
-                                      &m->occlusion_tex,  &m->emissive_tex,    &m->transmission_tex};
-    bool textured = false;
-    for (size_t k = 0; k < sizeof slots / sizeof slots[0]; k++)
-        textured = textured || slots[k]->texture != RT_NONE;
-    for (size_t k = 0; k < RT_XTEX_COUNT; k++)
-        textured = textured || m->ext_tex[k].texture != RT_NONE;
-    uint8_t needs = 0;
-    if (textured)
-        needs |= RT_MATERIAL_TEXTURED;
-    if (rt_surface_material_reads_frame(m))
-        needs |= RT_MATERIAL_FRAME;
-    if (m->emission.x > 0.0f || m->emission.y > 0.0f || m->emission.z > 0.0f) /* rt_surface_emission's test */
-        needs |= RT_MATERIAL_EMITS;
-    return needs;
-}
-
 #if defined(__GNUC__)
 #define SURFACE_INLINE static inline __attribute__((always_inline)) /* one copy per caller, `frame` folded */
 #else

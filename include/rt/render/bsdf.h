@@ -7,7 +7,8 @@
  * the side the light leaves towards (wo.z > 0), x and y the tangents.
  *
  *   rt_bsdf b;
- *   rt_bsdf_from_surface(&ctx, &sf, &b);              // material + textures at a hit
+ *   rt_bsdf_from_surface(&ctx, &sf, &b);              // material + textures at a hit (material_eval.h)
+ *   // or rt_bsdf_make(&b, n, base, metallic, roughness, ior, transmission, lambert) and the like
  *   rt_vec3 wo = rt_bsdf_to_local(&b, sf.wo);
  *   float pdf;
  *   rt_vec3 f = rt_bsdf_eval(&b, wo, wi, &pdf);       // f (no cosine), pdf of rt_bsdf_sample
@@ -64,7 +65,6 @@
 
 #include "rt/render/ggx_albedo.h"
 #include "rt/render/microfacet.h"
-#include "rt/render/surface.h"
 
 #define RT_BSDF_MIN_ALPHA 1e-4f /* GGX alpha floor for roughness > 0 (roughness 0 is a delta interface) */
 
@@ -126,18 +126,8 @@ typedef struct rt_bsdf_sample {
     bool delta;       /* transmission or a mirror reflection: sampled only, never light-sampled, so no MIS */
 } rt_bsdf_sample;
 
-/* Absorption coefficient inside a material (Beer-Lambert: transmittance
- * exp(-sigma d) over a distance d travelled inside): a dielectric's
- * `absorption` plus, for a dielectric or a glTF volume (thickness > 0,
- * transmission > 0), -ln(attenuation_color) / attenuation_distance. Zero
- * when nothing absorbs. */
-rt_vec3 rt_material_absorption(const rt_material *m);
-
-/* Builds the BSDF of a hit: material factors x textures (base colour,
- * metallic-roughness, transmission), frame from the shading normal (the
- * geometric one when wo lies below the shading normal). */
-void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b);
-/* The same from plain parameters, frame n (unit) with ng = n; for tests. */
+/* A BSDF from plain parameters, frame n (unit) with ng = n (tests; a hit's
+ * BSDF comes from rt_bsdf_from_surface, rt/render/material_eval.h). */
 void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float roughness, float ior,
                   float transmission, bool lambert);
 /* A dielectric (bsdf dielectric): eta = n_wo / n_wi, GGX alpha (0: smooth). */
@@ -151,7 +141,16 @@ void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alp
 /* A conductor (bsdf conductor) the same way: GGX alphas along x and y of
  * the frame (both 0: a delta mirror). */
 void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float alpha_x, float alpha_y,
-                            rt_smith smith);
+                            bool separable);
+/* The pieces the make functions are built of, for the material
+ * evaluation: the frame (n unit, ng the geometric normal on its side; t, b
+ * from rt_onb), then one model's parameters, which leave the frame alone:
+ * Lambert of albedo base, the glTF metallic-roughness BSDF, a conductor
+ * (separable: Smith G1 G1 instead of height-correlated). */
+void rt_bsdf_set_frame(rt_bsdf *b, rt_vec3 n, rt_vec3 ng);
+void rt_bsdf_set_lambert(rt_bsdf *b, rt_vec3 base);
+void rt_bsdf_set_gltf(rt_bsdf *b, rt_vec3 base, float metallic, float roughness, float ior, float transmission);
+void rt_bsdf_set_conductor(rt_bsdf *b, rt_vec3 eta, rt_vec3 k, float ax, float ay, bool separable);
 
 /* Adds Kulla and Conty's (2017) multiple-scattering lobe to a rough
  * conductor (height-correlated Smith; nothing for a delta or separable
@@ -173,11 +172,9 @@ void rt_bsdf_compensate(rt_bsdf *b);
  * = n_t^2 f(wi, wo) seen from the other side. */
 float rt_bsdf_ms_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi);
 
-/* The glTF PBR-next extensions' parameters at a point (rt_bsdf_set_ext).
- * rt_bsdf_ext_of_material takes a material's factors (no textures: the
- * path tracer multiplies those in at a hit); rt_bsdf_ext_default is that
- * of rt_material_default()'s material, the values that leave the core
- * BSDF, so the defaults live in one place (scene.c). */
+/* The glTF PBR-next extensions' parameters at a point (rt_bsdf_set_ext);
+ * a material's come from rt_bsdf_ext_of_material, the defaults that leave
+ * the core BSDF from rt_bsdf_ext_default (rt/render/material_eval.h). */
 typedef struct rt_bsdf_ext {
     float spec_weight;          /* KHR_materials_specular: specularFactor */
     rt_vec3 spec_color;         /* specularColorFactor */
@@ -191,8 +188,6 @@ typedef struct rt_bsdf_ext {
     rt_vec3 diffuse_transmission_color;
     float dispersion;           /* KHR_materials_dispersion: 20 / Abbe number (needs transmission) */
 } rt_bsdf_ext;
-void rt_bsdf_ext_of_material(const rt_material *m, rt_bsdf_ext *e);
-void rt_bsdf_ext_default(rt_bsdf_ext *e);
 /* Puts the extensions' layers over a glTF BSDF from rt_bsdf_make or
  * rt_bsdf_from_surface (anything else is left as it is); with the default
  * parameters b stays the core BSDF. */

@@ -41,14 +41,14 @@ typedef struct rt_render_state {
     struct rt_light_table *light_table;
     /* per material (scene->materials order), RT_MATERIAL_* bits: what the
      * surface record and the path tracer's vertex need of it, derived once
-     * (rt_material_needs, rt/render/surface.h) instead of at every hit */
+     * (rt_material_needs, rt/render/material_eval.h) instead of at every hit */
     uint8_t *material_needs;
 } rt_render_state;
 
 /* The bits of rt_render_state.material_needs. */
 enum rt_material_need {
     RT_MATERIAL_TEXTURED = 1, /* some texture slot is set: surface records need its UVs */
-    RT_MATERIAL_FRAME = 2,    /* it reads the tangent frame (rt_surface_material_reads_frame) */
+    RT_MATERIAL_FRAME = 2,    /* it reads the tangent frame (rt_surface_material_reads_frame, rt/render/material_eval.h) */
     RT_MATERIAL_EMITS = 4,    /* some emission channel is > 0: rt_surface_emission may be nonzero */
 };
 
