@@ -23,7 +23,7 @@
 #ifndef RT_SURFACE_H
 #define RT_SURFACE_H
 
-#include "rt/render/render_state.h"
+#include "rt/render/trace.h"
 #include "rt/render/sampling.h"
 
 typedef struct rt_surface {
