@@ -709,7 +709,7 @@ static void test_dielectric_bsdf(void **state)
     for (int e = 0; e < 4; e++) {
         rt_bsdf b;
         rt_bsdf_make_dielectric(&b, rt_v3(0, 0, 1), etas[e], 0.0f);
-        assert_true(b.delta && b.radiance_eta2);
+        assert_true(b.delta && (b.kind == RT_BSDF_KIND_DIELECTRIC));
         for (int k = 1; k <= 10; k++) {
             float c = (float)k / 10.0f;
             rt_vec3 wo = dir_from(c, 0.3f);

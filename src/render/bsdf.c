@@ -67,7 +67,7 @@
  * the index's F0 for an opaque one. */
 static inline float fresnel_dielectric(const rt_bsdf *b, float c)
 {
-    if (b->transmission > 0.0f || b->plastic)
+    if (b->transmission > 0.0f || b->kind == RT_BSDF_KIND_PLASTIC)
         return rt_fresnel_exact(c, b->eta);
     return b->f0 + (1.0f - b->f0) * rt_schlick_weight(c);
 }
@@ -96,19 +96,15 @@ static inline rt_vec3 clean_base(rt_vec3 base)
     return rt_finite3(base) ? base : rt_v3s(0.0f);
 }
 
-/* The core BSDF's kind flags: Lambert or the metallic-roughness lobes,
- * nothing layered or special, no cached wo (rt_bsdf_set_wo). */
-static inline void set_kind(rt_bsdf *b, bool lambert)
+/* A BSDF of this kind, with none of its options (thin, compensation,
+ * separable Smith) on and no cached wo (rt_bsdf_set_wo). */
+static inline void set_kind(rt_bsdf *b, rt_bsdf_kind kind)
 {
-    b->lambert = lambert;
+    b->kind = kind;
     b->wo_z = NAN;
-    b->layered = false;
     b->thin = false;
-    b->conductor = false;
     b->ms = false;
     b->separable = false;
-    b->radiance_eta2 = false;
-    b->plastic = false;
 }
 
 /* The Lambert BSDF of albedo base (clamped to finite, non-negative):
@@ -116,7 +112,7 @@ static inline void set_kind(rt_bsdf *b, bool lambert)
 void rt_bsdf_set_lambert(rt_bsdf *b, rt_vec3 base)
 {
     base = clean_base(base);
-    set_kind(b, true);
+    set_kind(b, RT_BSDF_KIND_LAMBERT);
     b->base = base;
     b->alpha_y = 1.0f;
     b->diffuse = base;
@@ -141,7 +137,7 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
     transmission = isfinite(transmission) ? rt_clampf(transmission, 0.0f, 1.0f) : 0.0f;
     if (!(ior > 0.0f) || !isfinite(ior))
         ior = 1.5f;
-    set_kind(b, false);
+    set_kind(b, RT_BSDF_KIND_GLTF);
     b->base = base;
     float r0 = (ior - 1.0f) / (ior + 1.0f);
     b->diffuse = rt_scale(base, 1.0f - metallic);
@@ -168,7 +164,7 @@ void rt_bsdf_set_gltf(rt_bsdf *b, rt_vec3 base, float metallic, float roughness,
 void rt_bsdf_set_conductor(rt_bsdf *b, rt_vec3 eta, rt_vec3 k, float ax, float ay, bool separable)
 {
     set_params(b, rt_v3s(0.0f), 0.0f, 1.0f, 1.5f, 0.0f, false);
-    b->conductor = true;
+    b->kind = RT_BSDF_KIND_CONDUCTOR;
     b->eta_c = rt_finite3(eta) ? rt_vmax(eta, rt_v3s(0.0f)) : rt_v3s(1.0f);
     b->k_c = rt_finite3(k) ? rt_vmax(k, rt_v3s(0.0f)) : rt_v3s(0.0f);
     ax = isfinite(ax) ? rt_clampf(ax, 0.0f, 1.0f) : 1.0f;
@@ -191,11 +187,11 @@ static void dielectric_compensate(rt_bsdf *b);
 void rt_bsdf_compensate(rt_bsdf *b)
 {
     b->wo_z = NAN;
-    if (b->radiance_eta2) {
+    if (b->kind == RT_BSDF_KIND_DIELECTRIC) {
         dielectric_compensate(b);
         return;
     }
-    if (!b->conductor || b->delta || b->separable)
+    if (b->kind != RT_BSDF_KIND_CONDUCTOR || b->delta || b->separable)
         return;
     float alpha = sqrtf(b->alpha * b->alpha_y);
     float ea = rt_ggx_albedo_avg(alpha);
@@ -223,7 +219,7 @@ void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha)
     alpha = isfinite(alpha) ? rt_clampf(alpha, 0.0f, 1.0f) : 1.0f;
     b->delta = alpha == 0.0f;
     b->alpha = b->alpha_y = rt_fmaxf(alpha, RT_BSDF_MIN_ALPHA);
-    b->radiance_eta2 = true;
+    b->kind = RT_BSDF_KIND_DIELECTRIC;
 }
 
 void rt_bsdf_set_eta(rt_bsdf *b, float eta)
@@ -234,7 +230,7 @@ void rt_bsdf_set_eta(rt_bsdf *b, float eta)
     b->f0 = r0 * r0;
     bool changed = eta != b->eta;
     b->eta = eta;
-    if (changed && b->ms && b->radiance_eta2)
+    if (changed && b->ms && b->kind == RT_BSDF_KIND_DIELECTRIC)
         dielectric_compensate(b); /* E and the split depend on eta */
 }
 
@@ -249,7 +245,7 @@ void rt_bsdf_set_eta(rt_bsdf *b, float eta)
 static void dielectric_compensate(rt_bsdf *b)
 {
     b->ms = false;
-    if (b->delta || !b->radiance_eta2)
+    if (b->delta || b->kind != RT_BSDF_KIND_DIELECTRIC)
         return;
     float alpha = b->alpha, eta = b->eta;
     float lo = 1.0f - rt_ggx_dielectric_albedo_avg(alpha, eta);
@@ -272,7 +268,7 @@ static void dielectric_compensate(rt_bsdf *b)
 
 float rt_bsdf_ms_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi)
 {
-    if (!b->ms || !b->radiance_eta2 || !(wo.z > 0.0f) || !(wi.z < 0.0f))
+    if (!b->ms || b->kind != RT_BSDF_KIND_DIELECTRIC || !(wo.z > 0.0f) || !(wi.z < 0.0f))
         return 0.0f;
     return b->ms_trans * (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[0], wo.z)) *
            (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[1], -wi.z));
@@ -286,7 +282,7 @@ void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alp
     float r0 = (eta - 1.0f) / (eta + 1.0f);
     b->f0 = r0 * r0;
     b->eta = eta;
-    b->plastic = true;
+    b->kind = RT_BSDF_KIND_PLASTIC;
     alpha = isfinite(alpha) ? rt_clampf(alpha, 0.0f, 1.0f) : 1.0f;
     b->delta = alpha == 0.0f;
     b->alpha = b->alpha_y = rt_fmaxf(alpha, RT_BSDF_MIN_ALPHA);
@@ -311,36 +307,29 @@ typedef struct layered_probs {
 static layered_probs layered_lobe_probs(const rt_bsdf *b, rt_vec3 wo);
 static rt_vec3 layered_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, const layered_probs *p, float *pdf);
 
-/* The lobe probabilities, with a compensated dielectric's transmitted
- * multiple-scattering lobe apart (*p_ms_transmit; its reflected lobe is
- * the diffuse one). */
-static void lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit,
-                       float *p_ms_transmit)
+/* The conductor's lobes: the specular one, and with compensation the
+ * multiple-scattering lobe, sampled as a diffuse one, by the share of
+ * their albedos at wo. */
+static void conductor_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular)
 {
-    *p_diffuse = *p_specular = *p_transmit = *p_ms_transmit = 0.0f;
-    if (b->layered) {
-        layered_probs p = layered_lobe_probs(b, wo);
-        *p_diffuse = p.d;
-        *p_specular = p.s + p.c;
-        *p_transmit = p.t + p.dt;
-        return;
+    *p_specular = 1.0f;
+    if (b->ms) { /* the lobes' albedos at wo: about F E(mu_o) and F_ms (1 - E(mu_o)) */
+        float e = rt_ggx_albedo(wo.z, b->ms_alpha);
+        float ws = mean3(rt_fresnel_conductor(wo.z, b->eta_c, b->k_c)) * e;
+        float wm = mean3(b->ms_scale) * RT_PI * (1.0f - rt_ggx_albedo_avg(b->ms_alpha)) * (1.0f - e);
+        float pm = (ws + wm > 0.0f) ? wm / (ws + wm) : 0.0f;
+        *p_diffuse = isfinite(pm) ? rt_clampf(pm, 0.0f, 0.95f) : 0.0f;
+        *p_specular = 1.0f - *p_diffuse;
     }
-    if (b->conductor) {
-        *p_specular = 1.0f;
-        if (b->ms) { /* the lobes' albedos at wo: about F E(mu_o) and F_ms (1 - E(mu_o)) */
-            float e = rt_ggx_albedo(wo.z, b->ms_alpha);
-            float ws = mean3(rt_fresnel_conductor(wo.z, b->eta_c, b->k_c)) * e;
-            float wm = mean3(b->ms_scale) * RT_PI * (1.0f - rt_ggx_albedo_avg(b->ms_alpha)) * (1.0f - e);
-            float pm = (ws + wm > 0.0f) ? wm / (ws + wm) : 0.0f;
-            *p_diffuse = isfinite(pm) ? rt_clampf(pm, 0.0f, 0.95f) : 0.0f;
-            *p_specular = 1.0f - *p_diffuse;
-        }
-        return;
-    }
-    if (b->lambert) {
-        *p_diffuse = mean3(b->diffuse) > 0.0f ? 1.0f : 0.0f;
-        return;
-    }
+}
+
+/* The lobes of a dielectric interface over a base (the glTF BSDF, the
+ * dielectric, the plastic): diffuse, specular, refraction, and a
+ * compensated dielectric's transmitted multiple-scattering lobe apart
+ * (*p_ms_transmit; its reflected lobe is the diffuse one). */
+static void dielectric_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular,
+                                  float *p_transmit, float *p_ms_transmit)
+{
     /* F at the macro normal estimates each lobe's share. A delta interface
      * uses it exactly; a rough one floors both shares, so every lobe that
      * can contribute at some microfacet stays sampleable (inside glass past
@@ -349,7 +338,7 @@ static void lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_
     float fd = fresnel_dielectric(b, wo.z);
     rt_vec3 F = fresnel_specular(b, wo.z, fd);
     float ws = mean3(F), td = 1.0f - fd;
-    if (b->plastic) /* the diffuse lobe's albedo: (1 - Fo) diffuse (1 - Fdr_out), about (1 - Fo) diffuse */
+    if (b->kind == RT_BSDF_KIND_PLASTIC) /* the diffuse lobe's albedo: (1 - Fo) diffuse (1 - Fdr_out), about (1 - Fo) diffuse */
         td *= 1.0f - b->f0;
     if (!b->delta) {
         ws = rt_fmaxf(ws, 0.02f);
@@ -374,11 +363,40 @@ static void lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_
     }
 }
 
+
+/* The lobe probabilities by the BSDF's kind, with a compensated
+ * dielectric's transmitted multiple-scattering lobe apart (*p_ms_transmit). */
+static void lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit,
+                       float *p_ms_transmit)
+{
+    *p_diffuse = *p_specular = *p_transmit = *p_ms_transmit = 0.0f;
+    switch (b->kind) {
+    case RT_BSDF_KIND_LAMBERT:
+        *p_diffuse = mean3(b->diffuse) > 0.0f ? 1.0f : 0.0f;
+        return;
+    case RT_BSDF_KIND_GLTF_LAYERED: {
+        layered_probs p = layered_lobe_probs(b, wo);
+        *p_diffuse = p.d;
+        *p_specular = p.s + p.c;
+        *p_transmit = p.t + p.dt;
+        return;
+    }
+    case RT_BSDF_KIND_CONDUCTOR:
+        conductor_lobe_probs(b, wo, p_diffuse, p_specular);
+        return;
+    case RT_BSDF_KIND_GLTF:
+    case RT_BSDF_KIND_DIELECTRIC:
+    case RT_BSDF_KIND_PLASTIC:
+        dielectric_lobe_probs(b, wo, p_diffuse, p_specular, p_transmit, p_ms_transmit);
+        return;
+    }
+}
+
 /* lobe_probs, from rt_bsdf_set_wo's cache when it holds this wo (the core
  * BSDF's probabilities depend on wo only through wo.z). */
 static inline void lobe_probs_at(const rt_bsdf *b, rt_vec3 wo, float *pd, float *ps, float *pt, float *ptm)
 {
-    if (wo.z == b->wo_z && !b->layered) {
+    if (wo.z == b->wo_z && b->kind != RT_BSDF_KIND_GLTF_LAYERED) {
         *pd = b->p_d, *ps = b->p_s, *pt = b->p_t, *ptm = b->p_tm;
         return;
     }
@@ -388,7 +406,7 @@ static inline void lobe_probs_at(const rt_bsdf *b, rt_vec3 wo, float *pd, float 
 void rt_bsdf_set_wo(rt_bsdf *b, rt_vec3 wo)
 {
     b->wo_z = NAN;
-    if (b->layered || b->lambert || !(wo.z > 0.0f))
+    if (b->kind == RT_BSDF_KIND_GLTF_LAYERED || b->kind == RT_BSDF_KIND_LAMBERT || !(wo.z > 0.0f))
         return; /* layered: probabilities of the whole wo; Lambert: nothing to cache */
     lobe_probs(b, wo, &b->p_d, &b->p_s, &b->p_t, &b->p_tm);
     b->wo_z = wo.z;
@@ -401,17 +419,13 @@ void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p
     *p_transmit += ptm;
 }
 
-/* f and pdf of the non-delta lobes, given lobe probabilities. */
-static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, float ps, float *pdf)
+/* The conductor's f and pdf (non-delta lobes), given its lobe probabilities. */
+static rt_vec3 conductor_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, float ps, float *pdf)
 {
     *pdf = 0.0f;
     if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
         return rt_v3s(0.0f);
-    if (b->lambert) {
-        *pdf = pd * wi.z * RT_INV_PI;
-        return rt_scale(b->diffuse, RT_INV_PI);
-    }
-    if (b->conductor && b->delta)
+    if (b->delta)
         return rt_v3s(0.0f);
     rt_vec3 h = rt_add(wo, wi);
     float l2 = rt_length2(h);
@@ -419,26 +433,39 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
         return rt_v3s(0.0f);
     h = rt_scale(h, 1.0f / sqrtf(l2));
     float voh = rt_dot(wo, h);
-    if (b->conductor) {
-        /* F(wo.h) D G2 / (4 cos_o cos_i), VNDF pdf G1(wo) D / (4 cos_o) */
-        float D = rt_ggx_d_xy(h, b->alpha, b->alpha_y);
-        float spec = D * rt_ggx_g2_xy(wo, wi, b->alpha, b->alpha_y, b->separable) / (4.0f * wo.z * wi.z);
-        float pv = rt_ggx_g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
-        if (!isfinite(spec) || !isfinite(pv))
-            return rt_v3s(0.0f);
-        *pdf = ps * pv;
-        rt_vec3 f = rt_scale(rt_fresnel_conductor(voh, b->eta_c, b->k_c), spec);
-        if (b->ms) {
-            float m = (1.0f - rt_ggx_albedo(wo.z, b->ms_alpha)) * (1.0f - rt_ggx_albedo(wi.z, b->ms_alpha));
-            f = rt_add(f, rt_scale(b->ms_scale, m));
-            *pdf += pd * wi.z * RT_INV_PI;
-        }
-        return f;
+    /* F(wo.h) D G2 / (4 cos_o cos_i), VNDF pdf G1(wo) D / (4 cos_o) */
+    float D = rt_ggx_d_xy(h, b->alpha, b->alpha_y);
+    float spec = D * rt_ggx_g2_xy(wo, wi, b->alpha, b->alpha_y, b->separable) / (4.0f * wo.z * wi.z);
+    float pv = rt_ggx_g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
+    if (!isfinite(spec) || !isfinite(pv))
+        return rt_v3s(0.0f);
+    *pdf = ps * pv;
+    rt_vec3 f = rt_scale(rt_fresnel_conductor(voh, b->eta_c, b->k_c), spec);
+    if (b->ms) {
+        float m = (1.0f - rt_ggx_albedo(wo.z, b->ms_alpha)) * (1.0f - rt_ggx_albedo(wi.z, b->ms_alpha));
+        f = rt_add(f, rt_scale(b->ms_scale, m));
+        *pdf += pd * wi.z * RT_INV_PI;
     }
+    return f;
+}
+
+/* The dielectric interface's f and pdf (glTF, dielectric, plastic; the
+ * non-delta lobes), given its lobe probabilities. */
+static rt_vec3 dielectric_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, float ps, float *pdf)
+{
+    *pdf = 0.0f;
+    if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
+        return rt_v3s(0.0f);
+    rt_vec3 h = rt_add(wo, wi);
+    float l2 = rt_length2(h);
+    if (!(l2 > 1e-20f)) /* opposite directions: both grazing */
+        return rt_v3s(0.0f);
+    h = rt_scale(h, 1.0f / sqrtf(l2));
+    float voh = rt_dot(wo, h);
     float fd = fresnel_dielectric(b, voh);
     /* diffuse: the dielectric's fresnel_mix leaves 1 - Fd to the base;
      * under a plastic's coat, what enters at wi and leaves at wo */
-    float tdiff = b->plastic ? (1.0f - fresnel_dielectric(b, wo.z)) * (1.0f - fresnel_dielectric(b, wi.z))
+    float tdiff = b->kind == RT_BSDF_KIND_PLASTIC ? (1.0f - fresnel_dielectric(b, wo.z)) * (1.0f - fresnel_dielectric(b, wi.z))
                              : (1.0f - fd) * (1.0f - b->transmission);
     rt_vec3 f = rt_scale(b->diffuse, tdiff * RT_INV_PI);
     float p = pd * wi.z * RT_INV_PI;
@@ -469,22 +496,29 @@ static inline float lambert_prob(const rt_bsdf *b) { return mean3(b->diffuse) > 
 
 rt_vec3 rt_bsdf_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float *pdf)
 {
-    if (b->lambert) { /* eval_lobes' Lambert case, without the other lobes' bookkeeping */
-        float dummy_p, *p = pdf ? pdf : &dummy_p;
+    float dummy, *p = pdf ? pdf : &dummy;
+    float pd, ps, pt, ptm;
+    switch (b->kind) {
+    case RT_BSDF_KIND_LAMBERT: /* one cosine lobe, without the other lobes' bookkeeping */
         *p = 0.0f;
         if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
             return rt_v3s(0.0f);
         *p = lambert_prob(b) * wi.z * RT_INV_PI;
         return rt_scale(b->diffuse, RT_INV_PI);
+    case RT_BSDF_KIND_GLTF_LAYERED: {
+        layered_probs lp = layered_lobe_probs(b, wo);
+        return layered_eval(b, wo, wi, &lp, p);
     }
-    if (b->layered) {
-        float dummy_l;
-        layered_probs p = layered_lobe_probs(b, wo);
-        return layered_eval(b, wo, wi, &p, pdf ? pdf : &dummy_l);
+    case RT_BSDF_KIND_CONDUCTOR:
+        lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
+        return conductor_eval(b, wo, wi, pd, ps, p);
+    case RT_BSDF_KIND_GLTF:
+    case RT_BSDF_KIND_DIELECTRIC:
+    case RT_BSDF_KIND_PLASTIC:
+        lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
+        return dielectric_eval(b, wo, wi, pd, ps, p);
     }
-    float pd, ps, pt, ptm, dummy;
-    lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
-    return eval_lobes(b, wo, wi, pd, ps, pdf ? pdf : &dummy);
+    return rt_v3s(0.0f);
 }
 
 static bool delta_sample(rt_bsdf_sample *s, rt_vec3 wi, rt_vec3 w)
@@ -551,7 +585,7 @@ static float clamp01(float x) { return isfinite(x) ? rt_clampf(x, 0.0f, 1.0f) : 
 void rt_bsdf_set_ext(rt_bsdf *b, const rt_bsdf_ext *e)
 {
     b->wo_z = NAN;
-    if (b->lambert || b->conductor || b->plastic || b->radiance_eta2)
+    if (b->kind != RT_BSDF_KIND_GLTF && b->kind != RT_BSDF_KIND_GLTF_LAYERED)
         return; /* the extensions extend the glTF BSDF only */
     b->spec_weight = clamp01(e->spec_weight);
     b->spec_color = rt_finite3(e->spec_color) ? rt_vmax(e->spec_color, rt_v3s(0.0f)) : rt_v3s(1.0f);
@@ -597,9 +631,10 @@ void rt_bsdf_set_ext(rt_bsdf *b, const rt_bsdf_ext *e)
         b->eta_rgb = rt_v3(n[0], n[1], n[2]);
         b->dispersive = true;
     }
-    b->layered = b->dispersive || b->spec_weight != 1.0f || b->spec_color.x != 1.0f || b->spec_color.y != 1.0f ||
+    bool layered = b->dispersive || b->spec_weight != 1.0f || b->spec_color.x != 1.0f || b->spec_color.y != 1.0f ||
                  b->spec_color.z != 1.0f || b->clearcoat > 0.0f || rt_max3(b->sheen) > 0.0f || s > 0.0f ||
                  b->iridescence > 0.0f || b->diffuse_transmission > 0.0f;
+    b->kind = layered ? RT_BSDF_KIND_GLTF_LAYERED : RT_BSDF_KIND_GLTF;
 }
 
 static inline rt_vec3 to_coat(const rt_bsdf *b, rt_vec3 w)
@@ -821,23 +856,48 @@ static bool layered_sample(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe,
     return finish_sample(wi, f, pdf, s);
 }
 
-bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
+/* Lambert: the general path's steps for one cosine lobe of probability 1. */
+static bool lambert_sample(const rt_bsdf *b, rt_vec2 u, rt_bsdf_sample *s)
 {
-    if (!(wo.z > 0.0f))
+    if (!(lambert_prob(b) > 0.0f))
         return false;
-    if (b->lambert) { /* the general path's steps for one cosine lobe of probability 1 */
-        if (!(lambert_prob(b) > 0.0f))
-            return false;
-        rt_vec3 wi = rt_sample_cosine_hemisphere(u);
-        if (!(wi.z > 0.0f) || !rt_finite3(wi))
-            return false;
-        wi = rt_normalize(wi);
-        if (!(wi.z > 0.0f))
-            return false; /* eval_lobes' test */
-        return finish_sample(wi, rt_scale(b->diffuse, RT_INV_PI), 1.0f * wi.z * RT_INV_PI, s);
+    rt_vec3 wi = rt_sample_cosine_hemisphere(u);
+    if (!(wi.z > 0.0f) || !rt_finite3(wi))
+        return false;
+    wi = rt_normalize(wi);
+    if (!(wi.z > 0.0f))
+        return false; /* eval_lobes' test */
+    return finish_sample(wi, rt_scale(b->diffuse, RT_INV_PI), 1.0f * wi.z * RT_INV_PI, s);
+}
+
+static bool conductor_sample(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
+{
+    float pd, ps, pt, ptm;
+    lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
+    if (!(pd + ps + pt + ptm > 0.0f))
+        return false;
+    if (b->delta)
+        return delta_sample(s, rt_v3(-wo.x, -wo.y, wo.z), rt_fresnel_conductor(wo.z, b->eta_c, b->k_c));
+    rt_vec3 wi;
+    if (ulobe < pd || !(ps > 0.0f)) {
+        wi = rt_sample_cosine_hemisphere(u);
+    } else {
+        rt_vec3 h = rt_ggx_sample_vndf_xy(wo, b->alpha, b->alpha_y, u);
+        wi = rt_sub(rt_scale(h, 2.0f * rt_dot(wo, h)), wo);
     }
-    if (b->layered)
-        return layered_sample(b, wo, u, ulobe, s);
+    if (!(wi.z > 0.0f) || !rt_finite3(wi))
+        return false;
+    wi = rt_normalize(wi);
+    float pdf;
+    rt_vec3 f = conductor_eval(b, wo, wi, pd, ps, &pdf);
+    return finish_sample(wi, f, pdf, s);
+}
+
+/* The dielectric interface (glTF, dielectric, plastic): its compensation's
+ * transmitted lobe, refraction (thin or bending), a delta mirror, or the
+ * diffuse and specular lobes. */
+static bool dielectric_sample(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
+{
     float pd, ps, pt, ptm;
     lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
     if (!(pd + ps + pt + ptm > 0.0f))
@@ -872,18 +932,16 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
         wi = rt_normalize(wi);
         float fd = fresnel_dielectric(b, ci);
         float g = b->delta ? 1.0f : rt_ggx_g2(wo, wi, b->alpha) / rt_ggx_g1(wo, b->alpha);
-        float scale = b->radiance_eta2 ? eta * eta : 1.0f; /* L / n^2 is invariant */
+        float scale = b->kind == RT_BSDF_KIND_DIELECTRIC ? eta * eta : 1.0f; /* L / n^2 is invariant */
         return delta_sample(s, wi, rt_scale(b->diffuse, (1.0f - fd) * g * b->transmission * scale / pt));
     }
-    if (b->conductor && b->delta)
-        return delta_sample(s, rt_v3(-wo.x, -wo.y, wo.z), rt_fresnel_conductor(wo.z, b->eta_c, b->k_c));
     if (b->delta && ps > 0.0f && ulobe >= pd) {
         /* mirror reflection about the normal: weight F / (its probability) */
         float fd = fresnel_dielectric(b, wo.z);
         return delta_sample(s, rt_v3(-wo.x, -wo.y, wo.z), rt_scale(fresnel_specular(b, wo.z, fd), 1.0f / ps));
     }
     rt_vec3 wi;
-    if (ulobe < pd || b->lambert || b->delta || !(ps > 0.0f)) {
+    if (ulobe < pd || b->delta || !(ps > 0.0f)) {
         wi = rt_sample_cosine_hemisphere(u);
     } else {
         rt_vec3 h = rt_ggx_sample_vndf_xy(wo, b->alpha, b->alpha_y, u);
@@ -893,6 +951,25 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
         return false;
     wi = rt_normalize(wi);
     float pdf;
-    rt_vec3 f = eval_lobes(b, wo, wi, pd, ps, &pdf);
+    rt_vec3 f = dielectric_eval(b, wo, wi, pd, ps, &pdf);
     return finish_sample(wi, f, pdf, s);
+}
+
+bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
+{
+    if (!(wo.z > 0.0f))
+        return false;
+    switch (b->kind) {
+    case RT_BSDF_KIND_LAMBERT:
+        return lambert_sample(b, u, s);
+    case RT_BSDF_KIND_GLTF_LAYERED:
+        return layered_sample(b, wo, u, ulobe, s);
+    case RT_BSDF_KIND_CONDUCTOR:
+        return conductor_sample(b, wo, u, ulobe, s);
+    case RT_BSDF_KIND_GLTF:
+    case RT_BSDF_KIND_DIELECTRIC:
+    case RT_BSDF_KIND_PLASTIC:
+        return dielectric_sample(b, wo, u, ulobe, s);
+    }
+    return false;
 }

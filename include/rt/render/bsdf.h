@@ -43,9 +43,9 @@
  * 2007), sampled only (a "delta" sample: not light-sampled, no MIS).
  * Roughness exactly 0 is a true delta interface: mirror reflection and
  * refraction about the normal, both sampled only, so rt_bsdf_eval holds
- * just the diffuse lobe. RT_BSDF_LAMBERT is exactly B / pi.
+ * just the diffuse lobe. RT_BSDF_KIND_LAMBERT is exactly B / pi.
  *
- * RT_BSDF_CONDUCTOR (rt_bsdf.conductor) is a metal of complex index
+ * RT_BSDF_KIND_CONDUCTOR is a metal of complex index
  * eta + i k per channel: f = F_conductor(wo.h) D G2 / (4 cos_o cos_i) with
  * anisotropic GGX (alpha along t and b), G2 height-correlated or
  * separable; alpha 0 is a delta mirror of weight F_conductor(cos_o). With
@@ -68,10 +68,23 @@
 
 #define RT_BSDF_MIN_ALPHA 1e-4f /* GGX alpha floor for roughness > 0 (roughness 0 is a delta interface) */
 
+/* Which lobes a BSDF has. A closed set: rt_bsdf_eval, rt_bsdf_sample_dir
+ * and the lobe probabilities switch over it in bsdf.c (with no default, so
+ * the compiler names every switch a new kind must join); the fields of
+ * rt_bsdf below say which kinds read them. */
+typedef enum rt_bsdf_kind {
+    RT_BSDF_KIND_LAMBERT,      /* diffuse / pi */
+    RT_BSDF_KIND_GLTF,         /* glTF metallic-roughness: diffuse, GGX specular, transmission (rt_bsdf_make) */
+    RT_BSDF_KIND_GLTF_LAYERED, /* the same under the PBR-next extensions' layers (rt_bsdf_set_ext) */
+    RT_BSDF_KIND_CONDUCTOR,    /* F(eta_c, k_c) D G2 / (4 cos cos), anisotropic GGX */
+    RT_BSDF_KIND_DIELECTRIC,   /* glass of index ratio eta; refraction scales radiance by eta^2 (n_wo / n_wi)^2 */
+    RT_BSDF_KIND_PLASTIC,      /* coat over Lambert: diffuse = R / (1 - R Fdr_in) / eta_in^2, times (1 - Fo)(1 - Fi) / pi */
+} rt_bsdf_kind;
+
 typedef struct rt_bsdf {
     rt_vec3 t, b, n;  /* shading frame, world space; n on the side of wo */
     rt_vec3 ng;       /* geometric normal on the side of wo */
-    bool lambert;     /* pure Lambert: f = diffuse / pi */
+    rt_bsdf_kind kind;
     bool delta;       /* roughness 0: mirror reflection and refraction, sampled only */
     rt_vec3 base;     /* base colour B: the metal's normal-incidence reflectance */
     rt_vec3 diffuse;  /* (1 - m) B (Lambert: the albedo) */
@@ -79,10 +92,7 @@ typedef struct rt_bsdf {
     float f0;         /* the dielectric's normal-incidence reflectance ((eta - 1) / (eta + 1))^2 */
     float alpha;      /* GGX alpha (at least RT_BSDF_MIN_ALPHA); along the tangent t for a conductor */
     float alpha_y;    /* GGX alpha along the bitangent b (= alpha unless anisotropic) */
-    bool conductor;   /* bsdf conductor: F(eta_c, k_c) D G2 / (4 cos cos) */
     bool separable;   /* conductor: separable Smith G1 G1 instead of height-correlated */
-    bool radiance_eta2; /* dielectric: refraction scales radiance by eta^2 (n_wo / n_wi)^2 */
-    bool plastic;     /* coat over Lambert: diffuse = R / (1 - R Fdr_in) / eta_in^2, times (1 - Fo)(1 - Fi) / pi */
     rt_vec3 eta_c, k_c; /* conductor: complex index relative to the outside */
     bool ms;          /* conductor or dielectric: Kulla-Conty multiple-scattering lobe (rt_bsdf_compensate) */
     float ms_alpha;   /* its table alpha, sqrt(alpha alpha_y) */
@@ -96,9 +106,9 @@ typedef struct rt_bsdf {
     bool thin;        /* glTF transmission without a volume (thickness 0, thin-walled): light goes straight
                        * through, the microfacet reflection mirrored through the surface, no bending */
     /* The glTF PBR-next extensions over the glTF BSDF (docs/shading.md,
-     * "Extension layering"); layered false: none is on, and the fields
-     * below are not read (the core BSDF above, bit for bit). */
-    bool layered;
+     * "Extension layering"); read by RT_BSDF_KIND_GLTF_LAYERED only: with
+     * none on, rt_bsdf_set_ext leaves the kind RT_BSDF_KIND_GLTF (the core
+     * BSDF above, bit for bit). */
     float spec_weight;     /* KHR_materials_specular: specularFactor x texture (A) */
     rt_vec3 spec_color;    /* specularColorFactor x texture: dielectric F0 = min(F0 spec_color, 1) */
     float clearcoat;       /* KHR_materials_clearcoat weight c */
