@@ -12,6 +12,8 @@
 
 #include "rt/render/microfacet.h"
 
+#include "ggx_albedo_table.h"
+
 float rt_ggx_albedo(float mu, float alpha)
 {
     enum { N = RT_GGX_ALBEDO_N };
