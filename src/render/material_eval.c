@@ -162,66 +162,68 @@ static void set_ext_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, 
     rt_bsdf_set_ext(b, &e);
 }
 
-void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
+/* The material's factors x textures into the BSDF of its model, on the
+ * frame rt_bsdf_from_surface set (n its normal): one function a model. */
+static void lambert_at(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_material *m, rt_bsdf *b)
+{
+    /* base colour x texture x vertex colour, nothing else */
+    if (m->base_color_tex.texture == RT_NONE) { /* rt_surface_base_color's arithmetic, inline */
+        rt_vec4 v = sf->vertex_color;
+        rt_bsdf_set_lambert(b, rt_v3(m->color.x * v.x, m->color.y * v.y, m->color.z * v.z));
+    } else {
+        rt_vec4 c = rt_surface_base_color(ctx, sf);
+        rt_bsdf_set_lambert(b, rt_v3(c.x, c.y, c.z));
+    }
+}
+
+static void conductor_at(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_material *m, rt_vec3 n, rt_bsdf *b)
 {
     const rt_scene *s = ctx->state->scene;
-    RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
-    const rt_material *m = &s->materials[sf->material];
-    /* frame: the shading normal, unless wo is not above it (normal maps,
-     * interpolated normals at silhouettes); then the geometric normal */
-    rt_vec3 n = sf->n;
-    if (!(rt_dot(n, sf->wo) > 1e-4f) || !rt_finite3(n))
-        n = sf->ng;
+    float roughness = m->roughness;
+    if (m->metal_rough_tex.texture != RT_NONE) {
+        rt_vec2 uv = rt_texture_slot_uv(&m->metal_rough_tex,
+                                        m->metal_rough_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
+        roughness *= rt_texture_sample(s, m->metal_rough_tex.texture, uv, false).y;
+    }
+    float ax = m->alpha_u >= 0.0f ? m->alpha_u : roughness * roughness;
+    float ay = m->alpha_v >= 0.0f ? m->alpha_v : roughness * roughness;
+    if (ax != ay) { /* anisotropic: x along the surface tangent */
+        rt_vec3 t = rt_sub(sf->t, rt_scale(n, rt_dot(sf->t, n)));
+        float l2 = rt_length2(t);
+        if (l2 > 1e-12f && isfinite(l2)) {
+            b->t = rt_scale(t, 1.0f / sqrtf(l2));
+            b->b = rt_cross(n, b->t);
+        }
+    }
+    rt_bsdf_set_conductor(b, m->eta, m->k, ax, ay, m->smith == RT_SMITH_SEPARABLE);
+    if (s->settings.energy_compensation)
+        rt_bsdf_compensate(b);
+}
+
+static void dielectric_at(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_material *m, rt_vec3 n, rt_bsdf *b)
+{
+    const rt_scene *s = ctx->state->scene;
+    /* eta = n_wo / n_wi: exterior over interior entering the front */
+    float eta = m->exterior_ior / m->ior;
+    float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
+    rt_bsdf_make_dielectric(b, n, sf->front ? eta : 1.0f / eta, alpha);
     rt_bsdf_set_frame(b, n, sf->ng);
-    if (m->bsdf == RT_BSDF_LAMBERT) { /* base colour x texture x vertex colour, nothing else */
-        if (m->base_color_tex.texture == RT_NONE) { /* rt_surface_base_color's arithmetic, inline */
-            rt_vec4 v = sf->vertex_color;
-            rt_bsdf_set_lambert(b, rt_v3(m->color.x * v.x, m->color.y * v.y, m->color.z * v.z));
-        } else {
-            rt_vec4 c = rt_surface_base_color(ctx, sf);
-            rt_bsdf_set_lambert(b, rt_v3(c.x, c.y, c.z));
-        }
-        return;
-    }
-    if (m->bsdf == RT_BSDF_CONDUCTOR) {
-        float roughness = m->roughness;
-        if (m->metal_rough_tex.texture != RT_NONE) {
-            rt_vec2 uv = rt_texture_slot_uv(&m->metal_rough_tex,
-                                            m->metal_rough_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
-            roughness *= rt_texture_sample(s, m->metal_rough_tex.texture, uv, false).y;
-        }
-        float ax = m->alpha_u >= 0.0f ? m->alpha_u : roughness * roughness;
-        float ay = m->alpha_v >= 0.0f ? m->alpha_v : roughness * roughness;
-        if (ax != ay) { /* anisotropic: x along the surface tangent */
-            rt_vec3 t = rt_sub(sf->t, rt_scale(n, rt_dot(sf->t, n)));
-            float l2 = rt_length2(t);
-            if (l2 > 1e-12f && isfinite(l2)) {
-                b->t = rt_scale(t, 1.0f / sqrtf(l2));
-                b->b = rt_cross(n, b->t);
-            }
-        }
-        rt_bsdf_set_conductor(b, m->eta, m->k, ax, ay, m->smith == RT_SMITH_SEPARABLE);
-        if (s->settings.energy_compensation)
-            rt_bsdf_compensate(b);
-        return;
-    }
-    if (m->bsdf == RT_BSDF_DIELECTRIC) {
-        /* eta = n_wo / n_wi: exterior over interior entering the front */
-        float eta = m->exterior_ior / m->ior;
-        float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
-        rt_bsdf_make_dielectric(b, n, sf->front ? eta : 1.0f / eta, alpha);
-        rt_bsdf_set_frame(b, n, sf->ng);
-        if (s->settings.energy_compensation)
-            rt_bsdf_compensate(b);
-        return;
-    }
-    if (m->bsdf == RT_BSDF_PLASTIC) { /* opaque: the same from either side */
-        rt_vec4 c = rt_surface_base_color(ctx, sf);
-        float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
-        rt_bsdf_make_plastic(b, n, rt_v3(c.x, c.y, c.z), m->exterior_ior / m->ior, alpha);
-        rt_bsdf_set_frame(b, n, sf->ng);
-        return;
-    }
+    if (s->settings.energy_compensation)
+        rt_bsdf_compensate(b);
+}
+
+/* opaque: the same from either side */
+static void plastic_at(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_material *m, rt_vec3 n, rt_bsdf *b)
+{
+    rt_vec4 c = rt_surface_base_color(ctx, sf);
+    float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
+    rt_bsdf_make_plastic(b, n, rt_v3(c.x, c.y, c.z), m->exterior_ior / m->ior, alpha);
+    rt_bsdf_set_frame(b, n, sf->ng);
+}
+
+static void gltf_at(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_material *m, rt_bsdf *b)
+{
+    const rt_scene *s = ctx->state->scene;
     rt_vec4 b4 = rt_surface_base_color(ctx, sf);
     float metallic = m->metallic, roughness = m->roughness, transmission = m->transmission;
     if (m->metal_rough_tex.texture != RT_NONE) {
@@ -242,6 +244,36 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
     b->thin = m->bsdf == RT_BSDF_GLTF && b->transmission > 0.0f && m->thin_walled;
     if (m->extended && m->bsdf == RT_BSDF_GLTF)
         set_ext_from_surface(ctx, sf, m, b);
+}
+
+void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
+{
+    const rt_scene *s = ctx->state->scene;
+    RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
+    const rt_material *m = &s->materials[sf->material];
+    /* frame: the shading normal, unless wo is not above it (normal maps,
+     * interpolated normals at silhouettes); then the geometric normal */
+    rt_vec3 n = sf->n;
+    if (!(rt_dot(n, sf->wo) > 1e-4f) || !rt_finite3(n))
+        n = sf->ng;
+    rt_bsdf_set_frame(b, n, sf->ng);
+    switch (m->bsdf) { /* no default: a new model is named here by the compiler */
+    case RT_BSDF_LAMBERT:
+        lambert_at(ctx, sf, m, b);
+        return;
+    case RT_BSDF_CONDUCTOR:
+        conductor_at(ctx, sf, m, n, b);
+        return;
+    case RT_BSDF_DIELECTRIC:
+        dielectric_at(ctx, sf, m, n, b);
+        return;
+    case RT_BSDF_PLASTIC:
+        plastic_at(ctx, sf, m, n, b);
+        return;
+    case RT_BSDF_GLTF:
+        break;
+    }
+    gltf_at(ctx, sf, m, b); /* (and, as before, any value out of the enum) */
 }
 
 bool rt_surface_material_reads_frame(const rt_material *m)
