@@ -1,6 +1,12 @@
-/* bsdf.c - Lambert, the glTF metallic-roughness BSDF and the conductor
- * for the path tracer: evaluation, pdf and importance sampling (see rt/render/bsdf.h),
- * built from the GGX and Fresnel terms of rt/render/microfacet.h.
+/* bsdf.c - the lobes of every BSDF kind for the path tracer (see
+ * rt/render/bsdf.h): Lambert, the glTF metallic-roughness BSDF and its
+ * extensions' layers, the conductor, the dielectric and the plastic;
+ * evaluation, pdf and importance sampling, built from the GGX and Fresnel
+ * terms of rt/render/microfacet.h. One closed kind (rt_bsdf_kind) picks the
+ * lobes: lobe_probs, rt_bsdf_eval and rt_bsdf_sample_dir switch over it,
+ * the glTF, dielectric and plastic kinds sharing one dielectric interface
+ * over a base, the conductor and the layered glTF BSDF with functions of
+ * their own. The material at a hit becomes one of these in material_eval.c.
  *
  * Sources:
  * - The BRDF: glTF 2.0 specification, appendix B "BRDF Implementation",
