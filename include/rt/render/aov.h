@@ -19,7 +19,7 @@
 #ifndef RT_AOV_H
 #define RT_AOV_H
 
-#include "rt/render/render_state.h"
+#include "rt/render/trace.h"
 #include "rt/render/sampling.h"
 
 typedef struct rt_aov_buffers {

@@ -32,6 +32,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "rt/render/render_state.h" /* RT_PREPARE_*: what an integrator asks to be prepared */
 #include "rt/render/sampling.h"
 #include "rt/render/surface.h"
 
