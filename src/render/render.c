@@ -538,7 +538,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     int pass_samples = opt.pass_samples != 0 ? opt.pass_samples : integrator->pass_samples;
     job.passes = pass_samples > 0;
     rt_camera_frame_init(&job.camera, &scene->camera, set->width, set->height);
-    if (set->integrator == RT_INTEGRATOR_PATH || set->integrator == RT_INTEGRATOR_PATH_SCALAR)
+    if (integrator->film_sampler)
         job.camera.sampler = (rt_sampler_kind)set->sampler; /* the path tracer's film and lens: its sampler's */
     job.tile_size = opt.tile_size > 0 ? (opt.tile_size < 65536 ? opt.tile_size : 65536) : 32;
     job.tiles_x = (int)(((int64_t)job.rw + job.tile_size - 1) / job.tile_size);
