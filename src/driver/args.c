@@ -19,6 +19,7 @@
 #include "rt/base/number.h"
 #include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
+#include "rt/io/environment_image.h"
 #include "rt/render/render.h"
 #include "tev.h"
 
@@ -701,8 +702,12 @@ rt_result args_apply_settings(const args *a, rt_scene *s, rt_error *err)
     for (size_t i = 0; i < a->setting_count; i++) {
         const setting_flag *sf = &a->settings[i];
         rt_setting_problem pb;
-        if (rt_setting_set(s, sf->setting, sf->value, &pb) != RT_OK)
+        if (rt_setting_set(&s->settings, sf->setting, sf->value, &pb) != RT_OK)
             return rt_fail(err, pb.code, "%s %s: %s", sf->flag, sf->arg, pb.message);
+        rt_error inner = {0};
+        rt_result r = rt_environment_image_load(s, &inner); /* --set environment=FILE: its image */
+        if (r != RT_OK)
+            return rt_fail(err, r, "%s %s: %s", sf->flag, sf->arg, inner.message);
     }
     return RT_OK;
 }

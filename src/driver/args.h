@@ -4,7 +4,7 @@
  * `--samples=64`); a flag missing its value says so rather than taking the
  * next flag as its value. The flags that set scene settings (-s, -r, --seed,
  * --integrator, and --set KEY=VALUE for any setting) go through the settings
- * table (rt/scene/settings.h): they are checked while parsing, so a bad value
+ * table (rt/render/settings.h): they are checked while parsing, so a bad value
  * is refused before anything is loaded, and applied after loading, in the
  * order given, so a later flag wins.
  *
@@ -27,7 +27,7 @@
 #include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
 #include "rt/scene/scene.h"
-#include "rt/scene/settings.h"
+#include "rt/render/settings.h"
 
 #define ARGS_OK (-1)
 

@@ -10,7 +10,7 @@
 #include <unistd.h>
 
 #include "rt/base/file.h"
-#include "rt/scene/settings.h"
+#include "rt/render/settings.h"
 
 void input_default_output(const rt_scene *s, const char *input, char *out, size_t size)
 {

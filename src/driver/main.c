@@ -43,7 +43,7 @@
 #include "rt/render/limits.h"
 #include "rt/render/render.h"
 #include "rt/scene/scene.h"
-#include "rt/scene/settings.h"
+#include "rt/render/settings.h"
 #include "rt/scene/validate.h"
 
 #include "args.h"

@@ -8,7 +8,7 @@
 #include "rt/base/log.h"
 #include "rt/render/camera.h"
 #include "rt/render/integrator.h"
-#include "rt/scene/settings.h"
+#include "rt/render/settings.h"
 
 /* The kd-tree's primitive ids are the 30 payload bits of its references
  * (RT_KD_PAYLOAD), one value kept free. */

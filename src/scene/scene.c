@@ -1,7 +1,8 @@
 /* scene.c - the scene tables: defaults, appends, marks and rollback, bounds,
  * automatic framing, and the named metals' constants (sources in
- * rt/scene/scene.h). (rt_settings_default() is in settings.c, driven by the
- * settings table.) */
+ * rt/scene/scene.h), and the render settings' defaults (rt_settings_default:
+ * the settings table, rt/render/settings.h, shows them in --help and the
+ * docs). */
 #include "rt/scene/scene.h"
 
 #include "rt/base/alloc.h"
@@ -108,6 +109,32 @@ const rt_metal rt_metals[] = {
     {"W", {3.69245f, 3.50000f, 3.30896f}, {2.93698f, 2.72915f, 2.52585f}},
 };
 const size_t rt_metal_count = sizeof rt_metals / sizeof *rt_metals;
+
+void rt_settings_default(rt_settings *st)
+{
+    memset(st, 0, sizeof *st);
+    st->width = st->height = 512;
+    st->samples = 1;
+    st->integrator = RT_INTEGRATOR_DIRECT;
+    st->max_bounce = 1;
+    st->max_depth = 0;
+    st->rr_depth = 5;
+    st->motion_steps = 8;
+    st->sampler = RT_SAMPLER_SOBOL;
+    st->energy_compensation = 0;
+    st->diffuse_bounces = 0;
+    st->diffuse_rays = 128;
+    st->shadow_samples = 16;
+    st->seed = 0;
+    st->background = rt_v3(0, 0, 0);
+    st->ambient_light = rt_v3(0, 0, 0);
+    st->ambient_light_set = false;
+    st->exposure = 1.0f;
+    st->clamp = 0.0f;
+    st->ray_offset = 0.0f;
+    st->environment_texture = RT_NONE;
+    st->environment_strength = 1.0f;
+}
 
 void rt_scene_init(rt_scene *s)
 {

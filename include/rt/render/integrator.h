@@ -51,7 +51,7 @@ typedef struct rt_integrator_info {
 } rt_integrator_info;
 
 /* Every name in table order, NULL-terminated: the words of the `integrator`
- * setting (rt/scene/settings.h) and of --integrator. */
+ * setting (rt/render/settings.h) and of --integrator. */
 extern const char *const rt_integrator_words[];
 
 /* Number of integrators; ids are 0 .. count - 1. */

@@ -68,7 +68,7 @@ typedef enum rt_sampler_kind {
 } rt_sampler_kind;
 
 /* Render settings. rt_settings_default() gives the documented defaults; the
- * table of them (names, ranges, defaults, help) is rt/scene/settings.h. */
+ * table of them (names, ranges, defaults, help) is rt/render/settings.h. */
 typedef struct rt_settings {
     int width, height;
     int samples;          /* samples per pixel (stratified when a square) */
@@ -88,6 +88,7 @@ typedef struct rt_settings {
     uint32_t seed;
     rt_vec3 background;   /* radiance of rays that leave the scene */
     uint32_t environment_texture; /* lat-long image, RT_NONE for constant background */
+    char environment_file[4096];  /* the `environment` setting's file, "" = none; io loads it into environment_texture */
     float environment_strength;
     /* whitted: ambient radiance that materials' `ambient` coefficient
      * reflects. Unset (the default): the background's radiance, i.e. the
