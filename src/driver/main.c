@@ -52,7 +52,7 @@
 #include "frames.h"
 #include "info.h"
 #include "input.h"
-#include "motion.h"
+#include "rt/job/motion.h"
 #include "output.h"
 #include "part.h"
 #include "progress.h"
@@ -361,7 +361,7 @@ static rt_result render_slices(const rt_scene *scene, const rt_kdtree *tree, con
     int done_to = pj->s_begin; /* samples [pj->s_begin, done_to) are in the sums */
     for (int k = 0; k < slices && r == RT_OK; k++) {
         int b, e;
-        motion_samples(k, slices, scene->settings.samples, &b, &e);
+        rt_motion_samples(k, slices, scene->settings.samples, &b, &e);
         b = b > pj->s_begin ? b : pj->s_begin;
         e = e < pj->s_end ? e : pj->s_end;
         if (b >= e)
@@ -374,7 +374,7 @@ static rt_result render_slices(const rt_scene *scene, const rt_kdtree *tree, con
         if (own) {
             args ak = *a;
             ak.posed = true;
-            ak.frame_time = (float)motion_time(frame, &scene->camera, k, slices);
+            ak.frame_time = (float)rt_motion_time(frame, &scene->camera, k, slices);
             char out[1024];
             bool animated = false;
             char detail[64];
@@ -418,7 +418,7 @@ static rt_result render_slices(const rt_scene *scene, const rt_kdtree *tree, con
         }
         r = rt_render(use, use_tree, ro, fb, &st, err);
         rt_info("motion: slice %d of %d (t = %g s): samples %d:%d, %.3f s", k + 1, slices,
-                motion_time(frame, &scene->camera, k, slices), b, e, st.seconds);
+                rt_motion_time(frame, &scene->camera, k, slices), b, e, st.seconds);
         if (own) {
             rt_kdtree_free(&tk);
             free_slice(&sk, scene->image_count);
@@ -665,7 +665,7 @@ static int render_one(rt_scene *scene, const args *a, double t_start)
     }
     /* an open shutter over animated models: motion blur in time slices, the
      * first posed here at its time (a static scene renders as it is) */
-    int slices = motion_slices(&scene->camera, scene->settings.motion_steps, scene->settings.samples);
+    int slices = rt_motion_slices(&scene->camera, scene->settings.motion_steps, scene->settings.samples);
     if (slices && a->window) {
         rt_warn("--window shows the shutter's midpoint; motion blur is rendered without --window");
         slices = 1;
@@ -673,7 +673,7 @@ static int render_one(rt_scene *scene, const args *a, double t_start)
     if (slices && (animated || !a->posed)) {
         args a0 = *a;
         a0.posed = true;
-        a0.frame_time = (float)motion_time(a->posed ? a->frame_time : 0.0f, &scene->camera, 0, slices);
+        a0.frame_time = (float)rt_motion_time(a->posed ? a->frame_time : 0.0f, &scene->camera, 0, slices);
         rt_scene s0; /* loaded again at slice 0's time, keeping the decoded images */
         rt_scene_init(&s0);
         size_t n = scene->image_count;

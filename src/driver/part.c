@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "part_split.h"
+#include "rt/job/part_split.h"
 #include "rt/base/alloc.h"
 #include "rt/base/file.h"
 #include "rt/render/aov.h"
@@ -74,40 +74,6 @@ static void settings_text(const rt_scene *scene, char *buf, size_t size)
              s->motion_steps);
 }
 
-/* Component q of the AOV a layer holds (name: albedo, normal, position, depth). */
-static float *aov_field(rt_aov_sample *s, const char *name, int q)
-{
-    rt_vec3 *v = strcmp(name, "albedo") == 0   ? &s->albedo
-                 : strcmp(name, "normal") == 0 ? &s->normal
-                 : strcmp(name, "position") == 0 ? &s->position
-                                                 : NULL;
-    if (!v)
-        return &s->depth;
-    return q == 0 ? &v->x : q == 1 ? &v->y : &v->z;
-}
-
-void aov_to_layers(const rt_part_info *info, const rt_aov_sample *sums, float *const *layers, size_t n)
-{
-    for (int k = 0; k < info->layer_count; k++) {
-        int c = info->layer_channels[k];
-        for (size_t i = 0; i < n; i++) {
-            rt_aov_sample s = sums[i];
-            for (int q = 0; q < c; q++)
-                layers[k][(size_t)c * i + (size_t)q] = *aov_field(&s, info->layer_name[k], q);
-        }
-    }
-}
-
-void layers_to_aov(const rt_part_info *info, const float *const *layers, rt_aov_sample *sums, size_t n)
-{
-    for (int k = 0; k < info->layer_count; k++) {
-        int c = info->layer_channels[k];
-        for (size_t i = 0; i < n; i++)
-            for (int q = 0; q < c; q++)
-                *aov_field(&sums[i], info->layer_name[k], q) = layers[k][(size_t)c * i + (size_t)q];
-    }
-}
-
 rt_result part_identity(const rt_scene *scene, const char *input, rt_part_info *info, rt_error *err)
 {
     memset(info, 0, sizeof *info);
@@ -141,48 +107,6 @@ rt_result part_identity(const rt_scene *scene, const char *input, rt_part_info *
     info->y1 = s->height;
     info->s_end = s->samples;
     return RT_OK;
-}
-
-/* The first line where two settings texts differ, into a and b. */
-static void first_difference(const char *x, const char *y, char *a, char *b, size_t size)
-{
-    while (*x || *y) {
-        size_t nx = strcspn(x, "\n"), ny = strcspn(y, "\n");
-        if (nx != ny || memcmp(x, y, nx) != 0) {
-            snprintf(a, size, "%.*s", (int)nx, x);
-            snprintf(b, size, "%.*s", (int)ny, y);
-            return;
-        }
-        x += nx + (x[nx] == '\n');
-        y += ny + (y[ny] == '\n');
-    }
-    a[0] = b[0] = 0;
-}
-
-const char *part_mismatch(const rt_part_info *a, const rt_part_info *b, char *buf, size_t size)
-{
-    if (strcmp(a->version, b->version) != 0)
-        snprintf(buf, size, "rendered by rt %s, not rt %s", a->version, b->version);
-    else if (a->scene_hash != b->scene_hash)
-        snprintf(buf, size, "another scene file (%s, FNV-1a %016llx; not %s, %016llx)", a->scene,
-                 (unsigned long long)a->scene_hash, b->scene, (unsigned long long)b->scene_hash);
-    else if (a->width != b->width || a->height != b->height)
-        snprintf(buf, size, "image size %dx%d, not %dx%d", a->width, a->height, b->width, b->height);
-    else if (a->spp != b->spp)
-        snprintf(buf, size, "%d samples per pixel, not %d", a->spp, b->spp);
-    else if (a->seed != b->seed)
-        snprintf(buf, size, "seed %u, not %u", (unsigned)a->seed, (unsigned)b->seed);
-    else if (a->layer_count != b->layer_count ||
-             memcmp(a->layer_name, b->layer_name, sizeof a->layer_name) != 0)
-        snprintf(buf, size, "other AOVs (%d layer%s, not %d)", a->layer_count, a->layer_count == 1 ? "" : "s",
-                 b->layer_count);
-    else if (strcmp(a->settings, b->settings) != 0) {
-        char x[256], y[256];
-        first_difference(a->settings, b->settings, x, y, sizeof x);
-        snprintf(buf, size, "other settings: '%s', not '%s'", x, y);
-    } else
-        return NULL;
-    return buf;
 }
 
 /* Zeroed sums, block sums and counts (and AOV sums when aov) for n pixels. */
@@ -256,7 +180,7 @@ rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, cons
                            a->crop[2], a->crop[3], s->width, s->height);
         pj->region = (rt_render_region){a->crop[0], a->crop[1], a->crop[2], a->crop[3]};
     }
-    if (a->part_count && (r = part_split(scene, tree, a->part_index, a->part_count, &pj->region, err)) != RT_OK)
+    if (a->part_count && (r = rt_part_split(scene, tree, a->part_index, a->part_count, &pj->region, err)) != RT_OK)
         return r;
     if (a->has_spp_range) {
         if (a->spp_end > s->samples)
@@ -297,7 +221,7 @@ static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_er
     if ((r = rt_part_read(a->resume, &p, err)) != RT_OK)
         return r;
     char why[1024];
-    if (part_mismatch(&p.info, &pj->info, why, sizeof why)) {
+    if (rt_part_mismatch(&p.info, &pj->info, why, sizeof why)) {
         r = rt_fail(err, RT_ERR_INVALID, "--resume %s: the part is of another render: %s", a->resume, why);
         rt_part_free(&p);
         return r;
@@ -344,7 +268,7 @@ static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_er
             rt_part_free(&p);
             return rt_fail(err, RT_ERR_NOMEM, "out of memory for the AOV sums of %s", a->resume);
         }
-        layers_to_aov(&p.info, (const float *const *)p.layer, pj->accum.aov_sum, np);
+        rt_part_layers_to_aov(&p.info, (const float *const *)p.layer, pj->accum.aov_sum, np);
     }
     rt_part_free(&p);
     bool whole = pj->region.x0 == 0 && pj->region.y0 == 0 && pj->region.x1 == s->width &&
@@ -403,7 +327,7 @@ rt_result part_job_write(const part_job *pj, const char *path, int samples_done,
         if (!(layers[k] = rt_alloc(n, (size_t)info.layer_channels[k] * sizeof(float))))
             r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the AOV layers", path);
     if (r == RT_OK) {
-        aov_to_layers(&info, pj->accum.aov_sum, layers, n);
+        rt_part_aov_to_layers(&info, pj->accum.aov_sum, layers, n);
         r = rt_part_write(path, &info, fold, blocks, pj->accum.good, (const float *const *)layers, temp, err);
     }
     free(zeros);

@@ -18,7 +18,7 @@
 
 #include "args.h"
 #include "rt/accel/kdtree.h"
-#include "rt/io/part.h"
+#include "rt/job/part.h"
 #include "rt/render/render.h"
 
 typedef struct part_job {
@@ -49,14 +49,5 @@ rt_result part_job_accum(part_job *pj, bool aov, rt_error *err);
 /* Writes the sums as a part at path covering samples [part_begin, s_begin +
  * samples_done). */
 rt_result part_job_write(const part_job *pj, const char *path, int samples_done, rt_write_temp *temp, rt_error *err);
-
-/* A part's AOV layers (info->layer_name: albedo, normal, position, depth)
- * to and from the render's per-pixel AOV sums, n pixels. */
-void aov_to_layers(const rt_part_info *info, const struct rt_aov_sample *sums, float *const *layers, size_t n);
-void layers_to_aov(const rt_part_info *info, const float *const *layers, struct rt_aov_sample *sums, size_t n);
-
-/* NULL when a and b are parts of the same render; else what differs, in
- * words ("settings differ: 'samples 64' against 'samples 16'"), in buf. */
-const char *part_mismatch(const rt_part_info *a, const rt_part_info *b, char *buf, size_t size);
 
 #endif

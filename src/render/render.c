@@ -89,33 +89,6 @@ typedef struct worker {
  * chunks, and the radiance buffer is WAVE_CHUNK x 12 bytes a worker. */
 enum { WAVE_CHUNK = 16384 };
 
-/* The pixel's AOVs: means over its `good` samples; the variance of the mean
- * luminance from the sample variance, sum of L^2 - (sum L)^2 / n over n - 1.
- * Reads the accumulated sums only, so it may run after every pass. */
-static void aov_store(rt_aov_buffers *aov, size_t pixel, const rt_aov_sample *s, uint32_t good, float lum_sum,
-                      double lum_sq)
-{
-    float inv = good ? 1.0f / (float)good : 0.0f;
-    const rt_vec3 *v3[3] = {&s->albedo, &s->normal, &s->position};
-    float *dst3[3] = {aov->albedo, aov->normal, aov->position};
-    for (int k = 0; k < 3; k++)
-        if (dst3[k]) {
-            dst3[k][3 * pixel] = v3[k]->x * inv;
-            dst3[k][3 * pixel + 1] = v3[k]->y * inv;
-            dst3[k][3 * pixel + 2] = v3[k]->z * inv;
-        }
-    if (aov->depth)
-        aov->depth[pixel] = s->depth * inv;
-    if (aov->spp)
-        aov->spp[pixel] = (float)good;
-    if (aov->variance) {
-        double n = (double)good, var = 0.0;
-        if (good > 1)
-            var = (lum_sq - (double)lum_sum * (double)lum_sum / n) / (n - 1.0) / n;
-        aov->variance[pixel] = (float)(var > 0.0 ? var : 0.0);
-    }
-}
-
 /* A pixel's running sum: the fold of its finished sample blocks, the sum of
  * the current block's good samples, and how many samples were good. */
 typedef struct pixel_sum {
@@ -138,7 +111,7 @@ static void fold_block(const rt_render_job *job, size_t local, uint32_t s, pixel
             k[2] = p->block.z;
         }
     }
-    p->fold = rt_add(p->fold, p->block);
+    p->fold = rt_sample_fold(p->fold, p->block);
     p->block = rt_v3s(0);
 }
 
@@ -200,13 +173,7 @@ static inline void add_samples(const rt_render_job *job, worker *w, rt_trace_ctx
  * alone, exactly, when that block is still empty of samples). */
 static inline rt_vec3 pixel_total(const pixel_sum *p)
 {
-    return rt_add(p->fold, p->block);
-}
-
-/* The pixel value of a sum of `good` samples. */
-static inline rt_vec3 resolve(rt_vec3 sum, uint32_t good)
-{
-    return good ? rt_scale(sum, 1.0f / (float)good) : sum;
+    return rt_sample_fold(p->fold, p->block);
 }
 
 /* Tile `tile` of the region, in the region's (fb's) coordinates. */
@@ -264,8 +231,8 @@ static void pixel_end(rt_render_job *job, size_t pixel, const pixel_sum *p)
     rt_vec3 sum = pixel_total(p);
     uint32_t good = p->good;
     if (job->aov)
-        aov_store(job->aov, pixel, &job->aov_sum[pixel], good, rt_luminance(sum), job->lum_sq[pixel]);
-    sum = resolve(sum, good);
+        rt_aov_resolve(job->aov, pixel, &job->aov_sum[pixel], good, rt_luminance(sum), job->lum_sq[pixel]);
+    sum = rt_sample_resolve(sum, good);
     float *px = job->fb->rgb + 3 * pixel;
     px[0] = sum.x;
     px[1] = sum.y;
@@ -464,8 +431,8 @@ static void resolve_image(rt_render_job *job)
         pixel_sum p = {load3(job->sum + 3 * k), load3(job->block + 3 * k), job->good[k]};
         rt_vec3 sum = pixel_total(&p);
         if (job->aov)
-            aov_store(job->aov, k, &job->aov_sum[k], p.good, rt_luminance(sum), job->lum_sq[k]);
-        rt_vec3 v = resolve(sum, p.good);
+            rt_aov_resolve(job->aov, k, &job->aov_sum[k], p.good, rt_luminance(sum), job->lum_sq[k]);
+        rt_vec3 v = rt_sample_resolve(sum, p.good);
         float *px = job->fb->rgb + 3 * k;
         px[0] = v.x;
         px[1] = v.y;
