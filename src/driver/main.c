@@ -309,26 +309,12 @@ static rt_result prepare_again(rt_scene *scene, const args *a, char *output, siz
     return r;
 }
 
-/* A motion slice's scene starts with slice 0's decoded images, shared (the
+/* A motion slice's scene starts with slice 0's decoded images, shared
+ * (rt_scene_share_images: counted, the last scene freed frees them; the
  * loaders find an image by its name before decoding it, so the slice's
  * textures point at the same images, at the same indices): a slice costs
  * its geometry, not another decode of every texture (measured: the Fox's
  * one PNG was 2/3 of the instructions of an 8-slice render without this). */
-static bool lend_images(rt_scene *slice, const rt_scene *first)
-{
-    for (size_t i = 0; i < first->image_count; i++)
-        if (rt_scene_add_image(slice, &first->images[i]) == RT_NONE)
-            return false;
-    return true;
-}
-
-/* Frees a slice's scene but not the n images lent to it. */
-static void free_slice(rt_scene *slice, size_t n)
-{
-    for (size_t i = 0; i < n && i < slice->image_count; i++)
-        slice->images[i].rgba8 = NULL, slice->images[i].rgbaf = NULL;
-    rt_scene_free(slice);
-}
 
 /* Motion blur (motion.h): slice k of `slices` renders its run of samples
  * (within the job's) into the job's sums, slice 0 with the scene and tree
@@ -350,7 +336,7 @@ static int pass_samples_for(const args *a, const part_job *pj, const rt_scene *s
     return 0;
 }
 
-static rt_result render_slices(const rt_scene *scene, const rt_kdtree *tree, const args *a, int slices,
+static rt_result render_slices(rt_scene *scene, const rt_kdtree *tree, const args *a, int slices,
                                const part_job *pj, rt_render_options *ro, rt_framebuffer *fb, rt_render_stats *rs,
                                progress_view *view, rt_error *err)
 {
@@ -381,17 +367,17 @@ static rt_result render_slices(const rt_scene *scene, const rt_kdtree *tree, con
             snprintf(detail, sizeof detail, "slice %d of %d, t = %g s", k + 1, slices, (double)ak.frame_time);
             progress_phase(view, "motion", detail);
             rt_scene_init(&sk);
-            if (!lend_images(&sk, scene)) {
-                free_slice(&sk, scene->image_count);
+            if (!rt_scene_share_images(&sk, scene)) {
+                rt_scene_free(&sk);
                 r = rt_fail(err, RT_ERR_NOMEM, "out of memory for the images of motion slice %d", k + 1);
                 break;
             }
             if ((r = prepare_again(&sk, &ak, out, sizeof out, &animated, err)) != RT_OK) {
-                free_slice(&sk, scene->image_count);
+                rt_scene_free(&sk);
                 break;
             }
             if ((r = rt_kdtree_build(&tk, &sk, NULL, err)) != RT_OK) {
-                free_slice(&sk, scene->image_count);
+                rt_scene_free(&sk);
                 break;
             }
             use = &sk;
@@ -421,7 +407,7 @@ static rt_result render_slices(const rt_scene *scene, const rt_kdtree *tree, con
                 rt_motion_time(frame, &scene->camera, k, slices), b, e, st.seconds);
         if (own) {
             rt_kdtree_free(&tk);
-            free_slice(&sk, scene->image_count);
+            rt_scene_free(&sk);
         }
         int reached = st.partial ? b : b + st.samples_done;
         rs->seconds += st.seconds;
@@ -449,7 +435,7 @@ static rt_result render_slices(const rt_scene *scene, const rt_kdtree *tree, con
  * does --time-limit; with --window, again at each new camera) and writes
  * the image; returns the exit status.
  * t_start: when the run began, for the wall time in the "wrote" line. */
-static int render_and_write(const rt_scene *scene, const args *a, int slices, const char *output,
+static int render_and_write(rt_scene *scene, const args *a, int slices, const char *output,
                             progress_view *view, double t_start)
 {
     const rt_settings *set = &scene->settings;
@@ -677,20 +663,21 @@ static int render_one(rt_scene *scene, const args *a, double t_start)
         rt_scene s0; /* loaded again at slice 0's time, keeping the decoded images */
         rt_scene_init(&s0);
         size_t n = scene->image_count;
-        if (!lend_images(&s0, scene) || prepare_again(&s0, &a0, output, sizeof output, &animated, &err) != RT_OK) {
+        if (!rt_scene_share_images(&s0, scene) ||
+            prepare_again(&s0, &a0, output, sizeof output, &animated, &err) != RT_OK) {
             if (s0.image_count < n)
                 rt_fail(&err, RT_ERR_NOMEM, "out of memory for the images of motion slice 1");
-            free_slice(&s0, n);
+            rt_scene_free(&s0);
             progress_clear(&view);
             memory_budget_report(&err, &a->budget);
             progress_view_free(&view);
             return 2;
         }
         if (animated) {
-            free_slice(scene, n); /* the images are s0's now */
+            rt_scene_free(scene); /* s0 holds the images too */
             *scene = s0;
         } else { /* nothing follows the time: the scene as first loaded, unblurred */
-            free_slice(&s0, n);
+            rt_scene_free(&s0);
         }
         if (animated && slices > 1 && (a->aovs & ((1u << AOV_VARIANCE) | (1u << AOV_SPP)))) {
             progress_clear(&view);

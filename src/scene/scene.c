@@ -146,12 +146,20 @@ void rt_scene_init(rt_scene *s)
     s->camera.vfov_deg = 40.0f;
 }
 
+/* Lets go of an image's pixels: freed unless another scene still shares them. */
+static void image_release(rt_image *img)
+{
+    if (img->shares && --*img->shares > 0)
+        return;
+    free(img->shares);
+    free(img->rgba8);
+    free(img->rgbaf);
+}
+
 void rt_scene_free(rt_scene *s)
 {
-    for (size_t i = 0; i < s->image_count; i++) {
-        free(s->images[i].rgba8);
-        free(s->images[i].rgbaf);
-    }
+    for (size_t i = 0; i < s->image_count; i++)
+        image_release(&s->images[i]);
     free(s->images);
     free(s->materials);
     free(s->textures);
@@ -198,6 +206,22 @@ uint32_t rt_scene_add_texture(rt_scene *s, const rt_texture *t)
 uint32_t rt_scene_add_image(rt_scene *s, const rt_image *img)
 {
     return table_push((void **)&s->images, &s->image_count, &s->image_cap, img, sizeof *img);
+}
+
+bool rt_scene_share_images(rt_scene *s, rt_scene *from)
+{
+    for (size_t i = 0; i < from->image_count; i++) {
+        rt_image *img = &from->images[i];
+        if (!img->shares) {
+            if (!(img->shares = malloc(sizeof *img->shares)))
+                return false;
+            *img->shares = 1;
+        }
+        if (rt_scene_add_image(s, img) == RT_NONE)
+            return false;
+        ++*img->shares;
+    }
+    return true;
 }
 
 uint32_t rt_scene_add_light(rt_scene *s, const rt_light *l)
@@ -360,10 +384,8 @@ static void truncate_to(size_t *count, size_t mark)
 
 void rt_scene_rollback(rt_scene *s, const rt_scene_mark *m)
 {
-    for (size_t i = m->images; i < s->image_count; i++) {
-        free(s->images[i].rgba8);
-        free(s->images[i].rgbaf);
-    }
+    for (size_t i = m->images; i < s->image_count; i++)
+        image_release(&s->images[i]);
     truncate_to(&s->image_count, m->images);
     truncate_to(&s->material_count, m->materials);
     truncate_to(&s->texture_count, m->textures);

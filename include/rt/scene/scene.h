@@ -115,6 +115,7 @@ typedef struct rt_image {
     uint8_t *rgba8;
     float *rgbaf;
     char name[256]; /* path or "file.glb#image3", for messages and caching */
+    int *shares;    /* NULL: the pixels are this scene's; else how many scenes hold them (rt_scene_share_images) */
 } rt_image;
 
 /* A texture: which image, how it is sampled, or a procedural pattern. */
@@ -361,6 +362,11 @@ uint32_t rt_scene_find_material(const rt_scene *s, const char *name); /* RT_NONE
 uint32_t rt_scene_add_texture(rt_scene *s, const rt_texture *t);
 uint32_t rt_scene_add_image(rt_scene *s, const rt_image *img); /* takes ownership of the pixels */
 uint32_t rt_scene_add_light(rt_scene *s, const rt_light *l);
+/* Appends every image of `from` to s, sharing the decoded pixels (counted:
+ * the last scene freed frees them), so loading the same files into s finds
+ * them decoded (motion-blur slices, rt/job/motion.h). false when out of
+ * memory: s keeps the images shared so far, freed with it. */
+bool rt_scene_share_images(rt_scene *s, rt_scene *from);
 uint32_t rt_scene_add_camera(rt_scene *s, const rt_camera *c);
 uint32_t rt_scene_add_sphere(rt_scene *s, rt_vec3 center, float radius, uint32_t material);
 uint32_t rt_scene_add_quad(rt_scene *s, rt_vec3 corner, rt_vec3 edge_u, rt_vec3 edge_v, uint32_t material);
