@@ -72,7 +72,6 @@ typedef struct flag {
     const char *help;       /* lines for --help; FLAG_SETTING: the table's */
 } flag;
 
-const char *const aov_names[AOV_COUNT] = {"albedo", "normal", "depth", "position", "variance", "spp"};
 
 /* In --help order. */
 static const flag flags[] = {
@@ -566,9 +565,9 @@ int args_parse(args *a, int argc, char **argv)
             while (*s) {
                 size_t n = strcspn(s, ",");
                 int k = 0;
-                while (k < AOV_COUNT && !(strlen(aov_names[k]) == n && strncmp(s, aov_names[k], n) == 0))
+                while (k < RT_AOV_COUNT && !(strlen(rt_aov_names[k]) == n && strncmp(s, rt_aov_names[k], n) == 0))
                     k++;
-                if (k == AOV_COUNT)
+                if (k == RT_AOV_COUNT)
                     return fail_usage("%s: unknown AOV '%.*s' (albedo, normal, depth, position, variance, spp)", name,
                                       (int)n, s);
                 a->aovs |= 1u << k;
@@ -695,6 +694,31 @@ bool args_sets(const args *a, const char *name)
         if (strcmp(a->settings[i].setting->name, name) == 0)
             return true;
     return false;
+}
+
+void args_job_options(const args *a, rt_job_options *o)
+{
+    *o = (rt_job_options){.input = a->input,
+                          .threads = a->threads,
+                          .posed = a->posed,
+                          .frame_time = a->frame_time,
+                          .animation = a->animation,
+                          .exposure_ev = a->exposure_ev,
+                          .tonemap = a->tonemap,
+                          .half = a->half,
+                          .denoise = a->denoise,
+                          .denoise_quality = a->denoise_quality,
+                          .aovs = a->aovs,
+                          .output_is_part = args_output_is_part(a),
+                          .has_crop = a->has_crop,
+                          .crop = {a->crop[0], a->crop[1], a->crop[2], a->crop[3]},
+                          .part_index = a->part_index,
+                          .part_count = a->part_count,
+                          .has_spp_range = a->has_spp_range,
+                          .spp_begin = a->spp_begin,
+                          .spp_end = a->spp_end,
+                          .resume = a->resume,
+                          .part_out = a->part_out};
 }
 
 rt_result args_apply_settings(const args *a, rt_scene *s, rt_error *err)

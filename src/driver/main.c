@@ -53,8 +53,8 @@
 #include "info.h"
 #include "input.h"
 #include "rt/job/motion.h"
-#include "output.h"
-#include "part.h"
+#include "rt/job/output.h"
+#include "rt/job/part_job.h"
 #include "progress.h"
 #include "tev.h"
 #include "viewer.h"
@@ -220,10 +220,12 @@ static rt_result prepare(rt_scene *scene, const args *a, char *output, size_t si
  * incomplete tiled image, and --part-out's part; says so; returns the exit
  * status (128 + the signal that stopped it, 2 on an error, else 0: also
  * when the window was closed). */
-static int write_result(const args *a, const rt_settings *set, const part_job *pj, rt_result r,
-                        const rt_render_stats *rsp, rt_framebuffer *fb, output_aovs *aov, const char *output,
+static int write_result(const args *a, const rt_settings *set, const rt_part_job *pj, rt_result r,
+                        const rt_render_stats *rsp, rt_framebuffer *fb, rt_job_aovs *aov, const char *output,
                         progress_view *view, double t_start, rt_error *err)
 {
+    rt_job_options jo;
+    args_job_options(a, &jo);
     const rt_render_stats rs = *rsp;
     int status = 0;
     if (r != RT_OK && r != RT_ERR_INTERRUPTED) {
@@ -249,7 +251,7 @@ static int write_result(const args *a, const rt_settings *set, const part_job *p
             fprintf(stderr, "rt: stopped before any %s finished (%s); no part written, %s left as it was%s\n",
                     rs.passes ? "pass" : "tile", reason ? reason : "?", output,
                     rs.passes ? "" : " (a tiled part keeps nothing when stopped: render parts in --passes N)");
-        } else if (part_job_write(pj, output, rs.samples_done, &write_temp, err) != RT_OK) {
+        } else if (rt_part_job_write(pj, output, rs.samples_done, &write_temp, err) != RT_OK) {
             memory_budget_report(err, &a->budget);
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
@@ -271,7 +273,7 @@ static int write_result(const args *a, const rt_settings *set, const part_job *p
         if (rs.partial && rs.tiles_done == 0) {
             fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s left as it was\n",
                     rs.passes ? "pass" : "tile", reason ? reason : "?", output);
-        } else if (output_write(a, set, fb, aov, target, &write_temp, err) != RT_OK) {
+        } else if (rt_job_output_write(&jo, set, fb, aov, target, &write_temp, err) != RT_OK) {
             memory_budget_report(err, &a->budget);
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
@@ -285,7 +287,7 @@ static int write_result(const args *a, const rt_settings *set, const part_job *p
             fprintf(stderr, "rt: %s: no part written: %s\n", a->part_out,
                     rs.passes ? "no pass finished"
                               : "a render in tiles keeps no part when stopped (--passes 0 asked for tiles)");
-        else if (part_job_write(pj, a->part_out, rs.samples_done, &write_temp, err) != RT_OK) {
+        else if (rt_part_job_write(pj, a->part_out, rs.samples_done, &write_temp, err) != RT_OK) {
             memory_budget_report(err, &a->budget);
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL || stopped)
@@ -327,7 +329,7 @@ static rt_result prepare_again(rt_scene *scene, const args *a, char *output, siz
  * integrator would tile (direct, whitted), so that a stop by --time-limit,
  * Ctrl-C or SIGTERM keeps the passes it finished (pixels are the same for
  * any pass split). */
-static int pass_samples_for(const args *a, const part_job *pj, const rt_scene *scene)
+static int pass_samples_for(const args *a, const rt_part_job *pj, const rt_scene *scene)
 {
     if (a->pass_samples)
         return a->pass_samples;
@@ -337,7 +339,7 @@ static int pass_samples_for(const args *a, const part_job *pj, const rt_scene *s
 }
 
 static rt_result render_slices(rt_scene *scene, const rt_kdtree *tree, const args *a, int slices,
-                               const part_job *pj, rt_render_options *ro, rt_framebuffer *fb, rt_render_stats *rs,
+                               const rt_part_job *pj, rt_render_options *ro, rt_framebuffer *fb, rt_render_stats *rs,
                                progress_view *view, rt_error *err)
 {
     rt_result r = RT_OK;
@@ -438,6 +440,8 @@ static rt_result render_slices(rt_scene *scene, const rt_kdtree *tree, const arg
 static int render_and_write(rt_scene *scene, const args *a, int slices, const char *output,
                             progress_view *view, double t_start)
 {
+    rt_job_options jo;
+    args_job_options(a, &jo);
     const rt_settings *set = &scene->settings;
     rt_error err = {0};
     rt_kdtree tree;
@@ -454,9 +458,9 @@ static int render_and_write(rt_scene *scene, const args *a, int slices, const ch
             tree.stats.build_ms, tree.stats.nodes, tree.stats.leaves, tree.stats.empty_leaves, tree.stats.prim_refs,
             tree.stats.depth, tree.stats.wide_nodes, (double)tree.stats.bytes / (1024.0 * 1024.0));
 
-    part_job pj;
-    if (part_job_init(&pj, a, scene, &tree, &err) != RT_OK) {
-        part_job_free(&pj); /* whatever a failed --resume had taken from its part */
+    rt_part_job pj;
+    if (rt_part_job_init(&pj, &jo, scene, &tree, &err) != RT_OK) {
+        rt_part_job_free(&pj); /* whatever a failed --resume had taken from its part */
         progress_clear(view);
         memory_budget_report(&err, &a->budget);
         rt_kdtree_free(&tree);
@@ -466,7 +470,7 @@ static int render_and_write(rt_scene *scene, const args *a, int slices, const ch
         progress_clear(view);
         fprintf(stderr, "rt: %s: a part is written as .exr or .pfm (with %s.json beside it), not as an 8-bit image\n",
                 output, output);
-        part_job_free(&pj);
+        rt_part_job_free(&pj);
         rt_kdtree_free(&tree);
         return 2;
     }
@@ -477,7 +481,7 @@ static int render_and_write(rt_scene *scene, const args *a, int slices, const ch
     if (aov_part) {
         progress_clear(view);
         fprintf(stderr, "rt: %s: a part with AOVs is written as .exr (their sums are layers of it)\n", aov_part);
-        part_job_free(&pj);
+        rt_part_job_free(&pj);
         rt_kdtree_free(&tree);
         return 2;
     }
@@ -489,17 +493,17 @@ static int render_and_write(rt_scene *scene, const args *a, int slices, const ch
     if (rt_framebuffer_init(&fb, pj.region.x1 - pj.region.x0, pj.region.y1 - pj.region.y0, &err) != RT_OK) {
         progress_clear(view);
         memory_budget_report(&err, &a->budget);
-        part_job_free(&pj);
+        rt_part_job_free(&pj);
         rt_kdtree_free(&tree);
         return 2;
     }
 
-    output_aovs aov;
-    if (output_aovs_init(&aov, a, fb.width, fb.height, &err) != RT_OK) {
+    rt_job_aovs aov;
+    if (rt_job_aovs_init(&aov, &jo, fb.width, fb.height, &err) != RT_OK) {
         progress_clear(view);
         memory_budget_report(&err, &a->budget);
         rt_framebuffer_free(&fb);
-        part_job_free(&pj);
+        rt_part_job_free(&pj);
         rt_kdtree_free(&tree);
         return 2;
     }
@@ -511,9 +515,9 @@ static int render_and_write(rt_scene *scene, const args *a, int slices, const ch
         if (!window_open(&window, fb.width, fb.height, title, why, sizeof why)) {
             progress_clear(view);
             fprintf(stderr, "rt: --window: cannot open a window: %s\n", why);
-            output_aovs_free(&aov);
+            rt_job_aovs_free(&aov);
             rt_framebuffer_free(&fb);
-            part_job_free(&pj);
+            rt_part_job_free(&pj);
             rt_kdtree_free(&tree);
             return 2;
         }
@@ -537,8 +541,8 @@ static int render_and_write(rt_scene *scene, const args *a, int slices, const ch
     tev_stream tev;
     if (a->display_server) {
         const char *base = strrchr(output, '/');
-        rt_image_layer layers[AOV_COUNT];
-        int nl = output_aovs_layers(&aov, layers, AOV_COUNT); /* --aov: extra layers in tev */
+        rt_image_layer layers[RT_AOV_COUNT];
+        int nl = rt_job_aovs_layers(&aov, layers, RT_AOV_COUNT); /* --aov: extra layers in tev */
         tev_stream_open(&tev, a->display_server, base ? base + 1 : output, fb.width, fb.height, layers, nl);
         view->tev = &tev;
     }
@@ -551,7 +555,7 @@ static int render_and_write(rt_scene *scene, const args *a, int slices, const ch
     ro.cancel = &render_stop;
     ro.progress = view->bar || view->preview_path || view->tev || view->window ? progress_report : NULL;
     ro.progress_user = view;
-    ro.aov = output_aovs_for_render(&aov);
+    ro.aov = rt_job_aovs_for_render(&aov);
     ro.region = pj.region;
     ro.sample_begin = pj.s_begin;
     ro.sample_end = pj.s_end;
@@ -580,7 +584,7 @@ static int render_and_write(rt_scene *scene, const args *a, int slices, const ch
     rt_result r;
     int status = 0;
     if (slices > 1) { /* motion blur: the slices after the first, each posed and with its own tree */
-        if (!pj.need_accum && part_job_accum(&pj, ro.aov != NULL, &err) != RT_OK) {
+        if (!pj.need_accum && rt_part_job_accum(&pj, ro.aov != NULL, &err) != RT_OK) {
             progress_clear(view);
             memory_budget_report(&err, &a->budget);
             r = RT_ERR_NOMEM;
@@ -626,9 +630,9 @@ static int render_and_write(rt_scene *scene, const args *a, int slices, const ch
         window_close(&window);
     view->window = NULL;
     view->viewer = NULL;
-    output_aovs_free(&aov);
+    rt_job_aovs_free(&aov);
     rt_framebuffer_free(&fb);
-    part_job_free(&pj);
+    rt_part_job_free(&pj);
     rt_kdtree_free(&tree);
     return status;
 }
@@ -679,7 +683,7 @@ static int render_one(rt_scene *scene, const args *a, double t_start)
         } else { /* nothing follows the time: the scene as first loaded, unblurred */
             rt_scene_free(&s0);
         }
-        if (animated && slices > 1 && (a->aovs & ((1u << AOV_VARIANCE) | (1u << AOV_SPP)))) {
+        if (animated && slices > 1 && (a->aovs & ((1u << RT_AOV_VARIANCE) | (1u << RT_AOV_SPP)))) {
             progress_clear(&view);
             fprintf(stderr, "rt: --aov variance and spp are not kept over the slices of a motion-blurred render "
                             "(the camera's shutter is open over animated models)\n");
@@ -711,7 +715,9 @@ int main(int argc, char **argv)
         return info_print(&a);
 
     rt_error err = {0};
-    if (output_check(&a, &err) != RT_OK) {
+    rt_job_options jo;
+    args_job_options(&a, &jo);
+    if (rt_job_output_check(&jo, &err) != RT_OK) {
         fprintf(stderr, "rt: %s\n", err.message);
         return 2;
     }

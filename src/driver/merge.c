@@ -13,8 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "output.h"
-#include "part.h"
+#include "rt/job/output.h"
+#include "rt/job/part_job.h"
 #include "rt/base/alloc.h"
 #include "rt/base/file.h"
 #include "rt/base/number.h"
@@ -135,9 +135,9 @@ int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs)
         }
     }
     rt_framebuffer fb = {0};
-    output_aovs aov;
+    rt_job_aovs aov;
     memset(&aov, 0, sizeof aov);
-    args oa; /* what output_write reads: the AOVs, the tone flags */
+    rt_job_options oa; /* what the output reads: the AOVs, the tone flags */
     memset(&oa, 0, sizeof oa);
     oa.exposure_ev = ev;
     oa.tonemap = tm;
@@ -145,16 +145,16 @@ int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs)
     if (status == 0) {
         const rt_part_info *first = &m.parts[0].info;
         for (int l = 0; l < first->layer_count; l++)
-            for (int k = 0; k < AOV_COUNT; k++)
-                if (strcmp(aov_names[k], first->layer_name[l]) == 0)
+            for (int k = 0; k < RT_AOV_COUNT; k++)
+                if (strcmp(rt_aov_names[k], first->layer_name[l]) == 0)
                     oa.aovs |= 1u << k;
         if (rt_framebuffer_init(&fb, first->width, first->height, &err) != RT_OK ||
-            output_aovs_init(&aov, &oa, first->width, first->height, &err) != RT_OK) {
+            rt_job_aovs_init(&aov, &oa, first->width, first->height, &err) != RT_OK) {
             fprintf(errs, "rt: merge: out of memory for a %dx%d image\n", first->width, first->height);
             status = 2;
         }
     }
-    if (status == 0 && rt_merge_image(&m, &fb, output_aovs_for_render(&aov), &err) != RT_OK) {
+    if (status == 0 && rt_merge_image(&m, &fb, rt_job_aovs_for_render(&aov), &err) != RT_OK) {
         fprintf(errs, "rt: merge: %s\n", err.message);
         status = 2;
     }
@@ -162,7 +162,7 @@ int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs)
         rt_settings set;
         memset(&set, 0, sizeof set);
         set.exposure = m.parts[0].info.exposure;
-        if (output_write(&oa, &set, &fb, &aov, dst, NULL, &err) != RT_OK) {
+        if (rt_job_output_write(&oa, &set, &fb, &aov, dst, NULL, &err) != RT_OK) {
             fprintf(errs, "rt: merge: %s\n", err.message);
             status = 2;
         } else {
@@ -171,7 +171,7 @@ int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs)
         }
     }
     rt_framebuffer_free(&fb);
-    output_aovs_free(&aov);
+    rt_job_aovs_free(&aov);
     rt_merge_free(&m);
     free(inputs);
     return status;

@@ -1,10 +1,10 @@
-/* part.c - the driver's side of parts (part.h, docs/farm.md): the region
- * and samples the part flags ask for, the identity of a render that every
+/* part_job.c - a render job's side of parts (rt/job/part_job.h,
+ * docs/farm.md): the region and samples the part options ask for, the identity of a render that every
  * part of it carries (the FNV-1a hash of the input's bytes, the settings
  * that change pixels as "key value" lines with floats in C99 hexadecimal
  * so they compare exactly, the image size, the samples, the seed, rt's
  * version), and --resume's check that a part belongs to this render. */
-#include "part.h"
+#include "rt/job/part_job.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -14,6 +14,7 @@
 #include "rt/job/part_split.h"
 #include "rt/base/alloc.h"
 #include "rt/base/file.h"
+#include "rt/base/log.h"
 #include "rt/render/aov.h"
 #include "rt/render/integrator.h"
 
@@ -74,7 +75,7 @@ static void settings_text(const rt_scene *scene, char *buf, size_t size)
              s->motion_steps);
 }
 
-rt_result part_identity(const rt_scene *scene, const char *input, rt_part_info *info, rt_error *err)
+rt_result rt_part_identity(const rt_scene *scene, const char *input, rt_part_info *info, rt_error *err)
 {
     memset(info, 0, sizeof *info);
     snprintf(info->version, sizeof info->version, "%s", RT_VERSION);
@@ -110,14 +111,14 @@ rt_result part_identity(const rt_scene *scene, const char *input, rt_part_info *
 }
 
 /* Zeroed sums, block sums and counts (and AOV sums when aov) for n pixels. */
-static rt_result alloc_sums(part_job *pj, size_t n, bool aov, rt_error *err)
+static rt_result alloc_sums(rt_part_job *pj, size_t n, bool aov, rt_error *err)
 {
     pj->accum.sum = rt_alloc(n, 3 * sizeof(float));
     pj->accum.block = rt_alloc(n, 3 * sizeof(float));
     pj->accum.good = rt_alloc(n, sizeof(uint32_t));
     pj->accum.aov_sum = aov ? rt_alloc(n, sizeof *pj->accum.aov_sum) : NULL;
     if (!pj->accum.sum || !pj->accum.block || !pj->accum.good || (aov && !pj->accum.aov_sum)) {
-        part_job_free(pj);
+        rt_part_job_free(pj);
         return rt_fail(err, RT_ERR_NOMEM, "out of memory for the sums of %zu pixels", n);
     }
     memset(pj->accum.sum, 0, n * 3 * sizeof(float));
@@ -134,7 +135,7 @@ static rt_result alloc_sums(part_job *pj, size_t n, bool aov, rt_error *err)
  * the render keeps the finished ones in accum.kept (n pixels each), the
  * last stays in accum.block. Else the part keeps its fold and last block,
  * and merges within the bound (docs/farm.md). */
-static rt_result keep_blocks(part_job *pj, size_t n, rt_error *err)
+static rt_result keep_blocks(rt_part_job *pj, size_t n, rt_error *err)
 {
     int first = pj->part_begin / RT_SAMPLE_BLOCK, last = (pj->s_end - 1) / RT_SAMPLE_BLOCK;
     pj->keep_blocks = pj->part_begin > 0 && pj->part_begin % RT_SAMPLE_BLOCK == 0 && last - first < RT_PART_MAX_BLOCKS;
@@ -147,7 +148,7 @@ static rt_result keep_blocks(part_job *pj, size_t n, rt_error *err)
         return RT_OK;
     pj->accum.kept = rt_alloc(n * (size_t)(last - first), 3 * sizeof(float));
     if (!pj->accum.kept) {
-        part_job_free(pj);
+        rt_part_job_free(pj);
         return rt_fail(err, RT_ERR_NOMEM, "out of memory for %d block sums of %zu pixels", last - first, n);
     }
     pj->accum.kept_first = first;
@@ -155,20 +156,20 @@ static rt_result keep_blocks(part_job *pj, size_t n, rt_error *err)
     return RT_OK;
 }
 
-static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_error *err);
+static rt_result resume(rt_part_job *pj, const rt_job_options *a, const rt_settings *s, rt_error *err);
 
-rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, const rt_kdtree *tree, rt_error *err)
+rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_scene *scene, const rt_kdtree *tree, rt_error *err)
 {
     memset(pj, 0, sizeof *pj);
     const rt_settings *s = &scene->settings;
-    pj->to_part = args_output_is_part(a);
+    pj->to_part = a->output_is_part;
     pj->region = (rt_render_region){0, 0, s->width, s->height};
     pj->s_begin = 0;
     pj->s_end = s->samples;
     bool any = pj->to_part || a->resume || a->part_out;
     if (!any)
         return RT_OK;
-    rt_result r = part_identity(scene, a->input, &pj->info, err);
+    rt_result r = rt_part_identity(scene, a->input, &pj->info, err);
     if (r != RT_OK)
         return r;
     if (a->posed) /* the pose changes pixels: frame time and animation are settings of the render */
@@ -193,16 +194,16 @@ rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, cons
     }
     pj->part_begin = pj->s_begin;
     if ((pj->to_part || a->resume || a->part_out) &&
-        (a->denoise || (a->aovs & ((1u << AOV_VARIANCE) | (1u << AOV_SPP)))))
+        (a->denoise || (a->aovs & ((1u << RT_AOV_VARIANCE) | (1u << RT_AOV_SPP)))))
         return rt_fail(err, RT_ERR_INVALID,
                        "parts keep the albedo, normal, depth and position AOVs; not the variance or spp AOVs, nor "
                        "--denoise (merge the parts, then denoise the image)");
-    /* the AOV sums a part carries: its layers, in aov_names order */
-    for (int k = 0; k < AOV_COUNT; k++)
+    /* the AOV sums a part carries: its layers, in rt_aov_names order */
+    for (int k = 0; k < RT_AOV_COUNT; k++)
         if (a->aovs & (1u << k)) {
             rt_part_info *in = &pj->info;
-            snprintf(in->layer_name[in->layer_count], sizeof in->layer_name[0], "%s", aov_names[k]);
-            in->layer_channels[in->layer_count++] = k == AOV_DEPTH ? 1 : 3;
+            snprintf(in->layer_name[in->layer_count], sizeof in->layer_name[0], "%s", rt_aov_names[k]);
+            in->layer_channels[in->layer_count++] = k == RT_AOV_DEPTH ? 1 : 3;
         }
     size_t n = (size_t)(pj->region.x1 - pj->region.x0) * (size_t)(pj->region.y1 - pj->region.y0);
     pj->need_accum = true;
@@ -213,8 +214,8 @@ rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, cons
     return keep_blocks(pj, n, err);
 }
 
-/* part_job_init for --resume: the region, samples and sums of the part. */
-static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_error *err)
+/* rt_part_job_init for --resume: the region, samples and sums of the part. */
+static rt_result resume(rt_part_job *pj, const rt_job_options *a, const rt_settings *s, rt_error *err)
 {
     rt_result r;
     rt_part p;
@@ -250,7 +251,7 @@ static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_er
     pj->accum.block = rt_alloc(np, 3 * sizeof(float));
     if (!pj->accum.block) {
         rt_part_free(&p);
-        part_job_free(pj);
+        rt_part_job_free(pj);
         return rt_fail(err, RT_ERR_NOMEM, "out of memory for the sums of %s", a->resume);
     }
     memcpy(pj->accum.block, p.blocks + (size_t)(nb - 1) * 3 * np, np * 3 * sizeof(float));
@@ -277,13 +278,13 @@ static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_er
     return RT_OK;
 }
 
-rt_result part_job_accum(part_job *pj, bool aov, rt_error *err)
+rt_result rt_part_job_accum(rt_part_job *pj, bool aov, rt_error *err)
 {
     size_t n = (size_t)(pj->region.x1 - pj->region.x0) * (size_t)(pj->region.y1 - pj->region.y0);
     return alloc_sums(pj, n, aov, err);
 }
 
-void part_job_free(part_job *pj)
+void rt_part_job_free(rt_part_job *pj)
 {
     free(pj->accum.sum);
     free(pj->accum.block);
@@ -293,7 +294,7 @@ void part_job_free(part_job *pj)
     memset(&pj->accum, 0, sizeof pj->accum);
 }
 
-rt_result part_job_write(const part_job *pj, const char *path, int samples_done, rt_write_temp *temp, rt_error *err)
+rt_result rt_part_job_write(const rt_part_job *pj, const char *path, int samples_done, rt_write_temp *temp, rt_error *err)
 {
     rt_part_info info = pj->info;
     info.x0 = pj->region.x0;
