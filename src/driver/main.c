@@ -53,6 +53,7 @@
 #include "info.h"
 #include "input.h"
 #include "rt/job/motion.h"
+#include "rt/job/slices.h"
 #include "rt/job/output.h"
 #include "rt/job/part_job.h"
 #include "progress.h"
@@ -311,126 +312,35 @@ static rt_result prepare_again(rt_scene *scene, const args *a, char *output, siz
     return r;
 }
 
-/* A motion slice's scene starts with slice 0's decoded images, shared
- * (rt_scene_share_images: counted, the last scene freed frees them; the
- * loaders find an image by its name before decoding it, so the slice's
- * textures point at the same images, at the same indices): a slice costs
- * its geometry, not another decode of every texture (measured: the Fox's
- * one PNG was 2/3 of the instructions of an 8-slice render without this). */
+/* What the job's motion slices (rt/job/slices.h) ask the driver: a slice's
+ * scene loaded and prepared from the flags at its time, and the progress
+ * line told of each slice. */
+typedef struct slice_loader {
+    const args *a;
+    progress_view *view;
+} slice_loader;
 
-/* Motion blur (motion.h): slice k of `slices` renders its run of samples
- * (within the job's) into the job's sums, slice 0 with the scene and tree
- * given (posed at its time by render_one), the others loaded and built
- * here one at a time; a stop (Ctrl-C, --time-limit) ends the run at the
- * samples reached. *rs sums the slices' statistics. */
-/* Samples a pass for rt_render_options.pass_samples (0: the integrator's
- * default; -1: tiles): --passes when given; else a render that keeps a part
- * (a part output, --part-out, --resume) goes in passes of 4 even where the
- * integrator would tile (direct, whitted), so that a stop by --time-limit,
- * Ctrl-C or SIGTERM keeps the passes it finished (pixels are the same for
- * any pass split). */
-static int pass_samples_for(const args *a, const rt_part_job *pj, const rt_scene *scene)
+static rt_result load_slice(void *user, rt_scene *slice, float time, rt_error *err)
 {
-    if (a->pass_samples)
-        return a->pass_samples;
-    if (pj->need_accum && rt_integrator_info_of(scene->settings.integrator)->pass_samples <= 0)
-        return 4;
-    return 0;
+    const slice_loader *sl = user;
+    args ak = *sl->a;
+    ak.posed = true;
+    ak.frame_time = time;
+    char out[1024];
+    bool animated = false;
+    return prepare_again(slice, &ak, out, sizeof out, &animated, err);
 }
 
-static rt_result render_slices(rt_scene *scene, const rt_kdtree *tree, const args *a, int slices,
-                               const rt_part_job *pj, rt_render_options *ro, rt_framebuffer *fb, rt_render_stats *rs,
-                               progress_view *view, rt_error *err)
+static void slice_loading(void *user, int k, int slices, float time)
 {
-    rt_result r = RT_OK;
-    memset(rs, 0, sizeof *rs);
-    double t0 = rt_now_seconds();
-    float frame = a->posed ? a->frame_time : 0.0f;
-    int done_to = pj->s_begin; /* samples [pj->s_begin, done_to) are in the sums */
-    for (int k = 0; k < slices && r == RT_OK; k++) {
-        int b, e;
-        rt_motion_samples(k, slices, scene->settings.samples, &b, &e);
-        b = b > pj->s_begin ? b : pj->s_begin;
-        e = e < pj->s_end ? e : pj->s_end;
-        if (b >= e)
-            continue;
-        rt_scene sk;
-        rt_kdtree tk;
-        const rt_scene *use = scene;
-        const rt_kdtree *use_tree = tree;
-        bool own = k > 0;
-        if (own) {
-            args ak = *a;
-            ak.posed = true;
-            ak.frame_time = (float)rt_motion_time(frame, &scene->camera, k, slices);
-            char out[1024];
-            bool animated = false;
-            char detail[64];
-            snprintf(detail, sizeof detail, "slice %d of %d, t = %g s", k + 1, slices, (double)ak.frame_time);
-            progress_phase(view, "motion", detail);
-            rt_scene_init(&sk);
-            if (!rt_scene_share_images(&sk, scene)) {
-                rt_scene_free(&sk);
-                r = rt_fail(err, RT_ERR_NOMEM, "out of memory for the images of motion slice %d", k + 1);
-                break;
-            }
-            if ((r = prepare_again(&sk, &ak, out, sizeof out, &animated, err)) != RT_OK) {
-                rt_scene_free(&sk);
-                break;
-            }
-            if ((r = rt_kdtree_build(&tk, &sk, NULL, err)) != RT_OK) {
-                rt_scene_free(&sk);
-                break;
-            }
-            use = &sk;
-            use_tree = &tk;
-            progress_restart(view, rs->tiles_total);
-        }
-        rt_render_stats st;
-        memset(&st, 0, sizeof st);
-        ro->sample_begin = b;
-        ro->sample_end = e;
-        /* tiles would leave a stopped slice with some pixels further on than
-         * others, which the sums of a part (or --resume) cannot say: a slice
-         * is rendered in passes (the same bytes), one pass of all its
-         * samples where tiles were asked for */
-        int pass = pass_samples_for(a, pj, scene);
-        if (pass == 0)
-            pass = rt_integrator_info_of(scene->settings.integrator)->pass_samples;
-        if (pass <= 0)
-            ro->pass_samples = e - b;
-        if (a->time_limit > 0.0) { /* what is left of it */
-            ro->time_limit = a->time_limit - (rt_now_seconds() - t0);
-            if (ro->time_limit <= 0.0)
-                ro->time_limit = 1e-9;
-        }
-        r = rt_render(use, use_tree, ro, fb, &st, err);
-        rt_info("motion: slice %d of %d (t = %g s): samples %d:%d, %.3f s", k + 1, slices,
-                rt_motion_time(frame, &scene->camera, k, slices), b, e, st.seconds);
-        if (own) {
-            rt_kdtree_free(&tk);
-            rt_scene_free(&sk);
-        }
-        int reached = st.partial ? b : b + st.samples_done;
-        rs->seconds += st.seconds;
-        rs->rays += st.rays;
-        rs->camera_rays += st.camera_rays;
-        rs->bad_samples += st.bad_samples;
-        rs->threads = st.threads;
-        rs->passes = st.passes;
-        rs->tiles_total = st.tiles_total;
-        rs->tiles_done = st.tiles_done;
-        rs->time_limited = st.time_limited;
-        rs->partial = st.partial && done_to == pj->s_begin; /* nothing whole yet */
-        done_to = reached;
-        if (r == RT_OK && !st.time_limited && a->time_limit > 0.0 && k + 1 < slices &&
-            rt_now_seconds() - t0 >= a->time_limit) /* a slice is a pass: stop after the one that crossed it */
-            rs->time_limited = true;
-        if (r == RT_OK && rs->time_limited)
-            break;
-    }
-    rs->samples_done = done_to - pj->s_begin;
-    return r;
+    char detail[64];
+    snprintf(detail, sizeof detail, "slice %d of %d, t = %g s", k + 1, slices, (double)time);
+    progress_phase(((const slice_loader *)user)->view, "motion", detail);
+}
+
+static void slice_rendering(void *user, int tiles_total)
+{
+    progress_restart(((const slice_loader *)user)->view, tiles_total);
 }
 
 /* Builds the kd-tree, renders (Ctrl-C and SIGTERM stop the workers, as
@@ -550,7 +460,7 @@ static int render_and_write(rt_scene *scene, const args *a, int slices, const ch
     memset(&ro, 0, sizeof ro);
     ro.threads = a->threads;
     ro.tile_size = a->tile;
-    ro.pass_samples = pass_samples_for(a, &pj, scene);
+    ro.pass_samples = rt_job_pass_samples(a->pass_samples, pj.need_accum, scene->settings.integrator);
     ro.time_limit = a->time_limit;
     ro.cancel = &render_stop;
     ro.progress = view->bar || view->preview_path || view->tev || view->window ? progress_report : NULL;
@@ -590,7 +500,12 @@ static int render_and_write(rt_scene *scene, const args *a, int slices, const ch
             r = RT_ERR_NOMEM;
         } else {
             ro.accum = &pj.accum;
-            r = render_slices(scene, &tree, a, slices, &pj, &ro, &fb, &rs, view, &err);
+            slice_loader sl = {a, view};
+            rt_job_slices plan = {.slices = slices, .frame_time = a->posed ? a->frame_time : 0.0f,
+                                  .s_begin = pj.s_begin, .s_end = pj.s_end, .pass_samples = ro.pass_samples,
+                                  .time_limit = a->time_limit, .load = load_slice, .loading = slice_loading,
+                                  .rendering = slice_rendering, .user = &sl};
+            r = rt_job_render_slices(scene, &tree, &plan, &ro, &fb, &rs, &err);
         }
         status = r == RT_ERR_NOMEM ? 2 : write_result(a, set, &pj, r, &rs, &fb, &aov, output, view, t_start, &err);
         written = true;
