@@ -14,54 +14,9 @@
 #include "rt/image/tonemap.h"
 #include "rt/io/framebuffer.h"
 #include "rt/io/load.h"
-#include "rt/render/camera.h"
+#include "rt/job/frame.h"
 #include "rt/render/integrator.h"
-#include "rt/render/limits.h"
 #include "rt/scene/validate.h"
-
-/* --look-from, --look-at, --up, --fov over the file's or the framed camera;
- * a camera they leave degenerate is an error naming them. */
-static rt_result apply_pose_flags(rt_scene *scene, const args *a, rt_error *err)
-{
-    if (!a->has_look_from && !a->has_look_at && !a->has_up && !a->has_fov)
-        return RT_OK;
-    rt_camera *c = &scene->camera;
-    char given[512] = "", v[128];
-    if (a->has_look_from) {
-        snprintf(v, sizeof v, " --look-from %g,%g,%g", a->look_from.x, a->look_from.y, a->look_from.z);
-        strncat(given, v, sizeof given - strlen(given) - 1);
-    }
-    if (a->has_look_at) {
-        snprintf(v, sizeof v, " --look-at %g,%g,%g", a->look_at.x, a->look_at.y, a->look_at.z);
-        strncat(given, v, sizeof given - strlen(given) - 1);
-    }
-    if (a->has_up) {
-        snprintf(v, sizeof v, " --up %g,%g,%g", a->up.x, a->up.y, a->up.z);
-        strncat(given, v, sizeof given - strlen(given) - 1);
-    }
-    if (a->has_fov) {
-        snprintf(v, sizeof v, " --fov %g", a->fov);
-        strncat(given, v, sizeof given - strlen(given) - 1);
-    }
-    if (a->has_look_from)
-        c->position = a->look_from;
-    if (a->has_look_at)
-        c->look_at = a->look_at;
-    if (a->has_up)
-        c->up = a->up;
-    if (a->has_fov)
-        c->vfov_deg = a->fov;
-    if (a->has_look_from || a->has_look_at)
-        c->focus_distance = 0.0f; /* the distance to look_at, which moved */
-    rt_camera_frame cf;
-    if (!rt_camera_frame_init(&cf, c, scene->settings.width, scene->settings.height))
-        return rt_fail(err, RT_ERR_INVALID,
-                       "%s: the camera is degenerate (the position equals the point looked at, or up is parallel "
-                       "to the view direction)",
-                       given + 1);
-    scene->camera_set = true;
-    return RT_OK;
-}
 
 /* The loaded scene as the flags want it: setting flags applied, --camera
  * chosen, a glTF camera fitted to the image, the camera framed when the
@@ -100,27 +55,10 @@ rt_result prepare_scene(rt_scene *scene, const args *a, char *output, size_t siz
     if ((r = args_apply_settings(a, scene, err)) != RT_OK)
         return r;
     rt_settings *set = &scene->settings;
-    if (a->camera >= 0) {
-        if ((size_t)a->camera >= scene->camera_count)
-            return rt_fail(err, RT_ERR_INVALID, "--camera %d: the loaded models have %zu camera%s", a->camera,
-                           scene->camera_count, scene->camera_count == 1 ? "" : "s");
-        scene->camera = scene->cameras[a->camera];
-        scene->camera_set = true;
-    }
-    if (a->camera_auto) { /* ignore the file's camera: frame the scene below */
-        scene->camera_set = false;
-        scene->camera.aspect_ratio = 0.0f;
-    }
-    /* a glTF camera made for another aspect ratio: keep the height, fit the width */
-    if (!args_sets(a, "resolution") && a->input && info.kind == RT_LOAD_GLTF && scene->camera_set &&
-        scene->camera.aspect_ratio > 0.0f)
-        set->width = input_width_for_aspect(set->height, scene->camera.aspect_ratio);
-    bool camera_from_input = scene->camera_set;
-    if (!scene->camera_set)
-        rt_scene_frame_camera(scene);
-    if ((r = apply_pose_flags(scene, a, err)) != RT_OK)
-        return r;
-    if ((r = rt_render_check_limits(scene, input_name(a->input), camera_from_input, err)) != RT_OK)
+    rt_job_options jo;
+    args_job_options(a, &jo);
+    jo.fit_aspect = !args_sets(a, "resolution") && a->input && info.kind == RT_LOAD_GLTF;
+    if ((r = rt_job_frame(scene, &jo, input_name(a->input), err)) != RT_OK)
         return r;
 
     if (a->output)

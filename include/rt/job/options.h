@@ -12,6 +12,7 @@
 
 #include <stdbool.h>
 
+#include "rt/base/vec.h"
 #include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
 
@@ -36,6 +37,14 @@ typedef struct rt_job_options {
     bool posed;             /* posed at frame_time with animation (an animated glTF) */
     float frame_time;
     int animation;
+    /* the view (rt_job_frame) */
+    bool use_camera;        /* camera `camera` of the loaded models' cameras */
+    int camera;
+    bool camera_auto;       /* frame the scene, ignoring the file's camera */
+    bool fit_aspect;        /* a camera made for another aspect ratio (glTF) keeps the height, fits the width */
+    bool has_look_from, has_look_at, has_up, has_fov; /* each replaces one part of the camera */
+    rt_vec3 look_from, look_at, up;
+    float fov;
     /* output */
     float exposure_ev;      /* stops for 8-bit output, on top of the scene's exposure */
     rt_tonemap tonemap;     /* the curve for 8-bit output */
