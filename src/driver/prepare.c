@@ -1,8 +1,8 @@
 /* prepare.c - the `rt` command's flags applied to a scene (prepare.h): the
  * input loaded (input.c), validated, the setting flags applied (args.c),
- * --camera chosen, a glTF camera fitted to the image, the camera framed
- * when the input has none, --look-from/--look-at/--up/--fov, the limits
- * checked (rt_render_check_limits), the output path chosen and checked,
+ * the view framed by the job stage from the camera flags (rt_job_frame:
+ * --camera, a glTF camera fitted to the image, framing, --look-from,
+ * --look-at, --up, --fov, the limits), the output path chosen and checked,
  * and the -v lines about the scene. */
 #include "prepare.h"
 
@@ -18,9 +18,8 @@
 #include "rt/render/integrator.h"
 #include "rt/scene/validate.h"
 
-/* The loaded scene as the flags want it: setting flags applied, --camera
- * chosen, a glTF camera fitted to the image, the camera framed when the
- * input has none, the limits checked, the output path chosen and checked. */
+/* The loaded scene as the flags want it: setting flags applied, the view
+ * framed (rt_job_frame), the output path chosen and checked. */
 rt_result prepare_scene(rt_scene *scene, const args *a, char *output, size_t size, bool *animated, rt_error *err)
 {
     rt_load_info info;
