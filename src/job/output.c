@@ -103,8 +103,8 @@ static rt_result write_aov_file(const float *data, int channels, int w, int h, c
     return r;
 }
 
-rt_result rt_job_output_write(const rt_job_options *a, const rt_settings *set, rt_framebuffer *fb, const rt_job_aovs *aov,
-                       const char *path, rt_write_temp *temp, rt_error *err)
+rt_result rt_job_output_write(const rt_job_options *a, const rt_settings *set, rt_framebuffer *fb,
+                              const rt_job_aovs *aov, const char *path, rt_write_temp *temp, rt_error *err)
 {
     rt_image_options opt = {.exposure = set->exposure * rt_exposure_scale(a->exposure_ev), .tonemap = a->tonemap,
                             .half = a->half};

@@ -158,7 +158,8 @@ static rt_result keep_blocks(rt_part_job *pj, size_t n, rt_error *err)
 
 static rt_result resume(rt_part_job *pj, const rt_job_options *a, const rt_settings *s, rt_error *err);
 
-rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_scene *scene, const rt_kdtree *tree, rt_error *err)
+rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_scene *scene, const rt_kdtree *tree,
+                           rt_error *err)
 {
     memset(pj, 0, sizeof *pj);
     const rt_settings *s = &scene->settings;
@@ -294,7 +295,8 @@ void rt_part_job_free(rt_part_job *pj)
     memset(&pj->accum, 0, sizeof pj->accum);
 }
 
-rt_result rt_part_job_write(const rt_part_job *pj, const char *path, int samples_done, rt_write_temp *temp, rt_error *err)
+rt_result rt_part_job_write(const rt_part_job *pj, const char *path, int samples_done, rt_write_temp *temp,
+                            rt_error *err)
 {
     rt_part_info info = pj->info;
     info.x0 = pj->region.x0;

@@ -32,7 +32,7 @@ typedef enum rt_aov_kind {
 extern const char *const rt_aov_names[RT_AOV_COUNT];
 
 typedef struct rt_job_options {
-    const char *input;      /* the scene or model file (its bytes are a part's identity); NULL = built-in, "-" = stdin */
+    const char *input;      /* the scene or model file (its bytes: a part's identity); NULL = built-in, "-" = stdin */
     int threads;            /* 0 = all cores */
     bool posed;             /* posed at frame_time with animation (an animated glTF) */
     float frame_time;

@@ -23,10 +23,10 @@
 
 typedef struct rt_part_job {
     bool to_part;            /* the output is a part, not an image */
-    rt_render_region region; /* the pixels rendered (the whole image when no part flag) */
+    rt_render_region region; /* the pixels rendered (the whole image unless a crop or a band) */
     int s_begin, s_end;      /* the samples this run adds */
-    int part_begin;          /* the first sample the sums hold (--resume: the part's; else s_begin) */
-    bool need_accum;         /* sums kept: a part output, --part-out or --resume */
+    int part_begin;          /* the first sample the sums hold (a resumed part's; else s_begin) */
+    bool need_accum;         /* sums kept: a part output, options.part_out or options.resume */
     bool keep_blocks;        /* the part keeps each sample block apart (part_begin a block edge past 0) */
     rt_render_accum accum;   /* region-sized; zeros, or the resumed part's sums (and kept blocks) */
     rt_part_info info;       /* what the parts written are parts of (with the AOV layers) */
@@ -36,10 +36,12 @@ typedef struct rt_part_job {
  * version) into info; the region and samples are left for the caller. */
 rt_result rt_part_identity(const rt_scene *scene, const char *input, rt_part_info *info, rt_error *err);
 
-/* Plans the render from the flags (and the part --resume names), checks
- * them against the scene, allocates the sums. After a failure too, pj is
- * released with rt_part_job_free (which may be called again). */
-rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_scene *scene, const rt_kdtree *tree, rt_error *err);
+/* Plans the render from the options (and the part options.resume names),
+ * checks them against the scene, allocates the sums. After a failure too,
+ * pj is released with rt_part_job_free (which may be called again). The
+ * messages name the command-line flags the options come from. */
+rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_scene *scene, const rt_kdtree *tree,
+                           rt_error *err);
 void rt_part_job_free(rt_part_job *pj);
 /* Zeroed sums (and AOV sums when aov) for a render that is not a part but
  * is made of several rt_render calls into the same sums (motion blur's
@@ -48,6 +50,7 @@ rt_result rt_part_job_accum(rt_part_job *pj, bool aov, rt_error *err);
 
 /* Writes the sums as a part at path covering samples [part_begin, s_begin +
  * samples_done). */
-rt_result rt_part_job_write(const rt_part_job *pj, const char *path, int samples_done, rt_write_temp *temp, rt_error *err);
+rt_result rt_part_job_write(const rt_part_job *pj, const char *path, int samples_done, rt_write_temp *temp,
+                            rt_error *err);
 
 #endif
