@@ -52,8 +52,9 @@ BUILD   ?= build
 SHARED  ?= ../shared
 RT      ?= rt
 
-# The library, by pipeline stage (docs/architecture.md); the driver is src/driver.
-STAGES   := base io scene accel render image
+# The library, by pipeline stage, lowest first: each stage includes and calls
+# only the stages before it (docs/architecture.md); the driver is src/driver.
+STAGES   := base image scene accel render io job
 LIB_SRC  := $(foreach d,$(STAGES),$(wildcard src/$(d)/*.c))
 LIB_CXX  := $(foreach d,$(STAGES),$(wildcard src/$(d)/*.cc))
 LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:src/%.cc=$(BUILD)/obj/%.o)

@@ -72,3 +72,30 @@ void rt_aov_trace(const rt_trace_ctx *ctx, rt_ray ray, rt_rng *rng, rt_aov_sampl
         ray.tmax = INFINITY;
     }
 }
+
+/* The pixel's AOVs: means over its `good` samples; the variance of the mean
+ * luminance from the sample variance, sum of L^2 - (sum L)^2 / n over n - 1.
+ * Reads the accumulated sums only, so it may run after every pass. */
+void rt_aov_resolve(rt_aov_buffers *aov, size_t pixel, const rt_aov_sample *s, uint32_t good, float lum_sum,
+                      double lum_sq)
+{
+    float inv = good ? 1.0f / (float)good : 0.0f;
+    const rt_vec3 *v3[3] = {&s->albedo, &s->normal, &s->position};
+    float *dst3[3] = {aov->albedo, aov->normal, aov->position};
+    for (int k = 0; k < 3; k++)
+        if (dst3[k]) {
+            dst3[k][3 * pixel] = v3[k]->x * inv;
+            dst3[k][3 * pixel + 1] = v3[k]->y * inv;
+            dst3[k][3 * pixel + 2] = v3[k]->z * inv;
+        }
+    if (aov->depth)
+        aov->depth[pixel] = s->depth * inv;
+    if (aov->spp)
+        aov->spp[pixel] = (float)good;
+    if (aov->variance) {
+        double n = (double)good, var = 0.0;
+        if (good > 1)
+            var = (lum_sq - (double)lum_sum * (double)lum_sum / n) / (n - 1.0) / n;
+        aov->variance[pixel] = (float)(var > 0.0 ? var : 0.0);
+    }
+}
