@@ -20,7 +20,6 @@
 
 #include "rt/base/file.h"
 #include "rt/base/number.h"
-#include "rt/io/image_load.h"
 #include "rt/render/integrator.h"
 
 #define MAX_PATH_LEN 4096 /* the scene format's limit on file paths */
