@@ -118,14 +118,14 @@ $(BUILD)/tests/test_corpus: tests/test_corpus.c tests/fuzz/harness.c tests/fuzz/
 	$(CC) $(CFLAGS) -Itests -o $@ tests/test_corpus.c tests/fuzz/harness.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # rt compare's driver code is tested in-process
-$(BUILD)/tests/test_compare: tests/test_compare.c src/driver/compare.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
+$(BUILD)/tests/test_compare: tests/test_compare.c src/driver/cmd_compare.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -Itests -o $@ tests/test_compare.c src/driver/compare.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+	$(CC) $(CFLAGS) -Itests -o $@ tests/test_compare.c src/driver/cmd_compare.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # rt convert's driver code is tested in-process too
-$(BUILD)/tests/test_hdr: tests/test_hdr.c src/driver/convert.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
+$(BUILD)/tests/test_hdr: tests/test_hdr.c src/driver/cmd_convert.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -Itests -o $@ tests/test_hdr.c src/driver/convert.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+	$(CC) $(CFLAGS) -Itests -o $@ tests/test_hdr.c src/driver/cmd_convert.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # the kd-tree's portable path (no AVX2), tested on machines that have AVX2 too
 TEST_BIN += $(BUILD)/tests/test_kdtree_scalar

@@ -486,10 +486,8 @@ static int parse_aovs(args *a, const char *name, const char *value)
     const char *s = value;
     while (*s) {
         size_t n = strcspn(s, ",");
-        int k = 0;
-        while (k < RT_AOV_COUNT && !(strlen(rt_aov_names[k]) == n && strncmp(s, rt_aov_names[k], n) == 0))
-            k++;
-        if (k == RT_AOV_COUNT)
+        rt_aov_kind k;
+        if (!rt_aov_by_name(s, n, &k))
             return fail_usage("%s: unknown AOV '%.*s' (albedo, normal, depth, position, variance, spp)", name, (int)n,
                               s);
         a->aovs |= 1u << k;

@@ -5,7 +5,7 @@
  * the render (render), parts, motion slices, merges and outputs (job). A
  * part of a render spread over machines (--part, --crop, --spp-range,
  * --resume, --part-out: docs/farm.md) renders its region and samples and
- * writes its sums; `rt merge` (merge.c) puts parts together.
+ * writes its sums; `rt merge` (cmd_merge.c) puts parts together.
  *
  * Exit status: 0 on success (also when --time-limit stopped the render),
  * 2 for bad input (flags, scene files, models, images, an unwritable

@@ -17,8 +17,6 @@
 #include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
 
-const char *const rt_aov_names[RT_AOV_COUNT] = {"albedo", "normal", "depth", "position", "variance", "spp"};
-
 rt_result rt_job_output_check(const rt_job_options *a, rt_error *err)
 {
     if (!a->denoise)

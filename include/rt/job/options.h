@@ -11,6 +11,7 @@
 #define RT_JOB_OPTIONS_H
 
 #include <stdbool.h>
+#include <stddef.h>
 
 #include "rt/base/vec.h"
 #include "rt/image/denoise.h"
@@ -30,6 +31,9 @@ typedef enum rt_aov_kind {
 } rt_aov_kind;
 /* Their names: "albedo", "normal", ... (--aov, EXR layers, file names). */
 extern const char *const rt_aov_names[RT_AOV_COUNT];
+/* The AOV whose name is the len bytes at name (not NUL-terminated: an
+ * item of a comma list); false when none is. */
+bool rt_aov_by_name(const char *name, size_t len, rt_aov_kind *out);
 
 typedef struct rt_job_options {
     const char *input;      /* the scene or model file (its bytes: a part's identity); NULL = built-in, "-" = stdin */

@@ -1,4 +1,4 @@
-/* merge.c - `rt merge PART... -o OUT [--exposure EV] [--tonemap NAME]
+/* cmd_merge.c - `rt merge PART... -o OUT [--exposure EV] [--tonemap NAME]
  * [--half]`: the parts of one render (docs/farm.md) into its image. The
  * flags and the output are this file's; reading the parts, checking that
  * they make one image, and the fold and resolve of their sums are the job
@@ -144,10 +144,11 @@ int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs)
     oa.half = half;
     if (status == 0) {
         const rt_part_info *first = &m.parts[0].info;
-        for (int l = 0; l < first->layer_count; l++)
-            for (int k = 0; k < RT_AOV_COUNT; k++)
-                if (strcmp(rt_aov_names[k], first->layer_name[l]) == 0)
-                    oa.aovs |= 1u << k;
+        for (int l = 0; l < first->layer_count; l++) {
+            rt_aov_kind k;
+            if (rt_aov_by_name(first->layer_name[l], strlen(first->layer_name[l]), &k))
+                oa.aovs |= 1u << k;
+        }
         if (rt_framebuffer_init(&fb, first->width, first->height, &err) != RT_OK ||
             rt_job_aovs_init(&aov, &oa, first->width, first->height, &err) != RT_OK) {
             fprintf(errs, "rt: merge: out of memory for a %dx%d image\n", first->width, first->height);
