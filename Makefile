@@ -152,6 +152,7 @@ $(OIDN_VENV)/.installed:
 # not in SKIPS_ALLOWED fails the run (tests/run.sh).
 SKIPS_ALLOWED ?=
 test: $(RT) $(TEST_BIN)
+	@sh tools/check-stages.sh
 	@RT_SHARED=$(SHARED) RT_BIN=./$(RT) RT_SKIPS_ALLOWED="$(SKIPS_ALLOWED)" sh tests/run.sh $(TEST_BIN)
 
 # The tests a sanitizer build cannot run, and why (each skips saying so):
