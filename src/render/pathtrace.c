@@ -53,8 +53,17 @@
  *
  * Area lights are pure emitters: their visible quad emits from its front
  * and reflects nothing. Shadow rays pass alpha cut-outs and blended
- * surfaces (times 1 - alpha); refractive (transmissive) surfaces block them,
- * light through glass arrives by BSDF sampling. Alpha blending on camera
+ * surfaces (times 1 - alpha), and smooth thin-walled panes (glTF
+ * transmission without a volume, roughness 0) times the weight of their
+ * straight-through delta lobe (rt_path_shadow); a BSDF-sampled path that
+ * takes that lobe passes the pane without making it the vertex its MIS
+ * weights refer to (prev_p, prev_pdf, prev_delta stay), so light beyond
+ * it is weighed against the light sampling of the vertex before, whose
+ * shadow ray passed the same pane (as pbrt-v4 skips interface materials,
+ * keeping the previous interaction for MIS; a pass is no bounce for
+ * max_depth). Other refractive
+ * (transmissive) surfaces block them: light through glass that bends or
+ * blurs arrives by BSDF sampling. Alpha blending on camera
  * and bounce rays is stochastic: the surface is kept with probability alpha.
  * All random numbers come from the rng handed in, so images do not depend
  * on the thread count; every contribution is checked finite. The light,
