@@ -52,7 +52,7 @@ enum lane_status {
 };
 
 enum { KIND_BUCKETS = 8 }; /* material kinds (rt_bsdf_model) sorted apart; more fold into the last */
-/* light-sampling records a batch holds at most (about 80 bytes each with
+/* light-sampling records a batch holds at most (about 90 bytes each with
  * their shadow rays): the batch shrinks in scenes with many lights */
 #define MAX_RECORDS ((size_t)1 << 18)
 
