@@ -533,6 +533,7 @@ static bool delta_sample(rt_bsdf_sample *s, rt_vec3 wi, rt_vec3 w)
     s->weight = w;
     s->pdf = 0.0f;
     s->delta = true;
+    s->straight = false;
     return rt_finite3(wi) && rt_finite3(w) && rt_max3(w) > 0.0f;
 }
 
@@ -554,7 +555,9 @@ static bool thin_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, rt_vec3 c, fl
     float g = b->delta ? 1.0f : rt_ggx_g2(wo, r, b->alpha) / rt_ggx_g1(wo, b->alpha);
     float f = b->transmission > 0.0f ? rt_fresnel_exact(ci, b->eta) : 0.0f;
     rt_vec3 wi = rt_normalize(rt_v3(r.x, r.y, -r.z));
-    return delta_sample(s, wi, rt_scale(c, (1.0f - f) * g * b->transmission * scale));
+    bool ok = delta_sample(s, wi, rt_scale(c, (1.0f - f) * g * b->transmission * scale));
+    s->straight = b->delta; /* wi = -wo: rt_bsdf_straight_through's lobe */
+    return ok;
 }
 
 /* ------------------------------------------------ extension layering
@@ -779,6 +782,7 @@ static inline bool finish_sample(rt_vec3 wi, rt_vec3 f, float pdf, rt_bsdf_sampl
     s->weight = w;
     s->pdf = pdf;
     s->delta = false;
+    s->straight = false;
     return true;
 }
 
@@ -978,4 +982,34 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
         return dielectric_sample(b, wo, u, ulobe, s);
     }
     return false;
+}
+
+rt_vec3 rt_bsdf_straight_through(const rt_bsdf *b, rt_vec3 wo)
+{
+    if (!b->thin || !b->delta || !(wo.z > 0.0f) || !(b->transmission > 0.0f))
+        return rt_v3s(0.0f);
+    float pt, over = 1.0f; /* the lobe's probability (0: never sampled), what a coat and sheen let through */
+    switch (b->kind) {
+    case RT_BSDF_KIND_GLTF: {
+        float pd, ps, ptm;
+        lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
+        break;
+    }
+    case RT_BSDF_KIND_GLTF_LAYERED:
+        pt = layered_lobe_probs(b, wo).t;
+        over = coat_scale(b, to_coat(b, wo).z) * sheen_scale(b, wo.z);
+        break;
+    case RT_BSDF_KIND_LAMBERT:
+    case RT_BSDF_KIND_CONDUCTOR:
+    case RT_BSDF_KIND_DIELECTRIC:
+    case RT_BSDF_KIND_PLASTIC:
+    default:
+        return rt_v3s(0.0f);
+    }
+    if (!(pt > 0.0f))
+        return rt_v3s(0.0f);
+    /* thin_transmit at the macro normal: h = n, g = 1 */
+    float f = rt_fresnel_exact(wo.z, b->eta);
+    rt_vec3 w = rt_scale(b->diffuse, (1.0f - f) * b->transmission * over);
+    return rt_finite3(w) ? rt_vmax(w, rt_v3s(0.0f)) : rt_v3s(0.0f);
 }

@@ -32,6 +32,7 @@
 
 #include "rt/base/alloc.h"
 #include "rt/render/environment.h"
+#include "rt/render/material_eval.h"
 #include "rt/render/spherical.h"
 
 /* The unit direction and the distance from p to the point q on a light,
@@ -234,9 +235,68 @@ rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, r
     return shadow_walk(ctx, sf, wi, dist, true);
 }
 
-float rt_shadow_visibility(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
+/* What a path that reached surface s2 along the shadow ray would carry on
+ * along it: the straight-through lobe's weight, under the path tracer's own
+ * tests (rt_path_vertex_begin: a lit surface seen from above its frame;
+ * rt_path_vertex_end: the direction leaves through the geometric surface);
+ * zero for anything else. */
+static rt_vec3 straight_through(const rt_trace_ctx *ctx, const rt_surface *s2)
 {
-    return shadow_walk(ctx, sf, wi, dist, false).x;
+    const rt_material *m = &ctx->state->scene->materials[s2->material];
+    if (m->unlit)
+        return rt_v3s(0.0f);
+    rt_bsdf b;
+    rt_bsdf_from_surface(ctx, s2, &b);
+    rt_vec3 wo = rt_bsdf_to_local(&b, s2->wo);
+    rt_vec3 w = rt_bsdf_straight_through(&b, wo);
+    if (!(rt_max3(w) > 0.0f))
+        return rt_v3s(0.0f);
+    rt_vec3 wi = rt_normalize(rt_bsdf_to_world(&b, rt_normalize(rt_neg(wo))));
+    return rt_dot(wi, s2->ng) < 0.0f ? w : rt_v3s(0.0f);
+}
+
+rt_vec3 rt_shadow_path_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist,
+                                     bool thin_passes)
+{
+    rt_ray r = rt_shadow_ray(ctx, sf, wi, dist);
+    if (ctx->ray_count)
+        (*ctx->ray_count)++;
+    if (!ctx->state->shadows_need_shading)
+        return rt_kdtree_occluded(ctx->state->tree, &r) ? rt_v3s(0) : rt_v3s(1);
+    const rt_scene *s = ctx->state->scene;
+    rt_vec3 tr = rt_v3s(1);
+    for (int layer = 0; layer < 64; layer++) {
+        rt_hit h;
+        if (!rt_kdtree_intersect(ctx->state->tree, &r, &h))
+            return tr;
+        uint32_t mi = rt_prim_material(s, h.prim);
+        RT_DCHECK(mi < s->material_count);
+        const rt_material *m = &s->materials[mi];
+        /* (the glTF BSDF is thin-walled only with transmission: material_eval.c) */
+        bool may_pass = thin_passes && m->bsdf == RT_BSDF_GLTF && m->thin_walled && m->transmission > 0.0f;
+        if (m->alpha_mode == RT_ALPHA_OPAQUE && !may_pass)
+            return rt_v3s(0); /* no surface record needed */
+        rt_surface s2;
+        rt_surface_at(ctx, &r, &h, &s2);
+        float coverage = 1.0f;
+        if (m->alpha_mode == RT_ALPHA_OPAQUE || !rt_surface_cut_away(ctx, &s2, &coverage)) {
+            /* kept with probability coverage (stochastic blending), which
+             * a path then scatters on; the rest it steps past */
+            rt_vec3 pass = may_pass ? straight_through(ctx, &s2) : rt_v3s(0);
+            bool passes = rt_max3(pass) > 0.0f;
+            if (coverage < 1.0f)
+                tr = passes ? rt_mul(tr, rt_add(rt_v3s(1.0f - coverage), rt_scale(pass, coverage)))
+                            : rt_scale(tr, 1.0f - coverage);
+            else if (passes)
+                tr = rt_mul(tr, pass);
+            else
+                return rt_v3s(0);
+        }
+        if (rt_max3(tr) <= 0.0f)
+            return rt_v3s(0);
+        r.tmin = h.t; /* continue past this surface */
+    }
+    return rt_v3s(0);
 }
 
 /* ------------------------------------------------------------ light table */

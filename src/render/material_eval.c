@@ -238,10 +238,10 @@ static void gltf_at(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_mate
         transmission *= rt_texture_sample(s, m->transmission_tex.texture, uv, false).x;
     }
     rt_bsdf_set_gltf(b, rt_v3(b4.x, b4.y, b4.z), metallic, roughness, m->ior, transmission);
-    if (!sf->front)
-        b->eta = 1.0f / b->eta; /* leaving the object through its back */
     /* a glTF material without a volume (KHR_materials_volume thickness 0) is thin-walled */
     b->thin = m->bsdf == RT_BSDF_GLTF && b->transmission > 0.0f && m->thin_walled;
+    if (!sf->front && !b->thin)
+        b->eta = 1.0f / b->eta; /* leaving the object through its back (a thin wall has no inside: air on both sides) */
     if (m->extended && m->bsdf == RT_BSDF_GLTF)
         set_ext_from_surface(ctx, sf, m, b);
 }

@@ -53,8 +53,17 @@
  *
  * Area lights are pure emitters: their visible quad emits from its front
  * and reflects nothing. Shadow rays pass alpha cut-outs and blended
- * surfaces (times 1 - alpha); refractive (transmissive) surfaces block them,
- * light through glass arrives by BSDF sampling. Alpha blending on camera
+ * surfaces (times 1 - alpha), and smooth thin-walled panes (glTF
+ * transmission without a volume, roughness 0) times the weight of their
+ * straight-through delta lobe (rt_path_shadow); a BSDF-sampled path that
+ * takes that lobe passes the pane without making it the vertex its MIS
+ * weights refer to (prev_p, prev_pdf, prev_delta stay), so light beyond
+ * it is weighed against the light sampling of the vertex before, whose
+ * shadow ray passed the same pane (as pbrt-v4 skips interface materials,
+ * keeping the previous interaction for MIS; a pass is no bounce for
+ * max_depth). Other refractive
+ * (transmissive) surfaces block them: light through glass that bends or
+ * blurs arrives by BSDF sampling. Alpha blending on camera
  * and bounce rays is stochastic: the surface is kept with probability alpha.
  * All random numbers come from the rng handed in, so images do not depend
  * on the thread count; every contribution is checked finite. The light,
@@ -170,6 +179,13 @@ bool rt_path_nee_light(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surf
     rec->wi = ls.wi;
     rec->dist = ls.dist;
     return true;
+}
+
+rt_vec3 rt_path_shadow(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf,
+                       const rt_nee_record *rec)
+{
+    bool thin = rt_medium_current(&ps->media, ctx->state->scene->materials) == RT_NONE;
+    return rt_shadow_path_transmittance(ctx, sf, rec->wi, rec->dist, thin);
 }
 
 bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
@@ -297,6 +313,7 @@ bool rt_path_start(const rt_trace_ctx *ctx, const rt_ray *ray, rt_path_state *ps
     ps->prev_pdf = 0.0f;   /* BSDF pdf of the ray just traced */
     ps->prev_p = r.org;
     ps->bounces = 0;
+    ps->passes = 0;
     rt_medium_stack_init(&ps->media);
     ps->skips = RT_PATH_HARD_LIMIT;
     rt_sampler_cache_clear(&ps->samples); /* a new sample: the cache holds none of its values */
@@ -371,7 +388,7 @@ rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, 
         ps->L = rt_path_add_finite(ps->L, rt_mul(ps->beta, rt_v3(c.x, c.y, c.z)));
         return RT_VERTEX_STOP;
     }
-    if (ps->bounces >= max_depth)
+    if (ps->bounces - ps->passes >= max_depth || ps->bounces >= 2 * RT_PATH_HARD_LIMIT)
         return RT_VERTEX_STOP;
     rt_bsdf_from_surface(ctx, sf, b);
     if (rt_medium_is_medium(m)) { /* the index ratio to the medium beyond */
@@ -413,6 +430,10 @@ bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_sur
     float side = rt_dot(wi, sf->ng);
     if (bs.wi.z > 0.0f ? !(side > 0.0f) : !(side < 0.0f))
         return false; /* the shading normal disagrees with the geometry: no light leaks */
+    /* straight through a smooth thin surface, outside every medium: the
+     * shadow rays of the vertex before passed it too (rt_path_shadow), so
+     * light beyond is weighed against theirs, from there */
+    bool pass = bs.straight && rt_medium_current(&ps->media, ctx->state->scene->materials) == RT_NONE;
     rt_vec3 beta = rt_mul(ps->beta, bs.weight);
     ps->beta = beta;
     if (!rt_finite3(beta) || !(rt_max3(beta) > 0.0f))
@@ -422,9 +443,13 @@ bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_sur
         if (b->kind == RT_BSDF_KIND_DIELECTRIC && !b->thin) /* the weight held (n_i / n_t)^2 = b->eta^2: undo it for the roulette */
             ps->eta_scale /= b->eta * b->eta;
     }
-    ps->prev_delta = bs.delta;
-    ps->prev_pdf = bs.pdf;
-    ps->prev_p = sf->p;
+    if (pass) {
+        ps->passes++;
+    } else {
+        ps->prev_delta = bs.delta;
+        ps->prev_pdf = bs.pdf;
+        ps->prev_p = sf->p;
+    }
     ps->bounces++;
     float q = rt_path_rr_probability(ps, rr_depth);
     if (q < 1.0f) {
@@ -467,11 +492,11 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
         rt_nee_record rec;
         for (size_t i = 0; i < s->light_count; i++)
             if (rt_path_nee_light(ctx, &ps, &sf, &b, wo, rng, i, &rec))
-                sum = rt_path_nee_add(sum, &rec, rt_shadow_visibility(ctx, &sf, rec.wi, rec.dist));
+                sum = rt_path_nee_add(sum, &rec, rt_path_shadow(ctx, &ps, &sf, &rec));
         if (rt_path_nee_env(ctx, &ps, &b, wo, rng, &rec))
-            sum = rt_path_nee_add(sum, &rec, rt_shadow_visibility(ctx, &sf, rec.wi, rec.dist));
+            sum = rt_path_nee_add(sum, &rec, rt_path_shadow(ctx, &ps, &sf, &rec));
         if (rt_path_nee_emitter(ctx, &ps, &sf, &b, wo, rng, &rec))
-            sum = rt_path_nee_add(sum, &rec, rt_shadow_visibility(ctx, &sf, rec.wi, rec.dist));
+            sum = rt_path_nee_add(sum, &rec, rt_path_shadow(ctx, &ps, &sf, &rec));
         ps.L = rt_path_add_finite(ps.L, rt_mul(ps.beta, sum));
         if (!rt_path_vertex_end(ctx, &ps, &sf, &b, wo, rng))
             break;

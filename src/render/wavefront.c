@@ -32,7 +32,7 @@
  * batch size, lane assignment and split of the work (tests/test_wavefront.c).
  * Shadow rays are batched when no material needs shading on them (the render
  * state's shadows_need_shading); otherwise each vertex walks its shadow rays
- * at once through rt_shadow_visibility, as the scalar tracer does.
+ * at once through rt_path_shadow, as the scalar tracer does.
  */
 #include "rt/render/wavefront.h"
 
@@ -52,7 +52,7 @@ enum lane_status {
 };
 
 enum { KIND_BUCKETS = 8 }; /* material kinds (rt_bsdf_model) sorted apart; more fold into the last */
-/* light-sampling records a batch holds at most (about 80 bytes each with
+/* light-sampling records a batch holds at most (about 90 bytes each with
  * their shadow rays): the batch shrinks in scenes with many lights */
 #define MAX_RECORDS ((size_t)1 << 18)
 
@@ -78,7 +78,7 @@ struct rt_wavefront {
     rt_surface *sf;
     /* records of this bounce: the sample, its visibility, its shadow ray */
     rt_nee_record *rec;
-    float *vis;
+    rt_vec3 *vis;        /* what each record's shadow ray lets through */
     float *sox, *soy, *soz, *sdx, *sdy, *sdz, *stmin, *stmax;
     uint8_t *blocked;
     uint32_t *pending;   /* records whose shadow ray is to trace */
@@ -124,7 +124,8 @@ rt_wavefront *rt_wavefront_new(size_t batch, const rt_render_state *state)
     wf->layers = grab(B, sizeof(int32_t), &ok);
     wf->sf = grab(B, sizeof(rt_surface), &ok);
     wf->rec = grab(R, sizeof(rt_nee_record), &ok);
-    float **sfl[] = {&wf->vis, &wf->sox, &wf->soy, &wf->soz, &wf->sdx, &wf->sdy, &wf->sdz, &wf->stmin, &wf->stmax};
+    wf->vis = grab(R, sizeof(rt_vec3), &ok);
+    float **sfl[] = {&wf->sox, &wf->soy, &wf->soz, &wf->sdx, &wf->sdy, &wf->sdz, &wf->stmin, &wf->stmax};
     for (size_t i = 0; i < sizeof sfl / sizeof sfl[0]; i++)
         *sfl[i] = grab(R, sizeof(float), &ok);
     wf->blocked = grab(R, 1, &ok);
@@ -236,11 +237,12 @@ static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_acti
 
 /* One light-sampling record made at lane i's vertex: its visibility now
  * (shadows that need shading) or its shadow ray queued for the batch. */
-static void add_record(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_surface *sf, uint32_t r, size_t *n_pending)
+static void add_record(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf,
+                       uint32_t r, size_t *n_pending)
 {
     const rt_nee_record *rec = &wf->rec[r];
     if (ctx->state->shadows_need_shading) {
-        wf->vis[r] = rt_shadow_visibility(ctx, sf, rec->wi, rec->dist);
+        wf->vis[r] = rt_path_shadow(ctx, ps, sf, rec);
         return;
     }
     rt_ray sr = rt_shadow_ray(ctx, sf, rec->wi, rec->dist);
@@ -277,12 +279,12 @@ static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, si
     const size_t lights = ctx->state->scene->light_count;
     for (size_t l = 0; l < lights; l++)
         if (rt_path_nee_light(ctx, ps, sf, &b, wo, rng, l, &wf->rec[n]))
-            add_record(wf, ctx, sf, (uint32_t)n++, n_pending);
+            add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
     /* (skipped when they could make nothing: they would draw nothing) */
     if (env && rt_path_nee_env(ctx, ps, &b, wo, rng, &wf->rec[n]))
-        add_record(wf, ctx, sf, (uint32_t)n++, n_pending);
+        add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
     if (emitters && rt_path_nee_emitter(ctx, ps, sf, &b, wo, rng, &wf->rec[n]))
-        add_record(wf, ctx, sf, (uint32_t)n++, n_pending);
+        add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
     *n_rec = n;
     wf->nee[i] = 1;
     wf->rec_first[i] = (uint32_t)first;
@@ -346,7 +348,7 @@ void rt_wavefront_radiance(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_w
             rt_kdtree_occluded_batch(ctx->state->tree, &srb, wf->pending, n_pending, wf->blocked);
             for (size_t k = 0; k < n_pending; k++) {
                 uint32_t r = wf->pending[k];
-                wf->vis[r] = wf->blocked[r] ? 0.0f : 1.0f;
+                wf->vis[r] = rt_v3s(wf->blocked[r] ? 0.0f : 1.0f);
             }
         }
         /* resolve the light samples, retire finished paths, keep the rest in order */

@@ -134,6 +134,8 @@ typedef struct rt_bsdf_sample {
     rt_vec3 weight;   /* f |cos| / pdf, or the delta lobe's weight / its probability */
     float pdf;        /* solid-angle pdf; 0 for a delta sample */
     bool delta;       /* transmission or a mirror reflection: sampled only, never light-sampled, so no MIS */
+    bool straight;    /* the straight-through lobe of a smooth thin-walled surface (wi = -wo, weight
+                       * rt_bsdf_straight_through / its probability): the path tracer's shadow rays pass it */
 } rt_bsdf_sample;
 
 /* A BSDF from plain parameters, frame n (unit) with ng = n (tests; a hit's
@@ -226,6 +228,15 @@ rt_vec3 rt_bsdf_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float *pdf);
 /* Draws wi from u (2D) and ulobe (lobe choice); false when nothing is
  * scattered (black material, wo below the surface, a zero pdf). */
 bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s);
+/* The weight of the straight-through delta lobe of a smooth (roughness 0)
+ * thin-walled glTF transmission at wo: light arriving along -wo from the
+ * far side leaves along wo times this, c (1 - F(wo.z)) T (under a coat
+ * and sheen, times what they let through), exactly what
+ * rt_bsdf_sample_dir's `straight` sample delivers in expectation (its
+ * weight times its probability). Zero for anything else: a rough thin
+ * surface blurs what passes, a refracting one bends it, so neither passes
+ * light along a straight line. */
+rt_vec3 rt_bsdf_straight_through(const rt_bsdf *b, rt_vec3 wo);
 /* Probability that rt_bsdf_sample_dir picks each lobe at wo (for tests). */
 void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit);
 

@@ -56,10 +56,18 @@ float rt_area_light_pdf(const rt_light *l, rt_vec3 p, rt_vec3 d, float dist);
  * 1 when clear, and in between through transmissive or alpha-blended
  * surfaces (coloured by their transmission colour). */
 rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist);
-/* The same for the path tracer, where light through glass arrives by BSDF
- * sampling: transmissive surfaces block; alpha cut-outs pass, and blended
- * surfaces let 1 - alpha through. */
-float rt_shadow_visibility(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist);
+/* The same for the path tracer, which must count light only as its BSDF
+ * sampling would deliver it: alpha cut-outs pass, a blended surface lets
+ * 1 - alpha through (the share a path steps past), and, when thin_passes,
+ * a smooth thin-walled glTF transmission lets its straight-through lobe
+ * through (rt_bsdf_straight_through of the BSDF at the hit: colour,
+ * Fresnel, transmission), for the share the blending keeps. Every other
+ * transmissive surface blocks: light through glass that bends or blurs it
+ * arrives by BSDF sampling. Grey (x = y = z) unless a thin surface
+ * coloured it; without thin_passes, x is what the path tracer's
+ * visibility always was. */
+rt_vec3 rt_shadow_path_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist,
+                                     bool thin_passes);
 
 /* The shadow ray both use (one ray; past its first hit they walk on from
  * it): from sf's surface, offset to the side of wi, to just short of dist.

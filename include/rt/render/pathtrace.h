@@ -49,7 +49,8 @@ rt_vec3 rt_radiance_path(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng
  *         miss: rt_path_miss(ctx, &ps), stop; too deep: stop;
  *         switch (rt_path_vertex_begin(ctx, &ps, &sf, &b, &wo)): STOP: stop; PASS: loop;
  *         records from rt_path_nee_light (each light in order; all take &ps), rt_path_nee_env,
- *         rt_path_nee_emitter; sum = rt_path_nee_add(sum, &rec, visibility) in that order;
+ *         rt_path_nee_emitter; sum = rt_path_nee_add(sum, &rec, rt_path_shadow(ctx, &ps, &sf, &rec))
+ *         in that order;
  *         ps.L = rt_path_add_finite(ps.L, ps.beta * sum);
  *         if (!rt_path_vertex_end(ctx, &ps, &sf, &b, wo, rng)) stop;
  *   L = finite(ps.L) ? ps.L : 0
@@ -63,7 +64,12 @@ typedef struct rt_path_state {
     bool prev_delta;   /* the last scattering was a delta lobe (or the camera): no MIS */
     float prev_pdf;    /* BSDF pdf of the ray just traced */
     rt_vec3 prev_p;    /* where it left from */
-    int bounces;
+    /* (a pass straight through a smooth thin-walled surface, which shadow
+     * rays take too, leaves the three above as they were: the light
+     * reached beyond it is weighed against the light sampling of the
+     * vertex before) */
+    int bounces;       /* vertices scattered at, passes included: they pick the sampler dimensions */
+    int passes;        /* of which passes straight through thin surfaces: max_depth counts bounces - passes */
     rt_medium_stack media; /* the dielectrics it is inside (rt/render/medium.h) */
     int skips;         /* false intersections it may still pass */
     rt_sampler_cache samples; /* the stratified sampler's values of the current bounce (rt/render/sampler_block.h) */
@@ -109,13 +115,28 @@ bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *
                      rt_nee_record *rec);
 bool rt_path_nee_emitter(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                          rt_vec3 wo, rt_rng *rng, rt_nee_record *rec);
-/* One light-sampling term, f cos vis w / pdf times the radiance; zero when
- * the shadow ray is blocked (vis 0). */
-static inline rt_vec3 rt_path_nee_add(rt_vec3 sum, const rt_nee_record *rec, float vis)
+/* What the shadow ray of record rec, made at the path's current vertex
+ * sf, lets through (rt_shadow_path_transmittance): alpha as a path steps
+ * past it and, outside every medium (rt_medium_current is none, so no
+ * absorption is left out), smooth thin-walled surfaces by their
+ * straight-through lobe, which rt_path_vertex_end then passes without
+ * taking the vertex as the one to weigh light against. */
+rt_vec3 rt_path_shadow(const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf,
+                       const rt_nee_record *rec);
+/* One light-sampling term, f cos tr w / pdf times the radiance, for the
+ * transmittance tr of its shadow ray; zero when the shadow ray is blocked
+ * (tr 0). A grey tr (every scene without thin transmission) is one factor. */
+static inline rt_vec3 rt_path_nee_add(rt_vec3 sum, const rt_nee_record *rec, rt_vec3 tr)
 {
-    if (!(vis > 0.0f))
+    if (tr.x == tr.y && tr.y == tr.z) {
+        float vis = tr.x;
+        if (!(vis > 0.0f))
+            return sum;
+        return rt_path_add_finite(sum, rt_scale(rec->fl, rec->cos * vis * rec->w / rec->pdf));
+    }
+    if (!(rt_max3(tr) > 0.0f))
         return sum;
-    return rt_path_add_finite(sum, rt_scale(rec->fl, rec->cos * vis * rec->w / rec->pdf));
+    return rt_path_add_finite(sum, rt_scale(rt_mul(rec->fl, tr), rec->cos * rec->w / rec->pdf));
 }
 /* Whether rt_path_nee_env / rt_path_nee_emitter can make a record in this
  * render (a light table with an environment / with emitters): when not,
