@@ -127,7 +127,7 @@ int main(int argc, char **argv)
         rt_scene s;
         rt_scene_init(&s);
         rt_error err = {0};
-        if (rt_load(&s, argv[i], NULL, NULL, &err) != RT_OK) {
+        if (rt_load(&s, NULL, argv[i], NULL, NULL, &err) != RT_OK) {
             fprintf(stderr, "buildscale: %s\n", err.message);
             return 2;
         }

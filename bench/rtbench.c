@@ -202,7 +202,7 @@ int main(int argc, char **argv)
     rt_scene scene;
     rt_scene_init(&scene);
     double t0 = now_s();
-    if (rt_load(&scene, model, NULL, NULL, &err) != RT_OK) {
+    if (rt_load(&scene, NULL, model, NULL, NULL, &err) != RT_OK) {
         fprintf(stderr, "rtbench: %s\n", err.message);
         return 2;
     }

@@ -27,21 +27,21 @@
 /* Part `index` of `count` bands of rows of the render, written to path
  * (a float image of the band's sums, and path.json saying what it is a
  * part of). */
-static rt_result render_part(const rt_scene *scene, const rt_kdtree *tree, const char *input, int index, int count,
-                             const char *path, rt_error *err)
+static rt_result render_part(const rt_scene *scene, const rt_settings *settings, const rt_kdtree *tree,
+                             const char *input, int index, int count, const char *path, rt_error *err)
 {
     rt_job_options o = {.input = input, .part_index = index, .part_count = count, .output_is_part = true};
     rt_part_job pj;
     rt_framebuffer fb = {0};
-    rt_result r = rt_part_job_init(&pj, &o, scene, tree, err);
+    rt_result r = rt_part_job_init(&pj, &o, scene, settings, tree, err);
     if (r == RT_OK)
         r = rt_framebuffer_init(&fb, pj.region.x1 - pj.region.x0, pj.region.y1 - pj.region.y0, err);
     if (r == RT_OK) {
         rt_render_options ro = {.region = pj.region, .sample_begin = pj.s_begin, .sample_end = pj.s_end,
                                 .accum = &pj.accum,
-                                .pass_samples = rt_job_pass_samples(0, true, scene->settings.integrator)};
+                                .pass_samples = rt_job_pass_samples(0, true, settings->integrator)};
         rt_render_stats st;
-        r = rt_render(scene, tree, &ro, &fb, &st, err);
+        r = rt_render(scene, settings, tree, &ro, &fb, &st, err);
         if (r == RT_OK)
             r = rt_part_job_write(&pj, path, st.samples_done, NULL, err);
     }
@@ -70,32 +70,34 @@ int main(int argc, char **argv)
     const char *input = argc > 1 ? argv[1] : NULL; /* NULL: the built-in scene */
     const char *output = argc > 2 ? argv[2] : "out.png";
     rt_error err = {0};
-    rt_scene scene;
+    rt_scene scene; /* what is rendered */
     rt_scene_init(&scene);
+    rt_settings settings; /* how: the scene file's settings, or a model's defaults */
+    rt_settings_default(&settings);
     rt_load_options lo = {.for_render = true}; /* a bare model gets lights and a camera */
     rt_kdtree tree = {0};
     rt_framebuffer fb = {0}, merged = {0};
     char part[2][1100], merged_path[1100];
     const char *parts[2] = {part[0], part[1]};
     int status = 1;
-    if (rt_load(&scene, input, &lo, NULL, &err) != RT_OK || rt_scene_validate(&scene, &err) != RT_OK)
+    if (rt_load(&scene, &settings, input, &lo, NULL, &err) != RT_OK || rt_scene_validate(&scene, &err) != RT_OK)
         goto done;
-    scene.settings.width = 160;
-    scene.settings.height = 120;
+    settings.width = 160;
+    settings.height = 120;
     if (!scene.camera_set) /* a mesh brings no camera: frame it */
-        rt_scene_frame_camera(&scene);
+        rt_scene_frame_camera(&scene, 160.0f / 120.0f);
     if (rt_kdtree_build(&tree, &scene, NULL, &err) != RT_OK)
         goto done;
-    if (rt_framebuffer_init(&fb, scene.settings.width, scene.settings.height, &err) != RT_OK ||
-        rt_render(&scene, &tree, NULL, &fb, NULL, &err) != RT_OK ||
-        rt_framebuffer_write(&fb, output, scene.settings.exposure, &err) != RT_OK)
+    if (rt_framebuffer_init(&fb, settings.width, settings.height, &err) != RT_OK ||
+        rt_render(&scene, &settings, &tree, NULL, &fb, NULL, &err) != RT_OK ||
+        rt_framebuffer_write(&fb, output, settings.exposure, &err) != RT_OK)
         goto done;
     printf("wrote %s (%dx%d)\n", output, fb.width, fb.height);
 
     /* the same image from two parts */
     for (int i = 0; i < 2; i++) {
         snprintf(part[i], sizeof part[i], "%s.part%d.exr", output, i);
-        if (render_part(&scene, &tree, input, i, 2, part[i], &err) != RT_OK)
+        if (render_part(&scene, &settings, &tree, input, i, 2, part[i], &err) != RT_OK)
             goto done;
         printf("wrote %s and %s.json\n", part[i], part[i]);
     }

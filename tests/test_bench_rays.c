@@ -172,7 +172,7 @@ static void test_bench_rays(void **state)
         rt_scene scene;
         rt_scene_init(&scene);
         rt_error err = {0};
-        rt_result res = rt_load(&scene, test_shared_path(models[m].glb), NULL, NULL, &err);
+        rt_result res = rt_load(&scene, NULL, test_shared_path(models[m].glb), NULL, NULL, &err);
         if (res != RT_OK)
             fprintf(stderr, "%s\n", err.message);
         assert_int_equal(res, RT_OK);

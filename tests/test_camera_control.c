@@ -214,7 +214,7 @@ static void test_camera_line_round_trip(void **state)
         rt_scene s;
         rt_scene_init(&s);
         rt_error err = {0};
-        if (rt_scene_parse_string(&s, line, strlen(line), "<line>", "", &err) != RT_OK)
+        if (rt_scene_parse_string(&s, NULL, line, strlen(line), "<line>", "", &err) != RT_OK)
             fail_msg("'%s' does not parse: %s", line, err.message);
         assert_true(s.camera_set);
         assert_memory_equal(&s.camera.position, &c.position, sizeof c.position);

@@ -34,6 +34,7 @@
 
 typedef struct test_fixture {
     rt_scene s;
+    rt_settings settings; /* how to render s: its scene text's settings */
     rt_kdtree tree;
     rt_render_state rs;
     rt_trace_ctx ctx;
@@ -44,7 +45,8 @@ static inline void test_fixture_parse(test_fixture *f, const char *text)
 {
     rt_error err;
     rt_scene_init(&f->s);
-    if (rt_scene_parse_string(&f->s, text, strlen(text), "test", NULL, &err) != RT_OK)
+    rt_settings_default(&f->settings);
+    if (rt_scene_parse_string(&f->s, &f->settings, text, strlen(text), "test", NULL, &err) != RT_OK)
         fail_msg("parse: %s", err.message);
 }
 
@@ -54,7 +56,7 @@ static inline void test_fixture_build(test_fixture *f, unsigned prepare)
 {
     rt_error err;
     assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
-    assert_int_equal(rt_render_state_prepare(&f->rs, &f->s, &f->tree, prepare, &err), RT_OK);
+    assert_int_equal(rt_render_state_prepare(&f->rs, &f->s, &f->settings, &f->tree, prepare, &err), RT_OK);
     rt_trace_ctx_init(&f->ctx, &f->rs);
 }
 
@@ -96,21 +98,21 @@ static inline void test_scene_look(rt_scene *s, rt_vec3 from, rt_vec3 at, rt_vec
 }
 
 /* Renders a scene built in code (validated here, with a kd-tree of its
- * own) at its settings on `threads` threads in tiles of `tile` pixels (0:
+ * own) with settings on `threads` threads in tiles of `tile` pixels (0:
  * the default) into a new *fb; no sample may be bad. */
-static inline void test_render_scene(rt_scene *s, int threads, int tile, rt_framebuffer *fb)
+static inline void test_render_scene(rt_scene *s, const rt_settings *settings, int threads, int tile, rt_framebuffer *fb)
 {
     rt_error err = {0};
     assert_int_equal(rt_scene_validate(s, &err), RT_OK);
     rt_kdtree tree;
     assert_int_equal(rt_kdtree_build(&tree, s, NULL, &err), RT_OK);
-    assert_int_equal(rt_framebuffer_init(fb, s->settings.width, s->settings.height, &err), RT_OK);
+    assert_int_equal(rt_framebuffer_init(fb, settings->width, settings->height, &err), RT_OK);
     rt_render_options opt;
     memset(&opt, 0, sizeof opt);
     opt.threads = threads;
     opt.tile_size = tile;
     rt_render_stats st;
-    assert_int_equal(rt_render(s, &tree, &opt, fb, &st, &err), RT_OK);
+    assert_int_equal(rt_render(s, settings, &tree, &opt, fb, &st, &err), RT_OK);
     assert_int_equal(st.bad_samples, 0);
     rt_kdtree_free(&tree);
 }

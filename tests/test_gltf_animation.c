@@ -319,7 +319,7 @@ static rt_result scene_vertex(const char *text, bool posed, float t, int anim, f
     rt_scene_parse_options o = {.use_time = posed, .time = t, .animation = anim};
     char name[128];
     snprintf(name, sizeof name, "%s/scene.txt", dir);
-    rt_result r = rt_scene_parse_string_with(&s, text, strlen(text), name, NULL, &o, err);
+    rt_result r = rt_scene_parse_string_with(&s, NULL, text, strlen(text), name, NULL, &o, err);
     *x = r == RT_OK && s.vertices.count > 1 ? s.vertices.position[1].x : -99.0f;
     rt_scene_free(&s);
     return r;
@@ -424,7 +424,7 @@ static void test_scene_model_lines(void **state)
     rt_scene s;
     rt_scene_init(&s);
     rt_load_options lo = {.use_time = true, .time = 1.0f};
-    assert_int_equal(rt_load(&s, path, &lo, NULL, &err), RT_OK);
+    assert_int_equal(rt_load(&s, NULL, path, &lo, NULL, &err), RT_OK);
     assert_float_equal(s.vertices.position[1].x, 2.0f, 1e-6);
     rt_scene_free(&s);
     test_remove_dir(dir);

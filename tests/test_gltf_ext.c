@@ -51,7 +51,7 @@ static rt_result load_quiet(const char *path, rt_scene *s, rt_error *err, bool *
     rt_scene_init(s);
     memset(err, 0, sizeof *err);
     rt_load_options opt = {.for_render = for_render};
-    rt_result r = rt_load(s, path, &opt, NULL, err);
+    rt_result r = rt_load(s, NULL, path, &opt, NULL, err);
     fflush(stderr);
     dup2(saved, 2);
     close(saved);
@@ -170,15 +170,17 @@ enum { W = 96, H = 48 };
 static void render_file(const char *path, rt_framebuffer *fb)
 {
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_error err;
     bool warned;
     assert_int_equal(load_quiet(path, &s, &err, &warned, true), RT_OK);
     assert_false(warned);
-    s.settings.width = W;
-    s.settings.height = H;
-    s.settings.samples = 64;
-    s.settings.integrator = RT_INTEGRATOR_PATH;
-    test_render_scene(&s, 2, 0, fb);
+    set.width = W;
+    set.height = H;
+    set.samples = 64;
+    set.integrator = RT_INTEGRATOR_PATH;
+    test_render_scene(&s, &set, 2, 0, fb);
     for (int i = 0; i < W * H * 3; i++)
         assert_true(isfinite(fb->rgb[i]) && fb->rgb[i] >= 0.0f);
     rt_scene_free(&s);
@@ -307,7 +309,7 @@ static void test_variants(void **state)
         rt_scene_init(&s);
         rt_error err = {0};
         rt_load_options opt = {.variant = want[i].variant};
-        assert_int_equal(rt_load(&s, "assets/ext/variants.gltf", &opt, NULL, &err), RT_OK);
+        assert_int_equal(rt_load(&s, NULL, "assets/ext/variants.gltf", &opt, NULL, &err), RT_OK);
         const char *first, *last;
         first_last_material(&s, &first, &last);
         if (strcmp(first, want[i].first) != 0 || strcmp(last, want[i].last) != 0)
@@ -320,12 +322,12 @@ static void test_variants(void **state)
     rt_scene_init(&s);
     rt_error err = {0};
     rt_load_options opt = {.variant = "green"};
-    assert_int_equal(rt_load(&s, "assets/ext/variants.gltf", &opt, NULL, &err), RT_ERR_INVALID);
+    assert_int_equal(rt_load(&s, NULL, "assets/ext/variants.gltf", &opt, NULL, &err), RT_ERR_INVALID);
     assert_non_null(strstr(err.message, "variants.gltf"));
     assert_non_null(strstr(err.message, "'green'"));
     assert_non_null(strstr(err.message, "'red', 'blue'"));
     assert_int_equal(s.material_count, 0);
-    assert_int_equal(rt_load(&s, "scenes/cornell.txt", &opt, NULL, &err), RT_ERR_INVALID);
+    assert_int_equal(rt_load(&s, NULL, "scenes/cornell.txt", &opt, NULL, &err), RT_ERR_INVALID);
     rt_scene_free(&s);
     /* a mapping to a material or a variant that does not exist */
     static const char *const bad[] = {
@@ -348,7 +350,7 @@ static void test_variants(void **state)
         snprintf(path, sizeof path, "%s/variants%zu.gltf", tmp_dir, i);
         test_write_file(path, text, strlen(text));
         rt_scene_init(&s);
-        rt_result r = rt_load(&s, path, NULL, NULL, &err);
+        rt_result r = rt_load(&s, NULL, path, NULL, NULL, &err);
         if (r != RT_ERR_INVALID || !strstr(err.message, path) || !strstr(err.message, "byte"))
             fail_msg("mapping %s: got %s \"%s\"", bad[i], rt_result_name(r), err.message);
         rt_scene_free(&s);
@@ -384,15 +386,17 @@ static void test_shared_models(void **state)
             fail_msg("%s is not in %s", models[i], test_shared_path("assets/gltf"));
         found++;
         rt_scene s;
+        rt_settings set;
+        rt_settings_default(&set);
         rt_error err;
         bool warned;
         assert_int_equal(load_quiet(path, &s, &err, &warned, true), RT_OK);
         assert_false(warned);
-        s.settings.width = s.settings.height = 16;
-        s.settings.samples = 1;
-        s.settings.integrator = RT_INTEGRATOR_PATH;
+        set.width = set.height = 16;
+        set.samples = 1;
+        set.integrator = RT_INTEGRATOR_PATH;
         rt_framebuffer fb;
-        test_render_scene(&s, 2, 0, &fb);
+        test_render_scene(&s, &set, 2, 0, &fb);
         rt_framebuffer_free(&fb);
         rt_scene_free(&s);
     }

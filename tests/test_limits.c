@@ -226,33 +226,36 @@ static void test_render_limits(void **state)
 {
     (void)state;
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
+    rt_settings_default(&set);
     s.camera.position = rt_v3(0, 0, 5);
     s.camera.look_at = rt_v3(0, 0, 0);
     rt_error err = {0};
-    assert_int_equal(rt_render_check_limits(&s, "ok.txt", true, &err), RT_OK);
+    assert_int_equal(rt_render_check_limits(&s, &set, "ok.txt", true, &err), RT_OK);
     s.triangles.count = (size_t)1 << 30; /* the count alone (no arrays behind it) */
-    assert_int_equal(rt_render_check_limits(&s, "big.glb", true, &err), RT_ERR_LIMIT);
+    assert_int_equal(rt_render_check_limits(&s, &set, "big.glb", true, &err), RT_ERR_LIMIT);
     expect_message(&err, "big.glb: 1073741824 primitives", "over the limit");
     s.triangles.count = 0;
-    s.settings.samples = -3;
-    assert_int_equal(rt_render_check_limits(&s, "bad.txt", true, &err), RT_ERR_LIMIT);
+    set.samples = -3;
+    assert_int_equal(rt_render_check_limits(&s, &set, "bad.txt", true, &err), RT_ERR_LIMIT);
     expect_message(&err, "bad.txt: ", "samples");
-    rt_settings_default(&s.settings);
-    s.settings.integrator = RT_INTEGRATOR_WHITTED;
-    s.settings.diffuse_bounces = 3;
-    s.settings.diffuse_rays = 256; /* 256^3 = 2^24: just allowed */
-    assert_int_equal(rt_render_check_limits(&s, "tree.txt", true, &err), RT_OK);
-    s.settings.diffuse_rays = 257;
-    assert_int_equal(rt_render_check_limits(&s, "tree.txt", true, &err), RT_ERR_LIMIT);
+    rt_settings_default(&set);
+    set.integrator = RT_INTEGRATOR_WHITTED;
+    set.diffuse_bounces = 3;
+    set.diffuse_rays = 256; /* 256^3 = 2^24: just allowed */
+    assert_int_equal(rt_render_check_limits(&s, &set, "tree.txt", true, &err), RT_OK);
+    set.diffuse_rays = 257;
+    assert_int_equal(rt_render_check_limits(&s, &set, "tree.txt", true, &err), RT_ERR_LIMIT);
     expect_message(&err, "tree.txt: diffuse_rays 257 with diffuse_bounces 3", "rays per camera sample");
-    rt_settings_default(&s.settings);
+    rt_settings_default(&set);
     s.camera.look_at = s.camera.position;
-    assert_int_equal(rt_render_check_limits(&s, "cam.txt", true, &err), RT_ERR_INVALID);
+    assert_int_equal(rt_render_check_limits(&s, &set, "cam.txt", true, &err), RT_ERR_INVALID);
     expect_message(&err, "cam.txt: the camera is degenerate", NULL);
     rt_log_level was = rt_log_get_level();
     rt_log_set_level(RT_LOG_QUIET); /* the automatic camera's warning */
-    assert_int_equal(rt_render_check_limits(&s, "auto.glb", false, &err), RT_OK);
+    assert_int_equal(rt_render_check_limits(&s, &set, "auto.glb", false, &err), RT_OK);
     rt_log_set_level(was);
     rt_scene_free(&s);
 }
@@ -263,7 +266,7 @@ static rt_result parse(const char *text, rt_error *err)
 {
     rt_scene s;
     rt_scene_init(&s);
-    rt_result r = rt_scene_parse_string(&s, text, strlen(text), "t.txt", ".", err);
+    rt_result r = rt_scene_parse_string(&s, NULL, text, strlen(text), "t.txt", ".", err);
     rt_scene_free(&s);
     return r;
 }
@@ -361,47 +364,49 @@ static void test_mesh_numbers(void **state)
 
 /* ------------------------------------------------------------ rendering */
 
-static void render_scene(rt_scene *s, int threads, int tile, atomic_int *cancel, rt_framebuffer *fb,
+static void render_scene(rt_scene *s, const rt_settings *set, int threads, int tile, atomic_int *cancel, rt_framebuffer *fb,
                          rt_render_stats *st, rt_result expect)
 {
     rt_kdtree tree;
     rt_error err = {0};
     assert_int_equal(rt_kdtree_build(&tree, s, NULL, &err), RT_OK);
-    assert_int_equal(rt_framebuffer_init(fb, s->settings.width, s->settings.height, &err), RT_OK);
+    assert_int_equal(rt_framebuffer_init(fb, set->width, set->height, &err), RT_OK);
     rt_render_options o;
     memset(&o, 0, sizeof o);
     o.threads = threads;
     o.tile_size = tile;
     o.cancel = cancel;
-    assert_int_equal(rt_render(s, &tree, &o, fb, st, &err), expect);
+    assert_int_equal(rt_render(s, set, &tree, &o, fb, st, &err), expect);
     rt_kdtree_free(&tree);
 }
 
-static void builtin(rt_scene *s, int w, int h, int spp)
+static void builtin(rt_scene *s, rt_settings *set, int w, int h, int spp)
 {
     rt_scene_init(s);
+    rt_settings_default(set);
     rt_error err = {0};
-    assert_int_equal(rt_scene_parse_string(s, rt_default_scene_text, strlen(rt_default_scene_text), "<built-in>", NULL,
+    assert_int_equal(rt_scene_parse_string(s, set, rt_default_scene_text, strlen(rt_default_scene_text), "<built-in>", NULL,
                                            &err),
                      RT_OK);
-    s->settings.width = w;
-    s->settings.height = h;
-    s->settings.samples = spp;
+    set->width = w;
+    set->height = h;
+    set->samples = spp;
 }
 
 static void test_same_image_any_threads_and_tiles(void **state)
 {
     (void)state;
     rt_scene s;
-    builtin(&s, 21, 13, 2);
+    rt_settings set;
+    builtin(&s, &set, 21, 13, 2);
     rt_framebuffer ref, fb;
     rt_render_stats st;
-    render_scene(&s, 1, 4, NULL, &ref, &st, RT_OK);
+    render_scene(&s, &set, 1, 4, NULL, &ref, &st, RT_OK);
     assert_int_equal(st.tiles_total, 6 * 4);
     assert_int_equal(st.bad_samples, 0);
     const int cases[][2] = {{2, 4}, {3, 1}, {64, 4}, {64, 5}, {8, 100} /* one tile, eight threads */, {1, 21}};
     for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
-        render_scene(&s, cases[i][0], cases[i][1], NULL, &fb, &st, RT_OK);
+        render_scene(&s, &set, cases[i][0], cases[i][1], NULL, &fb, &st, RT_OK);
         if (memcmp(ref.rgb, fb.rgb, sizeof(float) * 3 * 21 * 13) != 0)
             fail_msg("%d threads, %d-pixel tiles: a different image", cases[i][0], cases[i][1]);
         rt_framebuffer_free(&fb);
@@ -410,8 +415,8 @@ static void test_same_image_any_threads_and_tiles(void **state)
     rt_scene_free(&s);
 
     /* 1x1 */
-    builtin(&s, 1, 1, 4);
-    render_scene(&s, 4, 0, NULL, &fb, &st, RT_OK);
+    builtin(&s, &set, 1, 1, 4);
+    render_scene(&s, &set, 4, 0, NULL, &fb, &st, RT_OK);
     assert_int_equal(st.tiles_total, 1);
     assert_true(isfinite(fb.rgb[0]) && fb.rgb[0] > 0.0f);
     rt_framebuffer_free(&fb);
@@ -422,12 +427,13 @@ static void test_cancelled_render(void **state)
 {
     (void)state;
     rt_scene s;
-    builtin(&s, 40, 30, 1);
+    rt_settings set;
+    builtin(&s, &set, 40, 30, 1);
     atomic_int cancel;
     atomic_init(&cancel, 1);
     rt_framebuffer fb;
     rt_render_stats st;
-    render_scene(&s, 4, 8, &cancel, &fb, &st, RT_ERR_INTERRUPTED);
+    render_scene(&s, &set, 4, 8, &cancel, &fb, &st, RT_ERR_INTERRUPTED);
     assert_true(st.interrupted);
     assert_int_equal(st.tiles_done, 0);
     assert_int_equal(st.tiles_total, 5 * 4);
@@ -441,7 +447,9 @@ static void test_tile_count_cap(void **state)
 {
     (void)state;
     rt_scene s;
-    builtin(&s, 32768, 32768, 1);
+    rt_settings set;
+    rt_settings_default(&set);
+    builtin(&s, &set, 32768, 32768, 1);
     rt_kdtree tree;
     rt_error err = {0};
     assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
@@ -451,7 +459,7 @@ static void test_tile_count_cap(void **state)
     memset(&o, 0, sizeof o);
     o.tile_size = 1;
     rt_render_stats st;
-    assert_int_equal(rt_render(&s, &tree, &o, &fb, &st, &err), RT_ERR_LIMIT);
+    assert_int_equal(rt_render(&s, &set, &tree, &o, &fb, &st, &err), RT_ERR_LIMIT);
     expect_message(&err, "1073741824 tiles", "larger tiles");
     rt_kdtree_free(&tree);
     rt_scene_free(&s);
@@ -462,7 +470,9 @@ static void test_degenerate_geometry_renders_clean(void **state)
 {
     (void)state;
     rt_scene s;
-    builtin(&s, 16, 16, 4);
+    rt_settings set;
+    rt_settings_default(&set);
+    builtin(&s, &set, 16, 16, 4);
     /* a zero-area triangle, a needle, and a triangle at 1e30 */
     uint32_t v = rt_scene_add_vertices(&s, 9);
     assert_int_not_equal(v, RT_NONE);
@@ -476,10 +486,10 @@ static void test_degenerate_geometry_renders_clean(void **state)
                              RT_NONE);
     const rt_integrator kinds[] = {RT_INTEGRATOR_DIRECT, RT_INTEGRATOR_WHITTED, RT_INTEGRATOR_PATH};
     for (size_t k = 0; k < 3; k++) {
-        s.settings.integrator = kinds[k];
+        set.integrator = kinds[k];
         rt_framebuffer fb;
         rt_render_stats st;
-        render_scene(&s, 2, 8, NULL, &fb, &st, RT_OK);
+        render_scene(&s, &set, 2, 8, NULL, &fb, &st, RT_OK);
         assert_int_equal(st.bad_samples, 0);
         for (size_t i = 0; i < 3u * 16u * 16u; i++)
             assert_true(isfinite(fb.rgb[i]) && fb.rgb[i] >= 0.0f);

@@ -63,8 +63,8 @@ static void copy_in(const char *from, const char *name)
     free(bytes);
 }
 
-/* The scene as a mark sees it must equal `before`. (The settings and camera
- * are compared as bytes: both come from plain struct copies.) */
+/* The scene as a mark sees it must equal `before`. (The environment and
+ * camera are compared as bytes: both come from plain struct copies.) */
 static void assert_unchanged(const rt_scene *s, const rt_scene_mark *before)
 {
     rt_scene_mark now = rt_scene_mark_of(s);
@@ -80,7 +80,7 @@ static void assert_unchanged(const rt_scene *s, const rt_scene_mark *before)
     assert_int_equal(now.vertex_attrs, before->vertex_attrs);
     assert_int_equal(now.camera_set, before->camera_set);
     assert_memory_equal(&now.camera, &before->camera, sizeof now.camera);
-    assert_memory_equal(&now.settings, &before->settings, sizeof now.settings);
+    assert_memory_equal(&now.environment, &before->environment, sizeof now.environment);
 }
 
 static void expect_failure(rt_result r, const rt_error *err, const char *needle)
@@ -246,7 +246,7 @@ static void test_load_by_content(void **state)
     write_text("ply-named.txt", ply_text);
     rt_scene s;
     rt_scene_init(&s);
-    assert_int_equal(rt_load(&s, tpath("ply-named.txt"), NULL, &info, &err), RT_OK);
+    assert_int_equal(rt_load(&s, NULL, tpath("ply-named.txt"), NULL, &info, &err), RT_OK);
     assert_int_equal(info.kind, RT_LOAD_MESH);
     assert_int_equal(info.meshes, 1);
     assert_int_equal(info.primitives, 1);
@@ -274,7 +274,7 @@ static void test_load_by_content(void **state)
     size_t size;
     assert_int_equal(rt_read_file("assets/box.gltf", 0, &bytes, &size, &err), RT_OK);
     rt_scene_init(&s);
-    assert_int_equal(rt_load_memory(&s, bytes, size, tpath("box.dat"), NULL, &info, &err), RT_OK);
+    assert_int_equal(rt_load_memory(&s, NULL, bytes, size, tpath("box.dat"), NULL, &info, &err), RT_OK);
     free(bytes);
     assert_int_equal(info.kind, RT_LOAD_GLTF);
     assert_int_equal(info.meshes, 1);
@@ -288,18 +288,18 @@ static void test_load_by_content(void **state)
      * OBJ loads from memory */
     write_text("cube.stl", "solid cube\nfacet normal 0 0 1\n");
     rt_scene_init(&s);
-    expect_failure(rt_load(&s, tpath("cube.stl"), NULL, NULL, &err), &err, "cube.stl: unknown input format '.stl'");
+    expect_failure(rt_load(&s, NULL, tpath("cube.stl"), NULL, NULL, &err), &err, "cube.stl: unknown input format '.stl'");
     assert_non_null(strstr(err.message, ".gltf, .glb"));
     assert_null(strstr(err.message, "unknown keyword"));
     static const char obj[] = "# from a pipe\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-    assert_int_equal(rt_load_memory(&s, obj, sizeof obj - 1, "<stdin>", NULL, &info, &err), RT_OK);
+    assert_int_equal(rt_load_memory(&s, NULL, obj, sizeof obj - 1, "<stdin>", NULL, &info, &err), RT_OK);
     assert_int_equal(info.kind, RT_LOAD_MESH);
     assert_int_equal(s.triangles.count, 1);
     rt_scene_free(&s);
 
     /* the built-in scene */
     rt_scene_init(&s);
-    assert_int_equal(rt_load(&s, NULL, NULL, &info, &err), RT_OK);
+    assert_int_equal(rt_load(&s, NULL, NULL, NULL, &info, &err), RT_OK);
     assert_int_equal(info.kind, RT_LOAD_SCENE);
     assert_int_equal(info.meshes + info.primitives + info.nodes, 0);
     assert_int_equal(s.spheres.count, 1);
@@ -309,7 +309,7 @@ static void test_load_by_content(void **state)
 
     /* a missing file: the read error, and the kind its name suggests */
     rt_scene_init(&s);
-    assert_int_equal(rt_load(&s, tpath("missing.glb"), NULL, &info, &err), RT_ERR_IO);
+    assert_int_equal(rt_load(&s, NULL, tpath("missing.glb"), NULL, &info, &err), RT_ERR_IO);
     assert_int_equal(info.kind, RT_LOAD_GLTF);
     assert_non_null(strstr(err.message, "missing.glb: cannot open: "));
     rt_scene_free(&s);
@@ -321,18 +321,23 @@ static void test_for_render(void **state)
     rt_error err = {0};
     rt_load_options opt = {.for_render = true};
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
+    rt_settings_default(&set);
     write_text("tri.ply", ply_text);
-    assert_int_equal(rt_load(&s, tpath("tri.ply"), &opt, NULL, &err), RT_OK);
-    assert_int_equal(s.settings.samples, 64);
-    assert_int_equal(s.settings.integrator, RT_INTEGRATOR_PATH);
+    assert_int_equal(rt_load(&s, &set, tpath("tri.ply"), &opt, NULL, &err), RT_OK);
+    assert_int_equal(set.samples, 64);
+    assert_int_equal(set.integrator, RT_INTEGRATOR_PATH);
     assert_int_equal(s.light_count, 1);
     assert_int_equal(s.lights[0].kind, RT_LIGHT_DIRECTIONAL);
     assert_false(s.camera_set); /* framed by the driver later */
     rt_scene_free(&s);
 
     rt_scene_init(&s);
-    assert_int_equal(rt_load(&s, "assets/box.gltf", &opt, NULL, &err), RT_OK);
+
+    rt_settings_default(&set);
+    assert_int_equal(rt_load(&s, &set, "assets/box.gltf", &opt, NULL, &err), RT_OK);
     assert_true(s.camera_set);
     assert_memory_equal(&s.camera, &s.cameras[0], sizeof s.camera);
     assert_int_equal(s.light_count, 1);
@@ -340,7 +345,8 @@ static void test_for_render(void **state)
 
     /* a scene file keeps its own lights and samples */
     rt_scene_init(&s);
-    assert_int_equal(rt_load(&s, "scenes/cornell.txt", &opt, NULL, &err), RT_OK);
+    rt_settings_default(&set);
+    assert_int_equal(rt_load(&s, &set, "scenes/cornell.txt", &opt, NULL, &err), RT_OK);
     assert_int_equal(s.light_count, 1);
     assert_int_equal(s.lights[0].kind, RT_LIGHT_AREA);
     rt_scene_free(&s);
@@ -352,7 +358,10 @@ static void test_rollback_unit(void **state)
 {
     (void)state;
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
+    rt_settings_default(&set);
     rt_material m;
     rt_material_default(&m, "kept");
     assert_int_not_equal(rt_scene_add_material(&s, &m), RT_NONE);
@@ -381,8 +390,8 @@ static void test_rollback_unit(void **state)
     assert_int_not_equal(rt_scene_add_triangle(&s, v, v + 1, v + 2, 0, 0), RT_NONE);
     assert_int_not_equal(rt_scene_add_sphere(&s, rt_v3(0, 0, 0), 1, 0), RT_NONE);
     assert_int_not_equal(rt_scene_add_quad(&s, rt_v3(0, 0, 0), rt_v3(1, 0, 0), rt_v3(0, 1, 0), 0), RT_NONE);
-    s.settings.samples = 77;
-    snprintf(s.settings.output, sizeof s.settings.output, "changed.png");
+    set.samples = 77;
+    snprintf(set.output, sizeof set.output, "changed.png");
     s.camera.vfov_deg = 10;
     s.camera_set = true;
 
@@ -404,7 +413,7 @@ static void load_valid_scene(rt_scene *s)
 {
     rt_error err = {0};
     rt_scene_init(s);
-    rt_result r = rt_load(s, "scenes/textures.txt", NULL, NULL, &err);
+    rt_result r = rt_load(s, NULL, "scenes/textures.txt", NULL, NULL, &err);
     if (r != RT_OK)
         fprintf(stderr, "%s\n", err.message);
     assert_int_equal(r, RT_OK);
@@ -437,15 +446,22 @@ static void test_rollback_scene_text(void **state)
     rt_scene s;
     load_valid_scene(&s);
     rt_scene_mark before = rt_scene_mark_of(&s);
+    rt_settings set, set_before; /* the settings the failed loads were given stay as they were too */
+    rt_settings_default(&set);
+    set.samples = 7;
+    set_before = set;
     rt_error err = {0};
-    expect_failure(rt_scene_parse_file(&s, tpath("broken.txt"), &err), &err, "broken.txt:15:");
+    expect_failure(rt_scene_parse_file(&s, &set, tpath("broken.txt"), &err), &err, "broken.txt:15:");
     assert_unchanged(&s, &before);
+    assert_memory_equal(&set, &set_before, sizeof set);
     /* also through rt_load, and when only the end of the file can tell */
-    expect_failure(rt_load(&s, tpath("broken.txt"), NULL, NULL, &err), &err, "broken.txt:15:");
+    expect_failure(rt_load(&s, &set, tpath("broken.txt"), NULL, NULL, &err), &err, "broken.txt:15:");
     assert_unchanged(&s, &before);
+    assert_memory_equal(&set, &set_before, sizeof set);
     write_text("late.txt", "samples 5\nmaterial m\nsphere 0 0 0 1 m\ncamera gltf 7\n");
-    expect_failure(rt_load(&s, tpath("late.txt"), NULL, NULL, &err), &err, "camera gltf 7");
+    expect_failure(rt_load(&s, &set, tpath("late.txt"), NULL, NULL, &err), &err, "camera gltf 7");
     assert_unchanged(&s, &before);
+    assert_memory_equal(&set, &set_before, sizeof set);
     rt_scene_free(&s);
 }
 
@@ -493,16 +509,20 @@ static void test_rollback_gltf(void **state)
     rt_scene_mark before = rt_scene_mark_of(&s);
     expect_failure(rt_gltf_load(&s, tpath("bad.gltf"), NULL, NULL, &err), &err, "is not finite");
     assert_unchanged(&s, &before);
-    expect_failure(rt_load(&s, tpath("bad.gltf"), &(rt_load_options){.for_render = true}, NULL, &err), &err,
+    rt_settings set, set_before; /* for_render's model settings are rolled back too */
+    rt_settings_default(&set);
+    set_before = set;
+    expect_failure(rt_load(&s, &set, tpath("bad.gltf"), &(rt_load_options){.for_render = true}, NULL, &err), &err,
                    "is not finite");
     assert_unchanged(&s, &before);
+    assert_memory_equal(&set, &set_before, sizeof set);
     rt_scene_free(&s);
 
     /* into a scene that had no colours: the array the failed load enabled goes too */
     load_valid_scene(&s);
     before = rt_scene_mark_of(&s);
     assert_int_equal(before.vertex_attrs & RT_ATTR_COLOR, 0);
-    expect_failure(rt_load(&s, tpath("bad.gltf"), NULL, NULL, &err), &err, "is not finite");
+    expect_failure(rt_load(&s, NULL, tpath("bad.gltf"), NULL, NULL, &err), &err, "is not finite");
     assert_unchanged(&s, &before);
     assert_null(s.vertices.color);
     rt_scene_free(&s);
@@ -537,7 +557,7 @@ static void test_rollback_obj(void **state)
     expect_failure(rt_mesh_load(&s, tpath("bad2.obj"), NULL, &st, &err), &err, "bad2.obj:7");
     assert_unchanged(&s, &before);
     /* through rt_load, whose "default" material goes too */
-    expect_failure(rt_load(&s, tpath("bad2.obj"), NULL, NULL, &err), &err, "bad2.obj:7");
+    expect_failure(rt_load(&s, NULL, tpath("bad2.obj"), NULL, NULL, &err), &err, "bad2.obj:7");
     assert_unchanged(&s, &before);
     rt_scene_free(&s);
 }
@@ -574,9 +594,9 @@ static void test_rollback_ply_off(void **state)
     assert_unchanged(&s, &before);
     for (int k = 0; k < 2; k++) {
         rt_load_options opt = {.for_render = k == 1};
-        expect_failure(rt_load(&s, tpath("bad.ply"), &opt, NULL, &err), &err, "bad.ply");
+        expect_failure(rt_load(&s, NULL, tpath("bad.ply"), &opt, NULL, &err), &err, "bad.ply");
         assert_unchanged(&s, &before);
-        expect_failure(rt_load(&s, tpath("bad.off"), &opt, NULL, &err), &err, "bad.off:7");
+        expect_failure(rt_load(&s, NULL, tpath("bad.off"), &opt, NULL, &err), &err, "bad.off:7");
         assert_unchanged(&s, &before);
     }
     rt_scene_free(&s);

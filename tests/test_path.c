@@ -397,7 +397,7 @@ static void test_rr_depth_unbiased(void **state)
                  rr[k]);
         fixture f;
         load(&f, text, false);
-        assert_int_equal(f.s.settings.rr_depth, rr[k]);
+        assert_int_equal(f.settings.rr_depth, rr[k]);
         double sd, mean = mean_inside_sphere(&f, 40000, 13, &sd);
         if (fabs(mean - 2.5) > 4.0 * sd + 1e-3)
             fail_msg("rr_depth %d: %.4f +- %.4f, want 2.5", rr[k], mean, sd);
@@ -528,8 +528,8 @@ static void add_env(rt_scene *s, int w, int h, float sky, float sun, int si, int
     tex.wrap_t = RT_WRAP_CLAMP;
     uint32_t t = rt_scene_add_texture(s, &tex);
     assert_true(t != RT_NONE);
-    s->settings.environment_texture = t;
-    s->settings.environment_strength = 1.0f;
+    s->environment.environment_texture = t;
+    s->environment.environment_strength = 1.0f;
 }
 
 static void load_env(fixture *f, const char *text, float sky, float sun, bool table)
@@ -741,12 +741,12 @@ static const char *every_material =
 static void render_fixture(fixture *f, int threads, rt_framebuffer *fb, rt_render_stats *st)
 {
     rt_error err;
-    assert_int_equal(rt_framebuffer_init(fb, f->s.settings.width, f->s.settings.height, &err), RT_OK);
+    assert_int_equal(rt_framebuffer_init(fb, f->settings.width, f->settings.height, &err), RT_OK);
     rt_render_options opt;
     memset(&opt, 0, sizeof opt);
     opt.threads = threads;
     opt.tile_size = 8;
-    assert_int_equal(rt_render(&f->s, &f->tree, &opt, fb, st, &err), RT_OK);
+    assert_int_equal(rt_render(&f->s, &f->settings, &f->tree, &opt, fb, st, &err), RT_OK);
 }
 
 static void test_every_material_finite_and_deterministic(void **state)
@@ -772,7 +772,7 @@ static void test_every_material_finite_and_deterministic(void **state)
     /* the same through the emitter table: every sample finite */
     rt_render_state rs;
     rt_error err;
-    assert_int_equal(rt_render_state_prepare(&rs, &f.s, &f.tree, RT_PREPARE_LIGHT_TABLE, &err), RT_OK);
+    assert_int_equal(rt_render_state_prepare(&rs, &f.s, &f.settings, &f.tree, RT_PREPARE_LIGHT_TABLE, &err), RT_OK);
     assert_int_equal(rs.light_table->count, 1); /* the lamp triangle (the area light's quad is a light already) */
     rt_trace_ctx ctx;
     rt_trace_ctx_init(&ctx, &rs);
@@ -813,12 +813,12 @@ static void test_cornell_reference(void **state)
     assert_int_equal(ref.height, 512);
     fixture f;
     rt_scene_init(&f.s);
-    if (rt_scene_parse_file(&f.s, "scenes/cornell-reference.txt", &err) != RT_OK)
+    if (rt_scene_parse_file(&f.s, NULL, "scenes/cornell-reference.txt", &err) != RT_OK)
         fail_msg("%s", err.message);
     assert_int_equal(f.s.triangles.count, 30);
     assert_int_equal(f.s.light_count, 1);
-    f.s.settings.width = f.s.settings.height = 64;
-    f.s.settings.samples = 256;
+    f.settings.width = f.settings.height = 64;
+    f.settings.samples = 256;
     assert_int_equal(rt_kdtree_build(&f.tree, &f.s, NULL, &err), RT_OK);
     memset(&f.rs, 0, sizeof f.rs);
     rt_framebuffer img;

@@ -30,7 +30,10 @@ static void test_lambert_plane_point_light(void **state)
 {
     (void)state;
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
+    rt_settings_default(&set);
     const float albedo = 0.6f, I = 10.0f;
     const rt_vec3 light = rt_v3(0.3f, 2.0f, -0.2f);
     uint32_t m = add_lambert(&s, "plane", rt_v3s(albedo));
@@ -43,12 +46,12 @@ static void test_lambert_plane_point_light(void **state)
     l.position = light;
     l.quad = RT_NONE;
     rt_scene_add_light(&s, &l);
-    s.settings.width = 40;
-    s.settings.height = 30;
-    s.settings.samples = 1;
+    set.width = 40;
+    set.height = 30;
+    set.samples = 1;
     test_scene_look(&s, rt_v3(0, 3, 1), rt_v3(0, 0, 0), rt_v3(0, 1, 0), 50);
     rt_framebuffer fb;
-    test_render_scene(&s, 2, 8, &fb);
+    test_render_scene(&s, &set, 2, 8, &fb);
 
     rt_camera_frame cf;
     rt_camera_frame_init(&cf, &s.camera, fb.width, fb.height);
@@ -74,9 +77,10 @@ static void test_lambert_plane_point_light(void **state)
 }
 
 /* A small scene with an area light, spheres, quads and triangles. */
-static void build_busy_scene(rt_scene *s)
+static void build_busy_scene(rt_scene *s, rt_settings *set)
 {
     rt_scene_init(s);
+    rt_settings_default(set);
     uint32_t white = add_lambert(s, "white", rt_v3(0.7f, 0.7f, 0.7f));
     uint32_t red = add_lambert(s, "red", rt_v3(0.7f, 0.1f, 0.1f));
     rt_material em;
@@ -105,10 +109,10 @@ static void build_busy_scene(rt_scene *s)
     l.edge_v = ev;
     l.quad = q;
     rt_scene_add_light(s, &l);
-    s->settings.width = 37;
-    s->settings.height = 23;
-    s->settings.samples = 5;
-    s->settings.shadow_samples = 4;
+    set->width = 37;
+    set->height = 23;
+    set->samples = 5;
+    set->shadow_samples = 4;
     test_scene_look(s, rt_v3(0, 1.5f, 4), rt_v3(0, 0.5f, 0), rt_v3(0, 1, 0), 45);
 }
 
@@ -116,11 +120,13 @@ static void test_same_image_any_thread_count(void **state)
 {
     (void)state;
     rt_scene s;
-    build_busy_scene(&s);
+    rt_settings set;
+    rt_settings_default(&set);
+    build_busy_scene(&s, &set);
     rt_framebuffer a, b, c;
-    test_render_scene(&s, 1, 32, &a);
-    test_render_scene(&s, 2, 32, &b);
-    test_render_scene(&s, 7, 5, &c); /* more threads than useful, odd tiles */
+    test_render_scene(&s, &set, 1, 32, &a);
+    test_render_scene(&s, &set, 2, 32, &b);
+    test_render_scene(&s, &set, 7, 5, &c); /* more threads than useful, odd tiles */
     size_t n = (size_t)a.width * a.height * 3 * sizeof(float);
     assert_memory_equal(a.rgb, b.rgb, n);
     assert_memory_equal(a.rgb, c.rgb, n);
@@ -178,14 +184,16 @@ static void test_progress_reports(void **state)
 {
     (void)state;
     rt_scene s;
-    build_busy_scene(&s);
-    s.settings.samples = 16;
+    rt_settings set;
+    rt_settings_default(&set);
+    build_busy_scene(&s, &set);
+    set.samples = 16;
     rt_error err = {0};
     assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
     rt_kdtree tree;
     assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
     rt_framebuffer fb;
-    assert_int_equal(rt_framebuffer_init(&fb, s.settings.width, s.settings.height, &err), RT_OK);
+    assert_int_equal(rt_framebuffer_init(&fb, set.width, set.height, &err), RT_OK);
     size_t npx = (size_t)fb.width * (size_t)fb.height;
     progress_log log;
     memset(&log, 0, sizeof log);
@@ -200,7 +208,7 @@ static void test_progress_reports(void **state)
     opt.progress = log_progress;
     opt.progress_user = &log;
     rt_render_stats st;
-    assert_int_equal(rt_render(&s, &tree, &opt, &fb, &st, &err), RT_OK);
+    assert_int_equal(rt_render(&s, &set, &tree, &opt, &fb, &st, &err), RT_OK);
     assert_true(log.calls >= 1);
     assert_int_equal(log.finals, 1);
     assert_true(log.final_was_last);
@@ -215,36 +223,36 @@ static void test_progress_reports(void **state)
 }
 
 /* Renders with explicit options; returns rt_render's result. */
-static rt_result render_with(rt_scene *s, const rt_render_options *opt, rt_framebuffer *fb, rt_render_stats *st)
+static rt_result render_with(rt_scene *s, rt_settings *set, const rt_render_options *opt, rt_framebuffer *fb, rt_render_stats *st)
 {
     rt_error err = {0};
     assert_int_equal(rt_scene_validate(s, &err), RT_OK);
     rt_kdtree tree;
     assert_int_equal(rt_kdtree_build(&tree, s, NULL, &err), RT_OK);
-    assert_int_equal(rt_framebuffer_init(fb, s->settings.width, s->settings.height, &err), RT_OK);
-    rt_result r = rt_render(s, &tree, opt, fb, st, &err);
+    assert_int_equal(rt_framebuffer_init(fb, set->width, set->height, &err), RT_OK);
+    rt_result r = rt_render(s, set, &tree, opt, fb, st, &err);
     rt_kdtree_free(&tree);
     return r;
 }
 
 /* The reference the pass tests compare with: the scene tiled, one thread,
  * 32-pixel tiles (opt is left holding those options). */
-static void render_tiled_reference(rt_scene *s, rt_render_options *opt, rt_framebuffer *ref, rt_render_stats *st)
+static void render_tiled_reference(rt_scene *s, rt_settings *set, rt_render_options *opt, rt_framebuffer *ref, rt_render_stats *st)
 {
     memset(opt, 0, sizeof *opt);
     opt->threads = 1;
     opt->tile_size = 32;
     opt->pass_samples = -1;
-    assert_int_equal(render_with(s, opt, ref, st), RT_OK);
+    assert_int_equal(render_with(s, set, opt, ref, st), RT_OK);
 }
 
 /* Renders s with opt, asserts it completed with `samples` per pixel and
  * gave ref's bytes; *st keeps its statistics. */
-static void assert_renders_like(rt_scene *s, const rt_render_options *opt, const rt_framebuffer *ref, int samples,
+static void assert_renders_like(rt_scene *s, rt_settings *set, const rt_render_options *opt, const rt_framebuffer *ref, int samples,
                                 rt_render_stats *st)
 {
     rt_framebuffer fb;
-    assert_int_equal(render_with(s, opt, &fb, st), RT_OK);
+    assert_int_equal(render_with(s, set, opt, &fb, st), RT_OK);
     assert_int_equal(st->samples_done, samples);
     assert_false(st->partial || st->interrupted || st->time_limited);
     assert_memory_equal(ref->rgb, fb.rgb, (size_t)ref->width * ref->height * 3 * sizeof(float));
@@ -260,18 +268,20 @@ static void test_passes_same_bytes_as_tiles(void **state)
 {
     (void)state;
     rt_scene s;
-    build_busy_scene(&s);
-    s.settings.samples = 13;
-    s.settings.clamp = 3.0f; /* the clamp's arithmetic too */
+    rt_settings set;
+    rt_settings_default(&set);
+    build_busy_scene(&s, &set);
+    set.samples = 13;
+    set.clamp = 3.0f; /* the clamp's arithmetic too */
     const rt_integrator integrators[] = {RT_INTEGRATOR_PATH, RT_INTEGRATOR_PATH_SCALAR, RT_INTEGRATOR_DIRECT,
                                          RT_INTEGRATOR_WHITTED};
     const int pass_sizes[] = {1, 2, 4, 5, 13, 32, 0};
     for (size_t k = 0; k < sizeof integrators / sizeof *integrators; k++) {
-        s.settings.integrator = integrators[k];
+        set.integrator = integrators[k];
         rt_render_options opt;
         rt_framebuffer ref;
         rt_render_stats st;
-        render_tiled_reference(&s, &opt, &ref, &st);
+        render_tiled_reference(&s, &set, &opt, &ref, &st);
         assert_false(st.passes);
         assert_int_equal(st.samples_done, 13);
         double sum = 0;
@@ -283,7 +293,7 @@ static void test_passes_same_bytes_as_tiles(void **state)
                 opt.threads = threads;
                 opt.tile_size = threads == 3 ? 5 : 16 * threads;
                 opt.pass_samples = pass_sizes[p];
-                assert_renders_like(&s, &opt, &ref, 13, &st);
+                assert_renders_like(&s, &set, &opt, &ref, 13, &st);
                 bool passes = pass_sizes[p] > 0 || integrators[k] == RT_INTEGRATOR_PATH ||
                               integrators[k] == RT_INTEGRATOR_PATH_SCALAR;
                 assert_int_equal(st.passes, passes);
@@ -303,21 +313,23 @@ static void test_passes_same_bytes_above_a_block(void **state)
 {
     (void)state;
     rt_scene s;
-    build_busy_scene(&s);
-    s.settings.samples = 130;
+    rt_settings set;
+    rt_settings_default(&set);
+    build_busy_scene(&s, &set);
+    set.samples = 130;
     const rt_integrator integrators[] = {RT_INTEGRATOR_PATH, RT_INTEGRATOR_PATH_SCALAR, RT_INTEGRATOR_DIRECT};
     const int pass_sizes[] = {1, 7, 64, 100, 130};
     for (size_t k = 0; k < sizeof integrators / sizeof *integrators; k++) {
-        s.settings.integrator = integrators[k];
+        set.integrator = integrators[k];
         rt_render_options opt;
         rt_framebuffer ref;
         rt_render_stats st;
-        render_tiled_reference(&s, &opt, &ref, &st);
+        render_tiled_reference(&s, &set, &opt, &ref, &st);
         for (size_t p = 0; p < sizeof pass_sizes / sizeof *pass_sizes; p++) {
             opt.threads = 1 + (int)(p % 2);
             opt.tile_size = p % 2 ? 5 : 16;
             opt.pass_samples = pass_sizes[p];
-            assert_renders_like(&s, &opt, &ref, 130, &st);
+            assert_renders_like(&s, &set, &opt, &ref, 130, &st);
             assert_true(st.passes);
         }
         rt_framebuffer_free(&ref);
@@ -333,12 +345,14 @@ static void test_time_limit(void **state)
 {
     (void)state;
     rt_scene s;
-    build_busy_scene(&s);
-    s.settings.samples = 64;
+    rt_settings set;
+    rt_settings_default(&set);
+    build_busy_scene(&s, &set);
+    set.samples = 64;
     const rt_integrator integrators[] = {RT_INTEGRATOR_PATH, RT_INTEGRATOR_PATH_SCALAR, RT_INTEGRATOR_DIRECT,
                                          RT_INTEGRATOR_WHITTED};
     for (size_t k = 0; k < sizeof integrators / sizeof *integrators; k++) {
-        s.settings.integrator = integrators[k];
+        set.integrator = integrators[k];
         rt_render_options opt;
         memset(&opt, 0, sizeof opt);
         opt.threads = 2;
@@ -346,7 +360,7 @@ static void test_time_limit(void **state)
         opt.time_limit = 1e-9;
         rt_framebuffer fb;
         rt_render_stats st;
-        assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
+        assert_int_equal(render_with(&s, &set, &opt, &fb, &st), RT_OK);
         assert_true(st.passes && st.time_limited && !st.interrupted && !st.partial);
         assert_int_equal(st.samples_done, 3);
         assert_int_equal(st.passes_done, 1);
@@ -354,7 +368,7 @@ static void test_time_limit(void **state)
         rt_framebuffer_free(&fb);
 
         opt.pass_samples = -1; /* tiles */
-        assert_int_equal(render_with(&s, &opt, &fb, &st), RT_OK);
+        assert_int_equal(render_with(&s, &set, &opt, &fb, &st), RT_OK);
         assert_true(!st.passes && st.time_limited && !st.interrupted && st.partial);
         assert_true(st.tiles_done < st.tiles_total);
         assert_int_equal(st.samples_done, 0);
@@ -390,9 +404,11 @@ static void test_pass_progress_and_cancel(void **state)
 {
     (void)state;
     rt_scene s;
-    build_busy_scene(&s);
-    s.settings.samples = 40;
-    s.settings.integrator = RT_INTEGRATOR_PATH;
+    rt_settings set;
+    rt_settings_default(&set);
+    build_busy_scene(&s, &set);
+    set.samples = 40;
+    set.integrator = RT_INTEGRATOR_PATH;
     cancel_after_pass c;
     memset(&c, 0, sizeof c);
     atomic_init(&c.cancel, 0);
@@ -406,7 +422,7 @@ static void test_pass_progress_and_cancel(void **state)
     opt.progress_user = &c;
     rt_framebuffer a, b;
     rt_render_stats st;
-    assert_int_equal(render_with(&s, &opt, &a, &st), RT_ERR_INTERRUPTED);
+    assert_int_equal(render_with(&s, &set, &opt, &a, &st), RT_ERR_INTERRUPTED);
     assert_true(st.interrupted && !st.partial && !st.time_limited);
     assert_int_equal(st.samples_done, 6);
     assert_int_equal(c.last_samples, 6);
@@ -414,7 +430,7 @@ static void test_pass_progress_and_cancel(void **state)
     opt.threads = 1;
     opt.pass_samples = 6;
     opt.time_limit = 1e-9;
-    assert_int_equal(render_with(&s, &opt, &b, &st), RT_OK);
+    assert_int_equal(render_with(&s, &set, &opt, &b, &st), RT_OK);
     assert_int_equal(st.samples_done, 6);
     assert_memory_equal(a.rgb, b.rgb, (size_t)a.width * a.height * 3 * sizeof(float));
     rt_framebuffer_free(&a);
@@ -427,18 +443,20 @@ static void test_area_light_visible_one_sided(void **state)
 {
     (void)state;
     rt_scene s;
-    build_busy_scene(&s);
-    s.settings.width = 1;
-    s.settings.height = 1;
-    s.settings.samples = 1;
+    rt_settings set;
+    rt_settings_default(&set);
+    build_busy_scene(&s, &set);
+    set.width = 1;
+    set.height = 1;
+    set.samples = 1;
     test_scene_look(&s, rt_v3(0, 1.0f, 0.0f), rt_v3(0, 3, 0.0f), rt_v3(0, 0, 1), 1);
     rt_framebuffer fb;
-    test_render_scene(&s, 1, 32, &fb);
+    test_render_scene(&s, &set, 1, 32, &fb);
     assert_float_equal(fb.rgb[0], 5.0f, 1e-5);
     rt_framebuffer_free(&fb);
     s.camera.position = rt_v3(0, 4.0f, 0.0f);
     s.camera.look_at = rt_v3(0, 0, 0.0f);
-    test_render_scene(&s, 1, 32, &fb);
+    test_render_scene(&s, &set, 1, 32, &fb);
     assert_float_equal(fb.rgb[0], 0.0f, 1e-6); /* back of the emitter, lit from nowhere */
     rt_framebuffer_free(&fb);
     rt_scene_free(&s);

@@ -309,6 +309,7 @@ static void test_dimensions_decorrelated(void **state)
 
 typedef struct fixture {
     rt_scene s;
+    rt_settings settings;
     rt_kdtree tree;
 } fixture;
 
@@ -332,9 +333,10 @@ static void cornell_fixture(fixture *f)
 {
     rt_error err;
     rt_scene_init(&f->s);
-    if (rt_scene_parse_file(&f->s, "scenes/cornell-reference.txt", &err) != RT_OK)
+    rt_settings_default(&f->settings);
+    if (rt_scene_parse_file(&f->s, &f->settings, "scenes/cornell-reference.txt", &err) != RT_OK)
         fail_msg("%s", err.message);
-    f->s.settings.seed = 0;
+    f->settings.seed = 0;
     assert_int_equal(rt_kdtree_build(&f->tree, &f->s, NULL, &err), RT_OK);
 }
 
@@ -350,8 +352,8 @@ static void render(fixture *f, rt_integrator in, rt_sampler_kind kind, rt_render
                    rt_framebuffer *fb)
 {
     rt_error err;
-    f->s.settings.integrator = in;
-    f->s.settings.sampler = (int)kind;
+    f->settings.integrator = in;
+    f->settings.sampler = (int)kind;
     assert_int_equal(rt_framebuffer_init(fb, region.x1 - region.x0, region.y1 - region.y0, &err), RT_OK);
     rt_render_options opt;
     memset(&opt, 0, sizeof opt);
@@ -359,7 +361,7 @@ static void render(fixture *f, rt_integrator in, rt_sampler_kind kind, rt_render
     opt.region = region;
     opt.sample_end = sample_end;
     rt_render_stats st;
-    assert_int_equal(rt_render(&f->s, &f->tree, &opt, fb, &st, &err), RT_OK);
+    assert_int_equal(rt_render(&f->s, &f->settings, &f->tree, &opt, fb, &st, &err), RT_OK);
     assert_int_equal(st.bad_samples, 0);
 }
 
@@ -378,7 +380,7 @@ static void test_cornell_mse_stratified(void **state)
     test_require_cornell_reference(&ref);
     fixture f;
     cornell_fixture(&f);
-    f.s.settings.samples = 16;
+    f.settings.samples = 16;
     const rt_sampler_kind kinds[] = {RT_SAMPLER_INDEPENDENT, RT_SAMPLER_CMJ, RT_SAMPLER_SOBOL};
     double mse[3];
     const rt_render_region crop = {192, 192, 320, 320}, corner = {192, 192, 224, 224};
@@ -420,7 +422,7 @@ static void test_prefix_covers_pixel(void **state)
     const rt_render_region crop = {192, 192, 320, 320};
     double mse[2];
     for (int k = 0; k < 2; k++) {
-        f.s.settings.samples = k == 0 ? 16 : 64;
+        f.settings.samples = k == 0 ? 16 : 64;
         rt_framebuffer img;
         render(&f, RT_INTEGRATOR_PATH, RT_SAMPLER_SOBOL, crop, 16, &img);
         mse[k] = crop_mse(&img, &ref, crop);

@@ -58,7 +58,7 @@ static void load_text(rt_scene *s, const char *file, const char *text)
     test_write_file(path, text, strlen(text));
     rt_scene_init(s);
     rt_error err = {0};
-    if (rt_scene_parse_file(s, path, &err) != RT_OK)
+    if (rt_scene_parse_file(s, NULL, path, &err) != RT_OK)
         fail_msg("%s: %s", file, err.message);
 }
 
@@ -226,8 +226,10 @@ enum { RW = 64, RH = 24 };
 static void render_scene(const char *file, const char *text, rt_framebuffer *fb)
 {
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     load_text(&s, file, text);
-    test_render_scene(&s, 2, 0, fb);
+    test_render_scene(&s, &set, 2, 0, fb);
     rt_scene_free(&s);
 }
 
@@ -358,7 +360,7 @@ static void test_bad_values(void **state)
         rt_scene s;
         rt_scene_init(&s);
         rt_error err = {0};
-        rt_result r = rt_scene_parse_file(&s, path, &err);
+        rt_result r = rt_scene_parse_file(&s, NULL, path, &err);
         char prefix[600];
         snprintf(prefix, sizeof prefix, "%s:%s: ", path, bad[i].where);
         if (r == RT_OK || strncmp(err.message, prefix, strlen(prefix)) != 0 || !strstr(err.message, bad[i].part))
@@ -409,6 +411,8 @@ static void test_coat_ignores_base_normal_map(void **state)
 {
     (void)state;
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     /* a constant normal map tilting the normal by atan(0.6 / 0.4) towards +u */
     load_text(&s, "coat.txt",
               "texture tilt constant 0.8 0.5 0.7\n"
@@ -422,7 +426,7 @@ static void test_coat_ignores_base_normal_map(void **state)
     rt_error err = {0};
     assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
     rt_render_state rs;
-    assert_int_equal(rt_render_state_prepare(&rs, &s, NULL, 0, &err), RT_OK);
+    assert_int_equal(rt_render_state_prepare(&rs, &s, &set, NULL, 0, &err), RT_OK);
     rt_trace_ctx ctx;
     rt_trace_ctx_init(&ctx, &rs);
     rt_vec3 tilted = rt_normalize(rt_v3(0.6f, 0.0f, 0.4f));
@@ -455,7 +459,7 @@ static void test_shipped_scene(void **state)
     rt_scene s;
     rt_scene_init(&s);
     rt_error err = {0};
-    assert_int_equal(rt_scene_parse_file(&s, "scenes/pbr-extensions.txt", &err), RT_OK);
+    assert_int_equal(rt_scene_parse_file(&s, NULL, "scenes/pbr-extensions.txt", &err), RT_OK);
     size_t extended = 0;
     for (size_t i = 0; i < s.material_count; i++)
         extended += s.materials[i].extended;

@@ -43,12 +43,20 @@ static const char *tmp_path(const char *rel)
     return buf[k];
 }
 
-/* Parses text as "t.txt" (relative paths resolve against tmp_dir). */
-static rt_result parse(rt_scene *s, const char *text, rt_error *err)
+/* Parses text as "t.txt" (relative paths resolve against tmp_dir), its
+ * settings into *set (defaults first; NULL: checked, not kept). */
+static rt_result parse_settings(rt_scene *s, rt_settings *set, const char *text, rt_error *err)
 {
     rt_scene_init(s);
+    if (set)
+        rt_settings_default(set);
     memset(err, 0, sizeof *err);
-    return rt_scene_parse_string(s, text, strlen(text), "t.txt", tmp_dir, err);
+    return rt_scene_parse_string(s, set, text, strlen(text), "t.txt", tmp_dir, err);
+}
+
+static rt_result parse(rt_scene *s, const char *text, rt_error *err)
+{
+    return parse_settings(s, NULL, text, err);
 }
 
 /* Parses text that must fail with `code`, a message starting with
@@ -89,15 +97,20 @@ static void expect_errors_in(const error_case *cases, size_t n, const char *tabl
         expect_error_at(cases[i].text, cases[i].code, cases[i].where, cases[i].part, table, (int)i);
 }
 
-static void expect_ok(const char *text, rt_scene *s)
+static void expect_ok_settings(const char *text, rt_scene *s, rt_settings *set)
 {
     rt_error err;
-    rt_result r = parse(s, text, &err);
+    rt_result r = parse_settings(s, set, text, &err);
     if (r != RT_OK) {
         print_error("unexpected error %d: %s\n", r, err.message);
         rt_scene_free(s);
         fail();
     }
+}
+
+static void expect_ok(const char *text, rt_scene *s)
+{
+    expect_ok_settings(text, s, NULL);
 }
 
 /* A parse that must succeed: its message is shown when it does not. */
@@ -142,7 +155,7 @@ static const char *scene_format_doc_section(const char *heading)
 }
 
 
-static void check_cornell(const rt_scene *s)
+static void check_cornell(const rt_scene *s, const rt_settings *set)
 {
     assert_int_equal(s->material_count, 4); /* white, red, green, the area light's */
     assert_int_equal(s->quads.count, 11);   /* 5 walls, 5 box faces, the light */
@@ -150,9 +163,9 @@ static void check_cornell(const rt_scene *s)
     assert_int_equal(s->triangles.count, 0);
     assert_int_equal(s->light_count, 1);
     assert_true(s->camera_set);
-    assert_int_equal(s->settings.width, 512);
-    assert_int_equal(s->settings.height, 512);
-    assert_int_equal(s->settings.integrator, RT_INTEGRATOR_DIRECT);
+    assert_int_equal(set->width, 512);
+    assert_int_equal(set->height, 512);
+    assert_int_equal(set->integrator, RT_INTEGRATOR_DIRECT);
     const rt_light *l = &s->lights[0];
     assert_int_equal(l->kind, RT_LIGHT_AREA);
     assert_int_equal(l->quad, 10);
@@ -183,11 +196,13 @@ static void test_default_scene(void **state)
     rt_scene s;
     rt_error err;
     rt_scene_init(&s);
-    rt_result r = rt_scene_parse_string(&s, rt_default_scene_text, strlen(rt_default_scene_text), "<default>", NULL,
+    rt_settings set;
+    rt_settings_default(&set);
+    rt_result r = rt_scene_parse_string(&s, &set, rt_default_scene_text, strlen(rt_default_scene_text), "<default>", NULL,
                                         &err);
     assert_parsed(r, &err);
-    check_cornell(&s);
-    assert_string_equal(s.settings.output, ""); /* the driver writes out.png */
+    check_cornell(&s, &set);
+    assert_string_equal(set.output, ""); /* the driver writes out.png */
     rt_scene_free(&s);
 }
 
@@ -199,13 +214,16 @@ static void test_cornell_file_matches_default(void **state)
     rt_error err;
     rt_scene_init(&a);
     rt_scene_init(&b);
-    assert_int_equal(rt_scene_parse_string(&a, rt_default_scene_text, strlen(rt_default_scene_text), "<default>",
+    rt_settings seta, setb;
+    rt_settings_default(&seta);
+    rt_settings_default(&setb);
+    assert_int_equal(rt_scene_parse_string(&a, &seta, rt_default_scene_text, strlen(rt_default_scene_text), "<default>",
                                            NULL, &err),
                      RT_OK);
-    rt_result r = rt_scene_parse_file(&b, "scenes/cornell.txt", &err);
+    rt_result r = rt_scene_parse_file(&b, &setb, "scenes/cornell.txt", &err);
     assert_parsed(r, &err);
-    check_cornell(&b);
-    assert_string_equal(b.settings.output, "cornell.png");
+    check_cornell(&b, &setb);
+    assert_string_equal(setb.output, "cornell.png");
     assert_int_equal(a.quads.count, b.quads.count);
     for (size_t i = 0; i < a.quads.count; i++) {
         assert_float_equal(a.quads.px[i], b.quads.px[i], 0);
@@ -218,8 +236,8 @@ static void test_cornell_file_matches_default(void **state)
     assert_memory_equal(&a.lights[0], &b.lights[0], sizeof a.lights[0]);
     for (size_t i = 0; i < a.material_count; i++)
         assert_memory_equal(&a.materials[i], &b.materials[i], sizeof a.materials[i]);
-    memset(b.settings.output, 0, sizeof b.settings.output);
-    assert_memory_equal(&a.settings, &b.settings, sizeof a.settings);
+    memset(setb.output, 0, sizeof setb.output);
+    assert_memory_equal(&seta, &setb, sizeof seta);
     rt_scene_free(&a);
     rt_scene_free(&b);
 }
@@ -243,7 +261,7 @@ static void test_all_scene_files(void **state)
         rt_scene s;
         rt_error err;
         rt_scene_init(&s);
-        rt_result r = rt_scene_parse_file(&s, path, &err);
+        rt_result r = rt_scene_parse_file(&s, NULL, path, &err);
         if (r != RT_OK)
             fail_msg("%s: %s", path, err.message);
         if (rt_scene_prim_count(&s) == 0)
@@ -261,7 +279,7 @@ static void test_spheres_scene(void **state)
     rt_scene s;
     rt_error err;
     rt_scene_init(&s);
-    rt_result r = rt_scene_parse_file(&s, "scenes/spheres.txt", &err);
+    rt_result r = rt_scene_parse_file(&s, NULL, "scenes/spheres.txt", &err);
     assert_parsed(r, &err);
     assert_int_equal(s.spheres.count, 5);
     assert_int_equal(s.quads.count, 1);
@@ -283,7 +301,7 @@ static void test_textures_scene(void **state)
     rt_scene s;
     rt_error err;
     rt_scene_init(&s);
-    rt_result r = rt_scene_parse_file(&s, "scenes/textures.txt", &err);
+    rt_result r = rt_scene_parse_file(&s, NULL, "scenes/textures.txt", &err);
     assert_parsed(r, &err);
     assert_int_equal(s.image_count, 2);     /* uvgrid.png once, bumps.png */
     assert_int_equal(s.camera_count, 1);    /* box.gltf's camera, not selected */
@@ -312,13 +330,15 @@ static void test_docs_example(void **state)
     rt_scene s;
     rt_error err;
     rt_scene_init(&s);
-    rt_result r = rt_scene_parse_string(&s, start, (size_t)(end - start), "docs/scene-format.md#example", "scenes",
+    rt_settings set;
+    rt_settings_default(&set);
+    rt_result r = rt_scene_parse_string(&s, &set, start, (size_t)(end - start), "docs/scene-format.md#example", "scenes",
                                         &err);
     assert_parsed(r, &err);
     assert_int_equal(s.light_count, 4);
     assert_int_equal(s.spheres.count, 2);
-    assert_int_equal(s.settings.integrator, RT_INTEGRATOR_WHITTED);
-    assert_string_equal(s.settings.output, "example.png");
+    assert_int_equal(set.integrator, RT_INTEGRATOR_WHITTED);
+    assert_string_equal(set.output, "example.png");
     assert_true(s.triangles.count > 500);
     rt_scene_free(&s);
 }
@@ -331,7 +351,7 @@ static void test_camera_gltf(void **state)
     rt_error err;
     rt_scene_init(&s);
     const char *text = "camera gltf 0\nmodel ../assets/box.gltf\n";
-    rt_result r = rt_scene_parse_string(&s, text, strlen(text), "t.txt", "scenes", &err);
+    rt_result r = rt_scene_parse_string(&s, NULL, text, strlen(text), "t.txt", "scenes", &err);
     assert_parsed(r, &err);
     assert_int_equal(s.camera_count, 1);
     assert_true(s.camera_set);
@@ -341,14 +361,14 @@ static void test_camera_gltf(void **state)
 
     rt_scene_init(&s);
     text = "model ../assets/box.gltf\ncamera gltf 1\n";
-    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", "scenes", &err), RT_ERR_INVALID);
+    assert_int_equal(rt_scene_parse_string(&s, NULL, text, strlen(text), "t.txt", "scenes", &err), RT_ERR_INVALID);
     assert_string_equal(err.message, "t.txt:2:13: camera gltf 1: the loaded models have 1 camera");
     rt_scene_free(&s);
 
     /* a model's transform moves its triangles: the unit cube, scaled 2 and moved up 5 */
     rt_scene_init(&s);
     text = "model ../assets/box.gltf translate 0 5 0 scale 2\n";
-    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", "scenes", &err), RT_OK);
+    assert_int_equal(rt_scene_parse_string(&s, NULL, text, strlen(text), "t.txt", "scenes", &err), RT_OK);
     rt_box b = rt_scene_bounds(&s);
     assert_float_equal(b.lo.y, 4, 1e-4);
     assert_float_equal(b.hi.y, 6, 1e-4);
@@ -361,7 +381,8 @@ static void test_settings_values(void **state)
 {
     (void)state;
     rt_scene s;
-    expect_ok("resolution 640 480\n"
+    rt_settings set;
+    expect_ok_settings("resolution 640 480\n"
               "samples 64\n"
               "integrator whitted\n"
               "max_bounce 7\n"
@@ -375,8 +396,8 @@ static void test_settings_values(void **state)
               "clamp 10\n"
               "ray_offset 0.001\n"
               "output \"my render.png\"\n",
-              &s);
-    const rt_settings *st = &s.settings;
+              &s, &set);
+    const rt_settings *st = &set;
     assert_int_equal(st->width, 640);
     assert_int_equal(st->height, 480);
     assert_int_equal(st->samples, 64);
@@ -386,26 +407,26 @@ static void test_settings_values(void **state)
     assert_int_equal(st->diffuse_rays, 32);
     assert_int_equal(st->shadow_samples, 9);
     assert_int_equal(st->seed, 4294967295u);
-    assert_vec3(st->background, 0.1f, 0.2f, 0.3f);
-    assert_true(st->ambient_light_set);
-    assert_vec3(st->ambient_light, 0.05f, 0.04f, 0.03f);
+    assert_vec3(s.environment.background, 0.1f, 0.2f, 0.3f);
+    assert_true(s.environment.ambient_light_set);
+    assert_vec3(s.environment.ambient_light, 0.05f, 0.04f, 0.03f);
     assert_float_equal(st->exposure, 1.5, 0);
     assert_float_equal(st->clamp, 10, 0);
     assert_float_equal(st->ray_offset, 0.001, 1e-9);
     assert_string_equal(st->output, "my render.png");
-    assert_int_equal(st->environment_texture, RT_NONE);
+    assert_int_equal(s.environment.environment_texture, RT_NONE);
     assert_false(s.camera_set);
     rt_scene_free(&s);
 
     /* defaults stay when nothing is said */
-    expect_ok("# nothing but a comment\n", &s);
+    expect_ok_settings("# nothing but a comment\n", &s, &set);
     rt_settings def;
     rt_settings_default(&def);
-    assert_memory_equal(&s.settings, &def, sizeof def);
+    assert_memory_equal(&set, &def, sizeof def);
     rt_scene_free(&s);
 
-    expect_ok("integrator path\n", &s);
-    assert_int_equal(s.settings.integrator, RT_INTEGRATOR_PATH);
+    expect_ok_settings("integrator path\n", &s, &set);
+    assert_int_equal(set.integrator, RT_INTEGRATOR_PATH);
     rt_scene_free(&s);
 }
 
@@ -428,12 +449,15 @@ static void test_settings_table_defaults(void **state)
     assert_int_equal(d.shadow_samples, 16);
     assert_true(d.ray_offset == 0.0f && d.clamp == 0.0f && d.exposure == 1.0f);
     assert_int_equal(d.seed, 0);
-    assert_vec3(d.background, 0, 0, 0);
-    assert_int_equal(d.environment_texture, RT_NONE);
-    assert_true(d.environment_strength == 1.0f);
-    assert_false(d.ambient_light_set);
-    assert_vec3(d.ambient_light, 0, 0, 0);
     assert_string_equal(d.output, "");
+    rt_scene_environment e;
+    memset(&e, 0x5a, sizeof e);
+    rt_scene_environment_default(&e);
+    assert_vec3(e.background, 0, 0, 0);
+    assert_int_equal(e.environment_texture, RT_NONE);
+    assert_true(e.environment_strength == 1.0f);
+    assert_false(e.ambient_light_set);
+    assert_vec3(e.ambient_light, 0, 0, 0);
 
     /* every entry is found by its name, and a default written out parses back to it */
     for (size_t i = 0; i < rt_settings_count; i++) {
@@ -445,19 +469,21 @@ static void test_settings_table_defaults(void **state)
             continue; /* "unset", "none" */
         snprintf(text, sizeof text, "%s %s\n", def->name, dflt);
         rt_scene sc;
-        expect_ok(text, &sc);
-        assert_memory_equal(&sc.settings, &d, sizeof d);
+        rt_settings setc;
+        expect_ok_settings(text, &sc, &setc);
+        assert_memory_equal(&setc, &d, sizeof d);
+        assert_memory_equal(&sc.environment, &e, sizeof e);
         rt_scene_free(&sc);
     }
     assert_null(rt_setting_find("sampels"));
     rt_setting_problem pb;
-    assert_int_equal(rt_settings_check(&d, &pb), RT_OK);
+    assert_int_equal(rt_settings_check(&d, &e, &pb), RT_OK);
     d.samples = RT_MAX_SAMPLES + 1;
-    assert_int_equal(rt_settings_check(&d, &pb), RT_ERR_INVALID);
+    assert_int_equal(rt_settings_check(&d, &e, &pb), RT_ERR_INVALID);
     assert_string_equal(pb.message, "samples per pixel must be between 1 and 1048576, got 1048577");
     rt_settings_default(&d);
-    d.background.y = -1.0f;
-    assert_int_equal(rt_settings_check(&d, &pb), RT_ERR_INVALID);
+    e.background.y = -1.0f;
+    assert_int_equal(rt_settings_check(&d, &e, &pb), RT_ERR_INVALID);
     assert_string_equal(pb.message, "the background colour (green) must be >= 0, got -1");
 }
 
@@ -468,55 +494,57 @@ static void test_settings_text_form(void **state)
     (void)state;
     rt_scene s;
     rt_scene_init(&s);
+    rt_settings set;
+    rt_settings_default(&set);
     rt_setting_problem pb;
     const rt_setting *res = rt_setting_find("resolution");
     static const char *const sizes[] = {"640x480", "640X480", "640 480", "640,480", " 640 , 480 "};
     for (size_t i = 0; i < sizeof sizes / sizeof *sizes; i++) {
-        s.settings.width = s.settings.height = 1;
-        assert_int_equal(rt_setting_set(&s.settings, res, sizes[i], &pb), RT_OK);
-        assert_int_equal(s.settings.width, 640);
-        assert_int_equal(s.settings.height, 480);
+        set.width = set.height = 1;
+        assert_int_equal(rt_setting_set(&set, &s.environment, res, sizes[i], &pb), RT_OK);
+        assert_int_equal(set.width, 640);
+        assert_int_equal(set.height, 480);
     }
-    assert_int_equal(rt_setting_set(&s.settings, res, "640", &pb), RT_ERR_PARSE);
+    assert_int_equal(rt_setting_set(&set, &s.environment, res, "640", &pb), RT_ERR_PARSE);
     assert_string_equal(pb.message, "expected an integer for the image height, got nothing");
-    assert_int_equal(rt_setting_set(&s.settings, res, "0x5", &pb), RT_ERR_INVALID);
+    assert_int_equal(rt_setting_set(&set, &s.environment, res, "0x5", &pb), RT_ERR_INVALID);
     assert_string_equal(pb.message, "the image width must be between 1 and 32768, got '0'");
-    assert_int_equal(rt_setting_set(&s.settings, res, "640x480x2", &pb), RT_ERR_PARSE);
+    assert_int_equal(rt_setting_set(&set, &s.environment, res, "640x480x2", &pb), RT_ERR_PARSE);
     assert_string_equal(pb.message, "expected an integer for the image height, got '480x2'");
-    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("samples"), "4 5", &pb), RT_ERR_PARSE);
+    assert_int_equal(rt_setting_set(&set, &s.environment, rt_setting_find("samples"), "4 5", &pb), RT_ERR_PARSE);
     assert_string_equal(pb.message, "unexpected '5' after the end of the value");
-    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("samples"), "", &pb), RT_ERR_PARSE);
+    assert_int_equal(rt_setting_set(&set, &s.environment, rt_setting_find("samples"), "", &pb), RT_ERR_PARSE);
     assert_string_equal(pb.message, "expected an integer for samples per pixel, got nothing");
-    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("integrator"), "magic", &pb), RT_ERR_PARSE);
+    assert_int_equal(rt_setting_set(&set, &s.environment, rt_setting_find("integrator"), "magic", &pb), RT_ERR_PARSE);
     assert_string_equal(pb.message, "expected an integrator (direct|whitted|path|path_scalar), got 'magic'");
 
-    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("background"), "0.1,0.2 0.3", &pb), RT_OK);
-    assert_vec3(s.settings.background, 0.1f, 0.2f, 0.3f);
-    assert_false(s.settings.ambient_light_set);
-    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("ambient_light"), "1 2 3", &pb), RT_OK);
-    assert_true(s.settings.ambient_light_set);
-    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("output"), "a b,c.png", &pb), RT_OK);
-    assert_string_equal(s.settings.output, "a b,c.png");
-    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("output"), "", &pb), RT_ERR_INVALID);
+    assert_int_equal(rt_setting_set(&set, &s.environment, rt_setting_find("background"), "0.1,0.2 0.3", &pb), RT_OK);
+    assert_vec3(s.environment.background, 0.1f, 0.2f, 0.3f);
+    assert_false(s.environment.ambient_light_set);
+    assert_int_equal(rt_setting_set(&set, &s.environment, rt_setting_find("ambient_light"), "1 2 3", &pb), RT_OK);
+    assert_true(s.environment.ambient_light_set);
+    assert_int_equal(rt_setting_set(&set, &s.environment, rt_setting_find("output"), "a b,c.png", &pb), RT_OK);
+    assert_string_equal(set.output, "a b,c.png");
+    assert_int_equal(rt_setting_set(&set, &s.environment, rt_setting_find("output"), "", &pb), RT_ERR_INVALID);
     assert_string_equal(pb.message, "expected an output file name, got an empty string");
-    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("seed"), "4294967295", &pb), RT_OK);
-    assert_int_equal(s.settings.seed, 4294967295u);
+    assert_int_equal(rt_setting_set(&set, &s.environment, rt_setting_find("seed"), "4294967295", &pb), RT_OK);
+    assert_int_equal(set.seed, 4294967295u);
 
     /* a NULL scene only checks */
-    assert_int_equal(rt_setting_set(NULL, rt_setting_find("exposure"), "0", &pb), RT_ERR_INVALID);
+    assert_int_equal(rt_setting_set(NULL, NULL, rt_setting_find("exposure"), "0", &pb), RT_ERR_INVALID);
     assert_string_equal(pb.message, "the exposure must be > 0, got '0'");
-    assert_int_equal(rt_setting_set(NULL, rt_setting_find("environment"), "no-such.hdr strength 2", &pb), RT_OK);
-    assert_int_equal(rt_setting_set(NULL, rt_setting_find("environment"), "sky.hdr strength -1", &pb),
+    assert_int_equal(rt_setting_set(NULL, NULL, rt_setting_find("environment"), "no-such.hdr strength 2", &pb), RT_OK);
+    assert_int_equal(rt_setting_set(NULL, NULL, rt_setting_find("environment"), "sky.hdr strength -1", &pb),
                      RT_ERR_INVALID);
     assert_string_equal(pb.message, "the environment strength must be >= 0, got '-1'");
     /* the table keeps the environment's file name; io loads the image (relative to the current directory) */
-    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("environment"), tmp_path("no-such.hdr"), &pb), RT_OK);
-    assert_string_equal(s.settings.environment_file, tmp_path("no-such.hdr"));
-    assert_int_equal(s.settings.environment_texture, RT_NONE);
+    assert_int_equal(rt_setting_set(&set, &s.environment, rt_setting_find("environment"), tmp_path("no-such.hdr"), &pb), RT_OK);
+    assert_string_equal(s.environment.environment_file, tmp_path("no-such.hdr"));
+    assert_int_equal(s.environment.environment_texture, RT_NONE);
     rt_error err = {0};
     assert_int_equal(rt_environment_image_load(&s, &err), RT_ERR_IO);
     assert_non_null(strstr(err.message, "no-such.hdr"));
-    assert_int_equal(s.settings.environment_texture, RT_NONE);
+    assert_int_equal(s.environment.environment_texture, RT_NONE);
     rt_scene_free(&s);
 }
 
@@ -774,7 +802,8 @@ static void test_comments_and_continuations(void **state)
 {
     (void)state;
     rt_scene s;
-    expect_ok("# a comment line\n"
+    rt_settings set;
+    expect_ok_settings("# a comment line\n"
               "   # an indented one\n"
               "\n"
               "material m#comment right after a token\n"
@@ -787,12 +816,12 @@ static void test_comments_and_continuations(void **state)
               "samples 8\\\n"
               "\t\t# the statement ends here, so the samples line is complete\n"
               "sphere\t5 5 5 1 m",
-              &s); /* no final newline */
+              &s, &set); /* no final newline */
     assert_int_equal(s.spheres.count, 3);
     assert_float_equal(s.spheres.cz[0], 3, 0);
     assert_float_equal(s.spheres.radius[0], 4, 0);
     assert_float_equal(s.spheres.radius[1], 1, 0);
-    assert_int_equal(s.settings.samples, 8);
+    assert_int_equal(set.samples, 8);
     assert_float_equal(s.spheres.cx[2], 5, 0);
     rt_scene_free(&s);
 
@@ -803,8 +832,8 @@ static void test_comments_and_continuations(void **state)
     rt_scene_free(&s);
 
     /* a UTF-8 byte order mark is skipped */
-    expect_ok("\xef\xbb\xbfsamples 3\n", &s);
-    assert_int_equal(s.settings.samples, 3);
+    expect_ok_settings("\xef\xbb\xbfsamples 3\n", &s, &set);
+    assert_int_equal(set.samples, 3);
     rt_scene_free(&s);
 
     /* empty input */
@@ -864,7 +893,7 @@ static void test_errors_syntax(void **state)
         rt_scene s;
         rt_error err;
         rt_scene_init(&s);
-        assert_int_equal(rt_scene_parse_string(&s, text, sizeof text - 1, "t.txt", NULL, &err), RT_ERR_PARSE);
+        assert_int_equal(rt_scene_parse_string(&s, NULL, text, sizeof text - 1, "t.txt", NULL, &err), RT_ERR_PARSE);
         assert_non_null(strstr(err.message, "t.txt:2:3: unexpected control character 0x00"));
         rt_scene_free(&s);
     }
@@ -1166,8 +1195,8 @@ static void test_textures_from_files(void **state)
     assert_int_equal(s.textures[2].kind, RT_TEX_IMAGE);
     assert_int_equal(s.textures[2].image, 0);
     assert_int_equal(s.materials[1].normal_tex.texture, 1);
-    assert_int_equal(s.settings.environment_texture, 3);
-    assert_float_equal(s.settings.environment_strength, 2.5, 0);
+    assert_int_equal(s.environment.environment_texture, 3);
+    assert_float_equal(s.environment.environment_strength, 2.5, 0);
     rt_scene_free(&s);
 
     /* loader errors keep their message, prefixed with the scene location */
@@ -1175,7 +1204,7 @@ static void test_textures_from_files(void **state)
     rt_scene_init(&s);
     test_write_file(tmp_path("garbage.png"), "not an image", 12);
     const char *text = "material m texture garbage.png\n";
-    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", tmp_dir, &err), RT_ERR_INVALID);
+    assert_int_equal(rt_scene_parse_string(&s, NULL, text, strlen(text), "t.txt", tmp_dir, &err), RT_ERR_INVALID);
     assert_true(strncmp(err.message, "t.txt:1:20: ", 12) == 0);
     assert_non_null(strstr(err.message, tmp_path("garbage.png")));
     rt_scene_free(&s);
@@ -1184,7 +1213,7 @@ static void test_textures_from_files(void **state)
     rt_scene_init(&s);
     text = "texture t image nothing.jpg\n"
            "material m texture missing.png normal_map missing.png emission_map t metallic_roughness_map t\n";
-    assert_int_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", tmp_dir, &err), RT_OK);
+    assert_int_equal(rt_scene_parse_string(&s, NULL, text, strlen(text), "t.txt", tmp_dir, &err), RT_OK);
     const rt_material *mm = &s.materials[rt_scene_find_material(&s, "m")];
     for (int k = 0; k < 2; k++) {
         uint32_t t = k ? mm->emissive_tex.texture : mm->base_color_tex.texture;
@@ -1208,7 +1237,7 @@ static void test_textures_from_files(void **state)
     /* the glTF loader's error, whatever its code, comes with the scene location */
     rt_scene_init(&s);
     text = "model missing.gltf\n";
-    assert_int_not_equal(rt_scene_parse_string(&s, text, strlen(text), "t.txt", tmp_dir, &err), RT_OK);
+    assert_int_not_equal(rt_scene_parse_string(&s, NULL, text, strlen(text), "t.txt", tmp_dir, &err), RT_OK);
     assert_true(strncmp(err.message, "t.txt:1:7: ", 11) == 0);
     assert_non_null(strstr(err.message, "missing.gltf"));
     rt_scene_free(&s);
@@ -1225,7 +1254,7 @@ static void test_paths_relative_to_scene_file(void **state)
     rt_scene s;
     rt_error err;
     rt_scene_init(&s);
-    rt_result r = rt_scene_parse_file(&s, tmp_path("sub/scene.txt"), &err);
+    rt_result r = rt_scene_parse_file(&s, NULL, tmp_path("sub/scene.txt"), &err);
     assert_parsed(r, &err);
     assert_int_equal(s.image_count, 1);
     assert_string_equal(s.images[0].name, tmp_path("sub/tex.ppm"));
@@ -1235,14 +1264,14 @@ static void test_paths_relative_to_scene_file(void **state)
     const char *bad = "material m\n\nsphere 0 0 0 r m\n";
     test_write_file(tmp_path("sub/bad.txt"), bad, strlen(bad));
     rt_scene_init(&s);
-    assert_int_equal(rt_scene_parse_file(&s, tmp_path("sub/bad.txt"), &err), RT_ERR_PARSE);
+    assert_int_equal(rt_scene_parse_file(&s, NULL, tmp_path("sub/bad.txt"), &err), RT_ERR_PARSE);
     char want[256];
     snprintf(want, sizeof want, "%s:3:14: expected a number for the sphere radius, got 'r'", tmp_path("sub/bad.txt"));
     assert_string_equal(err.message, want);
     rt_scene_free(&s);
 
     rt_scene_init(&s);
-    assert_int_equal(rt_scene_parse_file(&s, tmp_path("no/such/scene.txt"), &err), RT_ERR_IO);
+    assert_int_equal(rt_scene_parse_file(&s, NULL, tmp_path("no/such/scene.txt"), &err), RT_ERR_IO);
     snprintf(want, sizeof want, "%s: cannot open", tmp_path("no/such/scene.txt"));
     assert_non_null(strstr(err.message, want));
     rt_scene_free(&s);
@@ -1344,7 +1373,7 @@ static void test_mutations_do_not_crash(void **state)
         rt_error err;
         memset(&err, 0, sizeof err);
         rt_scene_init(&s);
-        rt_result r = rt_scene_parse_string(&s, buf, len, "m.txt", tmp_dir, &err);
+        rt_result r = rt_scene_parse_string(&s, NULL, buf, len, "m.txt", tmp_dir, &err);
         if (r != RT_OK) {
             failures++;
             assert_true(strncmp(err.message, "m.txt:", 6) == 0);

@@ -92,7 +92,9 @@ static rt_surface surface(const rt_scene *s, uint32_t prim, float u, float v, rt
 {
     rt_render_state rs;
     rt_error err;
-    assert_int_equal(rt_render_state_prepare(&rs, s, NULL, 0, &err), RT_OK);
+    rt_settings set;
+    rt_settings_default(&set);
+    assert_int_equal(rt_render_state_prepare(&rs, s, &set, NULL, 0, &err), RT_OK);
     rt_trace_ctx ctx;
     rt_trace_ctx_init(&ctx, &rs);
     rt_ray r = rt_ray_make(rt_sub(p_expect, view_dir), view_dir, 0.0f, INFINITY);
@@ -207,7 +209,10 @@ static void test_surface_record_variants(void **state)
 {
     (void)state;
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
+    rt_settings_default(&set);
     uint32_t m = material_with_normal_map(&s, normal_constant(&s, rt_normalize(rt_v3(0.3f, -0.2f, 1.0f))));
     rt_mat4 xf = some_rotation();
     add_square_mesh(&s, &xf, m, false);
@@ -215,7 +220,7 @@ static void test_surface_record_variants(void **state)
     rt_scene_add_quad(&s, rt_v3(-5, -1, 1), rt_v3(0, 0, -2), rt_v3(0, 3, 0), m);
     rt_render_state rs;
     rt_error err;
-    assert_int_equal(rt_render_state_prepare(&rs, &s, NULL, 0, &err), RT_OK);
+    assert_int_equal(rt_render_state_prepare(&rs, &s, &set, NULL, 0, &err), RT_OK);
     rt_trace_ctx ctx;
     rt_trace_ctx_init(&ctx, &rs);
     const rt_vec3 dirs[2] = {{0.3f, -0.4f, -0.866f}, {-0.2f, 0.5f, 0.84f}};
@@ -254,12 +259,13 @@ static void test_surface_record_variants(void **state)
     /* without a texture the shading record leaves the UVs out (zero), and
      * only them */
     rt_scene_init(&s);
+    rt_settings_default(&set);
     rt_material plain;
     rt_material_default(&plain, "plain");
     m = rt_scene_add_material(&s, &plain);
     add_square_mesh(&s, &xf, m, false);
     rt_scene_add_sphere(&s, rt_v3(5, 0, 0), 1.5f, m);
-    assert_int_equal(rt_render_state_prepare(&rs, &s, NULL, 0, &err), RT_OK);
+    assert_int_equal(rt_render_state_prepare(&rs, &s, &set, NULL, 0, &err), RT_OK);
     rt_trace_ctx_init(&ctx, &rs);
     assert_int_equal(rs.material_needs[m] & RT_MATERIAL_TEXTURED, 0);
     for (uint32_t prim = 0; prim < 3; prim++) {
@@ -285,7 +291,10 @@ static void test_uv_conventions(void **state)
 {
     (void)state;
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
+    rt_settings_default(&set);
     rt_material m;
     rt_material_default(&m, "m");
     uint32_t mi = rt_scene_add_material(&s, &m);
@@ -302,6 +311,7 @@ static void test_uv_conventions(void **state)
 
     /* an image's top-left texel shows at the quad's corner p + ev */
     rt_scene_init(&s);
+    rt_settings_default(&set);
     rt_image img;
     memset(&img, 0, sizeof img);
     img.width = img.height = 2;
@@ -318,7 +328,7 @@ static void test_uv_conventions(void **state)
     rt_scene_add_quad(&s, rt_v3(0, 0, 0), rt_v3(1, 0, 0), rt_v3(0, 1, 0), mi);
     rt_render_state rs;
     rt_error err;
-    assert_int_equal(rt_render_state_prepare(&rs, &s, NULL, 0, &err), RT_OK);
+    assert_int_equal(rt_render_state_prepare(&rs, &s, &set, NULL, 0, &err), RT_OK);
     rt_trace_ctx ctx;
     rt_trace_ctx_init(&ctx, &rs);
     sf = surface(&s, 0, 0.1f, 0.9f, rt_v3(0.1f, 0.9f, 0), rt_v3(0, 0, -1));
@@ -334,13 +344,16 @@ static void test_uv_conventions(void **state)
 static void render_all(int map_kind, rt_framebuffer *fb)
 {
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
-    s.settings.integrator = RT_INTEGRATOR_WHITTED;
-    s.settings.width = 24;
-    s.settings.height = 16;
-    s.settings.samples = 2;
-    s.settings.max_bounce = 2;
-    s.settings.background = rt_v3(0.3f, 0.4f, 0.5f);
+    rt_settings_default(&set);
+    set.integrator = RT_INTEGRATOR_WHITTED;
+    set.width = 24;
+    set.height = 16;
+    set.samples = 2;
+    set.max_bounce = 2;
+    s.environment.background = rt_v3(0.3f, 0.4f, 0.5f);
     uint32_t tex = RT_NONE;
     if (map_kind == 1)
         tex = normal_constant(&s, rt_v3(0, 0, 1));
@@ -375,12 +388,12 @@ static void render_all(int map_kind, rt_framebuffer *fb)
     assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
     rt_kdtree tree;
     assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
-    assert_int_equal(rt_framebuffer_init(fb, s.settings.width, s.settings.height, &err), RT_OK);
+    assert_int_equal(rt_framebuffer_init(fb, set.width, set.height, &err), RT_OK);
     rt_render_options opt;
     memset(&opt, 0, sizeof opt);
     opt.threads = 1;
     rt_render_stats st;
-    assert_int_equal(rt_render(&s, &tree, &opt, fb, &st, &err), RT_OK);
+    assert_int_equal(rt_render(&s, &set, &tree, &opt, fb, &st, &err), RT_OK);
     assert_int_equal(st.bad_samples, 0);
     rt_kdtree_free(&tree);
     rt_scene_free(&s);
@@ -509,7 +522,10 @@ static void check_domes(const char *rel, size_t expect_domes)
 {
     const char *path = test_shared_path(rel);
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
+    rt_settings_default(&set);
     rt_error err = {0};
     rt_gltf_stats gs;
     if (rt_gltf_load(&s, path, NULL, &gs, &err) != RT_OK)
@@ -518,7 +534,7 @@ static void check_domes(const char *rel, size_t expect_domes)
     rt_kdtree tree;
     assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
     rt_render_state rs;
-    assert_int_equal(rt_render_state_prepare(&rs, &s, &tree, 0, &err), RT_OK);
+    assert_int_equal(rt_render_state_prepare(&rs, &s, &set, &tree, 0, &err), RT_OK);
     rt_trace_ctx ctx;
     rt_trace_ctx_init(&ctx, &rs);
     rt_box b = rt_scene_bounds(&s);

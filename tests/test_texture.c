@@ -321,7 +321,7 @@ static void test_loader_and_cache(void **state)
                        "material c texture tex.png normal_map tex.png\n";
     test_write_file(scene, text, strlen(text));
     rt_scene_init(&s);
-    assert_int_equal(rt_scene_parse_file(&s, scene, &err), RT_OK);
+    assert_int_equal(rt_scene_parse_file(&s, NULL, scene, &err), RT_OK);
     assert_int_equal(s.image_count, 1);
     assert_true(s.material_count >= 3);
     rt_scene_free(&s);

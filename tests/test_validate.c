@@ -65,7 +65,7 @@ static void valid_scene(rt_scene *s)
     l.position = rt_v3(0, 2, 2);
     l.quad = RT_NONE;
     assert_int_not_equal(rt_scene_add_light(s, &l), RT_NONE);
-    s->settings.environment_texture = t1;
+    s->environment.environment_texture = t1;
 }
 
 /* The scene must fail validation with RT_ERR_INVALID and a message
@@ -253,10 +253,10 @@ static void test_settings(void **state)
     (void)state;
     rt_scene s;
     valid_scene(&s);
-    s.settings.environment_texture = 2;
+    s.environment.environment_texture = 2;
     expect_invalid(&s, "settings: environment texture 2 is out of range (2 textures)");
     valid_scene(&s);
-    s.settings.background.x = NAN;
+    s.environment.background.x = NAN;
     expect_invalid(&s, "settings: background or environment strength is not finite");
 }
 
@@ -268,8 +268,8 @@ static void expect_valid_text(const char *name, const char *text, bool is_file)
     rt_scene_init(&s);
     rt_error err;
     memset(&err, 0, sizeof err);
-    rt_result r = is_file ? rt_scene_parse_file(&s, name, &err)
-                          : rt_scene_parse_string(&s, text, strlen(text), name, ".", &err);
+    rt_result r = is_file ? rt_scene_parse_file(&s, NULL, name, &err)
+                          : rt_scene_parse_string(&s, NULL, text, strlen(text), name, ".", &err);
     if (r != RT_OK)
         fail_msg("%s: does not load: %s", name, err.message);
     if (rt_scene_validate(&s, &err) != RT_OK)

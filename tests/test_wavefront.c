@@ -42,7 +42,7 @@ static void soup_scene(rt_scene *s)
                        "sphere 0.2 0.3 0.4 0.15 m\nsphere 0.7 0.6 0.5 0.1 m\nsphere 0.5 0.5 0.5 0.3 m\n"
                        "quad 0 0 0  1 0 0  0 1 0  m\nquad 0.1 0.9 0.1  0.8 0 0  0 0 0.8  m\n";
     rt_scene_init(s);
-    if (rt_scene_parse_string(s, text, strlen(text), "soup", NULL, &err) != RT_OK)
+    if (rt_scene_parse_string(s, NULL, text, strlen(text), "soup", NULL, &err) != RT_OK)
         fail_msg("parse: %s", err.message);
     test_rng r = {0x9e3779b97f4a7c15ull};
     for (int i = 0; i < 400; i++) {
@@ -208,7 +208,7 @@ static void load_cornell(fixture *f, int res)
     fclose(fp);
     text[n] = 0;
     load_text(f, text);
-    f->s.settings.width = f->s.settings.height = res;
+    f->settings.width = f->settings.height = res;
 }
 
 static void unload(fixture *f) { test_fixture_free(f); }
@@ -217,7 +217,7 @@ static void unload(fixture *f) { test_fixture_free(f); }
  * the given batch size and pixels per work unit, against rt_radiance_path. */
 static void check_against_scalar(fixture *f, size_t batch, uint32_t per_unit, int y0, int y1, uint32_t spp)
 {
-    int W = f->s.settings.width, H = f->s.settings.height;
+    int W = f->settings.width, H = f->settings.height;
     rt_camera_frame cf;
     rt_camera_frame_init(&cf, &f->s.camera, W, H);
     rt_wavefront *wf = rt_wavefront_new(batch, &f->rs);
@@ -232,8 +232,8 @@ static void check_against_scalar(fixture *f, size_t batch, uint32_t per_unit, in
         /* samples split in two halves of the range, the second first */
         uint32_t half = spp / 2;
         uint32_t count = npx - p < per_unit ? npx - p : per_unit;
-        rt_wavefront_work hi = {&cf, W, f->s.settings.seed, spp, 0, W, y0, p, count, half, spp};
-        rt_wavefront_work lo = {&cf, W, f->s.settings.seed, spp, 0, W, y0, p, count, 0, half};
+        rt_wavefront_work hi = {&cf, W, f->settings.seed, spp, 0, W, y0, p, count, half, spp};
+        rt_wavefront_work lo = {&cf, W, f->settings.seed, spp, 0, W, y0, p, count, 0, half};
         static float tmp[3 * 4096];
         assert_true(count * spp <= 4096);
         rt_wavefront_radiance(wf, &ctx, &hi, tmp);
@@ -253,7 +253,7 @@ static void check_against_scalar(fixture *f, size_t batch, uint32_t per_unit, in
         int x = (int)(p % (uint32_t)W), y = y0 + (int)(p / (uint32_t)W);
         for (uint32_t s = 0; s < spp; s++) {
             rt_rng rng;
-            rt_ray r = rt_camera_pixel_sample(&cf, W, f->s.settings.seed, spp, x, y, s, &rng);
+            rt_ray r = rt_camera_pixel_sample(&cf, W, f->settings.seed, spp, x, y, s, &rng);
             rt_vec3 L = rt_radiance_path(&sctx, &r, &rng);
             const float *o = out + 3 * ((size_t)p * spp + s);
             if (memcmp(o, &L.x, sizeof(float)) || memcmp(o + 1, &L.y, sizeof(float)) ||
@@ -277,7 +277,7 @@ static void test_wavefront_equals_scalar(void **state)
     assert_true(f.rs.shadows_need_shading);
     const size_t batches[] = {1, 7, 256, 4096};
     for (int smp = RT_SAMPLER_INDEPENDENT; smp <= RT_SAMPLER_SOBOL; smp++) { /* each sampler (rt/render/sampler.h) */
-        f.s.settings.sampler = smp;
+        f.settings.sampler = smp;
         for (size_t b = 0; b < 4; b++)
             if (smp == RT_SAMPLER_INDEPENDENT || b % 2 == 1)
                 check_against_scalar(&f, batches[b], b == 1 ? 5 : 48, 0, 16, 6);
@@ -306,8 +306,8 @@ static void test_wavefront_equals_scalar(void **state)
 static void render_with(fixture *f, rt_integrator in, int threads, int tile, int passes, int batch, rt_framebuffer *fb)
 {
     rt_error err;
-    f->s.settings.integrator = in;
-    assert_int_equal(rt_framebuffer_init(fb, f->s.settings.width, f->s.settings.height, &err), RT_OK);
+    f->settings.integrator = in;
+    assert_int_equal(rt_framebuffer_init(fb, f->settings.width, f->settings.height, &err), RT_OK);
     rt_render_options opt;
     memset(&opt, 0, sizeof opt);
     opt.threads = threads;
@@ -315,7 +315,7 @@ static void render_with(fixture *f, rt_integrator in, int threads, int tile, int
     opt.pass_samples = passes;
     opt.batch_size = batch;
     rt_render_stats st;
-    assert_int_equal(rt_render(&f->s, &f->tree, &opt, fb, &st, &err), RT_OK);
+    assert_int_equal(rt_render(&f->s, &f->settings, &f->tree, &opt, fb, &st, &err), RT_OK);
     assert_int_equal(st.bad_samples, 0);
 }
 
@@ -325,7 +325,7 @@ static void test_render_bytes_any_split(void **state)
     fixture f;
     load_text(&f, every_material);
     for (int smp = RT_SAMPLER_INDEPENDENT; smp <= RT_SAMPLER_SOBOL; smp++) { /* each sampler */
-        f.s.settings.sampler = smp;
+        f.settings.sampler = smp;
         rt_framebuffer ref;
         render_with(&f, RT_INTEGRATOR_PATH_SCALAR, 1, 8, -1, 0, &ref);
         size_t n = (size_t)ref.width * (size_t)ref.height * 3 * sizeof(float);
@@ -354,7 +354,7 @@ static void test_cornell_wavefront_equals_scalar(void **state)
     (void)state;
     fixture f;
     load_cornell(&f, 64);
-    f.s.settings.samples = 32;
+    f.settings.samples = 32;
     rt_framebuffer img, scalar;
     render_with(&f, RT_INTEGRATOR_PATH, 2, 32, 0, 0, &img);
     render_with(&f, RT_INTEGRATOR_PATH_SCALAR, 2, 32, 0, 0, &scalar);

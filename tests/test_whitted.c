@@ -155,12 +155,12 @@ typedef struct built {
     rt_trace_ctx ctx;
 } built;
 
-static void build(built *b, rt_scene *s)
+static void build(built *b, rt_scene *s, const rt_settings *set)
 {
     rt_error err = {0};
     assert_int_equal(rt_scene_validate(s, &err), RT_OK);
     assert_int_equal(rt_kdtree_build(&b->tree, s, NULL, &err), RT_OK);
-    assert_int_equal(rt_render_state_prepare(&b->rs, s, &b->tree, 0, &err), RT_OK);
+    assert_int_equal(rt_render_state_prepare(&b->rs, s, set, &b->tree, 0, &err), RT_OK);
     rt_trace_ctx_init(&b->ctx, &b->rs);
 }
 
@@ -211,8 +211,11 @@ static void test_glass_slab(void **state)
 {
     (void)state;
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
-    s.settings.max_bounce = 4;
+    rt_settings_default(&set);
+    set.max_bounce = 4;
     rt_material glass = plain("glass");
     glass.transmission = 1.0f;
     glass.ior = 1.5f;
@@ -231,7 +234,7 @@ static void test_glass_slab(void **state)
     rt_scene_add_quad(&s, rt_v3((float)x_refracted - hw, -2, -hw), rt_v3(0, 0, 2 * hw), rt_v3(2 * hw, 0, 0), e);
     rt_scene_add_quad(&s, rt_v3((float)x_straight - hw, -2, -hw), rt_v3(0, 0, 2 * hw), rt_v3(2 * hw, 0, 0), e);
     built b;
-    build(&b, &s);
+    build(&b, &s, &set);
     rt_vec3 L = radiance(&b, rt_v3(0, 1, 0), rt_v3((float)sin(th), (float)-cos(th), 0));
     /* transmittance in and out, from the Fresnel equations written out here */
     double ci = cos(th), ct = sqrt(1 - sin_t * sin_t);
@@ -243,7 +246,7 @@ static void test_glass_slab(void **state)
      * ray really lands there (1 cm target) and not at the straight line */
     unbuild(&b);
     s.quads.px[2] += 0.05f;
-    build(&b, &s);
+    build(&b, &s, &set);
     L = radiance(&b, rt_v3(0, 1, 0), rt_v3((float)sin(th), (float)-cos(th), 0));
     assert_true(L.x == 0.0f);
     unbuild(&b);
@@ -257,11 +260,14 @@ static void test_mirror_shows_wall(void **state)
 {
     (void)state;
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
-    s.settings.ambient_light = rt_v3s(1.0f);
-    s.settings.ambient_light_set = true;
-    s.settings.integrator = RT_INTEGRATOR_WHITTED;
-    s.settings.max_bounce = 1;
+    rt_settings_default(&set);
+    s.environment.ambient_light = rt_v3s(1.0f);
+    s.environment.ambient_light_set = true;
+    set.integrator = RT_INTEGRATOR_WHITTED;
+    set.max_bounce = 1;
     const float R = 0.7f;
     const rt_vec3 C = rt_v3(0.9f, 0.3f, 0.1f);
     rt_material wall = plain("wall");
@@ -274,17 +280,17 @@ static void test_mirror_shows_wall(void **state)
     /* mirror in the plane z = 0 facing +z; wall at z = 3 facing -z, behind the camera */
     rt_scene_add_quad(&s, rt_v3(-5, -5, 0), rt_v3(10, 0, 0), rt_v3(0, 10, 0), mm);
     rt_scene_add_quad(&s, rt_v3(-50, -50, 3), rt_v3(0, 100, 0), rt_v3(100, 0, 0), mw);
-    s.settings.width = 8;
-    s.settings.height = 8;
-    s.settings.samples = 4;
+    set.width = 8;
+    set.height = 8;
+    set.samples = 4;
     test_scene_look(&s, rt_v3(0, 0, 2), rt_v3(0, 0, 0), rt_v3(0, 1, 0), 30);
     built b;
-    build(&b, &s);
+    build(&b, &s, &set);
     rt_vec3 L = radiance(&b, rt_v3(0.2f, 0.1f, 2), rt_v3(-0.1f, 0.05f, -1));
     assert_true(fabsf(L.x - R * C.x) < 1e-6f && fabsf(L.y - R * C.y) < 1e-6f && fabsf(L.z - R * C.z) < 1e-6f);
 
     rt_framebuffer fb;
-    test_render_scene(&s, 2, 0, &fb);
+    test_render_scene(&s, &set, 2, 0, &fb);
     for (int i = 0; i < 64; i++) {
         assert_true(fabsf(fb.rgb[3 * i] - R * C.x) < 1e-5f);
         assert_true(fabsf(fb.rgb[3 * i + 1] - R * C.y) < 1e-5f);
@@ -300,8 +306,11 @@ static void test_mirror_shows_wall(void **state)
 static void floor_image(const rt_material *sphere_mat, float *out, int n)
 {
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
-    s.settings.max_bounce = 4;
+    rt_settings_default(&set);
+    set.max_bounce = 4;
     rt_material fl = plain("floor");
     fl.color = rt_v3(0.8f, 0.6f, 0.4f);
     fl.diffuse = 1.0f;
@@ -315,7 +324,7 @@ static void floor_image(const rt_material *sphere_mat, float *out, int n)
     }
     add_light(&s, RT_LIGHT_POINT, rt_v3(0.1f, 3, 0.05f), 10.0f);
     built b;
-    build(&b, &s);
+    build(&b, &s, &set);
     for (int y = 0; y < n; y++)
         for (int x = 0; x < n; x++) {
             /* rays from above the light's side, through the sphere region */
@@ -363,6 +372,8 @@ static void test_transparent_sphere_no_shadow(void **state)
     tinted.transmission_color = rt_v3s(0.5f);
     rt_scene s;
     rt_scene_init(&s);
+    rt_settings set;
+    rt_settings_default(&set);
     rt_material fl = plain("floor");
     fl.color = rt_v3s(1);
     fl.diffuse = 1.0f;
@@ -371,7 +382,7 @@ static void test_transparent_sphere_no_shadow(void **state)
     rt_scene_add_sphere(&s, rt_v3(0, 1, 0), 0.5f, rt_scene_add_material(&s, &tinted));
     add_light(&s, RT_LIGHT_POINT, rt_v3(0, 3, 0), 9.0f);
     built b;
-    build(&b, &s);
+    build(&b, &s, &set);
     /* floor point (0, 0, 0) seen from the side, light straight above through the sphere */
     rt_vec3 L = radiance(&b, rt_v3(3, 0.5f, 0), rt_v3(-3, -0.5f, 0));
     float expect = 9.0f / 9.0f * RT_INV_PI * 0.25f; /* E = I / d^2 = 1, times 0.5^2 */
@@ -386,10 +397,13 @@ static void test_transparent_sphere_no_shadow(void **state)
 static void nested_image(float inner_ior, bool with_inner, float *out, int n)
 {
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
-    s.settings.max_bounce = 8;
-    s.settings.ambient_light = rt_v3s(1);
-    s.settings.ambient_light_set = true;
+    rt_settings_default(&set);
+    set.max_bounce = 8;
+    s.environment.ambient_light = rt_v3s(1);
+    s.environment.ambient_light_set = true;
     rt_texture tex = rt_texture_checker(rt_v4(1, 1, 1, 1), rt_v4(0.1f, 0.2f, 0.3f, 1), 4.0f);
     uint32_t t = rt_scene_add_texture(&s, &tex);
     rt_material wall = plain("wall");
@@ -409,7 +423,7 @@ static void nested_image(float inner_ior, bool with_inner, float *out, int n)
         rt_scene_add_sphere(&s, rt_v3(0.1f, 0.05f, 0), 0.5f, rt_scene_add_material(&s, &ball));
     }
     built b;
-    build(&b, &s);
+    build(&b, &s, &set);
     for (int y = 0; y < n; y++)
         for (int x = 0; x < n; x++) {
             rt_vec3 org = rt_v3(0, 0, 4);
@@ -454,12 +468,15 @@ static void test_finite(void **state)
 {
     (void)state;
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
-    s.settings.max_bounce = 6;
-    s.settings.diffuse_bounces = 1;
-    s.settings.diffuse_rays = 4;
-    s.settings.shadow_samples = 2;
-    s.settings.background = rt_v3(0.2f, 0.3f, 0.4f);
+    rt_settings_default(&set);
+    set.max_bounce = 6;
+    set.diffuse_bounces = 1;
+    set.diffuse_rays = 4;
+    set.shadow_samples = 2;
+    s.environment.background = rt_v3(0.2f, 0.3f, 0.4f);
     rt_material d;
     rt_material_default(&d, "d");
     rt_material glass = d, mirror = d, mix = d;
@@ -479,7 +496,7 @@ static void test_finite(void **state)
     add_light(&s, RT_LIGHT_POINT, rt_v3(0, 4, 0), 20.0f);
     add_light(&s, RT_LIGHT_DIRECTIONAL, rt_v3(0, 0, 0), 1.0f);
     built b;
-    build(&b, &s);
+    build(&b, &s, &set);
     test_rng rng = {99};
     for (int i = 0; i < 3000; i++) {
         rt_vec3 o = rt_v3(6 * test_rng_float(&rng) - 3, 3 * test_rng_float(&rng), 6 * test_rng_float(&rng) - 3);
@@ -504,11 +521,14 @@ static void test_diffuse_bounces_furnace(void **state)
     const float rho = 0.5f, Le = 1.0f, A = 0.2f, ka = 0.7f, kd = 0.9f;
     for (int levels = 0; levels <= 3; levels++) {
         rt_scene s;
+        rt_settings set;
+        rt_settings_default(&set);
         rt_scene_init(&s);
-        s.settings.diffuse_bounces = levels;
-        s.settings.diffuse_rays = 3;
-        s.settings.ambient_light = rt_v3s(A);
-        s.settings.ambient_light_set = true;
+        rt_settings_default(&set);
+        set.diffuse_bounces = levels;
+        set.diffuse_rays = 3;
+        s.environment.ambient_light = rt_v3s(A);
+        s.environment.ambient_light_set = true;
         rt_material wall = plain("wall");
         wall.color = rt_v3s(rho);
         wall.diffuse = kd;
@@ -516,7 +536,7 @@ static void test_diffuse_bounces_furnace(void **state)
         wall.emission = rt_v3s(Le);
         rt_scene_add_sphere(&s, rt_v3(0.5f, -0.2f, 0.1f), 2.0f, rt_scene_add_material(&s, &wall));
         built b;
-        build(&b, &s);
+        build(&b, &s, &set);
         double L = Le + ka * rho * A;
         for (int k = levels - 1; k >= 0; k--)
             L = Le + kd * rho * L;
@@ -536,8 +556,11 @@ static void test_diffuse_bounces_furnace(void **state)
 static float area_light_floor(int occluder) /* 0 none, 1 half, 2 full */
 {
     rt_scene s;
+    rt_settings set;
+    rt_settings_default(&set);
     rt_scene_init(&s);
-    s.settings.shadow_samples = 64;
+    rt_settings_default(&set);
+    set.shadow_samples = 64;
     rt_material fl = plain("floor");
     fl.color = rt_v3s(0.5f);
     fl.diffuse = 1.0f;
@@ -560,7 +583,7 @@ static float area_light_floor(int occluder) /* 0 none, 1 half, 2 full */
     l.quad = RT_NONE;
     rt_scene_add_light(&s, &l);
     built b;
-    build(&b, &s);
+    build(&b, &s, &set);
     float sum = 0;
     for (int i = 0; i < 8; i++) /* several rng streams: average out the jitter */
         sum += rt_luminance(radiance(&b, rt_v3(0, 0.5f, 0.5f), rt_v3(0, -0.5f, -0.5f + 1e-4f * i)));
@@ -596,9 +619,11 @@ static void test_ambient_default(void **state)
     for (int use_image = 0; use_image < 2; use_image++) {
         rt_scene s;
         rt_scene_init(&s);
-        s.settings.background = rt_v3(0.2f, 0.4f, 0.6f);
-        s.settings.environment_strength = 1.5f;
-        rt_vec3 expect_a = rt_scale(s.settings.background, 1.5f);
+        rt_settings set;
+        rt_settings_default(&set);
+        s.environment.background = rt_v3(0.2f, 0.4f, 0.6f);
+        s.environment.environment_strength = 1.5f;
+        rt_vec3 expect_a = rt_scale(s.environment.background, 1.5f);
         if (use_image) { /* rows 0.1 / 0.3 (north / south halves): mean 0.2 */
             rt_image img;
             memset(&img, 0, sizeof img);
@@ -612,7 +637,7 @@ static void test_ambient_default(void **state)
             snprintf(img.name, sizeof img.name, "env");
             rt_texture t = rt_texture_image(rt_scene_add_image(&s, &img));
             t.filter = RT_FILTER_NEAREST;
-            s.settings.environment_texture = rt_scene_add_texture(&s, &t);
+            s.environment.environment_texture = rt_scene_add_texture(&s, &t);
             expect_a = rt_v3s(0.2f * 1.5f);
         }
         rt_material fl = plain("floor");
@@ -620,16 +645,16 @@ static void test_ambient_default(void **state)
         fl.ambient = 0.5f;
         rt_scene_add_quad(&s, rt_v3(-5, 0, -5), rt_v3(0, 0, 10), rt_v3(10, 0, 0), rt_scene_add_material(&s, &fl));
         built b;
-        build(&b, &s);
+        build(&b, &s, &set);
         rt_vec3 L = radiance(&b, rt_v3(0, 1, 0), rt_v3(0.1f, -1, 0.2f));
         assert_true(fabsf(L.x - 0.5f * 1.0f * expect_a.x) < 1e-3f * expect_a.x);
         assert_true(fabsf(L.y - 0.5f * 0.5f * expect_a.y) < 1e-3f * expect_a.y);
         assert_true(fabsf(L.z - 0.5f * 0.25f * expect_a.z) < 1e-3f * expect_a.z);
         unbuild(&b);
         /* an explicit ambient_light wins */
-        s.settings.ambient_light = rt_v3s(2.0f);
-        s.settings.ambient_light_set = true;
-        build(&b, &s);
+        s.environment.ambient_light = rt_v3s(2.0f);
+        s.environment.ambient_light_set = true;
+        build(&b, &s, &set);
         L = radiance(&b, rt_v3(0, 1, 0), rt_v3(0.1f, -1, 0.2f));
         assert_true(fabsf(L.x - 1.0f) < 1e-6f && fabsf(L.z - 0.25f) < 1e-6f);
         unbuild(&b);
@@ -643,6 +668,8 @@ static void test_matches_direct(void **state)
     (void)state;
     rt_scene s;
     rt_scene_init(&s);
+    rt_settings set;
+    rt_settings_default(&set);
     rt_material fl = plain("floor");
     fl.color = rt_v3(0.6f, 0.5f, 0.4f);
     fl.diffuse = 1.0f;
@@ -650,7 +677,7 @@ static void test_matches_direct(void **state)
     rt_scene_add_quad(&s, rt_v3(-10, 0, -10), rt_v3(0, 0, 20), rt_v3(20, 0, 0), mf);
     add_light(&s, RT_LIGHT_POINT, rt_v3(0.3f, 2, -0.2f), 10.0f);
     built b;
-    build(&b, &s);
+    build(&b, &s, &set);
     for (int i = 0; i < 50; i++) {
         rt_vec3 o = rt_v3(0, 3, 1), d = rt_v3(-1.0f + i * 0.04f, -3, -1.0f + i * 0.03f);
         rt_ray r = rt_ray_make(o, d, 0.0f, INFINITY);

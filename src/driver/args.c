@@ -392,7 +392,7 @@ static int parse_set(args *a, const char *name, const char *arg)
         return fail_usage("%s %s: no setting is called '%s' (the settings: %s)", name, arg, key, names);
     }
     rt_setting_problem pb;
-    if (rt_setting_set(NULL, def, eq + 1, &pb) != RT_OK)
+    if (rt_setting_set(NULL, NULL, def, eq + 1, &pb) != RT_OK)
         return fail_usage("%s %s: %s", name, arg, pb.message);
     return add_setting(a, name, arg, def, eq + 1);
 }
@@ -442,7 +442,7 @@ static int parse_setting_flag(args *a, const flag *fl, const char *name, const c
 {
     const rt_setting *def = rt_setting_find(fl->setting);
     rt_setting_problem pb;
-    if (rt_setting_set(NULL, def, value, &pb) != RT_OK) {
+    if (rt_setting_set(NULL, NULL, def, value, &pb) != RT_OK) {
         char wants[256];
         setting_wants(def, wants, sizeof wants);
         return fail_usage("%s wants %s, got '%s'", name, wants, value);
@@ -771,12 +771,12 @@ void args_job_options(const args *a, rt_job_options *o)
                           .part_out = a->part_out};
 }
 
-rt_result args_apply_settings(const args *a, rt_scene *s, rt_error *err)
+rt_result args_apply_settings(const args *a, rt_scene *s, rt_settings *settings, rt_error *err)
 {
     for (size_t i = 0; i < a->setting_count; i++) {
         const setting_flag *sf = &a->settings[i];
         rt_setting_problem pb;
-        if (rt_setting_set(&s->settings, sf->setting, sf->value, &pb) != RT_OK)
+        if (rt_setting_set(settings, &s->environment, sf->setting, sf->value, &pb) != RT_OK)
             return rt_fail(err, pb.code, "%s %s: %s", sf->flag, sf->arg, pb.message);
         rt_error inner = {0};
         rt_result r = rt_environment_image_load(s, &inner); /* --set environment=FILE: its image */

@@ -13,7 +13,7 @@
  *   if (status != ARGS_OK)
  *       return status;                          // 0 after --help or --version, 2 after a bad flag
  *   ... load the scene ...
- *   if (args_apply_settings(&a, &scene, &err) != RT_OK) ...   // "--set environment=sky.hdr: ..."
+ *   if (args_apply_settings(&a, &scene, &settings, &err) != RT_OK) ...   // "--set environment=sky.hdr: ..."
  */
 #ifndef RT_DRIVER_ARGS_H
 #define RT_DRIVER_ARGS_H
@@ -102,6 +102,6 @@ bool args_output_is_part(const args *a);
 /* The job's options (rt/job/options.h) from the flags. */
 void args_job_options(const args *a, rt_job_options *o);
 /* Applies the setting flags to the loaded scene, in command-line order. */
-rt_result args_apply_settings(const args *a, rt_scene *s, rt_error *err);
+rt_result args_apply_settings(const args *a, rt_scene *s, rt_settings *settings, rt_error *err);
 
 #endif

@@ -23,10 +23,12 @@ static int print_info(const char *path, const args *a)
     const memory_budget *budget = &a->budget;
     rt_scene s;
     rt_scene_init(&s);
+    rt_settings loaded; /* the file's own settings */
+    rt_settings_default(&loaded);
     rt_error err = {0};
     rt_load_info info;
     rt_load_options lo = {.use_time = a->posed, .time = a->frame_time, .animation = a->animation};
-    rt_result r = input_load(&s, path, &lo, &info, &err);
+    rt_result r = input_load(&s, &loaded, path, &lo, &info, &err);
     if (r != RT_OK) {
         memory_budget_report(&err, budget);
         rt_scene_free(&s);
@@ -58,9 +60,9 @@ static int print_info(const char *path, const args *a)
     printf("lights: %zu\n", s.light_count);
 
     /* how it would render */
-    rt_settings set = s.settings;
+    rt_settings set = loaded;
     if (info.kind != RT_LOAD_SCENE)
-        rt_load_model_settings(&set);
+        rt_load_model_settings(&set, &s.environment);
     const rt_camera *cam = NULL;
     if (s.camera_set) {
         printf("camera: scene file\n");
@@ -79,9 +81,8 @@ static int print_info(const char *path, const args *a)
         print_vec("camera.up", cam->up);
         printf("camera.fov: %.9g\n", cam->vfov_deg);
     }
-    s.settings = set;
     char output[1024];
-    input_default_output(&s, path, output, sizeof output);
+    input_default_output(&set, path, output, sizeof output);
     printf("resolution: %dx%d\n", set.width, set.height);
     printf("samples: %d\n", set.samples);
     printf("integrator: %s\n", rt_integrator_name(set.integrator));

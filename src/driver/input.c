@@ -11,10 +11,10 @@
 
 #include "rt/base/file.h"
 
-void input_default_output(const rt_scene *s, const char *input, char *out, size_t size)
+void input_default_output(const rt_settings *s, const char *input, char *out, size_t size)
 {
-    if (s && s->settings.output[0]) {
-        snprintf(out, size, "%s", s->settings.output);
+    if (s && s->output[0]) {
+        snprintf(out, size, "%s", s->output);
         return;
     }
     if (!input || strcmp(input, "-") == 0) {
@@ -30,10 +30,11 @@ void input_default_output(const rt_scene *s, const char *input, char *out, size_
 
 /* Relative paths in a scene from standard input resolve against the
  * current directory. */
-rt_result input_load(rt_scene *s, const char *input, const rt_load_options *lo, rt_load_info *info, rt_error *err)
+rt_result input_load(rt_scene *s, rt_settings *settings, const char *input, const rt_load_options *lo,
+                     rt_load_info *info, rt_error *err)
 {
     if (!input || strcmp(input, "-") != 0)
-        return rt_load(s, input, lo, info, err);
+        return rt_load(s, settings, input, lo, info, err);
     memset(info, 0, sizeof *info);
     if (isatty(0))
         return rt_fail(err, RT_ERR_IO,
@@ -45,7 +46,7 @@ rt_result input_load(rt_scene *s, const char *input, const rt_load_options *lo, 
         const char *what = strncmp(inner.message, "/dev/stdin: ", 12) == 0 ? inner.message + 12 : inner.message;
         return rt_fail(err, inner.code, "<stdin>: %s", what);
     }
-    rt_result r = rt_load_memory(s, bytes, size, "<stdin>", lo, info, err);
+    rt_result r = rt_load_memory(s, settings, bytes, size, "<stdin>", lo, info, err);
     free(bytes);
     return r;
 }

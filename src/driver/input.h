@@ -22,12 +22,13 @@
 
 /* rt_load for a path or the built-in scene; standard input for "-" (a
  * terminal there is refused, RT_ERR_IO). */
-rt_result input_load(rt_scene *s, const char *input, const rt_load_options *lo, rt_load_info *info, rt_error *err);
+rt_result input_load(rt_scene *s, rt_settings *settings, const char *input, const rt_load_options *lo,
+                     rt_load_info *info, rt_error *err);
 /* The name messages use for an input. */
 const char *input_name(const char *input);
-/* The output when -o is not given: the scene's `output` (s may be NULL),
+/* The output when -o is not given: the scene file's `output` setting (s may be NULL),
  * else the input's base name with .png in the current directory, out.png
  * for the built-in scene and standard input. */
-void input_default_output(const rt_scene *s, const char *input, char *out, size_t size);
+void input_default_output(const rt_settings *s, const char *input, char *out, size_t size);
 
 #endif

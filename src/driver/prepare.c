@@ -20,7 +20,8 @@
 
 /* The loaded scene as the flags want it: setting flags applied, the view
  * framed (rt_job_frame), the output path chosen and checked. */
-rt_result prepare_scene(rt_scene *scene, const args *a, char *output, size_t size, bool *animated, rt_error *err)
+rt_result prepare_scene(rt_scene *scene, rt_settings *set, const args *a, char *output, size_t size, bool *animated,
+                        rt_error *err)
 {
     rt_load_info info;
     rt_load_options lo = {.for_render = true,
@@ -40,7 +41,7 @@ rt_result prepare_scene(rt_scene *scene, const args *a, char *output, size_t siz
         if ((r = rt_output_check(output, err)) != RT_OK)
             return r;
     }
-    if ((r = input_load(scene, a->input, &lo, &info, err)) != RT_OK)
+    if ((r = input_load(scene, set, a->input, &lo, &info, err)) != RT_OK)
         return r;
     *animated = info.animated;
     if ((r = rt_scene_validate(scene, err)) != RT_OK) { /* from here on the tables are trusted */
@@ -51,19 +52,18 @@ rt_result prepare_scene(rt_scene *scene, const args *a, char *output, size_t siz
         rt_warn("%s: nothing to render (no spheres, quads, triangles or meshes); the image will show only the "
                 "background",
                 input_name(a->input));
-    if ((r = args_apply_settings(a, scene, err)) != RT_OK)
+    if ((r = args_apply_settings(a, scene, set, err)) != RT_OK)
         return r;
-    rt_settings *set = &scene->settings;
     rt_job_options jo;
     args_job_options(a, &jo);
     jo.fit_aspect = !args_sets(a, "resolution") && a->input && info.kind == RT_LOAD_GLTF;
-    if ((r = rt_job_frame(scene, &jo, input_name(a->input), err)) != RT_OK)
+    if ((r = rt_job_frame(scene, set, &jo, input_name(a->input), err)) != RT_OK)
         return r;
 
     if (a->output)
         snprintf(output, size, "%s", a->output);
     else
-        input_default_output(scene, a->input, output, size);
+        input_default_output(set, a->input, output, size);
     if ((r = rt_output_check(output, err)) != RT_OK ||
         (r = rt_output_check_size(output, set->width, set->height, err)) != RT_OK)
         return r;
@@ -92,13 +92,13 @@ rt_result prepare_scene(rt_scene *scene, const args *a, char *output, size_t siz
 /* prepare_scene() for the same input at another time (a motion slice): its
  * warnings were the first load's, so they are not said again (-v keeps
  * its lines). */
-rt_result prepare_scene_again(rt_scene *scene, const args *a, char *output, size_t size, bool *animated,
-                               rt_error *err)
+rt_result prepare_scene_again(rt_scene *scene, rt_settings *set, const args *a, char *output, size_t size,
+                              bool *animated, rt_error *err)
 {
     rt_log_level level = rt_log_get_level();
     if (level == RT_LOG_NORMAL)
         rt_log_set_level(RT_LOG_QUIET);
-    rt_result r = prepare_scene(scene, a, output, size, animated, err);
+    rt_result r = prepare_scene(scene, set, a, output, size, animated, err);
     rt_log_set_level(level);
     return r;
 }

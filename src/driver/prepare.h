@@ -12,14 +12,15 @@
 
 #include "args.h"
 
-/* Loads a->input into scene (rolled back on failure), validates it, applies
- * the setting and camera flags, checks the limits, and chooses and checks
- * the output path (into output); *animated when the input follows the
- * frame time. */
-rt_result prepare_scene(rt_scene *scene, const args *a, char *output, size_t size, bool *animated, rt_error *err);
+/* Loads a->input into scene and its settings into settings (defaults
+ * given; both rolled back on failure), validates it, applies the setting
+ * and camera flags, checks the limits, and chooses and checks the output
+ * path (into output); *animated when the input follows the frame time. */
+rt_result prepare_scene(rt_scene *scene, rt_settings *settings, const args *a, char *output, size_t size,
+                        bool *animated, rt_error *err);
 /* The same for the same input at another time (a motion slice): the first
  * load's warnings are not said again (-v keeps its lines). */
-rt_result prepare_scene_again(rt_scene *scene, const args *a, char *output, size_t size, bool *animated,
-                              rt_error *err);
+rt_result prepare_scene_again(rt_scene *scene, rt_settings *settings, const args *a, char *output, size_t size,
+                              bool *animated, rt_error *err);
 
 #endif

@@ -36,6 +36,7 @@ typedef struct run {
     const args *a;
     rt_job_options jo;
     rt_scene *scene;
+    const rt_settings *settings; /* how to render it: the render's own (run_one's) */
     const char *output;
     progress_view *view;
     double t_start;
@@ -60,7 +61,7 @@ typedef struct run {
 static int write_result(run *rn, rt_result r, rt_error *err)
 {
     const args *a = rn->a;
-    const rt_settings *set = &rn->scene->settings;
+    const rt_settings *set = rn->settings;
     const rt_part_job *pj = &rn->pj;
     rt_framebuffer *fb = &rn->fb;
     rt_job_aovs *aov = &rn->aov;
@@ -208,7 +209,7 @@ static int run_setup(run *rn)
             ts->build_ms, ts->nodes, ts->leaves, ts->empty_leaves, ts->prim_refs, ts->depth, ts->wide_nodes,
             (double)ts->bytes / (1024.0 * 1024.0));
     rn->have_pj = true;
-    if (rt_part_job_init(&rn->pj, &rn->jo, rn->scene, &rn->tree, &err) != RT_OK)
+    if (rt_part_job_init(&rn->pj, &rn->jo, rn->scene, rn->settings, &rn->tree, &err) != RT_OK)
         return run_failed(rn, &err);
     if (check_part_outputs(rn) != 0)
         return 2;
@@ -253,7 +254,7 @@ static void run_watch(run *rn)
     if (a->preview_seconds > 0.0 && to_part)
         rt_warn("--preview: a part's output holds sums, not an image; no preview is written");
     view->preview_seconds = a->preview_seconds;
-    view->exposure = rn->scene->settings.exposure;
+    view->exposure = rn->settings->exposure;
     view->time_limit = a->time_limit;
     view->temp = rn->sig->temp;
     if (a->display_server) {
@@ -272,7 +273,7 @@ static void run_options(run *rn)
 {
     const args *a = rn->a;
     const rt_scene *scene = rn->scene;
-    const rt_settings *set = &scene->settings;
+    const rt_settings *set = rn->settings;
     progress_view *view = rn->view;
     rt_render_options *ro = &rn->ro;
     memset(ro, 0, sizeof *ro);
@@ -317,7 +318,9 @@ static rt_result load_slice(void *user, rt_scene *slice, float time, rt_error *e
     ak.frame_time = time;
     char out[1024];
     bool animated = false;
-    return prepare_scene_again(slice, &ak, out, sizeof out, &animated, err);
+    rt_settings settings; /* the same as the render's: the slices render with rn->settings */
+    rt_settings_default(&settings);
+    return prepare_scene_again(slice, &settings, &ak, out, sizeof out, &animated, err);
 }
 
 static void slice_loading(void *user, int k, int slices, float time)
@@ -348,7 +351,7 @@ static int run_slices(run *rn, int slices)
                           .s_begin = pj->s_begin, .s_end = pj->s_end, .pass_samples = rn->ro.pass_samples,
                           .time_limit = a->time_limit, .load = load_slice, .loading = slice_loading,
                           .rendering = slice_rendering, .user = rn};
-    rt_result r = rt_job_render_slices(rn->scene, &rn->tree, &plan, &rn->ro, &rn->fb, &rn->rs, &err);
+    rt_result r = rt_job_render_slices(rn->scene, rn->settings, &rn->tree, &plan, &rn->ro, &rn->fb, &rn->rs, &err);
     return r == RT_ERR_NOMEM ? 2 : write_result(rn, r, &err);
 }
 
@@ -364,7 +367,7 @@ static int run_renders(run *rn)
     rt_result r;
     int status = 0;
     for (;;) {
-        r = rt_render(&shown, &rn->tree, &rn->ro, &rn->fb, &rn->rs, &err);
+        r = rt_render(&shown, rn->settings, &rn->tree, &rn->ro, &rn->fb, &rn->rs, &err);
         if (!a->window || atomic_load(sig->interrupted) || (r != RT_OK && r != RT_ERR_INTERRUPTED))
             break;
         if (r == RT_OK) { /* finished (or the time limit): written now, then the window waits */
@@ -393,14 +396,15 @@ static int run_renders(run *rn)
  * --time-limit; with --window, again at each new camera) and writes the
  * image; the exit status. t_start: when the run began, for the wall time in
  * the "wrote" line. */
-static int render_and_write(rt_scene *scene, const args *a, int slices, const char *output, progress_view *view,
-                            double t_start, const run_signals *sig)
+static int render_and_write(rt_scene *scene, const rt_settings *settings, const args *a, int slices,
+                            const char *output, progress_view *view, double t_start, const run_signals *sig)
 {
     run rn;
     memset(&rn, 0, sizeof rn);
     rn.a = a;
     args_job_options(a, &rn.jo);
     rn.scene = scene;
+    rn.settings = settings;
     rn.output = output;
     rn.view = view;
     rn.t_start = t_start;
@@ -431,7 +435,9 @@ int run_one(rt_scene *scene, const args *a, double t_start, const run_signals *s
     progress_view_init(&view, a->log_level >= RT_LOG_NORMAL && isatty(2));
     progress_phase(&view, "load", a->input ? a->input : "the built-in scene");
     bool animated = false;
-    if (prepare_scene(scene, a, output, sizeof output, &animated, &err) != RT_OK) {
+    rt_settings settings; /* this render's: the scene file's, the model defaults, the flags */
+    rt_settings_default(&settings);
+    if (prepare_scene(scene, &settings, a, output, sizeof output, &animated, &err) != RT_OK) {
         progress_clear(&view);
         memory_budget_report(&err, &a->budget);
         progress_view_free(&view);
@@ -439,7 +445,7 @@ int run_one(rt_scene *scene, const args *a, double t_start, const run_signals *s
     }
     /* an open shutter over animated models: motion blur in time slices, the
      * first posed here at its time (a static scene renders as it is) */
-    int slices = rt_motion_slices(&scene->camera, scene->settings.motion_steps, scene->settings.samples);
+    int slices = rt_motion_slices(&scene->camera, settings.motion_steps, settings.samples);
     if (slices && a->window) {
         rt_warn("--window shows the shutter's midpoint; motion blur is rendered without --window");
         slices = 1;
@@ -450,9 +456,11 @@ int run_one(rt_scene *scene, const args *a, double t_start, const run_signals *s
         a0.frame_time = (float)rt_motion_time(a->posed ? a->frame_time : 0.0f, &scene->camera, 0, slices);
         rt_scene s0; /* loaded again at slice 0's time, keeping the decoded images */
         rt_scene_init(&s0);
+        rt_settings settings0;
+        rt_settings_default(&settings0);
         size_t n = scene->image_count;
         if (!rt_scene_share_images(&s0, scene) ||
-            prepare_scene_again(&s0, &a0, output, sizeof output, &animated, &err) != RT_OK) {
+            prepare_scene_again(&s0, &settings0, &a0, output, sizeof output, &animated, &err) != RT_OK) {
             if (s0.image_count < n)
                 rt_fail(&err, RT_ERR_NOMEM, "out of memory for the images of motion slice 1");
             rt_scene_free(&s0);
@@ -464,6 +472,7 @@ int run_one(rt_scene *scene, const args *a, double t_start, const run_signals *s
         if (animated) {
             rt_scene_free(scene); /* s0 holds the images too */
             *scene = s0;
+            settings = settings0;
         } else { /* nothing follows the time: the scene as first loaded, unblurred */
             rt_scene_free(&s0);
         }
@@ -475,7 +484,7 @@ int run_one(rt_scene *scene, const args *a, double t_start, const run_signals *s
             return 2;
         }
     }
-    int status = render_and_write(scene, a, animated ? slices : 1, output, &view, t_start, sig);
+    int status = render_and_write(scene, &settings, a, animated ? slices : 1, output, &view, t_start, sig);
     progress_view_free(&view);
     return status;
 }

@@ -10,7 +10,7 @@
 
 rt_result rt_environment_image_load(rt_scene *s, rt_error *err)
 {
-    rt_settings *st = &s->settings;
+    rt_scene_environment *st = &s->environment;
     if (st->environment_file[0] == '\0' || st->environment_texture != RT_NONE)
         return RT_OK;
     uint32_t img = RT_NONE;

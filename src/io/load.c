@@ -107,19 +107,21 @@ const char *rt_load_kind_name(rt_load_kind kind)
  * (256x256 against 512-spp renders: bunny RMSE 0.0099 and LDR-FLIP 0.0076
  * at 64 spp against 0.0138 / 0.0099 at 32 and 0.048 / 0.049 for direct at
  * 16; MetalRoughSpheres LDR-FLIP 0.0138 at 64, 0.0168 at 32, 0.148 direct). */
-void rt_load_model_settings(rt_settings *set)
+void rt_load_model_settings(rt_settings *set, rt_scene_environment *env)
 {
-    set->samples = 64;
-    set->integrator = rt_integrator_for_models();
-    set->background = rt_v3(0.55f, 0.6f, 0.7f);
+    if (set) {
+        set->samples = 64;
+        set->integrator = rt_integrator_for_models();
+    }
+    env->background = rt_v3(0.55f, 0.6f, 0.7f);
 }
 
 /* Lighting and sampling for a bare model: a soft sky, a key light from
  * above when the model brings no lights, the path tracer and enough
  * samples for a clean image. */
-static bool add_default_lighting(rt_scene *s)
+static bool add_default_lighting(rt_scene *s, rt_settings *settings)
 {
-    rt_load_model_settings(&s->settings);
+    rt_load_model_settings(settings, &s->environment);
     if (s->light_count == 0) {
         rt_light sun;
         memset(&sun, 0, sizeof sun);
@@ -135,8 +137,8 @@ static bool add_default_lighting(rt_scene *s)
 }
 
 /* The reader for kind, then what for_render adds to that kind. */
-static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const char *name, rt_load_kind kind,
-                           const rt_load_options *opt, rt_load_info *info, rt_error *err)
+static rt_result load_kind(rt_scene *s, rt_settings *settings, const void *bytes, size_t size, const char *name,
+                           rt_load_kind kind, const rt_load_options *opt, rt_load_info *info, rt_error *err)
 {
     rt_result r;
     switch (kind) {
@@ -151,7 +153,7 @@ static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const ch
         info->nodes = gs.nodes;
         info->animated = gs.animated;
         if (r == RT_OK && opt->for_render) {
-            if (!add_default_lighting(s))
+            if (!add_default_lighting(s, settings))
                 r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", name);
             if (s->camera_count) {
                 s->camera = s->cameras[0];
@@ -169,7 +171,7 @@ static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const ch
         r = mo.material == RT_NONE ? rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", name)
                                    : rt_mesh_load_memory(s, bytes, size, name, &mo, NULL, err);
         info->meshes = info->primitives = r == RT_OK ? 1 : 0;
-        if (r == RT_OK && opt->for_render && !add_default_lighting(s))
+        if (r == RT_OK && opt->for_render && !add_default_lighting(s, settings))
             r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory adding the default light", name);
         return r;
     }
@@ -183,34 +185,41 @@ static rt_result load_kind(rt_scene *s, const void *bytes, size_t size, const ch
     }
     rt_scene_parse_options po = {
         .use_time = opt->use_time, .time = opt->time, .animation = opt->animation, .animated = &info->animated};
-    return rt_scene_parse_string_with(s, bytes, size, name, NULL, &po, err);
+    return rt_scene_parse_string_with(s, settings, bytes, size, name, NULL, &po, err);
 }
 
 /* Marks the scene, loads, adds tangents for rendering, and rolls back on
  * any error. t0 is when the load began (reading included). */
-static rt_result load_marked(rt_scene *s, const void *bytes, size_t size, const char *name, rt_load_kind kind,
-                             const rt_load_options *options, rt_load_info *info, double t0, rt_error *err)
+static rt_result load_marked(rt_scene *s, rt_settings *settings, const void *bytes, size_t size, const char *name,
+                             rt_load_kind kind, const rt_load_options *options, rt_load_info *info, double t0,
+                             rt_error *err)
 {
     static const rt_load_options defaults = {0};
     if (!options)
         options = &defaults;
     bool for_render = options->for_render;
     rt_scene_mark mark = rt_scene_mark_of(s);
+    rt_settings settings_before;
+    if (settings)
+        settings_before = *settings;
     if (options->variant && kind != RT_LOAD_GLTF) {
         info->load_ms = 1e3 * rt_now_seconds() - t0;
         return rt_fail(err, RT_ERR_INVALID, "%s: --variant picks a glTF model's material variant; this is not a glTF file",
                        name ? name : "the built-in scene");
     }
-    rt_result r = load_kind(s, bytes, size, name, kind, options, info, err);
+    rt_result r = load_kind(s, settings, bytes, size, name, kind, options, info, err);
     if (r == RT_OK && for_render) /* normal-mapped meshes without tangents get per-vertex ones */
         r = rt_scene_generate_tangents(s, err);
-    if (r != RT_OK)
+    if (r != RT_OK) {
         rt_scene_rollback(s, &mark);
+        if (settings)
+            *settings = settings_before;
+    }
     info->load_ms = 1e3 * rt_now_seconds() - t0;
     return r;
 }
 
-rt_result rt_load_memory(rt_scene *s, const void *bytes, size_t size, const char *name,
+rt_result rt_load_memory(rt_scene *s, rt_settings *settings, const void *bytes, size_t size, const char *name,
                          const rt_load_options *options, rt_load_info *info, rt_error *err)
 {
     double t0 = 1e3 * rt_now_seconds();
@@ -223,11 +232,11 @@ rt_result rt_load_memory(rt_scene *s, const void *bytes, size_t size, const char
     if (!bytes && size)
         return rt_fail(err, RT_ERR_INVALID, "%s: no data", name);
     info->kind = rt_load_kind_of(bytes, size, name);
-    return load_marked(s, size ? bytes : "", size, name, info->kind, options, info, t0, err);
+    return load_marked(s, settings, size ? bytes : "", size, name, info->kind, options, info, t0, err);
 }
 
-rt_result rt_load(rt_scene *s, const char *path, const rt_load_options *options, rt_load_info *info,
-                  rt_error *err)
+rt_result rt_load(rt_scene *s, rt_settings *settings, const char *path, const rt_load_options *options,
+                  rt_load_info *info, rt_error *err)
 {
     double t0 = 1e3 * rt_now_seconds();
     rt_load_info local_info;
@@ -235,7 +244,7 @@ rt_result rt_load(rt_scene *s, const char *path, const rt_load_options *options,
         info = &local_info;
     memset(info, 0, sizeof *info);
     if (!path)
-        return load_marked(s, rt_default_scene_text, strlen(rt_default_scene_text), "<built-in scene>",
+        return load_marked(s, settings, rt_default_scene_text, strlen(rt_default_scene_text), "<built-in scene>",
                            RT_LOAD_SCENE, options, info, t0, err);
     char *bytes;
     size_t size;
@@ -246,7 +255,7 @@ rt_result rt_load(rt_scene *s, const char *path, const rt_load_options *options,
         return r;
     }
     info->kind = rt_load_kind_of(bytes, size, path);
-    r = load_marked(s, bytes, size, path, info->kind, options, info, t0, err);
+    r = load_marked(s, settings, bytes, size, path, info->kind, options, info, t0, err);
     free(bytes);
     return r;
 }

@@ -82,6 +82,7 @@ typedef struct name_table {
 
 typedef struct parser {
     rt_scene *s;
+    rt_settings *settings; /* the setting statements' values; NULL: checked, not kept */
     const char *name; /* file name for messages */
     const char *dir;  /* directory relative paths resolve against ("" = the current one) */
     rt_error *err;
@@ -658,7 +659,7 @@ static rt_result st_setting(parser *p, const rt_setting *def, const tok *kw)
         p->pos = first + v.words;
         if ((r = expect_end(p, def->name)) != RT_OK)
             return r;
-        r = rt_setting_store(&p->s->settings, def, &v, p->dir, &pb);
+        r = rt_setting_store(p->settings, &p->s->environment, def, &v, p->dir, &pb);
     }
     if (r == RT_OK && def->type == RT_SETTING_ENVIRONMENT) { /* the table keeps the name; the image is io's */
         rt_error inner = {0};
@@ -1858,14 +1859,15 @@ static rt_result finish(parser *p)
     return RT_OK;
 }
 
-rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const char *name, const char *dir,
-                                rt_error *err)
+rt_result rt_scene_parse_string(rt_scene *s, rt_settings *settings, const char *text, size_t len, const char *name,
+                                const char *dir, rt_error *err)
 {
-    return rt_scene_parse_string_with(s, text, len, name, dir, NULL, err);
+    return rt_scene_parse_string_with(s, settings, text, len, name, dir, NULL, err);
 }
 
-rt_result rt_scene_parse_string_with(rt_scene *s, const char *text, size_t len, const char *name, const char *dir,
-                                     const rt_scene_parse_options *options, rt_error *err)
+rt_result rt_scene_parse_string_with(rt_scene *s, rt_settings *settings, const char *text, size_t len,
+                                     const char *name, const char *dir, const rt_scene_parse_options *options,
+                                     rt_error *err)
 {
     if (!name)
         name = "<scene>";
@@ -1890,6 +1892,7 @@ rt_result rt_scene_parse_string_with(rt_scene *s, const char *text, size_t len, 
     parser p;
     memset(&p, 0, sizeof p);
     p.s = s;
+    p.settings = settings;
     p.name = name;
     p.dir = dir;
     p.err = err;
@@ -1898,13 +1901,19 @@ rt_result rt_scene_parse_string_with(rt_scene *s, const char *text, size_t len, 
         p.pose = *options;
     /* a UTF-8 byte order mark is not part of the first statement */
     size_t skip = len >= 3 && memcmp(buf, "\xef\xbb\xbf", 3) == 0 ? 3 : 0;
-    rt_scene_mark mark = rt_scene_mark_of(s); /* a failed parse leaves the scene as it was */
+    rt_scene_mark mark = rt_scene_mark_of(s); /* a failed parse leaves the scene and settings as they were */
+    rt_settings settings_before;
+    if (settings)
+        settings_before = *settings;
     rt_result r = run(&p, buf + skip, len - skip);
     p.ntok = 0;
     if (r == RT_OK)
         r = finish(&p);
-    if (r != RT_OK)
+    if (r != RT_OK) {
         rt_scene_rollback(s, &mark);
+        if (settings)
+            *settings = settings_before;
+    }
     free(p.toks);
     free(p.missing_tex);
     name_table_free(&p.materials);
@@ -1913,7 +1922,7 @@ rt_result rt_scene_parse_string_with(rt_scene *s, const char *text, size_t len, 
     return r;
 }
 
-rt_result rt_scene_parse_file(rt_scene *s, const char *path, rt_error *err)
+rt_result rt_scene_parse_file(rt_scene *s, rt_settings *settings, const char *path, rt_error *err)
 {
     if (!path)
         return rt_fail(err, RT_ERR_INVALID, "no scene file given");
@@ -1922,7 +1931,7 @@ rt_result rt_scene_parse_file(rt_scene *s, const char *path, rt_error *err)
     rt_result r = rt_read_file(path, MAX_SCENE_BYTES, &text, &len, err);
     if (r != RT_OK)
         return r;
-    r = rt_scene_parse_string(s, text, len, path, NULL, err);
+    r = rt_scene_parse_string(s, settings, text, len, path, NULL, err);
     free(text);
     return r;
 }

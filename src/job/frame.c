@@ -20,7 +20,7 @@ int rt_job_width_for_aspect(int height, float aspect_ratio)
 
 /* Look-from, look-at, up and field of view over the file's or the framed
  * camera; a camera they leave degenerate is an error naming them. */
-static rt_result apply_pose(rt_scene *scene, const rt_job_options *a, rt_error *err)
+static rt_result apply_pose(rt_scene *scene, const rt_settings *set, const rt_job_options *a, rt_error *err)
 {
     if (!a->has_look_from && !a->has_look_at && !a->has_up && !a->has_fov)
         return RT_OK;
@@ -53,7 +53,7 @@ static rt_result apply_pose(rt_scene *scene, const rt_job_options *a, rt_error *
     if (a->has_look_from || a->has_look_at)
         c->focus_distance = 0.0f; /* the distance to look_at, which moved */
     rt_camera_frame cf;
-    if (!rt_camera_frame_init(&cf, c, scene->settings.width, scene->settings.height))
+    if (!rt_camera_frame_init(&cf, c, set->width, set->height))
         return rt_fail(err, RT_ERR_INVALID,
                        "%s: the camera is degenerate (the position equals the point looked at, or up is parallel "
                        "to the view direction)",
@@ -62,9 +62,8 @@ static rt_result apply_pose(rt_scene *scene, const rt_job_options *a, rt_error *
     return RT_OK;
 }
 
-rt_result rt_job_frame(rt_scene *scene, const rt_job_options *o, const char *name, rt_error *err)
+rt_result rt_job_frame(rt_scene *scene, rt_settings *set, const rt_job_options *o, const char *name, rt_error *err)
 {
-    rt_settings *set = &scene->settings;
     if (o->use_camera) {
         if (o->camera < 0 || (size_t)o->camera >= scene->camera_count)
             return rt_fail(err, RT_ERR_INVALID, "--camera %d: the loaded models have %zu camera%s", o->camera,
@@ -81,9 +80,9 @@ rt_result rt_job_frame(rt_scene *scene, const rt_job_options *o, const char *nam
         set->width = rt_job_width_for_aspect(set->height, scene->camera.aspect_ratio);
     bool camera_from_input = scene->camera_set;
     if (!scene->camera_set)
-        rt_scene_frame_camera(scene);
-    rt_result r = apply_pose(scene, o, err);
+        rt_scene_frame_camera(scene, (float)set->width / (float)(set->height > 0 ? set->height : 1));
+    rt_result r = apply_pose(scene, set, o, err);
     if (r != RT_OK)
         return r;
-    return rt_render_check_limits(scene, name, camera_from_input, err);
+    return rt_render_check_limits(scene, set, name, camera_from_input, err);
 }

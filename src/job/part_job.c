@@ -36,9 +36,9 @@ static void line(char *buf, size_t size, const char *fmt, ...)
     }
 }
 
-static void settings_text(const rt_scene *scene, char *buf, size_t size)
+static void settings_text(const rt_scene *scene, const rt_settings *s, char *buf, size_t size)
 {
-    const rt_settings *s = &scene->settings;
+    const rt_scene_environment *e = &scene->environment;
     const rt_camera *c = &scene->camera;
     buf[0] = 0;
     line(buf, size, "resolution %d %d", s->width, s->height);
@@ -54,16 +54,16 @@ static void settings_text(const rt_scene *scene, char *buf, size_t size)
     line(buf, size, "shadow_samples %d", s->shadow_samples);
     line(buf, size, "ray_offset %a", (double)s->ray_offset);
     line(buf, size, "clamp %a", (double)s->clamp);
-    line(buf, size, "background %a %a %a", (double)s->background.x, (double)s->background.y,
-         (double)s->background.z);
+    line(buf, size, "background %a %a %a", (double)e->background.x, (double)e->background.y,
+         (double)e->background.z);
     const char *env = "none";
-    if (s->environment_texture != RT_NONE && s->environment_texture < scene->texture_count &&
-        scene->textures[s->environment_texture].image < scene->image_count)
-        env = rt_path_basename(scene->images[scene->textures[s->environment_texture].image].name);
-    line(buf, size, "environment %s strength %a", env, (double)s->environment_strength);
-    if (s->ambient_light_set)
-        line(buf, size, "ambient_light %a %a %a", (double)s->ambient_light.x, (double)s->ambient_light.y,
-             (double)s->ambient_light.z);
+    if (e->environment_texture != RT_NONE && e->environment_texture < scene->texture_count &&
+        scene->textures[e->environment_texture].image < scene->image_count)
+        env = rt_path_basename(scene->images[scene->textures[e->environment_texture].image].name);
+    line(buf, size, "environment %s strength %a", env, (double)e->environment_strength);
+    if (e->ambient_light_set)
+        line(buf, size, "ambient_light %a %a %a", (double)e->ambient_light.x, (double)e->ambient_light.y,
+             (double)e->ambient_light.z);
     line(buf, size, "camera.position %a %a %a", (double)c->position.x, (double)c->position.y, (double)c->position.z);
     line(buf, size, "camera.look_at %a %a %a", (double)c->look_at.x, (double)c->look_at.y, (double)c->look_at.z);
     line(buf, size, "camera.up %a %a %a", (double)c->up.x, (double)c->up.y, (double)c->up.z);
@@ -75,7 +75,8 @@ static void settings_text(const rt_scene *scene, char *buf, size_t size)
              s->motion_steps);
 }
 
-rt_result rt_part_identity(const rt_scene *scene, const char *input, rt_part_info *info, rt_error *err)
+rt_result rt_part_identity(const rt_scene *scene, const rt_settings *s, const char *input, rt_part_info *info,
+                           rt_error *err)
 {
     memset(info, 0, sizeof *info);
     snprintf(info->version, sizeof info->version, "%s", RT_VERSION);
@@ -97,8 +98,7 @@ rt_result rt_part_identity(const rt_scene *scene, const char *input, rt_part_inf
         info->scene_hash = rt_fnv1a64(builtin, sizeof builtin - 1, RT_FNV1A64_INIT);
         snprintf(info->scene, sizeof info->scene, "<built-in scene>");
     }
-    settings_text(scene, info->settings, sizeof info->settings);
-    const rt_settings *s = &scene->settings;
+    settings_text(scene, s, info->settings, sizeof info->settings);
     info->width = s->width;
     info->height = s->height;
     info->spp = s->samples;
@@ -158,11 +158,11 @@ static rt_result keep_blocks(rt_part_job *pj, size_t n, rt_error *err)
 
 static rt_result resume(rt_part_job *pj, const rt_job_options *a, const rt_settings *s, rt_error *err);
 
-rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_scene *scene, const rt_kdtree *tree,
+rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_scene *scene, const rt_settings *s,
+                           const rt_kdtree *tree,
                            rt_error *err)
 {
     memset(pj, 0, sizeof *pj);
-    const rt_settings *s = &scene->settings;
     pj->to_part = a->output_is_part;
     pj->region = (rt_render_region){0, 0, s->width, s->height};
     pj->s_begin = 0;
@@ -170,7 +170,7 @@ rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_sc
     bool any = pj->to_part || a->resume || a->part_out;
     if (!any)
         return RT_OK;
-    rt_result r = rt_part_identity(scene, a->input, &pj->info, err);
+    rt_result r = rt_part_identity(scene, s, a->input, &pj->info, err);
     if (r != RT_OK)
         return r;
     if (a->posed) /* the pose changes pixels: frame time and animation are settings of the render */
@@ -182,7 +182,7 @@ rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_sc
                            a->crop[2], a->crop[3], s->width, s->height);
         pj->region = (rt_render_region){a->crop[0], a->crop[1], a->crop[2], a->crop[3]};
     }
-    if (a->part_count && (r = rt_part_split(scene, tree, a->part_index, a->part_count, &pj->region, err)) != RT_OK)
+    if (a->part_count && (r = rt_part_split(scene, s, tree, a->part_index, a->part_count, &pj->region, err)) != RT_OK)
         return r;
     if (a->has_spp_range) {
         if (a->spp_end > s->samples)

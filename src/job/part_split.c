@@ -48,10 +48,9 @@ static int place_cut(int want, int prev, int rows, int left)
     return cut > rows - left ? rows - left : cut;
 }
 
-rt_result rt_part_split(const rt_scene *scene, const rt_kdtree *tree, int index, int count, rt_render_region *band,
-                     rt_error *err)
+rt_result rt_part_split(const rt_scene *scene, const rt_settings *set, const rt_kdtree *tree, int index, int count,
+                        rt_render_region *band, rt_error *err)
 {
-    const rt_settings *set = &scene->settings;
     int W = set->width, H = set->height;
     if (count < 1 || index < 0 || index >= count)
         return rt_fail(err, RT_ERR_INVALID, "--part %d/%d: I counts from 0 to N - 1", index, count);
@@ -71,7 +70,7 @@ rt_result rt_part_split(const rt_scene *scene, const rt_kdtree *tree, int index,
         return rt_fail(err, RT_ERR_NOMEM, "out of memory for the cost estimate of --part");
     const rt_integrator_info *integ = rt_integrator_info_of(set->integrator);
     rt_render_state state;
-    rt_result r = integ ? rt_render_state_prepare(&state, scene, tree, integ->prepare, err)
+    rt_result r = integ ? rt_render_state_prepare(&state, scene, set, tree, integ->prepare, err)
                         : rt_fail(err, RT_ERR_INVALID, "unknown integrator");
     if (r != RT_OK) {
         free(row_cost);

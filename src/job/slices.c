@@ -58,7 +58,8 @@ static void add_stats(rt_render_stats *rs, const rt_render_stats *st)
     rs->time_limited = st->time_limited;
 }
 
-rt_result rt_job_render_slices(rt_scene *scene, const rt_kdtree *tree, const rt_job_slices *plan,
+rt_result rt_job_render_slices(rt_scene *scene, const rt_settings *settings, const rt_kdtree *tree,
+                               const rt_job_slices *plan,
                                rt_render_options *ro, rt_framebuffer *fb, rt_render_stats *rs, rt_error *err)
 {
     rt_result r = RT_OK;
@@ -67,7 +68,7 @@ rt_result rt_job_render_slices(rt_scene *scene, const rt_kdtree *tree, const rt_
     int slices = plan->slices, done_to = plan->s_begin; /* samples [s_begin, done_to) are in the sums */
     for (int k = 0; k < slices && r == RT_OK; k++) {
         int b, e;
-        rt_motion_samples(k, slices, scene->settings.samples, &b, &e);
+        rt_motion_samples(k, slices, settings->samples, &b, &e);
         b = b > plan->s_begin ? b : plan->s_begin;
         e = e < plan->s_end ? e : plan->s_end;
         if (b >= e)
@@ -87,7 +88,7 @@ rt_result rt_job_render_slices(rt_scene *scene, const rt_kdtree *tree, const rt_
         ro->sample_end = e;
         int pass = plan->pass_samples;
         if (pass == 0)
-            pass = rt_integrator_info_of(scene->settings.integrator)->pass_samples;
+            pass = rt_integrator_info_of(settings->integrator)->pass_samples;
         if (pass <= 0) /* tiles asked for: one pass of all the slice's samples */
             ro->pass_samples = e - b;
         if (plan->time_limit > 0.0) { /* what is left of it */
@@ -95,7 +96,7 @@ rt_result rt_job_render_slices(rt_scene *scene, const rt_kdtree *tree, const rt_
             if (ro->time_limit <= 0.0)
                 ro->time_limit = 1e-9;
         }
-        r = rt_render(own ? &sk : scene, own ? &tk : tree, ro, fb, &st, err);
+        r = rt_render(own ? &sk : scene, settings, own ? &tk : tree, ro, fb, &st, err);
         rt_info("motion: slice %d of %d (t = %g s): samples %d:%d, %.3f s", k + 1, slices,
                 rt_motion_time(plan->frame_time, &scene->camera, k, slices), b, e, st.seconds);
         if (own) {

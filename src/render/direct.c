@@ -20,7 +20,7 @@ rt_vec3 rt_direct_lambert(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3
     rt_vec3 sum = rt_v3s(0);
     if (rt_max3(albedo) <= 0.0f)
         return sum;
-    int area_samples = s->settings.shadow_samples > 0 ? s->settings.shadow_samples : 1;
+    int area_samples = ctx->state->settings->shadow_samples > 0 ? ctx->state->settings->shadow_samples : 1;
     uint32_t pattern = rt_rng_u32(rng);
     for (size_t i = 0; i < s->light_count; i++) {
         const rt_light *l = &s->lights[i];
@@ -45,7 +45,7 @@ rt_vec3 rt_direct_lambert(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3
     sum = rt_scale(rt_mul(sum, albedo), RT_INV_PI);
     /* environment light: one cosine-weighted ray */
     rt_vec3 env_probe = rt_environment(s, sf->n);
-    if (s->settings.environment_texture != RT_NONE || rt_max3(env_probe) > 0.0f) {
+    if (s->environment.environment_texture != RT_NONE || rt_max3(env_probe) > 0.0f) {
         rt_vec3 h = rt_sample_cosine_hemisphere(rt_v2(rt_rng_float(rng), rt_rng_float(rng)));
         rt_vec3 d = rt_add(rt_add(rt_scale(sf->t, h.x), rt_scale(sf->b, h.y)), rt_scale(sf->n, h.z));
         if (rt_dot(d, sf->ng) > 0.0f) {

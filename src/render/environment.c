@@ -12,7 +12,7 @@
 
 rt_vec3 rt_environment(const rt_scene *s, rt_vec3 d)
 {
-    const rt_settings *st = &s->settings;
+    const rt_scene_environment *st = &s->environment;
     if (st->environment_texture != RT_NONE) {
         rt_vec4 c = rt_texture_sample(s, st->environment_texture, rt_latlong_from_dir(rt_normalize(d)), false);
         return rt_scale(rt_v3(c.x, c.y, c.z), st->environment_strength);
@@ -22,7 +22,7 @@ rt_vec3 rt_environment(const rt_scene *s, rt_vec3 d)
 
 rt_vec3 rt_environment_mean(const rt_scene *s)
 {
-    const rt_settings *st = &s->settings;
+    const rt_scene_environment *st = &s->environment;
     if (st->environment_texture == RT_NONE)
         return rt_scale(st->background, st->environment_strength);
     enum { NU = 64, NV = 32 };

@@ -89,7 +89,7 @@ void rt_integrator_list(char *buf, size_t size, const char *sep, const char *las
 
 rt_vec3 rt_radiance(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng)
 {
-    const rt_integrator_info *in = rt_integrator_info_of(ctx->state->scene->settings.integrator);
+    const rt_integrator_info *in = rt_integrator_info_of(ctx->state->settings->integrator);
     RT_DCHECK(in != NULL);
     return in->radiance(ctx, ray, rng);
 }

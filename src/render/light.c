@@ -356,7 +356,7 @@ void rt_light_table_free(rt_light_table *t)
  * out of memory. */
 static bool build_env(rt_light_table *t, const rt_scene *s)
 {
-    const rt_settings *st = &s->settings;
+    const rt_scene_environment *st = &s->environment;
     uint32_t tex = st->environment_texture;
     if (tex == RT_NONE || !(st->environment_strength > 0.0f))
         return true;

@@ -14,15 +14,16 @@
  * (RT_KD_PAYLOAD), one value kept free. */
 #define MAX_PRIMITIVES ((size_t)RT_KD_PAYLOAD - 1)
 
-rt_result rt_render_check_limits(const rt_scene *s, const char *name, bool camera_required, rt_error *err)
+rt_result rt_render_check_limits(const rt_scene *s, const rt_settings *set, const char *name, bool camera_required,
+                                 rt_error *err)
 {
     size_t prims = rt_scene_prim_count(s);
     if (prims > MAX_PRIMITIVES)
         return rt_fail(err, RT_ERR_LIMIT, "%s: %zu primitives (triangles %zu, spheres %zu, quads %zu), over the limit of %zu",
                        name, prims, s->triangles.count, s->spheres.count, s->quads.count, MAX_PRIMITIVES);
-    const rt_settings *set = &s->settings;
+
     rt_setting_problem pb;
-    if (rt_settings_check(set, &pb) != RT_OK)
+    if (rt_settings_check(set, &s->environment, &pb) != RT_OK)
         return rt_fail(err, RT_ERR_LIMIT, "%s: %s", name, pb.message);
     const rt_integrator_info *in = rt_integrator_info_of(set->integrator);
     if (in && in->diffuse_tree && set->diffuse_bounces > 0 && set->diffuse_rays > 1) {

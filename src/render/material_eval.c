@@ -196,19 +196,18 @@ static void conductor_at(const rt_trace_ctx *ctx, const rt_surface *sf, const rt
         }
     }
     rt_bsdf_set_conductor(b, m->eta, m->k, ax, ay, m->smith == RT_SMITH_SEPARABLE);
-    if (s->settings.energy_compensation)
+    if (ctx->state->settings->energy_compensation)
         rt_bsdf_compensate(b);
 }
 
 static void dielectric_at(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_material *m, rt_vec3 n, rt_bsdf *b)
 {
-    const rt_scene *s = ctx->state->scene;
     /* eta = n_wo / n_wi: exterior over interior entering the front */
     float eta = m->exterior_ior / m->ior;
     float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
     rt_bsdf_make_dielectric(b, n, sf->front ? eta : 1.0f / eta, alpha);
     rt_bsdf_set_frame(b, n, sf->ng);
-    if (s->settings.energy_compensation)
+    if (ctx->state->settings->energy_compensation)
         rt_bsdf_compensate(b);
 }
 

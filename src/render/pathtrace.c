@@ -104,7 +104,7 @@ static inline uint32_t path_dim(const rt_trace_ctx *ctx, const rt_path_state *ps
 /* The 2D value of slot `slot` of bounce `bounce`. */
 static inline rt_vec2 path_2d_of(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, int bounce, uint32_t slot)
 {
-    const rt_settings *st = &ctx->state->scene->settings;
+    const rt_settings *st = ctx->state->settings;
     rt_sampler_kind kind = (rt_sampler_kind)st->sampler;
     uint32_t dim0 = (uint32_t)bounce * path_stride(ctx);
     if (kind != RT_SAMPLER_INDEPENDENT && rt_sampler_block_usable()) {
@@ -124,7 +124,7 @@ static inline rt_vec2 path_2d(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng
  * (rt_sampler_1d), so it reads the cache; CMJ's and the stream's are apart. */
 static inline float path_1d(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, uint32_t slot)
 {
-    const rt_settings *st = &ctx->state->scene->settings;
+    const rt_settings *st = ctx->state->settings;
     if (st->sampler == RT_SAMPLER_SOBOL && rt_sampler_block_usable())
         return path_2d(ctx, ps, rng, slot).x;
     return rt_sample_1d((rt_sampler_kind)st->sampler, (uint32_t)st->samples, rng, path_dim(ctx, ps, slot));
@@ -332,7 +332,7 @@ rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, 
                                     rt_vec3 *wo)
 {
     const rt_scene *s = ctx->state->scene;
-    int max_depth = s->settings.max_depth > 0 ? s->settings.max_depth : RT_PATH_HARD_LIMIT;
+    int max_depth = ctx->state->settings->max_depth > 0 ? ctx->state->settings->max_depth : RT_PATH_HARD_LIMIT;
     if (max_depth > RT_PATH_HARD_LIMIT)
         max_depth = RT_PATH_HARD_LIMIT;
     const rt_material *m = &s->materials[sf->material];
@@ -404,13 +404,13 @@ rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, 
 bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                         rt_vec3 wo, rt_rng *rng)
 {
-    int rr_depth = ctx->state->scene->settings.rr_depth;
+    int rr_depth = ctx->state->settings->rr_depth;
     /* continue the path by sampling the BSDF */
     /* the lobe choice and the roulette share a 2D dimension, computed
      * once and only when read: a Lambertian BSDF (one lobe) ignores ulobe
      * and most paths end before the roulette. `independent` draws both from
      * the stream, in call order. */
-    bool stratified = ctx->state->scene->settings.sampler != RT_SAMPLER_INDEPENDENT;
+    bool stratified = ctx->state->settings->sampler != RT_SAMPLER_INDEPENDENT;
     int lr_bounce = ps->bounces; /* the roulette reads it after ps->bounces++ */
     rt_vec2 ulr = rt_v2(0.0f, 0.0f);
     bool have_lr = false;

@@ -44,6 +44,7 @@
 
 struct rt_render_job {
     const rt_scene *scene;
+    const rt_settings *settings;  /* how to render it */
     rt_framebuffer *fb;           /* the region's pixels */
     rt_camera_frame camera;
     int width, height;            /* the whole image (settings) */
@@ -122,7 +123,7 @@ static void fold_block(const rt_render_job *job, size_t local, uint32_t s, pixel
 static inline void add_sample(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, size_t local,
                               uint32_t s, rt_vec3 L, pixel_sum *p)
 {
-    const rt_settings *st = &job->scene->settings;
+    const rt_settings *st = job->settings;
     uint64_t pixel = (uint64_t)y * (uint64_t)job->width + (uint64_t)x;
     if (s % RT_SAMPLE_BLOCK == 0)
         fold_block(job, local, s, p);
@@ -157,7 +158,7 @@ static inline void add_sample(const rt_render_job *job, worker *w, rt_trace_ctx 
 static inline void add_samples(const rt_render_job *job, worker *w, rt_trace_ctx *ctx, int x, int y, size_t local,
                                uint32_t s0, uint32_t s1, pixel_sum *p_io)
 {
-    const rt_settings *st = &job->scene->settings;
+    const rt_settings *st = job->settings;
     pixel_sum p = *p_io;
     for (uint32_t s = s0; s < s1; s++) {
         rt_rng rng;
@@ -255,7 +256,7 @@ static bool render_tile_wavefront(rt_render_job *job, worker *w, rt_trace_ctx *c
     uint32_t ns = s1 - s0, tw = (uint32_t)(x1 - x0);
     uint32_t npx = tw * (uint32_t)(y1 - y0);
     uint32_t per_chunk = ns >= WAVE_CHUNK ? 1 : WAVE_CHUNK / ns;
-    rt_wavefront_work wk = {&job->camera, job->width, job->scene->settings.seed, job->spp, x0 + job->rx0,
+    rt_wavefront_work wk = {&job->camera, job->width, job->settings->seed, job->spp, x0 + job->rx0,
                             x1 + job->rx0, y0 + job->ry0, 0, 0, 0, 0};
     for (uint32_t p = 0; p < npx; p += per_chunk) {
         if (cancelled(job))
@@ -457,10 +458,9 @@ static void free_job(rt_render_job *job, worker *workers, int nthreads)
 
 /* The request checked: the region (the whole image when zero) inside the
  * image, fb its size, the caller's sums complete, the integrator known. */
-static rt_result check_request(const rt_scene *scene, const rt_render_options *opt, const rt_framebuffer *fb,
+static rt_result check_request(const rt_settings *set, const rt_render_options *opt, const rt_framebuffer *fb,
                                rt_render_region *region, const rt_integrator_info **integrator, rt_error *err)
 {
-    const rt_settings *set = &scene->settings;
     rt_render_region reg = opt->region;
     if (reg.x0 == 0 && reg.y0 == 0 && reg.x1 == 0 && reg.y1 == 0)
         reg = (rt_render_region){0, 0, set->width, set->height};
@@ -484,13 +484,13 @@ static rt_result check_request(const rt_scene *scene, const rt_render_options *o
 
 /* The job's plan: samples, region, camera, tiles; *pass_samples is the
  * samples a pass (<= 0: tiles). */
-static rt_result plan_job(rt_render_job *job, const rt_scene *scene, const rt_render_options *opt,
-                          rt_render_region reg, const rt_integrator_info *integrator, rt_framebuffer *fb,
-                          int *pass_samples, rt_error *err)
+static rt_result plan_job(rt_render_job *job, const rt_scene *scene, const rt_settings *set,
+                          const rt_render_options *opt, rt_render_region reg, const rt_integrator_info *integrator,
+                          rt_framebuffer *fb, int *pass_samples, rt_error *err)
 {
-    const rt_settings *set = &scene->settings;
     memset(job, 0, sizeof *job);
     job->scene = scene;
+    job->settings = set;
     job->fb = fb;
     job->cancel = opt->cancel;
     job->spp = set->samples > 0 ? (uint32_t)set->samples : 1;
@@ -654,8 +654,8 @@ static int render_passes(rt_render_job *job, worker *workers, int nthreads, cons
     return started;
 }
 
-rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_render_options *options,
-                    rt_framebuffer *fb, rt_render_stats *stats, rt_error *err)
+rt_result rt_render(const rt_scene *scene, const rt_settings *settings, const rt_kdtree *tree,
+                    const rt_render_options *options, rt_framebuffer *fb, rt_render_stats *stats, rt_error *err)
 {
     rt_render_options opt;
     memset(&opt, 0, sizeof opt);
@@ -666,10 +666,10 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     RT_DCHECK(rt_scene_validate(scene, NULL) == RT_OK);
     rt_render_region reg = {0, 0, 0, 0};
     const rt_integrator_info *integrator = NULL;
-    rt_result r = check_request(scene, &opt, fb, &reg, &integrator, err);
+    rt_result r = check_request(settings, &opt, fb, &reg, &integrator, err);
     rt_render_job job;
     int pass_samples = 0;
-    if (r != RT_OK || (r = plan_job(&job, scene, &opt, reg, integrator, fb, &pass_samples, err)) != RT_OK)
+    if (r != RT_OK || (r = plan_job(&job, scene, settings, &opt, reg, integrator, fb, &pass_samples, err)) != RT_OK)
         return r;
     int nthreads = opt.threads > 0 ? opt.threads : rt_cpu_count();
     if (nthreads > 1024)
@@ -679,7 +679,7 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
         return r;
     /* what the integrator reads, derived once, before the workers start */
     rt_render_state state;
-    if ((r = rt_render_state_prepare(&state, scene, tree, integrator->prepare, err)) != RT_OK) {
+    if ((r = rt_render_state_prepare(&state, scene, settings, tree, integrator->prepare, err)) != RT_OK) {
         free_job(&job, workers, nthreads);
         return r;
     }

@@ -21,15 +21,16 @@
  * given, else the mean radiance of the environment over the sphere. */
 static rt_vec3 ambient_radiance(const rt_scene *scene)
 {
-    const rt_settings *st = &scene->settings;
+    const rt_scene_environment *st = &scene->environment;
     return st->ambient_light_set ? st->ambient_light : rt_environment_mean(scene);
 }
 
-rt_result rt_render_state_prepare(rt_render_state *rs, const rt_scene *scene, const rt_kdtree *tree,
-                                  unsigned prepare, rt_error *err)
+rt_result rt_render_state_prepare(rt_render_state *rs, const rt_scene *scene, const rt_settings *settings,
+                                  const rt_kdtree *tree, unsigned prepare, rt_error *err)
 {
     memset(rs, 0, sizeof *rs);
     rs->scene = scene;
+    rs->settings = settings;
     rs->tree = tree;
     rt_box b = tree ? tree->bounds : rt_scene_bounds(scene);
     float scale = 0.0f;

@@ -1,9 +1,9 @@
-/* settings.c - the one table of render settings (settings.h) and what it
- * drives: reading and checking a setting's words, storing them into
- * rt_settings, and the texts for help and documentation (the defaults are
- * rt_settings_default()'s, scene.c, beside the struct they fill). It knows
- * no scene and reads no file: the environment's image file is a name here,
- * loaded by io (rt/io/environment_image.h).
+/* settings.c - the render settings' defaults (rt_settings_default) and the
+ * one table of settings (settings.h) and what it drives: reading and
+ * checking a setting's words, storing them into rt_settings (or, for the
+ * scene's content, its rt_scene_environment), and the texts for help and
+ * documentation. It reads no file: the environment's image file is a name
+ * here, loaded by io (rt/io/environment_image.h).
  *
  * The table follows yocto-gl's habit of one parameter table behind both the
  * scene format and the command line. Messages keep the scene parser's
@@ -21,6 +21,7 @@
 #include "rt/base/file.h"
 #include "rt/base/number.h"
 #include "rt/render/integrator.h"
+#include "rt/render/sampler.h"
 
 #define MAX_PATH_LEN 4096 /* the scene format's limit on file paths */
 
@@ -28,9 +29,10 @@ _Static_assert(sizeof(rt_integrator) == sizeof(int), "enum settings are stored a
 
 #define FIELD(f) offsetof(rt_settings, f)
 #define FIELD_SIZE(f) sizeof(((rt_settings *)0)->f)
+#define ENV_FIELD(f) offsetof(rt_scene_environment, f), .of_scene = true
 
 static const char *const onoff_words[] = {"off", "on", NULL};
-/* in rt_sampler_kind order (rt/scene/scene.h) */
+/* in rt_sampler_kind order (rt/render/sampler.h) */
 static const char *const sampler_words[] = {"independent", "cmj", "sobol", NULL};
 
 /* Table order is the order of --help and of the scene parser's "did you mean" search. */
@@ -60,11 +62,11 @@ const rt_setting rt_settings_table[] = {
     {.name = "shadow_samples", .args = "N", .type = RT_SETTING_INT, .field = FIELD(shadow_samples), .min = 1,
      .max = 65536, .what = "shadow_samples", .help = "samples per area light per shading point"},
     {.name = "seed", .args = "N", .type = RT_SETTING_UINT32, .field = FIELD(seed), .min = 0, .max = UINT32_MAX, .what = "the seed", .help = "a random seed"},
-    {.name = "background", .args = "R G B", .type = RT_SETTING_COLOR, .field = FIELD(background), .min = 0,
+    {.name = "background", .args = "R G B", .type = RT_SETTING_COLOR, .field = ENV_FIELD(background), .min = 0,
      .max = FLT_MAX, .what = "the background colour",
      .help = "radiance of rays that leave the scene, linear RGB"},
-    {.name = "ambient_light", .args = "R G B", .type = RT_SETTING_COLOR, .field = FIELD(ambient_light),
-     .marks_given = true, .given = FIELD(ambient_light_set), .min = 0, .max = FLT_MAX,
+    {.name = "ambient_light", .args = "R G B", .type = RT_SETTING_COLOR, .field = ENV_FIELD(ambient_light),
+     .marks_given = true, .given = offsetof(rt_scene_environment, ambient_light_set), .min = 0, .max = FLT_MAX,
      .what = "the ambient light colour",
      .help = "whitted: the ambient radiance materials reflect; unset = the background's"},
     {.name = "exposure", .args = "X", .type = RT_SETTING_FLOAT, .field = FIELD(exposure), .min = 0, .max = FLT_MAX,
@@ -75,7 +77,7 @@ const rt_setting rt_settings_table[] = {
      .max = FLT_MAX, .what = "the ray offset",
      .help = "extra offset of secondary rays in scene units, on top of the automatic one"},
     {.name = "environment", .args = "FILE [strength S]", .type = RT_SETTING_ENVIRONMENT,
-     .field = FIELD(environment_texture), .field2 = FIELD(environment_strength), .min = 0, .max = FLT_MAX, .what = "environment",
+     .field = ENV_FIELD(environment_texture), .field2 = offsetof(rt_scene_environment, environment_strength), .min = 0, .max = FLT_MAX, .what = "environment",
      .help = "latitude-longitude environment image in place of the background, scaled by S"},
     {.name = "output", .args = "FILE", .type = RT_SETTING_STRING, .field = FIELD(output), .min = 1,
      .max = FIELD_SIZE(output) - 1, .what = "an output file name",
@@ -83,6 +85,27 @@ const rt_setting rt_settings_table[] = {
 };
 const size_t rt_settings_count = sizeof rt_settings_table / sizeof *rt_settings_table;
 _Static_assert(sizeof rt_settings_table / sizeof *rt_settings_table <= RT_SETTINGS_MAX, "raise RT_SETTINGS_MAX");
+
+void rt_settings_default(rt_settings *st)
+{
+    memset(st, 0, sizeof *st);
+    st->width = st->height = 512;
+    st->samples = 1;
+    st->integrator = RT_INTEGRATOR_DIRECT;
+    st->max_bounce = 1;
+    st->max_depth = 0;
+    st->rr_depth = 5;
+    st->motion_steps = 8;
+    st->sampler = RT_SAMPLER_SOBOL;
+    st->energy_compensation = 0;
+    st->diffuse_bounces = 0;
+    st->diffuse_rays = 128;
+    st->shadow_samples = 16;
+    st->seed = 0;
+    st->exposure = 1.0f;
+    st->clamp = 0.0f;
+    st->ray_offset = 0.0f;
+}
 
 const rt_setting *rt_setting_find(const char *name)
 {
@@ -94,19 +117,31 @@ const rt_setting *rt_setting_find(const char *name)
 
 /* ------------------------------------------------------------ fields */
 
-static void *field_of(rt_settings *st, size_t offset)
+/* The struct a setting's fields are in: the render's settings, or the
+ * scene's environment (of_scene); NULL when the caller gave none. */
+static void *target_of(rt_settings *st, rt_scene_environment *env, const rt_setting *def)
 {
-    return (char *)st + offset;
+    return def->of_scene ? (void *)env : (void *)st;
 }
 
-static const void *const_field_of(const rt_settings *st, size_t offset)
+static const void *const_target_of(const rt_settings *st, const rt_scene_environment *env, const rt_setting *def)
 {
-    return (const char *)st + offset;
+    return def->of_scene ? (const void *)env : (const void *)st;
+}
+
+static void *field_of(void *target, size_t offset)
+{
+    return (char *)target + offset;
+}
+
+static const void *const_field_of(const void *target, size_t offset)
+{
+    return (const char *)target + offset;
 }
 
 /* Writes an already checked value into its field(s); the environment's
  * file name by store_environment() instead. */
-static void store_value(rt_settings *st, const rt_setting *def, const rt_setting_value *v)
+static void store_value(void *st, const rt_setting *def, const rt_setting_value *v)
 {
     switch (def->type) {
     case RT_SETTING_INT:
@@ -286,8 +321,8 @@ rt_result rt_setting_read(const rt_setting *def, const char *const *w, const boo
         if (count < 1)
             return problem(pb, RT_ERR_PARSE, 0, true, "expected an %s image file", def->what);
         v->text = w[0];
-        rt_settings d; /* the strength when the line gives none: the default's */
-        rt_settings_default(&d);
+        rt_scene_environment d; /* the strength when the line gives none: the default's */
+        rt_scene_environment_default(&d);
         v->f[0] = *(const float *)const_field_of(&d, def->field2);
         v->words = 1;
         if (count > 1 && literal(&ws, 1) && strcmp(w[1], "strength") == 0) {
@@ -306,7 +341,7 @@ rt_result rt_setting_read(const rt_setting *def, const char *const *w, const boo
 /* The environment: the file name (relative to dir) and the strength; the
  * image is not loaded yet (environment_texture is RT_NONE until io's
  * rt_environment_image_load). Problems are about word 0, the file. */
-static rt_result store_environment(rt_settings *st, const rt_setting *def, const rt_setting_value *v,
+static rt_result store_environment(rt_scene_environment *st, const rt_setting *def, const rt_setting_value *v,
                                    const char *dir, rt_setting_problem *pb)
 {
     char path[MAX_PATH_LEN];
@@ -322,9 +357,10 @@ static rt_result store_environment(rt_settings *st, const rt_setting *def, const
     return RT_OK;
 }
 
-rt_result rt_setting_store(rt_settings *st, const rt_setting *def, const rt_setting_value *v, const char *dir,
-                           rt_setting_problem *pb)
+rt_result rt_setting_store(rt_settings *settings, rt_scene_environment *env, const rt_setting *def,
+                           const rt_setting_value *v, const char *dir, rt_setting_problem *pb)
 {
+    void *st = target_of(settings, env, def);
     if (def->type == RT_SETTING_STRING) {
         size_t n = strlen(v->text);
         if (n == 0)
@@ -334,7 +370,7 @@ rt_result rt_setting_store(rt_settings *st, const rt_setting *def, const rt_sett
                            (size_t)def->max);
     }
     if (def->type == RT_SETTING_ENVIRONMENT)
-        return store_environment(st, def, v, dir, pb);
+        return store_environment(env, def, v, dir, pb);
     if (!st)
         return RT_OK;
     store_value(st, def, v);
@@ -345,7 +381,8 @@ rt_result rt_setting_store(rt_settings *st, const rt_setting *def, const rt_sett
 
 /* ------------------------------------------------------------ the command-line form */
 
-rt_result rt_setting_set(rt_settings *st, const rt_setting *def, const char *text, rt_setting_problem *pb)
+rt_result rt_setting_set(rt_settings *st, rt_scene_environment *env, const rt_setting *def, const char *text,
+                         rt_setting_problem *pb)
 {
     char buf[MAX_PATH_LEN + 64];
     char *w[RT_SETTING_MAX_WORDS + 1] = {0};
@@ -379,7 +416,7 @@ rt_result rt_setting_set(rt_settings *st, const rt_setting *def, const char *tex
     if (r == RT_OK && v.words < n)
         r = problem(pb, RT_ERR_PARSE, v.words, false, "unexpected '%s' after the end of the value", w[v.words]);
     if (r == RT_OK)
-        r = rt_setting_store(st, def, &v, NULL, pb);
+        r = rt_setting_store(st, env, def, &v, NULL, pb);
     if (r != RT_OK && pb->got) {
         size_t m = strlen(pb->message);
         if (pb->word < n)
@@ -393,11 +430,14 @@ rt_result rt_setting_set(rt_settings *st, const rt_setting *def, const char *tex
 
 /* ------------------------------------------------------------ checks and texts */
 
-rt_result rt_settings_check(const rt_settings *st, rt_setting_problem *pb)
+rt_result rt_settings_check(const rt_settings *settings, const rt_scene_environment *env, rt_setting_problem *pb)
 {
     char what[256];
     for (size_t k = 0; k < rt_settings_count; k++) {
         const rt_setting *def = &rt_settings_table[k];
+        const void *st = const_target_of(settings, env, def);
+        if (!st)
+            continue;
         switch (def->type) {
         case RT_SETTING_INT:
         case RT_SETTING_SIZE:
@@ -497,7 +537,9 @@ void rt_setting_default_text(const rt_setting *def, char *buf, size_t size)
 {
     rt_settings defaults;
     rt_settings_default(&defaults);
-    const rt_settings *d = &defaults;
+    rt_scene_environment env_defaults;
+    rt_scene_environment_default(&env_defaults);
+    const void *d = const_target_of(&defaults, &env_defaults, def);
     if (def->marks_given) {
         snprintf(buf, size, "unset");
         return;

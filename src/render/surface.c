@@ -82,7 +82,7 @@ static rt_vec2 slot_uv(const rt_surface *sf, const rt_texture_slot *slot)
 static inline rt_vec3 spawn_origin(const rt_trace_ctx *ctx, rt_vec3 p, rt_vec3 side)
 {
     rt_vec3 o = rt_offset_ray_origin(p, side, ctx->state->scale);
-    float extra = ctx->state->scene->settings.ray_offset;
+    float extra = ctx->state->settings->ray_offset;
     return extra > 0.0f ? rt_madd(o, side, extra) : o;
 }
 

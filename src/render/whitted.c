@@ -342,7 +342,7 @@ static rt_vec3 trace(wctx *w, rt_ray r, const rt_medium_stack *med, int depth, i
 
 rt_vec3 rt_radiance_whitted_in(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng, const rt_medium_stack *start)
 {
-    const rt_settings *st = &ctx->state->scene->settings;
+    const rt_settings *st = ctx->state->settings;
     wctx w;
     w.ctx = ctx;
     w.rng = rng;

@@ -1,8 +1,6 @@
 /* scene.c - the scene tables: defaults, appends, marks and rollback, bounds,
- * automatic framing, and the named metals' constants (sources in
- * rt/scene/scene.h), and the render settings' defaults (rt_settings_default:
- * the settings table, rt/render/settings.h, shows them in --help and the
- * docs). */
+ * automatic framing, the environment's defaults and the named metals'
+ * constants (sources in rt/scene/scene.h). */
 #include "rt/scene/scene.h"
 
 #include "rt/base/alloc.h"
@@ -110,36 +108,20 @@ const rt_metal rt_metals[] = {
 };
 const size_t rt_metal_count = sizeof rt_metals / sizeof *rt_metals;
 
-void rt_settings_default(rt_settings *st)
+void rt_scene_environment_default(rt_scene_environment *e)
 {
-    memset(st, 0, sizeof *st);
-    st->width = st->height = 512;
-    st->samples = 1;
-    st->integrator = RT_INTEGRATOR_DIRECT;
-    st->max_bounce = 1;
-    st->max_depth = 0;
-    st->rr_depth = 5;
-    st->motion_steps = 8;
-    st->sampler = RT_SAMPLER_SOBOL;
-    st->energy_compensation = 0;
-    st->diffuse_bounces = 0;
-    st->diffuse_rays = 128;
-    st->shadow_samples = 16;
-    st->seed = 0;
-    st->background = rt_v3(0, 0, 0);
-    st->ambient_light = rt_v3(0, 0, 0);
-    st->ambient_light_set = false;
-    st->exposure = 1.0f;
-    st->clamp = 0.0f;
-    st->ray_offset = 0.0f;
-    st->environment_texture = RT_NONE;
-    st->environment_strength = 1.0f;
+    memset(e, 0, sizeof *e);
+    e->background = rt_v3(0, 0, 0);
+    e->ambient_light = rt_v3(0, 0, 0);
+    e->ambient_light_set = false;
+    e->environment_texture = RT_NONE;
+    e->environment_strength = 1.0f;
 }
 
 void rt_scene_init(rt_scene *s)
 {
     memset(s, 0, sizeof *s);
-    rt_settings_default(&s->settings);
+    rt_scene_environment_default(&s->environment);
     s->camera.position = rt_v3(0, 0, 5);
     s->camera.look_at = rt_v3(0, 0, 0);
     s->camera.up = rt_v3(0, 1, 0);
@@ -371,7 +353,7 @@ rt_scene_mark rt_scene_mark_of(const rt_scene *s)
                      (s->vertices.color ? RT_ATTR_COLOR : 0u);
     m.camera_set = s->camera_set;
     m.camera = s->camera;
-    m.settings = s->settings;
+    m.environment = s->environment;
     return m;
 }
 
@@ -410,7 +392,7 @@ void rt_scene_rollback(rt_scene *s, const rt_scene_mark *m)
     }
     s->camera_set = m->camera_set;
     s->camera = m->camera;
-    s->settings = m->settings;
+    s->environment = m->environment;
 }
 
 rt_box rt_scene_prim_bounds(const rt_scene *s, uint32_t prim)
@@ -453,14 +435,13 @@ rt_box rt_scene_bounds(const rt_scene *s)
     return b;
 }
 
-void rt_scene_frame_camera(rt_scene *s)
+void rt_scene_frame_camera(rt_scene *s, float aspect)
 {
     rt_box b = rt_scene_bounds(s);
     if (rt_box_is_empty(b) || !rt_finite3(b.lo) || !rt_finite3(b.hi))
         b.lo = rt_v3s(-1), b.hi = rt_v3s(1);
     rt_vec3 c = rt_scale(rt_add(b.lo, b.hi), 0.5f);
     float fov = 40.0f;
-    float aspect = (float)s->settings.width / (float)(s->settings.height > 0 ? s->settings.height : 1);
     float tan_v = tanf(0.5f * fov * (RT_PI / 180.0f)), tan_h = tan_v * aspect;
     /* look from the front (+z), a little above and to the side: the usual product shot */
     rt_vec3 dir = rt_normalize(rt_v3(0.35f, 0.3f, 1.0f));

@@ -151,9 +151,11 @@ static rt_result check_lights(const rt_scene *s, rt_error *err)
     return r;
 }
 
-static rt_result check_settings(const rt_scene *s, rt_error *err)
+/* The environment (the messages keep their word "settings": the scene
+ * format's statements that set it are settings-table entries). */
+static rt_result check_environment(const rt_scene *s, rt_error *err)
 {
-    const rt_settings *st = &s->settings;
+    const rt_scene_environment *st = &s->environment;
     if (st->environment_texture != RT_NONE && st->environment_texture >= s->texture_count)
         return rt_fail(err, RT_ERR_INVALID, "settings: environment texture %u is out of range (%zu texture%s)",
                        st->environment_texture, PLURAL(s->texture_count));
@@ -167,7 +169,7 @@ rt_result rt_scene_validate(const rt_scene *s, rt_error *err)
     rt_result r;
     if ((r = check_materials(s, err)) != RT_OK || (r = check_textures(s, err)) != RT_OK ||
         (r = check_geometry(s, err)) != RT_OK || (r = check_lights(s, err)) != RT_OK ||
-        (r = check_settings(s, err)) != RT_OK)
+        (r = check_environment(s, err)) != RT_OK)
         return r;
     return RT_OK;
 }

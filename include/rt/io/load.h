@@ -6,7 +6,7 @@
  *   rt_scene_init(&scene);
  *   rt_load_options opt = {.for_render = true};   // zero = load the file as it is
  *   rt_load_info info;
- *   if (rt_load(&scene, "bunny.ply", &opt, &info, &err) != RT_OK) {
+ *   if (rt_load(&scene, &settings, "bunny.ply", &opt, &info, &err) != RT_OK) {
  *       fprintf(stderr, "rt: %s\n", err.message);   // the scene is as it was before the call
  *       ...
  *   }
@@ -40,6 +40,7 @@
 #include <stddef.h>
 
 #include "rt/base/error.h"
+#include "rt/render/settings.h"
 #include "rt/scene/scene.h"
 
 typedef enum rt_load_kind { RT_LOAD_SCENE = 0, RT_LOAD_GLTF, RT_LOAD_MESH, RT_LOAD_UNKNOWN } rt_load_kind;
@@ -62,15 +63,17 @@ typedef struct rt_load_info {
     bool animated;      /* posed by an animation (a glTF, or a scene file's model line): another time may differ */
 } rt_load_info;
 
-/* Appends the input at path (NULL = the built-in scene) to s. options and
- * info may be NULL. */
-rt_result rt_load(rt_scene *s, const char *path, const rt_load_options *options, rt_load_info *info,
-                  rt_error *err);
+/* Appends the input at path (NULL = the built-in scene) to s; a scene
+ * file's setting statements, or for_render's settings for a model, go to
+ * settings (NULL: not kept). options and info may be NULL. A failed load
+ * leaves the scene and the settings as they were. */
+rt_result rt_load(rt_scene *s, rt_settings *settings, const char *path, const rt_load_options *options,
+                  rt_load_info *info, rt_error *err);
 
 /* The same for an input held in memory (size bytes at bytes, not kept);
  * name stands for the file in messages, picks the reader when the content
  * does not, and relative paths in the input resolve against its directory. */
-rt_result rt_load_memory(rt_scene *s, const void *bytes, size_t size, const char *name,
+rt_result rt_load_memory(rt_scene *s, rt_settings *settings, const void *bytes, size_t size, const char *name,
                          const rt_load_options *options, rt_load_info *info, rt_error *err);
 
 /* The reader an input goes to: by content (bytes may be NULL to skip it),
@@ -79,8 +82,9 @@ rt_result rt_load_memory(rt_scene *s, const void *bytes, size_t size, const char
 rt_load_kind rt_load_kind_of(const void *bytes, size_t size, const char *name);
 
 /* The settings a glTF model or a mesh rendered on its own gets (for_render
- * does this to the scene's settings): its samples, integrator and sky. */
-void rt_load_model_settings(rt_settings *set);
+ * does this to the load's settings and the scene's environment): its
+ * samples and integrator (set NULL: none), and its sky. */
+void rt_load_model_settings(rt_settings *set, rt_scene_environment *env);
 
 /* True when name is read as scene text unless its content says otherwise:
  * .txt, .rt, .scene, no extension, or NULL. */

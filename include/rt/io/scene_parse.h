@@ -17,16 +17,19 @@
 #include <stddef.h>
 
 #include "rt/base/error.h"
+#include "rt/render/settings.h"
 #include "rt/scene/scene.h"
 
-/* Parses a scene file; relative paths in it (meshes, textures, models) are
- * relative to the file's directory. */
-rt_result rt_scene_parse_file(rt_scene *s, const char *path, rt_error *err);
+/* Parses a scene file into s, its setting statements (`samples`,
+ * `resolution`, ...: how to render) into settings (NULL: checked, not
+ * kept); relative paths in it (meshes, textures, models) are relative to
+ * the file's directory. A failed parse leaves both as they were. */
+rt_result rt_scene_parse_file(rt_scene *s, rt_settings *settings, const char *path, rt_error *err);
 /* Parses scene text held in memory (the reader rt_load uses); `name` is
  * used in messages, and relative paths resolve against `dir`, or against
  * the directory of `name` when dir is NULL ("" = the current directory). */
-rt_result rt_scene_parse_string(rt_scene *s, const char *text, size_t len, const char *name, const char *dir,
-                                rt_error *err);
+rt_result rt_scene_parse_string(rt_scene *s, rt_settings *settings, const char *text, size_t len, const char *name,
+                                const char *dir, rt_error *err);
 
 /* The time at which `model` lines pose their glTF animations (the driver's
  * --frame-time / --frames and --animation): zero = no frame time, so a
@@ -43,8 +46,9 @@ typedef struct rt_scene_parse_options {
 
 /* rt_scene_parse_string with model lines posed at options' time (NULL =
  * none); the reader rt_load uses. */
-rt_result rt_scene_parse_string_with(rt_scene *s, const char *text, size_t len, const char *name, const char *dir,
-                                     const rt_scene_parse_options *options, rt_error *err);
+rt_result rt_scene_parse_string_with(rt_scene *s, rt_settings *settings, const char *text, size_t len,
+                                     const char *name, const char *dir, const rt_scene_parse_options *options,
+                                     rt_error *err);
 
 /* The material keys of the format (`color`, `clearcoat`, ...), by index:
  * NULL past the last (for the docs test and tools). */

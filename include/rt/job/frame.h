@@ -5,19 +5,21 @@
  * field of view), and the limits checked (rt_render_check_limits).
  *
  *   rt_job_options o = {.camera_auto = true};
- *   if (rt_job_frame(&scene, &o, "bunny.obj", &err) != RT_OK) ...   // messages name "bunny.obj"
+ *   if (rt_job_frame(&scene, &settings, &o, "bunny.obj", &err) != RT_OK) ...   // messages name "bunny.obj"
  */
 #ifndef RT_JOB_FRAME_H
 #define RT_JOB_FRAME_H
 
 #include "rt/base/error.h"
 #include "rt/job/options.h"
+#include "rt/render/settings.h"
 #include "rt/scene/scene.h"
 
-/* The camera and image size as the options say, then the limits; name is
+/* The camera and image size (the settings' width) as the options say, then the limits; name is
  * the input's name for messages. A camera the options leave degenerate is
  * an error naming them; so is a camera index the models do not have. */
-rt_result rt_job_frame(rt_scene *scene, const rt_job_options *o, const char *name, rt_error *err);
+rt_result rt_job_frame(rt_scene *scene, rt_settings *settings, const rt_job_options *o, const char *name,
+                       rt_error *err);
 
 /* The width that gives an image of `height` the aspect ratio, within the
  * image size limits. */

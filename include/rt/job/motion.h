@@ -6,11 +6,11 @@
  * is the shutter's box filter to K steps and has the bytes of any other
  * split (threads, tiles, passes, parts) of the same samples.
  *
- *   int K = rt_motion_slices(&scene.camera, scene.settings.motion_steps, scene.settings.samples);
+ *   int K = rt_motion_slices(&scene.camera, settings.motion_steps, settings.samples);
  *   for (int k = 0; k < K; k++) {
  *       double t = rt_motion_time(frame_time, &scene.camera, k, K);   // pose slice k here
  *       int s0, s1;
- *       rt_motion_samples(k, K, scene.settings.samples, &s0, &s1);    // ... and render these samples
+ *       rt_motion_samples(k, K, settings.samples, &s0, &s1);    // ... and render these samples
  *   }
  */
 #ifndef RT_JOB_MOTION_H

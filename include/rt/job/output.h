@@ -8,7 +8,7 @@
  *   rt_job_aovs aov;
  *   rt_job_aovs_init(&aov, &o, w, h, &err);           // render options .aov = rt_job_aovs_for_render(&aov)
  *   ... render into fb ...
- *   rt_job_output_write(&o, &scene.settings, &fb, &aov, "out.exr", NULL, &err);
+ *   rt_job_output_write(&o, &settings, &fb, &aov, "out.exr", NULL, &err);
  *   rt_job_aovs_free(&aov);
  */
 #ifndef RT_JOB_OUTPUT_H
@@ -17,6 +17,7 @@
 #include "rt/job/options.h"
 #include "rt/io/image_write.h"
 #include "rt/render/aov.h"
+#include "rt/render/settings.h"
 
 typedef struct rt_job_aovs {
     rt_aov_buffers buf; /* the images the render fills */

@@ -4,7 +4,7 @@
  * writes; and the identity every part of a render carries.
  *
  *   rt_part_job pj;
- *   if (rt_part_job_init(&pj, &options, &scene, &tree, &err) != RT_OK) ...  // after the kd-tree
+ *   if (rt_part_job_init(&pj, &options, &scene, &settings, &tree, &err) != RT_OK) ...  // after the kd-tree
  *   ro.region = pj.region; ro.sample_begin = pj.s_begin; ro.sample_end = pj.s_end;
  *   ro.accum = pj.need_accum ? &pj.accum : NULL;
  *   ... render into a framebuffer of the region's size ...
@@ -34,13 +34,15 @@ typedef struct rt_part_job {
 
 /* The identity of a render (scene hash, settings text, size, samples, seed,
  * version) into info; the region and samples are left for the caller. */
-rt_result rt_part_identity(const rt_scene *scene, const char *input, rt_part_info *info, rt_error *err);
+rt_result rt_part_identity(const rt_scene *scene, const rt_settings *settings, const char *input, rt_part_info *info,
+                           rt_error *err);
 
 /* Plans the render from the options (and the part options.resume names),
  * checks them against the scene, allocates the sums. After a failure too,
  * pj is released with rt_part_job_free (which may be called again). The
  * messages name the command-line flags the options come from. */
-rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_scene *scene, const rt_kdtree *tree,
+rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_scene *scene,
+                           const rt_settings *settings, const rt_kdtree *tree,
                            rt_error *err);
 void rt_part_job_free(rt_part_job *pj);
 /* Zeroed sums (and AOV sums when aov) for a render that is not a part but

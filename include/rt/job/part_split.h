@@ -2,7 +2,7 @@
  * renders (docs/farm.md, "Parts of similar cost").
  *
  *   rt_render_region band;
- *   if (rt_part_split(&scene, &tree, 2, 7, &band, &err) != RT_OK) ...
+ *   if (rt_part_split(&scene, &settings, &tree, 2, 7, &band, &err) != RT_OK) ...
  *   ... render options .region = band ...
  */
 #ifndef RT_JOB_PART_SPLIT_H
@@ -18,7 +18,8 @@
  * not exceed the image's height); the bands tile the image. The estimate
  * is a pure function of the scene, the settings and count, so every
  * machine computes the same bands. */
-rt_result rt_part_split(const rt_scene *scene, const rt_kdtree *tree, int index, int count, rt_render_region *band,
+rt_result rt_part_split(const rt_scene *scene, const rt_settings *settings, const rt_kdtree *tree, int index,
+                        int count, rt_render_region *band,
                      rt_error *err);
 
 #endif

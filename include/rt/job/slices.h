@@ -8,7 +8,7 @@
  *   rt_job_slices plan = {.slices = K, .frame_time = t, .s_begin = 0, .s_end = spp,
  *                         .load = load_at, .user = &mine};   // load_at(user, scene, time, err)
  *   ro.accum = &sums;                                        // the sums the slices share
- *   r = rt_job_render_slices(&scene, &tree, &plan, &ro, &fb, &stats, &err);
+ *   r = rt_job_render_slices(&scene, &settings, &tree, &plan, &ro, &fb, &stats, &err);
  */
 #ifndef RT_JOB_SLICES_H
 #define RT_JOB_SLICES_H
@@ -25,7 +25,8 @@ typedef struct rt_job_slices {
     int pass_samples;   /* rt_job_pass_samples' answer for the job (0: the integrator's) */
     double time_limit;  /* seconds for all slices; 0 = none */
     /* Loads and prepares slice k's scene at `time` into `slice` (which
-     * already holds slice 0's images): the caller's loading. */
+     * already holds slice 0's images): the caller's loading (its settings
+     * are the job's: every slice renders with `settings`). */
     rt_result (*load)(void *user, rt_scene *slice, float time, rt_error *err);
     /* Told when slice k (k > 0) starts loading, and when it starts
      * rendering with this many tiles; NULL = not told. */
@@ -41,10 +42,11 @@ typedef struct rt_job_slices {
  * same for any pass split). */
 int rt_job_pass_samples(int asked, bool keeps_sums, rt_integrator integrator);
 
-/* Renders the slices into ro->accum's sums (ro's sample range and pass
+/* Renders the slices with settings into ro->accum's sums (ro's sample range and pass
  * samples are set per slice); *rs sums the slices' statistics, samples_done
  * counting from plan->s_begin. */
-rt_result rt_job_render_slices(rt_scene *scene, const rt_kdtree *tree, const rt_job_slices *plan,
+rt_result rt_job_render_slices(rt_scene *scene, const rt_settings *settings, const rt_kdtree *tree,
+                               const rt_job_slices *plan,
                                rt_render_options *ro, rt_framebuffer *fb, rt_render_stats *rs, rt_error *err);
 
 #endif

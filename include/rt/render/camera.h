@@ -19,6 +19,7 @@
 #define RT_CAMERA_H
 
 #include "rt/accel/intersect.h"
+#include "rt/render/sampler.h" /* rt_sampler_kind */
 #include "rt/render/sampling.h"
 #include "rt/scene/scene.h"
 

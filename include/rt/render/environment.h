@@ -11,8 +11,8 @@
  * Mapping: u = 0.5 + atan2(x, z) / 2pi, v = acos(y) / pi, so +y (v = 0) is the
  * top row of the image, -z the left and right edges and +z its centre
  * column. The environment's radiance is its texel (linear, never sRGB
- * decoded) times settings.environment_strength; without an image it is
- * settings.background times the strength.
+ * decoded) times environment.environment_strength; without an image it is
+ * environment.background times the strength.
  */
 #ifndef RT_ENVIRONMENT_H
 #define RT_ENVIRONMENT_H

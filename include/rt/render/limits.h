@@ -21,13 +21,15 @@
 #include <stdbool.h>
 
 #include "rt/base/error.h"
+#include "rt/render/settings.h"
 #include "rt/scene/scene.h"
 
 /* whitted: rays one camera sample may spawn through diffuse gathering;
  * more is a render that never ends. */
 #define RT_MAX_DIFFUSE_TREE ((double)(1 << 24))
 
-/* RT_OK, or the first limit `s` breaks, its message starting "name: ". */
-rt_result rt_render_check_limits(const rt_scene *s, const char *name, bool camera_required, rt_error *err);
+/* RT_OK, or the first limit `s` rendered with `settings` breaks, its message starting "name: ". */
+rt_result rt_render_check_limits(const rt_scene *s, const rt_settings *settings, const char *name,
+                                 bool camera_required, rt_error *err);
 
 #endif

@@ -11,7 +11,7 @@
  *   rt_render_options opt = {0};       // zero = defaults: all cores, 32px tiles,
  *   opt.threads = 4;                   //   the integrator's pass size, no time limit
  *   rt_render_stats st;
- *   rt_render(&scene, &tree, &opt, &fb, &st, &err);
+ *   rt_render(&scene, &settings, &tree, &opt, &fb, &st, &err);
  *
  * Two ways to spend the samples:
  * - Tiles: each tile gets all its samples, then the next tile. A finished
@@ -69,6 +69,7 @@
 #include "rt/image/framebuffer.h"
 #include "rt/accel/kdtree.h"
 #include "rt/render/sample_block.h" /* RT_SAMPLE_BLOCK: how a pixel's sum is kept */
+#include "rt/render/settings.h"
 #include "rt/scene/scene.h"
 
 /* One tile of the image: its pixels [x0, x1) x [y0, y1), and whether
@@ -159,7 +160,8 @@ typedef struct rt_render_stats {
  * black, stats.partial), passes the image at stats.samples_done (partial
  * when no pass finished). Stopped by the time limit it returns RT_OK with
  * stats.time_limited and the same kind of image. */
-rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_render_options *options,
+rt_result rt_render(const rt_scene *scene, const rt_settings *settings, const rt_kdtree *tree,
+                    const rt_render_options *options,
                     rt_framebuffer *fb, rt_render_stats *stats, rt_error *err);
 
 

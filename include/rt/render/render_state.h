@@ -29,11 +29,11 @@ enum rt_prepare {
     RT_PREPARE_LIGHT_TABLE = 1, /* the table of emitters to sample by power (rt/render/light.h) */
 };
 
-/* Derives the state from scene and tree (which it points to, not copies);
+/* Derives the state from scene, settings and tree (which it points to, not copies);
  * `prepare` (RT_PREPARE_* bits) adds what an integrator needs. Fails only
  * when out of memory. */
-rt_result rt_render_state_prepare(rt_render_state *rs, const rt_scene *scene, const rt_kdtree *tree,
-                                  unsigned prepare, rt_error *err);
+rt_result rt_render_state_prepare(rt_render_state *rs, const rt_scene *scene, const rt_settings *settings,
+                                  const rt_kdtree *tree, unsigned prepare, rt_error *err);
 void rt_render_state_free(rt_render_state *rs);
 
 #endif

@@ -61,7 +61,14 @@
 #include <stdint.h>
 
 #include "rt/render/sampling.h"
-#include "rt/scene/scene.h"
+
+/* Where a path's random numbers come from (rt/render/sampler.h); the
+ * values are the words of the `sampler` setting, in order. */
+typedef enum rt_sampler_kind {
+    RT_SAMPLER_INDEPENDENT = 0, /* a PCG stream per sample (pixel and lens stratified only) */
+    RT_SAMPLER_CMJ,             /* padded correlated multi-jittering over the spp */
+    RT_SAMPLER_SOBOL,           /* padded Owen-scrambled Sobol */
+} rt_sampler_kind;
 
 /* The camera's dimensions (rt_camera_pixel_sample), apart from the path's
  * (bounce x (5 + lights) + slot): the film position and the lens point. */

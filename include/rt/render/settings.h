@@ -1,13 +1,22 @@
-/* rt/render/settings.h - the one table of render settings.
+/* rt/render/settings.h - how to render a scene (rt_settings, owned by the
+ * job beside the scene) and the one table of settings.
  *
- * Every field of rt_settings (scene.h) that a user can set is one entry of
+ * Every field of rt_settings that a user can set is one entry of
  * rt_settings_table: its name (the scene-format keyword and the key of the
  * driver's `--set KEY=VALUE`), its type, its field, its range and a line of
- * help; its default is what rt_settings_default() (scene.c) puts in the
- * field. The table drives the scene format's setting statements, the
+ * help; its default is what rt_settings_default() puts in the field. Three
+ * entries describe the scene's content, not how to render it (`background`,
+ * `environment`, `ambient_light`, marked of_scene): their fields are the
+ * scene's rt_scene_environment (rt/scene/scene.h), so every store takes
+ * both. The table drives the scene format's setting statements, the
  * driver's setting flags (-s, -r, --seed, --integrator, --set) and their
  * --help text, so they cannot drift apart. It lives with the renderer (its
- * `integrator` words are the integrator table's) and knows no scene.
+ * `integrator` words are the integrator table's).
+ *
+ *   rt_settings settings;
+ *   rt_settings_default(&settings);
+ *   rt_load(&scene, &settings, "scene.txt", NULL, NULL, &err);   // the file's statements
+ *   rt_render(&scene, &settings, &tree, &opt, &fb, &stats, &err);
  *
  * A setting's value is a short list of words, as written after its name in a
  * scene file (`resolution 640 480`). Reading the words checks them without
@@ -18,13 +27,13 @@
  *   rt_setting_value v;
  *   rt_setting_problem pb;
  *   if (rt_setting_read(def, words, NULL, nwords, &v, &pb) != RT_OK ||
- *       rt_setting_store(&scene.settings, def, &v, scene_dir, &pb) != RT_OK)
+ *       rt_setting_store(&settings, &scene.environment, def, &v, scene_dir, &pb) != RT_OK)
  *       ... pb.message names what is wrong, pb.word which word ...
  *
  * From the command line the value is one string, split into words at blanks
  * and commas (`--set background=0.1,0.2,0.3`; a resolution may be `640x480`):
  *
- *   if (rt_setting_set(&scene.settings, def, "640x480", &pb) != RT_OK)  // NULL: only check
+ *   if (rt_setting_set(&settings, &scene.environment, def, "640x480", &pb) != RT_OK)  // NULLs: only check
  *       fprintf(stderr, "rt: --set resolution=640x480: %s\n", pb.message);
  *
  *   for (size_t i = 0; i < rt_settings_count; i++)                // every setting, in table order
@@ -37,7 +46,46 @@
 #include <stddef.h>
 
 #include "rt/base/error.h"
-#include "rt/scene/scene.h" /* rt_settings, for now a member of the scene */
+#include "rt/base/vec.h"
+#include "rt/scene/scene.h" /* rt_scene_environment: the table's background, environment, ambient_light */
+
+/* Which integrator renders: a line of the integrator table
+ * (rt/render/integrator.h), which also holds the names scene files and the
+ * command line use. The built-in ones are named here; an integrator added
+ * to the table needs no name here unless code refers to it. */
+typedef enum rt_integrator {
+    RT_INTEGRATOR_DIRECT = 0, /* direct light, Lambert: the foundation slice */
+    RT_INTEGRATOR_WHITTED,    /* Phong, mirrors, glass, diffuse bounces */
+    RT_INTEGRATOR_PATH,       /* physically based path tracer (wavefront) */
+    RT_INTEGRATOR_PATH_SCALAR, /* the same, one path at a time (the reference) */
+} rt_integrator;
+
+/* Render settings: how to render a scene, not what is in it (that is the
+ * scene's, rt/scene/scene.h, its environment included). The job and the
+ * driver own one per render; loaders fill it beside the scene; the render
+ * state points at it. rt_settings_default() gives the documented defaults. */
+typedef struct rt_settings {
+    int width, height;
+    int samples;          /* samples per pixel (stratified when a square) */
+    rt_integrator integrator;
+    int max_bounce;       /* mirror/refraction recursion depth */
+    int max_depth;        /* path: most scattering events a path may have; 0 = unlimited (Russian roulette ends paths) */
+    int rr_depth;         /* path: Russian roulette from this many bounces on; 0 = adaptive (once the throughput is below 1) */
+    int motion_steps;     /* time slices over an open camera shutter: each posed, its own kd-tree (docs/gltf.md) */
+    int sampler;          /* path: an rt_sampler_kind (rt/render/sampler.h) */
+    int energy_compensation; /* path: 1 = Kulla-Conty multiple-scattering lobe on rough conductors (default 0, off) */
+    int diffuse_bounces;  /* levels of indirect diffuse light (whitted) */
+    int diffuse_rays;     /* cosine-distributed rays per diffuse level */
+    int shadow_samples;   /* samples per area light per shading point */
+    float ray_offset;     /* extra user offset, scene units (0 = robust automatic offset only) */
+    float clamp;          /* max sample luminance, 0 = no clamp (fireflies) */
+    float exposure;       /* linear scale before writing 8-bit output */
+    uint32_t seed;
+    /* The scene's own output name (`output` line); the driver may override. */
+    char output[512];
+} rt_settings;
+
+void rt_settings_default(rt_settings *s);
 
 /* The limits the table (and so the scene format and every flag) enforces. */
 #define RT_MAX_IMAGE_SIDE 32768      /* pixels, each side */
@@ -61,7 +109,9 @@ typedef struct rt_setting {
     const char *name;         /* the scene-format keyword and the --set key */
     const char *args;         /* its words as written in --help and the docs: "W H", "N", "R G B" */
     rt_setting_type type;
-    size_t field;             /* offsetof(rt_settings, ...) of the value */
+    size_t field;             /* offsetof(rt_settings, ...) of the value (of_scene: of rt_scene_environment) */
+    bool of_scene;            /* the value is the scene's content (background, environment, ambient_light): its
+                                 fields are in the scene's rt_scene_environment, not in rt_settings */
     size_t field2;            /* SIZE: the height's; ENVIRONMENT: the strength's */
     bool marks_given;         /* also sets the bool at `given` when given (unset has a meaning) */
     size_t given;
@@ -100,31 +150,33 @@ typedef struct rt_setting_problem {
  * caller decides what extra words mean. No side effects. */
 rt_result rt_setting_read(const rt_setting *def, const char *const *words, const bool *quoted, size_t count,
                           rt_setting_value *v, rt_setting_problem *pb);
-/* Stores a value read by rt_setting_read into st. `environment` stores
- * its file name (a relative one resolved against dir, NULL = the current
- * directory) in st->environment_file and its strength, and sets
+/* Stores a value read by rt_setting_read into st, or for the scene's
+ * content (of_scene: background, environment, ambient_light) into env.
+ * `environment` stores its file name (a relative one resolved against dir,
+ * NULL = the current directory) in env->environment_file and its strength, and sets
  * environment_texture to RT_NONE: the caller loads the image
  * (rt_environment_image_load, rt/io/environment_image.h); `output` checks
- * its length. st == NULL only checks. */
-rt_result rt_setting_store(rt_settings *st, const rt_setting *def, const rt_setting_value *v, const char *dir,
-                           rt_setting_problem *pb);
+ * its length. A NULL st or env only checks the values that go there. */
+rt_result rt_setting_store(rt_settings *st, rt_scene_environment *env, const rt_setting *def,
+                           const rt_setting_value *v, const char *dir, rt_setting_problem *pb);
 
 /* The command-line form: `text` split into words at blanks and commas (a
  * STRING takes the text whole; a SIZE also splits `640x480` or `640X480`),
  * read, checked for extra words, and stored as rt_setting_store does (an
- * environment's image is the caller's to load). st == NULL only checks.
+ * environment's image is the caller's to load). A NULL st or env only checks.
  * pb->message is complete, with the word at fault quoted. */
-rt_result rt_setting_set(rt_settings *st, const rt_setting *def, const char *text, rt_setting_problem *pb);
+rt_result rt_setting_set(rt_settings *st, rt_scene_environment *env, const rt_setting *def, const char *text,
+                         rt_setting_problem *pb);
 
 /* Every value in its range, as the table says (for settings that were not
- * read through it). The first one out of range is described in pb. */
-rt_result rt_settings_check(const rt_settings *st, rt_setting_problem *pb);
+ * read through it); env NULL skips the scene's entries. The first one out
+ * of range is described in pb. */
+rt_result rt_settings_check(const rt_settings *st, const rt_scene_environment *env, rt_setting_problem *pb);
 
 /* For help and documentation: the allowed values ("1..1048576", "> 0",
  * "direct|whitted|path") and the default ("512 512", "direct", "none"). */
 void rt_setting_range_text(const rt_setting *def, char *buf, size_t size);
 void rt_setting_default_text(const rt_setting *def, char *buf, size_t size);
 
-/* rt_settings_default() (scene.h) fills every field with its default. */
 
 #endif

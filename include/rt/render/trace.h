@@ -19,14 +19,16 @@
 
 #include "rt/accel/intersect.h"
 #include "rt/accel/kdtree.h"
+#include "rt/render/settings.h"
 #include "rt/scene/scene.h"
 
 typedef struct rt_render_state {
     const rt_scene *scene;
+    const rt_settings *settings; /* how to render it: the job's, read by the integrators */
     const rt_kdtree *tree;     /* may be NULL for code that only builds surface records (tests) */
     float scale;               /* largest absolute scene coordinate: sizes ray offsets */
     bool shadows_need_shading; /* some material is transmissive or alpha-tested */
-    rt_vec3 ambient;           /* whitted ambient radiance (settings.ambient_light or the environment's mean) */
+    rt_vec3 ambient;           /* whitted ambient radiance (environment.ambient_light or the environment's mean) */
     /* RT_PREPARE_LIGHT_TABLE: the scene's emitter table; NULL otherwise, and
      * then the path tracer finds emissive primitives by BSDF sampling only */
     struct rt_light_table *light_table;

@@ -4,15 +4,16 @@
  * yocto-gl: no per-object allocations, no pointers between records (records
  * refer to each other by index). Loaders (scene_parse.c, gltf.c, mesh_obj.c,
  * mesh_ply.c, mesh_off.c) append to these tables; the kd-tree and the
- * integrators only read them.
+ * renderer only read them.
  *
  *   Geometry    vertices (SoA-ish attribute arrays), triangles (index triplets,
  *               material, flags), spheres and quads (structure-of-arrays).
  *   Appearance  materials (one table for the text format and glTF alike),
- *               textures (image + sampler), images (decoded pixels, once).
+ *               textures (image, wrap, filter), images (decoded pixels, once).
  *   Light       lights (point, directional, spot, area over a quad) and a
  *               constant or image environment.
- *   View        camera and render settings.
+ *   View        the camera. How to render the scene (resolution, samples,
+ *               ...) is not the scene's but the render stage's.
  *
  * Primitive ids: one id space over all kinds, used by the kd-tree and hits.
  * Ids [0, T) are triangles, [T, T+S) spheres, [T+S, T+S+Q) quads, where
@@ -48,47 +49,17 @@ typedef struct rt_camera {
     float shutter_open, shutter_close; /* seconds from the frame time; equal = no motion blur (the default 0 0) */
 } rt_camera;
 
-/* Which integrator renders: a line of the integrator table
- * (rt/render/integrator.h), which also holds the names scene files and the
- * command line use. The built-in ones are named here; an integrator added
- * to the table needs no name here unless code refers to it. */
-typedef enum rt_integrator {
-    RT_INTEGRATOR_DIRECT = 0, /* direct light, Lambert: the foundation slice */
-    RT_INTEGRATOR_WHITTED,    /* Phong, mirrors, glass, diffuse bounces */
-    RT_INTEGRATOR_PATH,       /* physically based path tracer (wavefront) */
-    RT_INTEGRATOR_PATH_SCALAR, /* the same, one path at a time (the reference) */
-} rt_integrator;
+/* ---------------------------------------------------------- environment */
 
-/* Where a path's random numbers come from (rt/render/sampler.h); the
- * values are the words of the `sampler` setting, in order. */
-typedef enum rt_sampler_kind {
-    RT_SAMPLER_INDEPENDENT = 0, /* a PCG stream per sample (pixel and lens stratified only) */
-    RT_SAMPLER_CMJ,             /* padded correlated multi-jittering over the spp */
-    RT_SAMPLER_SOBOL,           /* padded Owen-scrambled Sobol */
-} rt_sampler_kind;
-
-/* Render settings. rt_settings_default() gives the documented defaults; the
- * table of them (names, ranges, defaults, help) is rt/render/settings.h. */
-typedef struct rt_settings {
-    int width, height;
-    int samples;          /* samples per pixel (stratified when a square) */
-    rt_integrator integrator;
-    int max_bounce;       /* mirror/refraction recursion depth */
-    int max_depth;        /* path: most scattering events a path may have; 0 = unlimited (Russian roulette ends paths) */
-    int rr_depth;         /* path: Russian roulette from this many bounces on; 0 = adaptive (once the throughput is below 1) */
-    int motion_steps;     /* time slices over an open camera shutter: each posed, its own kd-tree (docs/gltf.md) */
-    int sampler;          /* path: an rt_sampler_kind */
-    int energy_compensation; /* path: 1 = Kulla-Conty multiple-scattering lobe on rough conductors (default 0, off) */
-    int diffuse_bounces;  /* levels of indirect diffuse light (whitted) */
-    int diffuse_rays;     /* cosine-distributed rays per diffuse level */
-    int shadow_samples;   /* samples per area light per shading point */
-    float ray_offset;     /* extra user offset, scene units (0 = robust automatic offset only) */
-    float clamp;          /* max sample luminance, 0 = no clamp (fireflies) */
-    float exposure;       /* linear scale before writing 8-bit output */
-    uint32_t seed;
+/* What rays that leave the scene see, and the whitted renderer's ambient
+ * light: scene content, written by the scene format's `background`,
+ * `environment` and `ambient_light` statements (the render stage's table
+ * of statements stores them here). The image itself is
+ * a texture of the scene (io's rt_environment_image_load loads the file). */
+typedef struct rt_scene_environment {
     rt_vec3 background;   /* radiance of rays that leave the scene */
     uint32_t environment_texture; /* lat-long image, RT_NONE for constant background */
-    char environment_file[4096];  /* the `environment` setting's file, "" = none; io loads it into environment_texture */
+    char environment_file[4096];  /* the `environment` statement's file, "" = none; io loads it into environment_texture */
     float environment_strength;
     /* whitted: ambient radiance that materials' `ambient` coefficient
      * reflects. Unset (the default): the background's radiance, i.e. the
@@ -96,11 +67,10 @@ typedef struct rt_settings {
      * of the environment image (see docs/shading.md). */
     rt_vec3 ambient_light;
     bool ambient_light_set;
-    /* The scene's own output name (`output` line); the driver may override. */
-    char output[512];
-} rt_settings;
+} rt_scene_environment;
 
-void rt_settings_default(rt_settings *s);
+/* The defaults: black background, no image, strength 1, ambient unset. */
+void rt_scene_environment_default(rt_scene_environment *e);
 
 /* ------------------------------------------------------------ textures */
 
@@ -176,7 +146,7 @@ typedef enum rt_ext_slot {
 } rt_ext_slot;
 
 /* One material table for every source. The Phong fields drive the whitted
- * integrator; the PBR fields drive the path tracer; colour, textures,
+ * renderer; the PBR fields drive the path tracer; colour, textures,
  * reflection and transmission are read by both. rt_material_default() gives
  * the documented defaults (the old renderer's constants: ambient 0.4,
  * diffuse 0.8, specular 0.05). */
@@ -338,7 +308,7 @@ typedef struct rt_quads {
 typedef struct rt_scene {
     rt_camera camera;
     bool camera_set;   /* false: frame the scene bounds automatically */
-    rt_settings settings;
+    rt_scene_environment environment;
 
     rt_material *materials; size_t material_count, material_cap;
     rt_texture *textures;   size_t texture_count, texture_cap;
@@ -390,10 +360,10 @@ bool rt_scene_reserve_triangles(rt_scene *s, size_t n);
  *       rt_scene_rollback(s, &mark);
  *
  * The mark holds every table's count, which optional vertex attribute
- * arrays existed, and the camera and settings (which the scene format sets).
+ * arrays existed, and the camera and environment (which the scene format sets).
  * Rolling back truncates every table to its count (images beyond it free
  * their pixels), frees the attribute arrays enabled since, and restores the
- * camera and settings. Marks nest: a loader inside another rolls back its
+ * camera and environment. Marks nest: a loader inside another rolls back its
  * own part. */
 typedef struct rt_scene_mark {
     size_t materials, textures, images, lights, cameras;
@@ -401,7 +371,7 @@ typedef struct rt_scene_mark {
     unsigned vertex_attrs; /* RT_ATTR_* arrays that existed */
     bool camera_set;
     rt_camera camera;
-    rt_settings settings;
+    rt_scene_environment environment;
 } rt_scene_mark;
 
 rt_scene_mark rt_scene_mark_of(const rt_scene *s);
@@ -430,7 +400,8 @@ rt_box rt_scene_prim_bounds(const rt_scene *s, uint32_t prim);
 rt_box rt_scene_bounds(const rt_scene *s);
 
 /* Points the camera at the scene's bounds from the front (+z side), for
- * models without a camera. */
-void rt_scene_frame_camera(rt_scene *s);
+ * models without a camera, framed for an image of this aspect ratio
+ * (width / height). */
+void rt_scene_frame_camera(rt_scene *s, float aspect);
 
 #endif

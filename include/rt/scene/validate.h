@@ -21,7 +21,7 @@
  *   - lights: a known kind, finite colour, intensity, position, direction
  *     and edges; an area light's quad RT_NONE or in range, and no quad
  *     shared by two area lights; other lights have no quad;
- *   - settings: the environment texture RT_NONE or in range, finite
+ *   - environment: the environment texture RT_NONE or in range, finite
  *     background and environment strength.
  * The first problem found is reported (RT_ERR_NOMEM only when the quads
  * of area lights cannot be checked for lack of memory). Loaders keep their own located
