@@ -52,8 +52,9 @@ BUILD   ?= build
 SHARED  ?= ../shared
 RT      ?= rt
 
-# The library, by pipeline stage (docs/architecture.md); the driver is src/driver.
-STAGES   := base io scene accel render image
+# The library, by pipeline stage, lowest first: each stage includes and calls
+# only the stages before it (docs/architecture.md); the driver is src/driver.
+STAGES   := base image scene accel render io job
 LIB_SRC  := $(foreach d,$(STAGES),$(wildcard src/$(d)/*.c))
 LIB_CXX  := $(foreach d,$(STAGES),$(wildcard src/$(d)/*.cc))
 LIB_OBJ  := $(LIB_SRC:src/%.c=$(BUILD)/obj/%.o) $(LIB_CXX:src/%.cc=$(BUILD)/obj/%.o)
@@ -117,14 +118,14 @@ $(BUILD)/tests/test_corpus: tests/test_corpus.c tests/fuzz/harness.c tests/fuzz/
 	$(CC) $(CFLAGS) -Itests -o $@ tests/test_corpus.c tests/fuzz/harness.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # rt compare's driver code is tested in-process
-$(BUILD)/tests/test_compare: tests/test_compare.c src/driver/compare.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
+$(BUILD)/tests/test_compare: tests/test_compare.c src/driver/cmd_compare.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -Itests -o $@ tests/test_compare.c src/driver/compare.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+	$(CC) $(CFLAGS) -Itests -o $@ tests/test_compare.c src/driver/cmd_compare.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # rt convert's driver code is tested in-process too
-$(BUILD)/tests/test_hdr: tests/test_hdr.c src/driver/convert.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
+$(BUILD)/tests/test_hdr: tests/test_hdr.c src/driver/cmd_convert.c src/driver/commands.h $(BUILD)/librt.a tests/test_util.h tests/test_scenes.h | $(DEPS_OK)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -Itests -o $@ tests/test_hdr.c src/driver/convert.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
+	$(CC) $(CFLAGS) -Itests -o $@ tests/test_hdr.c src/driver/cmd_convert.c $(BUILD)/librt.a $(LDLIBS) -lcmocka
 
 # the kd-tree's portable path (no AVX2), tested on machines that have AVX2 too
 TEST_BIN += $(BUILD)/tests/test_kdtree_scalar
@@ -151,6 +152,7 @@ $(OIDN_VENV)/.installed:
 # not in SKIPS_ALLOWED fails the run (tests/run.sh).
 SKIPS_ALLOWED ?=
 test: $(RT) $(TEST_BIN)
+	@sh tools/check-stages.sh
 	@RT_SHARED=$(SHARED) RT_BIN=./$(RT) RT_SKIPS_ALLOWED="$(SKIPS_ALLOWED)" sh tests/run.sh $(TEST_BIN)
 
 # The tests a sanitizer build cannot run, and why (each skips saying so):

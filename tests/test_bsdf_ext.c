@@ -18,6 +18,7 @@
 #include "rt/render/bsdf_clearcoat.h"
 #include "rt/render/bsdf_iridescence.h"
 #include "rt/render/bsdf_sheen.h"
+#include "rt/render/material_eval.h"
 #include "rt/render/sampling.h"
 
 static rt_vec3 uniform_hemi(test_rng *r) { return dir_from(test_rng_float(r), 2.0f * RT_PI * test_rng_float(r)); }
@@ -101,7 +102,7 @@ static void test_clearcoat_four_percent(void **state)
     e.spec_weight = 0.0f; /* no base specular: only the coat reflects */
     rt_bsdf b;
     make(&b, rt_v3s(0), 0, 0.5f, &e);
-    assert_true(b.layered && b.cc_delta);
+    assert_true((b.kind == RT_BSDF_KIND_GLTF_LAYERED) && b.cc_delta);
     double s, q;
     albedo(&b, rt_v3(0, 0, 1), 4096, &s, &q);
     assert_true(fabs(s - 0.04) < 1e-4);
@@ -201,11 +202,11 @@ static void test_defaults_leave_core(void **state)
     rt_bsdf_ext_default(&e);
     rt_bsdf b;
     make(&b, rt_v3(0.8f, 0.5f, 0.2f), 0.3f, 0.4f, &e);
-    assert_false(b.layered);
+    assert_false((b.kind == RT_BSDF_KIND_GLTF_LAYERED));
     /* specularFactor 0 on a dielectric: no specular lobe and no Fresnel loss, exactly Lambert */
     e.spec_weight = 0.0f;
     make(&b, rt_v3(0.8f, 0.5f, 0.2f), 0.0f, 0.4f, &e);
-    assert_true(b.layered);
+    assert_true((b.kind == RT_BSDF_KIND_GLTF_LAYERED));
     test_rng r = {5};
     for (int i = 0; i < 500; i++) {
         rt_vec3 wo = uniform_hemi(&r), wi = uniform_hemi(&r);
@@ -263,7 +264,7 @@ static void test_layered_reciprocal(void **state)
     for (int c = 0; c < n; c++) {
         rt_bsdf b;
         make(&b, cases[c].base, cases[c].metallic, cases[c].roughness, &cases[c].e);
-        assert_true(b.layered);
+        assert_true((b.kind == RT_BSDF_KIND_GLTF_LAYERED));
         for (int i = 0; i < 1000; i++) {
             rt_vec3 wo = uniform_hemi(&r), wi = uniform_hemi(&r);
             rt_vec3 f1 = rt_bsdf_eval(&b, wo, wi, NULL), f2 = rt_bsdf_eval(&b, wi, wo, NULL);
@@ -311,7 +312,7 @@ static void test_dispersion(void **state)
     rt_bsdf_make(&plain, rt_v3(0, 0, 1), rt_v3s(1), 0.0f, 0.0f, 1.5f, 1.0f, false);
     rt_bsdf_make(&b, rt_v3(0, 0, 1), rt_v3s(1), 0.0f, 0.0f, 1.5f, 1.0f, false);
     rt_bsdf_set_ext(&b, &e);
-    assert_true(b.layered && b.dispersive);
+    assert_true((b.kind == RT_BSDF_KIND_GLTF_LAYERED) && b.dispersive);
     /* n_F - n_C = (n_d - 1) / V */
     float nr = 1.0f / b.eta_rgb.x, ng = 1.0f / b.eta_rgb.y, nb = 1.0f / b.eta_rgb.z;
     assert_true(fabsf(ng - 1.5f) < 1e-6f && nr < ng && ng < nb);

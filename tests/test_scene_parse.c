@@ -15,7 +15,8 @@
 
 #include "rt/base/log.h"
 #include "rt/io/scene_parse.h"
-#include "rt/scene/settings.h"
+#include "rt/io/environment_image.h"
+#include "rt/render/settings.h"
 
 static char tmp_dir[64]; /* this run's scratch directory (test_make_dir) */
 
@@ -472,33 +473,33 @@ static void test_settings_text_form(void **state)
     static const char *const sizes[] = {"640x480", "640X480", "640 480", "640,480", " 640 , 480 "};
     for (size_t i = 0; i < sizeof sizes / sizeof *sizes; i++) {
         s.settings.width = s.settings.height = 1;
-        assert_int_equal(rt_setting_set(&s, res, sizes[i], &pb), RT_OK);
+        assert_int_equal(rt_setting_set(&s.settings, res, sizes[i], &pb), RT_OK);
         assert_int_equal(s.settings.width, 640);
         assert_int_equal(s.settings.height, 480);
     }
-    assert_int_equal(rt_setting_set(&s, res, "640", &pb), RT_ERR_PARSE);
+    assert_int_equal(rt_setting_set(&s.settings, res, "640", &pb), RT_ERR_PARSE);
     assert_string_equal(pb.message, "expected an integer for the image height, got nothing");
-    assert_int_equal(rt_setting_set(&s, res, "0x5", &pb), RT_ERR_INVALID);
+    assert_int_equal(rt_setting_set(&s.settings, res, "0x5", &pb), RT_ERR_INVALID);
     assert_string_equal(pb.message, "the image width must be between 1 and 32768, got '0'");
-    assert_int_equal(rt_setting_set(&s, res, "640x480x2", &pb), RT_ERR_PARSE);
+    assert_int_equal(rt_setting_set(&s.settings, res, "640x480x2", &pb), RT_ERR_PARSE);
     assert_string_equal(pb.message, "expected an integer for the image height, got '480x2'");
-    assert_int_equal(rt_setting_set(&s, rt_setting_find("samples"), "4 5", &pb), RT_ERR_PARSE);
+    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("samples"), "4 5", &pb), RT_ERR_PARSE);
     assert_string_equal(pb.message, "unexpected '5' after the end of the value");
-    assert_int_equal(rt_setting_set(&s, rt_setting_find("samples"), "", &pb), RT_ERR_PARSE);
+    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("samples"), "", &pb), RT_ERR_PARSE);
     assert_string_equal(pb.message, "expected an integer for samples per pixel, got nothing");
-    assert_int_equal(rt_setting_set(&s, rt_setting_find("integrator"), "magic", &pb), RT_ERR_PARSE);
+    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("integrator"), "magic", &pb), RT_ERR_PARSE);
     assert_string_equal(pb.message, "expected an integrator (direct|whitted|path|path_scalar), got 'magic'");
 
-    assert_int_equal(rt_setting_set(&s, rt_setting_find("background"), "0.1,0.2 0.3", &pb), RT_OK);
+    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("background"), "0.1,0.2 0.3", &pb), RT_OK);
     assert_vec3(s.settings.background, 0.1f, 0.2f, 0.3f);
     assert_false(s.settings.ambient_light_set);
-    assert_int_equal(rt_setting_set(&s, rt_setting_find("ambient_light"), "1 2 3", &pb), RT_OK);
+    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("ambient_light"), "1 2 3", &pb), RT_OK);
     assert_true(s.settings.ambient_light_set);
-    assert_int_equal(rt_setting_set(&s, rt_setting_find("output"), "a b,c.png", &pb), RT_OK);
+    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("output"), "a b,c.png", &pb), RT_OK);
     assert_string_equal(s.settings.output, "a b,c.png");
-    assert_int_equal(rt_setting_set(&s, rt_setting_find("output"), "", &pb), RT_ERR_INVALID);
+    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("output"), "", &pb), RT_ERR_INVALID);
     assert_string_equal(pb.message, "expected an output file name, got an empty string");
-    assert_int_equal(rt_setting_set(&s, rt_setting_find("seed"), "4294967295", &pb), RT_OK);
+    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("seed"), "4294967295", &pb), RT_OK);
     assert_int_equal(s.settings.seed, 4294967295u);
 
     /* a NULL scene only checks */
@@ -508,9 +509,13 @@ static void test_settings_text_form(void **state)
     assert_int_equal(rt_setting_set(NULL, rt_setting_find("environment"), "sky.hdr strength -1", &pb),
                      RT_ERR_INVALID);
     assert_string_equal(pb.message, "the environment strength must be >= 0, got '-1'");
-    /* with a scene, the environment image is loaded (relative to the current directory) */
-    assert_int_equal(rt_setting_set(&s, rt_setting_find("environment"), tmp_path("no-such.hdr"), &pb), RT_ERR_IO);
-    assert_non_null(strstr(pb.message, "no-such.hdr"));
+    /* the table keeps the environment's file name; io loads the image (relative to the current directory) */
+    assert_int_equal(rt_setting_set(&s.settings, rt_setting_find("environment"), tmp_path("no-such.hdr"), &pb), RT_OK);
+    assert_string_equal(s.settings.environment_file, tmp_path("no-such.hdr"));
+    assert_int_equal(s.settings.environment_texture, RT_NONE);
+    rt_error err = {0};
+    assert_int_equal(rt_environment_image_load(&s, &err), RT_ERR_IO);
+    assert_non_null(strstr(err.message, "no-such.hdr"));
     assert_int_equal(s.settings.environment_texture, RT_NONE);
     rt_scene_free(&s);
 }

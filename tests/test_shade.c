@@ -15,6 +15,7 @@
 #include "rt/image/framebuffer.h"
 #include "rt/accel/kdtree.h"
 #include "rt/render/render.h"
+#include "rt/render/render_state.h"
 #include "rt/scene/scene.h"
 #include "rt/render/surface.h"
 #include "rt/scene/tangents.h"

@@ -133,7 +133,7 @@ static int conductor_tables(void)
            " * (rows); E_avg(alpha) = 2 int E(mu) mu dmu. Used by rt/render/ggx_albedo.h\n"
            " * for Kulla and Conty's (2017) energy compensation. */\n",
            N, N - 1);
-    printf("#include \"rt/render/ggx_albedo.h\"\n\n");
+    printf("#include \"ggx_albedo_table.h\"\n\n");
     printf("const float rt_ggx_albedo_table[RT_GGX_ALBEDO_N][RT_GGX_ALBEDO_N] = {\n");
     for (int j = 0; j < N; j++) {
         printf("    {");
@@ -268,7 +268,7 @@ static int dielectric_tables(void)
            " * multiple-scattering flux crossing from the thin side under uniform light. Used by\n"
            " * rt/render/ggx_albedo.h for Kulla and Conty's (2017) energy compensation of bsdf dielectric. */\n",
            NR - 1, N - 1, N);
-    printf("#include \"rt/render/ggx_albedo.h\"\n\n");
+    printf("#include \"ggx_albedo_table.h\"\n\n");
     printf("const float rt_ggx_dielectric_table[2][RT_GGX_DIELECTRIC_NR][RT_GGX_ALBEDO_N][RT_GGX_ALBEDO_N] = {\n");
     for (int side = 0; side < 2; side++) {
         printf("  {\n");

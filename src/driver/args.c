@@ -19,6 +19,7 @@
 #include "rt/base/number.h"
 #include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
+#include "rt/io/environment_image.h"
 #include "rt/render/render.h"
 #include "tev.h"
 
@@ -62,6 +63,27 @@ typedef enum flag_kind {
     FLAG_VERSION,
 } flag_kind;
 
+/* How a plain flag stores its value in args, checked against its range:
+ * the table says it, args_parse does it for every such flag alike. */
+typedef enum store_kind {
+    STORE_NONE,    /* the flag's own code (parse_view_flag, parse_output_flag, parse_part_flag, ...) */
+    STORE_TEXT,    /* the value as given, into a const char * */
+    STORE_TRUE,    /* no value: the bool becomes true */
+    STORE_INT,     /* an integer in [min, max] into an int */
+    STORE_FLOAT,   /* a number in the range into a float */
+    STORE_SECONDS, /* a number in the range into a double */
+} store_kind;
+
+typedef struct flag_store {
+    store_kind kind;
+    size_t field;            /* offsetof(args, ...) */
+    bool marks;              /* also sets the bool at `given` */
+    size_t given;
+    double min, max;         /* the range; above_min/below_max: exclusive at that end */
+    bool above_min, below_max;
+    const char *wants;       /* the message's "NAME wants WANTS, got 'VALUE'" */
+} flag_store;
+
 typedef struct flag {
     const char *short_name; /* "-s", or NULL */
     const char *long_name;  /* "--samples" */
@@ -69,84 +91,89 @@ typedef struct flag {
     flag_kind kind;
     const char *setting;    /* FLAG_SETTING: the name in the settings table */
     const char *help;       /* lines for --help; FLAG_SETTING: the table's */
+    flag_store store;       /* a plain flag: where its value goes */
 } flag;
 
-const char *const aov_names[AOV_COUNT] = {"albedo", "normal", "depth", "position", "variance", "spp"};
+#define ARG(f) offsetof(args, f)
+#define SETS_TEXT(f) .store = {STORE_TEXT, ARG(f), false, 0, 0, 0, false, false, NULL}
+#define SETS_TRUE(f) .store = {STORE_TRUE, ARG(f), false, 0, 0, 0, false, false, NULL}
+#define OWN .store = {STORE_NONE, 0, false, 0, 0, 0, false, false, NULL}
+
 
 /* In --help order. */
 static const flag flags[] = {
     {"-o", "--output", "FILE", FLAG_OUTPUT, NULL,
      "output image: .png (8-bit sRGB), .pfm (linear float), .hdr (Radiance), .exr (OpenEXR)\n"
-     "default: the scene's `output`, else INPUT-NAME.png in this directory"},
+     "default: the scene's `output`, else INPUT-NAME.png in this directory", SETS_TEXT(output)},
     {NULL, "--exposure", "EV", FLAG_EXPOSURE, NULL,
-     "exposure in stops for 8-bit output (x 2^EV, on top of the scene's `exposure`); float outputs stay linear"},
-    {NULL, "--tonemap", "NAME", FLAG_TONEMAP, NULL, "tone curve for 8-bit output: clamp (default), filmic, aces or agx"},
-    {NULL, "--half", NULL, FLAG_HALF, NULL, "EXR output in 16-bit half floats (default 32-bit float)"},
+     "exposure in stops for 8-bit output (x 2^EV, on top of the scene's `exposure`); float outputs stay linear", .store = {STORE_FLOAT, ARG(exposure_ev), false, 0, -64, 64, false, false, "stops of exposure from -64 to 64"}},
+    {NULL, "--tonemap", "NAME", FLAG_TONEMAP, NULL, "tone curve for 8-bit output: clamp (default), filmic, aces or agx", OWN},
+    {NULL, "--half", NULL, FLAG_HALF, NULL, "EXR output in 16-bit half floats (default 32-bit float)", SETS_TRUE(half)},
     {NULL, "--denoise", NULL, FLAG_DENOISE, NULL,
-     "denoise the render with Intel Open Image Denoise (install it with 'make denoiser'), on -t threads"},
+     "denoise the render with Intel Open Image Denoise (install it with 'make denoiser'), on -t threads", SETS_TRUE(denoise)},
     {NULL, "--denoise-quality", "NAME", FLAG_DENOISE_QUALITY, NULL,
      "the denoiser's quality with --denoise: fast, balanced (default) or high (the same as RT_OIDN_QUALITY=NAME; "
-     "the flag wins)"},
+     "the flag wins)", OWN},
     {NULL, "--aov", "LIST", FLAG_AOV, NULL,
      "extra images, comma-separated: albedo, normal, depth, position, variance, spp; layers of an .exr output, "
-     "else files NAME.albedo.pfm ..."},
-    {"-t", "--threads", "N", FLAG_THREADS, NULL, "render threads"},
-    {"-s", "--samples", "N", FLAG_SETTING, "samples", NULL},
-    {"-r", "--resolution", "WxH", FLAG_SETTING, "resolution", NULL},
-    {"-q", "--quiet", NULL, FLAG_QUIET, NULL, "quiet: no progress bar, no warnings"},
-    {"-v", "--verbose", NULL, FLAG_VERBOSE, NULL, "verbose: scene statistics, kd-tree build, render time, rays per second"},
-    {NULL, "--integrator", "NAME", FLAG_SETTING, "integrator", NULL},
-    {NULL, "--seed", "N", FLAG_SETTING, "seed", NULL},
+     "else files NAME.albedo.pfm ...", OWN},
+    {"-t", "--threads", "N", FLAG_THREADS, NULL, "render threads", .store = {STORE_INT, ARG(threads), false, 0, 1, 1024, false, false, "a thread count from 1 to 1024"}},
+    {"-s", "--samples", "N", FLAG_SETTING, "samples", NULL, OWN},
+    {"-r", "--resolution", "WxH", FLAG_SETTING, "resolution", NULL, OWN},
+    {"-q", "--quiet", NULL, FLAG_QUIET, NULL, "quiet: no progress bar, no warnings", OWN},
+    {"-v", "--verbose", NULL, FLAG_VERBOSE, NULL, "verbose: scene statistics, kd-tree build, render time, rays per second", OWN},
+    {NULL, "--integrator", "NAME", FLAG_SETTING, "integrator", NULL, OWN},
+    {NULL, "--seed", "N", FLAG_SETTING, "seed", NULL, OWN},
     {NULL, "--set", "KEY=VALUE", FLAG_SET, NULL,
-     "set any scene setting listed below, as a scene file would (repeatable)"},
+     "set any scene setting listed below, as a scene file would (repeatable)", OWN},
     {NULL, "--camera", "N|auto", FLAG_CAMERA, NULL,
      "use camera N of the loaded glTF models, or 'auto': frame the whole scene automatically, ignoring the file's "
-     "camera"},
+     "camera", OWN},
     {NULL, "--variant", "NAME", FLAG_VARIANT, NULL,
-     "show a glTF model's material variant NAME (KHR_materials_variants); default: the file's default materials"},
-    {NULL, "--look-from", "X,Y,Z", FLAG_LOOK_FROM, NULL, "camera position (replaces the file's or the automatic one)"},
-    {NULL, "--look-at", "X,Y,Z", FLAG_LOOK_AT, NULL, "point the camera looks at"},
-    {NULL, "--up", "X,Y,Z", FLAG_UP, NULL, "camera up direction"},
-    {NULL, "--fov", "DEG", FLAG_FOV, NULL, "vertical field of view in degrees, between 0 and 180"},
+     "show a glTF model's material variant NAME (KHR_materials_variants); default: the file's default materials", OWN},
+    {NULL, "--look-from", "X,Y,Z", FLAG_LOOK_FROM, NULL, "camera position (replaces the file's or the automatic one)", OWN},
+    {NULL, "--look-at", "X,Y,Z", FLAG_LOOK_AT, NULL, "point the camera looks at", OWN},
+    {NULL, "--up", "X,Y,Z", FLAG_UP, NULL, "camera up direction", OWN},
+    {NULL, "--fov", "DEG", FLAG_FOV, NULL, "vertical field of view in degrees, between 0 and 180", .store = {STORE_FLOAT, ARG(fov), true, ARG(has_fov), 0, 180, true, true, "a field of view in degrees between 0 and 180 (exclusive)"}},
     {NULL, "--frame-time", "SECONDS", FLAG_FRAME_TIME, NULL,
      "pose an animated glTF (given directly or on a scene's model lines) at this time: its animation, skins and "
-     "morph targets (default: the file's static pose)"},
-    {NULL, "--animation", "N", FLAG_ANIMATION, NULL, "which glTF animation --frame-time plays (default 0, the first)"},
-    {NULL, "--tile", "N", FLAG_TILE, NULL, "tile size in pixels (default 32)"},
+     "morph targets (default: the file's static pose)", .store = {STORE_FLOAT, ARG(frame_time), true, ARG(posed), -1e7, 1e7, false, false, "seconds (a finite number, at most 1e7 in size)"}},
+    {NULL, "--animation", "N", FLAG_ANIMATION, NULL, "which glTF animation --frame-time plays (default 0, the first)", .store = {STORE_INT, ARG(animation), true, ARG(posed), 0, 1000000, false, false, "an animation index (0 = the first)"}},
+    {NULL, "--tile", "N", FLAG_TILE, NULL, "tile size in pixels (default 32)", .store = {STORE_INT, ARG(tile), false, 0, 1, 4096, false, false, "a tile size from 1 to 4096"}},
     {NULL, "--preview", "SECONDS", FLAG_PREVIEW, NULL,
-     "live view: rewrite the output with the finished tiles every SECONDS"},
+     "live view: rewrite the output with the finished tiles every SECONDS", .store = {STORE_SECONDS, ARG(preview_seconds), false, 0, 0.1, 3600, false, false, "seconds between updates (0.1 to 3600)"}},
     {NULL, "--passes", "N", FLAG_PASSES, NULL,
      "render in passes of N samples per pixel over the whole image; 0 = tile by tile\n"
-     "(default: passes of 4 for path and for parts, tiles for direct and whitted)"},
+     "(default: passes of 4 for path and for parts, tiles for direct and whitted)", .store = {STORE_INT, ARG(pass_samples), false, 0, 0, 1 << 20, false, false, "samples per pixel a pass from 0 (tiles) to 1048576"}},
     {NULL, "--time-limit", "SECONDS", FLAG_TIME_LIMIT, NULL,
-     "stop after the pass (tiles: the tiles in hand) that crosses SECONDS of rendering and write the image"},
+     "stop after the pass (tiles: the tiles in hand) that crosses SECONDS of rendering and write the image", .store = {STORE_SECONDS, ARG(time_limit), false, 0, 0, 1e7, true, false, "seconds (more than 0, at most 1e7)"}},
     {NULL, "--display-server", "HOST:PORT", FLAG_DISPLAY_SERVER, NULL,
-     "stream the image as it renders to the tev viewer listening there (tev's default: 127.0.0.1:14158)"},
+     "stream the image as it renders to the tev viewer listening there (tev's default: 127.0.0.1:14158)", OWN},
     {NULL, "--window", NULL, FLAG_WINDOW, NULL,
-     "show the image in a window as it renders (SDL2); it stays up after the render until closed (Esc, q)"},
+     "show the image in a window as it renders (SDL2); it stays up after the render until closed (Esc, q)", SETS_TRUE(window)},
     {NULL, "--info", "FILE", FLAG_INFO, NULL,
      "print what a scene or model contains and how it would render (key: value lines) and exit; "
-     "more files may follow (rt --info a.glb b.txt), one block each"},
-    {NULL, "--max-memory", "SIZE", FLAG_MAX_MEMORY, NULL, "memory budget, e.g. 4G or 512M; 'none' for no limit"},
+     "more files may follow (rt --info a.glb b.txt), one block each", SETS_TEXT(info_path)},
+    {NULL, "--max-memory", "SIZE", FLAG_MAX_MEMORY, NULL, "memory budget, e.g. 4G or 512M; 'none' for no limit", OWN},
     {NULL, "--crop", "X0 Y0 X1 Y1", FLAG_CROP, NULL,
      "render only pixels X0 <= x < X1, Y0 <= y < Y1 as a part (docs/farm.md): a float image of sums and counts "
-     "(.exr or .pfm) with a NAME.json sidecar, for rt merge"},
+     "(.exr or .pfm) with a NAME.json sidecar, for rt merge", OWN},
     {NULL, "--part", "I/N", FLAG_PART, NULL,
-     "render part I (0 .. N-1) of N bands of rows of similar cost, as a part (docs/farm.md)"},
+     "render part I (0 .. N-1) of N bands of rows of similar cost, as a part (docs/farm.md)", OWN},
     {NULL, "--spp-range", "A:B", FLAG_SPP_RANGE, NULL,
-     "render only samples A .. B-1 of every pixel (of the -s samples), as a part (docs/farm.md)"},
+     "render only samples A .. B-1 of every pixel (of the -s samples), as a part (docs/farm.md)", OWN},
     {NULL, "--resume", "PART", FLAG_RESUME, NULL,
      "continue a part (one stopped by --time-limit or Ctrl-C) to all samples: exactly the sums a straight render "
-     "makes"},
+     "makes", SETS_TEXT(resume)},
     {NULL, "--part-out", "FILE", FLAG_PART_OUT, NULL,
-     "also write the render as a part FILE (.exr or .pfm, with FILE.json), e.g. to --resume it after a stop"},
+     "also write the render as a part FILE (.exr or .pfm, with FILE.json), e.g. to --resume it after a stop", SETS_TEXT(part_out)},
     {NULL, "--frames", "A:B", FLAG_FRAMES, NULL,
      "render frames A .. B-1 of an animated glTF or scene (--animation N), each on its own at time frame / fps; "
      "-o names "
-     "them with %04d (out.%04d.png)"},
-    {NULL, "--fps", "F", FLAG_FPS, NULL, "frames per second for --frames (default 24)"},
-    {"-h", "--help", NULL, FLAG_HELP, NULL, "this text"},
-    {NULL, "--version", NULL, FLAG_VERSION, NULL, "print the version"},
+     "them with %04d (out.%04d.png)", OWN},
+    {NULL, "--fps", "F", FLAG_FPS, NULL, "frames per second for --frames (default 24)", .store = {STORE_SECONDS, ARG(fps), false, 0, 0, 10000, true, false, "frames per second (more than 0, at most 10000)"}},
+    {"-h", "--help", NULL, FLAG_HELP, NULL, "this text", OWN},
+    {NULL, "--version", NULL, FLAG_VERSION, NULL, "print the version", OWN},
 };
 #define FLAG_COUNT (sizeof flags / sizeof *flags)
 
@@ -370,6 +397,286 @@ static int parse_set(args *a, const char *name, const char *arg)
     return add_setting(a, name, arg, def, eq + 1);
 }
 
+/* A plain flag's value stored as its table line says (flag_store), or the
+ * message for one out of its range. */
+static int store_flag(args *a, const flag *fl, const char *name, const char *value)
+{
+    const flag_store *st = &fl->store;
+    char *field = (char *)a + st->field;
+    float v = 0.0f;
+    switch (st->kind) {
+    case STORE_NONE:
+        return ARGS_OK;
+    case STORE_TEXT:
+        *(const char **)field = value;
+        break;
+    case STORE_TRUE:
+        *(bool *)field = true;
+        break;
+    case STORE_INT:
+        if (!int_value(value, (long long)st->min, (long long)st->max, (int *)field))
+            return fail_usage("%s wants %s, got '%s'", name, st->wants, value);
+        break;
+    case STORE_FLOAT:
+    case STORE_SECONDS: {
+        bool ok = rt_parse_float(value, &v) == RT_NUMBER_OK;
+        ok = ok && (st->above_min ? v > (float)st->min : v >= (float)st->min);
+        ok = ok && (st->below_max ? v < (float)st->max : v <= (float)st->max);
+        if (!ok)
+            return fail_usage("%s wants %s, got '%s'", name, st->wants, value);
+        if (st->kind == STORE_FLOAT)
+            *(float *)field = v;
+        else
+            *(double *)field = (double)v;
+        break;
+    }
+    }
+    if (st->marks)
+        *(bool *)((char *)a + st->given) = true;
+    return ARGS_OK;
+}
+
+/* -s, -r, --integrator, --seed: a setting of the table, checked now,
+ * applied after the load. */
+static int parse_setting_flag(args *a, const flag *fl, const char *name, const char *value)
+{
+    const rt_setting *def = rt_setting_find(fl->setting);
+    rt_setting_problem pb;
+    if (rt_setting_set(NULL, def, value, &pb) != RT_OK) {
+        char wants[256];
+        setting_wants(def, wants, sizeof wants);
+        return fail_usage("%s wants %s, got '%s'", name, wants, value);
+    }
+    return add_setting(a, name, value, def, value);
+}
+
+/* --camera, --variant, --look-from, --look-at, --up. */
+static int parse_view_flag(args *a, const flag *fl, const char *name, const char *value)
+{
+    if (fl->kind == FLAG_CAMERA) {
+        a->camera_auto = strcmp(value, "auto") == 0;
+        a->camera = -1;
+        if (!a->camera_auto && !int_value(value, 0, INT32_MAX, &a->camera))
+            return fail_usage("%s wants a camera index (0, 1, ...) or 'auto', got '%s'", name, value);
+        return ARGS_OK;
+    }
+    if (fl->kind == FLAG_VARIANT) {
+        if (!*value)
+            return fail_usage("%s wants the name of a material variant", name);
+        a->variant = value;
+        return ARGS_OK;
+    }
+    rt_vec3 v;
+    if (!vec3_value(value, &v))
+        return fail_usage("%s wants three numbers X,Y,Z (e.g. 0,1,5), got '%s'", name, value);
+    if (fl->kind == FLAG_UP && v.x == 0.0f && v.y == 0.0f && v.z == 0.0f)
+        return fail_usage("%s wants a direction, got the zero vector '%s'", name, value);
+    if (fl->kind == FLAG_LOOK_FROM)
+        a->look_from = v, a->has_look_from = true;
+    else if (fl->kind == FLAG_LOOK_AT)
+        a->look_at = v, a->has_look_at = true;
+    else
+        a->up = v, a->has_up = true;
+    return ARGS_OK;
+}
+
+/* --aov LIST: names of rt_aov_names, comma-separated. */
+static int parse_aovs(args *a, const char *name, const char *value)
+{
+    const char *s = value;
+    while (*s) {
+        size_t n = strcspn(s, ",");
+        rt_aov_kind k;
+        if (!rt_aov_by_name(s, n, &k))
+            return fail_usage("%s: unknown AOV '%.*s' (albedo, normal, depth, position, variance, spp)", name, (int)n,
+                              s);
+        a->aovs |= 1u << k;
+        s += n + (s[n] == ',');
+    }
+    if (!a->aovs)
+        return fail_usage("%s wants a list such as albedo,normal", name);
+    return ARGS_OK;
+}
+
+/* --tonemap, --denoise-quality, --aov, --display-server, --max-memory. */
+static int parse_output_flag(args *a, const flag *fl, const char *name, const char *value)
+{
+    char host[256], port[16];
+    switch (fl->kind) {
+    case FLAG_TONEMAP:
+        if (!rt_tonemap_parse(value, &a->tonemap))
+            return fail_usage("%s wants one of %s, got '%s'", name, RT_TONEMAP_NAMES, value);
+        return ARGS_OK;
+    case FLAG_DENOISE_QUALITY:
+        if (!rt_denoise_quality_parse(value, &a->denoise_quality))
+            return fail_usage("%s wants %s, got '%s'", name, RT_DENOISE_QUALITY_NAMES, value);
+        return ARGS_OK;
+    case FLAG_AOV:
+        return parse_aovs(a, name, value);
+    case FLAG_DISPLAY_SERVER:
+        if (!tev_parse_address(value, host, sizeof host, port, sizeof port))
+            return fail_usage("%s wants HOST:PORT with a port from 1 to 65535 (e.g. 127.0.0.1:14158), got '%s'", name,
+                              value);
+        a->display_server = value;
+        return ARGS_OK;
+    default: /* FLAG_MAX_MEMORY */
+        if (!memory_budget_parse(value, &a->budget.bytes))
+            return fail_usage("%s wants a size such as 4G, 512M or 'none', got '%s'", name, value);
+        if (a->budget.bytes && a->budget.bytes < (64ull << 20))
+            return fail_usage("%s: '%s' is below the 64M rt needs to start", name, value);
+        a->budget.from_flag = true;
+        return ARGS_OK;
+    }
+}
+
+/* "A:B" (or "A/B" for --part) into *lo, *hi, each checked against its
+ * range; false when it is not two integers so. */
+static bool int_pair(const char *value, char sep, long long lo_min, long long lo_max, long long hi_min,
+                     long long hi_max, int *lo, int *hi)
+{
+    const char *mid = strchr(value, sep);
+    char first[32];
+    if (!mid || (size_t)(mid - value) >= sizeof first)
+        return false;
+    memcpy(first, value, (size_t)(mid - value));
+    first[mid - value] = 0;
+    return int_value(first, lo_min, lo_max, lo) && int_value(mid + 1, hi_min, hi_max, hi);
+}
+
+/* --crop X0 Y0 X1 Y1 (four words, pbrt's habit, or X0,Y0,X1,Y1); *i moves
+ * past the words it takes. */
+static int parse_crop(args *a, const char *name, const char *value, int argc, char **argv, int *i)
+{
+    const char *w[4] = {value, NULL, NULL, NULL};
+    char buf[128];
+    int nw = 1;
+    if (strchr(value, ',')) {
+        snprintf(buf, sizeof buf, "%s", value);
+        char *c = buf;
+        for (nw = 0; nw < 4 && c; nw++) {
+            w[nw] = c;
+            c = strchr(c, ',');
+            if (c)
+                *c++ = 0;
+        }
+        if (c)
+            nw = 5;
+    } else {
+        while (nw < 4 && *i + 1 < argc && !looks_like_flag(argv[*i + 1]))
+            w[nw++] = argv[++*i];
+    }
+    bool ok = nw == 4;
+    for (int k = 0; k < 4 && ok; k++)
+        ok = int_value(w[k], 0, 32768, &a->crop[k]);
+    if (!ok || a->crop[0] >= a->crop[2] || a->crop[1] >= a->crop[3])
+        return fail_usage("%s wants four pixel bounds X0 Y0 X1 Y1 with X0 < X1 and Y0 < Y1 (half-open: "
+                          "--crop 0 0 64 32 is the top-left 64x32 pixels)",
+                          name);
+    a->has_crop = true;
+    return ARGS_OK;
+}
+
+/* --crop, --part, --spp-range, --frames. */
+static int parse_part_flag(args *a, const flag *fl, const char *name, const char *value, int argc, char **argv,
+                           int *i)
+{
+    switch (fl->kind) {
+    case FLAG_CROP:
+        return parse_crop(a, name, value, argc, argv, i);
+    case FLAG_PART:
+        if (!strchr(value, '/') || strchr(value, '/') - value >= 32)
+            return fail_usage("%s wants I/N (part I of N, I from 0 to N-1), got '%s'", name, value);
+        if (!int_pair(value, '/', 0, 32767, 1, 32768, &a->part_index, &a->part_count) ||
+            a->part_index >= a->part_count)
+            return fail_usage("%s wants I/N with N from 1 to 32768 and I from 0 to N-1 (parts count from 0), "
+                              "got '%s'",
+                              name, value);
+        return ARGS_OK;
+    case FLAG_SPP_RANGE:
+        if (!strchr(value, ':') || strchr(value, ':') - value >= 32)
+            return fail_usage("%s wants A:B (samples A to B-1), got '%s'", name, value);
+        if (!int_pair(value, ':', 0, RT_MAX_SAMPLES - 1, 1, RT_MAX_SAMPLES, &a->spp_begin, &a->spp_end) ||
+            a->spp_begin >= a->spp_end)
+            return fail_usage("%s wants A:B with 0 <= A < B <= %d (samples A to B-1), got '%s'", name,
+                              RT_MAX_SAMPLES, value);
+        a->has_spp_range = true;
+        return ARGS_OK;
+    default: /* FLAG_FRAMES */
+        if (!strchr(value, ':') || strchr(value, ':') - value >= 32)
+            return fail_usage("%s wants A:B (frames A to B-1), got '%s'", name, value);
+        if (!int_pair(value, ':', 0, 99999999, 1, 100000000, &a->frame_begin, &a->frame_end) ||
+            a->frame_begin >= a->frame_end)
+            return fail_usage("%s wants A:B with 0 <= A < B <= 100000000 (frames A to B-1), got '%s'", name, value);
+        a->has_frames = true;
+        return ARGS_OK;
+    }
+}
+
+/* One flag (its value taken): the table's plain store, or its own code.
+ * Returns ARGS_OK, or the exit status (0 after --help and --version). */
+static int parse_flag(args *a, const flag *fl, const char *name, const char *value, int argc, char **argv, int *i)
+{
+    switch (fl->kind) {
+    case FLAG_HELP:
+        usage(stdout);
+        return 0;
+    case FLAG_VERSION:
+        printf("rt %s\n", RT_VERSION);
+        return 0;
+    case FLAG_SETTING:
+        return parse_setting_flag(a, fl, name, value);
+    case FLAG_SET:
+        return parse_set(a, name, value);
+    case FLAG_QUIET:
+        a->log_level = RT_LOG_QUIET;
+        return ARGS_OK;
+    case FLAG_VERBOSE:
+        a->log_level = RT_LOG_VERBOSE;
+        return ARGS_OK;
+    case FLAG_CAMERA:
+    case FLAG_VARIANT:
+    case FLAG_LOOK_FROM:
+    case FLAG_LOOK_AT:
+    case FLAG_UP:
+        return parse_view_flag(a, fl, name, value);
+    case FLAG_TONEMAP:
+    case FLAG_DENOISE_QUALITY:
+    case FLAG_AOV:
+    case FLAG_DISPLAY_SERVER:
+    case FLAG_MAX_MEMORY:
+        return parse_output_flag(a, fl, name, value);
+    case FLAG_CROP:
+    case FLAG_PART:
+    case FLAG_SPP_RANGE:
+    case FLAG_FRAMES:
+        return parse_part_flag(a, fl, name, value, argc, argv, i);
+    default: {
+        int r = store_flag(a, fl, name, value);
+        if (r == ARGS_OK && fl->kind == FLAG_PASSES && a->pass_samples == 0)
+            a->pass_samples = -1; /* rt_render's "tiles" */
+        return r;
+    }
+    }
+}
+
+/* Flags that do not go together, once all are read. */
+static int check_combinations(const args *a)
+{
+    if (a->denoise_quality != RT_DENOISE_DEFAULT && !a->denoise)
+        return fail_usage("--denoise-quality goes with --denoise (rt --denoise --denoise-quality high ...)");
+    if (a->part_count && a->has_crop)
+        return fail_usage("--part and --crop both choose the region; give one of them");
+    if (a->has_frames && a->posed && a->frame_time != 0.0f)
+        return fail_usage("--frames sets each frame's time (frame / fps); drop --frame-time");
+    if (a->resume && (a->part_count || a->has_crop || a->has_spp_range))
+        return fail_usage("--resume takes the region and samples from the part it continues; drop --part, --crop "
+                          "and --spp-range");
+    if (!a->info_path && a->more_input_count)
+        return fail_usage("only one input file, please (got a second: '%s'); --info takes several",
+                          a->more_inputs[0]);
+    return ARGS_OK;
+}
+
 int args_parse(args *a, int argc, char **argv)
 {
     memset(a, 0, sizeof *a);
@@ -411,279 +718,11 @@ int args_parse(args *a, int argc, char **argv)
         } else if (eq) {
             return fail_usage("option %s takes no value, got '%s'", name, arg);
         }
-        switch (fl->kind) {
-        case FLAG_HELP:
-            usage(stdout);
-            return 0;
-        case FLAG_VERSION:
-            printf("rt %s\n", RT_VERSION);
-            return 0;
-        case FLAG_OUTPUT:
-            a->output = value;
-            break;
-        case FLAG_THREADS:
-            if (!int_value(value, 1, 1024, &a->threads))
-                return fail_usage("%s wants a thread count from 1 to 1024, got '%s'", name, value);
-            break;
-        case FLAG_SETTING: {
-            const rt_setting *def = rt_setting_find(fl->setting);
-            rt_setting_problem pb;
-            if (rt_setting_set(NULL, def, value, &pb) != RT_OK) {
-                char wants[256];
-                setting_wants(def, wants, sizeof wants);
-                return fail_usage("%s wants %s, got '%s'", name, wants, value);
-            }
-            int r = add_setting(a, name, value, def, value);
-            if (r != ARGS_OK)
-                return r;
-            break;
-        }
-        case FLAG_SET: {
-            int r = parse_set(a, name, value);
-            if (r != ARGS_OK)
-                return r;
-            break;
-        }
-        case FLAG_QUIET:
-            a->log_level = RT_LOG_QUIET;
-            break;
-        case FLAG_VERBOSE:
-            a->log_level = RT_LOG_VERBOSE;
-            break;
-        case FLAG_CAMERA:
-            a->camera_auto = strcmp(value, "auto") == 0;
-            a->camera = -1;
-            if (!a->camera_auto && !int_value(value, 0, INT32_MAX, &a->camera))
-                return fail_usage("%s wants a camera index (0, 1, ...) or 'auto', got '%s'", name, value);
-            break;
-        case FLAG_VARIANT:
-            if (!*value)
-                return fail_usage("%s wants the name of a material variant", name);
-            a->variant = value;
-            break;
-        case FLAG_LOOK_FROM:
-        case FLAG_LOOK_AT:
-        case FLAG_UP: {
-            rt_vec3 v;
-            if (!vec3_value(value, &v))
-                return fail_usage("%s wants three numbers X,Y,Z (e.g. 0,1,5), got '%s'", name, value);
-            if (fl->kind == FLAG_UP && v.x == 0.0f && v.y == 0.0f && v.z == 0.0f)
-                return fail_usage("%s wants a direction, got the zero vector '%s'", name, value);
-            if (fl->kind == FLAG_LOOK_FROM)
-                a->look_from = v, a->has_look_from = true;
-            else if (fl->kind == FLAG_LOOK_AT)
-                a->look_at = v, a->has_look_at = true;
-            else
-                a->up = v, a->has_up = true;
-            break;
-        }
-        case FLAG_FOV: {
-            float deg = 0.0f;
-            if (rt_parse_float(value, &deg) != RT_NUMBER_OK || !(deg > 0.0f && deg < 180.0f))
-                return fail_usage("%s wants a field of view in degrees between 0 and 180 (exclusive), got '%s'", name,
-                                  value);
-            a->fov = deg;
-            a->has_fov = true;
-            break;
-        }
-        case FLAG_TILE:
-            if (!int_value(value, 1, 4096, &a->tile))
-                return fail_usage("%s wants a tile size from 1 to 4096, got '%s'", name, value);
-            break;
-        case FLAG_PREVIEW: {
-            float s = 0.0f;
-            if (rt_parse_float(value, &s) != RT_NUMBER_OK || !(s >= 0.1f && s <= 3600.0f))
-                return fail_usage("%s wants seconds between updates (0.1 to 3600), got '%s'", name, value);
-            a->preview_seconds = (double)s;
-            break;
-        }
-        case FLAG_PASSES:
-            if (!int_value(value, 0, 1 << 20, &a->pass_samples))
-                return fail_usage("%s wants samples per pixel a pass from 0 (tiles) to 1048576, got '%s'", name,
-                                  value);
-            if (a->pass_samples == 0)
-                a->pass_samples = -1; /* rt_render's "tiles" */
-            break;
-        case FLAG_FRAME_TIME: {
-            float t = 0.0f;
-            if (rt_parse_float(value, &t) != RT_NUMBER_OK || !(fabsf(t) <= 1e7f))
-                return fail_usage("%s wants seconds (a finite number, at most 1e7 in size), got '%s'", name, value);
-            a->frame_time = t;
-            a->posed = true;
-            break;
-        }
-        case FLAG_ANIMATION: {
-            long long n = 0;
-            if (rt_parse_int(value, &n) != RT_NUMBER_OK || n < 0 || n > 1000000)
-                return fail_usage("%s wants an animation index (0 = the first), got '%s'", name, value);
-            a->animation = (int)n;
-            a->posed = true;
-            break;
-        }
-        case FLAG_TIME_LIMIT: {
-            float s = 0.0f;
-            if (rt_parse_float(value, &s) != RT_NUMBER_OK || !(s > 0.0f && s <= 1e7f))
-                return fail_usage("%s wants seconds (more than 0, at most 1e7), got '%s'", name, value);
-            a->time_limit = (double)s;
-            break;
-        }
-        case FLAG_DISPLAY_SERVER: {
-            char host[256], port[16];
-            if (!tev_parse_address(value, host, sizeof host, port, sizeof port))
-                return fail_usage("%s wants HOST:PORT with a port from 1 to 65535 (e.g. 127.0.0.1:14158), got '%s'",
-                                  name, value);
-            a->display_server = value;
-            break;
-        }
-        case FLAG_WINDOW:
-            a->window = true;
-            break;
-        case FLAG_INFO:
-            a->info_path = value;
-            break;
-        case FLAG_EXPOSURE:
-            if (rt_parse_float(value, &a->exposure_ev) != RT_NUMBER_OK || !(a->exposure_ev >= -64.0f) ||
-                !(a->exposure_ev <= 64.0f))
-                return fail_usage("%s wants stops of exposure from -64 to 64, got '%s'", name, value);
-            break;
-        case FLAG_TONEMAP:
-            if (!rt_tonemap_parse(value, &a->tonemap))
-                return fail_usage("%s wants one of %s, got '%s'", name, RT_TONEMAP_NAMES, value);
-            break;
-        case FLAG_HALF:
-            a->half = true;
-            break;
-        case FLAG_DENOISE:
-            a->denoise = true;
-            break;
-        case FLAG_DENOISE_QUALITY:
-            if (!rt_denoise_quality_parse(value, &a->denoise_quality))
-                return fail_usage("%s wants %s, got '%s'", name, RT_DENOISE_QUALITY_NAMES, value);
-            break;
-        case FLAG_AOV: {
-            const char *s = value;
-            while (*s) {
-                size_t n = strcspn(s, ",");
-                int k = 0;
-                while (k < AOV_COUNT && !(strlen(aov_names[k]) == n && strncmp(s, aov_names[k], n) == 0))
-                    k++;
-                if (k == AOV_COUNT)
-                    return fail_usage("%s: unknown AOV '%.*s' (albedo, normal, depth, position, variance, spp)", name,
-                                      (int)n, s);
-                a->aovs |= 1u << k;
-                s += n + (s[n] == ',');
-            }
-            if (!a->aovs)
-                return fail_usage("%s wants a list such as albedo,normal", name);
-            break;
-        }
-        case FLAG_CROP: {
-            /* four numbers, as four words (pbrt's habit) or X0,Y0,X1,Y1 */
-            const char *w[4] = {value, NULL, NULL, NULL};
-            char buf[128];
-            int nw = 1;
-            if (strchr(value, ',')) {
-                snprintf(buf, sizeof buf, "%s", value);
-                char *c = buf;
-                for (nw = 0; nw < 4 && c; nw++) {
-                    w[nw] = c;
-                    c = strchr(c, ',');
-                    if (c)
-                        *c++ = 0;
-                }
-                if (c)
-                    nw = 5;
-            } else {
-                while (nw < 4 && i + 1 < argc && !looks_like_flag(argv[i + 1]))
-                    w[nw++] = argv[++i];
-            }
-            bool ok = nw == 4;
-            for (int k = 0; k < 4 && ok; k++)
-                ok = int_value(w[k], 0, 32768, &a->crop[k]);
-            if (!ok || a->crop[0] >= a->crop[2] || a->crop[1] >= a->crop[3])
-                return fail_usage("%s wants four pixel bounds X0 Y0 X1 Y1 with X0 < X1 and Y0 < Y1 (half-open: "
-                                  "--crop 0 0 64 32 is the top-left 64x32 pixels)",
-                                  name);
-            a->has_crop = true;
-            break;
-        }
-        case FLAG_PART: {
-            const char *slash = strchr(value, '/');
-            char ib[32];
-            if (!slash || (size_t)(slash - value) >= sizeof ib)
-                return fail_usage("%s wants I/N (part I of N, I from 0 to N-1), got '%s'", name, value);
-            memcpy(ib, value, (size_t)(slash - value));
-            ib[slash - value] = 0;
-            if (!int_value(ib, 0, 32767, &a->part_index) || !int_value(slash + 1, 1, 32768, &a->part_count) ||
-                a->part_index >= a->part_count)
-                return fail_usage("%s wants I/N with N from 1 to 32768 and I from 0 to N-1 (parts count from 0), "
-                                  "got '%s'",
-                                  name, value);
-            break;
-        }
-        case FLAG_SPP_RANGE: {
-            const char *colon = strchr(value, ':');
-            char ab[32];
-            if (!colon || (size_t)(colon - value) >= sizeof ab)
-                return fail_usage("%s wants A:B (samples A to B-1), got '%s'", name, value);
-            memcpy(ab, value, (size_t)(colon - value));
-            ab[colon - value] = 0;
-            if (!int_value(ab, 0, RT_MAX_SAMPLES - 1, &a->spp_begin) ||
-                !int_value(colon + 1, 1, RT_MAX_SAMPLES, &a->spp_end) || a->spp_begin >= a->spp_end)
-                return fail_usage("%s wants A:B with 0 <= A < B <= %d (samples A to B-1), got '%s'", name,
-                                  RT_MAX_SAMPLES, value);
-            a->has_spp_range = true;
-            break;
-        }
-        case FLAG_RESUME:
-            a->resume = value;
-            break;
-        case FLAG_PART_OUT:
-            a->part_out = value;
-            break;
-        case FLAG_FRAMES: {
-            const char *colon = strchr(value, ':');
-            char fb[32];
-            if (!colon || (size_t)(colon - value) >= sizeof fb)
-                return fail_usage("%s wants A:B (frames A to B-1), got '%s'", name, value);
-            memcpy(fb, value, (size_t)(colon - value));
-            fb[colon - value] = 0;
-            if (!int_value(fb, 0, 99999999, &a->frame_begin) || !int_value(colon + 1, 1, 100000000, &a->frame_end) ||
-                a->frame_begin >= a->frame_end)
-                return fail_usage("%s wants A:B with 0 <= A < B <= 100000000 (frames A to B-1), got '%s'", name,
-                                  value);
-            a->has_frames = true;
-            break;
-        }
-        case FLAG_FPS: {
-            float f = 0.0f;
-            if (rt_parse_float(value, &f) != RT_NUMBER_OK || !(f > 0.0f && f <= 10000.0f))
-                return fail_usage("%s wants frames per second (more than 0, at most 10000), got '%s'", name, value);
-            a->fps = (double)f;
-            break;
-        }
-        case FLAG_MAX_MEMORY:
-            if (!memory_budget_parse(value, &a->budget.bytes))
-                return fail_usage("%s wants a size such as 4G, 512M or 'none', got '%s'", name, value);
-            if (a->budget.bytes && a->budget.bytes < (64ull << 20))
-                return fail_usage("%s: '%s' is below the 64M rt needs to start", name, value);
-            a->budget.from_flag = true;
-            break;
-        }
+        int r = parse_flag(a, fl, name, value, argc, argv, &i);
+        if (r != ARGS_OK)
+            return r;
     }
-    if (a->denoise_quality != RT_DENOISE_DEFAULT && !a->denoise)
-        return fail_usage("--denoise-quality goes with --denoise (rt --denoise --denoise-quality high ...)");
-    if (a->part_count && a->has_crop)
-        return fail_usage("--part and --crop both choose the region; give one of them");
-    if (a->has_frames && a->posed && a->frame_time != 0.0f)
-        return fail_usage("--frames sets each frame's time (frame / fps); drop --frame-time");
-    if (a->resume && (a->part_count || a->has_crop || a->has_spp_range))
-        return fail_usage("--resume takes the region and samples from the part it continues; drop --part, --crop "
-                          "and --spp-range");
-    if (!a->info_path && a->more_input_count)
-        return fail_usage("only one input file, please (got a second: '%s'); --info takes several",
-                          a->more_inputs[0]);
-    return ARGS_OK;
+    return check_combinations(a);
 }
 
 bool args_output_is_part(const args *a) { return a->has_crop || a->part_count > 0 || a->has_spp_range; }
@@ -696,13 +735,53 @@ bool args_sets(const args *a, const char *name)
     return false;
 }
 
+void args_job_options(const args *a, rt_job_options *o)
+{
+    *o = (rt_job_options){.input = a->input,
+                          .threads = a->threads,
+                          .posed = a->posed,
+                          .frame_time = a->frame_time,
+                          .animation = a->animation,
+                          .use_camera = a->camera >= 0,
+                          .camera = a->camera,
+                          .camera_auto = a->camera_auto,
+                          .has_look_from = a->has_look_from,
+                          .has_look_at = a->has_look_at,
+                          .has_up = a->has_up,
+                          .has_fov = a->has_fov,
+                          .look_from = a->look_from,
+                          .look_at = a->look_at,
+                          .up = a->up,
+                          .fov = a->fov,
+                          .exposure_ev = a->exposure_ev,
+                          .tonemap = a->tonemap,
+                          .half = a->half,
+                          .denoise = a->denoise,
+                          .denoise_quality = a->denoise_quality,
+                          .aovs = a->aovs,
+                          .output_is_part = args_output_is_part(a),
+                          .has_crop = a->has_crop,
+                          .crop = {a->crop[0], a->crop[1], a->crop[2], a->crop[3]},
+                          .part_index = a->part_index,
+                          .part_count = a->part_count,
+                          .has_spp_range = a->has_spp_range,
+                          .spp_begin = a->spp_begin,
+                          .spp_end = a->spp_end,
+                          .resume = a->resume,
+                          .part_out = a->part_out};
+}
+
 rt_result args_apply_settings(const args *a, rt_scene *s, rt_error *err)
 {
     for (size_t i = 0; i < a->setting_count; i++) {
         const setting_flag *sf = &a->settings[i];
         rt_setting_problem pb;
-        if (rt_setting_set(s, sf->setting, sf->value, &pb) != RT_OK)
+        if (rt_setting_set(&s->settings, sf->setting, sf->value, &pb) != RT_OK)
             return rt_fail(err, pb.code, "%s %s: %s", sf->flag, sf->arg, pb.message);
+        rt_error inner = {0};
+        rt_result r = rt_environment_image_load(s, &inner); /* --set environment=FILE: its image */
+        if (r != RT_OK)
+            return rt_fail(err, r, "%s %s: %s", sf->flag, sf->arg, inner.message);
     }
     return RT_OK;
 }

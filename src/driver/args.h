@@ -4,7 +4,7 @@
  * `--samples=64`); a flag missing its value says so rather than taking the
  * next flag as its value. The flags that set scene settings (-s, -r, --seed,
  * --integrator, and --set KEY=VALUE for any setting) go through the settings
- * table (rt/scene/settings.h): they are checked while parsing, so a bad value
+ * table (rt/render/settings.h): they are checked while parsing, so a bad value
  * is refused before anything is loaded, and applied after loading, in the
  * order given, so a later flag wins.
  *
@@ -27,14 +27,14 @@
 #include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
 #include "rt/scene/scene.h"
-#include "rt/scene/settings.h"
+#include "rt/job/options.h"
+#include "rt/render/settings.h"
 
 #define ARGS_OK (-1)
 
 #define ARGS_MAX_SETTINGS 64 /* setting flags on one command line */
 #define ARGS_MAX_INPUTS 256  /* files one --info reports */
 
-#define RT_VERSION "0.1.0"
 
 /* One setting flag as given: `-s 64`, `--set samples=64`. */
 typedef struct setting_flag {
@@ -75,7 +75,7 @@ typedef struct args {
     bool half;              /* --half: EXR in half floats */
     bool denoise;           /* --denoise: Intel Open Image Denoise on the render */
     rt_denoise_quality denoise_quality; /* --denoise-quality; RT_DENOISE_DEFAULT: RT_OIDN_QUALITY, else balanced */
-    unsigned aovs;          /* --aov: bit k for aov_names[k] */
+    unsigned aovs;          /* --aov: bit k for rt_aov_names[k] */
     /* parts of a render spread over machines (docs/farm.md) */
     bool has_crop;          /* --crop X0 Y0 X1 Y1 */
     int crop[4];
@@ -91,9 +91,6 @@ typedef struct args {
     size_t setting_count;
 } args;
 
-/* The AOVs --aov names, in bit order (rt/render/aov.h says what each holds). */
-enum { AOV_ALBEDO, AOV_NORMAL, AOV_DEPTH, AOV_POSITION, AOV_VARIANCE, AOV_SPP, AOV_COUNT };
-extern const char *const aov_names[AOV_COUNT];
 
 /* Parses argv into *a. Returns ARGS_OK to go on, else the exit status. */
 int args_parse(args *a, int argc, char **argv);
@@ -102,6 +99,8 @@ bool args_sets(const args *a, const char *name);
 /* True when the output is a part rather than an image: --crop, --part or
  * --spp-range given (--resume decides later, from the part it continues). */
 bool args_output_is_part(const args *a);
+/* The job's options (rt/job/options.h) from the flags. */
+void args_job_options(const args *a, rt_job_options *o);
 /* Applies the setting flags to the loaded scene, in command-line order. */
 rt_result args_apply_settings(const args *a, rt_scene *s, rt_error *err);
 

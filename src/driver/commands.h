@@ -1,6 +1,7 @@
 /* commands.h - rt's subcommands besides rendering, each a whole program:
  * main() hands over argc and argv shifted so that argv[0] is the command's
- * name, and returns what the command returns as the exit status.
+ * name, and returns what the command returns as the exit status. Each lives
+ * in src/driver/cmd_NAME.c, its library work in the stage it belongs to.
  *
  *   if (argc > 1 && strcmp(argv[1], "compare") == 0)
  *       return rt_cmd_compare(argc - 1, argv + 1);

@@ -7,6 +7,7 @@
 #include <stdio.h>
 
 #include "rt/io/load.h"
+#include "rt/job/frame.h"
 #include "rt/render/integrator.h"
 #include "rt/scene/scene.h"
 
@@ -68,7 +69,7 @@ static int print_info(const char *path, const args *a)
         printf("camera: gltf camera 0\n");
         cam = &s.cameras[0];
         if (cam->aspect_ratio > 0.0f) /* the width follows the camera's aspect ratio */
-            set.width = input_width_for_aspect(set.height, cam->aspect_ratio);
+            set.width = rt_job_width_for_aspect(set.height, cam->aspect_ratio);
     } else {
         printf("camera: auto (framed to the bounds)\n");
     }

@@ -10,7 +10,6 @@
 #include <unistd.h>
 
 #include "rt/base/file.h"
-#include "rt/scene/settings.h"
 
 void input_default_output(const rt_scene *s, const char *input, char *out, size_t size)
 {
@@ -54,10 +53,4 @@ rt_result input_load(rt_scene *s, const char *input, const rt_load_options *lo, 
 const char *input_name(const char *input)
 {
     return !input ? "<built-in scene>" : strcmp(input, "-") == 0 ? "<stdin>" : input;
-}
-
-int input_width_for_aspect(int height, float aspect_ratio)
-{
-    double w = (double)height * aspect_ratio + 0.5;
-    return w < 1.0 ? 1 : (w > (double)RT_MAX_IMAGE_SIDE ? RT_MAX_IMAGE_SIDE : (int)w);
 }

@@ -29,8 +29,5 @@ const char *input_name(const char *input);
  * else the input's base name with .png in the current directory, out.png
  * for the built-in scene and standard input. */
 void input_default_output(const rt_scene *s, const char *input, char *out, size_t size);
-/* The image width that keeps a glTF camera's aspect ratio (width over
- * height) at this height, within 1 .. RT_MAX_IMAGE_SIDE. */
-int input_width_for_aspect(int height, float aspect_ratio);
 
 #endif

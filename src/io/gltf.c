@@ -1,12 +1,12 @@
 /* gltf.c - glTF 2.0 (.gltf, .glb) loader for static scenes.
  *
  * Built the way cgltf (jkuhlmann/cgltf) is built, in four passes, each in
- * files of its own (gltf_internal.h lists them); this file holds the
+ * files of its own (gltf_doc.h lists them); this file holds the
  * entry points, the first pass and gl_load, which runs the others:
  *   1. read   the file; a GLB is split into its JSON and BIN chunks after
  *             checking the 12-byte header and every chunk length against the
  *             file size (glTF 2.0 spec, "GLB File Format Specification").
- *   2. map    the JSON (tokenized once by jsmn, see json.c) into flat tables
+ *   2. map    the JSON (tokenized once, see json.c) into flat tables
  *             of records with a count each: buffers, bufferViews, accessors,
  *             meshes/primitives, nodes, scenes, materials, textures,
  *             samplers, images, cameras, KHR_lights_punctual lights. Cross
@@ -43,7 +43,7 @@
  */
 #include "rt/io/gltf.h"
 
-#include "gltf_internal.h"
+#include "gltf_doc.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -52,29 +52,6 @@
 
 #include "rt/base/file.h"
 #include "rt/base/log.h"
-
-rt_result gl_fail_at(gl_doc *d, int tok, rt_result code, const char *fmt, ...)
-{
-    char msg[900];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    if (tok >= 0 && tok < d->j.count)
-        return rt_fail(d->err, code, "%s: byte %zu: %s", d->path, d->json_base + (size_t)d->j.tok[tok].start, msg);
-    return rt_fail(d->err, code, "%s: %s", d->path, msg);
-}
-
-/* Reads a file the document names (an external buffer). */
-rt_result gl_read_file(gl_doc *d, const char *path, const char *what, uint8_t **data, size_t *size)
-{
-    rt_error inner = {0};
-    char *bytes;
-    if (rt_read_file(path, GL_MAX_FILE, &bytes, size, &inner) != RT_OK)
-        return rt_fail(d->err, inner.code, "%s: %s%s", d->path, what, inner.message);
-    *data = (uint8_t *)bytes;
-    return RT_OK;
-}
 
 static uint32_t rd32(const uint8_t *p)
 {

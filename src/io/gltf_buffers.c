@@ -1,4 +1,4 @@
-/* gltf_buffers.c - the bytes behind a glTF document (gltf_internal.h):
+/* gltf_buffers.c - the bytes behind a glTF document (gltf_doc.h):
  * buffers from files beside the .gltf, base64 data: URIs or the GLB BIN
  * chunk, their real sizes checked against byteLength; accessor elements
  * as floats or unsigned integers (normalized integers by the spec's
@@ -9,7 +9,7 @@
  * Sources: Khronos glTF 2.0 specification ("Accessors", "Animations" for
  * the normalized integer formulas), the two extension specifications.
  */
-#include "gltf_internal.h"
+#include "gltf_doc.h"
 
 #include <math.h>
 #include <stdio.h>

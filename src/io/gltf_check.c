@@ -1,4 +1,4 @@
-/* gltf_check.c - the third pass of the glTF loader (gltf_internal.h):
+/* gltf_check.c - the third pass of the glTF loader (gltf_doc.h):
  * every index against its table, every accessor against its bufferView and
  * every bufferView against its buffer with overflow-safe arithmetic, the
  * compressed views and primitives, the node graph (shared children,
@@ -7,7 +7,7 @@
  * Source: Khronos glTF 2.0 specification ("Accessors", "Buffers and
  * Buffer Views", "Nodes and Hierarchy").
  */
-#include "gltf_internal.h"
+#include "gltf_doc.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -43,18 +43,6 @@ static bool span_fits(size_t offset, size_t count, size_t stride, size_t elem, s
         return true;
     size_t room = length - offset - elem;
     return stride == 0 ? true : (count - 1) <= room / stride;
-}
-
-/* "meshes[m].primitives[k]" for the primitive at index p of doc.prims. */
-const char *gl_prim_name(const gl_doc *d, size_t p, char *buf, size_t cap)
-{
-    for (size_t m = 0; m < d->mesh_count; m++)
-        if (p >= d->meshes[m].first && p - d->meshes[m].first < d->meshes[m].count) {
-            snprintf(buf, cap, "meshes[%zu].primitives[%zu]", m, p - d->meshes[m].first);
-            return buf;
-        }
-    snprintf(buf, cap, "primitive %zu", p);
-    return buf;
 }
 
 /* An EXT_meshopt_compression view: its source inside a buffer with data,

@@ -1,4 +1,4 @@
-/* gltf_flatten.c - the last pass of the glTF loader (gltf_internal.h): the
+/* gltf_flatten.c - the last pass of the glTF loader (gltf_doc.h): the
  * chosen scene's nodes visited with their world matrices (parent * local,
  * TRS = T * R * S), every triangle primitive of every mesh instance into
  * the scene's vertex and triangle tables (strips and fans converted with
@@ -8,7 +8,7 @@
  * Source: Khronos glTF 2.0 specification ("Meshes", "Nodes and
  * Hierarchy", "Cameras"), KHR_lights_punctual.
  */
-#include "gltf_internal.h"
+#include "gltf_doc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -92,15 +92,6 @@ static rt_result collect_visits(gl_doc *d, const rt_gltf_options *opt)
     free(roots);
     free(stack);
     return RT_OK;
-}
-
-/* World matrix of any node (joints need not be in the chosen scene). */
-rt_mat4 gl_node_world(const gl_doc *d, uint32_t n, const rt_mat4 *top)
-{
-    rt_mat4 m = d->nodes[n].local;
-    for (uint32_t p = d->nodes[n].parent; p != RT_NONE; p = d->nodes[p].parent)
-        m = rt_mat4_mul(d->nodes[p].local, m);
-    return rt_mat4_mul(*top, m);
 }
 
 static rt_result emit_primitive(gl_doc *d, rt_scene *s, uint32_t node, uint32_t pi, const rt_mat4 *M,

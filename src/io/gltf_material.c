@@ -1,4 +1,4 @@
-/* gltf_material.c - glTF materials into rt_material (gltf_internal.h): the
+/* gltf_material.c - glTF materials into rt_material (gltf_doc.h): the
  * metallic-roughness core, texture infos with KHR_texture_transform, and
  * the KHR_materials_* extensions (emissive_strength, transmission, ior,
  * volume, unlit, clearcoat, specular, sheen, anisotropy, iridescence,
@@ -8,7 +8,7 @@
  * Sources: Khronos glTF 2.0 specification ("Materials", "Samplers") and
  * the extension specifications; docs/gltf.md lists the mapping.
  */
-#include "gltf_internal.h"
+#include "gltf_doc.h"
 
 #include <math.h>
 #include <stdio.h>

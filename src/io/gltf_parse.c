@@ -1,14 +1,14 @@
-/* gltf_parse.c - the second pass of the glTF loader (gltf_internal.h): the
- * JSON document, tokenized once by jsmn (json.c), mapped into flat tables
+/* gltf_parse.c - the second pass of the glTF loader (gltf_doc.h): the
+ * JSON document, tokenized once (json.c), mapped into flat tables
  * of records with a count each (buffers, bufferViews, accessors with
  * sparse storage, meshes and primitives with morph targets and Draco
  * streams, nodes, scenes, cameras, KHR_lights_punctual lights, skins,
  * animations); cross references stay indices for gltf_check.c. Every
- * field is read through the typed readers here, whose messages name the
- * JSON path and the byte. Materials are gltf_material.c's.
+ * field is read through the typed readers of gltf_doc.c, whose messages
+ * name the JSON path and the byte. Materials are gltf_material.c's.
  * Source: Khronos glTF 2.0 specification, the sections of each object.
  */
-#include "gltf_internal.h"
+#include "gltf_doc.h"
 
 #include <float.h>
 #include <math.h>
@@ -19,149 +19,6 @@
 #include "rt/base/log.h"
 #include "rt/io/gltf_animation.h"
 #include "rt/io/meshopt.h"
-
-const char *const gl_attr_names[ATTR_COUNT] = {"POSITION", "NORMAL", "TANGENT", "TEXCOORD_0", "TEXCOORD_1",
-                                            "COLOR_0"};
-
-/* Checks that t is an object whose keys are all strings followed by a value. */
-rt_result gl_expect_object(gl_doc *d, int t, const char *where)
-{
-    if (jtype(d, t) != RT_JSON_OBJECT)
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s: expected an object", where);
-    int k = t + 1;
-    for (int n = 0; n < d->j.tok[t].size; n++) {
-        if (k + 1 >= d->j.count || d->j.tok[k].type != RT_JSON_STRING || d->j.tok[k].size != 1)
-            return gl_fail_at(d, k < d->j.count ? k : t, RT_ERR_PARSE, "%s: expected \"key\": value", where);
-        k = rt_json_skip(&d->j, k + 1);
-    }
-    return RT_OK;
-}
-
-rt_result gl_expect_array(gl_doc *d, int t, const char *where, const char *key)
-{
-    if (jtype(d, t) != RT_JSON_ARRAY)
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected an array", where, key);
-    return RT_OK;
-}
-
-static rt_result get_num(gl_doc *d, const char *where, const char *key, int t, double *v)
-{
-    if (!rt_json_number(&d->j, t, v))
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected a number", where, key);
-    return RT_OK;
-}
-
-rt_result gl_get_index(gl_doc *d, const char *where, const char *key, int t, uint32_t *out)
-{
-    double v;
-    if (!rt_json_number(&d->j, t, &v) || v < 0 || v != floor(v) || v > 4294967294.0)
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected an index (a non-negative integer)", where, key);
-    *out = (uint32_t)v;
-    return RT_OK;
-}
-
-static rt_result get_size(gl_doc *d, const char *where, const char *key, int t, size_t *out)
-{
-    double v;
-    if (!rt_json_number(&d->j, t, &v) || v < 0 || v != floor(v) || v > 9007199254740992.0 || v > (double)SIZE_MAX)
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected a non-negative integer", where, key);
-    *out = (size_t)v;
-    return RT_OK;
-}
-
-rt_result gl_get_int(gl_doc *d, const char *where, const char *key, int t, int *out)
-{
-    double v;
-    if (!rt_json_number(&d->j, t, &v) || v != floor(v) || v < -2147483647.0 || v > 2147483647.0)
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected an integer", where, key);
-    *out = (int)v;
-    return RT_OK;
-}
-
-rt_result gl_get_float(gl_doc *d, const char *where, const char *key, int t, float *out)
-{
-    rt_result r;
-    double v;
-    if ((r = get_num(d, where, key, t, &v)) != RT_OK)
-        return r;
-    if (fabs(v) > FLT_MAX)
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s: number out of float range", where, key);
-    *out = (float)v;
-    return RT_OK;
-}
-
-rt_result gl_get_floats(gl_doc *d, const char *where, const char *key, int t, float *out, int n)
-{
-    rt_result r;
-    if (jtype(d, t) != RT_JSON_ARRAY || jsize(d, t) != n)
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected an array of %d numbers", where, key, n);
-    for (int i = 0, e = t + 1; i < d->j.tok[t].size && e < d->j.count; i++, e = rt_json_skip(&d->j, e))
-        if ((r = gl_get_float(d, where, key, e, &out[i])) != RT_OK)
-            return r;
-    return RT_OK;
-}
-
-rt_result gl_get_ranged(gl_doc *d, const char *where, const char *key, int t, float lo, float hi, float *out)
-{
-    rt_result r;
-    float v = 0;
-    if ((r = gl_get_float(d, where, key, t, &v)) != RT_OK)
-        return r;
-    if (!(v >= lo && v <= hi))
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s %g is outside [%g, %g]", where, key, (double)v, (double)lo,
-                          (double)hi);
-    *out = v;
-    return RT_OK;
-}
-
-rt_result gl_get_floats_ranged(gl_doc *d, const char *where, const char *key, int t, int n, float lo, float hi,
-                               float *out)
-{
-    rt_result r;
-    float c[16] = {0};
-    if (n < 1 || n > 16)
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s: bad component count", where, key);
-    if ((r = gl_get_floats(d, where, key, t, c, n)) != RT_OK)
-        return r;
-    for (int i = 0; i < n; i++)
-        if (!(c[i] >= lo && c[i] <= hi))
-            return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s component %d (%g) is outside [%g, %g]", where, key, i,
-                              (double)c[i], (double)lo, (double)hi);
-    memcpy(out, c, (size_t)n * sizeof *out);
-    return RT_OK;
-}
-
-rt_result gl_get_bool(gl_doc *d, const char *where, const char *key, int t, bool *out)
-{
-    if (!rt_json_bool(&d->j, t, out))
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected true or false", where, key);
-    return RT_OK;
-}
-
-rt_result gl_get_string(gl_doc *d, const char *where, const char *key, int t, char *buf, size_t cap)
-{
-    if (rt_json_string(&d->j, t, buf, cap) < 0)
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s: expected a string (at most %zu bytes, valid escapes)", where,
-                          key, cap - 1);
-    return RT_OK;
-}
-
-/* Allocates one zeroed record per element of array token t. */
-rt_result gl_alloc_table(gl_doc *d, int t, const char *key, size_t elem, void **out, size_t *count)
-{
-    rt_result r;
-    if ((r = gl_expect_array(d, t, "glTF", key)) != RT_OK)
-        return r;
-    if (*out)
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s appears twice", key);
-    size_t n = (size_t)jsize(d, t);
-    void *p = rt_alloc(n, elem);
-    if (!p)
-        return gl_fail_at(d, t, RT_ERR_NOMEM, "out of memory for %zu %s", n, key);
-    *out = p;
-    *count = n;
-    return RT_OK;
-}
 
 static const struct { const char *name; bool supported; } known_extensions[] = {
     {"KHR_materials_emissive_strength", true}, {"KHR_texture_transform", true},
@@ -259,7 +116,7 @@ static rt_result parse_buffers(gl_doc *d, int t)
                     return gl_fail_at(d, v, RT_ERR_INVALID, "%s.uri: expected a string", where);
                 b->uri = v;
             } else if (KEY(k, "byteLength")) {
-                if ((r = get_size(d, where, "byteLength", v, &b->byte_length)) != RT_OK)
+                if ((r = gl_get_size(d, where, "byteLength", v, &b->byte_length)) != RT_OK)
                     return r;
             } else if (KEY(k, "extensions")) {
                 int mo = rt_json_get(&d->j, v, "EXT_meshopt_compression");
@@ -295,10 +152,10 @@ static rt_result parse_meshopt_view(gl_doc *d, const char *view, int t, gl_view 
     for (int k_n = 0, k = t + 1, v = t + 2; k_n < d->j.tok[t].size && v < d->j.count;
          k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
         if (KEY(k, "buffer")) r = gl_get_index(d, where, "buffer", v, &bv->mo_buffer);
-        else if (KEY(k, "byteOffset")) r = get_size(d, where, "byteOffset", v, &bv->mo_offset);
-        else if (KEY(k, "byteLength")) r = get_size(d, where, "byteLength", v, &bv->mo_length);
-        else if (KEY(k, "byteStride")) r = get_size(d, where, "byteStride", v, &bv->mo_stride);
-        else if (KEY(k, "count")) r = get_size(d, where, "count", v, &bv->mo_count);
+        else if (KEY(k, "byteOffset")) r = gl_get_size(d, where, "byteOffset", v, &bv->mo_offset);
+        else if (KEY(k, "byteLength")) r = gl_get_size(d, where, "byteLength", v, &bv->mo_length);
+        else if (KEY(k, "byteStride")) r = gl_get_size(d, where, "byteStride", v, &bv->mo_stride);
+        else if (KEY(k, "count")) r = gl_get_size(d, where, "count", v, &bv->mo_count);
         else if (KEY(k, "mode")) {
             if ((r = gl_get_string(d, where, "mode", v, name, sizeof name)) != RT_OK)
                 return r;
@@ -342,10 +199,10 @@ static rt_result parse_views(gl_doc *d, int t)
         for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
              k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
             if (KEY(k, "buffer")) r = gl_get_index(d, where, "buffer", v, &bv->buffer);
-            else if (KEY(k, "byteOffset")) r = get_size(d, where, "byteOffset", v, &bv->offset);
-            else if (KEY(k, "byteLength")) r = get_size(d, where, "byteLength", v, &bv->length);
+            else if (KEY(k, "byteOffset")) r = gl_get_size(d, where, "byteOffset", v, &bv->offset);
+            else if (KEY(k, "byteLength")) r = gl_get_size(d, where, "byteLength", v, &bv->length);
             else if (KEY(k, "byteStride")) {
-                if ((r = get_size(d, where, "byteStride", v, &bv->stride)) != RT_OK)
+                if ((r = gl_get_size(d, where, "byteStride", v, &bv->stride)) != RT_OK)
                     return r;
                 if (bv->stride < 4 || bv->stride > 252 || bv->stride % 4)
                     return gl_fail_at(d, v, RT_ERR_INVALID, "%s.byteStride %zu must be a multiple of 4 in [4, 252]",
@@ -368,27 +225,6 @@ static rt_result parse_views(gl_doc *d, int t)
     return RT_OK;
 }
 
-size_t gl_comp_size(int ct)
-{
-    switch (ct) {
-    case GL_BYTE: case GL_UNSIGNED_BYTE: return 1;
-    case GL_SHORT: case GL_UNSIGNED_SHORT: return 2;
-    case GL_UNSIGNED_INT: case GL_FLOAT: return 4;
-    }
-    return 0;
-}
-
-/* Element size with the spec's column padding for matrices ("Data Alignment"). */
-size_t gl_elem_size(const gl_accessor *a)
-{
-    size_t cs = gl_comp_size(a->ctype);
-    if (a->cols > 1) {
-        size_t col = ((size_t)a->rows * cs + 3) & ~(size_t)3;
-        return col * (size_t)a->cols;
-    }
-    return (size_t)a->ncomp * cs;
-}
-
 static rt_result parse_sparse(gl_doc *d, const char *where, int t, gl_accessor *a)
 {
     rt_result r = RT_OK;
@@ -401,7 +237,7 @@ static rt_result parse_sparse(gl_doc *d, const char *where, int t, gl_accessor *
     for (int k_n = 0, k = t + 1, v = t + 2; k_n < d->j.tok[t].size && v < d->j.count;
          k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
         if (KEY(k, "count")) {
-            if ((r = get_size(d, w, "count", v, &a->sparse_count)) != RT_OK)
+            if ((r = gl_get_size(d, w, "count", v, &a->sparse_count)) != RT_OK)
                 return r;
             have_count = true;
         } else if (KEY(k, "indices")) {
@@ -414,7 +250,7 @@ static rt_result parse_sparse(gl_doc *d, const char *where, int t, gl_accessor *
             for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
                  k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
                 if (KEY(k2, "bufferView")) r = gl_get_index(d, wi, "bufferView", v2, &a->sp_idx_view);
-                else if (KEY(k2, "byteOffset")) r = get_size(d, wi, "byteOffset", v2, &a->sp_idx_offset);
+                else if (KEY(k2, "byteOffset")) r = gl_get_size(d, wi, "byteOffset", v2, &a->sp_idx_offset);
                 else if (KEY(k2, "componentType")) r = gl_get_int(d, wi, "componentType", v2, &a->sp_idx_ctype);
                 if (r != RT_OK)
                     return r;
@@ -431,7 +267,7 @@ static rt_result parse_sparse(gl_doc *d, const char *where, int t, gl_accessor *
             for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
                  k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
                 if (KEY(k2, "bufferView")) r = gl_get_index(d, wv, "bufferView", v2, &a->sp_val_view);
-                else if (KEY(k2, "byteOffset")) r = get_size(d, wv, "byteOffset", v2, &a->sp_val_offset);
+                else if (KEY(k2, "byteOffset")) r = gl_get_size(d, wv, "byteOffset", v2, &a->sp_val_offset);
                 if (r != RT_OK)
                     return r;
             }
@@ -465,10 +301,10 @@ static rt_result parse_accessors(gl_doc *d, int t)
         for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
              k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
             if (KEY(k, "bufferView")) r = gl_get_index(d, where, "bufferView", v, &a->view);
-            else if (KEY(k, "byteOffset")) r = get_size(d, where, "byteOffset", v, &a->offset);
+            else if (KEY(k, "byteOffset")) r = gl_get_size(d, where, "byteOffset", v, &a->offset);
             else if (KEY(k, "componentType")) r = gl_get_int(d, where, "componentType", v, &a->ctype);
             else if (KEY(k, "normalized")) r = gl_get_bool(d, where, "normalized", v, &a->normalized);
-            else if (KEY(k, "count")) r = get_size(d, where, "count", v, &a->count);
+            else if (KEY(k, "count")) r = gl_get_size(d, where, "count", v, &a->count);
             else if (KEY(k, "type")) r = gl_get_string(d, where, "type", v, type, sizeof type);
             else if (KEY(k, "sparse")) sparse = v;
             if (r != RT_OK)
@@ -676,16 +512,6 @@ static rt_result parse_meshes(gl_doc *d, int t)
         }
     }
     return RT_OK;
-}
-
-/* glTF matrices are column-major; rt_mat4 is m[row][col]. */
-rt_mat4 gl_mat_from_gltf(const float *c)
-{
-    rt_mat4 r;
-    for (int row = 0; row < 4; row++)
-        for (int col = 0; col < 4; col++)
-            r.m[row][col] = c[col * 4 + row];
-    return r;
 }
 
 /* Items of a table that each hold an optional array of indices under

@@ -1,4 +1,4 @@
-/* gltf_pose.c - a glTF scene posed at a time (gltf_internal.h): the
+/* gltf_pose.c - a glTF scene posed at a time (gltf_doc.h): the
  * animation channels sampled (rt/io/gltf_animation.h: STEP, LINEAR with
  * slerp, CUBICSPLINE) into node translations, rotations, scales and morph
  * weights; the per-vertex skin matrices of a primitive (joint world
@@ -7,7 +7,7 @@
  * Source: Khronos glTF 2.0 specification ("Animations", "Skins",
  * "Morph Targets").
  */
-#include "gltf_internal.h"
+#include "gltf_doc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -226,6 +226,15 @@ rt_result gl_apply_morph(gl_doc *d, const gl_prim *p, const float *w, int slot, 
         free(delta);
     }
     return RT_OK;
+}
+
+/* World matrix of any node (joints need not be in the chosen scene). */
+rt_mat4 gl_node_world(const gl_doc *d, uint32_t n, const rt_mat4 *top)
+{
+    rt_mat4 m = d->nodes[n].local;
+    for (uint32_t p = d->nodes[n].parent; p != RT_NONE; p = d->nodes[p].parent)
+        m = rt_mat4_mul(d->nodes[p].local, m);
+    return rt_mat4_mul(*top, m);
 }
 
 /* Per-vertex skin matrices of a primitive of a skinned node (glTF 2.0,

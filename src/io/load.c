@@ -28,6 +28,7 @@
 #include "rt/io/gltf.h"
 #include "rt/io/mesh_io.h"
 #include "rt/io/scene_parse.h"
+#include "rt/render/integrator.h"
 #include "rt/scene/tangents.h"
 
 /* JSON text may start with a UTF-8 byte order mark and white space. */
@@ -109,7 +110,7 @@ const char *rt_load_kind_name(rt_load_kind kind)
 void rt_load_model_settings(rt_settings *set)
 {
     set->samples = 64;
-    set->integrator = RT_INTEGRATOR_PATH;
+    set->integrator = rt_integrator_for_models();
     set->background = rt_v3(0.55f, 0.6f, 0.7f);
 }
 

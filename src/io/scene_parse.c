@@ -49,7 +49,8 @@
 #include "rt/io/gltf.h"
 #include "rt/io/image_load.h"
 #include "rt/io/mesh_io.h"
-#include "rt/scene/settings.h"
+#include "rt/io/environment_image.h"
+#include "rt/render/settings.h"
 #include "rt/scene/texture.h"
 
 #define MAX_SCENE_BYTES ((size_t)256 << 20) /* 256 MiB of text keeps line and column in an int */
@@ -657,7 +658,14 @@ static rt_result st_setting(parser *p, const rt_setting *def, const tok *kw)
         p->pos = first + v.words;
         if ((r = expect_end(p, def->name)) != RT_OK)
             return r;
-        r = rt_setting_store(p->s, def, &v, p->dir, &pb);
+        r = rt_setting_store(&p->s->settings, def, &v, p->dir, &pb);
+    }
+    if (r == RT_OK && def->type == RT_SETTING_ENVIRONMENT) { /* the table keeps the name; the image is io's */
+        rt_error inner = {0};
+        if ((r = rt_environment_image_load(p->s, &inner)) != RT_OK) {
+            pb = (rt_setting_problem){.code = r, .word = 0, .got = false};
+            snprintf(pb.message, sizeof pb.message, "%s", inner.message);
+        }
     }
     if (r != RT_OK) {
         const tok *t = pb.word < n ? &p->toks[first + pb.word] : NULL; /* NULL: a word is missing */

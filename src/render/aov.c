@@ -11,7 +11,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "rt/render/bsdf.h"
+#include "rt/render/material_eval.h"
 #include "rt/render/surface.h"
 #include "rt/render/whitted.h"
 
@@ -39,16 +39,16 @@ void rt_aov_trace(const rt_trace_ctx *ctx, rt_ray ray, rt_rng *rng, rt_aov_sampl
         /* smooth metal or glass of the metallic-roughness model, or the
          * whitted model's mostly-mirror (reflect) and glass (transmission) */
         const rt_material *m = &ctx->state->scene->materials[sf.material];
-        bool metal_mirror = (!b.lambert && b.alpha <= AOV_DELTA_ALPHA && rt_luminance(b.diffuse) < 1e-4f) ||
+        bool metal_mirror = (!(b.kind == RT_BSDF_KIND_LAMBERT) && b.alpha <= AOV_DELTA_ALPHA && rt_luminance(b.diffuse) < 1e-4f) ||
                             m->reflectivity >= 0.5f;
-        bool glass = (!b.lambert && b.alpha <= AOV_DELTA_ALPHA && b.transmission > 0.999f) || m->transmission >= 0.5f;
+        bool glass = (!(b.kind == RT_BSDF_KIND_LAMBERT) && b.alpha <= AOV_DELTA_ALPHA && b.transmission > 0.999f) || m->transmission >= 0.5f;
         if ((!metal_mirror && !glass) || bounce == AOV_MAX_SPECULAR) {
             /* the specular lobe's reflectance at normal incidence: a
              * conductor's Fresnel, else the dielectric F0 mixed towards the
              * base colour by metallic (the glTF model's metal part) */
-            rt_vec3 spec = b.conductor ? rt_fresnel_conductor(1.0f, b.eta_c, b.k_c)
+            rt_vec3 spec = (b.kind == RT_BSDF_KIND_CONDUCTOR) ? rt_fresnel_conductor(1.0f, b.eta_c, b.k_c)
                                        : rt_add(rt_scale(b.base, b.metallic), rt_v3s((1.0f - b.metallic) * b.f0));
-            if (b.lambert)
+            if ((b.kind == RT_BSDF_KIND_LAMBERT))
                 spec = rt_v3s(0.0f);
             out->albedo = rt_v3(clamp01(b.diffuse.x + spec.x), clamp01(b.diffuse.y + spec.y),
                                 clamp01(b.diffuse.z + spec.z));
@@ -70,5 +70,32 @@ void rt_aov_trace(const rt_trace_ctx *ctx, rt_ray ray, rt_rng *rng, rt_aov_sampl
         ray.dir = next;
         ray.tmin = 0.0f;
         ray.tmax = INFINITY;
+    }
+}
+
+/* The pixel's AOVs: means over its `good` samples; the variance of the mean
+ * luminance from the sample variance, sum of L^2 - (sum L)^2 / n over n - 1.
+ * Reads the accumulated sums only, so it may run after every pass. */
+void rt_aov_resolve(rt_aov_buffers *aov, size_t pixel, const rt_aov_sample *s, uint32_t good, float lum_sum,
+                      double lum_sq)
+{
+    float inv = good ? 1.0f / (float)good : 0.0f;
+    const rt_vec3 *v3[3] = {&s->albedo, &s->normal, &s->position};
+    float *dst3[3] = {aov->albedo, aov->normal, aov->position};
+    for (int k = 0; k < 3; k++)
+        if (dst3[k]) {
+            dst3[k][3 * pixel] = v3[k]->x * inv;
+            dst3[k][3 * pixel + 1] = v3[k]->y * inv;
+            dst3[k][3 * pixel + 2] = v3[k]->z * inv;
+        }
+    if (aov->depth)
+        aov->depth[pixel] = s->depth * inv;
+    if (aov->spp)
+        aov->spp[pixel] = (float)good;
+    if (aov->variance) {
+        double n = (double)good, var = 0.0;
+        if (good > 1)
+            var = (lum_sq - (double)lum_sum * (double)lum_sum / n) / (n - 1.0) / n;
+        aov->variance[pixel] = (float)(var > 0.0 ? var : 0.0);
     }
 }

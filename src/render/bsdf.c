@@ -1,5 +1,12 @@
-/* bsdf.c - Lambert, the glTF metallic-roughness BSDF and the conductor
- * for the path tracer: evaluation, pdf and importance sampling (see rt/render/bsdf.h).
+/* bsdf.c - the lobes of every BSDF kind for the path tracer (see
+ * rt/render/bsdf.h): Lambert, the glTF metallic-roughness BSDF and its
+ * extensions' layers, the conductor, the dielectric and the plastic;
+ * evaluation, pdf and importance sampling, built from the GGX and Fresnel
+ * terms of rt/render/microfacet.h. One closed kind (rt_bsdf_kind) picks the
+ * lobes: lobe_probs, rt_bsdf_eval and rt_bsdf_sample_dir switch over it,
+ * the glTF, dielectric and plastic kinds sharing one dielectric interface
+ * over a base, the conductor and the layered glTF BSDF with functions of
+ * their own. The material at a hit becomes one of these in material_eval.c.
  *
  * Sources:
  * - The BRDF: glTF 2.0 specification, appendix B "BRDF Implementation",
@@ -53,185 +60,12 @@
  */
 #include "rt/render/bsdf.h"
 
-#include "rt/render/ggx_albedo.h"
 #include "rt/render/bsdf_clearcoat.h"
 #include "rt/render/bsdf_iridescence.h"
 #include "rt/render/bsdf_sheen.h"
+#include "rt/render/ggx_albedo.h"
+#include "rt/render/microfacet.h"
 #include "rt/render/sampling.h"
-#include "rt/scene/texture.h"
-
-/* Both evaluated from the tangent components: sin^2 = x^2 + y^2 is exact
- * near the normal, where 1 - cos^2 (and the textbook k = cos^2 (a^2 - 1)
- * + 1) cancels to nothing in single precision once alpha^2 falls below
- * the float epsilon. D = a^2 / (pi (a^2 cos^2 + sin^2)^2) then keeps full
- * relative precision down to alpha 1e-4 and below (a peak of 3e7). */
-float rt_ggx_d(rt_vec3 h, float alpha)
-{
-    if (!(h.z > 0.0f))
-        return 0.0f;
-    float a2 = alpha * alpha;
-    float s2 = h.x * h.x + h.y * h.y;
-    float k = a2 * (h.z * h.z) + s2;
-    float d = a2 / (RT_PI * k * k);
-    return isfinite(d) ? d : 0.0f;
-}
-
-float rt_ggx_lambda(rt_vec3 w, float alpha)
-{
-    float c2 = w.z * w.z;
-    float s2 = w.x * w.x + w.y * w.y;
-    if (!(c2 > 0.0f))
-        return INFINITY;
-    float t2 = alpha * alpha * s2 / c2; /* alpha^2 tan^2 theta */
-    /* sqrt(1 + t2) - 1 without cancellation for small t2 */
-    return 0.5f * t2 / (sqrtf(1.0f + t2) + 1.0f);
-}
-
-float rt_ggx_g1(rt_vec3 w, float alpha)
-{
-    float l = rt_ggx_lambda(w, alpha);
-    return isfinite(l) ? 1.0f / (1.0f + l) : 0.0f;
-}
-
-float rt_ggx_g2(rt_vec3 wo, rt_vec3 wi, float alpha)
-{
-    float lo = rt_ggx_lambda(wo, alpha), li = rt_ggx_lambda(wi, alpha);
-    if (!isfinite(lo) || !isfinite(li))
-        return 0.0f;
-    return 1.0f / (1.0f + lo + li);
-}
-
-static rt_vec3 vndf_xy(rt_vec3 wo, float ax, float ay, rt_vec2 u)
-{
-    /* stretch the view direction to the hemisphere configuration */
-    rt_vec3 vh = rt_normalize(rt_v3(ax * wo.x, ay * wo.y, wo.z));
-    float lensq = vh.x * vh.x + vh.y * vh.y;
-    rt_vec3 t1 = lensq > 1e-14f ? rt_scale(rt_v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(lensq)) : rt_v3(1, 0, 0);
-    rt_vec3 t2 = rt_cross(vh, t1);
-    /* a point on the projected area of the hemisphere */
-    float r = sqrtf(u.x), phi = 2.0f * RT_PI * u.y;
-    float sn, cs;
-    rt_sincosf(phi, &sn, &cs);
-    float p1 = r * cs, p2 = r * sn;
-    float s = 0.5f * (1.0f + vh.z);
-    p2 = (1.0f - s) * sqrtf(rt_fmaxf(0.0f, 1.0f - p1 * p1)) + s * p2;
-    rt_vec3 nh = rt_add(rt_add(rt_scale(t1, p1), rt_scale(t2, p2)),
-                        rt_scale(vh, sqrtf(rt_fmaxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));
-    /* unstretch */
-    rt_vec3 ne = rt_v3(ax * nh.x, ay * nh.y, rt_fmaxf(1e-7f, nh.z));
-    return rt_normalize(ne);
-}
-
-rt_vec3 rt_ggx_sample_vndf(rt_vec3 wo, float alpha, rt_vec2 u) { return vndf_xy(wo, alpha, alpha, u); }
-
-/* Anisotropic GGX (alpha ax along x, ay along y; Heitz 2014, eq. 85 and
- * 86): D = 1 / (pi ax ay ((x/ax)^2 + (y/ay)^2 + z^2)^2), Lambda with
- * alpha^2 tan^2 = (ax^2 x^2 + ay^2 y^2) / z^2; the isotropic forms when
- * ax = ay. */
-static float d_xy(rt_vec3 h, float ax, float ay)
-{
-    if (ax == ay)
-        return rt_ggx_d(h, ax);
-    if (!(h.z > 0.0f))
-        return 0.0f;
-    float x = h.x / ax, y = h.y / ay;
-    float k = x * x + y * y + h.z * h.z;
-    float d = 1.0f / (RT_PI * ax * ay * k * k);
-    return isfinite(d) ? d : 0.0f;
-}
-
-static float lambda_xy(rt_vec3 w, float ax, float ay)
-{
-    if (ax == ay)
-        return rt_ggx_lambda(w, ax);
-    float c2 = w.z * w.z;
-    if (!(c2 > 0.0f))
-        return INFINITY;
-    float t2 = (ax * ax * w.x * w.x + ay * ay * w.y * w.y) / c2;
-    return 0.5f * t2 / (sqrtf(1.0f + t2) + 1.0f);
-}
-
-static float g1_xy(rt_vec3 w, float ax, float ay)
-{
-    float l = lambda_xy(w, ax, ay);
-    return isfinite(l) ? 1.0f / (1.0f + l) : 0.0f;
-}
-
-/* Smith G2: height-correlated 1 / (1 + L(wo) + L(wi)) (Heitz 2014, eq.
- * 99), or separable G1(wo) G1(wi) (eq. 98, as older renderers use). */
-static float g2_xy(rt_vec3 wo, rt_vec3 wi, float ax, float ay, bool separable)
-{
-    float lo = lambda_xy(wo, ax, ay), li = lambda_xy(wi, ax, ay);
-    if (!isfinite(lo) || !isfinite(li))
-        return 0.0f;
-    return separable ? 1.0f / ((1.0f + lo) * (1.0f + li)) : 1.0f / (1.0f + lo + li);
-}
-
-float rt_ggx_reflect_pdf(rt_vec3 wo, rt_vec3 wi, float alpha)
-{
-    if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
-        return 0.0f;
-    rt_vec3 h = rt_add(wo, wi);
-    float l2 = rt_length2(h);
-    if (!(l2 > 1e-20f))
-        return 0.0f;
-    h = rt_scale(h, 1.0f / sqrtf(l2));
-    float p = rt_ggx_g1(wo, alpha) * rt_ggx_d(h, alpha) / (4.0f * wo.z);
-    return isfinite(p) ? p : 0.0f;
-}
-
-/* Exact unpolarised Fresnel reflectance of a conductor, eta + i k relative
- * to the outside, one channel (the closed form of pbrt-v3, 8.2.1, after
- * Born and Wolf 14.2). */
-static float fresnel_conductor1(float c, float eta, float k)
-{
-    c = rt_clampf(c, 0.0f, 1.0f);
-    float c2 = c * c, s2 = 1.0f - c2;
-    float eta2 = eta * eta, k2 = k * k;
-    float t0 = eta2 - k2 - s2;
-    float a2b2 = sqrtf(rt_fmaxf(0.0f, t0 * t0 + 4.0f * eta2 * k2));
-    float t1 = a2b2 + c2;
-    float a = sqrtf(rt_fmaxf(0.0f, 0.5f * (a2b2 + t0)));
-    float t2 = 2.0f * c * a;
-    float rs = (t1 - t2) / (t1 + t2);
-    float t3 = c2 * a2b2 + s2 * s2;
-    float t4 = t2 * s2;
-    float rp = rs * (t3 - t4) / (t3 + t4);
-    float f = 0.5f * (rs + rp);
-    return isfinite(f) ? rt_clampf(f, 0.0f, 1.0f) : 1.0f;
-}
-
-rt_vec3 rt_fresnel_conductor(float cos_i, rt_vec3 eta, rt_vec3 k)
-{
-    return rt_v3(fresnel_conductor1(cos_i, eta.x, k.x), fresnel_conductor1(cos_i, eta.y, k.y),
-                 fresnel_conductor1(cos_i, eta.z, k.z));
-}
-
-static inline float schlick_weight(float c)
-{
-    float x = 1.0f - rt_clampf(c, 0.0f, 1.0f);
-    float x2 = x * x;
-    return x2 * x2 * x;
-}
-
-static inline rt_vec3 schlick(rt_vec3 f0, float c)
-{
-    float w = schlick_weight(c);
-    return rt_add(f0, rt_scale(rt_sub(rt_v3s(1.0f), f0), w));
-}
-
-float rt_fresnel_exact(float cos_i, float eta)
-{
-    float ci = rt_clampf(cos_i, 0.0f, 1.0f);
-    float sin2_t = eta * eta * (1.0f - ci * ci);
-    if (!(sin2_t < 1.0f))
-        return 1.0f; /* total internal reflection (or a NaN input) */
-    float ct = sqrtf(1.0f - sin2_t);
-    float rs = (eta * ci - ct) / (eta * ci + ct);
-    float rp = (ci - eta * ct) / (ci + eta * ct);
-    float f = 0.5f * (rs * rs + rp * rp);
-    return isfinite(f) ? rt_clampf(f, 0.0f, 1.0f) : 1.0f;
-}
 
 /* The dielectric Fresnel Fd at a (micro)facet seen at cosine c from wo:
  * the exact equations for a transmissive surface (glass: reflection and
@@ -239,9 +73,9 @@ float rt_fresnel_exact(float cos_i, float eta)
  * the index's F0 for an opaque one. */
 static inline float fresnel_dielectric(const rt_bsdf *b, float c)
 {
-    if (b->transmission > 0.0f || b->plastic)
+    if (b->transmission > 0.0f || b->kind == RT_BSDF_KIND_PLASTIC)
         return rt_fresnel_exact(c, b->eta);
-    return b->f0 + (1.0f - b->f0) * schlick_weight(c);
+    return b->f0 + (1.0f - b->f0) * rt_schlick_weight(c);
 }
 
 static inline float mean3(rt_vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
@@ -250,11 +84,11 @@ static inline float mean3(rt_vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f);
  * conductor_fresnel (Schlick on the base colour) and the dielectric's Fd. */
 static inline rt_vec3 fresnel_specular(const rt_bsdf *b, float c, float fd)
 {
-    rt_vec3 fm = b->metallic > 0.0f ? schlick(b->base, c) : rt_v3s(0.0f);
+    rt_vec3 fm = b->metallic > 0.0f ? rt_fresnel_schlick(b->base, c) : rt_v3s(0.0f);
     return rt_lerp3(rt_v3s(fd), fm, b->metallic);
 }
 
-static void set_frame(rt_bsdf *b, rt_vec3 n, rt_vec3 ng)
+void rt_bsdf_set_frame(rt_bsdf *b, rt_vec3 n, rt_vec3 ng)
 {
     b->n = n;
     b->ng = ng;
@@ -268,27 +102,23 @@ static inline rt_vec3 clean_base(rt_vec3 base)
     return rt_finite3(base) ? base : rt_v3s(0.0f);
 }
 
-/* The core BSDF's kind flags: Lambert or the metallic-roughness lobes,
- * nothing layered or special, no cached wo (rt_bsdf_set_wo). */
-static inline void set_kind(rt_bsdf *b, bool lambert)
+/* A BSDF of this kind, with none of its options (thin, compensation,
+ * separable Smith) on and no cached wo (rt_bsdf_set_wo). */
+static inline void set_kind(rt_bsdf *b, rt_bsdf_kind kind)
 {
-    b->lambert = lambert;
+    b->kind = kind;
     b->wo_z = NAN;
-    b->layered = false;
     b->thin = false;
-    b->conductor = false;
     b->ms = false;
     b->separable = false;
-    b->radiance_eta2 = false;
-    b->plastic = false;
 }
 
 /* The Lambert BSDF of albedo base (clamped to finite, non-negative):
  * what set_params sets for lambert, without its other parameters. */
-static inline void set_lambert(rt_bsdf *b, rt_vec3 base)
+void rt_bsdf_set_lambert(rt_bsdf *b, rt_vec3 base)
 {
     base = clean_base(base);
-    set_kind(b, true);
+    set_kind(b, RT_BSDF_KIND_LAMBERT);
     b->base = base;
     b->alpha_y = 1.0f;
     b->diffuse = base;
@@ -304,7 +134,7 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
                        bool lambert)
 {
     if (lambert) {
-        set_lambert(b, base);
+        rt_bsdf_set_lambert(b, base);
         return;
     }
     base = clean_base(base);
@@ -313,7 +143,7 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
     transmission = isfinite(transmission) ? rt_clampf(transmission, 0.0f, 1.0f) : 0.0f;
     if (!(ior > 0.0f) || !isfinite(ior))
         ior = 1.5f;
-    set_kind(b, false);
+    set_kind(b, RT_BSDF_KIND_GLTF);
     b->base = base;
     float r0 = (ior - 1.0f) / (ior + 1.0f);
     b->diffuse = rt_scale(base, 1.0f - metallic);
@@ -328,14 +158,19 @@ static void set_params(rt_bsdf *b, rt_vec3 base, float metallic, float roughness
 void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float roughness, float ior,
                   float transmission, bool lambert)
 {
-    set_frame(b, n, n);
+    rt_bsdf_set_frame(b, n, n);
     set_params(b, base, metallic, roughness, ior, transmission, lambert);
 }
 
-static void set_conductor(rt_bsdf *b, rt_vec3 eta, rt_vec3 k, float ax, float ay, rt_smith smith)
+void rt_bsdf_set_gltf(rt_bsdf *b, rt_vec3 base, float metallic, float roughness, float ior, float transmission)
+{
+    set_params(b, base, metallic, roughness, ior, transmission, false);
+}
+
+void rt_bsdf_set_conductor(rt_bsdf *b, rt_vec3 eta, rt_vec3 k, float ax, float ay, bool separable)
 {
     set_params(b, rt_v3s(0.0f), 0.0f, 1.0f, 1.5f, 0.0f, false);
-    b->conductor = true;
+    b->kind = RT_BSDF_KIND_CONDUCTOR;
     b->eta_c = rt_finite3(eta) ? rt_vmax(eta, rt_v3s(0.0f)) : rt_v3s(1.0f);
     b->k_c = rt_finite3(k) ? rt_vmax(k, rt_v3s(0.0f)) : rt_v3s(0.0f);
     ax = isfinite(ax) ? rt_clampf(ax, 0.0f, 1.0f) : 1.0f;
@@ -343,14 +178,14 @@ static void set_conductor(rt_bsdf *b, rt_vec3 eta, rt_vec3 k, float ax, float ay
     b->delta = ax == 0.0f && ay == 0.0f;
     b->alpha = rt_fmaxf(ax, RT_BSDF_MIN_ALPHA);
     b->alpha_y = rt_fmaxf(ay, RT_BSDF_MIN_ALPHA);
-    b->separable = smith == RT_SMITH_SEPARABLE;
+    b->separable = separable;
 }
 
 void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float alpha_x, float alpha_y,
-                            rt_smith smith)
+                            bool separable)
 {
-    set_frame(b, n, n);
-    set_conductor(b, eta, k, alpha_x, alpha_y, smith);
+    rt_bsdf_set_frame(b, n, n);
+    rt_bsdf_set_conductor(b, eta, k, alpha_x, alpha_y, separable);
 }
 
 static void dielectric_compensate(rt_bsdf *b);
@@ -358,11 +193,11 @@ static void dielectric_compensate(rt_bsdf *b);
 void rt_bsdf_compensate(rt_bsdf *b)
 {
     b->wo_z = NAN;
-    if (b->radiance_eta2) {
+    if (b->kind == RT_BSDF_KIND_DIELECTRIC) {
         dielectric_compensate(b);
         return;
     }
-    if (!b->conductor || b->delta || b->separable)
+    if (b->kind != RT_BSDF_KIND_CONDUCTOR || b->delta || b->separable)
         return;
     float alpha = sqrtf(b->alpha * b->alpha_y);
     float ea = rt_ggx_albedo_avg(alpha);
@@ -379,25 +214,9 @@ void rt_bsdf_compensate(rt_bsdf *b)
     b->ms_scale = scale;
 }
 
-rt_vec3 rt_material_absorption(const rt_material *m)
-{
-    rt_vec3 sigma = rt_v3s(0.0f);
-    if (m->bsdf == RT_BSDF_DIELECTRIC)
-        sigma = m->absorption;
-    bool volume = m->bsdf == RT_BSDF_DIELECTRIC ||
-                  (m->bsdf == RT_BSDF_GLTF && m->thickness > 0.0f &&
-                   (m->transmission > 0.0f || m->diffuse_transmission > 0.0f));
-    if (volume && isfinite(m->attenuation_distance) && m->attenuation_distance > 0.0f) {
-        rt_vec3 c = rt_vmax(m->attenuation_color, rt_v3s(1e-6f));
-        rt_vec3 a = rt_v3(-logf(rt_fminf(c.x, 1.0f)), -logf(rt_fminf(c.y, 1.0f)), -logf(rt_fminf(c.z, 1.0f)));
-        sigma = rt_add(sigma, rt_scale(a, 1.0f / m->attenuation_distance));
-    }
-    return rt_finite3(sigma) ? rt_vmax(sigma, rt_v3s(0.0f)) : rt_v3s(0.0f);
-}
-
 void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha)
 {
-    set_frame(b, n, n);
+    rt_bsdf_set_frame(b, n, n);
     set_params(b, rt_v3s(1.0f), 0.0f, 1.0f, 1.5f, 1.0f, false);
     eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
     float r0 = (eta - 1.0f) / (eta + 1.0f);
@@ -406,7 +225,7 @@ void rt_bsdf_make_dielectric(rt_bsdf *b, rt_vec3 n, float eta, float alpha)
     alpha = isfinite(alpha) ? rt_clampf(alpha, 0.0f, 1.0f) : 1.0f;
     b->delta = alpha == 0.0f;
     b->alpha = b->alpha_y = rt_fmaxf(alpha, RT_BSDF_MIN_ALPHA);
-    b->radiance_eta2 = true;
+    b->kind = RT_BSDF_KIND_DIELECTRIC;
 }
 
 void rt_bsdf_set_eta(rt_bsdf *b, float eta)
@@ -417,7 +236,7 @@ void rt_bsdf_set_eta(rt_bsdf *b, float eta)
     b->f0 = r0 * r0;
     bool changed = eta != b->eta;
     b->eta = eta;
-    if (changed && b->ms && b->radiance_eta2)
+    if (changed && b->ms && b->kind == RT_BSDF_KIND_DIELECTRIC)
         dielectric_compensate(b); /* E and the split depend on eta */
 }
 
@@ -432,7 +251,7 @@ void rt_bsdf_set_eta(rt_bsdf *b, float eta)
 static void dielectric_compensate(rt_bsdf *b)
 {
     b->ms = false;
-    if (b->delta || !b->radiance_eta2)
+    if (b->delta || b->kind != RT_BSDF_KIND_DIELECTRIC)
         return;
     float alpha = b->alpha, eta = b->eta;
     float lo = 1.0f - rt_ggx_dielectric_albedo_avg(alpha, eta);
@@ -455,39 +274,21 @@ static void dielectric_compensate(rt_bsdf *b)
 
 float rt_bsdf_ms_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi)
 {
-    if (!b->ms || !b->radiance_eta2 || !(wo.z > 0.0f) || !(wi.z < 0.0f))
+    if (!b->ms || b->kind != RT_BSDF_KIND_DIELECTRIC || !(wo.z > 0.0f) || !(wi.z < 0.0f))
         return 0.0f;
     return b->ms_trans * (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[0], wo.z)) *
            (1.0f - rt_ggx_dielectric_albedo_at(&b->ms_cell[1], -wi.z));
 }
 
-float rt_fresnel_diffuse_reflectance(float eta)
-{
-    /* seen from the denser side: by reciprocity what does not reflect
-     * inside is what enters from outside, shrunk by the solid angle ratio,
-     * Fdr(eta) = 1 - (1 - Fdr(1 / eta)) / eta^2 (no kink to integrate) */
-    if (eta > 1.0f)
-        return 1.0f - (1.0f - rt_fresnel_diffuse_reflectance(1.0f / eta)) / (eta * eta);
-    /* integral of F(c) 2c dc, midpoint rule (F is smooth from outside:
-     * 64 points are within 2e-5) */
-    enum { N = 64 };
-    float sum = 0.0f;
-    for (int i = 0; i < N; i++) {
-        float c = ((float)i + 0.5f) / N;
-        sum += rt_fresnel_exact(c, eta) * 2.0f * c;
-    }
-    return sum / N;
-}
-
 void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alpha)
 {
-    set_frame(b, n, n);
+    rt_bsdf_set_frame(b, n, n);
     set_params(b, R, 0.0f, 1.0f, 1.5f, 0.0f, false);
     eta = (eta > 0.0f && isfinite(eta)) ? eta : 1.0f;
     float r0 = (eta - 1.0f) / (eta + 1.0f);
     b->f0 = r0 * r0;
     b->eta = eta;
-    b->plastic = true;
+    b->kind = RT_BSDF_KIND_PLASTIC;
     alpha = isfinite(alpha) ? rt_clampf(alpha, 0.0f, 1.0f) : 1.0f;
     b->delta = alpha == 0.0f;
     b->alpha = b->alpha_y = rt_fmaxf(alpha, RT_BSDF_MIN_ALPHA);
@@ -505,190 +306,6 @@ void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alp
         b->diffuse = rt_v3s(0.0f);
 }
 
-static rt_vec4 ext_sample(const rt_scene *s, const rt_surface *sf, const rt_material *m, rt_ext_slot k, bool srgb,
-                          bool *present)
-{
-    const rt_texture_slot *slot = &m->ext_tex[k];
-    *present = slot->texture != RT_NONE;
-    if (!*present)
-        return rt_v4(1.0f, 1.0f, 1.0f, 1.0f);
-    rt_vec2 uv = rt_texture_slot_uv(slot, slot->texcoord == 1 ? sf->uv1 : sf->uv0);
-    return rt_texture_sample(s, slot->texture, uv, srgb);
-}
-
-/* A tangent-space normal map's texel as a unit vector (2c - 1, scaled in x, y). */
-static rt_vec3 normal_texel(rt_vec4 c, float scale)
-{
-    rt_vec3 v = rt_v3((2.0f * c.x - 1.0f) * scale, (2.0f * c.y - 1.0f) * scale, 2.0f * c.z - 1.0f);
-    float l2 = rt_length2(v);
-    return l2 > 1e-12f && isfinite(l2) ? rt_scale(v, 1.0f / sqrtf(l2)) : rt_v3(0.0f, 0.0f, 1.0f);
-}
-
-/* The extensions' factors x textures at a hit (KHR_materials_*), and the
- * anisotropy direction as the frame's x. The factors come from the
- * material (rt_bsdf_ext_of_material), so its defaults are the only ones. */
-static void set_ext_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, const rt_material *m, rt_bsdf *b)
-{
-    const rt_scene *s = ctx->state->scene;
-    rt_bsdf_ext e;
-    bool has;
-    rt_bsdf_ext_of_material(m, &e);
-    e.clearcoat *= ext_sample(s, sf, m, RT_XTEX_CLEARCOAT, false, &has).x;
-    e.clearcoat_roughness *= ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_ROUGHNESS, false, &has).y;
-    /* the tangent frame before the coat's map: sf's (t, b, n) made orthonormal about b->n */
-    rt_vec3 t = rt_sub(sf->t, rt_scale(b->n, rt_dot(sf->t, b->n)));
-    float tl2 = rt_length2(t);
-    bool have_t = tl2 > 1e-12f && isfinite(tl2);
-    if (have_t)
-        t = rt_scale(t, 1.0f / sqrtf(tl2));
-    rt_vec3 bt = rt_cross(b->n, t);
-    if (have_t && rt_dot(bt, sf->b) < 0.0f)
-        bt = rt_neg(bt); /* keep the UV handedness */
-    /* the coat's normal: its own map, else the surface's normal without the
-     * base's normal map (KHR_materials_clearcoat: the coat inherits no
-     * texture of the material below it), in the frame of that normal */
-    if (e.clearcoat > 0.0f) {
-        rt_vec3 cn = b->n, ct = t, cbt = bt;
-        bool have_ct = have_t;
-        if (m->normal_tex.texture != RT_NONE && rt_dot(sf->n_unmapped, sf->wo) > 1e-4f &&
-            rt_finite3(sf->n_unmapped)) {
-            cn = sf->n_unmapped;
-            ct = rt_sub(sf->t, rt_scale(cn, rt_dot(sf->t, cn)));
-            float cl2 = rt_length2(ct);
-            have_ct = cl2 > 1e-12f && isfinite(cl2);
-            if (have_ct)
-                ct = rt_scale(ct, 1.0f / sqrtf(cl2));
-            cbt = rt_cross(cn, ct);
-            if (have_ct && rt_dot(cbt, sf->b) < 0.0f)
-                cbt = rt_neg(cbt);
-            e.clearcoat_normal = rt_bsdf_to_local(b, cn);
-        }
-        if (have_ct) {
-            rt_vec4 c = ext_sample(s, sf, m, RT_XTEX_CLEARCOAT_NORMAL, false, &has);
-            if (has) {
-                rt_vec3 v = normal_texel(c, m->clearcoat_normal_scale);
-                rt_vec3 w = rt_add(rt_add(rt_scale(ct, v.x), rt_scale(cbt, v.y)), rt_scale(cn, v.z));
-                e.clearcoat_normal = rt_bsdf_to_local(b, w);
-            }
-        }
-    }
-    e.spec_weight *= ext_sample(s, sf, m, RT_XTEX_SPECULAR, false, &has).w;
-    rt_vec4 sc = ext_sample(s, sf, m, RT_XTEX_SPECULAR_COLOR, true, &has);
-    e.spec_color = rt_mul(e.spec_color, rt_v3(sc.x, sc.y, sc.z));
-    rt_vec4 sh = ext_sample(s, sf, m, RT_XTEX_SHEEN_COLOR, true, &has);
-    e.sheen_color = rt_mul(e.sheen_color, rt_v3(sh.x, sh.y, sh.z));
-    e.sheen_roughness *= ext_sample(s, sf, m, RT_XTEX_SHEEN_ROUGHNESS, false, &has).w;
-    e.iridescence *= ext_sample(s, sf, m, RT_XTEX_IRIDESCENCE, false, &has).x;
-    rt_vec4 th = ext_sample(s, sf, m, RT_XTEX_IRIDESCENCE_THICKNESS, false, &has);
-    if (has)
-        e.iridescence_thickness = m->iridescence_thickness_min +
-                                  (m->iridescence_thickness_max - m->iridescence_thickness_min) * th.y;
-    e.diffuse_transmission *= ext_sample(s, sf, m, RT_XTEX_DIFFUSE_TRANSMISSION, false, &has).w;
-    rt_vec4 dc = ext_sample(s, sf, m, RT_XTEX_DIFFUSE_TRANSMISSION_COLOR, true, &has);
-    e.diffuse_transmission_color = rt_mul(e.diffuse_transmission_color, rt_v3(dc.x, dc.y, dc.z));
-    /* anisotropy: direction (cos r, sin r) in the tangent frame, or the
-     * texture's (2 RG - 1) rotated by r; strength x texture B */
-    rt_vec4 an = ext_sample(s, sf, m, RT_XTEX_ANISOTROPY, false, &has);
-    if (has)
-        e.anisotropy *= an.z;
-    if (e.anisotropy > 0.0f && have_t) {
-        float dx = has ? 2.0f * an.x - 1.0f : 1.0f, dy = has ? 2.0f * an.y - 1.0f : 0.0f;
-        float cr = cosf(m->anisotropy_rotation), sr = sinf(m->anisotropy_rotation);
-        float x = cr * dx - sr * dy, y = sr * dx + cr * dy;
-        rt_vec3 dir = rt_add(rt_scale(t, x), rt_scale(bt, y));
-        float l2 = rt_length2(dir);
-        if (l2 > 1e-12f && isfinite(l2)) {
-            rt_vec3 cn = rt_bsdf_to_world(b, e.clearcoat_normal); /* keep the coat's normal in world space */
-            b->t = rt_scale(dir, 1.0f / sqrtf(l2));
-            b->b = rt_cross(b->n, b->t);
-            e.clearcoat_normal = rt_bsdf_to_local(b, cn);
-        }
-    }
-    rt_bsdf_set_ext(b, &e);
-}
-
-void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b)
-{
-    const rt_scene *s = ctx->state->scene;
-    RT_DCHECK(sf->material < s->material_count); /* rt_scene_validate */
-    const rt_material *m = &s->materials[sf->material];
-    /* frame: the shading normal, unless wo is not above it (normal maps,
-     * interpolated normals at silhouettes); then the geometric normal */
-    rt_vec3 n = sf->n;
-    if (!(rt_dot(n, sf->wo) > 1e-4f) || !rt_finite3(n))
-        n = sf->ng;
-    set_frame(b, n, sf->ng);
-    if (m->bsdf == RT_BSDF_LAMBERT) { /* base colour x texture x vertex colour, nothing else */
-        if (m->base_color_tex.texture == RT_NONE) { /* rt_surface_base_color's arithmetic, inline */
-            rt_vec4 v = sf->vertex_color;
-            set_lambert(b, rt_v3(m->color.x * v.x, m->color.y * v.y, m->color.z * v.z));
-        } else {
-            rt_vec4 c = rt_surface_base_color(ctx, sf);
-            set_lambert(b, rt_v3(c.x, c.y, c.z));
-        }
-        return;
-    }
-    if (m->bsdf == RT_BSDF_CONDUCTOR) {
-        float roughness = m->roughness;
-        if (m->metal_rough_tex.texture != RT_NONE) {
-            rt_vec2 uv = rt_texture_slot_uv(&m->metal_rough_tex,
-                                            m->metal_rough_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
-            roughness *= rt_texture_sample(s, m->metal_rough_tex.texture, uv, false).y;
-        }
-        float ax = m->alpha_u >= 0.0f ? m->alpha_u : roughness * roughness;
-        float ay = m->alpha_v >= 0.0f ? m->alpha_v : roughness * roughness;
-        if (ax != ay) { /* anisotropic: x along the surface tangent */
-            rt_vec3 t = rt_sub(sf->t, rt_scale(n, rt_dot(sf->t, n)));
-            float l2 = rt_length2(t);
-            if (l2 > 1e-12f && isfinite(l2)) {
-                b->t = rt_scale(t, 1.0f / sqrtf(l2));
-                b->b = rt_cross(n, b->t);
-            }
-        }
-        set_conductor(b, m->eta, m->k, ax, ay, m->smith);
-        if (s->settings.energy_compensation)
-            rt_bsdf_compensate(b);
-        return;
-    }
-    if (m->bsdf == RT_BSDF_DIELECTRIC) {
-        /* eta = n_wo / n_wi: exterior over interior entering the front */
-        float eta = m->exterior_ior / m->ior;
-        float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
-        rt_bsdf_make_dielectric(b, n, sf->front ? eta : 1.0f / eta, alpha);
-        set_frame(b, n, sf->ng);
-        if (s->settings.energy_compensation)
-            rt_bsdf_compensate(b);
-        return;
-    }
-    if (m->bsdf == RT_BSDF_PLASTIC) { /* opaque: the same from either side */
-        rt_vec4 c = rt_surface_base_color(ctx, sf);
-        float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness;
-        rt_bsdf_make_plastic(b, n, rt_v3(c.x, c.y, c.z), m->exterior_ior / m->ior, alpha);
-        set_frame(b, n, sf->ng);
-        return;
-    }
-    rt_vec4 b4 = rt_surface_base_color(ctx, sf);
-    float metallic = m->metallic, roughness = m->roughness, transmission = m->transmission;
-    if (m->metal_rough_tex.texture != RT_NONE) {
-        rt_vec2 uv = rt_texture_slot_uv(&m->metal_rough_tex, m->metal_rough_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
-        rt_vec4 mr = rt_texture_sample(s, m->metal_rough_tex.texture, uv, false);
-        metallic *= mr.z;
-        roughness *= mr.y;
-    }
-    if (transmission > 0.0f && m->transmission_tex.texture != RT_NONE) {
-        rt_vec2 uv = rt_texture_slot_uv(&m->transmission_tex,
-                                        m->transmission_tex.texcoord == 1 ? sf->uv1 : sf->uv0);
-        transmission *= rt_texture_sample(s, m->transmission_tex.texture, uv, false).x;
-    }
-    set_params(b, rt_v3(b4.x, b4.y, b4.z), metallic, roughness, m->ior, transmission, false);
-    if (!sf->front)
-        b->eta = 1.0f / b->eta; /* leaving the object through its back */
-    /* a glTF material without a volume (KHR_materials_volume thickness 0) is thin-walled */
-    b->thin = m->bsdf == RT_BSDF_GLTF && b->transmission > 0.0f && m->thin_walled;
-    if (m->extended && m->bsdf == RT_BSDF_GLTF)
-        set_ext_from_surface(ctx, sf, m, b);
-}
-
 /* Lobe probabilities of the layered glTF BSDF (the extensions' section below). */
 typedef struct layered_probs {
     float d, s, c, t, dt; /* diffuse (with sheen), specular, coat, refraction, diffuse transmission */
@@ -696,36 +313,29 @@ typedef struct layered_probs {
 static layered_probs layered_lobe_probs(const rt_bsdf *b, rt_vec3 wo);
 static rt_vec3 layered_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, const layered_probs *p, float *pdf);
 
-/* The lobe probabilities, with a compensated dielectric's transmitted
- * multiple-scattering lobe apart (*p_ms_transmit; its reflected lobe is
- * the diffuse one). */
-static void lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit,
-                       float *p_ms_transmit)
+/* The conductor's lobes: the specular one, and with compensation the
+ * multiple-scattering lobe, sampled as a diffuse one, by the share of
+ * their albedos at wo. */
+static void conductor_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular)
 {
-    *p_diffuse = *p_specular = *p_transmit = *p_ms_transmit = 0.0f;
-    if (b->layered) {
-        layered_probs p = layered_lobe_probs(b, wo);
-        *p_diffuse = p.d;
-        *p_specular = p.s + p.c;
-        *p_transmit = p.t + p.dt;
-        return;
+    *p_specular = 1.0f;
+    if (b->ms) { /* the lobes' albedos at wo: about F E(mu_o) and F_ms (1 - E(mu_o)) */
+        float e = rt_ggx_albedo(wo.z, b->ms_alpha);
+        float ws = mean3(rt_fresnel_conductor(wo.z, b->eta_c, b->k_c)) * e;
+        float wm = mean3(b->ms_scale) * RT_PI * (1.0f - rt_ggx_albedo_avg(b->ms_alpha)) * (1.0f - e);
+        float pm = (ws + wm > 0.0f) ? wm / (ws + wm) : 0.0f;
+        *p_diffuse = isfinite(pm) ? rt_clampf(pm, 0.0f, 0.95f) : 0.0f;
+        *p_specular = 1.0f - *p_diffuse;
     }
-    if (b->conductor) {
-        *p_specular = 1.0f;
-        if (b->ms) { /* the lobes' albedos at wo: about F E(mu_o) and F_ms (1 - E(mu_o)) */
-            float e = rt_ggx_albedo(wo.z, b->ms_alpha);
-            float ws = mean3(rt_fresnel_conductor(wo.z, b->eta_c, b->k_c)) * e;
-            float wm = mean3(b->ms_scale) * RT_PI * (1.0f - rt_ggx_albedo_avg(b->ms_alpha)) * (1.0f - e);
-            float pm = (ws + wm > 0.0f) ? wm / (ws + wm) : 0.0f;
-            *p_diffuse = isfinite(pm) ? rt_clampf(pm, 0.0f, 0.95f) : 0.0f;
-            *p_specular = 1.0f - *p_diffuse;
-        }
-        return;
-    }
-    if (b->lambert) {
-        *p_diffuse = mean3(b->diffuse) > 0.0f ? 1.0f : 0.0f;
-        return;
-    }
+}
+
+/* The lobes of a dielectric interface over a base (the glTF BSDF, the
+ * dielectric, the plastic): diffuse, specular, refraction, and a
+ * compensated dielectric's transmitted multiple-scattering lobe apart
+ * (*p_ms_transmit; its reflected lobe is the diffuse one). */
+static void dielectric_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular,
+                                  float *p_transmit, float *p_ms_transmit)
+{
     /* F at the macro normal estimates each lobe's share. A delta interface
      * uses it exactly; a rough one floors both shares, so every lobe that
      * can contribute at some microfacet stays sampleable (inside glass past
@@ -734,7 +344,7 @@ static void lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_
     float fd = fresnel_dielectric(b, wo.z);
     rt_vec3 F = fresnel_specular(b, wo.z, fd);
     float ws = mean3(F), td = 1.0f - fd;
-    if (b->plastic) /* the diffuse lobe's albedo: (1 - Fo) diffuse (1 - Fdr_out), about (1 - Fo) diffuse */
+    if (b->kind == RT_BSDF_KIND_PLASTIC) /* the diffuse lobe's albedo: (1 - Fo) diffuse (1 - Fdr_out), about (1 - Fo) diffuse */
         td *= 1.0f - b->f0;
     if (!b->delta) {
         ws = rt_fmaxf(ws, 0.02f);
@@ -759,11 +369,40 @@ static void lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_
     }
 }
 
+
+/* The lobe probabilities by the BSDF's kind, with a compensated
+ * dielectric's transmitted multiple-scattering lobe apart (*p_ms_transmit). */
+static void lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p_specular, float *p_transmit,
+                       float *p_ms_transmit)
+{
+    *p_diffuse = *p_specular = *p_transmit = *p_ms_transmit = 0.0f;
+    switch (b->kind) {
+    case RT_BSDF_KIND_LAMBERT:
+        *p_diffuse = mean3(b->diffuse) > 0.0f ? 1.0f : 0.0f;
+        return;
+    case RT_BSDF_KIND_GLTF_LAYERED: {
+        layered_probs p = layered_lobe_probs(b, wo);
+        *p_diffuse = p.d;
+        *p_specular = p.s + p.c;
+        *p_transmit = p.t + p.dt;
+        return;
+    }
+    case RT_BSDF_KIND_CONDUCTOR:
+        conductor_lobe_probs(b, wo, p_diffuse, p_specular);
+        return;
+    case RT_BSDF_KIND_GLTF:
+    case RT_BSDF_KIND_DIELECTRIC:
+    case RT_BSDF_KIND_PLASTIC:
+        dielectric_lobe_probs(b, wo, p_diffuse, p_specular, p_transmit, p_ms_transmit);
+        return;
+    }
+}
+
 /* lobe_probs, from rt_bsdf_set_wo's cache when it holds this wo (the core
  * BSDF's probabilities depend on wo only through wo.z). */
 static inline void lobe_probs_at(const rt_bsdf *b, rt_vec3 wo, float *pd, float *ps, float *pt, float *ptm)
 {
-    if (wo.z == b->wo_z && !b->layered) {
+    if (wo.z == b->wo_z && b->kind != RT_BSDF_KIND_GLTF_LAYERED) {
         *pd = b->p_d, *ps = b->p_s, *pt = b->p_t, *ptm = b->p_tm;
         return;
     }
@@ -773,7 +412,7 @@ static inline void lobe_probs_at(const rt_bsdf *b, rt_vec3 wo, float *pd, float 
 void rt_bsdf_set_wo(rt_bsdf *b, rt_vec3 wo)
 {
     b->wo_z = NAN;
-    if (b->layered || b->lambert || !(wo.z > 0.0f))
+    if (b->kind == RT_BSDF_KIND_GLTF_LAYERED || b->kind == RT_BSDF_KIND_LAMBERT || !(wo.z > 0.0f))
         return; /* layered: probabilities of the whole wo; Lambert: nothing to cache */
     lobe_probs(b, wo, &b->p_d, &b->p_s, &b->p_t, &b->p_tm);
     b->wo_z = wo.z;
@@ -786,17 +425,13 @@ void rt_bsdf_lobe_probs(const rt_bsdf *b, rt_vec3 wo, float *p_diffuse, float *p
     *p_transmit += ptm;
 }
 
-/* f and pdf of the non-delta lobes, given lobe probabilities. */
-static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, float ps, float *pdf)
+/* The conductor's f and pdf (non-delta lobes), given its lobe probabilities. */
+static rt_vec3 conductor_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, float ps, float *pdf)
 {
     *pdf = 0.0f;
     if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
         return rt_v3s(0.0f);
-    if (b->lambert) {
-        *pdf = pd * wi.z * RT_INV_PI;
-        return rt_scale(b->diffuse, RT_INV_PI);
-    }
-    if (b->conductor && b->delta)
+    if (b->delta)
         return rt_v3s(0.0f);
     rt_vec3 h = rt_add(wo, wi);
     float l2 = rt_length2(h);
@@ -804,26 +439,39 @@ static rt_vec3 eval_lobes(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, fl
         return rt_v3s(0.0f);
     h = rt_scale(h, 1.0f / sqrtf(l2));
     float voh = rt_dot(wo, h);
-    if (b->conductor) {
-        /* F(wo.h) D G2 / (4 cos_o cos_i), VNDF pdf G1(wo) D / (4 cos_o) */
-        float D = d_xy(h, b->alpha, b->alpha_y);
-        float spec = D * g2_xy(wo, wi, b->alpha, b->alpha_y, b->separable) / (4.0f * wo.z * wi.z);
-        float pv = g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
-        if (!isfinite(spec) || !isfinite(pv))
-            return rt_v3s(0.0f);
-        *pdf = ps * pv;
-        rt_vec3 f = rt_scale(rt_fresnel_conductor(voh, b->eta_c, b->k_c), spec);
-        if (b->ms) {
-            float m = (1.0f - rt_ggx_albedo(wo.z, b->ms_alpha)) * (1.0f - rt_ggx_albedo(wi.z, b->ms_alpha));
-            f = rt_add(f, rt_scale(b->ms_scale, m));
-            *pdf += pd * wi.z * RT_INV_PI;
-        }
-        return f;
+    /* F(wo.h) D G2 / (4 cos_o cos_i), VNDF pdf G1(wo) D / (4 cos_o) */
+    float D = rt_ggx_d_xy(h, b->alpha, b->alpha_y);
+    float spec = D * rt_ggx_g2_xy(wo, wi, b->alpha, b->alpha_y, b->separable) / (4.0f * wo.z * wi.z);
+    float pv = rt_ggx_g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
+    if (!isfinite(spec) || !isfinite(pv))
+        return rt_v3s(0.0f);
+    *pdf = ps * pv;
+    rt_vec3 f = rt_scale(rt_fresnel_conductor(voh, b->eta_c, b->k_c), spec);
+    if (b->ms) {
+        float m = (1.0f - rt_ggx_albedo(wo.z, b->ms_alpha)) * (1.0f - rt_ggx_albedo(wi.z, b->ms_alpha));
+        f = rt_add(f, rt_scale(b->ms_scale, m));
+        *pdf += pd * wi.z * RT_INV_PI;
     }
+    return f;
+}
+
+/* The dielectric interface's f and pdf (glTF, dielectric, plastic; the
+ * non-delta lobes), given its lobe probabilities. */
+static rt_vec3 dielectric_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float pd, float ps, float *pdf)
+{
+    *pdf = 0.0f;
+    if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
+        return rt_v3s(0.0f);
+    rt_vec3 h = rt_add(wo, wi);
+    float l2 = rt_length2(h);
+    if (!(l2 > 1e-20f)) /* opposite directions: both grazing */
+        return rt_v3s(0.0f);
+    h = rt_scale(h, 1.0f / sqrtf(l2));
+    float voh = rt_dot(wo, h);
     float fd = fresnel_dielectric(b, voh);
     /* diffuse: the dielectric's fresnel_mix leaves 1 - Fd to the base;
      * under a plastic's coat, what enters at wi and leaves at wo */
-    float tdiff = b->plastic ? (1.0f - fresnel_dielectric(b, wo.z)) * (1.0f - fresnel_dielectric(b, wi.z))
+    float tdiff = b->kind == RT_BSDF_KIND_PLASTIC ? (1.0f - fresnel_dielectric(b, wo.z)) * (1.0f - fresnel_dielectric(b, wi.z))
                              : (1.0f - fd) * (1.0f - b->transmission);
     rt_vec3 f = rt_scale(b->diffuse, tdiff * RT_INV_PI);
     float p = pd * wi.z * RT_INV_PI;
@@ -854,22 +502,29 @@ static inline float lambert_prob(const rt_bsdf *b) { return mean3(b->diffuse) > 
 
 rt_vec3 rt_bsdf_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, float *pdf)
 {
-    if (b->lambert) { /* eval_lobes' Lambert case, without the other lobes' bookkeeping */
-        float dummy_p, *p = pdf ? pdf : &dummy_p;
+    float dummy, *p = pdf ? pdf : &dummy;
+    float pd, ps, pt, ptm;
+    switch (b->kind) {
+    case RT_BSDF_KIND_LAMBERT: /* one cosine lobe, without the other lobes' bookkeeping */
         *p = 0.0f;
         if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
             return rt_v3s(0.0f);
         *p = lambert_prob(b) * wi.z * RT_INV_PI;
         return rt_scale(b->diffuse, RT_INV_PI);
+    case RT_BSDF_KIND_GLTF_LAYERED: {
+        layered_probs lp = layered_lobe_probs(b, wo);
+        return layered_eval(b, wo, wi, &lp, p);
     }
-    if (b->layered) {
-        float dummy_l;
-        layered_probs p = layered_lobe_probs(b, wo);
-        return layered_eval(b, wo, wi, &p, pdf ? pdf : &dummy_l);
+    case RT_BSDF_KIND_CONDUCTOR:
+        lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
+        return conductor_eval(b, wo, wi, pd, ps, p);
+    case RT_BSDF_KIND_GLTF:
+    case RT_BSDF_KIND_DIELECTRIC:
+    case RT_BSDF_KIND_PLASTIC:
+        lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
+        return dielectric_eval(b, wo, wi, pd, ps, p);
     }
-    float pd, ps, pt, ptm, dummy;
-    lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
-    return eval_lobes(b, wo, wi, pd, ps, pdf ? pdf : &dummy);
+    return rt_v3s(0.0f);
 }
 
 static bool delta_sample(rt_bsdf_sample *s, rt_vec3 wi, rt_vec3 w)
@@ -907,10 +562,10 @@ static bool thin_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, rt_vec3 c, fl
  * The glTF material with the PBR-next extensions, as the extensions
  * define its layers (docs/shading.md, "Extension layering"):
  *
- *   Fd   = spec_weight schlick(min(F0 spec_color, 1), v.h)      KHR_materials_specular
+ *   Fd   = spec_weight rt_fresnel_schlick(min(F0 spec_color, 1), v.h)      KHR_materials_specular
  *          (the exact Fresnel times spec_color for a transmissive surface),
  *          mixed with the thin film's Fresnel by the iridescence factor
- *   Fm   = schlick(B, v.h), mixed with the film's Fresnel the same way
+ *   Fm   = rt_fresnel_schlick(B, v.h), mixed with the film's Fresnel the same way
  *   base = (1 - m)(1 - max3(Fd)) ((1 - T)(1 - dt) B / pi + ...) + lerp(Fd, Fm, m) D V
  *          with D, V anisotropic GGX (alpha along t = mix(alpha, 1, s^2))
  *   sheen_layer = sheen f_sheen + base (1 - max3(sheen) max(E(wo), E(wi)))
@@ -920,31 +575,6 @@ static bool thin_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, rt_vec3 c, fl
  * directions, so f stays reciprocal (the extensions' non-normative
  * shading uses wo only). Diffuse transmission (dt) and the refraction lobe
  * are sampled only (delta samples), as transmission is. */
-
-void rt_bsdf_ext_of_material(const rt_material *m, rt_bsdf_ext *e)
-{
-    e->spec_weight = m->specular_weight;
-    e->spec_color = m->specular_color;
-    e->clearcoat = m->clearcoat;
-    e->clearcoat_roughness = m->clearcoat_roughness;
-    e->clearcoat_normal = rt_v3(0.0f, 0.0f, 1.0f); /* the shading normal: a coat without a map of its own */
-    e->sheen_color = m->sheen_color;
-    e->sheen_roughness = m->sheen_roughness;
-    e->anisotropy = m->anisotropy;
-    e->iridescence = m->iridescence;
-    e->iridescence_ior = m->iridescence_ior;
-    e->iridescence_thickness = m->iridescence_thickness_max; /* without a thickness texture: the maximum */
-    e->diffuse_transmission = m->diffuse_transmission;
-    e->diffuse_transmission_color = m->diffuse_transmission_color;
-    e->dispersion = m->thin_walled ? 0.0f : m->dispersion; /* a thin wall does not bend light */
-}
-
-void rt_bsdf_ext_default(rt_bsdf_ext *e)
-{
-    rt_material m;
-    rt_material_default(&m, NULL);
-    rt_bsdf_ext_of_material(&m, e);
-}
 
 /* KHR_materials_dispersion: the index at wavelength lambda (nm) from the
  * index n_d at 587.6 nm and the Abbe number V = 20 / dispersion, Cauchy's
@@ -961,7 +591,7 @@ static float clamp01(float x) { return isfinite(x) ? rt_clampf(x, 0.0f, 1.0f) : 
 void rt_bsdf_set_ext(rt_bsdf *b, const rt_bsdf_ext *e)
 {
     b->wo_z = NAN;
-    if (b->lambert || b->conductor || b->plastic || b->radiance_eta2)
+    if (b->kind != RT_BSDF_KIND_GLTF && b->kind != RT_BSDF_KIND_GLTF_LAYERED)
         return; /* the extensions extend the glTF BSDF only */
     b->spec_weight = clamp01(e->spec_weight);
     b->spec_color = rt_finite3(e->spec_color) ? rt_vmax(e->spec_color, rt_v3s(0.0f)) : rt_v3s(1.0f);
@@ -1007,9 +637,10 @@ void rt_bsdf_set_ext(rt_bsdf *b, const rt_bsdf_ext *e)
         b->eta_rgb = rt_v3(n[0], n[1], n[2]);
         b->dispersive = true;
     }
-    b->layered = b->dispersive || b->spec_weight != 1.0f || b->spec_color.x != 1.0f || b->spec_color.y != 1.0f ||
+    bool layered = b->dispersive || b->spec_weight != 1.0f || b->spec_color.x != 1.0f || b->spec_color.y != 1.0f ||
                  b->spec_color.z != 1.0f || b->clearcoat > 0.0f || rt_max3(b->sheen) > 0.0f || s > 0.0f ||
                  b->iridescence > 0.0f || b->diffuse_transmission > 0.0f;
+    b->kind = layered ? RT_BSDF_KIND_GLTF_LAYERED : RT_BSDF_KIND_GLTF;
 }
 
 static inline rt_vec3 to_coat(const rt_bsdf *b, rt_vec3 w)
@@ -1027,8 +658,8 @@ static rt_vec3 layered_fresnel(const rt_bsdf *b, float c, float *fd_max)
     if (b->transmission > 0.0f)
         fd = rt_vmin(rt_scale(b->spec_color, rt_fresnel_exact(c, b->eta)), rt_v3s(1.0f));
     else
-        fd = schlick(f0, c);
-    rt_vec3 fm = b->metallic > 0.0f ? schlick(b->base, c) : rt_v3s(0.0f);
+        fd = rt_fresnel_schlick(f0, c);
+    rt_vec3 fm = b->metallic > 0.0f ? rt_fresnel_schlick(b->base, c) : rt_v3s(0.0f);
     if (b->iridescence > 0.0f) {
         rt_vec3 fi = rt_iridescence_fresnel(1.0f, b->irid_ior, f0, b->irid_thickness, c);
         fd = rt_lerp3(fd, rt_vmin(fi, rt_v3s(1.0f)), b->iridescence);
@@ -1105,11 +736,11 @@ static rt_vec3 layered_eval(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi, const laye
     rt_vec3 f = rt_scale(b->diffuse, tdiff * RT_INV_PI);
     float pr = p->d * wi.z * RT_INV_PI;
     if (!b->delta) {
-        float D = d_xy(h, b->alpha, b->alpha_y);
-        float spec = D * g2_xy(wo, wi, b->alpha, b->alpha_y, false) / (4.0f * wo.z * wi.z);
+        float D = rt_ggx_d_xy(h, b->alpha, b->alpha_y);
+        float spec = D * rt_ggx_g2_xy(wo, wi, b->alpha, b->alpha_y, false) / (4.0f * wo.z * wi.z);
         if (isfinite(spec))
             f = rt_add(f, rt_scale(F, spec));
-        float pv = g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
+        float pv = rt_ggx_g1_xy(wo, b->alpha, b->alpha_y) * D / (4.0f * wo.z);
         if (p->s > 0.0f && isfinite(pv))
             pr += p->s * pv;
     }
@@ -1217,7 +848,7 @@ static bool layered_sample(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe,
     if (ulobe < p.d || (b->delta && ulobe < p.d + p.s)) {
         wi = rt_sample_cosine_hemisphere(u);
     } else if (ulobe < p.d + p.s) {
-        rt_vec3 h = vndf_xy(wo, b->alpha, b->alpha_y, u);
+        rt_vec3 h = rt_ggx_sample_vndf_xy(wo, b->alpha, b->alpha_y, u);
         wi = rt_sub(rt_scale(h, 2.0f * rt_dot(wo, h)), wo);
     } else {
         rt_vec3 wc = rt_clearcoat_sample(co, b->cc_alpha, u);
@@ -1231,23 +862,48 @@ static bool layered_sample(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe,
     return finish_sample(wi, f, pdf, s);
 }
 
-bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
+/* Lambert: the general path's steps for one cosine lobe of probability 1. */
+static bool lambert_sample(const rt_bsdf *b, rt_vec2 u, rt_bsdf_sample *s)
 {
-    if (!(wo.z > 0.0f))
+    if (!(lambert_prob(b) > 0.0f))
         return false;
-    if (b->lambert) { /* the general path's steps for one cosine lobe of probability 1 */
-        if (!(lambert_prob(b) > 0.0f))
-            return false;
-        rt_vec3 wi = rt_sample_cosine_hemisphere(u);
-        if (!(wi.z > 0.0f) || !rt_finite3(wi))
-            return false;
-        wi = rt_normalize(wi);
-        if (!(wi.z > 0.0f))
-            return false; /* eval_lobes' test */
-        return finish_sample(wi, rt_scale(b->diffuse, RT_INV_PI), 1.0f * wi.z * RT_INV_PI, s);
+    rt_vec3 wi = rt_sample_cosine_hemisphere(u);
+    if (!(wi.z > 0.0f) || !rt_finite3(wi))
+        return false;
+    wi = rt_normalize(wi);
+    if (!(wi.z > 0.0f))
+        return false; /* eval_lobes' test */
+    return finish_sample(wi, rt_scale(b->diffuse, RT_INV_PI), 1.0f * wi.z * RT_INV_PI, s);
+}
+
+static bool conductor_sample(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
+{
+    float pd, ps, pt, ptm;
+    lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
+    if (!(pd + ps + pt + ptm > 0.0f))
+        return false;
+    if (b->delta)
+        return delta_sample(s, rt_v3(-wo.x, -wo.y, wo.z), rt_fresnel_conductor(wo.z, b->eta_c, b->k_c));
+    rt_vec3 wi;
+    if (ulobe < pd || !(ps > 0.0f)) {
+        wi = rt_sample_cosine_hemisphere(u);
+    } else {
+        rt_vec3 h = rt_ggx_sample_vndf_xy(wo, b->alpha, b->alpha_y, u);
+        wi = rt_sub(rt_scale(h, 2.0f * rt_dot(wo, h)), wo);
     }
-    if (b->layered)
-        return layered_sample(b, wo, u, ulobe, s);
+    if (!(wi.z > 0.0f) || !rt_finite3(wi))
+        return false;
+    wi = rt_normalize(wi);
+    float pdf;
+    rt_vec3 f = conductor_eval(b, wo, wi, pd, ps, &pdf);
+    return finish_sample(wi, f, pdf, s);
+}
+
+/* The dielectric interface (glTF, dielectric, plastic): its compensation's
+ * transmitted lobe, refraction (thin or bending), a delta mirror, or the
+ * diffuse and specular lobes. */
+static bool dielectric_sample(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
+{
     float pd, ps, pt, ptm;
     lobe_probs_at(b, wo, &pd, &ps, &pt, &ptm);
     if (!(pd + ps + pt + ptm > 0.0f))
@@ -1282,27 +938,44 @@ bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt
         wi = rt_normalize(wi);
         float fd = fresnel_dielectric(b, ci);
         float g = b->delta ? 1.0f : rt_ggx_g2(wo, wi, b->alpha) / rt_ggx_g1(wo, b->alpha);
-        float scale = b->radiance_eta2 ? eta * eta : 1.0f; /* L / n^2 is invariant */
+        float scale = b->kind == RT_BSDF_KIND_DIELECTRIC ? eta * eta : 1.0f; /* L / n^2 is invariant */
         return delta_sample(s, wi, rt_scale(b->diffuse, (1.0f - fd) * g * b->transmission * scale / pt));
     }
-    if (b->conductor && b->delta)
-        return delta_sample(s, rt_v3(-wo.x, -wo.y, wo.z), rt_fresnel_conductor(wo.z, b->eta_c, b->k_c));
     if (b->delta && ps > 0.0f && ulobe >= pd) {
         /* mirror reflection about the normal: weight F / (its probability) */
         float fd = fresnel_dielectric(b, wo.z);
         return delta_sample(s, rt_v3(-wo.x, -wo.y, wo.z), rt_scale(fresnel_specular(b, wo.z, fd), 1.0f / ps));
     }
     rt_vec3 wi;
-    if (ulobe < pd || b->lambert || b->delta || !(ps > 0.0f)) {
+    if (ulobe < pd || b->delta || !(ps > 0.0f)) {
         wi = rt_sample_cosine_hemisphere(u);
     } else {
-        rt_vec3 h = vndf_xy(wo, b->alpha, b->alpha_y, u);
+        rt_vec3 h = rt_ggx_sample_vndf_xy(wo, b->alpha, b->alpha_y, u);
         wi = rt_sub(rt_scale(h, 2.0f * rt_dot(wo, h)), wo);
     }
     if (!(wi.z > 0.0f) || !rt_finite3(wi))
         return false;
     wi = rt_normalize(wi);
     float pdf;
-    rt_vec3 f = eval_lobes(b, wo, wi, pd, ps, &pdf);
+    rt_vec3 f = dielectric_eval(b, wo, wi, pd, ps, &pdf);
     return finish_sample(wi, f, pdf, s);
+}
+
+bool rt_bsdf_sample_dir(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_bsdf_sample *s)
+{
+    if (!(wo.z > 0.0f))
+        return false;
+    switch (b->kind) {
+    case RT_BSDF_KIND_LAMBERT:
+        return lambert_sample(b, u, s);
+    case RT_BSDF_KIND_GLTF_LAYERED:
+        return layered_sample(b, wo, u, ulobe, s);
+    case RT_BSDF_KIND_CONDUCTOR:
+        return conductor_sample(b, wo, u, ulobe, s);
+    case RT_BSDF_KIND_GLTF:
+    case RT_BSDF_KIND_DIELECTRIC:
+    case RT_BSDF_KIND_PLASTIC:
+        return dielectric_sample(b, wo, u, ulobe, s);
+    }
+    return false;
 }

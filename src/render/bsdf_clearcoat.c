@@ -8,13 +8,13 @@
  * specular_brdf (GGX D, height-correlated Smith V). The Fresnel is taken at
  * the microfacet (wo.h) inside the lobe, as appendix B's fresnel_mix does,
  * which keeps the lobe reciprocal; the layers below are scaled by what the
- * coat transmits at the macro normal (bsdf.c). GGX helpers: rt/render/bsdf.h.
+ * coat transmits at the macro normal (bsdf.c). GGX helpers: rt/render/microfacet.h.
  */
 #include "rt/render/bsdf_clearcoat.h"
 
 #include <math.h>
 
-#include "rt/render/bsdf.h"
+#include "rt/render/microfacet.h"
 
 float rt_clearcoat_fresnel(float cos_t)
 {

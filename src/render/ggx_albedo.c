@@ -10,7 +10,9 @@
  */
 #include "rt/render/ggx_albedo.h"
 
-#include "rt/render/bsdf.h"
+#include "rt/render/microfacet.h"
+
+#include "ggx_albedo_table.h"
 
 float rt_ggx_albedo(float mu, float alpha)
 {

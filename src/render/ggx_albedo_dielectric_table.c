@@ -6,7 +6,7 @@
  * E_avg(alpha, eta) = 2 int E mu dmu [side][r][alpha]; M(alpha, r) [r][alpha], the
  * multiple-scattering flux crossing from the thin side under uniform light. Used by
  * rt/render/ggx_albedo.h for Kulla and Conty's (2017) energy compensation of bsdf dielectric. */
-#include "rt/render/ggx_albedo.h"
+#include "ggx_albedo_table.h"
 
 const float rt_ggx_dielectric_table[2][RT_GGX_DIELECTRIC_NR][RT_GGX_ALBEDO_N][RT_GGX_ALBEDO_N] = {
   {

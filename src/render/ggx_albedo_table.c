@@ -3,7 +3,7 @@
  * F = 1, height-correlated Smith, at mu = (i + 1/2) / 32 (columns) and alpha = j / 31
  * (rows); E_avg(alpha) = 2 int E(mu) mu dmu. Used by rt/render/ggx_albedo.h
  * for Kulla and Conty's (2017) energy compensation. */
-#include "rt/render/ggx_albedo.h"
+#include "ggx_albedo_table.h"
 
 const float rt_ggx_albedo_table[RT_GGX_ALBEDO_N][RT_GGX_ALBEDO_N] = {
     {1.000000f, 1.000000f, 1.000000f, 1.000000f, 1.000000f, 1.000000f, 1.000000f, 1.000000f,

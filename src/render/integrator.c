@@ -13,19 +13,23 @@
 
 /* One line an integrator: id, name, radiance function, what it needs
  * prepared, samples per pixel in each of rt_render's passes (0 = tile by
- * tile; rt/render/render.h says why direct and whitted stay tiled), and
- * whether rt_render runs it as a wavefront of paths (rt/render/wavefront.h:
- * the same radiance as the function, batch by batch). The built-in ids
- * (rt_integrator in rt/scene/scene.h) are pinned to their lines; a new
- * integrator takes the next number. */
+ * tile; rt/render/render.h says why direct and whitted stay tiled), whether
+ * rt_render runs it as a wavefront of paths (rt/render/wavefront.h: the
+ * same radiance as the function, batch by batch), whether the camera takes
+ * its film and lens samples from the `sampler` setting (else from correlated
+ * multi-jittering), whether it traces a tree of diffuse_rays ^
+ * diffuse_bounces rays per camera sample (rt_render_check_limits bounds it),
+ * and whether it is the one a bare model gets (rt_integrator_for_models).
+ * The built-in ids (rt_integrator in rt/scene/scene.h) are pinned to their
+ * lines; a new integrator takes the next number. */
 #define INTEGRATORS(X)                                                                                                 \
-    X(RT_INTEGRATOR_DIRECT, "direct", rt_radiance_direct, 0, 0, false)                                                 \
-    X(RT_INTEGRATOR_WHITTED, "whitted", rt_radiance_whitted, 0, 0, false)                                              \
-    X(RT_INTEGRATOR_PATH, "path", rt_radiance_path, RT_PREPARE_LIGHT_TABLE, 4, true)                                   \
-    X(RT_INTEGRATOR_PATH_SCALAR, "path_scalar", rt_radiance_path, RT_PREPARE_LIGHT_TABLE, 4, false)
+    X(RT_INTEGRATOR_DIRECT, "direct", rt_radiance_direct, 0, 0, false, false, false, false)                            \
+    X(RT_INTEGRATOR_WHITTED, "whitted", rt_radiance_whitted, 0, 0, false, false, true, false)                          \
+    X(RT_INTEGRATOR_PATH, "path", rt_radiance_path, RT_PREPARE_LIGHT_TABLE, 4, true, true, false, true)                \
+    X(RT_INTEGRATOR_PATH_SCALAR, "path_scalar", rt_radiance_path, RT_PREPARE_LIGHT_TABLE, 4, false, true, false, false)
 
-#define AS_INFO(id, name, fn, prepare, pass, wave) [id] = {name, fn, prepare, pass, wave},
-#define AS_WORD(id, name, fn, prepare, pass, wave) [id] = name,
+#define AS_INFO(id, name, fn, prepare, pass, wave, film, tree, models) [id] = {name, fn, prepare, pass, wave, film, tree, models},
+#define AS_WORD(id, name, fn, prepare, pass, wave, film, tree, models) [id] = name,
 static const rt_integrator_info integrators[] = {INTEGRATORS(AS_INFO)};
 const char *const rt_integrator_words[] = {INTEGRATORS(AS_WORD) NULL};
 #undef AS_INFO
@@ -41,6 +45,14 @@ size_t rt_integrator_count(void)
 const rt_integrator_info *rt_integrator_info_of(rt_integrator id)
 {
     return (size_t)id < INTEGRATOR_COUNT ? &integrators[id] : NULL;
+}
+
+rt_integrator rt_integrator_for_models(void)
+{
+    for (size_t i = 0; i < INTEGRATOR_COUNT; i++)
+        if (integrators[i].for_models)
+            return (rt_integrator)i;
+    return RT_INTEGRATOR_DIRECT;
 }
 
 bool rt_integrator_by_name(const char *name, rt_integrator *id)

@@ -7,7 +7,8 @@
 #include "rt/accel/kdtree.h"
 #include "rt/base/log.h"
 #include "rt/render/camera.h"
-#include "rt/scene/settings.h"
+#include "rt/render/integrator.h"
+#include "rt/render/settings.h"
 
 /* The kd-tree's primitive ids are the 30 payload bits of its references
  * (RT_KD_PAYLOAD), one value kept free. */
@@ -23,7 +24,8 @@ rt_result rt_render_check_limits(const rt_scene *s, const char *name, bool camer
     rt_setting_problem pb;
     if (rt_settings_check(set, &pb) != RT_OK)
         return rt_fail(err, RT_ERR_LIMIT, "%s: %s", name, pb.message);
-    if (set->integrator == RT_INTEGRATOR_WHITTED && set->diffuse_bounces > 0 && set->diffuse_rays > 1) {
+    const rt_integrator_info *in = rt_integrator_info_of(set->integrator);
+    if (in && in->diffuse_tree && set->diffuse_bounces > 0 && set->diffuse_rays > 1) {
         double rays = 1.0;
         for (int i = 0; i < set->diffuse_bounces && rays <= RT_MAX_DIFFUSE_TREE; i++)
             rays *= (double)set->diffuse_rays;

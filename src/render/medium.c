@@ -13,7 +13,7 @@
  */
 #include "rt/render/medium.h"
 
-#include "rt/render/bsdf.h"
+#include "rt/render/material_eval.h"
 
 void rt_medium_stack_init(rt_medium_stack *st) { st->depth = 0; }
 

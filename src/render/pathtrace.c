@@ -379,7 +379,7 @@ rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, 
         rt_bsdf_set_eta(b, sf->front ? eta : 1.0f / eta);
     }
     *wo = rt_bsdf_to_local(b, sf->wo);
-    if (!b->lambert) /* (Lambert has nothing to cache) */
+    if (b->kind != RT_BSDF_KIND_LAMBERT) /* (Lambert has nothing to cache) */
         rt_bsdf_set_wo(b, *wo); /* the light samples and the next direction share wo */
     return wo->z > 0.0f ? RT_VERTEX_SHADE : RT_VERTEX_STOP;
 }
@@ -400,7 +400,7 @@ bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_sur
     float ulobe = 0.0f;
     if (!stratified) {
         ulobe = rt_rng_float(rng);
-    } else if (b->layered || !b->lambert) {
+    } else if (b->kind != RT_BSDF_KIND_LAMBERT) {
         ulr = path_2d_of(ctx, ps, rng, lr_bounce, DIM_LOBE_RR);
         have_lr = true;
         ulobe = ulr.x;
@@ -419,7 +419,7 @@ bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_sur
         return false;
     if (bs.wi.z < 0.0f) { /* transmitted: into or out of the medium */
         rt_medium_cross(&ps->media, ctx->state->scene->materials, sf->material, sf->front);
-        if (b->radiance_eta2 && !b->thin) /* the weight held (n_i / n_t)^2 = b->eta^2: undo it for the roulette */
+        if (b->kind == RT_BSDF_KIND_DIELECTRIC && !b->thin) /* the weight held (n_i / n_t)^2 = b->eta^2: undo it for the roulette */
             ps->eta_scale /= b->eta * b->eta;
     }
     ps->prev_delta = bs.delta;

@@ -89,33 +89,6 @@ typedef struct worker {
  * chunks, and the radiance buffer is WAVE_CHUNK x 12 bytes a worker. */
 enum { WAVE_CHUNK = 16384 };
 
-/* The pixel's AOVs: means over its `good` samples; the variance of the mean
- * luminance from the sample variance, sum of L^2 - (sum L)^2 / n over n - 1.
- * Reads the accumulated sums only, so it may run after every pass. */
-static void aov_store(rt_aov_buffers *aov, size_t pixel, const rt_aov_sample *s, uint32_t good, float lum_sum,
-                      double lum_sq)
-{
-    float inv = good ? 1.0f / (float)good : 0.0f;
-    const rt_vec3 *v3[3] = {&s->albedo, &s->normal, &s->position};
-    float *dst3[3] = {aov->albedo, aov->normal, aov->position};
-    for (int k = 0; k < 3; k++)
-        if (dst3[k]) {
-            dst3[k][3 * pixel] = v3[k]->x * inv;
-            dst3[k][3 * pixel + 1] = v3[k]->y * inv;
-            dst3[k][3 * pixel + 2] = v3[k]->z * inv;
-        }
-    if (aov->depth)
-        aov->depth[pixel] = s->depth * inv;
-    if (aov->spp)
-        aov->spp[pixel] = (float)good;
-    if (aov->variance) {
-        double n = (double)good, var = 0.0;
-        if (good > 1)
-            var = (lum_sq - (double)lum_sum * (double)lum_sum / n) / (n - 1.0) / n;
-        aov->variance[pixel] = (float)(var > 0.0 ? var : 0.0);
-    }
-}
-
 /* A pixel's running sum: the fold of its finished sample blocks, the sum of
  * the current block's good samples, and how many samples were good. */
 typedef struct pixel_sum {
@@ -138,7 +111,7 @@ static void fold_block(const rt_render_job *job, size_t local, uint32_t s, pixel
             k[2] = p->block.z;
         }
     }
-    p->fold = rt_add(p->fold, p->block);
+    p->fold = rt_sample_fold(p->fold, p->block);
     p->block = rt_v3s(0);
 }
 
@@ -200,13 +173,7 @@ static inline void add_samples(const rt_render_job *job, worker *w, rt_trace_ctx
  * alone, exactly, when that block is still empty of samples). */
 static inline rt_vec3 pixel_total(const pixel_sum *p)
 {
-    return rt_add(p->fold, p->block);
-}
-
-/* The pixel value of a sum of `good` samples. */
-static inline rt_vec3 resolve(rt_vec3 sum, uint32_t good)
-{
-    return good ? rt_scale(sum, 1.0f / (float)good) : sum;
+    return rt_sample_fold(p->fold, p->block);
 }
 
 /* Tile `tile` of the region, in the region's (fb's) coordinates. */
@@ -264,8 +231,8 @@ static void pixel_end(rt_render_job *job, size_t pixel, const pixel_sum *p)
     rt_vec3 sum = pixel_total(p);
     uint32_t good = p->good;
     if (job->aov)
-        aov_store(job->aov, pixel, &job->aov_sum[pixel], good, rt_luminance(sum), job->lum_sq[pixel]);
-    sum = resolve(sum, good);
+        rt_aov_resolve(job->aov, pixel, &job->aov_sum[pixel], good, rt_luminance(sum), job->lum_sq[pixel]);
+    sum = rt_sample_resolve(sum, good);
     float *px = job->fb->rgb + 3 * pixel;
     px[0] = sum.x;
     px[1] = sum.y;
@@ -464,8 +431,8 @@ static void resolve_image(rt_render_job *job)
         pixel_sum p = {load3(job->sum + 3 * k), load3(job->block + 3 * k), job->good[k]};
         rt_vec3 sum = pixel_total(&p);
         if (job->aov)
-            aov_store(job->aov, k, &job->aov_sum[k], p.good, rt_luminance(sum), job->lum_sq[k]);
-        rt_vec3 v = resolve(sum, p.good);
+            rt_aov_resolve(job->aov, k, &job->aov_sum[k], p.good, rt_luminance(sum), job->lum_sq[k]);
+        rt_vec3 v = rt_sample_resolve(sum, p.good);
         float *px = job->fb->rgb + 3 * k;
         px[0] = v.x;
         px[1] = v.y;
@@ -488,18 +455,13 @@ static void free_job(rt_render_job *job, worker *workers, int nthreads)
     free(workers);
 }
 
-rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_render_options *options,
-                    rt_framebuffer *fb, rt_render_stats *stats, rt_error *err)
+/* The request checked: the region (the whole image when zero) inside the
+ * image, fb its size, the caller's sums complete, the integrator known. */
+static rt_result check_request(const rt_scene *scene, const rt_render_options *opt, const rt_framebuffer *fb,
+                               rt_render_region *region, const rt_integrator_info **integrator, rt_error *err)
 {
-    rt_render_options opt;
-    memset(&opt, 0, sizeof opt);
-    if (options)
-        opt = *options;
-    rt_render_stats st;
-    memset(&st, 0, sizeof st);
     const rt_settings *set = &scene->settings;
-    RT_DCHECK(rt_scene_validate(scene, NULL) == RT_OK);
-    rt_render_region reg = opt.region;
+    rt_render_region reg = opt->region;
     if (reg.x0 == 0 && reg.y0 == 0 && reg.x1 == 0 && reg.y1 == 0)
         reg = (rt_render_region){0, 0, set->width, set->height};
     if (reg.x0 < 0 || reg.y0 < 0 || reg.x1 > set->width || reg.y1 > set->height || reg.x0 >= reg.x1 ||
@@ -509,97 +471,219 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     if (fb->width != reg.x1 - reg.x0 || fb->height != reg.y1 - reg.y0 || !fb->rgb)
         return rt_fail(err, RT_ERR_INVALID, "framebuffer is %dx%d but the region rendered is %dx%d", fb->width,
                        fb->height, reg.x1 - reg.x0, reg.y1 - reg.y0);
-    if (opt.accum && (!opt.accum->sum || !opt.accum->block || !opt.accum->good ||
-                      (opt.accum->kept && (opt.accum->kept_first < 0 || opt.accum->kept_count < 0))))
+    if (opt->accum && (!opt->accum->sum || !opt->accum->block || !opt->accum->good ||
+                       (opt->accum->kept && (opt->accum->kept_first < 0 || opt->accum->kept_count < 0))))
         return rt_fail(err, RT_ERR_INVALID, "the caller's sums (opt.accum) need sum, block and good arrays");
-    const rt_integrator_info *integrator = rt_integrator_info_of(set->integrator);
-    if (!integrator)
+    *integrator = rt_integrator_info_of(set->integrator);
+    if (!*integrator)
         return rt_fail(err, RT_ERR_INVALID, "integrator %d is not one of the %zu rt knows", (int)set->integrator,
                        rt_integrator_count());
+    *region = reg;
+    return RT_OK;
+}
 
-    rt_render_job job;
-    memset(&job, 0, sizeof job);
-    job.scene = scene;
-    job.fb = fb;
-    job.cancel = opt.cancel;
-    job.spp = set->samples > 0 ? (uint32_t)set->samples : 1;
-    job.s_begin = (uint32_t)(opt.sample_begin > 0 ? opt.sample_begin : 0);
-    job.s_end = opt.sample_end > 0 ? (uint32_t)opt.sample_end : job.spp;
-    if (job.s_end > job.spp || job.s_begin >= job.s_end)
+/* The job's plan: samples, region, camera, tiles; *pass_samples is the
+ * samples a pass (<= 0: tiles). */
+static rt_result plan_job(rt_render_job *job, const rt_scene *scene, const rt_render_options *opt,
+                          rt_render_region reg, const rt_integrator_info *integrator, rt_framebuffer *fb,
+                          int *pass_samples, rt_error *err)
+{
+    const rt_settings *set = &scene->settings;
+    memset(job, 0, sizeof *job);
+    job->scene = scene;
+    job->fb = fb;
+    job->cancel = opt->cancel;
+    job->spp = set->samples > 0 ? (uint32_t)set->samples : 1;
+    job->s_begin = (uint32_t)(opt->sample_begin > 0 ? opt->sample_begin : 0);
+    job->s_end = opt->sample_end > 0 ? (uint32_t)opt->sample_end : job->spp;
+    if (job->s_end > job->spp || job->s_begin >= job->s_end)
         return rt_fail(err, RT_ERR_INVALID, "sample range %u:%u is not inside the %u samples per pixel",
-                       job.s_begin, job.s_end, job.spp);
-    job.width = set->width;
-    job.height = set->height;
-    job.rx0 = reg.x0;
-    job.ry0 = reg.y0;
-    job.rw = reg.x1 - reg.x0;
-    job.rh = reg.y1 - reg.y0;
-    job.accum = opt.accum;
-    int pass_samples = opt.pass_samples != 0 ? opt.pass_samples : integrator->pass_samples;
-    job.passes = pass_samples > 0;
-    rt_camera_frame_init(&job.camera, &scene->camera, set->width, set->height);
-    if (set->integrator == RT_INTEGRATOR_PATH || set->integrator == RT_INTEGRATOR_PATH_SCALAR)
-        job.camera.sampler = (rt_sampler_kind)set->sampler; /* the path tracer's film and lens: its sampler's */
-    job.tile_size = opt.tile_size > 0 ? (opt.tile_size < 65536 ? opt.tile_size : 65536) : 32;
-    job.tiles_x = (int)(((int64_t)job.rw + job.tile_size - 1) / job.tile_size);
-    job.tiles_y = (int)(((int64_t)job.rh + job.tile_size - 1) / job.tile_size);
-    if ((int64_t)job.tiles_x * job.tiles_y > (int64_t)(1 << 26))
+                       job->s_begin, job->s_end, job->spp);
+    job->width = set->width;
+    job->height = set->height;
+    job->rx0 = reg.x0;
+    job->ry0 = reg.y0;
+    job->rw = reg.x1 - reg.x0;
+    job->rh = reg.y1 - reg.y0;
+    job->accum = opt->accum;
+    *pass_samples = opt->pass_samples != 0 ? opt->pass_samples : integrator->pass_samples;
+    job->passes = *pass_samples > 0;
+    rt_camera_frame_init(&job->camera, &scene->camera, set->width, set->height);
+    if (integrator->film_sampler)
+        job->camera.sampler = (rt_sampler_kind)set->sampler; /* the path tracer's film and lens: its sampler's */
+    job->tile_size = opt->tile_size > 0 ? (opt->tile_size < 65536 ? opt->tile_size : 65536) : 32;
+    job->tiles_x = (int)(((int64_t)job->rw + job->tile_size - 1) / job->tile_size);
+    job->tiles_y = (int)(((int64_t)job->rh + job->tile_size - 1) / job->tile_size);
+    if ((int64_t)job->tiles_x * job->tiles_y > (int64_t)(1 << 26))
         return rt_fail(err, RT_ERR_LIMIT, "%dx%d image in %d-pixel tiles makes %lld tiles, over the limit of %d; use larger tiles",
-                       fb->width, fb->height, job.tile_size, (long long)job.tiles_x * job.tiles_y, 1 << 26);
-    job.tiles_total = job.tiles_x * job.tiles_y;
-    atomic_init(&job.next_tile, 0);
-    atomic_init(&job.tiles_done, 0);
-    atomic_init(&job.time_up, 0);
-    job.tile_finished = rt_alloc((size_t)job.tiles_total, sizeof *job.tile_finished);
+                       fb->width, fb->height, job->tile_size, (long long)job->tiles_x * job->tiles_y, 1 << 26);
+    job->tiles_total = job->tiles_x * job->tiles_y;
+    atomic_init(&job->next_tile, 0);
+    atomic_init(&job->tiles_done, 0);
+    atomic_init(&job->time_up, 0);
+    job->aov = opt->aov;
+    job->radiance = integrator->radiance;
+    job->wavefront = integrator->wavefront;
+    job->batch_size = opt->batch_size > 0 ? opt->batch_size : 0;
+    return RT_OK;
+}
+
+/* The job's buffers and the workers, the sums started from zero or from
+ * the caller's. */
+static rt_result alloc_job(rt_render_job *job, worker **workers_out, int nthreads, rt_error *err)
+{
+    rt_framebuffer *fb = job->fb;
+    job->tile_finished = rt_alloc((size_t)job->tiles_total, sizeof *job->tile_finished);
     size_t npx = (size_t)fb->width * (size_t)fb->height;
-    if (job.passes) {
-        job.sum = rt_alloc(npx, 3 * sizeof *job.sum);
-        job.block = rt_alloc(npx, 3 * sizeof *job.block);
-        job.good = rt_alloc(npx, sizeof *job.good);
+    if (job->passes) {
+        job->sum = rt_alloc(npx, 3 * sizeof *job->sum);
+        job->block = rt_alloc(npx, 3 * sizeof *job->block);
+        job->good = rt_alloc(npx, sizeof *job->good);
     }
-    job.aov = opt.aov;
-    if (job.aov) {
-        job.aov_sum = rt_alloc(npx, sizeof *job.aov_sum);
-        job.lum_sq = rt_alloc(npx, sizeof *job.lum_sq);
+    if (job->aov) {
+        job->aov_sum = rt_alloc(npx, sizeof *job->aov_sum);
+        job->lum_sq = rt_alloc(npx, sizeof *job->lum_sq);
     }
-    int nthreads = opt.threads > 0 ? opt.threads : rt_cpu_count();
-    if (nthreads > 1024)
-        nthreads = 1024;
     worker *workers = rt_alloc((size_t)nthreads, sizeof *workers);
-    if (!job.tile_finished || !workers || (job.passes && (!job.sum || !job.block || !job.good)) ||
-        (job.aov && (!job.aov_sum || !job.lum_sq))) {
-        free_job(&job, workers, nthreads);
+    *workers_out = workers;
+    if (!job->tile_finished || !workers || (job->passes && (!job->sum || !job->block || !job->good)) ||
+        (job->aov && (!job->aov_sum || !job->lum_sq))) {
+        free_job(job, workers, nthreads);
+        *workers_out = NULL;
         return rt_fail(err, RT_ERR_NOMEM, "out of memory setting up %d render threads for a %dx%d image", nthreads,
                        fb->width, fb->height);
     }
-    for (int t = 0; t < job.tiles_total; t++)
-        atomic_init(&job.tile_finished[t], 0);
-    bool aov_accum = job.aov && job.accum && job.accum->aov_sum;
-    if (aov_accum) /* the AOV sums continue the caller's too */
-        memcpy(job.aov_sum, job.accum->aov_sum, npx * sizeof *job.aov_sum);
-    if (job.passes) {
-        if (job.accum) { /* continue the caller's sums; they get them back after each whole pass */
-            memcpy(job.sum, job.accum->sum, npx * 3 * sizeof *job.sum);
-            memcpy(job.block, job.accum->block, npx * 3 * sizeof *job.block);
-            memcpy(job.good, job.accum->good, npx * sizeof *job.good);
+    for (int t = 0; t < job->tiles_total; t++)
+        atomic_init(&job->tile_finished[t], 0);
+    if (job->aov && job->accum && job->accum->aov_sum) /* the AOV sums continue the caller's too */
+        memcpy(job->aov_sum, job->accum->aov_sum, npx * sizeof *job->aov_sum);
+    if (job->passes) {
+        if (job->accum) { /* continue the caller's sums; they get them back after each whole pass */
+            memcpy(job->sum, job->accum->sum, npx * 3 * sizeof *job->sum);
+            memcpy(job->block, job->accum->block, npx * 3 * sizeof *job->block);
+            memcpy(job->good, job->accum->good, npx * sizeof *job->good);
         } else {
-            memset(job.sum, 0, npx * 3 * sizeof *job.sum);
-            memset(job.block, 0, npx * 3 * sizeof *job.block);
-            memset(job.good, 0, npx * sizeof *job.good);
+            memset(job->sum, 0, npx * 3 * sizeof *job->sum);
+            memset(job->block, 0, npx * 3 * sizeof *job->block);
+            memset(job->good, 0, npx * sizeof *job->good);
         }
         memset(fb->rgb, 0, npx * 3 * sizeof *fb->rgb);
     }
+    return RT_OK;
+}
+
+/* Tiles: every tile once with all of its samples. Returns the threads
+ * started; *cancelled when stopped by the cancel flag (not the time). */
+static int render_tiles(rt_render_job *job, worker *workers, int nthreads, const rt_render_options *opt,
+                        rt_render_progress *progress, double t0, rt_render_stats *st, bool *cancelled)
+{
+    rt_framebuffer *fb = job->fb;
+    size_t npx = (size_t)fb->width * (size_t)fb->height;
+    job->deadline = opt->time_limit > 0.0 ? t0 + opt->time_limit : 0.0;
+    int started = run_workers(job, workers, nthreads, opt, progress, t0);
+    if (job->aov && job->accum && job->accum->aov_sum)
+        memcpy(job->accum->aov_sum, job->aov_sum, npx * sizeof *job->aov_sum);
+    st->tiles_done = atomic_load(&job->tiles_done);
+    st->partial = st->tiles_done < job->tiles_total;
+    st->samples_done = st->partial ? 0 : (int)(job->s_end - job->s_begin);
+    *cancelled = st->partial && !atomic_load(&job->time_up);
+    st->time_limited = st->partial && !*cancelled;
+    if (st->partial) {
+        /* clear tiles that were started but not finished: a partial tile is worse than a black one */
+        for (int t = 0; t < job->tiles_total; t++) {
+            if (atomic_load(&job->tile_finished[t]))
+                continue;
+            int x0, y0, x1, y1;
+            tile_bounds(job, t, &x0, &y0, &x1, &y1);
+            for (int y = y0; y < y1; y++)
+                memset(fb->rgb + 3 * ((size_t)y * (size_t)job->rw + (size_t)x0), 0,
+                       3 * sizeof(float) * (size_t)(x1 - x0));
+        }
+    }
+    return started;
+}
+
+/* Passes of pass_samples over the whole image, each resolved into fb and
+ * handed back to the caller's sums when whole. Returns the most threads a
+ * pass started; *cancelled as for render_tiles. */
+static int render_passes(rt_render_job *job, worker *workers, int nthreads, const rt_render_options *opt,
+                         rt_render_progress *progress, double t0, int pass_samples, rt_render_stats *st,
+                         bool *cancelled)
+{
+    size_t npx = (size_t)job->fb->width * (size_t)job->fb->height;
+    int started = 0;
+    for (uint32_t s0 = job->s_begin; s0 < job->s_end;) {
+        if (job->cancel && atomic_load(job->cancel)) {
+            *cancelled = true;
+            break;
+        }
+        job->s0 = s0;
+        job->s1 = job->s_end - s0 > (uint32_t)pass_samples ? s0 + (uint32_t)pass_samples : job->s_end;
+        progress->pass_samples = (int)(job->s1 - job->s0);
+        int n = run_workers(job, workers, nthreads, opt, progress, t0);
+        started = n > started ? n : started;
+        if (atomic_load(&job->tiles_done) < job->tiles_total) {
+            *cancelled = true; /* the pass was cut short: fb keeps the last whole pass */
+            break;
+        }
+        resolve_image(job);
+        if (job->accum) {
+            memcpy(job->accum->sum, job->sum, npx * 3 * sizeof *job->sum);
+            memcpy(job->accum->block, job->block, npx * 3 * sizeof *job->block);
+            memcpy(job->accum->good, job->good, npx * sizeof *job->good);
+        }
+        if (job->aov && job->accum && job->accum->aov_sum)
+            memcpy(job->accum->aov_sum, job->aov_sum, npx * sizeof *job->aov_sum);
+        job->samples_done = (int)(job->s1 - job->s_begin);
+        st->passes_done++;
+        s0 = job->s1;
+        if (opt->progress && s0 < job->s_end) {
+            progress->tiles_done = job->tiles_total;
+            progress->samples_done = job->samples_done;
+            progress->elapsed = rt_now_seconds() - t0;
+            opt->progress(progress, opt->progress_user);
+        }
+        if (opt->time_limit > 0.0 && s0 < job->s_end && rt_now_seconds() - t0 >= opt->time_limit) {
+            st->time_limited = true;
+            break;
+        }
+    }
+    st->samples_done = job->samples_done;
+    st->partial = job->samples_done == 0;
+    st->tiles_done = st->partial ? 0 : job->tiles_total;
+    return started;
+}
+
+rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_render_options *options,
+                    rt_framebuffer *fb, rt_render_stats *stats, rt_error *err)
+{
+    rt_render_options opt;
+    memset(&opt, 0, sizeof opt);
+    if (options)
+        opt = *options;
+    rt_render_stats st;
+    memset(&st, 0, sizeof st);
+    RT_DCHECK(rt_scene_validate(scene, NULL) == RT_OK);
+    rt_render_region reg = {0, 0, 0, 0};
+    const rt_integrator_info *integrator = NULL;
+    rt_result r = check_request(scene, &opt, fb, &reg, &integrator, err);
+    rt_render_job job;
+    int pass_samples = 0;
+    if (r != RT_OK || (r = plan_job(&job, scene, &opt, reg, integrator, fb, &pass_samples, err)) != RT_OK)
+        return r;
+    int nthreads = opt.threads > 0 ? opt.threads : rt_cpu_count();
+    if (nthreads > 1024)
+        nthreads = 1024;
+    worker *workers;
+    if ((r = alloc_job(&job, &workers, nthreads, err)) != RT_OK)
+        return r;
     /* what the integrator reads, derived once, before the workers start */
     rt_render_state state;
-    rt_result sr = rt_render_state_prepare(&state, scene, tree, integrator->prepare, err);
-    if (sr != RT_OK) {
+    if ((r = rt_render_state_prepare(&state, scene, tree, integrator->prepare, err)) != RT_OK) {
         free_job(&job, workers, nthreads);
-        return sr;
+        return r;
     }
     job.state = &state;
-    job.radiance = integrator->radiance;
-    job.wavefront = integrator->wavefront;
-    job.batch_size = opt.batch_size > 0 ? opt.batch_size : 0;
     pthread_mutex_init(&job.lock, NULL);
     pthread_condattr_t ca;
     pthread_condattr_init(&ca);
@@ -616,71 +700,10 @@ rt_result rt_render(const rt_scene *scene, const rt_kdtree *tree, const rt_rende
     progress.job = &job;
 
     double t0 = rt_now_seconds();
-    int started = 0;
     bool cancelled = false;
-    if (!job.passes) {
-        job.deadline = opt.time_limit > 0.0 ? t0 + opt.time_limit : 0.0;
-        started = run_workers(&job, workers, nthreads, &opt, &progress, t0);
-        if (aov_accum)
-            memcpy(job.accum->aov_sum, job.aov_sum, npx * sizeof *job.aov_sum);
-        st.tiles_done = atomic_load(&job.tiles_done);
-        st.partial = st.tiles_done < job.tiles_total;
-        st.samples_done = st.partial ? 0 : (int)(job.s_end - job.s_begin);
-        cancelled = st.partial && !atomic_load(&job.time_up);
-        st.time_limited = st.partial && !cancelled;
-        if (st.partial) {
-            /* clear tiles that were started but not finished: a partial tile is worse than a black one */
-            for (int t = 0; t < job.tiles_total; t++) {
-                if (atomic_load(&job.tile_finished[t]))
-                    continue;
-                int x0, y0, x1, y1;
-                tile_bounds(&job, t, &x0, &y0, &x1, &y1);
-                for (int y = y0; y < y1; y++)
-                    memset(fb->rgb + 3 * ((size_t)y * (size_t)job.rw + (size_t)x0), 0,
-                           3 * sizeof(float) * (size_t)(x1 - x0));
-            }
-        }
-    } else {
-        for (uint32_t s0 = job.s_begin; s0 < job.s_end;) {
-            if (job.cancel && atomic_load(job.cancel)) {
-                cancelled = true;
-                break;
-            }
-            job.s0 = s0;
-            job.s1 = job.s_end - s0 > (uint32_t)pass_samples ? s0 + (uint32_t)pass_samples : job.s_end;
-            progress.pass_samples = (int)(job.s1 - job.s0);
-            int n = run_workers(&job, workers, nthreads, &opt, &progress, t0);
-            started = n > started ? n : started;
-            if (atomic_load(&job.tiles_done) < job.tiles_total) {
-                cancelled = true; /* the pass was cut short: fb keeps the last whole pass */
-                break;
-            }
-            resolve_image(&job);
-            if (job.accum) {
-                memcpy(job.accum->sum, job.sum, npx * 3 * sizeof *job.sum);
-                memcpy(job.accum->block, job.block, npx * 3 * sizeof *job.block);
-                memcpy(job.accum->good, job.good, npx * sizeof *job.good);
-            }
-            if (aov_accum)
-                memcpy(job.accum->aov_sum, job.aov_sum, npx * sizeof *job.aov_sum);
-            job.samples_done = (int)(job.s1 - job.s_begin);
-            st.passes_done++;
-            s0 = job.s1;
-            if (opt.progress && s0 < job.s_end) {
-                progress.tiles_done = job.tiles_total;
-                progress.samples_done = job.samples_done;
-                progress.elapsed = rt_now_seconds() - t0;
-                opt.progress(&progress, opt.progress_user);
-            }
-            if (opt.time_limit > 0.0 && s0 < job.s_end && rt_now_seconds() - t0 >= opt.time_limit) {
-                st.time_limited = true;
-                break;
-            }
-        }
-        st.samples_done = job.samples_done;
-        st.partial = job.samples_done == 0;
-        st.tiles_done = st.partial ? 0 : job.tiles_total;
-    }
+    int started = job.passes ? render_passes(&job, workers, nthreads, &opt, &progress, t0, pass_samples, &st,
+                                             &cancelled)
+                             : render_tiles(&job, workers, nthreads, &opt, &progress, t0, &st, &cancelled);
     st.seconds = rt_now_seconds() - t0;
     st.tiles_total = job.tiles_total;
     st.threads = started > 0 ? started : 1;

@@ -4,8 +4,8 @@
  * rt_offset_ray_origin), whether shadow rays must look at the surfaces
  * they cross, the whitted integrator's ambient radiance (docs/shading.md),
  * the light table when the integrator samples emitters, and what each
- * material needs of a surface record (rt_material_needs); and the counted
- * closest-hit query.
+ * material needs of a surface record (rt_material_needs). Readers see it
+ * through rt/render/trace.h.
  */
 #include "rt/render/render_state.h"
 
@@ -15,7 +15,7 @@
 #include "rt/base/alloc.h"
 #include "rt/render/environment.h"
 #include "rt/render/light.h"
-#include "rt/render/surface.h"
+#include "rt/render/material_eval.h"
 
 /* The whitted integrator's ambient radiance: the scene's ambient_light when
  * given, else the mean radiance of the environment over the sphere. */
@@ -50,10 +50,9 @@ rt_result rt_render_state_prepare(rt_render_state *rs, const rt_scene *scene, co
     rs->ambient = ambient_radiance(scene);
     if (prepare & RT_PREPARE_LIGHT_TABLE) {
         rs->light_table = rt_alloc(1, sizeof *rs->light_table);
-        if (!rs->light_table)
-            return rt_fail(err, RT_ERR_NOMEM, "out of memory preparing the render");
-        rt_result r = rt_light_table_build(rs->light_table, scene, err);
-        if (r != RT_OK) {
+        rt_result r = rs->light_table ? rt_light_table_build(rs->light_table, scene, err)
+                                      : rt_fail(err, RT_ERR_NOMEM, "out of memory preparing the render");
+        if (r != RT_OK) { /* one way out, which frees what was taken (material_needs leaked here before) */
             free(rs->light_table);
             rs->light_table = NULL;
             free(rs->material_needs);
@@ -72,21 +71,4 @@ void rt_render_state_free(rt_render_state *rs)
     free(rs->light_table);
     free(rs->material_needs);
     memset(rs, 0, sizeof *rs);
-}
-
-void rt_trace_ctx_init(rt_trace_ctx *ctx, const rt_render_state *state)
-{
-    ctx->state = state;
-    ctx->ray_count = NULL;
-    ctx->hit_count = NULL;
-}
-
-bool rt_trace(const rt_trace_ctx *ctx, const rt_ray *ray, rt_hit *hit)
-{
-    if (ctx->ray_count)
-        (*ctx->ray_count)++;
-    bool found = rt_kdtree_intersect(ctx->state->tree, ray, hit);
-    if (ctx->hit_count && found)
-        (*ctx->hit_count)++;
-    return found;
 }

@@ -72,30 +72,6 @@ static rt_vec2 slot_uv(const rt_surface *sf, const rt_texture_slot *slot)
     return rt_texture_slot_uv(slot, slot->texcoord == 1 ? sf->uv1 : sf->uv0);
 }
 
-bool rt_surface_material_reads_frame(const rt_material *m)
-{
-    return m->normal_tex.texture != RT_NONE || m->bsdf == RT_BSDF_CONDUCTOR || m->extended;
-}
-
-uint8_t rt_material_needs(const rt_material *m)
-{
-    const rt_texture_slot *slots[] = {&m->base_color_tex, &m->metal_rough_tex, &m->normal_tex,
-                                      &m->occlusion_tex,  &m->emissive_tex,    &m->transmission_tex};
-    bool textured = false;
-    for (size_t k = 0; k < sizeof slots / sizeof slots[0]; k++)
-        textured = textured || slots[k]->texture != RT_NONE;
-    for (size_t k = 0; k < RT_XTEX_COUNT; k++)
-        textured = textured || m->ext_tex[k].texture != RT_NONE;
-    uint8_t needs = 0;
-    if (textured)
-        needs |= RT_MATERIAL_TEXTURED;
-    if (rt_surface_material_reads_frame(m))
-        needs |= RT_MATERIAL_FRAME;
-    if (m->emission.x > 0.0f || m->emission.y > 0.0f || m->emission.z > 0.0f) /* rt_surface_emission's test */
-        needs |= RT_MATERIAL_EMITS;
-    return needs;
-}
-
 #if defined(__GNUC__)
 #define SURFACE_INLINE static inline __attribute__((always_inline)) /* one copy per caller, `frame` folded */
 #else
@@ -115,6 +91,75 @@ static inline rt_vec3 spawn_origin(const rt_trace_ctx *ctx, rt_vec3 p, rt_vec3 s
  * emission reads (rt_surface_at_emitter: no shading normal, normal map,
  * tangent frame or vertex colour). */
 typedef enum surface_need { NEED_ALL, NEED_SHADING, NEED_EMISSION } surface_need;
+
+/* The triangle part of surface_at: point, geometric and interpolated
+ * normals, UVs, vertex colour and the tangent (t, w) where `frame`. *t and
+ * *w come in as surface_at's defaults and are left alone without a frame. */
+SURFACE_INLINE void triangle_at(const rt_scene *s, uint32_t i, const rt_hit *hit, rt_surface *sf, bool uv, bool frame,
+                               bool emission_only, rt_vec3 *ng_out, rt_vec3 *n_out, rt_vec3 *t_io, float *w_io)
+{
+    rt_vec3 ng, n, t = *t_io;
+    float w = *w_io;
+    const uint32_t *idx = &s->triangles.index[3 * (size_t)i];
+    const rt_vertices *vx = &s->vertices;
+    uint8_t flags = s->triangles.flags[i];
+    rt_vec3 a = vx->position[idx[0]], b = vx->position[idx[1]], c = vx->position[idx[2]];
+    rt_vec3 e1 = rt_sub(b, a), e2 = rt_sub(c, a);
+    float bu = hit->u, bv = hit->v, bw = 1.0f - bu - bv;
+    sf->p = rt_add(rt_add(rt_scale(a, bw), rt_scale(b, bu)), rt_scale(c, bv));
+    ng = rt_normalize(rt_cross(e1, e2));
+    if (flags & RT_TRI_SMOOTH) {
+        /* vertex normals define the outside: turn a triangle wound the
+         * other way to agree with them (decided per triangle, so the
+         * side never changes across its face) */
+        rt_vec3 nsum = rt_add(rt_add(vx->normal[idx[0]], vx->normal[idx[1]]), vx->normal[idx[2]]);
+        if (rt_dot(nsum, ng) < 0.0f)
+            ng = rt_neg(ng);
+    }
+    n = ng;
+    if ((flags & RT_TRI_SMOOTH) && !emission_only) {
+        rt_vec3 ni = rt_add(rt_add(rt_scale(vx->normal[idx[0]], bw), rt_scale(vx->normal[idx[1]], bu)),
+                            rt_scale(vx->normal[idx[2]], bv));
+        if (rt_length2(ni) > 1e-20f && rt_finite3(ni))
+            n = rt_normalize(ni);
+    }
+    rt_vec2 t0 = rt_v2(0, 0), t1 = rt_v2(1, 0), t2 = rt_v2(0, 1);
+    if (uv || frame) { /* (a frame from the UVs reads them too) */
+        if (flags & RT_TRI_UV) {
+            t0 = vx->uv0[idx[0]], t1 = vx->uv0[idx[1]], t2 = vx->uv0[idx[2]];
+            sf->uv0 = rt_v2(t0.x * bw + t1.x * bu + t2.x * bv, t0.y * bw + t1.y * bu + t2.y * bv);
+        } else {
+            sf->uv0 = rt_v2(bu, bv);
+        }
+        if (vx->uv1) {
+            rt_vec2 s0 = vx->uv1[idx[0]], s1 = vx->uv1[idx[1]], s2 = vx->uv1[idx[2]];
+            sf->uv1 = rt_v2(s0.x * bw + s1.x * bu + s2.x * bv, s0.y * bw + s1.y * bu + s2.y * bv);
+        } else {
+            sf->uv1 = sf->uv0;
+        }
+    } else {
+        sf->uv0 = sf->uv1 = rt_v2(0, 0); /* no texture reads them */
+    }
+    RT_DCHECK(!(flags & RT_TRI_COLOR) || vx->color);
+    RT_DCHECK(!(flags & RT_TRI_TANGENT) || vx->tangent);
+    if ((flags & RT_TRI_COLOR) && !emission_only) {
+        rt_vec4 c0 = vx->color[idx[0]], c1 = vx->color[idx[1]], c2 = vx->color[idx[2]];
+        sf->vertex_color = rt_v4(c0.x * bw + c1.x * bu + c2.x * bv, c0.y * bw + c1.y * bu + c2.y * bv,
+                                 c0.z * bw + c1.z * bu + c2.z * bv, c0.w * bw + c1.w * bu + c2.w * bv);
+    }
+    if (frame && (flags & RT_TRI_TANGENT)) {
+        rt_vec4 q0 = vx->tangent[idx[0]], q1 = vx->tangent[idx[1]], q2 = vx->tangent[idx[2]];
+        t = rt_v3(q0.x * bw + q1.x * bu + q2.x * bv, q0.y * bw + q1.y * bu + q2.y * bv,
+                  q0.z * bw + q1.z * bu + q2.z * bv);
+        w = q0.w < 0.0f ? -1.0f : 1.0f;
+    } else if (frame) {
+        tangent_from_uv(e1, e2, rt_v2(t1.x - t0.x, t1.y - t0.y), rt_v2(t2.x - t0.x, t2.y - t0.y), ng, &t, &w);
+    }
+    *ng_out = ng;
+    *n_out = n;
+    *t_io = t;
+    *w_io = w;
+}
 
 /* The record; the tangent frame (t, b) only when `need` is NEED_ALL or the
  * material reads it (else zero). */
@@ -139,61 +184,7 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
     bool uv = need == NEED_ALL || (needs & RT_MATERIAL_TEXTURED);
     switch (kind) {
     case RT_PRIM_TRIANGLE: {
-        const uint32_t *idx = &s->triangles.index[3 * (size_t)i];
-        const rt_vertices *vx = &s->vertices;
-        uint8_t flags = s->triangles.flags[i];
-        rt_vec3 a = vx->position[idx[0]], b = vx->position[idx[1]], c = vx->position[idx[2]];
-        rt_vec3 e1 = rt_sub(b, a), e2 = rt_sub(c, a);
-        float bu = hit->u, bv = hit->v, bw = 1.0f - bu - bv;
-        sf->p = rt_add(rt_add(rt_scale(a, bw), rt_scale(b, bu)), rt_scale(c, bv));
-        ng = rt_normalize(rt_cross(e1, e2));
-        if (flags & RT_TRI_SMOOTH) {
-            /* vertex normals define the outside: turn a triangle wound the
-             * other way to agree with them (decided per triangle, so the
-             * side never changes across its face) */
-            rt_vec3 nsum = rt_add(rt_add(vx->normal[idx[0]], vx->normal[idx[1]]), vx->normal[idx[2]]);
-            if (rt_dot(nsum, ng) < 0.0f)
-                ng = rt_neg(ng);
-        }
-        n = ng;
-        if ((flags & RT_TRI_SMOOTH) && !emission_only) {
-            rt_vec3 ni = rt_add(rt_add(rt_scale(vx->normal[idx[0]], bw), rt_scale(vx->normal[idx[1]], bu)),
-                                rt_scale(vx->normal[idx[2]], bv));
-            if (rt_length2(ni) > 1e-20f && rt_finite3(ni))
-                n = rt_normalize(ni);
-        }
-        rt_vec2 t0 = rt_v2(0, 0), t1 = rt_v2(1, 0), t2 = rt_v2(0, 1);
-        if (uv || frame) { /* (a frame from the UVs reads them too) */
-            if (flags & RT_TRI_UV) {
-                t0 = vx->uv0[idx[0]], t1 = vx->uv0[idx[1]], t2 = vx->uv0[idx[2]];
-                sf->uv0 = rt_v2(t0.x * bw + t1.x * bu + t2.x * bv, t0.y * bw + t1.y * bu + t2.y * bv);
-            } else {
-                sf->uv0 = rt_v2(bu, bv);
-            }
-            if (vx->uv1) {
-                rt_vec2 s0 = vx->uv1[idx[0]], s1 = vx->uv1[idx[1]], s2 = vx->uv1[idx[2]];
-                sf->uv1 = rt_v2(s0.x * bw + s1.x * bu + s2.x * bv, s0.y * bw + s1.y * bu + s2.y * bv);
-            } else {
-                sf->uv1 = sf->uv0;
-            }
-        } else {
-            sf->uv0 = sf->uv1 = rt_v2(0, 0); /* no texture reads them */
-        }
-        RT_DCHECK(!(flags & RT_TRI_COLOR) || vx->color);
-        RT_DCHECK(!(flags & RT_TRI_TANGENT) || vx->tangent);
-        if ((flags & RT_TRI_COLOR) && !emission_only) {
-            rt_vec4 c0 = vx->color[idx[0]], c1 = vx->color[idx[1]], c2 = vx->color[idx[2]];
-            sf->vertex_color = rt_v4(c0.x * bw + c1.x * bu + c2.x * bv, c0.y * bw + c1.y * bu + c2.y * bv,
-                                     c0.z * bw + c1.z * bu + c2.z * bv, c0.w * bw + c1.w * bu + c2.w * bv);
-        }
-        if (frame && (flags & RT_TRI_TANGENT)) {
-            rt_vec4 q0 = vx->tangent[idx[0]], q1 = vx->tangent[idx[1]], q2 = vx->tangent[idx[2]];
-            t = rt_v3(q0.x * bw + q1.x * bu + q2.x * bv, q0.y * bw + q1.y * bu + q2.y * bv,
-                      q0.z * bw + q1.z * bu + q2.z * bv);
-            w = q0.w < 0.0f ? -1.0f : 1.0f;
-        } else if (frame) {
-            tangent_from_uv(e1, e2, rt_v2(t1.x - t0.x, t1.y - t0.y), rt_v2(t2.x - t0.x, t2.y - t0.y), ng, &t, &w);
-        }
+        triangle_at(s, i, hit, sf, uv, frame, emission_only, &ng, &n, &t, &w);
         break;
     }
     case RT_PRIM_SPHERE: {

@@ -1,7 +1,8 @@
 /* scene.c - the scene tables: defaults, appends, marks and rollback, bounds,
  * automatic framing, and the named metals' constants (sources in
- * rt/scene/scene.h). (rt_settings_default() is in settings.c, driven by the
- * settings table.) */
+ * rt/scene/scene.h), and the render settings' defaults (rt_settings_default:
+ * the settings table, rt/render/settings.h, shows them in --help and the
+ * docs). */
 #include "rt/scene/scene.h"
 
 #include "rt/base/alloc.h"
@@ -109,6 +110,32 @@ const rt_metal rt_metals[] = {
 };
 const size_t rt_metal_count = sizeof rt_metals / sizeof *rt_metals;
 
+void rt_settings_default(rt_settings *st)
+{
+    memset(st, 0, sizeof *st);
+    st->width = st->height = 512;
+    st->samples = 1;
+    st->integrator = RT_INTEGRATOR_DIRECT;
+    st->max_bounce = 1;
+    st->max_depth = 0;
+    st->rr_depth = 5;
+    st->motion_steps = 8;
+    st->sampler = RT_SAMPLER_SOBOL;
+    st->energy_compensation = 0;
+    st->diffuse_bounces = 0;
+    st->diffuse_rays = 128;
+    st->shadow_samples = 16;
+    st->seed = 0;
+    st->background = rt_v3(0, 0, 0);
+    st->ambient_light = rt_v3(0, 0, 0);
+    st->ambient_light_set = false;
+    st->exposure = 1.0f;
+    st->clamp = 0.0f;
+    st->ray_offset = 0.0f;
+    st->environment_texture = RT_NONE;
+    st->environment_strength = 1.0f;
+}
+
 void rt_scene_init(rt_scene *s)
 {
     memset(s, 0, sizeof *s);
@@ -119,12 +146,20 @@ void rt_scene_init(rt_scene *s)
     s->camera.vfov_deg = 40.0f;
 }
 
+/* Lets go of an image's pixels: freed unless another scene still shares them. */
+static void image_release(rt_image *img)
+{
+    if (img->shares && --*img->shares > 0)
+        return;
+    free(img->shares);
+    free(img->rgba8);
+    free(img->rgbaf);
+}
+
 void rt_scene_free(rt_scene *s)
 {
-    for (size_t i = 0; i < s->image_count; i++) {
-        free(s->images[i].rgba8);
-        free(s->images[i].rgbaf);
-    }
+    for (size_t i = 0; i < s->image_count; i++)
+        image_release(&s->images[i]);
     free(s->images);
     free(s->materials);
     free(s->textures);
@@ -171,6 +206,22 @@ uint32_t rt_scene_add_texture(rt_scene *s, const rt_texture *t)
 uint32_t rt_scene_add_image(rt_scene *s, const rt_image *img)
 {
     return table_push((void **)&s->images, &s->image_count, &s->image_cap, img, sizeof *img);
+}
+
+bool rt_scene_share_images(rt_scene *s, rt_scene *from)
+{
+    for (size_t i = 0; i < from->image_count; i++) {
+        rt_image *img = &from->images[i];
+        if (!img->shares) {
+            if (!(img->shares = malloc(sizeof *img->shares)))
+                return false;
+            *img->shares = 1;
+        }
+        if (rt_scene_add_image(s, img) == RT_NONE)
+            return false;
+        ++*img->shares;
+    }
+    return true;
 }
 
 uint32_t rt_scene_add_light(rt_scene *s, const rt_light *l)
@@ -333,10 +384,8 @@ static void truncate_to(size_t *count, size_t mark)
 
 void rt_scene_rollback(rt_scene *s, const rt_scene_mark *m)
 {
-    for (size_t i = m->images; i < s->image_count; i++) {
-        free(s->images[i].rgba8);
-        free(s->images[i].rgbaf);
-    }
+    for (size_t i = m->images; i < s->image_count; i++)
+        image_release(&s->images[i]);
     truncate_to(&s->image_count, m->images);
     truncate_to(&s->material_count, m->materials);
     truncate_to(&s->texture_count, m->textures);

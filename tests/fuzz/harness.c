@@ -17,7 +17,7 @@
 #include "rt/io/json.h"
 #include "rt/io/load.h"
 #include "rt/io/meshopt.h"
-#include "rt/io/part.h"
+#include "rt/job/part.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/texture.h"
 

@@ -32,7 +32,7 @@
 
 typedef enum rt_image_format { RT_FORMAT_PNG = 0, RT_FORMAT_PFM, RT_FORMAT_HDR, RT_FORMAT_EXR } rt_image_format;
 
-#define RT_MAX_IMAGE_LAYERS 72 /* a part: its counts, up to 64 sample blocks, its AOVs (rt/io/part.h) */
+#define RT_MAX_IMAGE_LAYERS 72 /* a part: its counts, up to 64 sample blocks, its AOVs (rt/job/part.h) */
 
 /* An extra image beside the beauty one (an AOV): EXR writes it as a layer. */
 typedef struct rt_image_layer {

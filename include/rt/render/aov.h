@@ -19,7 +19,7 @@
 #ifndef RT_AOV_H
 #define RT_AOV_H
 
-#include "rt/render/render_state.h"
+#include "rt/render/trace.h"
 #include "rt/render/sampling.h"
 
 typedef struct rt_aov_buffers {
@@ -37,5 +37,12 @@ typedef struct rt_aov_sample {
  * smooth glass (roughness ~0, metallic or transmissive) to the first other
  * surface. Zero everywhere on a miss. */
 void rt_aov_trace(const rt_trace_ctx *ctx, rt_ray ray, rt_rng *rng, rt_aov_sample *out);
+
+/* The pixel's AOVs from its sums over `good` samples: the means, and the
+ * variance of the mean luminance from lum_sum and lum_sq (the sums of the
+ * samples' luminance and its square). The renderer after each pass and a
+ * merge of parts resolve AOVs through this one function. */
+void rt_aov_resolve(rt_aov_buffers *aov, size_t pixel, const rt_aov_sample *s, uint32_t good, float lum_sum,
+                    double lum_sq);
 
 #endif

@@ -7,7 +7,8 @@
  * the side the light leaves towards (wo.z > 0), x and y the tangents.
  *
  *   rt_bsdf b;
- *   rt_bsdf_from_surface(&ctx, &sf, &b);              // material + textures at a hit
+ *   rt_bsdf_from_surface(&ctx, &sf, &b);              // material + textures at a hit (material_eval.h)
+ *   // or rt_bsdf_make(&b, n, base, metallic, roughness, ior, transmission, lambert) and the like
  *   rt_vec3 wo = rt_bsdf_to_local(&b, sf.wo);
  *   float pdf;
  *   rt_vec3 f = rt_bsdf_eval(&b, wo, wi, &pdf);       // f (no cosine), pdf of rt_bsdf_sample
@@ -42,9 +43,9 @@
  * 2007), sampled only (a "delta" sample: not light-sampled, no MIS).
  * Roughness exactly 0 is a true delta interface: mirror reflection and
  * refraction about the normal, both sampled only, so rt_bsdf_eval holds
- * just the diffuse lobe. RT_BSDF_LAMBERT is exactly B / pi.
+ * just the diffuse lobe. RT_BSDF_KIND_LAMBERT is exactly B / pi.
  *
- * RT_BSDF_CONDUCTOR (rt_bsdf.conductor) is a metal of complex index
+ * RT_BSDF_KIND_CONDUCTOR is a metal of complex index
  * eta + i k per channel: f = F_conductor(wo.h) D G2 / (4 cos_o cos_i) with
  * anisotropic GGX (alpha along t and b), G2 height-correlated or
  * separable; alpha 0 is a delta mirror of weight F_conductor(cos_o). With
@@ -63,14 +64,27 @@
 #include <stdbool.h>
 
 #include "rt/render/ggx_albedo.h"
-#include "rt/render/surface.h"
+#include "rt/render/microfacet.h"
 
 #define RT_BSDF_MIN_ALPHA 1e-4f /* GGX alpha floor for roughness > 0 (roughness 0 is a delta interface) */
+
+/* Which lobes a BSDF has. A closed set: rt_bsdf_eval, rt_bsdf_sample_dir
+ * and the lobe probabilities switch over it in bsdf.c (with no default, so
+ * the compiler names every switch a new kind must join); the fields of
+ * rt_bsdf below say which kinds read them. */
+typedef enum rt_bsdf_kind {
+    RT_BSDF_KIND_LAMBERT,      /* diffuse / pi */
+    RT_BSDF_KIND_GLTF,         /* glTF metallic-roughness: diffuse, GGX specular, transmission (rt_bsdf_make) */
+    RT_BSDF_KIND_GLTF_LAYERED, /* the same under the PBR-next extensions' layers (rt_bsdf_set_ext) */
+    RT_BSDF_KIND_CONDUCTOR,    /* F(eta_c, k_c) D G2 / (4 cos cos), anisotropic GGX */
+    RT_BSDF_KIND_DIELECTRIC,   /* glass of index ratio eta; refraction scales radiance by eta^2 (n_wo / n_wi)^2 */
+    RT_BSDF_KIND_PLASTIC,      /* coat over Lambert: diffuse = R / (1 - R Fdr_in) / eta_in^2, times (1 - Fo)(1 - Fi) / pi */
+} rt_bsdf_kind;
 
 typedef struct rt_bsdf {
     rt_vec3 t, b, n;  /* shading frame, world space; n on the side of wo */
     rt_vec3 ng;       /* geometric normal on the side of wo */
-    bool lambert;     /* pure Lambert: f = diffuse / pi */
+    rt_bsdf_kind kind;
     bool delta;       /* roughness 0: mirror reflection and refraction, sampled only */
     rt_vec3 base;     /* base colour B: the metal's normal-incidence reflectance */
     rt_vec3 diffuse;  /* (1 - m) B (Lambert: the albedo) */
@@ -78,10 +92,7 @@ typedef struct rt_bsdf {
     float f0;         /* the dielectric's normal-incidence reflectance ((eta - 1) / (eta + 1))^2 */
     float alpha;      /* GGX alpha (at least RT_BSDF_MIN_ALPHA); along the tangent t for a conductor */
     float alpha_y;    /* GGX alpha along the bitangent b (= alpha unless anisotropic) */
-    bool conductor;   /* bsdf conductor: F(eta_c, k_c) D G2 / (4 cos cos) */
     bool separable;   /* conductor: separable Smith G1 G1 instead of height-correlated */
-    bool radiance_eta2; /* dielectric: refraction scales radiance by eta^2 (n_wo / n_wi)^2 */
-    bool plastic;     /* coat over Lambert: diffuse = R / (1 - R Fdr_in) / eta_in^2, times (1 - Fo)(1 - Fi) / pi */
     rt_vec3 eta_c, k_c; /* conductor: complex index relative to the outside */
     bool ms;          /* conductor or dielectric: Kulla-Conty multiple-scattering lobe (rt_bsdf_compensate) */
     float ms_alpha;   /* its table alpha, sqrt(alpha alpha_y) */
@@ -95,9 +106,9 @@ typedef struct rt_bsdf {
     bool thin;        /* glTF transmission without a volume (thickness 0, thin-walled): light goes straight
                        * through, the microfacet reflection mirrored through the surface, no bending */
     /* The glTF PBR-next extensions over the glTF BSDF (docs/shading.md,
-     * "Extension layering"); layered false: none is on, and the fields
-     * below are not read (the core BSDF above, bit for bit). */
-    bool layered;
+     * "Extension layering"); read by RT_BSDF_KIND_GLTF_LAYERED only: with
+     * none on, rt_bsdf_set_ext leaves the kind RT_BSDF_KIND_GLTF (the core
+     * BSDF above, bit for bit). */
     float spec_weight;     /* KHR_materials_specular: specularFactor x texture (A) */
     rt_vec3 spec_color;    /* specularColorFactor x texture: dielectric F0 = min(F0 spec_color, 1) */
     float clearcoat;       /* KHR_materials_clearcoat weight c */
@@ -125,36 +136,8 @@ typedef struct rt_bsdf_sample {
     bool delta;       /* transmission or a mirror reflection: sampled only, never light-sampled, so no MIS */
 } rt_bsdf_sample;
 
-/* Exact unpolarised Fresnel reflectance of a smooth dielectric interface
- * (Born and Wolf, Principles of Optics, 1.5.2) at incident cosine cos_i,
- * eta = n_incident / n_transmitted; 1 past the critical angle. */
-float rt_fresnel_exact(float cos_i, float eta);
-/* Exact unpolarised Fresnel reflectance of a conductor of complex index
- * eta + i k (per channel, relative to the outside) at incident cosine cos_i. */
-rt_vec3 rt_fresnel_conductor(float cos_i, rt_vec3 eta, rt_vec3 k);
-
-/* Absorption coefficient inside a material (Beer-Lambert: transmittance
- * exp(-sigma d) over a distance d travelled inside): a dielectric's
- * `absorption` plus, for a dielectric or a glTF volume (thickness > 0,
- * transmission > 0), -ln(attenuation_color) / attenuation_distance. Zero
- * when nothing absorbs. */
-rt_vec3 rt_material_absorption(const rt_material *m);
-
-/* GGX building blocks, local frame (z = normal). */
-float rt_ggx_d(rt_vec3 h, float alpha);              /* D(h), 0 below the surface; h unit, stable to alpha 1e-4 */
-float rt_ggx_lambda(rt_vec3 w, float alpha);         /* Smith Lambda(w) */
-float rt_ggx_g1(rt_vec3 w, float alpha);             /* 1 / (1 + Lambda) */
-float rt_ggx_g2(rt_vec3 wo, rt_vec3 wi, float alpha); /* height-correlated 1 / (1 + L(wo) + L(wi)) */
-/* A visible normal for wo (wo.z > 0) from u in [0,1)^2 (Heitz 2018). */
-rt_vec3 rt_ggx_sample_vndf(rt_vec3 wo, float alpha, rt_vec2 u);
-/* pdf of reflecting wo into wi by VNDF sampling: G1(wo) D(h) / (4 wo.z). */
-float rt_ggx_reflect_pdf(rt_vec3 wo, rt_vec3 wi, float alpha);
-
-/* Builds the BSDF of a hit: material factors x textures (base colour,
- * metallic-roughness, transmission), frame from the shading normal (the
- * geometric one when wo lies below the shading normal). */
-void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf *b);
-/* The same from plain parameters, frame n (unit) with ng = n; for tests. */
+/* A BSDF from plain parameters, frame n (unit) with ng = n (tests; a hit's
+ * BSDF comes from rt_bsdf_from_surface, rt/render/material_eval.h). */
 void rt_bsdf_make(rt_bsdf *b, rt_vec3 n, rt_vec3 base, float metallic, float roughness, float ior,
                   float transmission, bool lambert);
 /* A dielectric (bsdf dielectric): eta = n_wo / n_wi, GGX alpha (0: smooth). */
@@ -165,14 +148,19 @@ void rt_bsdf_set_eta(rt_bsdf *b, float eta);
 /* A plastic (bsdf plastic): Lambertian reflectance R under a dielectric
  * coat, eta = n_outside / n_coat, coat GGX alpha (0: smooth). */
 void rt_bsdf_make_plastic(rt_bsdf *b, rt_vec3 n, rt_vec3 R, float eta, float alpha);
-/* Hemispherical (cosine-weighted) average of the exact Fresnel reflectance
- * at an interface of index ratio eta = n_incident / n_transmitted:
- * the internal diffuse reflectance for eta > 1. */
-float rt_fresnel_diffuse_reflectance(float eta);
 /* A conductor (bsdf conductor) the same way: GGX alphas along x and y of
  * the frame (both 0: a delta mirror). */
 void rt_bsdf_make_conductor(rt_bsdf *b, rt_vec3 n, rt_vec3 eta, rt_vec3 k, float alpha_x, float alpha_y,
-                            rt_smith smith);
+                            bool separable);
+/* The pieces the make functions are built of, for the material
+ * evaluation: the frame (n unit, ng the geometric normal on its side; t, b
+ * from rt_onb), then one model's parameters, which leave the frame alone:
+ * Lambert of albedo base, the glTF metallic-roughness BSDF, a conductor
+ * (separable: Smith G1 G1 instead of height-correlated). */
+void rt_bsdf_set_frame(rt_bsdf *b, rt_vec3 n, rt_vec3 ng);
+void rt_bsdf_set_lambert(rt_bsdf *b, rt_vec3 base);
+void rt_bsdf_set_gltf(rt_bsdf *b, rt_vec3 base, float metallic, float roughness, float ior, float transmission);
+void rt_bsdf_set_conductor(rt_bsdf *b, rt_vec3 eta, rt_vec3 k, float ax, float ay, bool separable);
 
 /* Adds Kulla and Conty's (2017) multiple-scattering lobe to a rough
  * conductor (height-correlated Smith; nothing for a delta or separable
@@ -194,11 +182,9 @@ void rt_bsdf_compensate(rt_bsdf *b);
  * = n_t^2 f(wi, wo) seen from the other side. */
 float rt_bsdf_ms_transmit(const rt_bsdf *b, rt_vec3 wo, rt_vec3 wi);
 
-/* The glTF PBR-next extensions' parameters at a point (rt_bsdf_set_ext).
- * rt_bsdf_ext_of_material takes a material's factors (no textures: the
- * path tracer multiplies those in at a hit); rt_bsdf_ext_default is that
- * of rt_material_default()'s material, the values that leave the core
- * BSDF, so the defaults live in one place (scene.c). */
+/* The glTF PBR-next extensions' parameters at a point (rt_bsdf_set_ext);
+ * a material's come from rt_bsdf_ext_of_material, the defaults that leave
+ * the core BSDF from rt_bsdf_ext_default (rt/render/material_eval.h). */
 typedef struct rt_bsdf_ext {
     float spec_weight;          /* KHR_materials_specular: specularFactor */
     rt_vec3 spec_color;         /* specularColorFactor */
@@ -212,8 +198,6 @@ typedef struct rt_bsdf_ext {
     rt_vec3 diffuse_transmission_color;
     float dispersion;           /* KHR_materials_dispersion: 20 / Abbe number (needs transmission) */
 } rt_bsdf_ext;
-void rt_bsdf_ext_of_material(const rt_material *m, rt_bsdf_ext *e);
-void rt_bsdf_ext_default(rt_bsdf_ext *e);
 /* Puts the extensions' layers over a glTF BSDF from rt_bsdf_make or
  * rt_bsdf_from_surface (anything else is left as it is); with the default
  * parameters b stays the core BSDF. */

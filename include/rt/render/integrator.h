@@ -32,6 +32,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "rt/render/render_state.h" /* RT_PREPARE_*: what an integrator asks to be prepared */
 #include "rt/render/sampling.h"
 #include "rt/render/surface.h"
 
@@ -45,16 +46,21 @@ typedef struct rt_integrator_info {
     unsigned prepare;        /* RT_PREPARE_* bits (rt/render/render_state.h): what the render state must hold */
     int pass_samples;        /* rt_render's default: samples per pixel a pass; 0 = tile by tile */
     bool wavefront;          /* rt_render traces batches of paths (rt/render/wavefront.h), same radiance */
+    bool film_sampler;       /* the camera's film and lens samples come from the `sampler` setting */
+    bool diffuse_tree;       /* traces diffuse_rays ^ diffuse_bounces rays a camera sample (a checked limit) */
+    bool for_models;         /* the one a bare glTF model or mesh gets (rt_integrator_for_models) */
 } rt_integrator_info;
 
 /* Every name in table order, NULL-terminated: the words of the `integrator`
- * setting (rt/scene/settings.h) and of --integrator. */
+ * setting (rt/render/settings.h) and of --integrator. */
 extern const char *const rt_integrator_words[];
 
 /* Number of integrators; ids are 0 .. count - 1. */
 size_t rt_integrator_count(void);
 /* The table line of id, NULL when there is none. */
 const rt_integrator_info *rt_integrator_info_of(rt_integrator id);
+/* The integrator a bare model gets (rt_load's for_render): its line says so. */
+rt_integrator rt_integrator_for_models(void);
 /* Name to id; false for an unknown name. */
 bool rt_integrator_by_name(const char *name, rt_integrator *id);
 /* Id to name; NULL for an unknown id. */

@@ -27,6 +27,7 @@
 
 #include "rt/render/bsdf.h"
 #include "rt/render/light.h"
+#include "rt/render/material_eval.h"
 #include "rt/render/medium.h"
 #include "rt/render/sampling.h"
 #include "rt/render/sampler_block.h"

@@ -23,7 +23,7 @@
 #ifndef RT_SURFACE_H
 #define RT_SURFACE_H
 
-#include "rt/render/render_state.h"
+#include "rt/render/trace.h"
 #include "rt/render/sampling.h"
 
 typedef struct rt_surface {
@@ -59,7 +59,7 @@ static inline uint32_t rt_prim_material(const rt_scene *s, uint32_t prim)
 
 void rt_surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf);
 /* The same record without the tangent frame (sf->t, sf->b zero) unless the
- * material reads it (rt_surface_material_reads_frame), and without UVs
+ * material reads it (RT_MATERIAL_FRAME of rt_material_needs), and without UVs
  * (uv0, uv1 zero) when it has no texture: for the path tracer, whose BSDF
  * builds its own frame about the shading normal, so a hit builds one
  * frame, not two. Every other field is rt_surface_at's, bit for bit. */
@@ -70,13 +70,6 @@ void rt_surface_at_shading(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_
  * n_unmapped = ng (no interpolated or mapped normal), t = b = 0,
  * vertex_color (1, 1, 1, 1). */
 void rt_surface_at_emitter(const rt_trace_ctx *ctx, const rt_ray *ray, const rt_hit *hit, rt_surface *sf);
-/* Whether rt_bsdf_from_surface or the record itself reads the tangent
- * frame: a normal map, a conductor (anisotropy), the glTF extensions. */
-bool rt_surface_material_reads_frame(const rt_material *m);
-/* The RT_MATERIAL_* bits of m (rt/render/render_state.h), which
- * rt_render_state_prepare keeps per material. */
-uint8_t rt_material_needs(const rt_material *m);
-
 /* Base colour (linear RGB, alpha) = factor x texture x vertex colour. */
 rt_vec4 rt_surface_base_color(const rt_trace_ctx *ctx, const rt_surface *sf);
 /* Emitted radiance towards sf.wo (zero on the back of one-sided emitters). */

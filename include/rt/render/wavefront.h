@@ -25,7 +25,7 @@
 #include <stdint.h>
 
 #include "rt/render/camera.h"
-#include "rt/render/render_state.h"
+#include "rt/render/trace.h"
 
 #define RT_WAVEFRONT_BATCH 1024 /* default paths in flight per worker (docs/performance.md measures 256-4096) */
 

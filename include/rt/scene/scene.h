@@ -68,7 +68,7 @@ typedef enum rt_sampler_kind {
 } rt_sampler_kind;
 
 /* Render settings. rt_settings_default() gives the documented defaults; the
- * table of them (names, ranges, defaults, help) is rt/scene/settings.h. */
+ * table of them (names, ranges, defaults, help) is rt/render/settings.h. */
 typedef struct rt_settings {
     int width, height;
     int samples;          /* samples per pixel (stratified when a square) */
@@ -88,6 +88,7 @@ typedef struct rt_settings {
     uint32_t seed;
     rt_vec3 background;   /* radiance of rays that leave the scene */
     uint32_t environment_texture; /* lat-long image, RT_NONE for constant background */
+    char environment_file[4096];  /* the `environment` setting's file, "" = none; io loads it into environment_texture */
     float environment_strength;
     /* whitted: ambient radiance that materials' `ambient` coefficient
      * reflects. Unset (the default): the background's radiance, i.e. the
@@ -114,6 +115,7 @@ typedef struct rt_image {
     uint8_t *rgba8;
     float *rgbaf;
     char name[256]; /* path or "file.glb#image3", for messages and caching */
+    int *shares;    /* NULL: the pixels are this scene's; else how many scenes hold them (rt_scene_share_images) */
 } rt_image;
 
 /* A texture: which image, how it is sampled, or a procedural pattern. */
@@ -360,6 +362,11 @@ uint32_t rt_scene_find_material(const rt_scene *s, const char *name); /* RT_NONE
 uint32_t rt_scene_add_texture(rt_scene *s, const rt_texture *t);
 uint32_t rt_scene_add_image(rt_scene *s, const rt_image *img); /* takes ownership of the pixels */
 uint32_t rt_scene_add_light(rt_scene *s, const rt_light *l);
+/* Appends every image of `from` to s, sharing the decoded pixels (counted:
+ * the last scene freed frees them), so loading the same files into s finds
+ * them decoded (motion-blur slices, rt/job/motion.h). false when out of
+ * memory: s keeps the images shared so far, freed with it. */
+bool rt_scene_share_images(rt_scene *s, rt_scene *from);
 uint32_t rt_scene_add_camera(rt_scene *s, const rt_camera *c);
 uint32_t rt_scene_add_sphere(rt_scene *s, rt_vec3 center, float radius, uint32_t material);
 uint32_t rt_scene_add_quad(rt_scene *s, rt_vec3 corner, rt_vec3 edge_u, rt_vec3 edge_v, uint32_t material);

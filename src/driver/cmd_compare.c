@@ -1,4 +1,4 @@
-/* compare.c - `rt compare CANDIDATE REFERENCE`: how far a render is from a
+/* cmd_compare.c - `rt compare CANDIDATE REFERENCE`: how far a render is from a
  * reference, as the error metrics of rt/image/compare.h and the LDR-FLIP and
  * HDR-FLIP means of rt/image/flip.h (Andersson et al., "FLIP: A Difference
  * Evaluator for Alternating Images", HPG 2020; "Visualizing Errors in

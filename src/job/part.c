@@ -1,4 +1,4 @@
-/* part.c - a part's image and JSON sidecar out and in (rt/io/part.h,
+/* part.c - a part's image and JSON sidecar out and in (rt/job/part.h,
  * docs/farm.md). The image holds the exact float sums and counts the render
  * kept (not their ratio): the fold of the first sample blocks and the sums
  * of the blocks kept apart (rt/render/sample_block.h), so a merge can fold
@@ -6,8 +6,10 @@
  * hashes (Fowler, Noll, Vo; the parameters of the IETF draft
  * draft-eastlake-fnv) of the image files, of the scene's bytes and of the
  * settings text; reading checks the ones it can. JSON (RFC 8259) through
- * the jsmn walker of rt/io/json.h. */
-#include "rt/io/part.h"
+ * the jsmn walker of rt/io/json.h. Also what parts are compared by (two
+ * parts are of one render when their identities match) and their AOV
+ * layers to and from the renderer's AOV sums. */
+#include "rt/job/part.h"
 
 #include <inttypes.h>
 #include <math.h>
@@ -21,6 +23,7 @@
 #include "rt/io/exr.h"
 #include "rt/io/image_read.h"
 #include "rt/io/json.h"
+#include "rt/render/aov.h"
 
 #define SIDECAR_MAX_BYTES (1u << 20)
 
@@ -579,5 +582,83 @@ void rt_part_free(rt_part *part)
     for (int k = 0; k < RT_PART_MAX_LAYERS; k++) {
         free(part->layer[k]);
         part->layer[k] = NULL;
+    }
+}
+
+/* ------------------------------------------------------------ identity and AOV layers */
+
+/* The first line where two settings texts differ, into a and b. */
+static void first_difference(const char *x, const char *y, char *a, char *b, size_t size)
+{
+    while (*x || *y) {
+        size_t nx = strcspn(x, "\n"), ny = strcspn(y, "\n");
+        if (nx != ny || memcmp(x, y, nx) != 0) {
+            snprintf(a, size, "%.*s", (int)nx, x);
+            snprintf(b, size, "%.*s", (int)ny, y);
+            return;
+        }
+        x += nx + (x[nx] == '\n');
+        y += ny + (y[ny] == '\n');
+    }
+    a[0] = b[0] = 0;
+}
+
+const char *rt_part_mismatch(const rt_part_info *a, const rt_part_info *b, char *buf, size_t size)
+{
+    if (strcmp(a->version, b->version) != 0)
+        snprintf(buf, size, "rendered by rt %s, not rt %s", a->version, b->version);
+    else if (a->scene_hash != b->scene_hash)
+        snprintf(buf, size, "another scene file (%s, FNV-1a %016llx; not %s, %016llx)", a->scene,
+                 (unsigned long long)a->scene_hash, b->scene, (unsigned long long)b->scene_hash);
+    else if (a->width != b->width || a->height != b->height)
+        snprintf(buf, size, "image size %dx%d, not %dx%d", a->width, a->height, b->width, b->height);
+    else if (a->spp != b->spp)
+        snprintf(buf, size, "%d samples per pixel, not %d", a->spp, b->spp);
+    else if (a->seed != b->seed)
+        snprintf(buf, size, "seed %u, not %u", (unsigned)a->seed, (unsigned)b->seed);
+    else if (a->layer_count != b->layer_count ||
+             memcmp(a->layer_name, b->layer_name, sizeof a->layer_name) != 0)
+        snprintf(buf, size, "other AOVs (%d layer%s, not %d)", a->layer_count, a->layer_count == 1 ? "" : "s",
+                 b->layer_count);
+    else if (strcmp(a->settings, b->settings) != 0) {
+        char x[256], y[256];
+        first_difference(a->settings, b->settings, x, y, sizeof x);
+        snprintf(buf, size, "other settings: '%s', not '%s'", x, y);
+    } else
+        return NULL;
+    return buf;
+}
+
+/* Component q of the AOV a layer holds (name: albedo, normal, position, depth). */
+static float *aov_field(rt_aov_sample *s, const char *name, int q)
+{
+    rt_vec3 *v = strcmp(name, "albedo") == 0   ? &s->albedo
+                 : strcmp(name, "normal") == 0 ? &s->normal
+                 : strcmp(name, "position") == 0 ? &s->position
+                                                 : NULL;
+    if (!v)
+        return &s->depth;
+    return q == 0 ? &v->x : q == 1 ? &v->y : &v->z;
+}
+
+void rt_part_aov_to_layers(const rt_part_info *info, const rt_aov_sample *sums, float *const *layers, size_t n)
+{
+    for (int k = 0; k < info->layer_count; k++) {
+        int c = info->layer_channels[k];
+        for (size_t i = 0; i < n; i++) {
+            rt_aov_sample s = sums[i];
+            for (int q = 0; q < c; q++)
+                layers[k][(size_t)c * i + (size_t)q] = *aov_field(&s, info->layer_name[k], q);
+        }
+    }
+}
+
+void rt_part_layers_to_aov(const rt_part_info *info, const float *const *layers, rt_aov_sample *sums, size_t n)
+{
+    for (int k = 0; k < info->layer_count; k++) {
+        int c = info->layer_channels[k];
+        for (size_t i = 0; i < n; i++)
+            for (int q = 0; q < c; q++)
+                *aov_field(&sums[i], info->layer_name[k], q) = layers[k][(size_t)c * i + (size_t)q];
     }
 }

@@ -1,19 +1,20 @@
-/* part.c - the driver's side of parts (part.h, docs/farm.md): the region
- * and samples the part flags ask for, the identity of a render that every
+/* part_job.c - a render job's side of parts (rt/job/part_job.h,
+ * docs/farm.md): the region and samples the part options ask for, the identity of a render that every
  * part of it carries (the FNV-1a hash of the input's bytes, the settings
  * that change pixels as "key value" lines with floats in C99 hexadecimal
  * so they compare exactly, the image size, the samples, the seed, rt's
  * version), and --resume's check that a part belongs to this render. */
-#include "part.h"
+#include "rt/job/part_job.h"
 
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "part_split.h"
+#include "rt/job/part_split.h"
 #include "rt/base/alloc.h"
 #include "rt/base/file.h"
+#include "rt/base/log.h"
 #include "rt/render/aov.h"
 #include "rt/render/integrator.h"
 
@@ -74,41 +75,7 @@ static void settings_text(const rt_scene *scene, char *buf, size_t size)
              s->motion_steps);
 }
 
-/* Component q of the AOV a layer holds (name: albedo, normal, position, depth). */
-static float *aov_field(rt_aov_sample *s, const char *name, int q)
-{
-    rt_vec3 *v = strcmp(name, "albedo") == 0   ? &s->albedo
-                 : strcmp(name, "normal") == 0 ? &s->normal
-                 : strcmp(name, "position") == 0 ? &s->position
-                                                 : NULL;
-    if (!v)
-        return &s->depth;
-    return q == 0 ? &v->x : q == 1 ? &v->y : &v->z;
-}
-
-void aov_to_layers(const rt_part_info *info, const rt_aov_sample *sums, float *const *layers, size_t n)
-{
-    for (int k = 0; k < info->layer_count; k++) {
-        int c = info->layer_channels[k];
-        for (size_t i = 0; i < n; i++) {
-            rt_aov_sample s = sums[i];
-            for (int q = 0; q < c; q++)
-                layers[k][(size_t)c * i + (size_t)q] = *aov_field(&s, info->layer_name[k], q);
-        }
-    }
-}
-
-void layers_to_aov(const rt_part_info *info, const float *const *layers, rt_aov_sample *sums, size_t n)
-{
-    for (int k = 0; k < info->layer_count; k++) {
-        int c = info->layer_channels[k];
-        for (size_t i = 0; i < n; i++)
-            for (int q = 0; q < c; q++)
-                *aov_field(&sums[i], info->layer_name[k], q) = layers[k][(size_t)c * i + (size_t)q];
-    }
-}
-
-rt_result part_identity(const rt_scene *scene, const char *input, rt_part_info *info, rt_error *err)
+rt_result rt_part_identity(const rt_scene *scene, const char *input, rt_part_info *info, rt_error *err)
 {
     memset(info, 0, sizeof *info);
     snprintf(info->version, sizeof info->version, "%s", RT_VERSION);
@@ -143,57 +110,15 @@ rt_result part_identity(const rt_scene *scene, const char *input, rt_part_info *
     return RT_OK;
 }
 
-/* The first line where two settings texts differ, into a and b. */
-static void first_difference(const char *x, const char *y, char *a, char *b, size_t size)
-{
-    while (*x || *y) {
-        size_t nx = strcspn(x, "\n"), ny = strcspn(y, "\n");
-        if (nx != ny || memcmp(x, y, nx) != 0) {
-            snprintf(a, size, "%.*s", (int)nx, x);
-            snprintf(b, size, "%.*s", (int)ny, y);
-            return;
-        }
-        x += nx + (x[nx] == '\n');
-        y += ny + (y[ny] == '\n');
-    }
-    a[0] = b[0] = 0;
-}
-
-const char *part_mismatch(const rt_part_info *a, const rt_part_info *b, char *buf, size_t size)
-{
-    if (strcmp(a->version, b->version) != 0)
-        snprintf(buf, size, "rendered by rt %s, not rt %s", a->version, b->version);
-    else if (a->scene_hash != b->scene_hash)
-        snprintf(buf, size, "another scene file (%s, FNV-1a %016llx; not %s, %016llx)", a->scene,
-                 (unsigned long long)a->scene_hash, b->scene, (unsigned long long)b->scene_hash);
-    else if (a->width != b->width || a->height != b->height)
-        snprintf(buf, size, "image size %dx%d, not %dx%d", a->width, a->height, b->width, b->height);
-    else if (a->spp != b->spp)
-        snprintf(buf, size, "%d samples per pixel, not %d", a->spp, b->spp);
-    else if (a->seed != b->seed)
-        snprintf(buf, size, "seed %u, not %u", (unsigned)a->seed, (unsigned)b->seed);
-    else if (a->layer_count != b->layer_count ||
-             memcmp(a->layer_name, b->layer_name, sizeof a->layer_name) != 0)
-        snprintf(buf, size, "other AOVs (%d layer%s, not %d)", a->layer_count, a->layer_count == 1 ? "" : "s",
-                 b->layer_count);
-    else if (strcmp(a->settings, b->settings) != 0) {
-        char x[256], y[256];
-        first_difference(a->settings, b->settings, x, y, sizeof x);
-        snprintf(buf, size, "other settings: '%s', not '%s'", x, y);
-    } else
-        return NULL;
-    return buf;
-}
-
 /* Zeroed sums, block sums and counts (and AOV sums when aov) for n pixels. */
-static rt_result alloc_sums(part_job *pj, size_t n, bool aov, rt_error *err)
+static rt_result alloc_sums(rt_part_job *pj, size_t n, bool aov, rt_error *err)
 {
     pj->accum.sum = rt_alloc(n, 3 * sizeof(float));
     pj->accum.block = rt_alloc(n, 3 * sizeof(float));
     pj->accum.good = rt_alloc(n, sizeof(uint32_t));
     pj->accum.aov_sum = aov ? rt_alloc(n, sizeof *pj->accum.aov_sum) : NULL;
     if (!pj->accum.sum || !pj->accum.block || !pj->accum.good || (aov && !pj->accum.aov_sum)) {
-        part_job_free(pj);
+        rt_part_job_free(pj);
         return rt_fail(err, RT_ERR_NOMEM, "out of memory for the sums of %zu pixels", n);
     }
     memset(pj->accum.sum, 0, n * 3 * sizeof(float));
@@ -210,7 +135,7 @@ static rt_result alloc_sums(part_job *pj, size_t n, bool aov, rt_error *err)
  * the render keeps the finished ones in accum.kept (n pixels each), the
  * last stays in accum.block. Else the part keeps its fold and last block,
  * and merges within the bound (docs/farm.md). */
-static rt_result keep_blocks(part_job *pj, size_t n, rt_error *err)
+static rt_result keep_blocks(rt_part_job *pj, size_t n, rt_error *err)
 {
     int first = pj->part_begin / RT_SAMPLE_BLOCK, last = (pj->s_end - 1) / RT_SAMPLE_BLOCK;
     pj->keep_blocks = pj->part_begin > 0 && pj->part_begin % RT_SAMPLE_BLOCK == 0 && last - first < RT_PART_MAX_BLOCKS;
@@ -223,7 +148,7 @@ static rt_result keep_blocks(part_job *pj, size_t n, rt_error *err)
         return RT_OK;
     pj->accum.kept = rt_alloc(n * (size_t)(last - first), 3 * sizeof(float));
     if (!pj->accum.kept) {
-        part_job_free(pj);
+        rt_part_job_free(pj);
         return rt_fail(err, RT_ERR_NOMEM, "out of memory for %d block sums of %zu pixels", last - first, n);
     }
     pj->accum.kept_first = first;
@@ -231,20 +156,21 @@ static rt_result keep_blocks(part_job *pj, size_t n, rt_error *err)
     return RT_OK;
 }
 
-static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_error *err);
+static rt_result resume(rt_part_job *pj, const rt_job_options *a, const rt_settings *s, rt_error *err);
 
-rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, const rt_kdtree *tree, rt_error *err)
+rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_scene *scene, const rt_kdtree *tree,
+                           rt_error *err)
 {
     memset(pj, 0, sizeof *pj);
     const rt_settings *s = &scene->settings;
-    pj->to_part = args_output_is_part(a);
+    pj->to_part = a->output_is_part;
     pj->region = (rt_render_region){0, 0, s->width, s->height};
     pj->s_begin = 0;
     pj->s_end = s->samples;
     bool any = pj->to_part || a->resume || a->part_out;
     if (!any)
         return RT_OK;
-    rt_result r = part_identity(scene, a->input, &pj->info, err);
+    rt_result r = rt_part_identity(scene, a->input, &pj->info, err);
     if (r != RT_OK)
         return r;
     if (a->posed) /* the pose changes pixels: frame time and animation are settings of the render */
@@ -256,7 +182,7 @@ rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, cons
                            a->crop[2], a->crop[3], s->width, s->height);
         pj->region = (rt_render_region){a->crop[0], a->crop[1], a->crop[2], a->crop[3]};
     }
-    if (a->part_count && (r = part_split(scene, tree, a->part_index, a->part_count, &pj->region, err)) != RT_OK)
+    if (a->part_count && (r = rt_part_split(scene, tree, a->part_index, a->part_count, &pj->region, err)) != RT_OK)
         return r;
     if (a->has_spp_range) {
         if (a->spp_end > s->samples)
@@ -269,16 +195,16 @@ rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, cons
     }
     pj->part_begin = pj->s_begin;
     if ((pj->to_part || a->resume || a->part_out) &&
-        (a->denoise || (a->aovs & ((1u << AOV_VARIANCE) | (1u << AOV_SPP)))))
+        (a->denoise || (a->aovs & ((1u << RT_AOV_VARIANCE) | (1u << RT_AOV_SPP)))))
         return rt_fail(err, RT_ERR_INVALID,
                        "parts keep the albedo, normal, depth and position AOVs; not the variance or spp AOVs, nor "
                        "--denoise (merge the parts, then denoise the image)");
-    /* the AOV sums a part carries: its layers, in aov_names order */
-    for (int k = 0; k < AOV_COUNT; k++)
+    /* the AOV sums a part carries: its layers, in rt_aov_names order */
+    for (int k = 0; k < RT_AOV_COUNT; k++)
         if (a->aovs & (1u << k)) {
             rt_part_info *in = &pj->info;
-            snprintf(in->layer_name[in->layer_count], sizeof in->layer_name[0], "%s", aov_names[k]);
-            in->layer_channels[in->layer_count++] = k == AOV_DEPTH ? 1 : 3;
+            snprintf(in->layer_name[in->layer_count], sizeof in->layer_name[0], "%s", rt_aov_names[k]);
+            in->layer_channels[in->layer_count++] = k == RT_AOV_DEPTH ? 1 : 3;
         }
     size_t n = (size_t)(pj->region.x1 - pj->region.x0) * (size_t)(pj->region.y1 - pj->region.y0);
     pj->need_accum = true;
@@ -289,15 +215,15 @@ rt_result part_job_init(part_job *pj, const args *a, const rt_scene *scene, cons
     return keep_blocks(pj, n, err);
 }
 
-/* part_job_init for --resume: the region, samples and sums of the part. */
-static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_error *err)
+/* rt_part_job_init for --resume: the region, samples and sums of the part. */
+static rt_result resume(rt_part_job *pj, const rt_job_options *a, const rt_settings *s, rt_error *err)
 {
     rt_result r;
     rt_part p;
     if ((r = rt_part_read(a->resume, &p, err)) != RT_OK)
         return r;
     char why[1024];
-    if (part_mismatch(&p.info, &pj->info, why, sizeof why)) {
+    if (rt_part_mismatch(&p.info, &pj->info, why, sizeof why)) {
         r = rt_fail(err, RT_ERR_INVALID, "--resume %s: the part is of another render: %s", a->resume, why);
         rt_part_free(&p);
         return r;
@@ -326,7 +252,7 @@ static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_er
     pj->accum.block = rt_alloc(np, 3 * sizeof(float));
     if (!pj->accum.block) {
         rt_part_free(&p);
-        part_job_free(pj);
+        rt_part_job_free(pj);
         return rt_fail(err, RT_ERR_NOMEM, "out of memory for the sums of %s", a->resume);
     }
     memcpy(pj->accum.block, p.blocks + (size_t)(nb - 1) * 3 * np, np * 3 * sizeof(float));
@@ -344,7 +270,7 @@ static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_er
             rt_part_free(&p);
             return rt_fail(err, RT_ERR_NOMEM, "out of memory for the AOV sums of %s", a->resume);
         }
-        layers_to_aov(&p.info, (const float *const *)p.layer, pj->accum.aov_sum, np);
+        rt_part_layers_to_aov(&p.info, (const float *const *)p.layer, pj->accum.aov_sum, np);
     }
     rt_part_free(&p);
     bool whole = pj->region.x0 == 0 && pj->region.y0 == 0 && pj->region.x1 == s->width &&
@@ -353,13 +279,13 @@ static rt_result resume(part_job *pj, const args *a, const rt_settings *s, rt_er
     return RT_OK;
 }
 
-rt_result part_job_accum(part_job *pj, bool aov, rt_error *err)
+rt_result rt_part_job_accum(rt_part_job *pj, bool aov, rt_error *err)
 {
     size_t n = (size_t)(pj->region.x1 - pj->region.x0) * (size_t)(pj->region.y1 - pj->region.y0);
     return alloc_sums(pj, n, aov, err);
 }
 
-void part_job_free(part_job *pj)
+void rt_part_job_free(rt_part_job *pj)
 {
     free(pj->accum.sum);
     free(pj->accum.block);
@@ -369,7 +295,8 @@ void part_job_free(part_job *pj)
     memset(&pj->accum, 0, sizeof pj->accum);
 }
 
-rt_result part_job_write(const part_job *pj, const char *path, int samples_done, rt_write_temp *temp, rt_error *err)
+rt_result rt_part_job_write(const rt_part_job *pj, const char *path, int samples_done, rt_write_temp *temp,
+                            rt_error *err)
 {
     rt_part_info info = pj->info;
     info.x0 = pj->region.x0;
@@ -403,7 +330,7 @@ rt_result part_job_write(const part_job *pj, const char *path, int samples_done,
         if (!(layers[k] = rt_alloc(n, (size_t)info.layer_channels[k] * sizeof(float))))
             r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the AOV layers", path);
     if (r == RT_OK) {
-        aov_to_layers(&info, pj->accum.aov_sum, layers, n);
+        rt_part_aov_to_layers(&info, pj->accum.aov_sum, layers, n);
         r = rt_part_write(path, &info, fold, blocks, pj->accum.good, (const float *const *)layers, temp, err);
     }
     free(zeros);

@@ -1,4 +1,4 @@
-/* convert.c - `rt convert IN OUT [--exposure EV] [--tonemap NAME] [--half]`:
+/* cmd_convert.c - `rt convert IN OUT [--exposure EV] [--tonemap NAME] [--half]`:
  * an image from one format to another. IN is read whatever its format
  * (rt/io/image_read.h: EXR, PFM, HDR, PNG...); OUT's extension picks the
  * writer, as for renders (rt/io/image_write.h). Exposure and the tone curve

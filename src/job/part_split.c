@@ -1,5 +1,5 @@
 /* part_split.c - cutting an image into N bands of similar cost for
- * `--part I/N` (part_split.h, docs/farm.md).
+ * `--part I/N` (rt/job/part_split.h, docs/farm.md).
  *
  * Cost estimate: the image is covered by a grid of square blocks (side B,
  * chosen so there are at most about 4096 blocks); in every block four
@@ -19,7 +19,7 @@
  * This takes one sample at ~16k pixels on one thread: for the path tracer
  * about as long as rendering a 128x128 image at 1 spp.
  */
-#include "part_split.h"
+#include "rt/job/part_split.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -48,7 +48,7 @@ static int place_cut(int want, int prev, int rows, int left)
     return cut > rows - left ? rows - left : cut;
 }
 
-rt_result part_split(const rt_scene *scene, const rt_kdtree *tree, int index, int count, rt_render_region *band,
+rt_result rt_part_split(const rt_scene *scene, const rt_kdtree *tree, int index, int count, rt_render_region *band,
                      rt_error *err)
 {
     const rt_settings *set = &scene->settings;

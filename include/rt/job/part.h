@@ -1,4 +1,4 @@
-/* rt/io/part.h - a part of a render spread over machines (docs/farm.md):
+/* rt/job/part.h - a part of a render spread over machines (docs/farm.md):
  * a float image of a region's per-pixel SUMS of good samples and their
  * COUNTS, and its JSON sidecar saying what it is a part of.
  *
@@ -101,5 +101,15 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
  * the sample range. A part of another format is refused, naming it. */
 rt_result rt_part_read(const char *path, rt_part *part, rt_error *err);
 void rt_part_free(rt_part *part);
+
+/* NULL when a and b are parts of the same render; else what differs, in
+ * words ("other settings: 'samples 64', not 'samples 16'"), in buf. */
+const char *rt_part_mismatch(const rt_part_info *a, const rt_part_info *b, char *buf, size_t size);
+
+/* A part's AOV layers (info->layer_name: albedo, normal, position, depth)
+ * to and from the render's per-pixel AOV sums, n pixels. */
+struct rt_aov_sample;
+void rt_part_aov_to_layers(const rt_part_info *info, const struct rt_aov_sample *sums, float *const *layers, size_t n);
+void rt_part_layers_to_aov(const rt_part_info *info, const float *const *layers, struct rt_aov_sample *sums, size_t n);
 
 #endif

@@ -1,7 +1,8 @@
-/* gltf_internal.h - what the files of the glTF loader share (private to
- * src/io): the limits, the document's records and gl_doc, the JSON field
- * readers and each pass's entry points. The passes, in the order gl_load
- * (gltf.c) runs them:
+/* gltf_doc.h - what the files of the glTF loader share (private to
+ * src/io): the limits, the document's records and gl_doc, and each file's
+ * entry points. gltf_doc.c, at the bottom, reads the document: located
+ * errors, external files, the typed JSON field readers. Above it the
+ * passes, in the order gl_load (gltf.c, at the top) runs them:
  *   gltf.c           read the file, split a GLB into JSON and BIN chunks
  *   gltf_parse.c     map the JSON into flat tables of records (with
  *   gltf_material.c  for materials, textures, samplers and images)
@@ -9,11 +10,13 @@
  *   gltf_buffers.c   read buffers; accessor data; meshopt and Draco decoding
  *   gltf_pose.c      pose nodes at a time; skin and morph matrices and weights
  *   gltf_flatten.c   the chosen scene into the scene's tables
- * Every function returns at its failures in plain sight: no macro hides a
- * return or a loop.
+ * gltf.c calls the passes and every pass calls gltf_doc.c; a pass calls
+ * the others only downward (gltf_parse.c the material readers,
+ * gltf_flatten.c the buffers, materials and pose): no circle. Every function returns at its failures in plain sight:
+ * no macro hides a return or a loop.
  */
-#ifndef RT_IO_GLTF_INTERNAL_H
-#define RT_IO_GLTF_INTERNAL_H
+#ifndef RT_IO_GLTF_DOC_H
+#define RT_IO_GLTF_DOC_H
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -195,17 +198,14 @@ static inline int jsize(const gl_doc *d, int t) { return t >= 0 && t < d->j.coun
 /* Whether key token k is the string s (d is the gl_doc in scope). */
 #define KEY(k, s) rt_json_key_is(&d->j, (k), (s))
 
-/* gltf.c: errors located in the document, external files, the passes in order */
+/* gltf_doc.c: errors located in the document, external files, the JSON field readers */
 /* Fails with code and a message located at token tok ("file: byte N: ..."; no byte for tok < 0). */
 rt_result gl_fail_at(gl_doc *d, int tok, rt_result code, const char *fmt, ...) RT_PRINTF(4, 5);
 rt_result gl_read_file(gl_doc *d, const char *path, const char *what, uint8_t **data, size_t *size);
-rt_result gl_apply_variant(gl_doc *d, const rt_gltf_options *opt);
-rt_result gl_load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st);
-
-/* gltf_parse.c: the JSON field readers and the mapping of the document into records */
 rt_result gl_expect_object(gl_doc *d, int t, const char *where);
 rt_result gl_expect_array(gl_doc *d, int t, const char *where, const char *key);
 rt_result gl_get_index(gl_doc *d, const char *where, const char *key, int t, uint32_t *out);
+rt_result gl_get_size(gl_doc *d, const char *where, const char *key, int t, size_t *out);
 rt_result gl_get_int(gl_doc *d, const char *where, const char *key, int t, int *out);
 rt_result gl_get_float(gl_doc *d, const char *where, const char *key, int t, float *out);
 rt_result gl_get_floats(gl_doc *d, const char *where, const char *key, int t, float *out, int n);
@@ -221,6 +221,13 @@ rt_result gl_alloc_table(gl_doc *d, int t, const char *key, size_t elem, void **
 size_t gl_comp_size(int ct);
 size_t gl_elem_size(const gl_accessor *a);
 rt_mat4 gl_mat_from_gltf(const float *c);
+const char *gl_prim_name(const gl_doc *d, size_t p, char *buf, size_t cap);
+
+/* gltf.c: the entry points; gl_load runs the passes in order */
+rt_result gl_apply_variant(gl_doc *d, const rt_gltf_options *opt);
+rt_result gl_load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st);
+
+/* gltf_parse.c: the mapping of the document into records */
 rt_result gl_parse_document(gl_doc *d);
 
 /* gltf_material.c: materials, textures, samplers, images; textures into the scene */
@@ -232,7 +239,6 @@ rt_result gl_parse_images(gl_doc *d, int t);
 rt_result gl_load_textures(gl_doc *d, rt_scene *s, rt_gltf_stats *st);
 
 /* gltf_check.c: every index, span and graph rule, before any buffer is read */
-const char *gl_prim_name(const gl_doc *d, size_t p, char *buf, size_t cap);
 rt_result gl_validate_meshopt_view(gl_doc *d, size_t i);
 rt_result gl_validate(gl_doc *d);
 
@@ -248,7 +254,8 @@ rt_result gl_read_uints(gl_doc *d, uint32_t ai, uint32_t *out);
 rt_result gl_decode_meshopt_views(gl_doc *d);
 rt_result gl_decode_draco_prims(gl_doc *d);
 
-/* gltf_pose.c: animations at a time, skins and morph targets */
+/* gltf_pose.c: animations at a time, node world matrices, skins and morph targets */
+rt_mat4 gl_node_world(const gl_doc *d, uint32_t n, const rt_mat4 *top);
 rt_result gl_pose_nodes(gl_doc *d, const rt_gltf_options *opt);
 rt_result gl_morph_weights(gl_doc *d, uint32_t node, uint32_t count, float *w);
 rt_result gl_apply_morph(gl_doc *d, const gl_prim *p, const float *w, int slot, float *f, size_t stride,
@@ -258,7 +265,6 @@ rt_result gl_skin_matrices(gl_doc *d, const gl_prim *p, uint32_t node, const rt_
 
 /* gltf_flatten.c: the chosen scene into the scene tables */
 rt_result gl_scratch(gl_doc *d, int slot, size_t floats, float **out);
-rt_mat4 gl_node_world(const gl_doc *d, uint32_t n, const rt_mat4 *top);
 rt_result gl_flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st);
 
 #endif

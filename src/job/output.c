@@ -1,9 +1,9 @@
-/* output.c - a finished render to its files (output.h): --aov images as EXR
+/* output.c - a finished render to its files (rt/job/output.h): AOV images as EXR
  * layers or NAME.aov.pfm files, --denoise through rt/image/denoise.h (Intel
  * Open Image Denoise's RT filter, with the albedo and normal AOVs), then the
  * exposure (the scene's linear `exposure` times 2^--exposure) and tone curve
  * for 8-bit output and --half for EXR, written by rt_framebuffer_write_with. */
-#include "output.h"
+#include "rt/job/output.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,7 +17,7 @@
 #include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
 
-rt_result output_check(const args *a, rt_error *err)
+rt_result rt_job_output_check(const rt_job_options *a, rt_error *err)
 {
     if (!a->denoise)
         return RT_OK;
@@ -31,58 +31,58 @@ rt_result output_check(const args *a, rt_error *err)
 static float **slot(rt_aov_buffers *b, int k)
 {
     switch (k) {
-    case AOV_ALBEDO: return &b->albedo;
-    case AOV_NORMAL: return &b->normal;
-    case AOV_DEPTH: return &b->depth;
-    case AOV_POSITION: return &b->position;
-    case AOV_VARIANCE: return &b->variance;
-    case AOV_SPP:
+    case RT_AOV_ALBEDO: return &b->albedo;
+    case RT_AOV_NORMAL: return &b->normal;
+    case RT_AOV_DEPTH: return &b->depth;
+    case RT_AOV_POSITION: return &b->position;
+    case RT_AOV_VARIANCE: return &b->variance;
+    case RT_AOV_SPP:
     default: return &b->spp;
     }
 }
 
-static int channels_of(int k) { return k == AOV_ALBEDO || k == AOV_NORMAL || k == AOV_POSITION ? 3 : 1; }
+static int channels_of(int k) { return k == RT_AOV_ALBEDO || k == RT_AOV_NORMAL || k == RT_AOV_POSITION ? 3 : 1; }
 
-rt_result output_aovs_init(output_aovs *o, const args *a, int width, int height, rt_error *err)
+rt_result rt_job_aovs_init(rt_job_aovs *o, const rt_job_options *a, int width, int height, rt_error *err)
 {
     memset(o, 0, sizeof *o);
     o->wanted = a->aovs;
-    unsigned need = a->aovs | (a->denoise ? (1u << AOV_ALBEDO) | (1u << AOV_NORMAL) : 0u);
-    for (int k = 0; k < AOV_COUNT; k++) {
+    unsigned need = a->aovs | (a->denoise ? (1u << RT_AOV_ALBEDO) | (1u << RT_AOV_NORMAL) : 0u);
+    for (int k = 0; k < RT_AOV_COUNT; k++) {
         if (!(need & (1u << k)))
             continue;
         float *p = rt_alloc((size_t)width * (size_t)height, (size_t)channels_of(k) * sizeof(float));
         if (!p) {
-            output_aovs_free(o);
-            return rt_fail(err, RT_ERR_NOMEM, "out of memory for the %s AOV (%dx%d)", aov_names[k], width, height);
+            rt_job_aovs_free(o);
+            return rt_fail(err, RT_ERR_NOMEM, "out of memory for the %s AOV (%dx%d)", rt_aov_names[k], width, height);
         }
         *slot(&o->buf, k) = p;
     }
     return RT_OK;
 }
 
-void output_aovs_free(output_aovs *o)
+void rt_job_aovs_free(rt_job_aovs *o)
 {
-    for (int k = 0; k < AOV_COUNT; k++) {
+    for (int k = 0; k < RT_AOV_COUNT; k++) {
         free(*slot(&o->buf, k));
         *slot(&o->buf, k) = NULL;
     }
 }
 
-rt_aov_buffers *output_aovs_for_render(output_aovs *o)
+rt_aov_buffers *rt_job_aovs_for_render(rt_job_aovs *o)
 {
-    for (int k = 0; k < AOV_COUNT; k++)
+    for (int k = 0; k < RT_AOV_COUNT; k++)
         if (*slot(&o->buf, k))
             return &o->buf;
     return NULL;
 }
 
-int output_aovs_layers(const output_aovs *o, rt_image_layer *layers, int max)
+int rt_job_aovs_layers(const rt_job_aovs *o, rt_image_layer *layers, int max)
 {
     int n = 0;
-    for (int k = 0; k < AOV_COUNT && n < max; k++)
+    for (int k = 0; k < RT_AOV_COUNT && n < max; k++)
         if (o->wanted & (1u << k))
-            layers[n++] = (rt_image_layer){aov_names[k], channels_of(k), *slot((rt_aov_buffers *)&o->buf, k)};
+            layers[n++] = (rt_image_layer){rt_aov_names[k], channels_of(k), *slot((rt_aov_buffers *)&o->buf, k)};
     return n;
 }
 
@@ -101,14 +101,14 @@ static rt_result write_aov_file(const float *data, int channels, int w, int h, c
     return r;
 }
 
-rt_result output_write(const args *a, const rt_settings *set, rt_framebuffer *fb, const output_aovs *aov,
-                       const char *path, rt_write_temp *temp, rt_error *err)
+rt_result rt_job_output_write(const rt_job_options *a, const rt_settings *set, rt_framebuffer *fb,
+                              const rt_job_aovs *aov, const char *path, rt_write_temp *temp, rt_error *err)
 {
     rt_image_options opt = {.exposure = set->exposure * rt_exposure_scale(a->exposure_ev), .tonemap = a->tonemap,
                             .half = a->half};
     rt_image_format fmt = RT_FORMAT_PNG;
     rt_output_format(path, &fmt, err);
-    rt_image_layer layers[AOV_COUNT + 1];
+    rt_image_layer layers[RT_AOV_COUNT + 1];
     int nl = 0;
     float *noisy = NULL;
     rt_result r = RT_OK;
@@ -133,15 +133,15 @@ rt_result output_write(const args *a, const rt_settings *set, rt_framebuffer *fb
     if (fmt == RT_FORMAT_EXR) {
         if (noisy)
             layers[nl++] = (rt_image_layer){"noisy", 3, noisy};
-        nl += output_aovs_layers(aov, layers + nl, AOV_COUNT);
+        nl += rt_job_aovs_layers(aov, layers + nl, RT_AOV_COUNT);
         opt.layers = layers;
         opt.layer_count = nl;
     } else {
         char p[4200];
         const char *ext = fmt == RT_FORMAT_PNG ? ".pfm" : NULL;
-        for (int k = 0; k < AOV_COUNT && r == RT_OK; k++)
+        for (int k = 0; k < RT_AOV_COUNT && r == RT_OK; k++)
             if (aov->wanted & (1u << k)) {
-                rt_path_tagged(path, aov_names[k], ext, p, sizeof p);
+                rt_path_tagged(path, rt_aov_names[k], ext, p, sizeof p);
                 r = write_aov_file(*slot((rt_aov_buffers *)&aov->buf, k), channels_of(k), fb->width, fb->height, p,
                                    err);
             }

@@ -1,13 +1,16 @@
 /* settings.c - the one table of render settings (settings.h) and what it
  * drives: reading and checking a setting's words, storing them into
- * rt_settings, the defaults, and the texts for help and documentation.
+ * rt_settings, and the texts for help and documentation (the defaults are
+ * rt_settings_default()'s, scene.c, beside the struct they fill). It knows
+ * no scene and reads no file: the environment's image file is a name here,
+ * loaded by io (rt/io/environment_image.h).
  *
  * The table follows yocto-gl's habit of one parameter table behind both the
  * scene format and the command line. Messages keep the scene parser's
  * wording ("expected an integer for samples per pixel", "the exposure must be
  * > 0"); the caller adds the location (file:line:col, or the flag).
  */
-#include "rt/scene/settings.h"
+#include "rt/render/settings.h"
 
 #include <float.h>
 #include <stdarg.h>
@@ -17,9 +20,7 @@
 
 #include "rt/base/file.h"
 #include "rt/base/number.h"
-#include "rt/io/image_load.h"
 #include "rt/render/integrator.h"
-#include "rt/scene/texture.h"
 
 #define MAX_PATH_LEN 4096 /* the scene format's limit on file paths */
 
@@ -35,55 +36,46 @@ static const char *const sampler_words[] = {"independent", "cmj", "sobol", NULL}
 /* Table order is the order of --help and of the scene parser's "did you mean" search. */
 const rt_setting rt_settings_table[] = {
     {.name = "resolution", .args = "W H", .type = RT_SETTING_SIZE, .field = FIELD(width), .field2 = FIELD(height),
-     .min = 1, .max = RT_MAX_IMAGE_SIDE, .defaults = {512, 512}, .what = "the image",
+     .min = 1, .max = RT_MAX_IMAGE_SIDE, .what = "the image",
      .help = "image width and height in pixels"},
     {.name = "samples", .args = "N", .type = RT_SETTING_INT, .field = FIELD(samples), .min = 1,
-     .max = RT_MAX_SAMPLES, .defaults = {1}, .what = "samples per pixel", .help = "samples per pixel"},
-    {.name = "integrator", .args = "NAME", .type = RT_SETTING_ENUM, .field = FIELD(integrator),
-     .defaults = {RT_INTEGRATOR_DIRECT}, .words = rt_integrator_words, .what = "an integrator",
+     .max = RT_MAX_SAMPLES, .what = "samples per pixel", .help = "samples per pixel"},
+    {.name = "integrator", .args = "NAME", .type = RT_SETTING_ENUM, .field = FIELD(integrator), .words = rt_integrator_words, .what = "an integrator",
      .help = "light transport: direct light only, Whitted ray tracing or path tracing"},
-    {.name = "max_bounce", .args = "N", .type = RT_SETTING_INT, .field = FIELD(max_bounce), .min = 0, .max = 256,
-     .defaults = {1}, .what = "max_bounce", .help = "whitted: mirror and refraction recursion depth"},
-    {.name = "max_depth", .args = "N", .type = RT_SETTING_INT, .field = FIELD(max_depth), .min = 0, .max = 1024,
-     .defaults = {0}, .what = "max_depth", .help = "path: the most scattering events a path may have; 0 = no cap"},
-    {.name = "rr_depth", .args = "N", .type = RT_SETTING_INT, .field = FIELD(rr_depth), .min = 0, .max = 1024,
-     .defaults = {5}, .what = "rr_depth",
+    {.name = "max_bounce", .args = "N", .type = RT_SETTING_INT, .field = FIELD(max_bounce), .min = 0, .max = 256, .what = "max_bounce", .help = "whitted: mirror and refraction recursion depth"},
+    {.name = "max_depth", .args = "N", .type = RT_SETTING_INT, .field = FIELD(max_depth), .min = 0, .max = 1024, .what = "max_depth", .help = "path: the most scattering events a path may have; 0 = no cap"},
+    {.name = "rr_depth", .args = "N", .type = RT_SETTING_INT, .field = FIELD(rr_depth), .min = 0, .max = 1024, .what = "rr_depth",
      .help = "path: Russian roulette from this many bounces on; 0 = adaptive (once the throughput is below 1)"},
     {.name = "motion_steps", .args = "K", .type = RT_SETTING_INT, .field = FIELD(motion_steps), .min = 1,
-     .max = 256, .defaults = {8}, .what = "motion_steps",
+     .max = 256, .what = "motion_steps",
      .help = "motion blur: poses (each with its own kd-tree) over the camera's shutter when models are animated"},
-    {.name = "sampler", .args = "NAME", .type = RT_SETTING_ENUM, .field = FIELD(sampler),
-     .defaults = {RT_SAMPLER_SOBOL}, .words = sampler_words, .what = "a sampler",
+    {.name = "sampler", .args = "NAME", .type = RT_SETTING_ENUM, .field = FIELD(sampler), .words = sampler_words, .what = "a sampler",
      .help = "path: the random numbers of light, BSDF and roulette decisions: a stream per sample, or stratified over the pixel's samples (cmj, sobol)"},
-    {.name = "energy_compensation", .args = "MODE", .type = RT_SETTING_ENUM, .field = FIELD(energy_compensation),
-     .defaults = {0}, .words = onoff_words, .what = "energy_compensation",
+    {.name = "energy_compensation", .args = "MODE", .type = RT_SETTING_ENUM, .field = FIELD(energy_compensation), .words = onoff_words, .what = "energy_compensation",
      .help = "path: restore the energy rough conductors lose to multiple scattering (Kulla-Conty 2017)"},
     {.name = "diffuse_bounces", .args = "N", .type = RT_SETTING_INT, .field = FIELD(diffuse_bounces), .min = 0,
-     .max = 64, .defaults = {0}, .what = "diffuse_bounces", .help = "whitted: levels of indirect diffuse light"},
+     .max = 64, .what = "diffuse_bounces", .help = "whitted: levels of indirect diffuse light"},
     {.name = "diffuse_rays", .args = "N", .type = RT_SETTING_INT, .field = FIELD(diffuse_rays), .min = 1,
-     .max = 65536, .defaults = {128}, .what = "diffuse_rays", .help = "whitted: cosine-distributed rays per diffuse level"},
+     .max = 65536, .what = "diffuse_rays", .help = "whitted: cosine-distributed rays per diffuse level"},
     {.name = "shadow_samples", .args = "N", .type = RT_SETTING_INT, .field = FIELD(shadow_samples), .min = 1,
-     .max = 65536, .defaults = {16}, .what = "shadow_samples", .help = "samples per area light per shading point"},
-    {.name = "seed", .args = "N", .type = RT_SETTING_UINT32, .field = FIELD(seed), .min = 0, .max = UINT32_MAX,
-     .defaults = {0}, .what = "the seed", .help = "a random seed"},
+     .max = 65536, .what = "shadow_samples", .help = "samples per area light per shading point"},
+    {.name = "seed", .args = "N", .type = RT_SETTING_UINT32, .field = FIELD(seed), .min = 0, .max = UINT32_MAX, .what = "the seed", .help = "a random seed"},
     {.name = "background", .args = "R G B", .type = RT_SETTING_COLOR, .field = FIELD(background), .min = 0,
-     .max = FLT_MAX, .defaults = {0, 0, 0}, .what = "the background colour",
+     .max = FLT_MAX, .what = "the background colour",
      .help = "radiance of rays that leave the scene, linear RGB"},
     {.name = "ambient_light", .args = "R G B", .type = RT_SETTING_COLOR, .field = FIELD(ambient_light),
-     .marks_given = true, .given = FIELD(ambient_light_set), .min = 0, .max = FLT_MAX, .defaults = {0, 0, 0},
+     .marks_given = true, .given = FIELD(ambient_light_set), .min = 0, .max = FLT_MAX,
      .what = "the ambient light colour",
      .help = "whitted: the ambient radiance materials reflect; unset = the background's"},
     {.name = "exposure", .args = "X", .type = RT_SETTING_FLOAT, .field = FIELD(exposure), .min = 0, .max = FLT_MAX,
-     .above_min = true, .defaults = {1}, .what = "the exposure",
+     .above_min = true, .what = "the exposure",
      .help = "linear scale applied before writing 8-bit output"},
-    {.name = "clamp", .args = "X", .type = RT_SETTING_FLOAT, .field = FIELD(clamp), .min = 0, .max = FLT_MAX,
-     .defaults = {0}, .what = "the clamp", .help = "maximum sample luminance, against fireflies; 0 = no clamp"},
+    {.name = "clamp", .args = "X", .type = RT_SETTING_FLOAT, .field = FIELD(clamp), .min = 0, .max = FLT_MAX, .what = "the clamp", .help = "maximum sample luminance, against fireflies; 0 = no clamp"},
     {.name = "ray_offset", .args = "X", .type = RT_SETTING_FLOAT, .field = FIELD(ray_offset), .min = 0,
-     .max = FLT_MAX, .defaults = {0}, .what = "the ray offset",
+     .max = FLT_MAX, .what = "the ray offset",
      .help = "extra offset of secondary rays in scene units, on top of the automatic one"},
     {.name = "environment", .args = "FILE [strength S]", .type = RT_SETTING_ENVIRONMENT,
-     .field = FIELD(environment_texture), .field2 = FIELD(environment_strength), .min = 0, .max = FLT_MAX,
-     .defaults = {1}, .what = "environment",
+     .field = FIELD(environment_texture), .field2 = FIELD(environment_strength), .min = 0, .max = FLT_MAX, .what = "environment",
      .help = "latitude-longitude environment image in place of the background, scaled by S"},
     {.name = "output", .args = "FILE", .type = RT_SETTING_STRING, .field = FIELD(output), .min = 1,
      .max = FIELD_SIZE(output) - 1, .what = "an output file name",
@@ -113,7 +105,7 @@ static const void *const_field_of(const rt_settings *st, size_t offset)
 }
 
 /* Writes an already checked value into its field(s); the environment's
- * image is loaded by store_environment() instead. */
+ * file name by store_environment() instead. */
 static void store_value(rt_settings *st, const rt_setting *def, const rt_setting_value *v)
 {
     switch (def->type) {
@@ -139,31 +131,6 @@ static void store_value(rt_settings *st, const rt_setting *def, const rt_setting
         break;
     case RT_SETTING_ENVIRONMENT: /* store_environment() */
         break;
-    }
-}
-
-/* Every setting at its table default: the defaults go through the same
- * store as a value read from a file. */
-void rt_settings_default(rt_settings *st)
-{
-    memset(st, 0, sizeof *st);
-    for (size_t i = 0; i < rt_settings_count; i++) {
-        const rt_setting *def = &rt_settings_table[i];
-        bool integer = def->type == RT_SETTING_INT || def->type == RT_SETTING_UINT32 ||
-                       def->type == RT_SETTING_ENUM || def->type == RT_SETTING_SIZE;
-        rt_setting_value v = {.text = ""};
-        for (int k = 0; k < 3; k++) {
-            if (integer && k < 2)
-                v.i[k] = (long long)def->defaults[k];
-            else if (!integer)
-                v.f[k] = (float)def->defaults[k];
-        }
-        if (def->type == RT_SETTING_ENVIRONMENT) {
-            *(uint32_t *)field_of(st, def->field) = RT_NONE;
-            *(float *)field_of(st, def->field2) = v.f[0];
-        } else {
-            store_value(st, def, &v);
-        }
     }
 }
 
@@ -315,11 +282,13 @@ rt_result rt_setting_read(const rt_setting *def, const char *const *w, const boo
         v->text = w[0];
         v->words = 1;
         break;
-    case RT_SETTING_ENVIRONMENT:
+    case RT_SETTING_ENVIRONMENT: {
         if (count < 1)
             return problem(pb, RT_ERR_PARSE, 0, true, "expected an %s image file", def->what);
         v->text = w[0];
-        v->f[0] = (float)def->defaults[0];
+        rt_settings d; /* the strength when the line gives none: the default's */
+        rt_settings_default(&d);
+        v->f[0] = *(const float *)const_field_of(&d, def->field2);
         v->words = 1;
         if (count > 1 && literal(&ws, 1) && strcmp(w[1], "strength") == 0) {
             snprintf(what, sizeof what, "the %s strength", def->what);
@@ -328,42 +297,32 @@ rt_result rt_setting_read(const rt_setting *def, const char *const *w, const boo
         }
         break;
     }
+    }
     return r;
 }
 
 /* ------------------------------------------------------------ storing */
 
-/* The environment: the image at `file` (relative to dir), repeating in
- * longitude and clamped at the poles. Problems are about word 0, the file. */
-static rt_result store_environment(rt_scene *s, const rt_setting *def, const rt_setting_value *v, const char *dir,
-                                   rt_setting_problem *pb)
+/* The environment: the file name (relative to dir) and the strength; the
+ * image is not loaded yet (environment_texture is RT_NONE until io's
+ * rt_environment_image_load). Problems are about word 0, the file. */
+static rt_result store_environment(rt_settings *st, const rt_setting *def, const rt_setting_value *v,
+                                   const char *dir, rt_setting_problem *pb)
 {
     char path[MAX_PATH_LEN];
     if (v->text[0] == '\0')
         return problem(pb, RT_ERR_INVALID, 0, false, "expected a file name, got an empty string");
     if (!rt_path_join(dir ? dir : "", v->text, path, sizeof path))
         return problem(pb, RT_ERR_LIMIT, 0, false, "file path is too long (at most %zu characters)", sizeof path - 1);
-    if (!s)
+    if (!st)
         return RT_OK;
-    rt_error inner = {0};
-    uint32_t img = RT_NONE;
-    rt_result r = rt_image_load_file(s, path, &img, &inner);
-    if (r != RT_OK)
-        return problem(pb, r, 0, false, "%s", inner.message);
-    if (img >= s->image_count)
-        return problem(pb, RT_ERR_INVALID, 0, false, "image loader returned no image for '%s'", path);
-    rt_texture tex = rt_texture_image(img);
-    tex.wrap_s = RT_WRAP_REPEAT; /* longitude wraps around */
-    tex.wrap_t = RT_WRAP_CLAMP;  /* latitude stops at the poles */
-    uint32_t id = rt_scene_add_texture(s, &tex);
-    if (id == RT_NONE)
-        return problem(pb, RT_ERR_NOMEM, 0, false, "out of memory");
-    *(uint32_t *)field_of(&s->settings, def->field) = id;
-    *(float *)field_of(&s->settings, def->field2) = v->f[0];
+    memcpy(st->environment_file, path, strlen(path) + 1);
+    *(uint32_t *)field_of(st, def->field) = RT_NONE;
+    *(float *)field_of(st, def->field2) = v->f[0];
     return RT_OK;
 }
 
-rt_result rt_setting_store(rt_scene *s, const rt_setting *def, const rt_setting_value *v, const char *dir,
+rt_result rt_setting_store(rt_settings *st, const rt_setting *def, const rt_setting_value *v, const char *dir,
                            rt_setting_problem *pb)
 {
     if (def->type == RT_SETTING_STRING) {
@@ -375,18 +334,18 @@ rt_result rt_setting_store(rt_scene *s, const rt_setting *def, const rt_setting_
                            (size_t)def->max);
     }
     if (def->type == RT_SETTING_ENVIRONMENT)
-        return store_environment(s, def, v, dir, pb);
-    if (!s)
+        return store_environment(st, def, v, dir, pb);
+    if (!st)
         return RT_OK;
-    store_value(&s->settings, def, v);
+    store_value(st, def, v);
     if (def->marks_given)
-        *(bool *)field_of(&s->settings, def->given) = true;
+        *(bool *)field_of(st, def->given) = true;
     return RT_OK;
 }
 
 /* ------------------------------------------------------------ the command-line form */
 
-rt_result rt_setting_set(rt_scene *s, const rt_setting *def, const char *text, rt_setting_problem *pb)
+rt_result rt_setting_set(rt_settings *st, const rt_setting *def, const char *text, rt_setting_problem *pb)
 {
     char buf[MAX_PATH_LEN + 64];
     char *w[RT_SETTING_MAX_WORDS + 1] = {0};
@@ -420,7 +379,7 @@ rt_result rt_setting_set(rt_scene *s, const rt_setting *def, const char *text, r
     if (r == RT_OK && v.words < n)
         r = problem(pb, RT_ERR_PARSE, v.words, false, "unexpected '%s' after the end of the value", w[v.words]);
     if (r == RT_OK)
-        r = rt_setting_store(s, def, &v, NULL, pb);
+        r = rt_setting_store(st, def, &v, NULL, pb);
     if (r != RT_OK && pb->got) {
         size_t m = strlen(pb->message);
         if (pb->word < n)
@@ -536,33 +495,43 @@ void rt_setting_range_text(const rt_setting *def, char *buf, size_t size)
 
 void rt_setting_default_text(const rt_setting *def, char *buf, size_t size)
 {
-    const double *d = def->defaults;
+    rt_settings defaults;
+    rt_settings_default(&defaults);
+    const rt_settings *d = &defaults;
     if (def->marks_given) {
         snprintf(buf, size, "unset");
         return;
     }
     switch (def->type) {
     case RT_SETTING_INT:
+    case RT_SETTING_ENUM: {
+        int v = *(const int *)const_field_of(d, def->field);
+        if (def->type == RT_SETTING_ENUM)
+            snprintf(buf, size, "%s", def->words[v]);
+        else
+            snprintf(buf, size, "%d", v);
+        return;
+    }
     case RT_SETTING_UINT32:
-        snprintf(buf, size, "%lld", (long long)d[0]);
+        snprintf(buf, size, "%u", (unsigned)*(const uint32_t *)const_field_of(d, def->field));
         return;
     case RT_SETTING_SIZE:
-        snprintf(buf, size, "%lld %lld", (long long)d[0], (long long)d[1]);
+        snprintf(buf, size, "%d %d", *(const int *)const_field_of(d, def->field),
+                 *(const int *)const_field_of(d, def->field2));
         return;
     case RT_SETTING_FLOAT:
-        snprintf(buf, size, "%g", d[0]);
+        snprintf(buf, size, "%g", (double)*(const float *)const_field_of(d, def->field));
         return;
-    case RT_SETTING_COLOR:
-        snprintf(buf, size, "%g %g %g", d[0], d[1], d[2]);
+    case RT_SETTING_COLOR: {
+        const rt_vec3 *c = (const rt_vec3 *)const_field_of(d, def->field);
+        snprintf(buf, size, "%g %g %g", (double)c->x, (double)c->y, (double)c->z);
         return;
-    case RT_SETTING_ENUM:
-        snprintf(buf, size, "%s", def->words[(size_t)d[0]]);
-        return;
+    }
     case RT_SETTING_STRING:
         snprintf(buf, size, "none");
         return;
     case RT_SETTING_ENVIRONMENT:
-        snprintf(buf, size, "none, strength %g", d[0]);
+        snprintf(buf, size, "none, strength %g", (double)*(const float *)const_field_of(d, def->field2));
         return;
     }
     buf[0] = 0;

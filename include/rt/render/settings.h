@@ -1,28 +1,30 @@
-/* rt/settings.h - the one table of render settings.
+/* rt/render/settings.h - the one table of render settings.
  *
  * Every field of rt_settings (scene.h) that a user can set is one entry of
  * rt_settings_table: its name (the scene-format keyword and the key of the
- * driver's `--set KEY=VALUE`), its type, its field, its range, its default and
- * a line of help. The table drives the scene format's setting statements,
- * the driver's setting flags (-s, -r, --seed, --integrator, --set) and their
- * --help text, and rt_settings_default(), so they cannot drift apart.
+ * driver's `--set KEY=VALUE`), its type, its field, its range and a line of
+ * help; its default is what rt_settings_default() (scene.c) puts in the
+ * field. The table drives the scene format's setting statements, the
+ * driver's setting flags (-s, -r, --seed, --integrator, --set) and their
+ * --help text, so they cannot drift apart. It lives with the renderer (its
+ * `integrator` words are the integrator table's) and knows no scene.
  *
  * A setting's value is a short list of words, as written after its name in a
  * scene file (`resolution 640 480`). Reading the words checks them without
- * side effects; storing writes the fields (and, for `environment`, loads the
- * image into the scene):
+ * side effects; storing writes the fields (for `environment`, the file name
+ * and the strength: io's rt_environment_image_load loads the image):
  *
  *   const rt_setting *def = rt_setting_find("samples");
  *   rt_setting_value v;
  *   rt_setting_problem pb;
  *   if (rt_setting_read(def, words, NULL, nwords, &v, &pb) != RT_OK ||
- *       rt_setting_store(&scene, def, &v, scene_dir, &pb) != RT_OK)
+ *       rt_setting_store(&scene.settings, def, &v, scene_dir, &pb) != RT_OK)
  *       ... pb.message names what is wrong, pb.word which word ...
  *
  * From the command line the value is one string, split into words at blanks
  * and commas (`--set background=0.1,0.2,0.3`; a resolution may be `640x480`):
  *
- *   if (rt_setting_set(&scene, def, "640x480", &pb) != RT_OK)     // NULL scene: only check
+ *   if (rt_setting_set(&scene.settings, def, "640x480", &pb) != RT_OK)  // NULL: only check
  *       fprintf(stderr, "rt: --set resolution=640x480: %s\n", pb.message);
  *
  *   for (size_t i = 0; i < rt_settings_count; i++)                // every setting, in table order
@@ -35,7 +37,7 @@
 #include <stddef.h>
 
 #include "rt/base/error.h"
-#include "rt/scene/scene.h"
+#include "rt/scene/scene.h" /* rt_settings, for now a member of the scene */
 
 /* The limits the table (and so the scene format and every flag) enforces. */
 #define RT_MAX_IMAGE_SIDE 32768      /* pixels, each side */
@@ -51,8 +53,8 @@ typedef enum rt_setting_type {
     RT_SETTING_COLOR,       /* an rt_vec3 in linear RGB: three numbers, each >= min */
     RT_SETTING_ENUM,        /* an int-sized enum: one of `words`, stored as its index */
     RT_SETTING_STRING,      /* a char array: one word of 1..max bytes (blanks allowed) */
-    RT_SETTING_ENVIRONMENT, /* FILE [strength S]: an image loaded as the lat-long environment;
-                               field is the texture id, field2 the strength (a float in [min, max]) */
+    RT_SETTING_ENVIRONMENT, /* FILE [strength S]: the lat-long environment image's file (environment_file),
+                               field the texture id (RT_NONE until loaded), field2 the strength (a float in [min, max]) */
 } rt_setting_type;
 
 typedef struct rt_setting {
@@ -65,7 +67,6 @@ typedef struct rt_setting {
     size_t given;
     double min, max;          /* range (STRING: length in bytes; ENVIRONMENT: the strength's) */
     bool above_min;           /* FLOAT: must be > min rather than >= min */
-    double defaults[3];       /* the value; SIZE: both sides; COLOR: RGB; ENUM: the index; ENVIRONMENT: the strength */
     const char *const *words; /* ENUM: the words, NULL-terminated; the index is the enum value */
     const char *what;         /* the noun in messages: "samples per pixel", "the seed" */
     const char *help;         /* one line for --help */
@@ -88,7 +89,7 @@ typedef struct rt_setting_value {
 /* What is wrong with a value, without a location: the caller adds one. */
 typedef struct rt_setting_problem {
     rt_result code;    /* RT_ERR_PARSE: not a value of the type or missing; RT_ERR_INVALID: out of range;
-                          RT_ERR_LIMIT: too long; or the code of the image loader */
+                          RT_ERR_LIMIT: too long */
     size_t word;       /* the word at fault; equal to the word count when a word is missing */
     bool got;          /* the message wants ", got WORD" (or the caller's "end of line") after it */
     char message[1024];
@@ -99,19 +100,21 @@ typedef struct rt_setting_problem {
  * caller decides what extra words mean. No side effects. */
 rt_result rt_setting_read(const rt_setting *def, const char *const *words, const bool *quoted, size_t count,
                           rt_setting_value *v, rt_setting_problem *pb);
-/* Stores a value read by rt_setting_read into s->settings. `environment`
- * loads its image (a relative file name resolves against dir, NULL = the
- * current directory) and adds its texture; `output` checks its length.
- * s == NULL checks only what needs no scene (nothing is loaded). */
-rt_result rt_setting_store(rt_scene *s, const rt_setting *def, const rt_setting_value *v, const char *dir,
+/* Stores a value read by rt_setting_read into st. `environment` stores
+ * its file name (a relative one resolved against dir, NULL = the current
+ * directory) in st->environment_file and its strength, and sets
+ * environment_texture to RT_NONE: the caller loads the image
+ * (rt_environment_image_load, rt/io/environment_image.h); `output` checks
+ * its length. st == NULL only checks. */
+rt_result rt_setting_store(rt_settings *st, const rt_setting *def, const rt_setting_value *v, const char *dir,
                            rt_setting_problem *pb);
 
 /* The command-line form: `text` split into words at blanks and commas (a
  * STRING takes the text whole; a SIZE also splits `640x480` or `640X480`),
- * read, checked for extra words, and stored. s == NULL only checks (an
- * environment image is then not loaded). pb->message is complete, with the
- * word at fault quoted. */
-rt_result rt_setting_set(rt_scene *s, const rt_setting *def, const char *text, rt_setting_problem *pb);
+ * read, checked for extra words, and stored as rt_setting_store does (an
+ * environment's image is the caller's to load). st == NULL only checks.
+ * pb->message is complete, with the word at fault quoted. */
+rt_result rt_setting_set(rt_settings *st, const rt_setting *def, const char *text, rt_setting_problem *pb);
 
 /* Every value in its range, as the table says (for settings that were not
  * read through it). The first one out of range is described in pb. */
@@ -122,6 +125,6 @@ rt_result rt_settings_check(const rt_settings *st, rt_setting_problem *pb);
 void rt_setting_range_text(const rt_setting *def, char *buf, size_t size);
 void rt_setting_default_text(const rt_setting *def, char *buf, size_t size);
 
-/* rt_settings_default() (scene.h) fills every field with the table's defaults. */
+/* rt_settings_default() (scene.h) fills every field with its default. */
 
 #endif

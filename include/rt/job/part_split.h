@@ -1,12 +1,12 @@
-/* part_split.h - `--part I/N`: which rows of the image part I of N renders
- * (driver-private; docs/farm.md, "Parts of similar cost").
+/* rt/job/part_split.h - `--part I/N`: which rows of the image part I of N
+ * renders (docs/farm.md, "Parts of similar cost").
  *
  *   rt_render_region band;
- *   if (part_split(&scene, &tree, 2, 7, &band, &err) != RT_OK) ...
+ *   if (rt_part_split(&scene, &tree, 2, 7, &band, &err) != RT_OK) ...
  *   ... render options .region = band ...
  */
-#ifndef RT_DRIVER_PART_SPLIT_H
-#define RT_DRIVER_PART_SPLIT_H
+#ifndef RT_JOB_PART_SPLIT_H
+#define RT_JOB_PART_SPLIT_H
 
 #include "rt/accel/kdtree.h"
 #include "rt/base/error.h"
@@ -18,7 +18,7 @@
  * not exceed the image's height); the bands tile the image. The estimate
  * is a pure function of the scene, the settings and count, so every
  * machine computes the same bands. */
-rt_result part_split(const rt_scene *scene, const rt_kdtree *tree, int index, int count, rt_render_region *band,
+rt_result rt_part_split(const rt_scene *scene, const rt_kdtree *tree, int index, int count, rt_render_region *band,
                      rt_error *err);
 
 #endif
