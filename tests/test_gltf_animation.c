@@ -9,6 +9,7 @@
 
 #include <math.h>
 
+#include "rt/base/file.h"
 #include "rt/io/gltf.h"
 #include "rt/io/gltf_animation.h"
 #include "rt/io/load.h"
@@ -247,6 +248,75 @@ static void test_morph(void **state)
     test_remove_dir(dir);
 }
 
+/* Loads name (posed at t = 1 when posed) and expects RT_ERR_INVALID with a
+ * message naming the file, the byte where `at` starts in the file and what. */
+static void expect_bad_at(const char *name, bool posed, const char *at, const char *what)
+{
+    char *text;
+    size_t size;
+    rt_error err;
+    assert_int_equal(rt_read_file(path_of(name), 0, &text, &size, &err), RT_OK);
+    const char *hit = strstr(text, at);
+    assert_non_null(hit);
+    char want[256];
+    snprintf(want, sizeof want, "%s: byte %zu: %s", path_of(name), (size_t)(hit - text), what);
+    free(text);
+    rt_scene s;
+    rt_result r = load_at(name, posed, 1.0f, 0, &s, &err);
+    test_expect_failure(r, &err, RT_ERR_INVALID, name, want);
+    assert_int_equal(s.triangles.count, 0);
+    rt_scene_free(&s);
+}
+
+/* Issue 25, class 1: every primitive of a mesh has the same number of
+ * morph targets (a second primitive with more once over-read the weights
+ * sized for the first), and every weights array has one per target. */
+static void test_morph_counts_checked(void **state)
+{
+    (void)state;
+    assert_true(test_make_dir(dir, sizeof dir, "morphcount"));
+    const float data[] = {TRI, 0, 2, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0.25f, 1, 0.5f};
+    static const char head[] =
+        "\"bufferViews\":[" TRI_VIEWS ",{\"buffer\":0,\"byteOffset\":44,\"byteLength\":36},"
+        "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12}],"
+        "\"accessors\":[" TRI_ACCESSORS ",{\"bufferView\":2,\"componentType\":5126,\"count\":3,"
+        "\"type\":\"VEC3\"},{\"bufferView\":3,\"componentType\":5126,\"count\":%d,\"type\":\"SCALAR\"}],"
+        "\"scenes\":[{\"nodes\":[0]}],";
+    static const char anim[] = "\"animations\":[{\"samplers\":[{\"input\":1,\"output\":3}],"
+                               "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"weights\"}}]}]";
+    static const char p1[] = "{\"attributes\":{\"POSITION\":0},\"targets\":[{\"POSITION\":2}]}";
+    static const char p2[] = "{\"attributes\":{\"POSITION\":0},\"targets\":[{\"POSITION\":2},{\"POSITION\":2}]}";
+    char body[4096], h[2048];
+    /* primitives of one mesh with 1 and 2 targets: refused posed or not */
+    snprintf(h, sizeof h, head, 2);
+    snprintf(body, sizeof body, "%s\"meshes\":[{\"primitives\":[%s,%s]}],\"nodes\":[{\"mesh\":0}],%s", h, p1, p2,
+             anim);
+    write_gltf("prims.gltf", data, sizeof data / sizeof *data, body);
+    expect_bad_at("prims.gltf", true, p2, "meshes[0].primitives[1]: has 2 morph targets, primitives[0] 1");
+    expect_bad_at("prims.gltf", false, p2, "meshes[0].primitives[1]: has 2 morph targets, primitives[0] 1");
+    /* mesh.weights with 2 weights for 1 target */
+    snprintf(body, sizeof body, "%s\"meshes\":[{\"weights\":[0.5,0.5],\"primitives\":[%s,%s]}],"
+             "\"nodes\":[{\"mesh\":0}]", h, p1, p1);
+    write_gltf("meshw.gltf", data, sizeof data / sizeof *data, body);
+    expect_bad_at("meshw.gltf", false, "[0.5,0.5]", "meshes[0].weights: expected an array of 1 numbers");
+    /* node.weights with 3 weights for 1 target, and on a node without a mesh */
+    snprintf(body, sizeof body, "%s\"meshes\":[{\"primitives\":[%s]}],\"nodes\":[{\"mesh\":0,\"weights\":[1,2,3]}]",
+             h, p1);
+    write_gltf("nodew.gltf", data, sizeof data / sizeof *data, body);
+    expect_bad_at("nodew.gltf", true, "[1,2,3]", "nodes[0].weights: expected an array of 1 numbers");
+    snprintf(body, sizeof body, "%s\"meshes\":[{\"primitives\":[%s]}],\"nodes\":[{\"mesh\":0},{\"weights\":[1]}]",
+             h, p1);
+    write_gltf("nodew2.gltf", data, sizeof data / sizeof *data, body);
+    expect_bad_at("nodew2.gltf", false, "[1]}", "nodes[1].weights: the node has no mesh");
+    /* animated weights: 3 outputs for 2 keys of 1 target */
+    snprintf(h, sizeof h, head, 3);
+    snprintf(body, sizeof body, "%s\"meshes\":[{\"primitives\":[%s]}],\"nodes\":[{\"mesh\":0}],%s", h, p1, anim);
+    write_gltf("animw.gltf", data, sizeof data / sizeof *data, body);
+    expect_bad_at("animw.gltf", true, "{\"bufferView\":3", "accessors[3] (output of animations[0].channels[0]): has 3 "
+                  "elements, expected 2");
+    test_remove_dir(dir);
+}
+
 static void test_broken_animation(void **state)
 {
     (void)state;
@@ -434,7 +504,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_curves), cmocka_unit_test(test_node_animation), cmocka_unit_test(test_skin),
-        cmocka_unit_test(test_morph),  cmocka_unit_test(test_broken_animation), cmocka_unit_test(test_fox),
+        cmocka_unit_test(test_morph),  cmocka_unit_test(test_morph_counts_checked),
+        cmocka_unit_test(test_broken_animation), cmocka_unit_test(test_fox),
         cmocka_unit_test(test_scene_model_lines),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

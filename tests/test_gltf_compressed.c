@@ -17,6 +17,7 @@
 
 #include <meshoptimizer.h>
 
+#include "rt/io/draco.h"
 #include "rt/io/gltf.h"
 #include "rt/io/meshopt.h"
 #include "rt/io/webp.h"
@@ -401,6 +402,37 @@ static void test_webp_limits(void **state)
     free(g);
 }
 
+/* Issue 25, class 7: a Draco stream (sequential encoding, 3 points, one
+ * face) whose GENERIC attribute (unique id 1) is DT_BOOL with the bytes 0,
+ * 1 and 7. Converting it through draco's ConvertValue loaded 7 as a C++
+ * bool (UBSan: invalid bool load); booleans are read as bytes, any nonzero
+ * byte is 1. */
+static void test_draco_bool_attribute_as_bytes(void **state)
+{
+    (void)state;
+    static const unsigned char stream[] = {
+        0x44, 0x52, 0x41, 0x43, 0x4f, 0x02, 0x02, 0x01, 0x00, 0x00, 0x00, 0x01, 0x03, 0x01, 0x00, 0x01,
+        0x02, 0x01, 0x02, 0x00, 0x09, 0x03, 0x00, 0x00, 0x04, 0x0b, 0x01, 0x00, 0x01, 0x00, 0x00, 0x00,
+        0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x80, 0x3f, 0x00,
+        0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x80, 0x3f, 0x00,
+        0x00, 0x00, 0x00, 0x00, 0x01, 0x07};
+    char why[200];
+    rt_draco_mesh *m = rt_draco_decode(stream, sizeof stream, why, sizeof why);
+    if (!m)
+        fail_msg("decode: %s", why);
+    assert_int_equal(rt_draco_points(m), 3);
+    assert_int_equal(rt_draco_components(m, 1), 1);
+    float v[3] = {-1, -1, -1};
+    assert_true(rt_draco_attribute(m, 1, 1, v));
+    assert_float_equal(v[0], 0.0f, 0);
+    assert_float_equal(v[1], 1.0f, 0);
+    assert_float_equal(v[2], 1.0f, 0);
+    float v4[12];
+    assert_true(rt_draco_attribute(m, 1, 4, v4)); /* padded as glTF reads a narrower attribute */
+    assert_float_equal(v4[8], 1.0f, 0);
+    rt_draco_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -408,6 +440,7 @@ int main(void)
         cmocka_unit_test(test_decodes_counts),
         cmocka_unit_test(test_decodes_like_original), cmocka_unit_test(test_meshopt_lossless_exact),
         cmocka_unit_test(test_meshopt_round_trip),    cmocka_unit_test(test_broken_streams),
+        cmocka_unit_test(test_draco_bool_attribute_as_bytes),
         cmocka_unit_test(test_basisu_fallback),       cmocka_unit_test(test_webp_limits),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -165,6 +165,87 @@ static void test_refused(void **state)
     }
 }
 
+/* Issue 25, class 6: every number the loader reads from a material, a
+ * texture info or a punctual light is held to its JSON schema's range
+ * (KHR_materials_ior: 0 or at least 1; emissiveStrength at least 0; ...),
+ * and the error names the file, the byte and the field. */
+static void test_schema_ranges(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *members, *what;
+    } bad[] = {
+        {"\"materials\": [{\"extensions\": {\"KHR_materials_ior\": {\"ior\": -1.5}}}]",
+         "materials[0].extensions.KHR_materials_ior.ior -1.5 is outside"},
+        {"\"materials\": [{\"extensions\": {\"KHR_materials_ior\": {\"ior\": 0.5}}}]",
+         "materials[0].extensions.KHR_materials_ior.ior 0.5 is neither 0 nor at least 1"},
+        {"\"materials\": [{\"extensions\": {\"KHR_materials_emissive_strength\": {\"emissiveStrength\": -2}}}]",
+         "KHR_materials_emissive_strength.emissiveStrength -2 is outside"},
+        {"\"materials\": [{\"extensions\": {\"KHR_materials_transmission\": {\"transmissionFactor\": 1.5}}}]",
+         "KHR_materials_transmission.transmissionFactor 1.5 is outside [0, 1]"},
+        {"\"materials\": [{\"extensions\": {\"KHR_materials_volume\": {\"thicknessFactor\": -1}}}]",
+         "KHR_materials_volume.thicknessFactor -1 is outside"},
+        {"\"materials\": [{\"extensions\": {\"KHR_materials_volume\": {\"attenuationColor\": [1, 2, 1]}}}]",
+         "KHR_materials_volume.attenuationColor component 1 (2) is outside [0, 1]"},
+        {"\"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [1, 1, 1, -0.5]}}]",
+         "pbrMetallicRoughness.baseColorFactor component 3 (-0.5) is outside [0, 1]"},
+        {"\"materials\": [{\"pbrMetallicRoughness\": {\"metallicFactor\": 2}}]",
+         "pbrMetallicRoughness.metallicFactor 2 is outside [0, 1]"},
+        {"\"materials\": [{\"pbrMetallicRoughness\": {\"roughnessFactor\": -1}}]",
+         "pbrMetallicRoughness.roughnessFactor -1 is outside [0, 1]"},
+        {"\"materials\": [{\"emissiveFactor\": [0, 0, 3]}]", "materials[0].emissiveFactor component 2 (3)"},
+        {"\"materials\": [{\"alphaCutoff\": -0.5}]", "materials[0].alphaCutoff -0.5 is outside"},
+        {"\"materials\": [{\"occlusionTexture\": {\"index\": 0, \"strength\": 1.5}}]",
+         "materials[0].occlusionTexture.strength 1.5 is outside [0, 1]"},
+        {"\"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"intensity\": -3}]}}",
+         "KHR_lights_punctual.lights[0].intensity -3 is outside"},
+        {"\"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"color\": [1, 1, 7]}]}}",
+         "KHR_lights_punctual.lights[0].color component 2 (7) is outside [0, 1]"},
+        {"\"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"spot\", "
+         "\"spot\": {\"outerConeAngle\": 2}}]}}",
+         "KHR_lights_punctual.lights[0].spot.outerConeAngle 2 is outside"},
+        {"\"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"spot\", "
+         "\"spot\": {\"innerConeAngle\": -0.1}}]}}",
+         "KHR_lights_punctual.lights[0].spot.innerConeAngle -0.1 is outside"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char text[1024], path[512];
+        snprintf(text, sizeof text, "{\"asset\": {\"version\": \"2.0\"}, %s}", bad[i].members);
+        snprintf(path, sizeof path, "%s/range%zu.gltf", tmp_dir, i);
+        test_write_file(path, text, strlen(text));
+        rt_scene s;
+        rt_error err;
+        bool warned;
+        rt_result r = load_quiet(path, &s, &err, &warned, false);
+        if (r != RT_ERR_INVALID || !strstr(err.message, path) || !strstr(err.message, ": byte ") ||
+            !strstr(err.message, bad[i].what))
+            fail_msg("%s: got %s \"%s\", wanted \"%s\"", bad[i].members, rt_result_name(r), err.message, bad[i].what);
+        rt_scene_free(&s);
+    }
+    /* the edges the schemas allow load */
+    static const char *const good[] = {
+        "\"materials\": [{\"extensions\": {\"KHR_materials_ior\": {\"ior\": 0}}}]",
+        "\"materials\": [{\"extensions\": {\"KHR_materials_ior\": {\"ior\": 1}}}]",
+        "\"materials\": [{\"extensions\": {\"KHR_materials_emissive_strength\": {\"emissiveStrength\": 0}}}]",
+        "\"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 1, 0, 1]}, \"alphaCutoff\": 0}]",
+        "\"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"spot\", \"intensity\": 0, "
+        "\"spot\": {\"innerConeAngle\": 0, \"outerConeAngle\": 1.5707963267948966}}]}}",
+    };
+    for (size_t i = 0; i < sizeof good / sizeof good[0]; i++) {
+        char text[1024], path[512];
+        snprintf(text, sizeof text, "{\"asset\": {\"version\": \"2.0\"}, %s}", good[i]);
+        snprintf(path, sizeof path, "%s/edge%zu.gltf", tmp_dir, i);
+        test_write_file(path, text, strlen(text));
+        rt_scene s;
+        rt_error err;
+        bool warned;
+        rt_result r = load_quiet(path, &s, &err, &warned, false);
+        if (r != RT_OK)
+            fail_msg("%s: %s", good[i], err.message);
+        rt_scene_free(&s);
+    }
+}
+
 /* Renders a generated file at W x H with the path tracer. */
 enum { W = 96, H = 48 };
 static void render_file(const char *path, rt_framebuffer *fb)
@@ -408,6 +489,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_parse_generated),
         cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_schema_ranges),
         cmocka_unit_test(test_render_generated),
         cmocka_unit_test(test_variants),
         cmocka_unit_test(test_shared_models),

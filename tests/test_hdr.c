@@ -14,6 +14,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -191,6 +192,76 @@ static void test_exr_texture_and_limits(void **state)
     }
     free(bytes);
     rt_framebuffer_free(&a);
+}
+
+/* Sets the data window of an EXR file in memory (its dataWindow box2i
+ * attribute) to 0,0 .. w-1,h-1. */
+static void set_data_window(char *bytes, size_t size, int32_t w, int32_t h)
+{
+    static const char key[] = "dataWindow\0box2i\0";
+    for (size_t i = 0; i + sizeof key + 20 < size; i++)
+        if (memcmp(bytes + i, key, sizeof key - 1) == 0) {
+            int32_t box[4] = {0, 0, w - 1, h - 1}; /* little-endian, as the test machines are */
+            memcpy(bytes + i + sizeof key - 1 + 4, box, sizeof box);
+            return;
+        }
+    fail_msg("no dataWindow attribute");
+}
+
+static int run_convert(const char *a, const char *b, const char *c, const char *d);
+
+/* Issue 25, class 2: a few hundred bytes of EXR whose header declares 10^8
+ * pixels are refused from the chunk table and the packed sizes, before
+ * the pixels are allocated (the error is not out-of-memory, and rt convert
+ * exits 2 under a 256 MiB data limit). */
+static void test_exr_header_claims_checked(void **state)
+{
+    (void)state;
+    rt_framebuffer a;
+    assert_int_equal(rt_framebuffer_init(&a, 16, 10, NULL), RT_OK); /* black: a few hundred bytes */
+    rt_error err = {0};
+    assert_int_equal(rt_framebuffer_write(&a, tmp("small.exr"), 1.0f, &err), RT_OK);
+    rt_framebuffer_free(&a);
+    char *bytes;
+    size_t size;
+    assert_int_equal(rt_read_file(tmp("small.exr"), 0, &bytes, &size, &err), RT_OK);
+    assert_true(size < 1000);
+    float *rgba = NULL;
+    int w, h;
+    char want[128];
+    /* 10000x10000: 625 chunks of 16 lines, an offset table larger than the file */
+    set_data_window(bytes, size, 10000, 10000);
+    assert_int_equal(rt_exr_decode(bytes, size, "big.exr", 32768, (uint64_t)1 << 32, &rgba, &w, &h, &err),
+                     RT_ERR_INVALID);
+    snprintf(want, sizeof want, "big.exr: byte %zu: EXR file ends, but its header declares 625 chunks", size);
+    test_expect_failure(RT_ERR_INVALID, &err, RT_ERR_INVALID, "big.exr", want);
+    assert_null(rgba);
+    test_write_file(tmp("big.exr"), bytes, size);
+    /* 30000x16: one chunk, whose few hundred packed bytes cannot unpack to 5.7 MB */
+    set_data_window(bytes, size, 30000, 16);
+    assert_int_equal(rt_exr_decode(bytes, size, "wide.exr", 32768, (uint64_t)1 << 32, &rgba, &w, &h, &err),
+                     RT_ERR_INVALID);
+    snprintf(want, sizeof want, "wide.exr: byte %zu: EXR file ends, but its 30000x16 data window needs 5760000", size);
+    test_expect_failure(RT_ERR_INVALID, &err, RT_ERR_INVALID, "wide.exr", want);
+    assert_null(rgba);
+    free(bytes);
+    /* rt convert under a data limit far below the 1.6 GB the header asks for */
+    if (!TEST_SANITIZED) { /* a sanitizer runtime reserves more than the limit; the checks above hold there */
+        fflush(NULL);
+        pid_t pid = fork();
+        assert_true(pid >= 0);
+        if (pid == 0) {
+            struct rlimit rl = {256u << 20, 256u << 20};
+            if (setrlimit(RLIMIT_DATA, &rl) != 0)
+                _exit(10);
+            _exit(run_convert(tmp("big.exr"), tmp("big.pfm"), NULL, NULL));
+        }
+        int st = 0;
+        assert_int_equal(waitpid(pid, &st, 0), pid);
+        assert_true(WIFEXITED(st));
+        assert_int_equal(WEXITSTATUS(st), 2);
+        assert_int_equal(access(tmp("big.pfm"), F_OK), -1);
+    }
 }
 
 /* Writes bytes[0 .. n) to the test folder's `name`; its path. */
@@ -927,6 +998,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_exr_float_round_trip), cmocka_unit_test(test_exr_half_round_trip),
         cmocka_unit_test(test_exr_layers),           cmocka_unit_test(test_exr_texture_and_limits),
+        cmocka_unit_test(test_exr_header_claims_checked),
         cmocka_unit_test(test_radiance_checked),     cmocka_unit_test(test_pfm_checked),
         cmocka_unit_test(test_pnm_checked),
         cmocka_unit_test(test_float_outputs_ignore_exposure),

@@ -67,7 +67,7 @@ for t in $TARGETS; do
     mkdir -p $B/corpus/$t $B/crashes/$t $B/seeds/$t
     dict=""
     case $t in
-        gltf|glb|gltf_bin) dict="-dict=tests/fuzz/gltf.dict" ;;
+        gltf|glb|gltf_bin|pose) dict="-dict=tests/fuzz/gltf.dict" ;;
         scene) dict="-dict=tests/fuzz/scene.dict" ;;
     esac
     seeds="$B/seeds/$t"

@@ -44,6 +44,34 @@ for p in glob.glob(os.path.join(shared, "assets/gltf/*/glTF/*.gltf")):
     bufs[0]["uri"] = "buffer.bin"
     js = json.dumps(doc).encode()
     put("gltf_bin", os.path.basename(p), struct.pack("<I", len(js)) + js + open(binpath, "rb").read())
+# pose: animated, skinned or morphed models, posed at 0.5 s of animation 0
+# (index byte, signed 16-bit time in 1/64 s, then a .glb or a gltf_bin input)
+POSE_HEAD = bytes([0]) + struct.pack("<h", 32)
+def posable(doc):
+    return bool(doc.get("animations") or doc.get("skins")) or \
+        any("targets" in pr for m in doc.get("meshes", []) for pr in m.get("primitives", []))
+for p in glob.glob(os.path.join(shared, "assets/gltf/*/glTF-Binary/*.glb")):
+    if not small(p):
+        continue
+    data = open(p, "rb").read()
+    try:
+        doc = json.loads(data[20:20 + struct.unpack_from("<I", data, 12)[0]])
+    except Exception:
+        continue
+    if posable(doc):
+        put("pose", os.path.basename(p), POSE_HEAD + data)
+for d in (os.path.join(out, "gltf_bin"),):
+    for p in glob.glob(os.path.join(d, "*")):
+        data = open(p, "rb").read()
+        try:
+            doc = json.loads(data[4:4 + struct.unpack_from("<I", data, 0)[0]])
+        except Exception:
+            continue
+        if posable(doc):
+            put("pose", os.path.basename(p), POSE_HEAD + data)
+# json: every .gltf seed as plain text (mode 0)
+for p in glob.glob(os.path.join(out, "gltf", "*")):
+    put("json", os.path.basename(p), bytes([0, 0, 0]) + open(p, "rb").read())
 for p in glob.glob(os.path.join(shared, "assets/cornell/*/*.obj")):
     obj = open(p, "rb").read()
     mtls = glob.glob(os.path.join(os.path.dirname(p), "*.mtl"))

@@ -5,7 +5,8 @@
 // triangle mesh; its "attributes" object maps glTF attribute names to the
 // mesh's attribute unique ids. Faces give the point indices of each
 // triangle; an attribute value is found for a point through
-// PointAttribute::mapped_index. Everything the library can throw (it is
+// PointAttribute::mapped_index; boolean attributes are read as bytes (any
+// nonzero byte is true), never loaded as C++ bool. Everything the library can throw (it is
 // built without exceptions, but std::bad_alloc can still come from new)
 // stops here.
 #include "rt/io/draco.h"
@@ -87,8 +88,19 @@ extern "C" bool rt_draco_attribute(const rt_draco_mesh *m, uint32_t unique_id, i
         draco::AttributeValueIndex i = a->mapped_index(p);
         if (i.value() >= a->size())
             return false;
-        if (!a->ConvertValue<float>(i, static_cast<int8_t>(have < ncomp ? have : ncomp), v))
+        const int n = have < ncomp ? have : ncomp;
+        if (a->data_type() == draco::DT_BOOL) {
+            // a stream's bool bytes may hold any value; loading one as a
+            // C++ bool (what ConvertValue does) is undefined unless 0 or 1
+            const int64_t pos = a->GetBytePos(i);
+            if (pos < 0 || pos + n > static_cast<int64_t>(a->buffer()->data_size()))
+                return false;
+            const uint8_t *b = a->buffer()->data() + pos;
+            for (int c = 0; c < n; c++)
+                v[c] = b[c] ? 1.0f : 0.0f;
+        } else if (!a->ConvertValue<float>(i, static_cast<int8_t>(n), v)) {
             return false;
+        }
         for (int c = 0; c < ncomp; c++)
             *out++ = v[c];
     }

@@ -12,7 +12,9 @@
  * describes the image, points the pipelines at rt's interleaved float pixels
  * and turns the library's error callback into one rt_error message. Reads
  * come from memory through a custom read function, so the same code serves
- * files, textures inside models and the fuzzer.
+ * files, textures inside models and the fuzzer. Before the pixels are
+ * allocated, the header's chunk table is checked against the bytes present
+ * (check_chunks).
  */
 #include "rt/io/exr.h"
 
@@ -337,6 +339,82 @@ static exr_result_t decode_pixels(exr_context_t ctx, exr_storage_t storage, cons
     return rv;
 }
 
+/* The most bytes of pixels one byte of a chunk can unpack to, by
+ * compression: none 1; RLE 128 bytes from a 2-byte run (64, rounded up);
+ * ZIP, ZIPS and PIZ deflate's 258 bytes from 2 bits (1032) or Huffman
+ * runs of at most 258 symbols from 10 bits (about 413); PXR24 deflate over
+ * 24 of a float's 32 bits (1376); B44 a flat 4x4 block of halves in 3
+ * bytes (11); DWAA/DWAB a DC value per 8x8 block, deflated (64 x 1032).
+ * Every bound is rounded up: it only has to refuse what no encoder makes. */
+static uint64_t max_unpack_ratio(exr_compression_t c)
+{
+    switch (c) {
+    case EXR_COMPRESSION_NONE: return 1;
+    case EXR_COMPRESSION_RLE: return 128;
+    case EXR_COMPRESSION_ZIPS: case EXR_COMPRESSION_ZIP: case EXR_COMPRESSION_PIZ: return 1100;
+    case EXR_COMPRESSION_PXR24: return 1400;
+    case EXR_COMPRESSION_B44: case EXR_COMPRESSION_B44A: return 1100;
+    default: return 70000; /* DWAA, DWAB */
+    }
+}
+
+/* The header's claims against the bytes present, before the pixels are
+ * allocated: the chunk offset table (8 bytes a chunk) must fit in the
+ * file, every chunk of level 0 must have a leader the library accepts
+ * (its offset and packed size inside the file), and the packed bytes must
+ * be able to unpack to what the data window needs at the compression's
+ * largest ratio. A few hundred bytes declaring 10^8 pixels fail here, not
+ * after a gigabyte is allocated and cleared. */
+static rt_result check_chunks(exr_context_t ctx, exr_storage_t storage, const exr_attr_box2i_t *dw, int w, int h,
+                              size_t size, const char *name, const exr_stream *s, rt_error *err)
+{
+    int32_t chunks = 0;
+    exr_compression_t comp = EXR_COMPRESSION_NONE;
+    exr_result_t rv = exr_get_chunk_count(ctx, 0, &chunks);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_get_compression(ctx, 0, &comp);
+    if (rv != EXR_ERR_SUCCESS || chunks <= 0)
+        return exr_failed(err, RT_ERR_INVALID, name, "no EXR chunk count", s, rv ? rv : EXR_ERR_INVALID_ATTR);
+    if ((uint64_t)chunks * 8u > size)
+        return rt_fail(err, RT_ERR_INVALID,
+                       "%s: byte %zu: EXR file ends, but its header declares %d chunks (an %llu-byte offset table)",
+                       name, size, chunks, (unsigned long long)chunks * 8u);
+    uint64_t packed = 0, unpacked = 0;
+    if (storage == EXR_STORAGE_SCANLINE) {
+        int32_t lines = 1;
+        exr_get_scanlines_per_chunk(ctx, 0, &lines);
+        for (int64_t y = dw->min.y; y <= dw->max.y && rv == EXR_ERR_SUCCESS; y += lines > 0 ? lines : 1) {
+            exr_chunk_info_t ci;
+            if ((rv = exr_read_scanline_chunk_info(ctx, 0, (int)y, &ci)) == EXR_ERR_SUCCESS) {
+                packed += ci.packed_size;
+                unpacked += ci.unpacked_size;
+            }
+        }
+    } else {
+        int32_t tw = 0, th = 0;
+        rv = exr_get_tile_sizes(ctx, 0, 0, 0, &tw, &th);
+        if (rv == EXR_ERR_SUCCESS && (tw <= 0 || th <= 0))
+            rv = EXR_ERR_INVALID_ATTR;
+        for (int ty = 0; rv == EXR_ERR_SUCCESS && (int64_t)ty * th < h; ty++)
+            for (int tx = 0; rv == EXR_ERR_SUCCESS && (int64_t)tx * tw < w; tx++) {
+                exr_chunk_info_t ci;
+                if ((rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &ci)) == EXR_ERR_SUCCESS) {
+                    packed += ci.packed_size;
+                    unpacked += ci.unpacked_size;
+                }
+            }
+    }
+    if (rv != EXR_ERR_SUCCESS)
+        return exr_failed(err, RT_ERR_INVALID, name, "bad EXR chunk table", s, rv);
+    if (packed > size || unpacked > packed * max_unpack_ratio(comp))
+        return rt_fail(err, RT_ERR_INVALID,
+                       "%s: byte %zu: EXR file ends, but its %dx%d data window needs %llu bytes of pixels and its "
+                       "chunks hold %llu packed bytes (compression %d unpacks at most %llu:1)",
+                       name, size, w, h, (unsigned long long)unpacked, (unsigned long long)packed, (int)comp,
+                       (unsigned long long)max_unpack_ratio(comp));
+    return RT_OK;
+}
+
 static rt_result decode(const void *data, size_t size, const char *name, int max_dim, uint64_t max_pixels,
                         const char *const *channels, int nchan, bool required, float **rgba_out, int *width,
                         int *height, rt_error *err)
@@ -391,6 +469,8 @@ static rt_result decode(const void *data, size_t size, const char *name, int max
     if ((result = check_channels(chl, name, channels, nchan, required, &has_rgb, &has_y, err)) != RT_OK)
         goto done;
     int w = (int)w64, h = (int)h64;
+    if ((result = check_chunks(ctx, storage, &dw, w, h, size, name, &s, err)) != RT_OK)
+        goto done;
     rgba = rt_alloc((size_t)w * (size_t)h, (size_t)nchan * sizeof(float));
     if (!rgba) {
         result = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for a %dx%d EXR image", name, w, h);

@@ -6,7 +6,7 @@
  *   1. read   the file; a GLB is split into its JSON and BIN chunks after
  *             checking the 12-byte header and every chunk length against the
  *             file size (glTF 2.0 spec, "GLB File Format Specification").
- *   2. map    the JSON (tokenized once by jsmn, see json.c) into flat tables
+ *   2. map    the JSON (tokenized once, see json.c) into flat tables
  *             of records with a count each: buffers, bufferViews, accessors,
  *             meshes/primitives, nodes, scenes, materials, textures,
  *             samplers, images, cameras, KHR_lights_punctual lights. Cross

@@ -251,6 +251,50 @@ static rt_result check_primitives(gl_doc *d)
     return RT_OK;
 }
 
+/* Morph targets: every primitive of a mesh has the same number of them
+ * (the spec's rule; the posing code sizes one weights array per mesh), and
+ * the mesh's `weights`, when given, has one weight per target. Animated
+ * weights and node weights are checked against the same count (check_nodes,
+ * gltf_pose.c). */
+static rt_result check_morph_counts(gl_doc *d)
+{
+    for (size_t m = 0; m < d->mesh_count; m++) {
+        const gl_mesh *me = &d->meshes[m];
+        uint32_t targets = me->count ? d->prims[me->first].target_count : 0;
+        for (uint32_t p = 1; p < me->count; p++) {
+            const gl_prim *pr = &d->prims[me->first + p];
+            if (pr->target_count != targets)
+                return gl_fail_at(d, pr->tok, RT_ERR_INVALID,
+                                  "meshes[%zu].primitives[%u]: has %u morph targets, primitives[0] %u (every "
+                                  "primitive of a mesh must have the same number)",
+                                  m, p, pr->target_count, targets);
+        }
+        if (me->weights >= 0 && (d->j.tok[me->weights].type != RT_JSON_ARRAY ||
+                                 d->j.tok[me->weights].size != (int)targets))
+            return gl_fail_at(d, me->weights, RT_ERR_INVALID,
+                              "meshes[%zu].weights: expected an array of %u numbers, one per morph target", m,
+                              targets);
+    }
+    return RT_OK;
+}
+
+/* A node's `weights`: one per morph target of its mesh. */
+static rt_result check_node_weights(gl_doc *d, size_t i)
+{
+    const gl_node *n = &d->nodes[i];
+    if (n->weights < 0)
+        return RT_OK;
+    if (n->mesh == RT_NONE)
+        return gl_fail_at(d, n->weights, RT_ERR_INVALID, "nodes[%zu].weights: the node has no mesh", i);
+    const gl_mesh *me = &d->meshes[n->mesh];
+    uint32_t targets = me->count ? d->prims[me->first].target_count : 0;
+    if (d->j.tok[n->weights].type != RT_JSON_ARRAY || d->j.tok[n->weights].size != (int)targets)
+        return gl_fail_at(d, n->weights, RT_ERR_INVALID,
+                          "nodes[%zu].weights: expected an array of %u numbers, one per morph target of mesh %u", i,
+                          targets, n->mesh);
+    return RT_OK;
+}
+
 /* Each node's references in range; children linked to their one parent. */
 static rt_result check_nodes(gl_doc *d)
 {
@@ -258,6 +302,8 @@ static rt_result check_nodes(gl_doc *d)
     for (size_t i = 0; i < d->node_count; i++) {
         gl_node *n = &d->nodes[i];
         if ((r = check_index(d, n->mesh, d->mesh_count, n->tok, "meshes", "nodes[%zu].mesh", i)) != RT_OK)
+            return r;
+        if ((r = check_node_weights(d, i)) != RT_OK)
             return r;
         if ((r = check_index(d, n->camera, d->camera_count, n->tok, "cameras", "nodes[%zu].camera", i)) != RT_OK)
             return r;
@@ -407,6 +453,8 @@ rt_result gl_validate(gl_doc *d)
     if ((r = check_accessors(d)) != RT_OK)
         return r;
     if ((r = check_primitives(d)) != RT_OK)
+        return r;
+    if ((r = check_morph_counts(d)) != RT_OK)
         return r;
     if ((r = check_nodes(d)) != RT_OK)
         return r;

@@ -123,6 +123,36 @@ rt_result gl_get_floats(gl_doc *d, const char *where, const char *key, int t, fl
     return RT_OK;
 }
 
+rt_result gl_get_ranged(gl_doc *d, const char *where, const char *key, int t, float lo, float hi, float *out)
+{
+    rt_result r;
+    float v = 0;
+    if ((r = gl_get_float(d, where, key, t, &v)) != RT_OK)
+        return r;
+    if (!(v >= lo && v <= hi))
+        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s %g is outside [%g, %g]", where, key, (double)v, (double)lo,
+                          (double)hi);
+    *out = v;
+    return RT_OK;
+}
+
+rt_result gl_get_floats_ranged(gl_doc *d, const char *where, const char *key, int t, int n, float lo, float hi,
+                               float *out)
+{
+    rt_result r;
+    float c[16] = {0};
+    if (n < 1 || n > 16)
+        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s: bad component count", where, key);
+    if ((r = gl_get_floats(d, where, key, t, c, n)) != RT_OK)
+        return r;
+    for (int i = 0; i < n; i++)
+        if (!(c[i] >= lo && c[i] <= hi))
+            return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s component %d (%g) is outside [%g, %g]", where, key, i,
+                              (double)c[i], (double)lo, (double)hi);
+    memcpy(out, c, (size_t)n * sizeof *out);
+    return RT_OK;
+}
+
 rt_result gl_get_bool(gl_doc *d, const char *where, const char *key, int t, bool *out)
 {
     if (!rt_json_bool(&d->j, t, out))

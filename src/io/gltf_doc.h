@@ -209,6 +209,12 @@ rt_result gl_get_size(gl_doc *d, const char *where, const char *key, int t, size
 rt_result gl_get_int(gl_doc *d, const char *where, const char *key, int t, int *out);
 rt_result gl_get_float(gl_doc *d, const char *where, const char *key, int t, float *out);
 rt_result gl_get_floats(gl_doc *d, const char *where, const char *key, int t, float *out, int n);
+/* A number, or n of them, that the schema bounds to [lo, hi] (GL_BIG for
+ * no upper bound); outside is RT_ERR_INVALID naming the field and value. */
+#define GL_BIG 3.0e38f
+rt_result gl_get_ranged(gl_doc *d, const char *where, const char *key, int t, float lo, float hi, float *out);
+rt_result gl_get_floats_ranged(gl_doc *d, const char *where, const char *key, int t, int n, float lo, float hi,
+                               float *out);
 rt_result gl_get_bool(gl_doc *d, const char *where, const char *key, int t, bool *out);
 rt_result gl_get_string(gl_doc *d, const char *where, const char *key, int t, char *buf, size_t cap);
 rt_result gl_alloc_table(gl_doc *d, int t, const char *key, size_t elem, void **out, size_t *count);

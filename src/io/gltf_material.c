@@ -35,7 +35,9 @@ static rt_result parse_texinfo(gl_doc *d, const char *where, const char *key, in
          k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
         if (KEY(k, "index")) r = gl_get_index(d, w, "index", v, &index);
         else if (KEY(k, "texCoord")) r = gl_get_int(d, w, "texCoord", v, &texcoord);
-        else if (extra_key && KEY(k, extra_key)) r = gl_get_float(d, w, extra_key, v, extra);
+        else if (extra_key && KEY(k, extra_key))
+            r = gl_get_ranged(d, w, extra_key, v, strcmp(extra_key, "strength") == 0 ? 0 : -GL_BIG,
+                              strcmp(extra_key, "strength") == 0 ? 1 : GL_BIG, extra);
         else if (KEY(k, "extensions")) {
             int x = rt_json_get(&d->j, v, "KHR_texture_transform");
             if (x < 0)
@@ -107,32 +109,15 @@ void gl_derive_phong(rt_material *m)
     m->reflectivity = metal * smooth;
 }
 
-/* A factor of a material extension that must lie in [lo, hi]. */
-static rt_result get_ranged(gl_doc *d, const char *where, const char *key, int t, float lo, float hi, float *out)
-{
-    rt_result r;
-    if ((r = gl_get_float(d, where, key, t, out)) != RT_OK)
-        return r;
-    if (!(*out >= lo && *out <= hi))
-        return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s %g is outside [%g, %g]", where, key, (double)*out, (double)lo,
-                          (double)hi);
-    return RT_OK;
-}
-
-/* An RGB factor with every component in [lo, hi]. */
+/* An RGB factor with every component in [lo, hi] (gl_get_floats_ranged). */
 static rt_result get_color_ranged(gl_doc *d, const char *where, const char *key, int t, float lo, float hi,
                                   rt_vec3 *out)
 {
-    rt_result r;
     float c[3];
-    if ((r = gl_get_floats(d, where, key, t, c, 3)) != RT_OK)
-        return r;
-    for (int i = 0; i < 3; i++)
-        if (!(c[i] >= lo && c[i] <= hi))
-            return gl_fail_at(d, t, RT_ERR_INVALID, "%s.%s component %d (%g) is outside [%g, %g]", where, key, i,
-                              (double)c[i], (double)lo, (double)hi);
-    *out = rt_v3(c[0], c[1], c[2]);
-    return RT_OK;
+    rt_result r = gl_get_floats_ranged(d, where, key, t, 3, lo, hi, c);
+    if (r == RT_OK)
+        *out = rt_v3(c[0], c[1], c[2]);
+    return r;
 }
 
 /* The PBR-next material extensions (KHR_materials_clearcoat, specular,
@@ -143,7 +128,7 @@ static rt_result parse_material_ext(gl_doc *d, const char *wx, int k2, int v2, r
 {
     rt_result r = RT_OK;
     char we[160];
-    float big = 3.0e38f;
+    const float big = GL_BIG;
     *known = true;
     if (KEY(k2, "KHR_materials_clearcoat")) {
         snprintf(we, sizeof we, "%s.KHR_materials_clearcoat", wx);
@@ -151,9 +136,9 @@ static rt_result parse_material_ext(gl_doc *d, const char *wx, int k2, int v2, r
             return r;
         for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
              k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
-            if (KEY(k3, "clearcoatFactor")) r = get_ranged(d, we, "clearcoatFactor", v3, 0, 1, &m->clearcoat);
+            if (KEY(k3, "clearcoatFactor")) r = gl_get_ranged(d, we, "clearcoatFactor", v3, 0, 1, &m->clearcoat);
             else if (KEY(k3, "clearcoatRoughnessFactor"))
-                r = get_ranged(d, we, "clearcoatRoughnessFactor", v3, 0, 1, &m->clearcoat_roughness);
+                r = gl_get_ranged(d, we, "clearcoatRoughnessFactor", v3, 0, 1, &m->clearcoat_roughness);
             else if (KEY(k3, "clearcoatTexture"))
                 r = parse_texinfo(d, we, "clearcoatTexture", v3, &m->ext_tex[RT_XTEX_CLEARCOAT], NULL, NULL);
             else if (KEY(k3, "clearcoatRoughnessTexture"))
@@ -171,7 +156,7 @@ static rt_result parse_material_ext(gl_doc *d, const char *wx, int k2, int v2, r
             return r;
         for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
              k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
-            if (KEY(k3, "specularFactor")) r = get_ranged(d, we, "specularFactor", v3, 0, 1, &m->specular_weight);
+            if (KEY(k3, "specularFactor")) r = gl_get_ranged(d, we, "specularFactor", v3, 0, 1, &m->specular_weight);
             else if (KEY(k3, "specularColorFactor"))
                 r = get_color_ranged(d, we, "specularColorFactor", v3, 0, big, &m->specular_color);
             else if (KEY(k3, "specularTexture"))
@@ -190,7 +175,7 @@ static rt_result parse_material_ext(gl_doc *d, const char *wx, int k2, int v2, r
              k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
             if (KEY(k3, "sheenColorFactor")) r = get_color_ranged(d, we, "sheenColorFactor", v3, 0, 1, &m->sheen_color);
             else if (KEY(k3, "sheenRoughnessFactor"))
-                r = get_ranged(d, we, "sheenRoughnessFactor", v3, 0, 1, &m->sheen_roughness);
+                r = gl_get_ranged(d, we, "sheenRoughnessFactor", v3, 0, 1, &m->sheen_roughness);
             else if (KEY(k3, "sheenColorTexture"))
                 r = parse_texinfo(d, we, "sheenColorTexture", v3, &m->ext_tex[RT_XTEX_SHEEN_COLOR], NULL, NULL);
             else if (KEY(k3, "sheenRoughnessTexture"))
@@ -205,9 +190,9 @@ static rt_result parse_material_ext(gl_doc *d, const char *wx, int k2, int v2, r
             return r;
         for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
              k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
-            if (KEY(k3, "anisotropyStrength")) r = get_ranged(d, we, "anisotropyStrength", v3, 0, 1, &m->anisotropy);
+            if (KEY(k3, "anisotropyStrength")) r = gl_get_ranged(d, we, "anisotropyStrength", v3, 0, 1, &m->anisotropy);
             else if (KEY(k3, "anisotropyRotation"))
-                r = get_ranged(d, we, "anisotropyRotation", v3, -big, big, &m->anisotropy_rotation);
+                r = gl_get_ranged(d, we, "anisotropyRotation", v3, -big, big, &m->anisotropy_rotation);
             else if (KEY(k3, "anisotropyTexture"))
                 r = parse_texinfo(d, we, "anisotropyTexture", v3, &m->ext_tex[RT_XTEX_ANISOTROPY], NULL, NULL);
             if (r != RT_OK)
@@ -219,13 +204,13 @@ static rt_result parse_material_ext(gl_doc *d, const char *wx, int k2, int v2, r
             return r;
         for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
              k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
-            if (KEY(k3, "iridescenceFactor")) r = get_ranged(d, we, "iridescenceFactor", v3, 0, 1, &m->iridescence);
+            if (KEY(k3, "iridescenceFactor")) r = gl_get_ranged(d, we, "iridescenceFactor", v3, 0, 1, &m->iridescence);
             else if (KEY(k3, "iridescenceIor"))
-                r = get_ranged(d, we, "iridescenceIor", v3, 1, big, &m->iridescence_ior);
+                r = gl_get_ranged(d, we, "iridescenceIor", v3, 1, big, &m->iridescence_ior);
             else if (KEY(k3, "iridescenceThicknessMinimum"))
-                r = get_ranged(d, we, "iridescenceThicknessMinimum", v3, 0, big, &m->iridescence_thickness_min);
+                r = gl_get_ranged(d, we, "iridescenceThicknessMinimum", v3, 0, big, &m->iridescence_thickness_min);
             else if (KEY(k3, "iridescenceThicknessMaximum"))
-                r = get_ranged(d, we, "iridescenceThicknessMaximum", v3, 0, big, &m->iridescence_thickness_max);
+                r = gl_get_ranged(d, we, "iridescenceThicknessMaximum", v3, 0, big, &m->iridescence_thickness_max);
             else if (KEY(k3, "iridescenceTexture"))
                 r = parse_texinfo(d, we, "iridescenceTexture", v3, &m->ext_tex[RT_XTEX_IRIDESCENCE], NULL, NULL);
             else if (KEY(k3, "iridescenceThicknessTexture"))
@@ -240,7 +225,7 @@ static rt_result parse_material_ext(gl_doc *d, const char *wx, int k2, int v2, r
             return r;
         int s = rt_json_get(&d->j, v2, "dispersion");
         if (s >= 0)
-            r = get_ranged(d, we, "dispersion", s, 0, big, &m->dispersion);
+            r = gl_get_ranged(d, we, "dispersion", s, 0, big, &m->dispersion);
         if (r != RT_OK)
             return r;
     } else if (KEY(k2, "KHR_materials_diffuse_transmission")) {
@@ -250,7 +235,7 @@ static rt_result parse_material_ext(gl_doc *d, const char *wx, int k2, int v2, r
         for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
              k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
             if (KEY(k3, "diffuseTransmissionFactor"))
-                r = get_ranged(d, we, "diffuseTransmissionFactor", v3, 0, 1, &m->diffuse_transmission);
+                r = gl_get_ranged(d, we, "diffuseTransmissionFactor", v3, 0, 1, &m->diffuse_transmission);
             else if (KEY(k3, "diffuseTransmissionColorFactor"))
                 r = get_color_ranged(d, we, "diffuseTransmissionColorFactor", v3, 0, 1,
                                      &m->diffuse_transmission_color);
@@ -281,12 +266,12 @@ static rt_result parse_pbr(gl_doc *d, const char *where, int v, rt_material *m)
          k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
         if (KEY(k2, "baseColorFactor")) {
             float c[4];
-            if ((r = gl_get_floats(d, wp, "baseColorFactor", v2, c, 4)) != RT_OK)
+            if ((r = gl_get_floats_ranged(d, wp, "baseColorFactor", v2, 4, 0, 1, c)) != RT_OK)
                 return r;
             m->color = rt_v3(c[0], c[1], c[2]);
             m->alpha = c[3];
-        } else if (KEY(k2, "metallicFactor")) r = gl_get_float(d, wp, "metallicFactor", v2, &m->metallic);
-        else if (KEY(k2, "roughnessFactor")) r = gl_get_float(d, wp, "roughnessFactor", v2, &m->roughness);
+        } else if (KEY(k2, "metallicFactor")) r = gl_get_ranged(d, wp, "metallicFactor", v2, 0, 1, &m->metallic);
+        else if (KEY(k2, "roughnessFactor")) r = gl_get_ranged(d, wp, "roughnessFactor", v2, 0, 1, &m->roughness);
         else if (KEY(k2, "baseColorTexture"))
             r = parse_texinfo(d, wp, "baseColorTexture", v2, &m->base_color_tex, NULL, NULL);
         else if (KEY(k2, "metallicRoughnessTexture"))
@@ -309,7 +294,7 @@ static rt_result parse_core_ext(gl_doc *d, const char *wx, int k2, int v2, rt_ma
             return r;
         int s = rt_json_get(&d->j, v2, "emissiveStrength");
         if (s >= 0)
-            r = gl_get_float(d, we, "emissiveStrength", s, &m->emission_strength);
+            r = gl_get_ranged(d, we, "emissiveStrength", s, 0, GL_BIG, &m->emission_strength);
         if (r != RT_OK)
             return r;
     } else if (KEY(k2, "KHR_materials_transmission")) {
@@ -319,7 +304,7 @@ static rt_result parse_core_ext(gl_doc *d, const char *wx, int k2, int v2, rt_ma
         for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
              k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
             if (KEY(k3, "transmissionFactor"))
-                r = gl_get_float(d, we, "transmissionFactor", v3, &m->transmission);
+                r = gl_get_ranged(d, we, "transmissionFactor", v3, 0, 1, &m->transmission);
             else if (KEY(k3, "transmissionTexture"))
                 r = parse_texinfo(d, we, "transmissionTexture", v3, &m->transmission_tex, NULL, NULL);
             if (r != RT_OK)
@@ -331,9 +316,11 @@ static rt_result parse_core_ext(gl_doc *d, const char *wx, int k2, int v2, rt_ma
             return r;
         int s = rt_json_get(&d->j, v2, "ior");
         if (s >= 0)
-            r = gl_get_float(d, we, "ior", s, &m->ior);
+            r = gl_get_ranged(d, we, "ior", s, 0, GL_BIG, &m->ior);
         if (r != RT_OK)
             return r;
+        if (m->ior > 0 && m->ior < 1) /* the schema: 0 (a limit the renderer may treat as 1) or at least 1 */
+            return gl_fail_at(d, s, RT_ERR_INVALID, "%s.ior %g is neither 0 nor at least 1", we, (double)m->ior);
     } else if (KEY(k2, "KHR_materials_volume")) {
         snprintf(we, sizeof we, "%s.KHR_materials_volume", wx);
         if ((r = gl_expect_object(d, v2, we)) != RT_OK)
@@ -341,12 +328,12 @@ static rt_result parse_core_ext(gl_doc *d, const char *wx, int k2, int v2, rt_ma
         for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
              k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
             if (KEY(k3, "thicknessFactor"))
-                r = gl_get_float(d, we, "thicknessFactor", v3, &m->thickness);
+                r = gl_get_ranged(d, we, "thicknessFactor", v3, 0, GL_BIG, &m->thickness);
             else if (KEY(k3, "attenuationDistance"))
                 r = gl_get_float(d, we, "attenuationDistance", v3, &m->attenuation_distance);
             else if (KEY(k3, "attenuationColor")) {
                 float c[3];
-                if ((r = gl_get_floats(d, we, "attenuationColor", v3, c, 3)) != RT_OK)
+                if ((r = gl_get_floats_ranged(d, we, "attenuationColor", v3, 3, 0, 1, c)) != RT_OK)
                     return r;
                 m->attenuation_color = rt_v3(c[0], c[1], c[2]);
             }
@@ -426,7 +413,7 @@ rt_result gl_parse_materials(gl_doc *d, int t)
                     return r;
             } else if (KEY(k, "emissiveFactor")) {
                 float c[3];
-                if ((r = gl_get_floats(d, where, "emissiveFactor", v, c, 3)) != RT_OK)
+                if ((r = gl_get_floats_ranged(d, where, "emissiveFactor", v, 3, 0, 1, c)) != RT_OK)
                     return r;
                 m->emission = rt_v3(c[0], c[1], c[2]);
             } else if (KEY(k, "alphaMode")) {
@@ -440,7 +427,7 @@ rt_result gl_parse_materials(gl_doc *d, int t)
                     return gl_fail_at(d, v, RT_ERR_INVALID, "%s.alphaMode \"%s\" is not OPAQUE, MASK or BLEND", where,
                                       mode);
             } else if (KEY(k, "alphaCutoff")) {
-                if ((r = gl_get_float(d, where, "alphaCutoff", v, &m->alpha_cutoff)) != RT_OK)
+                if ((r = gl_get_ranged(d, where, "alphaCutoff", v, 0, GL_BIG, &m->alpha_cutoff)) != RT_OK)
                     return r;
             } else if (KEY(k, "doubleSided")) {
                 if ((r = gl_get_bool(d, where, "doubleSided", v, &m->double_sided)) != RT_OK)

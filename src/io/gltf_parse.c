@@ -1,5 +1,5 @@
 /* gltf_parse.c - the second pass of the glTF loader (gltf_doc.h): the
- * JSON document, tokenized once by jsmn (json.c), mapped into flat tables
+ * JSON document, tokenized once (json.c), mapped into flat tables
  * of records with a count each (buffers, bufferViews, accessors with
  * sparse storage, meshes and primitives with morph targets and Draco
  * streams, nodes, scenes, cameras, KHR_lights_punctual lights, skins,
@@ -738,20 +738,21 @@ static rt_result parse_lights(gl_doc *d, int ext)
              k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
             if (KEY(k, "type")) r = gl_get_string(d, where, "type", v, type, sizeof type);
             else if (KEY(k, "color")) {
-                float c[3];
-                if ((r = gl_get_floats(d, where, "color", v, c, 3)) != RT_OK)
+                float c[3] = {1, 1, 1};
+                if ((r = gl_get_floats_ranged(d, where, "color", v, 3, 0, 1, c)) != RT_OK)
                     return r;
                 g->color = rt_v3(c[0], c[1], c[2]);
-            } else if (KEY(k, "intensity")) r = gl_get_float(d, where, "intensity", v, &g->intensity);
-            else if (KEY(k, "range")) r = gl_get_float(d, where, "range", v, &g->range);
+            } else if (KEY(k, "intensity")) r = gl_get_ranged(d, where, "intensity", v, 0, GL_BIG, &g->intensity);
+            else if (KEY(k, "range")) r = gl_get_ranged(d, where, "range", v, 0, GL_BIG, &g->range);
             else if (KEY(k, "spot")) {
                 if ((r = gl_expect_object(d, v, where)) != RT_OK)
                     return r;
                 for (int k2_n = 0, k2 = v + 1, v2 = v + 2; k2_n < d->j.tok[v].size && v2 < d->j.count;
                      k2_n++, k2 = rt_json_skip(&d->j, v2), v2 = k2 + 1) {
-                    if (KEY(k2, "innerConeAngle")) r = gl_get_float(d, where, "spot.innerConeAngle", v2, &g->inner);
-                    else if (KEY(k2, "outerConeAngle")) r = gl_get_float(d, where, "spot.outerConeAngle", v2,
-                                                                         &g->outer);
+                    if (KEY(k2, "innerConeAngle"))
+                        r = gl_get_ranged(d, where, "spot.innerConeAngle", v2, 0, RT_PI / 2, &g->inner);
+                    else if (KEY(k2, "outerConeAngle"))
+                        r = gl_get_ranged(d, where, "spot.outerConeAngle", v2, 0, RT_PI / 2 + 1e-6f, &g->outer);
                     if (r != RT_OK)
                         return r;
                 }

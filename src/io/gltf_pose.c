@@ -192,7 +192,8 @@ rt_result gl_morph_weights(gl_doc *d, uint32_t node, uint32_t count, float *w)
     const gl_node *n = &d->nodes[node];
     memset(w, 0, count * sizeof *w);
     if (n->pose_weights) {
-        memcpy(w, n->pose_weights, count * sizeof *w);
+        /* equal since gl_validate's check_morph_counts; min() keeps the copy in bounds regardless */
+        memcpy(w, n->pose_weights, (count < n->pose_weight_count ? count : n->pose_weight_count) * sizeof *w);
         return RT_OK;
     }
     int tok = n->weights >= 0 ? n->weights : d->meshes[n->mesh].weights;

@@ -1,23 +1,20 @@
-/* json.c - token walking over jsmn (zserge/jsmn, MIT, the Debian libjsmn-dev
- * header; not copied here).
+/* json.c - a strict JSON tokenizer and the token walkers of rt/io/json.h.
  *
- * jsmn runs twice: once with a NULL token array to count tokens, then into an
- * array of exactly that size (the count is bounded by the text length, so a
- * lying file cannot make us allocate more than a few bytes per input byte).
- * Strict mode is on, so primitives must be followed by a delimiter and keys
- * must be strings. Tokens are copied into rt_json_tok so no other file needs
- * jsmn's header. See include/rt/json.h.
- *
- * JSMN_PARENT_LINKS: without it jsmn finds the container a '}' or ']'
- * returns to by scanning back over every token so far, so a file of many
- * small objects (100 000 nodes, accessors, ...) took time quadratic in its
- * size (30 000 nodes: 7.8 s); with the links the step is one hop up.
+ * The tokenizer is our own (it replaced jsmn, whose closing brackets walked
+ * parent links back from the last token: nesting N deep cost N^2/2 hops, so
+ * a 600 KB file of nested arrays took 104 s). It keeps a stack of the open
+ * containers, so every byte is looked at once and a closing bracket pops
+ * one entry: linear in the text. The stack is capped at RT_JSON_MAX_DEPTH
+ * open containers; deeper input is refused with the byte where it goes over.
+ * The grammar is RFC 8259's: objects of "key": value pairs, arrays, strings
+ * with the escapes \" \\ \/ \b \f \n \r \t \uXXXX, and primitives (numbers,
+ * true, false, null) read up to the next delimiter and checked by the
+ * walkers that read them (rt_json_number, rt_json_bool). Tokens go into an
+ * array grown by doubling; every token takes at least one byte of text, so
+ * a file cannot make us allocate more than a few bytes per input byte.
+ * A NUL byte ends the text (GLB pads its JSON chunk with spaces; a NUL
+ * before the end is checked by rt_json_parse). See include/rt/io/json.h.
  */
-#define JSMN_PARENT_LINKS
-#define JSMN_STRICT
-#define JSMN_STATIC
-#include <jsmn.h>
-
 #include "rt/io/json.h"
 
 #include <math.h>
@@ -34,6 +31,172 @@ static size_t skip_ws(const char *t, size_t i, size_t len)
     return i;
 }
 
+/* The tokenizer's state: the tokens so far and the stack of open containers. */
+typedef struct tokenizer {
+    const char *text;
+    size_t len, pos;
+    rt_json_tok *tok;
+    size_t count, cap;
+    int open[RT_JSON_MAX_DEPTH]; /* token index of each open container */
+    int depth;
+    const char *why; /* the error, with pos at its byte */
+    rt_result code;  /* and its kind */
+} tokenizer;
+
+static int fail(tokenizer *t, rt_result code, const char *why)
+{
+    t->code = code;
+    t->why = why;
+    return -1;
+}
+
+static int add_token(tokenizer *t, rt_json_type type, size_t start, size_t end)
+{
+    if (t->count >= (size_t)INT32_MAX || !rt_grow((void **)&t->tok, &t->cap, t->count + 1, sizeof *t->tok)) {
+        return fail(t, RT_ERR_NOMEM, "out of memory for JSON tokens");
+    }
+    rt_json_tok *k = &t->tok[t->count];
+    k->type = (int)type;
+    k->start = (int)start;
+    k->end = (int)end;
+    k->size = 0;
+    return (int)t->count++;
+}
+
+static bool is_hex(char c)
+{
+    return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F');
+}
+
+/* A string starting at the quote at t->pos; leaves pos after the closing quote. */
+static int scan_string(tokenizer *t)
+{
+    size_t start = t->pos + 1;
+    for (size_t i = start; i < t->len && t->text[i]; i++) {
+        char c = t->text[i];
+        if (c == '"') {
+            t->pos = i + 1;
+            return add_token(t, RT_JSON_STRING, start, i);
+        }
+        if (c != '\\')
+            continue;
+        if (i + 1 >= t->len || !t->text[i + 1])
+            break;
+        char e = t->text[++i];
+        if (e == 'u') {
+            for (int k = 1; k <= 4; k++)
+                if (i + (size_t)k >= t->len || !is_hex(t->text[i + (size_t)k])) {
+                    t->pos = i - 1;
+                    return fail(t, RT_ERR_PARSE, "bad \\u escape in a JSON string");
+                }
+            i += 4;
+        } else if (!strchr("\"\\/bfnrt", e)) {
+            t->pos = i - 1;
+            return fail(t, RT_ERR_PARSE, "bad escape in a JSON string");
+        }
+    }
+    return fail(t, RT_ERR_PARSE, "JSON ends early (unclosed string)"); /* pos: the opening quote */
+}
+
+/* A number, true, false or null: the bytes up to the next delimiter. */
+static int scan_primitive(tokenizer *t)
+{
+    size_t start = t->pos, i = start;
+    for (; i < t->len && t->text[i]; i++) {
+        char c = t->text[i];
+        if (c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == ',' || c == ']' || c == '}')
+            break;
+        if (c < 32 || c > 126) {
+            t->pos = i;
+            return fail(t, RT_ERR_PARSE, "invalid JSON character or structure");
+        }
+    }
+    t->pos = i;
+    return add_token(t, RT_JSON_PRIMITIVE, start, i);
+}
+
+/* What the tokenizer waits for next. */
+typedef enum expect { VALUE, KEY, COLON, COMMA_OR_CLOSE, VALUE_OR_CLOSE, KEY_OR_CLOSE } expect;
+
+/* One value (and everything inside it) from t->pos. */
+static int tokenize(tokenizer *t)
+{
+    expect want = VALUE;
+    for (;;) {
+        t->pos = skip_ws(t->text, t->pos, t->len);
+        if (t->pos >= t->len || !t->text[t->pos]) {
+            return fail(t, RT_ERR_PARSE, "JSON ends early (unclosed object or array)");
+        }
+        char c = t->text[t->pos];
+        int parent = t->depth ? t->open[t->depth - 1] : -1;
+        if ((c == '}' || c == ']') && (want == COMMA_OR_CLOSE || want == VALUE_OR_CLOSE || want == KEY_OR_CLOSE)) {
+            rt_json_type type = c == '}' ? RT_JSON_OBJECT : RT_JSON_ARRAY;
+            if (parent < 0 || t->tok[parent].type != (int)type) {
+                return fail(t, RT_ERR_PARSE, "invalid JSON character or structure");
+            }
+            t->tok[parent].end = (int)++t->pos;
+            if (--t->depth == 0)
+                return 0;
+            want = COMMA_OR_CLOSE;
+            continue;
+        }
+        if (want == COMMA_OR_CLOSE) {
+            if (c != ',') {
+                return fail(t, RT_ERR_PARSE, "invalid JSON character or structure");
+            }
+            t->pos++;
+            want = t->tok[parent].type == RT_JSON_OBJECT ? KEY : VALUE;
+            continue;
+        }
+        if (want == COLON) {
+            if (c != ':') {
+                return fail(t, RT_ERR_PARSE, "invalid JSON character or structure");
+            }
+            t->pos++;
+            want = VALUE;
+            continue;
+        }
+        if (want == KEY || want == KEY_OR_CLOSE) {
+            if (c != '"') {
+                return fail(t, RT_ERR_PARSE, "invalid JSON character or structure");
+            }
+            int k = scan_string(t);
+            if (k < 0)
+                return -1;
+            t->tok[parent].size++;
+            t->tok[k].size = 1;
+            want = COLON;
+            continue;
+        }
+        /* a value: its container (an array, or the object whose key came last) counts it */
+        if (parent >= 0 && t->tok[parent].type == RT_JSON_ARRAY)
+            t->tok[parent].size++;
+        int v;
+        if (c == '{' || c == '[') {
+            if (t->depth >= RT_JSON_MAX_DEPTH)
+                return fail(t, RT_ERR_LIMIT, "JSON nested deeper than " RT_JSON_MAX_DEPTH_TEXT " objects and arrays");
+            if ((v = add_token(t, c == '{' ? RT_JSON_OBJECT : RT_JSON_ARRAY, t->pos, t->pos)) < 0)
+                return -1;
+            t->open[t->depth++] = v;
+            t->pos++;
+            want = c == '{' ? KEY_OR_CLOSE : VALUE_OR_CLOSE;
+            continue;
+        }
+        if (c == '"')
+            v = scan_string(t);
+        else if (c == '-' || (c >= '0' && c <= '9') || c == 't' || c == 'f' || c == 'n')
+            v = scan_primitive(t);
+        else {
+            return fail(t, RT_ERR_PARSE, "invalid JSON character or structure");
+        }
+        if (v < 0)
+            return -1;
+        if (t->depth == 0)
+            return 0;
+        want = COMMA_OR_CLOSE;
+    }
+}
+
 rt_result rt_json_parse(rt_json *j, const char *text, size_t len, const char *name, size_t base, rt_error *err)
 {
     memset(j, 0, sizeof *j);
@@ -45,57 +208,27 @@ rt_result rt_json_parse(rt_json *j, const char *text, size_t len, const char *na
         return rt_fail(err, RT_ERR_PARSE, "%s: byte %zu: empty JSON", name, base + first);
     if (text[first] != '{')
         return rt_fail(err, RT_ERR_PARSE, "%s: byte %zu: JSON must start with '{'", name, base + first);
-    jsmn_parser p;
-    jsmn_init(&p);
-    int n = jsmn_parse(&p, text, len, NULL, 0);
-    if (n >= 0) {
-        jsmntok_t *jt = rt_alloc((size_t)n, sizeof *jt);
-        if (!jt)
-            return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for %d JSON tokens", name, n);
-        jsmn_init(&p);
-        int m = jsmn_parse(&p, text, len, jt, (unsigned)n);
-        if (m >= 0 && m != n)
-            m = JSMN_ERROR_INVAL; /* cannot happen: both passes see the same text */
-        if (m >= 0) {
-            j->tok = rt_alloc((size_t)n, sizeof *j->tok);
-            if (!j->tok) {
-                free(jt);
-                return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for %d JSON tokens", name, n);
-            }
-            for (int i = 0; i < n; i++) {
-                j->tok[i].type = (int)jt[i].type;
-                j->tok[i].start = jt[i].start;
-                j->tok[i].end = jt[i].end;
-                j->tok[i].size = jt[i].size;
-            }
-        }
-        free(jt);
-        n = m;
-    }
-    if (n < 0) {
-        size_t at = p.pos < len ? p.pos : len;
-        const char *why = n == JSMN_ERROR_PART ? "JSON ends early (unclosed object, array or string)"
-                                               : "invalid JSON character or structure";
-        return rt_fail(err, RT_ERR_PARSE, "%s: byte %zu: %s", name, base + at, why);
+    tokenizer *t = malloc(sizeof *t);
+    if (!t)
+        return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the JSON tokenizer", name);
+    memset(t, 0, sizeof *t);
+    t->text = text;
+    t->len = len;
+    t->pos = first;
+    if (tokenize(t) < 0) {
+        size_t at = t->pos < len ? t->pos : len;
+        rt_result r = rt_fail(err, t->code, "%s: byte %zu: %s", name, base + at, t->why);
+        free(t->tok);
+        free(t);
+        return r;
     }
     j->text = text;
     j->len = len;
-    j->count = n;
-    if (n < 1 || j->tok[0].type != RT_JSON_OBJECT) {
-        rt_json_free(j);
-        return rt_fail(err, RT_ERR_PARSE, "%s: byte %zu: JSON must be one object", name, base + first);
-    }
-    /* jsmn happily reads several top-level values; a glTF is exactly one. */
-    int after = rt_json_skip(j, 0);
-    size_t end = (size_t)j->tok[0].end;
-    size_t rest = skip_ws(text, end, len);
-    if (after != n || (rest < len && text[rest] != '\0')) {
-        size_t at = after < n ? (size_t)j->tok[after].start : rest;
-        rt_json_free(j);
-        return rt_fail(err, RT_ERR_PARSE, "%s: byte %zu: unexpected data after the top-level JSON object", name,
-                       base + at);
-    }
-    /* A NUL inside the text would have stopped jsmn early; only padding may follow. */
+    j->tok = t->tok;
+    j->count = (int)t->count;
+    size_t rest = skip_ws(text, t->pos, len);
+    free(t);
+    /* a glTF (and a sidecar) is exactly one object; only padding may follow it */
     for (size_t i = rest; i < len; i++) {
         if (text[i] != '\0' && text[i] != ' ' && text[i] != '\t' && text[i] != '\n' && text[i] != '\r') {
             rt_json_free(j);

@@ -14,6 +14,7 @@
 #include "rt/image/framebuffer.h"
 #include "rt/io/image_load.h"
 #include "rt/io/image_read.h"
+#include "rt/io/json.h"
 #include "rt/io/load.h"
 #include "rt/io/meshopt.h"
 #include "rt/job/part.h"
@@ -21,7 +22,8 @@
 #include "rt/scene/texture.h"
 
 const char *const rt_fuzz_targets[] = {"scene", "gltf",    "glb",   "gltf_bin", "obj",        "ply",  "off",
-                                       "image", "exr",     "meshopt", "draco", "part", "image_file", NULL};
+                                       "image", "exr",     "meshopt", "draco", "part", "image_file", "pose",
+                                       "json",  NULL};
 
 static char dir[64];
 
@@ -133,6 +135,111 @@ static void fuzz_draco(const uint8_t *data, size_t size)
     rt_draco_free(m);
 }
 
+/* pose: the animation index, a signed 16-bit time in 1/64 s, then a .glb,
+ * or (anything else) a .gltf and its buffer.bin as in gltf_bin; loaded as
+ * rt loads it for --time: the animation sampled, skins and morphs applied. */
+static void fuzz_pose(const uint8_t *data, size_t size)
+{
+    if (size < 3)
+        return;
+    rt_load_options opt = {0};
+    opt.use_time = true;
+    opt.animation = data[0] % 4;
+    opt.time = (float)(int16_t)(uint16_t)(data[1] | data[2] << 8) / 64.0f;
+    data += 3;
+    size -= 3;
+    char path[256];
+    const char *name = "fuzz.glb";
+    if (size < 4 || memcmp(data, "glTF", 4) != 0) {
+        size_t n;
+        split(data, size, &n);
+        write_temp("buffer.bin", data + 4 + n, size >= 4 ? size - 4 - n : 0, path, sizeof path);
+        if (size >= 4)
+            data += 4;
+        size = n;
+        name = "fuzz.gltf";
+    }
+    snprintf(path, sizeof path, "%s/%s", temp_dir(), name);
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_error err;
+    rt_load_memory(&s, data, size, path, &opt, NULL, &err);
+    rt_scene_free(&s);
+}
+
+/* Every token of a tokenized document read by every walker. */
+static void walk_json(const rt_json *j)
+{
+    char buf[64];
+    double v;
+    bool b;
+    for (int i = 0; i < j->count; i++) {
+        (void)rt_json_number(j, i, &v);
+        (void)rt_json_bool(j, i, &b);
+        (void)rt_json_string(j, i, buf, sizeof buf);
+        (void)rt_json_get(j, i, "a");
+        if (rt_json_skip(j, i) > j->count)
+            abort(); /* a walker must never step past the tokens */
+    }
+}
+
+/* json: a mode byte, then text for rt_json_parse. Mode 0 parses the text
+ * as it is; mode 1 wraps it in N arrays (N: the next two bytes, so up to
+ * 65 535 deep, past RT_JSON_MAX_DEPTH) inside {"a": ... }; mode 2 repeats
+ * it N times (up to 65 535, at most 2 MB) as the elements of one array:
+ * the depth and size extremes a few bytes cannot reach on their own. */
+static void fuzz_json(const uint8_t *data, size_t size)
+{
+    if (size < 3)
+        return;
+    int mode = data[0] % 3;
+    size_t n = (size_t)data[1] | (size_t)data[2] << 8;
+    const char *body = (const char *)data + 3;
+    size_t blen = size - 3, len = 0;
+    if (mode == 2 && n * (blen + 1) > ((size_t)1 << 21))
+        n = ((size_t)1 << 21) / (blen + 1); /* 2 MB at most: size, not allocation, is what is tested */
+    char *text;
+    if (mode == 0) {
+        text = malloc(blen + 1);
+        if (!text)
+            return;
+        memcpy(text, body, blen);
+        len = blen;
+    } else {
+        size_t cap = 8 + (mode == 1 ? 2 * n + blen : n * (blen + 1));
+        text = malloc(cap);
+        if (!text)
+            return;
+        memcpy(text, "{\"a\":[", 6);
+        len = 6;
+        for (size_t i = 0; i < n; i++) {
+            if (mode == 1) {
+                text[len++] = '[';
+            } else {
+                if (i)
+                    text[len++] = ',';
+                memcpy(text + len, body, blen);
+                len += blen;
+            }
+        }
+        if (mode == 1) {
+            memcpy(text + len, body, blen);
+            len += blen;
+            memset(text + len, ']', n);
+            len += n;
+        }
+        text[len++] = ']';
+        text[len++] = '}';
+    }
+    rt_json j;
+    rt_error err;
+    if (rt_json_parse(&j, text, len, "fuzz.json", 0, &err) == RT_OK) {
+        walk_json(&j);
+        rt_json_free(&j);
+    }
+    free(text);
+}
+
 int rt_fuzz_run(const char *target, const uint8_t *data, size_t size)
 {
     char path[256];
@@ -212,6 +319,10 @@ int rt_fuzz_run(const char *target, const uint8_t *data, size_t size)
         fuzz_meshopt(data, size);
     } else if (strcmp(target, "draco") == 0) {
         fuzz_draco(data, size);
+    } else if (strcmp(target, "pose") == 0) {
+        fuzz_pose(data, size);
+    } else if (strcmp(target, "json") == 0) {
+        fuzz_json(data, size);
     } else {
         return -1;
     }

@@ -15,8 +15,12 @@
  * part's JSON sidecar, then its EXR image, read by rt_part_read; "@HASH@"
  * in the sidecar becomes the image's hash), image_file (any bytes as an
  * image file through rt_image_read, as rt compare and rt convert read it:
- * PFM besides what image reads).
- * Every target but image, exr, meshopt, draco, part and image_file loads through rt_load_memory, as `rt` loads a file
+ * PFM besides what image reads), pose (an animation index byte, a signed
+ * 16-bit frame time in 1/64 s, then a .glb or a gltf_bin input: loaded
+ * posed at that time, so animation sampling, skins and morph targets run)
+ * and json (a mode byte, a u16 N, then text for rt_json_parse: as it is,
+ * wrapped in N arrays, or repeated N times in one array).
+ * Every target but image, exr, meshopt, draco, part, image_file and json loads through rt_load_memory, as `rt` loads a file
  * of that kind (fuzz.txt, fuzz.gltf, fuzz.obj, ...): the content picks the
  * reader before the name does.
  */

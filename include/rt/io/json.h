@@ -1,8 +1,8 @@
-/* rt/json.h - a thin token-walking layer over the jsmn tokenizer.
+/* rt/json.h - a strict JSON tokenizer and a thin token-walking layer.
  *
- * The text is tokenized once (jsmn in strict mode: tokens counted with a NULL
- * array first, then allocated exactly) into a flat array of tokens in
- * document order. A token's children follow it: an object's size is its
+ * The text is tokenized once, in time linear in its length (a stack of
+ * open containers, at most RT_JSON_MAX_DEPTH deep), into a flat array of
+ * tokens in document order. A token's children follow it: an object's size is its
  * number of keys, each key token has size 1 and its value right after it.
  * The walker functions never read past the token array, so a caller can walk
  * any tokenized input without further checks.
@@ -40,11 +40,15 @@ typedef struct rt_json {
     int count;
 } rt_json;
 
-#define RT_JSON_MAX_BYTES 0x7fffff00u /* jsmn keeps offsets in int */
+#define RT_JSON_MAX_BYTES 0x7fffff00u /* token offsets are int */
+/* Objects and arrays open at once; deeper input is RT_ERR_LIMIT. glTF
+ * files and sidecars nest under 20 deep. */
+#define RT_JSON_MAX_DEPTH 256
+#define RT_JSON_MAX_DEPTH_TEXT "256"
 
 /* Tokenizes text[0, len). Errors name `name` and the byte offset of the
  * problem plus `base` (the JSON's offset within its file, for GLB). The top
- * level must be one object; trailing bytes other than whitespace are an
+ * level must be one object, nested at most RT_JSON_MAX_DEPTH deep; trailing bytes other than whitespace are an
  * error. On success j->text points at text (not copied). */
 rt_result rt_json_parse(rt_json *j, const char *text, size_t len, const char *name, size_t base, rt_error *err);
 void rt_json_free(rt_json *j);
