@@ -2,6 +2,7 @@
 # Installs the Debian packages rt builds against, when they are missing.
 # Called by `make` (through the build/.deps stamp); safe to run by hand.
 #   libstb-dev     stb_image / stb_image_write (PNG, JPEG, HDR in and out)
+#   libjsmn-dev    the JSON tokenizer under src/io/json.c (glTF, part sidecars)
 #   libcmocka-dev  the test framework
 #   libopenexr-dev the OpenEXR Core C API (EXR images in and out)
 #   libmeshoptimizer-dev, libdraco-dev, libwebp-dev
@@ -67,6 +68,7 @@ check() { # header package [language]
     fi
 }
 check stb/stb_image.h libstb-dev
+check jsmn.h libjsmn-dev
 check cmocka.h libcmocka-dev
 check OpenEXR/openexr.h libopenexr-dev
 check meshoptimizer.h libmeshoptimizer-dev

@@ -1,20 +1,33 @@
-/* json.c - a strict JSON tokenizer and the token walkers of rt/io/json.h.
+/* json.c - JSON for the glTF loader and the part sidecars: a strict
+ * grammar check of our own, then jsmn (zserge/jsmn, MIT, the Debian
+ * libjsmn-dev header; not copied here) for the tokens, and the token
+ * walkers of rt/io/json.h.
  *
- * The tokenizer is our own (it replaced jsmn, whose closing brackets walked
- * parent links back from the last token: nesting N deep cost N^2/2 hops, so
- * a 600 KB file of nested arrays took 104 s). It keeps a stack of the open
- * containers, so every byte is looked at once and a closing bracket pops
- * one entry: linear in the text. The stack is capped at RT_JSON_MAX_DEPTH
- * open containers; deeper input is refused with the byte where it goes over.
- * The grammar is RFC 8259's: objects of "key": value pairs, arrays, strings
- * with the escapes \" \\ \/ \b \f \n \r \t \uXXXX, and primitives (numbers,
- * true, false, null) read up to the next delimiter and checked by the
- * walkers that read them (rt_json_number, rt_json_bool). Tokens go into an
- * array grown by doubling; every token takes at least one byte of text, so
- * a file cannot make us allocate more than a few bytes per input byte.
- * A NUL byte ends the text (GLB pads its JSON chunk with spaces; a NUL
- * before the end is checked by rt_json_parse). See include/rt/io/json.h.
+ * The check comes first, as the image guards come before stb_image: it
+ * reads the text once with a stack of the open containers, so it is linear
+ * in the text, and refuses what RFC 8259 refuses and jsmn's strict mode
+ * lets through (a missing or trailing comma, a value without its key),
+ * bad escapes, and nesting deeper than RT_JSON_MAX_DEPTH, each with the
+ * byte where it goes wrong. Only then does jsmn see the text, up to the
+ * end of its one top-level object. jsmn finds the container a closing
+ * bracket returns to by walking parent links back from the last token
+ * (JSMN_PARENT_LINKS; without them it scans back over every token), so its
+ * cost grows with the nesting depth at each closing bracket: unbounded,
+ * that was quadratic (a 600 KB file of nested arrays took 104 s, glTF
+ * extras 100 000 deep 11.6 s); with the depth capped it is linear.
+ *
+ * jsmn runs twice: once with a NULL token array to count tokens, then into
+ * an array of exactly that size (the count is bounded by the text length,
+ * so a lying file cannot make us allocate more than a few bytes per input
+ * byte). Tokens are copied into rt_json_tok so no other file needs jsmn's
+ * header. A NUL byte ends the text (GLB pads its JSON chunk with spaces;
+ * only padding may follow the object). See include/rt/io/json.h.
  */
+#define JSMN_PARENT_LINKS
+#define JSMN_STRICT
+#define JSMN_STATIC
+#include <jsmn.h>
+
 #include "rt/io/json.h"
 
 #include <math.h>
@@ -31,36 +44,21 @@ static size_t skip_ws(const char *t, size_t i, size_t len)
     return i;
 }
 
-/* The tokenizer's state: the tokens so far and the stack of open containers. */
-typedef struct tokenizer {
+/* The grammar check's state: where it reads and the stack of open containers. */
+typedef struct checker {
     const char *text;
     size_t len, pos;
-    rt_json_tok *tok;
-    size_t count, cap;
-    int open[RT_JSON_MAX_DEPTH]; /* token index of each open container */
+    char open[RT_JSON_MAX_DEPTH]; /* '{' or '[' of each open container */
     int depth;
     const char *why; /* the error, with pos at its byte */
     rt_result code;  /* and its kind */
-} tokenizer;
+} checker;
 
-static int fail(tokenizer *t, rt_result code, const char *why)
+static int fail(checker *c, rt_result code, const char *why)
 {
-    t->code = code;
-    t->why = why;
+    c->code = code;
+    c->why = why;
     return -1;
-}
-
-static int add_token(tokenizer *t, rt_json_type type, size_t start, size_t end)
-{
-    if (t->count >= (size_t)INT32_MAX || !rt_grow((void **)&t->tok, &t->cap, t->count + 1, sizeof *t->tok)) {
-        return fail(t, RT_ERR_NOMEM, "out of memory for JSON tokens");
-    }
-    rt_json_tok *k = &t->tok[t->count];
-    k->type = (int)type;
-    k->start = (int)start;
-    k->end = (int)end;
-    k->size = 0;
-    return (int)t->count++;
 }
 
 static bool is_hex(char c)
@@ -68,133 +66,160 @@ static bool is_hex(char c)
     return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F');
 }
 
-/* A string starting at the quote at t->pos; leaves pos after the closing quote. */
-static int scan_string(tokenizer *t)
+/* A string starting at the quote at c->pos; leaves pos after the closing quote. */
+static int scan_string(checker *c)
 {
-    size_t start = t->pos + 1;
-    for (size_t i = start; i < t->len && t->text[i]; i++) {
-        char c = t->text[i];
-        if (c == '"') {
-            t->pos = i + 1;
-            return add_token(t, RT_JSON_STRING, start, i);
+    for (size_t i = c->pos + 1; i < c->len && c->text[i]; i++) {
+        char ch = c->text[i];
+        if (ch == '"') {
+            c->pos = i + 1;
+            return 0;
         }
-        if (c != '\\')
+        if (ch != '\\')
             continue;
-        if (i + 1 >= t->len || !t->text[i + 1])
+        if (i + 1 >= c->len || !c->text[i + 1])
             break;
-        char e = t->text[++i];
+        char e = c->text[++i];
         if (e == 'u') {
             for (int k = 1; k <= 4; k++)
-                if (i + (size_t)k >= t->len || !is_hex(t->text[i + (size_t)k])) {
-                    t->pos = i - 1;
-                    return fail(t, RT_ERR_PARSE, "bad \\u escape in a JSON string");
+                if (i + (size_t)k >= c->len || !is_hex(c->text[i + (size_t)k])) {
+                    c->pos = i - 1;
+                    return fail(c, RT_ERR_PARSE, "bad \\u escape in a JSON string");
                 }
             i += 4;
         } else if (!strchr("\"\\/bfnrt", e)) {
-            t->pos = i - 1;
-            return fail(t, RT_ERR_PARSE, "bad escape in a JSON string");
+            c->pos = i - 1;
+            return fail(c, RT_ERR_PARSE, "bad escape in a JSON string");
         }
     }
-    return fail(t, RT_ERR_PARSE, "JSON ends early (unclosed string)"); /* pos: the opening quote */
+    return fail(c, RT_ERR_PARSE, "JSON ends early (unclosed string)"); /* pos: the opening quote */
 }
 
-/* A number, true, false or null: the bytes up to the next delimiter. */
-static int scan_primitive(tokenizer *t)
+/* A number, true, false or null: the bytes up to the next delimiter (the
+ * walkers that read them, rt_json_number and rt_json_bool, check them). */
+static int scan_primitive(checker *c)
 {
-    size_t start = t->pos, i = start;
-    for (; i < t->len && t->text[i]; i++) {
-        char c = t->text[i];
-        if (c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == ',' || c == ']' || c == '}')
+    size_t i = c->pos;
+    for (; i < c->len && c->text[i]; i++) {
+        char ch = c->text[i];
+        if (ch == ' ' || ch == '\t' || ch == '\n' || ch == '\r' || ch == ',' || ch == ']' || ch == '}')
             break;
-        if (c < 32 || c > 126) {
-            t->pos = i;
-            return fail(t, RT_ERR_PARSE, "invalid JSON character or structure");
+        if (ch < 32 || ch > 126) {
+            c->pos = i;
+            return fail(c, RT_ERR_PARSE, "invalid JSON character or structure");
         }
     }
-    t->pos = i;
-    return add_token(t, RT_JSON_PRIMITIVE, start, i);
+    c->pos = i;
+    return 0;
 }
 
-/* What the tokenizer waits for next. */
+/* What the check waits for next. */
 typedef enum expect { VALUE, KEY, COLON, COMMA_OR_CLOSE, VALUE_OR_CLOSE, KEY_OR_CLOSE } expect;
 
-/* One value (and everything inside it) from t->pos. */
-static int tokenize(tokenizer *t)
+/* One value (and everything inside it) from c->pos; leaves pos after it. */
+static int check_value(checker *c)
 {
     expect want = VALUE;
     for (;;) {
-        t->pos = skip_ws(t->text, t->pos, t->len);
-        if (t->pos >= t->len || !t->text[t->pos]) {
-            return fail(t, RT_ERR_PARSE, "JSON ends early (unclosed object or array)");
-        }
-        char c = t->text[t->pos];
-        int parent = t->depth ? t->open[t->depth - 1] : -1;
-        if ((c == '}' || c == ']') && (want == COMMA_OR_CLOSE || want == VALUE_OR_CLOSE || want == KEY_OR_CLOSE)) {
-            rt_json_type type = c == '}' ? RT_JSON_OBJECT : RT_JSON_ARRAY;
-            if (parent < 0 || t->tok[parent].type != (int)type) {
-                return fail(t, RT_ERR_PARSE, "invalid JSON character or structure");
-            }
-            t->tok[parent].end = (int)++t->pos;
-            if (--t->depth == 0)
+        c->pos = skip_ws(c->text, c->pos, c->len);
+        if (c->pos >= c->len || !c->text[c->pos])
+            return fail(c, RT_ERR_PARSE, "JSON ends early (unclosed object or array)");
+        char ch = c->text[c->pos];
+        char parent = c->depth ? c->open[c->depth - 1] : 0;
+        if ((ch == '}' || ch == ']') && (want == COMMA_OR_CLOSE || want == VALUE_OR_CLOSE || want == KEY_OR_CLOSE)) {
+            if (parent != (ch == '}' ? '{' : '['))
+                return fail(c, RT_ERR_PARSE, "invalid JSON character or structure");
+            c->pos++;
+            if (--c->depth == 0)
                 return 0;
             want = COMMA_OR_CLOSE;
             continue;
         }
         if (want == COMMA_OR_CLOSE) {
-            if (c != ',') {
-                return fail(t, RT_ERR_PARSE, "invalid JSON character or structure");
-            }
-            t->pos++;
-            want = t->tok[parent].type == RT_JSON_OBJECT ? KEY : VALUE;
+            if (ch != ',')
+                return fail(c, RT_ERR_PARSE, "invalid JSON character or structure");
+            c->pos++;
+            want = parent == '{' ? KEY : VALUE;
             continue;
         }
         if (want == COLON) {
-            if (c != ':') {
-                return fail(t, RT_ERR_PARSE, "invalid JSON character or structure");
-            }
-            t->pos++;
+            if (ch != ':')
+                return fail(c, RT_ERR_PARSE, "invalid JSON character or structure");
+            c->pos++;
             want = VALUE;
             continue;
         }
         if (want == KEY || want == KEY_OR_CLOSE) {
-            if (c != '"') {
-                return fail(t, RT_ERR_PARSE, "invalid JSON character or structure");
-            }
-            int k = scan_string(t);
-            if (k < 0)
-                return -1;
-            t->tok[parent].size++;
-            t->tok[k].size = 1;
+            if (ch != '"' || scan_string(c) < 0)
+                return ch != '"' ? fail(c, RT_ERR_PARSE, "invalid JSON character or structure") : -1;
             want = COLON;
             continue;
         }
-        /* a value: its container (an array, or the object whose key came last) counts it */
-        if (parent >= 0 && t->tok[parent].type == RT_JSON_ARRAY)
-            t->tok[parent].size++;
-        int v;
-        if (c == '{' || c == '[') {
-            if (t->depth >= RT_JSON_MAX_DEPTH)
-                return fail(t, RT_ERR_LIMIT, "JSON nested deeper than " RT_JSON_MAX_DEPTH_TEXT " objects and arrays");
-            if ((v = add_token(t, c == '{' ? RT_JSON_OBJECT : RT_JSON_ARRAY, t->pos, t->pos)) < 0)
-                return -1;
-            t->open[t->depth++] = v;
-            t->pos++;
-            want = c == '{' ? KEY_OR_CLOSE : VALUE_OR_CLOSE;
+        if (ch == '{' || ch == '[') {
+            if (c->depth >= RT_JSON_MAX_DEPTH)
+                return fail(c, RT_ERR_LIMIT, "JSON nested deeper than " RT_JSON_MAX_DEPTH_TEXT " objects and arrays");
+            c->open[c->depth++] = ch;
+            c->pos++;
+            want = ch == '{' ? KEY_OR_CLOSE : VALUE_OR_CLOSE;
             continue;
         }
-        if (c == '"')
-            v = scan_string(t);
-        else if (c == '-' || (c >= '0' && c <= '9') || c == 't' || c == 'f' || c == 'n')
-            v = scan_primitive(t);
-        else {
-            return fail(t, RT_ERR_PARSE, "invalid JSON character or structure");
-        }
-        if (v < 0)
+        int r;
+        if (ch == '"')
+            r = scan_string(c);
+        else if (ch == '-' || (ch >= '0' && ch <= '9') || ch == 't' || ch == 'f' || ch == 'n')
+            r = scan_primitive(c);
+        else
+            return fail(c, RT_ERR_PARSE, "invalid JSON character or structure");
+        if (r < 0)
             return -1;
-        if (t->depth == 0)
+        if (c->depth == 0)
             return 0;
         want = COMMA_OR_CLOSE;
     }
+}
+
+/* jsmn over text[0, end), which the check has passed: the tokens into j. */
+static rt_result tokenize(rt_json *j, const char *text, size_t end, const char *name, size_t base, rt_error *err)
+{
+    jsmn_parser p;
+    jsmn_init(&p);
+    int n = jsmn_parse(&p, text, end, NULL, 0);
+    if (n >= 0) {
+        jsmntok_t *jt = rt_alloc((size_t)n, sizeof *jt);
+        if (!jt)
+            return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for %d JSON tokens", name, n);
+        jsmn_init(&p);
+        int m = jsmn_parse(&p, text, end, jt, (unsigned)n);
+        if (m >= 0 && m != n)
+            m = JSMN_ERROR_INVAL; /* cannot happen: both passes see the same text */
+        if (m >= 0) {
+            j->tok = rt_alloc((size_t)n, sizeof *j->tok);
+            if (!j->tok) {
+                free(jt);
+                return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for %d JSON tokens", name, n);
+            }
+            for (int i = 0; i < n; i++) {
+                j->tok[i].type = (int)jt[i].type;
+                j->tok[i].start = jt[i].start;
+                j->tok[i].end = jt[i].end;
+                j->tok[i].size = jt[i].size;
+            }
+        }
+        free(jt);
+        n = m;
+    }
+    if (n < 0) { /* the check is stricter than jsmn, so this is a disagreement between the two */
+        size_t at = p.pos < end ? p.pos : end;
+        const char *why = n == JSMN_ERROR_PART ? "JSON ends early (unclosed object, array or string)"
+                                               : "invalid JSON character or structure";
+        return rt_fail(err, RT_ERR_PARSE, "%s: byte %zu: %s", name, base + at, why);
+    }
+    j->count = n;
+    if (n < 1 || j->tok[0].type != RT_JSON_OBJECT || rt_json_skip(j, 0) != n) {
+        rt_json_free(j);
+        return rt_fail(err, RT_ERR_PARSE, "%s: byte %zu: JSON must be one object", name, base);
+    }
+    return RT_OK;
 }
 
 rt_result rt_json_parse(rt_json *j, const char *text, size_t len, const char *name, size_t base, rt_error *err)
@@ -208,34 +233,32 @@ rt_result rt_json_parse(rt_json *j, const char *text, size_t len, const char *na
         return rt_fail(err, RT_ERR_PARSE, "%s: byte %zu: empty JSON", name, base + first);
     if (text[first] != '{')
         return rt_fail(err, RT_ERR_PARSE, "%s: byte %zu: JSON must start with '{'", name, base + first);
-    tokenizer *t = malloc(sizeof *t);
-    if (!t)
-        return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the JSON tokenizer", name);
-    memset(t, 0, sizeof *t);
-    t->text = text;
-    t->len = len;
-    t->pos = first;
-    if (tokenize(t) < 0) {
-        size_t at = t->pos < len ? t->pos : len;
-        rt_result r = rt_fail(err, t->code, "%s: byte %zu: %s", name, base + at, t->why);
-        free(t->tok);
-        free(t);
+    checker *c = malloc(sizeof *c);
+    if (!c)
+        return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the JSON check", name);
+    memset(c, 0, sizeof *c);
+    c->text = text;
+    c->len = len;
+    c->pos = first;
+    if (check_value(c) < 0) {
+        size_t at = c->pos < len ? c->pos : len;
+        rt_result r = rt_fail(err, c->code, "%s: byte %zu: %s", name, base + at, c->why);
+        free(c);
         return r;
     }
-    j->text = text;
-    j->len = len;
-    j->tok = t->tok;
-    j->count = (int)t->count;
-    size_t rest = skip_ws(text, t->pos, len);
-    free(t);
+    size_t end = c->pos;
+    free(c);
     /* a glTF (and a sidecar) is exactly one object; only padding may follow it */
-    for (size_t i = rest; i < len; i++) {
-        if (text[i] != '\0' && text[i] != ' ' && text[i] != '\t' && text[i] != '\n' && text[i] != '\r') {
-            rt_json_free(j);
+    for (size_t i = skip_ws(text, end, len); i < len; i++) {
+        if (text[i] != '\0' && text[i] != ' ' && text[i] != '\t' && text[i] != '\n' && text[i] != '\r')
             return rt_fail(err, RT_ERR_PARSE, "%s: byte %zu: unexpected data after the top-level JSON object",
                            name, base + i);
-        }
     }
+    rt_result r = tokenize(j, text, end, name, base, err);
+    if (r != RT_OK)
+        return r;
+    j->text = text;
+    j->len = len;
     return RT_OK;
 }
 

@@ -48,7 +48,7 @@ void rt_aov_trace(const rt_trace_ctx *ctx, rt_ray ray, rt_rng *rng, rt_aov_sampl
              * base colour by metallic (the glTF model's metal part) */
             rt_vec3 spec = (b.kind == RT_BSDF_KIND_CONDUCTOR) ? rt_fresnel_conductor(1.0f, b.eta_c, b.k_c)
                                        : rt_add(rt_scale(b.base, b.metallic), rt_v3s((1.0f - b.metallic) * b.f0));
-            if ((b.kind == RT_BSDF_KIND_LAMBERT))
+            if (b.kind == RT_BSDF_KIND_LAMBERT)
                 spec = rt_v3s(0.0f);
             out->albedo = rt_v3(clamp01(b.diffuse.x + spec.x), clamp01(b.diffuse.y + spec.y),
                                 clamp01(b.diffuse.z + spec.z));

@@ -162,8 +162,10 @@ static void fuzz_pose(const uint8_t *data, size_t size)
     snprintf(path, sizeof path, "%s/%s", temp_dir(), name);
     rt_scene s;
     rt_scene_init(&s);
+    rt_settings set;
+    rt_settings_default(&set);
     rt_error err;
-    rt_load_memory(&s, data, size, path, &opt, NULL, &err);
+    rt_load_memory(&s, &set, data, size, path, &opt, NULL, &err);
     rt_scene_free(&s);
 }
 

@@ -1,11 +1,12 @@
-/* rt/json.h - a strict JSON tokenizer and a thin token-walking layer.
+/* rt/json.h - JSON checked, tokenized and walked.
  *
- * The text is tokenized once, in time linear in its length (a stack of
- * open containers, at most RT_JSON_MAX_DEPTH deep), into a flat array of
- * tokens in document order. A token's children follow it: an object's size is its
- * number of keys, each key token has size 1 and its value right after it.
- * The walker functions never read past the token array, so a caller can walk
- * any tokenized input without further checks.
+ * The text is checked once against RFC 8259's grammar, in time linear in
+ * its length (a stack of open containers, at most RT_JSON_MAX_DEPTH deep),
+ * then tokenized by jsmn into a flat array of tokens in document order. A
+ * token's children follow it: an object's size is its number of keys, each
+ * key token has size 1 and its value right after it. The walker functions
+ * never read past the token array, so a caller can walk any tokenized input
+ * without further checks.
  *
  *   rt_json j;
  *   if (rt_json_parse(&j, text, len, "model.gltf", 0, &err) != RT_OK) ...
@@ -42,9 +43,11 @@ typedef struct rt_json {
 
 #define RT_JSON_MAX_BYTES 0x7fffff00u /* token offsets are int */
 /* Objects and arrays open at once; deeper input is RT_ERR_LIMIT. glTF
- * files and sidecars nest under 20 deep. */
-#define RT_JSON_MAX_DEPTH 256
-#define RT_JSON_MAX_DEPTH_TEXT "256"
+ * files and sidecars nest under 20 deep. The cap also bounds jsmn's walk
+ * back up its parent links at each closing bracket (json.c), so the
+ * tokens of any text cost at most a constant times its length. */
+#define RT_JSON_MAX_DEPTH 64
+#define RT_JSON_MAX_DEPTH_TEXT "64"
 
 /* Tokenizes text[0, len). Errors name `name` and the byte offset of the
  * problem plus `base` (the JSON's offset within its file, for GLB). The top
