@@ -813,7 +813,8 @@ static void test_cornell_reference(void **state)
     assert_int_equal(ref.height, 512);
     fixture f;
     rt_scene_init(&f.s);
-    if (rt_scene_parse_file(&f.s, NULL, "scenes/cornell-reference.txt", &err) != RT_OK)
+    rt_settings_default(&f.settings); /* the file's settings go here; then the size and samples below */
+    if (rt_scene_parse_file(&f.s, &f.settings, "scenes/cornell-reference.txt", &err) != RT_OK)
         fail_msg("%s", err.message);
     assert_int_equal(f.s.triangles.count, 30);
     assert_int_equal(f.s.light_count, 1);
