@@ -13,7 +13,7 @@
  *                   end flag, then the triangles it is the first to use);
  *   kdtree_trace.c  rt_kdtree_intersect and rt_kdtree_occluded over those
  *                   arrays (the AVX2 step and the portable one), compiled
- *                   twice: as itself (AVX2) and by kdtree_trace_portable.c
+ *                   twice: as itself (AVX2) and by kdtree.c
  *                   (no SIMD; the choice between them, once a tree);
  *   kdtree_packet.c rt_kdtree_intersect8 and rt_kdtree_occluded8: up to 8
  *                   coherent rays through the same arrays at once (one
@@ -106,7 +106,7 @@ typedef struct kd_ray {
  * single-ray traversal of kdtree_trace.c, the packets of kdtree_packet.c)
  * are compiled for AVX2 and FMA between KD_AVX2_BEGIN and KD_AVX2_END
  * whatever the build's flags, so a PORTABLE=1 build (the x86-64 baseline)
- * has them too; kdtree_trace_portable.c compiles kdtree_trace.c a second
+ * has them too; kdtree.c compiles kdtree_trace.c a second
  * time without SIMD. rt_kdtree_build picks one for the tree's life
  * (rt_kdtree.isa: rt_kd_isa_best, the CPU's); rt_kdtree_intersect and
  * rt_kdtree_occluded branch on it once a ray. Only these kernels are
@@ -129,7 +129,7 @@ typedef struct kd_ray {
 rt_kd_isa rt_kd_isa_best(void);
 
 /* kdtree_trace.c's entry points, once per variant (_avx2: the AVX2 pass,
- * _portable: kdtree_trace_portable.c's); kdtree.h's functions call one. */
+ * _portable: kdtree.c's); kdtree.h's functions call one. */
 bool rt_kd_intersect_avx2(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit);
 bool rt_kd_occluded_avx2(const rt_kdtree *tree, const rt_ray *ray);
 bool rt_kd_intersect_portable(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit);

@@ -37,7 +37,7 @@
  * (their cells' references are "empty"), so no step is spent on them.
  * This file is compiled twice (kdtree_internal.h, "Runtime AVX2
  * dispatch"): as itself, the AVX2 kernels (built for AVX2 and FMA whatever
- * the build's flags, names ending _avx2), and by kdtree_trace_portable.c
+ * the build's flags, names ending _avx2), and by kdtree.c
  * with KD_PORTABLE, where the same step runs as plain loops (_portable);
  * the tree says which one its rays take.
  *

@@ -1,5 +1,6 @@
-/* kdtree_trace_portable.c - the kd-tree's portable traversal, and the
- * choice between it and the AVX2 one (runtime dispatch).
+/* kdtree.c - the kd-tree's public queries (rt/accel/kdtree.h): the
+ * portable traversal, and the choice between it and the AVX2 one (runtime
+ * dispatch).
  *
  * kdtree_trace.c compiled a second time with KD_PORTABLE: the same
  * traversal with the wide step, the ray set-up and the leaf test as plain
@@ -10,7 +11,8 @@
  * kernels when they are compiled in (x86 with GCC or clang, whatever the
  * -march: a PORTABLE=1 build has them too) and the CPU has AVX2 and FMA
  * (__builtin_cpu_supports, GCC's and clang's view of CPUID). This file is
- * compiled for the build's target, so it runs on any CPU of it.
+ * compiled for the build's target, so it runs on any CPU of it. The build
+ * itself is kdtree_build.c's and kdtree_pack.c's.
  */
 #define KD_PORTABLE 1
 #include "kdtree_trace.c"
