@@ -1,0 +1,261 @@
+/* kdtree_stream_walk.c - the ray stream's walk through the kd-tree's wide
+ * nodes, KD_STREAM_LANES rays a SIMD step.
+ *
+ * Sources: Wald, Gribble, Boulos, Kensler, "SIMD ray stream tracing"
+ * (2007): a list of active rays per node, split by one plane test per ray
+ * into the near and far children's lists; Tsakok, "Faster incoherent
+ * rays: multi-BVH ray stream tracing" (HPG 2009) and Barringer and
+ * Akenine-Moller, "Dynamic ray stream traversal" (SIGGRAPH 2014): the
+ * lists as arrays of ray indices filtered node by node, depth first, with
+ * the children's lists written above the parent's on one stack-like
+ * arena, and a switch to single rays where a list thins out.
+ *
+ * For this tree's layout (rt/accel/kdtree.h: 64-byte wide nodes of three
+ * binary levels, 7 planes and 8 cells): a list entry is a ray index with
+ * the ray's t interval in the cell that listed it. At a wide node every ray
+ * of the list, KD_STREAM_LANES at a time in vector lanes, cuts its interval
+ * by the 7 planes level by level (the near side [l, min(h, hi)], the far
+ * side [max(l, lo), h], lo and hi the plane's t widened by mp |1/d|, as in
+ * kdtree_trace.c's wide step; a ray parallel to the plane's axis keeps the
+ * side(s) its origin is on, within mp), so each of the 8 cells gets the
+ * exact interval the single-ray walk gives it. A ray joins the list of
+ * every non-empty cell whose interval is non-empty and starts no later
+ * than its closest hit so far. The 8 lists are then pushed, farthest first
+ * in the order of the list's first ray (mixed directions cannot share one
+ * order; any order is exact, only culling depends on it), so the nearest
+ * is walked next. A leaf's list: each ray whose interval still starts
+ * before its closest hit runs the single-ray leaf test (kdtree_trace.c's,
+ * the watertight test: exact). A node reached by fewer than min_rays rays:
+ * each walks on alone from it (kdtree_trace.c's walk, from that node).
+ * The arena: a node's 8 lists are written above the end of its own list,
+ * the nearest (walked first) highest, each with room for the whole list;
+ * popping a list frees everything above its end.
+ *
+ * The answers: every primitive a ray tests is tested with the single-ray
+ * test on (tmin, closest so far), and the cells are culled only where the
+ * single-ray walk would cull them, so a ray finds the same closest t,
+ * primitive and barycentrics (on an exact tie, possibly the other
+ * primitive). Every width runs the same operations per lane on the same
+ * lists in the same order (lanes do not interact), so the widths agree bit
+ * for bit, tie-breaks included.
+ *
+ * Compiled once per width, from GCC/clang vector types (no intrinsics): as
+ * itself, 16 lanes for AVX-512 (F, BW, DQ, VL, by a target pragma whatever
+ * the build's flags; x86 with GCC or clang only), by kdtree_stream_walk8.c
+ * (8 lanes, AVX2) and kdtree_stream_walk4.c (4 lanes, the build's target).
+ * kdtree_stream.c calls only the widths the CPU has.
+ */
+#include "kdtree_stream_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+#if !defined(KD_STREAM_LANES) && defined(KD_HAVE_AVX2)
+#define KD_STREAM_LANES 16
+#define KD_STREAM_WALK rt_kd_stream_walk16
+#if defined(__clang__)
+#define KD_STREAM_BEGIN _Pragma("clang attribute push (__attribute__((target(\"avx512f,avx512bw,avx512dq,avx512vl\"))), apply_to = function)")
+#define KD_STREAM_END _Pragma("clang attribute pop")
+#else
+#define KD_STREAM_BEGIN _Pragma("GCC push_options") _Pragma("GCC target(\"avx512f,avx512bw,avx512dq,avx512vl\")")
+#define KD_STREAM_END _Pragma("GCC pop_options")
+#endif
+#endif
+
+#ifdef KD_STREAM_LANES
+KD_STREAM_BEGIN
+
+#define L KD_STREAM_LANES
+typedef float kd_vf __attribute__((vector_size(4 * KD_STREAM_LANES)));
+typedef int32_t kd_vi __attribute__((vector_size(4 * KD_STREAM_LANES)));
+
+#if defined(__GNUC__)
+#define KD_SINLINE static inline __attribute__((always_inline))
+#else
+#define KD_SINLINE static inline
+#endif
+
+/* m ? a : b per lane (m: 0 or -1) */
+KD_SINLINE kd_vf sel(kd_vi m, kd_vf a, kd_vf b)
+{
+    return (kd_vf)(((kd_vi)a & m) | ((kd_vi)b & ~m));
+}
+KD_SINLINE kd_vf vmin(kd_vf a, kd_vf b) { return sel(b < a, b, a); }
+KD_SINLINE kd_vf vmax(kd_vf a, kd_vf b) { return sel(b > a, b, a); }
+KD_SINLINE kd_vf splat(float x)
+{
+    kd_vf v;
+    for (int i = 0; i < L; i++)
+        v[i] = x;
+    return v;
+}
+
+/* One plane: the interval [l, h] cut into the below side's [bl, bh] and
+ * the above side's [al, ah]; ng: the ray runs towards -axis (the above side
+ * comes first). */
+KD_SINLINE void cut(kd_vf l, kd_vf h, kd_vf lo, kd_vf hi, kd_vi ng, kd_vf *bl, kd_vf *bh, kd_vf *al, kd_vf *ah)
+{
+    kd_vf nh = vmin(h, hi), fl = vmax(l, lo);
+    *bl = sel(ng, fl, l);
+    *bh = sel(ng, h, nh);
+    *al = sel(ng, l, fl);
+    *ah = sel(ng, nh, h);
+}
+
+typedef struct kd_entry {
+    uint32_t ref, count;
+    size_t begin;
+} kd_entry;
+#define KD_STREAM_STACK (8 * ((KD_MAX_DEPTH + 2) / 3 + 2))
+
+/* The rays of list [b, b + n) through wide node w: each joins the lists of
+ * the cells it crosses, written from `top` up; pushes them on the stack. */
+KD_SINLINE bool step(kd_stream *s, const rt_kdtree_wide *w, size_t b, size_t n, kd_entry *stack, int *sp)
+{
+    size_t top = b + n;
+    if (!rt_kd_stream_reserve(s, top + 8 * n))
+        return false;
+    uint32_t *lid = s->lid;
+    float *llo = s->llo, *lhi = s->lhi;
+    const float *best = s->best;
+    /* the cells' order for the list's first ray (keys as in kdtree_trace.c's
+     * wide step: bit 2 = the far side of plane 0, ...) */
+    uint32_t rep = lid[b];
+    unsigned axis[7], used = 0, ngb[7];
+    for (int p = 0; p < 7; p++) {
+        axis[p] = (w->axes >> (2 * p)) & 3u;
+        used |= 1u << axis[p];
+        ngb[p] = s->inv[axis[p]][rep] < 0.0f;
+    }
+    unsigned cell_of_key[8];
+    size_t out[8];
+    uint32_t cnt[8];
+    for (unsigned key = 0; key < 8; key++) {
+        unsigned b0 = (key >> 2 & 1u) ^ ngb[0], p1 = 1 + b0, b1 = (key >> 1 & 1u) ^ ngb[p1], p2 = 3 + 2 * b0 + b1,
+                 b2 = (key & 1u) ^ ngb[p2];
+        unsigned c = 4 * b0 + 2 * b1 + b2;
+        cell_of_key[key] = c;
+        out[c] = top + (size_t)(7 - key) * n;
+        cnt[c] = 0;
+    }
+    int nonempty = 0;
+    for (int c = 0; c < 8; c++)
+        if (w->child[c] != RT_KD_EMPTY)
+            nonempty |= 1 << c;
+    kd_vf split[7];
+    for (int p = 0; p < 7; p++)
+        split[p] = splat(w->split[p]);
+    const kd_vf pinf = splat(INFINITY), ninf = splat(-INFINITY);
+    for (size_t j = 0; j < n; j += L) {
+        size_t m = n - j < (size_t)L ? n - j : (size_t)L;
+        kd_vi id;
+        kd_vf l, h, bv;
+        for (int i = 0; i < L; i++) { /* idle lanes repeat the first ray */
+            size_t e = b + j + ((size_t)i < m ? (size_t)i : 0);
+            id[i] = (int32_t)lid[e];
+            l[i] = llo[e];
+            h[i] = lhi[e];
+        }
+        for (int i = 0; i < L; i++)
+            bv[i] = best[id[i]];
+        h = sel(bv < h, bv, h);
+        kd_vf o[3], inv[3], ma[3], mp = splat(0.0f);
+        kd_vi par[3];
+        for (int k = 0; k < 3; k++) {
+            if (!(used >> k & 1u))
+                continue;
+            const float *ok = s->o[k], *ik = s->inv[k], *mk = s->ma[k];
+            for (int i = 0; i < L; i++) {
+                o[k][i] = ok[id[i]];
+                inv[k][i] = ik[id[i]];
+                ma[k][i] = mk[id[i]];
+            }
+            if (s->any_par)
+                for (int i = 0; i < L; i++)
+                    par[k][i] = s->par[k][id[i]];
+        }
+        if (s->any_par)
+            for (int i = 0; i < L; i++)
+                mp[i] = s->mp[id[i]];
+        kd_vf lo[7], hi[7];
+        kd_vi ng[7];
+        for (int p = 0; p < 7; p++) {
+            unsigned k = axis[p];
+            kd_vf t = (split[p] - o[k]) * inv[k];
+            lo[p] = t - ma[k];
+            hi[p] = t + ma[k];
+            ng[p] = inv[k] < 0.0f;
+            if (s->any_par) {
+                kd_vf dist = o[k] - split[p];
+                lo[p] = sel(par[k], sel(dist >= -mp, ninf, pinf), lo[p]);
+                hi[p] = sel(par[k], sel(dist <= mp, pinf, ninf), hi[p]);
+                ng[p] &= ~par[k];
+            }
+        }
+        /* level by level: cell c = 4 b0 + 2 b1 + b2 */
+        kd_vf l1[2], h1[2], l2[4], h2[4], lc[8], hc[8];
+        cut(l, h, lo[0], hi[0], ng[0], &l1[0], &h1[0], &l1[1], &h1[1]);
+        for (int b0 = 0; b0 < 2; b0++)
+            cut(l1[b0], h1[b0], lo[1 + b0], hi[1 + b0], ng[1 + b0], &l2[2 * b0], &h2[2 * b0], &l2[2 * b0 + 1],
+                &h2[2 * b0 + 1]);
+        for (int q = 0; q < 4; q++)
+            cut(l2[q], h2[q], lo[3 + q], hi[3 + q], ng[3 + q], &lc[2 * q], &hc[2 * q], &lc[2 * q + 1], &hc[2 * q + 1]);
+        kd_vi bits = (kd_vi)splat(0.0f);
+        for (int c = 0; c < 8; c++)
+            if (nonempty >> c & 1)
+                bits |= (lc[c] <= hc[c]) & (lc[c] <= bv) & (1 << c);
+        for (size_t i = 0; i < m; i++) {
+            unsigned bm = (unsigned)bits[i];
+            while (bm) {
+                unsigned c = (unsigned)__builtin_ctz(bm);
+                bm &= bm - 1u;
+                size_t pos = out[c] + cnt[c]++;
+                lid[pos] = (uint32_t)id[i];
+                llo[pos] = lc[c][i];
+                lhi[pos] = hc[c][i];
+            }
+        }
+    }
+    for (unsigned key = 8; key-- > 0;) { /* farthest first: the nearest on top */
+        unsigned c = cell_of_key[key];
+        if (cnt[c])
+            stack[(*sp)++] = (kd_entry){w->child[c], cnt[c], out[c]};
+    }
+    return true;
+}
+
+bool KD_STREAM_WALK(kd_stream *s, size_t count)
+{
+    const rt_kdtree *tree = s->tree;
+    if (count == 0 || tree->root == RT_KD_EMPTY)
+        return true;
+    kd_entry stack[KD_STREAM_STACK];
+    int sp = 0;
+    stack[sp++] = (kd_entry){tree->root, (uint32_t)count, 0};
+    while (sp > 0) {
+        kd_entry e = stack[--sp];
+        if (e.ref >= RT_KD_LEAF) {
+            for (size_t k = e.begin; k < e.begin + e.count; k++) {
+                uint32_t i = s->lid[k];
+                if (s->llo[k] <= s->best[i])
+                    rt_kd_stream_leaf(s, e.ref, i);
+            }
+        } else if (e.count < (uint32_t)s->min_rays) {
+            for (size_t k = e.begin; k < e.begin + e.count; k++) {
+                uint32_t i = s->lid[k];
+                float b = s->best[i], l = s->llo[k], h = s->lhi[k];
+                if (l <= b)
+                    rt_kd_stream_single(s, e.ref, i, l, h < b ? h : b);
+            }
+        } else if (!step(s, &tree->wide[e.ref], e.begin, e.count, stack, &sp)) {
+            return false;
+        }
+    }
+    return true;
+}
+
+#undef L
+KD_STREAM_END
+#else
+typedef int kd_stream_walk_no_avx512; /* (ISO C wants something in a file) */
+#endif
