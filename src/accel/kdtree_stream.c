@@ -116,59 +116,6 @@ void rt_kd_stream_single(kd_stream *s, uint32_t ref, uint32_t i, float tn, float
         record(s, i, &h);
 }
 
-/* kdtree_trace.c's ray set-up (its portable form; the AVX2 form computes
- * the same): false for a ray that can hit nothing; else the ray's data at
- * index i and its t interval in the tree's (widened) box. */
-static bool setup_ray(kd_stream *s, uint32_t i, const rt_ray *ray, float *tn_out, float *tf_out)
-{
-    const rt_kdtree *tree = s->tree;
-    if (tree->root == RT_KD_EMPTY || !(ray->tmin < ray->tmax) || rt_box_is_empty(tree->bounds))
-        return false;
-    if (!rt_finite3(ray->org) || !rt_finite3(ray->dir))
-        return false;
-    if (ray->dir.x == 0.0f && ray->dir.y == 0.0f && ray->dir.z == 0.0f)
-        return false;
-    float omax = fmaxf(fabsf(ray->org.x), fmaxf(fabsf(ray->org.y), fabsf(ray->org.z)));
-    float mp = (tree->scale + omax) * 0x1p-18f;
-    const float o[3] = {ray->org.x, ray->org.y, ray->org.z}, d[3] = {ray->dir.x, ray->dir.y, ray->dir.z};
-    const float *lo = &tree->bounds.lo.x, *hi = &tree->bounds.hi.x;
-    float tn = ray->tmin, tf = ray->tmax;
-    for (int k = 0; k < 3; k++) {
-        float inv = 1.0f / d[k], ma = mp * fabsf(inv);
-        s->o[k][i] = o[k];
-        if (!(ma < INFINITY)) {
-            if (o[k] < lo[k] - mp || o[k] > hi[k] + mp)
-                return false;
-            s->inv[k][i] = 0.0f, s->ma[k][i] = 0.0f, s->par[k][i] = -1;
-            s->any_par = true;
-            continue;
-        }
-        s->inv[k][i] = inv, s->ma[k][i] = ma, s->par[k][i] = 0;
-        float t0 = (lo[k] - o[k]) * inv, t1 = (hi[k] - o[k]) * inv;
-        if (t0 > t1) {
-            float t = t0;
-            t0 = t1;
-            t1 = t;
-        }
-        t0 -= ma;
-        t1 += ma;
-        if (t0 > tn)
-            tn = t0;
-        if (t1 < tf)
-            tf = t1;
-    }
-    if (!(tn <= tf))
-        return false;
-    s->mp[i] = mp;
-    s->best[i] = ray->tmax;
-    s->ray[i] = *ray;
-    rt_tri_ray_init(&s->tr[i], ray->org, ray->dir);
-    s->hit[i].prim = RT_NONE;
-    *tn_out = tn;
-    *tf_out = tf;
-    return true;
-}
-
 /* The per-ray arrays of a chunk of up to `chunk` rays, in one block. */
 typedef struct stream_mem {
     void *block;
@@ -227,7 +174,21 @@ static bool walk(kd_stream *s, size_t count, int lanes)
     }
 }
 
-static rt_ray ray_at(const rt_ray_batch *rb, size_t i)
+static size_t setup(kd_stream *s, const rt_ray_batch *rb, size_t g0, size_t m, int lanes)
+{
+    switch (lanes) {
+#ifdef KD_HAVE_AVX2
+    case 16:
+        return rt_kd_stream_setup16(s, rb, g0, m);
+    case 8:
+        return rt_kd_stream_setup8(s, rb, g0, m);
+#endif
+    default:
+        return rt_kd_stream_setup4(s, rb, g0, m);
+    }
+}
+
+static inline rt_ray ray_at(const rt_ray_batch *rb, size_t i)
 {
     return rt_ray_make(rt_v3(rb->ox[i], rb->oy[i], rb->oz[i]), rt_v3(rb->dx[i], rb->dy[i], rb->dz[i]), rb->tmin[i],
                        rb->tmax[i]);
@@ -256,19 +217,8 @@ static size_t trace_stream(const rt_kdtree *tree, const rt_ray_batch *rays, size
         size_t m = n - c0 < chunk ? n - c0 : chunk;
         bool done = false;
         if (ok) {
-            size_t count = 0;
             s.any_par = false;
-            for (size_t i = 0; i < m; i++) {
-                rt_ray r = ray_at(rays, c0 + i);
-                float tn, tf;
-                s.hit[i].prim = RT_NONE;
-                if (setup_ray(&s, (uint32_t)i, &r, &tn, &tf)) {
-                    s.lid[count] = (uint32_t)i;
-                    s.llo[count] = tn;
-                    s.lhi[count] = tf;
-                    count++;
-                }
-            }
+            size_t count = setup(&s, rays, c0, m, lanes);
             done = walk(&s, count, lanes);
         }
         for (size_t i = 0; i < m; i++) {

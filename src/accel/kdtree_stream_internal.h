@@ -18,6 +18,7 @@
 #include <stdint.h>
 
 #include "kdtree_internal.h"
+#include "rt/accel/kdtree_batch.h"
 
 /* One chunk of rays as the walk reads it; index i is the ray's place in
  * the chunk. Per axis k: origin, 1/direction (0 on a parallel axis), the
@@ -57,5 +58,11 @@ void rt_kd_stream_single(kd_stream *s, uint32_t ref, uint32_t i, float tn, float
 bool rt_kd_stream_walk16(kd_stream *s, size_t count);
 bool rt_kd_stream_walk8(kd_stream *s, size_t count);
 bool rt_kd_stream_walk4(kd_stream *s, size_t count);
+/* The set-up of rays g0 .. g0 + m of rb into the chunk's arrays and the
+ * root list (the arena's first entries); returns how many can hit
+ * something (the others: hit[i].prim RT_NONE). s->any_par is or-ed. */
+size_t rt_kd_stream_setup16(kd_stream *s, const rt_ray_batch *rb, size_t g0, size_t m);
+size_t rt_kd_stream_setup8(kd_stream *s, const rt_ray_batch *rb, size_t g0, size_t m);
+size_t rt_kd_stream_setup4(kd_stream *s, const rt_ray_batch *rb, size_t g0, size_t m);
 
 #endif

@@ -49,10 +49,14 @@
 
 #include <math.h>
 #include <string.h>
+#if defined(KD_HAVE_AVX2)
+#include <immintrin.h>
+#endif
 
 #if !defined(KD_STREAM_LANES) && defined(KD_HAVE_AVX2)
 #define KD_STREAM_LANES 16
 #define KD_STREAM_WALK rt_kd_stream_walk16
+#define KD_STREAM_SETUP rt_kd_stream_setup16
 #if defined(__clang__)
 #define KD_STREAM_BEGIN _Pragma("clang attribute push (__attribute__((target(\"avx512f,avx512bw,avx512dq,avx512vl\"))), apply_to = function)")
 #define KD_STREAM_END _Pragma("clang attribute pop")
@@ -82,6 +86,37 @@ KD_SINLINE kd_vf sel(kd_vi m, kd_vf a, kd_vf b)
 }
 KD_SINLINE kd_vf vmin(kd_vf a, kd_vf b) { return sel(b < a, b, a); }
 KD_SINLINE kd_vf vmax(kd_vf a, kd_vf b) { return sel(b > a, b, a); }
+/* Lanes i of base[id[i]]: one gather instruction where the width has one
+ * (the only intrinsics here), else a loop; the same values either way. */
+#if KD_STREAM_LANES == 16
+KD_SINLINE kd_vf gatherf(const void *base, kd_vi id) { return (kd_vf)_mm512_i32gather_ps((__m512i)id, base, 4); }
+KD_SINLINE kd_vi gatheri(const void *base, kd_vi id) { return (kd_vi)_mm512_i32gather_epi32((__m512i)id, base, 4); }
+#elif KD_STREAM_LANES == 8
+KD_SINLINE kd_vf gatherf(const void *base, kd_vi id)
+{
+    return (kd_vf)_mm256_i32gather_ps((const float *)base, (__m256i)id, 4);
+}
+KD_SINLINE kd_vi gatheri(const void *base, kd_vi id)
+{
+    return (kd_vi)_mm256_i32gather_epi32((const int *)base, (__m256i)id, 4);
+}
+#else
+KD_SINLINE kd_vf gatherf(const void *base, kd_vi id)
+{
+    kd_vf v;
+    for (int i = 0; i < L; i++)
+        v[i] = ((const float *)base)[id[i]];
+    return v;
+}
+KD_SINLINE kd_vi gatheri(const void *base, kd_vi id)
+{
+    kd_vi v;
+    for (int i = 0; i < L; i++)
+        v[i] = ((const int32_t *)base)[id[i]];
+    return v;
+}
+#endif
+
 KD_SINLINE kd_vf splat(float x)
 {
     kd_vf v;
@@ -150,33 +185,33 @@ KD_SINLINE bool step(kd_stream *s, const rt_kdtree_wide *w, size_t b, size_t n, 
         size_t m = n - j < (size_t)L ? n - j : (size_t)L;
         kd_vi id;
         kd_vf l, h, bv;
-        for (int i = 0; i < L; i++) { /* idle lanes repeat the first ray */
-            size_t e = b + j + ((size_t)i < m ? (size_t)i : 0);
-            id[i] = (int32_t)lid[e];
-            l[i] = llo[e];
-            h[i] = lhi[e];
+        if (m == (size_t)L) { /* vector loads (lane by lane stores, then a vector load, stall) */
+            memcpy(&id, lid + b + j, sizeof id);
+            memcpy(&l, llo + b + j, sizeof l);
+            memcpy(&h, lhi + b + j, sizeof h);
+        } else {
+            for (int i = 0; i < L; i++) { /* idle lanes repeat the first ray */
+                size_t e = b + j + ((size_t)i < m ? (size_t)i : 0);
+                id[i] = (int32_t)lid[e];
+                l[i] = llo[e];
+                h[i] = lhi[e];
+            }
         }
-        for (int i = 0; i < L; i++)
-            bv[i] = best[id[i]];
+        bv = gatherf(best, id);
         h = sel(bv < h, bv, h);
         kd_vf o[3], inv[3], ma[3], mp = splat(0.0f);
         kd_vi par[3];
         for (int k = 0; k < 3; k++) {
             if (!(used >> k & 1u))
                 continue;
-            const float *ok = s->o[k], *ik = s->inv[k], *mk = s->ma[k];
-            for (int i = 0; i < L; i++) {
-                o[k][i] = ok[id[i]];
-                inv[k][i] = ik[id[i]];
-                ma[k][i] = mk[id[i]];
-            }
+            o[k] = gatherf(s->o[k], id);
+            inv[k] = gatherf(s->inv[k], id);
+            ma[k] = gatherf(s->ma[k], id);
             if (s->any_par)
-                for (int i = 0; i < L; i++)
-                    par[k][i] = s->par[k][id[i]];
+                par[k] = gatheri(s->par[k], id);
         }
         if (s->any_par)
-            for (int i = 0; i < L; i++)
-                mp[i] = s->mp[id[i]];
+            mp = gatherf(s->mp, id);
         kd_vf lo[7], hi[7];
         kd_vi ng[7];
         for (int p = 0; p < 7; p++) {
@@ -252,6 +287,93 @@ bool KD_STREAM_WALK(kd_stream *s, size_t count)
         }
     }
     return true;
+}
+
+/* The chunk's rays g0 .. g0 + m of the arrays, set up KD_STREAM_LANES at a
+ * time: kdtree_trace.c's ray_setup (its acceptance tests, cell widening
+ * mp, 1/d, parallel axes, the t interval in the tree's widened box: the
+ * same IEEE operations lane by lane), the per-ray arrays at index i - g0
+ * and the root list of the accepted rays; returns its length. */
+size_t KD_STREAM_SETUP(kd_stream *s, const rt_ray_batch *rb, size_t g0, size_t m)
+{
+    const rt_kdtree *tree = s->tree;
+    for (size_t i = 0; i < m; i++)
+        s->hit[i].prim = RT_NONE;
+    if (tree->root == RT_KD_EMPTY || rt_box_is_empty(tree->bounds))
+        return 0;
+    const float *blo = &tree->bounds.lo.x, *bhi = &tree->bounds.hi.x;
+    const float *src[8] = {rb->ox, rb->oy, rb->oz, rb->dx, rb->dy, rb->dz, rb->tmin, rb->tmax};
+    const kd_vi absmask = (kd_vi)splat(0.0f) | 0x7fffffff;
+    const kd_vf pinf = splat(INFINITY), zero = splat(0.0f);
+    size_t count = 0;
+    for (size_t j = 0; j < m; j += L) {
+        size_t n = m - j < (size_t)L ? m - j : (size_t)L;
+        kd_vf v[8];
+        for (int c = 0; c < 8; c++) {
+            if (n == (size_t)L)
+                memcpy(&v[c], src[c] + g0 + j, sizeof v[c]);
+            else
+                for (int i = 0; i < L; i++)
+                    v[c][i] = src[c][g0 + j + ((size_t)i < n ? (size_t)i : 0)];
+        }
+        kd_vf *o = v, *d = v + 3, tn = v[6], tf = v[7];
+        kd_vi ok = tn < tf;
+        kd_vf ao[3];
+        for (int k = 0; k < 3; k++) {
+            ao[k] = (kd_vf)((kd_vi)o[k] & absmask);
+            ok &= (ao[k] < pinf) & ((kd_vf)((kd_vi)d[k] & absmask) < pinf);
+        }
+        ok &= ~((d[0] == zero) & (d[1] == zero) & (d[2] == zero));
+        kd_vf omax = vmax(ao[0], vmax(ao[1], ao[2]));
+        kd_vf mp = (splat(tree->scale) + omax) * 0x1p-18f;
+        kd_vf inv[3], ma[3];
+        kd_vi par[3], anypar = ok & 0;
+        for (int k = 0; k < 3; k++) {
+            kd_vf iv = splat(1.0f) / d[k];
+            kd_vf mk = mp * (kd_vf)((kd_vi)iv & absmask);
+            kd_vi pk = ~(mk < pinf);
+            ok &= ~(pk & ((o[k] < splat(blo[k]) - mp) | (o[k] > splat(bhi[k]) + mp)));
+            kd_vf t0 = (splat(blo[k]) - o[k]) * iv, t1 = (splat(bhi[k]) - o[k]) * iv;
+            kd_vi sw = t0 > t1;
+            kd_vf a = sel(sw, t1, t0) - mk, b = sel(sw, t0, t1) + mk;
+            tn = sel(~pk & (a > tn), a, tn);
+            tf = sel(~pk & (b < tf), b, tf);
+            inv[k] = sel(pk, zero, iv);
+            ma[k] = sel(pk, zero, mk);
+            par[k] = pk;
+            anypar |= pk;
+        }
+        ok &= tn <= tf;
+        /* whole vectors where the group is full (pointers in locals: the
+         * stores could alias s's fields otherwise) */
+        kd_vf *fv[11] = {&o[0], &o[1], &o[2], &inv[0], &inv[1], &inv[2], &ma[0], &ma[1], &ma[2], &mp, &v[7]};
+        float *fd[11] = {s->o[0], s->o[1], s->o[2], s->inv[0], s->inv[1], s->inv[2], s->ma[0], s->ma[1], s->ma[2],
+                         s->mp, s->best};
+        for (int c = 0; c < 11; c++)
+            memcpy(fd[c] + j, fv[c], n * sizeof(float));
+        for (int k = 0; k < 3; k++)
+            memcpy(s->par[k] + j, &par[k], n * sizeof(int32_t));
+        int any = 0;
+        rt_ray *rays = s->ray;
+        rt_tri_ray *trs = s->tr;
+        uint32_t *lid = s->lid;
+        float *llo = s->llo, *lhi = s->lhi;
+        for (size_t i = 0; i < n; i++) {
+            if (!ok[i])
+                continue;
+            size_t r = j + i;
+            rt_ray ray = {{o[0][i], o[1][i], o[2][i]}, {d[0][i], d[1][i], d[2][i]}, v[6][i], v[7][i]};
+            rays[r] = ray;
+            rt_tri_ray_init(&trs[r], ray.org, ray.dir);
+            any |= anypar[i];
+            lid[count] = (uint32_t)r;
+            llo[count] = tn[i];
+            lhi[count] = tf[i];
+            count++;
+        }
+        s->any_par |= any != 0;
+    }
+    return count;
 }
 
 #undef L

@@ -4,6 +4,7 @@
  */
 #define KD_STREAM_LANES 4
 #define KD_STREAM_WALK rt_kd_stream_walk4
+#define KD_STREAM_SETUP rt_kd_stream_setup4
 #define KD_STREAM_BEGIN
 #define KD_STREAM_END
 #include "kdtree_stream_walk.c"

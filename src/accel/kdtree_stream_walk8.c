@@ -8,6 +8,7 @@
 #ifdef KD_HAVE_AVX2
 #define KD_STREAM_LANES 8
 #define KD_STREAM_WALK rt_kd_stream_walk8
+#define KD_STREAM_SETUP rt_kd_stream_setup8
 #if defined(__clang__)
 #define KD_STREAM_BEGIN _Pragma("clang attribute push (__attribute__((target(\"avx2\"))), apply_to = function)")
 #define KD_STREAM_END _Pragma("clang attribute pop")
