@@ -28,8 +28,9 @@
  * the watertight test: exact). A node reached by fewer than min_rays rays:
  * each walks on alone from it (kdtree_trace.c's walk, from that node).
  * The arena: a node's 8 lists are written above the end of its own list,
- * the nearest (walked first) highest, each with room for the whole list;
- * popping a list frees everything above its end.
+ * the nearest (walked first) highest, each with room for the whole list
+ * (and one vector more: AVX-512 compresses a cell's lanes and stores the
+ * whole vector); popping a list frees everything above its end.
  *
  * The answers: every primitive a ray tests is tested with the single-ray
  * test on (tmin, closest so far), and the cells are culled only where the
@@ -148,7 +149,8 @@ typedef struct kd_entry {
 KD_SINLINE bool step(kd_stream *s, const rt_kdtree_wide *w, size_t b, size_t n, kd_entry *stack, int *sp)
 {
     size_t top = b + n;
-    if (!rt_kd_stream_reserve(s, top + 8 * n))
+    size_t room = n + L; /* a list's room: n, and a vector's overrun */
+    if (!rt_kd_stream_reserve(s, top + 8 * room))
         return false;
     uint32_t *lid = s->lid;
     float *llo = s->llo, *lhi = s->lhi;
@@ -170,7 +172,7 @@ KD_SINLINE bool step(kd_stream *s, const rt_kdtree_wide *w, size_t b, size_t n, 
                  b2 = (key & 1u) ^ ngb[p2];
         unsigned c = 4 * b0 + 2 * b1 + b2;
         cell_of_key[key] = c;
-        out[c] = top + (size_t)(7 - key) * n;
+        out[c] = top + (size_t)(7 - key) * room;
         cnt[c] = 0;
     }
     int nonempty = 0;
@@ -235,6 +237,23 @@ KD_SINLINE bool step(kd_stream *s, const rt_kdtree_wide *w, size_t b, size_t n, 
                 &h2[2 * b0 + 1]);
         for (int q = 0; q < 4; q++)
             cut(l2[q], h2[q], lo[3 + q], hi[3 + q], ng[3 + q], &lc[2 * q], &hc[2 * q], &lc[2 * q + 1], &hc[2 * q + 1]);
+#if KD_STREAM_LANES == 16
+        /* AVX-512: each cell's rays compressed into place, in lane order
+         * (what the loop below does, one cell at a time) */
+        __mmask16 live = (__mmask16)(m == 16 ? 0xffffu : (1u << m) - 1u);
+        for (int c = 0; c < 8; c++) {
+            if (!(nonempty >> c & 1))
+                continue;
+            __mmask16 k = _mm512_movepi32_mask((__m512i)((lc[c] <= hc[c]) & (lc[c] <= bv))) & live;
+            if (!k)
+                continue;
+            size_t pos = out[c] + cnt[c];
+            _mm512_storeu_si512(lid + pos, _mm512_maskz_compress_epi32(k, (__m512i)id));
+            _mm512_storeu_ps(llo + pos, _mm512_maskz_compress_ps(k, (__m512)lc[c]));
+            _mm512_storeu_ps(lhi + pos, _mm512_maskz_compress_ps(k, (__m512)hc[c]));
+            cnt[c] += (uint32_t)__builtin_popcount(k);
+        }
+#else
         kd_vi bits = (kd_vi)splat(0.0f);
         for (int c = 0; c < 8; c++)
             if (nonempty >> c & 1)
@@ -250,6 +269,7 @@ KD_SINLINE bool step(kd_stream *s, const rt_kdtree_wide *w, size_t b, size_t n, 
                 lhi[pos] = hc[c][i];
             }
         }
+#endif
     }
     for (unsigned key = 8; key-- > 0;) { /* farthest first: the nearest on top */
         unsigned c = cell_of_key[key];
