@@ -1,20 +1,20 @@
 /* kdtree_stream.c - closest and any hit for streams of rays
- * (rt/accel/kdtree_stream.h): the set-up of each chunk of rays, the leaf
- * tests and the ray-by-ray walk the stream walk calls, and the choice of
- * SIMD width.
+ * (rt/accel/kdtree_stream.h): the chunks, their memory, the leaf tests and
+ * the ray-by-ray walk the stream walk calls, and the choice of SIMD width.
  *
  * A stream is walked params->chunk rays at a time (a chunk's per-ray data,
- * about 200 bytes a ray, stays in the cache while its lists are split).
- * Each ray is set up as kdtree_trace.c's ray_setup does (the same
- * acceptance tests, cell widening mp, 1/d, parallel axes and t interval in
- * the tree's box), then the chunk's list of accepted rays goes through
- * kdtree_stream_walk.c at the widest width the CPU has (16 lanes with
- * AVX-512, 8 with AVX2, else 4: __builtin_cpu_supports, once a call; a
- * tree built with params.portable takes 4), whose leaves and thin lists
- * come back here: a leaf is tested for one ray with kdtree_trace.c's leaf
- * test, a thin list's rays walk on alone with kdtree_trace.c's walk from
- * that node (both of the pass the tree uses: AVX2 or portable). When the
- * chunk's memory cannot be had, its rays are traced one by one instead.
+ * about 150 bytes a ray, stays in the cache while its lists are split).
+ * kdtree_stream_walk.c sets each chunk's rays up in lanes as
+ * kdtree_trace.c's ray_setup does (the same acceptance tests, cell
+ * widening mp, 1/d, parallel axes and t interval in the tree's box) and
+ * walks the list of accepted rays, at the widest width the CPU has (16
+ * lanes with AVX-512, 8 with AVX2, else 4: __builtin_cpu_supports, once a
+ * call, a switch, no table of function pointers; a tree built with
+ * params.portable takes 4). Its leaves and thin lists come back here: a
+ * leaf is tested for one ray with kdtree_trace.c's leaf test, a thin
+ * list's rays walk on alone with kdtree_trace.c's walk from that node
+ * (both of the pass the tree uses: AVX2 or portable). When the chunk's
+ * memory cannot be had, its rays are traced one by one instead.
  */
 #include "rt/accel/kdtree_stream.h"
 

@@ -295,7 +295,7 @@ bool KD_STREAM_WALK(kd_stream *s, size_t count)
                 if (s->llo[k] <= s->best[i])
                     rt_kd_stream_leaf(s, e.ref, i);
             }
-        } else if (e.count < (uint32_t)s->min_rays) {
+        } else if (e.count < (uint32_t)s->min_rays || sp + 8 > KD_STREAM_STACK) { /* (the stack: never, by depth) */
             for (size_t k = e.begin; k < e.begin + e.count; k++) {
                 uint32_t i = s->lid[k];
                 float b = s->best[i], l = s->llo[k], h = s->lhi[k];

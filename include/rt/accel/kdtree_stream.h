@@ -37,7 +37,7 @@ typedef struct rt_kd_stream_params {
     int min_rays; /* a cell reached by fewer rays than this is walked ray by ray (default RT_KD_STREAM_MIN_RAYS) */
     int chunk;    /* rays walked together (default RT_KD_STREAM_CHUNK) */
 } rt_kd_stream_params;
-#define RT_KD_STREAM_MIN_RAYS 8
+#define RT_KD_STREAM_MIN_RAYS 2
 #define RT_KD_STREAM_CHUNK 4096
 
 /* The widest walk this CPU can run on this tree: 16 with AVX-512 (F, BW,
