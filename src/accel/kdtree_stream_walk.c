@@ -144,49 +144,150 @@ typedef struct kd_entry {
 } kd_entry;
 #define KD_STREAM_STACK (8 * ((KD_MAX_DEPTH + 2) / 3 + 2))
 
-/* The rays of list [b, b + n) through wide node w: each joins the lists of
- * the cells it crosses, written from `top` up; pushes them on the stack. */
-KD_SINLINE bool step(kd_stream *s, const rt_kdtree_wide *w, size_t b, size_t n, kd_entry *stack, int *sp)
-{
-    size_t top = b + n;
-    size_t room = n + L; /* a list's room: n, and a vector's overrun */
-    if (!rt_kd_stream_reserve(s, top + 8 * room))
-        return false;
-    uint32_t *lid = s->lid;
-    float *llo = s->llo, *lhi = s->lhi;
-    const float *best = s->best;
-    /* the cells' order for the list's first ray (keys as in kdtree_trace.c's
-     * wide step: bit 2 = the far side of plane 0, ...) */
-    uint32_t rep = lid[b];
-    unsigned axis[7], used = 0, ngb[7];
-    for (int p = 0; p < 7; p++) {
-        axis[p] = (w->axes >> (2 * p)) & 3u;
-        used |= 1u << axis[p];
-        ngb[p] = s->inv[axis[p]][rep] < 0.0f;
-    }
+/* A node's 8 output lists: where each starts, how many rays it has, the
+ * order they are pushed in, and what the lane steps need of the node. */
+typedef struct kd_lists {
     unsigned cell_of_key[8];
     size_t out[8];
     uint32_t cnt[8];
+    unsigned axis[7], used; /* the planes' axes, and which axes occur */
+    int nonempty;           /* cells with a child */
+} kd_lists;
+
+/* The lists of list [b, b + n) at node w, from `top` up, `room` entries
+ * each, in the cells' order for the list's first ray (keys as in
+ * kdtree_trace.c's wide step: bit 2 = the far side of plane 0, ...): the
+ * nearest cell's list highest, since it is walked (and freed) first. */
+KD_SINLINE void lists_init(const kd_stream *s, const rt_kdtree_wide *w, size_t b, size_t top, size_t room,
+                           kd_lists *nl)
+{
+    uint32_t rep = s->lid[b];
+    unsigned ngb[7];
+    nl->used = 0;
+    for (int p = 0; p < 7; p++) {
+        nl->axis[p] = (w->axes >> (2 * p)) & 3u;
+        nl->used |= 1u << nl->axis[p];
+        ngb[p] = s->inv[nl->axis[p]][rep] < 0.0f;
+    }
     for (unsigned key = 0; key < 8; key++) {
         unsigned b0 = (key >> 2 & 1u) ^ ngb[0], p1 = 1 + b0, b1 = (key >> 1 & 1u) ^ ngb[p1], p2 = 3 + 2 * b0 + b1,
                  b2 = (key & 1u) ^ ngb[p2];
         unsigned c = 4 * b0 + 2 * b1 + b2;
-        cell_of_key[key] = c;
-        out[c] = top + (size_t)(7 - key) * room;
-        cnt[c] = 0;
+        nl->cell_of_key[key] = c;
+        nl->out[c] = top + (size_t)(7 - key) * room;
+        nl->cnt[c] = 0;
     }
-    int nonempty = 0;
+    nl->nonempty = 0;
     for (int c = 0; c < 8; c++)
         if (w->child[c] != RT_KD_EMPTY)
-            nonempty |= 1 << c;
+            nl->nonempty |= 1 << c;
+}
+
+/* One group of rays (lanes id, intervals [l, h], h already cut at the
+ * closest hit) through the node's 7 planes: each cell's interval [lc, hc]. */
+KD_SINLINE void cell_intervals(const kd_stream *s, const kd_lists *nl, const kd_vf *split, kd_vi id, kd_vf l, kd_vf h,
+                               kd_vf *lc, kd_vf *hc)
+{
+    const kd_vf pinf = splat(INFINITY), ninf = splat(-INFINITY);
+    kd_vf o[3], inv[3], ma[3], mp = splat(0.0f);
+    kd_vi par[3];
+    for (int k = 0; k < 3; k++) {
+        if (!(nl->used >> k & 1u))
+            continue;
+        o[k] = gatherf(s->o[k], id);
+        inv[k] = gatherf(s->inv[k], id);
+        ma[k] = gatherf(s->ma[k], id);
+        if (s->any_par)
+            par[k] = gatheri(s->par[k], id);
+    }
+    if (s->any_par)
+        mp = gatherf(s->mp, id);
+    kd_vf lo[7], hi[7];
+    kd_vi ng[7];
+    for (int p = 0; p < 7; p++) {
+        unsigned k = nl->axis[p];
+        kd_vf t = (split[p] - o[k]) * inv[k];
+        lo[p] = t - ma[k];
+        hi[p] = t + ma[k];
+        ng[p] = inv[k] < 0.0f;
+        if (s->any_par) {
+            kd_vf dist = o[k] - split[p];
+            lo[p] = sel(par[k], sel(dist >= -mp, ninf, pinf), lo[p]);
+            hi[p] = sel(par[k], sel(dist <= mp, pinf, ninf), hi[p]);
+            ng[p] &= ~par[k];
+        }
+    }
+    /* level by level: cell c = 4 b0 + 2 b1 + b2 */
+    kd_vf l1[2], h1[2], l2[4], h2[4];
+    cut(l, h, lo[0], hi[0], ng[0], &l1[0], &h1[0], &l1[1], &h1[1]);
+    for (int b0 = 0; b0 < 2; b0++)
+        cut(l1[b0], h1[b0], lo[1 + b0], hi[1 + b0], ng[1 + b0], &l2[2 * b0], &h2[2 * b0], &l2[2 * b0 + 1],
+            &h2[2 * b0 + 1]);
+    for (int q = 0; q < 4; q++)
+        cut(l2[q], h2[q], lo[3 + q], hi[3 + q], ng[3 + q], &lc[2 * q], &hc[2 * q], &lc[2 * q + 1], &hc[2 * q + 1]);
+}
+
+/* The group's first m lanes join the list of every non-empty cell whose
+ * interval is non-empty and starts no later than the ray's closest hit bv,
+ * in lane order. */
+KD_SINLINE void append_cells(kd_stream *s, kd_lists *nl, kd_vi id, size_t m, const kd_vf *lc, const kd_vf *hc,
+                             kd_vf bv)
+{
+    uint32_t *lid = s->lid;
+    float *llo = s->llo, *lhi = s->lhi;
+#if KD_STREAM_LANES == 16
+    /* AVX-512: each cell's rays compressed into place (a whole vector is
+     * stored: the lists' room has one vector of slack) */
+    __mmask16 live = (__mmask16)(m == 16 ? 0xffffu : (1u << m) - 1u);
+    for (int c = 0; c < 8; c++) {
+        if (!(nl->nonempty >> c & 1))
+            continue;
+        __mmask16 k = _mm512_movepi32_mask((__m512i)((lc[c] <= hc[c]) & (lc[c] <= bv))) & live;
+        if (!k)
+            continue;
+        size_t pos = nl->out[c] + nl->cnt[c];
+        _mm512_storeu_si512(lid + pos, _mm512_maskz_compress_epi32(k, (__m512i)id));
+        _mm512_storeu_ps(llo + pos, _mm512_maskz_compress_ps(k, (__m512)lc[c]));
+        _mm512_storeu_ps(lhi + pos, _mm512_maskz_compress_ps(k, (__m512)hc[c]));
+        nl->cnt[c] += (uint32_t)__builtin_popcount(k);
+    }
+#else
+    kd_vi bits = (kd_vi)splat(0.0f);
+    for (int c = 0; c < 8; c++)
+        if (nl->nonempty >> c & 1)
+            bits |= (lc[c] <= hc[c]) & (lc[c] <= bv) & (1 << c);
+    for (size_t i = 0; i < m; i++) {
+        unsigned bm = (unsigned)bits[i];
+        while (bm) {
+            unsigned c = (unsigned)__builtin_ctz(bm);
+            bm &= bm - 1u;
+            size_t pos = nl->out[c] + nl->cnt[c]++;
+            lid[pos] = (uint32_t)id[i];
+            llo[pos] = lc[c][i];
+            lhi[pos] = hc[c][i];
+        }
+    }
+#endif
+}
+
+/* The rays of list [b, b + n) through wide node w: each joins the lists of
+ * the cells it crosses, written above the list; pushes them on the stack. */
+KD_SINLINE bool step(kd_stream *s, const rt_kdtree_wide *w, size_t b, size_t n, kd_entry *stack, int *sp)
+{
+    size_t room = n + L; /* a list's room: n, and a vector's overrun */
+    if (!rt_kd_stream_reserve(s, b + n + 8 * room))
+        return false;
+    kd_lists nl;
+    lists_init(s, w, b, b + n, room, &nl);
     kd_vf split[7];
     for (int p = 0; p < 7; p++)
         split[p] = splat(w->split[p]);
-    const kd_vf pinf = splat(INFINITY), ninf = splat(-INFINITY);
+    const uint32_t *lid = s->lid;
+    const float *llo = s->llo, *lhi = s->lhi;
     for (size_t j = 0; j < n; j += L) {
         size_t m = n - j < (size_t)L ? n - j : (size_t)L;
         kd_vi id;
-        kd_vf l, h, bv;
+        kd_vf l, h;
         if (m == (size_t)L) { /* vector loads (lane by lane stores, then a vector load, stall) */
             memcpy(&id, lid + b + j, sizeof id);
             memcpy(&l, llo + b + j, sizeof l);
@@ -199,82 +300,15 @@ KD_SINLINE bool step(kd_stream *s, const rt_kdtree_wide *w, size_t b, size_t n, 
                 h[i] = lhi[e];
             }
         }
-        bv = gatherf(best, id);
+        kd_vf bv = gatherf(s->best, id), lc[8], hc[8];
         h = sel(bv < h, bv, h);
-        kd_vf o[3], inv[3], ma[3], mp = splat(0.0f);
-        kd_vi par[3];
-        for (int k = 0; k < 3; k++) {
-            if (!(used >> k & 1u))
-                continue;
-            o[k] = gatherf(s->o[k], id);
-            inv[k] = gatherf(s->inv[k], id);
-            ma[k] = gatherf(s->ma[k], id);
-            if (s->any_par)
-                par[k] = gatheri(s->par[k], id);
-        }
-        if (s->any_par)
-            mp = gatherf(s->mp, id);
-        kd_vf lo[7], hi[7];
-        kd_vi ng[7];
-        for (int p = 0; p < 7; p++) {
-            unsigned k = axis[p];
-            kd_vf t = (split[p] - o[k]) * inv[k];
-            lo[p] = t - ma[k];
-            hi[p] = t + ma[k];
-            ng[p] = inv[k] < 0.0f;
-            if (s->any_par) {
-                kd_vf dist = o[k] - split[p];
-                lo[p] = sel(par[k], sel(dist >= -mp, ninf, pinf), lo[p]);
-                hi[p] = sel(par[k], sel(dist <= mp, pinf, ninf), hi[p]);
-                ng[p] &= ~par[k];
-            }
-        }
-        /* level by level: cell c = 4 b0 + 2 b1 + b2 */
-        kd_vf l1[2], h1[2], l2[4], h2[4], lc[8], hc[8];
-        cut(l, h, lo[0], hi[0], ng[0], &l1[0], &h1[0], &l1[1], &h1[1]);
-        for (int b0 = 0; b0 < 2; b0++)
-            cut(l1[b0], h1[b0], lo[1 + b0], hi[1 + b0], ng[1 + b0], &l2[2 * b0], &h2[2 * b0], &l2[2 * b0 + 1],
-                &h2[2 * b0 + 1]);
-        for (int q = 0; q < 4; q++)
-            cut(l2[q], h2[q], lo[3 + q], hi[3 + q], ng[3 + q], &lc[2 * q], &hc[2 * q], &lc[2 * q + 1], &hc[2 * q + 1]);
-#if KD_STREAM_LANES == 16
-        /* AVX-512: each cell's rays compressed into place, in lane order
-         * (what the loop below does, one cell at a time) */
-        __mmask16 live = (__mmask16)(m == 16 ? 0xffffu : (1u << m) - 1u);
-        for (int c = 0; c < 8; c++) {
-            if (!(nonempty >> c & 1))
-                continue;
-            __mmask16 k = _mm512_movepi32_mask((__m512i)((lc[c] <= hc[c]) & (lc[c] <= bv))) & live;
-            if (!k)
-                continue;
-            size_t pos = out[c] + cnt[c];
-            _mm512_storeu_si512(lid + pos, _mm512_maskz_compress_epi32(k, (__m512i)id));
-            _mm512_storeu_ps(llo + pos, _mm512_maskz_compress_ps(k, (__m512)lc[c]));
-            _mm512_storeu_ps(lhi + pos, _mm512_maskz_compress_ps(k, (__m512)hc[c]));
-            cnt[c] += (uint32_t)__builtin_popcount(k);
-        }
-#else
-        kd_vi bits = (kd_vi)splat(0.0f);
-        for (int c = 0; c < 8; c++)
-            if (nonempty >> c & 1)
-                bits |= (lc[c] <= hc[c]) & (lc[c] <= bv) & (1 << c);
-        for (size_t i = 0; i < m; i++) {
-            unsigned bm = (unsigned)bits[i];
-            while (bm) {
-                unsigned c = (unsigned)__builtin_ctz(bm);
-                bm &= bm - 1u;
-                size_t pos = out[c] + cnt[c]++;
-                lid[pos] = (uint32_t)id[i];
-                llo[pos] = lc[c][i];
-                lhi[pos] = hc[c][i];
-            }
-        }
-#endif
+        cell_intervals(s, &nl, split, id, l, h, lc, hc);
+        append_cells(s, &nl, id, m, lc, hc, bv);
     }
     for (unsigned key = 8; key-- > 0;) { /* farthest first: the nearest on top */
-        unsigned c = cell_of_key[key];
-        if (cnt[c])
-            stack[(*sp)++] = (kd_entry){w->child[c], cnt[c], out[c]};
+        unsigned c = nl.cell_of_key[key];
+        if (nl.cnt[c])
+            stack[(*sp)++] = (kd_entry){w->child[c], nl.cnt[c], nl.out[c]};
     }
     return true;
 }
