@@ -313,6 +313,154 @@ KD_SINLINE bool step(kd_stream *s, const rt_kdtree_wide *w, size_t b, size_t n, 
     return true;
 }
 
+
+/* per lane: (k == 0 ? a : k == 1 ? b : c) */
+KD_SINLINE kd_vf pick3(kd_vi k, kd_vf a, kd_vf b, kd_vf c)
+{
+    return sel(k == 0, a, sel(k == 1, b, c));
+}
+
+/* The rays of a leaf test as lanes: index, origin, the watertight test's
+ * shear and axes (rt_tri_ray), tmin. */
+typedef struct kd_lane_rays {
+    kd_vi id, kx, ky, kz;
+    kd_vf o[3], sx, sy, sz, adz, ad, tmin;
+} kd_lane_rays;
+
+/* Triangle tid against the lanes `live` of lr (rt_intersect_triangle_ray
+ * lane by lane, see leaf_lanes): where it hits before *best, the hit
+ * replaces the lane's (best, hu, hv, prim) and sets found; an occlusion
+ * ray leaves `live` at its first hit. */
+KD_SINLINE void tri_lanes(const kd_stream *s, uint32_t tid, const kd_lane_rays *lr, kd_vi *live, kd_vf *best,
+                          kd_vf *hu, kd_vf *hv, kd_vi *prim, kd_vi *found)
+{
+    RT_NO_FP_CONTRACT
+    const float *v = s->tree->tri + tid;
+    const kd_vi kx = lr->kx, ky = lr->ky, kz = lr->kz;
+    const kd_vf sx = lr->sx, sy = lr->sy, sz = lr->sz, adz = lr->adz, ad = lr->ad, tmin = lr->tmin;
+    const kd_vf *o = lr->o;
+    kd_vf A[3], B[3], C[3];
+    for (int k = 0; k < 3; k++) {
+        A[k] = splat(v[k]) - o[k];
+        B[k] = splat(v[3 + k]) - o[k];
+        C[k] = splat(v[6 + k]) - o[k];
+    }
+    kd_vf Akz = pick3(kz, A[0], A[1], A[2]), Bkz = pick3(kz, B[0], B[1], B[2]), Ckz = pick3(kz, C[0], C[1], C[2]);
+    kd_vf Ax = pick3(kx, A[0], A[1], A[2]) - sx * Akz, Ay = pick3(ky, A[0], A[1], A[2]) - sy * Akz;
+    kd_vf Bx = pick3(kx, B[0], B[1], B[2]) - sx * Bkz, By = pick3(ky, B[0], B[1], B[2]) - sy * Bkz;
+    kd_vf Cx = pick3(kx, C[0], C[1], C[2]) - sx * Ckz, Cy = pick3(ky, C[0], C[1], C[2]) - sy * Ckz;
+    kd_vf U = Cx * By - Cy * Bx, V = Ax * Cy - Ay * Cx, W = Bx * Ay - By * Ax;
+    const kd_vf zero = splat(0.0f);
+    kd_vi edge = *live & ((U == zero) | (V == zero) | (W == zero));
+    kd_vi ok = *live & ~edge & ~(((U < zero) | (V < zero) | (W < zero)) & ((U > zero) | (V > zero) | (W > zero)));
+    int any = 0;
+    for (int i = 0; i < L; i++)
+        any |= ok[i] | edge[i];
+    if (any) {
+        kd_vf det = U + V + W;
+        kd_vf adet = (kd_vf)((kd_vi)det & 0x7fffffff);
+        ok &= (det != zero) & (adet < splat(INFINITY));
+        kd_vf T = U * (sz * Akz) + V * (sz * Bkz) + W * (sz * Ckz);
+        kd_vf inv = splat(1.0f) / det;
+        kd_vf t = T * inv;
+        ok &= (t > tmin) & (t < *best);
+        float e1[3] = {v[3] - v[0], v[4] - v[1], v[5] - v[2]}, e2[3] = {v[6] - v[0], v[7] - v[1], v[8] - v[2]};
+        float a1 = fabsf(e1[0]) + fabsf(e1[1]) + fabsf(e1[2]), a2 = fabsf(e2[0]) + fabsf(e2[1]) + fabsf(e2[2]);
+        ok &= adet * adz / a1 / a2 > 0x1p-16f * ad;
+        *best = sel(ok, t, *best);
+        *hu = sel(ok, V * inv, *hu);
+        *hv = sel(ok, W * inv, *hv);
+        *prim = (*prim & ~ok) | ((int32_t)tid & ok);
+        *found |= ok;
+        for (int i = 0; i < L; i++) { /* an edge function of zero: the reference decides */
+            if (!edge[i])
+                continue;
+            uint32_t r = (uint32_t)lr->id[i];
+            float tt, uu, vv;
+            if (rt_intersect_triangle_ray(&s->tr[r], rt_v3(v[0], v[1], v[2]), rt_v3(v[3], v[4], v[5]),
+                                          rt_v3(v[6], v[7], v[8]), tmin[i], (*best)[i], &tt, &uu, &vv)) {
+                (*best)[i] = tt, (*hu)[i] = uu, (*hv)[i] = vv, (*prim)[i] = (int32_t)tid, (*found)[i] = -1;
+            }
+        }
+        if (s->any)
+            *live &= ~*found;
+    }
+}
+
+/* A leaf of triangles only (ref RT_KD_LEAF, ids below other_base) against
+ * the rays of list [b, b + n), ray-major: each triangle against
+ * KD_STREAM_LANES rays at once, in the leaf's order, with the watertight
+ * test of intersect.h (rt_intersect_triangle_ray) lane by lane: each lane
+ * its ray's shear and axis order, the same IEEE operations (the vertices
+ * less the origin on all three axes, then picked by the lane's axes), and
+ * the reference itself, in scalar code, for a lane whose edge function
+ * rounds to zero (it recomputes those in double). A lane keeps a hit only
+ * when its t is below the closest so far: the first of equal t, as the
+ * single-ray leaf test. Rays whose interval starts after their closest hit
+ * are left out first. */
+KD_SINLINE void leaf_lanes(kd_stream *s, const uint32_t *ids, size_t b, size_t n)
+{
+    uint32_t keep[64];
+    const size_t trs = sizeof(rt_tri_ray) / sizeof(float), rs = sizeof(rt_ray) / sizeof(float);
+    for (size_t j0 = 0; j0 < n;) {
+        size_t m = 0; /* up to L rays that may still hit here */
+        for (; j0 < n && m < (size_t)L; j0++) {
+            uint32_t i = s->lid[b + j0];
+            if (s->llo[b + j0] <= s->best[i])
+                keep[m++] = i;
+        }
+        if (m == 0)
+            break;
+        kd_vi id, idt, idr;
+        for (int i = 0; i < L; i++)
+            id[i] = (int32_t)keep[(size_t)i < m ? (size_t)i : 0];
+        idt = id * (int32_t)trs;
+        idr = id * (int32_t)rs;
+        const rt_tri_ray *t0 = s->tr;
+        kd_lane_rays lr;
+        lr.id = id;
+        for (int k = 0; k < 3; k++)
+            lr.o[k] = gatherf(s->o[k], id);
+        lr.sx = gatherf(&t0->sx, idt), lr.sy = gatherf(&t0->sy, idt), lr.sz = gatherf(&t0->sz, idt);
+        lr.adz = gatherf(&t0->adz, idt), lr.ad = gatherf(&t0->ad, idt);
+        lr.kx = gatheri(&t0->kx, idt), lr.ky = gatheri(&t0->ky, idt), lr.kz = gatheri(&t0->kz, idt);
+        lr.tmin = gatherf(&s->ray->tmin, idr);
+        kd_vf best = gatherf(s->best, id);
+        kd_vi live = (kd_vi)splat(0.0f), found = live, prim = live;
+        for (int i = 0; i < L; i++)
+            live[i] = (size_t)i < m ? -1 : 0;
+        kd_vf hu = splat(0.0f), hv = hu;
+        for (const uint32_t *p = ids;; p++) {
+            tri_lanes(s, *p & RT_KD_PAYLOAD, &lr, &live, &best, &hu, &hv, &prim, &found);
+            if (*p & RT_KD_LAST)
+                break;
+        }
+        for (size_t i = 0; i < m; i++) {
+            if (!found[i])
+                continue;
+            rt_hit h = {best[i], hu[i], hv[i], (uint32_t)prim[i]};
+            uint32_t r = (uint32_t)id[i];
+            if (s->any) {
+                s->best[r] = NAN;
+                s->hit[r].prim = 0;
+            } else {
+                s->best[r] = h.t;
+                s->hit[r] = h;
+            }
+        }
+    }
+}
+
+/* Whether leaf list p holds triangles only (ids ascending: its last id is
+ * below other_base). */
+KD_SINLINE bool tri_leaf(const rt_kdtree *tree, const uint32_t *p)
+{
+    while (!(*p & RT_KD_LAST))
+        p++;
+    return (*p & RT_KD_PAYLOAD) < tree->other_base;
+}
+#define KD_STREAM_LEAF_LANES 4 /* rays a leaf list needs for the ray-major test */
+
 bool KD_STREAM_WALK(kd_stream *s, size_t count)
 {
     const rt_kdtree *tree = s->tree;
@@ -323,7 +471,10 @@ bool KD_STREAM_WALK(kd_stream *s, size_t count)
     stack[sp++] = (kd_entry){tree->root, (uint32_t)count, 0};
     while (sp > 0) {
         kd_entry e = stack[--sp];
-        if (e.ref >= RT_KD_LEAF) {
+        if (e.ref >= RT_KD_LEAF && e.ref < RT_KD_ONE && e.count >= KD_STREAM_LEAF_LANES &&
+            tri_leaf(tree, tree->prim_ids + (e.ref & RT_KD_PAYLOAD))) {
+            leaf_lanes(s, tree->prim_ids + (e.ref & RT_KD_PAYLOAD), e.begin, e.count);
+        } else if (e.ref >= RT_KD_LEAF) {
             for (size_t k = e.begin; k < e.begin + e.count; k++) {
                 uint32_t i = s->lid[k];
                 if (s->llo[k] <= s->best[i])
