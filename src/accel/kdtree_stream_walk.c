@@ -32,15 +32,21 @@
  * (and one vector more: AVX-512 compresses a cell's lanes and stores the
  * whole vector); popping a list frees everything above its end.
  *
+ * A leaf of triangles reached by KD_STREAM_LEAF_LANES rays or more (8-64
+ * on average on the benchmark sets) is tested ray-major instead: each of
+ * its triangles against the rays in lanes (leaf_lanes, tri_lanes), with
+ * the watertight test's own operations per lane.
+ *
  * The answers: every primitive a ray tests is tested with the single-ray
- * test on (tmin, closest so far), and the cells are culled only where the
+ * test's operations on (tmin, closest so far), in the leaf's order, and the cells are culled only where the
  * single-ray walk would cull them, so a ray finds the same closest t,
  * primitive and barycentrics (on an exact tie, possibly the other
  * primitive). Every width runs the same operations per lane on the same
  * lists in the same order (lanes do not interact), so the widths agree bit
  * for bit, tie-breaks included.
  *
- * Compiled once per width, from GCC/clang vector types (no intrinsics): as
+ * Compiled once per width, from GCC/clang vector types (intrinsics only for
+ * the gathers and AVX-512's compress): as
  * itself, 16 lanes for AVX-512 (F, BW, DQ, VL, by a target pragma whatever
  * the build's flags; x86 with GCC or clang only), by kdtree_stream_walk8.c
  * (8 lanes, AVX2) and kdtree_stream_walk4.c (4 lanes, the build's target).
