@@ -4,6 +4,7 @@
  *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
  *           [--build-threads N] [--occluded] [--portable] [--limit N]
  *           [--packets W H [--image-width N] [--lanes 8|16]]
+ *           [--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]]
  *
  * Loads the model with rt_load, as `rt` does (a glTF: every triangle of
  * the default scene in world space, as ../shared/bench/FORMAT.md defines;
@@ -26,8 +27,15 @@
  * in tiles of W x H pixels (W H = 4 2 or 4 4; at most 64 rays), 16 rays at
  * a time with rt_kdtree_intersect16 (kdtree_packet.h) when a tile has 16
  * or more, else 8 with rt_kdtree_intersect8 (--lanes 8|16 chooses), or
- * with --occluded the any-hit calls; the answers must be the same. Exit 2
- * on bad arguments or files.
+ * with --occluded the any-hit calls; the answers must be the same.
+ * --stream traces the set in file order as ray streams
+ * (rt_kdtree_intersect_stream / rt_kdtree_occluded_stream,
+ * kdtree_stream.h) of N rays a call (--stream-size, default 4096, as
+ * Embree's anchor calls rtcIntersect1M), each thread taking the next call's
+ * rays; --lanes chooses the SIMD width (default the widest the CPU runs;
+ * stream_lanes: says which ran), --min-rays and --chunk the stream's
+ * parameters (kd_stream_params). The rays are copied into the stream's
+ * arrays before the clock starts. Exit 2 on bad arguments or files.
  */
 #include <pthread.h>
 #include <stdatomic.h>
@@ -40,6 +48,7 @@
 #include "rt/io/load.h"
 #include "rt/accel/kdtree.h"
 #include "rt/accel/kdtree_packet.h"
+#include "rt/accel/kdtree_stream.h"
 #include "rt/accel/rayset.h"
 #include "rt/scene/scene.h"
 
@@ -65,6 +74,12 @@ typedef struct job {
     const size_t *order; /* packets: ray indices tile by tile, pack rays a tile (NULL: single rays) */
     size_t pack;
     int lanes; /* packets: rays a call, 8 or 16 */
+    const rt_ray_batch *stream; /* streams: the rays as arrays (NULL: not streams) */
+    rt_hit_batch stream_hits;
+    uint8_t *blocked;
+    rt_kd_stream_params stream_params;
+    size_t step; /* rays a thread takes at a time */
+    int threads;
     atomic_size_t next;
 } job;
 
@@ -95,11 +110,26 @@ static void *trace_worker(void *arg)
 {
     job *j = arg;
     for (;;) {
-        size_t start = atomic_fetch_add(&j->next, CHUNK);
+        size_t start = atomic_fetch_add(&j->next, j->step);
         if (start >= j->rays->count)
             break;
-        size_t end = start + CHUNK < j->rays->count ? start + CHUNK : j->rays->count;
-        if (j->order) { /* CHUNK is a multiple of every tile size */
+        size_t end = start + j->step < j->rays->count ? start + j->step : j->rays->count;
+        if (j->stream) { /* one stream call: the arrays from `start` on */
+            const rt_ray_batch *b = j->stream;
+            rt_ray_batch rb = {b->ox + start, b->oy + start, b->oz + start, b->dx + start, b->dy + start,
+                               b->dz + start, b->tmin + start, b->tmax + start};
+            if (j->occluded) {
+                rt_kdtree_occluded_stream(j->tree, &rb, end - start, j->blocked + start, &j->stream_params);
+                for (size_t i = start; i < end; i++)
+                    j->t_out[i] = j->blocked[i] ? 0.0f : INFINITY;
+            } else {
+                const rt_hit_batch *h = &j->stream_hits;
+                rt_hit_batch hb = {h->t + start, h->u + start, h->v + start, h->prim + start};
+                rt_kdtree_intersect_stream(j->tree, &rb, end - start, &hb, &j->stream_params);
+                for (size_t i = start; i < end; i++)
+                    j->t_out[i] = h->prim[i] != RT_NONE ? h->t[i] : INFINITY;
+            }
+        } else if (j->order) { /* CHUNK is a multiple of every tile size */
             for (size_t i = start; i < end; i += j->pack)
                 trace_tile(j, j->order + i, end - i < j->pack ? end - i : j->pack);
         } else if (j->occluded) {
@@ -116,10 +146,10 @@ static void *trace_worker(void *arg)
 }
 
 /* Wall seconds of one pass; *cpu gets the CPU seconds of all threads. */
-static double trace_all(const rt_kdtree *tree, const rt_rayset *rays, float *t_out, int threads, bool occluded,
-                        const size_t *order, size_t pack, int lanes, double *cpu)
+static double trace_all(job *jp, double *cpu)
 {
-    job j = {tree, rays, t_out, occluded, order, pack, lanes, 0};
+    job j = *jp;
+    int threads = jp->threads;
     atomic_init(&j.next, 0);
     pthread_t th[256];
     double c0 = cpu_s(), t0 = now_s();
@@ -144,7 +174,8 @@ static int cmp_double(const void *a, const void *b)
 static int usage(void)
 {
     fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K] [--build-threads N] "
-                    "[--occluded] [--portable] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]]\n");
+                    "[--occluded] [--portable] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]] "
+                    "[--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]]\n");
     return 2;
 }
 
@@ -154,7 +185,8 @@ int main(int argc, char **argv)
     int threads = 1, runs = 5, build_threads = 0;
     long limit = 0;
     int pw = 0, ph = 0, image_width = 640, lanes = 0;
-    bool occluded = false, portable = false;
+    bool occluded = false, portable = false, stream = false;
+    long stream_size = 4096, min_rays = 0, chunk = 0;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--ref") == 0 && i + 1 < argc)
             hits_path = argv[++i];
@@ -175,9 +207,16 @@ int main(int argc, char **argv)
             image_width = atoi(argv[++i]);
         else if (strcmp(argv[i], "--lanes") == 0 && i + 1 < argc) {
             lanes = atoi(argv[++i]);
-            if (lanes != 8 && lanes != 16)
+            if (lanes != 4 && lanes != 8 && lanes != 16)
                 return usage();
-        }
+        } else if (strcmp(argv[i], "--stream") == 0)
+            stream = true;
+        else if (strcmp(argv[i], "--stream-size") == 0 && i + 1 < argc)
+            stream_size = atol(argv[++i]);
+        else if (strcmp(argv[i], "--min-rays") == 0 && i + 1 < argc)
+            min_rays = atol(argv[++i]);
+        else if (strcmp(argv[i], "--chunk") == 0 && i + 1 < argc)
+            chunk = atol(argv[++i]);
         else if (strcmp(argv[i], "--occluded") == 0)
             occluded = true;
         else if (strcmp(argv[i], "--portable") == 0)
@@ -192,7 +231,9 @@ int main(int argc, char **argv)
             return usage();
     }
     if (!model || !rays_path || threads < 1 || threads > 256 || runs < 1 || runs > 1000 || build_threads < 0 ||
-        build_threads > 64 || limit < 0 || image_width < 1 || (pw && limit) || (lanes && !pw))
+        build_threads > 64 || limit < 0 || image_width < 1 || (pw && limit) || (lanes && !pw && !stream) ||
+        (stream && pw) || (lanes == 4 && !stream) || stream_size < 1 || stream_size > (1L << 24) || min_rays < 0 ||
+        min_rays > (1L << 30) || chunk < 0 || chunk > (1L << 24))
         return usage();
     if (pw && !lanes) /* 16-ray calls for tiles of 16 rays or more */
         lanes = pw * ph >= 16 ? 16 : 8;
@@ -255,8 +296,36 @@ int main(int argc, char **argv)
         fprintf(stderr, "rtbench: out of memory\n");
         return 2;
     }
+    job jb;
+    memset(&jb, 0, sizeof jb);
+    jb.tree = &tree, jb.rays = &rs, jb.t_out = t_out, jb.occluded = occluded, jb.order = order;
+    jb.pack = (size_t)pw * (size_t)ph, jb.lanes = lanes, jb.threads = threads, jb.step = CHUNK;
+    float *soa = NULL;
+    rt_ray_batch rb;
+    if (stream) { /* the rays as arrays, and the hits' (before the clock) */
+        size_t n = rs.count ? rs.count : 1;
+        soa = malloc(11 * n * sizeof(float) + n * sizeof(uint32_t) + n);
+        if (!soa) {
+            fprintf(stderr, "rtbench: out of memory\n");
+            return 2;
+        }
+        float *c[11];
+        for (int k = 0; k < 11; k++)
+            c[k] = soa + (size_t)k * n;
+        for (size_t i = 0; i < rs.count; i++) {
+            const rt_ray *r = &rs.rays[i];
+            c[0][i] = r->org.x, c[1][i] = r->org.y, c[2][i] = r->org.z, c[3][i] = r->dir.x, c[4][i] = r->dir.y;
+            c[5][i] = r->dir.z, c[6][i] = r->tmin, c[7][i] = r->tmax;
+        }
+        rb = (rt_ray_batch){c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]};
+        jb.stream = &rb;
+        jb.stream_hits = (rt_hit_batch){c[8], c[9], c[10], (uint32_t *)(void *)(soa + 11 * n)};
+        jb.blocked = (uint8_t *)(void *)(soa + 12 * n);
+        jb.stream_params = (rt_kd_stream_params){lanes, (int)min_rays, (int)chunk};
+        jb.step = (size_t)stream_size;
+    }
     for (int r = 0; r < runs; r++)
-        times[r] = trace_all(&tree, &rs, t_out, threads, occluded, order, (size_t)pw * (size_t)ph, lanes, &cpus[r]);
+        times[r] = trace_all(&jb, &cpus[r]);
     qsort(times, (size_t)runs, sizeof(double), cmp_double);
     qsort(cpus, (size_t)runs, sizeof(double), cmp_double);
     double median = runs % 2 ? times[runs / 2] : 0.5 * (times[runs / 2 - 1] + times[runs / 2]);
@@ -287,6 +356,13 @@ int main(int argc, char **argv)
     printf("query: %s\n", occluded ? "occluded" : "closest");
     if (pw)
         printf("packets: %dx%d tiles, %d rays a call\n", pw, ph, lanes);
+    if (stream) {
+        int sl = lanes && rt_kd_stream_lanes_supported(lanes) && (lanes == 4 || tree.isa != RT_KD_ISA_PORTABLE)
+                     ? lanes : rt_kd_stream_lanes_best(&tree);
+        printf("stream: %ld rays a call, min_rays %d, chunk %d\n", stream_size,
+               min_rays ? (int)min_rays : RT_KD_STREAM_MIN_RAYS, chunk ? (int)chunk : RT_KD_STREAM_CHUNK);
+        printf("stream_lanes: %d\n", sl);
+    }
     printf("mrays_per_s: %.3f\n", median > 0 ? 1e-6 * (double)rs.count / median : 0.0);
     printf("mrays_per_s_best: %.3f\n", times[0] > 0 ? 1e-6 * (double)rs.count / times[0] : 0.0);
     printf("cpu_mrays_per_s: %.3f\n", cpu_median > 0 ? 1e-6 * (double)rs.count / cpu_median : 0.0);
@@ -299,6 +375,7 @@ int main(int argc, char **argv)
         status = 1;
     }
     free(order);
+    free(soa);
     free(t_out);
     free(times);
     free(cpus);

@@ -146,4 +146,16 @@ bool rt_kd_leaf_hit_avx2(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray,
 bool rt_kd_prim_hit_avx2(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
                          rt_hit *hit);
 
+
+/* For the ray streams (kdtree_stream.c): kdtree_trace.c's single-ray walk
+ * from a child reference over a given t interval (ray->tmax: the closest
+ * hit so far; hit->prim a tree id), once per pass, and the portable pass's
+ * leaf test (the AVX2 pass's is rt_kd_leaf_hit_avx2 above). */
+bool rt_kd_walk_from_avx2(const rt_kdtree *tree, uint32_t ref, float tn, float tf, const rt_ray *ray, rt_hit *hit,
+                          bool any);
+bool rt_kd_walk_from_portable(const rt_kdtree *tree, uint32_t ref, float tn, float tf, const rt_ray *ray, rt_hit *hit,
+                              bool any);
+bool rt_kd_leaf_hit_portable(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr, float *best,
+                             rt_hit *hit, bool any);
+
 #endif

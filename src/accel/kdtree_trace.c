@@ -749,14 +749,15 @@ KD_INLINE int wide_step_avx2(const rt_kdtree_wide *w, const kd_ray *r, bool par,
 
 /* The shared traversal; any = stop at the first hit (occlusion). A stack
  * entry is a child reference with its t interval; the nearest is on top. */
-KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, bool any, bool par, const kd_ray *r)
+KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, bool any, bool par, const kd_ray *r,
+                            uint32_t start)
 {
     const rt_kdtree_wide *wide = tree->wide;
     const uint32_t *ids = tree->prim_ids;
     uint32_t sref[KD_WSTACK];
     float slo[KD_WSTACK], shi[KD_WSTACK];
     int sp = 0;
-    uint32_t ref = tree->root;
+    uint32_t ref = start;
     float tn = r->tn, tf = r->tf, best = ray->tmax;
     bool found = false;
     for (;;) {
@@ -822,8 +823,8 @@ KD_INLINE bool traverse(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit, b
     if (!ray_setup(tree, ray, &r))
         return false;
     if (!r.any_par)
-        return traverse_ray(tree, ray, hit, any, false, &r);
-    return traverse_ray(tree, ray, hit, any, true, &r);
+        return traverse_ray(tree, ray, hit, any, false, &r, tree->root);
+    return traverse_ray(tree, ray, hit, any, true, &r, tree->root);
 }
 
 KD_FLATTEN bool KD_NAME(rt_kd_intersect)(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit)
@@ -842,6 +843,36 @@ KD_FLATTEN bool KD_NAME(rt_kd_occluded)(const rt_kdtree *tree, const rt_ray *ray
     rt_hit h;
     return traverse(tree, ray, &h, true);
 }
+
+/* For the ray streams (kdtree_stream.c): the single-ray walk from child
+ * reference ref (a wide node or a leaf) over the ray's [tn, tf], the t
+ * interval the stream walk gave it in that cell, with ray->tmax the closest
+ * hit so far; hit->prim the tree's primitive id. The ray passed the same
+ * set-up in the stream (ray_setup would accept it). */
+KD_FLATTEN bool KD_NAME(rt_kd_walk_from)(const rt_kdtree *tree, uint32_t ref, float tn, float tf, const rt_ray *ray,
+                                         rt_hit *hit, bool any)
+{
+    kd_ray r;
+    if (!ray_setup(tree, ray, &r))
+        return false;
+    r.tn = tn;
+    r.tf = tf;
+    if (!r.any_par)
+        return traverse_ray(tree, ray, hit, any, false, &r, ref);
+    return traverse_ray(tree, ray, hit, any, true, &r, ref);
+}
+
+#ifndef KD_SIMD
+/* The portable pass's leaf test, for the ray streams (the AVX2 pass's is
+ * rt_kd_leaf_hit_avx2 below). */
+KD_FLATTEN bool rt_kd_leaf_hit_portable(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr,
+                                        float *best, rt_hit *hit, bool any)
+{
+    if (ref >= RT_KD_ONE)
+        return test_prim(tree, ref & RT_KD_PAYLOAD, ray, tr, best, hit);
+    return test_leaf(tree, tree->prim_ids + (ref & RT_KD_PAYLOAD), ray, tr, best, hit, any);
+}
+#endif
 
 #ifdef KD_SIMD
 /* For the packet traversal (kdtree_packet.c): one leaf, or one primitive,
