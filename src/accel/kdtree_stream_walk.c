@@ -110,14 +110,14 @@ KD_SINLINE kd_vi gatheri(const void *base, kd_vi id)
 #else
 KD_SINLINE kd_vf gatherf(const void *base, kd_vi id)
 {
-    kd_vf v;
+    kd_vf v = {0};
     for (int i = 0; i < L; i++)
         v[i] = ((const float *)base)[id[i]];
     return v;
 }
 KD_SINLINE kd_vi gatheri(const void *base, kd_vi id)
 {
-    kd_vi v;
+    kd_vi v = {0};
     for (int i = 0; i < L; i++)
         v[i] = ((const int32_t *)base)[id[i]];
     return v;
@@ -126,7 +126,7 @@ KD_SINLINE kd_vi gatheri(const void *base, kd_vi id)
 
 KD_SINLINE kd_vf splat(float x)
 {
-    kd_vf v;
+    kd_vf v = {0};
     for (int i = 0; i < L; i++)
         v[i] = x;
     return v;
