@@ -1,7 +1,7 @@
 /* rt/job/output.h - what a job does with a finished render: the AOV images
  * (options.aovs), the denoiser (options.denoise, fed the albedo and normal
  * AOVs), exposure and tone curve for 8-bit output, half EXR, then the
- * atomic write (rt/io/framebuffer.h).
+ * atomic write (rt/io/image_write.h).
  *
  *   rt_job_options o = {.aovs = 1u << RT_AOV_NORMAL};
  *   if (rt_job_output_check(&o, &err) != RT_OK) ...   // before rendering: the denoiser has its library
