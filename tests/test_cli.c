@@ -314,6 +314,11 @@ static void test_bad_flags(void **state)
     REFUSE(o, "--integrator wants", "'magic'", "--integrator", "magic", "-o", o);
     REFUSE(o, "--max-memory wants a size", "'lots'", "--max-memory", "lots", "-o", o);
     REFUSE(o, "--max-memory", "below the 64M", "--max-memory", "1M", "-o", o);
+    REFUSE(o, "--max-memory wants a size", "'0x10G'", "--max-memory", "0x10G", "-o", o); /* hexadecimal, as strtod reads */
+    REFUSE(o, "--max-memory wants a size", "'0'", "--max-memory", "0", "-o", o);           /* 'none' says no limit */
+    REFUSE(o, "--max-memory wants a size", "'0.0000001K'", "--max-memory", "0.0000001K", "-o", o); /* rounds to 0 */
+    REFUSE(o, "--max-memory wants a size", "'-1G'", "--max-memory", "-1G", "-o", o);
+    REFUSE(o, "--max-memory wants a size", "'1.2.3G'", "--max-memory", "1.2.3G", "-o", o);
     REFUSE(o, "--preview wants", "'0'", "--preview", "0", "-o", o);
     REFUSE(o, "--time-limit wants seconds (more than 0, at most 1e7)", "'0'", "--time-limit", "0", "-o", o);
     REFUSE(o, "--time-limit wants", "'-1'", "--time-limit", "-1", "-o", o);
@@ -327,6 +332,8 @@ static void test_bad_flags(void **state)
     REFUSE(o, "--passes wants", "'99999999999'", "--passes", "99999999999", "-o", o);
     REFUSE(o, "--display-server wants HOST:PORT", "'tev'", "--display-server", "tev", "-o", o);
     REFUSE(o, "--display-server wants", "'127.0.0.1:99999'", "--display-server", "127.0.0.1:99999", "-o", o);
+    REFUSE(o, "--display-server wants", "'[::1:14158'", "--display-server", "[::1:14158", "-o", o);
+    REFUSE(o, "--display-server wants", "'::1]:14158'", "--display-server", "::1]:14158", "-o", o);
     REFUSE(o, "unknown option", "'--bogus'", "--bogus", "-o", o);
     REFUSE(o, "only one input", "b.txt", "a.txt", "b.txt", "-o", o);
     REFUSE(o, "option -o needs a value", NULL, "-o");

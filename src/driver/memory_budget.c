@@ -69,10 +69,17 @@ bool memory_budget_parse(const char *s, unsigned long long *out)
         *out = 0;
         return true;
     }
+    /* a plain decimal number, as every numeric flag takes (no sign, no
+     * hexadecimal, no inf or nan: strtod alone would take them), then a unit */
+    size_t digits = 0, dots = 0, n = 0;
+    for (; (s[n] >= '0' && s[n] <= '9') || s[n] == '.'; n++)
+        s[n] == '.' ? dots++ : digits++;
+    if (digits == 0 || dots > 1)
+        return false;
     char *end;
     errno = 0;
     double v = strtod(s, &end);
-    if (errno || end == s || !(v >= 0.0))
+    if (errno || end != s + n || !(v >= 0.0))
         return false;
     double mul = 1.0;
     switch (*end) {
@@ -89,7 +96,7 @@ bool memory_budget_parse(const char *s, unsigned long long *out)
     if (*end)
         return false;
     double bytes = v * mul;
-    if (!(bytes < 9.0e18))
+    if (!(bytes < 9.0e18) || !(bytes >= 1.0)) /* 0 bytes would read as 'none': that is said as 'none' */
         return false;
     *out = (unsigned long long)bytes;
     return true;

@@ -162,7 +162,10 @@ bool tev_parse_address(const char *address, char *host, size_t host_size, char *
         return false;
     const char *h = address;
     size_t hn = (size_t)(colon - address);
-    if (h[0] == '[' && hn >= 2 && h[hn - 1] == ']') { /* [::1]:14158 */
+    bool opens = h[0] == '[', closes = hn >= 2 && h[hn - 1] == ']';
+    if (opens != closes) /* "[::1:14158", "::1]:14158": a bracket left open or never opened */
+        return false;
+    if (opens) { /* [::1]:14158 */
         h++;
         hn -= 2;
     }
