@@ -38,40 +38,6 @@
 
 #define RAYS_PER_SET 2500
 
-typedef struct bench_model {
-    char name[128];
-    char glb[512];
-} bench_model;
-
-/* Models from the manifest's table rows: "| Name | `path` | ...". */
-static size_t read_manifest(bench_model *out, size_t cap)
-{
-    FILE *f = fopen(test_shared_path("bench/MANIFEST.md"), "r");
-    if (!f)
-        return 0;
-    char line[2048];
-    size_t n = 0;
-    while (n < cap && fgets(line, sizeof line, f)) {
-        if (strncmp(line, "| ", 2) != 0)
-            continue;
-        const char *p = line + 2, *q = p;
-        while (isalnum((unsigned char)*q) || *q == '_')
-            q++;
-        if (q == p || strncmp(q, " | `", 4) != 0)
-            continue;
-        const char *g = q + 4, *ge = strchr(g, '`');
-        if (!ge || (size_t)(q - p) >= sizeof out[n].name || (size_t)(ge - g) >= sizeof out[n].glb)
-            continue;
-        memcpy(out[n].name, p, (size_t)(q - p));
-        out[n].name[q - p] = '\0';
-        memcpy(out[n].glb, g, (size_t)(ge - g));
-        out[n].glb[ge - g] = '\0';
-        n++;
-    }
-    fclose(f);
-    return n;
-}
-
 static void check_set(const rt_kdtree *tree, const char *model, const char *kind)
 {
     char rel[512], rays[4096], hits[4096];
@@ -164,8 +130,8 @@ static void test_bench_rays(void **state)
 {
     (void)state;
     test_require_shared();
-    bench_model models[16];
-    size_t n = read_manifest(models, 16);
+    test_bench_model models[16];
+    size_t n = test_bench_models(models, 16);
     if (n == 0) /* the shared assets are there: their ray sets must be too */
         fail_msg("no bench models in %s", test_shared_path("bench/MANIFEST.md"));
     for (size_t m = 0; m < n; m++) {

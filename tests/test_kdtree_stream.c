@@ -444,47 +444,13 @@ static void test_degenerate_rays(void **state)
 
 /* ------------------------------------------------ the shared ray sets */
 
-typedef struct bench_model {
-    char name[128];
-    char glb[512];
-} bench_model;
-
-/* Models from the manifest's table rows: "| Name | `path` | ...". */
-static size_t read_manifest(bench_model *out, size_t cap)
-{
-    FILE *f = fopen(test_shared_path("bench/MANIFEST.md"), "r");
-    if (!f)
-        return 0;
-    char line[2048];
-    size_t n = 0;
-    while (n < cap && fgets(line, sizeof line, f)) {
-        if (strncmp(line, "| ", 2) != 0)
-            continue;
-        const char *p = line + 2, *q = p;
-        while (isalnum((unsigned char)*q) || *q == '_')
-            q++;
-        if (q == p || strncmp(q, " | `", 4) != 0)
-            continue;
-        const char *g = q + 4, *ge = strchr(g, '`');
-        if (!ge || (size_t)(q - p) >= sizeof out[n].name || (size_t)(ge - g) >= sizeof out[n].glb)
-            continue;
-        memcpy(out[n].name, p, (size_t)(q - p));
-        out[n].name[q - p] = '\0';
-        memcpy(out[n].glb, g, (size_t)(ge - g));
-        out[n].glb[ge - g] = '\0';
-        n++;
-    }
-    fclose(f);
-    return n;
-}
-
 /* Blocks of 2048 consecutive rays (a stream as a renderer makes them),
  * spread over each primary and diffuse set of every model. */
 static void test_shared_sets(void **state)
 {
     (void)state;
-    bench_model models[16];
-    size_t nm = read_manifest(models, 16);
+    test_bench_model models[16];
+    size_t nm = test_bench_models(models, 16);
     if (nm == 0) {
         fprintf(stderr, "skip: no models in %s (set RT_SHARED)\n", test_shared_path("bench/MANIFEST.md"));
         skip();

@@ -12,6 +12,7 @@
 #ifndef RT_TEST_UTIL_H
 #define RT_TEST_UTIL_H
 
+#include <ctype.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stdbool.h>
@@ -212,6 +213,42 @@ static inline uint64_t test_rng_next(test_rng *r)
 static inline float test_rng_float(test_rng *r) /* [0, 1) */
 {
     return (float)(test_rng_next(r) >> 40) * (1.0f / 16777216.0f);
+}
+
+/* The shared benchmark models, from bench/MANIFEST.md's table rows
+ * ("| Name | `path` | ..."): up to cap of them into out; 0 when the
+ * manifest is not there. */
+typedef struct test_bench_model {
+    char name[128];
+    char glb[512];
+} test_bench_model;
+
+static inline size_t test_bench_models(test_bench_model *out, size_t cap)
+{
+    FILE *f = fopen(test_shared_path("bench/MANIFEST.md"), "r");
+    if (!f)
+        return 0;
+    char line[2048];
+    size_t n = 0;
+    while (n < cap && fgets(line, sizeof line, f)) {
+        if (strncmp(line, "| ", 2) != 0)
+            continue;
+        const char *p = line + 2, *q = p;
+        while (isalnum((unsigned char)*q) || *q == '_')
+            q++;
+        if (q == p || strncmp(q, " | `", 4) != 0)
+            continue;
+        const char *g = q + 4, *ge = strchr(g, '`');
+        if (!ge || (size_t)(q - p) >= sizeof out[n].name || (size_t)(ge - g) >= sizeof out[n].glb)
+            continue;
+        memcpy(out[n].name, p, (size_t)(q - p));
+        out[n].name[q - p] = '\0';
+        memcpy(out[n].glb, g, (size_t)(ge - g));
+        out[n].glb[ge - g] = '\0';
+        n++;
+    }
+    fclose(f);
+    return n;
 }
 
 #endif
