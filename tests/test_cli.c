@@ -473,6 +473,62 @@ static void test_camera_flags(void **state)
            "0,1,0", "--look-from", "0,0,0", "-o", o);
 }
 
+/* What users of pbrt-v4, Mitsuba 3 and Blender type: the aliases --spp,
+ * --outfile, --nthreads and -D KEY=VALUE, values attached to short flags
+ * (-s2, -r12x10, -Dseed=3), blanks in comma lists: each the same image as
+ * rt's own spelling. A mistyped flag gets the nearest name. */
+static void test_flag_conveniences(void **state)
+{
+    (void)state;
+    const char *o = out_png;
+    char ref[600], out[600];
+    snprintf(ref, sizeof ref, "%s", path_in("conv-ref.pfm"));
+    snprintf(out, sizeof out, "%s", path_in("conv.pfm"));
+    const char *const own[] = {"-r", "12x10", "-s", "2", "-t", "1", "--set", "seed=3", "--look-from", "0,1,3.5",
+                               "--aov", "albedo,normal", NULL};
+    render_ok(ref, own);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_args(r, (const char *const[]){"-q", "--outfile", out, "--spp", "2", "--nthreads", "1", "-D", "seed=3", "-r",
+                                      "12x10", "--look-from", "0, 1, 3.5", "--aov", "albedo, normal", NULL});
+    assert_int_equal(r->status, 0);
+    assert_same_file(ref, out);
+    unlink(out);
+    run_args(r, (const char *const[]){"-q", "-s2", "-r12x10", "-t1", "-Dseed=3", "--spp=2", "--look-from",
+                                      " 0 ,1,3.5 ", "--aov=albedo , normal", "-o", out, NULL});
+    assert_int_equal(r->status, 0);
+    assert_same_file(ref, out);
+    /* the wrote line names the AOV files, or an EXR's layers */
+    run_args(r, (const char *const[]){"-r", "12x10", "-s", "1", "--aov", "albedo,normal", "-o", path_in("conv.png"),
+                                      NULL});
+    assert_int_equal(r->status, 0);
+    char line[1400];
+    snprintf(line, sizeof line, "wrote %s and %s, %s: 12x10", path_in("conv.png"), path_in("conv.albedo.pfm"),
+             path_in("conv.normal.pfm"));
+    assert_contains(r->err, line);
+    run_args(r, (const char *const[]){"-r", "12x10", "-s", "1", "--aov", "depth,albedo", "-o", path_in("conv.exr"),
+                                      NULL});
+    assert_int_equal(r->status, 0);
+    snprintf(line, sizeof line, "wrote %s (layers albedo, depth): 12x10", path_in("conv.exr"));
+    assert_contains(r->err, line);
+    free(r);
+    unlink(ref), unlink(out), unlink(path_in("conv.png")), unlink(path_in("conv.exr"));
+    unlink(path_in("conv.albedo.pfm")), unlink(path_in("conv.normal.pfm"));
+    unlink(path_in("conv-ref.albedo.pfm")), unlink(path_in("conv-ref.normal.pfm"));
+
+    REFUSE(o, "unknown option '--sampels' (did you mean '--samples'?)", NULL, "--sampels", "4", "-o", o);
+    REFUSE(o, "unknown option '--fvo' (did you mean '--fov'?)", NULL, "--fvo=30", "-o", o);
+    REFUSE(o, "unknown option '-spp' (did you mean '--spp'?)", NULL, "-spp", "4", "-o", o); /* not -s "pp" */
+    REFUSE(o, "unknown option '-qv'", NULL, "-qv", "-o", o); /* no bundled short flags */
+    REFUSE(o, "-s wants samples per pixel", "'0'", "-s0", "-o", o);
+    REFUSE(o, "--spp wants samples per pixel", "'0'", "--spp=0", "-o", o);
+    REFUSE(o, "-r wants", "'0x5'", "-r0x5", "-o", o);
+    REFUSE(o, "-D samples=0: ", "samples per pixel must be between 1 and 1048576", "-Dsamples=0", "-o", o);
+    REFUSE(o, "--nthreads wants a thread count", "'0'", "--nthreads", "0", "-o", o);
+    REFUSE(o, "--look-from wants three numbers", "'0, , 5'", "--look-from", "0, , 5", "-o", o);
+    REFUSE(o, "--aov: unknown AOV", "'nope'", "--aov", "albedo, nope", "-o", o);
+}
+
 /* Every flag `rt --help` lists is in README.md's flag table ("Using it"). */
 static void test_help_flags_in_readme(void **state)
 {
@@ -2453,6 +2509,7 @@ int main(void)
         cmocka_unit_test(test_flag_forms),
         cmocka_unit_test(test_flag_forms_same_image),
         cmocka_unit_test(test_camera_flags),
+        cmocka_unit_test(test_flag_conveniences),
         cmocka_unit_test(test_help_flags_in_readme),
         cmocka_unit_test(test_verbose_lines_prefixed),
         cmocka_unit_test(test_no_input_says_so),
