@@ -2502,6 +2502,68 @@ static void test_compare_command(void **state)
     free(r);
 }
 
+/* rt convert and rt compare given a part (sums and counts, docs/farm.md):
+ * its region's picture, sum / count, the bits of the render's own pixels;
+ * a .pfm part's counts file and a broken part refused by name. */
+static void test_convert_compare_parts(void **state)
+{
+    (void)state;
+    const char *full = path_in("pc-full.pfm"), *crop = path_in("pc-crop.exr"), *whole = path_in("pc-whole.pfm");
+    const char *out = path_in("pc-out.pfm");
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_args(r, (const char *const[]){"-q", "-r", "16x12", "-s", "4", "-o", full, NULL});
+    assert_int_equal(r->status, 0);
+    run_args(r, (const char *const[]){"-q", "-r", "16x12", "-s", "4", "--crop", "4", "2", "12", "10", "-o", crop,
+                                      NULL});
+    assert_int_equal(r->status, 0);
+    run_args(r, (const char *const[]){"-q", "-r", "16x12", "-s", "4", "--part", "0/1", "-o", whole, NULL});
+    assert_int_equal(r->status, 0);
+    /* a lone crop: its 8x8 pixels, each the render's */
+    run_args(r, (const char *const[]){"convert", crop, out, NULL});
+    assert_int_equal(r->status, 0);
+    assert_contains(r->err, "is a part: pixels [4, 12) x [2, 10) of 16x12, samples 0:4 of 4");
+    rt_framebuffer a, b;
+    rt_error err = {0};
+    assert_int_equal(rt_image_read(full, &a, &err), RT_OK);
+    assert_int_equal(rt_image_read(out, &b, &err), RT_OK);
+    assert_int_equal(b.width, 8);
+    assert_int_equal(b.height, 8);
+    for (int y = 0; y < 8; y++)
+        assert_memory_equal(b.rgb + 3 * (size_t)y * 8, a.rgb + 3 * ((size_t)(y + 2) * 16 + 4), 8 * 3 * sizeof(float));
+    rt_framebuffer_free(&a);
+    rt_framebuffer_free(&b);
+    /* a part of the whole image, by its image or its sidecar: the render's bytes */
+    run_args(r, (const char *const[]){"convert", whole, out, NULL});
+    assert_int_equal(r->status, 0);
+    assert_same_file(full, out);
+    char sidecar[700];
+    snprintf(sidecar, sizeof sidecar, "%s.json", whole);
+    run_args(r, (const char *const[]){"compare", sidecar, full, "--max-rmse", "0", "--max-flip", "0", NULL});
+    assert_int_equal(r->status, 0);
+    assert_contains(r->err, "pc-whole.pfm.json is a part");
+    run_args(r, (const char *const[]){"compare", full, crop, NULL}); /* the crop is 8x8: sizes differ */
+    assert_int_equal(r->status, 2);
+    assert_contains(r->err, "is 16x12 but the reference");
+    /* not the part's companion files, nor a part whose sidecar lies */
+    REFUSE(out_png, "pc-whole.count.pfm holds the sample counts of the part", "pc-whole.pfm", "convert",
+           path_in("pc-whole.count.pfm"), out_png);
+    static char text[1 << 14];
+    size_t n = read_all(sidecar, text, sizeof text);
+    assert_true(n != (size_t)-1);
+    char *hash = strstr(text, "\"image_fnv1a64\": \"");
+    assert_non_null(hash);
+    hash[18] = hash[18] == '0' ? '1' : '0'; /* another image's hash */
+    test_write_file(sidecar, text, n);
+    REFUSE(out_png, "pc-whole.pfm", NULL, "convert", whole, out_png);
+    REFUSE(out_png, "pc-whole.pfm", NULL, "compare", whole, full);
+    free(r);
+    unlink(full), unlink(crop), unlink(out), unlink(whole), unlink(sidecar);
+    unlink(path_in("pc-whole.count.pfm")), unlink(path_in("pc-whole.block.0.pfm"));
+    snprintf(sidecar, sizeof sidecar, "%s.json", crop);
+    unlink(sidecar);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -2543,6 +2605,7 @@ int main(void)
         cmocka_unit_test(test_window_camera_xdotool),
         cmocka_unit_test(test_window_inputs),
         cmocka_unit_test(test_compare_command),
+        cmocka_unit_test(test_convert_compare_parts),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);
 }
