@@ -786,6 +786,93 @@ static void test_info(void **state)
            out_png);
 }
 
+/* --info applies the flags that change the render, as the render does
+ * (-r, -s, --integrator, -o, --set, --camera auto, --look-from), prints
+ * the automatic camera's pose (given back as flags, the same image), and
+ * lists the cameras, the animations with their frames at --fps and the
+ * material variants. */
+static void test_info_flags(void **state)
+{
+    (void)state;
+    static char text[1 << 14];
+    write_text("if.txt", "resolution 12 10\nsamples 3\nintegrator whitted\n"
+                         "camera position 0 1 5 look_at 0 1 0 fov 30\nmaterial m\nsphere 0 0 0 1 m\n"
+                         "sphere 1.5 0.2 -1 0.5 m\n");
+    const char *const args[] = {"--info", path_in("if.txt"), "-r", "100x80", "-s", "7", "--integrator", "path", "-o",
+                                "foo.exr", "--camera", "auto", "--look-from", "0,2,6", "--set", "exposure=2",
+                                "--seed=4", NULL};
+    assert_int_equal(run_stdout(args, text, sizeof text), 0);
+    assert_contains(text, "camera: auto (framed to the bounds; --camera auto), then --look-from\n"
+                          "camera.position: 0 2 6\n");
+    assert_contains(text, "resolution: 100x80\nsamples: 7\nintegrator: path\noutput: foo.exr\n");
+    assert_contains(text, "setting.exposure: 2 (--set)\nsetting.seed: 4 (--seed)\n");
+    /* the automatic camera's pose, given back as flags: the same image */
+    write_text("if-auto.txt", "resolution 16 12\nsamples 1\nmaterial m\nsphere 0 0 0 1 m\nsphere 1.5 0.2 -1 0.5 m\n");
+    const char *const auto_args[] = {"--info", path_in("if-auto.txt"), NULL};
+    assert_int_equal(run_stdout(auto_args, text, sizeof text), 0);
+    assert_contains(text, "camera: auto (framed to the bounds)\n");
+    char from[128], at[128], up[128], fov[64];
+    const char *c = strstr(text, "camera.position: ");
+    assert_non_null(c);
+    float v[10];
+    assert_int_equal(sscanf(c, "camera.position: %g %g %g\ncamera.look_at: %g %g %g\ncamera.up: %g %g %g\n"
+                               "camera.fov: %g", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6], &v[7], &v[8], &v[9]),
+                     10);
+    snprintf(from, sizeof from, "%.9g,%.9g,%.9g", v[0], v[1], v[2]);
+    snprintf(at, sizeof at, "%.9g,%.9g,%.9g", v[3], v[4], v[5]);
+    snprintf(up, sizeof up, "%.9g,%.9g,%.9g", v[6], v[7], v[8]);
+    snprintf(fov, sizeof fov, "%.9g", v[9]);
+    char a[600], b[600];
+    snprintf(a, sizeof a, "%s", path_in("if-a.pfm"));
+    snprintf(b, sizeof b, "%s", path_in("if-b.pfm"));
+    render_ok(a, (const char *const[]){path_in("if-auto.txt"), NULL});
+    render_ok(b, (const char *const[]){"--look-from", from, "--look-at", at, "--up", up, "--fov", fov,
+                                       path_in("if-auto.txt"), NULL});
+    assert_same_file(a, b);
+    unlink(a), unlink(b);
+    /* a glTF's cameras and variants; -r wins over the camera's aspect ratio */
+    const char *const gltf_args[] = {"--info", "assets/ext/variants.gltf", "-r", "64x64", "--variant", "blue", NULL};
+    assert_int_equal(run_stdout(gltf_args, text, sizeof text), 0);
+    assert_contains(text, "cameras: 1\ncamera.0: position 0 0 3.15815878 look_at 0 0 2.15815878 fov ");
+    assert_contains(text, "variants: 2\nvariant.0: red\nvariant.1: blue\n");
+    assert_contains(text, "camera: gltf camera 0\n");
+    assert_contains(text, "resolution: 64x64\n");
+    /* animations: names, lengths and frames at --fps */
+    const float data[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, /* the triangle */
+                          0, 1.5f, 0, 0.25f,         /* key times of the two animations */
+                          0, 0, 0, 2, 0, 0};         /* translations */
+    char *enc = test_base64(data, sizeof data);
+    static char json[8192];
+    snprintf(json, sizeof json,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,"
+             "\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":8},"
+             "{\"buffer\":0,\"byteOffset\":44,\"byteLength\":8},{\"buffer\":0,\"byteOffset\":52,\"byteLength\":24}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+             "\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":2,"
+             "\"type\":\"SCALAR\"},{\"bufferView\":2,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\"},"
+             "{\"bufferView\":3,\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+             "\"animations\":[{\"name\":\"Walk\",\"samplers\":[{\"input\":1,\"output\":3}],"
+             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]},"
+             "{\"samplers\":[{\"input\":2,\"output\":3}],"
+             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]}",
+             sizeof data, enc);
+    free(enc);
+    write_text("walk.gltf", json);
+    const char *const anim_args[] = {"--info", path_in("walk.gltf"), "--fps", "10", NULL};
+    assert_int_equal(run_stdout(anim_args, text, sizeof text), 0);
+    assert_contains(text, "animations: 2\nanimation.0: 'Walk', 1.5 s, frames 0:16 at 10 fps\n"
+                          "animation.1: (unnamed), 0.25 s, frames 0:3 at 10 fps\n");
+    /* a scene file's model lines count too */
+    snprintf(json, sizeof json, "model %s\n", path_in("walk.gltf"));
+    write_text("walk.txt", json);
+    const char *const scene_args[] = {"--info", path_in("walk.txt"), NULL};
+    assert_int_equal(run_stdout(scene_args, text, sizeof text), 0);
+    assert_contains(text, "animations: 2\nanimation.0: 'Walk', 1.5 s, frames 0:37 at 24 fps\n");
+}
+
 /* A model given directly renders with the path tracer at 64 spp; a scene
  * file keeps its integrator line. */
 static void test_model_defaults(void **state)
@@ -2578,6 +2665,7 @@ int main(void)
         cmocka_unit_test(test_bad_scene_files),
         cmocka_unit_test(test_inputs),
         cmocka_unit_test(test_info),
+        cmocka_unit_test(test_info_flags),
         cmocka_unit_test(test_model_defaults),
         cmocka_unit_test(test_bad_models),
         cmocka_unit_test(test_missing_textures),

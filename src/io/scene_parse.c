@@ -1506,6 +1506,7 @@ static rt_result st_model(parser *p, const tok *kw)
         return r;
     if ((r = apply_pose(p, &pose, &opt)) != RT_OK)
         return r;
+    opt.catalog = p->pose.catalog;
     opt.use_transform = x.translate_tok || x.rotate_tok || x.scale_tok;
     opt.transform = opt.use_transform ? xform_matrix(&x) : rt_mat4_identity();
     rt_error inner = {0};
