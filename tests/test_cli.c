@@ -2651,6 +2651,45 @@ static void test_convert_compare_parts(void **state)
     unlink(sidecar);
 }
 
+/* --crop with -o NAME.png: the cropped image (pbrt's --pixelbounds), each
+ * pixel the full render's; --part-out keeps the part beside it; -o .exr
+ * is a part as before. */
+static void test_crop_image(void **state)
+{
+    (void)state;
+    const char *full = path_in("ci-full.png"), *crop = path_in("ci-crop.png"), *part = path_in("ci-part.exr");
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_args(r, (const char *const[]){"-q", "-r", "16x12", "-s", "2", "-o", full, NULL});
+    assert_int_equal(r->status, 0);
+    run_args(r, (const char *const[]){"-r", "16x12", "-s", "2", "--crop", "4", "2", "12", "10", "-o", crop,
+                                      "--part-out", part, NULL});
+    assert_int_equal(r->status, 0);
+    assert_contains(r->err, ": 8x8, 2 of 2 spp");
+    int fw, fh, cw, ch, n;
+    unsigned char *f = stbi_load(full, &fw, &fh, &n, 3), *c = stbi_load(crop, &cw, &ch, &n, 3);
+    assert_non_null(f);
+    assert_non_null(c);
+    assert_int_equal(cw, 8);
+    assert_int_equal(ch, 8);
+    for (int y = 0; y < 8; y++)
+        assert_memory_equal(c + (size_t)y * 8 * 3, f + ((size_t)(y + 2) * 16 + 4) * 3, 8 * 3);
+    stbi_image_free(f);
+    stbi_image_free(c);
+    char sidecar[700];
+    snprintf(sidecar, sizeof sidecar, "%s.json", part);
+    assert_int_equal(access(sidecar, F_OK), 0); /* the part too */
+    unlink(part), unlink(sidecar), unlink(crop);
+    run_args(r, (const char *const[]){"-q", "-r", "16x12", "-s", "2", "--crop", "4", "2", "12", "10", "-o", part,
+                                      NULL});
+    assert_int_equal(r->status, 0);
+    assert_int_equal(access(sidecar, F_OK), 0); /* .exr: a part, as before */
+    REFUSE(out_png, "--crop 4 2 40 10: the image is only 16x12", NULL, "-r", "16x12", "--crop", "4", "2", "40", "10",
+           "-o", out_png);
+    free(r);
+    unlink(full), unlink(part), unlink(sidecar);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -2694,6 +2733,7 @@ int main(void)
         cmocka_unit_test(test_window_inputs),
         cmocka_unit_test(test_compare_command),
         cmocka_unit_test(test_convert_compare_parts),
+        cmocka_unit_test(test_crop_image),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);
 }

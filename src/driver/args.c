@@ -21,6 +21,7 @@
 #include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
 #include "rt/io/environment_image.h"
+#include "rt/job/part.h"
 #include "rt/render/render.h"
 #include "tev.h"
 
@@ -158,8 +159,9 @@ static const flag flags[] = {
      "more files may follow (rt --info a.glb b.txt), one block each", SETS_TEXT(info_path)},
     {NULL, "--max-memory", "SIZE", FLAG_MAX_MEMORY, NULL, "memory budget, e.g. 4G or 512M; 'none' for no limit", OWN},
     {NULL, "--crop", "X0 Y0 X1 Y1", FLAG_CROP, NULL,
-     "render only pixels X0 <= x < X1, Y0 <= y < Y1 as a part (docs/farm.md): a float image of sums and counts "
-     "(.exr or .pfm) with a NAME.json sidecar, for rt merge", OWN},
+     "render only pixels X0 <= x < X1, Y0 <= y < Y1: with -o NAME.png (or .hdr) the cropped image, as pbrt's "
+     "--pixelbounds; with no -o or -o NAME.exr (.pfm) a part (docs/farm.md): sums and counts with a NAME.json "
+     "sidecar, for rt merge (--part-out FILE writes one beside a cropped image)", OWN},
     {NULL, "--part", "I/N", FLAG_PART, NULL,
      "render part I (0 .. N-1) of N bands of rows of similar cost, as a part (docs/farm.md)", OWN},
     {NULL, "--spp-range", "A:B", FLAG_SPP_RANGE, NULL,
@@ -785,7 +787,14 @@ int args_parse(args *a, int argc, char **argv)
     return check_combinations(a);
 }
 
-bool args_output_is_part(const args *a) { return a->has_crop || a->part_count > 0 || a->has_spp_range; }
+/* --crop with -o naming an image format (.png, .hdr) is the cropped image,
+ * as pbrt-v4's --pixelbounds gives it; with .exr, .pfm or no -o, a part. */
+static bool crop_is_image(const args *a) { return a->has_crop && a->output && !rt_part_path_ok(a->output); }
+
+bool args_output_is_part(const args *a)
+{
+    return (a->has_crop && !crop_is_image(a)) || a->part_count > 0 || a->has_spp_range;
+}
 
 bool args_sets(const args *a, const char *name)
 {
