@@ -4,8 +4,12 @@
  * command line, the scene format and --help cannot disagree.
  *
  * Conventions (GNU getopt_long's, without its global state): short and long
- * forms, `--name=value`, `--` ends the flags. A value that looks like a flag
- * (`-s -o`) is not taken as a value; a lone `-` or a negative number is.
+ * forms, `--name=value`, a one-letter flag's value in the same word (`-s4`,
+ * `-r320x240`), `--` ends the flags. A value that looks like a flag (`-s -o`)
+ * is not taken as a value; a lone `-` or a negative number is. Other
+ * renderers' names are aliases in the table (pbrt-v4's --spp, --outfile,
+ * --nthreads; Mitsuba's -D for --set); an unknown flag is refused with the
+ * nearest name (rt/base/near_miss.h, as the scene parser does).
  */
 #include "args.h"
 

@@ -1,8 +1,8 @@
 /* args.h - the `rt` command line (driver-private): flags in, one record out.
  *
- * Every flag has a short and/or long form (`-s 64`, `--samples 64`,
- * `--samples=64`); a flag missing its value says so rather than taking the
- * next flag as its value. The flags that set scene settings (-s, -r, --seed,
+ * Every flag has a short and/or long form (`-s 64`, `-s64`, `--samples 64`,
+ * `--samples=64`, and aliases such as `--spp 64`); a flag missing its value
+ * says so rather than taking the next flag as its value. The flags that set scene settings (-s, -r, --seed,
  * --integrator, and --set KEY=VALUE for any setting) go through the settings
  * table (rt/render/settings.h): they are checked while parsing, so a bad value
  * is refused before anything is loaded, and applied after loading, in the
