@@ -167,3 +167,27 @@ put("image_file", "rgb-be-3x2.pfm", pfm(3, 2, False, True))
 put("image_file", "grey-4x2.pfm", pfm(4, 2, True, False))
 for p in sorted(glob.glob("tests/corpus/exr/*.exr")):
     put("image_file", os.path.basename(p), open(p, "rb").read())
+
+# nvdb: a small density grid and a two-grid file, written by OpenVDB's own
+# tools when they are here (python3-openvdb, libnanovdb-tools)
+import subprocess, tempfile
+NVDB_SCRIPT = """
+import sys, pyopenvdb as vdb
+g = vdb.FloatGrid(); g.name = 'density'; a = g.getAccessor()
+for i in range(3):
+    for j in range(2):
+        a.setValueOn((i, j, i - j), 0.25 * (i + 1))
+t = vdb.FloatGrid(); t.name = 'temperature'; t.getAccessor().setValueOn((9, 0, 0), 2.0)
+vdb.write(sys.argv[1], grids=[g])
+vdb.write(sys.argv[2], grids=[g, t])
+"""
+with tempfile.TemporaryDirectory() as tmp:
+    one, two = os.path.join(tmp, "one.vdb"), os.path.join(tmp, "two.vdb")
+    try:
+        subprocess.run(["/usr/bin/python3", "-c", NVDB_SCRIPT, one, two], check=True, capture_output=True)
+        for name, src in (("density.nvdb", one), ("two-grids.nvdb", two)):
+            dst = os.path.join(tmp, name)
+            subprocess.run(["nanovdb_convert", "-f", src, dst], check=True, capture_output=True)
+            put("nvdb", name, open(dst, "rb").read())
+    except (OSError, subprocess.CalledProcessError) as e:
+        print("fuzz_seeds: no nvdb seeds (python3-openvdb and libnanovdb-tools make them): %s" % e, file=sys.stderr)

@@ -9,10 +9,13 @@
 #                  compressed glTF: EXT_meshopt_compression,
 #                  KHR_draco_mesh_compression (C++; g++ builds src/io/draco.cc),
 #                  EXT_texture_webp
+#   libnanovdb-dev PNanoVDB.h, the C header rt reads NanoVDB density grids with
 # and, optionally (rt builds and runs without them; a failed install is only
 # reported): libsdl2-dev for --window, xvfb and xdotool for the tests that
 # open it and move its camera with real X input, strace for the test that
-# the image writer renames right after it links (test_cli).
+# the image writer renames right after it links (test_cli), python3-openvdb
+# and libnanovdb-tools for the tests that write NanoVDB grids with
+# OpenVDB's own tools (test_nanovdb, make fuzz's seeds).
 #
 # With arguments PACKAGE:COMMAND or PACKAGE ..., it installs instead just
 # the packages whose COMMAND is not on the PATH (or in /usr/sbin), or which
@@ -75,6 +78,7 @@ check meshoptimizer.h libmeshoptimizer-dev
 check webp/decode.h libwebp-dev
 command -v "$CXX" >/dev/null 2>&1 || missing="$missing g++"
 check draco/compression/decode.h libdraco-dev c++ "$CXX"
+check nanovdb/PNanoVDB.h libnanovdb-dev
 
 install_optional() {
     optional=""
@@ -82,13 +86,15 @@ install_optional() {
     [ -x /usr/bin/Xvfb ] || optional="$optional xvfb"
     command -v xdotool >/dev/null 2>&1 || optional="$optional xdotool"
     [ -x /usr/bin/strace ] || optional="$optional strace" # test_write_renames_right_after_link
+    command -v nanovdb_convert >/dev/null 2>&1 || optional="$optional libnanovdb-tools" # test_nanovdb
+    /usr/bin/python3 -c 'import pyopenvdb' >/dev/null 2>&1 || optional="$optional python3-openvdb"
     [ -n "$optional" ] || return 0
     if [ "$(id -u)" -eq 0 ]; then
         S=""
     elif sudo -n true 2>/dev/null; then
         S="sudo -n"
     else
-        echo "rt: optional packages not installed:$optional (for --window and its tests, strace for a test of the image writer)" >&2
+        echo "rt: optional packages not installed:$optional (for --window and its tests, strace for a test of the image writer, OpenVDB's tools for the NanoVDB tests)" >&2
         return 0
     fi
     echo "rt: installing optional packages:$optional" >&2

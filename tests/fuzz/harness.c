@@ -15,15 +15,17 @@
 #include "rt/io/image_load.h"
 #include "rt/io/image_read.h"
 #include "rt/io/json.h"
+#include "rt/io/nanovdb.h"
 #include "rt/io/load.h"
 #include "rt/io/meshopt.h"
 #include "rt/job/part.h"
+#include "rt/render/volume.h"
 #include "rt/scene/scene.h"
 #include "rt/scene/texture.h"
 
 const char *const rt_fuzz_targets[] = {"scene", "gltf",    "glb",   "gltf_bin", "obj",        "ply",  "off",
                                        "image", "exr",     "meshopt", "draco", "part", "image_file", "pose",
-                                       "json",  NULL};
+                                       "json",  "nvdb",    NULL};
 
 static char dir[64];
 
@@ -190,6 +192,23 @@ static void walk_json(const rt_json *j)
  * 65 535 deep, past RT_JSON_MAX_DEPTH) inside {"a": ... }; mode 2 repeats
  * it N times (up to 65 535, at most 2 MB) as the elements of one array:
  * the depth and size extremes a few bytes cannot reach on their own. */
+/* nvdb: the bytes as a NanoVDB file; a grid that loads is walked by the
+ * majorant and ratio tracking along a diagonal, as a medium would be. */
+static void fuzz_nvdb(const uint8_t *data, size_t size)
+{
+    rt_density_grid grid;
+    rt_mat4 index_to_world;
+    rt_error err;
+    if (rt_nanovdb_parse(data, size, "fuzz.nvdb", NULL, &grid, &index_to_world, &err) != RT_OK)
+        return;
+    rt_mat4 identity = rt_mat4_identity();
+    rt_volume v = rt_volume_grid(rt_v3(1, 1, 1), rt_v3(1, 1, 1), 0.0f, &grid, &identity);
+    rt_rng rng = rt_rng_seed(1, 2);
+    rt_vec3 o = rt_v3(-1, -1, -1), d = rt_v3((float)grid.nx + 2, (float)grid.ny + 2, (float)grid.nz + 2);
+    (void)rt_volume_ratio_tracking(&v, o, d, 1.0f, &rng);
+    rt_density_grid_free(&grid);
+}
+
 static void fuzz_json(const uint8_t *data, size_t size)
 {
     if (size < 3)
@@ -325,6 +344,8 @@ int rt_fuzz_run(const char *target, const uint8_t *data, size_t size)
         fuzz_pose(data, size);
     } else if (strcmp(target, "json") == 0) {
         fuzz_json(data, size);
+    } else if (strcmp(target, "nvdb") == 0) {
+        fuzz_nvdb(data, size);
     } else {
         return -1;
     }

@@ -19,8 +19,9 @@
  * 16-bit frame time in 1/64 s, then a .glb or a gltf_bin input: loaded
  * posed at that time, so animation sampling, skins and morph targets run)
  * and json (a mode byte, a u16 N, then text for rt_json_parse: as it is,
- * wrapped in N arrays, or repeated N times in one array).
- * Every target but image, exr, meshopt, draco, part, image_file and json loads through rt_load_memory, as `rt` loads a file
+ * wrapped in N arrays, or repeated N times in one array), nvdb (a NanoVDB
+ * file's bytes: the density grid read, then walked by ratio tracking).
+ * Every target but image, exr, meshopt, draco, part, image_file, json and nvdb loads through rt_load_memory, as `rt` loads a file
  * of that kind (fuzz.txt, fuzz.gltf, fuzz.obj, ...): the content picks the
  * reader before the name does.
  */
