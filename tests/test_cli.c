@@ -2586,7 +2586,7 @@ static void test_window_keys(void **state)
     int status1 = r->status, wrote1 = count_of(r->err, "rt: wrote ");
     static char err1[sizeof r->err];
     snprintf(err1, sizeof err1, "%s", r->err);
-    run_window_script(r, dpy, "wait done; key P; key C; key P; key E; key P; key Q", out,
+    run_window_script(r, dpy, "wait done; key P; key C; key P; key E; key P; key Q; wait done; key Escape", out,
                       (const char *const[]){"-q", "-r", "40x24", "-s", "4", "--integrator", "path", "--window", "-o",
                                             png, slow_scene(), NULL});
     stop_xvfb();

@@ -6,10 +6,14 @@
  * under Xvfb). Mouse and keys move the window's camera with the pure
  * functions of rt/render/camera_control.h (a turntable orbit about
  * look_at, as yocto-gl's and pbrt-v4's viewers do) and raise request bits
- * for the driver. RT_WINDOW_SCRIPT pushes synthetic events into SDL's own
- * queue (SDL_PushEvent), so a test drives the very code a mouse does.
- * Without SDL2 at build time every call is a stub and window_open says
- * why.
+ * for the driver; a glTF camera, whose look_at is only a direction, moves
+ * about the model's depth (rt_camera_depth, given as the pivot).
+ * RT_WINDOW_SCRIPT pushes synthetic events into SDL's own queue
+ * (SDL_PushEvent), so a test drives the very code a mouse does. SDL's
+ * messages go through rt's log (rt/base/log.h): SDL_Log by
+ * SDL_LogSetOutputFunction, and what its video backends print straight to
+ * stderr while the window opens by catching fd 2 meanwhile. Without SDL2
+ * at build time every call is a stub and window_open says why.
  */
 #include "window.h"
 
