@@ -72,7 +72,6 @@ static int write_result(run *rn, rt_result r, rt_error *err)
     int status = 0;
     progress_clear(view); /* the lines below start on a line of their own */
     if (r != RT_OK && r != RT_ERR_INTERRUPTED) {
-        progress_clear(view);
         memory_budget_report(err, &a->budget);
         return 2;
     }
