@@ -153,6 +153,7 @@ $(OIDN_VENV)/.installed:
 SKIPS_ALLOWED ?=
 test: $(RT) $(TEST_BIN)
 	@sh tools/check-stages.sh
+	@sh tools/check-doc-paths.sh
 	@RT_SHARED=$(SHARED) RT_BIN=./$(RT) RT_SKIPS_ALLOWED="$(SKIPS_ALLOWED)" sh tests/run.sh $(TEST_BIN)
 
 # The tests a sanitizer build cannot run, and why (each skips saying so):

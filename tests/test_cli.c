@@ -482,6 +482,62 @@ static void test_camera_flags(void **state)
            "0,1,0", "--look-from", "0,0,0", "-o", o);
 }
 
+/* What users of pbrt-v4, Mitsuba 3 and Blender type: the aliases --spp,
+ * --outfile, --nthreads and -D KEY=VALUE, values attached to short flags
+ * (-s2, -r12x10, -Dseed=3), blanks in comma lists: each the same image as
+ * rt's own spelling. A mistyped flag gets the nearest name. */
+static void test_flag_conveniences(void **state)
+{
+    (void)state;
+    const char *o = out_png;
+    char ref[600], out[600];
+    snprintf(ref, sizeof ref, "%s", path_in("conv-ref.pfm"));
+    snprintf(out, sizeof out, "%s", path_in("conv.pfm"));
+    const char *const own[] = {"-r", "12x10", "-s", "2", "-t", "1", "--set", "seed=3", "--look-from", "0,1,3.5",
+                               "--aov", "albedo,normal", NULL};
+    render_ok(ref, own);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_args(r, (const char *const[]){"-q", "--outfile", out, "--spp", "2", "--nthreads", "1", "-D", "seed=3", "-r",
+                                      "12x10", "--look-from", "0, 1, 3.5", "--aov", "albedo, normal", NULL});
+    assert_int_equal(r->status, 0);
+    assert_same_file(ref, out);
+    unlink(out);
+    run_args(r, (const char *const[]){"-q", "-s2", "-r12x10", "-t1", "-Dseed=3", "--spp=2", "--look-from",
+                                      " 0 ,1,3.5 ", "--aov=albedo , normal", "-o", out, NULL});
+    assert_int_equal(r->status, 0);
+    assert_same_file(ref, out);
+    /* the wrote line names the AOV files, or an EXR's layers */
+    run_args(r, (const char *const[]){"-r", "12x10", "-s", "1", "--aov", "albedo,normal", "-o", path_in("conv.png"),
+                                      NULL});
+    assert_int_equal(r->status, 0);
+    char line[1400];
+    snprintf(line, sizeof line, "wrote %s and %s, %s: 12x10", path_in("conv.png"), path_in("conv.albedo.pfm"),
+             path_in("conv.normal.pfm"));
+    assert_contains(r->err, line);
+    run_args(r, (const char *const[]){"-r", "12x10", "-s", "1", "--aov", "depth,albedo", "-o", path_in("conv.exr"),
+                                      NULL});
+    assert_int_equal(r->status, 0);
+    snprintf(line, sizeof line, "wrote %s (layers albedo, depth): 12x10", path_in("conv.exr"));
+    assert_contains(r->err, line);
+    free(r);
+    unlink(ref), unlink(out), unlink(path_in("conv.png")), unlink(path_in("conv.exr"));
+    unlink(path_in("conv.albedo.pfm")), unlink(path_in("conv.normal.pfm"));
+    unlink(path_in("conv-ref.albedo.pfm")), unlink(path_in("conv-ref.normal.pfm"));
+
+    REFUSE(o, "unknown option '--sampels' (did you mean '--samples'?)", NULL, "--sampels", "4", "-o", o);
+    REFUSE(o, "unknown option '--fvo' (did you mean '--fov'?)", NULL, "--fvo=30", "-o", o);
+    REFUSE(o, "unknown option '-spp' (did you mean '--spp'?)", NULL, "-spp", "4", "-o", o); /* not -s "pp" */
+    REFUSE(o, "unknown option '-qv'", NULL, "-qv", "-o", o); /* no bundled short flags */
+    REFUSE(o, "-s wants samples per pixel", "'0'", "-s0", "-o", o);
+    REFUSE(o, "--spp wants samples per pixel", "'0'", "--spp=0", "-o", o);
+    REFUSE(o, "-r wants", "'0x5'", "-r0x5", "-o", o);
+    REFUSE(o, "-D samples=0: ", "samples per pixel must be between 1 and 1048576", "-Dsamples=0", "-o", o);
+    REFUSE(o, "--nthreads wants a thread count", "'0'", "--nthreads", "0", "-o", o);
+    REFUSE(o, "--look-from wants three numbers", "'0, , 5'", "--look-from", "0, , 5", "-o", o);
+    REFUSE(o, "--aov: unknown AOV", "'nope'", "--aov", "albedo, nope", "-o", o);
+}
+
 /* Every flag `rt --help` lists is in README.md's flag table ("Using it"). */
 static void test_help_flags_in_readme(void **state)
 {
@@ -737,6 +793,93 @@ static void test_info(void **state)
     /* a render still takes one input */
     REFUSE(out_png, "only one input file", "--info takes several", path_in("i1.txt"), path_in("i2.txt"), "-o",
            out_png);
+}
+
+/* --info applies the flags that change the render, as the render does
+ * (-r, -s, --integrator, -o, --set, --camera auto, --look-from), prints
+ * the automatic camera's pose (given back as flags, the same image), and
+ * lists the cameras, the animations with their frames at --fps and the
+ * material variants. */
+static void test_info_flags(void **state)
+{
+    (void)state;
+    static char text[1 << 14];
+    write_text("if.txt", "resolution 12 10\nsamples 3\nintegrator whitted\n"
+                         "camera position 0 1 5 look_at 0 1 0 fov 30\nmaterial m\nsphere 0 0 0 1 m\n"
+                         "sphere 1.5 0.2 -1 0.5 m\n");
+    const char *const args[] = {"--info", path_in("if.txt"), "-r", "100x80", "-s", "7", "--integrator", "path", "-o",
+                                "foo.exr", "--camera", "auto", "--look-from", "0,2,6", "--set", "exposure=2",
+                                "--seed=4", NULL};
+    assert_int_equal(run_stdout(args, text, sizeof text), 0);
+    assert_contains(text, "camera: auto (framed to the bounds; --camera auto), then --look-from\n"
+                          "camera.position: 0 2 6\n");
+    assert_contains(text, "resolution: 100x80\nsamples: 7\nintegrator: path\noutput: foo.exr\n");
+    assert_contains(text, "setting.exposure: 2 (--set)\nsetting.seed: 4 (--seed)\n");
+    /* the automatic camera's pose, given back as flags: the same image */
+    write_text("if-auto.txt", "resolution 16 12\nsamples 1\nmaterial m\nsphere 0 0 0 1 m\nsphere 1.5 0.2 -1 0.5 m\n");
+    const char *const auto_args[] = {"--info", path_in("if-auto.txt"), NULL};
+    assert_int_equal(run_stdout(auto_args, text, sizeof text), 0);
+    assert_contains(text, "camera: auto (framed to the bounds)\n");
+    char from[128], at[128], up[128], fov[64];
+    const char *c = strstr(text, "camera.position: ");
+    assert_non_null(c);
+    float v[10];
+    assert_int_equal(sscanf(c, "camera.position: %g %g %g\ncamera.look_at: %g %g %g\ncamera.up: %g %g %g\n"
+                               "camera.fov: %g", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6], &v[7], &v[8], &v[9]),
+                     10);
+    snprintf(from, sizeof from, "%.9g,%.9g,%.9g", v[0], v[1], v[2]);
+    snprintf(at, sizeof at, "%.9g,%.9g,%.9g", v[3], v[4], v[5]);
+    snprintf(up, sizeof up, "%.9g,%.9g,%.9g", v[6], v[7], v[8]);
+    snprintf(fov, sizeof fov, "%.9g", v[9]);
+    char a[600], b[600];
+    snprintf(a, sizeof a, "%s", path_in("if-a.pfm"));
+    snprintf(b, sizeof b, "%s", path_in("if-b.pfm"));
+    render_ok(a, (const char *const[]){path_in("if-auto.txt"), NULL});
+    render_ok(b, (const char *const[]){"--look-from", from, "--look-at", at, "--up", up, "--fov", fov,
+                                       path_in("if-auto.txt"), NULL});
+    assert_same_file(a, b);
+    unlink(a), unlink(b);
+    /* a glTF's cameras and variants; -r wins over the camera's aspect ratio */
+    const char *const gltf_args[] = {"--info", "assets/ext/variants.gltf", "-r", "64x64", "--variant", "blue", NULL};
+    assert_int_equal(run_stdout(gltf_args, text, sizeof text), 0);
+    assert_contains(text, "cameras: 1\ncamera.0: position 0 0 3.15815878 look_at 0 0 2.15815878 fov ");
+    assert_contains(text, "variants: 2\nvariant.0: red\nvariant.1: blue\n");
+    assert_contains(text, "camera: gltf camera 0\n");
+    assert_contains(text, "resolution: 64x64\n");
+    /* animations: names, lengths and frames at --fps */
+    const float data[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, /* the triangle */
+                          0, 1.5f, 0, 0.25f,         /* key times of the two animations */
+                          0, 0, 0, 2, 0, 0};         /* translations */
+    char *enc = test_base64(data, sizeof data);
+    static char json[8192];
+    snprintf(json, sizeof json,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,"
+             "\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":8},"
+             "{\"buffer\":0,\"byteOffset\":44,\"byteLength\":8},{\"buffer\":0,\"byteOffset\":52,\"byteLength\":24}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+             "\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":2,"
+             "\"type\":\"SCALAR\"},{\"bufferView\":2,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\"},"
+             "{\"bufferView\":3,\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],"
+             "\"animations\":[{\"name\":\"Walk\",\"samplers\":[{\"input\":1,\"output\":3}],"
+             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]},"
+             "{\"samplers\":[{\"input\":2,\"output\":3}],"
+             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":0,\"path\":\"translation\"}}]}]}",
+             sizeof data, enc);
+    free(enc);
+    write_text("walk.gltf", json);
+    const char *const anim_args[] = {"--info", path_in("walk.gltf"), "--fps", "10", NULL};
+    assert_int_equal(run_stdout(anim_args, text, sizeof text), 0);
+    assert_contains(text, "animations: 2\nanimation.0: 'Walk', 1.5 s, frames 0:16 at 10 fps\n"
+                          "animation.1: (unnamed), 0.25 s, frames 0:3 at 10 fps\n");
+    /* a scene file's model lines count too */
+    snprintf(json, sizeof json, "model %s\n", path_in("walk.gltf"));
+    write_text("walk.txt", json);
+    const char *const scene_args[] = {"--info", path_in("walk.txt"), NULL};
+    assert_int_equal(run_stdout(scene_args, text, sizeof text), 0);
+    assert_contains(text, "animations: 2\nanimation.0: 'Walk', 1.5 s, frames 0:37 at 24 fps\n");
 }
 
 /* A model given directly renders with the path tracer at 64 spp; a scene
@@ -2752,6 +2895,107 @@ static void test_compare_command(void **state)
     free(r);
 }
 
+/* rt convert and rt compare given a part (sums and counts, docs/farm.md):
+ * its region's picture, sum / count, the bits of the render's own pixels;
+ * a .pfm part's counts file and a broken part refused by name. */
+static void test_convert_compare_parts(void **state)
+{
+    (void)state;
+    const char *full = path_in("pc-full.pfm"), *crop = path_in("pc-crop.exr"), *whole = path_in("pc-whole.pfm");
+    const char *out = path_in("pc-out.pfm");
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_args(r, (const char *const[]){"-q", "-r", "16x12", "-s", "4", "-o", full, NULL});
+    assert_int_equal(r->status, 0);
+    run_args(r, (const char *const[]){"-q", "-r", "16x12", "-s", "4", "--crop", "4", "2", "12", "10", "-o", crop,
+                                      NULL});
+    assert_int_equal(r->status, 0);
+    run_args(r, (const char *const[]){"-q", "-r", "16x12", "-s", "4", "--part", "0/1", "-o", whole, NULL});
+    assert_int_equal(r->status, 0);
+    /* a lone crop: its 8x8 pixels, each the render's */
+    run_args(r, (const char *const[]){"convert", crop, out, NULL});
+    assert_int_equal(r->status, 0);
+    assert_contains(r->err, "is a part: pixels [4, 12) x [2, 10) of 16x12, samples 0:4 of 4");
+    rt_framebuffer a, b;
+    rt_error err = {0};
+    assert_int_equal(rt_image_read(full, &a, &err), RT_OK);
+    assert_int_equal(rt_image_read(out, &b, &err), RT_OK);
+    assert_int_equal(b.width, 8);
+    assert_int_equal(b.height, 8);
+    for (int y = 0; y < 8; y++)
+        assert_memory_equal(b.rgb + 3 * (size_t)y * 8, a.rgb + 3 * ((size_t)(y + 2) * 16 + 4), 8 * 3 * sizeof(float));
+    rt_framebuffer_free(&a);
+    rt_framebuffer_free(&b);
+    /* a part of the whole image, by its image or its sidecar: the render's bytes */
+    run_args(r, (const char *const[]){"convert", whole, out, NULL});
+    assert_int_equal(r->status, 0);
+    assert_same_file(full, out);
+    char sidecar[700];
+    snprintf(sidecar, sizeof sidecar, "%s.json", whole);
+    run_args(r, (const char *const[]){"compare", sidecar, full, "--max-rmse", "0", "--max-flip", "0", NULL});
+    assert_int_equal(r->status, 0);
+    assert_contains(r->err, "pc-whole.pfm.json is a part");
+    run_args(r, (const char *const[]){"compare", full, crop, NULL}); /* the crop is 8x8: sizes differ */
+    assert_int_equal(r->status, 2);
+    assert_contains(r->err, "is 16x12 but the reference");
+    /* not the part's companion files, nor a part whose sidecar lies */
+    REFUSE(out_png, "pc-whole.count.pfm holds the sample counts of the part", "pc-whole.pfm", "convert",
+           path_in("pc-whole.count.pfm"), out_png);
+    static char text[1 << 14];
+    size_t n = read_all(sidecar, text, sizeof text);
+    assert_true(n != (size_t)-1);
+    char *hash = strstr(text, "\"image_fnv1a64\": \"");
+    assert_non_null(hash);
+    hash[18] = hash[18] == '0' ? '1' : '0'; /* another image's hash */
+    test_write_file(sidecar, text, n);
+    REFUSE(out_png, "pc-whole.pfm", NULL, "convert", whole, out_png);
+    REFUSE(out_png, "pc-whole.pfm", NULL, "compare", whole, full);
+    free(r);
+    unlink(full), unlink(crop), unlink(out), unlink(whole), unlink(sidecar);
+    unlink(path_in("pc-whole.count.pfm")), unlink(path_in("pc-whole.block.0.pfm"));
+    snprintf(sidecar, sizeof sidecar, "%s.json", crop);
+    unlink(sidecar);
+}
+
+/* --crop with -o NAME.png: the cropped image (pbrt's --pixelbounds), each
+ * pixel the full render's; --part-out keeps the part beside it; -o .exr
+ * is a part as before. */
+static void test_crop_image(void **state)
+{
+    (void)state;
+    const char *full = path_in("ci-full.png"), *crop = path_in("ci-crop.png"), *part = path_in("ci-part.exr");
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_args(r, (const char *const[]){"-q", "-r", "16x12", "-s", "2", "-o", full, NULL});
+    assert_int_equal(r->status, 0);
+    run_args(r, (const char *const[]){"-r", "16x12", "-s", "2", "--crop", "4", "2", "12", "10", "-o", crop,
+                                      "--part-out", part, NULL});
+    assert_int_equal(r->status, 0);
+    assert_contains(r->err, ": 8x8, 2 of 2 spp");
+    int fw, fh, cw, ch, n;
+    unsigned char *f = stbi_load(full, &fw, &fh, &n, 3), *c = stbi_load(crop, &cw, &ch, &n, 3);
+    assert_non_null(f);
+    assert_non_null(c);
+    assert_int_equal(cw, 8);
+    assert_int_equal(ch, 8);
+    for (int y = 0; y < 8; y++)
+        assert_memory_equal(c + (size_t)y * 8 * 3, f + ((size_t)(y + 2) * 16 + 4) * 3, 8 * 3);
+    stbi_image_free(f);
+    stbi_image_free(c);
+    char sidecar[700];
+    snprintf(sidecar, sizeof sidecar, "%s.json", part);
+    assert_int_equal(access(sidecar, F_OK), 0); /* the part too */
+    unlink(part), unlink(sidecar), unlink(crop);
+    run_args(r, (const char *const[]){"-q", "-r", "16x12", "-s", "2", "--crop", "4", "2", "12", "10", "-o", part,
+                                      NULL});
+    assert_int_equal(r->status, 0);
+    assert_int_equal(access(sidecar, F_OK), 0); /* .exr: a part, as before */
+    REFUSE(out_png, "--crop 4 2 40 10: the image is only 16x12", NULL, "-r", "16x12", "--crop", "4", "2", "40", "10",
+           "-o", out_png);
+    free(r);
+    unlink(full), unlink(part), unlink(sidecar);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -2759,12 +3003,14 @@ int main(void)
         cmocka_unit_test(test_flag_forms),
         cmocka_unit_test(test_flag_forms_same_image),
         cmocka_unit_test(test_camera_flags),
+        cmocka_unit_test(test_flag_conveniences),
         cmocka_unit_test(test_help_flags_in_readme),
         cmocka_unit_test(test_verbose_lines_prefixed),
         cmocka_unit_test(test_no_input_says_so),
         cmocka_unit_test(test_bad_scene_files),
         cmocka_unit_test(test_inputs),
         cmocka_unit_test(test_info),
+        cmocka_unit_test(test_info_flags),
         cmocka_unit_test(test_model_defaults),
         cmocka_unit_test(test_bad_models),
         cmocka_unit_test(test_missing_textures),
@@ -2797,6 +3043,8 @@ int main(void)
         cmocka_unit_test(test_terminal_lines_apart),
         cmocka_unit_test(test_progress_line_after_a_move),
         cmocka_unit_test(test_compare_command),
+        cmocka_unit_test(test_convert_compare_parts),
+        cmocka_unit_test(test_crop_image),
     };
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);
 }

@@ -4,8 +4,12 @@
  * command line, the scene format and --help cannot disagree.
  *
  * Conventions (GNU getopt_long's, without its global state): short and long
- * forms, `--name=value`, `--` ends the flags. A value that looks like a flag
- * (`-s -o`) is not taken as a value; a lone `-` or a negative number is.
+ * forms, `--name=value`, a one-letter flag's value in the same word (`-s4`,
+ * `-r320x240`), `--` ends the flags. A value that looks like a flag (`-s -o`)
+ * is not taken as a value; a lone `-` or a negative number is. Other
+ * renderers' names are aliases in the table (pbrt-v4's --spp, --outfile,
+ * --nthreads; Mitsuba's -D for --set); an unknown flag is refused with the
+ * nearest name (rt/base/near_miss.h, as the scene parser does).
  */
 #include "args.h"
 
@@ -16,10 +20,12 @@
 #include <string.h>
 
 #include "rt/base/log.h"
+#include "rt/base/near_miss.h"
 #include "rt/base/number.h"
 #include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
 #include "rt/io/environment_image.h"
+#include "rt/job/part.h"
 #include "rt/render/render.h"
 #include "tev.h"
 
@@ -92,6 +98,7 @@ typedef struct flag {
     const char *setting;    /* FLAG_SETTING: the name in the settings table */
     const char *help;       /* lines for --help; FLAG_SETTING: the table's */
     flag_store store;       /* a plain flag: where its value goes */
+    const char *alias;      /* another long name other renderers use ("--spp", pbrt's), or NULL */
 } flag;
 
 #define ARG(f) offsetof(args, f)
@@ -104,7 +111,7 @@ typedef struct flag {
 static const flag flags[] = {
     {"-o", "--output", "FILE", FLAG_OUTPUT, NULL,
      "output image: .png (8-bit sRGB), .pfm (linear float), .hdr (Radiance), .exr (OpenEXR)\n"
-     "default: the scene's `output`, else INPUT-NAME.png in this directory", SETS_TEXT(output)},
+     "default: the scene's `output`, else INPUT-NAME.png in this directory", SETS_TEXT(output), .alias = "--outfile"},
     {NULL, "--exposure", "EV", FLAG_EXPOSURE, NULL,
      "exposure in stops for 8-bit output (x 2^EV, on top of the scene's `exposure`); float outputs stay linear", .store = {STORE_FLOAT, ARG(exposure_ev), false, 0, -64, 64, false, false, "stops of exposure from -64 to 64"}},
     {NULL, "--tonemap", "NAME", FLAG_TONEMAP, NULL, "tone curve for 8-bit output: clamp (default), filmic, aces or agx", OWN},
@@ -117,15 +124,15 @@ static const flag flags[] = {
     {NULL, "--aov", "LIST", FLAG_AOV, NULL,
      "extra images, comma-separated: albedo, normal, depth, position, variance, spp; layers of an .exr output, "
      "else files NAME.albedo.pfm ...", OWN},
-    {"-t", "--threads", "N", FLAG_THREADS, NULL, "render threads", .store = {STORE_INT, ARG(threads), false, 0, 1, 1024, false, false, "a thread count from 1 to 1024"}},
-    {"-s", "--samples", "N", FLAG_SETTING, "samples", NULL, OWN},
+    {"-t", "--threads", "N", FLAG_THREADS, NULL, "render threads", .store = {STORE_INT, ARG(threads), false, 0, 1, 1024, false, false, "a thread count from 1 to 1024"}, .alias = "--nthreads"},
+    {"-s", "--samples", "N", FLAG_SETTING, "samples", NULL, OWN, .alias = "--spp"},
     {"-r", "--resolution", "WxH", FLAG_SETTING, "resolution", NULL, OWN},
     {"-q", "--quiet", NULL, FLAG_QUIET, NULL, "quiet: no progress bar, no warnings", OWN},
     {"-v", "--verbose", NULL, FLAG_VERBOSE, NULL, "verbose: scene statistics, kd-tree build, render time, rays per second", OWN},
     {NULL, "--integrator", "NAME", FLAG_SETTING, "integrator", NULL, OWN},
     {NULL, "--seed", "N", FLAG_SETTING, "seed", NULL, OWN},
-    {NULL, "--set", "KEY=VALUE", FLAG_SET, NULL,
-     "set any scene setting listed below, as a scene file would (repeatable)", OWN},
+    {"-D", "--set", "KEY=VALUE", FLAG_SET, NULL,
+     "set any scene setting listed below, as a scene file would (repeatable; -D as in Mitsuba)", OWN},
     {NULL, "--camera", "N|auto", FLAG_CAMERA, NULL,
      "use camera N of the loaded glTF models, or 'auto': frame the whole scene automatically, ignoring the file's "
      "camera", OWN},
@@ -156,8 +163,9 @@ static const flag flags[] = {
      "more files may follow (rt --info a.glb b.txt), one block each", SETS_TEXT(info_path)},
     {NULL, "--max-memory", "SIZE", FLAG_MAX_MEMORY, NULL, "memory budget, e.g. 4G or 512M; 'none' for no limit", OWN},
     {NULL, "--crop", "X0 Y0 X1 Y1", FLAG_CROP, NULL,
-     "render only pixels X0 <= x < X1, Y0 <= y < Y1 as a part (docs/farm.md): a float image of sums and counts "
-     "(.exr or .pfm) with a NAME.json sidecar, for rt merge", OWN},
+     "render only pixels X0 <= x < X1, Y0 <= y < Y1: with -o NAME.png (or .hdr) the cropped image, as pbrt's "
+     "--pixelbounds; with no -o or -o NAME.exr (.pfm) a part (docs/farm.md): sums and counts with a NAME.json "
+     "sidecar, for rt merge (--part-out FILE writes one beside a cropped image)", OWN},
     {NULL, "--part", "I/N", FLAG_PART, NULL,
      "render part I (0 .. N-1) of N bands of rows of similar cost, as a part (docs/farm.md)", OWN},
     {NULL, "--spp-range", "A:B", FLAG_SPP_RANGE, NULL,
@@ -225,8 +233,9 @@ static void usage(FILE *f)
     for (size_t i = 0; i < FLAG_COUNT; i++) {
         const flag *fl = &flags[i];
         char names[64], text[512];
-        snprintf(names, sizeof names, "%s%s%s%s%s", fl->short_name ? fl->short_name : "  ",
-                 fl->short_name ? ", " : "  ", fl->long_name, fl->value ? " " : "", fl->value ? fl->value : "");
+        snprintf(names, sizeof names, "%s%s%s%s%s%s%s", fl->short_name ? fl->short_name : "  ",
+                 fl->short_name ? ", " : "  ", fl->long_name, fl->alias ? ", " : "", fl->alias ? fl->alias : "",
+                 fl->value ? " " : "", fl->value ? fl->value : "");
         if (fl->kind == FLAG_SETTING) {
             const rt_setting *def = rt_setting_find(fl->setting);
             char range[128], dflt[128];
@@ -291,16 +300,49 @@ static bool looks_like_flag(const char *s)
     return s[0] == '-' && s[1] != 0 && !(s[1] >= '0' && s[1] <= '9') && s[1] != '.';
 }
 
-/* The flag named by a[0, len). */
+/* True when name (NUL-terminated or not) is exactly the len bytes at a. */
+static bool name_is(const char *name, const char *a, size_t len)
+{
+    return name && strlen(name) == len && strncmp(a, name, len) == 0;
+}
+
+/* The flag named by a[0, len): its short or long name, or its alias. */
 static const flag *find_flag(const char *a, size_t len)
 {
     for (size_t i = 0; i < FLAG_COUNT; i++) {
         const flag *fl = &flags[i];
-        if ((fl->short_name && strlen(fl->short_name) == len && strncmp(a, fl->short_name, len) == 0) ||
-            (strlen(fl->long_name) == len && strncmp(a, fl->long_name, len) == 0))
+        if (name_is(fl->short_name, a, len) || name_is(fl->long_name, a, len) || name_is(fl->alias, a, len))
             return fl;
     }
     return NULL;
+}
+
+/* True when `-spp`, `-samples`: a long name typed with one dash (pbrt-v3's
+ * and Blender's habit), which must not read as -s with the value "pp". */
+static bool find_flag_dashed(const char *a)
+{
+    char dashed[64];
+    snprintf(dashed, sizeof dashed, "-%s", a);
+    const flag *fl = find_flag(dashed, strcspn(dashed, "="));
+    return fl && (name_is(fl->long_name, dashed, strcspn(dashed, "=")) || fl->alias);
+}
+
+/* An unknown flag a[0, len), refused with the long name closest to it
+ * (rt/base/near_miss.h), as the scene parser does for keywords: `--sampels`
+ * -> '--samples', `-spp` -> '--spp'. */
+static int unknown_flag(const char *a, size_t len)
+{
+    char word[64];
+    snprintf(word, sizeof word, "%s%.*s", a[1] == '-' ? "" : "-", (int)(len < 60 ? len : 60), a);
+    rt_near_miss n = rt_near_miss_of(word);
+    for (size_t i = 0; i < FLAG_COUNT && strlen(word) >= 5; i++) { /* not for `-x`: every short word is near one */
+        rt_near_miss_consider(&n, flags[i].long_name);
+        if (flags[i].alias)
+            rt_near_miss_consider(&n, flags[i].alias);
+    }
+    if (n.best)
+        return fail_usage("unknown option '%.*s' (did you mean '%s'?)", (int)len, a, n.best);
+    return fail_usage("unknown option '%.*s'", (int)len, a);
 }
 
 /* An integer flag value in [lo, hi]. */
@@ -345,17 +387,30 @@ static void setting_wants(const rt_setting *def, char *buf, size_t size)
     }
 }
 
-/* "X,Y,Z": three finite numbers separated by commas. */
+/* An item of a comma list, the n bytes at s, into out (cap bytes) without
+ * the blanks around it (`--look-from "0, 1, 5"`); false when it does not fit. */
+static bool list_item(const char *s, size_t n, char *out, size_t cap)
+{
+    while (n && (*s == ' ' || *s == '\t'))
+        s++, n--;
+    while (n && (s[n - 1] == ' ' || s[n - 1] == '\t'))
+        n--;
+    if (n >= cap)
+        return false;
+    memcpy(out, s, n);
+    out[n] = 0;
+    return true;
+}
+
+/* "X,Y,Z": three finite numbers separated by commas (blanks around them allowed). */
 static bool vec3_value(const char *s, rt_vec3 *out)
 {
     float v[3];
     char part[64];
     for (int i = 0; i < 3; i++) {
         size_t n = strcspn(s, ",");
-        if (n == 0 || n >= sizeof part || (i < 2 ? s[n] != ',' : s[n] != 0))
+        if ((i < 2 ? s[n] != ',' : s[n] != 0) || !list_item(s, n, part, sizeof part))
             return false;
-        memcpy(part, s, n);
-        part[n] = 0;
         if (rt_parse_float(part, &v[i]) != RT_NUMBER_OK || !isfinite(v[i]))
             return false;
         s += n + (i < 2);
@@ -486,10 +541,12 @@ static int parse_aovs(args *a, const char *name, const char *value)
     const char *s = value;
     while (*s) {
         size_t n = strcspn(s, ",");
+        char item[32];
         rt_aov_kind k;
-        if (!rt_aov_by_name(s, n, &k))
-            return fail_usage("%s: unknown AOV '%.*s' (albedo, normal, depth, position, variance, spp)", name, (int)n,
-                              s);
+        bool fits = list_item(s, n, item, sizeof item);
+        if (!fits || !rt_aov_by_name(item, strlen(item), &k))
+            return fail_usage("%s: unknown AOV '%.*s' (albedo, normal, depth, position, variance, spp)", name,
+                              fits ? (int)strlen(item) : (int)n, fits ? item : s);
         a->aovs |= 1u << k;
         s += n + (s[n] == ',');
     }
@@ -558,6 +615,7 @@ static int parse_crop(args *a, const char *name, const char *value, int argc, ch
             c = strchr(c, ',');
             if (c)
                 *c++ = 0;
+            list_item(w[nw], strlen(w[nw]), (char *)w[nw], strlen(w[nw]) + 1); /* "0, 0, 64, 32" */
         }
         if (c)
             nw = 5;
@@ -704,12 +762,20 @@ int args_parse(args *a, int argc, char **argv)
         const char *eq = strncmp(arg, "--", 2) == 0 ? strchr(arg, '=') : NULL;
         size_t len = eq ? (size_t)(eq - arg) : strlen(arg);
         const flag *fl = find_flag(arg, len);
-        if (!fl)
-            return fail_usage("unknown option '%s'", arg);
-        const char *name = eq ? fl->long_name : arg; /* as typed */
+        const char *attached = NULL; /* -s4, -r320x240, -Dsamples=4: a short flag's value in the same word */
+        if (!fl && arg[1] != '-' && !find_flag_dashed(arg)) {
+            fl = find_flag(arg, 2);
+            attached = fl && fl->value ? arg + 2 : NULL;
+        }
+        if (!fl || (fl->short_name && !fl->value && arg[1] != '-' && len > 2))
+            return unknown_flag(arg, len);
+        /* the name as typed, for messages (kept: a setting flag's message comes after the load) */
+        const char *name = attached ? fl->short_name : !eq ? arg : name_is(fl->alias, arg, len) ? fl->alias : fl->long_name;
         const char *value = NULL;
         if (fl->value) {
-            if (eq)
+            if (attached)
+                value = attached;
+            else if (eq)
                 value = eq + 1;
             else if (i + 1 < argc && !looks_like_flag(argv[i + 1]))
                 value = argv[++i];
@@ -725,7 +791,14 @@ int args_parse(args *a, int argc, char **argv)
     return check_combinations(a);
 }
 
-bool args_output_is_part(const args *a) { return a->has_crop || a->part_count > 0 || a->has_spp_range; }
+/* --crop with -o naming an image format (.png, .hdr) is the cropped image,
+ * as pbrt-v4's --pixelbounds gives it; with .exr, .pfm or no -o, a part. */
+static bool crop_is_image(const args *a) { return a->has_crop && a->output && !rt_part_path_ok(a->output); }
+
+bool args_output_is_part(const args *a)
+{
+    return (a->has_crop && !crop_is_image(a)) || a->part_count > 0 || a->has_spp_range;
+}
 
 bool args_sets(const args *a, const char *name)
 {

@@ -1,8 +1,8 @@
 /* args.h - the `rt` command line (driver-private): flags in, one record out.
  *
- * Every flag has a short and/or long form (`-s 64`, `--samples 64`,
- * `--samples=64`); a flag missing its value says so rather than taking the
- * next flag as its value. The flags that set scene settings (-s, -r, --seed,
+ * Every flag has a short and/or long form (`-s 64`, `-s64`, `--samples 64`,
+ * `--samples=64`, and aliases such as `--spp 64`); a flag missing its value
+ * says so rather than taking the next flag as its value. The flags that set scene settings (-s, -r, --seed,
  * --integrator, and --set KEY=VALUE for any setting) go through the settings
  * table (rt/render/settings.h): they are checked while parsing, so a bad value
  * is refused before anything is loaded, and applied after loading, in the
@@ -96,8 +96,10 @@ typedef struct args {
 int args_parse(args *a, int argc, char **argv);
 /* True when a flag sets the setting called `name` (e.g. "resolution"). */
 bool args_sets(const args *a, const char *name);
-/* True when the output is a part rather than an image: --crop, --part or
- * --spp-range given (--resume decides later, from the part it continues). */
+/* True when the output is a part rather than an image: --part or
+ * --spp-range given, or --crop with no -o or an -o of a part's format
+ * (.exr, .pfm; --crop -o x.png is the cropped image); --resume decides
+ * later, from the part it continues. */
 bool args_output_is_part(const args *a);
 /* The job's options (rt/job/options.h) from the flags. */
 void args_job_options(const args *a, rt_job_options *o);

@@ -20,6 +20,7 @@
 #include "rt/image/srgb.h"
 #include "rt/io/image_write.h"
 #include "rt/io/image_read.h"
+#include "rt/job/part_image.h"
 
 static const char usage[] =
     "usage: rt compare CANDIDATE REFERENCE [options]\n"
@@ -131,15 +132,23 @@ static int parse_args(int argc, char **argv, compare_args *a, FILE *out, FILE *e
     return 0;
 }
 
-/* Reads a PFM, EXR, HDR (or 8-bit) image; fails with a message naming the
+/* Reads a PFM, EXR, HDR (or 8-bit) image, or a part resolved into its
+ * region's picture (rt/job/part_image.h); fails with a message naming the
  * file, including for non-finite values, which no metric can take. */
 static bool read_image(const char *path, rt_framebuffer *fb, FILE *errs)
 {
     rt_error err = {0};
-    if (rt_image_read(path, fb, &err) != RT_OK) {
+    rt_part_info info;
+    bool part = false;
+    if (rt_image_or_part_read(path, fb, &info, &part, &err) != RT_OK) {
         fprintf(errs, "rt: compare: %s\n", err.message);
         return false;
     }
+    if (part)
+        fprintf(errs, "rt: compare: %s is a part: pixels [%d, %d) x [%d, %d) of %dx%d, samples %d:%d of %d; "
+                      "compared as sum / count\n",
+                path, info.x0, info.x1, info.y0, info.y1, info.width, info.height, info.s_begin, info.s_end,
+                info.spp);
     size_t n = (size_t)fb->width * (size_t)fb->height * 3;
     for (size_t i = 0; i < n; i++)
         if (!isfinite(fb->rgb[i])) {

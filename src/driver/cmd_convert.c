@@ -3,7 +3,11 @@
  * (rt/io/image_read.h: EXR, PFM, HDR, PNG...); OUT's extension picks the
  * writer, as for renders (rt/io/image_write.h). Exposure and the tone curve
  * (rt/image/tonemap.h) shape 8-bit output; the float formats stay linear, so
- * asking for them with a float OUT is refused rather than ignored. */
+ * asking for them with a float OUT is refused rather than ignored. A part
+ * of a render (rt --crop, --part, --spp-range: its sidecar IN.json beside
+ * it) is resolved into the picture it holds, its region's pixels as sum /
+ * count (rt/job/part_image.h), with the scene's exposure as rt merge
+ * applies it; its raw sums would be a washed-out image. */
 #include "commands.h"
 
 #include <stdbool.h>
@@ -14,12 +18,15 @@
 #include "rt/image/tonemap.h"
 #include "rt/io/image_write.h"
 #include "rt/io/image_read.h"
+#include "rt/job/part_image.h"
 
 static const char usage[] =
     "usage: rt convert IN OUT [--exposure EV] [--tonemap NAME] [--half]\n"
     "\n"
     "Converts an image: IN is EXR, PFM, HDR (or PNG/JPEG), OUT is .png, .pfm, .hdr or .exr.\n"
-    "Float outputs (.pfm, .hdr, .exr) keep the linear values as they are.\n"
+    "Float outputs (.pfm, .hdr, .exr) keep the linear values as they are. IN may be a part\n"
+    "of a render (rt --crop, --part, --spp-range; IN.json beside it): OUT is then the picture\n"
+    "of its region, each pixel its sum / its count, at the scene's exposure (as rt merge).\n"
     "\n"
     "options:\n"
     "  --exposure EV    8-bit output: scale by 2^EV before the tone curve (default 0)\n"
@@ -97,11 +104,19 @@ int rt_cmd_convert_to(int argc, char **argv, FILE *out, FILE *errs)
         return 2;
     }
     rt_framebuffer fb;
-    if (rt_image_read(in, &fb, &err) != RT_OK) {
+    rt_part_info info;
+    bool part = false;
+    if (rt_image_or_part_read(in, &fb, &info, &part, &err) != RT_OK) {
         fprintf(errs, "rt: convert: %s\n", err.message);
         return 2;
     }
-    rt_image_options opt = {.exposure = rt_exposure_scale(ev), .tonemap = tm, .half = half};
+    rt_image_options opt = {.exposure = (part ? info.exposure : 1.0f) * rt_exposure_scale(ev), .tonemap = tm,
+                            .half = half};
+    if (part)
+        fprintf(errs, "rt: convert: %s is a part: pixels [%d, %d) x [%d, %d) of %dx%d, samples %d:%d of %d; "
+                      "writing its %dx%d pixels as sum / count\n",
+                in, info.x0, info.x1, info.y0, info.y1, info.width, info.height, info.s_begin, info.s_end, info.spp,
+                fb.width, fb.height);
     int status = 0;
     if (rt_framebuffer_write_with(&fb, dst, &opt, &err) != RT_OK) {
         fprintf(errs, "rt: convert: %s\n", err.message);

@@ -122,8 +122,11 @@ static int write_result(run *rn, rt_result r, rt_error *err)
             memory_budget_report(err, &a->budget);
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
-            fprintf(stderr, "rt: wrote %s: %dx%d, %s; %.2f s (render %.2f s)%s%s\n", target, fb->width, fb->height,
-                    what, rt_now_seconds() - rn->t_start, rs.seconds, rs.partial ? "; " : "", rs.partial ? kept : "");
+            char extras[2048]; /* the AOV files (or layers) too */
+            rt_job_output_extras(&rn->jo, aov, target, extras, sizeof extras);
+            fprintf(stderr, "rt: wrote %s%s: %dx%d, %s; %.2f s (render %.2f s)%s%s\n", target, extras, fb->width,
+                    fb->height, what, rt_now_seconds() - rn->t_start, rs.seconds, rs.partial ? "; " : "",
+                    rs.partial ? kept : "");
         }
     }
     if (status != 2 && a->part_out) {

@@ -246,6 +246,8 @@ rt_result gl_load(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_st
         return r;
     if ((r = gl_decode_draco_prims(d)) != RT_OK)
         return r;
+    if (opt && opt->catalog)
+        gl_catalog(d, opt->catalog);
     return gl_flatten(d, s, opt, st);
 }
 

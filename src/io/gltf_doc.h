@@ -254,6 +254,9 @@ rt_result gl_read_uints(gl_doc *d, uint32_t ai, uint32_t *out);
 rt_result gl_decode_meshopt_views(gl_doc *d);
 rt_result gl_decode_draco_prims(gl_doc *d);
 
+/* gltf_catalog.c: the animations and variants a file offers (rt_gltf_catalog) */
+void gl_catalog(gl_doc *d, rt_gltf_catalog *c);
+
 /* gltf_pose.c: animations at a time, node world matrices, skins and morph targets */
 rt_mat4 gl_node_world(const gl_doc *d, uint32_t n, const rt_mat4 *top);
 rt_result gl_pose_nodes(gl_doc *d, const rt_gltf_options *opt);

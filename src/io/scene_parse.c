@@ -45,6 +45,7 @@
 #include "rt/base/alloc.h"
 #include "rt/base/file.h"
 #include "rt/base/log.h"
+#include "rt/base/near_miss.h"
 #include "rt/base/number.h"
 #include "rt/io/gltf.h"
 #include "rt/io/image_load.h"
@@ -467,55 +468,18 @@ static rt_result check_new_name(parser *p, const tok *t, name_table *table, cons
     return RT_OK;
 }
 
-/* Edit distance, for "did you mean" hints on short words. */
-static int edit_distance(const char *a, const char *b)
-{
-    size_t n = strlen(a), m = strlen(b);
-    if (n > 32 || m > 32)
-        return 99;
-    int d[33][33];
-    for (size_t i = 0; i <= n; i++)
-        d[i][0] = (int)i;
-    for (size_t j = 0; j <= m; j++)
-        d[0][j] = (int)j;
-    for (size_t i = 1; i <= n; i++)
-        for (size_t j = 1; j <= m; j++) {
-            int c = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
-            int del = d[i - 1][j] + 1, ins = d[i][j - 1] + 1;
-            d[i][j] = c < del ? (c < ins ? c : ins) : (del < ins ? del : ins);
-        }
-    return d[n][m];
-}
-
-/* The candidate closest to a word, for "did you mean" hints: shown the
- * candidates one at a time (near_miss_consider), it keeps the first of the
- * closest within edit distance 2; best is NULL when none is that close. */
-typedef struct near_miss {
-    const char *word, *best;
-    int best_d;
-} near_miss;
-
-static near_miss near_miss_of(const char *word) { return (near_miss){word, NULL, 3}; }
-
-static void near_miss_consider(near_miss *n, const char *candidate)
-{
-    int d = edit_distance(n->word, candidate);
-    if (d < n->best_d)
-        n->best_d = d, n->best = candidate;
-}
-
 /* The defined name closest to `word` (edit distance under 3), for "did
  * you mean"; NULL when none is that close. Names the scene holds from other
  * loaders count too, except the internal "__" ones. */
 static const char *closest_name(const parser *p, const name_table *table, bool scene_materials, const char *word)
 {
-    near_miss n = near_miss_of(word);
+    rt_near_miss n = rt_near_miss_of(word);
     for (size_t i = 0; i < table->count; i++)
-        near_miss_consider(&n, table->items[i].name);
+        rt_near_miss_consider(&n, table->items[i].name);
     for (size_t i = 0; scene_materials && i < p->s->material_count; i++) {
         const char *name = p->s->materials[i].name;
         if (strncmp(name, "__", 2) != 0)
-            near_miss_consider(&n, name);
+            rt_near_miss_consider(&n, name);
     }
     return n.best;
 }
@@ -1008,9 +972,9 @@ static rt_result find_mat_key(parser *p, const tok *key, size_t *index)
            !(mat_keys[k].alias && strcmp(key->s, mat_keys[k].alias) == 0))
         k++;
     if (k == MAT_KEY_COUNT || key->quoted) {
-        near_miss n = near_miss_of(key->s);
+        rt_near_miss n = rt_near_miss_of(key->s);
         for (size_t i = 0; i < MAT_KEY_COUNT; i++)
-            near_miss_consider(&n, mat_keys[i].key);
+            rt_near_miss_consider(&n, mat_keys[i].key);
         if (n.best)
             return perr(p, RT_ERR_PARSE, key, "expected a material key, got %s (did you mean '%s'?)",
                         show(key, b, sizeof b), n.best);
@@ -1542,6 +1506,7 @@ static rt_result st_model(parser *p, const tok *kw)
         return r;
     if ((r = apply_pose(p, &pose, &opt)) != RT_OK)
         return r;
+    opt.catalog = p->pose.catalog;
     opt.use_transform = x.translate_tok || x.rotate_tok || x.scale_tok;
     opt.transform = opt.use_transform ? xform_matrix(&x) : rt_mat4_identity();
     rt_error inner = {0};
@@ -1704,11 +1669,11 @@ static rt_result run_statement(parser *p)
             if (strcmp(kw->s, keywords[i].word) == 0)
                 return keywords[i].fn(p, kw);
     }
-    near_miss n = near_miss_of(kw->s);
+    rt_near_miss n = rt_near_miss_of(kw->s);
     for (size_t i = 0; i < rt_settings_count; i++)
-        near_miss_consider(&n, rt_settings_table[i].name);
+        rt_near_miss_consider(&n, rt_settings_table[i].name);
     for (size_t i = 0; i < sizeof keywords / sizeof *keywords; i++)
-        near_miss_consider(&n, keywords[i].word);
+        rt_near_miss_consider(&n, keywords[i].word);
     if (n.best)
         return perr(p, RT_ERR_PARSE, kw, "unknown keyword %s (did you mean '%s'?)", show(kw, b, sizeof b), n.best);
     return perr(p, RT_ERR_PARSE, kw,

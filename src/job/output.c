@@ -101,6 +101,40 @@ static rt_result write_aov_file(const float *data, int channels, int w, int h, c
     return r;
 }
 
+/* Where the image `name` (an AOV, or "noisy") beside the output at path
+ * goes when the output is not an EXR: NAME.albedo.pfm beside NAME.png
+ * (8-bit would lose the values), else the output's own format. */
+static void side_file(const char *path, rt_image_format fmt, const char *name, bool aov, char *out, size_t size)
+{
+    rt_path_tagged(path, name, aov && fmt == RT_FORMAT_PNG ? ".pfm" : NULL, out, size);
+}
+
+void rt_job_output_extras(const rt_job_options *a, const rt_job_aovs *aov, const char *path, char *out, size_t size)
+{
+    rt_image_format fmt = RT_FORMAT_PNG;
+    rt_output_format(path, &fmt, NULL);
+    bool noisy = a->denoise && aov->wanted;
+    size_t used = 0;
+    out[0] = 0;
+    for (int k = -1; k < RT_AOV_COUNT; k++) {
+        if (k < 0 ? !noisy : !(aov->wanted & (1u << k)))
+            continue;
+        const char *name = k < 0 ? "noisy" : rt_aov_names[k];
+        char file[4200];
+        if (fmt == RT_FORMAT_EXR)
+            snprintf(file, sizeof file, "%s", name);
+        else
+            side_file(path, fmt, name, k >= 0, file, sizeof file);
+        const char *lead = used ? ", " : fmt == RT_FORMAT_EXR ? " (layers " : " and ";
+        int n = snprintf(out + used, size - used, "%s%s", lead, file);
+        if (n < 0 || (size_t)n >= size - used)
+            break;
+        used += (size_t)n;
+    }
+    if (used && fmt == RT_FORMAT_EXR && used + 1 < size)
+        out[used++] = ')', out[used] = 0;
+}
+
 rt_result rt_job_output_write(const rt_job_options *a, const rt_settings *set, rt_framebuffer *fb,
                               const rt_job_aovs *aov, const char *path, rt_write_temp *temp, rt_error *err)
 {
@@ -138,16 +172,15 @@ rt_result rt_job_output_write(const rt_job_options *a, const rt_settings *set, r
         opt.layer_count = nl;
     } else {
         char p[4200];
-        const char *ext = fmt == RT_FORMAT_PNG ? ".pfm" : NULL;
         for (int k = 0; k < RT_AOV_COUNT && r == RT_OK; k++)
             if (aov->wanted & (1u << k)) {
-                rt_path_tagged(path, rt_aov_names[k], ext, p, sizeof p);
+                side_file(path, fmt, rt_aov_names[k], true, p, sizeof p);
                 r = write_aov_file(*slot((rt_aov_buffers *)&aov->buf, k), channels_of(k), fb->width, fb->height, p,
                                    err);
             }
         if (r == RT_OK && noisy) {
             rt_framebuffer nf = {fb->width, fb->height, noisy};
-            rt_path_tagged(path, "noisy", NULL, p, sizeof p);
+            side_file(path, fmt, "noisy", false, p, sizeof p);
             r = rt_framebuffer_write_with(&nf, p, &opt, err);
         }
         if (r != RT_OK)

@@ -167,6 +167,12 @@ rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_sc
     pj->region = (rt_render_region){0, 0, s->width, s->height};
     pj->s_begin = 0;
     pj->s_end = s->samples;
+    if (a->has_crop) { /* a part of the region, or (not output_is_part) the cropped image */
+        if (a->crop[2] > s->width || a->crop[3] > s->height)
+            return rt_fail(err, RT_ERR_INVALID, "--crop %d %d %d %d: the image is only %dx%d", a->crop[0], a->crop[1],
+                           a->crop[2], a->crop[3], s->width, s->height);
+        pj->region = (rt_render_region){a->crop[0], a->crop[1], a->crop[2], a->crop[3]};
+    }
     bool any = pj->to_part || a->resume || a->part_out;
     if (!any)
         return RT_OK;
@@ -176,12 +182,6 @@ rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_sc
     if (a->posed) /* the pose changes pixels: frame time and animation are settings of the render */
         line(pj->info.settings, sizeof pj->info.settings, "frame_time %a animation %d", (double)a->frame_time,
              a->animation);
-    if (a->has_crop) {
-        if (a->crop[2] > s->width || a->crop[3] > s->height)
-            return rt_fail(err, RT_ERR_INVALID, "--crop %d %d %d %d: the image is only %dx%d", a->crop[0], a->crop[1],
-                           a->crop[2], a->crop[3], s->width, s->height);
-        pj->region = (rt_render_region){a->crop[0], a->crop[1], a->crop[2], a->crop[3]};
-    }
     if (a->part_count && (r = rt_part_split(scene, s, tree, a->part_index, a->part_count, &pj->region, err)) != RT_OK)
         return r;
     if (a->has_spp_range) {

@@ -17,6 +17,19 @@
 #include "rt/base/error.h"
 #include "rt/scene/scene.h"
 
+/* What a glTF file offers besides its geometry, for `rt --info`: its
+ * animations (name, length in seconds) and material variants, appended by
+ * each file loaded with rt_gltf_options.catalog (a scene file's model lines
+ * too); the counts are whole, the names the first RT_GLTF_CATALOG_MAX. */
+#define RT_GLTF_CATALOG_MAX 32
+typedef struct rt_gltf_catalog {
+    int animations;
+    char animation_name[RT_GLTF_CATALOG_MAX][64]; /* "" when unnamed */
+    float animation_seconds[RT_GLTF_CATALOG_MAX]; /* its last key time; -1 when its key times cannot be read */
+    int variants;
+    char variant_name[RT_GLTF_CATALOG_MAX][64];
+} rt_gltf_catalog;
+
 typedef struct rt_gltf_options {
     int scene_index;       /* which glTF scene, when use_scene_index; otherwise the file's default */
     bool use_scene_index;
@@ -29,6 +42,7 @@ typedef struct rt_gltf_options {
     const char *animation_name; /* when use_time: the animation with this `name` instead (NULL = by index) */
     bool animation_optional; /* a file without animations ignores `animation` (the scene format's model
                               * lines take the driver's --animation so) instead of failing */
+    rt_gltf_catalog *catalog; /* not NULL: the file's animations and variants appended to it */
 } rt_gltf_options;
 
 /* What one load added. meshes/primitives count instances (a mesh used by

@@ -51,6 +51,7 @@ typedef struct rt_load_options {
     bool use_time;   /* a glTF input is posed at `time` by its animation `animation` (rt_gltf_options) */
     float time;
     int animation;
+    struct rt_gltf_catalog *catalog; /* not NULL: the glTF inputs' animations and variants (rt/io/gltf.h, rt --info) */
 } rt_load_options;
 
 /* What one load found (what `rt --info` prints beside the scene's counts). */

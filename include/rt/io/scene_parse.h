@@ -42,6 +42,7 @@ typedef struct rt_scene_parse_options {
     int animation;   /* the animation a line without `animation` plays (a model without animations ignores it) */
     bool *animated;  /* out, may be NULL: set true when a model line's pose follows the frame time (an animation
                       * with channels, no fixed `time`), so that another time may give another pose */
+    struct rt_gltf_catalog *catalog; /* not NULL: the model lines' animations and variants (rt/io/gltf.h) */
 } rt_scene_parse_options;
 
 /* rt_scene_parse_string with model lines posed at options' time (NULL =

@@ -58,7 +58,7 @@ typedef struct rt_job_options {
     unsigned aovs;          /* bit k: rt_aov_names[k] is written */
     /* parts of a render spread over machines */
     bool output_is_part;    /* the output is a part (a crop, a band or a sample range), not an image */
-    bool has_crop;          /* crop: [x0, y0, x1, y1) */
+    bool has_crop;          /* crop: [x0, y0, x1, y1): a part's region, or without output_is_part the image's */
     int crop[4];
     int part_index, part_count; /* band part_index of part_count of similar cost; part_count 0 = none */
     bool has_spp_range;     /* samples [spp_begin, spp_end) only */

@@ -48,4 +48,9 @@ rt_aov_buffers *rt_job_aovs_for_render(rt_job_aovs *o);
 rt_result rt_job_output_write(const rt_job_options *a, const rt_settings *set, rt_framebuffer *fb,
                               const rt_job_aovs *aov, const char *path, rt_write_temp *temp, rt_error *err);
 
+/* What rt_job_output_write writes besides the image at path, for the
+ * "wrote" line: " and out.albedo.pfm, out.noisy.png", or for an .exr
+ * " (layers noisy, albedo)"; "" when nothing (out: size bytes). */
+void rt_job_output_extras(const rt_job_options *a, const rt_job_aovs *aov, const char *path, char *out, size_t size);
+
 #endif
