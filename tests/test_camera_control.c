@@ -5,13 +5,15 @@
  * opposite come back; pan keeps the view direction and, by
  * rt_camera_pan_scale per pixel, moves the old look_at by exactly that many
  * pixels on the film (projected through rt_camera_frame); dolly scales the
- * distance; walk keeps the direction; and the printed `camera` line, read
- * back by the scene parser, gives the very same floats.
+ * distance; walk keeps the direction; the printed `camera` line, read
+ * back by the scene parser, gives the very same floats; and the depth a
+ * glTF camera orbits about is the analytic distance to a sphere.
  */
 #include "test_util.h"
 
 #include <math.h>
 
+#include "rt/accel/kdtree.h"
 #include "rt/io/scene_parse.h"
 #include "rt/render/camera.h"
 #include "rt/render/camera_control.h"
@@ -236,12 +238,84 @@ static void test_camera_line_round_trip(void **state)
     assert_int_equal(strlen(small), sizeof small - 1);
 }
 
+/* rt_camera_depth against the analytic distance to a sphere of radius 1
+ * at the origin: a camera looking at a point inside it gets the first
+ * intersection of the view ray (the ray through the image's centre); one
+ * looking past it, the depth of the bounds' centre along the view; one
+ * looking away, 0. rt_camera_look_at_depth puts look_at at that distance
+ * along the same view. */
+static void test_depth(void **state)
+{
+    (void)state;
+    const char *text = "material m color 0.5 0.5 0.5\nsphere 0 0 0 1 m\n";
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_error err = {0};
+    if (rt_scene_parse_string(&s, NULL, text, strlen(text), "<sphere>", "", &err) != RT_OK)
+        fail_msg("the test scene does not parse: %s", err.message);
+    rt_kdtree tree;
+    assert_int_equal(rt_kdtree_build(&tree, &s, NULL, &err), RT_OK);
+    uint64_t st = 6;
+    int hits = 0, past = 0, away = 0;
+    for (int i = 0; i < 3000; i++) {
+        rt_camera c = random_camera(&st);
+        c.position = rt_scale(rt_normalize(c.position), uniform(&st, 1.5f, 30.0f));
+        int kind = i % 3;
+        if (kind == 0) /* at a point inside the sphere */
+            c.look_at = rt_scale(random_point(&st, 1.0f), 0.55f);
+        else if (kind == 1) /* past it: a point 3 units off the line to the centre, beyond it */
+            c.look_at = rt_add(rt_scale(c.position, -1.0f), rt_scale(rt_normalize(rt_cross(c.position, c.up)), 3.0f));
+        else /* away from it */
+            c.look_at = rt_scale(c.position, 2.0f);
+        rt_camera_frame cf;
+        if (!rt_camera_frame_init(&cf, &c, 64, 48))
+            continue;
+        /* in double: the ray p + t f against |x| = 1 */
+        double p[3] = {c.position.x, c.position.y, c.position.z}, f[3] = {c.look_at.x - p[0], c.look_at.y - p[1],
+                                                                          c.look_at.z - p[2]};
+        double fl = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+        for (int k = 0; k < 3; k++)
+            f[k] /= fl;
+        double b = -(p[0] * f[0] + p[1] * f[1] + p[2] * f[2]), cc = p[0] * p[0] + p[1] * p[1] + p[2] * p[2] - 1.0;
+        double disc = b * b - cc, want;
+        if (disc > 1e-3 && b - sqrt(disc) > 0.0) {
+            want = b - sqrt(disc);
+            hits++;
+        } else if (b < 0.0) { /* the sphere and its centre behind the camera */
+            want = 0.0;
+            away++;
+        } else if (disc < -1e-3) {
+            want = b; /* the bounds' centre, the origin, along the view */
+            past++;
+        } else {
+            continue; /* grazing: either answer would do */
+        }
+        float got = rt_camera_depth(&c, &s, &tree);
+        assert_near(got, want, 1e-4 * (1.0 + want), "depth");
+        if (got > 0.0f) {
+            rt_camera d = rt_camera_look_at_depth(c, got);
+            assert_near(dist(d.position, d.look_at), got, 1e-5 * got, "distance to the new look_at");
+            assert_near(rt_length(rt_sub(view_dir(&d), view_dir(&c))), 0.0, 1e-6, "view direction");
+            assert_true(memcmp(&d.position, &c.position, sizeof c.position) == 0);
+        }
+        rt_camera same = rt_camera_look_at_depth(c, 0.0f);
+        assert_true(memcmp(&same, &c, sizeof c) == 0);
+    }
+    assert_true(hits > 500 && past > 500 && away > 500);
+    assert_near(rt_camera_depth(&(rt_camera){.position = {0, 0, 5}, .look_at = {0, 0, 4}, .up = {0, 1, 0},
+                                             .vfov_deg = 40},
+                                &s, &tree),
+                4.0, 1e-6, "a glTF-like camera 5 units away, look_at 1 unit ahead");
+    rt_kdtree_free(&tree);
+    rt_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_orbit_keeps_distance), cmocka_unit_test(test_orbit_turns),
         cmocka_unit_test(test_pan_keeps_direction),  cmocka_unit_test(test_dolly_and_walk),
-        cmocka_unit_test(test_camera_line_round_trip),
+        cmocka_unit_test(test_camera_line_round_trip), cmocka_unit_test(test_depth),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -219,6 +219,15 @@ static void assert_contains(const char *hay, const char *needle)
         fail_msg("expected \"%s\" in rt's message:\n%s", needle, hay);
 }
 
+/* How many times needle occurs in hay. */
+static int count_of(const char *hay, const char *needle)
+{
+    int n = 0;
+    for (const char *p = strstr(hay, needle); p; p = strstr(p + 1, needle))
+        n++;
+    return n;
+}
+
 /* Runs rt with args (NULL-terminated) and expects a clean refusal: exit 2,
  * a message with both fragments, `protect` (an existing image) untouched. */
 static void expect_refusal_v(const char *protect, const char *msg1, const char *msg2, const char *const *args)
@@ -1493,7 +1502,8 @@ static int preview_tiles(const rt_framebuffer *fb, int finished[64])
  * until a preview shows a finished tile (tiles of 8192 samples a pixel: the
  * render is far from done), then rt is interrupted: every tile that preview
  * showed finished is, bit for bit, the tile NAME.partial.pfm keeps, and the
- * preview is left as the output. */
+ * preview is left as the output, as the message says (not "left as it
+ * was": --preview has written over it). */
 static void test_preview(void **state)
 {
     (void)state;
@@ -1526,6 +1536,11 @@ static void test_preview(void **state)
     assert_non_null(r);
     wait_for(pid, t0, 120.0, r);
     assert_int_equal(r->status, 130);
+    /* the message says what the output holds: a preview, not the earlier file */
+    char holds[700];
+    snprintf(holds, sizeof holds, "; %s holds the last live preview (--preview)\n", pfm);
+    assert_contains(r->err, holds);
+    assert_null(strstr(r->err, "left as it was"));
     free(r);
     rt_framebuffer part, out;
     assert_int_equal(rt_pfm_read(partial, &part, &err), RT_OK);
@@ -1997,8 +2012,10 @@ static void test_display_server_aovs(void **state)
     }
 }
 
-/* tev not there: the render goes on quietly (nothing said without -v) and
- * writes its image. */
+/* tev not there (a wrong port): rt says so once, without -v, naming the
+ * address and that it renders on and keeps trying (it tries at the start
+ * and again for the final image: one warning all the same); nothing with
+ * -q; the image is written. */
 static void test_display_server_absent(void **state)
 {
     (void)state;
@@ -2007,11 +2024,18 @@ static void test_display_server_absent(void **state)
     const char *pfm = path_in("absent.pfm");
     run_result *r = malloc(sizeof *r);
     assert_non_null(r);
+    run_args(r, (const char *const[]){"-q", "-r", "16x16", "-s", "2", "--display-server", address, "-o", pfm, NULL});
+    assert_int_equal(r->status, 0);
+    assert_string_equal(r->err, "");
     run_args(r, (const char *const[]){"-r", "16x16", "-s", "2", "--display-server", address, "-o", pfm, NULL});
     close(bound);
     assert_int_equal(r->status, 0);
-    if (strstr(r->err, "display server") || strstr(r->err, "warning"))
-        fail_msg("rt should say nothing about a missing tev without -v:\n%s", r->err);
+    char want[160];
+    snprintf(want, sizeof want, "rt: warning: --display-server %s: nothing listens there (", address);
+    assert_contains(r->err, want);
+    assert_contains(r->err, "); rendering on, and trying again every 2 s");
+    assert_int_equal(count_of(r->err, "--display-server"), 1);
+    assert_lines_prefixed(r->err);
     rt_framebuffer fb;
     rt_error err;
     assert_int_equal(rt_pfm_read(pfm, &fb, &err), RT_OK);
@@ -2260,14 +2284,6 @@ static void run_window_script(run_result *r, int dpy, const char *script, const 
     unsetenv("RT_WINDOW_SCRIPT");
     unsetenv("LSAN_OPTIONS");
     unsetenv("DISPLAY");
-}
-
-static int count_of(const char *hay, const char *needle)
-{
-    int n = 0;
-    for (const char *p = strstr(hay, needle); p; p = strstr(p + 1, needle))
-        n++;
-    return n;
 }
 
 /* The window's camera under Xvfb, driven through SDL's own event queue
@@ -2561,6 +2577,296 @@ static void test_window_camera_xdotool(void **state)
     free(r);
 }
 
+/* ------------------------------------------------------------ the terminal: lines kept apart */
+
+/* Runs rt with args under the Xvfb display dpy (-1: none) and
+ * RT_WINDOW_SCRIPT=script (NULL: none), its stderr, and its stdout too
+ * when stdout_too, on a terminal (test_terminal.h); what the terminal got
+ * into raw, the lines it shows into screen; the exit status. */
+static int run_terminal_window(int dpy, const char *script, bool stdout_too, const char *const *args, char *raw,
+                               size_t raw_cap, char *screen, size_t screen_cap)
+{
+    char dname[32];
+    snprintf(dname, sizeof dname, ":%d", dpy);
+    if (dpy >= 0)
+        setenv("DISPLAY", dname, 1);
+    if (script)
+        setenv("RT_WINDOW_SCRIPT", script, 1);
+    setenv("LSAN_OPTIONS", "detect_leaks=0", 1); /* SDL's libraries, as in test_window */
+    const char *argv[64];
+    make_argv(argv, 64, rt_bin_absolute(), args);
+    test_terminal_result tr;
+    test_terminal_run_io(argv, NULL, stdout_too, raw, raw_cap, &tr);
+    unsetenv("RT_WINDOW_SCRIPT");
+    unsetenv("LSAN_OPTIONS");
+    if (dpy >= 0)
+        unsetenv("DISPLAY");
+    test_terminal_screen(raw, screen, screen_cap);
+    return tr.status >= 0 ? tr.status : 128 + tr.signal;
+}
+
+/* Every line the terminal shows is one thing: a line of rt's ("rt: "), a
+ * line P printed ("camera position ", "# "), or the progress line; no
+ * line holds a second one after the progress bar or a phase. */
+static void assert_lines_apart(const char *screen)
+{
+    for (const char *l = screen; *l;) {
+        const char *nl = strchr(l, '\n');
+        size_t n = nl ? (size_t)(nl - l) : strlen(l);
+        char line[4096];
+        snprintf(line, sizeof line, "%.*s", (int)(n < sizeof line ? n : sizeof line - 1), l);
+        bool own = strncmp(line, "rt: ", 4) == 0 || strncmp(line, "camera position ", 16) == 0 ||
+                   strncmp(line, "# ", 2) == 0;
+        if (!own && !strstr(line, "render [") && !strstr(line, " ..."))
+            fail_msg("a line the terminal shows is none of rt's:\n%s\nin:\n%s", line, screen);
+        if (strstr(line + 1, "rt: ") || strstr(line + 1, "camera position"))
+            fail_msg("two things on one line of the terminal:\n%s\nin:\n%s", line, screen);
+        l = nl ? nl + 1 : l + n;
+    }
+}
+
+/* Lines written while the progress line is up start on a line of their
+ * own: -v lines while a phase ("load ...", "kd-tree ...") is shown, and
+ * the camera line P prints on stdout while the bar is up. */
+static void test_terminal_lines_apart(void **state)
+{
+    (void)state;
+    static char raw[1 << 17], screen[1 << 17];
+    const char *png = path_in("apart.png");
+    int status = run_terminal_window(-1, NULL, true,
+                                     (const char *const[]){"-v", "-r", "24x24", "-s", "8", "-o", png, slow_scene(),
+                                                           NULL},
+                                     raw, sizeof raw, screen, sizeof screen);
+    if (status != 0)
+        fail_msg("rt -v on a terminal exited %d:\n%s", status, screen);
+    assert_contains(screen, "\nrt: scene: ");
+    assert_contains(screen, "\nrt: kd-tree: built in ");
+    assert_lines_apart(screen);
+
+    require_window_tools(false);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    char saved[256];
+    save_display(saved);
+    int dpy = window_xvfb(r, png);
+    free(r);
+    /* P while the bar of a long render is up, then Esc */
+    status = run_terminal_window(dpy, "wait pass; key P; wait pass; key Escape", true,
+                                 (const char *const[]){"-r", "40x24", "-s", "100000", "--integrator", "path",
+                                                       "--passes", "2", "--window", "-o", png, slow_scene(), NULL},
+                                 raw, sizeof raw, screen, sizeof screen);
+    stop_xvfb();
+    restore_display(saved);
+    if (status != 0)
+        fail_msg("rt --window on a terminal exited %d:\n%s", status, screen);
+    assert_contains(screen, "camera position 0 0 4 look_at 0 0 0 up 0 1 0 fov 40\n# as flags: ");
+    assert_contains(screen, "of 100000 spp, window closed");
+    assert_lines_apart(screen);
+    unlink(png);
+}
+
+/* After a move of the window's camera the progress line gives the phases
+ * before rendering the times they took, not the time the window stood
+ * idle: every "load N.NNs, kd-tree N.NNs, window N.NNs" before "render ["
+ * on the terminal reads the same, with the window idle 1.5 s between the
+ * first render and the move. */
+static void test_progress_line_after_a_move(void **state)
+{
+    (void)state;
+    require_window_tools(false);
+    static char raw[1 << 17], screen[1 << 17];
+    const char *png = path_in("idle.png");
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    char saved[256];
+    save_display(saved);
+    int dpy = window_xvfb(r, png);
+    free(r);
+    int status = run_terminal_window(dpy, "wait done; sleep 1500; drag left 20 12 30 14; wait done; key Escape", false,
+                                     (const char *const[]){"-r", "40x24", "-s", "8", "--integrator", "path",
+                                                           "--passes", "2", "--window", "-o", png, slow_scene(), NULL},
+                                     raw, sizeof raw, screen, sizeof screen);
+    stop_xvfb();
+    restore_display(saved);
+    if (status != 0)
+        fail_msg("rt --window on a terminal exited %d:\n%s", status, screen);
+    assert_int_equal(count_of(screen, "rt: wrote "), 2); /* the first camera's image, then the moved one's */
+    int bars = 0;
+    char first[256] = "";
+    for (const char *k = strstr(raw, "s, render ["); k; k = strstr(k + 1, "s, render [")) {
+        const char *start = k;
+        while (start > raw && start[-1] != '\r' && start[-1] != '\n')
+            start--;
+        char phases[256]; /* "load 0.00s, kd-tree 0.00s, window 0.07s" */
+        snprintf(phases, sizeof phases, "%.*s", (int)(k + 1 - start), start);
+        if (!first[0])
+            snprintf(first, sizeof first, "%s", phases);
+        if (strcmp(phases, first) != 0)
+            fail_msg("the phases took \"%s\" at first, \"%s\" on a later progress line:\n%s", first, phases, screen);
+        bars++;
+    }
+    assert_true(bars >= 2);
+    unlink(png);
+}
+
+/* Q closes the window, as --help says (Esc too); C sinks along up and E
+ * rises, by the walking step (2% of the bounds' diagonal). */
+static void test_window_keys(void **state)
+{
+    (void)state;
+    require_window_tools(false);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *png = path_in("keys.png"), *out = path_in("keys.out");
+    char saved[256];
+    save_display(saved);
+    int dpy = window_xvfb(r, png);
+    /* q after the render: closed, nothing rendered again (the Escape after
+     * a second render would close a window that q had not) */
+    run_window_script(r, dpy, "wait done; key q; wait done; key Escape", NULL,
+                      (const char *const[]){"-r", "40x24", "-s", "4", "--integrator", "path", "--window", "-o", png,
+                                            slow_scene(), NULL});
+    int status1 = r->status, wrote1 = count_of(r->err, "rt: wrote ");
+    static char err1[sizeof r->err];
+    snprintf(err1, sizeof err1, "%s", r->err);
+    run_window_script(r, dpy, "wait done; key P; key C; key P; key E; key P; key Q; wait done; key Escape", out,
+                      (const char *const[]){"-q", "-r", "40x24", "-s", "4", "--integrator", "path", "--window", "-o",
+                                            png, slow_scene(), NULL});
+    stop_xvfb();
+    restore_display(saved);
+    if (status1 != 0 || wrote1 != 1)
+        fail_msg("q should close the window after the first render (exit %d, %d wrote lines):\n%s", status1, wrote1,
+                 err1);
+    if (r->status != 0)
+        fail_msg("rt --window failed (%d): %s", r->status, r->err);
+    static char text[8192];
+    read_all(out, text, sizeof text);
+    printed_camera c[3];
+    assert_int_equal(printed_cameras(text, c, 3), 3);
+    double step = 0.02 * 2.0 * sqrt(3.0); /* a sphere of radius 1: diagonal 2 sqrt(3) */
+    assert_true(fabs(c[1].p[1] - (c[0].p[1] - step)) < 1e-5 && fabs(c[1].at[1] - (c[0].at[1] - step)) < 1e-5);
+    assert_true(fabs(c[1].p[0] - c[0].p[0]) < 1e-6 && fabs(c[1].p[2] - c[0].p[2]) < 1e-6);
+    assert_true(fabs(c[2].p[1] - c[0].p[1]) < 1e-5);
+    unlink(png);
+    unlink(out);
+    free(r);
+}
+
+/* Pixels of an 8-bit image that differ from its top-left pixel (the
+ * background) by more than 8 in a channel. */
+static int model_pixels(const char *png)
+{
+    int w = 0, h = 0, n = 0, count = 0;
+    unsigned char *img = stbi_load(png, &w, &h, &n, 3);
+    assert_non_null(img);
+    for (int i = 0; i < w * h; i++)
+        for (int c = 0; c < 3; c++)
+            if (abs((int)img[3 * i + c] - (int)img[c]) > 8) {
+                count++;
+                break;
+            }
+    stbi_image_free(img);
+    return count;
+}
+
+/* A glTF camera's look_at is a point 1 unit ahead, which means nothing:
+ * orbiting about it swung the model out of the window. The window orbits
+ * about the model's depth instead (the first surface at the image's
+ * centre): after a drag of 45 degrees the box of assets/box.gltf
+ * (3.7 units away) is still in view, as large as before (within 25%),
+ * and the printed camera looks at a point of the box, at the first
+ * camera's distance. */
+static void test_window_orbits_a_gltf_camera(void **state)
+{
+    (void)state;
+    require_window_tools(false);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *png = path_in("orbit.png"), *first = path_in("orbit-first.png"), *out = path_in("orbit.out");
+    char saved[256];
+    save_display(saved);
+    int dpy = window_xvfb(r, png);
+    run_window_script(r, dpy, "wait done; key P; drag left 32 32 48 32; wait done; key P; key Escape", out,
+                      (const char *const[]){"-q", "-r", "64x64", "-s", "1", "--window", "-o", png, "assets/box.gltf",
+                                            NULL});
+    stop_xvfb();
+    restore_display(saved);
+    if (r->status != 0)
+        fail_msg("rt --window failed (%d): %s", r->status, r->err);
+    static char text[8192];
+    read_all(out, text, sizeof text);
+    printed_camera c[2];
+    assert_int_equal(printed_cameras(text, c, 2), 2);
+    assert_true(fabs(cam_dist(&c[0]) - 1.0) < 1e-5); /* the glTF camera as loaded */
+    /* a unit box turned about y: its points lie within sqrt(3)/2 of the origin */
+    if (sqrt(c[1].at[0] * c[1].at[0] + c[1].at[1] * c[1].at[1] + c[1].at[2] * c[1].at[2]) > 0.87)
+        fail_msg("the orbit's pivot %g %g %g is not on the box", c[1].at[0], c[1].at[1], c[1].at[2]);
+    double d0 = sqrt(c[0].p[0] * c[0].p[0] + c[0].p[1] * c[0].p[1] + c[0].p[2] * c[0].p[2]);
+    assert_true(cam_dist(&c[1]) > 0.5 * d0 && cam_dist(&c[1]) < d0);
+    assert_true(cam_turn(&c[1], &c[0]) > 0.5); /* it did turn */
+    render_ok(first, (const char *const[]){"-r", "64x64", "-s", "1", "assets/box.gltf", NULL});
+    int before = model_pixels(first), after = model_pixels(png);
+    if (!(before > 100 && after > 0.75 * before && after < 1.25 * before))
+        fail_msg("the box covers %d pixels before the orbit, %d after", before, after);
+    unlink(png);
+    unlink(first);
+    unlink(out);
+    free(r);
+}
+
+/* SDL's own messages go through rt's log: with no display to be had (a
+ * DISPLAY nobody serves, XDG_RUNTIME_DIR unset, so that SDL tries Wayland
+ * too and libwayland complains on stderr) every line is rt's, and the
+ * reason names the display; with -v SDL's lines come as "rt: SDL: ...". */
+static void test_window_sdl_messages(void **state)
+{
+    (void)state;
+    require_window_tools(false);
+    char saved[256];
+    save_display(saved);
+    char xdg[512] = "";
+    if (getenv("XDG_RUNTIME_DIR"))
+        snprintf(xdg, sizeof xdg, "%s", getenv("XDG_RUNTIME_DIR"));
+    unsetenv("XDG_RUNTIME_DIR");
+    unsetenv("WAYLAND_DISPLAY");
+    unsetenv("SDL_VIDEODRIVER");
+    int free_dpy = 7000;
+    char sock[64];
+    for (;; free_dpy++) { /* a display number nothing serves */
+        snprintf(sock, sizeof sock, "/tmp/.X11-unix/X%d", free_dpy);
+        if (access(sock, F_OK) != 0)
+            break;
+    }
+    char dname[32];
+    snprintf(dname, sizeof dname, ":%d", free_dpy);
+    setenv("DISPLAY", dname, 1);
+    setenv("LSAN_OPTIONS", "detect_leaks=0", 1);
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    const char *png = path_in("sdl.png");
+    put_precious(png);
+    run_args(r, (const char *const[]){"-r", "8x8", "-s", "1", "--window", "-o", png, NULL});
+    int status = r->status;
+    static char err[sizeof r->err];
+    snprintf(err, sizeof err, "%s", r->err);
+    run_args(r, (const char *const[]){"-v", "-r", "8x8", "-s", "1", "--window", "-o", png, NULL});
+    unsetenv("LSAN_OPTIONS");
+    if (xdg[0])
+        setenv("XDG_RUNTIME_DIR", xdg, 1);
+    restore_display(saved);
+    assert_int_equal(status, 2);
+    assert_lines_prefixed(err);
+    assert_contains(err, "rt: --window: cannot open a window: ");
+    char want[64];
+    snprintf(want, sizeof want, "DISPLAY=%s", dname);
+    assert_contains(err, want);
+    assert_int_equal(r->status, 2);
+    assert_lines_prefixed(r->err);
+    assert_precious(png);
+    unlink(png);
+    free(r);
+}
+
 /* `rt compare` is reached from the command line: an image against itself
  * (every metric 0, exit 0), against a different one with a threshold that
  * fails (exit 1), and against a missing file (exit 2, the file named). */
@@ -2731,6 +3037,11 @@ int main(void)
         cmocka_unit_test(test_window_camera),
         cmocka_unit_test(test_window_camera_xdotool),
         cmocka_unit_test(test_window_inputs),
+        cmocka_unit_test(test_window_keys),
+        cmocka_unit_test(test_window_orbits_a_gltf_camera),
+        cmocka_unit_test(test_window_sdl_messages),
+        cmocka_unit_test(test_terminal_lines_apart),
+        cmocka_unit_test(test_progress_line_after_a_move),
         cmocka_unit_test(test_compare_command),
         cmocka_unit_test(test_convert_compare_parts),
         cmocka_unit_test(test_crop_image),

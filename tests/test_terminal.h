@@ -15,7 +15,14 @@
  *
  * With at == NULL the program just runs. With at->again set, the signal is
  * sent a second time once the first has been delivered (read from
- * /proc/PID/status: no longer pending).
+ * /proc/PID/status: no longer pending). test_terminal_run_io puts stdout
+ * on the terminal too (as when a user runs rt in a shell), and
+ * test_terminal_screen turns what the terminal got into the lines it
+ * shows (carriage returns and erase-to-end-of-line applied):
+ *
+ *   test_terminal_run_io(argv, NULL, true, out, sizeof out, &r);
+ *   char screen[1 << 16];
+ *   test_terminal_screen(out, screen, sizeof screen);   // "line\nline\n..."
  */
 #ifndef RT_TEST_TERMINAL_H
 #define RT_TEST_TERMINAL_H
@@ -89,11 +96,54 @@ static inline bool test_terminal_pending(pid_t pid, int sig)
     return pending;
 }
 
+/* The lines a terminal shows after receiving `raw`: '\r' goes back to the
+ * line's start, "\033[K" erases from the cursor to the line's end, other
+ * escape sequences are dropped, '\n' ends the line; each line of the
+ * result ends with '\n' (the last one too, if not empty). */
+static inline void test_terminal_screen(const char *raw, char *screen, size_t cap)
+{
+    char line[4096];
+    size_t len = 0, col = 0, n = 0;
+    screen[0] = 0;
+    for (const char *c = raw;; c++) {
+        if (*c == '\n' || (*c == 0 && len > 0)) {
+            if (n + len + 2 < cap) {
+                memcpy(screen + n, line, len);
+                n += len;
+                screen[n++] = '\n';
+                screen[n] = 0;
+            }
+            len = col = 0;
+        }
+        if (*c == 0)
+            break;
+        if (*c == '\n')
+            continue;
+        if (*c == '\r') {
+            col = 0;
+        } else if (*c == '\033' && c[1] == '[') {
+            const char *e = c + 2;
+            while (*e && !((*e >= 'A' && *e <= 'Z') || (*e >= 'a' && *e <= 'z')))
+                e++;
+            if (*e == 'K' && e == c + 2)
+                len = col; /* erase to the end of the line */
+            c = *e ? e : e - 1;
+        } else if (col < sizeof line) {
+            line[col++] = *c;
+            len = col > len ? col : len;
+        }
+    }
+}
+
 /* Runs argv (argv[0] the program) with stdin and stdout on /dev/null and
  * stderr on a new terminal; what the terminal shows goes into out
  * (NUL-terminated). Fails the test when the program runs over 120 s. */
 static inline void test_terminal_run(const char *const *argv, const test_terminal_signal *at, char *out, size_t cap,
-                                     test_terminal_result *r)
+                                     test_terminal_result *r);
+
+/* The same, with stdout on the terminal too when stdout_too. */
+static inline void test_terminal_run_io(const char *const *argv, const test_terminal_signal *at, bool stdout_too,
+                                        char *out, size_t cap, test_terminal_result *r)
 {
     int master = posix_openpt(O_RDWR | O_NOCTTY);
     assert_true(master >= 0);
@@ -108,7 +158,7 @@ static inline void test_terminal_run(const char *const *argv, const test_termina
         if (t < 0 || null < 0)
             _exit(127);
         dup2(null, 0);
-        dup2(null, 1);
+        dup2(stdout_too ? t : null, 1);
         dup2(t, 2);
         close(master);
         execv(argv[0], (char *const *)argv);
@@ -164,6 +214,12 @@ static inline void test_terminal_run(const char *const *argv, const test_termina
     if (at && sent == 0)
         fail_msg("%s ended before its progress bar read %d%s: no signal was sent:\n%s", argv[0], at->at_least,
                  at->unit, out);
+}
+
+static inline void test_terminal_run(const char *const *argv, const test_terminal_signal *at, char *out, size_t cap,
+                                     test_terminal_result *r)
+{
+    test_terminal_run_io(argv, at, false, out, cap, r);
 }
 
 #endif

@@ -75,9 +75,8 @@ rt_result prepare_scene(rt_scene *scene, rt_settings *set, const args *a, char *
                 a->window ? " and the window" : " only");
     if (fmt != RT_FORMAT_EXR && a->half)
         rt_warn("%s: --half is for .exr output; ignored", output);
-    if (!a->input && a->log_level >= RT_LOG_NORMAL)
-        fprintf(stderr, "rt: no input given; rendering the built-in Cornell box to %s (rt --help for usage)\n",
-                output);
+    if (!a->input)
+        rt_note("no input given; rendering the built-in Cornell box to %s (rt --help for usage)", output);
 
     rt_info("scene: %s (loaded in %.1f ms)", input_name(a->input), info.load_ms);
     rt_info("  triangles %zu, spheres %zu, quads %zu, vertices %zu", scene->triangles.count, scene->spheres.count,

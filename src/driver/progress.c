@@ -23,14 +23,19 @@
 
 #include "viewer.h"
 
-/* "load 0.31s, kd-tree 0.12s, " for the phases before rendering. */
-static void phase_times(const progress_view *v, char *buf, size_t size, double render_start)
+/* "load 0.31s, kd-tree 0.12s, " for the phases before rendering. A
+ * phase ends where the next begins, the last one where the render after it
+ * started (noted at that render's first report): a render started again
+ * later (the window's camera moved) leaves the phases' times as they were,
+ * so time spent waiting on the window is never counted in them. */
+static void phase_times(progress_view *v, char *buf, size_t size, double render_start)
 {
     size_t n = 0;
     buf[0] = 0;
     for (int i = 0; i < v->phases && n < size; i++) {
-        double end = i + 1 < v->phases ? v->phase_start[i + 1] : render_start;
-        int k = snprintf(buf + n, size - n, "%s %.2fs, ", v->phase_name[i], end - v->phase_start[i]);
+        if (v->phase_end[i] == 0.0)
+            v->phase_end[i] = i + 1 < v->phases ? v->phase_start[i + 1] : render_start;
+        int k = snprintf(buf + n, size - n, "%s %.2fs, ", v->phase_name[i], v->phase_end[i] - v->phase_start[i]);
         if (k < 0)
             break;
         n += (size_t)k;
@@ -53,7 +58,7 @@ static double fraction_done(const rt_render_progress *p)
     return f < 0.0 ? 0.0 : (f > 1.0 ? 1.0 : f);
 }
 
-static void draw_bar(const progress_view *v, const rt_render_progress *p)
+static void draw_bar(progress_view *v, const rt_render_progress *p)
 {
     const int width = 24;
     double f = fraction_done(p);
@@ -70,28 +75,26 @@ static void draw_bar(const progress_view *v, const rt_render_progress *p)
         line[n++] = i < bar ? '#' : ' ';
     line[n++] = ']';
     line[n] = 0;
-    char phases[160];
+    char phases[160], eta[32] = "";
     phase_times(v, phases, sizeof phases, rt_now_seconds() - p->elapsed);
-    fprintf(stderr, "\r%srender %s %5.1f%% %s %6.1fs", phases, line, 100.0 * f, count, p->elapsed);
     if (!p->final && f > 0.0) {
-        double eta = p->elapsed * (1.0 - f) / f;
-        if (v->time_limit > 0.0 && eta > v->time_limit - p->elapsed)
-            eta = v->time_limit > p->elapsed ? v->time_limit - p->elapsed : 0.0;
-        fprintf(stderr, "  ETA %6.1fs", eta);
+        double left = p->elapsed * (1.0 - f) / f;
+        if (v->time_limit > 0.0 && left > v->time_limit - p->elapsed)
+            left = v->time_limit > p->elapsed ? v->time_limit - p->elapsed : 0.0;
+        snprintf(eta, sizeof eta, "  ETA %6.1fs", left);
     }
-    fputs("\033[K", stderr); /* clear what a longer line left */
+    rt_log_status("%srender %s %5.1f%% %s %6.1fs%s", phases, line, 100.0 * f, count, p->elapsed, eta);
     if (p->final)
-        fputc('\n', stderr);
-    fflush(stderr);
+        rt_log_status_keep();
 }
 
 /* Live view: a copy of the image where unfinished tiles are dim grey. */
-static void write_preview(const rt_render_progress *p, const char *path, float exposure, rt_write_temp *temp)
+static bool write_preview(const rt_render_progress *p, const char *path, float exposure, rt_write_temp *temp)
 {
     rt_framebuffer copy;
     rt_error err;
     if (rt_framebuffer_init(&copy, p->fb->width, p->fb->height, &err) != RT_OK)
-        return;
+        return false;
     for (int i = 0; i < p->tiles_total; i++) {
         rt_tile t = rt_render_progress_tile(p, i);
         for (int y = t.y0; y < t.y1; y++)
@@ -102,9 +105,11 @@ static void write_preview(const rt_render_progress *p, const char *path, float e
             }
     }
     rt_image_options opt = {.exposure = exposure};
-    if (rt_framebuffer_write_tracked(&copy, path, &opt, temp, &err) != RT_OK)
+    bool ok = rt_framebuffer_write_tracked(&copy, path, &opt, temp, &err) == RT_OK;
+    if (!ok)
         rt_warn("live preview: %s", err.message);
     rt_framebuffer_free(&copy);
+    return ok;
 }
 
 void progress_view_init(progress_view *v, bool bar)
@@ -209,19 +214,16 @@ void progress_phase(progress_view *v, const char *name, const char *detail)
         return;
     v->phase_name[v->phases] = name;
     v->phase_start[v->phases] = rt_now_seconds();
+    v->phase_end[v->phases] = 0.0;
     v->phases++;
-    if (v->bar) {
-        fprintf(stderr, "\r%s%s%s ...\033[K", name, detail ? " " : "", detail ? detail : "");
-        fflush(stderr);
-    }
+    if (v->bar)
+        rt_log_status("%s%s%s ...", name, detail ? " " : "", detail ? detail : "");
 }
 
 void progress_clear(progress_view *v)
 {
-    if (v->bar) {
-        fputs("\r\033[K", stderr);
-        fflush(stderr);
-    }
+    (void)v;
+    rt_log_status_clear(); /* rt/base/log.h knows whether a line is shown */
 }
 
 void progress_report(const rt_render_progress *p, void *view)
@@ -238,7 +240,8 @@ void progress_report(const rt_render_progress *p, void *view)
         show_in_window(v, p);
     double every = v->preview_seconds > 0.0 ? v->preview_seconds : 2.0;
     if (!p->final && v->preview_path && p->elapsed - v->last_preview >= every) {
-        write_preview(p, v->preview_path, v->exposure, v->temp);
+        if (write_preview(p, v->preview_path, v->exposure, v->temp))
+            v->previews++;
         v->last_preview = p->elapsed;
     }
 }

@@ -46,9 +46,11 @@ typedef struct progress_view {
     float exposure;           /* the scene's, for PNG previews */
     double time_limit;        /* --time-limit, for the estimate; 0 = none */
     double last_preview;      /* elapsed seconds at the last preview */
+    int previews;             /* previews written over the output so far */
     rt_write_temp *temp;      /* the preview write's temporary file, for the signal handler; may be NULL */
     const char *phase_name[PROGRESS_MAX_PHASES]; /* the phases before rendering, in order */
     double phase_start[PROGRESS_MAX_PHASES];     /* monotonic seconds */
+    double phase_end[PROGRESS_MAX_PHASES];       /* 0 until the render after it first reports */
     int phases;
     tev_stream *tev;          /* --display-server: stream the image there; NULL = none */
     unsigned char *tev_sent;  /* tiles: per tile, sent to tev since it connected */
@@ -70,7 +72,8 @@ void progress_phase(progress_view *v, const char *name, const char *detail);
  * and streamed starts over; tiles_total: the render's tile count. */
 void progress_restart(progress_view *v, int tiles_total);
 
-/* Clears the progress line (before an error message). */
+/* Clears the progress line (before a message not written through
+ * rt/base/log.h, which clears it itself). */
 void progress_clear(progress_view *v);
 
 /* rt_render_options.progress for a progress_view (the user pointer). */

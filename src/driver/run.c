@@ -26,6 +26,7 @@
 #include "rt/job/output.h"
 #include "rt/job/part_job.h"
 #include "rt/job/slices.h"
+#include "rt/render/camera_control.h"
 #include "rt/render/render.h"
 #include "tev.h"
 #include "viewer.h"
@@ -69,8 +70,8 @@ static int write_result(run *rn, rt_result r, rt_error *err)
     progress_view *view = rn->view;
     const rt_render_stats rs = rn->rs;
     int status = 0;
+    progress_clear(view); /* the lines below start on a line of their own */
     if (r != RT_OK && r != RT_ERR_INTERRUPTED) {
-        progress_clear(view);
         memory_budget_report(err, &a->budget);
         return 2;
     }
@@ -85,8 +86,11 @@ static int write_result(run *rn, rt_result r, rt_error *err)
     if (reason)
         snprintf(why, sizeof why, ", %s", reason);
     bool stopped = r == RT_ERR_INTERRUPTED || rs.time_limited;
-    char partial[1100], what[160];
+    char partial[1100], what[160], kept[1200];
     const char *target = output;
+    /* what the output holds when the result goes elsewhere: --preview has written over it */
+    snprintf(kept, sizeof kept, view->previews > 0 ? "%s holds the last live preview (--preview)" : "%s left as it was",
+             output);
     if (pj->to_part) {
         if (rs.partial) {
             fprintf(stderr, "rt: stopped before any %s finished (%s); no part written, %s left as it was%s\n",
@@ -112,17 +116,17 @@ static int write_result(run *rn, rt_result r, rt_error *err)
             snprintf(what, sizeof what, "%d of %d spp%s", pj->s_begin + rs.samples_done, set->samples, why);
         }
         if (rs.partial && rs.tiles_done == 0) {
-            fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s left as it was\n",
-                    rs.passes ? "pass" : "tile", reason ? reason : "?", output);
+            fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s\n",
+                    rs.passes ? "pass" : "tile", reason ? reason : "?", kept);
         } else if (rt_job_output_write(&rn->jo, set, fb, aov, target, rn->sig->temp, err) != RT_OK) {
             memory_budget_report(err, &a->budget);
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
             char extras[2048]; /* the AOV files (or layers) too */
             rt_job_output_extras(&rn->jo, aov, target, extras, sizeof extras);
-            fprintf(stderr, "rt: wrote %s%s: %dx%d, %s; %.2f s (render %.2f s)%s%s%s\n", target, extras, fb->width,
+            fprintf(stderr, "rt: wrote %s%s: %dx%d, %s; %.2f s (render %.2f s)%s%s\n", target, extras, fb->width,
                     fb->height, what, rt_now_seconds() - rn->t_start, rs.seconds, rs.partial ? "; " : "",
-                    rs.partial ? output : "", rs.partial ? " left as it was" : "");
+                    rs.partial ? kept : "");
         }
     }
     if (status != 2 && a->part_out) {
@@ -227,6 +231,7 @@ static int run_setup(run *rn)
     rn->have_aov = true;
     if (a->window) {
         char why[512], title[1100];
+        progress_phase(rn->view, "window", NULL); /* SDL takes a while to start: not the kd-tree's time */
         snprintf(title, sizeof title, "rt: %s", rn->output);
         if (!window_open(&rn->window, rn->fb.width, rn->fb.height, title, why, sizeof why)) {
             progress_clear(rn->view);
@@ -269,6 +274,20 @@ static void run_watch(run *rn)
     }
 }
 
+/* True when the camera's look_at is only a direction: a glTF camera's
+ * point 1 unit ahead (rt_gltf), not moved by --look-at. The window then
+ * orbits about the model's depth instead (rt_camera_depth). */
+static bool look_at_means_nothing(const run *rn)
+{
+    const rt_scene *scene = rn->scene;
+    if (rn->jo.has_look_at)
+        return false;
+    for (size_t k = 0; k < scene->camera_count; k++)
+        if (memcmp(&scene->cameras[k].look_at, &scene->camera.look_at, sizeof scene->camera.look_at) == 0)
+            return true;
+    return false;
+}
+
 /* The render's options from the flags and the part plan; the window's
  * viewer session. */
 static void run_options(run *rn)
@@ -303,7 +322,8 @@ static void run_options(run *rn)
         float diag = rt_box_diagonal(b), d = rt_length(rt_sub(scene->camera.look_at, scene->camera.position));
         rn->window.exposure = rn->session.image.exposure;
         rn->window.tonemap = a->tonemap;
-        window_set_camera(&rn->window, &scene->camera, isfinite(diag) && diag > 0.0f ? 0.02f * diag : 0.05f * d);
+        window_set_camera(&rn->window, &scene->camera, isfinite(diag) && diag > 0.0f ? 0.02f * diag : 0.05f * d,
+                          look_at_means_nothing(rn) ? rt_camera_depth(&scene->camera, scene, &rn->tree) : 0.0f);
         rn->window.interactive = !rn->pj.need_accum; /* kept sums (a part, --part-out, --resume): the camera stays */
         view->viewer = &rn->session;
     }

@@ -251,6 +251,7 @@ static bool send_all(tev_stream *t, const packet *p)
         if (n <= 0) {
             rt_info("display server %s:%s: connection lost (%s); reconnecting", t->host, t->port,
                     n < 0 ? strerror(errno) : "closed");
+            t->lost = true; /* tev closed: said with -v only, as is its coming back */
             disconnect(t);
             return false;
         }
@@ -285,14 +286,19 @@ bool tev_stream_connect(tev_stream *t, bool force)
     char why[256];
     t->fd = connect_to(t->host, t->port, why, sizeof why);
     if (t->fd < 0) {
-        if (!t->warned)
-            rt_info("display server %s:%s: not reachable (%s); retrying every %.0f s", t->host, t->port, why,
-                    TEV_RETRY_SECONDS);
+        if (!t->warned && !t->lost) /* said once a run, without -v: a wrong port is otherwise silent */
+            rt_warn("--display-server %s:%s: nothing listens there (%s); rendering on, and trying again every "
+                    "%.0f s (start tev, or check the port)",
+                    t->host, t->port, why, TEV_RETRY_SECONDS);
         t->warned = true;
         return false;
     }
-    rt_info("display server %s:%s: connected", t->host, t->port);
+    if (t->warned && !t->lost)
+        rt_note("--display-server %s:%s: connected", t->host, t->port);
+    else
+        rt_info("display server %s:%s: connected", t->host, t->port);
     t->warned = false;
+    t->lost = false;
     send_create(t);
     t->fresh = t->fd >= 0;
     return t->fd >= 0;

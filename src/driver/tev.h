@@ -9,10 +9,12 @@
  *   tev_stream_image(&t, fb);                     // the whole image (after a pass, at the end)
  *   tev_stream_close(&t);
  *
- * Nothing here fails the render: when tev is not there or goes away the
- * stream says so once (at -v) and connects again at the next update at
- * most every two seconds (tev_stream_image(..., force) tries at once),
- * sending the image anew; the caller then calls tev_stream_image.
+ * Nothing here fails the render: when nothing listens at the address the
+ * stream warns once (a wrong port is otherwise invisible), says so again
+ * when it connects after all; when tev goes away mid-render it says so at
+ * -v only. Either way it connects again at the next update at most every
+ * two seconds (tev_stream_image(..., force) tries at once), sending the
+ * image anew; the caller then calls tev_stream_image.
  *
  * The image has the channels R, G, B, then the layers' LAYER.R, LAYER.G,
  * LAYER.B (LAYER.Y for one channel), as rt's EXR output names them; every
@@ -39,6 +41,7 @@ typedef struct tev_stream {
     int fd;             /* -1 = not connected */
     bool fresh;         /* connected since the last whole image was sent */
     bool warned;        /* said once that tev is not reachable */
+    bool lost;          /* the connection was lost (tev closed): quiet retries */
     double last_try;    /* monotonic seconds of the last connection attempt */
     size_t bytes_sent;
 } tev_stream;

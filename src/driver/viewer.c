@@ -25,6 +25,7 @@ static void print_camera(const window_view *w)
     char line[700];
     const rt_camera *c = &w->camera;
     rt_camera_format(c, line, sizeof line);
+    rt_log_status_clear(); /* the lines start at the terminal's left edge, not after the progress bar */
     printf("%s\n", line);
     printf("# as flags: --look-from %.9g,%.9g,%.9g --look-at %.9g,%.9g,%.9g --up %.9g,%.9g,%.9g --fov %.9g\n",
            (double)c->position.x, (double)c->position.y, (double)c->position.z, (double)c->look_at.x,
@@ -58,8 +59,10 @@ static void write_snapshot(viewer *v, const rt_framebuffer *copy, const char *wh
     rt_error err = {0};
     if (rt_framebuffer_write_tracked(copy, path, &opt, v->temp, &err) != RT_OK)
         rt_warn("window snapshot: %s", err.message);
-    else
+    else { /* asked for by a key: said even with -q */
+        rt_log_status_clear();
         fprintf(stderr, "rt: wrote %s: %dx%d, %s (window snapshot)\n", path, copy->width, copy->height, what);
+    }
 }
 
 /* A snapshot while rendering: the finished tiles, or the image of the last pass. */

@@ -6,10 +6,14 @@
  * under Xvfb). Mouse and keys move the window's camera with the pure
  * functions of rt/render/camera_control.h (a turntable orbit about
  * look_at, as yocto-gl's and pbrt-v4's viewers do) and raise request bits
- * for the driver. RT_WINDOW_SCRIPT pushes synthetic events into SDL's own
- * queue (SDL_PushEvent), so a test drives the very code a mouse does.
- * Without SDL2 at build time every call is a stub and window_open says
- * why.
+ * for the driver; a glTF camera, whose look_at is only a direction, moves
+ * about the model's depth (rt_camera_depth, given as the pivot).
+ * RT_WINDOW_SCRIPT pushes synthetic events into SDL's own queue
+ * (SDL_PushEvent), so a test drives the very code a mouse does. SDL's
+ * messages go through rt's log (rt/base/log.h): SDL_Log by
+ * SDL_LogSetOutputFunction, and what its video backends print straight to
+ * stderr while the window opens by catching fd 2 meanwhile. Without SDL2
+ * at build time every call is a stub and window_open says why.
  */
 #include "window.h"
 
@@ -17,7 +21,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
+#include "rt/base/log.h"
 #include "rt/render/camera.h"
 #include "rt/render/camera_control.h"
 
@@ -38,12 +44,13 @@ void window_show_rect(window_view *w, const rt_framebuffer *fb, int x0, int y0, 
     }
 }
 
-void window_set_camera(window_view *w, const rt_camera *c, float step)
+void window_set_camera(window_view *w, const rt_camera *c, float step, float pivot)
 {
     w->interactive = true;
     w->camera = *c;
     w->home = *c;
     w->step = step > 0.0f && isfinite(step) ? step : 1.0f;
+    w->pivot = w->home_pivot = pivot > 0.0f && isfinite(pivot) ? pivot : 0.0f;
 }
 
 unsigned window_take_requests(window_view *w)
@@ -86,6 +93,9 @@ static bool parse_script(window_view *w, const char *text, char *why, size_t why
                         : strcmp(a, "middle") == 0 ? SDL_BUTTON_MIDDLE
                                                    : 0;
             ok = s->button != 0;
+        } else if (sscanf(step, "sleep %d %n", &s->v[0], &n) == 1 && !step[n]) {
+            s->kind = 's';
+            ok = s->v[0] >= 0;
         } else if (sscanf(step, "wheel %d %n", &s->v[0], &n) == 1 && !step[n]) {
             s->kind = 'w';
             ok = true;
@@ -103,22 +113,70 @@ static bool parse_script(window_view *w, const char *text, char *why, size_t why
     return true;
 }
 
-bool window_open(window_view *w, int width, int height, const char *title, char *why, size_t why_size)
+/* SDL's own log (SDL_Log and its errors) through rt's: "rt: SDL: ..."
+ * with -v, or nothing. */
+static void sdl_log(void *user, int category, SDL_LogPriority priority, const char *message)
 {
-    memset(w, 0, sizeof *w);
-    w->exposure = 1.0f;
-    const char *script = getenv("RT_WINDOW_SCRIPT");
-    if (script && *script && !parse_script(w, script, why, why_size))
-        return false;
-    const char *x11 = getenv("DISPLAY"), *wayland = getenv("WAYLAND_DISPLAY"), *chosen = getenv("SDL_VIDEODRIVER");
-    if (!(x11 && *x11) && !(wayland && *wayland) && !(chosen && *chosen)) {
-        snprintf(why, why_size, "no display (DISPLAY and WAYLAND_DISPLAY are not set)");
-        return false;
+    (void)user;
+    (void)category;
+    (void)priority;
+    rt_info("SDL: %s", message);
+}
+
+/* What SDL's video backends print straight to stderr while they start
+ * (libwayland's "error: XDG_RUNTIME_DIR is invalid or not set in the
+ * environment." when SDL tries Wayland, Xlib's complaints): fd 2 goes to
+ * a temporary file meanwhile, and its lines then through rt_info, so they
+ * carry rt's prefix and are shown only with -v (the reason a window
+ * cannot open is said anyway, from SDL_GetError). Only the main thread
+ * runs then: no render has started. */
+typedef struct stderr_capture {
+    FILE *file; /* NULL: not captured */
+    int saved;  /* the real stderr, dup'ed */
+} stderr_capture;
+
+static void capture_stderr(stderr_capture *c)
+{
+    c->file = NULL;
+    c->saved = -1;
+    fflush(stderr);
+    FILE *f = tmpfile();
+    int saved = f ? dup(2) : -1;
+    if (saved < 0 || dup2(fileno(f), 2) < 0) {
+        if (saved >= 0)
+            close(saved);
+        if (f)
+            fclose(f);
+        return;
     }
-    /* a plain X11/Wayland surface, never an OpenGL one: nothing to gain for
-     * one texture a pass, and Mesa's threads are then out of the process */
-    SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
-    SDL_SetHint(SDL_HINT_RENDER_DRIVER, "software");
+    c->file = f;
+    c->saved = saved;
+}
+
+static void release_stderr(stderr_capture *c)
+{
+    if (!c->file)
+        return;
+    fflush(stderr);
+    dup2(c->saved, 2);
+    close(c->saved);
+    rewind(c->file);
+    char line[1024];
+    while (fgets(line, sizeof line, c->file)) {
+        size_t n = strcspn(line, "\r\n");
+        line[n] = 0;
+        if (n > 0)
+            rt_info("SDL: %s", line);
+    }
+    fclose(c->file);
+    c->file = NULL;
+}
+
+/* SDL started, the window, its renderer and texture made; false (and why)
+ * with everything undone. */
+static bool open_video(window_view *w, int width, int height, const char *title, char *why, size_t why_size)
+{
+    const char *x11 = getenv("DISPLAY"), *wayland = getenv("WAYLAND_DISPLAY"), *chosen = getenv("SDL_VIDEODRIVER");
     if (SDL_Init(SDL_INIT_VIDEO) != 0) {
         snprintf(why, why_size, "%s", SDL_GetError());
         return false;
@@ -126,7 +184,9 @@ bool window_open(window_view *w, int width, int height, const char *title, char 
     /* SDL falls back to drivers that show nothing; only take one if asked to */
     const char *driver = SDL_GetCurrentVideoDriver();
     if (driver && !(chosen && *chosen) && (strcmp(driver, "offscreen") == 0 || strcmp(driver, "dummy") == 0)) {
-        snprintf(why, why_size, "no display could be opened (SDL fell back to its '%s' driver)", driver);
+        snprintf(why, why_size, "no display could be opened (%s%s%s%s%s; SDL fell back to its '%s' driver)",
+                 x11 && *x11 ? "DISPLAY=" : "", x11 && *x11 ? x11 : "", x11 && *x11 && wayland && *wayland ? ", " : "",
+                 wayland && *wayland ? "WAYLAND_DISPLAY=" : "", wayland && *wayland ? wayland : "", driver);
         SDL_Quit();
         return false;
     }
@@ -166,6 +226,32 @@ bool window_open(window_view *w, int width, int height, const char *title, char 
     w->rgb = rgb;
     w->width = width;
     w->height = height;
+    return true;
+}
+
+bool window_open(window_view *w, int width, int height, const char *title, char *why, size_t why_size)
+{
+    memset(w, 0, sizeof *w);
+    w->exposure = 1.0f;
+    const char *script = getenv("RT_WINDOW_SCRIPT");
+    if (script && *script && !parse_script(w, script, why, why_size))
+        return false;
+    const char *x11 = getenv("DISPLAY"), *wayland = getenv("WAYLAND_DISPLAY"), *chosen = getenv("SDL_VIDEODRIVER");
+    if (!(x11 && *x11) && !(wayland && *wayland) && !(chosen && *chosen)) {
+        snprintf(why, why_size, "no display (DISPLAY and WAYLAND_DISPLAY are not set)");
+        return false;
+    }
+    /* a plain X11/Wayland surface, never an OpenGL one: nothing to gain for
+     * one texture a pass, and Mesa's threads are then out of the process */
+    SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
+    SDL_SetHint(SDL_HINT_RENDER_DRIVER, "software");
+    SDL_LogSetOutputFunction(sdl_log, NULL);
+    stderr_capture cap;
+    capture_stderr(&cap);
+    bool ok = open_video(w, width, height, title, why, why_size);
+    release_stderr(&cap);
+    if (!ok)
+        return false;
     w->open = true;
     window_present(w);
     return true;
@@ -173,12 +259,22 @@ bool window_open(window_view *w, int width, int height, const char *title, char 
 
 /* ------------------------------------------------------------ input */
 
+/* The camera a move starts from: the current one, with look_at put at the
+ * model's depth while it is still a point that means nothing (a glTF
+ * camera's, 1 unit ahead: window_set_camera's pivot), so that orbit, pan
+ * and dolly turn about, follow and approach the model. */
+static rt_camera move_start(const window_view *w)
+{
+    return w->pivot > 0.0f ? rt_camera_look_at_depth(w->camera, w->pivot) : w->camera;
+}
+
 static void camera_moved(window_view *w, rt_camera c)
 {
     rt_camera_frame cf;
     if (!rt_camera_frame_init(&cf, &c, w->width, w->height) || memcmp(&c, &w->camera, sizeof c) == 0)
         return; /* a move that would break the camera, or none */
     w->camera = c;
+    w->pivot = 0.0f; /* look_at is the pivot from now on */
     w->requests |= WINDOW_CAMERA;
     w->render_done = false;
 }
@@ -188,7 +284,7 @@ static void camera_moved(window_view *w, rt_camera c)
  * mouse) or pan (the point at look_at's distance stays under the mouse). */
 static void drag_by(window_view *w, int dx, int dy)
 {
-    rt_camera c = w->camera;
+    rt_camera c = move_start(w);
     if (w->drag == 'o') {
         float rate = WINDOW_PI / (float)(w->width > w->height ? w->width : w->height);
         c = rt_camera_orbit(c, c.look_at, -(float)dx * rate, (float)dy * rate);
@@ -205,6 +301,9 @@ static void key_down(window_view *w, const SDL_Keysym *k)
     float s = w->step;
     switch (k->sym) {
     case SDLK_ESCAPE: w->open = false; return;
+    case SDLK_q: /* as --help says; Ctrl+Q too */
+        w->open = false;
+        return;
     case SDLK_F12: w->requests |= WINDOW_SAVE; return;
     case SDLK_p: w->requests |= WINDOW_PRINT; return;
     case SDLK_LEFTBRACKET: w->view_ev -= 1.0f / 3.0f; w->requests |= WINDOW_EXPOSURE; return;
@@ -219,13 +318,16 @@ static void key_down(window_view *w, const SDL_Keysym *k)
     if (!w->interactive || ctrl)
         return;
     switch (k->sym) {
-    case SDLK_w: camera_moved(w, rt_camera_walk(w->camera, s, 0, 0)); break;
-    case SDLK_s: camera_moved(w, rt_camera_walk(w->camera, -s, 0, 0)); break;
-    case SDLK_a: camera_moved(w, rt_camera_walk(w->camera, 0, -s, 0)); break;
-    case SDLK_d: camera_moved(w, rt_camera_walk(w->camera, 0, s, 0)); break;
-    case SDLK_e: camera_moved(w, rt_camera_walk(w->camera, 0, 0, s)); break;
-    case SDLK_q: camera_moved(w, rt_camera_walk(w->camera, 0, 0, -s)); break;
-    case SDLK_r: camera_moved(w, w->home); break;
+    case SDLK_w: camera_moved(w, rt_camera_walk(move_start(w), s, 0, 0)); break;
+    case SDLK_s: camera_moved(w, rt_camera_walk(move_start(w), -s, 0, 0)); break;
+    case SDLK_a: camera_moved(w, rt_camera_walk(move_start(w), 0, -s, 0)); break;
+    case SDLK_d: camera_moved(w, rt_camera_walk(move_start(w), 0, s, 0)); break;
+    case SDLK_e: camera_moved(w, rt_camera_walk(move_start(w), 0, 0, s)); break;
+    case SDLK_c: camera_moved(w, rt_camera_walk(move_start(w), 0, 0, -s)); break;
+    case SDLK_r:
+        camera_moved(w, w->home);
+        w->pivot = w->home_pivot;
+        break;
     default: break;
     }
 }
@@ -252,7 +354,7 @@ static void handle_event(window_view *w, const SDL_Event *ev)
         if (w->interactive) {
             int n = ev->wheel.direction == SDL_MOUSEWHEEL_FLIPPED ? -ev->wheel.y : ev->wheel.y;
             if (n)
-                camera_moved(w, rt_camera_dolly(w->camera, powf(0.85f, (float)n)));
+                camera_moved(w, rt_camera_dolly(move_start(w), powf(0.85f, (float)n)));
         }
         break;
     default: break;
@@ -275,8 +377,10 @@ static void run_script(window_view *w)
         if (!w->script_armed) { /* the step's start */
             w->script_armed = true;
             w->script_mark = w->shown;
+            w->script_since = SDL_GetTicks();
         }
-        if ((s->kind == 'd' && !w->render_done) || (s->kind == 'p' && w->shown == w->script_mark))
+        if ((s->kind == 'd' && !w->render_done) || (s->kind == 'p' && w->shown == w->script_mark) ||
+            (s->kind == 's' && SDL_GetTicks() - w->script_since < (Uint32)s->v[0]))
             return;
         SDL_Event e;
         Uint32 id = SDL_GetWindowID((SDL_Window *)w->window);

@@ -7,7 +7,7 @@
  *   if (!window_open(&w, width, height, "rt: out.png", why, sizeof why))
  *       ... "--window: cannot open a window: <why>" ...
  *   w.exposure = 1.0f; w.tonemap = RT_TONEMAP_CLAMP;     // the output's
- *   window_set_camera(&w, &scene.camera, step);          // enables the camera keys and mouse
+ *   window_set_camera(&w, &scene.camera, step, pivot);   // enables the camera keys and mouse
  *   window_show_rect(&w, fb, x0, y0, x1, y1);            // pixels that are final
  *   window_present(&w);                                  // draws; handles events
  *   unsigned what = window_take_requests(&w);            // WINDOW_CAMERA: w.camera moved, ...
@@ -15,12 +15,14 @@
  *   window_close(&w);
  *
  * The input (docs/watching.md has the table): left drag orbits about
- * look_at, right or middle drag (or shift + left) pans, the wheel dollies,
- * W A S D walk, E and Q rise and sink, R goes back to the first camera,
- * [ and ] change the view's exposure by 1/3 stop (0 resets it), F12 or
- * Ctrl+S ask for a snapshot, P for the camera line, Esc or the close
- * button close the window. The window only moves its own `camera` and
- * raises request bits; the driver (viewer.c) acts on them.
+ * look_at (or, for a camera whose look_at means nothing, a glTF camera's
+ * point 1 unit ahead, about the point at `pivot` along the view: the
+ * model's depth), right or middle drag (or shift + left) pans, the wheel
+ * dollies, W A S D walk, E and C rise and sink, R goes back to the first
+ * camera, [ and ] change the view's exposure by 1/3 stop (0 resets it),
+ * F12 or Ctrl+S ask for a snapshot, P for the camera line, Esc, Q or the
+ * close button close the window. The window only moves its own `camera`
+ * and raises request bits; the driver (viewer.c) acts on them.
  *
  * rt builds without SDL2 (the Makefile compiles this with RT_HAVE_SDL2
  * only when pkg-config finds sdl2); window_open then says so. All calls
@@ -32,6 +34,7 @@
  * through SDL's own event queue, one step after the other:
  *   wait done                      until the render at the current camera has finished
  *   wait pass                      until a new pass (or tile) has been shown
+ *   sleep MS                       MS milliseconds (the window idle)
  *   drag left|right|middle X0 Y0 X1 Y1   press, move, release (image pixels)
  *   wheel N                        N wheel notches (> 0: away from the user)
  *   key NAME                       a key press, SDL's key name (P, F12, Escape, [)
@@ -59,9 +62,9 @@ enum {
 #define WINDOW_SCRIPT_MAX 64
 
 typedef struct window_step {
-    char kind;        /* 'd' wait done, 'p' wait pass, 'g' drag, 'w' wheel, 'k' key */
+    char kind;        /* 'd' wait done, 'p' wait pass, 's' sleep, 'g' drag, 'w' wheel, 'k' key */
     int button;       /* drag: SDL button number */
-    int v[4];         /* drag: x0 y0 x1 y1; wheel: notches */
+    int v[4];         /* drag: x0 y0 x1 y1; wheel: notches; sleep: milliseconds */
     int key;          /* key: SDL keycode */
 } window_step;
 
@@ -76,7 +79,9 @@ typedef struct window_view {
     /* the interactive camera (enabled by window_set_camera) */
     bool interactive;
     rt_camera camera, home;            /* the view asked for; the first one (R) */
-    float step;                        /* W A S D E Q step, scene units */
+    float step;                        /* W A S D E C step, scene units */
+    float pivot, home_pivot;           /* > 0: moves start with look_at at this distance along the view
+                                        * (the model's depth), for `camera` and for `home` */
     int drag;                          /* 0, or 'o' orbit / 'p' pan while a button is held */
     unsigned requests;                 /* WINDOW_* bits */
     /* what the driver tells the test script */
@@ -85,19 +90,22 @@ typedef struct window_view {
     /* RT_WINDOW_SCRIPT */
     window_step script[WINDOW_SCRIPT_MAX];
     int script_len, script_at, script_mark;
+    unsigned script_since;             /* SDL ticks at the step's start */
     bool script_armed;
 } window_view;
 
 bool window_open(window_view *w, int width, int height, const char *title, char *why, size_t why_size);
-/* Enables the camera input, starting from *c; step: the walking step. */
-void window_set_camera(window_view *w, const rt_camera *c, float step);
+/* Enables the camera input, starting from *c; step: the walking step;
+ * pivot: 0, or the distance along the view to orbit about (and to pan and
+ * dolly at) instead of look_at's, which then means nothing. */
+void window_set_camera(window_view *w, const rt_camera *c, float step, float pivot);
 /* Tone-maps fb's pixels [x0, x1) x [y0, y1) into the shown image. */
 void window_show_rect(window_view *w, const rt_framebuffer *fb, int x0, int y0, int x1, int y1);
 /* Puts the shown image on screen and handles pending events. */
 void window_present(window_view *w);
 /* The WINDOW_* bits raised since the last call, cleared. */
 unsigned window_take_requests(window_view *w);
-/* Keeps the window up until the user closes it (Esc or the close
+/* Keeps the window up until the user closes it (Esc, Q or the close
  * button), a request is raised, or *stop becomes non-zero (Ctrl-C). */
 void window_wait(window_view *w, const atomic_int *stop);
 void window_close(window_view *w);

@@ -11,6 +11,10 @@
  * move position and look_at by one vector in the camera's frame (the frame
  * of rt_camera_frame_init: f = normalize(look_at - position), r =
  * normalize(f x up), u = r x f); dolly scales the distance to look_at.
+ * A camera whose look_at is only a direction (a glTF camera's, 1 unit
+ * ahead) gets its pivot from the scene: the first surface the ray through
+ * the image's centre meets (that ray is the view direction f itself), else
+ * the depth of the scene bounds' centre along f.
  *
  * The `camera` line prints floats with %.9g: nine significant digits
  * identify every binary32 value (IEEE 754-2008, 5.12.2), so the scene
@@ -20,6 +24,8 @@
 
 #include <math.h>
 #include <stdio.h>
+
+#include "rt/accel/kdtree.h"
 
 #define MIN_POLAR_DEG 1.0
 #define PI_D 3.14159265358979323846
@@ -115,6 +121,34 @@ rt_camera rt_camera_walk(rt_camera c, float forward, float right, float up)
     c.position = fv(dadd(dv(c.position), d));
     c.look_at = fv(dadd(dv(c.look_at), d));
     return c;
+}
+
+rt_camera rt_camera_look_at_depth(rt_camera c, float depth)
+{
+    dvec f, r, u;
+    frame(&c, &f, &r, &u);
+    if (!(depth > 0.0f) || !isfinite(depth) || dlen(f) == 0.0)
+        return c;
+    c.look_at = fv(dadd(dv(c.position), dscale(f, (double)depth)));
+    return c;
+}
+
+float rt_camera_depth(const rt_camera *c, const rt_scene *scene, const rt_kdtree *tree)
+{
+    dvec f, r, u;
+    frame(c, &f, &r, &u);
+    if (dlen(f) == 0.0)
+        return 0.0f;
+    rt_ray ray = rt_ray_make(c->position, fv(f), 0.0f, INFINITY);
+    rt_hit hit;
+    if (tree && rt_kdtree_intersect(tree, &ray, &hit) && hit.t > 0.0f && isfinite(hit.t))
+        return hit.t * rt_length(ray.dir); /* t is in units of |dir|, 1 up to rounding */
+    rt_box b = rt_scene_bounds(scene);
+    if (rt_box_is_empty(b))
+        return 0.0f;
+    dvec centre = dscale(dadd(dv(b.lo), dv(b.hi)), 0.5);
+    double d = ddot(dsub(centre, dv(c->position)), f);
+    return d > 0.0 && isfinite(d) ? (float)d : 0.0f;
 }
 
 float rt_camera_pan_scale(const rt_camera *c, int height)

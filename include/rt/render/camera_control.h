@@ -8,6 +8,8 @@
  *   c = rt_camera_dolly(c, 0.9f);                     // 90% of the distance to look_at
  *   c = rt_camera_walk(c, fwd, right, up);            // scene units; the view direction kept
  *   float s = rt_camera_pan_scale(&c, height);        // scene units per pixel at look_at
+ *   float d = rt_camera_depth(&c, &scene, &tree);     // how far ahead the model is (0: nothing ahead)
+ *   if (d > 0) c = rt_camera_look_at_depth(c, d);     // orbit about the model, not a point 1 unit ahead
  *   char line[512];
  *   rt_camera_format(&c, line, sizeof line);          // "camera position ... look_at ... up ... fov ..."
  *
@@ -24,6 +26,7 @@
 
 #include <stddef.h>
 
+#include "rt/accel/kdtree.h"
 #include "rt/scene/scene.h"
 
 /* Turns position and look_at about `pivot`: yaw radians about the up axis,
@@ -42,6 +45,18 @@ rt_camera rt_camera_dolly(rt_camera c, float factor);
 /* Moves position and look_at by `forward` along the view direction,
  * `right` along the image's right and `up` along the up vector. */
 rt_camera rt_camera_walk(rt_camera c, float forward, float right, float up);
+
+/* The camera with look_at moved along the view direction to `depth` scene
+ * units from position (the view is kept, up to rounding); c unchanged when
+ * depth is not above 0. */
+rt_camera rt_camera_look_at_depth(rt_camera c, float depth);
+
+/* How far along the view direction the scene is: the distance to the first
+ * surface the ray through the image's centre meets in `tree` (built for
+ * `scene`; may be NULL), else the depth of the centre of the scene's bounds
+ * along the view; 0 when that is not ahead of the camera (or the scene is
+ * empty). The pivot for a camera whose look_at is only a direction. */
+float rt_camera_depth(const rt_camera *c, const rt_scene *scene, const rt_kdtree *tree);
 
 /* Scene units a pixel spans at the distance of look_at, for an image
  * `height` pixels high (a pan by this per pixel keeps look_at under the
