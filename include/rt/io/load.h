@@ -51,6 +51,8 @@ typedef struct rt_load_options {
     bool use_time;   /* a glTF input is posed at `time` by its animation `animation` (rt_gltf_options) */
     float time;
     int animation;
+    const char *animation_name; /* the animation of this name instead (NULL = by index); a scene file's model lines
+                                 * without their own `animation` take it */
 } rt_load_options;
 
 /* What one load found (what `rt --info` prints beside the scene's counts). */
