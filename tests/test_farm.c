@@ -421,6 +421,16 @@ static void test_frames_animated_gltf(void **state)
     assert_true(n0 != n2 || memcmp(f0, f2, n0) != 0);
     free(f0);
     free(f2);
+    /* a scene's model line without its own `animation` plays the one --animation names */
+    char *eol = strstr(text, " animation Run\n");
+    assert_non_null(eol);
+    strcpy(eol, "\n");
+    f = fopen(in_dir("fox-any.txt"), "wb");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    RUN_OK("-q", "--frame-time", "0.5", "--animation", "Run", "-o", in_dir("fox-named.png"), in_dir("fox-any.txt"));
+    assert_same_bytes(in_dir("fox-named.png"), in_dir("fox-t.png"));
     assert_int_equal(RUN("-q", "--frame-time", "0.3", "--animation", "Trot", "-o", in_dir("trot.pfm"), foxglb), 2);
     assert_non_null(strstr(err_text, "no animation named 'Trot'"));
     assert_non_null(strstr(err_text, "'Run'"));
