@@ -755,6 +755,18 @@ static void test_frames_stopped_then_resumed(void **state)
             assert_int_equal(access(a, F_OK), -1);
         }
     }
+    /* with what a part cannot keep (the spp AOV) a stopped frame is still
+     * kept apart, without a part, and renders again from the start */
+    char aovs[600];
+    snprintf(aovs, sizeof aovs, "%s/aov.%%04d.pfm", dir);
+    RUN_OK("-q", "-s", "64", "--aov", "spp", "--frames", "2:3", "--time-limit", TIME_UP, "-o", aovs, scene);
+    assert_int_equal(access(in_dir("aov.0002.pfm"), F_OK), -1);
+    assert_int_equal(access(in_dir("aov.0002.partial.pfm"), F_OK), 0);
+    assert_int_equal(access(in_dir("aov.0002.part.exr.json"), F_OK), -1);
+    RUN_OK("-q", "-s", "64", "--aov", "spp", "--frames", "2:3", "-o", aovs, scene);
+    RUN_OK("-q", "-s", "64", "-o", in_dir("aov-straight.pfm"), scene);
+    assert_same_bytes(in_dir("aov.0002.pfm"), in_dir("aov-straight.pfm"));
+    assert_int_equal(access(in_dir("aov.0002.partial.pfm"), F_OK), -1);
     /* a stopped frame's part of other settings is not resumed over: refused, naming it */
     char pattern[600];
     snprintf(pattern, sizeof pattern, "%s/other.%%04d.pfm", dir);

@@ -55,13 +55,16 @@ typedef struct run {
 } run;
 
 /* A frame finished and written to output: the image and part an earlier
- * stop of it left (NAME.partial.EXT, NAME.part.exr and its sidecar) are
- * stale now, and would be taken for a stopped frame; removed. */
+ * stop of it left (NAME.partial.EXT, and NAME.part.exr with its sidecar
+ * when it keeps one) are stale now, and would be taken for a stopped
+ * frame; removed. */
 static void remove_stopped(const char *output, const char *stop_part)
 {
     char p[1100];
     if (rt_path_tagged(output, "partial", NULL, p, sizeof p))
         unlink(p);
+    if (!stop_part)
+        return;
     snprintf(p, sizeof p, "%s.json", stop_part);
     unlink(p); /* the sidecar first: a part without one is no part */
     unlink(stop_part);
@@ -82,7 +85,8 @@ static int write_image(run *rn, bool stopped, const char *reason, const char *wh
     const rt_render_stats rs = rn->rs;
     char partial[1100], what[160];
     const char *target = output;
-    bool to_side = rs.partial || (stop_part && stopped);
+    bool frame = a->has_frames; /* (an image: a part output is write_result's) */
+    bool to_side = rs.partial || (frame && stopped);
     if (to_side) {
         rt_path_tagged(output, "partial", NULL, partial, sizeof partial); /* where an incomplete image goes */
         target = partial;
@@ -110,7 +114,7 @@ static int write_image(run *rn, bool stopped, const char *reason, const char *wh
         fprintf(stderr, "rt: wrote %s and %s.json: the frame's samples 0:%d of %d, resumed by rendering the frame "
                         "again\n",
                 stop_part, stop_part, pj->s_begin + rs.samples_done, set->samples);
-    else if (stop_part)
+    else if (frame && !to_side)
         remove_stopped(output, stop_part);
     return 0;
 }
