@@ -12,8 +12,9 @@
 # as an evicted pod leaves it (resumed) and one pod started again (its
 # complete part kept); the merge Job, checked against a single-machine render
 # byte for byte, PNG as the manifest writes it and PFM (IMAGE=image.pfm) for
-# the float pixels; the frames Job's pods 0, 1 and the last, frame 1 already
-# there (kept), each frame against the single render (no animation yet).
+# the float pixels; the frames Job's pods 0, 1, 2 and the last, frame 1
+# already there (kept), frame 2 stopped after its first pass (resumed), each
+# frame against the single render (the scene has no animation).
 # Needs python3 with PyYAML (Debian's python3-yaml, installed when missing).
 # Environment: RT_BIN (default ./rt).
 set -eu
@@ -116,7 +117,8 @@ check(fspec.get("completionMode") == "Indexed", "render-frames-job.yaml: complet
 check(isinstance(nf, int) and nf >= 3, "render-frames-job.yaml: completions is not a number of frames")
 check("%" in fenv.get("OUTPUT", ""), "render-frames-job.yaml: OUTPUT is not a frame pattern")
 fcmd = " ".join(fc.get("command", []) + fc.get("args", []))
-check("JOB_COMPLETION_INDEX" in fcmd and "--frames" in fcmd, "render-frames-job.yaml: the command does not pass JOB_COMPLETION_INDEX to --frames")
+check("JOB_COMPLETION_INDEX" in fcmd and "--only-frames" in fcmd, "render-frames-job.yaml: the command does not pass JOB_COMPLETION_INDEX to --only-frames")
+check(fenv.get("FRAMES") == str(nf), f"render-frames-job.yaml: FRAMES is {fenv.get('FRAMES')} but completions is {nf}")
 
 spec = render["spec"]
 n = spec.get("completions")
@@ -162,7 +164,10 @@ run("merge-job.yaml", mc, dict(menv, WORK=volume), {})
 run("merge-job.yaml", mc, dict(menv, WORK=volume, IMAGE="image.pfm"), {})
 
 # The frames Job (its scene, a glTF in the manifest, is the test's scene
-# here): pods 0, 1 and the last, frame 1 already there (kept, not rendered)
+# here): pods 0, 1, 2 and the last, frame 1 already there (kept, not
+# rendered), frame 2 stopped by an eviction's SIGTERM after its first pass
+# (here a time limit, which leaves the same files: f.0002.partial.png and
+# the part f.0002.part.exr), resumed by its pod to the single render's bytes
 with open(single, "rb") as f:
     want = f.read()
 fdir = os.path.join(volume, "frames")
@@ -171,10 +176,16 @@ kept = os.path.join(fdir, "f.0001.png")
 with open(kept, "wb") as f:
     f.write(want)
 stamp = os.stat(kept).st_mtime_ns
-for i in (0, 1, nf - 1):
+r = subprocess.run(["rt", "-q", "--frames", f"0:{nf}", "--only-frames", "2:3", "--time-limit", "0.000001", "-o",
+                    os.path.join(volume, fenv["OUTPUT"]), os.path.join(volume, renv["SCENE"])])
+stopped = os.path.join(fdir, "f.0002.part.exr.json")
+check(r.returncode == 0 and os.path.exists(stopped) and not os.path.exists(os.path.join(fdir, "f.0002.png")),
+      "the stopped frame 2 was not kept apart (f.0002.part.exr, no f.0002.png)")
+for i in (0, 1, 2, nf - 1):
     run("render-frames-job.yaml", fc, dict(fenv, WORK=volume, SCENE=renv["SCENE"]), {"JOB_COMPLETION_INDEX": str(i)})
 check(os.stat(kept).st_mtime_ns == stamp, "frame 1 was there but its pod rendered it again")
-for i in (0, 1, nf - 1):
+check(not os.path.exists(stopped), "frame 2's pod left the part it resumed")
+for i in (0, 1, 2, nf - 1):
     name = os.path.join(volume, fenv["OUTPUT"] % i)
     if check(os.path.exists(name), f"render-frames-job.yaml: pod {i} wrote no {name}"):
         with open(name, "rb") as f:
@@ -184,7 +195,7 @@ if failures:
     for f in failures:
         print("test-kubernetes: " + f, file=sys.stderr)
     sys.exit(1)
-print(f"test-kubernetes: manifests checked; {n} indexed pods and the merge, 3 of {nf} frame pods run locally")
+print(f"test-kubernetes: manifests checked; {n} indexed pods and the merge, 4 of {nf} frame pods run locally")
 PY
 [ -f "$work/volume/parts/part.0.exr.json" ] || launch_fail "no sidecar part.0.exr.json beside part.0.exr"
 launch_same "$work/volume/image.png" "$work/single.png" "the Indexed Job's parts merged (PNG)"

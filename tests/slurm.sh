@@ -8,7 +8,8 @@
 # job through examples/slurm/submit.sh as a user would (one part already
 # there, half rendered, as a task stopped by its time limit leaves it:
 # submit.sh --resume) and, beside them, an array of frames
-# (examples/slurm/render-frames.sbatch, one frame already there), waits for
+# (examples/slurm/render-frames.sbatch, one frame already there, one stopped
+# and resumed), waits for
 # them, and checks that the merged image and every frame are the
 # single-machine render byte for byte.
 # Whether it passes, fails, times out or is interrupted, it cancels its
@@ -147,9 +148,14 @@ ids=$(RT="$RT" sh "$REPO/examples/slurm/submit.sh" --resume "$parts" scene.txt p
 array=${ids% *}
 merge=${ids#* }
 # An animation beside it: 2 tasks of 2 frames (frames 0..3; the scene has no
-# animation yet, so each is the single render), frame 1 already there.
+# animation, so each is the single render), frame 1 already there, frame 2
+# stopped after its first pass as a time limit's SIGTERM leaves it
+# (f.0002.partial.pfm and the part f.0002.part.exr, no f.0002.pfm).
 mkdir frames
 cp single.pfm frames/f.0001.pfm
+"$RT" -q --frames 0:4 --only-frames 2:3 --time-limit 0.000001 -o 'frames/f.%04d.pfm' scene.txt ||
+    launch_fail "the stopped frame 2 was not rendered"
+[ -f frames/f.0002.part.exr.json ] && [ ! -e frames/f.0002.pfm ] || launch_fail "the stopped frame 2 was not kept apart"
 frames=$(RT="$RT" RT_FRAMES_PER_TASK=2 sbatch --parsable --array=0-1 \
     "$REPO/examples/slurm/render-frames.sbatch" scene.txt 'frames/f.%04d.pfm')
 frames=${frames%%;*}
@@ -184,6 +190,9 @@ done
 grep -q 'resuming it' rt-part-"${array}"_1.out || launch_fail "task 1 did not resume its part: $(cat rt-part-"${array}"_1.out)"
 launch_same image.pfm single.pfm "$parts parts on Slurm (one resumed), merged"
 grep -q 'frame 1: .* is there, kept' rt-frames-"${frames}"_0.out || launch_fail "frame 1 was rendered again"
+grep -q 'frame 2: stopped at 4 of 8 samples .*: resuming it' rt-frames-"${frames}"_1.out ||
+    launch_fail "task 1 did not resume the stopped frame 2: $(cat rt-frames-"${frames}"_1.out)"
+[ ! -e frames/f.0002.part.exr ] || launch_fail "the resumed frame 2 left its part"
 for f in 0 1 2 3; do
     launch_same "frames/f.000$f.pfm" single.pfm "frame $f of the frames array"
 done

@@ -1440,9 +1440,61 @@ static void test_sigterm_writes_passes(void **state)
     interrupted_passes(SIGTERM);
 }
 
+/* The end of the samples a part's sidecar holds ("samples": [0, END]). */
+static int sidecar_samples_end(const char *json)
+{
+    char buf[8192];
+    size_t n = read_all(json, buf, sizeof buf - 1);
+    buf[n] = 0;
+    const char *s = strstr(buf, "\"samples\": [");
+    int a = -1, b = -1;
+    if (!s || sscanf(s, "\"samples\": [%d, %d]", &a, &b) != 2)
+        fail_msg("no samples in %s: %s", json, buf);
+    assert_int_equal(a, 0);
+    return b;
+}
+
+/* A frame of --frames stopped by SIGTERM (what a Slurm time limit or a pod
+ * eviction sends) is not kept as the finished frame: exit 143, no file
+ * under the frame's name, its image at the samples reached in
+ * NAME.partial.pfm and its sums in NAME.part.exr; run again, the frame
+ * resumes from that part (stopped again, the part holds more samples). */
+static void test_sigterm_frame_kept_apart(void **state)
+{
+    (void)state;
+    char pattern[600];
+    snprintf(pattern, sizeof pattern, "%s/term.%%04d.pfm", dir);
+    const char *frame = path_in("term.0005.pfm"), *partial = path_in("term.0005.partial.pfm");
+    const char *sidecar = path_in("term.0005.part.exr.json");
+    const char *const args[] = {"-s", "100000", "-t", "2", "--integrator", "path", "--frames", "5:6", "-o", pattern,
+                                slow_scene(), NULL};
+    run_result *r = malloc(sizeof *r);
+    assert_non_null(r);
+    run_and_signal(args, SIGTERM, " spp", 4, r);
+    assert_true(access(frame, F_OK) != 0);
+    char expect[700];
+    snprintf(expect, sizeof expect, "rt: wrote %s: 64x64, ", partial);
+    assert_contains(r->err, expect);
+    assert_contains(r->err, "spp, terminated");
+    assert_contains(r->err, "term.0005.part.exr and ");
+    rt_framebuffer fb;
+    rt_error err;
+    assert_int_equal(rt_pfm_read(partial, &fb, &err), RT_OK);
+    rt_framebuffer_free(&fb);
+    int first = sidecar_samples_end(sidecar);
+    assert_true(first >= 4 && first % 4 == 0);
+    run_and_signal(args, SIGTERM, " spp", first + 4, r);
+    assert_contains(r->err, "term.0005.part.exr: a stopped render of this frame; resuming it");
+    assert_true(access(frame, F_OK) != 0);
+    assert_true(sidecar_samples_end(sidecar) > first);
+    assert_no_temp_files();
+    free(r);
+}
+
 /* --time-limit already over when rendering starts (1 us: less than
  * starting a thread takes): in passes, exactly the first pass (4 spp) is
- * written to the output, labelled, exit 0; tiled, no tile is started (a
+ * written to the output, labelled, exit 0, also with an integrator that
+ * tiles (a time limit renders in passes); tiled (--passes 0), no tile is started (a
  * worker checks the deadline before taking one), nothing is written and
  * the output is left alone. */
 static void test_time_limit(void **state)
@@ -1462,6 +1514,18 @@ static void test_time_limit(void **state)
     rt_error err;
     assert_int_equal(rt_pfm_read(pfm, &fb, &err), RT_OK);
     rt_framebuffer_free(&fb);
+
+    /* an integrator that tiles (direct) renders in passes under a time
+     * limit: the whole image at the first pass, not a partial one */
+    put_precious(pfm);
+    run_args(r, (const char *const[]){"-q", "-s", "64", "--integrator", "direct", "--time-limit", "1e-6", "-o", pfm,
+                                      slow_scene(), NULL});
+    assert_int_equal(r->status, 0);
+    snprintf(expect, sizeof expect, "rt: wrote %s: 64x64, 4 of 64 spp, time limit; ", pfm);
+    assert_contains(r->err, expect);
+    assert_int_equal(rt_pfm_read(pfm, &fb, &err), RT_OK);
+    rt_framebuffer_free(&fb);
+    assert_true(access(partial, F_OK) != 0);
 
     put_precious(pfm);
     run_args(r, (const char *const[]){"-q", "-s", "64", "--integrator", "path", "--passes", "0", "--time-limit",
@@ -3024,6 +3088,7 @@ int main(void)
         cmocka_unit_test(test_sigint_writes_passes),
         cmocka_unit_test(test_sigterm_writes_passes),
         cmocka_unit_test(test_time_limit),
+        cmocka_unit_test(test_sigterm_frame_kept_apart),
         cmocka_unit_test(test_preview),
         cmocka_unit_test(test_progress_line_on_terminal),
         cmocka_unit_test(test_second_sigint_exits_at_once),

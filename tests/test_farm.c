@@ -310,9 +310,9 @@ static void test_aov_parts(void **state)
     assert_int_equal(access(in_dir("x.pfm"), F_OK), -1);
 }
 
-/* --frames A:B: one file a frame, named from the pattern; a scene without
- * animation gives the single render each frame; bad patterns are refused
- * up front. */
+/* --frames A:B: one file a frame, named from the pattern (%04d or
+ * Blender's ####; without -o, NAME.%04d.png); a scene without animation
+ * gives the single render each frame; bad patterns are refused up front. */
 static void test_frames(void **state)
 {
     (void)state;
@@ -328,7 +328,24 @@ static void test_frames(void **state)
     snprintf(pattern, sizeof pattern, "%s/fp%%d.exr", dir);
     RUN_OK("-q", "-s", "2", "--frames", "0:2", "--part", "1/2", "-o", pattern, scene);
     assert_int_equal(access(in_dir("fp1.exr.json"), F_OK), 0);
-    const char *bad[] = {"plain.png", "two%d%d.png", "s%s.png", "w%010d.png", "%"};
+    /* Blender's ####: the number zero-padded to as many digits */
+    snprintf(pattern, sizeof pattern, "%s/h.###.png", dir);
+    RUN_OK("-q", "-s", "2", "--frames", "8:10", "-o", pattern, scene);
+    assert_same_bytes(in_dir("h.008.png"), in_dir("one.png"));
+    assert_same_bytes(in_dir("h.009.png"), in_dir("one.png"));
+    /* without -o: NAME.%04d.png in the current directory (NAME: the input's) */
+    char bin[4096], cwd[4096];
+    assert_non_null(realpath(rt_bin(), bin));
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    setenv("RT_BIN", bin, 1);
+    assert_int_equal(chdir(dir), 0);
+    int status = RUN("-q", "-s", "2", "--frames", "3:5", "scene.txt");
+    assert_int_equal(chdir(cwd), 0);
+    if (status != 0)
+        fail_msg("--frames without -o failed: %s", err_text);
+    assert_same_bytes(in_dir("scene.0003.png"), in_dir("one.png"));
+    assert_same_bytes(in_dir("scene.0004.png"), in_dir("one.png"));
+    const char *bad[] = {"plain.png", "two%d%d.png", "s%s.png", "w%010d.png", "%", "two##.#.png", "long##########.png"};
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
         assert_int_equal(RUN("-q", "--frames", "0:2", "-o", in_dir(bad[i]), scene), 2);
         assert_non_null(strstr(err_text, "%0Nd"));
@@ -350,8 +367,12 @@ static void test_frames_animated_gltf(void **state)
     static char model[4096];
     snprintf(model, sizeof model, "%s", truck);
     snprintf(pattern, sizeof pattern, "%s/truck.%%d.png", dir);
-    RUN_OK("-q", "-r", "48x36", "-s", "2", "--frames", "0:3", "--fps", "4", "-o", pattern, model);
-    RUN_OK("-q", "-r", "48x36", "-s", "2", "--frame-time", "0.5", "-o", in_dir("truck-t.png"), model);
+    /* the truck has no camera: a fixed one, as the sequence's automatic
+     * camera frames all three frames, not frame 2 alone */
+    RUN_OK("-q", "-r", "48x36", "-s", "2", "--look-from", "3,2,4", "--look-at", "0,1,0", "--frames", "0:3", "--fps",
+           "4", "-o", pattern, model);
+    RUN_OK("-q", "-r", "48x36", "-s", "2", "--look-from", "3,2,4", "--look-at", "0,1,0", "--frame-time", "0.5", "-o",
+           in_dir("truck-t.png"), model);
     assert_same_bytes(in_dir("truck.2.png"), in_dir("truck-t.png"));
     size_t n0, n2;
     char *f0 = slurp(in_dir("truck.0.png"), &n0), *f2 = slurp(in_dir("truck.2.png"), &n2);
@@ -386,11 +407,85 @@ static void test_frames_animated_gltf(void **state)
     assert_true(n0 != n2 || memcmp(f0, f2, n0) != 0); /* the fox ran */
     free(f0);
     free(f2);
+    /* --animation by name: the Fox's third animation is 'Run'; an unknown
+     * name is refused, naming the file's */
+    static char foxglb[6200];
+    snprintf(foxglb, sizeof foxglb, "%s", fox);
+    RUN_OK("-q", "-r", "32x24", "-s", "1", "--frame-time", "0.3", "--animation", "2", "-o", in_dir("run2.pfm"), foxglb);
+    RUN_OK("-q", "-r", "32x24", "-s", "1", "--frame-time", "0.3", "--animation", "Run", "-o", in_dir("runname.pfm"),
+           foxglb);
+    assert_same_bytes(in_dir("run2.pfm"), in_dir("runname.pfm"));
+    RUN_OK("-q", "-r", "32x24", "-s", "1", "--frame-time", "0.3", "--animation", "Walk", "-o", in_dir("walk.pfm"),
+           foxglb);
+    f0 = slurp(in_dir("run2.pfm"), &n0), f2 = slurp(in_dir("walk.pfm"), &n2);
+    assert_true(n0 != n2 || memcmp(f0, f2, n0) != 0);
+    free(f0);
+    free(f2);
+    /* a scene's model line without its own `animation` plays the one --animation names */
+    char *eol = strstr(text, " animation Run\n");
+    assert_non_null(eol);
+    strcpy(eol, "\n");
+    f = fopen(in_dir("fox-any.txt"), "wb");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    RUN_OK("-q", "--frame-time", "0.5", "--animation", "Run", "-o", in_dir("fox-named.png"), in_dir("fox-any.txt"));
+    assert_same_bytes(in_dir("fox-named.png"), in_dir("fox-t.png"));
+    assert_int_equal(RUN("-q", "--frame-time", "0.3", "--animation", "Trot", "-o", in_dir("trot.pfm"), foxglb), 2);
+    assert_non_null(strstr(err_text, "no animation named 'Trot'"));
+    assert_non_null(strstr(err_text, "'Run'"));
     snprintf(pattern, sizeof pattern, "%s/foxp.%%d.exr", dir);
     RUN_OK("-q", "--frames", "0:2", "--part", "0/2", "-o", pattern, in_dir("fox.txt"));
     RUN_OK("-q", "--frames", "1:2", "--part", "1/2", "-o", pattern, in_dir("fox.txt"));
     assert_int_equal(RUN("merge", in_dir("foxp.0.exr"), in_dir("foxp.1.exr"), "-o", in_dir("foxp.png")), 2);
     assert_non_null(strstr(err_text, "frame_time"));
+}
+
+/* The camera lines of a part's sidecar ("camera.position ... focus_distance X"). */
+static void sidecar_camera(const char *json, char *out, size_t size)
+{
+    size_t n;
+    char *t = slurp(json, &n);
+    const char *a = strstr(t, "camera.position"), *b = a ? strstr(a, "frame_time") : NULL;
+    if (!a || !b)
+        fail_msg("no camera in %s", json);
+    snprintf(out, size, "%.*s", (int)(b - a), a);
+    free(t);
+}
+
+/* --frames with the automatic camera (the Fox has none) frames the whole
+ * sequence once: every frame has the same camera, and a machine rendering
+ * only its share (--only-frames) frames as the whole run did, to the same
+ * bytes; --only-frames outside --frames is refused. Before, each frame was
+ * framed on its own pose and the camera moved with the fox. */
+static void test_frames_one_camera(void **state)
+{
+    (void)state;
+    test_require_shared();
+    static char fox[4096];
+    snprintf(fox, sizeof fox, "%s", test_shared_path("assets/gltf/Fox/glTF-Binary/Fox.glb"));
+    char pattern[600], parts[600];
+    snprintf(pattern, sizeof pattern, "%s/seq.%%d.pfm", dir);
+    snprintf(parts, sizeof parts, "%s/seq.%%d.exr", dir);
+    RUN_OK("-q", "-r", "32x24", "-s", "1", "--animation", "2", "--frames", "0:12", "--fps", "8", "--part-out", parts,
+           "-o", pattern, fox);
+    char first[2048], other[2048], name[64];
+    sidecar_camera(in_dir("seq.0.exr.json"), first, sizeof first);
+    for (int f = 1; f < 12; f++) {
+        snprintf(name, sizeof name, "seq.%d.exr.json", f);
+        sidecar_camera(in_dir(name), other, sizeof other);
+        assert_string_equal(other, first);
+    }
+    snprintf(pattern, sizeof pattern, "%s/share.%%d.pfm", dir);
+    RUN_OK("-q", "-r", "32x24", "-s", "1", "--animation", "2", "--frames", "0:12", "--only-frames", "7:9", "--fps", "8",
+           "-o", pattern, fox);
+    assert_same_bytes(in_dir("share.7.pfm"), in_dir("seq.7.pfm"));
+    assert_same_bytes(in_dir("share.8.pfm"), in_dir("seq.8.pfm"));
+    assert_int_equal(access(in_dir("share.6.pfm"), F_OK), -1);
+    assert_int_equal(access(in_dir("share.9.pfm"), F_OK), -1);
+    assert_int_equal(RUN("-q", "--frames", "0:12", "--only-frames", "11:13", "-o", pattern, fox), 2);
+    assert_non_null(strstr(err_text, "--only-frames"));
+    assert_int_equal(RUN("-q", "--only-frames", "1:2", "-o", pattern, fox), 2);
 }
 
 /* quad.gltf in the scratch directory: a black quad 2 wide, 20 tall, two
@@ -616,6 +711,70 @@ static void test_time_limit_tiling_integrator(void **state)
            in_dir("tstop.exr"), "-o", in_dir("tstopped.pfm"), scene);
     assert_int_equal(access(in_dir("tstop.exr.json"), F_OK), -1);
     assert_non_null(strstr(err_text, "keeps no part"));
+}
+
+/* A frame stopped early (here by a time limit after its first pass; a
+ * signal takes the same path) is not the finished frame: its image goes to
+ * NAME.partial.EXT and its sums to NAME.part.exr, the frame's name stays
+ * free; the next run of the frame resumes the part to exactly the bytes of
+ * a render never stopped, and removes what the stop left. An integrator
+ * that tiles (direct) stops and resumes alike (a frame renders in passes). */
+static void test_frames_stopped_then_resumed(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    const char *integrators[] = {"path", "direct"};
+    for (int k = 0; k < 2; k++) {
+        char pattern[600], name[64];
+        snprintf(pattern, sizeof pattern, "%s/straight-%s.%%04d.pfm", dir, integrators[k]);
+        RUN_OK("-q", "-s", "64", "--integrator", integrators[k], "--frames", "5:7", "-o", pattern, scene);
+        snprintf(pattern, sizeof pattern, "%s/stop-%s.%%04d.pfm", dir, integrators[k]);
+        RUN_OK("-q", "-s", "64", "--integrator", integrators[k], "--frames", "5:7", "--time-limit", TIME_UP, "-o",
+               pattern, scene);
+        for (int f = 5; f < 7; f++) {
+            snprintf(name, sizeof name, "stop-%s.%04d", integrators[k], f);
+            char image[700], partial[700], sidecar[700];
+            snprintf(image, sizeof image, "%s.pfm", in_dir(name));
+            snprintf(partial, sizeof partial, "%s.partial.pfm", in_dir(name));
+            snprintf(sidecar, sizeof sidecar, "%s.part.exr.json", in_dir(name));
+            assert_int_equal(access(image, F_OK), -1); /* not under the finished frame's name */
+            assert_int_equal(access(partial, F_OK), 0);
+            assert_int_equal(sidecar_end(sidecar), 4); /* the first pass of 4 (also direct's, which tiles unstopped) */
+        }
+        RUN_OK("-q", "-s", "64", "--integrator", integrators[k], "--frames", "5:7", "-o", pattern, scene);
+        for (int f = 5; f < 7; f++) {
+            char a[700], b[700];
+            snprintf(a, sizeof a, "%s/stop-%s.%04d.pfm", dir, integrators[k], f);
+            snprintf(b, sizeof b, "%s/straight-%s.%04d.pfm", dir, integrators[k], f);
+            assert_same_bytes(a, b);
+            snprintf(a, sizeof a, "%s/stop-%s.%04d.part.exr.json", dir, integrators[k], f);
+            assert_int_equal(access(a, F_OK), -1); /* the stop's leftovers removed */
+            snprintf(a, sizeof a, "%s/stop-%s.%04d.part.exr", dir, integrators[k], f);
+            assert_int_equal(access(a, F_OK), -1);
+            snprintf(a, sizeof a, "%s/stop-%s.%04d.partial.pfm", dir, integrators[k], f);
+            assert_int_equal(access(a, F_OK), -1);
+        }
+    }
+    /* with what a part cannot keep (the spp AOV) a stopped frame is still
+     * kept apart, without a part, and renders again from the start */
+    char aovs[600];
+    snprintf(aovs, sizeof aovs, "%s/aov.%%04d.pfm", dir);
+    RUN_OK("-q", "-s", "64", "--aov", "spp", "--frames", "2:3", "--time-limit", TIME_UP, "-o", aovs, scene);
+    assert_int_equal(access(in_dir("aov.0002.pfm"), F_OK), -1);
+    assert_int_equal(access(in_dir("aov.0002.partial.pfm"), F_OK), 0);
+    assert_int_equal(access(in_dir("aov.0002.part.exr.json"), F_OK), -1);
+    RUN_OK("-q", "-s", "64", "--aov", "spp", "--frames", "2:3", "-o", aovs, scene);
+    RUN_OK("-q", "-s", "64", "-o", in_dir("aov-straight.pfm"), scene);
+    assert_same_bytes(in_dir("aov.0002.pfm"), in_dir("aov-straight.pfm"));
+    assert_int_equal(access(in_dir("aov.0002.partial.pfm"), F_OK), -1);
+    /* a stopped frame's part of other settings is not resumed over: refused, naming it */
+    char pattern[600];
+    snprintf(pattern, sizeof pattern, "%s/other.%%04d.pfm", dir);
+    RUN_OK("-q", "-s", "64", "--frames", "1:2", "--time-limit", TIME_UP, "-o", pattern, scene);
+    assert_int_equal(RUN("-q", "-s", "32", "--frames", "1:2", "-o", pattern, scene), 2);
+    assert_non_null(strstr(err_text, "other.0001.part.exr"));
+    assert_int_equal(access(in_dir("other.0001.pfm"), F_OK), -1);
+    assert_int_equal(RUN("-q", "--frames", "1:2", "--resume", in_dir("other.0001.part.exr"), "-o", pattern, scene), 2);
 }
 
 /* Ctrl-C in passes, sent once the progress bar shows the first of 64
@@ -1044,6 +1203,8 @@ int main(void)
         cmocka_unit_test(test_aov_parts),
         cmocka_unit_test(test_frames),
         cmocka_unit_test(test_frames_animated_gltf),
+        cmocka_unit_test(test_frames_one_camera),
+        cmocka_unit_test(test_frames_stopped_then_resumed),
         cmocka_unit_test(test_animation_index),
         cmocka_unit_test(test_motion_blur),
         cmocka_unit_test(test_part_bands),

@@ -65,6 +65,7 @@ typedef enum flag_kind {
     FLAG_PART_OUT,
     FLAG_FRAMES,
     FLAG_FPS,
+    FLAG_ONLY_FRAMES,
     FLAG_HELP,
     FLAG_VERSION,
 } flag_kind;
@@ -145,15 +146,15 @@ static const flag flags[] = {
     {NULL, "--frame-time", "SECONDS", FLAG_FRAME_TIME, NULL,
      "pose an animated glTF (given directly or on a scene's model lines) at this time: its animation, skins and "
      "morph targets (default: the file's static pose)", .store = {STORE_FLOAT, ARG(frame_time), true, ARG(posed), -1e7, 1e7, false, false, "seconds (a finite number, at most 1e7 in size)"}},
-    {NULL, "--animation", "N", FLAG_ANIMATION, NULL, "which glTF animation --frame-time plays (default 0, the first)", .store = {STORE_INT, ARG(animation), true, ARG(posed), 0, 1000000, false, false, "an animation index (0 = the first)"}},
+    {NULL, "--animation", "N|NAME", FLAG_ANIMATION, NULL, "which glTF animation --frame-time and --frames play: its index or its name (default 0, the first)", OWN},
     {NULL, "--tile", "N", FLAG_TILE, NULL, "tile size in pixels (default 32)", .store = {STORE_INT, ARG(tile), false, 0, 1, 4096, false, false, "a tile size from 1 to 4096"}},
     {NULL, "--preview", "SECONDS", FLAG_PREVIEW, NULL,
      "live view: rewrite the output with the finished tiles every SECONDS", .store = {STORE_SECONDS, ARG(preview_seconds), false, 0, 0.1, 3600, false, false, "seconds between updates (0.1 to 3600)"}},
     {NULL, "--passes", "N", FLAG_PASSES, NULL,
      "render in passes of N samples per pixel over the whole image; 0 = tile by tile\n"
-     "(default: passes of 4 for path and for parts, tiles for direct and whitted)", .store = {STORE_INT, ARG(pass_samples), false, 0, 0, 1 << 20, false, false, "samples per pixel a pass from 0 (tiles) to 1048576"}},
+     "(default: passes of 4 for path, for parts and with --time-limit, tiles for direct and whitted)", .store = {STORE_INT, ARG(pass_samples), false, 0, 0, 1 << 20, false, false, "samples per pixel a pass from 0 (tiles) to 1048576"}},
     {NULL, "--time-limit", "SECONDS", FLAG_TIME_LIMIT, NULL,
-     "stop after the pass (tiles: the tiles in hand) that crosses SECONDS of rendering and write the image", .store = {STORE_SECONDS, ARG(time_limit), false, 0, 0, 1e7, true, false, "seconds (more than 0, at most 1e7)"}},
+     "stop after the pass that crosses SECONDS of rendering and write the whole image at the samples reached (in passes with every integrator; --passes 0: the tiles in hand, to NAME.partial.EXT)", .store = {STORE_SECONDS, ARG(time_limit), false, 0, 0, 1e7, true, false, "seconds (more than 0, at most 1e7)"}},
     {NULL, "--display-server", "HOST:PORT", FLAG_DISPLAY_SERVER, NULL,
      "stream the image as it renders to the tev viewer listening there (tev's default: 127.0.0.1:14158)", OWN},
     {NULL, "--window", NULL, FLAG_WINDOW, NULL,
@@ -176,10 +177,13 @@ static const flag flags[] = {
     {NULL, "--part-out", "FILE", FLAG_PART_OUT, NULL,
      "also write the render as a part FILE (.exr or .pfm, with FILE.json), e.g. to --resume it after a stop", SETS_TEXT(part_out)},
     {NULL, "--frames", "A:B", FLAG_FRAMES, NULL,
-     "render frames A .. B-1 of an animated glTF or scene (--animation N), each on its own at time frame / fps; "
-     "-o names "
-     "them with %04d (out.%04d.png)", OWN},
+     "render frames A .. B-1 of an animated glTF or scene (--animation), each on its own at time frame / fps; "
+     "-o names them with %04d or #### (default NAME.%04d.png); a stopped frame goes to NAME.partial.EXT and "
+     "NAME.part.exr, resumed by the next run", OWN},
     {NULL, "--fps", "F", FLAG_FPS, NULL, "frames per second for --frames (default 24)", .store = {STORE_SECONDS, ARG(fps), false, 0, 0, 10000, true, false, "frames per second (more than 0, at most 10000)"}},
+    {NULL, "--only-frames", "C:D", FLAG_ONLY_FRAMES, NULL,
+     "render only frames C .. D-1 of the --frames A:B sequence (a machine's share of it), with the automatic "
+     "camera framed for all of A:B", OWN},
     {"-h", "--help", NULL, FLAG_HELP, NULL, "this text", OWN},
     {NULL, "--version", NULL, FLAG_VERSION, NULL, "print the version", OWN},
 };
@@ -505,9 +509,23 @@ static int parse_setting_flag(args *a, const flag *fl, const char *name, const c
     return add_setting(a, name, value, def, value);
 }
 
-/* --camera, --variant, --look-from, --look-at, --up. */
+/* --camera, --animation, --variant, --look-from, --look-at, --up. */
 static int parse_view_flag(args *a, const flag *fl, const char *name, const char *value)
 {
+    if (fl->kind == FLAG_ANIMATION) { /* an index, or the animation's name */
+        a->posed = true;
+        a->animation = 0;
+        a->animation_name = NULL;
+        if (*value >= '0' && *value <= '9') {
+            if (!int_value(value, 0, 1000000, &a->animation))
+                return fail_usage("%s wants an animation index (0 = the first) or name, got '%s'", name, value);
+        } else if (*value) {
+            a->animation_name = value;
+        } else {
+            return fail_usage("%s wants an animation index (0 = the first) or name", name);
+        }
+        return ARGS_OK;
+    }
     if (fl->kind == FLAG_CAMERA) {
         a->camera_auto = strcmp(value, "auto") == 0;
         a->camera = -1;
@@ -659,14 +677,17 @@ static int parse_part_flag(args *a, const flag *fl, const char *name, const char
                               RT_MAX_SAMPLES, value);
         a->has_spp_range = true;
         return ARGS_OK;
-    default: /* FLAG_FRAMES */
+    default: { /* FLAG_FRAMES, FLAG_ONLY_FRAMES */
+        bool only = fl->kind == FLAG_ONLY_FRAMES;
         if (!strchr(value, ':') || strchr(value, ':') - value >= 32)
             return fail_usage("%s wants A:B (frames A to B-1), got '%s'", name, value);
-        if (!int_pair(value, ':', 0, 99999999, 1, 100000000, &a->frame_begin, &a->frame_end) ||
-            a->frame_begin >= a->frame_end)
+        if (!int_pair(value, ':', 0, 99999999, 1, 100000000, only ? &a->only_begin : &a->frame_begin,
+                      only ? &a->only_end : &a->frame_end) ||
+            (only ? a->only_begin >= a->only_end : a->frame_begin >= a->frame_end))
             return fail_usage("%s wants A:B with 0 <= A < B <= 100000000 (frames A to B-1), got '%s'", name, value);
-        a->has_frames = true;
+        *(only ? &a->has_only_frames : &a->has_frames) = true;
         return ARGS_OK;
+    }
     }
 }
 
@@ -692,6 +713,7 @@ static int parse_flag(args *a, const flag *fl, const char *name, const char *val
         a->log_level = RT_LOG_VERBOSE;
         return ARGS_OK;
     case FLAG_CAMERA:
+    case FLAG_ANIMATION:
     case FLAG_VARIANT:
     case FLAG_LOOK_FROM:
     case FLAG_LOOK_AT:
@@ -707,6 +729,7 @@ static int parse_flag(args *a, const flag *fl, const char *name, const char *val
     case FLAG_PART:
     case FLAG_SPP_RANGE:
     case FLAG_FRAMES:
+    case FLAG_ONLY_FRAMES:
         return parse_part_flag(a, fl, name, value, argc, argv, i);
     default: {
         int r = store_flag(a, fl, name, value);
@@ -724,6 +747,9 @@ static int check_combinations(const args *a)
         return fail_usage("--denoise-quality goes with --denoise (rt --denoise --denoise-quality high ...)");
     if (a->part_count && a->has_crop)
         return fail_usage("--part and --crop both choose the region; give one of them");
+    if (a->has_only_frames && (!a->has_frames || a->only_begin < a->frame_begin || a->only_end > a->frame_end))
+        return fail_usage("--only-frames %d:%d: a share of the --frames A:B sequence, within it%s", a->only_begin,
+                          a->only_end, a->has_frames ? "" : " (no --frames given)");
     if (a->has_frames && a->posed && a->frame_time != 0.0f)
         return fail_usage("--frames sets each frame's time (frame / fps); drop --frame-time");
     if (a->resume && (a->part_count || a->has_crop || a->has_spp_range))
@@ -815,6 +841,7 @@ void args_job_options(const args *a, rt_job_options *o)
                           .posed = a->posed,
                           .frame_time = a->frame_time,
                           .animation = a->animation,
+                          .animation_name = a->animation_name,
                           .use_camera = a->camera >= 0,
                           .camera = a->camera,
                           .camera_auto = a->camera_auto,

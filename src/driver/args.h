@@ -63,6 +63,7 @@ typedef struct args {
     bool posed;             /* --frame-time or --animation: pose an animated glTF */
     float frame_time;       /* --frame-time seconds (0 with --animation alone) */
     int animation;          /* --animation N (0 = the first) */
+    const char *animation_name; /* --animation NAME: the glTF animation of that name; NULL = by index */
     double preview_seconds; /* --preview; 0 = no live view */
     int pass_samples;       /* --passes: rt_render_options.pass_samples (0 = the integrator's, -1 = tiles) */
     double time_limit;      /* --time-limit seconds; 0 = none */
@@ -87,6 +88,10 @@ typedef struct args {
     bool has_frames;        /* --frames A:B: frames A .. B-1, the output a %04d pattern */
     int frame_begin, frame_end;
     double fps;             /* --fps; 24 unless given */
+    bool has_only_frames;   /* --only-frames C:D: render frames C .. D-1 of A:B only (framed for all of A:B) */
+    int only_begin, only_end;
+    const char *stop_part;  /* not a flag: with --frames, where a stopped frame's part goes (NAME.part.exr) */
+    const rt_frame_extent *frame_extent; /* not a flag: with --frames, the sequence's automatic framing */
     setting_flag settings[ARGS_MAX_SETTINGS];
     size_t setting_count;
 } args;

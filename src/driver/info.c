@@ -127,7 +127,7 @@ static int print_info(const char *path, const args *a)
     rt_gltf_catalog catalog;
     memset(&catalog, 0, sizeof catalog);
     rt_load_options lo = {.use_time = a->posed, .time = a->frame_time, .animation = a->animation,
-                          .variant = a->variant, .catalog = &catalog};
+                          .animation_name = a->animation_name, .variant = a->variant, .catalog = &catalog};
     rt_result r = input_load(&s, &loaded, path, &lo, &info, &err);
     if (r != RT_OK) {
         memory_budget_report(&err, budget);
@@ -164,7 +164,9 @@ static int print_info(const char *path, const args *a)
     print_vec("camera.look_at", rs.camera.look_at);
     print_vec("camera.up", rs.camera.up);
     printf("camera.fov: %.9g\n", rs.camera.vfov_deg);
-    if (a->posed)
+    if (a->posed && a->animation_name)
+        printf("pose: animation '%s' at %g s\n", a->animation_name, (double)a->frame_time);
+    else if (a->posed)
         printf("pose: animation %d at %g s\n", a->animation, (double)a->frame_time);
     printf("resolution: %dx%d\n", set.width, set.height);
     printf("samples: %d\n", set.samples);

@@ -28,6 +28,7 @@ rt_result prepare_scene(rt_scene *scene, rt_settings *set, const args *a, char *
                           .use_time = a->posed,
                           .time = a->frame_time,
                           .animation = a->animation,
+                          .animation_name = a->animation_name,
                           .variant = a->variant};
     rt_result r;
     /* -o is checked before the load, which may take long, and so is a
@@ -57,6 +58,7 @@ rt_result prepare_scene(rt_scene *scene, rt_settings *set, const args *a, char *
     rt_job_options jo;
     args_job_options(a, &jo);
     jo.fit_aspect = !args_sets(a, "resolution") && a->input && info.kind == RT_LOAD_GLTF;
+    jo.frame_extent = a->frame_extent;
     if ((r = rt_job_frame(scene, set, &jo, input_name(a->input), err)) != RT_OK)
         return r;
 

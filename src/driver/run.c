@@ -5,7 +5,8 @@
  * renderer's progress callback), the render itself (motion-blur slices
  * through rt/job/slices.h; with --window again at each new camera), and
  * the result written where it belongs: a part, the output, or
- * NAME.partial.EXT for an incomplete tiled image. */
+ * NAME.partial.EXT for an incomplete tiled image or a stopped frame of
+ * --frames (with its part, rt_job_options.stop_part). */
 #include "run.h"
 
 #include <math.h>
@@ -54,9 +55,80 @@ typedef struct run {
     bool have_tree, have_pj, have_fb, have_aov;
 } run;
 
+/* A frame finished and written to output: the image and part an earlier
+ * stop of it left (NAME.partial.EXT, and NAME.part.exr with its sidecar
+ * when it keeps one) are stale now, and would be taken for a stopped
+ * frame; removed. */
+static void remove_stopped(const char *output, const char *stop_part)
+{
+    char p[1100];
+    if (rt_path_tagged(output, "partial", NULL, p, sizeof p))
+        unlink(p);
+    if (!stop_part)
+        return;
+    snprintf(p, sizeof p, "%s.json", stop_part);
+    unlink(p); /* the sidecar first: a part without one is no part */
+    unlink(stop_part);
+}
+
+/* write_result for an image: the output, or NAME.partial.EXT for an
+ * incomplete tiled image or a stopped frame, said on stderr; 2 on an error
+ * (its message said), else 0. A frame stopped early is not the finished
+ * frame: its image goes to NAME.partial.EXT and its sums to the part that
+ * resumes it (stop_part); once finished, what a stop left is removed. */
+static int write_image(run *rn, bool stopped, const char *reason, const char *why, rt_error *err)
+{
+    const args *a = rn->a;
+    const rt_settings *set = rn->settings;
+    const rt_part_job *pj = &rn->pj;
+    const rt_framebuffer *fb = &rn->fb;
+    const char *output = rn->output, *stop_part = rn->jo.stop_part;
+    const rt_render_stats rs = rn->rs;
+    char partial[1100], what[160], kept[1200];
+    const char *target = output;
+    bool frame = a->has_frames; /* (an image: a part output is write_result's) */
+    /* what the output holds when the result goes elsewhere: --preview has written over it */
+    snprintf(kept, sizeof kept, rn->view->previews > 0 ? "%s holds the last live preview (--preview)" : "%s left as it was",
+             output);
+    bool to_side = rs.partial || (frame && stopped);
+    if (to_side) {
+        rt_path_tagged(output, "partial", NULL, partial, sizeof partial); /* where an incomplete image goes */
+        target = partial;
+    }
+    if (rs.partial)
+        snprintf(what, sizeof what, "%d of %d tiles at %d spp%s", rs.tiles_done, rs.tiles_total, set->samples, why);
+    else
+        snprintf(what, sizeof what, "%d of %d spp%s", pj->s_begin + rs.samples_done, set->samples, why);
+    if (rs.partial && rs.tiles_done == 0) {
+        fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s\n",
+                rs.passes ? "pass" : "tile", reason ? reason : "?", kept);
+        return 0;
+    }
+    if (rt_job_output_write(&rn->jo, set, &rn->fb, &rn->aov, target, rn->sig->temp, err) != RT_OK ||
+        (to_side && !rs.partial && stop_part &&
+         rt_part_job_write(pj, stop_part, rs.samples_done, rn->sig->temp, err) != RT_OK)) {
+        memory_budget_report(err, &a->budget);
+        return 2;
+    }
+    if (a->log_level >= RT_LOG_NORMAL || stopped) {
+        char extras[2048]; /* the AOV files (or layers) too */
+        rt_job_output_extras(&rn->jo, &rn->aov, target, extras, sizeof extras);
+        fprintf(stderr, "rt: wrote %s%s: %dx%d, %s; %.2f s (render %.2f s)%s%s\n", target, extras, fb->width,
+                fb->height, what, rt_now_seconds() - rn->t_start, rs.seconds, to_side ? "; " : "",
+                to_side ? kept : "");
+    }
+    if (to_side && stop_part)
+        fprintf(stderr, "rt: wrote %s and %s.json: the frame's samples 0:%d of %d, resumed by rendering the frame "
+                        "again\n",
+                stop_part, stop_part, pj->s_begin + rs.samples_done, set->samples);
+    else if (frame && !to_side)
+        remove_stopped(output, stop_part);
+    return 0;
+}
+
 /* Writes a render's result (rt_render returned r with stats rs) where its
- * state says: a part (pj->to_part), the output, or NAME.partial.EXT for an
- * incomplete tiled image, and --part-out's part; says so; returns the exit
+ * state says: a part (pj->to_part), or the image (write_image), and
+ * --part-out's part; says so; returns the exit
  * status (128 + the signal that stopped it, 2 on an error, else 0: also
  * when the window was closed). */
 static int write_result(run *rn, rt_result r, rt_error *err)
@@ -64,8 +136,6 @@ static int write_result(run *rn, rt_result r, rt_error *err)
     const args *a = rn->a;
     const rt_settings *set = rn->settings;
     const rt_part_job *pj = &rn->pj;
-    rt_framebuffer *fb = &rn->fb;
-    rt_job_aovs *aov = &rn->aov;
     const char *output = rn->output;
     progress_view *view = rn->view;
     const rt_render_stats rs = rn->rs;
@@ -86,11 +156,6 @@ static int write_result(run *rn, rt_result r, rt_error *err)
     if (reason)
         snprintf(why, sizeof why, ", %s", reason);
     bool stopped = r == RT_ERR_INTERRUPTED || rs.time_limited;
-    char partial[1100], what[160], kept[1200];
-    const char *target = output;
-    /* what the output holds when the result goes elsewhere: --preview has written over it */
-    snprintf(kept, sizeof kept, view->previews > 0 ? "%s holds the last live preview (--preview)" : "%s left as it was",
-             output);
     if (pj->to_part) {
         if (rs.partial) {
             fprintf(stderr, "rt: stopped before any %s finished (%s); no part written, %s left as it was%s\n",
@@ -106,28 +171,8 @@ static int write_result(run *rn, rt_result r, rt_error *err)
                     set->height, pj->part_begin, pj->s_begin + rs.samples_done, set->samples, why,
                     rt_now_seconds() - rn->t_start, rs.seconds);
         }
-    } else {
-        if (rs.partial) {
-            rt_path_tagged(output, "partial", NULL, partial, sizeof partial); /* where an incomplete image goes */
-            target = partial;
-            snprintf(what, sizeof what, "%d of %d tiles at %d spp%s", rs.tiles_done, rs.tiles_total, set->samples,
-                     why);
-        } else {
-            snprintf(what, sizeof what, "%d of %d spp%s", pj->s_begin + rs.samples_done, set->samples, why);
-        }
-        if (rs.partial && rs.tiles_done == 0) {
-            fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s\n",
-                    rs.passes ? "pass" : "tile", reason ? reason : "?", kept);
-        } else if (rt_job_output_write(&rn->jo, set, fb, aov, target, rn->sig->temp, err) != RT_OK) {
-            memory_budget_report(err, &a->budget);
-            status = 2;
-        } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
-            char extras[2048]; /* the AOV files (or layers) too */
-            rt_job_output_extras(&rn->jo, aov, target, extras, sizeof extras);
-            fprintf(stderr, "rt: wrote %s%s: %dx%d, %s; %.2f s (render %.2f s)%s%s\n", target, extras, fb->width,
-                    fb->height, what, rt_now_seconds() - rn->t_start, rs.seconds, rs.partial ? "; " : "",
-                    rs.partial ? kept : "");
-        }
+    } else if (write_image(rn, stopped, reason, why, err) != 0) {
+        status = 2;
     }
     if (status != 2 && a->part_out) {
         if (rs.partial)
@@ -300,7 +345,10 @@ static void run_options(run *rn)
     memset(ro, 0, sizeof *ro);
     ro->threads = a->threads;
     ro->tile_size = a->tile;
-    ro->pass_samples = rt_job_pass_samples(a->pass_samples, rn->pj.need_accum, set->integrator);
+    /* a time limit renders in passes with every integrator, so that it
+     * leaves a whole image at the samples reached (tiles would leave some
+     * finished and the rest black) */
+    ro->pass_samples = rt_job_pass_samples(a->pass_samples, rn->pj.need_accum || a->time_limit > 0.0, set->integrator);
     ro->time_limit = a->time_limit;
     ro->cancel = rn->sig->stop;
     ro->progress = view->bar || view->preview_path || view->tev || view->window ? progress_report : NULL;
@@ -425,6 +473,7 @@ static int render_and_write(rt_scene *scene, const rt_settings *settings, const 
     memset(&rn, 0, sizeof rn);
     rn.a = a;
     args_job_options(a, &rn.jo);
+    rn.jo.stop_part = a->stop_part;
     rn.scene = scene;
     rn.settings = settings;
     rn.output = output;

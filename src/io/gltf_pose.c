@@ -136,8 +136,8 @@ static rt_result pose_animation(gl_doc *d, uint32_t a, float time);
 rt_result gl_pose_nodes(gl_doc *d, const rt_gltf_options *opt)
 {
     d->posed = true;
-    if (opt->animation_name)
-        return pose_named(d, opt);
+    if (opt->animation_name && !(d->anim_count == 0 && opt->animation_optional))
+        return pose_named(d, opt); /* (a scene's name for its models: one without animations ignores it) */
     if (d->anim_count == 0) {
         if (opt->animation > 0 && !opt->animation_optional)
             return rt_fail(d->err, RT_ERR_INVALID, "%s: animation %d requested, the file has none", d->path,

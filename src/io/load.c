@@ -146,8 +146,8 @@ static rt_result load_kind(rt_scene *s, rt_settings *settings, const void *bytes
         rt_gltf_stats gs;
         memset(&gs, 0, sizeof gs);
         rt_gltf_options go = {
-            .use_time = opt->use_time, .time = opt->time, .animation = opt->animation, .variant = opt->variant,
-            .catalog = opt->catalog};
+            .use_time = opt->use_time, .time = opt->time, .animation = opt->animation,
+            .animation_name = opt->animation_name, .variant = opt->variant, .catalog = opt->catalog};
         r = rt_gltf_load_memory(s, bytes, size, name, &go, &gs, err);
         info->meshes = gs.meshes;
         info->primitives = gs.primitives;
@@ -185,8 +185,8 @@ static rt_result load_kind(rt_scene *s, rt_settings *settings, const void *bytes
         break;
     }
     rt_scene_parse_options po = {
-        .use_time = opt->use_time, .time = opt->time, .animation = opt->animation, .animated = &info->animated,
-        .catalog = opt->catalog};
+        .use_time = opt->use_time, .time = opt->time, .animation = opt->animation,
+        .animation_name = opt->animation_name, .animated = &info->animated, .catalog = opt->catalog};
     return rt_scene_parse_string_with(s, settings, bytes, size, name, NULL, &po, err);
 }
 

@@ -1449,6 +1449,7 @@ static rt_result apply_pose(parser *p, const model_pose *m, rt_gltf_options *opt
     float frame = p->pose.use_time ? p->pose.time : 0.0f;
     opt->time = m->time_tok ? m->time : frame + (m->offset_tok ? m->offset : 0.0f);
     opt->animation = p->pose.animation;
+    opt->animation_name = p->pose.animation_name;
     opt->animation_optional = true;
     if (m->anim_tok) {
         long long n = 0;
@@ -1457,6 +1458,7 @@ static rt_result apply_pose(parser *p, const model_pose *m, rt_gltf_options *opt
             if (n < 0 || n > INT_MAX)
                 return perr(p, RT_ERR_INVALID, m->anim_tok, "an animation index counts from 0, got %s", m->anim_tok->s);
             opt->animation = (int)n;
+            opt->animation_name = NULL;
         } else {
             opt->animation_name = m->anim_tok->s;
         }

@@ -79,7 +79,9 @@ rt_result rt_job_frame(rt_scene *scene, rt_settings *set, const rt_job_options *
     if (o->fit_aspect && scene->camera_set && scene->camera.aspect_ratio > 0.0f)
         set->width = rt_job_width_for_aspect(set->height, scene->camera.aspect_ratio);
     bool camera_from_input = scene->camera_set;
-    if (!scene->camera_set)
+    if (!scene->camera_set && o->frame_extent) /* one camera for every frame of a sequence */
+        rt_scene_frame_camera_extent(scene, o->frame_extent);
+    else if (!scene->camera_set)
         rt_scene_frame_camera(scene, (float)set->width / (float)(set->height > 0 ? set->height : 1));
     rt_result r = apply_pose(scene, set, o, err);
     if (r != RT_OK)

@@ -173,13 +173,16 @@ rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_sc
                            a->crop[2], a->crop[3], s->width, s->height);
         pj->region = (rt_render_region){a->crop[0], a->crop[1], a->crop[2], a->crop[3]};
     }
-    bool any = pj->to_part || a->resume || a->part_out;
+    bool any = pj->to_part || a->resume || a->part_out || a->stop_part;
     if (!any)
         return RT_OK;
     rt_result r = rt_part_identity(scene, s, a->input, &pj->info, err);
     if (r != RT_OK)
         return r;
-    if (a->posed) /* the pose changes pixels: frame time and animation are settings of the render */
+    if (a->posed && a->animation_name) /* the pose changes pixels: frame time and animation are settings */
+        line(pj->info.settings, sizeof pj->info.settings, "frame_time %a animation '%s'", (double)a->frame_time,
+             a->animation_name);
+    else if (a->posed)
         line(pj->info.settings, sizeof pj->info.settings, "frame_time %a animation %d", (double)a->frame_time,
              a->animation);
     if (a->part_count && (r = rt_part_split(scene, s, tree, a->part_index, a->part_count, &pj->region, err)) != RT_OK)
@@ -194,7 +197,7 @@ rt_result rt_part_job_init(rt_part_job *pj, const rt_job_options *a, const rt_sc
         pj->s_end = a->spp_end;
     }
     pj->part_begin = pj->s_begin;
-    if ((pj->to_part || a->resume || a->part_out) &&
+    if ((pj->to_part || a->resume || a->part_out || a->stop_part) &&
         (a->denoise || (a->aovs & ((1u << RT_AOV_VARIANCE) | (1u << RT_AOV_SPP)))))
         return rt_fail(err, RT_ERR_INVALID,
                        "parts keep the albedo, normal, depth and position AOVs; not the variance or spp AOVs, nor "

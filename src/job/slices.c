@@ -17,11 +17,11 @@
 #include "rt/job/motion.h"
 #include "rt/render/integrator.h"
 
-int rt_job_pass_samples(int asked, bool keeps_sums, rt_integrator integrator)
+int rt_job_pass_samples(int asked, bool may_stop, rt_integrator integrator)
 {
     if (asked)
         return asked;
-    if (keeps_sums && rt_integrator_info_of(integrator)->pass_samples <= 0)
+    if (may_stop && rt_integrator_info_of(integrator)->pass_samples <= 0)
         return 4;
     return 0;
 }

@@ -435,46 +435,117 @@ rt_box rt_scene_bounds(const rt_scene *s)
     return b;
 }
 
-void rt_scene_frame_camera(rt_scene *s, float aspect)
+/* The automatic camera's view: from the front (+z), a little above and to
+ * the side, the usual product shot; its field of view. */
+#define FRAME_FOV 40.0f
+static void frame_axes(float aspect, rt_vec3 *dir, rt_vec3 *right, rt_vec3 *up, float *tan_v, float *tan_h)
 {
-    rt_box b = rt_scene_bounds(s);
-    if (rt_box_is_empty(b) || !rt_finite3(b.lo) || !rt_finite3(b.hi))
-        b.lo = rt_v3s(-1), b.hi = rt_v3s(1);
-    rt_vec3 c = rt_scale(rt_add(b.lo, b.hi), 0.5f);
-    float fov = 40.0f;
-    float tan_v = tanf(0.5f * fov * (RT_PI / 180.0f)), tan_h = tan_v * aspect;
-    /* look from the front (+z), a little above and to the side: the usual product shot */
-    rt_vec3 dir = rt_normalize(rt_v3(0.35f, 0.3f, 1.0f));
-    rt_vec3 right = rt_normalize(rt_cross(rt_neg(dir), rt_v3(0, 1, 0)));
-    rt_vec3 up = rt_cross(right, rt_neg(dir));
-    /* the nearest distance at which every vertex (and every corner of the
-     * other primitives' boxes) is in view: tighter than fitting the box */
-    float dist = 0.0f;
-    size_t nv = s->vertices.count, nother = s->spheres.count + s->quads.count;
-    for (size_t i = 0; i < nv + 8 * nother; i++) {
-        rt_vec3 p;
-        if (i < nv) {
-            p = s->vertices.position[i];
-        } else {
-            size_t k = i - nv;
-            rt_box pb = rt_scene_prim_bounds(s, (uint32_t)(s->triangles.count + k / 8));
-            p = rt_v3(k & 1 ? pb.hi.x : pb.lo.x, k & 2 ? pb.hi.y : pb.lo.y, k & 4 ? pb.hi.z : pb.lo.z);
-        }
-        if (!rt_finite3(p))
-            continue;
-        rt_vec3 q = rt_sub(p, c);
-        float z = rt_dot(q, dir);
-        dist = fmaxf(dist, z + fabsf(rt_dot(q, right)) / tan_h);
-        dist = fmaxf(dist, z + fabsf(rt_dot(q, up)) / tan_v);
+    *tan_v = tanf(0.5f * FRAME_FOV * (RT_PI / 180.0f));
+    *tan_h = *tan_v * aspect;
+    *dir = rt_normalize(rt_v3(0.35f, 0.3f, 1.0f));
+    *right = rt_normalize(rt_cross(rt_neg(*dir), rt_v3(0, 1, 0)));
+    *up = rt_cross(*right, rt_neg(*dir));
+}
+
+/* Point i of the points the camera must see: the vertices, then the
+ * corners of the other primitives' boxes; false when not finite. */
+static bool frame_point(const rt_scene *s, size_t i, rt_vec3 *p)
+{
+    size_t nv = s->vertices.count;
+    if (i < nv) {
+        *p = s->vertices.position[i];
+    } else {
+        size_t k = i - nv;
+        rt_box pb = rt_scene_prim_bounds(s, (uint32_t)(s->triangles.count + k / 8));
+        *p = rt_v3(k & 1 ? pb.hi.x : pb.lo.x, k & 2 ? pb.hi.y : pb.lo.y, k & 4 ? pb.hi.z : pb.lo.z);
     }
+    return rt_finite3(*p);
+}
+
+void rt_frame_extent_init(rt_frame_extent *e, float aspect)
+{
+    e->aspect = aspect;
+    e->bounds = rt_box_empty();
+    for (int k = 0; k < 4; k++)
+        e->reach[k] = -INFINITY;
+}
+
+void rt_frame_extent_add(rt_frame_extent *e, const rt_scene *s)
+{
+    rt_vec3 dir, right, up;
+    float tan_v, tan_h;
+    frame_axes(e->aspect, &dir, &right, &up, &tan_v, &tan_h);
+    e->bounds = rt_box_union(e->bounds, rt_scene_bounds(s));
+    size_t n = s->vertices.count + 8 * (s->spheres.count + s->quads.count);
+    for (size_t i = 0; i < n; i++) {
+        rt_vec3 p;
+        if (!frame_point(s, i, &p))
+            continue;
+        float z = rt_dot(p, dir), x = rt_dot(p, right) / tan_h, y = rt_dot(p, up) / tan_v;
+        e->reach[0] = fmaxf(e->reach[0], z + x);
+        e->reach[1] = fmaxf(e->reach[1], z - x);
+        e->reach[2] = fmaxf(e->reach[2], z + y);
+        e->reach[3] = fmaxf(e->reach[3], z - y);
+    }
+}
+
+/* The camera at distance dist (before the margin) from c along the view. */
+static void frame_place(rt_scene *s, rt_vec3 c, rt_vec3 dir, float dist)
+{
     if (!(dist > 0.0f) || !isfinite(dist))
         dist = 1.0f;
     dist *= 1.08f; /* a small margin */
     s->camera.position = rt_madd(c, dir, dist);
     s->camera.look_at = c;
     s->camera.up = rt_v3(0, 1, 0);
-    s->camera.vfov_deg = fov;
+    s->camera.vfov_deg = FRAME_FOV;
     s->camera.aperture = 0.0f;
     s->camera.focus_distance = 0.0f;
     s->camera_set = true;
+}
+
+void rt_scene_frame_camera_extent(rt_scene *s, const rt_frame_extent *e)
+{
+    rt_box b = e->bounds;
+    if (rt_box_is_empty(b) || !rt_finite3(b.lo) || !rt_finite3(b.hi))
+        b.lo = rt_v3s(-1), b.hi = rt_v3s(1);
+    rt_vec3 c = rt_scale(rt_add(b.lo, b.hi), 0.5f);
+    rt_vec3 dir, right, up;
+    float tan_v, tan_h;
+    frame_axes(e->aspect, &dir, &right, &up, &tan_v, &tan_h);
+    /* z_q + |x_q| / tan_h of q = p - c is the larger of (z_p + x_p / tan_h)
+     * - (z_c + x_c / tan_h) and the same with the minus signs: the reaches
+     * less the centre's */
+    float zc = rt_dot(c, dir), xc = rt_dot(c, right) / tan_h, yc = rt_dot(c, up) / tan_v;
+    float dist = 0.0f;
+    dist = fmaxf(dist, e->reach[0] - (zc + xc));
+    dist = fmaxf(dist, e->reach[1] - (zc - xc));
+    dist = fmaxf(dist, e->reach[2] - (zc + yc));
+    dist = fmaxf(dist, e->reach[3] - (zc - yc));
+    frame_place(s, c, dir, dist);
+}
+
+void rt_scene_frame_camera(rt_scene *s, float aspect)
+{
+    rt_box b = rt_scene_bounds(s);
+    if (rt_box_is_empty(b) || !rt_finite3(b.lo) || !rt_finite3(b.hi))
+        b.lo = rt_v3s(-1), b.hi = rt_v3s(1);
+    rt_vec3 c = rt_scale(rt_add(b.lo, b.hi), 0.5f);
+    rt_vec3 dir, right, up;
+    float tan_v, tan_h;
+    frame_axes(aspect, &dir, &right, &up, &tan_v, &tan_h);
+    /* the nearest distance at which every vertex (and every corner of the
+     * other primitives' boxes) is in view: tighter than fitting the box */
+    float dist = 0.0f;
+    size_t n = s->vertices.count + 8 * (s->spheres.count + s->quads.count);
+    for (size_t i = 0; i < n; i++) {
+        rt_vec3 p;
+        if (!frame_point(s, i, &p))
+            continue;
+        rt_vec3 q = rt_sub(p, c);
+        float z = rt_dot(q, dir);
+        dist = fmaxf(dist, z + fabsf(rt_dot(q, right)) / tan_h);
+        dist = fmaxf(dist, z + fabsf(rt_dot(q, up)) / tan_v);
+    }
+    frame_place(s, c, dir, dist);
 }

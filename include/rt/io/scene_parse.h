@@ -40,6 +40,7 @@ typedef struct rt_scene_parse_options {
     bool use_time;   /* the render has a frame time */
     float time;      /* its seconds */
     int animation;   /* the animation a line without `animation` plays (a model without animations ignores it) */
+    const char *animation_name; /* the same by name, instead of the index; NULL = by index */
     bool *animated;  /* out, may be NULL: set true when a model line's pose follows the frame time (an animation
                       * with channels, no fixed `time`), so that another time may give another pose */
     struct rt_gltf_catalog *catalog; /* not NULL: the model lines' animations and variants (rt/io/gltf.h) */

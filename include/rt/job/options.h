@@ -16,6 +16,7 @@
 #include "rt/base/vec.h"
 #include "rt/image/denoise.h"
 #include "rt/image/tonemap.h"
+#include "rt/scene/scene.h"
 
 #define RT_VERSION "0.1.0" /* rt's version, which every part carries */
 
@@ -41,11 +42,13 @@ typedef struct rt_job_options {
     bool posed;             /* posed at frame_time with animation (an animated glTF) */
     float frame_time;
     int animation;
+    const char *animation_name; /* the animation by its name; NULL = by index */
     /* the view (rt_job_frame) */
     bool use_camera;        /* camera `camera` of the loaded models' cameras */
     int camera;
     bool camera_auto;       /* frame the scene, ignoring the file's camera */
     bool fit_aspect;        /* a camera made for another aspect ratio (glTF) keeps the height, fits the width */
+    const rt_frame_extent *frame_extent; /* the framing covers these poses (rt --frames), not only the scene's; NULL = none */
     bool has_look_from, has_look_at, has_up, has_fov; /* each replaces one part of the camera */
     rt_vec3 look_from, look_at, up;
     float fov;
@@ -65,6 +68,8 @@ typedef struct rt_job_options {
     int spp_begin, spp_end;
     const char *resume;     /* a part to continue; NULL = none */
     const char *part_out;   /* also write the render as this part; NULL = none */
+    const char *stop_part;  /* a render stopped early (signal, time limit) writes this part to resume it (rt
+                             * --frames: NAME.part.exr); the sums are kept as for part_out. NULL = none */
 } rt_job_options;
 
 #endif

@@ -26,7 +26,7 @@ typedef struct rt_part_job {
     rt_render_region region; /* the pixels rendered (the whole image unless a crop or a band) */
     int s_begin, s_end;      /* the samples this run adds */
     int part_begin;          /* the first sample the sums hold (a resumed part's; else s_begin) */
-    bool need_accum;         /* sums kept: a part output, options.part_out or options.resume */
+    bool need_accum;         /* sums kept: a part output, options.part_out, stop_part or resume */
     bool keep_blocks;        /* the part keeps each sample block apart (part_begin a block edge past 0) */
     rt_render_accum accum;   /* region-sized; zeros, or the resumed part's sums (and kept blocks) */
     rt_part_info info;       /* what the parts written are parts of (with the AOV layers) */

@@ -36,11 +36,12 @@ typedef struct rt_job_slices {
 } rt_job_slices;
 
 /* Samples a pass for rt_render_options.pass_samples (0: the integrator's
- * default; -1: tiles): `asked` when not 0; else a render that keeps sums
- * (a part, a resumed part) goes in passes of 4 even where the integrator
- * would tile, so that a stop keeps the passes it finished (pixels are the
- * same for any pass split). */
-int rt_job_pass_samples(int asked, bool keeps_sums, rt_integrator integrator);
+ * default; -1: tiles): `asked` when not 0; else a render that may stop
+ * (it keeps sums: a part, a resumed part; or it has a time limit) goes in
+ * passes of 4 even where the integrator would tile, so that a stop keeps
+ * the passes it finished and a whole image (pixels are the same for any
+ * pass split). */
+int rt_job_pass_samples(int asked, bool may_stop, rt_integrator integrator);
 
 /* Renders the slices with settings into ro->accum's sums (ro's sample range and pass
  * samples are set per slice); *rs sums the slices' statistics, samples_done

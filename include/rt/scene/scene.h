@@ -404,4 +404,26 @@ rt_box rt_scene_bounds(const rt_scene *s);
  * (width / height). */
 void rt_scene_frame_camera(rt_scene *s, float aspect);
 
+/* What that camera must see of a scene over several poses (the frames of
+ * an animation), so that one camera frames them all: the union of their
+ * bounds (the camera looks at its centre) and, for each of the four sides
+ * of the view, the farthest any point reaches (the camera backs off until
+ * every point of every pose is in view). Gathered pose by pose, the poses
+ * need not be loaded together:
+ *
+ *   rt_frame_extent e;
+ *   rt_frame_extent_init(&e, 4.0f / 3.0f);
+ *   for each pose: rt_frame_extent_add(&e, &posed_scene);
+ *   rt_scene_frame_camera_extent(&scene, &e);   // the same camera for every pose
+ */
+typedef struct rt_frame_extent {
+    float aspect;   /* the image's width / height */
+    rt_box bounds;  /* the union of the poses' bounds */
+    float reach[4]; /* the largest dot(p, dir) + dot(p, right) / tan_h, - ..., + dot(p, up) / tan_v, - ... */
+} rt_frame_extent;
+void rt_frame_extent_init(rt_frame_extent *e, float aspect);
+void rt_frame_extent_add(rt_frame_extent *e, const rt_scene *s);
+/* The camera of rt_scene_frame_camera for every pose gathered in e. */
+void rt_scene_frame_camera_extent(rt_scene *s, const rt_frame_extent *e);
+
 #endif
