@@ -15,7 +15,9 @@
  * three levels that the traversal reads), bytes_per_triangle, mrays_per_s (median of K runs, wall clock),
  * mrays_per_s_best (the fastest run), cpu_mrays_per_s (rays per CPU-second
  * of the median run, summed over threads: on a shared, loaded machine this
- * is the steadier figure), hits, mismatches. With --occluded the same rays
+ * is the steadier figure), hits, thread_cpu_s and thread_rays (each
+ * thread's CPU seconds and rays over all runs: how evenly the threads
+ * shared the work), mismatches. With --occluded the same rays
  * go through the any-hit query (shadow rays) instead, and a mismatch is a
  * ray whose hit/miss differs from the reference. Exits 1 when more than
  * 0.01% of the rays disagree with the reference: speed bought with wrong
@@ -86,7 +88,15 @@ typedef struct job {
     size_t step; /* rays a thread takes at a time */
     int threads;
     atomic_size_t next;
+    double *thread_cpu; /* per thread: CPU seconds, over all runs */
+    size_t *thread_rays; /* per thread: rays traced, over all runs */
 } job;
+
+/* One thread's part of a pass: the job and the thread's number. */
+typedef struct worker {
+    job *j;
+    int index;
+} worker;
 
 /* The rays of one tile, j->lanes (8 or 16) at a time. */
 static void trace_tile(const job *j, const size_t *idx, size_t n)
@@ -122,14 +132,24 @@ static void trace_tile(const job *j, const size_t *idx, size_t n)
 
 enum { CHUNK = 1024 };
 
+static double thread_cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 static void *trace_worker(void *arg)
 {
-    job *j = arg;
+    worker *wk = arg;
+    job *j = wk->j;
+    double c0 = thread_cpu_s();
     for (;;) {
         size_t start = atomic_fetch_add(&j->next, j->step);
         if (start >= j->rays->count)
             break;
         size_t end = start + j->step < j->rays->count ? start + j->step : j->rays->count;
+        j->thread_rays[wk->index] += end - start;
         if (j->stream) { /* one stream call: the arrays from `start` on */
             const rt_ray_batch *b = j->stream;
             rt_ray_batch rb = {b->ox + start, b->oy + start, b->oz + start, b->dx + start, b->dy + start,
@@ -158,6 +178,7 @@ static void *trace_worker(void *arg)
             }
         }
     }
+    j->thread_cpu[wk->index] += thread_cpu_s() - c0;
     return NULL;
 }
 
@@ -168,12 +189,16 @@ static double trace_all(job *jp, double *cpu)
     int threads = jp->threads;
     atomic_init(&j.next, 0);
     pthread_t th[256];
+    worker wk[256];
     double c0 = cpu_s(), t0 = now_s();
     int started = 0;
-    for (int i = 1; i < threads; i++)
-        if (pthread_create(&th[started], NULL, trace_worker, &j) == 0)
+    for (int i = 1; i < threads; i++) {
+        wk[started + 1] = (worker){&j, started + 1};
+        if (pthread_create(&th[started], NULL, trace_worker, &wk[started + 1]) == 0)
             started++;
-    trace_worker(&j);
+    }
+    wk[0] = (worker){&j, 0};
+    trace_worker(&wk[0]);
     for (int i = 0; i < started; i++)
         pthread_join(th[i], NULL);
     double wall = now_s() - t0;
@@ -311,6 +336,8 @@ int main(int argc, char **argv)
     }
     float *t_out = malloc((rs.count ? rs.count : 1) * sizeof(float));
     double *times = malloc((size_t)runs * sizeof(double)), *cpus = malloc((size_t)runs * sizeof(double));
+    double thread_cpu[256] = {0};
+    size_t thread_rays[256] = {0};
     if (!t_out || !times || !cpus) {
         fprintf(stderr, "rtbench: out of memory\n");
         return 2;
@@ -319,6 +346,7 @@ int main(int argc, char **argv)
     memset(&jb, 0, sizeof jb);
     jb.tree = &tree, jb.rays = &rs, jb.t_out = t_out, jb.occluded = occluded, jb.order = order;
     jb.frustum = frustum;
+    jb.thread_cpu = thread_cpu, jb.thread_rays = thread_rays;
     jb.pack = (size_t)pw * (size_t)ph, jb.lanes = lanes, jb.threads = threads, jb.step = CHUNK;
     float *soa = NULL;
     rt_ray_batch rb;
@@ -389,6 +417,13 @@ int main(int argc, char **argv)
     printf("mrays_per_s_best: %.3f\n", times[0] > 0 ? 1e-6 * (double)rs.count / times[0] : 0.0);
     printf("cpu_mrays_per_s: %.3f\n", cpu_median > 0 ? 1e-6 * (double)rs.count / cpu_median : 0.0);
     printf("hits: %zu\n", hits);
+    printf("thread_cpu_s:"); /* each thread's CPU seconds and rays, over all runs: how evenly the work split */
+    for (int i = 0; i < threads; i++)
+        printf(" %.4f", thread_cpu[i]);
+    printf("\nthread_rays:");
+    for (int i = 0; i < threads; i++)
+        printf(" %zu", thread_rays[i]);
+    printf("\n");
     if (rs.ref_t)
         printf("mismatches: %zu\n", mismatches);
     int status = 0;
