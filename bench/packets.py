@@ -8,7 +8,8 @@ ray per pixel, row by row): Embree's `anchor bench ... --packets W H`
 16-wide rays natively; without AVX-512 Embree has no native ray16 and the
 anchor leaves it out), then bench/rtbench --packets 4 2
 (rt_kdtree_intersect8) and --packets 4 4 (rt_kdtree_intersect16), each
-with 1 and 2 threads. Prints Mrays/s (median of the runs, wall clock) and
+with 1 and 2 threads, and --frustum 4 4 and --frustum 8 8
+(rt_kdtree_intersect_frustum: a tile a call as one frustum). Prints Mrays/s (median of the runs, wall clock) and
 CPU Mrays/s (each thread's rays per CPU-second of its own, summed over
 the threads, as the anchor reports it: the steadier figure on a loaded
 machine) for both, and the ratios rt/Embree; a 4x4 row is
@@ -35,11 +36,11 @@ def image_size(model):
     return (int(m.group(1)), int(m.group(2))) if m else (640, 480)
 
 
-def rtbench(glb, model, threads, tw, th):
+def rtbench(glb, model, threads, tw, th, how="--packets"):
     w, _ = image_size(model)
     rays = os.path.join(shared, "bench", model, model + ".primary")
     d = common.rtbench([os.path.join(shared, glb), rays + ".rays", "--ref", rays + ".hits", "-t", str(threads),
-                        "--runs", runs, "--packets", str(tw), str(th), "--image-width", str(w)])
+                        "--runs", runs, how, str(tw), str(th), "--image-width", str(w)])
     if d["status"] != 0:
         print(d["stderr"], file=sys.stderr, end="")
     return d
@@ -67,10 +68,11 @@ print("%-28s %5s %3s %9s %9s %-16s %9s %9s %6s %6s %8s" % (
 no16 = False
 for model, glb in models:
     e = embree(model, glb)
-    for tw, th in ((4, 2), (4, 4)):
+    for tw, th, how in ((4, 2, "--packets"), (4, 4, "--packets"), (4, 4, "--frustum"), (8, 8, "--frustum")):
         for t in (1, 2):
-            r = rtbench(glb, model, t, tw, th)
-            key, query = ("packet%d_%dT" % (tw * th, t), "rtcIntersect%d" % (tw * th))
+            r = rtbench(glb, model, t, tw, th, how)
+            n16 = min(tw * th, 16)  # frustum tiles are compared with Embree's 16-ray packets
+            key, query = ("packet%d_%dT" % (n16, t), "rtcIntersect%d" % n16)
             if key not in e:  # no native ray16: the 4x2 tiles' rtcIntersect8
                 key, query = "packet8_%dT" % t, "rtcIntersect8 (*)"
                 no16 = True
@@ -80,8 +82,9 @@ for model, glb in models:
             mr, mc = float(r.get("mrays_per_s", 0)), float(r.get("cpu_mrays_per_s", 0)) * t
             er, ec = ef.get("mrays_s", 0.0), ef.get("cpu_mrays_s", 0.0)
             print("%-28s %5s %3d %9.2f %9.2f %-16s %9.2f %9.2f %6.2f %6.2f %8s" % (
-                model, "%dx%d" % (tw, th), t, mr, mc, query, er, ec, mr / er if er else 0, mc / ec if ec else 0,
+                model, "%dx%d%s" % (tw, th, "f" if how == "--frustum" else ""), t, mr, mc, query, er, ec, mr / er if er else 0, mc / ec if ec else 0,
                 "%s/%s" % (r.get("mismatches", "?"), ef.get("mismatch_vs_ref", "?"))))
+print("(4x4f, 8x8f: rt's frustum walk on those tiles)")
 if no16:
     print("(*) no native 16-wide rays for Embree on this CPU (they need AVX-512), so the anchor runs no"
           " rtcIntersect16: those 4x4 rows compare with rtcIntersect8 on 4x2 tiles")

@@ -3,7 +3,7 @@
  *
  *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
  *           [--build-threads N] [--occluded] [--portable] [--limit N]
- *           [--packets W H [--image-width N] [--lanes 8|16]]
+ *           [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H [--image-width N]]
  *           [--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]]
  *
  * Loads the model with rt_load, as `rt` does (a glTF: every triangle of
@@ -15,7 +15,9 @@
  * three levels that the traversal reads), bytes_per_triangle, mrays_per_s (median of K runs, wall clock),
  * mrays_per_s_best (the fastest run), cpu_mrays_per_s (rays per CPU-second
  * of the median run, summed over threads: on a shared, loaded machine this
- * is the steadier figure), hits, mismatches. With --occluded the same rays
+ * is the steadier figure), hits, thread_cpu_s and thread_rays (each
+ * thread's CPU seconds and rays over all runs: how evenly the threads
+ * shared the work), mismatches. With --occluded the same rays
  * go through the any-hit query (shadow rays) instead, and a mismatch is a
  * ray whose hit/miss differs from the reference. Exits 1 when more than
  * 0.01% of the rays disagree with the reference: speed bought with wrong
@@ -28,6 +30,9 @@
  * a time with rt_kdtree_intersect16 (kdtree_packet.h) when a tile has 16
  * or more, else 8 with rt_kdtree_intersect8 (--lanes 8|16 chooses), or
  * with --occluded the any-hit calls; the answers must be the same.
+ * --frustum W H traces the same tiles (at most 64 rays) a tile a call
+ * with rt_kdtree_intersect_frustum (kdtree_frustum.h: the tile's rays as
+ * one frustum), or with --occluded rt_kdtree_occluded_frustum.
  * --stream traces the set in file order as ray streams
  * (rt_kdtree_intersect_stream / rt_kdtree_occluded_stream,
  * kdtree_stream.h) of N rays a call (--stream-size, default 4096, as
@@ -47,6 +52,7 @@
 #include "rt/base/log.h"
 #include "rt/io/load.h"
 #include "rt/accel/kdtree.h"
+#include "rt/accel/kdtree_frustum.h"
 #include "rt/accel/kdtree_packet.h"
 #include "rt/accel/kdtree_stream.h"
 #include "rt/accel/rayset.h"
@@ -74,6 +80,7 @@ typedef struct job {
     const size_t *order; /* packets: ray indices tile by tile, pack rays a tile (NULL: single rays) */
     size_t pack;
     int lanes; /* packets: rays a call, 8 or 16 */
+    bool frustum; /* packets: the whole tile a call as a frustum */
     const rt_ray_batch *stream; /* streams: the rays as arrays (NULL: not streams) */
     rt_hit_batch stream_hits;
     uint8_t *blocked;
@@ -81,11 +88,30 @@ typedef struct job {
     size_t step; /* rays a thread takes at a time */
     int threads;
     atomic_size_t next;
+    double *thread_cpu; /* per thread: CPU seconds, over all runs */
+    size_t *thread_rays; /* per thread: rays traced, over all runs */
 } job;
+
+/* One thread's part of a pass: the job and the thread's number. */
+typedef struct worker {
+    job *j;
+    int index;
+} worker;
 
 /* The rays of one tile, j->lanes (8 or 16) at a time. */
 static void trace_tile(const job *j, const size_t *idx, size_t n)
 {
+    if (j->frustum) {
+        rt_ray r[RT_KD_FRUSTUM_MAX];
+        rt_hit h[RT_KD_FRUSTUM_MAX];
+        for (size_t i = 0; i < n; i++)
+            r[i] = j->rays->rays[idx[i]];
+        uint64_t hit = j->occluded ? rt_kdtree_occluded_frustum(j->tree, r, (int)n)
+                                   : rt_kdtree_intersect_frustum(j->tree, r, (int)n, h);
+        for (size_t i = 0; i < n; i++) /* occluded: hit/miss only, 0 for a hit */
+            j->t_out[idx[i]] = !(hit >> i & 1) ? INFINITY : j->occluded ? 0.0f : h[i].t;
+        return;
+    }
     for (size_t g = 0; g < n; g += (size_t)j->lanes) {
         int m = n - g < (size_t)j->lanes ? (int)(n - g) : j->lanes;
         rt_ray r[16];
@@ -106,14 +132,24 @@ static void trace_tile(const job *j, const size_t *idx, size_t n)
 
 enum { CHUNK = 1024 };
 
+static double thread_cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 static void *trace_worker(void *arg)
 {
-    job *j = arg;
+    worker *wk = arg;
+    job *j = wk->j;
+    double c0 = thread_cpu_s();
     for (;;) {
         size_t start = atomic_fetch_add(&j->next, j->step);
         if (start >= j->rays->count)
             break;
         size_t end = start + j->step < j->rays->count ? start + j->step : j->rays->count;
+        j->thread_rays[wk->index] += end - start;
         if (j->stream) { /* one stream call: the arrays from `start` on */
             const rt_ray_batch *b = j->stream;
             rt_ray_batch rb = {b->ox + start, b->oy + start, b->oz + start, b->dx + start, b->dy + start,
@@ -142,6 +178,7 @@ static void *trace_worker(void *arg)
             }
         }
     }
+    j->thread_cpu[wk->index] += thread_cpu_s() - c0;
     return NULL;
 }
 
@@ -152,12 +189,16 @@ static double trace_all(job *jp, double *cpu)
     int threads = jp->threads;
     atomic_init(&j.next, 0);
     pthread_t th[256];
+    worker wk[256];
     double c0 = cpu_s(), t0 = now_s();
     int started = 0;
-    for (int i = 1; i < threads; i++)
-        if (pthread_create(&th[started], NULL, trace_worker, &j) == 0)
+    for (int i = 1; i < threads; i++) {
+        wk[started + 1] = (worker){&j, started + 1};
+        if (pthread_create(&th[started], NULL, trace_worker, &wk[started + 1]) == 0)
             started++;
-    trace_worker(&j);
+    }
+    wk[0] = (worker){&j, 0};
+    trace_worker(&wk[0]);
     for (int i = 0; i < started; i++)
         pthread_join(th[i], NULL);
     double wall = now_s() - t0;
@@ -174,7 +215,7 @@ static int cmp_double(const void *a, const void *b)
 static int usage(void)
 {
     fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K] [--build-threads N] "
-                    "[--occluded] [--portable] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]] "
+                    "[--occluded] [--portable] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H] "
                     "[--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]]\n");
     return 2;
 }
@@ -185,7 +226,7 @@ int main(int argc, char **argv)
     int threads = 1, runs = 5, build_threads = 0;
     long limit = 0;
     int pw = 0, ph = 0, image_width = 640, lanes = 0;
-    bool occluded = false, portable = false, stream = false;
+    bool occluded = false, portable = false, stream = false, frustum = false;
     long stream_size = 4096, min_rays = 0, chunk = 0;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--ref") == 0 && i + 1 < argc)
@@ -198,7 +239,10 @@ int main(int argc, char **argv)
             build_threads = atoi(argv[++i]);
         else if (strcmp(argv[i], "--limit") == 0 && i + 1 < argc)
             limit = atol(argv[++i]);
-        else if (strcmp(argv[i], "--packets") == 0 && i + 2 < argc) {
+        else if ((strcmp(argv[i], "--packets") == 0 || strcmp(argv[i], "--frustum") == 0) && i + 2 < argc) {
+            if (pw)
+                return usage(); /* one of --packets and --frustum, once */
+            frustum = argv[i][2] == 'f';
             pw = atoi(argv[++i]);
             ph = atoi(argv[++i]);
             if (pw < 1 || ph < 1 || pw * ph > 64 || 1024 % (pw * ph) != 0)
@@ -231,11 +275,11 @@ int main(int argc, char **argv)
             return usage();
     }
     if (!model || !rays_path || threads < 1 || threads > 256 || runs < 1 || runs > 1000 || build_threads < 0 ||
-        build_threads > 64 || limit < 0 || image_width < 1 || (pw && limit) || (lanes && !pw && !stream) ||
+        build_threads > 64 || limit < 0 || image_width < 1 || (pw && limit) || (lanes && !pw && !stream) || (lanes && frustum) ||
         (stream && pw) || (lanes == 4 && !stream) || stream_size < 1 || stream_size > (1L << 24) || min_rays < 0 ||
         min_rays > (1L << 30) || chunk < 0 || chunk > (1L << 24))
         return usage();
-    if (pw && !lanes) /* 16-ray calls for tiles of 16 rays or more */
+    if (pw && !lanes && !frustum) /* 16-ray calls for tiles of 16 rays or more */
         lanes = pw * ph >= 16 ? 16 : 8;
     rt_log_set_level(RT_LOG_QUIET);
 
@@ -292,6 +336,8 @@ int main(int argc, char **argv)
     }
     float *t_out = malloc((rs.count ? rs.count : 1) * sizeof(float));
     double *times = malloc((size_t)runs * sizeof(double)), *cpus = malloc((size_t)runs * sizeof(double));
+    double thread_cpu[256] = {0};
+    size_t thread_rays[256] = {0};
     if (!t_out || !times || !cpus) {
         fprintf(stderr, "rtbench: out of memory\n");
         return 2;
@@ -299,6 +345,8 @@ int main(int argc, char **argv)
     job jb;
     memset(&jb, 0, sizeof jb);
     jb.tree = &tree, jb.rays = &rs, jb.t_out = t_out, jb.occluded = occluded, jb.order = order;
+    jb.frustum = frustum;
+    jb.thread_cpu = thread_cpu, jb.thread_rays = thread_rays;
     jb.pack = (size_t)pw * (size_t)ph, jb.lanes = lanes, jb.threads = threads, jb.step = CHUNK;
     float *soa = NULL;
     rt_ray_batch rb;
@@ -354,7 +402,9 @@ int main(int argc, char **argv)
     printf("threads: %d\n", threads);
     printf("rays: %zu\n", rs.count);
     printf("query: %s\n", occluded ? "occluded" : "closest");
-    if (pw)
+    if (pw && frustum)
+        printf("frustum: %dx%d tiles, a tile a call\n", pw, ph);
+    else if (pw)
         printf("packets: %dx%d tiles, %d rays a call\n", pw, ph, lanes);
     if (stream) {
         int sl = lanes && rt_kd_stream_lanes_supported(lanes) && (lanes == 4 || tree.isa != RT_KD_ISA_PORTABLE)
@@ -367,6 +417,13 @@ int main(int argc, char **argv)
     printf("mrays_per_s_best: %.3f\n", times[0] > 0 ? 1e-6 * (double)rs.count / times[0] : 0.0);
     printf("cpu_mrays_per_s: %.3f\n", cpu_median > 0 ? 1e-6 * (double)rs.count / cpu_median : 0.0);
     printf("hits: %zu\n", hits);
+    printf("thread_cpu_s:"); /* each thread's CPU seconds and rays, over all runs: how evenly the work split */
+    for (int i = 0; i < threads; i++)
+        printf(" %.4f", thread_cpu[i]);
+    printf("\nthread_rays:");
+    for (int i = 0; i < threads; i++)
+        printf(" %zu", thread_rays[i]);
+    printf("\n");
     if (rs.ref_t)
         printf("mismatches: %zu\n", mismatches);
     int status = 0;

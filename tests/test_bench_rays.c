@@ -20,6 +20,7 @@
  * the single ray's bit for bit, and through its any-hit query: each ray cut
  * exactly at its hit (tmax = t: not occluded, one ulp more: occluded), and
  * shadow rays from the hit points to a light, as the single query answers.
+ * 8x8 tiles go the same ways through the frustum walk (kdtree_frustum.h).
  *
  * Cost: all three models, including the 1M-triangle one (its build is about
  * 1-2 s on two cores). It stays in because it is the model that tests the
@@ -32,11 +33,57 @@
 
 #include "rt/io/load.h"
 #include "rt/accel/kdtree.h"
+#include "rt/accel/kdtree_frustum.h"
 #include "rt/accel/kdtree_packet.h"
 #include "rt/accel/rayset.h"
 #include "rt/scene/scene.h"
 
 #define RAYS_PER_SET 2500
+
+/* Frustum packets: 8x8 pixel tiles spread over a 640x480 primary set
+ * through rt_kdtree_intersect_frustum, each ray's t the single ray's bit
+ * for bit, and rt_kdtree_occluded_frustum on the same rays cut at their
+ * hit (open at tmax: not occluded; one ulp later: occluded) and on shadow
+ * rays from the hit points to a light above the model, as the single
+ * any-hit query answers. */
+static void check_frustum_tiles(const rt_kdtree *tree, const rt_rayset *rs, float diag)
+{
+    size_t tiles = 0;
+    rt_vec3 light = rt_add(rt_scale(rt_add(tree->bounds.lo, tree->bounds.hi), 0.5f),
+                           rt_v3(0.3f * diag, diag, 0.2f * diag));
+    for (size_t ty = 0; ty + 8 <= 480; ty += 24)
+        for (size_t tx = (ty * 5) % 40; tx + 8 <= 640; tx += 40) {
+            rt_ray pr[64], sr[64];
+            rt_hit ph[64];
+            for (int k = 0; k < 64; k++)
+                pr[k] = rs->rays[(ty + (size_t)k / 8) * 640 + tx + (size_t)k % 8];
+            uint64_t m = rt_kdtree_intersect_frustum(tree, pr, 64, ph);
+            for (int k = 0; k < 64; k++) {
+                rt_hit h;
+                bool hit = rt_kdtree_intersect(tree, &pr[k], &h);
+                assert_int_equal(hit, (int)(m >> k & 1));
+                if (hit)
+                    assert_true(h.t == ph[k].t);
+            }
+            for (int k = 0; k < 64; k++) {
+                sr[k] = pr[k];
+                if (m >> k & 1)
+                    sr[k].tmax = k % 2 ? ph[k].t : nextafterf(ph[k].t, INFINITY);
+            }
+            uint64_t o = rt_kdtree_occluded_frustum(tree, sr, 64);
+            for (int k = 0; k < 64; k++)
+                assert_int_equal(o >> k & 1, (m >> k & 1) ? k % 2 == 0 : 0);
+            for (int k = 0; k < 64; k++) {
+                rt_vec3 p = (m >> k & 1) ? rt_add(pr[k].org, rt_scale(pr[k].dir, ph[k].t)) : pr[k].org;
+                sr[k] = rt_ray_make(p, rt_sub(light, p), 1e-4f, 1.0f);
+            }
+            o = rt_kdtree_occluded_frustum(tree, sr, 64);
+            for (int k = 0; k < 64; k++)
+                assert_int_equal(o >> k & 1, rt_kdtree_occluded(tree, &sr[k]));
+            tiles++;
+        }
+    assert_true(tiles > 200);
+}
 
 static void check_set(const rt_kdtree *tree, const char *model, const char *kind)
 {
@@ -116,6 +163,7 @@ static void check_set(const rt_kdtree *tree, const char *model, const char *kind
                 tiles++;
             }
         assert_true(tiles > 2000);
+        check_frustum_tiles(tree, &rs, diag);
     }
     size_t allowed = tested / 10000;
     if (getenv("RT_TEST_VERBOSE"))

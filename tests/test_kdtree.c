@@ -16,6 +16,7 @@
 
 #include "rt/accel/intersect.h"
 #include "rt/accel/kdtree.h"
+#include "rt/accel/kdtree_frustum.h"
 #include "rt/accel/kdtree_packet.h"
 
 /* ------------------------------------------------------------ helpers */
@@ -870,20 +871,18 @@ static void test_edge_rays(void **state)
     }
 }
 
-/* One packet of n rays through rt_kdtree_intersect8 (n <= 8) or
- * rt_kdtree_intersect16 against brute force: the same hit or miss, the
- * same t bits, the same primitive or one that ties at exactly that t. */
-static void check_packet(const rt_scene *s, const rt_kdtree *tree, const rt_ray *rays, int n, check_stats *cs)
+/* The answers for a tile of n rays (mask: the rays that hit, h their hits)
+ * against brute force: the same hit or miss, the same t bits, the same
+ * primitive or one that ties at exactly that t. */
+static void check_tile_hits(const rt_scene *s, const rt_ray *rays, int n, uint64_t mask, const rt_hit *h,
+                            const char *what, check_stats *cs)
 {
-    rt_hit h[16];
-    memset(h, 0x55, sizeof h);
-    unsigned mask = n > 8 ? rt_kdtree_intersect16(tree, rays, n, h) : rt_kdtree_intersect8(tree, rays, n, h);
-    assert_true(mask >> n == 0);
+    assert_true(n == 64 || mask >> n == 0);
     for (int i = 0; i < n; i++) {
         rt_hit b;
         bool ha = mask >> i & 1, hb = ref_closest(s, &rays[i], &b);
         if (ha != hb || (ha && h[i].t != b.t))
-            fprintf(stderr, "packet ray %d of %d: kd %d (t %.9g prim %u) brute %d (t %.9g prim %u)\n", i, n, ha,
+            fprintf(stderr, "%s ray %d of %d: kd %d (t %.9g prim %u) brute %d (t %.9g prim %u)\n", what, i, n, ha,
                     (double)h[i].t, h[i].prim, hb, (double)b.t, b.prim);
         assert_int_equal(ha, hb);
         cs->rays++;
@@ -902,6 +901,43 @@ static void check_packet(const rt_scene *s, const rt_kdtree *tree, const rt_ray 
             cs->ties++;
         }
     }
+}
+
+/* One packet of n rays through rt_kdtree_intersect8 (n <= 8) or
+ * rt_kdtree_intersect16 against brute force. */
+static void check_packet(const rt_scene *s, const rt_kdtree *tree, const rt_ray *rays, int n, check_stats *cs)
+{
+    rt_hit h[16];
+    memset(h, 0x55, sizeof h);
+    unsigned mask = n > 8 ? rt_kdtree_intersect16(tree, rays, n, h) : rt_kdtree_intersect8(tree, rays, n, h);
+    check_tile_hits(s, rays, n, mask, h, "packet", cs);
+}
+
+/* The frustum's hits are the single walk's to the bit, ties included: each
+ * ray meets the same leaves in the same order with the same closest hit so
+ * far (kdtree_frustum.c), so the renderer can take either. */
+static void check_as_single(const rt_kdtree *tree, const rt_ray *rays, int n, uint64_t mask, const rt_hit *h)
+{
+    for (int i = 0; i < n; i++) {
+        rt_hit b;
+        bool hb = rt_kdtree_intersect(tree, &rays[i], &b);
+        assert_int_equal(hb, (int)(mask >> i & 1));
+        if (hb && (b.prim != h[i].prim || b.t != h[i].t || b.u != h[i].u || b.v != h[i].v))
+            fprintf(stderr, "frustum ray %d of %d: prim %u t %a, single prim %u t %a\n", i, n, h[i].prim,
+                    (double)h[i].t, b.prim, (double)b.t);
+        assert_true(!hb || (b.prim == h[i].prim && b.t == h[i].t && b.u == h[i].u && b.v == h[i].v));
+    }
+}
+
+/* A tile of n rays (up to 64) through rt_kdtree_intersect_frustum against
+ * brute force. */
+static void check_frustum(const rt_scene *s, const rt_kdtree *tree, const rt_ray *rays, int n, check_stats *cs)
+{
+    rt_hit h[RT_KD_FRUSTUM_MAX];
+    memset(h, 0x55, sizeof h);
+    uint64_t mask = rt_kdtree_intersect_frustum(tree, rays, n, h);
+    check_tile_hits(s, rays, n, mask, h, "frustum", cs);
+    check_as_single(tree, rays, n, mask, h);
 }
 
 /* The two scenes of the packet tests: 0, a random soup; 1, integer boxes
@@ -982,6 +1018,7 @@ static void test_packets(void **state)
                 }
                 check_packet(&s, &tree, rays, n < 8 ? n : 8, &cs); /* 4x2 */
                 check_packet(&s, &tree, rays, n == 8 ? 16 : n, &cs); /* 4x4 (n > 8: 16 lanes) */
+                check_frustum(&s, &tree, rays, n == 8 ? 16 : n, &cs); /* the 4x4 tile as a frustum */
             }
         }
         report(__func__, &cs);
@@ -998,6 +1035,8 @@ static void check_packet_occluded(const rt_scene *s, const rt_kdtree *tree, cons
 {
     unsigned mask = n > 8 ? rt_kdtree_occluded16(tree, rays, n) : rt_kdtree_occluded8(tree, rays, n);
     assert_true(mask >> n == 0);
+    uint64_t fmask = rt_kdtree_occluded_frustum(tree, rays, n); /* the same rays as one frustum */
+    assert_true(fmask == mask);
     for (int i = 0; i < n; i++) {
         bool pa = mask >> i & 1, sa = rt_kdtree_occluded(tree, &rays[i]), ba = ref_any(s, &rays[i]);
         if (pa != ba || sa != ba)
@@ -1101,6 +1140,92 @@ static void test_packets_occluded(void **state)
         report(__func__, &cs);
         assert_true(cs.hits > cs.rays / 10 && cs.hits < cs.rays - cs.rays / 10);
         assert_true(ends > 100);
+        rt_kdtree_free(&tree);
+        rt_scene_free(&s);
+    }
+}
+
+static void test_frustum(void **state)
+{
+    (void)state;
+    /* rt_kdtree_intersect_frustum and rt_kdtree_occluded_frustum on 8x8
+     * tiles (64 rays, four groups of 16) against brute force: pinhole
+     * cameras outside the scene and inside it, tight tiles and wide ones,
+     * the odd rays of test_packets (a ray parallel to an axis, one the
+     * other way: the tile goes as packets), n from 1 to 64; then shadow
+     * rays from the tile's hit points to a point light, and segments cut
+     * at their hit (tmax = t: not occluded; one ulp more: occluded) */
+    for (int sc = 0; sc < 2; sc++) {
+        rt_scene s;
+        rt_scene_init(&s);
+        test_rng r = {1300 + (uint64_t)sc};
+        packet_scene(&s, &r, sc);
+        rt_kdtree tree;
+        build_ok(&tree, &s);
+        check_stats cs = {0, 0, 0}, cso = {0, 0, 0};
+        float span = sc == 0 ? 1.0f : 9.0f;
+        for (int cam = 0; cam < 24; cam++) {
+            tile_camera tc = random_tile_camera(&r, span);
+            if (cam % 3 == 2) /* inside the scene's box */
+                tc.eye = rnd3(&r, 0.2f * span, 0.8f * span);
+            float pix = cam % 2 ? 1e-3f : 1e-2f;
+            for (int tile = 0; tile < 10; tile++) {
+                float x0 = rnd(&r, -0.5f, 0.5f), y0 = rnd(&r, -0.5f, 0.5f);
+                rt_ray rays[64];
+                for (int i = 0; i < 64; i++) {
+                    rt_vec3 d = rt_add(tc.fw, rt_add(rt_scale(tc.rx, x0 + pix * (float)(i % 8)),
+                                                     rt_scale(tc.uy, y0 + pix * (float)(i / 8))));
+                    rays[i] = rt_ray_make(tc.eye, d, 0.0f, INFINITY);
+                }
+                int n = 64;
+                switch (tile) {
+                case 1: n = 1 + (int)(test_rng_next(&r) % 63); break;
+                case 2: rays[37].dir.x = 0.0f; break;                 /* parallel to an axis */
+                case 3: rays[5].tmin = rays[5].tmax = 1.0f; break;    /* an empty interval */
+                case 4: rays[40].org.y = NAN; break;                  /* hits nothing */
+                case 5: rays[50] = rt_ray_make(tc.eye, rt_neg(rays[50].dir), 0.0f, INFINITY); break;
+                case 6: rays[2].tmax = rnd(&r, 0.5f, 2.0f) * span; rays[60].tmin = 0.5f * span; break;
+                default: break;
+                }
+                rt_hit h[64];
+                memset(h, 0x55, sizeof h);
+                uint64_t m = rt_kdtree_intersect_frustum(&tree, rays, n, h);
+                check_tile_hits(&s, rays, n, m, h, "frustum 8x8", &cs);
+                check_as_single(&tree, rays, n, m, h);
+                /* shadow rays: the hit points (or points along the rays) to a light */
+                rt_vec3 light = rnd3(&r, -0.5f * span, 1.5f * span);
+                rt_ray sr[64];
+                for (int i = 0; i < n; i++) {
+                    float t = (m >> i & 1) ? h[i].t : span;
+                    rt_vec3 p = rt_add(rays[i].org, rt_scale(rays[i].dir, t));
+                    sr[i] = rt_ray_make(p, rt_sub(light, p), 1e-4f, 1.0f);
+                    if (tile == 7 && !(rt_finite3(p))) /* a ray that hit nothing: a finite point */
+                        sr[i] = rt_ray_make(tc.eye, rt_sub(light, tc.eye), 1e-4f, 1.0f);
+                }
+                if (tile == 8) /* the camera rays cut at their hit */
+                    for (int i = 0; i < n; i++) {
+                        sr[i] = rays[i];
+                        if (m >> i & 1)
+                            sr[i].tmax = i % 2 ? h[i].t : nextafterf(h[i].t, INFINITY);
+                    }
+                uint64_t o = rt_kdtree_occluded_frustum(&tree, sr, n);
+                assert_true(n == 64 || o >> n == 0);
+                for (int i = 0; i < n; i++) {
+                    bool fa = o >> i & 1, ba = ref_any(&s, &sr[i]);
+                    if (fa != ba)
+                        fprintf(stderr, "frustum shadow ray %d of %d: %d, brute %d\n", i, n, fa, ba);
+                    assert_int_equal(fa, ba);
+                    if (tile == 8 && (m >> i & 1))
+                        assert_int_equal(fa, i % 2 == 0);
+                    cso.rays++;
+                    cso.hits += fa;
+                }
+            }
+        }
+        report(__func__, &cs);
+        report(__func__, &cso);
+        assert_true(cs.hits > cs.rays / 10);
+        assert_true(cso.hits > cso.rays / 20 && cso.hits < cso.rays - cso.rays / 20);
         rt_kdtree_free(&tree);
         rt_scene_free(&s);
     }
@@ -1226,6 +1351,7 @@ int main(void)
         cmocka_unit_test(test_edge_rays),
         cmocka_unit_test(test_packets),
         cmocka_unit_test(test_packets_occluded),
+        cmocka_unit_test(test_frustum),
         cmocka_unit_test(test_threads_safe_reads),
         cmocka_unit_test(test_parallel_build_identical),
     };

@@ -2,14 +2,14 @@
 """Prints the three constant tables of the wide kd-tree step in
 src/accel/kdtree_trace.c.
 
-kd_compress[m]: byte i = the lane of the i-th set bit of the 8-bit mask m
-(compaction by a permute). kd_cell_of_key[nb] / kd_key_of_cell[nb]: the
+rt_kd_compress[m]: byte i = the lane of the i-th set bit of the 8-bit mask m
+(compaction by a permute). rt_kd_cell_of_key[nb] / rt_kd_key_of_cell[nb]: the
 front-to-back order of a wide node's 8 cells when the ray crosses the planes
 in the 7-bit set nb towards -axis. A cell's key k (bit 2 = level 0) says on
 which side of its plane at each level it lies, 0 = the side entered first;
 the cell is c = 4 b0 + 2 b1 + b2 with b = k ^ neg(plane) at each level and
-planes 0, 1 + b0, 3 + 2 b0 + b1. Byte L of kd_cell_of_key[nb] is the cell
-with key 7 - L (farthest first); byte c of kd_key_of_cell[nb] is c's key.
+planes 0, 1 + b0, 3 + 2 b0 + b1. Byte L of rt_kd_cell_of_key[nb] is the cell
+with key 7 - L (farthest first); byte c of rt_kd_key_of_cell[nb] is c's key.
 
     python3 tools/kd_tables.py   # compare with the tables in src/accel/kdtree_trace.c
 """
@@ -28,7 +28,7 @@ def pack(values):
 
 
 def table(name, entries):
-    print("static const uint64_t %s[%d] = {" % (name, len(entries)))
+    print("const uint64_t %s[%d] = {" % (name, len(entries)))
     for i in range(0, len(entries), 4):
         print("    " + ", ".join("0x%016xull" % e for e in entries[i:i + 4]) + ",")
     print("};")
@@ -45,6 +45,6 @@ for nb in range(128):
     for k in range(8):
         keys[cell_of(k, nb)] = k
     key_of_cell.append(pack(keys))
-table("kd_compress", compress)
-table("kd_cell_of_key", cell_of_key)
-table("kd_key_of_cell", key_of_cell)
+table("rt_kd_compress", compress)
+table("rt_kd_cell_of_key", cell_of_key)
+table("rt_kd_key_of_cell", key_of_cell)

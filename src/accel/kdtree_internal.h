@@ -17,7 +17,11 @@
  *                   (no SIMD; the choice between them, once a tree);
  *   kdtree_packet.c rt_kdtree_intersect8 and rt_kdtree_occluded8: up to 8
  *                   coherent rays through the same arrays at once (one
- *                   walk for both; the leaves by kdtree_trace.c).
+ *                   walk for both; the leaves by kdtree_trace.c);
+ *                   its lane kernels are in kdtree_packet_lanes.h;
+ *   kdtree_frustum.c rt_kdtree_intersect_frustum: a tile of up to 64
+ *                   rays walked as one frustum (kdtree_packet_lanes.h's
+ *                   set-up and leaf test, kdtree_trace.c's step tables).
  *
  * Only the build and packing use rt_kdtree_node; the traversal reads
  * nothing but rt_kdtree and this file's KD_MAX_DEPTH and KD_IDS_PAD.
@@ -122,6 +126,18 @@ typedef struct kd_ray {
 #define KD_AVX2_BEGIN _Pragma("GCC push_options") _Pragma("GCC target(\"avx2,fma\")")
 #define KD_AVX2_END _Pragma("GCC pop_options")
 #endif
+#endif
+
+#ifdef KD_HAVE_AVX2
+/* kdtree_trace.c's tables for the 8-cell AVX2 step (printed by
+ * tools/kd_tables.py; also read by kdtree_frustum.c's step): byte i of
+ * rt_kd_compress[m] is the lane of the i-th set bit of m; for the 7 bits
+ * nb of the planes crossed towards -axis, byte L of rt_kd_cell_of_key[nb]
+ * is the cell with key 7 - L and byte c of rt_kd_key_of_cell[nb] the key
+ * of cell c (front-to-back keys, as in kdtree_trace.c's wide_step_scalar). */
+extern const uint64_t rt_kd_compress[256];
+extern const uint64_t rt_kd_cell_of_key[128];
+extern const uint64_t rt_kd_key_of_cell[128];
 #endif
 
 /* The traversal a tree can use on this CPU: RT_KD_ISA_AVX2 when the

@@ -522,7 +522,7 @@ KD_INLINE int wide_step_scalar(const rt_kdtree_wide *w, const kd_ray *r, bool pa
 /* Byte i of entry m: the lane of the i-th set bit of m (compaction by a
  * permute, as AVX2 has no compress instruction). This table and the two
  * below are printed by tools/kd_tables.py. */
-static const uint64_t kd_compress[256] = {
+const uint64_t rt_kd_compress[256] = {
     0x0000000000000000ull, 0x0000000000000000ull, 0x0000000000000001ull, 0x0000000000000100ull,
     0x0000000000000002ull, 0x0000000000000200ull, 0x0000000000000201ull, 0x0000000000020100ull,
     0x0000000000000003ull, 0x0000000000000300ull, 0x0000000000000301ull, 0x0000000000030100ull,
@@ -591,9 +591,9 @@ static const uint64_t kd_compress[256] = {
 
 /* The front-to-back order of a node's cells depends only on which of its 7
  * planes the ray crosses towards -axis (7 bits nb): byte L of
- * kd_cell_of_key[nb] is the cell with key 7 - L, byte c of
- * kd_key_of_cell[nb] the key of cell c (keys as in wide_step_scalar). */
-static const uint64_t kd_cell_of_key[128] = {
+ * rt_kd_cell_of_key[nb] is the cell with key 7 - L, byte c of
+ * rt_kd_key_of_cell[nb] the key of cell c (keys as in wide_step_scalar). */
+const uint64_t rt_kd_cell_of_key[128] = {
     0x0001020304050607ull, 0x0405060700010203ull, 0x0203000104050607ull, 0x0405060702030001ull,
     0x0001020306070405ull, 0x0607040500010203ull, 0x0203000106070405ull, 0x0607040502030001ull,
     0x0100020304050607ull, 0x0405060701000203ull, 0x0203010004050607ull, 0x0405060702030100ull,
@@ -627,7 +627,7 @@ static const uint64_t kd_cell_of_key[128] = {
     0x0100030205040706ull, 0x0504070601000302ull, 0x0302010005040706ull, 0x0504070603020100ull,
     0x0100030207060504ull, 0x0706050401000302ull, 0x0302010007060504ull, 0x0706050403020100ull,
 };
-static const uint64_t kd_key_of_cell[128] = {
+const uint64_t rt_kd_key_of_cell[128] = {
     0x0706050403020100ull, 0x0302010007060504ull, 0x0706050401000302ull, 0x0302010005040706ull,
     0x0504070603020100ull, 0x0100030207060504ull, 0x0504070601000302ull, 0x0100030205040706ull,
     0x0706050403020001ull, 0x0302010007060405ull, 0x0706050401000203ull, 0x0302010005040607ull,
@@ -702,8 +702,8 @@ KD_INLINE int wide_step_avx2(const rt_kdtree_wide *w, const kd_ray *r, bool par,
      * bits that say on which side of each the cell is for this ray */
     const __m256i q1 = _mm256_setr_epi32(1, 1, 1, 1, 2, 2, 2, 2), q2 = _mm256_setr_epi32(3, 3, 4, 4, 5, 5, 6, 6);
     unsigned nb = (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(neg)) & 0x7fu;
-    uint64_t order = kd_cell_of_key[nb];
-    __m256i key = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128((long long)kd_key_of_cell[nb]));
+    uint64_t order = rt_kd_cell_of_key[nb];
+    __m256i key = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128((long long)rt_kd_key_of_cell[nb]));
     /* blendv reads the sign bit: key bit 2, 1, 0 = far side at level 0, 1, 2 */
     __m256 m0 = _mm256_castsi256_ps(_mm256_slli_epi32(key, 29)), m1 = _mm256_castsi256_ps(_mm256_slli_epi32(key, 30)),
            m2 = _mm256_castsi256_ps(_mm256_slli_epi32(key, 31));
@@ -731,7 +731,7 @@ KD_INLINE int wide_step_avx2(const rt_kdtree_wide *w, const kd_ray *r, bool par,
     unsigned lane = 31u - (unsigned)__builtin_clz(mask), rest = mask ^ (1u << lane);
     out->l = l, out->h = h, out->cell = (unsigned)(order >> (8 * lane)) & 7u;
     __m256i idx = _mm256_permutevar8x32_epi32(
-        cell, _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(const void *)&kd_compress[rest])));
+        cell, _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(const void *)&rt_kd_compress[rest])));
     _mm256_storeu_si256((__m256i *)(void *)sref, _mm256_permutevar8x32_epi32(ref, idx));
     _mm256_storeu_ps(slo, _mm256_permutevar8x32_ps(l, idx));
     _mm256_storeu_ps(shi, _mm256_permutevar8x32_ps(h, idx));
