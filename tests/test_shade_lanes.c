@@ -1,7 +1,10 @@
 /* test_shade_lanes.c - the wavefront's BSDF sampling in SIMD lanes
  * (rt/render/shade_lanes.h) against the scalar steps it replaces, bit
- * for bit: for Lambert and rough GGX conductors (isotropic, anisotropic,
- * separable or height-correlated Smith) over random frames, geometric
+ * for bit: for Lambert, rough GGX conductors (isotropic, anisotropic,
+ * separable or height-correlated Smith) and the rough opaque glTF BRDF
+ * (metallic, dielectric and in between, both lobes), and smooth glass
+ * (either index ratio, tinted, mirror and refraction, total internal
+ * reflection) over random frames, geometric
  * normals that disagree with the shading normal, random and edge sample
  * values (u = (0.5, 0.5), the concentric map's centre; 0 and just below
  * 1), black albedos and grazing views, the lanes' ok flag, direction, pdf
@@ -36,15 +39,17 @@ static float edge_or_random(test_rng *r, int k)
 }
 
 /* The scalar steps for one vertex: false when the path ends there. */
-static bool scalar_steps(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, rt_vec3 beta, rt_vec3 *wi, float *pdf,
-                         rt_vec3 *beta_out)
+static bool scalar_steps(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_vec3 beta, rt_vec3 *wi,
+                         float *pdf, rt_vec3 *beta_out, bool *down)
 {
     rt_bsdf_sample bs;
-    if (!rt_bsdf_sample_dir(b, wo, u, 0.5f, &bs))
+    if (!rt_bsdf_sample_dir(b, wo, u, ulobe, &bs))
         return false;
     *wi = rt_normalize(rt_bsdf_to_world(b, bs.wi));
-    if (!(rt_dot(*wi, b->ng) > 0.0f))
+    float side = rt_dot(*wi, b->ng);
+    if (bs.wi.z > 0.0f ? !(side > 0.0f) : !(side < 0.0f))
         return false;
+    *down = bs.wi.z < 0.0f;
     *beta_out = rt_mul(beta, bs.weight);
     *pdf = bs.pdf;
     return rt_finite3(*beta_out) && rt_max3(*beta_out) > 0.0f;
@@ -58,7 +63,8 @@ static void check_kind(rt_bsdf_kind kind, size_t n, uint64_t seed)
     rt_bsdf *bs = malloc(n * sizeof *bs);
     rt_vec3 *wos = malloc(n * sizeof *wos), *betas = malloc(n * sizeof *betas);
     rt_vec2 *us = malloc(n * sizeof *us);
-    assert_true(bs && wos && betas && us);
+    float *ulobes = malloc(n * sizeof *ulobes);
+    assert_true(bs && wos && betas && us && ulobes);
     size_t live = 0;
     for (size_t k = 0; k < n; k++) {
         rt_bsdf *b = &bs[k];
@@ -67,6 +73,15 @@ static void check_kind(rt_bsdf_kind kind, size_t n, uint64_t seed)
         if (kind == RT_BSDF_KIND_LAMBERT) {
             rt_vec3 albedo = k % 13 == 5 ? rt_v3s(0.0f) : rt_v3(test_rng_float(&r), test_rng_float(&r), test_rng_float(&r));
             rt_bsdf_make(b, nn, albedo, 0.0f, 1.0f, 1.5f, 0.0f, true);
+        } else if (kind == RT_BSDF_KIND_GLTF) {
+            rt_vec3 base = rt_v3(test_rng_float(&r), test_rng_float(&r), test_rng_float(&r));
+            float metallic = k % 4 == 0 ? 0.0f : (k % 4 == 1 ? 1.0f : test_rng_float(&r));
+            rt_bsdf_make(b, nn, base, metallic, 0.02f + 0.98f * test_rng_float(&r), 1.2f + test_rng_float(&r), 0.0f,
+                         false);
+        } else if (kind == RT_BSDF_KIND_DIELECTRIC) {
+            rt_bsdf_make_dielectric(b, nn, 0.4f + 2.0f * test_rng_float(&r), 0.0f);
+            if (k % 5 == 2)
+                b->diffuse = rt_v3(test_rng_float(&r), test_rng_float(&r), test_rng_float(&r)); /* a tint */
         } else {
             float ax = 0.01f + test_rng_float(&r), ay = k % 2 ? ax : 0.01f + test_rng_float(&r);
             rt_vec3 eta = rt_v3(0.1f + 2.0f * test_rng_float(&r), 0.1f + 2.0f * test_rng_float(&r), 1.3f);
@@ -74,16 +89,17 @@ static void check_kind(rt_bsdf_kind kind, size_t n, uint64_t seed)
             rt_bsdf_make_conductor(b, nn, eta, kk, ax, ay, k % 3 == 0);
         }
         b->ng = ng;
-        assert_int_equal(rt_shade_lanes_kind(b), (int)kind);
         /* wo above the shading normal, grazing now and then */
         float ct = k % 17 == 1 ? 1e-4f : 0.02f + 0.98f * test_rng_float(&r), phi = 2.0f * RT_PI * test_rng_float(&r);
         float st = sqrtf(1.0f - ct * ct);
         rt_vec3 wo = rt_v3(st * cosf(phi), st * sinf(phi), ct);
         if (kind != RT_BSDF_KIND_LAMBERT)
             rt_bsdf_set_wo(b, wo);
+        assert_int_equal(rt_shade_lanes_kind(b), (int)kind);
         rt_vec2 u = rt_v2(edge_or_random(&r, (int)k), edge_or_random(&r, (int)(k / 11)));
         rt_vec3 beta = rt_v3(test_rng_float(&r), test_rng_float(&r), 2.0f * test_rng_float(&r));
-        wos[k] = wo, us[k] = u, betas[k] = beta;
+        float ulobe = edge_or_random(&r, (int)(k / 3));
+        wos[k] = wo, us[k] = u, betas[k] = beta, ulobes[k] = ulobe;
         l->tx[k] = b->t.x, l->ty[k] = b->t.y, l->tz[k] = b->t.z;
         l->bx[k] = b->b.x, l->by[k] = b->b.y, l->bz[k] = b->b.z;
         l->nx[k] = b->n.x, l->ny[k] = b->n.y, l->nz[k] = b->n.z;
@@ -95,20 +111,32 @@ static void check_kind(rt_bsdf_kind kind, size_t n, uint64_t seed)
         l->ax[k] = b->alpha, l->ay[k] = b->alpha_y, l->sep[k] = b->separable ? 1.0f : 0.0f;
         l->er[k] = b->eta_c.x, l->eg[k] = b->eta_c.y, l->eb[k] = b->eta_c.z;
         l->kr[k] = b->k_c.x, l->kg[k] = b->k_c.y, l->kb[k] = b->k_c.z;
+        l->cr[k] = b->base.x, l->cg[k] = b->base.y, l->cb[k] = b->base.z;
+        l->metal[k] = b->metallic, l->f0[k] = b->f0;
+        l->pd[k] = b->p_d, l->ps[k] = b->p_s, l->ulobe[k] = ulobe;
+        l->pt[k] = b->p_t, l->eta[k] = b->eta;
     }
     if (kind == RT_BSDF_KIND_LAMBERT)
         rt_lambert_sample_lanes(l, n);
-    else
+    else if (kind == RT_BSDF_KIND_CONDUCTOR)
         rt_conductor_sample_lanes(l, n);
+    else if (kind == RT_BSDF_KIND_GLTF)
+        rt_gltf_sample_lanes(l, n);
+    else
+        rt_dielectric_sample_lanes(l, n);
     for (size_t k = 0; k < n; k++) {
         rt_vec3 wi = rt_v3s(0.0f), beta = rt_v3s(0.0f);
         float pdf = 0.0f;
-        bool ok = scalar_steps(&bs[k], wos[k], us[k], betas[k], &wi, &pdf, &beta);
+        bool down = false;
+        bool ok = scalar_steps(&bs[k], wos[k], us[k], ulobes[k], betas[k], &wi, &pdf, &beta, &down);
         if (ok != (l->ok[k] != 0))
             fail_msg("kind %d, path %zu: lanes say %d, scalar %d", (int)kind, k, l->ok[k], ok);
         if (!ok)
             continue;
         live++;
+        if (down != (l->down[k] != 0))
+            fail_msg("kind %d, path %zu: lanes went %s, scalar %s", (int)kind, k, l->down[k] ? "down" : "up",
+                     down ? "down" : "up");
         float got[7] = {l->wx[k], l->wy[k], l->wz[k], l->pdf[k], l->br[k], l->bg[k], l->bb[k]};
         float want[7] = {wi.x, wi.y, wi.z, pdf, beta.x, beta.y, beta.z};
         if (memcmp(got, want, sizeof got) != 0)
@@ -123,6 +151,7 @@ static void check_kind(rt_bsdf_kind kind, size_t n, uint64_t seed)
     free(wos);
     free(betas);
     free(us);
+    free(ulobes);
     rt_shade_lanes_free(l);
 }
 
@@ -142,9 +171,26 @@ static void test_conductor_lanes_equal_scalar(void **state)
         check_kind(RT_BSDF_KIND_CONDUCTOR, counts[c] < 16 ? 64 + counts[c] : counts[c], 101 + c);
 }
 
+static void test_gltf_lanes_equal_scalar(void **state)
+{
+    (void)state;
+    const size_t counts[] = {RT_SHADE_LANES + 3, 4099, 20000};
+    for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++)
+        check_kind(RT_BSDF_KIND_GLTF, counts[c] < 16 ? 64 + counts[c] : counts[c], 201 + c);
+}
+
+static void test_dielectric_lanes_equal_scalar(void **state)
+{
+    (void)state;
+    const size_t counts[] = {RT_SHADE_LANES + 5, 4099, 20000};
+    for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++)
+        check_kind(RT_BSDF_KIND_DIELECTRIC, counts[c] < 16 ? 64 + counts[c] : counts[c], 301 + c);
+}
+
 /* Which BSDFs the lanes take: Lambert, rough conductors without the
- * multiple-scattering lobe; not a delta conductor, a compensated one, nor
- * the glTF BSDF. */
+ * multiple-scattering lobe, the rough opaque glTF BRDF once its lobe
+ * probabilities are cached, smooth glass likewise; not a delta conductor,
+ * a compensated one, a smooth or transmissive glTF BSDF, rough glass. */
 static void test_lanes_kind(void **state)
 {
     (void)state;
@@ -160,6 +206,20 @@ static void test_lanes_kind(void **state)
     rt_bsdf_make_conductor(&b, n, eta, k, 0.0f, 0.0f, false);
     assert_int_equal(rt_shade_lanes_kind(&b), -1);
     rt_bsdf_make(&b, n, rt_v3s(0.5f), 0.5f, 0.5f, 1.5f, 0.0f, false);
+    assert_int_equal(rt_shade_lanes_kind(&b), -1); /* no lobe probabilities cached yet */
+    rt_bsdf_set_wo(&b, rt_v3(0.0f, 0.6f, 0.8f));
+    assert_int_equal(rt_shade_lanes_kind(&b), RT_BSDF_KIND_GLTF);
+    rt_bsdf_make(&b, n, rt_v3s(0.5f), 0.5f, 0.0f, 1.5f, 0.0f, false); /* smooth: a delta mirror */
+    rt_bsdf_set_wo(&b, rt_v3(0.0f, 0.6f, 0.8f));
+    assert_int_equal(rt_shade_lanes_kind(&b), -1);
+    rt_bsdf_make(&b, n, rt_v3s(0.5f), 0.0f, 0.5f, 1.5f, 0.5f, false); /* transmissive */
+    rt_bsdf_set_wo(&b, rt_v3(0.0f, 0.6f, 0.8f));
+    assert_int_equal(rt_shade_lanes_kind(&b), -1);
+    rt_bsdf_make_dielectric(&b, n, 1.0f / 1.5f, 0.0f); /* smooth glass */
+    rt_bsdf_set_wo(&b, rt_v3(0.0f, 0.6f, 0.8f));
+    assert_int_equal(rt_shade_lanes_kind(&b), RT_BSDF_KIND_DIELECTRIC);
+    rt_bsdf_make_dielectric(&b, n, 1.0f / 1.5f, 0.2f); /* rough glass */
+    rt_bsdf_set_wo(&b, rt_v3(0.0f, 0.6f, 0.8f));
     assert_int_equal(rt_shade_lanes_kind(&b), -1);
 }
 
@@ -168,6 +228,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_lambert_lanes_equal_scalar),
         cmocka_unit_test(test_conductor_lanes_equal_scalar),
+        cmocka_unit_test(test_gltf_lanes_equal_scalar),
+        cmocka_unit_test(test_dielectric_lanes_equal_scalar),
         cmocka_unit_test(test_lanes_kind),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -103,10 +103,12 @@ static inline void vnormalize(vf *x, vf *y, vf *z)
 }
 
 /* The end of every kind's step: the local direction (x, y, z) taken to
- * the world and normalised, above the geometric surface, the throughput
+ * the world and normalised, on the geometric surface's side the sample
+ * is on (below: refracted), the throughput
  * times the weight (w), finite and positive (rt_path_vertex_end's steps);
  * the results stored. */
-static inline void world_and_weigh(rt_shade_lanes *l, size_t k, vf x, vf y, vf z, vf pdf, vf wr, vf wg, vf wb, vi ok)
+static inline void world_and_weigh(rt_shade_lanes *l, size_t k, vf x, vf y, vf z, vf pdf, vf wr, vf wg, vf wb, vi ok,
+                                   vi below)
 {
     vf tx = load(l->tx + k), ty = load(l->ty + k), tz = load(l->tz + k);
     vf bx = load(l->bx + k), by = load(l->by + k), bz = load(l->bz + k);
@@ -114,7 +116,7 @@ static inline void world_and_weigh(rt_shade_lanes *l, size_t k, vf x, vf y, vf z
     vf ox = tx * x + bx * y + nx * z, oy = ty * x + by * y + ny * z, oz = tz * x + bz * y + nz * z;
     vnormalize(&ox, &oy, &oz);
     vf side = ox * load(l->gx + k) + oy * load(l->gy + k) + oz * load(l->gz + k);
-    ok &= side > 0.0f;
+    ok &= (below & (side < 0.0f)) | (~below & (side > 0.0f));
     vf br = load(l->br + k) * wr, bg = load(l->bg + k) * wg, bb = load(l->bb + k) * wb;
     ok &= finite(br) & finite(bg) & finite(bb) & ((br > 0.0f) | (bg > 0.0f) | (bb > 0.0f));
     store(l->wx + k, ox);
@@ -124,8 +126,10 @@ static inline void world_and_weigh(rt_shade_lanes *l, size_t k, vf x, vf y, vf z
     store(l->br + k, br);
     store(l->bg + k, bg);
     store(l->bb + k, bb);
-    for (int j = 0; j < W; j++)
+    for (int j = 0; j < W; j++) {
         l->ok[k + (size_t)j] = ok[j] != 0;
+        l->down[k + (size_t)j] = below[j] != 0;
+    }
 }
 
 /* One SIMD step of Lambert: paths k .. k + W - 1 (bsdf.c's lambert_sample). */
@@ -145,7 +149,7 @@ static void lambert_step(rt_shade_lanes *l, size_t k)
     vf c = z / pdf;
     vf wr = dr * RT_INV_PI * c, wg = dg * RT_INV_PI * c, wb = db * RT_INV_PI * c;
     ok &= finite(wr) & finite(wg) & finite(wb);
-    world_and_weigh(l, k, x, y, z, pdf, wr, wg, wb, ok);
+    world_and_weigh(l, k, x, y, z, pdf, wr, wg, wb, ok, (vi){0});
 }
 
 /* The last step's unused lanes (n .. the next multiple of W): zeros in
@@ -155,7 +159,8 @@ static size_t pad(rt_shade_lanes *l, size_t n)
     size_t end = (n + W - 1) / W * W;
     float *in[] = {l->tx, l->ty, l->tz, l->bx, l->by, l->bz, l->nx, l->ny, l->nz, l->gx, l->gy, l->gz,
                    l->br, l->bg, l->bb, l->ux, l->uy, l->dr, l->dg, l->db, l->ox, l->oy, l->oz, l->ax,
-                   l->ay, l->sep, l->er, l->eg, l->eb, l->kr, l->kg, l->kb};
+                   l->ay, l->sep, l->er, l->eg, l->eb, l->kr, l->kg, l->kb, l->cr, l->cg, l->cb, l->metal,
+                   l->f0, l->pd, l->ps, l->ulobe, l->pt, l->eta};
     for (size_t a = 0; a < sizeof in / sizeof in[0]; a++)
         for (size_t k = n; k < end; k++)
             in[a][k] = 0.0f;
@@ -277,7 +282,7 @@ static void conductor_step(rt_shade_lanes *l, size_t k)
     vf wg = vfresnel_conductor(voh, load(l->eg + k), load(l->kg + k)) * spec * cw;
     vf wb = vfresnel_conductor(voh, load(l->eb + k), load(l->kb + k)) * spec * cw;
     ok &= finite(wr) & finite(wg) & finite(wb);
-    world_and_weigh(l, k, x, y, z, pdf, wr, wg, wb, ok);
+    world_and_weigh(l, k, x, y, z, pdf, wr, wg, wb, ok, (vi){0});
 }
 
 void rt_conductor_sample_lanes(rt_shade_lanes *l, size_t n)
@@ -285,6 +290,138 @@ void rt_conductor_sample_lanes(rt_shade_lanes *l, size_t n)
     size_t end = pad(l, n);
     for (size_t k = 0; k < end; k += W)
         conductor_step(l, k);
+}
+
+/* ------------------------------------------------------------ the glTF BRDF */
+
+/* microfacet.h's rt_schlick_weight: (1 - c)^5, c clamped to [0, 1] */
+static inline vf vschlick_weight(vf c)
+{
+    vf x = 1.0f - vclamp01(c);
+    vf x2 = x * x;
+    return x2 * x2 * x;
+}
+
+/* One channel of the specular lobe's Fresnel (bsdf.c's
+ * fresnel_specular): the mix by metallic m of Schlick on the base colour
+ * and the dielectric's fd */
+static inline vf vfresnel_specular(vf base, vf m, vf w, vf fd)
+{
+    vf fm = sel(m > 0.0f, base + (1.0f - base) * w, splat(0.0f));
+    return fd * (1.0f - m) + fm * m;
+}
+
+/* One SIMD step of the rough, opaque glTF BRDF: bsdf.c's
+ * dielectric_sample with no transmission (the diffuse lobe by the cosine
+ * or the specular one by its visible normals), dielectric_eval and
+ * finish_sample. */
+static void gltf_step(rt_shade_lanes *l, size_t k)
+{
+    vf wox = load(l->ox + k), woy = load(l->oy + k), woz = load(l->oz + k);
+    vf a = load(l->ax + k), ay = load(l->ay + k), pd = load(l->pd + k), ps = load(l->ps + k);
+    vf ux = load(l->ux + k), uy = load(l->uy + k);
+    vi ok = pd + ps > 0.0f;
+    vi diffuse = (load(l->ulobe + k) < pd) | ~(ps > 0.0f);
+    vf cx, cy, cz, hx, hy, hz;
+    vcosine_hemisphere(ux, uy, &cx, &cy, &cz);
+    vvndf(wox, woy, woz, a, ay, ux, uy, &hx, &hy, &hz); /* (the glTF BRDF's ay is a: its eval is isotropic) */
+    vf c = 2.0f * (wox * hx + woy * hy + woz * hz);
+    vf x = sel(diffuse, cx, hx * c - wox), y = sel(diffuse, cy, hy * c - woy), z = sel(diffuse, cz, hz * c - woz);
+    ok &= (z > 0.0f) & finite(x) & finite(y) & finite(z);
+    vnormalize(&x, &y, &z);
+    /* dielectric_eval: both above, the half vector */
+    ok &= (woz > 0.0f) & (z > 0.0f);
+    vf mx = wox + x, my = woy + y, mz = woz + z;
+    vf l2 = mx * mx + my * my + mz * mz;
+    ok &= l2 > 1e-20f;
+    vf inv = 1.0f / vsqrt(l2);
+    mx = mx * inv, my = my * inv, mz = mz * inv;
+    vf voh = wox * mx + woy * my + woz * mz;
+    vf f0 = load(l->f0 + k), w = vschlick_weight(voh);
+    vf fd = f0 + (1.0f - f0) * w;
+    /* the diffuse lobe: (1 - fd) (1 - T) diffuse / pi, T = 0 */
+    vf tdiff = (1.0f - fd) * 1.0f;
+    vf p = pd * z * RT_INV_PI;
+    /* the specular lobe: F D G2 / (4 cos cos), VNDF pdf */
+    vf D = vggx_d(mx, my, mz, a, a);
+    vf lo = vlambda(wox, woy, woz, a, a), li = vlambda(x, y, z, a, a);
+    vf g2 = sel(finite(lo) & finite(li), 1.0f / (1.0f + lo + li), splat(0.0f));
+    vf spec = D * g2 / (4.0f * woz * z);
+    spec = sel(finite(spec), spec, splat(0.0f));
+    vf g1 = sel(finite(lo), 1.0f / (1.0f + lo), splat(0.0f));
+    vf pv = g1 * D / (4.0f * woz);
+    p = sel((ps > 0.0f) & finite(pv), p + ps * pv, p);
+    /* finish_sample */
+    ok &= (p > 0.0f) & finite(p);
+    vf m = load(l->metal + k), cw = z / p;
+    vf fr = load(l->dr + k) * (tdiff * RT_INV_PI) + vfresnel_specular(load(l->cr + k), m, w, fd) * spec;
+    vf fg = load(l->dg + k) * (tdiff * RT_INV_PI) + vfresnel_specular(load(l->cg + k), m, w, fd) * spec;
+    vf fb = load(l->db + k) * (tdiff * RT_INV_PI) + vfresnel_specular(load(l->cb + k), m, w, fd) * spec;
+    vf wr = fr * cw, wg = fg * cw, wb = fb * cw;
+    ok &= finite(wr) & finite(wg) & finite(wb);
+    world_and_weigh(l, k, x, y, z, p, wr, wg, wb, ok, (vi){0});
+}
+
+void rt_gltf_sample_lanes(rt_shade_lanes *l, size_t n)
+{
+    size_t end = pad(l, n);
+    for (size_t k = 0; k < end; k += W)
+        gltf_step(l, k);
+}
+
+/* ------------------------------------------------------------ smooth dielectric */
+
+/* microfacet.c's rt_fresnel_exact: unpolarised Fresnel reflectance of a
+ * smooth dielectric interface, 1 past the critical angle */
+static inline vf vfresnel_exact(vf cos_i, vf eta)
+{
+    vf ci = vclamp01(cos_i);
+    vf sin2_t = eta * eta * (1.0f - ci * ci);
+    vf ct = vsqrt(1.0f - sin2_t);
+    vf rs = (eta * ci - ct) / (eta * ci + ct);
+    vf rp = (ci - eta * ct) / (ci + eta * ct);
+    vf f = 0.5f * (rs * rs + rp * rp);
+    return sel(sin2_t < 1.0f, sel(finite(f), vclamp01(f), splat(1.0f)), splat(1.0f));
+}
+
+/* One SIMD step of smooth glass: bsdf.c's dielectric_sample for a delta
+ * interface, refraction about the normal (weight (1 - F) T eta^2 tint /
+ * p_t) or the mirror (weight F / p_s), chosen by ulobe. */
+static void dielectric_step(rt_shade_lanes *l, size_t k)
+{
+    vf wox = load(l->ox + k), woy = load(l->oy + k), woz = load(l->oz + k);
+    vf pd = load(l->pd + k), ps = load(l->ps + k), pt = load(l->pt + k), ul = load(l->ulobe + k);
+    vf eta = load(l->eta + k);
+    vi ok = pd + ps + pt + 0.0f > 0.0f;
+    vi refract = (pt > 0.0f) & (ul >= pd + ps);
+    vi mirror = ~refract & (ps > 0.0f) & (ul >= pd);
+    ok &= refract | mirror;
+    /* refraction about the macro normal h = (0, 0, 1) */
+    vf ci = wox * 0.0f + woy * 0.0f + woz * 1.0f;
+    vf sin2_t = eta * eta * vmax(splat(0.0f), 1.0f - ci * ci);
+    vf ct = vsqrt(1.0f - sin2_t);
+    vf a = eta * ci - ct;
+    vf rx = wox * -eta + 0.0f * a, ry = woy * -eta + 0.0f * a, rz = woz * -eta + 1.0f * a;
+    ok &= ~refract | ((ci > 0.0f) & ~(sin2_t >= 1.0f) & (rz < 0.0f));
+    vnormalize(&rx, &ry, &rz);
+    vf tw = (1.0f - vfresnel_exact(ci, eta)) * 1.0f * 1.0f * (eta * eta) / pt;
+    /* the mirror */
+    vf mw = (vfresnel_exact(woz, eta) * (1.0f - 0.0f) + 0.0f * 0.0f) * (1.0f / ps);
+    vf x = sel(refract, rx, -wox), y = sel(refract, ry, -woy), z = sel(refract, rz, woz);
+    vf wr = sel(refract, load(l->dr + k) * tw, mw);
+    vf wg = sel(refract, load(l->dg + k) * tw, mw);
+    vf wb = sel(refract, load(l->db + k) * tw, mw);
+    /* delta_sample: finite, some weight */
+    ok &= finite(x) & finite(y) & finite(z) & finite(wr) & finite(wg) & finite(wb);
+    ok &= (wr > 0.0f) | (wg > 0.0f) | (wb > 0.0f);
+    world_and_weigh(l, k, x, y, z, splat(0.0f), wr, wg, wb, ok, refract);
+}
+
+void rt_dielectric_sample_lanes(rt_shade_lanes *l, size_t n)
+{
+    size_t end = pad(l, n);
+    for (size_t k = 0; k < end; k += W)
+        dielectric_step(l, k);
 }
 
 rt_shade_lanes *rt_shade_lanes_new(size_t batch)
@@ -296,12 +433,14 @@ rt_shade_lanes *rt_shade_lanes_new(size_t batch)
     size_t room = (batch + W - 1) / W * W;
     float **all[] = {&l->tx, &l->ty, &l->tz, &l->bx, &l->by, &l->bz, &l->nx, &l->ny, &l->nz, &l->gx, &l->gy,
                      &l->gz, &l->br, &l->bg, &l->bb, &l->ux, &l->uy, &l->dr, &l->dg, &l->db, &l->ox, &l->oy,
-                     &l->oz, &l->ax, &l->ay, &l->sep, &l->er, &l->eg, &l->eb, &l->kr, &l->kg, &l->kb, &l->wx,
-                     &l->wy, &l->wz, &l->pdf};
+                     &l->oz, &l->ax, &l->ay, &l->sep, &l->er, &l->eg, &l->eb, &l->kr, &l->kg, &l->kb, &l->cr,
+                     &l->cg, &l->cb, &l->metal, &l->f0, &l->pd, &l->ps, &l->ulobe, &l->pt, &l->eta, &l->wx, &l->wy,
+                     &l->wz, &l->pdf};
     bool ok = true;
     for (size_t a = 0; a < sizeof all / sizeof all[0]; a++)
         ok = (*all[a] = rt_alloc(room, sizeof(float))) != NULL && ok;
     ok = (l->ok = rt_alloc(room, 1)) != NULL && ok;
+    ok = (l->down = rt_alloc(room, 1)) != NULL && ok;
     if (!ok) {
         rt_shade_lanes_free(l);
         return NULL;
@@ -315,9 +454,11 @@ void rt_shade_lanes_free(rt_shade_lanes *l)
         return;
     float *all[] = {l->tx, l->ty, l->tz, l->bx, l->by, l->bz, l->nx, l->ny, l->nz, l->gx, l->gy, l->gz,
                     l->br, l->bg, l->bb, l->ux, l->uy, l->dr, l->dg, l->db, l->ox, l->oy, l->oz, l->ax,
-                    l->ay, l->sep, l->er, l->eg, l->eb, l->kr, l->kg, l->kb, l->wx, l->wy, l->wz, l->pdf};
+                    l->ay, l->sep, l->er, l->eg, l->eb, l->kr, l->kg, l->kb, l->cr, l->cg, l->cb, l->metal,
+                    l->f0, l->pd, l->ps, l->ulobe, l->pt, l->eta, l->wx, l->wy, l->wz, l->pdf};
     for (size_t a = 0; a < sizeof all / sizeof all[0]; a++)
         free(all[a]);
     free(l->ok);
+    free(l->down);
     free(l);
 }

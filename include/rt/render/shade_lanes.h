@@ -6,8 +6,8 @@
  *   rt_shade_lanes *l = rt_shade_lanes_new(batch);    // NULL: out of memory
  *   for each path k < n: l->tx[k] = b.t.x, ... (frame t, b, n; geometric normal g;
  *                        throughput br..bb; u = the direction's 2D value;
- *                        the kind's parameters: Lambert's albedo d = b.diffuse)
- *   rt_lambert_sample_lanes(l, n);                    // or rt_conductor_sample_lanes
+ *                        the kind's parameters: Lambert's albedo d = b.diffuse, ...)
+ *   rt_lambert_sample_lanes(l, n);                    // or rt_conductor_ / rt_gltf_sample_lanes
  *   for each k: l->ok[k] ? (world direction wx..wz, pdf, throughput br..bb updated) : the path ends
  *   rt_shade_lanes_free(l);
  *
@@ -49,23 +49,41 @@ typedef struct rt_shade_lanes {
     float *ux, *uy;                                   /* the direction's 2D sample value */
     /* Lambert */
     float *dr, *dg, *db;                              /* albedo (b.diffuse) */
-    /* GGX conductor (rough, without energy compensation) */
+    /* GGX conductor (rough, without energy compensation) and the glTF BRDF */
     float *ox, *oy, *oz;                              /* wo, local */
-    float *ax, *ay, *sep;                             /* alphas along t and b; separable Smith: 1, else 0 */
-    float *er, *eg, *eb, *kr, *kg, *kb;               /* complex index eta + i k, per channel */
+    float *ax, *ay, *sep;                             /* alphas along t and b (glTF: both alpha);
+                                                       * separable Smith: 1, else 0 */
+    float *er, *eg, *eb, *kr, *kg, *kb;               /* conductor: complex index eta + i k, per channel */
+    /* the glTF BRDF (rough, opaque): albedo above is (1 - m) B */
+    float *cr, *cg, *cb;                              /* base colour B */
+    float *metal, *f0;                                /* metallic m, the dielectric's F0 */
+    float *pd, *ps;                                   /* lobe probabilities at wo (rt_bsdf_set_wo's) */
+    float *ulobe;                                     /* the lobe choice's sample value */
+    /* the smooth dielectric (glass): albedo above is its tint, pd and ps as above */
+    float *pt;                                        /* the refraction's probability */
+    float *eta;                                       /* index ratio n_wo / n_wi */
     /* out */
     float *wx, *wy, *wz, *pdf;                        /* world direction (unit), its pdf */
     uint8_t *ok;                                      /* 1 when the path goes on */
+    uint8_t *down;                                    /* 1 when it went below the surface (refracted) */
 } rt_shade_lanes;
 
-/* Which lanes sample b: RT_BSDF_KIND_LAMBERT, RT_BSDF_KIND_CONDUCTOR, or
- * -1 for a BSDF the lanes do not cover (the scalar rt_path_vertex_end). */
+/* Which lanes sample b: RT_BSDF_KIND_LAMBERT, RT_BSDF_KIND_CONDUCTOR,
+ * RT_BSDF_KIND_GLTF (rough and opaque), RT_BSDF_KIND_DIELECTRIC (smooth
+ * glass), the last two with their lobe probabilities cached by
+ * rt_bsdf_set_wo, or -1 for a BSDF the lanes do not cover (the scalar
+ * rt_path_vertex_end). */
 static inline int rt_shade_lanes_kind(const rt_bsdf *b)
 {
     if (b->kind == RT_BSDF_KIND_LAMBERT)
         return RT_BSDF_KIND_LAMBERT;
     if (b->kind == RT_BSDF_KIND_CONDUCTOR && !b->delta && !b->ms)
         return RT_BSDF_KIND_CONDUCTOR;
+    if (b->kind == RT_BSDF_KIND_GLTF && !b->delta && !b->ms && !b->thin && b->transmission == 0.0f &&
+        b->wo_z == b->wo_z)
+        return RT_BSDF_KIND_GLTF;
+    if (b->kind == RT_BSDF_KIND_DIELECTRIC && b->delta && !b->ms && !b->thin && b->wo_z == b->wo_z)
+        return RT_BSDF_KIND_DIELECTRIC;
     return -1;
 }
 
@@ -77,5 +95,13 @@ void rt_shade_lanes_free(rt_shade_lanes *l);
  * VNDF-sampled specular one): rt_shade_lanes_kind says which a BSDF is. */
 void rt_lambert_sample_lanes(rt_shade_lanes *l, size_t n);
 void rt_conductor_sample_lanes(rt_shade_lanes *l, size_t n);
+/* The glTF metallic-roughness BRDF, rough and opaque (RT_BSDF_KIND_GLTF,
+ * no transmission, roughness above 0): the diffuse or the specular lobe
+ * by ulobe, then bsdf.c's dielectric_eval at the direction. */
+void rt_gltf_sample_lanes(rt_shade_lanes *l, size_t n);
+/* The smooth dielectric (RT_BSDF_KIND_DIELECTRIC, roughness 0, not thin):
+ * the mirror or the refraction by ulobe, delta samples (pdf 0); `down`
+ * says which. */
+void rt_dielectric_sample_lanes(rt_shade_lanes *l, size_t n);
 
 #endif
