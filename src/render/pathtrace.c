@@ -401,30 +401,59 @@ rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, 
     return wo->z > 0.0f ? RT_VERTEX_SHADE : RT_VERTEX_STOP;
 }
 
-bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
-                        rt_vec3 wo, rt_rng *rng)
+void rt_path_bsdf_draw_of(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, rt_bsdf_kind kind,
+                          rt_path_bsdf_draw *d)
 {
-    int rr_depth = ctx->state->settings->rr_depth;
-    /* continue the path by sampling the BSDF */
     /* the lobe choice and the roulette share a 2D dimension, computed
      * once and only when read: a Lambertian BSDF (one lobe) ignores ulobe
      * and most paths end before the roulette. `independent` draws both from
      * the stream, in call order. */
-    bool stratified = ctx->state->settings->sampler != RT_SAMPLER_INDEPENDENT;
-    int lr_bounce = ps->bounces; /* the roulette reads it after ps->bounces++ */
-    rt_vec2 ulr = rt_v2(0.0f, 0.0f);
-    bool have_lr = false;
-    float ulobe = 0.0f;
-    if (!stratified) {
-        ulobe = rt_rng_float(rng);
-    } else if (b->kind != RT_BSDF_KIND_LAMBERT) {
-        ulr = path_2d_of(ctx, ps, rng, lr_bounce, DIM_LOBE_RR);
-        have_lr = true;
-        ulobe = ulr.x;
+    d->stratified = ctx->state->settings->sampler != RT_SAMPLER_INDEPENDENT;
+    d->lr_bounce = ps->bounces; /* the roulette reads it after ps->bounces++ */
+    d->ulr = rt_v2(0.0f, 0.0f);
+    d->have_lr = false;
+    d->ulobe = 0.0f;
+    if (!d->stratified) {
+        d->ulobe = rt_rng_float(rng);
+    } else if (kind != RT_BSDF_KIND_LAMBERT) {
+        d->ulr = path_2d_of(ctx, ps, rng, d->lr_bounce, DIM_LOBE_RR);
+        d->have_lr = true;
+        d->ulobe = d->ulr.x;
     }
-    rt_vec2 u = path_2d(ctx, ps, rng, DIM_BSDF);
+    d->u = path_2d(ctx, ps, rng, DIM_BSDF);
+}
+
+bool rt_path_vertex_advance(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, rt_rng *rng,
+                            rt_path_bsdf_draw *d, rt_vec3 wi, float pdf, bool delta, bool pass)
+{
+    if (pass) {
+        ps->passes++;
+    } else {
+        ps->prev_delta = delta;
+        ps->prev_pdf = pdf;
+        ps->prev_p = sf->p;
+    }
+    ps->bounces++;
+    float q = rt_path_rr_probability(ps, ctx->state->settings->rr_depth);
+    if (q < 1.0f) {
+        if (d->stratified && !d->have_lr)
+            d->ulr = path_2d_of(ctx, ps, rng, d->lr_bounce, DIM_LOBE_RR);
+        if ((d->stratified ? d->ulr.y : rt_rng_float(rng)) >= q)
+            return false;
+        ps->beta = rt_scale(ps->beta, 1.0f / q);
+    }
+    ps->r = rt_ray_make(rt_surface_spawn(ctx, sf, wi), wi, 0.0f, INFINITY);
+    return true;
+}
+
+bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
+                        rt_vec3 wo, rt_rng *rng)
+{
+    /* continue the path by sampling the BSDF */
+    rt_path_bsdf_draw d;
+    rt_path_bsdf_draw_of(ctx, ps, rng, b->kind, &d);
     rt_bsdf_sample bs;
-    if (!rt_bsdf_sample_dir(b, wo, u, ulobe, &bs))
+    if (!rt_bsdf_sample_dir(b, wo, d.u, d.ulobe, &bs))
         return false;
     rt_vec3 wi = rt_normalize(rt_bsdf_to_world(b, bs.wi));
     float side = rt_dot(wi, sf->ng);
@@ -443,24 +472,7 @@ bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_sur
         if (b->kind == RT_BSDF_KIND_DIELECTRIC && !b->thin) /* the weight held (n_i / n_t)^2 = b->eta^2: undo it for the roulette */
             ps->eta_scale /= b->eta * b->eta;
     }
-    if (pass) {
-        ps->passes++;
-    } else {
-        ps->prev_delta = bs.delta;
-        ps->prev_pdf = bs.pdf;
-        ps->prev_p = sf->p;
-    }
-    ps->bounces++;
-    float q = rt_path_rr_probability(ps, rr_depth);
-    if (q < 1.0f) {
-        if (stratified && !have_lr)
-            ulr = path_2d_of(ctx, ps, rng, lr_bounce, DIM_LOBE_RR);
-        if ((stratified ? ulr.y : rt_rng_float(rng)) >= q)
-            return false;
-        ps->beta = rt_scale(beta, 1.0f / q);
-    }
-    ps->r = rt_ray_make(rt_surface_spawn(ctx, sf, wi), wi, 0.0f, INFINITY);
-    return true;
+    return rt_path_vertex_advance(ctx, ps, sf, rng, &d, wi, bs.pdf, bs.delta, pass);
 }
 
 /* ------------------------------------------------------------ integrator */

@@ -41,6 +41,7 @@
 #include "rt/accel/kdtree_batch.h"
 #include "rt/base/alloc.h"
 #include "rt/render/pathtrace.h"
+#include "rt/render/shade_lanes.h"
 
 enum lane_status {
     LANE_TRACE,   /* ray to trace */
@@ -84,7 +85,19 @@ struct rt_wavefront {
     uint32_t *pending;   /* records whose shadow ray is to trace */
     /* lane lists */
     uint32_t *active, *queue, *queue2, *order, *free_lanes;
+    /* this bounce's vertices of the kinds sampled in SIMD lanes, each
+     * kind's compacted apart (enum lane_kind): their lanes,
+     * the random numbers drawn for their BSDF samples, and the arrays the
+     * samples are taken in, RT_SHADE_LANES at a time (rt/render/shade_lanes.h) */
+    struct kind_lanes {
+        size_t n;
+        uint32_t *lane;
+        rt_path_bsdf_draw *draw;
+        rt_shade_lanes *soa;
+    } kl[4];
 };
+
+enum lane_kind { LANES_LAMBERT, LANES_CONDUCTOR, LANES_GLTF, LANES_DIELECTRIC, LANE_KINDS };
 
 static void *grab(size_t n, size_t size, bool *ok)
 {
@@ -130,6 +143,13 @@ rt_wavefront *rt_wavefront_new(size_t batch, const rt_render_state *state)
         *sfl[i] = grab(R, sizeof(float), &ok);
     wf->blocked = grab(R, 1, &ok);
     wf->pending = grab(R, sizeof(uint32_t), &ok);
+    for (int c = 0; c < LANE_KINDS; c++) {
+        wf->kl[c].lane = grab(B, sizeof(uint32_t), &ok);
+        wf->kl[c].draw = grab(B, sizeof(rt_path_bsdf_draw), &ok);
+        wf->kl[c].soa = rt_shade_lanes_new(B);
+        if (!wf->kl[c].soa)
+            ok = false;
+    }
     if (!ok) {
         rt_wavefront_free(wf);
         return NULL;
@@ -148,6 +168,11 @@ void rt_wavefront_free(rt_wavefront *wf)
                    wf->active, wf->queue, wf->queue2, wf->order, wf->free_lanes};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]);
+    for (int c = 0; c < LANE_KINDS; c++) {
+        free(wf->kl[c].lane);
+        free(wf->kl[c].draw);
+        rt_shade_lanes_free(wf->kl[c].soa);
+    }
     free(wf);
 }
 
@@ -252,6 +277,48 @@ static void add_record(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_path_
     wf->pending[(*n_pending)++] = r;
 }
 
+/* Lane i's vertex into the next slot of its kind's lanes: its frame,
+ * geometric normal, throughput and the kind's parameters, and the random
+ * numbers of its sample, drawn now as rt_path_vertex_end draws them. */
+static void lanes_gather(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, const rt_bsdf *b, rt_vec3 wo,
+                         int kind)
+{
+    struct kind_lanes *kl = &wf->kl[kind == RT_BSDF_KIND_LAMBERT     ? LANES_LAMBERT
+                                    : kind == RT_BSDF_KIND_CONDUCTOR ? LANES_CONDUCTOR
+                                    : kind == RT_BSDF_KIND_GLTF      ? LANES_GLTF
+                                                                     : LANES_DIELECTRIC];
+    rt_shade_lanes *l = kl->soa;
+    size_t k = kl->n++;
+    rt_path_state *ps = &wf->ps[i];
+    rt_path_bsdf_draw *d = &kl->draw[k];
+    rt_path_bsdf_draw_of(ctx, ps, &wf->rng[i], b->kind, d);
+    kl->lane[k] = i;
+    l->tx[k] = b->t.x, l->ty[k] = b->t.y, l->tz[k] = b->t.z;
+    l->bx[k] = b->b.x, l->by[k] = b->b.y, l->bz[k] = b->b.z;
+    l->nx[k] = b->n.x, l->ny[k] = b->n.y, l->nz[k] = b->n.z;
+    l->gx[k] = wf->sf[i].ng.x, l->gy[k] = wf->sf[i].ng.y, l->gz[k] = wf->sf[i].ng.z;
+    l->br[k] = ps->beta.x, l->bg[k] = ps->beta.y, l->bb[k] = ps->beta.z;
+    l->ux[k] = d->u.x, l->uy[k] = d->u.y;
+    if (kind != RT_BSDF_KIND_CONDUCTOR)
+        l->dr[k] = b->diffuse.x, l->dg[k] = b->diffuse.y, l->db[k] = b->diffuse.z;
+    if (kind == RT_BSDF_KIND_LAMBERT)
+        return;
+    l->ox[k] = wo.x, l->oy[k] = wo.y, l->oz[k] = wo.z;
+    l->ax[k] = b->alpha, l->ay[k] = b->alpha_y;
+    if (kind == RT_BSDF_KIND_CONDUCTOR) {
+        l->sep[k] = b->separable ? 1.0f : 0.0f;
+        l->er[k] = b->eta_c.x, l->eg[k] = b->eta_c.y, l->eb[k] = b->eta_c.z;
+        l->kr[k] = b->k_c.x, l->kg[k] = b->k_c.y, l->kb[k] = b->k_c.z;
+    } else if (kind == RT_BSDF_KIND_GLTF) {
+        l->cr[k] = b->base.x, l->cg[k] = b->base.y, l->cb[k] = b->base.z;
+        l->metal[k] = b->metallic, l->f0[k] = b->f0;
+        l->pd[k] = b->p_d, l->ps[k] = b->p_s, l->ulobe[k] = d->ulobe;
+    } else {
+        l->pd[k] = b->p_d, l->ps[k] = b->p_s, l->pt[k] = b->p_t, l->ulobe[k] = d->ulobe;
+        l->eta[k] = b->eta;
+    }
+}
+
 /* One path at its vertex: the scalar tracer's loop body up to its shadow
  * rays, then BSDF sampling (rt/render/pathtrace.h). */
 static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, size_t *n_rec, size_t *n_pending,
@@ -290,7 +357,51 @@ static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, si
     wf->rec_first[i] = (uint32_t)first;
     wf->rec_count[i] = (uint32_t)(n - first);
     wf->nbr[i] = ps->beta.x, wf->nbg[i] = ps->beta.y, wf->nbb[i] = ps->beta.z;
+    int lanes = rt_shade_lanes_kind(&b);
+    if (lanes >= 0) { /* sampled with the others of its kind, in lanes */
+        lanes_gather(wf, ctx, i, &b, wo, lanes);
+        return;
+    }
     wf->status[i] = rt_path_vertex_end(ctx, ps, sf, &b, wo, rng) ? LANE_LIVE : LANE_DONE;
+}
+
+/* Each kind's vertices' BSDF samples in SIMD lanes, then each path's
+ * roulette and next ray: rt_path_vertex_end's steps, the same bits. */
+static void shade_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx)
+{
+    for (int c = 0; c < LANE_KINDS; c++) {
+        struct kind_lanes *kl = &wf->kl[c];
+        rt_shade_lanes *l = kl->soa;
+        if (kl->n == 0)
+            continue;
+        if (c == LANES_LAMBERT)
+            rt_lambert_sample_lanes(l, kl->n);
+        else if (c == LANES_CONDUCTOR)
+            rt_conductor_sample_lanes(l, kl->n);
+        else if (c == LANES_GLTF)
+            rt_gltf_sample_lanes(l, kl->n);
+        else
+            rt_dielectric_sample_lanes(l, kl->n);
+        const rt_material *materials = ctx->state->scene->materials;
+        for (size_t k = 0; k < kl->n; k++) {
+            uint32_t i = kl->lane[k];
+            rt_path_state *ps = &wf->ps[i];
+            bool live = false;
+            if (l->ok[k]) {
+                const rt_surface *sf = &wf->sf[i];
+                ps->beta = rt_v3(l->br[k], l->bg[k], l->bb[k]);
+                if (l->down[k]) { /* refracted (glass only): into or out of its medium */
+                    rt_medium_cross(&ps->media, materials, sf->material, sf->front);
+                    ps->eta_scale /= l->eta[k] * l->eta[k];
+                }
+                live = rt_path_vertex_advance(ctx, ps, sf, &wf->rng[i], &kl->draw[k],
+                                              rt_v3(l->wx[k], l->wy[k], l->wz[k]), l->pdf[k],
+                                              c == LANES_DIELECTRIC, false);
+            }
+            wf->status[i] = live ? LANE_LIVE : LANE_DONE;
+        }
+        kl->n = 0;
+    }
 }
 
 /* The active lanes in shading order: surfaces grouped by material kind
@@ -341,6 +452,7 @@ void rt_wavefront_radiance(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_w
         size_t n_rec = 0, n_pending = 0;
         for (size_t k = 0; k < n_active; k++)
             shade_lane(wf, ctx, wf->order[k], &n_rec, &n_pending, env, emitters);
+        shade_lanes(wf, ctx);
         /* shadow rays, one batch */
         if (n_pending > 0) {
             if (ctx->ray_count)

@@ -158,6 +158,29 @@ static inline bool rt_path_samples_emitters(const rt_trace_ctx *ctx)
 bool rt_path_vertex_end(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                         rt_vec3 wo, rt_rng *rng);
 
+/* The parts of rt_path_vertex_end, for the wavefront's lanes
+ * (rt/render/shade_lanes.h), which sample a BSDF kind over many paths at
+ * once in between: rt_path_vertex_end is
+ *   rt_path_bsdf_draw_of; bs = rt_bsdf_sample_dir(b, wo, d.u, d.ulobe); wi = normalize(to world);
+ *   the geometric side test; beta *= bs.weight (finite, positive); the medium crossed;
+ *   rt_path_vertex_advance(..., wi, bs.pdf, bs.delta, pass).
+ * The random numbers of the BSDF sample, drawn as rt_path_vertex_end
+ * draws them (the roulette's may be drawn later, by rt_path_vertex_advance). */
+typedef struct rt_path_bsdf_draw {
+    rt_vec2 u;        /* the direction's */
+    float ulobe;      /* the lobe choice's */
+    rt_vec2 ulr;      /* lobe choice (x) and roulette (y), when have_lr */
+    bool have_lr, stratified;
+    int lr_bounce;    /* the bounce whose dimension the roulette reads */
+} rt_path_bsdf_draw;
+void rt_path_bsdf_draw_of(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, rt_bsdf_kind kind,
+                          rt_path_bsdf_draw *d);
+/* After ps->beta took the sample's weight: the vertex becomes the one MIS
+ * refers to (unless a pass), the bounce counts, the roulette plays, and
+ * ps->r leaves along wi (world, unit); false when the roulette ends it. */
+bool rt_path_vertex_advance(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, rt_rng *rng,
+                            rt_path_bsdf_draw *d, rt_vec3 wi, float pdf, bool delta, bool pass);
+
 /* The probability that Russian roulette lets the path continue once its
  * bounce ps->bounces is sampled (beta, eta_scale updated): 1 when the
  * roulette does not play. It weighs w = max channel of beta x eta_scale

@@ -1,0 +1,236 @@
+/* test_shade_lanes.c - the wavefront's BSDF sampling in SIMD lanes
+ * (rt/render/shade_lanes.h) against the scalar steps it replaces, bit
+ * for bit: for Lambert, rough GGX conductors (isotropic, anisotropic,
+ * separable or height-correlated Smith) and the rough opaque glTF BRDF
+ * (metallic, dielectric and in between, both lobes), and smooth glass
+ * (either index ratio, tinted, mirror and refraction, total internal
+ * reflection) over random frames, geometric
+ * normals that disagree with the shading normal, random and edge sample
+ * values (u = (0.5, 0.5), the concentric map's centre; 0 and just below
+ * 1), black albedos and grazing views, the lanes' ok flag, direction, pdf
+ * and throughput equal rt_bsdf_sample_dir's sample taken to the world and
+ * normalised, the geometric side test and beta times the weight
+ * (rt_path_vertex_end). Counts that are not a multiple of the lane width
+ * check the padding. The whole-image equality with path_scalar is
+ * test_wavefront.c's. */
+#include "test_util.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "rt/render/bsdf.h"
+#include "rt/render/shade_lanes.h"
+
+static rt_vec3 random_dir(test_rng *r)
+{
+    float z = 2.0f * test_rng_float(r) - 1.0f, phi = 2.0f * RT_PI * test_rng_float(r);
+    float s = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+    return rt_normalize(rt_v3(s * cosf(phi), s * sinf(phi), z));
+}
+
+static float edge_or_random(test_rng *r, int k)
+{
+    switch (k % 11) {
+    case 0: return 0.5f;
+    case 1: return 0.0f;
+    case 2: return 0x1.fffffep-1f;
+    default: return test_rng_float(r);
+    }
+}
+
+/* The scalar steps for one vertex: false when the path ends there. */
+static bool scalar_steps(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_vec3 beta, rt_vec3 *wi,
+                         float *pdf, rt_vec3 *beta_out, bool *down)
+{
+    rt_bsdf_sample bs;
+    if (!rt_bsdf_sample_dir(b, wo, u, ulobe, &bs))
+        return false;
+    *wi = rt_normalize(rt_bsdf_to_world(b, bs.wi));
+    float side = rt_dot(*wi, b->ng);
+    if (bs.wi.z > 0.0f ? !(side > 0.0f) : !(side < 0.0f))
+        return false;
+    *down = bs.wi.z < 0.0f;
+    *beta_out = rt_mul(beta, bs.weight);
+    *pdf = bs.pdf;
+    return rt_finite3(*beta_out) && rt_max3(*beta_out) > 0.0f;
+}
+
+static void check_kind(rt_bsdf_kind kind, size_t n, uint64_t seed)
+{
+    test_rng r = {seed};
+    rt_shade_lanes *l = rt_shade_lanes_new(n);
+    assert_non_null(l);
+    rt_bsdf *bs = malloc(n * sizeof *bs);
+    rt_vec3 *wos = malloc(n * sizeof *wos), *betas = malloc(n * sizeof *betas);
+    rt_vec2 *us = malloc(n * sizeof *us);
+    float *ulobes = malloc(n * sizeof *ulobes);
+    assert_true(bs && wos && betas && us && ulobes);
+    size_t live = 0;
+    for (size_t k = 0; k < n; k++) {
+        rt_bsdf *b = &bs[k];
+        rt_vec3 nn = random_dir(&r);
+        rt_vec3 ng = k % 7 == 3 ? random_dir(&r) : nn; /* now and then a geometric normal elsewhere */
+        if (kind == RT_BSDF_KIND_LAMBERT) {
+            rt_vec3 albedo = k % 13 == 5 ? rt_v3s(0.0f) : rt_v3(test_rng_float(&r), test_rng_float(&r), test_rng_float(&r));
+            rt_bsdf_make(b, nn, albedo, 0.0f, 1.0f, 1.5f, 0.0f, true);
+        } else if (kind == RT_BSDF_KIND_GLTF) {
+            rt_vec3 base = rt_v3(test_rng_float(&r), test_rng_float(&r), test_rng_float(&r));
+            float metallic = k % 4 == 0 ? 0.0f : (k % 4 == 1 ? 1.0f : test_rng_float(&r));
+            rt_bsdf_make(b, nn, base, metallic, 0.02f + 0.98f * test_rng_float(&r), 1.2f + test_rng_float(&r), 0.0f,
+                         false);
+        } else if (kind == RT_BSDF_KIND_DIELECTRIC) {
+            rt_bsdf_make_dielectric(b, nn, 0.4f + 2.0f * test_rng_float(&r), 0.0f);
+            if (k % 5 == 2)
+                b->diffuse = rt_v3(test_rng_float(&r), test_rng_float(&r), test_rng_float(&r)); /* a tint */
+        } else {
+            float ax = 0.01f + test_rng_float(&r), ay = k % 2 ? ax : 0.01f + test_rng_float(&r);
+            rt_vec3 eta = rt_v3(0.1f + 2.0f * test_rng_float(&r), 0.1f + 2.0f * test_rng_float(&r), 1.3f);
+            rt_vec3 kk = rt_v3(3.0f * test_rng_float(&r), 3.0f * test_rng_float(&r), 1.7f);
+            rt_bsdf_make_conductor(b, nn, eta, kk, ax, ay, k % 3 == 0);
+        }
+        b->ng = ng;
+        /* wo above the shading normal, grazing now and then */
+        float ct = k % 17 == 1 ? 1e-4f : 0.02f + 0.98f * test_rng_float(&r), phi = 2.0f * RT_PI * test_rng_float(&r);
+        float st = sqrtf(1.0f - ct * ct);
+        rt_vec3 wo = rt_v3(st * cosf(phi), st * sinf(phi), ct);
+        if (kind != RT_BSDF_KIND_LAMBERT)
+            rt_bsdf_set_wo(b, wo);
+        assert_int_equal(rt_shade_lanes_kind(b), (int)kind);
+        rt_vec2 u = rt_v2(edge_or_random(&r, (int)k), edge_or_random(&r, (int)(k / 11)));
+        rt_vec3 beta = rt_v3(test_rng_float(&r), test_rng_float(&r), 2.0f * test_rng_float(&r));
+        float ulobe = edge_or_random(&r, (int)(k / 3));
+        wos[k] = wo, us[k] = u, betas[k] = beta, ulobes[k] = ulobe;
+        l->tx[k] = b->t.x, l->ty[k] = b->t.y, l->tz[k] = b->t.z;
+        l->bx[k] = b->b.x, l->by[k] = b->b.y, l->bz[k] = b->b.z;
+        l->nx[k] = b->n.x, l->ny[k] = b->n.y, l->nz[k] = b->n.z;
+        l->gx[k] = ng.x, l->gy[k] = ng.y, l->gz[k] = ng.z;
+        l->br[k] = beta.x, l->bg[k] = beta.y, l->bb[k] = beta.z;
+        l->ux[k] = u.x, l->uy[k] = u.y;
+        l->dr[k] = b->diffuse.x, l->dg[k] = b->diffuse.y, l->db[k] = b->diffuse.z;
+        l->ox[k] = wo.x, l->oy[k] = wo.y, l->oz[k] = wo.z;
+        l->ax[k] = b->alpha, l->ay[k] = b->alpha_y, l->sep[k] = b->separable ? 1.0f : 0.0f;
+        l->er[k] = b->eta_c.x, l->eg[k] = b->eta_c.y, l->eb[k] = b->eta_c.z;
+        l->kr[k] = b->k_c.x, l->kg[k] = b->k_c.y, l->kb[k] = b->k_c.z;
+        l->cr[k] = b->base.x, l->cg[k] = b->base.y, l->cb[k] = b->base.z;
+        l->metal[k] = b->metallic, l->f0[k] = b->f0;
+        l->pd[k] = b->p_d, l->ps[k] = b->p_s, l->ulobe[k] = ulobe;
+        l->pt[k] = b->p_t, l->eta[k] = b->eta;
+    }
+    if (kind == RT_BSDF_KIND_LAMBERT)
+        rt_lambert_sample_lanes(l, n);
+    else if (kind == RT_BSDF_KIND_CONDUCTOR)
+        rt_conductor_sample_lanes(l, n);
+    else if (kind == RT_BSDF_KIND_GLTF)
+        rt_gltf_sample_lanes(l, n);
+    else
+        rt_dielectric_sample_lanes(l, n);
+    for (size_t k = 0; k < n; k++) {
+        rt_vec3 wi = rt_v3s(0.0f), beta = rt_v3s(0.0f);
+        float pdf = 0.0f;
+        bool down = false;
+        bool ok = scalar_steps(&bs[k], wos[k], us[k], ulobes[k], betas[k], &wi, &pdf, &beta, &down);
+        if (ok != (l->ok[k] != 0))
+            fail_msg("kind %d, path %zu: lanes say %d, scalar %d", (int)kind, k, l->ok[k], ok);
+        if (!ok)
+            continue;
+        live++;
+        if (down != (l->down[k] != 0))
+            fail_msg("kind %d, path %zu: lanes went %s, scalar %s", (int)kind, k, l->down[k] ? "down" : "up",
+                     down ? "down" : "up");
+        float got[7] = {l->wx[k], l->wy[k], l->wz[k], l->pdf[k], l->br[k], l->bg[k], l->bb[k]};
+        float want[7] = {wi.x, wi.y, wi.z, pdf, beta.x, beta.y, beta.z};
+        if (memcmp(got, want, sizeof got) != 0)
+            fail_msg("kind %d, path %zu: lanes (%.9g %.9g %.9g) pdf %.9g beta (%.9g %.9g %.9g), scalar (%.9g %.9g "
+                     "%.9g) pdf %.9g beta (%.9g %.9g %.9g)",
+                     (int)kind, k, got[0], got[1], got[2], got[3], got[4], got[5], got[6], want[0], want[1], want[2],
+                     want[3], want[4], want[5], want[6]);
+    }
+    /* most paths go on, not all (black albedos, the side test) */
+    assert_true(live > n / 2 && live < n);
+    free(bs);
+    free(wos);
+    free(betas);
+    free(us);
+    free(ulobes);
+    rt_shade_lanes_free(l);
+}
+
+static void test_lambert_lanes_equal_scalar(void **state)
+{
+    (void)state;
+    const size_t counts[] = {1, RT_SHADE_LANES - 1, RT_SHADE_LANES, 4099};
+    for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++)
+        check_kind(RT_BSDF_KIND_LAMBERT, counts[c] < 16 ? 64 + counts[c] : counts[c], 11 + c);
+}
+
+static void test_conductor_lanes_equal_scalar(void **state)
+{
+    (void)state;
+    const size_t counts[] = {RT_SHADE_LANES + 1, 4099, 20000};
+    for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++)
+        check_kind(RT_BSDF_KIND_CONDUCTOR, counts[c] < 16 ? 64 + counts[c] : counts[c], 101 + c);
+}
+
+static void test_gltf_lanes_equal_scalar(void **state)
+{
+    (void)state;
+    const size_t counts[] = {RT_SHADE_LANES + 3, 4099, 20000};
+    for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++)
+        check_kind(RT_BSDF_KIND_GLTF, counts[c] < 16 ? 64 + counts[c] : counts[c], 201 + c);
+}
+
+static void test_dielectric_lanes_equal_scalar(void **state)
+{
+    (void)state;
+    const size_t counts[] = {RT_SHADE_LANES + 5, 4099, 20000};
+    for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++)
+        check_kind(RT_BSDF_KIND_DIELECTRIC, counts[c] < 16 ? 64 + counts[c] : counts[c], 301 + c);
+}
+
+/* Which BSDFs the lanes take: Lambert, rough conductors without the
+ * multiple-scattering lobe, the rough opaque glTF BRDF once its lobe
+ * probabilities are cached, smooth glass likewise; not a delta conductor,
+ * a compensated one, a smooth or transmissive glTF BSDF, rough glass. */
+static void test_lanes_kind(void **state)
+{
+    (void)state;
+    rt_bsdf b;
+    rt_vec3 n = rt_v3(0.0f, 0.0f, 1.0f), eta = rt_v3(0.2f, 0.4f, 1.4f), k = rt_v3(3.4f, 2.3f, 1.8f);
+    rt_bsdf_make(&b, n, rt_v3s(0.5f), 0.0f, 1.0f, 1.5f, 0.0f, true);
+    assert_int_equal(rt_shade_lanes_kind(&b), RT_BSDF_KIND_LAMBERT);
+    rt_bsdf_make_conductor(&b, n, eta, k, 0.3f, 0.1f, false);
+    assert_int_equal(rt_shade_lanes_kind(&b), RT_BSDF_KIND_CONDUCTOR);
+    rt_bsdf_compensate(&b);
+    assert_true(b.ms);
+    assert_int_equal(rt_shade_lanes_kind(&b), -1);
+    rt_bsdf_make_conductor(&b, n, eta, k, 0.0f, 0.0f, false);
+    assert_int_equal(rt_shade_lanes_kind(&b), -1);
+    rt_bsdf_make(&b, n, rt_v3s(0.5f), 0.5f, 0.5f, 1.5f, 0.0f, false);
+    assert_int_equal(rt_shade_lanes_kind(&b), -1); /* no lobe probabilities cached yet */
+    rt_bsdf_set_wo(&b, rt_v3(0.0f, 0.6f, 0.8f));
+    assert_int_equal(rt_shade_lanes_kind(&b), RT_BSDF_KIND_GLTF);
+    rt_bsdf_make(&b, n, rt_v3s(0.5f), 0.5f, 0.0f, 1.5f, 0.0f, false); /* smooth: a delta mirror */
+    rt_bsdf_set_wo(&b, rt_v3(0.0f, 0.6f, 0.8f));
+    assert_int_equal(rt_shade_lanes_kind(&b), -1);
+    rt_bsdf_make(&b, n, rt_v3s(0.5f), 0.0f, 0.5f, 1.5f, 0.5f, false); /* transmissive */
+    rt_bsdf_set_wo(&b, rt_v3(0.0f, 0.6f, 0.8f));
+    assert_int_equal(rt_shade_lanes_kind(&b), -1);
+    rt_bsdf_make_dielectric(&b, n, 1.0f / 1.5f, 0.0f); /* smooth glass */
+    rt_bsdf_set_wo(&b, rt_v3(0.0f, 0.6f, 0.8f));
+    assert_int_equal(rt_shade_lanes_kind(&b), RT_BSDF_KIND_DIELECTRIC);
+    rt_bsdf_make_dielectric(&b, n, 1.0f / 1.5f, 0.2f); /* rough glass */
+    rt_bsdf_set_wo(&b, rt_v3(0.0f, 0.6f, 0.8f));
+    assert_int_equal(rt_shade_lanes_kind(&b), -1);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_lambert_lanes_equal_scalar),
+        cmocka_unit_test(test_conductor_lanes_equal_scalar),
+        cmocka_unit_test(test_gltf_lanes_equal_scalar),
+        cmocka_unit_test(test_dielectric_lanes_equal_scalar),
+        cmocka_unit_test(test_lanes_kind),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
