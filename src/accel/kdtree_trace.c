@@ -246,7 +246,10 @@ KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, 
             return false;
         u = v = 0.0f;
     } else {
-        if (!quad_hit(&tree->quads[id - tree->other_base - tree->sphere_count], ray, *best, &t, &u, &v))
+        size_t q = id - tree->other_base - tree->sphere_count;
+        if (q >= tree->quad_count) /* past the quads: an instance (kdtree_instances.c) */
+            return rt_kd_instance_hit(tree, (uint32_t)(q - tree->quad_count), id, ray, best, hit);
+        if (!quad_hit(&tree->quads[q], ray, *best, &t, &u, &v))
             return false;
     }
     *best = t;
@@ -831,10 +834,11 @@ KD_FLATTEN bool KD_NAME(rt_kd_intersect)(const rt_kdtree *tree, const rt_ray *ra
 {
     hit->prim = RT_NONE;
     if (traverse(tree, ray, hit, false)) {
-        hit->prim = rt_kdtree_scene_prim(tree, hit->prim);
+        rt_kd_finish_hit(tree, hit);
         return true;
     }
     hit->prim = RT_NONE;
+    hit->inst = 0;
     return false;
 }
 

@@ -9,6 +9,7 @@
 #include "rt/io/load.h"
 #include "rt/job/frame.h"
 #include "rt/render/integrator.h"
+#include "rt/scene/instance.h"
 #include "rt/scene/scene.h"
 
 #include "input.h"
@@ -27,7 +28,8 @@ static int print_info(const char *path, const args *a)
     rt_settings_default(&loaded);
     rt_error err = {0};
     rt_load_info info;
-    rt_load_options lo = {.use_time = a->posed, .time = a->frame_time, .animation = a->animation};
+    rt_load_options lo = {
+        .use_time = a->posed, .time = a->frame_time, .animation = a->animation, .flatten_instances = a->flatten};
     rt_result r = input_load(&s, &loaded, path, &lo, &info, &err);
     if (r != RT_OK) {
         memory_budget_report(&err, budget);
@@ -41,6 +43,9 @@ static int print_info(const char *path, const args *a)
     printf("vertices: %zu\n", s.vertices.count);
     printf("spheres: %zu\n", s.spheres.count);
     printf("quads: %zu\n", s.quads.count);
+    /* instancing: triangles above are the unique ones (an object's once) */
+    printf("instances: %zu\n", s.instance_count);
+    printf("instanced_triangles: %zu\n", rt_scene_instanced_triangles(&s));
     if (rt_box_is_empty(b))
         printf("bounds: none\n");
     else

@@ -146,7 +146,8 @@ static rt_result load_kind(rt_scene *s, rt_settings *settings, const void *bytes
         rt_gltf_stats gs;
         memset(&gs, 0, sizeof gs);
         rt_gltf_options go = {
-            .use_time = opt->use_time, .time = opt->time, .animation = opt->animation, .variant = opt->variant};
+            .use_time = opt->use_time, .time = opt->time, .animation = opt->animation, .variant = opt->variant,
+            .flatten_instances = opt->flatten_instances};
         r = rt_gltf_load_memory(s, bytes, size, name, &go, &gs, err);
         info->meshes = gs.meshes;
         info->primitives = gs.primitives;

@@ -4,6 +4,7 @@
 #include "rt/scene/scene.h"
 
 #include "rt/base/alloc.h"
+#include "rt/scene/instance.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -155,6 +156,8 @@ void rt_scene_free(rt_scene *s)
     rt_quads *q = &s->quads;
     free(q->px); free(q->py); free(q->pz); free(q->ux); free(q->uy); free(q->uz);
     free(q->vx); free(q->vy); free(q->vz); free(q->material);
+    free(s->objects);
+    free(s->instances);
     memset(s, 0, sizeof *s);
 }
 
@@ -349,6 +352,8 @@ rt_scene_mark rt_scene_mark_of(const rt_scene *s)
     m.triangles = s->triangles.count;
     m.spheres = s->spheres.count;
     m.quads = s->quads.count;
+    m.objects = s->object_count;
+    m.instances = s->instance_count;
     m.vertex_attrs = (s->vertices.uv1 ? RT_ATTR_UV1 : 0u) | (s->vertices.tangent ? RT_ATTR_TANGENT : 0u) |
                      (s->vertices.color ? RT_ATTR_COLOR : 0u);
     m.camera_set = s->camera_set;
@@ -377,6 +382,8 @@ void rt_scene_rollback(rt_scene *s, const rt_scene_mark *m)
     truncate_to(&s->triangles.count, m->triangles);
     truncate_to(&s->spheres.count, m->spheres);
     truncate_to(&s->quads.count, m->quads);
+    truncate_to(&s->object_count, m->objects);
+    truncate_to(&s->instance_count, m->instances);
     rt_vertices *v = &s->vertices;
     if (!(m->vertex_attrs & RT_ATTR_UV1)) {
         free(v->uv1);
@@ -431,7 +438,10 @@ rt_box rt_scene_bounds(const rt_scene *s)
     rt_box b = rt_box_empty();
     size_t n = rt_scene_prim_count(s);
     for (size_t i = 0; i < n; i++)
-        b = rt_box_union(b, rt_scene_prim_bounds(s, (uint32_t)i));
+        if (i >= s->triangles.count || !(s->triangles.flags[i] & RT_TRI_OBJECT))
+            b = rt_box_union(b, rt_scene_prim_bounds(s, (uint32_t)i));
+    for (size_t i = 0; i < s->instance_count; i++)
+        b = rt_box_union(b, s->instances[i].bounds);
     return b;
 }
 
@@ -450,14 +460,20 @@ void rt_scene_frame_camera(rt_scene *s, float aspect)
     /* the nearest distance at which every vertex (and every corner of the
      * other primitives' boxes) is in view: tighter than fitting the box */
     float dist = 0.0f;
-    size_t nv = s->vertices.count, nother = s->spheres.count + s->quads.count;
-    for (size_t i = 0; i < nv + 8 * nother; i++) {
+    size_t nv = s->vertices.count, nother = s->spheres.count + s->quads.count, ninst = s->instance_count;
+    size_t o = 0; /* the next object whose vertices (object space) are skipped; loaders add them in order */
+    for (size_t i = 0; i < nv + 8 * nother + 8 * ninst; i++) {
         rt_vec3 p;
         if (i < nv) {
+            while (o < s->object_count && s->objects[o].first_vertex + s->objects[o].vertex_count <= i)
+                o++;
+            if (o < s->object_count && i >= s->objects[o].first_vertex)
+                continue;
             p = s->vertices.position[i];
         } else {
             size_t k = i - nv;
-            rt_box pb = rt_scene_prim_bounds(s, (uint32_t)(s->triangles.count + k / 8));
+            rt_box pb = k < 8 * nother ? rt_scene_prim_bounds(s, (uint32_t)(s->triangles.count + k / 8))
+                                       : s->instances[(k - 8 * nother) / 8].bounds;
             p = rt_v3(k & 1 ? pb.hi.x : pb.lo.x, k & 2 ? pb.hi.y : pb.lo.y, k & 4 ? pb.hi.z : pb.lo.z);
         }
         if (!rt_finite3(p))

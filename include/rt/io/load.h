@@ -51,6 +51,7 @@ typedef struct rt_load_options {
     bool use_time;   /* a glTF input is posed at `time` by its animation `animation` (rt_gltf_options) */
     float time;
     int animation;
+    bool flatten_instances; /* glTF: no objects and instances, every mesh use flattened (rt_gltf_options) */
 } rt_load_options;
 
 /* What one load found (what `rt --info` prints beside the scene's counts). */
