@@ -4,8 +4,9 @@
  * every instance's triangles (same t bits), against the flattened load of
  * the same file (same hits and surfaces within the transforms' rounding,
  * images within float rounding), 10,000 instances through
- * EXT_mesh_gpu_instancing, and malformed instancing data (a clear error
- * naming the file and the field, or the documented skip). The GLB files
+ * EXT_mesh_gpu_instancing, malformed instancing data (a clear error
+ * naming the file and the field, or the documented skip), and the scene
+ * format's `object` ... `end` / `instance` lines. The GLB files
  * are written here: a small UV sphere placed on a grid, rotated about y,
  * scaled, some mirrored.
  */
@@ -20,6 +21,7 @@
 #include "rt/image/framebuffer.h"
 #include "rt/io/gltf.h"
 #include "rt/io/load.h"
+#include "rt/io/scene_parse.h"
 #include "rt/render/render.h"
 #include "rt/scene/instance.h"
 #include "rt/scene/scene.h"
@@ -587,12 +589,89 @@ static void test_rollback(void **state)
     rt_scene_free(&s);
 }
 
+/* The scene format's `object NAME` ... `end` and `instance NAME ...`:
+ * one object, three placements (one mirrored), hits as brute force finds
+ * them; and the errors, each naming the line. */
+static void test_scene_objects(void **state)
+{
+    (void)state;
+    const char *text = "material g color 0.3 0.7 0.3\n"
+                       "object tree\n"
+                       "  triangle -0.5 0 0  0.5 0 0  0 1.5 0 g\n"
+                       "  triangle 0 0 -0.5  0 0 0.5  0 1.5 0 g\n"
+                       "end\n"
+                       "instance tree\n"
+                       "instance tree translate 2 0 0 rotate 0 45 0 scale 1.5\n"
+                       "instance tree translate -2 0 1 scale -1 1 1\n"
+                       "sphere 0 -100 0 99.9 g\n";
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_error err = {0};
+    assert_int_equal(rt_scene_parse_string(&s, NULL, text, strlen(text), "objects.txt", "", &err), RT_OK);
+    assert_int_equal(s.object_count, 1);
+    assert_int_equal(s.instance_count, 3);
+    assert_int_equal(s.triangles.count, 2);
+    assert_true(s.instances[2].mirror);
+    rt_vec3 p = rt_mat4_point(&s.instances[1].to_world, rt_v3(0, 1.5f, 0));
+    assert_true(fabsf(p.x - 2.0f) < 1e-6f && fabsf(p.y - 2.25f) < 1e-6f);
+    assert_int_equal(rt_scene_validate(&s, &err), RT_OK);
+    rt_kdtree t;
+    assert_int_equal(rt_kdtree_build(&t, &s, NULL, &err), RT_OK);
+    test_rng g = {7};
+    int hits = 0;
+    for (int k = 0; k < 2000; k++) {
+        rt_ray r = rt_ray_make(rt_v3(8.0f * test_rng_float(&g) - 4.0f, 3.0f * test_rng_float(&g), 6.0f),
+                               rt_v3(0.2f * test_rng_float(&g) - 0.1f, -0.1f * test_rng_float(&g), -1.0f), 0.0f,
+                               INFINITY);
+        rt_hit h, want;
+        bool b = brute_force(&s, &r, &want);
+        bool found = rt_kdtree_intersect(&t, &r, &h);
+        if (found && h.inst == 0)
+            continue; /* the ground sphere, which brute_force does not test */
+        if (b && found) {
+            hits++;
+            assert_true(h.t == want.t && h.inst == want.inst);
+        } else {
+            assert_false(b && (!found || h.t > want.t));
+        }
+    }
+    assert_true(hits > 100);
+    rt_kdtree_free(&t);
+    rt_scene_free(&s);
+
+    const struct {
+        const char *text, *message;
+    } bad[] = {
+        {"material g color 1 1 1\nobject a\n sphere 0 0 0 1 g\nend\n", "objects.txt:3:2: 'sphere' inside object 'a'"},
+        {"material g color 1 1 1\nobject a\n triangle 0 0 0 1 0 0 0 1 0 g\n", "objects.txt:2:8: object 'a' has no 'end'"},
+        {"end\n", "objects.txt:1:1: 'end' without an open 'object'"},
+        {"object a\nend\n", "object 'a' holds no triangles"},
+        {"material g color 1 1 1\nobject tree\n triangle 0 0 0 1 0 0 0 1 0 g\nend\ninstance tre\n",
+         "objects.txt:5:10: undefined object 'tre' (did you mean 'tree'?)"},
+        {"material g color 1 1 1\nobject a\n triangle 0 0 0 1 0 0 0 1 0 g\nend\ninstance a scale 0\n",
+         "must not be zero"},
+        {"material g color 1 1 1\nobject a\n triangle 0 0 0 1 0 0 0 1 0 g\n instance a\nend\n", "'instance' inside object 'a'"},
+        {"material g color 1 1 1\nobject a\n triangle 0 0 0 1 0 0 0 1 0 g\nend\nobject a\n", "object 'a' is already defined on line 2"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        rt_scene_init(&s);
+        memset(&err, 0, sizeof err);
+        rt_result r = rt_scene_parse_string(&s, NULL, bad[i].text, strlen(bad[i].text), "objects.txt", "", &err);
+        if (r == RT_OK || !strstr(err.message, bad[i].message))
+            fail_msg("case %zu: %d '%s', wanted '%s'", i, (int)r, err.message, bad[i].message);
+        assert_int_equal(s.object_count, 0);
+        assert_int_equal(s.instance_count, 0);
+        rt_scene_free(&s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_instanced_hits),  cmocka_unit_test(test_shared_mesh_nodes),
         cmocka_unit_test(test_instanced_image), cmocka_unit_test(test_ten_thousand),
         cmocka_unit_test(test_malformed),       cmocka_unit_test(test_rollback),
+        cmocka_unit_test(test_scene_objects),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
