@@ -72,11 +72,14 @@ void rt_kd_free_objects(rt_kdtree *tree)
     tree->object_count = 0;
 }
 
-bool rt_kd_instance_hit(const rt_kdtree *tree, uint32_t i, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit)
+bool rt_kd_instance_hit(const rt_kdtree *tree, uint32_t i, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit,
+                        bool any)
 {
     const rt_instance *in = &tree->scene->instances[i];
     const rt_mat4 *m = &in->to_object;
     rt_ray r = rt_ray_make(rt_mat4_point(m, ray->org), rt_mat4_vector(m, ray->dir), ray->tmin, *best);
+    if (any)
+        return rt_kdtree_occluded(&tree->objects[in->object], &r);
     rt_hit h;
     if (!rt_kdtree_intersect(&tree->objects[in->object], &r, &h) || !(h.t < *best))
         return false;

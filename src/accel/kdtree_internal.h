@@ -167,9 +167,12 @@ void rt_kd_free_objects(rt_kdtree *tree);
  * through its tree, and on a closer hit *best = hit->t = t, hit->u, v,
  * hit->prim = id (the top level's primitive id of the instance) and
  * hit->inst = the object's triangle (scene id), which the entry points
- * turn into rt_hit's prim and inst (rt_kd_finish_hit). Out of line: rare
- * beside triangles, and recursive through rt_kdtree_intersect. */
-bool rt_kd_instance_hit(const rt_kdtree *tree, uint32_t i, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit);
+ * turn into rt_hit's prim and inst (rt_kd_finish_hit). any: only whether
+ * something lies in the interval (the object's any-hit traversal; *best
+ * and hit untouched). Out of line: rare beside triangles, and recursive
+ * through rt_kdtree_intersect / rt_kdtree_occluded. */
+bool rt_kd_instance_hit(const rt_kdtree *tree, uint32_t i, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit,
+                        bool any);
 
 /* A closest hit's tree id to the scene's (hit->prim) and hit->inst:
  * 0 for world geometry, instance + 1 (prim then the object's triangle,
