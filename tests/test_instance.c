@@ -665,13 +665,69 @@ static void test_scene_objects(void **state)
     }
 }
 
+/* Many objects: their trees are built side by side on several threads
+ * (kdtree_instances.c) and are the same, array for array, as built on
+ * one; the hits too. */
+static void test_parallel_object_builds(void **state)
+{
+    (void)state;
+    char *text = malloc(1 << 16);
+    assert_non_null(text);
+    size_t n = (size_t)snprintf(text, 1 << 16, "material g color 0.5 0.5 0.5\n");
+    test_rng g = {31};
+    for (int o = 0; o < 24; o++) {
+        n += (size_t)snprintf(text + n, (1 << 16) - n, "object o%d\n", o);
+        for (int k = 0; k <= o % 7; k++) {
+            float x = test_rng_float(&g), y = test_rng_float(&g), z = test_rng_float(&g);
+            n += (size_t)snprintf(text + n, (1 << 16) - n, " triangle %g %g %g  %g %g %g  %g %g %g g\n", x, y, z,
+                                  x + 0.3, y, z + 0.1, x, y + 0.4, z + 0.2);
+        }
+        n += (size_t)snprintf(text + n, (1 << 16) - n, "end\ninstance o%d translate %d 0 %d\n", o, o % 6, o / 6);
+    }
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_error err = {0};
+    assert_int_equal(rt_scene_parse_string(&s, NULL, text, n, "many.txt", "", &err), RT_OK);
+    free(text);
+    assert_int_equal(s.object_count, 24);
+    rt_kdtree a, b;
+    rt_kdtree_params p1 = {0}, p4 = {0};
+    p1.threads = 1;
+    p4.threads = 4;
+    assert_int_equal(rt_kdtree_build(&a, &s, &p1, &err), RT_OK);
+    assert_int_equal(rt_kdtree_build(&b, &s, &p4, &err), RT_OK);
+    assert_int_equal(a.object_count, 24);
+    assert_int_equal(b.object_count, 24);
+    for (size_t o = 0; o < 24; o++) {
+        const rt_kdtree *x = &a.objects[o], *y = &b.objects[o];
+        assert_int_equal(x->wide_count, y->wide_count);
+        assert_int_equal(x->prim_id_count, y->prim_id_count);
+        assert_int_equal(x->root, y->root);
+        assert_memory_equal(x->wide, y->wide, x->wide_count * sizeof *x->wide);
+        assert_memory_equal(x->prim_ids, y->prim_ids, x->prim_id_count * sizeof *x->prim_ids);
+    }
+    rt_box bb = rt_scene_bounds(&s);
+    for (int k = 0; k < 500; k++) {
+        rt_ray r = field_ray(&g, bb);
+        rt_hit ha, hb, want;
+        bool fa = rt_kdtree_intersect(&a, &r, &ha), fb = rt_kdtree_intersect(&b, &r, &hb);
+        assert_int_equal(fa, brute_force(&s, &r, &want));
+        assert_int_equal(fa, fb);
+        if (fa)
+            assert_true(ha.t == hb.t && ha.t == want.t && ha.prim == hb.prim && ha.inst == hb.inst);
+    }
+    rt_kdtree_free(&a);
+    rt_kdtree_free(&b);
+    rt_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_instanced_hits),  cmocka_unit_test(test_shared_mesh_nodes),
         cmocka_unit_test(test_instanced_image), cmocka_unit_test(test_ten_thousand),
         cmocka_unit_test(test_malformed),       cmocka_unit_test(test_rollback),
-        cmocka_unit_test(test_scene_objects),
+        cmocka_unit_test(test_scene_objects),   cmocka_unit_test(test_parallel_object_builds),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -16,49 +16,116 @@
  * scene record whose triangle arrays start at the object's first triangle
  * and hold only its triangles, no spheres, quads or instances), so the
  * ordinary build and traversal run unchanged; the view's triangle id plus
- * the object's first triangle is the scene's id.
+ * the object's first triangle is the scene's id. Objects too small for the
+ * build to fork (under KD_OBJECT_ALONE triangles) are built side by side,
+ * one object a thread, each on one thread; larger ones one after another,
+ * each on all threads (the build forks inside). A tree is the same for any
+ * thread count, so the result does not depend on the split.
  */
 #include "kdtree_internal.h"
 
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "rt/base/alloc.h"
+#include "rt/base/cpu.h"
 #include "rt/scene/instance.h"
+
+/* Objects below this many triangles are built one a thread (the build
+ * forks only at KD_FORK_MIN_PRIMS, kdtree_build.c). */
+#define KD_OBJECT_ALONE 4096
+
+/* The small objects' builds: each worker takes the next one. */
+typedef struct kd_object_jobs {
+    rt_kdtree *trees;
+    const rt_scene *views;
+    const rt_kdtree_params *params; /* threads = 1 */
+    size_t count;
+    atomic_size_t next;
+    rt_result *results; /* per object */
+    rt_error *errors;   /* per object */
+} kd_object_jobs;
+
+static void *build_small_objects(void *arg)
+{
+    kd_object_jobs *j = arg;
+    for (;;) {
+        size_t o = atomic_fetch_add(&j->next, 1);
+        if (o >= j->count)
+            return NULL;
+        if (j->views[o].triangles.count < KD_OBJECT_ALONE)
+            j->results[o] = rt_kdtree_build(&j->trees[o], &j->views[o], j->params, &j->errors[o]);
+    }
+}
+
+/* The view of object o: the scene with only its triangles. */
+static void object_view(rt_scene *v, const rt_scene *scene, const rt_object *ob)
+{
+    *v = *scene;
+    v->triangles.index = scene->triangles.index + 3 * ob->first_triangle;
+    v->triangles.material = scene->triangles.material + ob->first_triangle;
+    v->triangles.flags = scene->triangles.flags + ob->first_triangle;
+    v->triangles.count = v->triangles.cap = ob->triangle_count;
+    memset(&v->spheres, 0, sizeof v->spheres);
+    memset(&v->quads, 0, sizeof v->quads);
+    v->objects = NULL;
+    v->object_count = v->object_cap = 0;
+    v->instances = NULL;
+    v->instance_count = v->instance_cap = 0;
+}
 
 rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
 {
     size_t n = scene->object_count;
     tree->objects = rt_alloc(n, sizeof *tree->objects);
     tree->object_views = rt_alloc(n, sizeof *tree->object_views);
-    if (!tree->objects || !tree->object_views) {
+    rt_result *results = rt_alloc(n, sizeof *results);
+    rt_error *errors = rt_alloc(n, sizeof *errors);
+    if (!tree->objects || !tree->object_views || !results || !errors) {
+        free(results);
+        free(errors);
         rt_kd_free_objects(tree);
         return rt_fail(err, RT_ERR_NOMEM, "kdtree: out of memory for the trees of %zu instanced objects", n);
     }
     memset(tree->objects, 0, n * sizeof *tree->objects);
     for (size_t o = 0; o < n; o++) {
-        const rt_object *ob = &scene->objects[o];
-        rt_scene *v = &tree->object_views[o];
-        *v = *scene;
-        v->triangles.index = scene->triangles.index + 3 * ob->first_triangle;
-        v->triangles.material = scene->triangles.material + ob->first_triangle;
-        v->triangles.flags = scene->triangles.flags + ob->first_triangle;
-        v->triangles.count = v->triangles.cap = ob->triangle_count;
-        memset(&v->spheres, 0, sizeof v->spheres);
-        memset(&v->quads, 0, sizeof v->quads);
-        v->objects = NULL;
-        v->object_count = v->object_cap = 0;
-        v->instances = NULL;
-        v->instance_count = v->instance_cap = 0;
-        rt_result r = rt_kdtree_build(&tree->objects[o], v, params, err);
-        if (r != RT_OK) {
-            tree->object_count = o;
-            rt_kd_free_objects(tree);
-            return r;
-        }
-        tree->object_count = o + 1;
+        object_view(&tree->object_views[o], scene, &scene->objects[o]);
+        results[o] = RT_OK;
     }
-    return RT_OK;
+    tree->object_count = n; /* every tree zeroed or built: rt_kd_free_objects frees either */
+    int threads = params && params->threads > 0 ? params->threads : rt_cpu_count();
+    if (threads < 1)
+        threads = 1;
+    if (threads > 64)
+        threads = 64;
+    rt_kdtree_params one = params ? *params : (rt_kdtree_params){0};
+    one.threads = 1;
+    kd_object_jobs jobs = {tree->objects, tree->object_views, &one, n, 0, results, errors};
+    pthread_t th[64];
+    int started = 0;
+    for (int t = 1; t < threads && (size_t)t < n; t++) /* this thread is the first worker */
+        if (pthread_create(&th[started], NULL, build_small_objects, &jobs) == 0)
+            started++;
+    build_small_objects(&jobs);
+    for (int t = 0; t < started; t++)
+        pthread_join(th[t], NULL);
+    for (size_t o = 0; o < n; o++) /* the large ones, each forking on all threads */
+        if (tree->object_views[o].triangles.count >= KD_OBJECT_ALONE)
+            results[o] = rt_kdtree_build(&tree->objects[o], &tree->object_views[o], params, &errors[o]);
+    rt_result r = RT_OK;
+    for (size_t o = 0; o < n && r == RT_OK; o++)
+        if (results[o] != RT_OK) {
+            r = results[o];
+            if (err)
+                *err = errors[o];
+        }
+    free(results);
+    free(errors);
+    if (r != RT_OK)
+        rt_kd_free_objects(tree);
+    return r;
 }
 
 void rt_kd_free_objects(rt_kdtree *tree)
