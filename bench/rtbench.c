@@ -2,7 +2,7 @@
  * checked against Embree's reference hits.
  *
  *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
- *           [--build-threads N] [--occluded] [--portable] [--limit N]
+ *           [--build-threads N] [--occluded] [--portable] [--flatten] [--limit N]
  *           [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H [--image-width N]]
  *           [--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]]
  *
@@ -22,7 +22,11 @@
  * ray whose hit/miss differs from the reference. Exits 1 when more than
  * 0.01% of the rays disagree with the reference: speed bought with wrong
  * answers does not count. --portable: the portable traversal even when
- * the CPU has AVX2 (traversal: says which one ran). --limit N keeps N rays spread evenly over the set
+ * the CPU has AVX2 (traversal: says which one ran). --flatten: a glTF's
+ * meshes used more than once are flattened into world triangles instead
+ * of kept once and placed by instances (rt/scene/instance.h; with
+ * instances, --packets is refused: the packets do not enter them, and the
+ * streams trace ray by ray). --limit N keeps N rays spread evenly over the set
  * (every count/N-th, with its reference hit): a fixed small subset for
  * instruction counts under callgrind. --packets W H traces the set (a
  * primary set: one ray per pixel, row by row, N pixels wide, default 640)
@@ -160,7 +164,7 @@ static void *trace_worker(void *arg)
                     j->t_out[i] = j->blocked[i] ? 0.0f : INFINITY;
             } else {
                 const rt_hit_batch *h = &j->stream_hits;
-                rt_hit_batch hb = {h->t + start, h->u + start, h->v + start, h->prim + start};
+                rt_hit_batch hb = {h->t + start, h->u + start, h->v + start, h->prim + start, NULL};
                 rt_kdtree_intersect_stream(j->tree, &rb, end - start, &hb, &j->stream_params);
                 for (size_t i = start; i < end; i++)
                     j->t_out[i] = h->prim[i] != RT_NONE ? h->t[i] : INFINITY;
@@ -215,7 +219,7 @@ static int cmp_double(const void *a, const void *b)
 static int usage(void)
 {
     fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K] [--build-threads N] "
-                    "[--occluded] [--portable] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H] "
+                    "[--occluded] [--portable] [--flatten] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H] "
                     "[--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]]\n");
     return 2;
 }
@@ -224,6 +228,7 @@ int main(int argc, char **argv)
 {
     const char *model = NULL, *rays_path = NULL, *hits_path = NULL;
     int threads = 1, runs = 5, build_threads = 0;
+    bool flatten = false;
     long limit = 0;
     int pw = 0, ph = 0, image_width = 640, lanes = 0;
     bool occluded = false, portable = false, stream = false, frustum = false;
@@ -265,6 +270,8 @@ int main(int argc, char **argv)
             occluded = true;
         else if (strcmp(argv[i], "--portable") == 0)
             portable = true;
+        else if (strcmp(argv[i], "--flatten") == 0)
+            flatten = true;
         else if (argv[i][0] == '-')
             return usage();
         else if (!model)
@@ -287,7 +294,8 @@ int main(int argc, char **argv)
     rt_scene scene;
     rt_scene_init(&scene);
     double t0 = now_s();
-    if (rt_load(&scene, NULL, model, NULL, NULL, &err) != RT_OK) {
+    rt_load_options lo = {.flatten_instances = flatten};
+    if (rt_load(&scene, NULL, model, &lo, NULL, &err) != RT_OK) {
         fprintf(stderr, "rtbench: %s\n", err.message);
         return 2;
     }
@@ -313,6 +321,11 @@ int main(int argc, char **argv)
     params.portable = portable;
     if (rt_kdtree_build(&tree, &scene, &params, &err) != RT_OK) {
         fprintf(stderr, "rtbench: %s\n", err.message);
+        return 2;
+    }
+    if (pw && tree.instance_count) {
+        fprintf(stderr, "rtbench: %s has instances, which the packets do not enter: trace it without --packets, or "
+                        "with --flatten\n", model);
         return 2;
     }
     size_t *order = NULL;
@@ -367,7 +380,7 @@ int main(int argc, char **argv)
         }
         rb = (rt_ray_batch){c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]};
         jb.stream = &rb;
-        jb.stream_hits = (rt_hit_batch){c[8], c[9], c[10], (uint32_t *)(void *)(soa + 11 * n)};
+        jb.stream_hits = (rt_hit_batch){c[8], c[9], c[10], (uint32_t *)(void *)(soa + 11 * n), NULL};
         jb.blocked = (uint8_t *)(void *)(soa + 12 * n);
         jb.stream_params = (rt_kd_stream_params){lanes, (int)min_rays, (int)chunk};
         jb.step = (size_t)stream_size;
@@ -391,6 +404,7 @@ int main(int argc, char **argv)
     printf("model: %s\n", model);
     printf("rays_file: %s\n", rays_path);
     printf("triangles: %zu\n", scene.triangles.count);
+    printf("instances: %zu\n", scene.instance_count);
     printf("load_ms: %.1f\n", load_ms);
     printf("build_ms: %.1f\n", tree.stats.build_ms);
     printf("nodes: %zu\n", tree.stats.nodes);

@@ -13,6 +13,7 @@
 #include "rt/io/base64.h"
 #include "rt/io/gltf.h"
 #include "rt/io/json.h"
+#include "rt/scene/instance.h"
 #include "rt/scene/scene.h"
 
 /* ------------------------------------------------------------ helpers */
@@ -49,12 +50,32 @@ static const char *tmp_path(const char *name)
 static void write_text(const char *name, const char *text) { test_write_file(tmp_path(name), text, strlen(text)); }
 
 /* Loads a file into a fresh scene; returns the result, keeps the error. */
+/* The flattening loader these tests check: every use of a mesh in world
+ * triangles (test_instance.c checks the objects and instances). */
 static rt_result load(const char *path, rt_scene *s, rt_gltf_stats *st, rt_error *err)
 {
     rt_scene_init(s);
     memset(err, 0, sizeof *err);
     rt_gltf_options opt = {0};
+    opt.flatten_instances = true;
     return rt_gltf_load(s, path, &opt, st, err);
+}
+
+/* The same file loaded with instancing places as many triangles as the
+ * flattened load holds: its world triangles plus the instances'. */
+static void check_instanced_count(const char *file, size_t flattened)
+{
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_gltf_stats st;
+    rt_error err;
+    assert_int_equal(rt_gltf_load(&s, file, NULL, &st, &err), RT_OK);
+    size_t world = s.triangles.count - rt_scene_object_triangles(&s) + rt_scene_instanced_triangles(&s);
+    if (world != flattened)
+        fprintf(stderr, "%s: instanced load places %zu triangles, flattened %zu\n", file, world, flattened);
+    assert_int_equal(world, flattened);
+    assert_int_equal(st.instanced_triangles, rt_scene_instanced_triangles(&s));
+    rt_scene_free(&s);
 }
 
 /* Expects failure with `code` and a message containing the file name and `what`. */
@@ -222,6 +243,8 @@ static void test_manifest_models(void **state)
             if (st.triangles > 500000)
                 fprintf(stderr, "note: %s: %zu triangles loaded in %.3f s\n", file, st.triangles, t1 - t0);
             check_against_row(file, row, &s, &st);
+            if (!have_first && st.triangles <= 500000)
+                check_instanced_count(file, st.triangles);
             files++;
             if (!have_first) {
                 first = s;
@@ -332,6 +355,7 @@ static void test_sample_features(void **state)
     rt_scene_free(&s);
     rt_scene_init(&s);
     rt_gltf_options opt = {0};
+    opt.flatten_instances = true;
     opt.use_scene_index = true;
     opt.scene_index = 0;
     assert_int_equal(rt_gltf_load(&s, test_shared_path("assets/gltf/MultipleScenes/glTF/MultipleScenes.gltf"), &opt,
@@ -532,6 +556,7 @@ static void test_transforms(void **state)
     /* options->transform on top of the node transforms */
     rt_scene_init(&s);
     rt_gltf_options opt = {0};
+    opt.flatten_instances = true;
     opt.use_transform = true;
     opt.transform = rt_mat4_translate(rt_v3(0, 0, 5));
     assert_int_equal(rt_gltf_load(&s, tmp_path("xf.gltf"), &opt, &st, &err), RT_OK);

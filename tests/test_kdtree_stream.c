@@ -120,7 +120,7 @@ static void soa_make(soa *s, const rt_ray *rays, size_t n)
         c[6][i] = rays[i].tmin, c[7][i] = rays[i].tmax;
     }
     s->rb = (rt_ray_batch){c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]};
-    s->hb = (rt_hit_batch){c[8], c[9], c[10], s->prim};
+    s->hb = (rt_hit_batch){c[8], c[9], c[10], s->prim, NULL};
 }
 
 static void soa_free(soa *s)

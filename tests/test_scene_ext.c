@@ -434,7 +434,7 @@ static void test_coat_ignores_base_normal_map(void **state)
         rt_vec3 p = rt_v3(0.1f, 0.2f, (float)q);
         rt_vec3 dir = rt_normalize(rt_v3(0.1f, 0.05f, -1.0f));
         rt_ray r = rt_ray_make(rt_sub(p, rt_scale(dir, 3.0f)), dir, 0.0f, INFINITY);
-        rt_hit h = {3.0f, 0.55f, 0.6f, q}; /* quads are the only primitives: ids 0, 1, 2 */
+        rt_hit h = {3.0f, 0.55f, 0.6f, q, 0}; /* quads are the only primitives: ids 0, 1, 2 */
         rt_surface sf;
         rt_surface_at(&ctx, &r, &h, &sf);
         rt_bsdf b;

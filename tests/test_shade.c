@@ -98,7 +98,7 @@ static rt_surface surface(const rt_scene *s, uint32_t prim, float u, float v, rt
     rt_trace_ctx ctx;
     rt_trace_ctx_init(&ctx, &rs);
     rt_ray r = rt_ray_make(rt_sub(p_expect, view_dir), view_dir, 0.0f, INFINITY);
-    rt_hit h = {1.0f, u, v, prim};
+    rt_hit h = {1.0f, u, v, prim, 0};
     rt_surface sf;
     rt_surface_at(&ctx, &r, &h, &sf);
     rt_render_state_free(&rs);
@@ -227,7 +227,7 @@ static void test_surface_record_variants(void **state)
     for (uint32_t prim = 0; prim < 4; prim++)
         for (int d = 0; d < 2; d++) {
             rt_ray r = rt_ray_make(rt_v3(0.1f, 0.2f, 3.0f), rt_normalize(dirs[d]), 0.0f, INFINITY);
-            rt_hit h = {2.5f, 0.3f, 0.45f, prim};
+            rt_hit h = {2.5f, 0.3f, 0.45f, prim, 0};
             rt_surface a, sh, em;
             rt_surface_at(&ctx, &r, &h, &a);
             rt_surface_at_shading(&ctx, &r, &h, &sh);
@@ -270,7 +270,7 @@ static void test_surface_record_variants(void **state)
     assert_int_equal(rs.material_needs[m] & RT_MATERIAL_TEXTURED, 0);
     for (uint32_t prim = 0; prim < 3; prim++) {
         rt_ray r = rt_ray_make(rt_v3(0.1f, 0.2f, 3.0f), rt_normalize(dirs[0]), 0.0f, INFINITY);
-        rt_hit h = {2.5f, 0.3f, 0.45f, prim};
+        rt_hit h = {2.5f, 0.3f, 0.45f, prim, 0};
         rt_surface a, sh;
         rt_surface_at(&ctx, &r, &h, &a);
         rt_surface_at_shading(&ctx, &r, &h, &sh);

@@ -116,7 +116,7 @@ static void test_batch_traversal_matches_single_rays(void **state)
     for (int i = 0; i < N; i++)
         prim[i] = 0xdeadbeefu, blocked[i] = 7;
     rt_ray_batch rb = {ox, oy, oz, dx, dy, dz, tmin, tmax};
-    rt_hit_batch hb = {t, u, v, prim};
+    rt_hit_batch hb = {t, u, v, prim, NULL};
     size_t hits = rt_kdtree_intersect_batch(&tree, &rb, lanes, n, &hb);
     size_t blocks = rt_kdtree_occluded_batch(&tree, &rb, lanes, n, blocked);
     size_t want_hits = 0, want_blocks = 0;
@@ -178,7 +178,7 @@ static void test_batch_packets_match_single_rays(void **state)
         runs++;
     }
     rt_ray_batch rb = {ox, oy, oz, dx, dy, dz, tmin, tmax};
-    rt_hit_batch hb = {t, u, v, prim};
+    rt_hit_batch hb = {t, u, v, prim, NULL};
     size_t hits = rt_kdtree_intersect_batch(&tree, &rb, NULL, N, &hb);
     size_t want = 0;
     for (int k = 0; k < N; k++)

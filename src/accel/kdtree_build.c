@@ -68,6 +68,7 @@
 #include "rt/base/cpu.h"
 #include "rt/base/log.h"
 #include "rt/base/alloc.h"
+#include "rt/scene/instance.h"
 
 /* ------------------------------------------------------------- events */
 
@@ -215,7 +216,8 @@ typedef struct kd_fork kd_fork;
 
 typedef struct kd_build {
     const rt_scene *s;
-    uint32_t T, S, Q;
+    uint32_t T, S, Q, I; /* I: instances, primitives T + S + Q + i (rt/scene/instance.h) */
+    bool skip_objects;   /* the scene has objects: their triangles (object space) stay out */
     double kt, ki, lambda;
     int max_depth;
     uint8_t *side;   /* per primitive, during one split */
@@ -262,6 +264,12 @@ static bool prim_clip_bounds(const kd_build *c, uint32_t prim, rt_box box, rt_bo
             poly[0][v][0] = p.x, poly[0][v][1] = p.y, poly[0][v][2] = p.z;
         }
         n = 3;
+    } else if (prim >= c->T + c->S + c->Q) { /* an instance: its world box */
+        const rt_box *ib = &s->instances[prim - c->T - c->S - c->Q].bounds;
+        for (int k = 0; k < 3; k++) {
+            lo[k] = (&ib->lo.x)[k];
+            hi[k] = (&ib->hi.x)[k];
+        }
     } else if (prim < c->T + c->S) {
         uint32_t i = prim - c->T;
         const rt_spheres *sp = &s->spheres;
@@ -642,7 +650,7 @@ static void build_forked(kd_build *c, kd_fork *f, uint32_t node, int k, float sp
     c->forks[c->fork_count++] = f;
     kd_build *o = &f->out;
     o->s = c->s;
-    o->T = c->T, o->S = c->S, o->Q = c->Q;
+    o->T = c->T, o->S = c->S, o->Q = c->Q, o->I = c->I, o->skip_objects = c->skip_objects;
     o->kt = c->kt, o->ki = c->ki, o->lambda = c->lambda;
     o->max_depth = c->max_depth;
     o->fork_depth = c->fork_depth, o->fork_min = c->fork_min, o->nprims_total = c->nprims_total;
@@ -851,6 +859,8 @@ static int init_build(kd_build *c, const rt_scene *scene, const rt_kdtree_params
     c->T = (uint32_t)scene->triangles.count;
     c->S = (uint32_t)scene->spheres.count;
     c->Q = (uint32_t)scene->quads.count;
+    c->skip_objects = scene->object_count > 0;
+    c->I = c->skip_objects ? (uint32_t)scene->instance_count : 0;
     c->kt = params && params->traversal_cost > 0.0f ? params->traversal_cost : 4.0;
     c->ki = params && params->intersect_cost > 0.0f ? params->intersect_cost : 1.0;
     double eb = params && params->empty_bonus > 0.0f ? params->empty_bonus : 0.2;
@@ -882,8 +892,9 @@ static bool prim_bounds(const kd_build *c, rt_kdtree *tree, size_t i, rt_box *ou
         const uint32_t *ix = scene->triangles.index + 3 * i;
         float *dst = tree->tri + 9 * i;
         memset(dst, 0, 9 * sizeof *dst);
-        if (ix[0] >= nverts || ix[1] >= nverts || ix[2] >= nverts) {
-            ok = false;
+        if (ix[0] >= nverts || ix[1] >= nverts || ix[2] >= nverts ||
+            (c->skip_objects && (scene->triangles.flags[i] & RT_TRI_OBJECT))) {
+            ok = false; /* (an object's triangle: its instances place it) */
         } else {
             rt_vec3 a = scene->vertices.position[ix[0]], bb = scene->vertices.position[ix[1]],
                     cc = scene->vertices.position[ix[2]];
@@ -897,6 +908,9 @@ static bool prim_bounds(const kd_build *c, rt_kdtree *tree, size_t i, rt_box *ou
                 b = rt_box_point(rt_box_point(rt_box_point(b, a), bb), cc);
             }
         }
+    } else if (i >= T + S + c->Q) {
+        const rt_box *ib = &scene->instances[i - T - S - c->Q].bounds;
+        ok = rt_finite3(ib->lo) && rt_finite3(ib->hi) && prim_clip_bounds(c, (uint32_t)i, everywhere, &b);
     } else if (i < T + S) {
         size_t j = i - T;
         const rt_spheres *sp = &scene->spheres;
@@ -921,8 +935,10 @@ static bool prim_bounds(const kd_build *c, rt_kdtree *tree, size_t i, rt_box *ou
  * the tree's bounds; returns how many can be hit. */
 static size_t bound_prims(const kd_build *c, rt_kdtree *tree, rt_box *pb, size_t N)
 {
-    size_t nvalid = 0;
+    size_t nvalid = 0, placed = 0; /* placed: objects' triangles, left out on purpose */
     for (size_t i = 0; i < N; i++) {
+        if (c->skip_objects && i < c->T && (c->s->triangles.flags[i] & RT_TRI_OBJECT))
+            placed++;
         rt_box b;
         bool ok = prim_bounds(c, tree, i, &b);
         pb[i] = b;
@@ -933,9 +949,9 @@ static size_t bound_prims(const kd_build *c, rt_kdtree *tree, rt_box *pb, size_t
             pb[i] = rt_box_empty();
         }
     }
-    if (nvalid < N)
-        rt_info("kdtree: %zu of %zu primitives can never be hit (non-finite or degenerate) and are left out", N - nvalid,
-                N);
+    if (nvalid + placed < N)
+        rt_info("kdtree: %zu of %zu primitives can never be hit (non-finite or degenerate) and are left out",
+                N - nvalid - placed, N - placed);
     return nvalid;
 }
 
@@ -1027,12 +1043,19 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     tree->scene = scene;
     tree->isa = params && params->portable ? RT_KD_ISA_PORTABLE : rt_kd_isa_best(); /* once a tree */
     tree->bounds = rt_box_empty();
-    size_t T = scene->triangles.count, S = scene->spheres.count, Q = scene->quads.count, N = T + S + Q;
+    size_t T = scene->triangles.count, S = scene->spheres.count, Q = scene->quads.count;
+    size_t I = scene->object_count > 0 ? scene->instance_count : 0, N = T + S + Q + I;
     if (N >= (size_t)PRIM_MASK)
         return rt_fail(err, RT_ERR_LIMIT, "kdtree: %zu primitives, at most %u supported", N, PRIM_MASK - 1u);
     tree->triangle_count = T;
     tree->sphere_count = S;
     tree->quad_count = Q;
+    tree->instance_count = I;
+    if (scene->object_count > 0) {
+        rt_result r = rt_kd_build_objects(tree, scene, params, err);
+        if (r != RT_OK)
+            return r;
+    }
 
     kd_build c;
     int threads = init_build(&c, scene, params);
@@ -1102,6 +1125,8 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     c.st.wide_nodes = tree->wide_count;
     c.st.bytes = tree->wide_count * sizeof *tree->wide + tree->prim_id_count * sizeof *tree->prim_ids +
                  Q * sizeof *tree->quads;
+    for (size_t o = 0; o < tree->object_count; o++)
+        c.st.bytes += tree->objects[o].stats.bytes;
     free(c.nodes);
     free(c.ids);
     c.st.build_ms = 1e3 * rt_now_seconds() - t0;
@@ -1116,6 +1141,7 @@ oom:
     free(c.nodes);
     free(c.ids);
     free(tree->tri);
+    rt_kd_free_objects(tree);
     memset(tree, 0, sizeof *tree);
     if (c.limit)
         return rt_fail(err, RT_ERR_LIMIT, "kdtree: %zu primitives make more nodes or references than the node format holds",
@@ -1130,5 +1156,6 @@ void rt_kdtree_free(rt_kdtree *tree)
     free(tree->wide);
     free(tree->prim_ids); /* tree->tri is the same array */
     free(tree->quads);
+    rt_kd_free_objects(tree);
     memset(tree, 0, sizeof *tree);
 }

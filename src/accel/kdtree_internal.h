@@ -174,4 +174,36 @@ bool rt_kd_walk_from_portable(const rt_kdtree *tree, uint32_t ref, float tn, flo
 bool rt_kd_leaf_hit_portable(const rt_kdtree *tree, uint32_t ref, const rt_ray *ray, const rt_tri_ray *tr, float *best,
                              rt_hit *hit, bool any);
 
+/* Instancing (kdtree_instances.c): the objects' trees, built before the
+ * top level (tree->objects, tree->object_views; false: err says why, and
+ * nothing is left allocated), and freed with it. */
+rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err);
+void rt_kd_free_objects(rt_kdtree *tree);
+/* A ray against instance i on (ray->tmin, *best): into the object's space,
+ * through its tree, and on a closer hit *best = hit->t = t, hit->u, v,
+ * hit->prim = id (the top level's primitive id of the instance) and
+ * hit->inst = the object's triangle (scene id), which the entry points
+ * turn into rt_hit's prim and inst (rt_kd_finish_hit). any: only whether
+ * something lies in the interval (the object's any-hit traversal; *best
+ * and hit untouched). Out of line: rare beside triangles, and recursive
+ * through rt_kdtree_intersect / rt_kdtree_occluded. */
+bool rt_kd_instance_hit(const rt_kdtree *tree, uint32_t i, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit,
+                        bool any);
+
+/* A closest hit's tree id to the scene's (hit->prim) and hit->inst:
+ * 0 for world geometry, instance + 1 (prim then the object's triangle,
+ * which rt_kd_instance_hit left in hit->inst). */
+static inline void rt_kd_finish_hit(const rt_kdtree *tree, rt_hit *hit)
+{
+    uint32_t p = rt_kdtree_scene_prim(tree, hit->prim);
+    uint32_t first_instance = (uint32_t)(tree->triangle_count + tree->sphere_count + tree->quad_count);
+    if (tree->instance_count > 0 && p >= first_instance) {
+        hit->prim = hit->inst;
+        hit->inst = p - first_instance + 1u;
+        return;
+    }
+    hit->prim = p;
+    hit->inst = 0;
+}
+
 #endif

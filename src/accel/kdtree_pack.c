@@ -237,7 +237,7 @@ bool rt_kd_pack_wide(rt_kdtree *tree, const rt_kd_binary *bin, bool *limit)
             }
     }
     memset(x.where, 0xff, (x.T ? x.T : 1) * sizeof *x.where);
-    size_t others = tree->sphere_count + tree->quad_count;
+    size_t others = tree->sphere_count + tree->quad_count + tree->instance_count;
     if (words + others > RT_KD_PAYLOAD) {
         free(x.where);
         *limit = true;

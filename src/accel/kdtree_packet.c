@@ -247,7 +247,7 @@ static bool occluded16_avx2(const rt_kdtree *tree, const rt_ray *rays, int n, un
     return packet_walk(tree, rays, n, NULL, true, 2, mask);
 }
 KD_AVX2_END
-#define KD_PACKETS(tree) ((tree)->isa == RT_KD_ISA_AVX2)
+#define KD_PACKETS(tree) ((tree)->isa == RT_KD_ISA_AVX2 && (tree)->instance_count == 0) /* packets do not enter instances */
 #else
 #define KD_PACKETS(tree) false
 #define intersect8_avx2(tree, rays, n, hits, mask) ((void)(mask), false)

@@ -211,7 +211,9 @@ static size_t trace_stream(const rt_kdtree *tree, const rt_ray_batch *rays, size
     s.any = any;
     s.min_rays = params && params->min_rays > 0 ? params->min_rays : RT_KD_STREAM_MIN_RAYS;
     stream_mem mem;
-    bool ok = stream_alloc(&s, &mem, chunk) && rt_kd_stream_reserve(&s, chunk);
+    memset(&mem, 0, sizeof mem);
+    /* (a tree with instances: ray by ray, below; the walk does not enter them) */
+    bool ok = tree->instance_count == 0 && stream_alloc(&s, &mem, chunk) && rt_kd_stream_reserve(&s, chunk);
     size_t found = 0;
     for (size_t c0 = 0; c0 < n; c0 += chunk) {
         size_t m = n - c0 < chunk ? n - c0 : chunk;
@@ -223,7 +225,7 @@ static size_t trace_stream(const rt_kdtree *tree, const rt_ray_batch *rays, size
         }
         for (size_t i = 0; i < m; i++) {
             size_t g = c0 + i;
-            rt_hit h = {0.0f, 0.0f, 0.0f, RT_NONE};
+            rt_hit h = {0.0f, 0.0f, 0.0f, RT_NONE, 0};
             if (!done) { /* no memory for the lists: one by one */
                 rt_ray r = ray_at(rays, g);
                 if (any)
@@ -243,6 +245,8 @@ static size_t trace_stream(const rt_kdtree *tree, const rt_ray_batch *rays, size
             }
             hits->prim[g] = h.prim;
             if (hit) {
+                if (hits->inst)
+                    hits->inst[g] = h.inst;
                 hits->t[g] = h.t;
                 hits->u[g] = h.u;
                 hits->v[g] = h.v;

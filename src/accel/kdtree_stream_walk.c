@@ -444,7 +444,7 @@ KD_SINLINE void leaf_lanes(kd_stream *s, const uint32_t *ids, size_t b, size_t n
         for (size_t i = 0; i < m; i++) {
             if (!found[i])
                 continue;
-            rt_hit h = {best[i], hu[i], hv[i], (uint32_t)prim[i]};
+            rt_hit h = {best[i], hu[i], hv[i], (uint32_t)prim[i], 0};
             uint32_t r = (uint32_t)id[i];
             if (s->any) {
                 s->best[r] = NAN;

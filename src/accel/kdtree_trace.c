@@ -228,9 +228,11 @@ static bool quad_hit(const rt_quad_prep *q, const rt_ray *ray, float best, float
     return rt_intersect_quad_prepared(ray->org, ray->dir, q, ray->tmin, best, t, u, v);
 }
 
-/* Tests one primitive with the reference functions on (tmin, *best). */
+/* Tests one primitive with the reference functions on (tmin, *best).
+ * any: an instance may answer "something is hit" without finding the
+ * closest (occlusion); every other primitive is tested the same way. */
 KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr, float *best,
-                         rt_hit *hit)
+                         rt_hit *hit, bool any)
 {
     float t, u, v;
     if (id < tree->other_base) {
@@ -246,7 +248,10 @@ KD_INLINE bool test_prim(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, 
             return false;
         u = v = 0.0f;
     } else {
-        if (!quad_hit(&tree->quads[id - tree->other_base - tree->sphere_count], ray, *best, &t, &u, &v))
+        size_t q = id - tree->other_base - tree->sphere_count;
+        if (q >= tree->quad_count) /* past the quads: an instance (kdtree_instances.c) */
+            return rt_kd_instance_hit(tree, (uint32_t)(q - tree->quad_count), id, ray, best, hit, any);
+        if (!quad_hit(&tree->quads[q], ray, *best, &t, &u, &v))
             return false;
     }
     *best = t;
@@ -362,7 +367,7 @@ KD_INLINE bool tri8(const rt_kdtree *tree, const uint32_t *ids, __m256i id, uint
             return false;
         bool found = false; /* an edge function rounded to zero: the reference decides, in order */
         for (uint32_t i = 0; i < n; i++)
-            found |= test_prim(tree, ids[i] & RT_KD_PAYLOAD, ray, tr, best, hit);
+            found |= test_prim(tree, ids[i] & RT_KD_PAYLOAD, ray, tr, best, hit, false);
         return found;
     }
     /* intersect.h's guard against determinants that are rounding noise */
@@ -435,7 +440,7 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, const rt_ray 
                 return true;
         }
         for (unsigned i = nt; i < n; i++)
-            if (test_prim(tree, p[i] & RT_KD_PAYLOAD, ray, tr, best, hit)) {
+            if (test_prim(tree, p[i] & RT_KD_PAYLOAD, ray, tr, best, hit, any)) {
                 found = true;
                 if (any)
                     return true;
@@ -446,7 +451,7 @@ KD_INLINE bool test_leaf(const rt_kdtree *tree, const uint32_t *p, const rt_ray 
 #else
     uint32_t n = leaf_length(p);
     for (uint32_t i = 0; i < n; i++)
-        if (test_prim(tree, p[i] & RT_KD_PAYLOAD, ray, tr, best, hit)) {
+        if (test_prim(tree, p[i] & RT_KD_PAYLOAD, ray, tr, best, hit, any)) {
             found = true;
             if (any)
                 return true;
@@ -788,7 +793,7 @@ KD_INLINE bool traverse_ray(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hi
 #endif
         }
         if (ref >= RT_KD_ONE) {
-            if (test_prim(tree, ref & RT_KD_PAYLOAD, ray, &r->tr, &best, hit)) {
+            if (test_prim(tree, ref & RT_KD_PAYLOAD, ray, &r->tr, &best, hit, any)) {
                 found = true;
                 if (any)
                     return true;
@@ -831,10 +836,11 @@ KD_FLATTEN bool KD_NAME(rt_kd_intersect)(const rt_kdtree *tree, const rt_ray *ra
 {
     hit->prim = RT_NONE;
     if (traverse(tree, ray, hit, false)) {
-        hit->prim = rt_kdtree_scene_prim(tree, hit->prim);
+        rt_kd_finish_hit(tree, hit);
         return true;
     }
     hit->prim = RT_NONE;
+    hit->inst = 0;
     return false;
 }
 
@@ -869,7 +875,7 @@ KD_FLATTEN bool rt_kd_leaf_hit_portable(const rt_kdtree *tree, uint32_t ref, con
                                         float *best, rt_hit *hit, bool any)
 {
     if (ref >= RT_KD_ONE)
-        return test_prim(tree, ref & RT_KD_PAYLOAD, ray, tr, best, hit);
+        return test_prim(tree, ref & RT_KD_PAYLOAD, ray, tr, best, hit, any);
     return test_leaf(tree, tree->prim_ids + (ref & RT_KD_PAYLOAD), ray, tr, best, hit, any);
 }
 #endif
@@ -881,7 +887,7 @@ KD_FLATTEN bool rt_kd_leaf_hit_avx2(const rt_kdtree *tree, uint32_t ref, const r
                                     float *best, rt_hit *hit, bool any)
 {
     if (ref >= RT_KD_ONE)
-        return test_prim(tree, ref & RT_KD_PAYLOAD, ray, tr, best, hit);
+        return test_prim(tree, ref & RT_KD_PAYLOAD, ray, tr, best, hit, any);
     const uint32_t *p = tree->prim_ids + (ref & RT_KD_PAYLOAD);
     return test_leaf(tree, p, ray, tr, best, hit, any);
 }
@@ -889,7 +895,7 @@ KD_FLATTEN bool rt_kd_leaf_hit_avx2(const rt_kdtree *tree, uint32_t ref, const r
 KD_FLATTEN bool rt_kd_prim_hit_avx2(const rt_kdtree *tree, uint32_t id, const rt_ray *ray, const rt_tri_ray *tr,
                                     float *best, rt_hit *hit)
 {
-    return test_prim(tree, id, ray, tr, best, hit);
+    return test_prim(tree, id, ray, tr, best, hit, false);
 }
 KD_AVX2_END
 #endif

@@ -55,6 +55,7 @@ typedef enum flag_kind {
     FLAG_EXPOSURE,
     FLAG_TONEMAP,
     FLAG_HALF,
+    FLAG_FLATTEN,
     FLAG_DENOISE,
     FLAG_DENOISE_QUALITY,
     FLAG_AOV,
@@ -137,6 +138,9 @@ static const flag flags[] = {
     {NULL, "--camera", "N|auto", FLAG_CAMERA, NULL,
      "use camera N of the loaded glTF models, or 'auto': frame the whole scene automatically, ignoring the file's "
      "camera", OWN},
+    {NULL, "--flatten", NULL, FLAG_FLATTEN, NULL,
+     "a glTF input keeps no instances: every use of a mesh becomes world triangles, as before instancing "
+     "(to compare; docs/gltf.md, Instancing)", SETS_TRUE(flatten)},
     {NULL, "--variant", "NAME", FLAG_VARIANT, NULL,
      "show a glTF model's material variant NAME (KHR_materials_variants); default: the file's default materials", OWN},
     {NULL, "--look-from", "X,Y,Z", FLAG_LOOK_FROM, NULL, "camera position (replaces the file's or the automatic one)", OWN},

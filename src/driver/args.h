@@ -74,6 +74,7 @@ typedef struct args {
     float exposure_ev;      /* --exposure: stops for 8-bit output, on top of the scene's */
     rt_tonemap tonemap;     /* --tonemap: the curve for 8-bit output */
     bool half;              /* --half: EXR in half floats */
+    bool flatten;           /* --flatten: glTF meshes used more than once flattened, no instances */
     bool denoise;           /* --denoise: Intel Open Image Denoise on the render */
     rt_denoise_quality denoise_quality; /* --denoise-quality; RT_DENOISE_DEFAULT: RT_OIDN_QUALITY, else balanced */
     unsigned aovs;          /* --aov: bit k for rt_aov_names[k] */

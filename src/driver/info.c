@@ -16,6 +16,7 @@
 #include "rt/io/gltf.h"
 #include "rt/io/load.h"
 #include "rt/render/integrator.h"
+#include "rt/scene/instance.h"
 #include "rt/scene/scene.h"
 
 #include "input.h"
@@ -36,6 +37,9 @@ static void print_contents(const char *path, const rt_scene *s, const rt_load_in
     printf("vertices: %zu\n", s->vertices.count);
     printf("spheres: %zu\n", s->spheres.count);
     printf("quads: %zu\n", s->quads.count);
+    /* instancing: triangles above are the unique ones (an object's once) */
+    printf("instances: %zu\n", s->instance_count);
+    printf("instanced_triangles: %zu\n", rt_scene_instanced_triangles(s));
     if (rt_box_is_empty(b))
         printf("bounds: none\n");
     else
@@ -127,7 +131,8 @@ static int print_info(const char *path, const args *a)
     rt_gltf_catalog catalog;
     memset(&catalog, 0, sizeof catalog);
     rt_load_options lo = {.use_time = a->posed, .time = a->frame_time, .animation = a->animation,
-                          .animation_name = a->animation_name, .variant = a->variant, .catalog = &catalog};
+                          .animation_name = a->animation_name, .variant = a->variant, .catalog = &catalog,
+                          .flatten_instances = a->flatten};
     rt_result r = input_load(&s, &loaded, path, &lo, &info, &err);
     if (r != RT_OK) {
         memory_budget_report(&err, budget);

@@ -16,6 +16,7 @@
 #include "rt/io/load.h"
 #include "rt/job/frame.h"
 #include "rt/render/integrator.h"
+#include "rt/scene/instance.h"
 #include "rt/scene/validate.h"
 
 /* The loaded scene as the flags want it: setting flags applied, the view
@@ -29,7 +30,8 @@ rt_result prepare_scene(rt_scene *scene, rt_settings *set, const args *a, char *
                           .time = a->frame_time,
                           .animation = a->animation,
                           .animation_name = a->animation_name,
-                          .variant = a->variant};
+                          .variant = a->variant,
+                          .flatten_instances = a->flatten};
     rt_result r;
     /* -o is checked before the load, which may take long, and so is a
      * model's default output (models have no `output` line); a scene's own
@@ -83,6 +85,9 @@ rt_result prepare_scene(rt_scene *scene, rt_settings *set, const args *a, char *
     rt_info("scene: %s (loaded in %.1f ms)", input_name(a->input), info.load_ms);
     rt_info("  triangles %zu, spheres %zu, quads %zu, vertices %zu", scene->triangles.count, scene->spheres.count,
             scene->quads.count, scene->vertices.count);
+    if (scene->instance_count)
+        rt_info("  instances %zu of %zu objects, placing %zu triangles", scene->instance_count, scene->object_count,
+                rt_scene_instanced_triangles(scene));
     rt_info("  materials %zu, textures %zu, images %zu, lights %zu", scene->material_count, scene->texture_count,
             scene->image_count, scene->light_count);
     rt_info("  %dx%d, %d samples per pixel, integrator %s", set->width, set->height, set->samples,

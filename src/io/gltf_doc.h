@@ -113,6 +113,10 @@ typedef struct gl_node {
     int weights;                     /* token of its morph weights, -1 = none */
     float *pose_weights;             /* when posed: its morph weights (pose_weight_count), owned */
     uint32_t pose_weight_count;
+    /* EXT_mesh_gpu_instancing: accessors of TRANSLATION, ROTATION, SCALE
+     * (RT_NONE: absent); gpu_tok the extension's token, -1 = not instanced */
+    uint32_t gpu_attr[3];
+    int gpu_tok;
     int tok;
 } gl_node;
 
@@ -269,5 +273,17 @@ rt_result gl_skin_matrices(gl_doc *d, const gl_prim *p, uint32_t node, const rt_
 /* gltf_flatten.c: the chosen scene into the scene tables */
 rt_result gl_scratch(gl_doc *d, int slot, size_t floats, float **out);
 rt_result gl_flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf_stats *st);
+
+/* gltf_instances.c: which meshes are kept once and placed by instances,
+ * and EXT_mesh_gpu_instancing's transforms */
+#define GL_OBJECT_PLANNED (RT_NONE - 1u) /* mesh_object: an object, not emitted yet */
+/* mesh_object[m] (d->mesh_count entries): GL_OBJECT_PLANNED for a mesh to
+ * keep once (used more than once, the same shape at every use, no
+ * emitter), RT_NONE for one to flatten. */
+rt_result gl_plan_objects(gl_doc *d, const rt_gltf_options *opt, uint32_t *mesh_object);
+/* Node ni's EXT_mesh_gpu_instancing transforms T * R * S (*count of them,
+ * *out owned by the caller); checks types, counts and finiteness, errors
+ * naming the node, the attribute and the element. */
+rt_result gl_gpu_instances(gl_doc *d, uint32_t ni, rt_mat4 **out, size_t *count);
 
 #endif

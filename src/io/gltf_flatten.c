@@ -4,9 +4,13 @@
  * the scene's vertex and triangle tables (strips and fans converted with
  * the spec's vertex orders; positions by M, normals by M's inverse
  * transpose, tangents by M with w flipped by sign(det M), and winding
- * flipped with it), then materials, cameras and lights.
+ * flipped with it), then materials, cameras and lights. A mesh used more
+ * than once (gltf_instances.c decides) goes in once, in its own space, as
+ * an object, and each use adds an instance (rt/scene/instance.h) instead
+ * of a copy; EXT_mesh_gpu_instancing nodes place their mesh once per
+ * instance, either way.
  * Source: Khronos glTF 2.0 specification ("Meshes", "Nodes and
- * Hierarchy", "Cameras"), KHR_lights_punctual.
+ * Hierarchy", "Cameras"), KHR_lights_punctual, EXT_mesh_gpu_instancing.
  */
 #include "gltf_doc.h"
 
@@ -16,6 +20,7 @@
 
 #include "rt/base/alloc.h"
 #include "rt/base/log.h"
+#include "rt/scene/instance.h"
 #include "rt/scene/texture.h"
 
 rt_result gl_scratch(gl_doc *d, int slot, size_t floats, float **out)
@@ -34,6 +39,54 @@ static size_t prim_triangles(const gl_doc *d, const gl_prim *p)
     if (p->mode == 4)
         return n / 3;
     return n >= 3 ? n - 2 : 0;
+}
+
+/* How the visited nodes place their meshes: per mesh, flattened
+ * (RT_NONE) or an object (GL_OBJECT_PLANNED, then GL_OBJECT_COUNTED once
+ * its geometry is counted, then its object index once emitted); per visit,
+ * an EXT_mesh_gpu_instancing node's transforms (NULL: the node once). */
+#define GL_OBJECT_COUNTED (RT_NONE - 2u)
+typedef struct gl_placements {
+    uint32_t *mesh_object;
+    rt_mat4 **gpu;
+    size_t *gpu_count;
+    size_t instances; /* instances the objects' uses will add */
+} gl_placements;
+
+static void free_placements(gl_placements *pl, size_t visits)
+{
+    for (size_t v = 0; pl->gpu && v < visits; v++)
+        free(pl->gpu[v]);
+    free(pl->gpu);
+    free(pl->gpu_count);
+    free(pl->mesh_object);
+}
+
+/* How many times visit v places its mesh. */
+static size_t placements_of(const gl_placements *pl, size_t v) { return pl->gpu[v] ? pl->gpu_count[v] : 1; }
+
+static rt_result make_placements(gl_doc *d, const rt_gltf_options *opt, gl_placements *pl)
+{
+    pl->mesh_object = rt_alloc(d->mesh_count ? d->mesh_count : 1, sizeof *pl->mesh_object);
+    pl->gpu = rt_alloc(d->visit_count ? d->visit_count : 1, sizeof *pl->gpu);
+    pl->gpu_count = rt_alloc(d->visit_count ? d->visit_count : 1, sizeof *pl->gpu_count);
+    if (!pl->mesh_object || !pl->gpu || !pl->gpu_count)
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu nodes", d->path, d->visit_count);
+    rt_result r = gl_plan_objects(d, opt, pl->mesh_object);
+    for (size_t v = 0; v < d->visit_count && r == RT_OK; v++) {
+        uint32_t ni = d->visits[v].node;
+        const gl_node *n = &d->nodes[ni];
+        if (n->mesh == RT_NONE)
+            continue;
+        if (n->gpu_tok >= 0) {
+            r = gl_gpu_instances(d, ni, &pl->gpu[v], &pl->gpu_count[v]);
+            if (r == RT_OK && !pl->gpu[v])
+                pl->gpu_count[v] = 0;
+        }
+        if (r == RT_OK && pl->mesh_object[n->mesh] != RT_NONE)
+            pl->instances += placements_of(pl, v);
+    }
+    return r;
 }
 
 /* The nodes of the chosen scene in depth-first order with world matrices. */
@@ -252,7 +305,7 @@ typedef struct gl_totals {
     bool need_default; /* a primitive without a material */
 } gl_totals;
 
-static rt_result count_geometry(gl_doc *d, rt_gltf_stats *st, gl_totals *t)
+static rt_result count_geometry(gl_doc *d, rt_gltf_stats *st, gl_totals *t, gl_placements *pl)
 {
     size_t zeros = 0;
     bool warned_modes = false, warned_skin = false, warned_pos = false;
@@ -266,6 +319,12 @@ static rt_result count_geometry(gl_doc *d, rt_gltf_stats *st, gl_totals *t)
         if (n->mesh == RT_NONE)
             continue;
         const gl_mesh *m = &d->meshes[n->mesh];
+        /* geometry added: an object's once, a flattened mesh's at every placement */
+        size_t reps = placements_of(pl, v);
+        uint32_t *obj = &pl->mesh_object[n->mesh];
+        size_t copies = *obj == RT_NONE ? reps : *obj == GL_OBJECT_PLANNED ? 1 : 0;
+        if (*obj == GL_OBJECT_PLANNED)
+            *obj = GL_OBJECT_COUNTED;
         for (uint32_t k = 0; k < m->count; k++) {
             const gl_prim *p = &d->prims[m->first + k];
             if (p->targets && !warned_skin && !d->posed) {
@@ -286,13 +345,18 @@ static rt_result count_geometry(gl_doc *d, rt_gltf_stats *st, gl_totals *t)
                 continue;
             }
             const gl_accessor *pa = &d->accessors[p->attr[ATTR_POSITION]];
-            t->verts += pa->count;
-            if (pa->view == RT_NONE && (zeros += pa->count) > GL_MAX_ZEROS)
+            if (copies > 0 && pa->count > (GL_MAX_VERTICES + 1) / copies)
+                return rt_fail(d->err, RT_ERR_LIMIT,
+                               "%s: the scene has over %zu vertices or triangles (instancing included); over the "
+                               "loader's limit",
+                               d->path, GL_MAX_VERTICES);
+            t->verts += pa->count * copies;
+            if (pa->view == RT_NONE && (zeros += pa->count * copies) > GL_MAX_ZEROS)
                 return rt_fail(d->err, RT_ERR_LIMIT,
                                "%s: over %zu vertices come from accessors without a bufferView (instancing "
                                "included); over the loader's limit",
                                d->path, GL_MAX_ZEROS);
-            t->tris += prim_triangles(d, p);
+            t->tris += prim_triangles(d, p) * copies;
             if (t->verts > GL_MAX_VERTICES || t->tris > GL_MAX_TRIANGLES)
                 return rt_fail(d->err, RT_ERR_LIMIT,
                                "%s: the scene has over %zu vertices or triangles (instancing included); over the "
@@ -303,9 +367,9 @@ static rt_result count_geometry(gl_doc *d, rt_gltf_stats *st, gl_totals *t)
             if (p->attr[ATTR_TEXCOORD_1] != RT_NONE) t->attrs |= RT_ATTR_UV1;
             if (p->attr[ATTR_TANGENT] != RT_NONE && p->attr[ATTR_NORMAL] != RT_NONE) t->attrs |= RT_ATTR_TANGENT;
             if (p->attr[ATTR_COLOR_0] != RT_NONE) t->attrs |= RT_ATTR_COLOR;
-            st->primitives++;
+            st->primitives += reps;
         }
-        st->meshes++;
+        st->meshes += reps;
     }
     return RT_OK;
 }
@@ -355,16 +419,84 @@ static rt_result add_materials(gl_doc *d, rt_scene *s, rt_gltf_stats *st, bool n
     return RT_OK;
 }
 
+/* Every triangle primitive of node `node`'s mesh by M (vertices from
+ * *vbase on, which it advances). */
+static rt_result emit_mesh(gl_doc *d, rt_scene *s, uint32_t node, const rt_mat4 *M, const rt_mat4 *top,
+                           uint32_t mat_base, uint32_t default_mat, size_t *vbase)
+{
+    const gl_mesh *m = &d->meshes[d->nodes[node].mesh];
+    for (uint32_t k = 0; k < m->count; k++) {
+        const gl_prim *p = &d->prims[m->first + k];
+        if (!is_triangles(p->mode) || p->attr[ATTR_POSITION] == RT_NONE)
+            continue;
+        uint32_t mat = p->material == RT_NONE ? default_mat : mat_base + p->material;
+        rt_result r;
+        if ((r = emit_primitive(d, s, node, k, M, top, mat, *vbase)) != RT_OK)
+            return r;
+        *vbase += d->accessors[p->attr[ATTR_POSITION]].count;
+    }
+    return RT_OK;
+}
+
+/* Visit v's uses of an object mesh: the object itself the first time
+ * (its primitives in object space), then one instance per placement.
+ * A transform that is singular (a zero scale) places nothing, with a
+ * warning; one that is not finite is an error. */
+static rt_result place_object(gl_doc *d, rt_scene *s, rt_gltf_stats *st, gl_placements *pl, size_t v,
+                              uint32_t mat_base, uint32_t default_mat, size_t *vbase)
+{
+    uint32_t ni = d->visits[v].node, mesh = d->nodes[ni].mesh;
+    uint32_t *obj = &pl->mesh_object[mesh];
+    rt_result r;
+    if (*obj == GL_OBJECT_COUNTED) {
+        size_t t0 = s->triangles.count, v0 = *vbase;
+        rt_mat4 id = rt_mat4_identity();
+        if ((r = emit_mesh(d, s, ni, &id, &id, mat_base, default_mat, vbase)) != RT_OK)
+            return r;
+        *obj = rt_scene_add_object(s, t0, s->triangles.count - t0, v0, *vbase - v0);
+        if (*obj == RT_NONE)
+            return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding meshes[%u] as an object", d->path, mesh);
+        st->objects++;
+    }
+    size_t reps = placements_of(pl, v), skipped = 0;
+    const char *why = NULL;
+    for (size_t k = 0; k < reps; k++) {
+        rt_mat4 W = pl->gpu[v] ? rt_mat4_mul(d->visits[v].world, pl->gpu[v][k]) : d->visits[v].world;
+        rt_instance_check c = rt_instance_check_transform(&W);
+        if (c == RT_INSTANCE_NOT_FINITE)
+            return gl_fail_at(d, pl->gpu[v] ? d->nodes[ni].gpu_tok : d->nodes[ni].tok, RT_ERR_INVALID,
+                              "nodes[%u]%s: instance %zu's transform is not finite", ni,
+                              pl->gpu[v] ? ".extensions.EXT_mesh_gpu_instancing" : "", k);
+        if (c != RT_INSTANCE_OK) {
+            why = rt_instance_check_name(c);
+            skipped++;
+            continue;
+        }
+        if (rt_scene_add_instance(s, *obj, &W) == RT_NONE)
+            return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory placing instance %zu of nodes[%u]", d->path, k, ni);
+        st->instances++;
+        st->instanced_triangles += s->objects[*obj].triangle_count;
+    }
+    if (skipped)
+        rt_warn("%s: nodes[%u]%s: %zu of %zu instances skipped, their transform is %s", d->path, ni,
+                pl->gpu[v] ? ".extensions.EXT_mesh_gpu_instancing" : "", skipped, reps, why);
+    return RT_OK;
+}
+
 /* Every triangle primitive of every visited node into the scene's tables
- * reserved at once, and the bounds of the vertices they use. */
+ * reserved at once (objects once, with their instances), and the bounds of
+ * the vertices they use. */
 static rt_result add_geometry(gl_doc *d, rt_scene *s, rt_gltf_stats *st, const gl_totals *t, const rt_mat4 *top,
-                              uint32_t mat_base, uint32_t default_mat)
+                              uint32_t mat_base, uint32_t default_mat, gl_placements *pl)
 {
     if (t->attrs && !rt_scene_enable_attr(s, t->attrs))
         return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for vertex attributes", d->path);
-    size_t tri_first = s->triangles.count;
+    size_t tri_first = s->triangles.count, inst_first = s->instance_count;
     if (!rt_scene_reserve_triangles(s, t->tris))
         return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu triangles", d->path, t->tris);
+    if (pl->instances && !rt_scene_reserve_instances(s, pl->instances))
+        return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu instances (%zu bytes each, %zu bytes)",
+                       d->path, pl->instances, RT_INSTANCE_BYTES, pl->instances * RT_INSTANCE_BYTES);
     size_t vbase = s->vertices.count;
     if (t->verts && rt_scene_add_vertices(s, t->verts) == RT_NONE)
         return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory for %zu vertices", d->path, t->verts);
@@ -372,29 +504,36 @@ static rt_result add_geometry(gl_doc *d, rt_scene *s, rt_gltf_stats *st, const g
         const gl_node *n = &d->nodes[d->visits[v].node];
         if (n->mesh == RT_NONE)
             continue;
-        const gl_mesh *m = &d->meshes[n->mesh];
-        for (uint32_t k = 0; k < m->count; k++) {
-            const gl_prim *p = &d->prims[m->first + k];
-            if (!is_triangles(p->mode) || p->attr[ATTR_POSITION] == RT_NONE)
-                continue;
-            uint32_t mat = p->material == RT_NONE ? default_mat : mat_base + p->material;
-            rt_result r;
-            if ((r = emit_primitive(d, s, d->visits[v].node, k, &d->visits[v].world, top, mat, vbase)) != RT_OK)
-                return r;
-            vbase += d->accessors[p->attr[ATTR_POSITION]].count;
+        rt_result r = RT_OK;
+        if (pl->mesh_object[n->mesh] != RT_NONE) {
+            r = place_object(d, s, st, pl, v, mat_base, default_mat, &vbase);
+        } else if (!pl->gpu[v]) {
+            r = emit_mesh(d, s, d->visits[v].node, &d->visits[v].world, top, mat_base, default_mat, &vbase);
+        } else {
+            for (size_t k = 0; k < pl->gpu_count[v] && r == RT_OK; k++) {
+                rt_mat4 W = rt_mat4_mul(d->visits[v].world, pl->gpu[v][k]);
+                r = emit_mesh(d, s, d->visits[v].node, &W, top, mat_base, default_mat, &vbase);
+            }
         }
+        if (r != RT_OK)
+            return r;
     }
     st->triangles = s->triangles.count - tri_first;
-    /* bounds of the vertices triangles use (positions are finite: plain
-     * compares, no fminf calls, which cost more than the rest of the load) */
+    /* bounds of the vertices world triangles use (positions are finite:
+     * plain compares, no fminf calls, which cost more than the rest of the
+     * load), and of the instances */
     rt_box b = rt_box_empty();
     const uint32_t *ix = s->triangles.index;
     for (size_t k = 3 * tri_first; k < 3 * s->triangles.count; k++) {
+        if (st->objects && (s->triangles.flags[k / 3] & RT_TRI_OBJECT))
+            continue;
         rt_vec3 q = s->vertices.position[ix[k]];
         b.lo.x = q.x < b.lo.x ? q.x : b.lo.x; b.hi.x = q.x > b.hi.x ? q.x : b.hi.x;
         b.lo.y = q.y < b.lo.y ? q.y : b.lo.y; b.hi.y = q.y > b.hi.y ? q.y : b.hi.y;
         b.lo.z = q.z < b.lo.z ? q.z : b.lo.z; b.hi.z = q.z > b.hi.z ? q.z : b.hi.z;
     }
+    for (size_t i = inst_first; i < s->instance_count; i++)
+        b = rt_box_union(b, s->instances[i].bounds);
     st->bounds = b;
     return RT_OK;
 }
@@ -462,16 +601,20 @@ rt_result gl_flatten(gl_doc *d, rt_scene *s, const rt_gltf_options *opt, rt_gltf
     st->nodes = d->visit_count;
 
     gl_totals t = {0};
-    if ((r = count_geometry(d, st, &t)) != RT_OK)
-        return r;
-    if (s->vertices.count + t.verts >= RT_NONE || s->triangles.count + t.tris >= RT_NONE)
-        return rt_fail(d->err, RT_ERR_LIMIT, "%s: the scene would exceed 2^32 vertices or triangles", d->path);
-    if ((r = gl_load_textures(d, s, st)) != RT_OK)
-        return r;
-    uint32_t mat_base, default_mat;
-    if ((r = add_materials(d, s, st, t.need_default, &mat_base, &default_mat)) != RT_OK)
-        return r;
-    if ((r = add_geometry(d, s, st, &t, &top, mat_base, default_mat)) != RT_OK)
+    gl_placements pl = {0};
+    if ((r = make_placements(d, opt, &pl)) == RT_OK)
+        r = count_geometry(d, st, &t, &pl);
+    if (r == RT_OK && (s->vertices.count + t.verts >= RT_NONE || s->triangles.count + t.tris >= RT_NONE))
+        r = rt_fail(d->err, RT_ERR_LIMIT, "%s: the scene would exceed 2^32 vertices or triangles", d->path);
+    if (r == RT_OK)
+        r = gl_load_textures(d, s, st);
+    uint32_t mat_base = 0, default_mat = RT_NONE;
+    if (r == RT_OK)
+        r = add_materials(d, s, st, t.need_default, &mat_base, &default_mat);
+    if (r == RT_OK)
+        r = add_geometry(d, s, st, &t, &top, mat_base, default_mat, &pl);
+    free_placements(&pl, d->visit_count);
+    if (r != RT_OK)
         return r;
     return add_cameras_and_lights(d, s, st);
 }

@@ -31,7 +31,7 @@ static const struct { const char *name; bool supported; } known_extensions[] = {
     {"KHR_materials_iridescence", true},       {"KHR_materials_dispersion", true},
     {"KHR_materials_diffuse_transmission", true}, {"KHR_materials_variants", true},
     {"EXT_meshopt_compression", true},         {"KHR_draco_mesh_compression", true},
-    {"EXT_texture_webp", true},
+    {"EXT_texture_webp", true},                {"EXT_mesh_gpu_instancing", true},
 };
 
 static bool extension_supported(const gl_doc *d, int t)
@@ -558,6 +558,34 @@ static rt_result read_index_list(gl_doc *d, int e, const char *where, const char
     return RT_OK;
 }
 
+/* A node's EXT_mesh_gpu_instancing (its `extensions` object at ext): the
+ * accessors of its TRANSLATION, ROTATION and SCALE attributes (others,
+ * such as _ID, are ignored); gltf_instances.c checks and reads them. */
+static rt_result parse_gpu_instancing(gl_doc *d, gl_node *n, const char *where, int ext)
+{
+    static const char *const names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+    int g = rt_json_get(&d->j, ext, "EXT_mesh_gpu_instancing");
+    if (g < 0)
+        return RT_OK;
+    rt_result r;
+    if ((r = gl_expect_object(d, g, where)) != RT_OK)
+        return r;
+    n->gpu_tok = g;
+    int at = rt_json_get(&d->j, g, "attributes");
+    if (at < 0)
+        return RT_OK;
+    if ((r = gl_expect_object(d, at, where)) != RT_OK)
+        return r;
+    for (int a = 0; a < 3; a++) {
+        char field[96];
+        snprintf(field, sizeof field, "extensions.EXT_mesh_gpu_instancing.attributes.%s", names[a]);
+        int x = rt_json_get(&d->j, at, names[a]);
+        if (x >= 0 && (r = gl_get_index(d, where, field, x, &n->gpu_attr[a])) != RT_OK)
+            return r;
+    }
+    return RT_OK;
+}
+
 static rt_result parse_nodes(gl_doc *d, int t)
 {
     rt_result r = RT_OK;
@@ -573,6 +601,8 @@ static rt_result parse_nodes(gl_doc *d, int t)
         n->mesh = n->camera = n->light = n->skin = n->parent = RT_NONE;
         n->first_child = (uint32_t)d->children_count;
         n->weights = -1;
+        n->gpu_attr[0] = n->gpu_attr[1] = n->gpu_attr[2] = RT_NONE;
+        n->gpu_tok = -1;
         bool have_matrix = false, have_trs = false;
         float matrix[16], tr[3] = {0, 0, 0}, rot[4] = {0, 0, 0, 1}, sc[3] = {1, 1, 1};
         for (int k_n = 0, k = e + 1, v = e + 2; k_n < d->j.tok[e].size && v < d->j.count;
@@ -609,6 +639,8 @@ static rt_result parse_nodes(gl_doc *d, int t)
                     if (r != RT_OK)
                         return r;
                 }
+                if ((r = parse_gpu_instancing(d, n, where, v)) != RT_OK)
+                    return r;
             }
             if (r != RT_OK)
                 return r;

@@ -147,7 +147,8 @@ static rt_result load_kind(rt_scene *s, rt_settings *settings, const void *bytes
         memset(&gs, 0, sizeof gs);
         rt_gltf_options go = {
             .use_time = opt->use_time, .time = opt->time, .animation = opt->animation,
-            .animation_name = opt->animation_name, .variant = opt->variant, .catalog = opt->catalog};
+            .animation_name = opt->animation_name, .variant = opt->variant, .catalog = opt->catalog,
+            .flatten_instances = opt->flatten_instances};
         r = rt_gltf_load_memory(s, bytes, size, name, &go, &gs, err);
         info->meshes = gs.meshes;
         info->primitives = gs.primitives;

@@ -52,6 +52,7 @@
 #include "rt/io/mesh_io.h"
 #include "rt/io/environment_image.h"
 #include "rt/render/settings.h"
+#include "rt/scene/instance.h"
 #include "rt/scene/texture.h"
 
 #define MAX_SCENE_BYTES ((size_t)256 << 20) /* 256 MiB of text keeps line and column in an int */
@@ -94,7 +95,12 @@ typedef struct parser {
     size_t ntok, tok_cap;
     size_t pos; /* cursor into toks */
 
-    name_table materials, textures;
+    name_table materials, textures, objects;
+    /* an open `object NAME` block: its statement, and the triangles and
+     * vertices before it (rt/scene/instance.h) */
+    bool in_object;
+    tok object_name;
+    size_t object_t0, object_v0;
     uint32_t default_material; /* made on first use by a mesh without a material */
     /* textures standing in for a missing image (rt_texture_missing): a data
      * slot given one is left empty instead */
@@ -1399,6 +1405,82 @@ static rt_result st_mesh(parser *p, const tok *kw)
     return RT_OK;
 }
 
+/* `object NAME`: the triangles, meshes and models up to `end` form an
+ * object, kept in its own space and placed only by `instance` lines. */
+static rt_result st_object(parser *p, const tok *kw)
+{
+    const tok *name = NULL;
+    rt_result r;
+    if (p->in_object)
+        return perr(p, RT_ERR_INVALID, kw, "objects do not nest: object '%s' (line %d) has no 'end' before this",
+                    p->object_name.s, p->object_name.line);
+    if ((r = get_word(p, "an object name", &name)) != RT_OK ||
+        (r = check_new_name(p, name, &p->objects, "object")) != RT_OK || (r = expect_end(p, "object")) != RT_OK)
+        return r;
+    p->in_object = true;
+    p->object_name = *name;
+    p->object_t0 = p->s->triangles.count;
+    p->object_v0 = p->s->vertices.count;
+    return RT_OK;
+}
+
+/* `end`: closes the open object. */
+static rt_result st_end(parser *p, const tok *kw)
+{
+    rt_result r;
+    if (!p->in_object)
+        return perr(p, RT_ERR_PARSE, kw, "'end' without an open 'object'");
+    if ((r = expect_end(p, "end")) != RT_OK)
+        return r;
+    size_t nt = p->s->triangles.count - p->object_t0;
+    if (nt == 0)
+        return perr(p, RT_ERR_INVALID, &p->object_name, "object '%s' holds no triangles", p->object_name.s);
+    uint32_t id = rt_scene_add_object(p->s, p->object_t0, nt, p->object_v0, p->s->vertices.count - p->object_v0);
+    if (id == RT_NONE || !name_add(&p->objects, p->object_name.s, id, p->object_name.line))
+        return nomem(p, kw);
+    p->in_object = false;
+    return RT_OK;
+}
+
+/* `instance NAME [translate X Y Z] [rotate X Y Z] [scale S | SX SY SZ]`:
+ * one placement of an object, by the transform of `mesh` and `model`. */
+static rt_result st_instance(parser *p, const tok *kw)
+{
+    const tok *name = NULL;
+    rt_result r;
+    char b[80];
+    if (p->in_object)
+        return perr(p, RT_ERR_INVALID, kw, "instances do not nest: 'instance' inside object '%s' (line %d)",
+                    p->object_name.s, p->object_name.line);
+    if ((r = get_word(p, "an object name", &name)) != RT_OK)
+        return r;
+    const name_entry *e = name_find(&p->objects, name->s);
+    if (!e) {
+        const char *near = closest_name(p, &p->objects, false, name->s);
+        if (near)
+            return perr(p, RT_ERR_INVALID, name, "undefined object %s (did you mean '%s'?)", show(name, b, sizeof b),
+                        near);
+        return perr(p, RT_ERR_INVALID, name, "undefined object %s (define it with 'object' ... 'end' before use)",
+                    show(name, b, sizeof b));
+    }
+    xform x = {0};
+    while (peek(p)) {
+        bool taken = false;
+        if ((r = get_xform_option(p, &x, "instance", &taken)) != RT_OK)
+            return r;
+        if (!taken)
+            return perr(p, RT_ERR_PARSE, peek(p), "expected an instance option (translate, rotate, scale), got %s",
+                        show(peek(p), b, sizeof b));
+    }
+    rt_mat4 m = xform_matrix(&x);
+    rt_instance_check c = rt_instance_check_transform(&m);
+    if (c != RT_INSTANCE_OK)
+        return perr(p, RT_ERR_INVALID, kw, "the instance's transform is %s", rt_instance_check_name(c));
+    if (rt_scene_add_instance(p->s, e->index, &m) == RT_NONE)
+        return nomem(p, kw);
+    return RT_OK;
+}
+
 /* The pose options of a `model` line: `time T`, `time_offset T`,
  * `animation NAME|INDEX`; *taken tells whether one was read. */
 typedef struct model_pose {
@@ -1476,6 +1558,7 @@ static rt_result st_model(parser *p, const tok *kw)
     xform x = {0};
     model_pose pose = {0};
     rt_gltf_options opt = {0};
+    opt.flatten_instances = p->in_object; /* an object holds triangles; instances do not nest */
     const tok *scene_tok = NULL;
     while (peek(p)) {
         bool taken = false;
@@ -1656,7 +1739,17 @@ static const keyword keywords[] = {
     {"mesh", st_mesh},
     {"model", st_model},
     {"light", st_light},
+    {"object", st_object},
+    {"end", st_end},
+    {"instance", st_instance},
 };
+
+/* What an object block may hold: triangles, from these statements. */
+static bool allowed_in_object(const char *word)
+{
+    return strcmp(word, "triangle") == 0 || strcmp(word, "mesh") == 0 || strcmp(word, "model") == 0 ||
+           strcmp(word, "end") == 0 || strcmp(word, "material") == 0 || strcmp(word, "texture") == 0;
+}
 
 static rt_result run_statement(parser *p)
 {
@@ -1667,9 +1760,16 @@ static rt_result run_statement(parser *p)
         const rt_setting *def = rt_setting_find(kw->s);
         if (def)
             return st_setting(p, def, kw);
-        for (size_t i = 0; i < sizeof keywords / sizeof *keywords; i++)
-            if (strcmp(kw->s, keywords[i].word) == 0)
-                return keywords[i].fn(p, kw);
+        for (size_t i = 0; i < sizeof keywords / sizeof *keywords; i++) {
+            if (strcmp(kw->s, keywords[i].word) != 0)
+                continue;
+            if (p->in_object && !allowed_in_object(kw->s))
+                return perr(p, RT_ERR_INVALID, kw,
+                            "'%s' inside object '%s' (line %d): an object holds triangle, mesh and model lines "
+                            "(and material and texture definitions)",
+                            kw->s, p->object_name.s, p->object_name.line);
+            return keywords[i].fn(p, kw);
+        }
     }
     rt_near_miss n = rt_near_miss_of(kw->s);
     for (size_t i = 0; i < rt_settings_count; i++)
@@ -1680,7 +1780,7 @@ static rt_result run_statement(parser *p)
         return perr(p, RT_ERR_PARSE, kw, "unknown keyword %s (did you mean '%s'?)", show(kw, b, sizeof b), n.best);
     return perr(p, RT_ERR_PARSE, kw,
                 "unknown keyword %s (expected a setting, camera, texture, material, sphere, quad, triangle, mesh, "
-                "model or light)",
+                "model, light, object, end or instance)",
                 show(kw, b, sizeof b));
 }
 
@@ -1815,6 +1915,8 @@ static rt_result run(parser *p, char *buf, size_t len)
 /* After the last statement: things that depend on the whole file. */
 static rt_result finish(parser *p)
 {
+    if (p->in_object)
+        return perr(p, RT_ERR_PARSE, &p->object_name, "object '%s' has no 'end' line", p->object_name.s);
     if (p->camera_gltf) {
         if (p->camera_gltf_index >= (long long)p->s->camera_count)
             return perr(p, RT_ERR_INVALID, &p->camera_gltf_tok,
@@ -1885,6 +1987,7 @@ rt_result rt_scene_parse_string_with(rt_scene *s, rt_settings *settings, const c
     free(p.missing_tex);
     name_table_free(&p.materials);
     name_table_free(&p.textures);
+    name_table_free(&p.objects);
     free(buf);
     return r;
 }

@@ -503,6 +503,8 @@ rt_result rt_light_table_build(rt_light_table *t, const rt_scene *s, rt_error *e
         float pw;
         if (p >= quad0 && t->quad_light[p - quad0] != RT_NONE)
             continue;
+        if (p < s->triangles.count && (s->triangles.flags[p] & RT_TRI_OBJECT))
+            continue; /* an object's triangle: in object space, not sampled (instances are not lights) */
         if (emissive_material(s, rt_prim_material(s, (uint32_t)p), &pw) && prim_area(s, (uint32_t)p) > 0.0f)
             n++;
     }
@@ -525,6 +527,8 @@ rt_result rt_light_table_build(rt_light_table *t, const rt_scene *s, rt_error *e
         float pw, a;
         if (p >= quad0 && t->quad_light[p - quad0] != RT_NONE)
             continue;
+        if (p < s->triangles.count && (s->triangles.flags[p] & RT_TRI_OBJECT))
+            continue; /* an object's triangle: in object space, not sampled (instances are not lights) */
         if (!emissive_material(s, rt_prim_material(s, (uint32_t)p), &pw) || !((a = prim_area(s, (uint32_t)p)) > 0.0f))
             continue;
         t->prim[k] = (uint32_t)p;

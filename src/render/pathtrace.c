@@ -236,6 +236,7 @@ bool rt_path_nee_emitter(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_su
     uint32_t prim = t->prim[k], local;
     rt_hit h;
     h.prim = prim;
+    h.inst = 0; /* emitters are world geometry (the light table holds no object's triangles) */
     rt_vec3 q;
     float solid = 0.0f; /* the solid angle when sampled by it, else 0 (by area) */
     switch (rt_prim_kind_of(s, prim, &local)) {

@@ -17,6 +17,7 @@
 #include "rt/render/surface.h"
 
 #include "rt/render/environment.h"
+#include "rt/scene/instance.h"
 #include "rt/scene/texture.h"
 
 /* Tangent from UV derivatives: t = dP/du, and the handedness sign w such
@@ -92,34 +93,74 @@ static inline rt_vec3 spawn_origin(const rt_trace_ctx *ctx, rt_vec3 p, rt_vec3 s
  * tangent frame or vertex colour). */
 typedef enum surface_need { NEED_ALL, NEED_SHADING, NEED_EMISSION } surface_need;
 
+/* A vertex's position, normal and tangent in the world: as stored, or
+ * (an instance's object, xf) moved by the instance the way the glTF loader
+ * flattens a node (gltf_flatten.c): positions by to_world, normals by the
+ * normal matrix and renormalised, tangents by to_world and renormalised,
+ * their sign w flipped by a mirroring transform. */
+SURFACE_INLINE rt_vec3 vertex_position(const rt_vertices *vx, const rt_instance *xf, uint32_t v)
+{
+    return xf ? rt_mat4_point(&xf->to_world, vx->position[v]) : vx->position[v];
+}
+SURFACE_INLINE rt_vec3 vertex_normal(const rt_vertices *vx, const rt_instance *xf, uint32_t v)
+{
+    if (!xf)
+        return vx->normal[v];
+    rt_vec3 n = vx->normal[v];
+    return rt_finite3(n) && rt_length2(n) > 0.0f ? rt_normalize(rt_mat4_vector(&xf->normal, n)) : n;
+}
+SURFACE_INLINE rt_vec4 vertex_tangent(const rt_vertices *vx, const rt_instance *xf, uint32_t v)
+{
+    if (!xf)
+        return vx->tangent[v];
+    rt_vec4 q = vx->tangent[v];
+    rt_vec3 t = rt_mat4_vector(&xf->to_world, rt_v3(q.x, q.y, q.z));
+    t = rt_finite3(t) && rt_length2(t) > 0.0f ? rt_normalize(t) : rt_v3s(0);
+    return rt_v4(t.x, t.y, t.z, xf->mirror ? -q.w : q.w);
+}
+
 /* The triangle part of surface_at: point, geometric and interpolated
  * normals, UVs, vertex colour and the tangent (t, w) where `frame`. *t and
- * *w come in as surface_at's defaults and are left alone without a frame. */
-SURFACE_INLINE void triangle_at(const rt_scene *s, uint32_t i, const rt_hit *hit, rt_surface *sf, bool uv, bool frame,
-                               bool emission_only, rt_vec3 *ng_out, rt_vec3 *n_out, rt_vec3 *t_io, float *w_io)
+ * *w come in as surface_at's defaults and are left alone without a frame.
+ * xf: the instance the triangle was hit through (NULL: world geometry);
+ * a mirroring one reverses the winding as flattening does (corners 1 and
+ * 2 swapped, and with them the barycentrics). */
+SURFACE_INLINE void triangle_at(const rt_scene *s, const rt_instance *xf, uint32_t i, const rt_hit *hit,
+                               rt_surface *sf, bool uv, bool frame, bool emission_only, rt_vec3 *ng_out,
+                               rt_vec3 *n_out, rt_vec3 *t_io, float *w_io)
 {
     rt_vec3 ng, n, t = *t_io;
     float w = *w_io;
     const uint32_t *idx = &s->triangles.index[3 * (size_t)i];
+    float bu = hit->u, bv = hit->v;
+    uint32_t swapped[3];
+    if (xf && xf->mirror) {
+        swapped[0] = idx[0], swapped[1] = idx[2], swapped[2] = idx[1];
+        idx = swapped;
+        bu = hit->v, bv = hit->u;
+    }
     const rt_vertices *vx = &s->vertices;
     uint8_t flags = s->triangles.flags[i];
-    rt_vec3 a = vx->position[idx[0]], b = vx->position[idx[1]], c = vx->position[idx[2]];
+    rt_vec3 a = vertex_position(vx, xf, idx[0]), b = vertex_position(vx, xf, idx[1]),
+            c = vertex_position(vx, xf, idx[2]);
     rt_vec3 e1 = rt_sub(b, a), e2 = rt_sub(c, a);
-    float bu = hit->u, bv = hit->v, bw = 1.0f - bu - bv;
+    float bw = 1.0f - bu - bv;
     sf->p = rt_add(rt_add(rt_scale(a, bw), rt_scale(b, bu)), rt_scale(c, bv));
     ng = rt_normalize(rt_cross(e1, e2));
     if (flags & RT_TRI_SMOOTH) {
         /* vertex normals define the outside: turn a triangle wound the
          * other way to agree with them (decided per triangle, so the
          * side never changes across its face) */
-        rt_vec3 nsum = rt_add(rt_add(vx->normal[idx[0]], vx->normal[idx[1]]), vx->normal[idx[2]]);
+        rt_vec3 n0 = vertex_normal(vx, xf, idx[0]), n1 = vertex_normal(vx, xf, idx[1]),
+                n2 = vertex_normal(vx, xf, idx[2]);
+        rt_vec3 nsum = rt_add(rt_add(n0, n1), n2);
         if (rt_dot(nsum, ng) < 0.0f)
             ng = rt_neg(ng);
     }
     n = ng;
     if ((flags & RT_TRI_SMOOTH) && !emission_only) {
-        rt_vec3 ni = rt_add(rt_add(rt_scale(vx->normal[idx[0]], bw), rt_scale(vx->normal[idx[1]], bu)),
-                            rt_scale(vx->normal[idx[2]], bv));
+        rt_vec3 ni = rt_add(rt_add(rt_scale(vertex_normal(vx, xf, idx[0]), bw), rt_scale(vertex_normal(vx, xf, idx[1]), bu)),
+                            rt_scale(vertex_normal(vx, xf, idx[2]), bv));
         if (rt_length2(ni) > 1e-20f && rt_finite3(ni))
             n = rt_normalize(ni);
     }
@@ -148,7 +189,8 @@ SURFACE_INLINE void triangle_at(const rt_scene *s, uint32_t i, const rt_hit *hit
                                  c0.z * bw + c1.z * bu + c2.z * bv, c0.w * bw + c1.w * bu + c2.w * bv);
     }
     if (frame && (flags & RT_TRI_TANGENT)) {
-        rt_vec4 q0 = vx->tangent[idx[0]], q1 = vx->tangent[idx[1]], q2 = vx->tangent[idx[2]];
+        rt_vec4 q0 = vertex_tangent(vx, xf, idx[0]), q1 = vertex_tangent(vx, xf, idx[1]),
+                q2 = vertex_tangent(vx, xf, idx[2]);
         t = rt_v3(q0.x * bw + q1.x * bu + q2.x * bv, q0.y * bw + q1.y * bu + q2.y * bv,
                   q0.z * bw + q1.z * bu + q2.z * bv);
         w = q0.w < 0.0f ? -1.0f : 1.0f;
@@ -184,7 +226,10 @@ SURFACE_INLINE void surface_at(const rt_trace_ctx *ctx, const rt_ray *ray, const
     bool uv = need == NEED_ALL || (needs & RT_MATERIAL_TEXTURED);
     switch (kind) {
     case RT_PRIM_TRIANGLE: {
-        triangle_at(s, i, hit, sf, uv, frame, emission_only, &ng, &n, &t, &w);
+        if (hit->inst == 0) /* world geometry */
+            triangle_at(s, NULL, i, hit, sf, uv, frame, emission_only, &ng, &n, &t, &w);
+        else
+            triangle_at(s, &s->instances[hit->inst - 1], i, hit, sf, uv, frame, emission_only, &ng, &n, &t, &w);
         break;
     }
     case RT_PRIM_SPHERE: {

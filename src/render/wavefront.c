@@ -71,7 +71,7 @@ struct rt_wavefront {
     /* the rays to trace, gathered from the paths, and their hits */
     float *ox, *oy, *oz, *dx, *dy, *dz, *tmin, *tmax;
     float *ht, *hu, *hv;
-    uint32_t *hprim;
+    uint32_t *hprim, *hinst; /* hinst: rt_hit's inst (instances) */
     /* this bounce's light samples: the lane's first record, how many, the
      * throughput they are weighted by */
     uint32_t *rec_first, *rec_count;
@@ -126,7 +126,7 @@ rt_wavefront *rt_wavefront_new(size_t batch, const rt_render_state *state)
                     &wf->hu, &wf->hv, &wf->nbr, &wf->nbg, &wf->nbb};
     for (size_t i = 0; i < sizeof fl / sizeof fl[0]; i++)
         *fl[i] = grab(B, sizeof(float), &ok);
-    uint32_t **u32[] = {&wf->hprim, &wf->out, &wf->rec_first, &wf->rec_count, &wf->active,
+    uint32_t **u32[] = {&wf->hprim, &wf->hinst, &wf->out, &wf->rec_first, &wf->rec_count, &wf->active,
                         &wf->queue, &wf->queue2, &wf->order, &wf->free_lanes};
     for (size_t i = 0; i < sizeof u32 / sizeof u32[0]; i++)
         *u32[i] = grab(B, sizeof(uint32_t), &ok);
@@ -162,7 +162,7 @@ void rt_wavefront_free(rt_wavefront *wf)
     if (!wf)
         return;
     void *all[] = {wf->ps, wf->rng, wf->ox, wf->oy, wf->oz, wf->dx, wf->dy, wf->dz, wf->tmin, wf->tmax, wf->ht,
-                   wf->hu, wf->hv, wf->hprim, wf->status, wf->nee, wf->layers, wf->out, wf->rec_first,
+                   wf->hu, wf->hv, wf->hprim, wf->hinst, wf->status, wf->nee, wf->layers, wf->out, wf->rec_first,
                    wf->rec_count, wf->nbr, wf->nbg, wf->nbb, wf->sf, wf->rec, wf->vis, wf->sox, wf->soy,
                    wf->soz, wf->sdx, wf->sdy, wf->sdz, wf->stmin, wf->stmax, wf->blocked, wf->pending,
                    wf->active, wf->queue, wf->queue2, wf->order, wf->free_lanes};
@@ -211,7 +211,7 @@ static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_acti
     const rt_kdtree *tree = ctx->state->tree;
     const rt_material *materials = ctx->state->scene->materials;
     rt_ray_batch rb = {wf->ox, wf->oy, wf->oz, wf->dx, wf->dy, wf->dz, wf->tmin, wf->tmax};
-    rt_hit_batch hb = {wf->ht, wf->hu, wf->hv, wf->hprim};
+    rt_hit_batch hb = {wf->ht, wf->hu, wf->hv, wf->hprim, wf->hinst};
     uint32_t *q = wf->queue, *q2 = wf->queue2;
     size_t n = n_active;
     for (size_t k = 0; k < n; k++) { /* the rays, gathered */
@@ -235,7 +235,7 @@ static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_acti
                 wf->status[i] = LANE_MISS;
                 continue;
             }
-            rt_hit h = {wf->ht[i], wf->hu[i], wf->hv[i], wf->hprim[i]};
+            rt_hit h = {wf->ht[i], wf->hu[i], wf->hv[i], wf->hprim[i], tree->instance_count ? wf->hinst[i] : 0};
             rt_surface *sf = &wf->sf[i];
             rt_surface_at_shading(ctx, &wf->ps[i].r, &h, sf);
             bool cut = false;

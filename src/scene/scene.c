@@ -4,6 +4,7 @@
 #include "rt/scene/scene.h"
 
 #include "rt/base/alloc.h"
+#include "rt/scene/instance.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -155,6 +156,8 @@ void rt_scene_free(rt_scene *s)
     rt_quads *q = &s->quads;
     free(q->px); free(q->py); free(q->pz); free(q->ux); free(q->uy); free(q->uz);
     free(q->vx); free(q->vy); free(q->vz); free(q->material);
+    free(s->objects);
+    free(s->instances);
     memset(s, 0, sizeof *s);
 }
 
@@ -349,6 +352,8 @@ rt_scene_mark rt_scene_mark_of(const rt_scene *s)
     m.triangles = s->triangles.count;
     m.spheres = s->spheres.count;
     m.quads = s->quads.count;
+    m.objects = s->object_count;
+    m.instances = s->instance_count;
     m.vertex_attrs = (s->vertices.uv1 ? RT_ATTR_UV1 : 0u) | (s->vertices.tangent ? RT_ATTR_TANGENT : 0u) |
                      (s->vertices.color ? RT_ATTR_COLOR : 0u);
     m.camera_set = s->camera_set;
@@ -377,6 +382,8 @@ void rt_scene_rollback(rt_scene *s, const rt_scene_mark *m)
     truncate_to(&s->triangles.count, m->triangles);
     truncate_to(&s->spheres.count, m->spheres);
     truncate_to(&s->quads.count, m->quads);
+    truncate_to(&s->object_count, m->objects);
+    truncate_to(&s->instance_count, m->instances);
     rt_vertices *v = &s->vertices;
     if (!(m->vertex_attrs & RT_ATTR_UV1)) {
         free(v->uv1);
@@ -431,7 +438,10 @@ rt_box rt_scene_bounds(const rt_scene *s)
     rt_box b = rt_box_empty();
     size_t n = rt_scene_prim_count(s);
     for (size_t i = 0; i < n; i++)
-        b = rt_box_union(b, rt_scene_prim_bounds(s, (uint32_t)i));
+        if (i >= s->triangles.count || !(s->triangles.flags[i] & RT_TRI_OBJECT))
+            b = rt_box_union(b, rt_scene_prim_bounds(s, (uint32_t)i));
+    for (size_t i = 0; i < s->instance_count; i++)
+        b = rt_box_union(b, s->instances[i].bounds);
     return b;
 }
 
@@ -447,16 +457,32 @@ static void frame_axes(float aspect, rt_vec3 *dir, rt_vec3 *right, rt_vec3 *up, 
     *up = rt_cross(*right, rt_neg(*dir));
 }
 
-/* Point i of the points the camera must see: the vertices, then the
- * corners of the other primitives' boxes; false when not finite. */
-static bool frame_point(const rt_scene *s, size_t i, rt_vec3 *p)
+/* How many points the camera must see: the vertices, then 8 corners of
+ * each other primitive's box and of each instance's world box. */
+static size_t frame_point_count(const rt_scene *s)
 {
-    size_t nv = s->vertices.count;
+    return s->vertices.count + 8 * (s->spheres.count + s->quads.count + s->instance_count);
+}
+
+/* Point i of those points (i counting up from 0 in one walk: *object is
+ * the walk's cursor over the objects, 0 at the start); false when not
+ * finite or when the vertex is an object's (object space: its instances'
+ * boxes stand for it). */
+static bool frame_point(const rt_scene *s, size_t i, size_t *object, rt_vec3 *p)
+{
+    size_t nv = s->vertices.count, nother = s->spheres.count + s->quads.count;
     if (i < nv) {
+        size_t o = *object; /* loaders add objects' vertices in order */
+        while (o < s->object_count && s->objects[o].first_vertex + s->objects[o].vertex_count <= i)
+            o++;
+        *object = o;
+        if (o < s->object_count && i >= s->objects[o].first_vertex)
+            return false;
         *p = s->vertices.position[i];
     } else {
         size_t k = i - nv;
-        rt_box pb = rt_scene_prim_bounds(s, (uint32_t)(s->triangles.count + k / 8));
+        rt_box pb = k < 8 * nother ? rt_scene_prim_bounds(s, (uint32_t)(s->triangles.count + k / 8))
+                                   : s->instances[(k - 8 * nother) / 8].bounds;
         *p = rt_v3(k & 1 ? pb.hi.x : pb.lo.x, k & 2 ? pb.hi.y : pb.lo.y, k & 4 ? pb.hi.z : pb.lo.z);
     }
     return rt_finite3(*p);
@@ -476,10 +502,10 @@ void rt_frame_extent_add(rt_frame_extent *e, const rt_scene *s)
     float tan_v, tan_h;
     frame_axes(e->aspect, &dir, &right, &up, &tan_v, &tan_h);
     e->bounds = rt_box_union(e->bounds, rt_scene_bounds(s));
-    size_t n = s->vertices.count + 8 * (s->spheres.count + s->quads.count);
+    size_t n = frame_point_count(s), object = 0;
     for (size_t i = 0; i < n; i++) {
         rt_vec3 p;
-        if (!frame_point(s, i, &p))
+        if (!frame_point(s, i, &object, &p))
             continue;
         float z = rt_dot(p, dir), x = rt_dot(p, right) / tan_h, y = rt_dot(p, up) / tan_v;
         e->reach[0] = fmaxf(e->reach[0], z + x);
@@ -537,10 +563,10 @@ void rt_scene_frame_camera(rt_scene *s, float aspect)
     /* the nearest distance at which every vertex (and every corner of the
      * other primitives' boxes) is in view: tighter than fitting the box */
     float dist = 0.0f;
-    size_t n = s->vertices.count + 8 * (s->spheres.count + s->quads.count);
+    size_t n = frame_point_count(s), object = 0;
     for (size_t i = 0; i < n; i++) {
         rt_vec3 p;
-        if (!frame_point(s, i, &p))
+        if (!frame_point(s, i, &object, &p))
             continue;
         rt_vec3 q = rt_sub(p, c);
         float z = rt_dot(q, dir);

@@ -5,6 +5,7 @@
  * them. Linear in the size of the scene.
  */
 #include "rt/scene/validate.h"
+#include "rt/scene/instance.h"
 
 #include "rt/base/alloc.h"
 
@@ -164,12 +165,34 @@ static rt_result check_environment(const rt_scene *s, rt_error *err)
     return RT_OK;
 }
 
+/* Objects lie inside the triangle and vertex tables; instances name an
+ * object and have a usable transform (rt/scene/instance.h). */
+static rt_result check_instances(const rt_scene *s, rt_error *err)
+{
+    for (size_t i = 0; i < s->object_count; i++) {
+        const rt_object *o = &s->objects[i];
+        if (o->first_triangle + o->triangle_count > s->triangles.count ||
+            o->first_vertex + o->vertex_count > s->vertices.count)
+            return rt_fail(err, RT_ERR_INVALID, "object %zu: its triangles or vertices lie past the tables", i);
+    }
+    for (size_t i = 0; i < s->instance_count; i++) {
+        const rt_instance *in = &s->instances[i];
+        if (in->object >= s->object_count)
+            return rt_fail(err, RT_ERR_INVALID, "instance %zu: object %u is out of range (%zu objects)", i, in->object,
+                           s->object_count);
+        rt_instance_check c = rt_instance_check_transform(&in->to_world);
+        if (c != RT_INSTANCE_OK)
+            return rt_fail(err, RT_ERR_INVALID, "instance %zu: its transform is %s", i, rt_instance_check_name(c));
+    }
+    return RT_OK;
+}
+
 rt_result rt_scene_validate(const rt_scene *s, rt_error *err)
 {
     rt_result r;
     if ((r = check_materials(s, err)) != RT_OK || (r = check_textures(s, err)) != RT_OK ||
         (r = check_geometry(s, err)) != RT_OK || (r = check_lights(s, err)) != RT_OK ||
-        (r = check_environment(s, err)) != RT_OK)
+        (r = check_environment(s, err)) != RT_OK || (r = check_instances(s, err)) != RT_OK)
         return r;
     return RT_OK;
 }

@@ -34,6 +34,19 @@
  * coordinates, a zero edge, a zero-area quad, a non-finite sphere) are left
  * out of the tree.
  *
+ * Instances (rt/scene/instance.h): when the scene has some, the build
+ * makes one tree per object over its own triangles (object space, the same
+ * kind of tree) and the tree itself is the top level, over the world
+ * geometry and the instances' world boxes (an instance is a primitive of
+ * it, scene id T + S + Q + instance, after the quads). A ray reaching an
+ * instance in a leaf goes into object space by the instance's inverse (t
+ * is unchanged: the direction is not renormalised) and is traced in the
+ * object's tree; the hit reports the object's triangle (its scene id) and
+ * hit.inst = instance + 1. The packet and stream traversals
+ * (kdtree_packet.h, kdtree_stream.h) do not enter instances: on a tree
+ * with instances, rt_kdtree_intersect_batch and the streams trace ray by
+ * ray, and rt_kdtree_intersect8/16 must not be called.
+ *
  * The tree keeps a pointer to the scene (for spheres) and each quad's
  * prepared test (rt_quad_prep): the scene must outlive it and must not
  * gain or move primitives after the build.
@@ -72,7 +85,7 @@ typedef struct rt_kdtree_stats {
     size_t max_leaf_prims;
     int depth;
     double build_ms;
-    size_t bytes;         /* wide nodes + leaf blocks (ids and triangles) + prepared quads */
+    size_t bytes;         /* wide nodes + leaf blocks (ids and triangles) + prepared quads (+ the objects' trees) */
 } rt_kdtree_stats;
 
 /* Three levels of the binary tree: planes in breadth-first order (0 the top
@@ -117,6 +130,12 @@ typedef struct rt_kdtree {
     rt_box bounds;
     int max_depth;
     rt_kdtree_stats stats;
+    /* instancing: one tree per scene object (object_count, each over a
+     * view of the scene holding only that object's triangles), and the
+     * instances' count; primitive ids past the quads are instances */
+    struct rt_kdtree *objects;
+    struct rt_scene *object_views;
+    size_t object_count, instance_count;
 } rt_kdtree;
 
 rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err);

@@ -15,6 +15,8 @@
  * consecutive rays in the list that share one origin (a pinhole camera's
  * rays, listed pixel by pixel) are traced 8 at a time as packets
  * (rt/accel/kdtree_packet.h): list coherent rays next to each other.
+ * On a tree with instances every ray goes alone (rt_kdtree_intersect), and
+ * hits->inst should be given (rt_hit.inst: which instance, + 1).
  */
 #ifndef RT_KDTREE_BATCH_H
 #define RT_KDTREE_BATCH_H
@@ -36,6 +38,7 @@ typedef struct rt_ray_batch {
 typedef struct rt_hit_batch {
     float *t, *u, *v;
     uint32_t *prim;
+    uint32_t *inst; /* rt_hit's inst, written on a hit; NULL: not wanted (a tree without instances) */
 } rt_hit_batch;
 
 /* Closest hit of rays lanes[0 .. n) (NULL: 0 .. n); returns how many hit. */

@@ -24,7 +24,9 @@ typedef struct rt_ray {
 typedef struct rt_hit {
     float t;
     float u, v;    /* triangle barycentrics of v1, v2; quad (s, t); sphere unused */
-    uint32_t prim; /* primitive id (see scene.h), RT_NONE for a miss */
+    uint32_t prim; /* primitive id (see scene.h), RT_NONE for a miss; on an instance its object's triangle */
+    uint32_t inst; /* 0: prim is world geometry; n > 0: prim was hit through instance n - 1
+                    * (rt/scene/instance.h), so a zeroed hit is never an instance's */
 } rt_hit;
 
 static inline rt_ray rt_ray_make(rt_vec3 org, rt_vec3 dir, float tmin, float tmax)

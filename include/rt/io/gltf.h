@@ -4,7 +4,10 @@
  * JSON is tokenized once, mapped to flat arrays of records (buffers,
  * bufferViews, accessors, meshes, nodes, materials, ...) with index cross
  * references, validated, then flattened into the scene: every triangle
- * primitive of the chosen scene with each node's world transform applied.
+ * primitive of the chosen scene with each node's world transform applied,
+ * except meshes used more than once (two nodes, or EXT_mesh_gpu_instancing),
+ * which are kept once in their own space and placed by instances
+ * (rt/scene/instance.h; docs/gltf.md says which).
  *
  *   rt_gltf_options opt = {0};          // zero = defaults: default scene
  *   if (rt_gltf_load(&scene, "helmet.glb", &opt, &stats, &err) != RT_OK) ...
@@ -43,6 +46,8 @@ typedef struct rt_gltf_options {
     bool animation_optional; /* a file without animations ignores `animation` (the scene format's model
                               * lines take the driver's --animation so) instead of failing */
     rt_gltf_catalog *catalog; /* not NULL: the file's animations and variants appended to it */
+    bool flatten_instances; /* every use of every mesh flattened into world triangles, none kept as an
+                             * object with instances (rt/scene/instance.h): the loader as it was before */
 } rt_gltf_options;
 
 /* What one load added. meshes/primitives count instances (a mesh used by
@@ -52,6 +57,7 @@ typedef struct rt_gltf_options {
  * is scene->cameras[camera_count - cameras]). */
 typedef struct rt_gltf_stats {
     size_t triangles, meshes, primitives, materials, textures, images, cameras, lights, nodes;
+    size_t objects, instances, instanced_triangles; /* meshes kept once, their placements, the triangles placed */
     rt_box bounds;         /* world bounds of the vertices the loaded triangles use */
     bool animated;         /* posed by an animation with channels: another time may give another pose */
 } rt_gltf_stats;

@@ -54,6 +54,7 @@ typedef struct rt_load_options {
     struct rt_gltf_catalog *catalog; /* not NULL: the glTF inputs' animations and variants (rt/io/gltf.h, rt --info) */
     const char *animation_name; /* the animation of this name instead (NULL = by index); a scene file's model lines
                                  * without their own `animation` take it */
+    bool flatten_instances; /* glTF: no objects and instances, every mesh use flattened (rt_gltf_options) */
 } rt_load_options;
 
 /* What one load found (what `rt --info` prints beside the scene's counts). */

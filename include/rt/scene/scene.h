@@ -19,6 +19,14 @@
  * Ids [0, T) are triangles, [T, T+S) spheres, [T+S, T+S+Q) quads, where
  * T, S, Q are the counts at kd-tree build time (see rt_prim_kind()).
  *
+ * Instances (rt/scene/instance.h): an object is a run of triangles (and
+ * their vertices) kept in its own space and flagged RT_TRI_OBJECT; only its
+ * instances, each an affine transform, place it in the world. The kd-tree
+ * gives each object its own tree and puts the instances in the top level;
+ * a hit on an instance names the object's triangle (its id in [0, T)) and
+ * the instance (rt_hit.inst). Everything that reads triangles as world
+ * geometry skips the flagged ones (rt_scene_bounds does).
+ *
  *   rt_scene s;
  *   rt_scene_init(&s);
  *   uint32_t m = rt_scene_add_material(&s, &mat);
@@ -278,6 +286,7 @@ enum rt_triangle_flags {
     RT_TRI_TANGENT = 2, /* vertex tangents are valid */
     RT_TRI_COLOR = 4,   /* vertex colours are valid */
     RT_TRI_UV = 8,      /* vertex UVs are meaningful (else generated) */
+    RT_TRI_OBJECT = 16, /* in an object's own space: placed only by instances (rt/scene/instance.h) */
 };
 
 typedef struct rt_triangles {
@@ -320,6 +329,11 @@ typedef struct rt_scene {
     rt_triangles triangles;
     rt_spheres spheres;
     rt_quads quads;
+
+    /* instancing (rt/scene/instance.h): objects in their own space, and
+     * their placements */
+    struct rt_object *objects;     size_t object_count, object_cap;
+    struct rt_instance *instances; size_t instance_count, instance_cap;
 } rt_scene;
 
 void rt_scene_init(rt_scene *s);
@@ -368,6 +382,7 @@ bool rt_scene_reserve_triangles(rt_scene *s, size_t n);
 typedef struct rt_scene_mark {
     size_t materials, textures, images, lights, cameras;
     size_t vertices, triangles, spheres, quads;
+    size_t objects, instances;
     unsigned vertex_attrs; /* RT_ATTR_* arrays that existed */
     bool camera_set;
     rt_camera camera;
@@ -395,7 +410,9 @@ static inline rt_vec3 rt_tri_vertex(const rt_scene *s, size_t tri, int corner)
 {
     return s->vertices.position[s->triangles.index[3 * tri + (size_t)corner]];
 }
-/* World bounds of one primitive, and of the whole scene (primitives only). */
+/* Bounds of one primitive (an object's triangle: in its object's space),
+ * and the world bounds of the whole scene (primitives and instances; not
+ * the objects' own triangles). */
 rt_box rt_scene_prim_bounds(const rt_scene *s, uint32_t prim);
 rt_box rt_scene_bounds(const rt_scene *s);
 

@@ -1,0 +1,160 @@
+/* kdtree_instances.c - the bottom level of an instanced kd-tree
+ * (rt/accel/kdtree.h, "Instances"): one tree per scene object over its own
+ * triangles in object space, and a ray's visit to an instance.
+ *
+ * Two-level acceleration as pbrt (TransformedPrimitive over a shared
+ * aggregate, Pharr, Jakob and Humphreys, "Physically Based Rendering", 4th
+ * ed., section 7.1.4) and Embree's instances do it: the top level's leaves
+ * hold instances beside ordinary primitives; a ray that reaches one is
+ * moved into the object's space by the inverse transform, traced in the
+ * object's tree over the same (tmin, closest so far) interval, and its hit
+ * is reported with the instance. The direction is transformed but not
+ * renormalised, so t means the same distance along the ray in both spaces
+ * and the closest hit over all instances is a plain comparison of t.
+ *
+ * Each object's tree is built over a view of the scene (a copy of the
+ * scene record whose triangle arrays start at the object's first triangle
+ * and hold only its triangles, no spheres, quads or instances), so the
+ * ordinary build and traversal run unchanged; the view's triangle id plus
+ * the object's first triangle is the scene's id. Objects too small for the
+ * build to fork (under KD_OBJECT_ALONE triangles) are built side by side,
+ * one object a thread, each on one thread; larger ones one after another,
+ * each on all threads (the build forks inside). A tree is the same for any
+ * thread count, so the result does not depend on the split.
+ */
+#include "kdtree_internal.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rt/base/alloc.h"
+#include "rt/base/cpu.h"
+#include "rt/scene/instance.h"
+
+/* Objects below this many triangles are built one a thread (the build
+ * forks only at KD_FORK_MIN_PRIMS, kdtree_build.c). */
+#define KD_OBJECT_ALONE 4096
+
+/* The small objects' builds: each worker takes the next one. */
+typedef struct kd_object_jobs {
+    rt_kdtree *trees;
+    const rt_scene *views;
+    const rt_kdtree_params *params; /* threads = 1 */
+    size_t count;
+    atomic_size_t next;
+    rt_result *results; /* per object */
+    rt_error *errors;   /* per object */
+} kd_object_jobs;
+
+static void *build_small_objects(void *arg)
+{
+    kd_object_jobs *j = arg;
+    for (;;) {
+        size_t o = atomic_fetch_add(&j->next, 1);
+        if (o >= j->count)
+            return NULL;
+        if (j->views[o].triangles.count < KD_OBJECT_ALONE)
+            j->results[o] = rt_kdtree_build(&j->trees[o], &j->views[o], j->params, &j->errors[o]);
+    }
+}
+
+/* The view of object o: the scene with only its triangles. */
+static void object_view(rt_scene *v, const rt_scene *scene, const rt_object *ob)
+{
+    *v = *scene;
+    v->triangles.index = scene->triangles.index + 3 * ob->first_triangle;
+    v->triangles.material = scene->triangles.material + ob->first_triangle;
+    v->triangles.flags = scene->triangles.flags + ob->first_triangle;
+    v->triangles.count = v->triangles.cap = ob->triangle_count;
+    memset(&v->spheres, 0, sizeof v->spheres);
+    memset(&v->quads, 0, sizeof v->quads);
+    v->objects = NULL;
+    v->object_count = v->object_cap = 0;
+    v->instances = NULL;
+    v->instance_count = v->instance_cap = 0;
+}
+
+rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
+{
+    size_t n = scene->object_count;
+    tree->objects = rt_alloc(n, sizeof *tree->objects);
+    tree->object_views = rt_alloc(n, sizeof *tree->object_views);
+    rt_result *results = rt_alloc(n, sizeof *results);
+    rt_error *errors = rt_alloc(n, sizeof *errors);
+    if (!tree->objects || !tree->object_views || !results || !errors) {
+        free(results);
+        free(errors);
+        rt_kd_free_objects(tree);
+        return rt_fail(err, RT_ERR_NOMEM, "kdtree: out of memory for the trees of %zu instanced objects", n);
+    }
+    memset(tree->objects, 0, n * sizeof *tree->objects);
+    for (size_t o = 0; o < n; o++) {
+        object_view(&tree->object_views[o], scene, &scene->objects[o]);
+        results[o] = RT_OK;
+    }
+    tree->object_count = n; /* every tree zeroed or built: rt_kd_free_objects frees either */
+    int threads = params && params->threads > 0 ? params->threads : rt_cpu_count();
+    if (threads < 1)
+        threads = 1;
+    if (threads > 64)
+        threads = 64;
+    rt_kdtree_params one = params ? *params : (rt_kdtree_params){0};
+    one.threads = 1;
+    kd_object_jobs jobs = {tree->objects, tree->object_views, &one, n, 0, results, errors};
+    pthread_t th[64];
+    int started = 0;
+    for (int t = 1; t < threads && (size_t)t < n; t++) /* this thread is the first worker */
+        if (pthread_create(&th[started], NULL, build_small_objects, &jobs) == 0)
+            started++;
+    build_small_objects(&jobs);
+    for (int t = 0; t < started; t++)
+        pthread_join(th[t], NULL);
+    for (size_t o = 0; o < n; o++) /* the large ones, each forking on all threads */
+        if (tree->object_views[o].triangles.count >= KD_OBJECT_ALONE)
+            results[o] = rt_kdtree_build(&tree->objects[o], &tree->object_views[o], params, &errors[o]);
+    rt_result r = RT_OK;
+    for (size_t o = 0; o < n && r == RT_OK; o++)
+        if (results[o] != RT_OK) {
+            r = results[o];
+            if (err)
+                *err = errors[o];
+        }
+    free(results);
+    free(errors);
+    if (r != RT_OK)
+        rt_kd_free_objects(tree);
+    return r;
+}
+
+void rt_kd_free_objects(rt_kdtree *tree)
+{
+    for (size_t o = 0; o < tree->object_count; o++)
+        rt_kdtree_free(&tree->objects[o]);
+    free(tree->objects);
+    free(tree->object_views);
+    tree->objects = NULL;
+    tree->object_views = NULL;
+    tree->object_count = 0;
+}
+
+bool rt_kd_instance_hit(const rt_kdtree *tree, uint32_t i, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit,
+                        bool any)
+{
+    const rt_instance *in = &tree->scene->instances[i];
+    const rt_mat4 *m = &in->to_object;
+    rt_ray r = rt_ray_make(rt_mat4_point(m, ray->org), rt_mat4_vector(m, ray->dir), ray->tmin, *best);
+    if (any)
+        return rt_kdtree_occluded(&tree->objects[in->object], &r);
+    rt_hit h;
+    if (!rt_kdtree_intersect(&tree->objects[in->object], &r, &h) || !(h.t < *best))
+        return false;
+    *best = h.t;
+    hit->t = h.t;
+    hit->u = h.u;
+    hit->v = h.v;
+    hit->prim = id;
+    hit->inst = h.prim + (uint32_t)tree->scene->objects[in->object].first_triangle;
+    return true;
+}
