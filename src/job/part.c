@@ -23,6 +23,7 @@
 #include "rt/io/exr.h"
 #include "rt/io/image_read.h"
 #include "rt/io/json.h"
+#include "rt/job/options.h"
 #include "rt/render/aov.h"
 
 #define SIDECAR_MAX_BYTES (1u << 20)
@@ -299,6 +300,13 @@ static bool float_text(const char *s, float *out)
     return end != s && *end == 0 && isfinite(*out);
 }
 
+/* The AOVs a part carries as layers (what rt_part_job writes): the sums
+ * of albedo, normal, depth and position; not variance or spp. */
+static bool layer_kind_ok(rt_aov_kind k)
+{
+    return k == RT_AOV_ALBEDO || k == RT_AOV_NORMAL || k == RT_AOV_DEPTH || k == RT_AOV_POSITION;
+}
+
 /* The sidecar's fields into info; the image hashes into the rest. */
 static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *image_hash, uint64_t *count_hash,
                               uint64_t *block_hash, bool *has_count, rt_error *err)
@@ -388,13 +396,17 @@ static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *im
     if (r == RT_OK && li >= 0) {
         if (j.tok[li].type != RT_JSON_ARRAY || j.tok[li].size > RT_PART_MAX_LAYERS)
             r = bad(err, side, "\"layers\" must be an array of at most 4 [name, channels] pairs");
-        int e = li + 1;
+        int e = li + 1, last = -1;
         for (int k = 0; r == RT_OK && k < j.tok[li].size; k++, e = rt_json_skip(&j, e)) {
             double ch = 0;
+            rt_aov_kind kind = RT_AOV_COUNT;
             if (j.tok[e].type != RT_JSON_ARRAY || j.tok[e].size != 2 ||
                 rt_json_string(&j, e + 1, info->layer_name[k], sizeof info->layer_name[k]) <= 0 ||
-                strchr(info->layer_name[k], '.') || !rt_json_number(&j, e + 2, &ch) || (ch != 1 && ch != 3))
-                r = bad(err, side, "\"layers\" entries must be [\"name\", 1 or 3]");
+                !rt_aov_by_name(info->layer_name[k], strlen(info->layer_name[k]), &kind) || !layer_kind_ok(kind) ||
+                (int)kind <= last || !rt_json_number(&j, e + 2, &ch) || ch != (kind == RT_AOV_DEPTH ? 1 : 3))
+                r = bad(err, side, "\"layers\" entries must be [\"albedo\", 3], [\"normal\", 3], [\"depth\", 1] or "
+                                   "[\"position\", 3], each at most once and in that order");
+            last = (int)kind;
             info->layer_channels[k] = (int)ch;
             info->layer_count = k + 1;
         }
@@ -419,9 +431,11 @@ static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *im
 }
 
 /* The image at path, checked against its hash: an EXR's `count` named
- * channels, else a PFM's three. */
-static rt_result read_image(const char *path, uint64_t want, bool exr, const char *const *names, int count,
-                            float **px, int *w, int *h, rt_error *err)
+ * channels, else a PFM's three. An EXR's header may not claim more than
+ * the sidecar's region (rw x rh) before pixels are allocated; a PFM's
+ * size is checked against its bytes by rt_pfm_read. */
+static rt_result read_image(const char *path, uint64_t want, bool exr, const char *const *names, int count, int rw,
+                            int rh, float **px, int *w, int *h, rt_error *err)
 {
     char *bytes;
     size_t size;
@@ -436,7 +450,9 @@ static rt_result read_image(const char *path, uint64_t want, bool exr, const cha
                        path);
     }
     if (exr) {
-        r = rt_exr_decode_channels(bytes, size, path, 32768, 1ull << 30, names, count, px, w, h, err);
+        r = rt_exr_decode_channels_sized(bytes, size, path, rw, rh, names, count, px, err);
+        *w = rw;
+        *h = rh;
         free(bytes);
         return r;
     }
@@ -496,7 +512,7 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
                      info->layer_channels[k] == 1 ? "Y" : c == 0 ? "R" : c == 1 ? "G" : "B");
             names[nc] = names_buf[nc];
         }
-    r = read_image(image, image_hash, exr, names, nc, &px, &w, &h, err);
+    r = read_image(image, image_hash, exr, names, nc, rw, rh, &px, &w, &h, err);
     if (r == RT_OK && (w != rw || h != rh))
         r = rt_fail(err, RT_ERR_INVALID, "%s: the image is %dx%d but its sidecar's region is %dx%d", image, w, h, rw,
                     rh);
@@ -509,8 +525,8 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
             r = rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
             break;
         }
-        r = read_image(file, k < 0 ? count_hash : block_hash[k], false, NULL, 0, k < 0 ? &cpx : &bpx[k], &cw, &ch,
-                       err);
+        r = read_image(file, k < 0 ? count_hash : block_hash[k], false, NULL, 0, rw, rh, k < 0 ? &cpx : &bpx[k], &cw,
+                       &ch, err);
         if (r == RT_OK && (cw != rw || ch != rh))
             r = rt_fail(err, RT_ERR_INVALID, "%s: the image is %dx%d but its sidecar's region is %dx%d", file, cw,
                         ch, rw, rh);
@@ -603,8 +619,20 @@ static void first_difference(const char *x, const char *y, char *a, char *b, siz
     a[0] = b[0] = 0;
 }
 
+/* The first layer whose name or channel count differs (the whole layout a
+ * merge reads: names alone let a 1-channel layer be read as 3), or -1. */
+static int layout_difference(const rt_part_info *a, const rt_part_info *b)
+{
+    for (int k = 0; k < a->layer_count && k < RT_PART_MAX_LAYERS; k++)
+        if (a->layer_channels[k] != b->layer_channels[k] ||
+            strncmp(a->layer_name[k], b->layer_name[k], sizeof a->layer_name[k]) != 0)
+            return k;
+    return -1;
+}
+
 const char *rt_part_mismatch(const rt_part_info *a, const rt_part_info *b, char *buf, size_t size)
 {
+    int k;
     if (strcmp(a->version, b->version) != 0)
         snprintf(buf, size, "rendered by rt %s, not rt %s", a->version, b->version);
     else if (a->scene_hash != b->scene_hash)
@@ -616,10 +644,12 @@ const char *rt_part_mismatch(const rt_part_info *a, const rt_part_info *b, char 
         snprintf(buf, size, "%d samples per pixel, not %d", a->spp, b->spp);
     else if (a->seed != b->seed)
         snprintf(buf, size, "seed %u, not %u", (unsigned)a->seed, (unsigned)b->seed);
-    else if (a->layer_count != b->layer_count ||
-             memcmp(a->layer_name, b->layer_name, sizeof a->layer_name) != 0)
+    else if (a->layer_count != b->layer_count)
         snprintf(buf, size, "other AOVs (%d layer%s, not %d)", a->layer_count, a->layer_count == 1 ? "" : "s",
                  b->layer_count);
+    else if ((k = layout_difference(a, b)) >= 0)
+        snprintf(buf, size, "other AOVs (layer %d is %s of %d channel%s, not %s of %d)", k + 1, a->layer_name[k],
+                 a->layer_channels[k], a->layer_channels[k] == 1 ? "" : "s", b->layer_name[k], b->layer_channels[k]);
     else if (strcmp(a->settings, b->settings) != 0) {
         char x[256], y[256];
         first_difference(a->settings, b->settings, x, y, sizeof x);
