@@ -85,18 +85,22 @@ static int write_result(run *rn, rt_result r, rt_error *err)
     if (reason)
         snprintf(why, sizeof why, ", %s", reason);
     bool stopped = r == RT_ERR_INTERRUPTED || rs.time_limited;
-    char partial[1100], what[160];
+    char partial[1100], what[160], said[2][1400] = {"", ""};
     const char *target = output;
+    /* every file of the result (the image or part, its AOV files or sidecar,
+     * --part-out's part) into one batch: none replaces an earlier file
+     * unless all were written */
+    rt_write_batch batch;
+    rt_write_batch_init(&batch, rn->sig->temp);
     if (pj->to_part) {
         if (rs.partial) {
             fprintf(stderr, "rt: stopped before any %s finished (%s); no part written, %s left as it was%s\n",
                     rs.passes ? "pass" : "tile", reason ? reason : "?", output,
                     rs.passes ? "" : " (a tiled part keeps nothing when stopped: render parts in --passes N)");
-        } else if (rt_part_job_write(pj, output, rs.samples_done, rn->sig->temp, err) != RT_OK) {
-            memory_budget_report(err, &a->budget);
+        } else if (rt_part_job_write(pj, output, rs.samples_done, &batch, err) != RT_OK) {
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
-            fprintf(stderr, "rt: wrote %s and %s.json: part [%d, %d) x [%d, %d) of %dx%d, samples %d:%d of %d%s; "
+            snprintf(said[0], sizeof said[0], "rt: wrote %s and %s.json: part [%d, %d) x [%d, %d) of %dx%d, samples %d:%d of %d%s; "
                             "%.2f s (render %.2f s)\n",
                     output, output, pj->region.x0, pj->region.x1, pj->region.y0, pj->region.y1, set->width,
                     set->height, pj->part_begin, pj->s_begin + rs.samples_done, set->samples, why,
@@ -114,11 +118,10 @@ static int write_result(run *rn, rt_result r, rt_error *err)
         if (rs.partial && rs.tiles_done == 0) {
             fprintf(stderr, "rt: stopped before any %s finished (%s); nothing written, %s left as it was\n",
                     rs.passes ? "pass" : "tile", reason ? reason : "?", output);
-        } else if (rt_job_output_write(&rn->jo, set, fb, aov, target, rn->sig->temp, err) != RT_OK) {
-            memory_budget_report(err, &a->budget);
+        } else if (rt_job_output_write(&rn->jo, set, fb, aov, target, &batch, err) != RT_OK) {
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
-            fprintf(stderr, "rt: wrote %s: %dx%d, %s; %.2f s (render %.2f s)%s%s%s\n", target, fb->width, fb->height,
+            snprintf(said[0], sizeof said[0], "rt: wrote %s: %dx%d, %s; %.2f s (render %.2f s)%s%s%s\n", target, fb->width, fb->height,
                     what, rt_now_seconds() - rn->t_start, rs.seconds, rs.partial ? "; " : "", rs.partial ? output : "",
                     rs.partial ? " left as it was" : "");
         }
@@ -128,13 +131,22 @@ static int write_result(run *rn, rt_result r, rt_error *err)
             fprintf(stderr, "rt: %s: no part written: %s\n", a->part_out,
                     rs.passes ? "no pass finished"
                               : "a render in tiles keeps no part when stopped (--passes 0 asked for tiles)");
-        else if (rt_part_job_write(pj, a->part_out, rs.samples_done, rn->sig->temp, err) != RT_OK) {
-            memory_budget_report(err, &a->budget);
+        else if (rt_part_job_write(pj, a->part_out, rs.samples_done, &batch, err) != RT_OK)
             status = 2;
-        } else if (a->log_level >= RT_LOG_NORMAL || stopped)
-            fprintf(stderr, "rt: wrote %s and %s.json: samples %d:%d of %d\n", a->part_out, a->part_out,
+        else if (a->log_level >= RT_LOG_NORMAL || stopped)
+            snprintf(said[1], sizeof said[1], "rt: wrote %s and %s.json: samples %d:%d of %d\n", a->part_out, a->part_out,
                     pj->part_begin, pj->s_begin + rs.samples_done, set->samples);
     }
+    if (status == 2)
+        rt_write_batch_discard(&batch);
+    else if (rt_write_batch_commit(&batch, err) != RT_OK)
+        status = 2;
+    if (status == 2) {
+        memory_budget_report(err, &a->budget);
+        return 2;
+    }
+    fputs(said[0], stderr);
+    fputs(said[1], stderr);
     return status;
 }
 

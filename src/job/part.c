@@ -70,11 +70,12 @@ bool rt_part_blocks_ok(int s_begin, int s_end, int first, int count)
     return count == 1 || (long long)first * RT_SAMPLE_BLOCK == s_begin;
 }
 
-static rt_result hash_file(const char *path, uint64_t *h, rt_error *err)
+/* The hash of a file written in batch b, read back before it is renamed into place. */
+static rt_result hash_file(const rt_write_batch *b, const char *path, uint64_t *h, rt_error *err)
 {
     char *bytes;
     size_t size;
-    rt_result r = rt_read_file(path, 0, &bytes, &size, err);
+    rt_result r = rt_write_batch_read(b, path, &bytes, &size, err);
     if (r != RT_OK)
         return r;
     *h = rt_fnv1a64(bytes, size, RT_FNV1A64_INIT);
@@ -135,8 +136,44 @@ static void put_string(text *t, const char *s)
     put(t, "\"");
 }
 
+static rt_result write_files(const char *path, const rt_part_info *info, const float *sum,
+                             const float *const *blocks, const uint32_t *good, const float *const *layers,
+                             rt_write_batch *batch, rt_error *err);
+
+rt_result rt_part_check_paths(const char *path, rt_error *err)
+{
+    char side[4200], cpath[4200];
+    if (!rt_part_path_ok(path))
+        return rt_fail(err, RT_ERR_INVALID, "%s: a part is written as .exr or .pfm", path);
+    if (!rt_part_sidecar_path(path, side, sizeof side) || !count_path(path, cpath, sizeof cpath))
+        return rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
+    rt_result r = rt_output_check(path, err);
+    if (r == RT_OK)
+        r = rt_output_check_file(side, err);
+    if (r == RT_OK && rt_path_has_ext(path, ".pfm"))
+        r = rt_output_check_file(cpath, err);
+    return r;
+}
+
 rt_result rt_part_write(const char *path, const rt_part_info *info, const float *sum, const float *const *blocks,
-                        const uint32_t *good, const float *const *layers, rt_write_temp *temp, rt_error *err)
+                        const uint32_t *good, const float *const *layers, rt_write_batch *batch, rt_error *err)
+{
+    if (batch)
+        return write_files(path, info, sum, blocks, good, layers, batch, err);
+    rt_write_batch own;
+    rt_write_batch_init(&own, NULL);
+    rt_result r = write_files(path, info, sum, blocks, good, layers, &own, err);
+    if (r != RT_OK) {
+        rt_write_batch_discard(&own);
+        return r;
+    }
+    return rt_write_batch_commit(&own, err);
+}
+
+/* Every file of the part into the batch: the image(s), then the sidecar. */
+static rt_result write_files(const char *path, const rt_part_info *info, const float *sum,
+                             const float *const *blocks, const uint32_t *good, const float *const *layers,
+                             rt_write_batch *batch, rt_error *err)
 {
     char side[4200], cpath[4200], bpath[4200];
     if (!rt_part_path_ok(path))
@@ -174,7 +211,7 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
         for (int k = 0; k < info->layer_count; k++)
             layer[nl++] = (rt_image_layer){info->layer_name[k], info->layer_channels[k], layers[k]};
         rt_image_options opt = {.layers = layer, .layer_count = nl};
-        r = rt_framebuffer_write_tracked(&fb, path, &opt, temp, err);
+        r = rt_framebuffer_write_batched(&fb, path, &opt, batch, err);
     } else {
         float *grey = rt_alloc(n, 3 * sizeof(float));
         if (!grey) {
@@ -185,23 +222,23 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
             grey[3 * i] = grey[3 * i + 1] = grey[3 * i + 2] = counts[i];
         rt_framebuffer cfb = {w, h, grey};
         rt_image_options opt = {0};
-        r = rt_framebuffer_write_tracked(&cfb, cpath, &opt, temp, err);
+        r = rt_framebuffer_write_batched(&cfb, cpath, &opt, batch, err);
         free(grey);
         if (r == RT_OK)
-            r = hash_file(cpath, &count_hash, err);
+            r = hash_file(batch, cpath, &count_hash, err);
         for (int k = 0; k < bcount && r == RT_OK; k++) {
             rt_framebuffer bfb = {w, h, (float *)blocks[k]};
             block_path(path, bfirst + k, bpath, sizeof bpath);
-            r = rt_framebuffer_write_tracked(&bfb, bpath, &opt, temp, err);
+            r = rt_framebuffer_write_batched(&bfb, bpath, &opt, batch, err);
             if (r == RT_OK)
-                r = hash_file(bpath, &block_hash[k], err);
+                r = hash_file(batch, bpath, &block_hash[k], err);
         }
         if (r == RT_OK)
-            r = rt_framebuffer_write_tracked(&fb, path, &opt, temp, err);
+            r = rt_framebuffer_write_batched(&fb, path, &opt, batch, err);
     }
     free(counts);
     if (r == RT_OK)
-        r = hash_file(path, &image_hash, err);
+        r = hash_file(batch, path, &image_hash, err);
     if (r != RT_OK)
         return r;
 
@@ -240,7 +277,7 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
         free(t.buf);
         return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the sidecar", side);
     }
-    r = rt_file_write_atomic(side, t.buf, t.len, temp, err);
+    r = rt_file_write_batched(side, t.buf, t.len, batch, err);
     free(t.buf);
     return r;
 }
