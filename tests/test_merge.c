@@ -195,6 +195,26 @@ static void test_part_image_bounded_by_sidecar(void **state)
                         "the image is 64x64, not the 2x2 expected");
 }
 
+/* A sidecar's hashes are exactly 16 hex digits: strtoull took a sign,
+ * blanks and "0x", so " -0x00000000001" passed for a hash. */
+static void test_sidecar_hashes_strict(void **state)
+{
+    (void)state;
+    write_part(in_dir("h.exr"), 4, 2, 0, 0, 4, 2, 0, NULL, NULL);
+    edit_sidecar(in_dir("h.exr"), "\"scene_fnv1a64\": \"0000000000000001\"", "\"scene_fnv1a64\": \"-x00000000000001\"");
+    rt_part p;
+    rt_error err = {0};
+    test_expect_failure(rt_part_read(in_dir("h.exr"), &p, &err), &err, RT_ERR_INVALID, "h.exr.json",
+                        "\"scene_fnv1a64\" missing or not 16 hex digits");
+    edit_sidecar(in_dir("h.exr"), "\"scene_fnv1a64\": \"-x00000000000001\"", "\"scene_fnv1a64\": \" 0x0000000000001\"");
+    test_expect_failure(rt_part_read(in_dir("h.exr"), &p, &err), &err, RT_ERR_INVALID, "h.exr.json",
+                        "\"scene_fnv1a64\" missing or not 16 hex digits");
+    edit_sidecar(in_dir("h.exr"), "\"scene_fnv1a64\": \" 0x0000000000001\"", "\"scene_fnv1a64\": \"000000000000000F\"");
+    assert_int_equal(rt_part_read(in_dir("h.exr"), &p, &err), RT_OK);
+    assert_true(p.info.scene_hash == 15);
+    rt_part_free(&p);
+}
+
 /* Sidecars may claim a 30000x30000 image around one pixel of data: refused
  * before the image (and an int a pixel for the gap report) is allocated. */
 static void test_cover_checked_before_allocating(void **state)
@@ -296,6 +316,7 @@ int main(void)
         cmocka_unit_test(test_exr_channel_twice_refused),
         cmocka_unit_test(test_part_image_bounded_by_sidecar),
         cmocka_unit_test(test_cover_checked_before_allocating),
+        cmocka_unit_test(test_sidecar_hashes_strict),
         cmocka_unit_test(test_key_index_linear),
         cmocka_unit_test(test_thousands_of_parts),
     };

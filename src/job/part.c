@@ -305,13 +305,27 @@ static bool get_string(const rt_json *j, int obj, const char *key, char *out, si
     return i >= 0 && rt_json_string(j, i, out, cap) >= 0;
 }
 
+/* Exactly 16 hex digits (strtoull alone takes blanks, a sign and "0x"). */
+static bool hex16(const char *s, uint64_t *out)
+{
+    uint64_t v = 0;
+    for (int i = 0; i < 16; i++) {
+        char c = s[i];
+        int d = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+        if (d < 0)
+            return false;
+        v = v << 4 | (uint64_t)d;
+    }
+    if (s[16] != 0)
+        return false;
+    *out = v;
+    return true;
+}
+
 static bool get_hash(const rt_json *j, int obj, const char *key, uint64_t *out)
 {
-    char s[32], *end;
-    if (!get_string(j, obj, key, s, sizeof s) || strlen(s) != 16)
-        return false;
-    *out = strtoull(s, &end, 16);
-    return *end == 0;
+    char s[32];
+    return get_string(j, obj, key, s, sizeof s) && hex16(s, out);
 }
 
 /* An array of n integers in [lo, hi]. */
@@ -424,8 +438,8 @@ static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *im
         if (bi < 0 || j.tok[bi].type != RT_JSON_ARRAY || j.tok[bi].size != blk[1])
             r = bad(err, side, "\"block_fnv1a64\" must list a hash for each block");
         for (int k = 0, e = bi + 1; r == RT_OK && k < blk[1]; k++, e = rt_json_skip(&j, e)) {
-            char hex[32], *end;
-            if (rt_json_string(&j, e, hex, sizeof hex) != 16 || (block_hash[k] = strtoull(hex, &end, 16), *end != 0))
+            char hex[32];
+            if (rt_json_string(&j, e, hex, sizeof hex) != 16 || !hex16(hex, &block_hash[k]))
                 r = bad(err, side, "\"block_fnv1a64\" entries must be 16 hex digits");
         }
     }
