@@ -645,6 +645,17 @@ static void test_rt_compare(void **state)
     assert_int_equal(res.status, 2);
     res = run_compare(cand, ref, "--max-rmse", "x", NULL);
     assert_int_equal(res.status, 2);
+    /* the one number syntax of every flag: no hexadecimal, blanks or signs of infinity */
+    static const char *const not_numbers[] = {"0x1p-3", " 0.5", "0.5 ", "inf", "1e999", "+0x10", ".", "1e"};
+    for (size_t i = 0; i < sizeof not_numbers / sizeof not_numbers[0]; i++) {
+        res = run_compare(cand, ref, "--max-rmse", not_numbers[i], NULL);
+        if (res.status != 2)
+            fail_msg("--max-rmse '%s' was taken (status %d)", not_numbers[i], res.status);
+        res = run_compare(cand, ref, "--ppd", not_numbers[i], NULL);
+        assert_int_equal(res.status, 2);
+    }
+    res = run_compare(cand, ref, "--max-rmse", "1e3", "--ppd", "3.0e1", NULL);
+    assert_int_equal(res.status, 0);
     res = run_compare(cand, ref, "--ppd", "0", NULL);
     assert_int_equal(res.status, 2);
     res = run_compare(cand, ref, "--max-flip", NULL);

@@ -246,6 +246,69 @@ static void test_schema_ranges(void **state)
     }
 }
 
+/* Issue 25, class 6, the audit: the rest of every extension's (and the
+ * core's extension-like objects') schema ranges. Loads `members` into a
+ * minimal document; a refusal must name the file, a byte and `what`. */
+static void expect_range_refused(const char *members, const char *what, int i)
+{
+    char text[1024], path[512];
+    snprintf(text, sizeof text, "{\"asset\": {\"version\": \"2.0\"}, %s}", members);
+    snprintf(path, sizeof path, "%s/audit%d.gltf", tmp_dir, i);
+    test_write_file(path, text, strlen(text));
+    rt_scene s;
+    rt_error err;
+    bool warned;
+    rt_result r = load_quiet(path, &s, &err, &warned, false);
+    if (what && (r != RT_ERR_INVALID || !strstr(err.message, path) || !strstr(err.message, ": byte ") ||
+                 !strstr(err.message, what)))
+        fail_msg("%s: got %s \"%s\", wanted \"%s\"", members, rt_result_name(r), err.message, what);
+    if (!what && r != RT_OK)
+        fail_msg("%s: %s", members, err.message);
+    rt_scene_free(&s);
+}
+
+static void test_schema_ranges_audit(void **state)
+{
+    (void)state;
+#define LIGHT(x) "\"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", " x "}]}}"
+#define CAMERA(x) "\"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 1, " x "}}]"
+#define MATERIAL(ext, x) "\"materials\": [{\"extensions\": {\"" ext "\": {" x "}}}]"
+    static const struct {
+        const char *members, *what;
+    } cases[] = {
+        /* KHR_lights_punctual: range exclusiveMinimum 0 */
+        {LIGHT("\"range\": 0"), "KHR_lights_punctual.lights[0].range must be greater than 0"},
+        {LIGHT("\"range\": 0.001"), NULL},
+        /* camera.perspective: aspectRatio, znear, zfar exclusiveMinimum 0; zfar > znear */
+        {CAMERA("\"znear\": 0"), "cameras[0].perspective.znear 0 must be greater than 0"},
+        {CAMERA("\"znear\": 0.1, \"aspectRatio\": -1.5"), "cameras[0].perspective.aspectRatio -1.5 must be greater"},
+        {CAMERA("\"znear\": 0.1, \"zfar\": 0.05"), "cameras[0].perspective.zfar 0.05 must be greater than znear 0.1"},
+        {CAMERA("\"znear\": 0.1, \"zfar\": 100, \"aspectRatio\": 1.5"), NULL},
+        /* sampler.minFilter: the six values of the enum */
+        {"\"samplers\": [{\"minFilter\": 1234}]", "samplers[0]: minFilter 1234 is not"},
+        {"\"samplers\": [{\"minFilter\": 9987, \"magFilter\": 9728}]", NULL},
+        /* the PBR-next extensions */
+        {MATERIAL("KHR_materials_clearcoat", "\"clearcoatFactor\": 1.5"), "clearcoatFactor 1.5 is outside [0, 1]"},
+        {MATERIAL("KHR_materials_specular", "\"specularColorFactor\": [1, -1, 1]"),
+         "specularColorFactor component 1 (-1) is outside"},
+        {MATERIAL("KHR_materials_specular", "\"specularColorFactor\": [2, 3, 4]"), NULL}, /* minimum 0, no maximum */
+        {MATERIAL("KHR_materials_sheen", "\"sheenRoughnessFactor\": -0.5"), "sheenRoughnessFactor -0.5 is outside"},
+        {MATERIAL("KHR_materials_anisotropy", "\"anisotropyStrength\": 2"), "anisotropyStrength 2 is outside"},
+        {MATERIAL("KHR_materials_iridescence", "\"iridescenceIor\": 0.9"), "iridescenceIor 0.9 is outside"},
+        {MATERIAL("KHR_materials_iridescence", "\"iridescenceThicknessMinimum\": -1"),
+         "iridescenceThicknessMinimum -1 is outside"},
+        {MATERIAL("KHR_materials_dispersion", "\"dispersion\": -0.1"), "dispersion -0.1 is outside"},
+        {MATERIAL("KHR_materials_diffuse_transmission", "\"diffuseTransmissionColorFactor\": [1, 1, 1.5]"),
+         "diffuseTransmissionColorFactor component 2 (1.5) is outside [0, 1]"},
+        {MATERIAL("KHR_materials_volume", "\"attenuationDistance\": 0"), "attenuationDistance must be positive"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+        expect_range_refused(cases[i].members, cases[i].what, (int)i);
+#undef LIGHT
+#undef CAMERA
+#undef MATERIAL
+}
+
 /* Renders a generated file at W x H with the path tracer. */
 enum { W = 96, H = 48 };
 static void render_file(const char *path, rt_framebuffer *fb)
@@ -490,6 +553,7 @@ int main(void)
         cmocka_unit_test(test_parse_generated),
         cmocka_unit_test(test_refused),
         cmocka_unit_test(test_schema_ranges),
+        cmocka_unit_test(test_schema_ranges_audit),
         cmocka_unit_test(test_render_generated),
         cmocka_unit_test(test_variants),
         cmocka_unit_test(test_shared_models),

@@ -206,3 +206,13 @@ bool rt_same_file(const char *a, const char *b)
     struct stat sa, sb;
     return a && b && stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
+
+bool rt_file_id(const char *path, uint64_t id[2])
+{
+    struct stat st;
+    if (!path || stat(path, &st) != 0)
+        return false;
+    id[0] = (uint64_t)st.st_dev;
+    id[1] = (uint64_t)st.st_ino;
+    return true;
+}

@@ -68,3 +68,18 @@ rt_number_status rt_parse_float(const char *s, float *out)
     *out = (float)d;
     return RT_NUMBER_OK;
 }
+
+rt_number_status rt_parse_double(const char *s, double *out)
+{
+    if (!decimal_syntax(s, true))
+        return RT_NUMBER_BAD;
+    errno = 0;
+    char *end = NULL;
+    double d = strtod(s, &end);
+    if (!end || *end != '\0')
+        return RT_NUMBER_BAD;
+    if (!isfinite(d))
+        return RT_NUMBER_RANGE;
+    *out = d;
+    return RT_NUMBER_OK;
+}

@@ -14,6 +14,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "rt/base/number.h"
 #include "rt/base/file.h"
 #include "rt/image/compare.h"
 #include "rt/image/flip.h"
@@ -50,12 +51,12 @@ typedef struct compare_args {
     float ppd;
 } compare_args;
 
+/* A threshold: a plain decimal number >= 0 (rt/base/number.h, the syntax
+ * every numeric flag takes: no hexadecimal, blanks, inf or nan). */
 static bool parse_number(const char *s, double *out)
 {
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || *end || errno || !isfinite(v) || v < 0)
+    double v;
+    if (rt_parse_double(s, &v) != RT_NUMBER_OK || v < 0)
         return false;
     *out = v;
     return true;

@@ -111,27 +111,21 @@ int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs)
     }
     if (status != 0)
         memset(&m, 0, sizeof m);
+    /* the output over a part's image or sidecar: the output's identity once, each part's as it is read */
+    uint64_t dst_id[2], side_id[2];
+    bool dst_exists = status == 0 && rt_file_id(dst, dst_id);
     for (int i = 0; i < n && status == 0; i++) {
-        if (rt_merge_add(&m, inputs[i], &err) != RT_OK) {
+        if (rt_merge_add(&m, inputs[i], &err) != RT_OK) { /* also a part given twice */
             fprintf(errs, "rt: merge: %s\n", err.message);
             status = 2;
             break;
         }
         char side[4200];
         rt_part_sidecar_path(m.parts[i].path, side, sizeof side);
-        if (rt_same_file(dst, m.parts[i].path) || rt_same_file(dst, side)) {
+        if (dst_exists && ((dst_id[0] == m.file_id[i][0] && dst_id[1] == m.file_id[i][1]) ||
+                           (rt_file_id(side, side_id) && dst_id[0] == side_id[0] && dst_id[1] == side_id[1]))) {
             fprintf(errs, "rt: merge: %s: the output is one of the part's own files; write the image elsewhere\n", dst);
             status = 2;
-            break;
-        }
-        for (int k = 0; k < i && status == 0; k++) { /* the same file, by the same name or another */
-            if (strcmp(m.parts[k].path, m.parts[i].path) == 0 || rt_same_file(m.parts[k].path, m.parts[i].path)) {
-                if (strcmp(m.parts[k].path, m.parts[i].path) == 0)
-                    fprintf(errs, "rt: merge: %s is given twice\n", m.parts[i].path);
-                else
-                    fprintf(errs, "rt: merge: %s is given twice (also as %s)\n", m.parts[i].path, m.parts[k].path);
-                status = 2;
-            }
         }
     }
     rt_framebuffer fb = {0};
@@ -142,6 +136,10 @@ int rt_cmd_merge_to(int argc, char **argv, FILE *out, FILE *errs)
     oa.exposure_ev = ev;
     oa.tonemap = tm;
     oa.half = half;
+    if (status == 0 && rt_merge_check_cover(&m, &err) != RT_OK) { /* before the image is allocated */
+        fprintf(errs, "rt: merge: %s\n", err.message);
+        status = 2;
+    }
     if (status == 0) {
         const rt_part_info *first = &m.parts[0].info;
         for (int l = 0; l < first->layer_count; l++) {

@@ -96,7 +96,7 @@ static int check_outputs(args *a, char *part_default, size_t size)
         rt_path_tagged(name, "part", ".exr", part_default, size);
         a->output = part_default;
     }
-    if (a->part_out && (!rt_part_path_ok(a->part_out) || rt_output_check(a->part_out, &err) != RT_OK)) {
+    if (a->part_out && (!rt_part_path_ok(a->part_out) || rt_part_check_paths(a->part_out, &err) != RT_OK)) {
         fprintf(stderr, "rt: --part-out %s: %s\n", a->part_out,
                 rt_part_path_ok(a->part_out) ? err.message : "a part is written as .exr or .pfm");
         return 2;

@@ -15,6 +15,8 @@
 #include "rt/io/image_write.h"
 #include "rt/io/load.h"
 #include "rt/job/frame.h"
+#include "rt/job/output.h"
+#include "rt/job/part.h"
 #include "rt/render/integrator.h"
 #include "rt/scene/instance.h"
 #include "rt/scene/validate.h"
@@ -68,8 +70,12 @@ rt_result prepare_scene(rt_scene *scene, rt_settings *set, const args *a, char *
         snprintf(output, size, "%s", a->output);
     else
         input_default_output(set, a->input, output, size);
+    /* every file the render will write (AOV files, NAME.partial.EXT, a part's sidecar) before it starts */
     if ((r = rt_output_check(output, err)) != RT_OK ||
-        (r = rt_output_check_size(output, set->width, set->height, err)) != RT_OK)
+        (r = args_output_is_part(a) ? rt_part_check_paths(output, err) : rt_job_output_check_paths(&jo, output, err)) !=
+            RT_OK ||
+        (r = rt_output_check_size(output, set->width, set->height, err)) != RT_OK ||
+        (a->stop_part && (r = rt_part_check_paths(a->stop_part, err)) != RT_OK)) /* a stopped frame's part */
         return r;
     /* rt convert and rt merge refuse these; a render keeps them for the window */
     rt_image_format fmt = RT_FORMAT_PNG;

@@ -71,12 +71,19 @@ static void remove_stopped(const char *output, const char *stop_part)
     unlink(stop_part);
 }
 
-/* write_result for an image: the output, or NAME.partial.EXT for an
- * incomplete tiled image or a stopped frame, said on stderr; 2 on an error
- * (its message said), else 0. A frame stopped early is not the finished
- * frame: its image goes to NAME.partial.EXT and its sums to the part that
- * resumes it (stop_part); once finished, what a stop left is removed. */
-static int write_image(run *rn, bool stopped, const char *reason, const char *why, rt_error *err)
+/* What a result's files are, said once they are all in place. */
+enum { SAID_MAIN, SAID_PART_OUT, SAID_STOP_PART, SAID_COUNT };
+typedef char said_lines[SAID_COUNT][4600];
+
+/* write_result for an image, into the batch: the output, or
+ * NAME.partial.EXT for an incomplete tiled image or a stopped frame; what
+ * to say once the batch is placed goes into said; 2 on an error, else 0.
+ * A frame stopped early is not the finished frame: its image goes to
+ * NAME.partial.EXT and its sums to the part that resumes it (stop_part);
+ * *finished_frame says that a frame was finished, whose stop leftovers the
+ * caller removes once the batch is placed. */
+static int write_image(run *rn, bool stopped, const char *reason, const char *why, rt_write_batch *batch,
+                       said_lines said, bool *finished_frame, rt_error *err)
 {
     const args *a = rn->a;
     const rt_settings *set = rn->settings;
@@ -104,33 +111,31 @@ static int write_image(run *rn, bool stopped, const char *reason, const char *wh
                 rs.passes ? "pass" : "tile", reason ? reason : "?", kept);
         return 0;
     }
-    if (rt_job_output_write(&rn->jo, set, &rn->fb, &rn->aov, target, rn->sig->temp, err) != RT_OK ||
+    if (rt_job_output_write(&rn->jo, set, &rn->fb, &rn->aov, target, batch, err) != RT_OK ||
         (to_side && !rs.partial && stop_part &&
-         rt_part_job_write(pj, stop_part, rs.samples_done, rn->sig->temp, err) != RT_OK)) {
-        memory_budget_report(err, &a->budget);
+         rt_part_job_write(pj, stop_part, rs.samples_done, batch, err) != RT_OK))
         return 2;
-    }
     if (a->log_level >= RT_LOG_NORMAL || stopped) {
         char extras[2048]; /* the AOV files (or layers) too */
         rt_job_output_extras(&rn->jo, &rn->aov, target, extras, sizeof extras);
-        fprintf(stderr, "rt: wrote %s%s: %dx%d, %s; %.2f s (render %.2f s)%s%s\n", target, extras, fb->width,
-                fb->height, what, rt_now_seconds() - rn->t_start, rs.seconds, to_side ? "; " : "",
-                to_side ? kept : "");
+        snprintf(said[SAID_MAIN], sizeof said[0], "rt: wrote %s%s: %dx%d, %s; %.2f s (render %.2f s)%s%s\n", target,
+                 extras, fb->width, fb->height, what, rt_now_seconds() - rn->t_start, rs.seconds, to_side ? "; " : "",
+                 to_side ? kept : "");
     }
     if (to_side && stop_part)
-        fprintf(stderr, "rt: wrote %s and %s.json: the frame's samples 0:%d of %d, resumed by rendering the frame "
-                        "again\n",
-                stop_part, stop_part, pj->s_begin + rs.samples_done, set->samples);
-    else if (frame && !to_side)
-        remove_stopped(output, stop_part);
+        snprintf(said[SAID_STOP_PART], sizeof said[0],
+                 "rt: wrote %s and %s.json: the frame's samples 0:%d of %d, resumed by rendering the frame again\n",
+                 stop_part, stop_part, pj->s_begin + rs.samples_done, set->samples);
+    *finished_frame = frame && !to_side;
     return 0;
 }
 
 /* Writes a render's result (rt_render returned r with stats rs) where its
  * state says: a part (pj->to_part), or the image (write_image), and
- * --part-out's part; says so; returns the exit
- * status (128 + the signal that stopped it, 2 on an error, else 0: also
- * when the window was closed). */
+ * --part-out's part, all as one batch: none replaces an earlier file unless
+ * every one was written; says so; returns the exit status (128 + the
+ * signal that stopped it, 2 on an error, else 0: also when the window was
+ * closed). */
 static int write_result(run *rn, rt_result r, rt_error *err)
 {
     const args *a = rn->a;
@@ -156,22 +161,26 @@ static int write_result(run *rn, rt_result r, rt_error *err)
     if (reason)
         snprintf(why, sizeof why, ", %s", reason);
     bool stopped = r == RT_ERR_INTERRUPTED || rs.time_limited;
+    said_lines said = {"", "", ""};
+    bool finished_frame = false;
+    rt_write_batch batch;
+    rt_write_batch_init(&batch, rn->sig->temp);
     if (pj->to_part) {
         if (rs.partial) {
             fprintf(stderr, "rt: stopped before any %s finished (%s); no part written, %s left as it was%s\n",
                     rs.passes ? "pass" : "tile", reason ? reason : "?", output,
                     rs.passes ? "" : " (a tiled part keeps nothing when stopped: render parts in --passes N)");
-        } else if (rt_part_job_write(pj, output, rs.samples_done, rn->sig->temp, err) != RT_OK) {
-            memory_budget_report(err, &a->budget);
+        } else if (rt_part_job_write(pj, output, rs.samples_done, &batch, err) != RT_OK) {
             status = 2;
         } else if (a->log_level >= RT_LOG_NORMAL || stopped) {
-            fprintf(stderr, "rt: wrote %s and %s.json: part [%d, %d) x [%d, %d) of %dx%d, samples %d:%d of %d%s; "
-                            "%.2f s (render %.2f s)\n",
-                    output, output, pj->region.x0, pj->region.x1, pj->region.y0, pj->region.y1, set->width,
-                    set->height, pj->part_begin, pj->s_begin + rs.samples_done, set->samples, why,
-                    rt_now_seconds() - rn->t_start, rs.seconds);
+            snprintf(said[SAID_MAIN], sizeof said[0],
+                     "rt: wrote %s and %s.json: part [%d, %d) x [%d, %d) of %dx%d, samples %d:%d of %d%s; "
+                     "%.2f s (render %.2f s)\n",
+                     output, output, pj->region.x0, pj->region.x1, pj->region.y0, pj->region.y1, set->width,
+                     set->height, pj->part_begin, pj->s_begin + rs.samples_done, set->samples, why,
+                     rt_now_seconds() - rn->t_start, rs.seconds);
         }
-    } else if (write_image(rn, stopped, reason, why, err) != 0) {
+    } else if (write_image(rn, stopped, reason, why, &batch, said, &finished_frame, err) != 0) {
         status = 2;
     }
     if (status != 2 && a->part_out) {
@@ -179,13 +188,24 @@ static int write_result(run *rn, rt_result r, rt_error *err)
             fprintf(stderr, "rt: %s: no part written: %s\n", a->part_out,
                     rs.passes ? "no pass finished"
                               : "a render in tiles keeps no part when stopped (--passes 0 asked for tiles)");
-        else if (rt_part_job_write(pj, a->part_out, rs.samples_done, rn->sig->temp, err) != RT_OK) {
-            memory_budget_report(err, &a->budget);
+        else if (rt_part_job_write(pj, a->part_out, rs.samples_done, &batch, err) != RT_OK)
             status = 2;
-        } else if (a->log_level >= RT_LOG_NORMAL || stopped)
-            fprintf(stderr, "rt: wrote %s and %s.json: samples %d:%d of %d\n", a->part_out, a->part_out,
-                    pj->part_begin, pj->s_begin + rs.samples_done, set->samples);
+        else if (a->log_level >= RT_LOG_NORMAL || stopped)
+            snprintf(said[SAID_PART_OUT], sizeof said[0], "rt: wrote %s and %s.json: samples %d:%d of %d\n",
+                     a->part_out, a->part_out, pj->part_begin, pj->s_begin + rs.samples_done, set->samples);
     }
+    if (status == 2)
+        rt_write_batch_discard(&batch);
+    else if (rt_write_batch_commit(&batch, err) != RT_OK)
+        status = 2;
+    if (status == 2) {
+        memory_budget_report(err, &a->budget);
+        return 2;
+    }
+    if (finished_frame)
+        remove_stopped(output, rn->jo.stop_part); /* what a stop of this frame left */
+    for (int k = 0; k < SAID_COUNT; k++)
+        fputs(said[k], stderr);
     return status;
 }
 

@@ -45,6 +45,17 @@ static void on_error(exr_const_context_t ctxt, exr_result_t code, const char *ms
         snprintf(s->message, sizeof s->message, "%s", msg ? msg : exr_get_default_error_message(code));
 }
 
+/* Writing: the library holds the write context's lock while it reports an
+ * error, and exr_get_user_data takes that lock again (a non-recursive
+ * mutex), so on_error would hang the writer; errors are read from the
+ * returned code instead. */
+static void on_write_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
+{
+    (void)ctxt;
+    (void)code;
+    (void)msg;
+}
+
 static int64_t read_memory(exr_const_context_t ctxt, void *ud, void *buffer, uint64_t sz, uint64_t offset,
                            exr_stream_error_func_ptr_t error_cb)
 {
@@ -129,11 +140,15 @@ rt_result rt_exr_write(FILE *f, const char *path, int width, int height, const r
         }
     }
 
+    for (int a = 0; a < nch; a++) /* the library refuses a channel twice (LAYER named twice) */
+        for (int b = 0; b < a; b++)
+            if (strcmp(ch[a].name, ch[b].name) == 0)
+                return rt_fail(err, RT_ERR_INVALID, "%s: EXR channel %s given twice", path, ch[a].name);
     exr_stream s;
     memset(&s, 0, sizeof s);
     s.file = f;
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = on_error;
+    init.error_handler_fn = on_write_error;
     init.user_data = &s;
     init.write_fn = write_file;
     exr_context_t ctx = NULL;
@@ -415,9 +430,10 @@ static rt_result check_chunks(exr_context_t ctx, exr_storage_t storage, const ex
     return RT_OK;
 }
 
+/* want_w, want_h: the size the data window must have (0: any within the limits). */
 static rt_result decode(const void *data, size_t size, const char *name, int max_dim, uint64_t max_pixels,
-                        const char *const *channels, int nchan, bool required, float **rgba_out, int *width,
-                        int *height, rt_error *err)
+                        int want_w, int want_h, const char *const *channels, int nchan, bool required,
+                        float **rgba_out, int *width, int *height, rt_error *err)
 {
     *rgba_out = NULL;
     *width = *height = 0;
@@ -460,6 +476,11 @@ static rt_result decode(const void *data, size_t size, const char *name, int max
         goto done;
     }
     int64_t w64 = (int64_t)dw.max.x - dw.min.x + 1, h64 = (int64_t)dw.max.y - dw.min.y + 1;
+    if (want_w > 0 && (w64 != want_w || h64 != want_h)) {
+        result = rt_fail(err, RT_ERR_INVALID, "%s: the image is %lldx%lld, not the %dx%d expected", name,
+                         (long long)w64, (long long)h64, want_w, want_h);
+        goto done;
+    }
     if (w64 <= 0 || h64 <= 0 || w64 > max_dim || h64 > max_dim || (uint64_t)w64 * (uint64_t)h64 > max_pixels) {
         result = rt_fail(err, RT_ERR_LIMIT, "%s: EXR image is %lldx%lld, over the limit of %dx%d and %llu pixels",
                          name, (long long)w64, (long long)h64, max_dim, max_dim, (unsigned long long)max_pixels);
@@ -503,7 +524,7 @@ rt_result rt_exr_decode(const void *data, size_t size, const char *name, int max
                         float **rgba, int *width, int *height, rt_error *err)
 {
     static const char *const rgba_names[4] = {"R", "G", "B", "A"};
-    return decode(data, size, name, max_dim, max_pixels, rgba_names, 4, false, rgba, width, height, err);
+    return decode(data, size, name, max_dim, max_pixels, 0, 0, rgba_names, 4, false, rgba, width, height, err);
 }
 
 rt_result rt_exr_decode_channels(const void *data, size_t size, const char *name, int max_dim, uint64_t max_pixels,
@@ -512,5 +533,17 @@ rt_result rt_exr_decode_channels(const void *data, size_t size, const char *name
 {
     if (count < 1 || count > MAX_CHANNELS)
         return rt_fail(err, RT_ERR_INVALID, "%s: %d EXR channels asked for", name, count);
-    return decode(data, size, name, max_dim, max_pixels, channels, count, true, pixels, width, height, err);
+    return decode(data, size, name, max_dim, max_pixels, 0, 0, channels, count, true, pixels, width, height, err);
+}
+
+rt_result rt_exr_decode_channels_sized(const void *data, size_t size, const char *name, int width, int height,
+                                       const char *const *channels, int count, float **pixels, rt_error *err)
+{
+    if (count < 1 || count > MAX_CHANNELS)
+        return rt_fail(err, RT_ERR_INVALID, "%s: %d EXR channels asked for", name, count);
+    if (width < 1 || height < 1)
+        return rt_fail(err, RT_ERR_INVALID, "%s: an EXR image of %dx%d asked for", name, width, height);
+    int w, h, side = width > height ? width : height;
+    return decode(data, size, name, side, (uint64_t)width * (uint64_t)height, width, height, channels, count, true,
+                  pixels, &w, &h, err);
 }

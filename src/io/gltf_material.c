@@ -520,6 +520,9 @@ rt_result gl_parse_samplers(gl_doc *d, int t)
                 return gl_fail_at(d, e, RT_ERR_INVALID, "%s: wrap mode %d is not 33071, 33648 or 10497", where, w[k]);
         if (sm->mag != 0 && sm->mag != 9728 && sm->mag != 9729)
             return gl_fail_at(d, e, RT_ERR_INVALID, "%s: magFilter %d is not 9728 or 9729", where, sm->mag);
+        if (sm->min != 0 && !(sm->min == 9728 || sm->min == 9729 || (sm->min >= 9984 && sm->min <= 9987)))
+            return gl_fail_at(d, e, RT_ERR_INVALID, "%s: minFilter %d is not 9728, 9729 or 9984 to 9987", where,
+                              sm->min);
     }
     return RT_OK;
 }

@@ -721,17 +721,28 @@ static rt_result parse_cameras(gl_doc *d, int t)
             if ((r = gl_expect_object(d, persp, wp)) != RT_OK)
                 return r;
             c->yfov = -1;
+            /* the schema: aspectRatio, znear and zfar each > 0 when given, and zfar > znear */
+            int at[3] = {-1, -1, -1};
             for (int k_n = 0, k = persp + 1, v = persp + 2; k_n < d->j.tok[persp].size && v < d->j.count;
                  k_n++, k = rt_json_skip(&d->j, v), v = k + 1) {
                 if (KEY(k, "yfov")) r = gl_get_float(d, wp, "yfov", v, &c->yfov);
-                else if (KEY(k, "aspectRatio")) r = gl_get_float(d, wp, "aspectRatio", v, &c->aspect);
-                else if (KEY(k, "znear")) r = gl_get_float(d, wp, "znear", v, &c->znear);
-                else if (KEY(k, "zfar")) r = gl_get_float(d, wp, "zfar", v, &c->zfar);
+                else if (KEY(k, "aspectRatio")) r = gl_get_float(d, wp, "aspectRatio", at[0] = v, &c->aspect);
+                else if (KEY(k, "znear")) r = gl_get_float(d, wp, "znear", at[1] = v, &c->znear);
+                else if (KEY(k, "zfar")) r = gl_get_float(d, wp, "zfar", at[2] = v, &c->zfar);
                 if (r != RT_OK)
                     return r;
             }
             if (!(c->yfov > 0 && c->yfov < RT_PI))
                 return gl_fail_at(d, persp, RT_ERR_INVALID, "%s.yfov must be in (0, pi)", wp);
+            static const char *const names[3] = {"aspectRatio", "znear", "zfar"};
+            const float got[3] = {c->aspect, c->znear, c->zfar};
+            for (int q = 0; q < 3; q++)
+                if (at[q] >= 0 && !(got[q] > 0))
+                    return gl_fail_at(d, at[q], RT_ERR_INVALID, "%s.%s %g must be greater than 0", wp, names[q],
+                                      (double)got[q]);
+            if (at[1] >= 0 && at[2] >= 0 && !(c->zfar > c->znear))
+                return gl_fail_at(d, at[2], RT_ERR_INVALID, "%s.zfar %g must be greater than znear %g", wp,
+                                  (double)c->zfar, (double)c->znear);
         } else if (strcmp(type, "orthographic") != 0) {
             return gl_fail_at(d, e, RT_ERR_INVALID, "%s: type \"%s\" is not perspective or orthographic", where, type);
         }
@@ -775,7 +786,11 @@ static rt_result parse_lights(gl_doc *d, int ext)
                     return r;
                 g->color = rt_v3(c[0], c[1], c[2]);
             } else if (KEY(k, "intensity")) r = gl_get_ranged(d, where, "intensity", v, 0, GL_BIG, &g->intensity);
-            else if (KEY(k, "range")) r = gl_get_ranged(d, where, "range", v, 0, GL_BIG, &g->range);
+            else if (KEY(k, "range")) {
+                /* exclusiveMinimum 0 (no range at all is said by leaving it out) */
+                if ((r = gl_get_ranged(d, where, "range", v, 0, GL_BIG, &g->range)) == RT_OK && !(g->range > 0))
+                    return gl_fail_at(d, v, RT_ERR_INVALID, "%s.range must be greater than 0", where);
+            }
             else if (KEY(k, "spot")) {
                 if ((r = gl_expect_object(d, v, where)) != RT_OK)
                     return r;

@@ -98,7 +98,7 @@ static bool open_temp_beside(const char *path, temp_file *t, rt_write_temp *trac
     t->name[0] = 0;
 #ifdef O_TMPFILE
     if (access("/proc/self/fd", X_OK) == 0) {
-        int fd = open(t->dir, O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+        int fd = open(t->dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0666); /* read back by rt_write_batch_read */
         if (fd >= 0) {
             t->unnamed = true;
             return (t->f = fdopen_or_close(fd)) != NULL;
@@ -166,24 +166,35 @@ static bool name_temp(temp_file *t, int fd)
     return false;
 }
 
-rt_result rt_output_check(const char *path, rt_error *err)
+/* What a file is renamed over must be a regular file or nothing: a
+ * directory there (or a device, a FIFO) would fail only at the rename. */
+static rt_result check_target(const char *path, rt_error *err)
 {
-    rt_image_format fmt;
-    rt_result r = rt_output_format(path, &fmt, err);
-    if (r != RT_OK)
-        return r;
-    /* the image is renamed over the exact path: a directory there (or a
-     * device, a FIFO) would fail only then, after the render */
     struct stat st;
     if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
-        return rt_fail(err, RT_ERR_IO, "%s: is a directory; give an image file name", path);
+        return rt_fail(err, RT_ERR_IO, "%s: is a directory; give a file name", path);
     if (stat(path, &st) == 0 && !S_ISREG(st.st_mode))
-        return rt_fail(err, RT_ERR_IO, "%s: not a regular file; give an image file name", path);
+        return rt_fail(err, RT_ERR_IO, "%s: not a regular file; give a file name", path);
+    return RT_OK;
+}
+
+rt_result rt_output_check_file(const char *path, rt_error *err)
+{
+    rt_result r = check_target(path, err);
+    if (r != RT_OK)
+        return r;
     temp_file t;
     if (!open_temp_beside(path, &t, NULL))
         return rt_fail(err, RT_ERR_IO, "%s: cannot write there: %s", path, strerror(errno));
     discard_temp(&t);
     return RT_OK;
+}
+
+rt_result rt_output_check(const char *path, rt_error *err)
+{
+    rt_image_format fmt;
+    rt_result r = rt_output_format(path, &fmt, err);
+    return r != RT_OK ? r : rt_output_check_file(path, err);
 }
 
 /* stb_image_write builds a PNG in memory with int sizes: the filtered rows
@@ -256,9 +267,19 @@ rt_result rt_framebuffer_write_with(const rt_framebuffer *fb, const char *path, 
 }
 
 static rt_result finish_temp(temp_file *t, const char *path, int ok, rt_error *err);
+static rt_result batch_add(rt_write_batch *b, temp_file *t, const char *path, int ok, rt_error *err);
 
 rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *path, const rt_image_options *opt,
                                        rt_write_temp *temp, rt_error *err)
+{
+    rt_write_batch b;
+    rt_write_batch_init(&b, temp);
+    rt_result r = rt_framebuffer_write_batched(fb, path, opt, &b, err);
+    return r == RT_OK ? rt_write_batch_commit(&b, err) : (rt_write_batch_discard(&b), r);
+}
+
+rt_result rt_framebuffer_write_batched(const rt_framebuffer *fb, const char *path, const rt_image_options *opt,
+                                       rt_write_batch *batch, rt_error *err)
 {
     rt_image_format fmt;
     rt_result r = rt_output_format(path, &fmt, err);
@@ -266,8 +287,10 @@ rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *pat
         return r;
     if ((r = rt_output_check_size(path, fb->width, fb->height, err)) != RT_OK)
         return r;
+    if ((r = check_target(path, err)) != RT_OK)
+        return r;
     temp_file t;
-    if (!open_temp_beside(path, &t, temp))
+    if (!open_temp_beside(path, &t, batch->track))
         return rt_fail(err, RT_ERR_IO, "%s: cannot create a file there: %s", path, strerror(errno));
     FILE *f = t.f;
     int ok;
@@ -294,14 +317,19 @@ rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *pat
         ok = write_png(f, fb, exposure > 0.0f && isfinite(exposure) ? exposure : 1.0f, opt->tonemap);
         break;
     }
-    return finish_temp(&t, path, ok, err);
+    return batch_add(batch, &t, path, ok, err);
 }
 
-/* Completes a write: flushes the temporary file, gives it its mode, names
- * it and renames it over path; on any failure removes it. */
-static rt_result finish_temp(temp_file *t, const char *path, int ok, rt_error *err)
+/* Completes a temporary file's bytes: flushes and closes it and gives it
+ * the mode of the file it will replace (or a plain fopen's), keeping a
+ * duplicate descriptor in *keep (for linkat, and to read it back); on any
+ * failure removes it. The file is closed before it gets a name, so that a
+ * failed close (a network file system reports write errors there)
+ * replaces nothing. */
+static rt_result seal_temp(temp_file *t, const char *path, int ok, int *keep, rt_error *err)
 {
     FILE *f = t->f;
+    *keep = -1;
     if (fflush(f) != 0 || ferror(f))
         ok = 0;
     int saved = errno;
@@ -322,15 +350,7 @@ static rt_result finish_temp(temp_file *t, const char *path, int ok, rt_error *e
         mode = 0666 & ~mask;
     }
     fchmod(fileno(f), mode);
-    /* The file is closed before it gets a name, so that a failed close (a
-     * network file system reports write errors there) replaces nothing,
-     * and the name is renamed over path by the very next system call: a
-     * close between the two (ext4 may wait on the inode's writeback there)
-     * was a window of milliseconds where SIGKILL left the .rt-tmp name
-     * behind. An unnamed file is kept open for linkat by a duplicate of
-     * its descriptor, closed after the rename. */
-    int keep = -1;
-    if (t->unnamed && (keep = dup(fileno(f))) < 0) {
+    if ((*keep = dup(fileno(f))) < 0) {
         saved = errno;
         discard_temp(t);
         return rt_fail(err, RT_ERR_IO, "%s: write failed: %s", path, strerror(saved));
@@ -338,11 +358,22 @@ static rt_result finish_temp(temp_file *t, const char *path, int ok, rt_error *e
     t->f = NULL;
     if (fclose(f) != 0) {
         saved = errno;
-        if (keep >= 0)
-            close(keep);
+        close(*keep);
+        *keep = -1;
         discard_temp(t);
         return rt_fail(err, RT_ERR_IO, "%s: write failed: %s", path, strerror(saved));
     }
+    return RT_OK;
+}
+
+/* Puts a sealed temporary file in place: the name is renamed over path by
+ * the very next system call after it is linked in (a close between the
+ * two, where ext4 may wait on the inode's writeback, was a window of
+ * milliseconds where SIGKILL left the .rt-tmp name behind); on failure
+ * removes it. Closes keep. */
+static rt_result place_temp(temp_file *t, const char *path, int keep, rt_error *err)
+{
+    int saved;
     if (!name_temp(t, keep)) {
         saved = errno;
         close(keep);
@@ -351,22 +382,158 @@ static rt_result finish_temp(temp_file *t, const char *path, int ok, rt_error *e
     }
     if (rename(t->name, path) != 0) {
         saved = errno;
-        if (keep >= 0)
-            close(keep);
+        close(keep);
         discard_temp(t);
         return rt_fail(err, RT_ERR_IO, "%s: cannot rename the finished image into place: %s", path, strerror(saved));
     }
     publish_name(t, NULL); /* renamed: nothing left to remove */
-    if (keep >= 0)
-        close(keep);
+    close(keep);
     return RT_OK;
+}
+
+/* Completes a write at once: seals the temporary file and renames it over path. */
+static rt_result finish_temp(temp_file *t, const char *path, int ok, rt_error *err)
+{
+    int keep;
+    rt_result r = seal_temp(t, path, ok, &keep, err);
+    return r != RT_OK ? r : place_temp(t, path, keep, err);
+}
+
+/* ------------------------------------------------------------ batches */
+
+/* One file of a batch: sealed, waiting for the commit. */
+struct rt_write_pending {
+    temp_file t;
+    int keep;
+    char path[4200];
+};
+
+void rt_write_batch_init(rt_write_batch *b, rt_write_temp *track)
+{
+    memset(b, 0, sizeof *b);
+    b->track = track;
+}
+
+/* Seals t and adds it to the batch under path (a later file for the same
+ * path replaces the earlier one). */
+static rt_result batch_add(rt_write_batch *b, temp_file *t, const char *path, int ok, rt_error *err)
+{
+    if (strlen(path) >= sizeof b->items[0].path) {
+        discard_temp(t);
+        return rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
+    }
+    if (!rt_grow((void **)&b->items, &b->cap, b->count + 1, sizeof *b->items)) {
+        discard_temp(t);
+        return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
+    }
+    int keep;
+    rt_result r = seal_temp(t, path, ok, &keep, err);
+    if (r != RT_OK)
+        return r;
+    for (size_t i = 0; i < b->count; i++)
+        if (strcmp(b->items[i].path, path) == 0) {
+            close(b->items[i].keep);
+            discard_temp(&b->items[i].t);
+            b->items[i].t = *t;
+            b->items[i].keep = keep;
+            return RT_OK;
+        }
+    struct rt_write_pending *p = &b->items[b->count++];
+    p->t = *t;
+    p->keep = keep;
+    snprintf(p->path, sizeof p->path, "%s", path);
+    return RT_OK;
+}
+
+rt_result rt_write_batch_read(const rt_write_batch *b, const char *path, char **bytes, size_t *size, rt_error *err)
+{
+    for (size_t i = 0; i < b->count; i++) {
+        if (strcmp(b->items[i].path, path) != 0)
+            continue;
+        struct stat st;
+        int fd = b->items[i].keep;
+        if (fstat(fd, &st) != 0 || st.st_size < 0)
+            return rt_fail(err, RT_ERR_IO, "%s: cannot read the written file back: %s", path, strerror(errno));
+        size_t n = (size_t)st.st_size, got = 0;
+        char *buf = malloc(n + 1);
+        if (!buf)
+            return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory", path);
+        while (got < n) {
+            ssize_t k = pread(fd, buf + got, n - got, (off_t)got);
+            if (k < 0 && errno == EINTR)
+                continue;
+            if (k <= 0) {
+                free(buf);
+                return rt_fail(err, RT_ERR_IO, "%s: cannot read the written file back: %s", path,
+                               k < 0 ? strerror(errno) : "short read");
+            }
+            got += (size_t)k;
+        }
+        buf[n] = 0;
+        *bytes = buf;
+        *size = n;
+        return RT_OK;
+    }
+    return rt_fail(err, RT_ERR_INVALID, "%s: not written in this batch", path);
+}
+
+rt_result rt_write_batch_commit(rt_write_batch *b, rt_error *err)
+{
+    /* every target first: a directory put in one's place since the check
+     * before rendering fails the batch before anything is replaced */
+    rt_result r = RT_OK;
+    for (size_t i = 0; i < b->count && r == RT_OK; i++)
+        r = check_target(b->items[i].path, err);
+    size_t placed = 0;
+    for (; placed < b->count && r == RT_OK; placed++) {
+        struct rt_write_pending *p = &b->items[placed];
+        p->t.track = b->track;
+        r = place_temp(&p->t, p->path, p->keep, err);
+        p->keep = -1;
+    }
+    for (size_t i = placed; i < b->count; i++) { /* what was not placed is removed */
+        if (b->items[i].keep >= 0)
+            close(b->items[i].keep);
+        discard_temp(&b->items[i].t);
+    }
+    free(b->items);
+    b->items = NULL;
+    b->count = b->cap = 0;
+    return r;
+}
+
+void rt_write_batch_discard(rt_write_batch *b)
+{
+    for (size_t i = 0; i < b->count; i++) {
+        close(b->items[i].keep);
+        discard_temp(&b->items[i].t);
+    }
+    free(b->items);
+    b->items = NULL;
+    b->count = b->cap = 0;
 }
 
 rt_result rt_file_write_atomic(const char *path, const void *bytes, size_t size, rt_write_temp *temp, rt_error *err)
 {
+    rt_result r = check_target(path, err);
+    if (r != RT_OK)
+        return r;
     temp_file t;
     if (!open_temp_beside(path, &t, temp))
         return rt_fail(err, RT_ERR_IO, "%s: cannot create a file there: %s", path, strerror(errno));
     int ok = fwrite(bytes, 1, size, t.f) == size;
     return finish_temp(&t, path, ok, err);
+}
+
+rt_result rt_file_write_batched(const char *path, const void *bytes, size_t size, rt_write_batch *batch,
+                                rt_error *err)
+{
+    rt_result r = check_target(path, err);
+    if (r != RT_OK)
+        return r;
+    temp_file t;
+    if (!open_temp_beside(path, &t, batch->track))
+        return rt_fail(err, RT_ERR_IO, "%s: cannot create a file there: %s", path, strerror(errno));
+    int ok = fwrite(bytes, 1, size, t.f) == size;
+    return batch_add(batch, &t, path, ok, err);
 }

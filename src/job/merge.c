@@ -13,39 +13,36 @@
  * regions must tile the image exactly once. A pixel is then resolved by the
  * renderer's rt_sample_resolve and its AOVs by rt_aov_resolve, so region
  * parts give a single render's bytes exactly. Any problem names the part
- * at fault. */
+ * at fault. A part's file is keyed by (device, inode) and its region by
+ * its corners in hash indexes (rt/base/key_index.h), and the fold order
+ * is one sort, so thousands of parts cost no pairwise step. */
 #include "rt/job/merge.h"
 
+#include <errno.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "rt/base/alloc.h"
+#include "rt/base/file.h"
 #include "rt/render/sample_block.h"
 
 static inline rt_vec3 load3(const float *f) { return rt_v3(f[0], f[1], f[2]); }
 
-static bool same_region(const rt_part_info *a, const rt_part_info *b)
-{
-    return a->x0 == b->x0 && a->y0 == b->y0 && a->x1 == b->x1 && a->y1 == b->y1;
-}
+/* A part's place in the fold: its region's group, then its first sample. */
+typedef struct fold_order {
+    int group, s_begin, part;
+} fold_order;
 
-static int by_first_sample(const void *x, const void *y, const rt_part *parts)
+static int by_group_then_sample(const void *x, const void *y)
 {
-    const rt_part_info *a = &parts[*(const int *)x].info, *b = &parts[*(const int *)y].info;
-    return a->s_begin < b->s_begin ? -1 : a->s_begin > b->s_begin;
-}
-
-/* Insertion sort of the indices by first sample (few parts; qsort has no context). */
-static void sort_group(int *idx, int n, const rt_part *parts)
-{
-    for (int i = 1; i < n; i++)
-        for (int k = i; k > 0 && by_first_sample(&idx[k - 1], &idx[k], parts) > 0; k--) {
-            int t = idx[k];
-            idx[k] = idx[k - 1];
-            idx[k - 1] = t;
-        }
+    const fold_order *a = x, *b = y;
+    if (a->group != b->group)
+        return a->group < b->group ? -1 : 1;
+    if (a->s_begin != b->s_begin)
+        return a->s_begin < b->s_begin ? -1 : 1;
+    return (a->part > b->part) - (a->part < b->part);
 }
 
 /* 2 when some pixel has no owner: the message names the box the missing
@@ -84,21 +81,25 @@ static int assemble(const rt_merge *m, float *sum, uint32_t *good, float *const 
     int W = first->width, H = first->height;
     int *owner = rt_alloc((size_t)W * (size_t)H, sizeof *owner);
     int *idx = rt_alloc((size_t)m->count, sizeof *idx);
-    if (!owner || !idx) {
+    fold_order *order = rt_alloc((size_t)m->count, sizeof *order);
+    if (!owner || !idx || !order) {
         free(owner);
         free(idx);
+        free(order);
         rt_fail(err, RT_ERR_NOMEM, "out of memory for a %dx%d image", W, H);
         return 2;
     }
     for (size_t i = 0; i < (size_t)W * (size_t)H; i++)
         owner[i] = -1;
+    /* the parts by group, each group's by first sample: one sort, no pass over the parts a group */
+    for (int i = 0; i < m->count; i++)
+        order[i] = (fold_order){m->group[i], P[i].info.s_begin, i};
+    qsort(order, (size_t)m->count, sizeof *order, by_group_then_sample);
     int status = 0;
-    for (int g = 0; g < m->groups && status == 0; g++) {
-        int n = 0;
-        for (int i = 0; i < m->count; i++)
-            if (m->group[i] == g)
-                idx[n++] = i;
-        sort_group(idx, n, P);
+    for (int at_part = 0; at_part < m->count && status == 0;) {
+        int n = 0, g = order[at_part].group;
+        while (at_part < m->count && order[at_part].group == g)
+            idx[n++] = order[at_part++].part;
         const rt_part_info *r = &P[idx[0]].info;
         /* the sample ranges: 0 .. spp, each sample once */
         int at = 0;
@@ -168,16 +169,20 @@ static int assemble(const rt_merge *m, float *sum, uint32_t *good, float *const 
         status = report_gap(owner, W, H, err);
     free(owner);
     free(idx);
+    free(order);
     return status;
 }
 
 rt_result rt_merge_init(rt_merge *m, int capacity, rt_error *err)
 {
     memset(m, 0, sizeof *m);
-    m->parts = rt_alloc((size_t)(capacity > 0 ? capacity : 1), sizeof *m->parts);
-    m->group = rt_alloc((size_t)(capacity > 0 ? capacity : 1), sizeof *m->group);
+    size_t cap = (size_t)(capacity > 0 ? capacity : 1);
+    m->parts = rt_alloc(cap, sizeof *m->parts);
+    m->group = rt_alloc(cap, sizeof *m->group);
+    m->file_id = rt_alloc(cap, sizeof *m->file_id);
     m->cap = capacity;
-    if (!m->parts || !m->group) {
+    if (!m->parts || !m->group || !m->file_id || !rt_key_index_init(&m->files, cap) ||
+        !rt_key_index_init(&m->regions, cap)) {
         rt_merge_free(m);
         return rt_fail(err, RT_ERR_NOMEM, "out of memory for %d parts", capacity);
     }
@@ -193,16 +198,43 @@ rt_result rt_merge_add(rt_merge *m, const char *path, rt_error *err)
     if (r != RT_OK)
         return r;
     m->count = i + 1;
+    const rt_part *p = &m->parts[i];
+    /* the same file, by the same name or another: keyed by (device, inode) */
+    if (!rt_file_id(p->path, m->file_id[i]))
+        return rt_fail(err, RT_ERR_IO, "%s: cannot stat: %s", p->path, strerror(errno));
+    int first = rt_key_index_add(&m->files, m->file_id[i], i);
+    if (first >= 0 && strcmp(m->parts[first].path, p->path) == 0)
+        return rt_fail(err, RT_ERR_INVALID, "%s is given twice", p->path);
+    if (first >= 0)
+        return rt_fail(err, RT_ERR_INVALID, "%s is given twice (also as %s)", p->path, m->parts[first].path);
     char why[1200];
-    if (i > 0 && rt_part_mismatch(&m->parts[i].info, &m->parts[0].info, why, sizeof why))
-        return rt_fail(err, RT_ERR_INVALID, "%s: not a part of the same render as %s: %s", m->parts[i].path,
+    if (i > 0 && rt_part_mismatch(&p->info, &m->parts[0].info, why, sizeof why))
+        return rt_fail(err, RT_ERR_INVALID, "%s: not a part of the same render as %s: %s", p->path,
                        m->parts[0].path, why);
-    m->group[i] = -1;
-    for (int k = 0; k < i && m->group[i] < 0; k++)
-        if (same_region(&m->parts[k].info, &m->parts[i].info))
-            m->group[i] = m->group[k];
-    if (m->group[i] < 0)
-        m->group[i] = m->groups++;
+    /* parts of one region are sample ranges of it: one group a region */
+    const rt_part_info *q = &p->info;
+    uint64_t region[2] = {(uint64_t)(uint32_t)q->x0 << 32 | (uint32_t)q->y0,
+                          (uint64_t)(uint32_t)q->x1 << 32 | (uint32_t)q->y1};
+    int g = rt_key_index_add(&m->regions, region, m->groups);
+    if (g < 0)
+        m->covered += (uint64_t)(q->x1 - q->x0) * (uint64_t)(q->y1 - q->y0);
+    m->group[i] = g >= 0 ? g : m->groups++;
+    return RT_OK;
+}
+
+rt_result rt_merge_check_cover(const rt_merge *m, rt_error *err)
+{
+    if (m->count < 1)
+        return rt_fail(err, RT_ERR_INVALID, "no parts to merge");
+    const rt_part_info *first = &m->parts[0].info;
+    uint64_t pixels = (uint64_t)first->width * (uint64_t)first->height;
+    /* the gap report needs an int a pixel: fine when the parts hold a good share of the image */
+    if (m->covered < pixels && pixels > 4 * m->covered + ((uint64_t)1 << 20))
+        return rt_fail(err, RT_ERR_INVALID,
+                       "parts are missing: the regions of the %d part%s given cover %llu of the %dx%d image's %llu "
+                       "pixels",
+                       m->count, m->count == 1 ? "" : "s", (unsigned long long)m->covered, first->width,
+                       first->height, (unsigned long long)pixels);
     return RT_OK;
 }
 
@@ -237,6 +269,9 @@ static rt_result resolve(const rt_merge *m, const float *sum, const uint32_t *go
 
 rt_result rt_merge_image(const rt_merge *m, rt_framebuffer *fb, rt_aov_buffers *aov, rt_error *err)
 {
+    rt_result c = rt_merge_check_cover(m, err);
+    if (c != RT_OK)
+        return c;
     const rt_part_info *first = &m->parts[0].info;
     size_t np = (size_t)first->width * (size_t)first->height;
     float *sum = rt_alloc(np, 3 * sizeof(float));
@@ -267,5 +302,8 @@ void rt_merge_free(rt_merge *m)
         rt_part_free(&m->parts[i]);
     free(m->parts);
     free(m->group);
+    free(m->file_id);
+    rt_key_index_free(&m->files);
+    rt_key_index_free(&m->regions);
     memset(m, 0, sizeof *m);
 }

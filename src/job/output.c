@@ -86,8 +86,9 @@ int rt_job_aovs_layers(const rt_job_aovs *o, rt_image_layer *layers, int max)
     return n;
 }
 
-/* One image file of an AOV (1 channel: grey). */
-static rt_result write_aov_file(const float *data, int channels, int w, int h, const char *path, rt_error *err)
+/* One image file of an AOV (1 channel: grey), into the batch. */
+static rt_result write_aov_file(const float *data, int channels, int w, int h, const char *path,
+                                rt_write_batch *batch, rt_error *err)
 {
     rt_framebuffer fb;
     rt_result r = rt_framebuffer_init(&fb, w, h, err);
@@ -96,7 +97,8 @@ static rt_result write_aov_file(const float *data, int channels, int w, int h, c
     for (size_t i = 0; i < (size_t)w * (size_t)h; i++)
         for (int c = 0; c < 3; c++)
             fb.rgb[3 * i + (size_t)c] = data[(size_t)channels * i + (size_t)(channels == 3 ? c : 0)];
-    r = rt_framebuffer_write(&fb, path, 1.0f, err);
+    rt_image_options opt = {.exposure = 1.0f};
+    r = rt_framebuffer_write_batched(&fb, path, &opt, batch, err);
     rt_framebuffer_free(&fb);
     return r;
 }
@@ -135,9 +137,55 @@ void rt_job_output_extras(const rt_job_options *a, const rt_job_aovs *aov, const
         out[used++] = ')', out[used] = 0;
 }
 
-rt_result rt_job_output_write(const rt_job_options *a, const rt_settings *set, rt_framebuffer *fb,
-                              const rt_job_aovs *aov, const char *path, rt_write_temp *temp, rt_error *err)
+/* The files beside an image at path that are not its layers: each AOV
+ * asked for (NAME.albedo.EXT; .pfm beside a .png), and the noisy image
+ * when denoising with AOVs; none beside an .exr. Returns how many. */
+static int side_files(const rt_job_options *a, const char *path, char (*out)[4200], int max)
 {
+    rt_image_format fmt = RT_FORMAT_PNG;
+    int n = 0;
+    if (rt_output_format(path, &fmt, NULL) != RT_OK || fmt == RT_FORMAT_EXR)
+        return 0;
+    for (int k = 0; k < RT_AOV_COUNT && n < max; k++)
+        if (a->aovs & (1u << k))
+            side_file(path, fmt, rt_aov_names[k], true, out[n++], sizeof out[0]);
+    if (a->denoise && a->aovs && n < max)
+        side_file(path, fmt, "noisy", false, out[n++], sizeof out[0]);
+    return n;
+}
+
+rt_result rt_job_output_check_paths(const rt_job_options *a, const char *path, rt_error *err)
+{
+    char partial[4200], side[RT_AOV_COUNT + 1][4200];
+    rt_result r = rt_output_check(path, err);
+    if (r != RT_OK)
+        return r;
+    if (!rt_path_tagged(path, "partial", NULL, partial, sizeof partial))
+        return rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
+    const char *images[2] = {path, partial}; /* a stopped tiled render writes NAME.partial.EXT instead */
+    for (int i = 0; i < 2 && r == RT_OK; i++) {
+        if (i > 0)
+            r = rt_output_check_file(partial, err);
+        int n = side_files(a, images[i], side, RT_AOV_COUNT + 1);
+        for (int k = 0; k < n && r == RT_OK; k++)
+            r = rt_output_check_file(side[k], err);
+    }
+    return r;
+}
+
+rt_result rt_job_output_write(const rt_job_options *a, const rt_settings *set, rt_framebuffer *fb,
+                              const rt_job_aovs *aov, const char *path, rt_write_batch *batch, rt_error *err)
+{
+    if (!batch) { /* the files of this output alone, placed together */
+        rt_write_batch own;
+        rt_write_batch_init(&own, NULL);
+        rt_result r = rt_job_output_write(a, set, fb, aov, path, &own, err);
+        if (r != RT_OK) {
+            rt_write_batch_discard(&own);
+            return r;
+        }
+        return rt_write_batch_commit(&own, err);
+    }
     rt_image_options opt = {.exposure = set->exposure * rt_exposure_scale(a->exposure_ev), .tonemap = a->tonemap,
                             .half = a->half};
     rt_image_format fmt = RT_FORMAT_PNG;
@@ -176,17 +224,17 @@ rt_result rt_job_output_write(const rt_job_options *a, const rt_settings *set, r
             if (aov->wanted & (1u << k)) {
                 side_file(path, fmt, rt_aov_names[k], true, p, sizeof p);
                 r = write_aov_file(*slot((rt_aov_buffers *)&aov->buf, k), channels_of(k), fb->width, fb->height, p,
-                                   err);
+                                   batch, err);
             }
         if (r == RT_OK && noisy) {
             rt_framebuffer nf = {fb->width, fb->height, noisy};
             side_file(path, fmt, "noisy", false, p, sizeof p);
-            r = rt_framebuffer_write_with(&nf, p, &opt, err);
+            r = rt_framebuffer_write_batched(&nf, p, &opt, batch, err);
         }
         if (r != RT_OK)
             goto done;
     }
-    r = rt_framebuffer_write_tracked(fb, path, &opt, temp, err);
+    r = rt_framebuffer_write_batched(fb, path, &opt, batch, err);
 done:
     free(noisy);
     return r;

@@ -23,6 +23,7 @@
 #include "rt/io/exr.h"
 #include "rt/io/image_read.h"
 #include "rt/io/json.h"
+#include "rt/job/options.h"
 #include "rt/render/aov.h"
 
 #define SIDECAR_MAX_BYTES (1u << 20)
@@ -69,11 +70,12 @@ bool rt_part_blocks_ok(int s_begin, int s_end, int first, int count)
     return count == 1 || (long long)first * RT_SAMPLE_BLOCK == s_begin;
 }
 
-static rt_result hash_file(const char *path, uint64_t *h, rt_error *err)
+/* The hash of a file written in batch b, read back before it is renamed into place. */
+static rt_result hash_file(const rt_write_batch *b, const char *path, uint64_t *h, rt_error *err)
 {
     char *bytes;
     size_t size;
-    rt_result r = rt_read_file(path, 0, &bytes, &size, err);
+    rt_result r = rt_write_batch_read(b, path, &bytes, &size, err);
     if (r != RT_OK)
         return r;
     *h = rt_fnv1a64(bytes, size, RT_FNV1A64_INIT);
@@ -134,8 +136,44 @@ static void put_string(text *t, const char *s)
     put(t, "\"");
 }
 
+static rt_result write_files(const char *path, const rt_part_info *info, const float *sum,
+                             const float *const *blocks, const uint32_t *good, const float *const *layers,
+                             rt_write_batch *batch, rt_error *err);
+
+rt_result rt_part_check_paths(const char *path, rt_error *err)
+{
+    char side[4200], cpath[4200];
+    if (!rt_part_path_ok(path))
+        return rt_fail(err, RT_ERR_INVALID, "%s: a part is written as .exr or .pfm", path);
+    if (!rt_part_sidecar_path(path, side, sizeof side) || !count_path(path, cpath, sizeof cpath))
+        return rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
+    rt_result r = rt_output_check(path, err);
+    if (r == RT_OK)
+        r = rt_output_check_file(side, err);
+    if (r == RT_OK && rt_path_has_ext(path, ".pfm"))
+        r = rt_output_check_file(cpath, err);
+    return r;
+}
+
 rt_result rt_part_write(const char *path, const rt_part_info *info, const float *sum, const float *const *blocks,
-                        const uint32_t *good, const float *const *layers, rt_write_temp *temp, rt_error *err)
+                        const uint32_t *good, const float *const *layers, rt_write_batch *batch, rt_error *err)
+{
+    if (batch)
+        return write_files(path, info, sum, blocks, good, layers, batch, err);
+    rt_write_batch own;
+    rt_write_batch_init(&own, NULL);
+    rt_result r = write_files(path, info, sum, blocks, good, layers, &own, err);
+    if (r != RT_OK) {
+        rt_write_batch_discard(&own);
+        return r;
+    }
+    return rt_write_batch_commit(&own, err);
+}
+
+/* Every file of the part into the batch: the image(s), then the sidecar. */
+static rt_result write_files(const char *path, const rt_part_info *info, const float *sum,
+                             const float *const *blocks, const uint32_t *good, const float *const *layers,
+                             rt_write_batch *batch, rt_error *err)
 {
     char side[4200], cpath[4200], bpath[4200];
     if (!rt_part_path_ok(path))
@@ -173,7 +211,7 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
         for (int k = 0; k < info->layer_count; k++)
             layer[nl++] = (rt_image_layer){info->layer_name[k], info->layer_channels[k], layers[k]};
         rt_image_options opt = {.layers = layer, .layer_count = nl};
-        r = rt_framebuffer_write_tracked(&fb, path, &opt, temp, err);
+        r = rt_framebuffer_write_batched(&fb, path, &opt, batch, err);
     } else {
         float *grey = rt_alloc(n, 3 * sizeof(float));
         if (!grey) {
@@ -184,23 +222,23 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
             grey[3 * i] = grey[3 * i + 1] = grey[3 * i + 2] = counts[i];
         rt_framebuffer cfb = {w, h, grey};
         rt_image_options opt = {0};
-        r = rt_framebuffer_write_tracked(&cfb, cpath, &opt, temp, err);
+        r = rt_framebuffer_write_batched(&cfb, cpath, &opt, batch, err);
         free(grey);
         if (r == RT_OK)
-            r = hash_file(cpath, &count_hash, err);
+            r = hash_file(batch, cpath, &count_hash, err);
         for (int k = 0; k < bcount && r == RT_OK; k++) {
             rt_framebuffer bfb = {w, h, (float *)blocks[k]};
             block_path(path, bfirst + k, bpath, sizeof bpath);
-            r = rt_framebuffer_write_tracked(&bfb, bpath, &opt, temp, err);
+            r = rt_framebuffer_write_batched(&bfb, bpath, &opt, batch, err);
             if (r == RT_OK)
-                r = hash_file(bpath, &block_hash[k], err);
+                r = hash_file(batch, bpath, &block_hash[k], err);
         }
         if (r == RT_OK)
-            r = rt_framebuffer_write_tracked(&fb, path, &opt, temp, err);
+            r = rt_framebuffer_write_batched(&fb, path, &opt, batch, err);
     }
     free(counts);
     if (r == RT_OK)
-        r = hash_file(path, &image_hash, err);
+        r = hash_file(batch, path, &image_hash, err);
     if (r != RT_OK)
         return r;
 
@@ -239,7 +277,7 @@ rt_result rt_part_write(const char *path, const rt_part_info *info, const float 
         free(t.buf);
         return rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the sidecar", side);
     }
-    r = rt_file_write_atomic(side, t.buf, t.len, temp, err);
+    r = rt_file_write_batched(side, t.buf, t.len, batch, err);
     free(t.buf);
     return r;
 }
@@ -267,13 +305,27 @@ static bool get_string(const rt_json *j, int obj, const char *key, char *out, si
     return i >= 0 && rt_json_string(j, i, out, cap) >= 0;
 }
 
+/* Exactly 16 hex digits (strtoull alone takes blanks, a sign and "0x"). */
+static bool hex16(const char *s, uint64_t *out)
+{
+    uint64_t v = 0;
+    for (int i = 0; i < 16; i++) {
+        char c = s[i];
+        int d = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+        if (d < 0)
+            return false;
+        v = v << 4 | (uint64_t)d;
+    }
+    if (s[16] != 0)
+        return false;
+    *out = v;
+    return true;
+}
+
 static bool get_hash(const rt_json *j, int obj, const char *key, uint64_t *out)
 {
-    char s[32], *end;
-    if (!get_string(j, obj, key, s, sizeof s) || strlen(s) != 16)
-        return false;
-    *out = strtoull(s, &end, 16);
-    return *end == 0;
+    char s[32];
+    return get_string(j, obj, key, s, sizeof s) && hex16(s, out);
 }
 
 /* An array of n integers in [lo, hi]. */
@@ -297,6 +349,13 @@ static bool float_text(const char *s, float *out)
     char *end = NULL;
     *out = strtof(s, &end);
     return end != s && *end == 0 && isfinite(*out);
+}
+
+/* The AOVs a part carries as layers (what rt_part_job writes): the sums
+ * of albedo, normal, depth and position; not variance or spp. */
+static bool layer_kind_ok(rt_aov_kind k)
+{
+    return k == RT_AOV_ALBEDO || k == RT_AOV_NORMAL || k == RT_AOV_DEPTH || k == RT_AOV_POSITION;
 }
 
 /* The sidecar's fields into info; the image hashes into the rest. */
@@ -379,8 +438,8 @@ static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *im
         if (bi < 0 || j.tok[bi].type != RT_JSON_ARRAY || j.tok[bi].size != blk[1])
             r = bad(err, side, "\"block_fnv1a64\" must list a hash for each block");
         for (int k = 0, e = bi + 1; r == RT_OK && k < blk[1]; k++, e = rt_json_skip(&j, e)) {
-            char hex[32], *end;
-            if (rt_json_string(&j, e, hex, sizeof hex) != 16 || (block_hash[k] = strtoull(hex, &end, 16), *end != 0))
+            char hex[32];
+            if (rt_json_string(&j, e, hex, sizeof hex) != 16 || !hex16(hex, &block_hash[k]))
                 r = bad(err, side, "\"block_fnv1a64\" entries must be 16 hex digits");
         }
     }
@@ -388,13 +447,17 @@ static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *im
     if (r == RT_OK && li >= 0) {
         if (j.tok[li].type != RT_JSON_ARRAY || j.tok[li].size > RT_PART_MAX_LAYERS)
             r = bad(err, side, "\"layers\" must be an array of at most 4 [name, channels] pairs");
-        int e = li + 1;
+        int e = li + 1, last = -1;
         for (int k = 0; r == RT_OK && k < j.tok[li].size; k++, e = rt_json_skip(&j, e)) {
             double ch = 0;
+            rt_aov_kind kind = RT_AOV_COUNT;
             if (j.tok[e].type != RT_JSON_ARRAY || j.tok[e].size != 2 ||
                 rt_json_string(&j, e + 1, info->layer_name[k], sizeof info->layer_name[k]) <= 0 ||
-                strchr(info->layer_name[k], '.') || !rt_json_number(&j, e + 2, &ch) || (ch != 1 && ch != 3))
-                r = bad(err, side, "\"layers\" entries must be [\"name\", 1 or 3]");
+                !rt_aov_by_name(info->layer_name[k], strlen(info->layer_name[k]), &kind) || !layer_kind_ok(kind) ||
+                (int)kind <= last || !rt_json_number(&j, e + 2, &ch) || ch != (kind == RT_AOV_DEPTH ? 1 : 3))
+                r = bad(err, side, "\"layers\" entries must be [\"albedo\", 3], [\"normal\", 3], [\"depth\", 1] or "
+                                   "[\"position\", 3], each at most once and in that order");
+            last = (int)kind;
             info->layer_channels[k] = (int)ch;
             info->layer_count = k + 1;
         }
@@ -419,9 +482,11 @@ static rt_result read_sidecar(const char *side, rt_part_info *info, uint64_t *im
 }
 
 /* The image at path, checked against its hash: an EXR's `count` named
- * channels, else a PFM's three. */
-static rt_result read_image(const char *path, uint64_t want, bool exr, const char *const *names, int count,
-                            float **px, int *w, int *h, rt_error *err)
+ * channels, else a PFM's three. An EXR's header may not claim more than
+ * the sidecar's region (rw x rh) before pixels are allocated; a PFM's
+ * size is checked against its bytes by rt_pfm_read. */
+static rt_result read_image(const char *path, uint64_t want, bool exr, const char *const *names, int count, int rw,
+                            int rh, float **px, int *w, int *h, rt_error *err)
 {
     char *bytes;
     size_t size;
@@ -436,7 +501,9 @@ static rt_result read_image(const char *path, uint64_t want, bool exr, const cha
                        path);
     }
     if (exr) {
-        r = rt_exr_decode_channels(bytes, size, path, 32768, 1ull << 30, names, count, px, w, h, err);
+        r = rt_exr_decode_channels_sized(bytes, size, path, rw, rh, names, count, px, err);
+        *w = rw;
+        *h = rh;
         free(bytes);
         return r;
     }
@@ -496,7 +563,7 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
                      info->layer_channels[k] == 1 ? "Y" : c == 0 ? "R" : c == 1 ? "G" : "B");
             names[nc] = names_buf[nc];
         }
-    r = read_image(image, image_hash, exr, names, nc, &px, &w, &h, err);
+    r = read_image(image, image_hash, exr, names, nc, rw, rh, &px, &w, &h, err);
     if (r == RT_OK && (w != rw || h != rh))
         r = rt_fail(err, RT_ERR_INVALID, "%s: the image is %dx%d but its sidecar's region is %dx%d", image, w, h, rw,
                     rh);
@@ -509,8 +576,8 @@ rt_result rt_part_read(const char *path, rt_part *part, rt_error *err)
             r = rt_fail(err, RT_ERR_LIMIT, "%s: path too long", path);
             break;
         }
-        r = read_image(file, k < 0 ? count_hash : block_hash[k], false, NULL, 0, k < 0 ? &cpx : &bpx[k], &cw, &ch,
-                       err);
+        r = read_image(file, k < 0 ? count_hash : block_hash[k], false, NULL, 0, rw, rh, k < 0 ? &cpx : &bpx[k], &cw,
+                       &ch, err);
         if (r == RT_OK && (cw != rw || ch != rh))
             r = rt_fail(err, RT_ERR_INVALID, "%s: the image is %dx%d but its sidecar's region is %dx%d", file, cw,
                         ch, rw, rh);
@@ -603,8 +670,20 @@ static void first_difference(const char *x, const char *y, char *a, char *b, siz
     a[0] = b[0] = 0;
 }
 
+/* The first layer whose name or channel count differs (the whole layout a
+ * merge reads: names alone let a 1-channel layer be read as 3), or -1. */
+static int layout_difference(const rt_part_info *a, const rt_part_info *b)
+{
+    for (int k = 0; k < a->layer_count && k < RT_PART_MAX_LAYERS; k++)
+        if (a->layer_channels[k] != b->layer_channels[k] ||
+            strncmp(a->layer_name[k], b->layer_name[k], sizeof a->layer_name[k]) != 0)
+            return k;
+    return -1;
+}
+
 const char *rt_part_mismatch(const rt_part_info *a, const rt_part_info *b, char *buf, size_t size)
 {
+    int k;
     if (strcmp(a->version, b->version) != 0)
         snprintf(buf, size, "rendered by rt %s, not rt %s", a->version, b->version);
     else if (a->scene_hash != b->scene_hash)
@@ -616,10 +695,12 @@ const char *rt_part_mismatch(const rt_part_info *a, const rt_part_info *b, char 
         snprintf(buf, size, "%d samples per pixel, not %d", a->spp, b->spp);
     else if (a->seed != b->seed)
         snprintf(buf, size, "seed %u, not %u", (unsigned)a->seed, (unsigned)b->seed);
-    else if (a->layer_count != b->layer_count ||
-             memcmp(a->layer_name, b->layer_name, sizeof a->layer_name) != 0)
+    else if (a->layer_count != b->layer_count)
         snprintf(buf, size, "other AOVs (%d layer%s, not %d)", a->layer_count, a->layer_count == 1 ? "" : "s",
                  b->layer_count);
+    else if ((k = layout_difference(a, b)) >= 0)
+        snprintf(buf, size, "other AOVs (layer %d is %s of %d channel%s, not %s of %d)", k + 1, a->layer_name[k],
+                 a->layer_channels[k], a->layer_channels[k] == 1 ? "" : "s", b->layer_name[k], b->layer_channels[k]);
     else if (strcmp(a->settings, b->settings) != 0) {
         char x[256], y[256];
         first_difference(a->settings, b->settings, x, y, sizeof x);

@@ -298,7 +298,7 @@ void rt_part_job_free(rt_part_job *pj)
     memset(&pj->accum, 0, sizeof pj->accum);
 }
 
-rt_result rt_part_job_write(const rt_part_job *pj, const char *path, int samples_done, rt_write_temp *temp,
+rt_result rt_part_job_write(const rt_part_job *pj, const char *path, int samples_done, rt_write_batch *batch,
                             rt_error *err)
 {
     rt_part_info info = pj->info;
@@ -334,7 +334,7 @@ rt_result rt_part_job_write(const rt_part_job *pj, const char *path, int samples
             r = rt_fail(err, RT_ERR_NOMEM, "%s: out of memory for the AOV layers", path);
     if (r == RT_OK) {
         rt_part_aov_to_layers(&info, pj->accum.aov_sum, layers, n);
-        r = rt_part_write(path, &info, fold, blocks, pj->accum.good, (const float *const *)layers, temp, err);
+        r = rt_part_write(path, &info, fold, blocks, pj->accum.good, (const float *const *)layers, batch, err);
     }
     free(zeros);
     for (int k = 0; k < info.layer_count; k++)

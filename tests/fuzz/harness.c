@@ -18,6 +18,8 @@
 #include "rt/io/nanovdb.h"
 #include "rt/io/load.h"
 #include "rt/io/meshopt.h"
+#include "rt/job/merge.h"
+#include "rt/job/output.h"
 #include "rt/job/part.h"
 #include "rt/render/volume.h"
 #include "rt/scene/scene.h"
@@ -25,13 +27,15 @@
 
 const char *const rt_fuzz_targets[] = {"scene", "gltf",    "glb",   "gltf_bin", "obj",        "ply",  "off",
                                        "image", "exr",     "meshopt", "draco", "part", "image_file", "pose",
-                                       "json",  "nvdb",    NULL};
+                                       "json",  "nvdb",    "merge",   NULL};
 
 static char dir[64];
 
 static void remove_temp_dir(void)
 {
-    static const char *const files[] = {"buffer.bin", "m.mtl", "p.exr", "p.exr.json", "fuzz.img", NULL};
+    static const char *const files[] = {"buffer.bin", "m.mtl",      "p.exr",  "p.exr.json", "fuzz.img",   "m0.exr",
+                                        "m0.exr.json", "m1.exr",  "m1.exr.json", "m2.exr", "m2.exr.json", "m3.exr",
+                                        "m3.exr.json", NULL};
     char path[256];
     for (int i = 0; files[i]; i++) {
         snprintf(path, sizeof path, "%s/%s", dir, files[i]);
@@ -90,6 +94,91 @@ static void load(const char *name, const uint8_t *data, size_t size)
     rt_error err;
     rt_load_memory(&s, &set, data, size, path, NULL, NULL, &err);
     rt_scene_free(&s);
+}
+
+/* A part as the `part` target takes it: u32 length, the sidecar (its
+ * "@HASH@" replaced by the image's FNV-1a, so the fuzzer gets past the
+ * hash check), the image; written as `name` and name.json. path: name's. */
+static void write_part(const char *name, const uint8_t *data, size_t size, char *path, size_t path_size)
+{
+    size_t n;
+    split(data, size, &n);
+    const uint8_t *json = size >= 4 ? data + 4 : data, *img = json + n;
+    size_t img_size = size >= 4 ? size - 4 - n : 0;
+    char side[64];
+    snprintf(side, sizeof side, "%s.json", name);
+    char hash[17];
+    snprintf(hash, sizeof hash, "%016llx", (unsigned long long)rt_fnv1a64(img, img_size, RT_FNV1A64_INIT));
+    char *text = malloc(n + 17);
+    if (!text)
+        abort();
+    size_t o = 0;
+    for (size_t i = 0; i < n;) {
+        if (i + 6 <= n && memcmp(json + i, "@HASH@", 6) == 0) {
+            memcpy(text + o, hash, 16);
+            o += 16;
+            i += 6;
+            memcpy(text + o, json + i, n - i);
+            o += n - i;
+            break;
+        }
+        text[o++] = (char)json[i++];
+    }
+    write_temp(side, (const uint8_t *)text, o, path, path_size);
+    free(text);
+    write_temp(name, img, img_size, path, path_size);
+}
+
+/* merge: a byte whose low two bits + 1 are the number of parts, then each
+ * part as a u32 length and that many bytes of a `part` input (the last
+ * takes what is left); read and merged as `rt merge` does (same render,
+ * the same file twice, regions tiling the image, sample ranges, then the
+ * fold and resolve into the image and its AOVs). */
+static void fuzz_merge(const uint8_t *data, size_t size)
+{
+    if (size < 1)
+        return;
+    int parts = data[0] % 4 + 1;
+    data++;
+    size--;
+    rt_merge m;
+    rt_error err;
+    if (rt_merge_init(&m, parts, &err) != RT_OK)
+        return;
+    bool ok = true;
+    for (int k = 0; k < parts && ok; k++) {
+        size_t n;
+        split(data, size, &n);
+        if (k == parts - 1)
+            n = size >= 4 ? size - 4 : 0;
+        const uint8_t *part = size >= 4 ? data + 4 : data;
+        char name[16], path[256];
+        snprintf(name, sizeof name, "m%d.exr", k);
+        write_part(name, part, n, path, sizeof path);
+        ok = rt_merge_add(&m, path, &err) == RT_OK;
+        data = part + n;
+        size = size >= 4 ? size - 4 - n : 0;
+    }
+    if (ok && rt_merge_check_cover(&m, &err) == RT_OK) {
+        const rt_part_info *first = &m.parts[0].info;
+        rt_framebuffer fb;
+        rt_job_options o;
+        memset(&o, 0, sizeof o);
+        for (int l = 0; l < first->layer_count; l++) {
+            rt_aov_kind kind;
+            if (rt_aov_by_name(first->layer_name[l], strlen(first->layer_name[l]), &kind))
+                o.aovs |= 1u << kind;
+        }
+        rt_job_aovs aov;
+        memset(&aov, 0, sizeof aov);
+        if (rt_framebuffer_init(&fb, first->width, first->height, &err) == RT_OK) {
+            if (rt_job_aovs_init(&aov, &o, first->width, first->height, &err) == RT_OK)
+                (void)rt_merge_image(&m, &fb, rt_job_aovs_for_render(&aov), &err);
+            rt_job_aovs_free(&aov);
+            rt_framebuffer_free(&fb);
+        }
+    }
+    rt_merge_free(&m);
 }
 
 /* meshopt: mode, filter, stride / 4 - 1 (or the index size), count (u16
@@ -299,37 +388,13 @@ int rt_fuzz_run(const char *target, const uint8_t *data, size_t size)
         if (rt_image_read(path, &fb, &err) == RT_OK)
             rt_framebuffer_free(&fb);
     } else if (strcmp(target, "part") == 0) {
-        /* u32 length, the sidecar (its "@HASH@" replaced by the image's
-         * FNV-1a, so the fuzzer gets past the hash check), the image */
-        size_t n;
-        split(data, size, &n);
-        const uint8_t *json = size >= 4 ? data + 4 : data, *img = json + n;
-        size_t img_size = size >= 4 ? size - 4 - n : 0;
-        write_temp("p.exr", img, img_size, path, sizeof path);
-        char hash[17];
-        snprintf(hash, sizeof hash, "%016llx", (unsigned long long)rt_fnv1a64(img, img_size, RT_FNV1A64_INIT));
-        char *text = malloc(n + 17);
-        if (!text)
-            abort();
-        size_t o = 0;
-        for (size_t i = 0; i < n;) {
-            if (i + 6 <= n && memcmp(json + i, "@HASH@", 6) == 0) {
-                memcpy(text + o, hash, 16);
-                o += 16;
-                i += 6;
-                memcpy(text + o, json + i, n - i);
-                o += n - i;
-                break;
-            }
-            text[o++] = (char)json[i++];
-        }
-        write_temp("p.exr.json", (const uint8_t *)text, o, path, sizeof path);
-        free(text);
+        write_part("p.exr", data, size, path, sizeof path);
         rt_part part;
         rt_error err;
-        snprintf(path, sizeof path, "%s/p.exr", temp_dir());
         if (rt_part_read(path, &part, &err) == RT_OK)
             rt_part_free(&part);
+    } else if (strcmp(target, "merge") == 0) {
+        fuzz_merge(data, size);
     } else if (strcmp(target, "exr") == 0) {
         rt_error err;
         float *rgba = NULL;

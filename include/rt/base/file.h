@@ -49,6 +49,9 @@ rt_result rt_read_file(const char *path, size_t max_size, char **bytes, size_t *
  * hard link, a symbolic link or "./x" for "x" count), so that a command
  * can refuse to write its output over one of its inputs. */
 bool rt_same_file(const char *a, const char *b);
+/* The identity of the file at path, (device, inode), into id; false when
+ * it cannot be stat'ed. Equal ids are the same file (rt_same_file). */
+bool rt_file_id(const char *path, uint64_t id[2]);
 
 /* True when the last component of path ends in ext (".obj"), ignoring ASCII
  * case. */

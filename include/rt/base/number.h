@@ -25,5 +25,7 @@ typedef enum rt_number_status {
 rt_number_status rt_parse_int(const char *s, long long *out);
 /* A decimal float, finite and within float range (about +-3.4e38). */
 rt_number_status rt_parse_float(const char *s, float *out);
+/* The same syntax at double precision (thresholds compared with doubles). */
+rt_number_status rt_parse_double(const char *s, double *out);
 
 #endif

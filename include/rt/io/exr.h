@@ -64,5 +64,10 @@ rt_result rt_exr_decode(const void *data, size_t size, const char *name, int max
 rt_result rt_exr_decode_channels(const void *data, size_t size, const char *name, int max_dim, uint64_t max_pixels,
                                  const char *const *channels, int count, float **pixels, int *width, int *height,
                                  rt_error *err);
+/* The same, for a file whose size is known beforehand (a part's region,
+ * from its sidecar): a data window other than width x height is refused,
+ * naming both sizes, before any pixel memory is allocated. */
+rt_result rt_exr_decode_channels_sized(const void *data, size_t size, const char *name, int width, int height,
+                                       const char *const *channels, int count, float **pixels, rt_error *err);
 
 #endif

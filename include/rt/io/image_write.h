@@ -81,4 +81,44 @@ rt_result rt_framebuffer_write_tracked(const rt_framebuffer *fb, const char *pat
 /* Writes bytes to path the same atomic way (a part's sidecar, docs/farm.md). */
 rt_result rt_file_write_atomic(const char *path, const void *bytes, size_t size, rt_write_temp *temp, rt_error *err);
 
+/* Checks before a render that path (any file: a sidecar, an AOV image) can
+ * be written as the image is: not a directory or other non-file, in a
+ * directory where a temporary file can be made. rt_output_check is the
+ * format check and this. */
+rt_result rt_output_check_file(const char *path, rt_error *err);
+
+/* Several files written together (an image, its AOV files, a part's
+ * sidecar): each goes to its own temporary file, and none replaces
+ * anything until rt_write_batch_commit, which first checks every target
+ * again and then renames them in the order written; a failure anywhere
+ * before that leaves every earlier file as it was, and the temporary
+ * files are removed (unnamed on Linux while pending, so a killed process
+ * leaves none).
+ *
+ *   rt_write_batch b;
+ *   rt_write_batch_init(&b, temp);                       // temp: as for rt_framebuffer_write_tracked, or NULL
+ *   r = rt_framebuffer_write_batched(&fb, "out.png", &opt, &b, &err);
+ *   if (r == RT_OK) r = rt_file_write_batched("out.png.json", text, len, &b, &err);
+ *   r = r == RT_OK ? rt_write_batch_commit(&b, &err) : (rt_write_batch_discard(&b), r);
+ */
+struct rt_write_pending;
+typedef struct rt_write_batch {
+    struct rt_write_pending *items;
+    size_t count, cap;
+    rt_write_temp *track;
+} rt_write_batch;
+void rt_write_batch_init(rt_write_batch *b, rt_write_temp *track);
+rt_result rt_framebuffer_write_batched(const rt_framebuffer *fb, const char *path, const rt_image_options *opt,
+                                       rt_write_batch *batch, rt_error *err);
+rt_result rt_file_write_batched(const char *path, const void *bytes, size_t size, rt_write_batch *batch,
+                                rt_error *err);
+/* The bytes written for path in this batch, not yet committed (malloc'ed,
+ * NUL after the last; the caller frees): a part hashes its images so. */
+rt_result rt_write_batch_read(const rt_write_batch *b, const char *path, char **bytes, size_t *size, rt_error *err);
+/* Renames every file of the batch into place (after checking every target);
+ * on failure removes those not yet placed. The batch is empty afterwards. */
+rt_result rt_write_batch_commit(rt_write_batch *b, rt_error *err);
+/* Removes every pending file; nothing is replaced. */
+void rt_write_batch_discard(rt_write_batch *b);
+
 #endif

@@ -5,10 +5,11 @@
  *
  *   rt_job_options o = {.aovs = 1u << RT_AOV_NORMAL};
  *   if (rt_job_output_check(&o, &err) != RT_OK) ...   // before rendering: the denoiser has its library
+ *   if (rt_job_output_check_paths(&o, "out.png", &err) != RT_OK) ...   // and every file can be written
  *   rt_job_aovs aov;
  *   rt_job_aovs_init(&aov, &o, w, h, &err);           // render options .aov = rt_job_aovs_for_render(&aov)
  *   ... render into fb ...
- *   rt_job_output_write(&o, &settings, &fb, &aov, "out.exr", NULL, &err);
+ *   rt_job_output_write(&o, &settings, &fb, &aov, "out.exr", NULL, &err);   // or into a batch
  *   rt_job_aovs_free(&aov);
  */
 #ifndef RT_JOB_OUTPUT_H
@@ -40,13 +41,19 @@ int rt_job_aovs_layers(const rt_job_aovs *o, rt_image_layer *layers, int max);
 /* The render's .aov: NULL when no AOV is needed. */
 rt_aov_buffers *rt_job_aovs_for_render(rt_job_aovs *o);
 
+/* Checks before rendering every file an output at path may write: the
+ * image, its AOV and noisy files, and NAME.partial.EXT with its own (a
+ * stopped tiled render's), each a file rt can replace (rt_output_check_file). */
+rt_result rt_job_output_check_paths(const rt_job_options *a, const char *path, rt_error *err);
+
 /* Denoises fb in place when asked (writing the noisy image beside it when
  * AOVs are asked for too), then writes it and the AOVs: layers of an .exr,
  * else files NAME.albedo.EXT beside it (NAME.EXT the output; PNG output
- * writes them as .pfm, which keeps their values). The image's own write
- * keeps *temp up to date for the signal handler (temp may be NULL). */
+ * writes them as .pfm, which keeps their values). The files join batch,
+ * placed by rt_write_batch_commit (rt/io/image_write.h) with the rest of
+ * the render's; batch NULL places them at once, all or none. */
 rt_result rt_job_output_write(const rt_job_options *a, const rt_settings *set, rt_framebuffer *fb,
-                              const rt_job_aovs *aov, const char *path, rt_write_temp *temp, rt_error *err);
+                              const rt_job_aovs *aov, const char *path, rt_write_batch *batch, rt_error *err);
 
 /* What rt_job_output_write writes besides the image at path, for the
  * "wrote" line: " and out.albedo.pfm, out.noisy.png", or for an .exr

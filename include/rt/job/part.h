@@ -20,7 +20,7 @@
  *
  *   rt_part_info info = {...};                     // what the part is
  *   info.block_first = (info.s_end - 1) / RT_SAMPLE_BLOCK, info.block_count = 1;   // rt_part_blocks_ok
- *   rt_part_write("p.exr", &info, fold, blocks, good, NULL, NULL, &err);   // layers: NULL when info.layer_count is 0
+ *   rt_part_write("p.exr", &info, fold, blocks, good, NULL, NULL, &err);   // batch NULL: written and placed now   // layers: NULL when info.layer_count is 0
  *
  *   rt_part p;
  *   if (rt_part_read("p.exr", &p, &err) != RT_OK) ... err names the file and what is wrong ...
@@ -89,10 +89,16 @@ bool rt_part_blocks_ok(int s_begin, int s_end, int first, int count);
 /* Writes the part's image(s), then its sidecar. sum (the fold), the
  * info->block_count planes of blocks, good and the
  * info->layer_count layers (EXR layers NAME.R/G/B or NAME.Y) are the
- * region's. temp (may be NULL) tracks the temporary file for a signal
- * handler. */
+ * region's. batch NULL: the files replace earlier ones only once all are
+ * written (a failure leaves every earlier file as it was); else they join
+ * the batch, renamed into place by rt_write_batch_commit with the rest of
+ * a render's files. */
 rt_result rt_part_write(const char *path, const rt_part_info *info, const float *sum, const float *const *blocks,
-                        const uint32_t *good, const float *const *layers, rt_write_temp *temp, rt_error *err);
+                        const uint32_t *good, const float *const *layers, rt_write_batch *batch, rt_error *err);
+/* Checks before a render every file a part at path writes that can be
+ * known then: the image, the sidecar, a .pfm part's counts (block files
+ * are checked when the batch is committed). */
+rt_result rt_part_check_paths(const char *path, rt_error *err);
 
 /* Reads a part: `path` is its image or its sidecar (NAME.json). Checks the
  * sidecar's fields and ranges, the image hashes, the image size against the

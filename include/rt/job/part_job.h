@@ -8,7 +8,7 @@
  *   ro.region = pj.region; ro.sample_begin = pj.s_begin; ro.sample_end = pj.s_end;
  *   ro.accum = pj.need_accum ? &pj.accum : NULL;
  *   ... render into a framebuffer of the region's size ...
- *   rt_part_job_write(&pj, "p.exr", stats.samples_done, &temp, &err);
+ *   rt_part_job_write(&pj, "p.exr", stats.samples_done, &batch, &err);   // then rt_write_batch_commit
  *   rt_part_job_free(&pj);
  */
 #ifndef RT_JOB_PART_JOB_H
@@ -51,8 +51,8 @@ void rt_part_job_free(rt_part_job *pj);
 rt_result rt_part_job_accum(rt_part_job *pj, bool aov, rt_error *err);
 
 /* Writes the sums as a part at path covering samples [part_begin, s_begin +
- * samples_done). */
-rt_result rt_part_job_write(const rt_part_job *pj, const char *path, int samples_done, rt_write_temp *temp,
+ * samples_done) into batch (rt_part_write: NULL places the files at once). */
+rt_result rt_part_job_write(const rt_part_job *pj, const char *path, int samples_done, rt_write_batch *batch,
                             rt_error *err);
 
 #endif
