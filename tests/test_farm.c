@@ -773,6 +773,7 @@ static void test_frames_stopped_then_resumed(void **state)
     RUN_OK("-q", "-s", "64", "--frames", "1:2", "--time-limit", TIME_UP, "-o", pattern, scene);
     assert_int_equal(RUN("-q", "-s", "32", "--frames", "1:2", "-o", pattern, scene), 2);
     assert_non_null(strstr(err_text, "other.0001.part.exr"));
+    assert_non_null(strstr(err_text, "to render the frame over")); /* and says what to do */
     assert_int_equal(access(in_dir("other.0001.pfm"), F_OK), -1);
     assert_int_equal(RUN("-q", "--frames", "1:2", "--resume", in_dir("other.0001.part.exr"), "-o", pattern, scene), 2);
 }

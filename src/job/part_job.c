@@ -227,7 +227,13 @@ static rt_result resume(rt_part_job *pj, const rt_job_options *a, const rt_setti
         return r;
     char why[1024];
     if (rt_part_mismatch(&p.info, &pj->info, why, sizeof why)) {
-        r = rt_fail(err, RT_ERR_INVALID, "--resume %s: the part is of another render: %s", a->resume, why);
+        if (a->stop_part && strcmp(a->stop_part, a->resume) == 0) /* --frames found it, not the user */
+            r = rt_fail(err, RT_ERR_INVALID,
+                        "%s: a stopped render of this frame with other settings (%s): delete it and %s.json to "
+                        "render the frame over",
+                        a->resume, why, a->resume);
+        else
+            r = rt_fail(err, RT_ERR_INVALID, "--resume %s: the part is of another render: %s", a->resume, why);
         rt_part_free(&p);
         return r;
     }
