@@ -9,6 +9,9 @@
  *   light from behind the camera, max_depth 1, against
  *   sigma_s p(-1) E (1 - exp(-2 sigma_t d)) / (2 sigma_t) (light sampling
  *   with the phase function, ratio tracking of the shadow rays);
+ * - single scattering from a box of medium under an area light close
+ *   above it, against quadrature (solid-angle light sampling, shadow rays
+ *   through a null face to the light);
  * - a white furnace: a sphere of albedo-1 chromatic forward-scattering
  *   medium (g 0.7) under a uniform sky of radiance 1 stays 1;
  * - a voxel grid of constant density 0.5 with doubled coefficients renders
@@ -177,11 +180,62 @@ static void test_constant_grid_is_homogeneous(void **state)
     test_fixture_free(&grid);
 }
 
+/* Single scattering under an area light close above a box of medium: the
+ * light is sampled by solid angle from points near it, and the shadow rays
+ * cross the box's null top face on their way. Against quadrature along the
+ * ray: the medium point's transmittance to each point of the light (out
+ * through the top face) times the phase function and the light's solid
+ * angle. (Its shadow rays once stopped on the light's own quad, which a
+ * sampled distance can overshoot: a third of the light.) */
+static void test_single_scattering_area_light(void **state)
+{
+    (void)state;
+    test_fixture f;
+    test_fixture_load(&f,
+                      "sampler independent\nmax_depth 1\n"
+                      "medium m homogeneous sigma_a 0.002 0.002 0.002 sigma_s 0.008 0.008 0.008 g 0.3\n"
+                      "material box bsdf null interior m\n"
+                      "quad 100 350 100   350 0 0   0 0 350     box\n"
+                      "quad 100 525 100   0 0 350   350 0 0     box\n"
+                      "quad 100 350 100   0 0 350   0 175 0     box\n"
+                      "quad 450 350 100   0 175 0   0 0 350     box\n"
+                      "quad 100 350 100   0 175 0   350 0 0     box\n"
+                      "quad 100 350 450   350 0 0   0 175 0     box\n"
+                      "light area 343 548.7 227  0 0 105  -130 0 0  1 1 1  1\n",
+                      RT_PREPARE_LIGHT_TABLE);
+    const rt_light *l = &f.s.lights[0];
+    const rt_vec3 o = rt_v3(278, 480, -800), d = rt_normalize(rt_v3(0, 0.02f, 1));
+    const double st = 0.01, ss = 0.008, t0 = (100 - o.z) / d.z, t1 = (450 - o.z) / d.z;
+    const rt_vec3 n = rt_normalize(rt_cross(l->edge_u, l->edge_v));
+    const double area = rt_length(rt_cross(l->edge_u, l->edge_v));
+    double want = 0;
+    const int NT = 200, NU = 40;
+    for (int i = 0; i < NT; i++) { /* midpoint rule along the ray and over the light */
+        double t = t0 + (i + 0.5) * (t1 - t0) / NT, ls = 0;
+        rt_vec3 p = rt_madd(o, d, (float)t);
+        for (int a = 0; a < NU; a++)
+            for (int b = 0; b < NU; b++) {
+                rt_vec3 x = rt_add(l->position, rt_add(rt_scale(l->edge_u, (a + 0.5f) / NU),
+                                                      rt_scale(l->edge_v, (b + 0.5f) / NU)));
+                rt_vec3 w = rt_sub(x, p);
+                float d2 = rt_length2(w);
+                w = rt_scale(w, 1.0f / sqrtf(d2));
+                double inside = (525.0 - p.y) / w.y; /* leaves through the top face */
+                ls += exp(-st * inside) * rt_hg_pdf(0.3f, rt_dot(d, w)) * -rt_dot(n, w) / d2 * area / (NU * NU);
+            }
+        want += exp(-st * (t - t0)) * ss * ls * (t1 - t0) / NT;
+    }
+    estimate e = estimate_ray(&f, o, d, 100000);
+    expect_near("single scattering under an area light", e, rt_v3s((float)want));
+    test_fixture_free(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_beer_lambert_slab),
         cmocka_unit_test(test_single_scattering_slab),
+        cmocka_unit_test(test_single_scattering_area_light),
         cmocka_unit_test(test_white_furnace),
         cmocka_unit_test(test_constant_grid_is_homogeneous),
     };

@@ -252,9 +252,12 @@ static bool ratio_track(const rt_volume *v, rt_vec3 o, rt_vec3 d, float t_max, i
 
 /* What reaches vertex vx from along unit wi over dist (INFINITY: the
  * environment) through the media and null boundaries between: false when a
- * surface blocks it. */
+ * surface blocks it. light_prim: the primitive of the light sampled (an
+ * area light's quad, else RT_NONE), which ends the walk where it is met:
+ * a sampled distance can overshoot the light's plane by more than the
+ * shadow ray's margin of 1e-4 (3e-4 of it measured near a large light). */
 static bool shadow(const rt_trace_ctx *ctx, const vp_state *ps, const vp_vertex *vx, rt_vec3 wi, float dist,
-                   rt_rng *rng, rt_vec3 *T, rt_vec3 *ru, rt_vec3 *rl)
+                   uint32_t light_prim, rt_rng *rng, rt_vec3 *T, rt_vec3 *ru, rt_vec3 *rl)
 {
     const rt_scene *s = ctx->state->scene;
     rt_ray r;
@@ -277,7 +280,7 @@ static bool shadow(const rt_trace_ctx *ctx, const vp_state *ps, const vp_vertex 
             if (!ratio_track(&v, r.org, wi, w == RT_WALK_SURFACE ? seg.tmin : r.tmax, ps->hero, rng, T, ru, rl))
                 return false;
         }
-        if (w == RT_WALK_MISS)
+        if (w == RT_WALK_MISS || (light_prim != RT_NONE && sf.prim == light_prim))
             return true;
         if (s->materials[sf.material].bsdf != RT_BSDF_NULL)
             return false;
@@ -310,14 +313,14 @@ static rt_vec3 vertex_f(const vp_vertex *vx, rt_vec3 wi, float *pdf)
 /* One light sample's contribution (to be multiplied by beta): li is the
  * radiance over the sampling pdf pdf_l (0 for a delta light, no MIS). */
 static rt_vec3 light_term(const rt_trace_ctx *ctx, const vp_state *ps, const vp_vertex *vx, rt_vec3 wi, float dist,
-                          rt_vec3 li, float pdf_l, rt_rng *rng)
+                          uint32_t light_prim, rt_vec3 li, float pdf_l, rt_rng *rng)
 {
     float pdf_f;
     rt_vec3 f = vertex_f(vx, wi, &pdf_f);
     if (!(rt_max3(f) > 0.0f && rt_max3(li) > 0.0f))
         return rt_v3s(0.0f);
     rt_vec3 T, ru, rl;
-    if (!shadow(ctx, ps, vx, wi, dist, rng, &T, &ru, &rl))
+    if (!shadow(ctx, ps, vx, wi, dist, light_prim, rng, &T, &ru, &rl))
         return rt_v3s(0.0f);
     rt_vec3 den = rt_mul(ps->r_u, rl);
     if (pdf_l > 0.0f)
@@ -340,8 +343,9 @@ static rt_vec3 sample_lights(const rt_trace_ctx *ctx, const vp_state *ps, const 
         rt_light_sample ls;
         if (!rt_light_sample_at(ctx, l, vx->p, rt_v2(ux, uy), &ls))
             continue;
-        float pdf_l = l->kind == RT_LIGHT_AREA && l->quad != RT_NONE ? ls.pdf : 0.0f;
-        sum = rt_path_add_finite(sum, light_term(ctx, ps, vx, ls.wi, ls.dist, ls.li, pdf_l, rng));
+        bool quad = l->kind == RT_LIGHT_AREA && l->quad != RT_NONE;
+        uint32_t prim = quad ? (uint32_t)(s->triangles.count + s->spheres.count + l->quad) : RT_NONE;
+        sum = rt_path_add_finite(sum, light_term(ctx, ps, vx, ls.wi, ls.dist, prim, ls.li, quad ? ls.pdf : 0.0f, rng));
     }
     if (rt_path_samples_env(ctx)) {
         float ux = rt_rng_float(rng), uy = rt_rng_float(rng);
@@ -349,7 +353,7 @@ static rt_vec3 sample_lights(const rt_trace_ctx *ctx, const vp_state *ps, const 
         float pdf_l;
         if (rt_light_table_sample_env(ctx->state->light_table, rt_v2(ux, uy), &d, &pdf_l) && pdf_l > 0.0f) {
             rt_vec3 li = rt_scale(rt_environment(s, d), 1.0f / pdf_l);
-            sum = rt_path_add_finite(sum, light_term(ctx, ps, vx, d, INFINITY, li, pdf_l, rng));
+            sum = rt_path_add_finite(sum, light_term(ctx, ps, vx, d, INFINITY, RT_NONE, li, pdf_l, rng));
         }
     }
     return sum;
