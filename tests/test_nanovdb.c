@@ -27,6 +27,7 @@
 
 #include "rt/base/file.h"
 #include "rt/io/nanovdb.h"
+#include "rt/io/scene_parse.h"
 
 static char dir[128];
 static unsigned char *file_bytes;
@@ -288,12 +289,67 @@ static void test_broken_files_refused(void **state)
     free(b);
 }
 
+/* A scene's `medium ... nanovdb FILE` line: the file relative to the
+ * scene's directory, the grid by name, the coefficients times a `scale`
+ * given before the placement, the file's map composed with the line's
+ * transform (a `scale` after `translate` scales the grid), and its inverse. */
+static void test_medium_line(void **state)
+{
+    (void)state;
+    need_file();
+    char scene_name[192];
+    snprintf(scene_name, sizeof scene_name, "%s/scene.txt", dir);
+    const char *text = "medium smoke nanovdb grid.nvdb grid density sigma_a 1 2 3 sigma_s 4 5 6 scale 0.5 g 0.2 "
+                       "translate 10 0 0 scale 2\n";
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_error err = {0};
+    rt_result r = rt_scene_parse_string(&s, NULL, text, strlen(text), scene_name, NULL, &err);
+    if (r != RT_OK)
+        fail_msg("%s", err.message);
+    assert_int_equal(s.medium_count, 1);
+    const rt_medium_def *m = &s.media[0];
+    assert_int_equal(m->kind, RT_MEDIUM_GRID);
+    assert_float_equal(m->sigma_a.z, 1.5f, 0);
+    assert_float_equal(m->sigma_s.x, 2.0f, 0);
+    rt_density_grid g;
+    rt_mat4 file_map;
+    assert_int_equal(rt_nanovdb_parse(file_bytes, file_size, "grid.nvdb", "density", &g, &file_map, &err), RT_OK);
+    assert_int_equal(m->grid.nx, g.nx);
+    assert_int_equal(m->grid.ny, g.ny);
+    assert_int_equal(m->grid.nz, g.nz);
+    rt_density_grid_free(&g);
+    rt_vec3 ps[3] = {rt_v3(0, 0, 0), rt_v3(1.5f, 2.5f, 0.5f), rt_v3(-3, 7, 2)};
+    for (int i = 0; i < 3; i++) {
+        rt_vec3 want = rt_add(rt_scale(rt_mat4_point(&file_map, ps[i]), 2.0f), rt_v3(10, 0, 0));
+        rt_vec3 got = rt_mat4_point(&m->index_to_world, ps[i]);
+        assert_float_equal(got.x, want.x, 1e-4f);
+        assert_float_equal(got.y, want.y, 1e-4f);
+        assert_float_equal(got.z, want.z, 1e-4f);
+        rt_vec3 back = rt_mat4_point(&m->world_to_index, got);
+        assert_float_equal(back.x, ps[i].x, 1e-4f);
+        assert_float_equal(back.y, ps[i].y, 1e-4f);
+        assert_float_equal(back.z, ps[i].z, 1e-4f);
+    }
+    rt_scene_free(&s);
+    /* no such grid: the error names the scene's line and the file */
+    const char *bad = "medium smoke nanovdb grid.nvdb grid smoke sigma_a 1 1 1 sigma_s 1 1 1\n";
+    rt_scene_init(&s);
+    r = rt_scene_parse_string(&s, NULL, bad, strlen(bad), scene_name, NULL, &err);
+    assert_int_equal(r, RT_ERR_INVALID);
+    assert_non_null(strstr(err.message, "scene.txt:1:22: "));
+    assert_non_null(strstr(err.message, "no grid named \"smoke\""));
+    assert_int_equal(s.medium_count, 0);
+    rt_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_values_and_placement),
         cmocka_unit_test(test_grid_by_name),
         cmocka_unit_test(test_broken_files_refused),
+        cmocka_unit_test(test_medium_line),
     };
     return cmocka_run_group_tests_name("nanovdb", tests, setup, teardown);
 }

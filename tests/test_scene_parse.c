@@ -1385,6 +1385,69 @@ static void test_mutations_do_not_crash(void **state)
     assert_true(failures > 100); /* the mutations did reach the error paths */
 }
 
+/* Participating media (issue 28): the `medium` lines, `scene_medium`, the
+ * materials that bound media, and their errors. */
+static void test_media(void **state)
+{
+    (void)state;
+    rt_scene s;
+    expect_ok("medium fog homogeneous sigma_a 0.1 0.2 0.3 sigma_s 1 2 3 g 0.5 scale 2\n"
+              "medium milk homogeneous sigma_s 4 4 4 sigma_a 0 0 0\n"
+              "scene_medium fog\n"
+              "material box bsdf null interior milk priority 2\n"
+              "material glass bsdf dielectric ior 1.33 interior milk exterior fog\n"
+              "material plain color 0.5 0.5 0.5\n",
+              &s);
+    assert_int_equal(s.medium_count, 2);
+    assert_string_equal(s.media[0].name, "fog");
+    assert_int_equal(s.media[0].kind, RT_MEDIUM_HOMOGENEOUS);
+    assert_vec3(s.media[0].sigma_a, 0.2f, 0.4f, 0.6f); /* times the scale */
+    assert_vec3(s.media[0].sigma_s, 2, 4, 6);
+    assert_float_equal(s.media[0].g, 0.5f, 0);
+    assert_float_equal(s.media[1].g, 0.0f, 0);
+    assert_int_equal(s.environment.medium, 0);
+    assert_int_equal(s.materials[0].bsdf, RT_BSDF_NULL);
+    assert_int_equal(s.materials[0].interior_medium, 1);
+    assert_int_equal(s.materials[0].exterior_medium, RT_NONE);
+    assert_int_equal(s.materials[0].priority, 2);
+    assert_int_equal(s.materials[0].alpha_mode, RT_ALPHA_MASK); /* invisible to integrators without media */
+    assert_float_equal(s.materials[0].ior, 1.0f, 0);
+    assert_int_equal(s.materials[1].interior_medium, 1);
+    assert_int_equal(s.materials[1].exterior_medium, 0);
+    assert_int_equal(s.materials[2].interior_medium, RT_NONE);
+    assert_true(rt_scene_has_media(&s));
+    rt_scene_free(&s);
+    expect_ok("material plain color 0.5 0.5 0.5\nmedium unused homogeneous sigma_a 1 1 1 sigma_s 1 1 1\n", &s);
+    assert_int_equal(s.environment.medium, RT_NONE);
+    assert_false(rt_scene_has_media(&s)); /* defined, not used: the surface path tracer renders it */
+    rt_scene_free(&s);
+
+    static const error_case cases[] = {
+        {"medium f homogeneous sigma_a 1 1 1\n", RT_ERR_PARSE, "1:35", "needs 'sigma_a R G B' and 'sigma_s R G B'"},
+        {"medium f homogeneous sigma_a 1 1 1 sigma_s 1 -1 1\n", RT_ERR_INVALID, "1:46", "sigma_s (green)"},
+        {"medium f homogeneous sigma_a 1 1 1 sigma_s 1 1 1 g 1\n", RT_ERR_INVALID, "1:52", "g (Henyey-Greenstein)"},
+        {"medium f homogeneous sigma_a 1 1 1 sigma_s 1 1 1 scale -2\n", RT_ERR_INVALID, "1:56", "scale"},
+        {"medium f homogeneous sigma_a 1 1 1 sigma_a 1 1 1\n", RT_ERR_INVALID, "1:36", "given twice"},
+        {"medium f homogeneous sigma_a 1 1 1 sigma_s 1 1 1 translate 0 0 0\n", RT_ERR_PARSE, "1:50",
+         "expected a medium key (sigma_a, sigma_s, g, scale), got 'translate'"},
+        {"medium f foggy sigma_a 1 1 1\n", RT_ERR_PARSE, "1:10", "homogeneous|nanovdb"},
+        {"medium f homogeneous sigma_a 1 1 1 sigma_s 1 1 1\nmedium f homogeneous sigma_a 1 1 1 sigma_s 1 1 1\n",
+         RT_ERR_INVALID, "2:8", "already defined on line 1"},
+        {"medium f nanovdb missing.nvdb sigma_a 1 1 1 sigma_s 1 1 1\n", RT_ERR_IO, "1:18", "missing.nvdb"},
+        {"scene_medium fog\n", RT_ERR_INVALID, "1:14", "undefined medium 'fog'"},
+        {"medium fog homogeneous sigma_a 1 1 1 sigma_s 1 1 1\nscene_medium fgo\n", RT_ERR_INVALID, "2:14",
+         "did you mean 'fog'?"},
+        {"medium fog homogeneous sigma_a 1 1 1 sigma_s 1 1 1\nscene_medium fog fog\n", RT_ERR_PARSE, "2:18", ""},
+        {"material m bsdf null\n", RT_ERR_INVALID, "1:12", "'bsdf null' needs 'interior MEDIUM'"},
+        {"medium f homogeneous sigma_a 1 1 1 sigma_s 1 1 1\nmaterial m bsdf null interior f color 1 0 0\n",
+         RT_ERR_INVALID, "2:33", "does not go with 'bsdf null'"},
+        {"medium f homogeneous sigma_a 1 1 1 sigma_s 1 1 1\nmaterial m interior f\n", RT_ERR_INVALID, "2:12",
+         "needs 'bsdf dielectric' or 'bsdf null'"},
+        {"material m bsdf dielectric interior nothing\n", RT_ERR_INVALID, "1:37", "undefined medium 'nothing'"},
+    };
+    expect_errors(cases);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1414,6 +1477,7 @@ int main(void)
         cmocka_unit_test(test_paths_relative_to_scene_file),
         cmocka_unit_test(test_mesh_transform),
         cmocka_unit_test(test_mutations_do_not_crash),
+        cmocka_unit_test(test_media),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -50,6 +50,7 @@
 #include "rt/io/gltf.h"
 #include "rt/io/image_load.h"
 #include "rt/io/mesh_io.h"
+#include "rt/io/nanovdb.h"
 #include "rt/io/environment_image.h"
 #include "rt/render/settings.h"
 #include "rt/scene/instance.h"
@@ -95,7 +96,8 @@ typedef struct parser {
     size_t ntok, tok_cap;
     size_t pos; /* cursor into toks */
 
-    name_table materials, textures, objects;
+    name_table materials, textures, objects, media;
+    int scene_medium_line;    /* line of the `scene_medium` statement, 0 = none yet */
     /* an open `object NAME` block: its statement, and the triangles and
      * vertices before it (rt/scene/instance.h) */
     bool in_object;
@@ -517,6 +519,27 @@ static rt_result get_material(parser *p, const char *what, uint32_t *out)
                 show(t, b, sizeof b), what);
 }
 
+/* A participating medium by name (`medium` lines before this one). */
+static rt_result get_medium(parser *p, const char *what, uint32_t *out)
+{
+    const tok *t = peek(p);
+    char b[80];
+    if (!t)
+        return perr(p, RT_ERR_PARSE, NULL, "expected a medium name for %s, got end of line", what);
+    p->pos++;
+    uint32_t m = rt_scene_find_medium(p->s, t->s);
+    if (m != RT_NONE) {
+        *out = m;
+        return RT_OK;
+    }
+    const char *near = closest_name(p, &p->media, false, t->s);
+    if (near)
+        return perr(p, RT_ERR_INVALID, t, "undefined medium %s for %s (did you mean '%s'?)", show(t, b, sizeof b),
+                    what, near);
+    return perr(p, RT_ERR_INVALID, t, "undefined medium %s for %s (define it with 'medium' before use)",
+                show(t, b, sizeof b), what);
+}
+
 /* Joins the scene's directory and a relative path. */
 static rt_result resolve_path(parser *p, const tok *t, char *out, size_t size)
 {
@@ -826,6 +849,7 @@ typedef enum mat_kind {
     MK_SMITH,
     MK_COLOR01,    /* an RGB colour with each component in [0, 1] */
     MK_THICKNESS,  /* iridescence_thickness MIN MAX: two numbers >= 0 */
+    MK_MEDIUM,     /* the name of a medium defined before (interior, exterior) */
 } mat_kind;
 
 typedef struct mat_key {
@@ -868,6 +892,8 @@ static const mat_key mat_keys[] = {
     {"smith", NULL, MK_SMITH, MOFF(smith), 0, 0},
     {"exterior_ior", NULL, MK_FLOAT, MOFF(exterior_ior), 0.01f, 100},
     {"priority", NULL, MK_INT, MOFF(priority), 0, 1000},
+    {"interior", NULL, MK_MEDIUM, MOFF(interior_medium), 0, 0},
+    {"exterior", NULL, MK_MEDIUM, MOFF(exterior_medium), 0, 0},
     {"absorption", NULL, MK_COLOR, MOFF(absorption), 0, 0},
     {"thickness", NULL, MK_FLOAT, MOFF(thickness), 0, FLT_MAX},
     {"thin_walled", NULL, MK_BOOL, MOFF(thin_walled), 0, 0},
@@ -1034,16 +1060,17 @@ static rt_result read_mat_value(parser *p, const mat_key *mk, rt_material *m, fl
         break;
     }
     case MK_BSDF: {
-        static const char *const models[] = {"gltf", "lambert", "conductor", "dielectric", "plastic"};
-        static const rt_bsdf_model values[] = {RT_BSDF_GLTF, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR,
-                                               RT_BSDF_DIELECTRIC, RT_BSDF_PLASTIC};
+        static const char *const models[] = {"gltf", "lambert", "conductor", "dielectric", "plastic", "null"};
+        static const rt_bsdf_model values[] = {RT_BSDF_GLTF,       RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR,
+                                               RT_BSDF_DIELECTRIC, RT_BSDF_PLASTIC, RT_BSDF_NULL};
         int i = 0;
-        r = get_choice(p, what, models, 5, "gltf|lambert|conductor|dielectric|plastic", &i);
+        r = get_choice(p, what, models, 6, "gltf|lambert|conductor|dielectric|plastic|null", &i);
         if (r == RT_OK)
             *(rt_bsdf_model *)field = values[i];
         break;
     }
     case MK_METAL: r = get_metal(p, what, m); break;
+    case MK_MEDIUM: r = get_medium(p, what, (uint32_t *)field); break;
     case MK_GGX:
         r = get_float_in(p, what, 0.0f, 1.0f, &m->alpha_u);
         if (r == RT_OK && mk->offset == 1)
@@ -1102,9 +1129,18 @@ static rt_result check_mat_keys(parser *p, const rt_material *m, const tok *cons
         bool complex_ior = mk->kind == MK_COLOR && (mk->offset == offsetof(rt_material, eta) ||
                                                     mk->offset == offsetof(rt_material, k));
         bool exterior = mk->kind == MK_FLOAT && mk->offset == offsetof(rt_material, exterior_ior);
-        bool absorbs = (mk->kind == MK_COLOR && mk->offset == offsetof(rt_material, absorption)) ||
-                       (mk->kind == MK_INT && mk->offset == offsetof(rt_material, priority));
+        bool absorbs = mk->kind == MK_COLOR && mk->offset == offsetof(rt_material, absorption);
+        bool media_key = mk->kind == MK_MEDIUM || (mk->kind == MK_INT && mk->offset == offsetof(rt_material, priority));
         if (!seen[i])
+            continue;
+        if (m->bsdf == RT_BSDF_NULL && !media_key && mk->kind != MK_BSDF)
+            return perr(p, RT_ERR_INVALID, seen[i],
+                        "material key '%s' does not go with 'bsdf null' (a boundary only: interior, exterior, "
+                        "priority)", mk->key);
+        if (media_key && m->bsdf != RT_BSDF_DIELECTRIC && m->bsdf != RT_BSDF_NULL)
+            return perr(p, RT_ERR_INVALID, seen[i], "material key '%s' needs 'bsdf dielectric' or 'bsdf null'",
+                        mk->key);
+        if (media_key)
             continue;
         if (mat_key_is_ext(mk) && m->bsdf != RT_BSDF_GLTF)
             return perr(p, RT_ERR_INVALID, seen[i],
@@ -1127,6 +1163,10 @@ static rt_result check_mat_keys(parser *p, const rt_material *m, const tok *cons
         else if (mk->kind == MK_GGX)
             *(mk->offset ? &k_alpha_uv : &k_alpha) = seen[i];
     }
+    if (m->bsdf == RT_BSDF_NULL && m->interior_medium == RT_NONE) {
+        const tok *at = seen[mat_key_index("bsdf")];
+        return perr(p, RT_ERR_INVALID, at, "'bsdf null' needs 'interior MEDIUM' (the medium it bounds)");
+    }
     if (k_metal && k_eta)
         return perr(p, RT_ERR_INVALID, k_eta, "material key '%s': give either 'metal NAME' or 'eta' and 'k', not both",
                     k_eta->s);
@@ -1139,6 +1179,15 @@ static rt_result check_mat_keys(parser *p, const rt_material *m, const tok *cons
  * UV transform on every slot, and what the path tracer layers. */
 static void finish_material(rt_material *m, const tok *const *seen, const float uv[4])
 {
+    /* a null boundary is no surface: cut away everywhere for the
+     * integrators that do not trace media (their rays and shadow rays pass
+     * it), an index of 1 on both sides for nested dielectrics in it */
+    if (m->bsdf == RT_BSDF_NULL) {
+        m->alpha_mode = RT_ALPHA_MASK;
+        m->alpha_cutoff = 2.0f;
+        m->ior = 1.0f;
+        m->exterior_ior = 1.0f;
+    }
     /* glass transmits: whitted refracts it, shadow rays treat it as glass */
     if (m->bsdf == RT_BSDF_DIELECTRIC && !seen[mat_key_index("transmission")])
         m->transmission = 1.0f;
@@ -1719,6 +1768,168 @@ static rt_result st_light(parser *p, const tok *kw)
     return RT_OK;
 }
 
+/* ------------------------------------------------------------ media */
+
+/* True when the three tokens after the cursor's are numbers: `scale X Y Z`. */
+static bool three_numbers_follow(const parser *p)
+{
+    float v;
+    for (size_t i = 1; i <= 3; i++) {
+        if (p->pos + i >= p->ntok)
+            return false;
+        const tok *t = &p->toks[p->pos + i];
+        if (t->quoted || rt_parse_float(t->s, &v) == RT_NUMBER_BAD)
+            return false;
+    }
+    return true;
+}
+
+/* One coefficient key of a medium line (sigma_a, sigma_s, g, scale), read
+ * into m; *taken false (nothing read) for any other word. */
+static rt_result get_medium_key(parser *p, rt_medium_def *m, float *scale, const tok *seen[4], bool *taken)
+{
+    static const char *const keys[4] = {"sigma_a", "sigma_s", "g", "scale"};
+    const tok *t = peek(p);
+    *taken = false;
+    int k = 0;
+    while (k < 4 && strcmp(t->s, keys[k]) != 0)
+        k++;
+    if (k == 4 || t->quoted)
+        return RT_OK;
+    if (seen[k])
+        return perr(p, RT_ERR_INVALID, t, "medium key '%s' is given twice (first at column %d)", keys[k],
+                    seen[k]->col);
+    seen[k] = t;
+    p->pos++;
+    *taken = true;
+    switch (k) {
+    case 0: return get_color(p, "the medium's sigma_a", &m->sigma_a);
+    case 1: return get_color(p, "the medium's sigma_s", &m->sigma_s);
+    case 2: return get_float_in(p, "the medium's g (Henyey-Greenstein)", -RT_MEDIUM_G_MAX, RT_MEDIUM_G_MAX, &m->g);
+    default: return get_float_in(p, "the medium's scale", 0.0f, FLT_MAX, scale);
+    }
+}
+
+/* The inverse of an affine map (the cofactors over the determinant);
+ * false when it is singular. */
+static bool affine_inverse(const rt_mat4 *a, rt_mat4 *out)
+{
+    rt_mat4 c; /* inverse transpose times |det| */
+    float det = rt_mat4_det3(a);
+    if (!rt_mat4_normal_matrix(a, &c) || !(fabsf(det) > 1e-30f))
+        return false;
+    rt_mat4 r = rt_mat4_identity();
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            r.m[i][j] = c.m[j][i] / fabsf(det);
+    rt_vec3 t = rt_mat4_vector(&r, rt_v3(a->m[0][3], a->m[1][3], a->m[2][3]));
+    r.m[0][3] = -t.x;
+    r.m[1][3] = -t.y;
+    r.m[2][3] = -t.z;
+    *out = r;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 4; j++)
+            if (!isfinite(r.m[i][j]))
+                return false;
+    return true;
+}
+
+/* `medium NAME homogeneous sigma_a R G B sigma_s R G B [g G] [scale S]` or
+ * `medium NAME nanovdb FILE [grid GRIDNAME] (the same keys) [translate X Y Z]
+ * [rotate X Y Z] [scale S | scale X Y Z]`: a `scale` with one number before
+ * any translate or rotate scales the coefficients, any other the grid. */
+static rt_result st_medium(parser *p, const tok *kw)
+{
+    const tok *name = NULL, *file = NULL, *grid_name = NULL;
+    rt_result r;
+    char b[80];
+    if ((r = get_word(p, "a medium name", &name)) != RT_OK ||
+        (r = check_new_name(p, name, &p->media, "medium")) != RT_OK)
+        return r;
+    static const char *const kinds[] = {"homogeneous", "nanovdb"};
+    int kind = 0;
+    if ((r = get_choice(p, "the medium kind", kinds, 2, "homogeneous|nanovdb", &kind)) != RT_OK)
+        return r;
+    if (kind == 1 && (r = get_word(p, "a NanoVDB file (.nvdb)", &file)) != RT_OK)
+        return r;
+    if (kind == 1 && peek_is(p, "grid")) {
+        p->pos++;
+        if ((r = get_word(p, "the grid name", &grid_name)) != RT_OK)
+            return r;
+    }
+    rt_medium_def m;
+    memset(&m, 0, sizeof m);
+    snprintf(m.name, sizeof m.name, "%s", name->s);
+    m.kind = kind == 1 ? RT_MEDIUM_GRID : RT_MEDIUM_HOMOGENEOUS;
+    m.index_to_world = m.world_to_index = rt_mat4_identity();
+    const tok *seen[4] = {0};
+    float scale = 1.0f;
+    xform x = {0};
+    bool placing = false; /* a translate or rotate was read: `scale` is the grid's */
+    while (peek(p)) {
+        bool taken = false;
+        bool grid_scale = peek_is(p, "scale") && (placing || seen[3] || three_numbers_follow(p));
+        if (!grid_scale && !placing && (r = get_medium_key(p, &m, &scale, seen, &taken)) != RT_OK)
+            return r;
+        if (taken)
+            continue;
+        if (kind == 1 && (r = get_xform_option(p, &x, "medium", &taken)) != RT_OK)
+            return r;
+        if (taken) {
+            placing = true;
+            continue;
+        }
+        const tok *t = peek(p);
+        return perr(p, RT_ERR_PARSE, t, "expected a medium key (sigma_a, sigma_s, g, scale%s), got %s",
+                    kind == 1 ? ", translate, rotate" : "", show(t, b, sizeof b));
+    }
+    if (!seen[0] || !seen[1])
+        return perr(p, RT_ERR_PARSE, NULL, "medium %s needs 'sigma_a R G B' and 'sigma_s R G B'",
+                    show(name, b, sizeof b));
+    m.sigma_a = rt_scale(m.sigma_a, scale);
+    m.sigma_s = rt_scale(m.sigma_s, scale);
+    if (!rt_finite3(m.sigma_a) || !rt_finite3(m.sigma_s))
+        return perr(p, RT_ERR_INVALID, seen[3], "the medium's coefficients times its scale overflow");
+    if (kind == 1) {
+        char path[MAX_PATH_LEN];
+        if ((r = resolve_path(p, file, path, sizeof path)) != RT_OK)
+            return r;
+        rt_error inner = {0};
+        rt_mat4 index_to_world;
+        r = rt_nanovdb_load(path, grid_name ? grid_name->s : NULL, &m.grid, &index_to_world, &inner);
+        if (r != RT_OK)
+            return loader_err(p, file, r, &inner);
+        rt_mat4 place = xform_matrix(&x);
+        m.index_to_world = rt_mat4_mul(place, index_to_world);
+        if (!affine_inverse(&m.index_to_world, &m.world_to_index)) {
+            rt_density_grid_free(&m.grid);
+            return perr(p, RT_ERR_INVALID, file, "the grid's placement in the world is singular");
+        }
+        rt_info("%s:%d: medium %s: %s, %d x %d x %d voxels", p->name, kw->line, m.name, path, m.grid.nx, m.grid.ny,
+                m.grid.nz);
+    }
+    uint32_t id = rt_scene_add_medium(p->s, &m); /* (takes the grid, also on failure) */
+    if (id == RT_NONE || !name_add(&p->media, name->s, id, name->line))
+        return nomem(p, name);
+    return RT_OK;
+}
+
+/* `scene_medium NAME`: the medium the camera sits in and that fills
+ * everything no boundary encloses. */
+static rt_result st_scene_medium(parser *p, const tok *kw)
+{
+    uint32_t m = RT_NONE;
+    rt_result r;
+    if ((r = get_medium(p, "scene_medium", &m)) != RT_OK || (r = expect_end(p, "scene_medium")) != RT_OK)
+        return r;
+    if (p->scene_medium_line)
+        rt_warn("%s:%d:%d: 'scene_medium' was already set on line %d; the later value wins", p->name, kw->line,
+                kw->col, p->scene_medium_line);
+    p->scene_medium_line = kw->line;
+    p->s->environment.medium = m;
+    return RT_OK;
+}
+
 /* ------------------------------------------------------------ statements */
 
 typedef rt_result (*handler)(parser *p, const tok *kw);
@@ -1742,6 +1953,8 @@ static const keyword keywords[] = {
     {"object", st_object},
     {"end", st_end},
     {"instance", st_instance},
+    {"medium", st_medium},
+    {"scene_medium", st_scene_medium},
 };
 
 /* What an object block may hold: triangles, from these statements. */
@@ -1780,7 +1993,7 @@ static rt_result run_statement(parser *p)
         return perr(p, RT_ERR_PARSE, kw, "unknown keyword %s (did you mean '%s'?)", show(kw, b, sizeof b), n.best);
     return perr(p, RT_ERR_PARSE, kw,
                 "unknown keyword %s (expected a setting, camera, texture, material, sphere, quad, triangle, mesh, "
-                "model, light, object, end or instance)",
+                "model, light, object, end, instance, medium or scene_medium)",
                 show(kw, b, sizeof b));
 }
 
@@ -1988,6 +2201,7 @@ rt_result rt_scene_parse_string_with(rt_scene *s, rt_settings *settings, const c
     name_table_free(&p.materials);
     name_table_free(&p.textures);
     name_table_free(&p.objects);
+    name_table_free(&p.media);
     free(buf);
     return r;
 }

@@ -270,6 +270,7 @@ void rt_bsdf_from_surface(const rt_trace_ctx *ctx, const rt_surface *sf, rt_bsdf
         plastic_at(ctx, sf, m, n, b);
         return;
     case RT_BSDF_GLTF:
+    case RT_BSDF_NULL: /* (no surface: the media tracer passes it before any BSDF) */
         break;
     }
     gltf_at(ctx, sf, m, b); /* (and, as before, any value out of the enum) */

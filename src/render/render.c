@@ -38,6 +38,8 @@
 #include "rt/render/aov.h"
 #include "rt/render/camera.h"
 #include "rt/render/integrator.h"
+#include "rt/render/pathtrace.h"
+#include "rt/render/volpath.h"
 #include "rt/render/sampling.h"
 #include "rt/render/wavefront.h"
 #include "rt/scene/validate.h"
@@ -524,6 +526,15 @@ static rt_result plan_job(rt_render_job *job, const rt_scene *scene, const rt_se
     job->aov = opt->aov;
     job->radiance = integrator->radiance;
     job->wavefront = integrator->wavefront;
+    if (rt_scene_has_media(scene)) { /* participating media: the path tracer's volumetric form, one path at a time */
+        if (integrator->radiance == rt_radiance_path) {
+            job->radiance = rt_radiance_volpath;
+            job->wavefront = false;
+        } else {
+            rt_warn("integrator %s ignores participating media and null boundaries (the path integrator renders "
+                    "them)", integrator->name);
+        }
+    }
     job->batch_size = opt->batch_size > 0 ? opt->batch_size : 0;
     return RT_OK;
 }

@@ -49,6 +49,8 @@ void rt_material_default(rt_material *m, const char *name)
     m->smith = RT_SMITH_CORRELATED;
     m->exterior_ior = 1.0f;
     m->priority = 0;
+    m->interior_medium = RT_NONE;
+    m->exterior_medium = RT_NONE;
     m->absorption = rt_v3s(0.0f);
     m->thickness = 0.0f;
     m->thin_walled = false;
@@ -117,6 +119,7 @@ void rt_scene_environment_default(rt_scene_environment *e)
     e->ambient_light_set = false;
     e->environment_texture = RT_NONE;
     e->environment_strength = 1.0f;
+    e->medium = RT_NONE;
 }
 
 void rt_scene_init(rt_scene *s)
@@ -148,6 +151,9 @@ void rt_scene_free(rt_scene *s)
     free(s->textures);
     free(s->lights);
     free(s->cameras);
+    for (size_t i = 0; i < s->medium_count; i++)
+        rt_density_grid_free(&s->media[i].grid);
+    free(s->media);
     rt_vertices *v = &s->vertices;
     free(v->position); free(v->normal); free(v->uv0); free(v->uv1); free(v->tangent); free(v->color);
     free(s->triangles.index); free(s->triangles.material); free(s->triangles.flags);
@@ -212,6 +218,34 @@ bool rt_scene_share_images(rt_scene *s, rt_scene *from)
 uint32_t rt_scene_add_light(rt_scene *s, const rt_light *l)
 {
     return table_push((void **)&s->lights, &s->light_count, &s->light_cap, l, sizeof *l);
+}
+
+uint32_t rt_scene_add_medium(rt_scene *s, rt_medium_def *m)
+{
+    uint32_t i = table_push((void **)&s->media, &s->medium_count, &s->medium_cap, m, sizeof *m);
+    if (i == RT_NONE)
+        rt_density_grid_free(&m->grid);
+    return i;
+}
+
+uint32_t rt_scene_find_medium(const rt_scene *s, const char *name)
+{
+    for (size_t i = s->medium_count; i-- > 0;)
+        if (strcmp(s->media[i].name, name) == 0)
+            return (uint32_t)i;
+    return RT_NONE;
+}
+
+bool rt_scene_has_media(const rt_scene *s)
+{
+    if (s->environment.medium != RT_NONE)
+        return true;
+    for (size_t i = 0; i < s->material_count; i++) {
+        const rt_material *m = &s->materials[i];
+        if (m->bsdf == RT_BSDF_NULL || m->interior_medium != RT_NONE || m->exterior_medium != RT_NONE)
+            return true;
+    }
+    return false;
 }
 
 uint32_t rt_scene_add_camera(rt_scene *s, const rt_camera *c)
@@ -348,6 +382,7 @@ rt_scene_mark rt_scene_mark_of(const rt_scene *s)
     m.images = s->image_count;
     m.lights = s->light_count;
     m.cameras = s->camera_count;
+    m.media = s->medium_count;
     m.vertices = s->vertices.count;
     m.triangles = s->triangles.count;
     m.spheres = s->spheres.count;
@@ -378,6 +413,9 @@ void rt_scene_rollback(rt_scene *s, const rt_scene_mark *m)
     truncate_to(&s->texture_count, m->textures);
     truncate_to(&s->light_count, m->lights);
     truncate_to(&s->camera_count, m->cameras);
+    for (size_t i = m->media; i < s->medium_count; i++)
+        rt_density_grid_free(&s->media[i].grid);
+    truncate_to(&s->medium_count, m->media);
     truncate_to(&s->vertices.count, m->vertices);
     truncate_to(&s->triangles.count, m->triangles);
     truncate_to(&s->spheres.count, m->spheres);

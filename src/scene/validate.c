@@ -30,6 +30,8 @@ static rt_result check_slot(const rt_scene *s, size_t mi, const rt_texture_slot 
     return RT_OK;
 }
 
+static float min3(rt_vec3 v) { return fminf(v.x, fminf(v.y, v.z)); }
+
 static rt_result check_materials(const rt_scene *s, rt_error *err)
 {
     size_t prims = rt_scene_prim_count(s);
@@ -39,6 +41,10 @@ static rt_result check_materials(const rt_scene *s, rt_error *err)
         const rt_material *m = &s->materials[i];
         if (!rt_finite3(m->color) || !rt_finite3(m->emission) || !finite1(m->emission_strength))
             return rt_fail(err, RT_ERR_INVALID, "material %zu ('%s'): colour or emission is not finite", i, m->name);
+        if ((m->interior_medium != RT_NONE && m->interior_medium >= s->medium_count) ||
+            (m->exterior_medium != RT_NONE && m->exterior_medium >= s->medium_count))
+            return rt_fail(err, RT_ERR_INVALID, "material %zu ('%s'): its medium is out of range (%zu medi%s)", i,
+                           m->name, s->medium_count, s->medium_count == 1 ? "um" : "a");
         const struct {
             const rt_texture_slot *slot;
             const char *what;
@@ -162,6 +168,17 @@ static rt_result check_environment(const rt_scene *s, rt_error *err)
                        st->environment_texture, PLURAL(s->texture_count));
     if (!rt_finite3(st->background) || !finite1(st->environment_strength))
         return rt_fail(err, RT_ERR_INVALID, "settings: background or environment strength is not finite");
+    if (st->medium != RT_NONE && st->medium >= s->medium_count)
+        return rt_fail(err, RT_ERR_INVALID, "scene_medium %u is out of range (%zu medi%s)", st->medium,
+                       s->medium_count, s->medium_count == 1 ? "um" : "a");
+    for (size_t i = 0; i < s->medium_count; i++) {
+        const rt_medium_def *m = &s->media[i];
+        bool ok = rt_finite3(m->sigma_a) && rt_finite3(m->sigma_s) && min3(m->sigma_a) >= 0.0f &&
+                  min3(m->sigma_s) >= 0.0f && fabsf(m->g) <= RT_MEDIUM_G_MAX;
+        if (!ok || (m->kind == RT_MEDIUM_GRID && !m->grid.block_max))
+            return rt_fail(err, RT_ERR_INVALID, "medium %zu ('%s'): coefficients, g or grid out of range", i,
+                           m->name);
+    }
     return RT_OK;
 }
 

@@ -43,6 +43,7 @@
 
 #include "rt/base/error.h"
 #include "rt/base/vec.h"
+#include "rt/scene/density_grid.h"
 
 #define RT_NONE UINT32_MAX /* "no index": no texture, no hit, no material */
 
@@ -75,9 +76,13 @@ typedef struct rt_scene_environment {
      * of the environment image (see docs/shading.md). */
     rt_vec3 ambient_light;
     bool ambient_light_set;
+    /* `scene_medium NAME`: the participating medium (index into the scene's
+     * media) the camera sits in and that fills everything no boundary
+     * encloses; RT_NONE = vacuum */
+    uint32_t medium;
 } rt_scene_environment;
 
-/* The defaults: black background, no image, strength 1, ambient unset. */
+/* The defaults: black background, no image, strength 1, ambient unset, no medium. */
 void rt_scene_environment_default(rt_scene_environment *e);
 
 /* ------------------------------------------------------------ textures */
@@ -129,7 +134,12 @@ typedef enum rt_alpha_mode { RT_ALPHA_OPAQUE = 0, RT_ALPHA_MASK, RT_ALPHA_BLEND 
  * a dielectric coat over a Lambertian base with the internal reflections
  * between them summed (`bsdf plastic`). */
 typedef enum rt_bsdf_model {
-    RT_BSDF_GLTF = 0, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR, RT_BSDF_DIELECTRIC, RT_BSDF_PLASTIC
+    RT_BSDF_GLTF = 0, RT_BSDF_LAMBERT, RT_BSDF_CONDUCTOR, RT_BSDF_DIELECTRIC, RT_BSDF_PLASTIC,
+    /* `bsdf null`: no surface at all, only the boundary of a participating
+     * medium (interior_medium): light goes straight through unbent. The
+     * parser makes it alpha-cut everywhere (alpha_mode mask, cutoff 2), so
+     * integrators that do not trace media never see it. */
+    RT_BSDF_NULL
 } rt_bsdf_model;
 
 /* Smith masking-shadowing term of the microfacet models. */
@@ -187,6 +197,10 @@ typedef struct rt_material {
     /* dielectric and plastic: ior is the inside's (the coat's) index */
     float exterior_ior;     /* index outside (default 1) */
     int priority;           /* dielectric: nested-media priority, higher wins (rt/render/medium.h) */
+    /* participating media on either side (indices into the scene's media,
+     * RT_NONE = none): inside a closed dielectric or null boundary, and
+     * outside it where that is not the scene's medium */
+    uint32_t interior_medium, exterior_medium;
     rt_vec3 absorption;     /* absorption coefficient inside, per scene unit (adds to attenuation_*) */
     float thickness;        /* KHR_materials_volume */
     bool thin_walled;       /* glTF: no volume (thickness 0), transmission goes straight through; scene text: false */
@@ -262,6 +276,29 @@ typedef struct rt_light {
     uint32_t quad;       /* area: the visible quad primitive (index into quads), RT_NONE if none */
 } rt_light;
 
+/* --------------------------------------------------------------- media */
+
+/* A participating medium (docs/media.md): absorption and scattering
+ * coefficients per RGB channel and per world unit (the scene format's
+ * `scale` already applied) at density 1, a Henyey-Greenstein anisotropy,
+ * and a density that is 1 everywhere (homogeneous) or a voxel grid placed
+ * in the world by index_to_world (the file's own map composed with the
+ * medium line's transform). The render stage samples it as an rt_volume
+ * (rt/render/volume.h). */
+#define RT_MEDIUM_G_MAX 0.999f /* |g| at most (rt/render/phase.h's RT_HG_G_MAX) */
+
+typedef enum rt_medium_kind { RT_MEDIUM_HOMOGENEOUS = 0, RT_MEDIUM_GRID } rt_medium_kind;
+
+typedef struct rt_medium_def {
+    char name[64];
+    rt_medium_kind kind;
+    rt_vec3 sigma_a, sigma_s;  /* per world unit, >= 0 */
+    float g;                   /* in (-1, 1) */
+    rt_density_grid grid;      /* RT_MEDIUM_GRID: owned by the scene */
+    rt_mat4 index_to_world;    /* RT_MEDIUM_GRID: the grid's index space to the world */
+    rt_mat4 world_to_index;    /* RT_MEDIUM_GRID: its inverse (the loader sets both) */
+} rt_medium_def;
+
 /* ------------------------------------------------------------ geometry */
 
 /* Per-vertex attributes. position, normal and uv0 always exist for every
@@ -324,6 +361,7 @@ typedef struct rt_scene {
     rt_image *images;       size_t image_count, image_cap;
     rt_light *lights;       size_t light_count, light_cap;
     rt_camera *cameras;     size_t camera_count, camera_cap; /* from models (glTF cameras) */
+    rt_medium_def *media;   size_t medium_count, medium_cap; /* participating media (grids owned) */
 
     rt_vertices vertices;
     rt_triangles triangles;
@@ -346,6 +384,12 @@ uint32_t rt_scene_find_material(const rt_scene *s, const char *name); /* RT_NONE
 uint32_t rt_scene_add_texture(rt_scene *s, const rt_texture *t);
 uint32_t rt_scene_add_image(rt_scene *s, const rt_image *img); /* takes ownership of the pixels */
 uint32_t rt_scene_add_light(rt_scene *s, const rt_light *l);
+/* Takes ownership of the medium's grid (freed with the scene), also on failure. */
+uint32_t rt_scene_add_medium(rt_scene *s, rt_medium_def *m);
+uint32_t rt_scene_find_medium(const rt_scene *s, const char *name); /* RT_NONE if absent */
+/* Whether a path must trace participating media: some medium is used by
+ * the scene or a material, or some material is a null boundary. */
+bool rt_scene_has_media(const rt_scene *s);
 /* Appends every image of `from` to s, sharing the decoded pixels (counted:
  * the last scene freed frees them), so loading the same files into s finds
  * them decoded (motion-blur slices, rt/job/motion.h). false when out of
@@ -380,7 +424,7 @@ bool rt_scene_reserve_triangles(rt_scene *s, size_t n);
  * camera and environment. Marks nest: a loader inside another rolls back its
  * own part. */
 typedef struct rt_scene_mark {
-    size_t materials, textures, images, lights, cameras;
+    size_t materials, textures, images, lights, cameras, media;
     size_t vertices, triangles, spheres, quads;
     size_t objects, instances;
     unsigned vertex_attrs; /* RT_ATTR_* arrays that existed */
