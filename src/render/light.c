@@ -175,14 +175,19 @@ bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, r
 rt_ray rt_shadow_ray(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
 {
     rt_vec3 o = rt_surface_spawn(ctx, sf, wi);
-    /* stop just short of the light's own surface (area lights are geometry
-     * too), measured from the offset origin: the offset moves it towards
-     * the light by up to ~1e-5 of the scene's scale, more than 1e-4 of a
-     * short distance in a small scene */
-    float tmax = INFINITY;
-    if (isfinite(dist))
-        tmax = rt_dot(rt_sub(rt_madd(sf->p, wi, dist), o), wi) * (1.0f - 1e-4f);
-    return rt_ray_make(o, wi, 0.0f, tmax);
+    if (!isfinite(dist))
+        return rt_ray_make(o, wi, 0.0f, INFINITY);
+    /* Aimed from the offset origin at the sampled point itself, and
+     * stopped just short of it (area lights are geometry too). Along wi
+     * from o, the ray would meet the light's plane off the point, short of
+     * dist by the offset over the cosine there: from a surface facing a
+     * light close above it, most rays ran into the light's own quad and
+     * counted as shadowed (test_shadow_rays_reach_the_light). */
+    rt_vec3 to = rt_sub(rt_madd(sf->p, wi, dist), o);
+    float len = rt_length(to);
+    if (!(len > 0.0f))
+        return rt_ray_make(o, wi, 0.0f, 0.0f);
+    return rt_ray_make(o, rt_scale(to, 1.0f / len), 0.0f, len * (1.0f - 1e-4f));
 }
 
 static rt_vec3 shadow_walk(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist, bool glass_passes)

@@ -265,7 +265,7 @@ static bool shadow(const rt_trace_ctx *ctx, const vp_state *ps, const vp_vertex 
         r = rt_shadow_ray(ctx, vx->sf, wi, dist);
     else
         r = rt_ray_make(vx->p, wi, 0.0f, isfinite(dist) ? dist * (1.0f - 1e-4f) : INFINITY);
-    rt_vec3 end = rt_madd(r.org, wi, r.tmax); /* (unused for an infinite ray) */
+    rt_vec3 end = rt_madd(r.org, r.dir, r.tmax); /* (unused for an infinite ray) */
     rt_medium_stack st = ps->stack;
     uint32_t medium = ps->medium;
     *T = *ru = *rl = rt_v3s(1.0f);

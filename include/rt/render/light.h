@@ -70,7 +70,9 @@ rt_vec3 rt_shadow_path_transmittance(const rt_trace_ctx *ctx, const rt_surface *
                                      bool thin_passes);
 
 /* The shadow ray both use (one ray; past its first hit they walk on from
- * it): from sf's surface, offset to the side of wi, to just short of dist.
+ * it): from sf's surface, offset to the side of wi, aimed at the sampled
+ * point sf->p + wi dist and stopped just short of it (its direction is wi
+ * up to the offset; an infinite dist: along wi).
  * When the render state's shadows_need_shading is false, visibility is
  * exactly !rt_kdtree_occluded of this ray (the wavefront tracer batches them). */
 rt_ray rt_shadow_ray(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist);
