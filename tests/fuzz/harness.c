@@ -152,7 +152,7 @@ static void fuzz_merge(const uint8_t *data, size_t size)
         if (k == parts - 1)
             n = size >= 4 ? size - 4 : 0;
         const uint8_t *part = size >= 4 ? data + 4 : data;
-        char name[16], path[256];
+        char name[24], path[256];
         snprintf(name, sizeof name, "m%d.exr", k);
         write_part(name, part, n, path, sizeof path);
         ok = rt_merge_add(&m, path, &err) == RT_OK;
