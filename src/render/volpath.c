@@ -136,6 +136,55 @@ static rt_surface_walk next_surface(const rt_trace_ctx *ctx, rt_ray *r, rt_rng *
     return RT_WALK_TOO_DEEP;
 }
 
+/* The majorant walk both trackers share (pbrt-v4's SampleT_maj): tentative
+ * collisions along o + t d drawn against the hero channel's majorant,
+ * piece by piece, with T_maj the majorant's transmittance since the last
+ * collision the caller took (it resets T_maj to 1 when it does). */
+typedef struct maj_walk {
+    rt_majorant_iter it;
+    rt_vec3 T_maj, maj; /* maj: the current piece's majorant */
+    float t, t1;        /* the walk's position and the current piece's end */
+    bool in_piece;
+    int h;
+} maj_walk;
+
+static void maj_walk_init(maj_walk *w, const rt_volume *v, rt_vec3 o, rt_vec3 d, float t_min, float t_max, int h)
+{
+    rt_majorant_iter_init(&w->it, v, o, d, t_min, t_max);
+    w->T_maj = rt_v3s(1.0f);
+    w->in_piece = false;
+    w->h = h;
+}
+
+/* The next tentative collision at *t (T_maj taken up to it): true; false
+ * at the end of the walk (T_maj taken up to t_max). */
+static bool maj_walk_next(maj_walk *w, rt_rng *rng, float *t)
+{
+    for (;;) {
+        if (!w->in_piece) {
+            float t0;
+            if (!rt_majorant_next(&w->it, &t0, &w->t1, &w->maj))
+                return false;
+            if (!(ch(w->maj, w->h) > 0.0f)) {
+                w->T_maj = rt_mul(w->T_maj, seg_tr(w->maj, w->t1 - t0));
+                continue;
+            }
+            w->t = t0;
+            w->in_piece = true;
+        }
+        float tn = w->t - log1pf(-rt_rng_float(rng)) / ch(w->maj, w->h);
+        if (!(tn < w->t1)) {
+            w->T_maj = rt_mul(w->T_maj, seg_tr(w->maj, w->t1 - w->t));
+            w->in_piece = false;
+            continue;
+        }
+        w->T_maj = rt_mul(w->T_maj, seg_tr(w->maj, tn - w->t));
+        w->t = tn;
+        *t = tn;
+        return true;
+    }
+}
+
 typedef enum vp_flight { FLIGHT_PASS, FLIGHT_SCATTER, FLIGHT_END } vp_flight;
 
 /* Delta tracking with null collisions over [t_min, t_max) of r (unit
@@ -147,48 +196,36 @@ static vp_flight free_flight(const rt_volume *v, const rt_ray *r, float t_min, f
                              float *t_out)
 {
     const int h = ps->hero;
-    rt_majorant_iter it;
-    rt_majorant_iter_init(&it, v, r->org, r->dir, t_min, t_max);
-    rt_vec3 T_maj = rt_v3s(1.0f), maj;
-    float t0, t1;
-    while (rt_majorant_next(&it, &t0, &t1, &maj)) {
-        float mh = ch(maj, h);
-        if (!(mh > 0.0f)) {
-            T_maj = rt_mul(T_maj, seg_tr(maj, t1 - t0));
-            continue;
+    maj_walk walk;
+    maj_walk_init(&walk, v, r->org, r->dir, t_min, t_max, h);
+    float t;
+    while (maj_walk_next(&walk, rng, &t)) {
+        const rt_vec3 T_maj = walk.T_maj, maj = walk.maj;
+        const float mh = ch(maj, h);
+        float density = rt_volume_density(v, rt_madd(r->org, r->dir, t));
+        rt_vec3 sa = rt_scale(v->sigma_a, density), ss = rt_scale(v->sigma_s, density);
+        float u = rt_rng_float(rng) * mh;
+        if (u < ch(sa, h))
+            return FLIGHT_END; /* absorbed */
+        if (u < ch(sa, h) + ch(ss, h)) {
+            rt_vec3 wt = rt_scale(rt_mul(T_maj, ss), 1.0f / (ch(T_maj, h) * ch(ss, h)));
+            ps->beta = rt_mul(ps->beta, wt);
+            ps->r_u = rt_mul(ps->r_u, wt);
+            *t_out = t;
+            return rt_finite3(ps->beta) && rt_finite3(ps->r_u) ? FLIGHT_SCATTER : FLIGHT_END;
         }
-        for (float t = t0;;) {
-            float tn = t - log1pf(-rt_rng_float(rng)) / mh;
-            if (!(tn < t1)) {
-                T_maj = rt_mul(T_maj, seg_tr(maj, t1 - t));
-                break;
-            }
-            T_maj = rt_mul(T_maj, seg_tr(maj, tn - t));
-            t = tn;
-            float density = rt_volume_density(v, rt_madd(r->org, r->dir, t));
-            rt_vec3 sa = rt_scale(v->sigma_a, density), ss = rt_scale(v->sigma_s, density);
-            float u = rt_rng_float(rng) * mh;
-            if (u < ch(sa, h))
-                return FLIGHT_END; /* absorbed */
-            if (u < ch(sa, h) + ch(ss, h)) {
-                rt_vec3 w = rt_scale(rt_mul(T_maj, ss), 1.0f / (ch(T_maj, h) * ch(ss, h)));
-                ps->beta = rt_mul(ps->beta, w);
-                ps->r_u = rt_mul(ps->r_u, w);
-                *t_out = t;
-                return rt_finite3(ps->beta) && rt_finite3(ps->r_u) ? FLIGHT_SCATTER : FLIGHT_END;
-            }
-            rt_vec3 sn = rt_vmax(rt_sub(maj, rt_add(sa, ss)), rt_v3s(0.0f)); /* null collision */
-            float pdf = ch(T_maj, h) * ch(sn, h);
-            if (!(pdf > 0.0f))
-                return FLIGHT_END;
-            ps->beta = rt_mul(ps->beta, rt_scale(rt_mul(T_maj, sn), 1.0f / pdf));
-            ps->r_u = rt_mul(ps->r_u, rt_scale(rt_mul(T_maj, sn), 1.0f / pdf));
-            ps->r_l = rt_mul(ps->r_l, rt_scale(rt_mul(T_maj, maj), 1.0f / pdf));
-            T_maj = rt_v3s(1.0f);
-            if (!(rt_max3(ps->beta) > 0.0f && rt_max3(ps->r_u) > 0.0f) || !rt_finite3(ps->beta))
-                return FLIGHT_END;
-        }
+        rt_vec3 sn = rt_vmax(rt_sub(maj, rt_add(sa, ss)), rt_v3s(0.0f)); /* null collision */
+        float pdf = ch(T_maj, h) * ch(sn, h);
+        if (!(pdf > 0.0f))
+            return FLIGHT_END;
+        ps->beta = rt_mul(ps->beta, rt_scale(rt_mul(T_maj, sn), 1.0f / pdf));
+        ps->r_u = rt_mul(ps->r_u, rt_scale(rt_mul(T_maj, sn), 1.0f / pdf));
+        ps->r_l = rt_mul(ps->r_l, rt_scale(rt_mul(T_maj, maj), 1.0f / pdf));
+        walk.T_maj = rt_v3s(1.0f);
+        if (!(rt_max3(ps->beta) > 0.0f && rt_max3(ps->r_u) > 0.0f) || !rt_finite3(ps->beta))
+            return FLIGHT_END;
     }
+    const rt_vec3 T_maj = walk.T_maj;
     float th = ch(T_maj, h);
     if (!(th > 0.0f))
         return FLIGHT_END;
@@ -205,41 +242,29 @@ static vp_flight free_flight(const rt_volume *v, const rt_ray *r, float t_min, f
 static bool ratio_track(const rt_volume *v, rt_vec3 o, rt_vec3 d, float t_max, int h, rt_rng *rng, rt_vec3 *T,
                         rt_vec3 *ru, rt_vec3 *rl)
 {
-    rt_majorant_iter it;
-    rt_majorant_iter_init(&it, v, o, d, 0.0f, t_max);
-    rt_vec3 T_maj = rt_v3s(1.0f), maj;
-    float t0, t1;
-    while (rt_majorant_next(&it, &t0, &t1, &maj)) {
-        float mh = ch(maj, h);
-        if (!(mh > 0.0f)) {
-            T_maj = rt_mul(T_maj, seg_tr(maj, t1 - t0));
-            continue;
-        }
-        for (float t = t0;;) {
-            float tn = t - log1pf(-rt_rng_float(rng)) / mh;
-            if (!(tn < t1)) {
-                T_maj = rt_mul(T_maj, seg_tr(maj, t1 - t));
-                break;
-            }
-            T_maj = rt_mul(T_maj, seg_tr(maj, tn - t));
-            t = tn;
-            rt_vec3 st = rt_scale(rt_volume_sigma_t(v), rt_volume_density(v, rt_madd(o, d, t)));
-            rt_vec3 sn = rt_vmax(rt_sub(maj, st), rt_v3s(0.0f));
-            float pdf = ch(T_maj, h) * mh;
-            *T = rt_mul(*T, rt_scale(rt_mul(T_maj, sn), 1.0f / pdf));
-            *rl = rt_mul(*rl, rt_scale(rt_mul(T_maj, maj), 1.0f / pdf));
-            *ru = rt_mul(*ru, rt_scale(rt_mul(T_maj, sn), 1.0f / pdf));
-            T_maj = rt_v3s(1.0f);
-            rt_vec3 tr = rt_scale(*T, 1.0f / avg3(rt_add(*rl, *ru)));
-            if (rt_max3(tr) < 0.05f) { /* roulette on a faint shadow ray */
-                if (rt_rng_float(rng) < 0.75f)
-                    return false;
-                *T = rt_scale(*T, 4.0f);
-            }
-            if (!(rt_max3(*T) > 0.0f) || !rt_finite3(*T))
+    maj_walk walk;
+    maj_walk_init(&walk, v, o, d, 0.0f, t_max, h);
+    float t;
+    while (maj_walk_next(&walk, rng, &t)) {
+        const rt_vec3 T_maj = walk.T_maj, maj = walk.maj;
+        const float mh = ch(maj, h);
+        rt_vec3 st = rt_scale(rt_volume_sigma_t(v), rt_volume_density(v, rt_madd(o, d, t)));
+        rt_vec3 sn = rt_vmax(rt_sub(maj, st), rt_v3s(0.0f));
+        float pdf = ch(T_maj, h) * mh;
+        *T = rt_mul(*T, rt_scale(rt_mul(T_maj, sn), 1.0f / pdf));
+        *rl = rt_mul(*rl, rt_scale(rt_mul(T_maj, maj), 1.0f / pdf));
+        *ru = rt_mul(*ru, rt_scale(rt_mul(T_maj, sn), 1.0f / pdf));
+        walk.T_maj = rt_v3s(1.0f);
+        rt_vec3 tr = rt_scale(*T, 1.0f / avg3(rt_add(*rl, *ru)));
+        if (rt_max3(tr) < 0.05f) { /* roulette on a faint shadow ray */
+            if (rt_rng_float(rng) < 0.75f)
                 return false;
+            *T = rt_scale(*T, 4.0f);
         }
+        if (!(rt_max3(*T) > 0.0f) || !rt_finite3(*T))
+            return false;
     }
+    const rt_vec3 T_maj = walk.T_maj;
     float th = ch(T_maj, h);
     if (!(th > 0.0f))
         return false;
