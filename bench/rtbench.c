@@ -2,7 +2,7 @@
  * checked against Embree's reference hits.
  *
  *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
- *           [--build-threads N] [--occluded] [--portable] [--flatten] [--limit N]
+ *           [--build-threads N] [--occluded] [--portable] [--instances] [--limit N]
  *           [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H [--image-width N]]
  *           [--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]]
  *
@@ -22,11 +22,12 @@
  * ray whose hit/miss differs from the reference. Exits 1 when more than
  * 0.01% of the rays disagree with the reference: speed bought with wrong
  * answers does not count. --portable: the portable traversal even when
- * the CPU has AVX2 (traversal: says which one ran). --flatten: a glTF's
- * meshes used more than once are flattened into world triangles instead
- * of kept once and placed by instances (rt/scene/instance.h; with
- * instances, --packets is refused: the packets do not enter them, and the
- * streams trace ray by ray). --limit N keeps N rays spread evenly over the set
+ * the CPU has AVX2 (traversal: says which one ran). The model is loaded
+ * as ../shared/bench/FORMAT.md defines the rays' scene, every triangle in
+ * world space, as Embree's single-level BVH sees it; --instances keeps a
+ * glTF's meshes used more than once as objects placed by instances instead
+ * (rt/scene/instance.h; --packets is then refused: the packets do not
+ * enter them, and the streams trace ray by ray). --limit N keeps N rays spread evenly over the set
  * (every count/N-th, with its reference hit): a fixed small subset for
  * instruction counts under callgrind. --packets W H traces the set (a
  * primary set: one ray per pixel, row by row, N pixels wide, default 640)
@@ -219,7 +220,7 @@ static int cmp_double(const void *a, const void *b)
 static int usage(void)
 {
     fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K] [--build-threads N] "
-                    "[--occluded] [--portable] [--flatten] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H] "
+                    "[--occluded] [--portable] [--instances] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H] "
                     "[--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]]\n");
     return 2;
 }
@@ -228,7 +229,7 @@ int main(int argc, char **argv)
 {
     const char *model = NULL, *rays_path = NULL, *hits_path = NULL;
     int threads = 1, runs = 5, build_threads = 0;
-    bool flatten = false;
+    bool flatten = true; /* FORMAT.md's scene: every triangle in world space */
     long limit = 0;
     int pw = 0, ph = 0, image_width = 640, lanes = 0;
     bool occluded = false, portable = false, stream = false, frustum = false;
@@ -270,8 +271,8 @@ int main(int argc, char **argv)
             occluded = true;
         else if (strcmp(argv[i], "--portable") == 0)
             portable = true;
-        else if (strcmp(argv[i], "--flatten") == 0)
-            flatten = true;
+        else if (strcmp(argv[i], "--instances") == 0)
+            flatten = false;
         else if (argv[i][0] == '-')
             return usage();
         else if (!model)
@@ -325,7 +326,7 @@ int main(int argc, char **argv)
     }
     if (pw && tree.instance_count) {
         fprintf(stderr, "rtbench: %s has instances, which the packets do not enter: trace it without --packets, or "
-                        "with --flatten\n", model);
+                        "without --instances\n", model);
         return 2;
     }
     size_t *order = NULL;
