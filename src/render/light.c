@@ -168,10 +168,7 @@ bool rt_light_sample_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, r
     }
 }
 
-/* Light arriving along a shadow ray from sf->p towards wi, stopping just
- * short of distance dist: walks the hits, passing alpha cut-outs, scaling
- * by 1 - alpha through blended surfaces and, when glass_passes, by the
- * transmission colour through transmissive ones (otherwise they block). */
+/* The shadow ray towards a light sample (rt/render/light.h). */
 rt_ray rt_shadow_ray(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
 {
     rt_vec3 o = rt_surface_spawn(ctx, sf, wi);
@@ -190,54 +187,26 @@ rt_ray rt_shadow_ray(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, 
     return rt_ray_make(o, rt_scale(to, 1.0f / len), 0.0f, len * (1.0f - 1e-4f));
 }
 
-static rt_vec3 shadow_walk(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist, bool glass_passes)
+/* What passes a surface a shadow ray met (material m, hit h), under the
+ * plain rule (direct, whitted: transmissive surfaces pass their
+ * transmission colour, cut-outs pass, blended surfaces 1 - alpha) or the
+ * path tracer's (path: only cut-outs, the share of blended surfaces a path
+ * steps past and, with thin_passes, smooth thin-walled panes' straight-
+ * through lobe); zero where it blocks. */
+static rt_vec3 plain_pass(const rt_trace_ctx *ctx, const rt_ray *r, const rt_hit *h, const rt_material *m)
 {
-    rt_ray r = rt_shadow_ray(ctx, sf, wi, dist);
-    if (ctx->ray_count)
-        (*ctx->ray_count)++;
-    if (!ctx->state->shadows_need_shading)
-        return rt_kdtree_occluded(ctx->state->tree, &r) ? rt_v3s(0) : rt_v3s(1);
-    const rt_scene *s = ctx->state->scene;
-    rt_vec3 tr = rt_v3s(1);
-    for (int layer = 0; layer < 64; layer++) {
-        rt_hit h;
-        if (!rt_kdtree_intersect(ctx->state->tree, &r, &h))
-            return tr;
-        uint32_t mi = rt_prim_material(s, h.prim);
-        RT_DCHECK(mi < s->material_count);
-        const rt_material *m = &s->materials[mi];
-        bool transmits = m->transmission > 0.0f;
-        if (m->alpha_mode == RT_ALPHA_OPAQUE) { /* no surface record needed */
-            if (!transmits || !glass_passes)
-                return rt_v3s(0);
-            tr = rt_mul(tr, rt_scale(m->transmission_color, m->transmission));
-            if (rt_max3(tr) <= 0.0f)
-                return rt_v3s(0);
-            r.tmin = h.t;
-            continue;
-        }
-        rt_surface s2;
-        rt_surface_at(ctx, &r, &h, &s2);
-        float coverage;
-        if (!rt_surface_cut_away(ctx, &s2, &coverage)) {
-            if (transmits && glass_passes) {
-                tr = rt_mul(tr, rt_scale(m->transmission_color, m->transmission));
-            } else if (!transmits && coverage < 1.0f) {
-                tr = rt_scale(tr, 1.0f - coverage);
-            } else {
-                return rt_v3s(0);
-            }
-        }
-        if (rt_max3(tr) <= 0.0f)
-            return rt_v3s(0);
-        r.tmin = h.t; /* continue past this surface */
-    }
-    return rt_v3s(0);
-}
-
-rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
-{
-    return shadow_walk(ctx, sf, wi, dist, true);
+    bool transmits = m->transmission > 0.0f;
+    rt_vec3 glass = rt_scale(m->transmission_color, m->transmission);
+    if (m->alpha_mode == RT_ALPHA_OPAQUE) /* no surface record needed */
+        return transmits ? glass : rt_v3s(0);
+    rt_surface s2;
+    rt_surface_at(ctx, r, h, &s2);
+    float coverage;
+    if (rt_surface_cut_away(ctx, &s2, &coverage))
+        return rt_v3s(1);
+    if (transmits)
+        return glass;
+    return coverage < 1.0f ? rt_v3s(1.0f - coverage) : rt_v3s(0);
 }
 
 /* What a path that reached surface s2 along the shadow ray would carry on
@@ -260,8 +229,32 @@ static rt_vec3 straight_through(const rt_trace_ctx *ctx, const rt_surface *s2)
     return rt_dot(wi, s2->ng) < 0.0f ? w : rt_v3s(0.0f);
 }
 
-rt_vec3 rt_shadow_path_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist,
-                                     bool thin_passes)
+static rt_vec3 path_pass(const rt_trace_ctx *ctx, const rt_ray *r, const rt_hit *h, const rt_material *m,
+                         bool thin_passes)
+{
+    /* (the glTF BSDF is thin-walled only with transmission: material_eval.c) */
+    bool may_pass = thin_passes && m->bsdf == RT_BSDF_GLTF && m->thin_walled && m->transmission > 0.0f;
+    if (m->alpha_mode == RT_ALPHA_OPAQUE && !may_pass)
+        return rt_v3s(0); /* no surface record needed */
+    rt_surface s2;
+    rt_surface_at(ctx, r, h, &s2);
+    float coverage = 1.0f;
+    if (m->alpha_mode != RT_ALPHA_OPAQUE && rt_surface_cut_away(ctx, &s2, &coverage))
+        return rt_v3s(1);
+    /* kept with probability coverage (stochastic blending), which a path
+     * then scatters on; the rest it steps past */
+    rt_vec3 pass = may_pass ? straight_through(ctx, &s2) : rt_v3s(0);
+    bool passes = rt_max3(pass) > 0.0f;
+    if (coverage < 1.0f)
+        return passes ? rt_add(rt_v3s(1.0f - coverage), rt_scale(pass, coverage)) : rt_v3s(1.0f - coverage);
+    return passes ? pass : rt_v3s(0);
+}
+
+/* The one shadow walk: from sf towards wi, short of dist (rt_shadow_ray),
+ * past every surface by the rule's pass (path_rule: the path tracer's);
+ * the product of what passed, zero once something blocks. */
+static rt_vec3 shadow_walk(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist, bool path_rule,
+                           bool thin_passes)
 {
     rt_ray r = rt_shadow_ray(ctx, sf, wi, dist);
     if (ctx->ray_count)
@@ -277,31 +270,26 @@ rt_vec3 rt_shadow_path_transmittance(const rt_trace_ctx *ctx, const rt_surface *
         uint32_t mi = rt_prim_material(s, h.prim);
         RT_DCHECK(mi < s->material_count);
         const rt_material *m = &s->materials[mi];
-        /* (the glTF BSDF is thin-walled only with transmission: material_eval.c) */
-        bool may_pass = thin_passes && m->bsdf == RT_BSDF_GLTF && m->thin_walled && m->transmission > 0.0f;
-        if (m->alpha_mode == RT_ALPHA_OPAQUE && !may_pass)
-            return rt_v3s(0); /* no surface record needed */
-        rt_surface s2;
-        rt_surface_at(ctx, &r, &h, &s2);
-        float coverage = 1.0f;
-        if (m->alpha_mode == RT_ALPHA_OPAQUE || !rt_surface_cut_away(ctx, &s2, &coverage)) {
-            /* kept with probability coverage (stochastic blending), which
-             * a path then scatters on; the rest it steps past */
-            rt_vec3 pass = may_pass ? straight_through(ctx, &s2) : rt_v3s(0);
-            bool passes = rt_max3(pass) > 0.0f;
-            if (coverage < 1.0f)
-                tr = passes ? rt_mul(tr, rt_add(rt_v3s(1.0f - coverage), rt_scale(pass, coverage)))
-                            : rt_scale(tr, 1.0f - coverage);
-            else if (passes)
-                tr = rt_mul(tr, pass);
-            else
-                return rt_v3s(0);
-        }
+        rt_vec3 pass = path_rule ? path_pass(ctx, &r, &h, m, thin_passes) : plain_pass(ctx, &r, &h, m);
+        if (!(rt_max3(pass) > 0.0f))
+            return rt_v3s(0);
+        tr = rt_mul(tr, pass); /* (times 1, exactly, past a cut-out) */
         if (rt_max3(tr) <= 0.0f)
             return rt_v3s(0);
         r.tmin = h.t; /* continue past this surface */
     }
     return rt_v3s(0);
+}
+
+rt_vec3 rt_shadow_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist)
+{
+    return shadow_walk(ctx, sf, wi, dist, false, false);
+}
+
+rt_vec3 rt_shadow_path_transmittance(const rt_trace_ctx *ctx, const rt_surface *sf, rt_vec3 wi, float dist,
+                                     bool thin_passes)
+{
+    return shadow_walk(ctx, sf, wi, dist, true, thin_passes);
 }
 
 /* ------------------------------------------------------------ light table */
