@@ -83,34 +83,6 @@ static int run(const char *const *args)
             fail_msg("rt failed: %s", err_text);                                                                       \
     } while (0)
 
-static char *slurp(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        fail_msg("cannot open %s", path);
-    static char *buf;
-    free(buf);
-    buf = malloc(1 << 22);
-    assert_non_null(buf);
-    *size = fread(buf, 1, 1 << 22, f);
-    fclose(f);
-    char *copy = malloc(*size + 1);
-    assert_non_null(copy);
-    memcpy(copy, buf, *size);
-    copy[*size] = 0;
-    return copy;
-}
-
-static void assert_same_bytes(const char *a, const char *b)
-{
-    size_t na, nb;
-    char *x = slurp(a, &na), *y = slurp(b, &nb);
-    if (na != nb || memcmp(x, y, na) != 0)
-        fail_msg("%s and %s differ", a, b);
-    free(x);
-    free(y);
-}
-
 static int setup(void **state)
 {
     (void)state;
@@ -118,16 +90,9 @@ static int setup(void **state)
         return -1;
     snprintf(scene_path, sizeof scene_path, "%s/scene.txt", dir);
     /* the glass Cornell box, small, path traced (passes; --integrator picks the others) */
-    FILE *in = fopen("scenes/glass-cornell.txt", "rb"), *f = fopen(in_dir("scene.txt"), "wb");
-    if (!in || !f)
+    if (!test_copy_scene_with("scenes/glass-cornell.txt", scene_path,
+                              "\nresolution 40 30\nsamples 16\nintegrator path\nseed 7\n"))
         return -1;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, in)) > 0)
-        fwrite(buf, 1, n, f);
-    fputs("\nresolution 40 30\nsamples 16\nintegrator path\nseed 7\n", f);
-    fclose(in);
-    fclose(f);
     return 0;
 }
 
@@ -165,11 +130,11 @@ static void check_region_parts(const char *integrator, int n)
     args[na] = NULL;
     if (run(args) != 0)
         fail_msg("merge failed: %s", err_text);
-    assert_same_bytes(in_dir("merged.png"), in_dir("full.png"));
+    test_assert_same_bytes(in_dir("merged.png"), in_dir("full.png"));
     args[na - 1] = in_dir("merged.pfm");
     if (run(args) != 0)
         fail_msg("merge failed: %s", err_text);
-    assert_same_bytes(in_dir("merged.pfm"), in_dir("full.pfm"));
+    test_assert_same_bytes(in_dir("merged.pfm"), in_dir("full.pfm"));
 }
 
 static void test_parts_1_3_7_same_bytes(void **state)
@@ -192,9 +157,9 @@ static void test_crop_parts_same_bytes(void **state)
     RUN_OK("-q", "--crop", "17,0,40,11", "-o", in_dir("c1.pfm"), scene);
     RUN_OK("-q", "--crop", "17", "11", "40", "30", "--passes", "3", "-o", in_dir("c2.exr"), scene);
     RUN_OK("merge", in_dir("c0.exr"), in_dir("c1.pfm.json"), in_dir("c2.exr"), "-o", in_dir("m.png"));
-    assert_same_bytes(in_dir("m.png"), in_dir("full.png"));
+    test_assert_same_bytes(in_dir("m.png"), in_dir("full.png"));
     RUN_OK("merge", in_dir("c2.exr"), in_dir("c0.exr"), in_dir("c1.pfm"), "-o", in_dir("m.pfm"));
-    assert_same_bytes(in_dir("m.pfm"), in_dir("full.pfm"));
+    test_assert_same_bytes(in_dir("m.pfm"), in_dir("full.pfm"));
 }
 
 /* Every channel of a within the bound docs/farm.md states of b: merging
@@ -236,7 +201,7 @@ static void test_sample_ranges(void **state)
     /* one range of all samples is the render itself */
     RUN_OK("-q", "--spp-range", "0:16", "-o", in_dir("all.exr"), scene);
     RUN_OK("merge", in_dir("all.exr"), "-o", in_dir("one.pfm"));
-    assert_same_bytes(in_dir("one.pfm"), in_dir("full.pfm"));
+    test_assert_same_bytes(in_dir("one.pfm"), in_dir("full.pfm"));
     /* regions and ranges together: part 1 of 3 in two ranges, the others whole */
     RUN_OK("-q", "--part", "0/3", "-o", in_dir("q0.exr"), scene);
     RUN_OK("-q", "--part", "1/3", "--spp-range", "0:7", "-o", in_dir("q1a.exr"), scene);
@@ -247,7 +212,7 @@ static void test_sample_ranges(void **state)
     /* ... and --resume continues the sum exactly */
     RUN_OK("-q", "--resume", in_dir("q1a.exr"), "-o", in_dir("q1r.exr"), scene);
     RUN_OK("merge", in_dir("q0.exr"), in_dir("q1r.exr"), in_dir("q2.exr"), "-o", in_dir("mix.png"));
-    assert_same_bytes(in_dir("mix.png"), in_dir("full.png"));
+    test_assert_same_bytes(in_dir("mix.png"), in_dir("full.png"));
 }
 
 static void test_resume_exact(void **state)
@@ -257,11 +222,11 @@ static void test_resume_exact(void **state)
     const char *scene = scene_path;
     RUN_OK("-q", "--spp-range", "0:5", "-o", in_dir("a.pfm"), scene);
     RUN_OK("-q", "--resume", in_dir("a.pfm"), "-o", in_dir("r.pfm"), scene);
-    assert_same_bytes(in_dir("r.pfm"), in_dir("full.pfm"));
+    test_assert_same_bytes(in_dir("r.pfm"), in_dir("full.pfm"));
     RUN_OK("-q", "--resume", in_dir("a.pfm"), "--passes", "0", "-o", in_dir("rt.pfm"), scene); /* tiles */
-    assert_same_bytes(in_dir("rt.pfm"), in_dir("full.pfm"));
+    test_assert_same_bytes(in_dir("rt.pfm"), in_dir("full.pfm"));
     RUN_OK("-q", "--resume", in_dir("a.pfm.json"), "-o", in_dir("r.png"), scene);
-    assert_same_bytes(in_dir("r.png"), in_dir("full.png"));
+    test_assert_same_bytes(in_dir("r.png"), in_dir("full.png"));
     /* a resumed part that is not the whole image is a part again */
     assert_int_equal(RUN("-q", "--resume", in_dir("a.pfm"), "--spp-range", "5:16", "-o", in_dir("x.pfm"), scene), 2);
     /* a part of another render is refused, naming what differs */
@@ -290,15 +255,15 @@ static void test_aov_parts(void **state)
     RUN_OK("-q", "--aov", aovs, "--part", "2/3", "--spp-range", "0:6", "-o", in_dir("ap2a.exr"), scene);
     RUN_OK("-q", "--aov", aovs, "--resume", in_dir("ap2a.exr"), "-o", in_dir("ap2.exr"), scene);
     RUN_OK("merge", in_dir("ap0.exr"), in_dir("ap1.exr"), in_dir("ap2.exr"), "-o", in_dir("am.exr"));
-    assert_same_bytes(in_dir("am.exr"), in_dir("af.exr"));
+    test_assert_same_bytes(in_dir("am.exr"), in_dir("af.exr"));
     RUN_OK("merge", in_dir("ap0.exr"), in_dir("ap1.exr"), in_dir("ap2.exr"), "-o", in_dir("am.png"));
-    assert_same_bytes(in_dir("am.png"), in_dir("af.png"));
+    test_assert_same_bytes(in_dir("am.png"), in_dir("af.png"));
     const char *names[4] = {"albedo", "normal", "depth", "position"};
     for (int k = 0; k < 4; k++) {
         char a[64], b[64];
         snprintf(a, sizeof a, "am.%s.pfm", names[k]);
         snprintf(b, sizeof b, "af.%s.pfm", names[k]);
-        assert_same_bytes(in_dir(a), in_dir(b));
+        test_assert_same_bytes(in_dir(a), in_dir(b));
     }
     /* parts with other AOVs are of another render; variance and spp are not kept */
     RUN_OK("-q", "--aov", "albedo", "--part", "2/3", "-o", in_dir("ap2x.exr"), scene);
@@ -321,8 +286,8 @@ static void test_frames(void **state)
     char pattern[600];
     snprintf(pattern, sizeof pattern, "%s/f%%%%.%%04d.png", dir);
     RUN_OK("-q", "-s", "2", "--frames", "8:11", "--fps", "30", "-o", pattern, scene);
-    assert_same_bytes(in_dir("f%.0008.png"), in_dir("one.png"));
-    assert_same_bytes(in_dir("f%.0010.png"), in_dir("one.png"));
+    test_assert_same_bytes(in_dir("f%.0008.png"), in_dir("one.png"));
+    test_assert_same_bytes(in_dir("f%.0010.png"), in_dir("one.png"));
     assert_int_equal(access(in_dir("f%.0011.png"), F_OK), -1);
     assert_int_equal(access(in_dir("f%.0007.png"), F_OK), -1);
     snprintf(pattern, sizeof pattern, "%s/fp%%d.exr", dir);
@@ -331,8 +296,8 @@ static void test_frames(void **state)
     /* Blender's ####: the number zero-padded to as many digits */
     snprintf(pattern, sizeof pattern, "%s/h.###.png", dir);
     RUN_OK("-q", "-s", "2", "--frames", "8:10", "-o", pattern, scene);
-    assert_same_bytes(in_dir("h.008.png"), in_dir("one.png"));
-    assert_same_bytes(in_dir("h.009.png"), in_dir("one.png"));
+    test_assert_same_bytes(in_dir("h.008.png"), in_dir("one.png"));
+    test_assert_same_bytes(in_dir("h.009.png"), in_dir("one.png"));
     /* without -o: NAME.%04d.png in the current directory (NAME: the input's) */
     char bin[4096], cwd[4096];
     assert_non_null(realpath(rt_bin(), bin));
@@ -343,8 +308,8 @@ static void test_frames(void **state)
     assert_int_equal(chdir(cwd), 0);
     if (status != 0)
         fail_msg("--frames without -o failed: %s", err_text);
-    assert_same_bytes(in_dir("scene.0003.png"), in_dir("one.png"));
-    assert_same_bytes(in_dir("scene.0004.png"), in_dir("one.png"));
+    test_assert_same_bytes(in_dir("scene.0003.png"), in_dir("one.png"));
+    test_assert_same_bytes(in_dir("scene.0004.png"), in_dir("one.png"));
     const char *bad[] = {"plain.png", "two%d%d.png", "s%s.png", "w%010d.png", "%", "two##.#.png", "long##########.png"};
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
         assert_int_equal(RUN("-q", "--frames", "0:2", "-o", in_dir(bad[i]), scene), 2);
@@ -373,9 +338,9 @@ static void test_frames_animated_gltf(void **state)
            "4", "-o", pattern, model);
     RUN_OK("-q", "-r", "48x36", "-s", "2", "--look-from", "3,2,4", "--look-at", "0,1,0", "--frame-time", "0.5", "-o",
            in_dir("truck-t.png"), model);
-    assert_same_bytes(in_dir("truck.2.png"), in_dir("truck-t.png"));
+    test_assert_same_bytes(in_dir("truck.2.png"), in_dir("truck-t.png"));
     size_t n0, n2;
-    char *f0 = slurp(in_dir("truck.0.png"), &n0), *f2 = slurp(in_dir("truck.2.png"), &n2);
+    char *f0 = test_slurp(in_dir("truck.0.png"), &n0), *f2 = test_slurp(in_dir("truck.2.png"), &n2);
     assert_true(n0 != n2 || memcmp(f0, f2, n0) != 0); /* the truck moved */
     free(f0);
     free(f2);
@@ -402,8 +367,8 @@ static void test_frames_animated_gltf(void **state)
     snprintf(pattern, sizeof pattern, "%s/fox.%%d.png", dir);
     RUN_OK("-q", "--frames", "0:3", "--fps", "4", "-o", pattern, in_dir("fox.txt"));
     RUN_OK("-q", "--frame-time", "0.5", "-o", in_dir("fox-t.png"), in_dir("fox.txt"));
-    assert_same_bytes(in_dir("fox.2.png"), in_dir("fox-t.png"));
-    f0 = slurp(in_dir("fox.0.png"), &n0), f2 = slurp(in_dir("fox.2.png"), &n2);
+    test_assert_same_bytes(in_dir("fox.2.png"), in_dir("fox-t.png"));
+    f0 = test_slurp(in_dir("fox.0.png"), &n0), f2 = test_slurp(in_dir("fox.2.png"), &n2);
     assert_true(n0 != n2 || memcmp(f0, f2, n0) != 0); /* the fox ran */
     free(f0);
     free(f2);
@@ -414,10 +379,10 @@ static void test_frames_animated_gltf(void **state)
     RUN_OK("-q", "-r", "32x24", "-s", "1", "--frame-time", "0.3", "--animation", "2", "-o", in_dir("run2.pfm"), foxglb);
     RUN_OK("-q", "-r", "32x24", "-s", "1", "--frame-time", "0.3", "--animation", "Run", "-o", in_dir("runname.pfm"),
            foxglb);
-    assert_same_bytes(in_dir("run2.pfm"), in_dir("runname.pfm"));
+    test_assert_same_bytes(in_dir("run2.pfm"), in_dir("runname.pfm"));
     RUN_OK("-q", "-r", "32x24", "-s", "1", "--frame-time", "0.3", "--animation", "Walk", "-o", in_dir("walk.pfm"),
            foxglb);
-    f0 = slurp(in_dir("run2.pfm"), &n0), f2 = slurp(in_dir("walk.pfm"), &n2);
+    f0 = test_slurp(in_dir("run2.pfm"), &n0), f2 = test_slurp(in_dir("walk.pfm"), &n2);
     assert_true(n0 != n2 || memcmp(f0, f2, n0) != 0);
     free(f0);
     free(f2);
@@ -430,7 +395,7 @@ static void test_frames_animated_gltf(void **state)
     fputs(text, f);
     fclose(f);
     RUN_OK("-q", "--frame-time", "0.5", "--animation", "Run", "-o", in_dir("fox-named.png"), in_dir("fox-any.txt"));
-    assert_same_bytes(in_dir("fox-named.png"), in_dir("fox-t.png"));
+    test_assert_same_bytes(in_dir("fox-named.png"), in_dir("fox-t.png"));
     assert_int_equal(RUN("-q", "--frame-time", "0.3", "--animation", "Trot", "-o", in_dir("trot.pfm"), foxglb), 2);
     assert_non_null(strstr(err_text, "no animation named 'Trot'"));
     assert_non_null(strstr(err_text, "'Run'"));
@@ -445,7 +410,7 @@ static void test_frames_animated_gltf(void **state)
 static void sidecar_camera(const char *json, char *out, size_t size)
 {
     size_t n;
-    char *t = slurp(json, &n);
+    char *t = test_slurp(json, &n);
     const char *a = strstr(t, "camera.position"), *b = a ? strstr(a, "frame_time") : NULL;
     if (!a || !b)
         fail_msg("no camera in %s", json);
@@ -479,8 +444,8 @@ static void test_frames_one_camera(void **state)
     snprintf(pattern, sizeof pattern, "%s/share.%%d.pfm", dir);
     RUN_OK("-q", "-r", "32x24", "-s", "1", "--animation", "2", "--frames", "0:12", "--only-frames", "7:9", "--fps", "8",
            "-o", pattern, fox);
-    assert_same_bytes(in_dir("share.7.pfm"), in_dir("seq.7.pfm"));
-    assert_same_bytes(in_dir("share.8.pfm"), in_dir("seq.8.pfm"));
+    test_assert_same_bytes(in_dir("share.7.pfm"), in_dir("seq.7.pfm"));
+    test_assert_same_bytes(in_dir("share.8.pfm"), in_dir("seq.8.pfm"));
     assert_int_equal(access(in_dir("share.6.pfm"), F_OK), -1);
     assert_int_equal(access(in_dir("share.9.pfm"), F_OK), -1);
     assert_int_equal(RUN("-q", "--frames", "0:12", "--only-frames", "11:13", "-o", pattern, fox), 2);
@@ -581,19 +546,19 @@ static void test_motion_blur(void **state)
     assert_true(column_mean(in_dir("blur.pfm"), 15) == 1.0);
     /* any split of the work: the same bytes */
     RUN_OK("-q", "-t", "1", "--passes", "0", "--tile", "3", "-o", in_dir("blur-t1.pfm"), in_dir("blur.txt"));
-    assert_same_bytes(in_dir("blur-t1.pfm"), in_dir("blur.pfm"));
+    test_assert_same_bytes(in_dir("blur-t1.pfm"), in_dir("blur.pfm"));
     RUN_OK("-q", "-t", "2", "--passes", "5", "-o", in_dir("blur-p5.pfm"), in_dir("blur.txt"));
-    assert_same_bytes(in_dir("blur-p5.pfm"), in_dir("blur.pfm"));
+    test_assert_same_bytes(in_dir("blur-p5.pfm"), in_dir("blur.pfm"));
     RUN_OK("-q", "--part", "0/2", "-o", in_dir("bp0.exr"), in_dir("blur.txt"));
     RUN_OK("-q", "--part", "1/2", "--spp-range", "0:100", "-o", in_dir("bp1a.exr"), in_dir("blur.txt"));
     RUN_OK("-q", "--part", "1/2", "--spp-range", "100:256", "-o", in_dir("bp1b.exr"), in_dir("blur.txt"));
     RUN_OK("merge", in_dir("bp0.exr"), in_dir("bp1a.exr"), in_dir("bp1b.exr"), "-o", in_dir("bm.pfm"));
-    assert_same_bytes(in_dir("bm.pfm"), in_dir("blur.pfm"));
+    test_assert_same_bytes(in_dir("bm.pfm"), in_dir("blur.pfm"));
     /* stopped between slices (a slice is one pass), kept as a part, resumed: the same bytes */
     RUN_OK("-q", "--time-limit", "0.000001", "--part-out", in_dir("bstop.exr"), "-o", in_dir("bstop.pfm"),
            in_dir("blur.txt"));
     RUN_OK("-q", "--resume", in_dir("bstop.exr"), "-o", in_dir("bres.pfm"), in_dir("blur.txt"));
-    assert_same_bytes(in_dir("bres.pfm"), in_dir("blur.pfm"));
+    test_assert_same_bytes(in_dir("bres.pfm"), in_dir("blur.pfm"));
     /* a part of another shutter is of another render */
     write_motion_scene("blur2.txt", "shutter 0 0.5", "motion_steps 16", "");
     RUN_OK("-q", "--part", "1/2", "-o", in_dir("bp1x.exr"), in_dir("blur2.txt"));
@@ -603,7 +568,7 @@ static void test_motion_blur(void **state)
     write_motion_scene("still.txt", "", "", "");
     RUN_OK("-q", "-o", in_dir("k1.pfm"), in_dir("k1.txt"));
     RUN_OK("-q", "--frame-time", "0.5", "-o", in_dir("mid.pfm"), in_dir("still.txt"));
-    assert_same_bytes(in_dir("k1.pfm"), in_dir("mid.pfm"));
+    test_assert_same_bytes(in_dir("k1.pfm"), in_dir("mid.pfm"));
     assert_true(column_mean(in_dir("mid.pfm"), 8) == 0.0); /* the quad over x in [0, 2] at t = 0.5 */
     RUN_OK("-q", "--frame-time", "0.25", "-o", in_dir("open.pfm"), in_dir("still.txt"));
     assert_true(column_mean(in_dir("open.pfm"), 8) == 1.0); /* and over [-2, 0] at 0.25 */
@@ -615,7 +580,7 @@ static void test_motion_blur(void **state)
     RUN_OK("-v", "-o", in_dir("fixed.pfm"), in_dir("fixed.txt"));
     assert_null(strstr(err_text, "motion: slice"));
     RUN_OK("-q", "-o", in_dir("fixed0.pfm"), in_dir("fixed0.txt"));
-    assert_same_bytes(in_dir("fixed.pfm"), in_dir("fixed0.pfm"));
+    test_assert_same_bytes(in_dir("fixed.pfm"), in_dir("fixed0.pfm"));
     /* a shutter that closes before it opens */
     write_motion_scene("bad.txt", "shutter 1 0", "", "");
     assert_int_equal(RUN("-q", "-o", in_dir("x.pfm"), in_dir("bad.txt")), 2);
@@ -636,7 +601,7 @@ static void test_animation_index(void **state)
     RUN_OK("-q", "--frame-time", "0.5", "-o", in_dir("anim-default.pfm"), in_dir("still.txt"));
     RUN_OK("-q", "--frame-time", "0.5", "--animation", "0", "-o", in_dir("anim0.pfm"), in_dir("still.txt"));
     RUN_OK("-q", "--frame-time", "0.5", "--animation", "1", "-o", in_dir("anim1.pfm"), in_dir("still.txt"));
-    assert_same_bytes(in_dir("anim-default.pfm"), in_dir("anim0.pfm"));
+    test_assert_same_bytes(in_dir("anim-default.pfm"), in_dir("anim0.pfm"));
     assert_true(column_mean(in_dir("anim0.pfm"), 8) == 0.0 && column_mean(in_dir("anim0.pfm"), 2) == 1.0);
     assert_true(column_mean(in_dir("anim1.pfm"), 2) == 0.0 && column_mean(in_dir("anim1.pfm"), 8) == 1.0);
     assert_int_equal(RUN("-q", "--frame-time", "0.5", "--animation", "2", "-o", in_dir("anim2.pfm"),
@@ -650,7 +615,7 @@ static void test_animation_index(void **state)
 static int sidecar_end(const char *json)
 {
     size_t n;
-    char *t = slurp(json, &n);
+    char *t = test_slurp(json, &n);
     const char *s = strstr(t, "\"samples\": [");
     assert_non_null(s);
     int a = -1, b = -1;
@@ -678,7 +643,7 @@ static void test_time_limit_then_resume(void **state)
            in_dir("stopped.pfm"), scene);
     assert_int_equal(sidecar_end(in_dir("stop.exr.json")), 1);
     RUN_OK("-q", "-s", "64", "--resume", in_dir("stop.exr"), "-o", in_dir("resumed.pfm"), scene);
-    assert_same_bytes(in_dir("resumed.pfm"), in_dir("full64.pfm"));
+    test_assert_same_bytes(in_dir("resumed.pfm"), in_dir("full64.pfm"));
     RUN_OK("-q", "-s", "64", "--spp-range", "1:64", "-o", in_dir("rest.exr"), scene);
     RUN_OK("merge", in_dir("stop.exr"), in_dir("rest.exr"), "-o", in_dir("merged64.pfm"));
     assert_within_summation_bound(in_dir("merged64.pfm"), in_dir("full64.pfm"), 64);
@@ -686,7 +651,7 @@ static void test_time_limit_then_resume(void **state)
     RUN_OK("-q", "-s", "64", "--passes", "1", "--time-limit", TIME_UP, "--part", "0/1", "-o", in_dir("p.exr"), scene);
     assert_int_equal(sidecar_end(in_dir("p.exr.json")), 1);
     RUN_OK("-q", "-s", "64", "--resume", in_dir("p.exr"), "-o", in_dir("p-resumed.pfm"), scene);
-    assert_same_bytes(in_dir("p-resumed.pfm"), in_dir("full64.pfm"));
+    test_assert_same_bytes(in_dir("p-resumed.pfm"), in_dir("full64.pfm"));
 }
 
 /* The integrators that tile (whitted, direct) render in passes when the
@@ -702,7 +667,7 @@ static void test_time_limit_tiling_integrator(void **state)
     assert_int_equal(sidecar_end(in_dir("wstop.exr.json")), 4); /* the first whole pass of 4 */
     RUN_OK("-q", "-s", "64", "--integrator", "whitted", "--resume", in_dir("wstop.exr"), "-o", in_dir("wresumed.pfm"),
            scene);
-    assert_same_bytes(in_dir("wresumed.pfm"), in_dir("wfull.pfm"));
+    test_assert_same_bytes(in_dir("wresumed.pfm"), in_dir("wfull.pfm"));
     RUN_OK("-q", "-s", "64", "--integrator", "direct", "--time-limit", TIME_UP, "--crop", "0", "0", "40", "15", "-o",
            in_dir("dstop.exr"), scene);
     assert_int_equal(sidecar_end(in_dir("dstop.exr.json")), 4);
@@ -746,7 +711,7 @@ static void test_frames_stopped_then_resumed(void **state)
             char a[700], b[700];
             snprintf(a, sizeof a, "%s/stop-%s.%04d.pfm", dir, integrators[k], f);
             snprintf(b, sizeof b, "%s/straight-%s.%04d.pfm", dir, integrators[k], f);
-            assert_same_bytes(a, b);
+            test_assert_same_bytes(a, b);
             snprintf(a, sizeof a, "%s/stop-%s.%04d.part.exr.json", dir, integrators[k], f);
             assert_int_equal(access(a, F_OK), -1); /* the stop's leftovers removed */
             snprintf(a, sizeof a, "%s/stop-%s.%04d.part.exr", dir, integrators[k], f);
@@ -765,7 +730,7 @@ static void test_frames_stopped_then_resumed(void **state)
     assert_int_equal(access(in_dir("aov.0002.part.exr.json"), F_OK), -1);
     RUN_OK("-q", "-s", "64", "--aov", "spp", "--frames", "2:3", "-o", aovs, scene);
     RUN_OK("-q", "-s", "64", "-o", in_dir("aov-straight.pfm"), scene);
-    assert_same_bytes(in_dir("aov.0002.pfm"), in_dir("aov-straight.pfm"));
+    test_assert_same_bytes(in_dir("aov.0002.pfm"), in_dir("aov-straight.pfm"));
     assert_int_equal(access(in_dir("aov.0002.partial.pfm"), F_OK), -1);
     /* a stopped frame's part of other settings is not resumed over: refused, naming it */
     char pattern[600];
@@ -799,7 +764,7 @@ static void test_interrupt_then_resume(void **state)
     int k = sidecar_end(in_dir("int.exr.json"));
     assert_true(k >= r.signalled_at && k < 64);
     RUN_OK("-q", "-s", "64", "--resume", in_dir("int.exr"), "-o", in_dir("int-resumed.pfm"), scene);
-    assert_same_bytes(in_dir("int-resumed.pfm"), in_dir("full64i.pfm"));
+    test_assert_same_bytes(in_dir("int-resumed.pfm"), in_dir("full64i.pfm"));
 }
 
 static const char precious[] = "an earlier image the user keeps\n";
@@ -814,7 +779,7 @@ static void refuse(const char *names, const char *const *args)
     if (strncmp(err_text, "rt: merge: ", 11) != 0 || (names && !strstr(err_text, names)))
         fail_msg("expected a message naming '%s', got: %s", names, err_text);
     size_t n;
-    char *t = slurp(in_dir("keep.png"), &n);
+    char *t = test_slurp(in_dir("keep.png"), &n);
     assert_int_equal(n, sizeof precious - 1);
     assert_memory_equal(t, precious, n);
     free(t);
@@ -825,7 +790,7 @@ static void refuse(const char *names, const char *const *args)
 static void copy(const char *from, const char *to, size_t cut)
 {
     size_t n;
-    char *t = slurp(from, &n);
+    char *t = test_slurp(from, &n);
     test_write_file(to, t, cut && cut < n ? cut : n);
     free(t);
 }
@@ -881,7 +846,7 @@ static void test_merge_refusals(void **state)
     copy(in_dir("g1.exr.json"), in_dir("j.exr.json"), 200);
     REFUSE("j.exr.json", in_dir("g0.exr"), in_dir("j.exr"), in_dir("g2.exr"));
     size_t n;
-    char *t = slurp(in_dir("g1.exr.json"), &n);
+    char *t = test_slurp(in_dir("g1.exr.json"), &n);
     char *s = strstr(t, "samples 16");
     assert_non_null(s);
     s[8] = '5'; /* "samples 56" */
@@ -905,7 +870,7 @@ static void test_merge_refusals(void **state)
         {"\"seed\": 7", "\"seed\": 1e300", "\"seed\" must be"},
     };
     for (size_t e = 0; e < sizeof edits / sizeof edits[0]; e++) {
-        t = slurp(in_dir("g1.exr.json"), &n);
+        t = test_slurp(in_dir("g1.exr.json"), &n);
         char *at = strstr(t, edits[e][0]), edited[16384];
         assert_non_null(at);
         snprintf(edited, sizeof edited, "%.*s%s%s", (int)(at - t), t, edits[e][1], at + strlen(edits[e][0]));
@@ -941,7 +906,7 @@ static void test_merge_refusals(void **state)
     assert_int_equal(RUN("-q", "--part", "0/3", "-o", in_dir("keep.png"), scene), 2);
     assert_non_null(strstr(err_text, ".exr or .pfm"));
     size_t m;
-    char *k = slurp(in_dir("keep.png"), &m);
+    char *k = test_slurp(in_dir("keep.png"), &m);
     assert_memory_equal(k, precious, sizeof precious - 1);
     free(k);
     /* bad part flags */
@@ -964,7 +929,7 @@ static void test_part_bands(void **state)
             snprintf(part, sizeof part, "%d/%d", i, n);
             RUN_OK("-q", "-s", "1", "--part", part, "-o", in_dir("band.exr"), scene);
             size_t sz;
-            char *t = slurp(in_dir("band.exr.json"), &sz);
+            char *t = test_slurp(in_dir("band.exr.json"), &sz);
             int reg[4];
             const char *s = strstr(t, "\"region\": [");
             assert_non_null(s);
@@ -985,7 +950,7 @@ static void test_part_bands(void **state)
 static void sidecar_blocks(const char *json, int *first, int *count)
 {
     size_t n;
-    char *t = slurp(json, &n);
+    char *t = test_slurp(json, &n);
     const char *s = strstr(t, "\"blocks\": [");
     assert_non_null(s);
     assert_int_equal(sscanf(s, "\"blocks\": [%d, %d]", first, count), 2);
@@ -1030,9 +995,9 @@ static void test_aligned_ranges_same_bytes(void **state)
     assert_int_equal(count, 2);
     assert_int_equal(access(in_dir("a1.block.2.pfm"), F_OK), 0);
     MERGE(in_dir("m2.pfm"), in_dir("a1.pfm"), in_dir("a0.exr"));
-    assert_same_bytes(in_dir("m2.pfm"), in_dir("s192.pfm"));
+    test_assert_same_bytes(in_dir("m2.pfm"), in_dir("s192.pfm"));
     MERGE(in_dir("m2.png"), in_dir("a0.exr"), in_dir("a1.pfm"));
-    assert_same_bytes(in_dir("m2.png"), in_dir("s192.png"));
+    test_assert_same_bytes(in_dir("m2.png"), in_dir("s192.png"));
     /* 320 spp: 0:128 + 128:192 + 192:320 */
     RUN_OK("-q", "-r", "16x12", "-s", "320", "-o", in_dir("s320.pfm"), scene);
     RUN_OK("-q", "-r", "16x12", "-s", "320", "-o", in_dir("s320.png"), scene);
@@ -1042,9 +1007,9 @@ static void test_aligned_ranges_same_bytes(void **state)
            in_dir("b1.pfm"), scene);
     RUN_OK("-q", "-r", "16x12", "-s", "320", "-t", "2", "--spp-range", "192:320", "-o", in_dir("b2.exr"), scene);
     MERGE(in_dir("m3.pfm"), in_dir("b2.exr"), in_dir("b0.exr"), in_dir("b1.pfm"));
-    assert_same_bytes(in_dir("m3.pfm"), in_dir("s320.pfm"));
+    test_assert_same_bytes(in_dir("m3.pfm"), in_dir("s320.pfm"));
     MERGE(in_dir("m3.png"), in_dir("b0.exr"), in_dir("b1.pfm"), in_dir("b2.exr"));
-    assert_same_bytes(in_dir("m3.png"), in_dir("s320.png"));
+    test_assert_same_bytes(in_dir("m3.png"), in_dir("s320.png"));
     /* regions and ranges together: part 0 whole, part 1 in 2 ranges, part 2 in 3 */
     RUN_OK("-q", "-r", "16x12", "-s", "192", "--part", "0/3", "-o", in_dir("q0.exr"), scene);
     RUN_OK("-q", "-r", "16x12", "-s", "192", "--part", "1/3", "--spp-range", "0:64", "-o", in_dir("q1a.pfm"), scene);
@@ -1056,10 +1021,10 @@ static void test_aligned_ranges_same_bytes(void **state)
            scene);
     MERGE(in_dir("mq.pfm"), in_dir("q2b.exr"), in_dir("q1b.exr"), in_dir("q0.exr"), in_dir("q1a.pfm"),
           in_dir("q2a.exr"));
-    assert_same_bytes(in_dir("mq.pfm"), in_dir("s192.pfm"));
+    test_assert_same_bytes(in_dir("mq.pfm"), in_dir("s192.pfm"));
     MERGE(in_dir("mq.png"), in_dir("q0.exr"), in_dir("q1a.pfm"), in_dir("q1b.exr"), in_dir("q2a.exr"),
           in_dir("q2b.exr"));
-    assert_same_bytes(in_dir("mq.png"), in_dir("s192.png"));
+    test_assert_same_bytes(in_dir("mq.png"), in_dir("s192.png"));
     /* one path at a time (direct: tiles) */
     RUN_OK("-q", "-r", "16x12", "-s", "130", "--integrator", "direct", "-o", in_dir("d.pfm"), scene);
     RUN_OK("-q", "-r", "16x12", "-s", "130", "--integrator", "direct", "--spp-range", "0:64", "-t", "1", "-o",
@@ -1069,7 +1034,7 @@ static void test_aligned_ranges_same_bytes(void **state)
     RUN_OK("-q", "-r", "16x12", "-s", "130", "--integrator", "direct", "--spp-range", "128:130", "-o",
            in_dir("d2.pfm"), scene);
     MERGE(in_dir("md.pfm"), in_dir("d0.exr"), in_dir("d1.exr"), in_dir("d2.pfm"));
-    assert_same_bytes(in_dir("md.pfm"), in_dir("d.pfm"));
+    test_assert_same_bytes(in_dir("md.pfm"), in_dir("d.pfm"));
     /* a range off the block edges still merges, within the bound */
     RUN_OK("-q", "-r", "16x12", "-s", "192", "--spp-range", "0:100", "-o", in_dir("u0.exr"), scene);
     RUN_OK("-q", "-r", "16x12", "-s", "192", "--spp-range", "100:192", "-o", in_dir("u1.exr"), scene);
@@ -1091,10 +1056,10 @@ static void test_resume_inside_a_block(void **state)
     RUN_OK("-q", "-r", "16x12", "-s", "200", "-o", in_dir("s200.pfm"), scene);
     RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "0:70", "-o", in_dir("r70.exr"), scene);
     RUN_OK("-q", "-r", "16x12", "-s", "200", "--resume", in_dir("r70.exr"), "-o", in_dir("r.pfm"), scene);
-    assert_same_bytes(in_dir("r.pfm"), in_dir("s200.pfm"));
+    test_assert_same_bytes(in_dir("r.pfm"), in_dir("s200.pfm"));
     RUN_OK("-q", "-r", "16x12", "-s", "200", "--resume", in_dir("r70.exr"), "--passes", "0", "-o", in_dir("rt.pfm"),
            scene);
-    assert_same_bytes(in_dir("rt.pfm"), in_dir("s200.pfm"));
+    test_assert_same_bytes(in_dir("rt.pfm"), in_dir("s200.pfm"));
     /* samples 64:100, resumed to 64:200, after 0:64 */
     RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "64:100", "-o", in_dir("k.pfm"), scene);
     RUN_OK("-q", "-r", "16x12", "-s", "200", "--resume", in_dir("k.pfm"), "-o", in_dir("k2.exr"), scene);
@@ -1104,14 +1069,14 @@ static void test_resume_inside_a_block(void **state)
     assert_int_equal(count, 3);
     RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "0:64", "-o", in_dir("k0.exr"), scene);
     MERGE(in_dir("mk.pfm"), in_dir("k0.exr"), in_dir("k2.exr"));
-    assert_same_bytes(in_dir("mk.pfm"), in_dir("s200.pfm"));
+    test_assert_same_bytes(in_dir("mk.pfm"), in_dir("s200.pfm"));
     /* ... also when a time limit stopped it (after its first pass) */
     RUN_OK("-q", "-r", "16x12", "-s", "200", "--spp-range", "64:200", "--passes", "1", "--time-limit", TIME_UP, "-o",
            in_dir("kt.exr"), scene);
     assert_int_equal(sidecar_end(in_dir("kt.exr.json")), 65);
     RUN_OK("-q", "-r", "16x12", "-s", "200", "--resume", in_dir("kt.exr"), "-o", in_dir("kt.exr"), scene);
     MERGE(in_dir("mkt.pfm"), in_dir("kt.exr"), in_dir("k0.exr"));
-    assert_same_bytes(in_dir("mkt.pfm"), in_dir("s200.pfm"));
+    test_assert_same_bytes(in_dir("mkt.pfm"), in_dir("s200.pfm"));
 }
 
 /* A range from a block edge longer than the 64 blocks a part keeps apart
@@ -1140,7 +1105,7 @@ static void test_old_format_refused(void **state)
     const char *scene = scene_path;
     RUN_OK("-q", "--spp-range", "0:8", "-o", in_dir("old.exr"), scene);
     size_t n;
-    char *t = slurp(in_dir("old.exr.json"), &n);
+    char *t = test_slurp(in_dir("old.exr.json"), &n);
     char *s = strstr(t, "\"rt_part\": 2");
     assert_non_null(s);
     s[11] = '1';
@@ -1152,7 +1117,7 @@ static void test_old_format_refused(void **state)
     assert_int_equal(RUN("-q", "--resume", in_dir("old.exr"), "-o", in_dir("keep.png"), scene), 2);
     assert_non_null(strstr(err_text, "old.exr.json: part format 1"));
     size_t m;
-    char *k = slurp(in_dir("keep.png"), &m);
+    char *k = test_slurp(in_dir("keep.png"), &m);
     assert_int_equal(m, sizeof precious - 1);
     assert_memory_equal(k, precious, m);
     free(k);
@@ -1179,7 +1144,7 @@ static void test_part_bands_cost(void **state)
         snprintf(part, sizeof part, "%d/4", i);
         RUN_OK("-q", "--part", part, "-o", in_dir("wb.exr"), in_dir("wall.txt"));
         size_t sz;
-        char *t = slurp(in_dir("wb.exr.json"), &sz);
+        char *t = test_slurp(in_dir("wb.exr.json"), &sz);
         const char *s = strstr(t, "\"region\": [");
         int reg[4];
         assert_non_null(s);

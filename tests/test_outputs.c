@@ -91,44 +91,10 @@ static int run(const char *const *args)
             fail_msg("rt failed: %s", err_text);                                                                       \
     } while (0)
 
-static char *slurp(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        fail_msg("cannot open %s", path);
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap + 1);
-    assert_non_null(buf);
-    for (size_t got; (got = fread(buf + n, 1, cap - n, f)) > 0;) {
-        n += got;
-        if (n == cap) {
-            char *nb = realloc(buf, 2 * cap + 1);
-            assert_non_null(nb);
-            buf = nb;
-            cap *= 2;
-        }
-    }
-    fclose(f);
-    buf[n] = 0;
-    *size = n;
-    return buf;
-}
-
-/* path holds exactly the bytes of `want` (another file). */
-static void assert_same_file(const char *path, const char *want)
-{
-    size_t na, nb;
-    char *a = slurp(path, &na), *b = slurp(want, &nb);
-    if (na != nb || memcmp(a, b, na) != 0)
-        fail_msg("%s changed", path);
-    free(a);
-    free(b);
-}
-
 static void copy(const char *from, const char *to)
 {
     size_t n;
-    char *t = slurp(from, &n);
+    char *t = test_slurp(from, &n);
     test_write_file(to, t, n);
     free(t);
 }
@@ -152,16 +118,8 @@ static int setup(void **state)
         return -1;
     snprintf(scene_path, sizeof scene_path, "%s/s.txt", dir);
     /* the glass Cornell box, tiny */
-    FILE *in = fopen("scenes/glass-cornell.txt", "rb"), *f = fopen(in_dir("s.txt"), "wb");
-    if (!in || !f)
+    if (!test_copy_scene_with("scenes/glass-cornell.txt", scene_path, "\nresolution 12 8\nsamples 4\nintegrator path\nseed 5\n"))
         return -1;
-    char buf[4096];
-    size_t n;
-    while ((n = fread(buf, 1, sizeof buf, in)) > 0)
-        fwrite(buf, 1, n, f);
-    fputs("\nresolution 12 8\nsamples 4\nintegrator path\nseed 5\n", f);
-    fclose(in);
-    fclose(f);
     return 0;
 }
 
@@ -186,7 +144,7 @@ static void test_every_output_checked_before_rendering(void **state)
     assert_int_equal(mkdir(in_dir("p.exr.json"), 0755), 0);
     assert_int_equal(RUN("-q", "--part", "1/2", "-o", in_dir("p.exr"), scene), 2);
     assert_non_null(strstr(err_text, "p.exr.json: is a directory"));
-    assert_same_file(in_dir("p.exr"), in_dir("p-was.exr"));
+    test_assert_same_bytes(in_dir("p.exr"), in_dir("p-was.exr"));
     rmdir(in_dir("p.exr.json"));
     /* --part-out's sidecar likewise, the main output too */
     RUN_OK("-q", "-o", in_dir("img.png"), scene);
@@ -194,18 +152,18 @@ static void test_every_output_checked_before_rendering(void **state)
     assert_int_equal(mkdir(in_dir("po.exr.json"), 0755), 0);
     assert_int_equal(RUN("-q", "--part-out", in_dir("po.exr"), "-o", in_dir("img.png"), scene), 2);
     assert_non_null(strstr(err_text, "po.exr.json: is a directory"));
-    assert_same_file(in_dir("img.png"), in_dir("img-was.png"));
+    test_assert_same_bytes(in_dir("img.png"), in_dir("img-was.png"));
     /* an AOV file, and the partial image a stopped tiled render would write */
     assert_int_equal(mkdir(in_dir("img.depth.pfm"), 0755), 0);
     assert_int_equal(RUN("-q", "--aov", "albedo,depth", "-o", in_dir("img.png"), scene), 2);
     assert_non_null(strstr(err_text, "img.depth.pfm: is a directory"));
-    assert_same_file(in_dir("img.png"), in_dir("img-was.png"));
+    test_assert_same_bytes(in_dir("img.png"), in_dir("img-was.png"));
     assert_int_equal(access(in_dir("img.albedo.pfm"), F_OK), -1); /* not written either */
     assert_int_equal(mkdir(in_dir("img.partial.png"), 0755), 0);
     assert_int_equal(RUN("-q", "-o", in_dir("img.png"), scene), 2);
     if (!strstr(err_text, "img.partial.png: is a directory"))
         fail_msg("%s", err_text);
-    assert_same_file(in_dir("img.png"), in_dir("img-was.png"));
+    test_assert_same_bytes(in_dir("img.png"), in_dir("img-was.png"));
     assert_no_temp_files();
 }
 
@@ -224,9 +182,9 @@ static void test_failed_write_replaces_nothing(void **state)
     assert_int_equal(mkdir(in_dir("q.block.0.pfm"), 0755), 0);
     assert_int_equal(RUN("-q", "--part", "1/2", "-o", in_dir("q.pfm"), scene), 2);
     assert_non_null(strstr(err_text, "q.block.0.pfm: is a directory"));
-    assert_same_file(in_dir("q.pfm"), in_dir("q-was.pfm"));
-    assert_same_file(in_dir("q.count.pfm"), in_dir("q-was.count.pfm")); /* written before the block: not placed */
-    assert_same_file(in_dir("q.pfm.json"), in_dir("q-was.pfm.json"));
+    test_assert_same_bytes(in_dir("q.pfm"), in_dir("q-was.pfm"));
+    test_assert_same_bytes(in_dir("q.count.pfm"), in_dir("q-was.count.pfm")); /* written before the block: not placed */
+    test_assert_same_bytes(in_dir("q.pfm.json"), in_dir("q-was.pfm.json"));
     assert_no_temp_files();
 }
 
@@ -266,7 +224,7 @@ static void test_tiny_files_claiming_huge_images(void **state)
     const char *scene = scene_path;
     RUN_OK("-q", "-o", in_dir("small.exr"), scene);
     size_t n;
-    char *bytes = slurp(in_dir("small.exr"), &n);
+    char *bytes = test_slurp(in_dir("small.exr"), &n);
     assert_true(n < 4096);
     set_windows(bytes, n, 10000, 10000);
     test_write_file(in_dir("huge.exr"), bytes, n);
@@ -279,7 +237,7 @@ static void test_tiny_files_claiming_huge_images(void **state)
     expect_refused_small("rt compare");
     /* a part of one pixel whose sidecar says the image is 10000x10000 */
     RUN_OK("-q", "--crop", "0", "0", "1", "1", "-o", in_dir("px.exr"), scene);
-    char *side = slurp(in_dir("px.exr.json"), &n), edited[20000];
+    char *side = test_slurp(in_dir("px.exr.json"), &n), edited[20000];
     char *w = strstr(side, "\"width\": 12,\n  \"height\": 8");
     assert_non_null(w);
     snprintf(edited, sizeof edited, "%.*s\"width\": 10000,\n  \"height\": 10000%s", (int)(w - side), side,
@@ -290,7 +248,7 @@ static void test_tiny_files_claiming_huge_images(void **state)
     assert_int_equal(RUN("merge", in_dir("px.exr"), "-o", in_dir("keep.png")), 2);
     assert_non_null(strstr(err_text, "cover 1 of the 10000x10000 image"));
     expect_refused_small("rt merge");
-    char *k = slurp(in_dir("keep.png"), &n);
+    char *k = test_slurp(in_dir("keep.png"), &n);
     assert_int_equal(n, 4);
     free(k);
 }

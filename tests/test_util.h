@@ -148,6 +148,63 @@ static inline void test_write_file(const char *path, const void *data, size_t si
     fclose(f);
 }
 
+/* A whole file's bytes, NUL-terminated (the caller frees them); fails the
+ * test when it cannot be read. */
+static inline char *test_slurp(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        fail_msg("cannot open %s", path);
+    size_t cap = 1 << 16, n = 0;
+    char *buf = malloc(cap + 1);
+    assert_non_null(buf);
+    for (size_t got; (got = fread(buf + n, 1, cap - n, f)) > 0;) {
+        n += got;
+        if (n == cap) {
+            char *nb = realloc(buf, 2 * cap + 1);
+            assert_non_null(nb);
+            buf = nb;
+            cap *= 2;
+        }
+    }
+    fclose(f);
+    buf[n] = 0;
+    *size = n;
+    return buf;
+}
+
+/* Files a and b hold the same bytes. */
+static inline void test_assert_same_bytes(const char *a, const char *b)
+{
+    size_t na, nb;
+    char *x = test_slurp(a, &na), *y = test_slurp(b, &nb);
+    if (na != nb || memcmp(x, y, na) != 0)
+        fail_msg("%s and %s differ", a, b);
+    free(x);
+    free(y);
+}
+
+/* A shipped scene copied to dst with lines appended (settings that make it
+ * small and fast); false when either file cannot be opened. */
+static inline int test_copy_scene_with(const char *src, const char *dst, const char *extra)
+{
+    FILE *in = fopen(src, "rb"), *f = fopen(dst, "wb");
+    if (!in || !f) {
+        if (in)
+            fclose(in);
+        if (f)
+            fclose(f);
+        return 0;
+    }
+    char buf[4096];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, in)) > 0)
+        fwrite(buf, 1, n, f);
+    fputs(extra, f);
+    fclose(in);
+    return fclose(f) == 0;
+}
+
 /* The tests' one scratch-directory helper: a fresh directory
  * /tmp/rt_test_TAG_XXXXXX into dir (size >= 64), made in a group setup or
  * a test, and test_remove_dir in the teardown; false when it cannot be
