@@ -29,6 +29,7 @@
 
 #include <math.h>
 
+#include "rt/render/aov.h"
 #include "rt/render/phase.h"
 #include "rt/render/volpath.h"
 #include "test_fixture.h"
@@ -289,6 +290,53 @@ static void test_camera_inside_medium(void **state)
     test_fixture_free(&f);
 }
 
+/* The denoiser's AOVs with media: a camera ray whose first event is a
+ * collision in a medium reports its single-scattering albedo and a zero
+ * normal. A slab of grey medium (optical depth 0.7, albedo 0.5) between
+ * null faces in front of a wall of albedo 0.9: the mean albedo is
+ * (1 - T) 0.5 + T 0.9 with T = exp(-0.7), and the mean normal T times the
+ * wall's; a dense chromatic ball gives its albedo (0.9, 0.8, 0.7) alone. */
+static void test_aov_albedo_of_media(void **state)
+{
+    (void)state;
+    test_fixture f;
+    test_fixture_load(&f,
+                      "sampler independent\nintegrator path\n"
+                      "medium haze homogeneous sigma_a 0.35 0.35 0.35 sigma_s 0.35 0.35 0.35\n"
+                      "medium milk homogeneous sigma_a 1 2 3 sigma_s 9 8 7\n"
+                      "material box bsdf null interior haze\n"
+                      "material ball bsdf null interior milk\n"
+                      "material wall color 0.9 0.9 0.9 bsdf lambert\n" SLAB_FACES
+                      "quad -500 -500 -2  0 1000 0   1000 0 0   wall\n"
+                      "sphere 100 0 0 1 ball\n",
+                      RT_PREPARE_LIGHT_TABLE);
+    const int n = 20000;
+    double alb = 0, nz = 0;
+    for (int i = 0; i < n; i++) {
+        rt_rng rng = rt_rng_for_sample(99, (uint64_t)i, 0);
+        rt_aov_sample a;
+        rt_aov_trace(&f.ctx, rt_ray_make(rt_v3(0.1f, 0.2f, 5), rt_v3(0, 0, -1), 0.0f, INFINITY), &rng, &a);
+        alb += a.albedo.x;
+        nz += a.normal.z;
+    }
+    const double T = exp(-0.7), want = (1 - T) * 0.5 + T * 0.9;
+    /* a Bernoulli mix of 0.5 and 0.9: its standard error */
+    const double se = 0.4 * sqrt(T * (1 - T) / n);
+    print_message("albedo through haze %.4f (expected %.4f +- %.4f), normal z %.4f (expected %.4f)\n", alb / n, want,
+                  se, nz / n, T);
+    assert_true(fabs(alb / n - want) < 4 * se);
+    assert_true(fabs(nz / n - T) < 4 * sqrt(T * (1 - T) / n));
+    rt_rng rng = rt_rng_for_sample(99, 0, 0);
+    rt_aov_sample a;
+    rt_aov_trace(&f.ctx, rt_ray_make(rt_v3(100, 0, 5), rt_v3(0, 0, -1), 0.0f, INFINITY), &rng, &a);
+    assert_float_equal(a.albedo.x, 0.9f, 1e-6f);
+    assert_float_equal(a.albedo.y, 0.8f, 1e-6f);
+    assert_float_equal(a.albedo.z, 0.7f, 1e-6f);
+    assert_true(a.normal.x == 0.0f && a.normal.y == 0.0f && a.normal.z == 0.0f);
+    assert_true(a.depth > 4.0f && a.depth < 4.5f); /* inside the ball, close under its surface */
+    test_fixture_free(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -297,6 +345,7 @@ int main(void)
         cmocka_unit_test(test_single_scattering_area_light),
         cmocka_unit_test(test_single_scattering_emissive_triangles),
         cmocka_unit_test(test_camera_inside_medium),
+        cmocka_unit_test(test_aov_albedo_of_media),
         cmocka_unit_test(test_white_furnace),
         cmocka_unit_test(test_constant_grid_is_homogeneous),
     };

@@ -608,3 +608,51 @@ rt_vec3 rt_radiance_volpath(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *
     }
     return rt_finite3(ps.L) ? ps.L : rt_v3s(0.0f);
 }
+
+bool rt_volpath_aov_event(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng, rt_vec3 *albedo, rt_vec3 *p)
+{
+    const rt_scene *s = ctx->state->scene;
+    rt_ray r = *ray;
+    float len = rt_length(r.dir);
+    if (!(len > 0.0f) || !isfinite(len))
+        return false;
+    r.dir = rt_scale(r.dir, 1.0f / len);
+    r.tmin *= len;
+    r.tmax *= len;
+    vp_state ps = {.medium = s->environment.medium};
+    rt_medium_stack_init(&ps.stack);
+    camera_medium(ctx, &r, &ps);
+    int h = (int)(rt_rng_float(rng) * 3.0f); /* the channel whose distances decide */
+    h = h > 2 ? 2 : h;
+    for (int k = 0; k < RT_PATH_LAYERS; k++) {
+        rt_ray seg = r;
+        rt_surface sf;
+        rt_surface_walk w = next_surface(ctx, &seg, rng, &sf);
+        if (w == RT_WALK_TOO_DEEP)
+            return false;
+        if (ps.medium != RT_NONE) { /* delta tracking to the first real collision */
+            rt_volume v = volume_of(s, ps.medium);
+            maj_walk walk;
+            maj_walk_init(&walk, &v, r.org, r.dir, r.tmin, w == RT_WALK_SURFACE ? seg.tmin : r.tmax, h);
+            float t;
+            while (maj_walk_next(&walk, rng, &t)) {
+                rt_vec3 q = rt_madd(r.org, r.dir, t), st = rt_volume_sigma_t(&v);
+                if (rt_rng_float(rng) * ch(walk.maj, h) < ch(st, h) * rt_volume_density(&v, q)) {
+                    *albedo = rt_v3(st.x > 0.0f ? v.sigma_s.x / st.x : 0.0f, st.y > 0.0f ? v.sigma_s.y / st.y : 0.0f,
+                                    st.z > 0.0f ? v.sigma_s.z / st.z : 0.0f);
+                    *p = q;
+                    return true;
+                }
+            }
+        }
+        if (w == RT_WALK_MISS)
+            return false;
+        const rt_material *m = &s->materials[sf.material];
+        if (!(m->bsdf == RT_BSDF_NULL ||
+              (is_boundary(m) && rt_medium_stack_false_hit(&ps.stack, s->materials, sf.material, sf.front))))
+            return false; /* a surface first */
+        cross(s, &ps.stack, &ps.medium, sf.material, sf.front);
+        r = rt_ray_make(rt_surface_spawn(ctx, &sf, r.dir), r.dir, 0.0f, INFINITY);
+    }
+    return false;
+}
