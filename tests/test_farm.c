@@ -241,12 +241,10 @@ static void test_resume_exact(void **state)
     assert_non_null(strstr(err_text, "all there are"));
 }
 
-/* AOVs in parts: their sums travel as EXR layers; merged and resumed they
- * are the single render's bytes, EXR layers and PFM files alike. */
-static void test_aov_parts(void **state)
+/* A full render and three parts of it (one tiled, one resumed) merged,
+ * with AOVs: the same bytes, EXR layers and PFM files alike. */
+static void aov_parts_merge_exactly(const char *scene)
 {
-    (void)state;
-    const char *scene = scene_path;
     const char *aovs = "albedo,normal,depth,position";
     RUN_OK("-q", "--aov", aovs, "-o", in_dir("af.exr"), scene);
     RUN_OK("-q", "--aov", aovs, "-o", in_dir("af.png"), scene);
@@ -265,6 +263,15 @@ static void test_aov_parts(void **state)
         snprintf(b, sizeof b, "af.%s.pfm", names[k]);
         test_assert_same_bytes(in_dir(a), in_dir(b));
     }
+}
+
+/* AOVs in parts: their sums travel as EXR layers; merged and resumed they
+ * are the single render's bytes, EXR layers and PFM files alike. */
+static void test_aov_parts(void **state)
+{
+    (void)state;
+    const char *scene = scene_path;
+    aov_parts_merge_exactly(scene);
     /* parts with other AOVs are of another render; variance and spp are not kept */
     RUN_OK("-q", "--aov", "albedo", "--part", "2/3", "-o", in_dir("ap2x.exr"), scene);
     assert_int_equal(RUN("merge", in_dir("ap0.exr"), in_dir("ap1.exr"), in_dir("ap2x.exr"), "-o", in_dir("x.exr")), 2);
@@ -273,6 +280,29 @@ static void test_aov_parts(void **state)
     assert_int_equal(RUN("-q", "--aov", "albedo", "--part", "0/3", "-o", in_dir("x.pfm"), scene), 2);
     assert_int_equal(access(in_dir("x.exr"), F_OK), -1);
     assert_int_equal(access(in_dir("x.pfm"), F_OK), -1);
+}
+
+/* The same with participating media (the volumetric path tracer, whose
+ * AOVs report the first collision in a medium): fog the camera sits in and
+ * a ball of smoke in a null boundary, small and quick. */
+static void test_aov_parts_media(void **state)
+{
+    (void)state;
+    const char *text = "resolution 24 16\nsamples 12\nintegrator path\nseed 3\n"
+                       "camera position 0 1 5 look_at 0 0.6 0 up 0 1 0 fov 45\n"
+                       "medium fog homogeneous sigma_a 0.01 0.01 0.01 sigma_s 0.2 0.2 0.2 g 0.5\n"
+                       "medium smoke homogeneous sigma_a 0.2 0.3 0.4 sigma_s 2 1.5 1 g 0.3\n"
+                       "scene_medium fog\n"
+                       "material floor color 0.6 0.6 0.6\nmaterial ball bsdf null interior smoke\n"
+                       "quad -5 0 -5  0 0 10  10 0 0  floor\nsphere 0 0.6 0 0.6 ball\n"
+                       "light point 1 3 2  1 1 1  20\n";
+    char scene[600];
+    snprintf(scene, sizeof scene, "%s", in_dir("media.txt"));
+    FILE *f = fopen(scene, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    assert_int_equal(fclose(f), 0);
+    aov_parts_merge_exactly(scene);
 }
 
 /* --frames A:B: one file a frame, named from the pattern (%04d or
@@ -1167,6 +1197,7 @@ int main(void)
         cmocka_unit_test(test_interrupt_then_resume),
         cmocka_unit_test(test_merge_refusals),
         cmocka_unit_test(test_aov_parts),
+        cmocka_unit_test(test_aov_parts_media),
         cmocka_unit_test(test_frames),
         cmocka_unit_test(test_frames_animated_gltf),
         cmocka_unit_test(test_frames_one_camera),

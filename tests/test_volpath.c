@@ -11,7 +11,11 @@
  *   with the phase function, ratio tracking of the shadow rays);
  * - single scattering from a box of medium under an area light close
  *   above it, against quadrature (solid-angle light sampling, shadow rays
- *   through a null face to the light);
+ *   through a null face to the light), and under the same rectangle as
+ *   two emissive triangles (the light table's NEE with MIS, with a
+ *   standard error like the area light's);
+ * - a camera inside a null sphere of absorber starts in it (Beer-Lambert
+ *   from the centre);
  * - a white furnace: a sphere of albedo-1 chromatic forward-scattering
  *   medium (g 0.7) under a uniform sky of radiance 1 stays 1;
  * - a voxel grid of constant density 0.5 with doubled coefficients renders
@@ -25,6 +29,7 @@
 
 #include <math.h>
 
+#include "rt/render/aov.h"
 #include "rt/render/phase.h"
 #include "rt/render/volpath.h"
 #include "test_fixture.h"
@@ -180,34 +185,39 @@ static void test_constant_grid_is_homogeneous(void **state)
     test_fixture_free(&grid);
 }
 
-/* Single scattering under an area light close above a box of medium: the
- * light is sampled by solid angle from points near it, and the shadow rays
- * cross the box's null top face on their way. Against quadrature along the
- * ray: the medium point's transmittance to each point of the light (out
- * through the top face) times the phase function and the light's solid
- * angle. (Its shadow rays once stopped on the light's own quad, which a
- * sampled distance can overshoot: a third of the light.) */
-static void test_single_scattering_area_light(void **state)
+/* Single scattering under a light close above a box of medium, against
+ * quadrature along the ray: the medium point's transmittance to each point
+ * of the light (out through the top face) times the phase function and the
+ * light's solid angle. The light is given by `light`: a `light area`
+ * (sampled by solid angle from points near it) or the same rectangle as
+ * two emissive triangles of the light table (sampled by power, then by
+ * solid angle or area, with MIS against phase sampling). The shadow rays
+ * cross the box's null top face on their way; sent on along their first
+ * direction from the face's offset, they met the light's own plane past
+ * the sampled point and counted as blocked (a third of the light). */
+static estimate single_scattering_under(const char *light, double *expected)
 {
-    (void)state;
+    char text[2048];
+    snprintf(text, sizeof text,
+             "sampler independent\nmax_depth 1\n"
+             "medium m homogeneous sigma_a 0.002 0.002 0.002 sigma_s 0.008 0.008 0.008 g 0.3\n"
+             "material box bsdf null interior m\n"
+             "quad 100 350 100   350 0 0   0 0 350     box\n"
+             "quad 100 525 100   0 0 350   350 0 0     box\n"
+             "quad 100 350 100   0 0 350   0 175 0     box\n"
+             "quad 450 350 100   0 175 0   0 0 350     box\n"
+             "quad 100 350 100   0 175 0   350 0 0     box\n"
+             "quad 100 350 450   350 0 0   0 175 0     box\n"
+             "%s",
+             light);
     test_fixture f;
-    test_fixture_load(&f,
-                      "sampler independent\nmax_depth 1\n"
-                      "medium m homogeneous sigma_a 0.002 0.002 0.002 sigma_s 0.008 0.008 0.008 g 0.3\n"
-                      "material box bsdf null interior m\n"
-                      "quad 100 350 100   350 0 0   0 0 350     box\n"
-                      "quad 100 525 100   0 0 350   350 0 0     box\n"
-                      "quad 100 350 100   0 0 350   0 175 0     box\n"
-                      "quad 450 350 100   0 175 0   0 0 350     box\n"
-                      "quad 100 350 100   0 175 0   350 0 0     box\n"
-                      "quad 100 350 450   350 0 0   0 175 0     box\n"
-                      "light area 343 548.7 227  0 0 105  -130 0 0  1 1 1  1\n",
-                      RT_PREPARE_LIGHT_TABLE);
-    const rt_light *l = &f.s.lights[0];
+    test_fixture_load(&f, text, RT_PREPARE_LIGHT_TABLE);
+    /* the rectangle both lights are: corner, edges, facing -y */
+    const rt_vec3 pos = rt_v3(343, 548.7f, 227), eu = rt_v3(0, 0, 105), ev = rt_v3(-130, 0, 0);
     const rt_vec3 o = rt_v3(278, 480, -800), d = rt_normalize(rt_v3(0, 0.02f, 1));
     const double st = 0.01, ss = 0.008, t0 = (100 - o.z) / d.z, t1 = (450 - o.z) / d.z;
-    const rt_vec3 n = rt_normalize(rt_cross(l->edge_u, l->edge_v));
-    const double area = rt_length(rt_cross(l->edge_u, l->edge_v));
+    const rt_vec3 n = rt_normalize(rt_cross(eu, ev));
+    const double area = rt_length(rt_cross(eu, ev));
     double want = 0;
     const int NT = 200, NU = 40;
     for (int i = 0; i < NT; i++) { /* midpoint rule along the ray and over the light */
@@ -215,8 +225,7 @@ static void test_single_scattering_area_light(void **state)
         rt_vec3 p = rt_madd(o, d, (float)t);
         for (int a = 0; a < NU; a++)
             for (int b = 0; b < NU; b++) {
-                rt_vec3 x = rt_add(l->position, rt_add(rt_scale(l->edge_u, (a + 0.5f) / NU),
-                                                      rt_scale(l->edge_v, (b + 0.5f) / NU)));
+                rt_vec3 x = rt_add(pos, rt_add(rt_scale(eu, (a + 0.5f) / NU), rt_scale(ev, (b + 0.5f) / NU)));
                 rt_vec3 w = rt_sub(x, p);
                 float d2 = rt_length2(w);
                 w = rt_scale(w, 1.0f / sqrtf(d2));
@@ -226,7 +235,105 @@ static void test_single_scattering_area_light(void **state)
         want += exp(-st * (t - t0)) * ss * ls * (t1 - t0) / NT;
     }
     estimate e = estimate_ray(&f, o, d, 100000);
+    test_fixture_free(&f);
+    *expected = want;
+    return e;
+}
+
+static void test_single_scattering_area_light(void **state)
+{
+    (void)state;
+    double want;
+    estimate e = single_scattering_under("light area 343 548.7 227  0 0 105  -130 0 0  1 1 1  1\n", &want);
     expect_near("single scattering under an area light", e, rt_v3s((float)want));
+}
+
+/* The same light as two emissive triangles: found by light sampling (NEE
+ * through the light table, ratio-tracked shadow rays, MIS with the phase
+ * function), the estimate is as good as the area light's; by phase
+ * sampling alone (as before) its standard error was 3 times the
+ * area light's for the same mean. */
+static void test_single_scattering_emissive_triangles(void **state)
+{
+    (void)state;
+    double want, want_area;
+    estimate area = single_scattering_under("light area 343 548.7 227  0 0 105  -130 0 0  1 1 1  1\n", &want_area);
+    estimate e = single_scattering_under("material lamp color 0 0 0 emission 1 1 1 double_sided false\n"
+                                         "triangle 343 548.7 227  343 548.7 332  213 548.7 332  lamp\n"
+                                         "triangle 343 548.7 227  213 548.7 332  213 548.7 227  lamp\n",
+                                         &want);
+    expect_near("single scattering under emissive triangles", e, rt_v3s((float)want));
+    print_message("standard error: emissive triangles %.6f, area light %.6f\n", e.se.x, area.se.x);
+    assert_true(e.se.x < 2.0f * area.se.x);
+}
+
+/* A camera inside a closed null boundary starts in its medium: from the
+ * centre of a sphere of radius 1 of pure absorber, the white background
+ * arrives through exp(-sigma_a) (it arrived unattenuated when every path
+ * started in the scene's medium). */
+static void test_camera_inside_medium(void **state)
+{
+    (void)state;
+    test_fixture f;
+    test_fixture_load(&f,
+                      "sampler independent\nbackground 1 1 1\n"
+                      "medium ink homogeneous sigma_a 0.5 1 2 sigma_s 0 0 0\n"
+                      "material box bsdf null interior ink\n"
+                      "sphere 0 0 0 1 box\n"
+                      "sphere 5 0 0 1 box\n", /* another one, off to the side: outside it, no change */
+                      RT_PREPARE_LIGHT_TABLE);
+    estimate e = estimate_ray(&f, rt_v3(0, 0, 0), rt_v3(0.3f, 0.4f, -1), 4000);
+    expect_near("camera inside a medium", e, rt_v3(expf(-0.5f), expf(-1.0f), expf(-2.0f)));
+    /* looking through the other sphere: its diameter on top */
+    e = estimate_ray(&f, rt_v3(0, 0, 0), rt_v3(1, 0, 0), 4000);
+    expect_near("camera inside a medium, through another", e, rt_v3(expf(-1.5f), expf(-3.0f), expf(-6.0f)));
+    test_fixture_free(&f);
+}
+
+/* The denoiser's AOVs with media: a camera ray whose first event is a
+ * collision in a medium reports its single-scattering albedo and a zero
+ * normal. A slab of grey medium (optical depth 0.7, albedo 0.5) between
+ * null faces in front of a wall of albedo 0.9: the mean albedo is
+ * (1 - T) 0.5 + T 0.9 with T = exp(-0.7), and the mean normal T times the
+ * wall's; a dense chromatic ball gives its albedo (0.9, 0.8, 0.7) alone. */
+static void test_aov_albedo_of_media(void **state)
+{
+    (void)state;
+    test_fixture f;
+    test_fixture_load(&f,
+                      "sampler independent\nintegrator path\n"
+                      "medium haze homogeneous sigma_a 0.35 0.35 0.35 sigma_s 0.35 0.35 0.35\n"
+                      "medium milk homogeneous sigma_a 1 2 3 sigma_s 9 8 7\n"
+                      "material box bsdf null interior haze\n"
+                      "material ball bsdf null interior milk\n"
+                      "material wall color 0.9 0.9 0.9 bsdf lambert\n" SLAB_FACES
+                      "quad -500 -500 -2  0 1000 0   1000 0 0   wall\n"
+                      "sphere 100 0 0 1 ball\n",
+                      RT_PREPARE_LIGHT_TABLE);
+    const int n = 20000;
+    double alb = 0, nz = 0;
+    for (int i = 0; i < n; i++) {
+        rt_rng rng = rt_rng_for_sample(99, (uint64_t)i, 0);
+        rt_aov_sample a;
+        rt_aov_trace(&f.ctx, rt_ray_make(rt_v3(0.1f, 0.2f, 5), rt_v3(0, 0, -1), 0.0f, INFINITY), &rng, &a);
+        alb += a.albedo.x;
+        nz += a.normal.z;
+    }
+    const double T = exp(-0.7), want = (1 - T) * 0.5 + T * 0.9;
+    /* a Bernoulli mix of 0.5 and 0.9: its standard error */
+    const double se = 0.4 * sqrt(T * (1 - T) / n);
+    print_message("albedo through haze %.4f (expected %.4f +- %.4f), normal z %.4f (expected %.4f)\n", alb / n, want,
+                  se, nz / n, T);
+    assert_true(fabs(alb / n - want) < 4 * se);
+    assert_true(fabs(nz / n - T) < 4 * sqrt(T * (1 - T) / n));
+    rt_rng rng = rt_rng_for_sample(99, 0, 0);
+    rt_aov_sample a;
+    rt_aov_trace(&f.ctx, rt_ray_make(rt_v3(100, 0, 5), rt_v3(0, 0, -1), 0.0f, INFINITY), &rng, &a);
+    assert_float_equal(a.albedo.x, 0.9f, 1e-6f);
+    assert_float_equal(a.albedo.y, 0.8f, 1e-6f);
+    assert_float_equal(a.albedo.z, 0.7f, 1e-6f);
+    assert_true(a.normal.x == 0.0f && a.normal.y == 0.0f && a.normal.z == 0.0f);
+    assert_true(a.depth > 4.0f && a.depth < 4.5f); /* inside the ball, close under its surface */
     test_fixture_free(&f);
 }
 
@@ -236,6 +343,9 @@ int main(void)
         cmocka_unit_test(test_beer_lambert_slab),
         cmocka_unit_test(test_single_scattering_slab),
         cmocka_unit_test(test_single_scattering_area_light),
+        cmocka_unit_test(test_single_scattering_emissive_triangles),
+        cmocka_unit_test(test_camera_inside_medium),
+        cmocka_unit_test(test_aov_albedo_of_media),
         cmocka_unit_test(test_white_furnace),
         cmocka_unit_test(test_constant_grid_is_homogeneous),
     };

@@ -5,7 +5,10 @@
  * a non-delta lobe, and report its albedo and shading normal; depth and
  * position are the first hit's. This follows Intel Open Image Denoise's
  * guidance for its albedo and normal inputs ("for perfect specular
- * surfaces ... the albedo/normal of the next hit"). */
+ * surfaces ... the albedo/normal of the next hit"). With participating
+ * media (the path integrator), a camera ray whose first event is a
+ * collision in a medium reports the medium's single-scattering albedo,
+ * a zero normal and the collision's position and distance. */
 #include "rt/render/aov.h"
 
 #include <math.h>
@@ -13,6 +16,7 @@
 
 #include "rt/render/material_eval.h"
 #include "rt/render/surface.h"
+#include "rt/render/volpath.h"
 #include "rt/render/whitted.h"
 
 #define AOV_MAX_SPECULAR 8
@@ -24,6 +28,19 @@ static float clamp01(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; 
 void rt_aov_trace(const rt_trace_ctx *ctx, rt_ray ray, rt_rng *rng, rt_aov_sample *out)
 {
     memset(out, 0, sizeof *out);
+    rt_integrator in = ctx->state->settings->integrator;
+    if ((in == RT_INTEGRATOR_PATH || in == RT_INTEGRATOR_PATH_SCALAR) && rt_scene_has_media(ctx->state->scene)) {
+        /* a collision in a medium first: its single-scattering albedo, and
+         * no normal (OIDN's "no surface here": a point in a medium faces
+         * nowhere, and the zero weakens the normal guide in a pixel as much
+         * as the medium hides the surfaces behind it) */
+        rt_vec3 p;
+        if (rt_volpath_aov_event(ctx, &ray, rng, &out->albedo, &p)) {
+            out->position = p;
+            out->depth = rt_length(rt_sub(p, ray.org));
+            return;
+        }
+    }
     int layers = 16;
     for (int bounce = 0; bounce <= AOV_MAX_SPECULAR; bounce++) {
         rt_surface sf;

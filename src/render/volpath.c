@@ -19,8 +19,10 @@
  *   up in a chromatic medium, combined with light/BSDF (phase) MIS;
  * - light sampling at every scattering event, on surfaces (the BSDF) and
  *   in media (the Henyey-Greenstein phase function, rt/render/phase.h):
- *   every light of the scene once (rt_light_sample_at) and the environment
- *   image by the light table; shadow rays pass null boundaries and
+ *   every light of the scene once (rt_light_sample_at), one emissive
+ *   primitive of the light table by power (rt/render/emitter_sample.h)
+ *   and the environment image by the light table; shadow rays pass null
+ *   boundaries (aimed again at the light point past each) and
  *   alpha cut-outs and estimate the transmittance of the media between by
  *   ratio tracking with the same ratios (pbrt-v4's SampleLd, with its
  *   Russian roulette on low transmittance); other surfaces block them;
@@ -31,16 +33,17 @@
  * - Russian roulette on beta x eta_scale / average(r_u), as the surface
  *   path tracer's rule (rr_depth).
  * What it reuses unchanged: surfaces and BSDFs (rt/render/material_eval.h),
- * light sampling (rt/render/light.h), nested dielectrics' stack and
- * absorption (rt/render/medium.h), the environment. What it leaves out
- * (docs/media.md): the light table's emissive primitives are found by
- * BSDF and phase sampling only (counted in full), and the path draws its
- * numbers from the sample's rng stream (the hero channel from the sampler).
+ * light sampling (rt/render/light.h, emitter_sample.h), nested
+ * dielectrics' stack and absorption (rt/render/medium.h), the environment.
+ * A camera inside closed boundaries starts in their medium (camera_medium).
+ * What it leaves out (docs/media.md): the path draws its numbers from the
+ * sample's rng stream (the hero channel from the sampler).
  */
 #include "rt/render/volpath.h"
 
 #include <math.h>
 
+#include "rt/render/emitter_sample.h"
 #include "rt/render/environment.h"
 #include "rt/render/light.h"
 #include "rt/render/material_eval.h"
@@ -112,6 +115,42 @@ static void cross(const rt_scene *s, rt_medium_stack *st, uint32_t *medium, uint
     }
     uint32_t ext = s->materials[mat].exterior_medium;
     *medium = ext != RT_NONE ? ext : s->environment.medium;
+}
+
+/* The boundaries a camera at r's origin is inside (pbrt and Mitsuba users
+ * name the camera's medium; rt finds it): the boundary surfaces along r
+ * out to infinity, crossed back from there to the origin, as a path coming
+ * in from outside everything would cross them. Only in scenes with a
+ * bounded medium (a material with an interior medium); a walk longer than
+ * RT_PATH_LAYERS surfaces leaves the scene's medium. */
+static void camera_medium(const rt_trace_ctx *ctx, const rt_ray *r, vp_state *ps)
+{
+    const rt_scene *s = ctx->state->scene;
+    size_t m = 0;
+    while (m < s->material_count && s->materials[m].interior_medium == RT_NONE)
+        m++;
+    if (m == s->material_count)
+        return;
+    uint32_t mat[RT_PATH_LAYERS];
+    bool front[RT_PATH_LAYERS];
+    int n = 0;
+    rt_ray w = rt_ray_make(r->org, r->dir, 0.0f, INFINITY);
+    for (int k = 0;; k++) {
+        rt_hit hit;
+        if (!rt_trace(ctx, &w, &hit))
+            break;
+        if (k == RT_PATH_LAYERS)
+            return;
+        rt_surface sf;
+        rt_surface_at(ctx, &w, &hit, &sf);
+        if (is_boundary(&s->materials[sf.material])) {
+            mat[n] = sf.material;
+            front[n++] = sf.front;
+        }
+        w = rt_ray_make(rt_surface_spawn(ctx, &sf, r->dir), r->dir, 0.0f, INFINITY);
+    }
+    while (n-- > 0)
+        cross(s, &ps->stack, &ps->medium, mat[n], !front[n]);
 }
 
 /* The next surface along r that the alpha keeps, null boundaries included
@@ -277,12 +316,13 @@ static bool ratio_track(const rt_volume *v, rt_vec3 o, rt_vec3 d, float t_max, i
 
 /* What reaches vertex vx from along unit wi over dist (INFINITY: the
  * environment) through the media and null boundaries between: false when a
- * surface blocks it. light_prim: the primitive of the light sampled (an
- * area light's quad, else RT_NONE), which ends the walk where it is met:
- * a sampled distance can overshoot the light's plane by more than the
- * shadow ray's margin of 1e-4 (3e-4 of it measured near a large light). */
+ * surface blocks it. Every segment is aimed at the sampled point from its
+ * own origin (offset off the boundary it crossed) and stops just short of
+ * it, as rt_shadow_ray does from a surface: sent along wi from an origin
+ * offset along a boundary's normal, it would meet the light's plane past
+ * the point, on the light itself. */
 static bool shadow(const rt_trace_ctx *ctx, const vp_state *ps, const vp_vertex *vx, rt_vec3 wi, float dist,
-                   uint32_t light_prim, rt_rng *rng, rt_vec3 *T, rt_vec3 *ru, rt_vec3 *rl)
+                   rt_rng *rng, rt_vec3 *T, rt_vec3 *ru, rt_vec3 *rl)
 {
     const rt_scene *s = ctx->state->scene;
     rt_ray r;
@@ -290,7 +330,7 @@ static bool shadow(const rt_trace_ctx *ctx, const vp_state *ps, const vp_vertex 
         r = rt_shadow_ray(ctx, vx->sf, wi, dist);
     else
         r = rt_ray_make(vx->p, wi, 0.0f, isfinite(dist) ? dist * (1.0f - 1e-4f) : INFINITY);
-    rt_vec3 end = rt_madd(r.org, r.dir, r.tmax); /* (unused for an infinite ray) */
+    const rt_vec3 target = rt_madd(vx->p, wi, isfinite(dist) ? dist : 0.0f); /* (unused for an infinite ray) */
     rt_medium_stack st = ps->stack;
     uint32_t medium = ps->medium;
     *T = *ru = *rl = rt_v3s(1.0f);
@@ -302,18 +342,24 @@ static bool shadow(const rt_trace_ctx *ctx, const vp_state *ps, const vp_vertex 
             return false;
         if (medium != RT_NONE) {
             rt_volume v = volume_of(s, medium);
-            if (!ratio_track(&v, r.org, wi, w == RT_WALK_SURFACE ? seg.tmin : r.tmax, ps->hero, rng, T, ru, rl))
+            if (!ratio_track(&v, r.org, r.dir, w == RT_WALK_SURFACE ? seg.tmin : r.tmax, ps->hero, rng, T, ru, rl))
                 return false;
         }
-        if (w == RT_WALK_MISS || (light_prim != RT_NONE && sf.prim == light_prim))
+        if (w == RT_WALK_MISS)
             return true;
         if (s->materials[sf.material].bsdf != RT_BSDF_NULL)
             return false;
         cross(s, &st, &medium, sf.material, sf.front);
         rt_vec3 o = rt_surface_spawn(ctx, &sf, wi);
-        r = rt_ray_make(o, wi, 0.0f, isfinite(r.tmax) ? rt_dot(rt_sub(end, o), wi) : INFINITY);
-        if (!(r.tmax > 0.0f))
-            return true;
+        if (!isfinite(dist)) {
+            r = rt_ray_make(o, wi, 0.0f, INFINITY);
+            continue;
+        }
+        rt_vec3 to = rt_sub(target, o);
+        float len = rt_length(to);
+        if (!(rt_dot(to, wi) > 0.0f && len > 0.0f))
+            return true; /* the boundary lies at the light point */
+        r = rt_ray_make(o, rt_scale(to, 1.0f / len), 0.0f, len * (1.0f - 1e-4f));
     }
     return false;
 }
@@ -338,14 +384,14 @@ static rt_vec3 vertex_f(const vp_vertex *vx, rt_vec3 wi, float *pdf)
 /* One light sample's contribution (to be multiplied by beta): li is the
  * radiance over the sampling pdf pdf_l (0 for a delta light, no MIS). */
 static rt_vec3 light_term(const rt_trace_ctx *ctx, const vp_state *ps, const vp_vertex *vx, rt_vec3 wi, float dist,
-                          uint32_t light_prim, rt_vec3 li, float pdf_l, rt_rng *rng)
+                          rt_vec3 li, float pdf_l, rt_rng *rng)
 {
     float pdf_f;
     rt_vec3 f = vertex_f(vx, wi, &pdf_f);
     if (!(rt_max3(f) > 0.0f && rt_max3(li) > 0.0f))
         return rt_v3s(0.0f);
     rt_vec3 T, ru, rl;
-    if (!shadow(ctx, ps, vx, wi, dist, light_prim, rng, &T, &ru, &rl))
+    if (!shadow(ctx, ps, vx, wi, dist, rng, &T, &ru, &rl))
         return rt_v3s(0.0f);
     rt_vec3 den = rt_mul(ps->r_u, rl);
     if (pdf_l > 0.0f)
@@ -369,8 +415,15 @@ static rt_vec3 sample_lights(const rt_trace_ctx *ctx, const vp_state *ps, const 
         if (!rt_light_sample_at(ctx, l, vx->p, rt_v2(ux, uy), &ls))
             continue;
         bool quad = l->kind == RT_LIGHT_AREA && l->quad != RT_NONE;
-        uint32_t prim = quad ? (uint32_t)(s->triangles.count + s->spheres.count + l->quad) : RT_NONE;
-        sum = rt_path_add_finite(sum, light_term(ctx, ps, vx, ls.wi, ls.dist, prim, ls.li, quad ? ls.pdf : 0.0f, rng));
+        sum = rt_path_add_finite(sum, light_term(ctx, ps, vx, ls.wi, ls.dist, ls.li, quad ? ls.pdf : 0.0f, rng));
+    }
+    if (rt_path_samples_emitters(ctx)) { /* one emissive primitive of the light table, by power */
+        float ul = rt_rng_float(rng), ux = rt_rng_float(rng), uy = rt_rng_float(rng);
+        rt_emitter_sample es;
+        if (rt_emitter_sample_at(ctx, vx->p, ul, rt_v2(ux, uy), &es)) {
+            rt_vec3 li = rt_scale(es.Le, 1.0f / es.pdf);
+            sum = rt_path_add_finite(sum, light_term(ctx, ps, vx, es.wi, es.dist, li, es.pdf, rng));
+        }
     }
     if (rt_path_samples_env(ctx)) {
         float ux = rt_rng_float(rng), uy = rt_rng_float(rng);
@@ -378,7 +431,7 @@ static rt_vec3 sample_lights(const rt_trace_ctx *ctx, const vp_state *ps, const 
         float pdf_l;
         if (rt_light_table_sample_env(ctx->state->light_table, rt_v2(ux, uy), &d, &pdf_l) && pdf_l > 0.0f) {
             rt_vec3 li = rt_scale(rt_environment(s, d), 1.0f / pdf_l);
-            sum = rt_path_add_finite(sum, light_term(ctx, ps, vx, d, INFINITY, RT_NONE, li, pdf_l, rng));
+            sum = rt_path_add_finite(sum, light_term(ctx, ps, vx, d, INFINITY, li, pdf_l, rng));
         }
     }
     return sum;
@@ -430,10 +483,12 @@ static bool surface_vertex(const rt_trace_ctx *ctx, vp_state *ps, const rt_surfa
     bool emissive = rt_max3(rt_scale(m->emission, m->emission_strength)) > 0.0f;
     uint32_t light = emissive ? rt_area_light_of_prim(s, ctx->state->light_table, sf->prim) : RT_NONE;
     if (rt_max3(Le) > 0.0f) {
-        float pdf_l = 0.0f;
+        float d2 = rt_length2(rt_sub(sf->p, ps->prev_p)), pdf_l;
         if (light != RT_NONE)
-            pdf_l = rt_area_light_pdf(&s->lights[light], ps->prev_p, r->dir, rt_length(rt_sub(sf->p, ps->prev_p)));
-        add_emission(ps, Le, pdf_l);
+            pdf_l = rt_area_light_pdf(&s->lights[light], ps->prev_p, r->dir, sqrtf(d2));
+        else /* an emitter of the light table, as sample_lights draws it */
+            pdf_l = rt_emitter_pdf(ctx, sf->prim, ps->prev_p, r->dir, d2, sf->ng);
+        add_emission(ps, Le, isfinite(pdf_l) ? pdf_l : 0.0f);
     }
     if (light != RT_NONE)
         return false; /* an area light's quad reflects nothing */
@@ -494,6 +549,7 @@ rt_vec3 rt_radiance_volpath(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *
                    .medium = s->environment.medium, .specular = true, .prev_p = r.org, .eta_scale = 1.0f,
                    .skips = RT_PATH_HARD_LIMIT};
     rt_medium_stack_init(&ps.stack);
+    camera_medium(ctx, &r, &ps);
     float uh = rt_sample_1d((rt_sampler_kind)set->sampler, (uint32_t)set->samples, rng, DIM_HERO);
     ps.hero = uh < 1.0f / 3.0f ? 0 : (uh < 2.0f / 3.0f ? 1 : 2);
     for (;;) {
@@ -551,4 +607,52 @@ rt_vec3 rt_radiance_volpath(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *
             break;
     }
     return rt_finite3(ps.L) ? ps.L : rt_v3s(0.0f);
+}
+
+bool rt_volpath_aov_event(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *rng, rt_vec3 *albedo, rt_vec3 *p)
+{
+    const rt_scene *s = ctx->state->scene;
+    rt_ray r = *ray;
+    float len = rt_length(r.dir);
+    if (!(len > 0.0f) || !isfinite(len))
+        return false;
+    r.dir = rt_scale(r.dir, 1.0f / len);
+    r.tmin *= len;
+    r.tmax *= len;
+    vp_state ps = {.medium = s->environment.medium};
+    rt_medium_stack_init(&ps.stack);
+    camera_medium(ctx, &r, &ps);
+    int h = (int)(rt_rng_float(rng) * 3.0f); /* the channel whose distances decide */
+    h = h > 2 ? 2 : h;
+    for (int k = 0; k < RT_PATH_LAYERS; k++) {
+        rt_ray seg = r;
+        rt_surface sf;
+        rt_surface_walk w = next_surface(ctx, &seg, rng, &sf);
+        if (w == RT_WALK_TOO_DEEP)
+            return false;
+        if (ps.medium != RT_NONE) { /* delta tracking to the first real collision */
+            rt_volume v = volume_of(s, ps.medium);
+            maj_walk walk;
+            maj_walk_init(&walk, &v, r.org, r.dir, r.tmin, w == RT_WALK_SURFACE ? seg.tmin : r.tmax, h);
+            float t;
+            while (maj_walk_next(&walk, rng, &t)) {
+                rt_vec3 q = rt_madd(r.org, r.dir, t), st = rt_volume_sigma_t(&v);
+                if (rt_rng_float(rng) * ch(walk.maj, h) < ch(st, h) * rt_volume_density(&v, q)) {
+                    *albedo = rt_v3(st.x > 0.0f ? v.sigma_s.x / st.x : 0.0f, st.y > 0.0f ? v.sigma_s.y / st.y : 0.0f,
+                                    st.z > 0.0f ? v.sigma_s.z / st.z : 0.0f);
+                    *p = q;
+                    return true;
+                }
+            }
+        }
+        if (w == RT_WALK_MISS)
+            return false;
+        const rt_material *m = &s->materials[sf.material];
+        if (!(m->bsdf == RT_BSDF_NULL ||
+              (is_boundary(m) && rt_medium_stack_false_hit(&ps.stack, s->materials, sf.material, sf.front))))
+            return false; /* a surface first */
+        cross(s, &ps.stack, &ps.medium, sf.material, sf.front);
+        r = rt_ray_make(rt_surface_spawn(ctx, &sf, r.dir), r.dir, 0.0f, INFINITY);
+    }
+    return false;
 }

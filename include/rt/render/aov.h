@@ -2,10 +2,15 @@
  * beauty one, for denoisers and compositing.
  *
  *   albedo    the first non-specular surface's reflectance (diffuse + specular
- *             tint), seen through perfect mirrors and glass, as OIDN wants it
- *   normal    that surface's shading normal (world space, facing the ray)
- *   depth     distance along the camera ray to the first surface (0: none)
- *   position  world position of the first surface
+ *             tint), seen through perfect mirrors and glass, as OIDN wants it;
+ *             with the path integrator in a scene with media, a collision in
+ *             a medium before that surface gives the medium's
+ *             single-scattering albedo sigma_s / sigma_t instead
+ *   normal    that surface's shading normal (world space, facing the ray);
+ *             zero for a collision in a medium (OIDN's "no surface")
+ *   depth     distance along the camera ray to the first surface (0: none),
+ *             or to the collision in a medium
+ *   position  world position of the first surface (or of that collision)
  *   variance  the variance of the pixel's mean (sample variance of the
  *             luminance / samples)
  *   spp       samples that counted (NaN/Inf samples are dropped)
