@@ -1444,6 +1444,17 @@ static void test_media(void **state)
         {"medium f homogeneous sigma_a 1 1 1 sigma_s 1 1 1\nmaterial m interior f\n", RT_ERR_INVALID, "2:12",
          "needs 'bsdf dielectric' or 'bsdf null'"},
         {"material m bsdf dielectric interior nothing\n", RT_ERR_INVALID, "1:37", "undefined medium 'nothing'"},
+        /* subsurface scattering (rt/scene/subsurface.h) */
+        {"material m subsurface_radius 1 1 1\n", RT_ERR_INVALID, "1:12", "needs 'bsdf dielectric'"},
+        {"material m bsdf dielectric subsurface_albedo 1 1 1\n", RT_ERR_INVALID, "1:28", "needs 'subsurface_radius"},
+        {"material m bsdf dielectric subsurface_radius 1 0 1\n", RT_ERR_INVALID, "1:28", "above 0 in every channel"},
+        {"material m bsdf dielectric subsurface_radius 1 nan 1\n", RT_ERR_PARSE, "1:48", ""},
+        {"material m bsdf dielectric subsurface_radius 1 1 1 subsurface_albedo 1.5 1 1\n", RT_ERR_INVALID, "1:70",
+         "subsurface_albedo"},
+        {"material m bsdf dielectric subsurface_radius 1 1 1 subsurface_g 1\n", RT_ERR_INVALID, "1:65", "subsurface_g"},
+        {"medium f homogeneous sigma_a 1 1 1 sigma_s 1 1 1\n"
+         "material m bsdf dielectric interior f subsurface_radius 1 1 1\n",
+         RT_ERR_INVALID, "2:28", "'interior' does not go with 'subsurface_radius'"},
     };
     expect_errors(cases);
 }

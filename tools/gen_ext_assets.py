@@ -18,6 +18,9 @@ regenerate bit for bit:
   transmission.gltf   diffuse transmission 0, 0.5, 1 (green), and dispersion on glass
   gallery.gltf        one sphere of each: coat 0.3, gold sheen, blue F0, anisotropic
                       metal, 400 nm film, diffuse transmission (the README picture)
+  scatter.gltf        KHR_materials_volume_scatter (draft) under KHR_materials_volume: amber
+                      glass that only absorbs, orange wax, milk under diffuse transmission,
+                      rough jade scattering forwards
   variants.gltf       KHR_materials_variants: two grey spheres; variant "blue" turns the
                       first blue, "red" the second red
 """
@@ -182,6 +185,28 @@ def main():
                 KHR_materials_transmission={"transmissionFactor": 1.0},
                 KHR_materials_volume={"thicknessFactor": 0.8},
                 KHR_materials_dispersion={"dispersion": 0.5}),
+        ],
+        "scatter": [
+            mat("amber glass", (1, 1, 1), roughness=0.0,
+                KHR_materials_transmission={"transmissionFactor": 1.0},
+                KHR_materials_volume={"thicknessFactor": 0.8, "attenuationColor": [0.9, 0.6, 0.3],
+                                      "attenuationDistance": 0.5}),
+            mat("wax", (1, 1, 1), roughness=0.0,
+                KHR_materials_transmission={"transmissionFactor": 1.0},
+                KHR_materials_volume={"thicknessFactor": 0.8, "attenuationColor": [0.2, 0.3, 0.4],
+                                      "attenuationDistance": 0.1},
+                KHR_materials_volume_scatter={"multiscatterColor": [0.95, 0.6, 0.25]}),
+            mat("milk", (1, 1, 1), roughness=0.5,
+                KHR_materials_diffuse_transmission={"diffuseTransmissionFactor": 1.0},
+                KHR_materials_volume={"thicknessFactor": 0.8, "attenuationColor": [0.2, 0.2, 0.2],
+                                      "attenuationDistance": 0.1},
+                KHR_materials_volume_scatter={"multiscatterColor": [0.97, 0.96, 0.93]}),
+            mat("jade", (1, 1, 1), roughness=0.3,
+                KHR_materials_transmission={"transmissionFactor": 1.0},
+                KHR_materials_ior={"ior": 1.6},
+                KHR_materials_volume={"thicknessFactor": 0.8, "attenuationColor": [0.3, 0.5, 0.35],
+                                      "attenuationDistance": 0.1},
+                KHR_materials_volume_scatter={"multiscatterColor": [0.45, 0.85, 0.55], "scatterAnisotropy": 0.5}),
         ],
     }
     files["gallery"] = [  # one of each, for docs/images/gltf-extensions.png

@@ -21,6 +21,7 @@
 #include "rt/base/alloc.h"
 #include "rt/base/log.h"
 #include "rt/scene/instance.h"
+#include "rt/scene/subsurface.h"
 #include "rt/scene/texture.h"
 
 rt_result gl_scratch(gl_doc *d, int slot, size_t floats, float **out)
@@ -397,7 +398,8 @@ static rt_result add_materials(gl_doc *d, rt_scene *s, rt_gltf_stats *st, bool n
             if (t != RT_NONE)
                 m.ext_tex[k].texture = d->texture_missing[t] ? RT_NONE : d->texture_map[t];
         }
-        if (rt_scene_add_material(s, &m) == RT_NONE)
+        /* KHR_materials_volume_scatter: the medium inside (rt/scene/subsurface.h) */
+        if (!rt_subsurface_attach(s, &m) || rt_scene_add_material(s, &m) == RT_NONE)
             return rt_fail(d->err, RT_ERR_NOMEM, "%s: out of memory adding materials", d->path);
         st->materials++;
     }

@@ -283,7 +283,8 @@ static rt_result parse_pbr(gl_doc *d, const char *where, int v, rt_material *m)
 }
 
 /* The extensions glTF materials had first: KHR_materials_emissive_strength,
- * transmission, ior, volume and unlit; any other key k2 is ignored. */
+ * transmission, ior, volume (and the draft volume_scatter) and unlit; any
+ * other key k2 is ignored. */
 static rt_result parse_core_ext(gl_doc *d, const char *wx, int k2, int v2, rt_material *m)
 {
     rt_result r = RT_OK;
@@ -342,6 +343,24 @@ static rt_result parse_core_ext(gl_doc *d, const char *wx, int k2, int v2, rt_ma
         }
         if (!(m->attenuation_distance > 0))
             return gl_fail_at(d, v2, RT_ERR_INVALID, "%s.attenuationDistance must be positive", we);
+    } else if (KEY(k2, "KHR_materials_volume_scatter")) {
+        /* the draft (KhronosGroup/glTF pull request 2453): the multiple-
+         * scattering albedo and the anisotropy of a medium whose extinction
+         * is KHR_materials_volume's attenuation (rt/scene/subsurface.h) */
+        snprintf(we, sizeof we, "%s.KHR_materials_volume_scatter", wx);
+        if ((r = gl_expect_object(d, v2, we)) != RT_OK)
+            return r;
+        m->subsurface = true;
+        m->subsurface_albedo = rt_v3s(0.0f);
+        for (int k3_n = 0, k3 = v2 + 1, v3 = v2 + 2; k3_n < d->j.tok[v2].size && v3 < d->j.count;
+             k3_n++, k3 = rt_json_skip(&d->j, v3), v3 = k3 + 1) {
+            if (KEY(k3, "multiscatterColor"))
+                r = get_color_ranged(d, we, "multiscatterColor", v3, 0, 1, &m->subsurface_albedo);
+            else if (KEY(k3, "scatterAnisotropy"))
+                r = gl_get_ranged(d, we, "scatterAnisotropy", v3, -1, 1, &m->subsurface_g);
+            if (r != RT_OK)
+                return r;
+        }
     } else if (KEY(k2, "KHR_materials_unlit")) {
         m->unlit = true;
     }

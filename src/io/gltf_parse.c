@@ -32,6 +32,7 @@ static const struct { const char *name; bool supported; } known_extensions[] = {
     {"KHR_materials_diffuse_transmission", true}, {"KHR_materials_variants", true},
     {"EXT_meshopt_compression", true},         {"KHR_draco_mesh_compression", true},
     {"EXT_texture_webp", true},                {"EXT_mesh_gpu_instancing", true},
+    {"KHR_materials_volume_scatter", true},
 };
 
 static bool extension_supported(const gl_doc *d, int t)

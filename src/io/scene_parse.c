@@ -54,6 +54,7 @@
 #include "rt/io/environment_image.h"
 #include "rt/render/settings.h"
 #include "rt/scene/instance.h"
+#include "rt/scene/subsurface.h"
 #include "rt/scene/texture.h"
 
 #define MAX_SCENE_BYTES ((size_t)256 << 20) /* 256 MiB of text keeps line and column in an int */
@@ -899,6 +900,9 @@ static const mat_key mat_keys[] = {
     {"thin_walled", NULL, MK_BOOL, MOFF(thin_walled), 0, 0},
     {"attenuation_color", NULL, MK_COLOR, MOFF(attenuation_color), 0, 0},
     {"attenuation_distance", NULL, MK_DISTANCE, MOFF(attenuation_distance), 0, 0},
+    {"subsurface_albedo", NULL, MK_COLOR01, MOFF(subsurface_albedo), 0, 0},
+    {"subsurface_radius", NULL, MK_COLOR, MOFF(subsurface_radius), 0, 0},
+    {"subsurface_g", NULL, MK_FLOAT, MOFF(subsurface_g), -RT_MEDIUM_G_MAX, RT_MEDIUM_G_MAX},
     {"texture", "base_color_texture", MK_TEXTURE, MOFF(base_color_tex), 0, 0},
     {"normal_map", "normal_texture", MK_TEXTURE, MOFF(normal_tex), 0, 0},
     {"metallic_roughness_map", "metallic_roughness_texture", MK_TEXTURE, MOFF(metal_rough_tex), 0, 0},
@@ -1118,10 +1122,38 @@ static rt_result read_mat_value(parser *p, const mat_key *mk, rt_material *m, fl
     return r;
 }
 
+/* The subsurface keys (rt/scene/subsurface.h): under a dielectric
+ * boundary, a radius above 0 in every channel, not beside an interior
+ * medium of its own. */
+static rt_result check_subsurface_keys(parser *p, const rt_material *m, const tok *const *seen)
+{
+    static const char *const keys[] = {"subsurface_albedo", "subsurface_radius", "subsurface_g"};
+    const tok *first = NULL;
+    for (int i = 0; i < 3 && !first; i++)
+        first = seen[mat_key_index(keys[i])];
+    if (!first)
+        return RT_OK;
+    const tok *radius = seen[mat_key_index("subsurface_radius")];
+    if (m->bsdf != RT_BSDF_DIELECTRIC)
+        return perr(p, RT_ERR_INVALID, first, "material key '%s' needs 'bsdf dielectric' (the boundary it walks under)",
+                    first->s);
+    if (!radius)
+        return perr(p, RT_ERR_INVALID, first, "material key '%s' needs 'subsurface_radius R G B' (the mean free path)",
+                    first->s);
+    if (!(m->subsurface_radius.x > 0.0f && m->subsurface_radius.y > 0.0f && m->subsurface_radius.z > 0.0f))
+        return perr(p, RT_ERR_INVALID, radius, "material subsurface_radius must be above 0 in every channel");
+    if (seen[mat_key_index("interior")])
+        return perr(p, RT_ERR_INVALID, seen[mat_key_index("interior")],
+                    "material key 'interior' does not go with 'subsurface_radius' (the subsurface keys make the "
+                    "interior medium)");
+    return RT_OK;
+}
+
 /* The keys that need a particular bsdf, and the pairs given either one way
  * or the other (seen: the token of each key given, NULL if not). */
 static rt_result check_mat_keys(parser *p, const rt_material *m, const tok *const *seen)
 {
+    rt_result r;
     /* the conductor's keys: only with bsdf conductor, one way each */
     const tok *k_metal = NULL, *k_eta = NULL, *k_alpha = NULL, *k_alpha_uv = NULL;
     for (size_t i = 0; i < MAT_KEY_COUNT; i++) {
@@ -1163,6 +1195,8 @@ static rt_result check_mat_keys(parser *p, const rt_material *m, const tok *cons
         else if (mk->kind == MK_GGX)
             *(mk->offset ? &k_alpha_uv : &k_alpha) = seen[i];
     }
+    if ((r = check_subsurface_keys(p, m, seen)) != RT_OK)
+        return r;
     if (m->bsdf == RT_BSDF_NULL && m->interior_medium == RT_NONE) {
         const tok *at = seen[mat_key_index("bsdf")];
         return perr(p, RT_ERR_INVALID, at, "'bsdf null' needs 'interior MEDIUM' (the medium it bounds)");
@@ -1246,6 +1280,9 @@ static rt_result st_material(parser *p, const tok *kw)
     if ((r = check_mat_keys(p, &m, seen)) != RT_OK)
         return r;
     finish_material(&m, seen, uv);
+    m.subsurface = seen[mat_key_index("subsurface_radius")] != NULL;
+    if (!rt_subsurface_attach(p->s, &m))
+        return nomem(p, name);
     uint32_t id = rt_scene_add_material(p->s, &m);
     if (id == RT_NONE || !name_add(&p->materials, name->s, id, name->line))
         return nomem(p, name);

@@ -88,6 +88,13 @@ float rt_medium_outside_ior(const rt_medium_stack *st, const rt_material *mats, 
     return t < 0 ? mats[mat].exterior_ior : mats[st->material[t]].ior;
 }
 
+bool rt_medium_index_matched(const rt_medium_stack *st, const rt_material *mats, uint32_t mat, bool front)
+{
+    const rt_material *m = &mats[mat];
+    float alpha = m->alpha_u >= 0.0f ? m->alpha_u : m->roughness * m->roughness; /* as the dielectric BSDF's */
+    return m->bsdf == RT_BSDF_DIELECTRIC && alpha == 0.0f && rt_medium_outside_ior(st, mats, mat, front) == m->ior;
+}
+
 void rt_medium_cross(rt_medium_stack *st, const rt_material *mats, uint32_t mat, bool front)
 {
     if (rt_medium_is_medium(&mats[mat]))

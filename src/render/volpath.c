@@ -27,7 +27,9 @@
  *   ratio tracking with the same ratios (pbrt-v4's SampleLd, with its
  *   Russian roulette on low transmittance); other surfaces block them;
  * - media change at boundaries by the nested-media stack of
- *   rt/render/medium.h (priorities, false intersections): the medium is
+ *   rt/render/medium.h (priorities, false intersections; an index-matched
+ *   smooth dielectric, as an index-matched subsurface material's
+ *   boundary, is passed as a null boundary is): the medium is
  *   the interior medium of the stack's current entry, else the crossed
  *   boundary's exterior medium, else the scene's medium;
  * - Russian roulette on beta x eta_scale / average(r_u), as the surface
@@ -345,9 +347,13 @@ static bool shadow(const rt_trace_ctx *ctx, const vp_state *ps, const vp_vertex 
             if (!ratio_track(&v, r.org, r.dir, w == RT_WALK_SURFACE ? seg.tmin : r.tmax, ps->hero, rng, T, ru, rl))
                 return false;
         }
+        if (w == RT_WALK_SURFACE) /* a dielectric's own absorption inside it (rt/render/medium.h) */
+            *T = rt_mul(*T, rt_medium_transmittance(
+                                s->materials, rt_medium_of_segment(&st, s->materials, sf.material, sf.front), seg.tmin));
         if (w == RT_WALK_MISS)
             return true;
-        if (s->materials[sf.material].bsdf != RT_BSDF_NULL)
+        if (s->materials[sf.material].bsdf != RT_BSDF_NULL &&
+            !rt_medium_index_matched(&st, s->materials, sf.material, sf.front))
             return false;
         cross(s, &st, &medium, sf.material, sf.front);
         rt_vec3 o = rt_surface_spawn(ctx, &sf, wi);
@@ -594,7 +600,7 @@ rt_vec3 rt_radiance_volpath(const rt_trace_ctx *ctx, const rt_ray *ray, rt_rng *
         uint32_t absorber = rt_medium_of_segment(&ps.stack, s->materials, sf.material, sf.front);
         if (absorber != RT_NONE) /* a dielectric's Beer-Lambert absorption (rt/render/medium.h) */
             ps.beta = rt_mul(ps.beta, rt_medium_transmittance(s->materials, absorber, t_hit));
-        if (m->bsdf == RT_BSDF_NULL ||
+        if (m->bsdf == RT_BSDF_NULL || rt_medium_index_matched(&ps.stack, s->materials, sf.material, sf.front) ||
             (is_boundary(m) && rt_medium_stack_false_hit(&ps.stack, s->materials, sf.material, sf.front))) {
             /* no surface here: straight on into the medium beyond */
             cross(s, &ps.stack, &ps.medium, sf.material, sf.front);

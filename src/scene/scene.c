@@ -56,6 +56,10 @@ void rt_material_default(rt_material *m, const char *name)
     m->thin_walled = false;
     m->attenuation_color = rt_v3s(1.0f);
     m->attenuation_distance = INFINITY;
+    m->subsurface = false;
+    m->subsurface_albedo = rt_v3s(0.8f);
+    m->subsurface_radius = rt_v3s(0.0f);
+    m->subsurface_g = 0.0f;
     rt_texture_slot_none(&m->base_color_tex);
     rt_texture_slot_none(&m->metal_rough_tex);
     rt_texture_slot_none(&m->normal_tex);

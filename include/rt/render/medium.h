@@ -91,6 +91,13 @@ float rt_medium_outside_ior(const rt_medium_stack *st, const rt_material *mats, 
  * medium changes nothing. Non-media are ignored. */
 void rt_medium_cross(rt_medium_stack *st, const rt_material *mats, uint32_t mat, bool front);
 
+/* True when the hit on `mat` is a smooth dielectric with the same index
+ * on both sides (rt_medium_outside_ior equals its own): light passes it
+ * unbent and unreflected (Fresnel 0), so the media tracer passes it, paths
+ * and shadow rays alike, as it passes a null boundary (an index-matched
+ * subsurface material: docs/media.md). */
+bool rt_medium_index_matched(const rt_medium_stack *st, const rt_material *mats, uint32_t mat, bool front);
+
 /* rt_medium_false_hit and rt_medium_cross for a caller that decides
  * itself which materials are media: `mat` is taken to be one (the
  * functions above are these, for bsdf dielectric materials only). */

@@ -206,6 +206,13 @@ typedef struct rt_material {
     bool thin_walled;       /* glTF: no volume (thickness 0), transmission goes straight through; scene text: false */
     rt_vec3 attenuation_color;
     float attenuation_distance; /* INFINITY = no absorption */
+    /* random-walk subsurface scattering (rt/scene/subsurface.h): a
+     * homogeneous medium inside the boundary, made from these by
+     * rt_subsurface_attach when `subsurface` is set */
+    bool subsurface;
+    rt_vec3 subsurface_albedo;  /* multiple-scattering albedo, each in [0, 1] */
+    rt_vec3 subsurface_radius;  /* mean free path per channel, scene units; 0: from attenuation_* (glTF) */
+    float subsurface_g;         /* Henyey-Greenstein anisotropy */
     /* textures */
     rt_texture_slot base_color_tex; /* sRGB colour */
     rt_texture_slot metal_rough_tex; /* B = metal, G = roughness */
