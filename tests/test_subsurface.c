@@ -32,6 +32,7 @@
 #include "rt/render/volpath.h"
 #include "rt/scene/subsurface.h"
 #include "test_fixture.h"
+#include "test_volpath_estimate.h"
 
 static char tmp_dir[256];
 
@@ -46,47 +47,6 @@ static int teardown(void **state)
     (void)state;
     test_remove_dir(tmp_dir);
     return 0;
-}
-
-typedef struct estimate {
-    rt_vec3 mean, se; /* per channel: the mean and its standard error */
-} estimate;
-
-/* The mean of n paths along org -> dir. */
-static estimate estimate_ray(const test_fixture *f, rt_vec3 org, rt_vec3 dir, int n)
-{
-    double s[3] = {0, 0, 0}, s2[3] = {0, 0, 0};
-    for (int i = 0; i < n; i++) {
-        rt_rng rng = rt_rng_for_sample(4321, (uint64_t)i, 0);
-        rt_ray r = rt_ray_make(org, rt_normalize(dir), 0.0f, INFINITY);
-        rt_vec3 L = rt_radiance_volpath(&f->ctx, &r, &rng);
-        assert_true(rt_finite3(L) && L.x >= 0.0f && L.y >= 0.0f && L.z >= 0.0f);
-        const double v[3] = {L.x, L.y, L.z};
-        for (int k = 0; k < 3; k++) {
-            s[k] += v[k];
-            s2[k] += v[k] * v[k];
-        }
-    }
-    double m[3], e[3];
-    for (int k = 0; k < 3; k++) {
-        m[k] = s[k] / n;
-        double var = s2[k] / n - m[k] * m[k];
-        e[k] = sqrt(var > 0 ? var / n : 0);
-    }
-    return (estimate){rt_v3((float)m[0], (float)m[1], (float)m[2]), rt_v3((float)e[0], (float)e[1], (float)e[2])};
-}
-
-static void expect_near(const char *what, estimate e, rt_vec3 want)
-{
-    const float got[3] = {e.mean.x, e.mean.y, e.mean.z}, se[3] = {e.se.x, e.se.y, e.se.z};
-    const float w[3] = {want.x, want.y, want.z};
-    for (int k = 0; k < 3; k++) {
-        float tol = 4.0f * se[k] + 0.002f * w[k] + 1e-5f;
-        if (!(fabsf(got[k] - w[k]) <= tol))
-            fail_msg("%s, channel %d: %.5f, expected %.5f (+- %.5f)", what, k, got[k], w[k], tol);
-    }
-    print_message("%s: %.4f %.4f %.4f (expected %.4f %.4f %.4f, se %.4f %.4f %.4f)\n", what, e.mean.x, e.mean.y,
-                  e.mean.z, want.x, want.y, want.z, e.se.x, e.se.y, e.se.z);
 }
 
 /* van de Hulst's albedo of a semi-infinite isotropic medium of
@@ -169,9 +129,9 @@ static void test_white_furnace(void **state)
         test_fixture_load(&f, text, RT_PREPARE_LIGHT_TABLE);
         char what[64];
         snprintf(what, sizeof what, "furnace, %s, through the centre", boundaries[i]);
-        expect_near(what, estimate_ray(&f, rt_v3(0, 0, 4), rt_v3(0, 0, -1), 100000), rt_v3s(1.0f));
+        test_expect_near(what, test_estimate_ray(&f, rt_v3(0, 0, 4), rt_v3(0, 0, -1), 100000, 4321), rt_v3s(1.0f));
         snprintf(what, sizeof what, "furnace, %s, off centre", boundaries[i]);
-        expect_near(what, estimate_ray(&f, rt_v3(0.6f, 0.3f, 4), rt_v3(0, 0, -1), 100000), rt_v3s(1.0f));
+        test_expect_near(what, test_estimate_ray(&f, rt_v3(0.6f, 0.3f, 4), rt_v3(0, 0, -1), 100000, 4321), rt_v3s(1.0f));
         test_fixture_free(&f);
     }
 }
@@ -200,10 +160,10 @@ static void test_index_matched_is_the_medium(void **state)
     test_fixture_load(&null, null_text, RT_PREPARE_LIGHT_TABLE);
     const rt_vec3 org[2] = {rt_v3(0, 0, 4), rt_v3(0.4f, 0.5f, 4)};
     for (int k = 0; k < 2; k++) {
-        estimate a = estimate_ray(&null, org[k], rt_v3(0, 0, -1), 30000);
-        estimate b = estimate_ray(&sss, org[k], rt_v3(0, 0, -1), 30000);
+        test_estimate a = test_estimate_ray(&null, org[k], rt_v3(0, 0, -1), 30000, 4321);
+        test_estimate b = test_estimate_ray(&sss, org[k], rt_v3(0, 0, -1), 30000, 4321);
         rt_vec3 se = rt_v3(hypotf(a.se.x, b.se.x), hypotf(a.se.y, b.se.y), hypotf(a.se.z, b.se.z));
-        expect_near("subsurface behind ior 1 against the medium behind a null boundary", (estimate){b.mean, se},
+        test_expect_near("subsurface behind ior 1 against the medium behind a null boundary", (test_estimate){b.mean, se},
                     a.mean);
         assert_true(rt_fminf(a.mean.x, rt_fminf(a.mean.y, a.mean.z)) > 0.02f); /* light did arrive */
     }
@@ -320,8 +280,8 @@ static void test_gltf_white_furnace(void **state)
         test_fixture f;
         test_fixture_load(&f, text, RT_PREPARE_LIGHT_TABLE);
         assert_int_equal(f.s.medium_count, 1);
-        expect_near(i == 0 ? "glTF furnace, transmission, ior 1" : "glTF furnace, diffuse transmission",
-                    estimate_ray(&f, rt_v3(0.3f, 0.2f, 4), rt_v3(0, 0, -1), 100000), rt_v3s(1.0f));
+        test_expect_near(i == 0 ? "glTF furnace, transmission, ior 1" : "glTF furnace, diffuse transmission",
+                    test_estimate_ray(&f, rt_v3(0.3f, 0.2f, 4), rt_v3(0, 0, -1), 100000, 4321), rt_v3s(1.0f));
         test_fixture_free(&f);
     }
 }

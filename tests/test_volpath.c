@@ -33,47 +33,7 @@
 #include "rt/render/phase.h"
 #include "rt/render/volpath.h"
 #include "test_fixture.h"
-
-typedef struct estimate {
-    rt_vec3 mean, se; /* per channel: the mean and its standard error */
-} estimate;
-
-/* The mean of n paths along org -> dir (pixel stream i of seed 7). */
-static estimate estimate_ray(const test_fixture *f, rt_vec3 org, rt_vec3 dir, int n)
-{
-    double s[3] = {0, 0, 0}, s2[3] = {0, 0, 0};
-    for (int i = 0; i < n; i++) {
-        rt_rng rng = rt_rng_for_sample(1234, (uint64_t)i, 0);
-        rt_ray r = rt_ray_make(org, rt_normalize(dir), 0.0f, INFINITY);
-        rt_vec3 L = rt_radiance_volpath(&f->ctx, &r, &rng);
-        assert_true(rt_finite3(L) && L.x >= 0.0f && L.y >= 0.0f && L.z >= 0.0f);
-        const double v[3] = {L.x, L.y, L.z};
-        for (int k = 0; k < 3; k++) {
-            s[k] += v[k];
-            s2[k] += v[k] * v[k];
-        }
-    }
-    double m[3], e[3];
-    for (int k = 0; k < 3; k++) {
-        m[k] = s[k] / n;
-        double var = s2[k] / n - m[k] * m[k];
-        e[k] = sqrt(var > 0 ? var / n : 0);
-    }
-    return (estimate){rt_v3((float)m[0], (float)m[1], (float)m[2]), rt_v3((float)e[0], (float)e[1], (float)e[2])};
-}
-
-static void expect_near(const char *what, estimate e, rt_vec3 want)
-{
-    const float got[3] = {e.mean.x, e.mean.y, e.mean.z}, se[3] = {e.se.x, e.se.y, e.se.z};
-    const float w[3] = {want.x, want.y, want.z};
-    for (int k = 0; k < 3; k++) {
-        float tol = 4.0f * se[k] + 0.002f * w[k] + 1e-5f;
-        if (!(fabsf(got[k] - w[k]) <= tol))
-            fail_msg("%s, channel %d: %.5f, expected %.5f (+- %.5f)", what, k, got[k], w[k], tol);
-    }
-    print_message("%s: %.4f %.4f %.4f (expected %.4f %.4f %.4f, se %.4f %.4f %.4f)\n", what, e.mean.x, e.mean.y,
-                  e.mean.z, want.x, want.y, want.z, e.se.x, e.se.y, e.se.z);
-}
+#include "test_volpath_estimate.h"
 
 /* Two faces of a slab z in [-0.5, 0.5], wide as the world here: the front
  * (+z) faces the camera, the back faces away (cross(U, V) outwards). */
@@ -90,11 +50,11 @@ static void test_beer_lambert_slab(void **state)
                       "medium ink homogeneous sigma_a 0.25 1 2.5 sigma_s 0 0 0\n"
                       "material box bsdf null interior ink\n" SLAB_FACES,
                       RT_PREPARE_LIGHT_TABLE);
-    estimate e = estimate_ray(&f, rt_v3(0.1f, 0.2f, 5.0f), rt_v3(0, 0, -1), 30000);
-    expect_near("slab transmittance", e, rt_v3(expf(-0.25f), expf(-1.0f), expf(-2.5f)));
+    test_estimate e = test_estimate_ray(&f, rt_v3(0.1f, 0.2f, 5.0f), rt_v3(0, 0, -1), 30000, 1234);
+    test_expect_near("slab transmittance", e, rt_v3(expf(-0.25f), expf(-1.0f), expf(-2.5f)));
     /* at 60 degrees the path in the slab is twice as long */
-    e = estimate_ray(&f, rt_v3(0, 0, 5.0f), rt_v3(sqrtf(3.0f), 0, -1), 30000);
-    expect_near("slab transmittance at 60 degrees", e, rt_v3(expf(-0.5f), expf(-2.0f), expf(-5.0f)));
+    e = test_estimate_ray(&f, rt_v3(0, 0, 5.0f), rt_v3(sqrtf(3.0f), 0, -1), 30000, 1234);
+    test_expect_near("slab transmittance at 60 degrees", e, rt_v3(expf(-0.5f), expf(-2.0f), expf(-5.0f)));
     test_fixture_free(&f);
 }
 
@@ -116,8 +76,8 @@ static void test_single_scattering_slab(void **state)
     float want[3];
     for (int k = 0; k < 3; k++)
         want[k] = s_s[k] * p * E * (1.0f - expf(-2.0f * st[k])) / (2.0f * st[k]);
-    estimate e = estimate_ray(&f, rt_v3(0.1f, -0.3f, 4.0f), rt_v3(0, 0, -1), 40000);
-    expect_near("single scattering", e, rt_v3(want[0], want[1], want[2]));
+    test_estimate e = test_estimate_ray(&f, rt_v3(0.1f, -0.3f, 4.0f), rt_v3(0, 0, -1), 40000, 1234);
+    test_expect_near("single scattering", e, rt_v3(want[0], want[1], want[2]));
     test_fixture_free(&f);
 }
 
@@ -131,10 +91,10 @@ static void test_white_furnace(void **state)
                       "material box bsdf null interior cloud\n"
                       "sphere 0 0 0 1 box\n",
                       RT_PREPARE_LIGHT_TABLE);
-    estimate e = estimate_ray(&f, rt_v3(0, 0, 4), rt_v3(0, 0, -1), 20000);
-    expect_near("furnace, through the centre", e, rt_v3s(1.0f));
-    e = estimate_ray(&f, rt_v3(0.7f, 0.2f, 4), rt_v3(0, 0, -1), 20000);
-    expect_near("furnace, off centre", e, rt_v3s(1.0f));
+    test_estimate e = test_estimate_ray(&f, rt_v3(0, 0, 4), rt_v3(0, 0, -1), 20000, 1234);
+    test_expect_near("furnace, through the centre", e, rt_v3s(1.0f));
+    e = test_estimate_ray(&f, rt_v3(0.7f, 0.2f, 4), rt_v3(0, 0, -1), 20000, 1234);
+    test_expect_near("furnace, off centre", e, rt_v3s(1.0f));
     test_fixture_free(&f);
 }
 
@@ -174,11 +134,11 @@ static void test_constant_grid_is_homogeneous(void **state)
     test_fixture_build(&grid, RT_PREPARE_LIGHT_TABLE);
     const rt_vec3 org[2] = {rt_v3(0, 0, 4), rt_v3(0.3f, 0.4f, 4)};
     for (int k = 0; k < 2; k++) {
-        estimate a = estimate_ray(&hom, org[k], rt_v3(0, 0, -1), 30000);
-        estimate b = estimate_ray(&grid, org[k], rt_v3(0, 0, -1), 30000);
+        test_estimate a = test_estimate_ray(&hom, org[k], rt_v3(0, 0, -1), 30000, 1234);
+        test_estimate b = test_estimate_ray(&grid, org[k], rt_v3(0, 0, -1), 30000, 1234);
         /* two estimates: their difference's standard error */
         rt_vec3 se = rt_v3(hypotf(a.se.x, b.se.x), hypotf(a.se.y, b.se.y), hypotf(a.se.z, b.se.z));
-        expect_near("grid of constant density against homogeneous", (estimate){b.mean, se}, a.mean);
+        test_expect_near("grid of constant density against homogeneous", (test_estimate){b.mean, se}, a.mean);
         assert_true(rt_fminf(a.mean.x, rt_fminf(a.mean.y, a.mean.z)) > 0.02f); /* light did arrive */
     }
     test_fixture_free(&hom);
@@ -195,7 +155,7 @@ static void test_constant_grid_is_homogeneous(void **state)
  * cross the box's null top face on their way; sent on along their first
  * direction from the face's offset, they met the light's own plane past
  * the sampled point and counted as blocked (a third of the light). */
-static estimate single_scattering_under(const char *light, double *expected)
+static test_estimate single_scattering_under(const char *light, double *expected)
 {
     char text[2048];
     snprintf(text, sizeof text,
@@ -234,7 +194,7 @@ static estimate single_scattering_under(const char *light, double *expected)
             }
         want += exp(-st * (t - t0)) * ss * ls * (t1 - t0) / NT;
     }
-    estimate e = estimate_ray(&f, o, d, 100000);
+    test_estimate e = test_estimate_ray(&f, o, d, 100000, 1234);
     test_fixture_free(&f);
     *expected = want;
     return e;
@@ -244,8 +204,8 @@ static void test_single_scattering_area_light(void **state)
 {
     (void)state;
     double want;
-    estimate e = single_scattering_under("light area 343 548.7 227  0 0 105  -130 0 0  1 1 1  1\n", &want);
-    expect_near("single scattering under an area light", e, rt_v3s((float)want));
+    test_estimate e = single_scattering_under("light area 343 548.7 227  0 0 105  -130 0 0  1 1 1  1\n", &want);
+    test_expect_near("single scattering under an area light", e, rt_v3s((float)want));
 }
 
 /* The same light as two emissive triangles: found by light sampling (NEE
@@ -257,12 +217,12 @@ static void test_single_scattering_emissive_triangles(void **state)
 {
     (void)state;
     double want, want_area;
-    estimate area = single_scattering_under("light area 343 548.7 227  0 0 105  -130 0 0  1 1 1  1\n", &want_area);
-    estimate e = single_scattering_under("material lamp color 0 0 0 emission 1 1 1 double_sided false\n"
+    test_estimate area = single_scattering_under("light area 343 548.7 227  0 0 105  -130 0 0  1 1 1  1\n", &want_area);
+    test_estimate e = single_scattering_under("material lamp color 0 0 0 emission 1 1 1 double_sided false\n"
                                          "triangle 343 548.7 227  343 548.7 332  213 548.7 332  lamp\n"
                                          "triangle 343 548.7 227  213 548.7 332  213 548.7 227  lamp\n",
                                          &want);
-    expect_near("single scattering under emissive triangles", e, rt_v3s((float)want));
+    test_expect_near("single scattering under emissive triangles", e, rt_v3s((float)want));
     print_message("standard error: emissive triangles %.6f, area light %.6f\n", e.se.x, area.se.x);
     assert_true(e.se.x < 2.0f * area.se.x);
 }
@@ -282,11 +242,11 @@ static void test_camera_inside_medium(void **state)
                       "sphere 0 0 0 1 box\n"
                       "sphere 5 0 0 1 box\n", /* another one, off to the side: outside it, no change */
                       RT_PREPARE_LIGHT_TABLE);
-    estimate e = estimate_ray(&f, rt_v3(0, 0, 0), rt_v3(0.3f, 0.4f, -1), 4000);
-    expect_near("camera inside a medium", e, rt_v3(expf(-0.5f), expf(-1.0f), expf(-2.0f)));
+    test_estimate e = test_estimate_ray(&f, rt_v3(0, 0, 0), rt_v3(0.3f, 0.4f, -1), 4000, 1234);
+    test_expect_near("camera inside a medium", e, rt_v3(expf(-0.5f), expf(-1.0f), expf(-2.0f)));
     /* looking through the other sphere: its diameter on top */
-    e = estimate_ray(&f, rt_v3(0, 0, 0), rt_v3(1, 0, 0), 4000);
-    expect_near("camera inside a medium, through another", e, rt_v3(expf(-1.5f), expf(-3.0f), expf(-6.0f)));
+    e = test_estimate_ray(&f, rt_v3(0, 0, 0), rt_v3(1, 0, 0), 4000, 1234);
+    test_expect_near("camera inside a medium, through another", e, rt_v3(expf(-1.5f), expf(-3.0f), expf(-6.0f)));
     test_fixture_free(&f);
 }
 
