@@ -1607,7 +1607,8 @@ static rt_result st_model(parser *p, const tok *kw)
     xform x = {0};
     model_pose pose = {0};
     rt_gltf_options opt = {0};
-    opt.flatten_instances = p->in_object; /* an object holds triangles; instances do not nest */
+    opt.flatten_instances = p->in_object || p->pose.flatten_instances; /* an object holds triangles; instances
+                                                                          * do not nest */
     const tok *scene_tok = NULL;
     while (peek(p)) {
         bool taken = false;
