@@ -2,7 +2,8 @@
  * (issue 27): animated and motion-blurred instances, which node animation
  * moves by their transforms while the objects' kd-trees are built once
  * and kept (rt_kdtree_kept, rt/accel/kdtree.h), for --frames and for the
- * slices of an open shutter.
+ * slices of an open shutter; and scene-file `model` lines that load one
+ * file twice, which place the first load again as instances.
  *
  * The glTF file is written here: one small mesh (a UV sphere) used by four
  * nodes, two of them under an animated parent (rotation about y), one
@@ -13,7 +14,8 @@
  * with one object tree built over all the times. The rt command's
  * --frames and a scene with an open shutter over the model say the same
  * in their -v lines, and render the flattened load's images within float
- * rounding.
+ * rounding. The model lines' file is the same mesh and ground without the
+ * animation, each used once.
  */
 #include "test_util.h"
 #include "test_fixture.h"
@@ -143,6 +145,35 @@ static void write_animated(void)
 #undef J
     assert_true(j < sizeof js);
     test_write_file(tmp_path("anim.gltf"), js, j);
+}
+
+/* single.gltf (over anim.bin): the mesh once, turned, and the ground;
+ * lamp.gltf: the same with an emissive mesh. */
+static void write_single(void)
+{
+    write_animated();
+    for (int lamp = 0; lamp < 2; lamp++) {
+        char js[4096];
+        size_t j = 0;
+        size_t whole_len = 0;
+        char *whole = test_slurp(tmp_path("anim.gltf"), &whole_len);
+        char *cut = strstr(whole, "\"materials\"");
+        assert_non_null(cut);
+        *cut = 0; /* asset, buffers, views and accessors as they are */
+        j = (size_t)snprintf(js, sizeof js, "%s", whole);
+        free(whole);
+        j += (size_t)snprintf(
+            js + j, sizeof js - j,
+            "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.3,0.7,0.3,1],\"metallicFactor\":0}%s},"
+            "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.6,0.5,0.4,1],\"metallicFactor\":0}}],"
+            "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2,\"material\":0}]},"
+            "{\"primitives\":[{\"attributes\":{\"POSITION\":3,\"NORMAL\":4},\"indices\":5,\"material\":1}]}],"
+            "\"nodes\":[{\"mesh\":0,\"rotation\":[0.25881905,0,0,0.96592583]},{\"mesh\":1,\"scale\":[0.2,1,0.2]}],"
+            "\"scenes\":[{\"nodes\":[0,1]}]}",
+            lamp ? ",\"emissiveFactor\":[1,0.8,0.6]" : "");
+        assert_true(j < sizeof js);
+        test_write_file(tmp_path(lamp ? "lamp.gltf" : "single.gltf"), js, j);
+    }
 }
 
 static void load_at(rt_scene *s, float time, bool flatten)
@@ -295,6 +326,215 @@ static void test_kept_only_when_same(void **state)
     rt_scene_free(&sb);
 }
 
+/* --------------------------------------------------- model lines again */
+
+/* Parses scene text whose paths resolve in the scratch directory. */
+static void parse(rt_scene *s, const char *text, bool flatten)
+{
+    rt_scene_init(s);
+    rt_scene_parse_options opt = {0};
+    opt.flatten_instances = flatten;
+    rt_error err = {0};
+    if (rt_scene_parse_string_with(s, NULL, text, strlen(text), "models.txt", tmp_dir, &opt, &err) != RT_OK)
+        fail_msg("%s", err.message);
+    assert_int_equal(rt_scene_validate(s, &err), RT_OK);
+}
+
+/* Renders of two scenes agree within float rounding: 99% of the values
+ * within 1e-3 relative, the means within 1e-4. */
+static void assert_framebuffers_close(const rt_framebuffer *a, const rt_framebuffer *b)
+{
+    assert_int_equal(a->width, b->width);
+    assert_int_equal(a->height, b->height);
+    size_t n = (size_t)a->width * (size_t)a->height * 3, close = 0;
+    double sa = 0.0, sb = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        sa += a->rgb[i];
+        sb += b->rgb[i];
+        if (fabsf(a->rgb[i] - b->rgb[i]) <= 1e-3f * fmaxf(1.0f, fabsf(b->rgb[i])))
+            close++;
+    }
+    print_message("%zu of %zu values within 1e-3, means %.6f and %.6f\n", close, n, sa / (double)n, sb / (double)n);
+    assert_true(sa > 0.0);
+    assert_true(close >= n * 99 / 100);
+    assert_true(fabs(sa - sb) <= 1e-4 * fabs(sb));
+}
+
+/* Three lines of one file and pose: one load, an object and three
+ * instances (the first line's own transform included); a fourth line
+ * with another pose option is loaded again; --flatten loads every line.
+ * Hits and images are the flattened scene's within rounding. */
+static void test_model_lines_share_a_load(void **state)
+{
+    (void)state;
+    write_single();
+    const char *text = "camera position 0 7 9 look_at 0 0.3 0 fov 45\n"
+                       "light directional -0.3 -1 -0.4  1 1 1  3\nbackground 0.3 0.35 0.4\n"
+                       "model single.gltf translate 0 0 -2 rotate 0 10 0\n"
+                       "model single.gltf translate 3 0 0 rotate 0 30 0 scale 1.2\n"
+                       "model single.gltf translate -3 0 1 scale -1 1 1\n"
+                       "model single.gltf translate 0 0 2.5 time 0\n";
+    rt_scene si, sf;
+    parse(&si, text, false);
+    parse(&sf, text, true);
+    assert_int_equal(si.object_count, 1);
+    assert_int_equal(si.instance_count, 3);
+    assert_int_equal(si.triangles.count, 2 * (NT + 2)); /* the shared load, and the line with `time` */
+    assert_int_equal(rt_scene_instanced_triangles(&si), 3 * (NT + 2));
+    assert_true(si.instances[2].mirror);
+    assert_int_equal(sf.object_count, 0);
+    assert_int_equal(sf.instance_count, 0);
+    assert_int_equal(sf.triangles.count, 4 * (NT + 2));
+    rt_kdtree ti, tf;
+    rt_error err = {0};
+    assert_int_equal(rt_kdtree_build(&ti, &si, NULL, &err), RT_OK);
+    assert_int_equal(rt_kdtree_build(&tf, &sf, NULL, &err), RT_OK);
+    test_rng g = {4242};
+    rt_box b = rt_scene_bounds(&sf);
+    int hits = 0, agree = 0;
+    enum { N = 3000 };
+    for (int k = 0; k < N; k++) {
+        rt_ray r = box_ray(&g, b);
+        rt_hit hi, hf;
+        bool fi = rt_kdtree_intersect(&ti, &r, &hi), ff = rt_kdtree_intersect(&tf, &r, &hf);
+        hits += fi;
+        if (fi == ff && (!fi || fabsf(hi.t - hf.t) <= 1e-4f * hf.t))
+            agree++;
+    }
+    print_message("model lines: %d of %d rays hit; %d agree with the flattened scene\n", hits, N, agree);
+    assert_true(hits > N / 6);
+    assert_true(agree >= N * 995 / 1000);
+    rt_kdtree_free(&ti);
+    rt_kdtree_free(&tf);
+    rt_settings set;
+    rt_settings_default(&set);
+    set.width = 64;
+    set.height = 48;
+    set.samples = 4;
+    set.integrator = RT_INTEGRATOR_PATH;
+    rt_framebuffer fi, ff;
+    test_render_scene(&si, &set, 2, 0, &fi);
+    test_render_scene(&sf, &set, 2, 0, &ff);
+    assert_framebuffers_close(&fi, &ff);
+    rt_framebuffer_free(&fi);
+    rt_framebuffer_free(&ff);
+    rt_scene_free(&si);
+    rt_scene_free(&sf);
+}
+
+/* The first load becomes an object only at the second line, after an
+ * `object` block made an object over later vertices: it goes before that
+ * one (objects stay in vertex order) and `instance` still places the
+ * block's object. A model that emits light is loaded at every line (its
+ * triangles stay world geometry, for the light table). */
+static void test_model_lines_order_and_lamps(void **state)
+{
+    (void)state;
+    write_single();
+    const char *text = "material g color 0.5 0.5 0.5\n"
+                       "model single.gltf\n"
+                       "object blk\n triangle 0 0 0  1 0 0  0 1 0 g\nend\n"
+                       "model single.gltf translate 4 0 0\n"
+                       "instance blk translate 0 2 0\n"
+                       "model lamp.gltf\nmodel lamp.gltf translate 0 0 4\n";
+    rt_scene s;
+    parse(&s, text, false);
+    assert_int_equal(s.object_count, 2);
+    assert_int_equal(s.instance_count, 3);
+    assert_true(s.objects[0].first_vertex < s.objects[1].first_vertex);
+    assert_int_equal(s.objects[0].triangle_count, NT + 2); /* the model's, before the block's */
+    assert_int_equal(s.objects[1].triangle_count, 1);
+    size_t placed[2] = {0, 0};
+    for (size_t i = 0; i < s.instance_count; i++)
+        placed[s.instances[i].object]++;
+    assert_int_equal(placed[0], 2);
+    assert_int_equal(placed[1], 1); /* the block's, renumbered */
+    /* the lamp twice, world geometry both times */
+    assert_int_equal(s.triangles.count, (NT + 2) + 1 + 2 * (NT + 2));
+    rt_scene_frame_camera(&s, 1.0f);
+    rt_scene_free(&s);
+}
+
+/* ---------------------------------------------------------- the limits */
+
+/* NAME.glb: a grid of w x h quads (2 w h triangles) placed n times by
+ * EXT_mesh_gpu_instancing (TRANSLATION only, a row of copies). */
+static void write_grid_field(const char *name, int w, int h, size_t n)
+{
+    size_t nv = (size_t)(w + 1) * (size_t)(h + 1), nt = 2 * (size_t)w * (size_t)h;
+    size_t bytes = 12 * nv + 12 * nt + 12 * n;
+    unsigned char *bin = malloc(bytes);
+    assert_non_null(bin);
+    float *pos = (float *)bin;
+    uint32_t *idx = (uint32_t *)(bin + 12 * nv);
+    float *tr = (float *)(bin + 12 * nv + 12 * nt);
+    for (int y = 0, v = 0; y <= h; y++)
+        for (int x = 0; x <= w; x++, v++)
+            pos[3 * v] = (float)x / (float)w, pos[3 * v + 1] = 0.0f, pos[3 * v + 2] = (float)y / (float)h;
+    for (int y = 0, k = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            uint32_t a = (uint32_t)(y * (w + 1) + x), b = a + (uint32_t)w + 1;
+            idx[k++] = a, idx[k++] = b, idx[k++] = a + 1;
+            idx[k++] = a + 1, idx[k++] = b, idx[k++] = b + 1;
+        }
+    for (size_t i = 0; i < n; i++)
+        tr[3 * i] = 1.5f * (float)(i % 1000), tr[3 * i + 1] = 0.0f, tr[3 * i + 2] = 1.5f * (float)(i / 1000);
+    char js[2048];
+    int j = snprintf(js, sizeof js,
+                     "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\"],"
+                     "\"buffers\":[{\"byteLength\":%zu}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":%zu},"
+                     "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu},{\"buffer\":0,\"byteOffset\":%zu,"
+                     "\"byteLength\":%zu}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%zu,"
+                     "\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,0,1]},{\"bufferView\":1,\"componentType\":5125,"
+                     "\"count\":%zu,\"type\":\"SCALAR\"},{\"bufferView\":2,\"componentType\":5126,\"count\":%zu,"
+                     "\"type\":\"VEC3\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},"
+                     "\"indices\":1}]}],\"nodes\":[{\"mesh\":0,\"extensions\":{\"EXT_mesh_gpu_instancing\":"
+                     "{\"attributes\":{\"TRANSLATION\":2}}}}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0}",
+                     bytes, 12 * nv, 12 * nv, 12 * nt, 12 * nv + 12 * nt, 12 * n, nv, 3 * nt, n);
+    assert_true(j > 0 && (size_t)j < sizeof js - 4);
+    while (j % 4)
+        js[j++] = ' ';
+    uint32_t hdr[5] = {0x46546C67u, 2u, (uint32_t)(12 + 8 + (size_t)j + 8 + bytes), (uint32_t)j, 0x4E4F534Au};
+    uint32_t bh[2] = {(uint32_t)bytes, 0x004E4942u};
+    FILE *fp = fopen(tmp_path(name), "wb");
+    assert_non_null(fp);
+    assert_int_equal(fwrite(hdr, 4, 5, fp), 5);
+    assert_int_equal(fwrite(js, 1, (size_t)j, fp), (size_t)j);
+    assert_int_equal(fwrite(bh, 4, 2, fp), 2);
+    assert_int_equal(fwrite(bin, 1, bytes, fp), bytes);
+    fclose(fp);
+    free(bin);
+}
+
+/* The loader's 2^25 limit counts unique triangles: 10,000 instances of a
+ * 3,400-triangle mesh (34 M placed, over 2^25) load, and the same file
+ * flattened is refused before anything is allocated. */
+static void test_limit_counts_unique_triangles(void **state)
+{
+    (void)state;
+    write_grid_field("big.glb", 34, 50, 10000);
+    rt_scene s;
+    rt_scene_init(&s);
+    rt_gltf_options opt = {0};
+    rt_gltf_stats st;
+    rt_error err = {0};
+    if (rt_gltf_load(&s, tmp_path("big.glb"), &opt, &st, &err) != RT_OK)
+        fail_msg("big.glb: %s", err.message);
+    assert_int_equal(s.triangles.count, 3400);
+    assert_int_equal(s.instance_count, 10000);
+    assert_int_equal(rt_scene_instanced_triangles(&s), (size_t)34000000);
+    assert_true(rt_scene_instanced_triangles(&s) > ((size_t)1 << 25));
+    rt_scene_free(&s);
+    rt_scene_init(&s);
+    opt.flatten_instances = true;
+    assert_int_equal(rt_gltf_load(&s, tmp_path("big.glb"), &opt, &st, &err), RT_ERR_LIMIT);
+    assert_non_null(strstr(err.message, "big.glb"));
+    assert_non_null(strstr(err.message, "over the loader's limit"));
+    assert_non_null(strstr(err.message, "flattened copies"));
+    assert_int_equal(s.triangles.count, 0);
+    rt_scene_free(&s);
+}
+
 /* ------------------------------------------------------- the rt command */
 
 static const char *rt_bin(void)
@@ -332,6 +572,50 @@ static void require_rt(void)
         fprintf(stderr, "skip: %s is not built (make rt, or set RT_BIN)\n", rt_bin());
         skip();
     }
+}
+
+/* rt --info says the unique triangles, the instances and the triangles
+ * they place. */
+static void test_cli_info_counts(void **state)
+{
+    (void)state;
+    require_rt();
+    write_grid_field("info.glb", 34, 50, 10000);
+    char log[600], out[600];
+    snprintf(log, sizeof log, "%s/info.log", tmp_dir);
+    snprintf(out, sizeof out, "%s/info.txt", tmp_dir);
+    const char *args[] = {rt_bin(), "--info", tmp_path("info.glb"), NULL};
+    assert_int_equal(run_rt_out(args, log, out), 0);
+    size_t len = 0;
+    char *text = test_slurp(out, &len);
+    assert_non_null(strstr(text, "\ntriangles: 3400\n"));
+    assert_non_null(strstr(text, "\ninstances: 10000\n"));
+    assert_non_null(strstr(text, "\ninstanced_triangles: 34000000\n"));
+    free(text);
+}
+
+/* More instances than --max-memory holds: the load stops before adding
+ * any, naming the count and the bytes; exit status 2. */
+static void test_cli_instances_over_budget(void **state)
+{
+    (void)state;
+    require_rt();
+    test_skip_in_sanitizer_build("rt does not enforce --max-memory there (memory_budget.c)");
+    enum { N = 1200000 };
+    write_grid_field("huge.glb", 1, 1, N);
+    char log[600], want[200];
+    snprintf(log, sizeof log, "%s/huge.log", tmp_dir);
+    const char *args[] = {rt_bin(), tmp_path("huge.glb"), "--max-memory", "256M", "-r", "32x32", "-s", "1",
+                          "-o", tmp_path("huge.png"), NULL};
+    assert_int_equal(run_rt(args, log), 2);
+    size_t len = 0;
+    char *text = test_slurp(log, &len);
+    snprintf(want, sizeof want, "out of memory for %d instances (%zu bytes each, %zu bytes)", N, RT_INSTANCE_BYTES,
+             (size_t)N * RT_INSTANCE_BYTES);
+    if (!strstr(text, want) || !strstr(text, "huge.glb") || !strstr(text, "--max-memory"))
+        fail_msg("wanted '%s' naming the file and the budget, got: %s", want, text);
+    free(text);
+    assert_int_equal(access(tmp_path("huge.png"), F_OK), -1);
 }
 
 static size_t count_of(const char *text, const char *what)
@@ -455,6 +739,11 @@ int main(void)
         cmocka_unit_test(test_kept_only_when_same),
         cmocka_unit_test(test_cli_frames),
         cmocka_unit_test(test_cli_motion_slices),
+        cmocka_unit_test(test_model_lines_share_a_load),
+        cmocka_unit_test(test_model_lines_order_and_lamps),
+        cmocka_unit_test(test_limit_counts_unique_triangles),
+        cmocka_unit_test(test_cli_info_counts),
+        cmocka_unit_test(test_cli_instances_over_budget),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
