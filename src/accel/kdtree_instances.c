@@ -202,36 +202,12 @@ static void object_view(rt_scene *v, const rt_scene *scene, const rt_object *ob)
     v->instance_count = v->instance_cap = 0;
 }
 
-rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
+/* The objects whose trees the kept set has: taken into the tree
+ * (taken[o]), the set's counts updated. */
+static void take_kept(rt_kdtree *tree, rt_kdtree_kept *kept, const rt_kdtree_params *shape, bool *taken)
 {
-    size_t n = scene->object_count;
-    tree->objects = rt_alloc(n, sizeof *tree->objects);
-    tree->object_views = rt_alloc(n, sizeof *tree->object_views);
-    rt_result *results = rt_alloc(n, sizeof *results);
-    rt_error *errors = rt_alloc(n, sizeof *errors);
-    if (!tree->objects || !tree->object_views || !results || !errors) {
-        free(results);
-        free(errors);
-        rt_kd_free_objects(tree);
-        return rt_fail(err, RT_ERR_NOMEM, "kdtree: out of memory for the trees of %zu instanced objects", n);
-    }
-    memset(tree->objects, 0, n * sizeof *tree->objects);
-    for (size_t o = 0; o < n; o++) {
-        object_view(&tree->object_views[o], scene, &scene->objects[o]);
-        results[o] = RT_OK;
-    }
-    tree->object_count = n; /* every tree zeroed or built: rt_kd_free_objects frees either */
-    rt_kdtree_kept *kept = params ? params->kept : NULL;
-    rt_kdtree_params shape = shaping(params);
-    bool *taken = rt_alloc(n, sizeof *taken);
-    if (!taken) {
-        free(results);
-        free(errors);
-        rt_kd_free_objects(tree);
-        return rt_fail(err, RT_ERR_NOMEM, "kdtree: out of memory for the trees of %zu instanced objects", n);
-    }
-    for (size_t o = 0; o < n; o++) {
-        rt_kd_kept_tree *k = kept ? find_kept(kept, &tree->object_views[o], &shape, o) : NULL;
+    for (size_t o = 0; o < tree->object_count; o++) {
+        rt_kd_kept_tree *k = kept ? find_kept(kept, &tree->object_views[o], shape, o) : NULL;
         taken[o] = k != NULL;
         if (k) {
             tree->objects[o] = k->tree;
@@ -240,6 +216,14 @@ rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_k
             kept->taken++;
         }
     }
+}
+
+/* The trees not taken: the small ones side by side, one a thread, then
+ * the large ones one after another on all threads; per object results. */
+static void build_missing(rt_kdtree *tree, const rt_kdtree_params *params, const bool *taken, rt_result *results,
+                          rt_error *errors)
+{
+    size_t n = tree->object_count;
     int threads = params && params->threads > 0 ? params->threads : rt_cpu_count();
     if (threads < 1)
         threads = 1;
@@ -262,6 +246,33 @@ rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_k
     for (size_t o = 0; o < n; o++) /* the large ones, each forking on all threads */
         if (!taken[o] && tree->object_views[o].triangles.count >= KD_OBJECT_ALONE)
             results[o] = rt_kdtree_build(&tree->objects[o], &tree->object_views[o], &all, &errors[o]);
+}
+
+rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
+{
+    size_t n = scene->object_count;
+    tree->objects = rt_alloc(n, sizeof *tree->objects);
+    tree->object_views = rt_alloc(n, sizeof *tree->object_views);
+    rt_result *results = rt_alloc(n, sizeof *results);
+    rt_error *errors = rt_alloc(n, sizeof *errors);
+    bool *taken = rt_alloc(n, sizeof *taken);
+    if (!tree->objects || !tree->object_views || !results || !errors || !taken) {
+        free(results);
+        free(errors);
+        free(taken);
+        rt_kd_free_objects(tree);
+        return rt_fail(err, RT_ERR_NOMEM, "kdtree: out of memory for the trees of %zu instanced objects", n);
+    }
+    memset(tree->objects, 0, n * sizeof *tree->objects);
+    for (size_t o = 0; o < n; o++) {
+        object_view(&tree->object_views[o], scene, &scene->objects[o]);
+        results[o] = RT_OK;
+    }
+    tree->object_count = n; /* every tree zeroed or built: rt_kd_free_objects frees either */
+    rt_kdtree_kept *kept = params ? params->kept : NULL;
+    rt_kdtree_params shape = shaping(params);
+    take_kept(tree, kept, &shape, taken);
+    build_missing(tree, params, taken, results, errors);
     rt_result r = RT_OK;
     for (size_t o = 0; o < n && r == RT_OK; o++)
         if (results[o] != RT_OK) {
@@ -283,10 +294,8 @@ rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_k
         for (size_t o = 0; o < n; o++)
             if (!taken[o])
                 rt_kdtree_free(&tree->objects[o]);
-        tree->objects_kept = true;
-    } else {
-        tree->objects_kept = kept != NULL;
     }
+    tree->objects_kept = r != RT_OK || kept != NULL;
     free(taken);
     if (r != RT_OK)
         rt_kd_free_objects(tree);
