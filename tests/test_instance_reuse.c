@@ -616,6 +616,23 @@ static void test_cli_instances_over_budget(void **state)
         fail_msg("wanted '%s' naming the file and the budget, got: %s", want, text);
     free(text);
     assert_int_equal(access(tmp_path("huge.png"), F_OK), -1);
+
+    /* the scene format's instance lines: the line, the count and the bytes */
+    FILE *fp = fopen(tmp_path("lines.txt"), "w");
+    assert_non_null(fp);
+    fprintf(fp, "material g color 0.5 0.5 0.5\nobject o\n triangle 0 0 0  1 0 0  0 1 0 g\nend\n");
+    for (int i = 0; i < 600000; i++)
+        fprintf(fp, "instance o translate %d 0 0\n", i % 1000);
+    fclose(fp);
+    const char *largs[] = {rt_bin(), tmp_path("lines.txt"), "--max-memory", "64M", "-r", "32x32", "-s", "1",
+                           "-o", tmp_path("lines.png"), NULL};
+    assert_int_equal(run_rt(largs, log), 2);
+    text = test_slurp(log, &len);
+    if (!strstr(text, "lines.txt:") || !strstr(text, "out of memory for more than ") || !strstr(text, " instances (") ||
+        !strstr(text, "bytes each"))
+        fail_msg("wanted the line, the count and the bytes, got: %s", text);
+    print_message("%s", text);
+    free(text);
 }
 
 static size_t count_of(const char *text, const char *what)

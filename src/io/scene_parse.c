@@ -221,6 +221,16 @@ static rt_result nomem(parser *p, const tok *t)
     return perr(p, RT_ERR_NOMEM, t, "out of memory");
 }
 
+/* Out of memory placing one more instance (the table grows by doubling):
+ * the count placed and the bytes they take (rt/scene/instance.h), for
+ * --max-memory's user. */
+static rt_result instance_nomem(parser *p, const tok *t)
+{
+    size_t n = p->s->instance_count;
+    return perr(p, RT_ERR_NOMEM, t, "out of memory for more than %zu instances (%zu bytes each, %zu bytes)", n,
+                (size_t)RT_INSTANCE_BYTES, n * (size_t)RT_INSTANCE_BYTES);
+}
+
 /* ------------------------------------------------------------ cursor */
 
 static const tok *peek(const parser *p)
@@ -1542,7 +1552,7 @@ static rt_result st_instance(parser *p, const tok *kw)
     if (c != RT_INSTANCE_OK)
         return perr(p, RT_ERR_INVALID, kw, "the instance's transform is %s", rt_instance_check_name(c));
     if (rt_scene_add_instance(p->s, e->index, &m) == RT_NONE)
-        return nomem(p, kw);
+        return instance_nomem(p, kw);
     return RT_OK;
 }
 
@@ -1709,7 +1719,7 @@ static rt_result place_model_again(parser *p, const tok *kw, model_load *m, cons
         m->object = id;
         rt_mat4 same = rt_mat4_identity();
         if (rt_scene_add_instance(s, id, &same) == RT_NONE)
-            return nomem(p, kw);
+            return instance_nomem(p, kw);
     }
     rt_mat4 rel = rt_mat4_mul(*to_world, rt_instance_inverse(&m->placed));
     rt_instance_check c = rt_instance_check_transform(&rel);
@@ -1717,7 +1727,7 @@ static rt_result place_model_again(parser *p, const tok *kw, model_load *m, cons
         return perr(p, RT_ERR_INVALID, kw, "the model's transform relative to line %d's is %s", m->line,
                     rt_instance_check_name(c));
     if (rt_scene_add_instance(s, m->object, &rel) == RT_NONE)
-        return nomem(p, kw);
+        return instance_nomem(p, kw);
     return RT_OK;
 }
 
