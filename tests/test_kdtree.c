@@ -429,9 +429,12 @@ static void test_params(void **state)
     test_rng r = {77};
     random_soup(&s, &r, 1000, 0.05f);
     rt_kdtree_params p[3] = {
-        {1.0f, 80.0f, 0.5f, 0, 0, TEST_PORTABLE}, /* pbrt's costs: deep trees */
-        {1.0f, 1.0f, 0.0f, 0, 0, TEST_PORTABLE},
-        {10.0f, 1.0f, 0.0f, 3, 0, TEST_PORTABLE}, /* shallow */
+        {.traversal_cost = 1.0f, .intersect_cost = 80.0f, .empty_bonus = 0.5f,
+         .max_depth = 0, .threads = 0, .portable = TEST_PORTABLE}, /* pbrt's costs: deep trees */
+        {.traversal_cost = 1.0f, .intersect_cost = 1.0f, .empty_bonus = 0.0f,
+         .max_depth = 0, .threads = 0, .portable = TEST_PORTABLE},
+        {.traversal_cost = 10.0f, .intersect_cost = 1.0f, .empty_bonus = 0.0f,
+         .max_depth = 3, .threads = 0, .portable = TEST_PORTABLE}, /* shallow */
     };
     for (int i = 0; i < 3; i++) {
         rt_kdtree tree;
@@ -463,7 +466,8 @@ static void test_deepest_tree(void **state)
             rt_vec3 c = rt_v3(axis == 0 ? d : 0.1f * d, axis == 1 ? d : 0.1f * d, axis == 2 ? d : 0.1f * d);
             add_tri(&s, c, rt_add(c, rt_v3(e, 0, 0)), rt_add(c, rt_v3(0, e, e)));
         }
-    rt_kdtree_params p = {1.0f, 80.0f, 0.5f, 60, 1, TEST_PORTABLE};
+    rt_kdtree_params p = {.traversal_cost = 1.0f, .intersect_cost = 80.0f, .empty_bonus = 0.5f,
+         .max_depth = 60, .threads = 1, .portable = TEST_PORTABLE};
     rt_kdtree tree;
     rt_error err = {0};
     assert_int_equal(rt_kdtree_build(&tree, &s, &p, &err), RT_OK);

@@ -3,7 +3,7 @@
 
     python3 tools/gen-instanced-gltf.py OUT.glb [--instances N] [--triangles T]
         [--nodes] [--rotation float|short|byte] [--grid SPACING] [--seed S]
-        [--rays OUT.rays [--rays-size WxH]]
+        [--rays OUT.rays [--rays-size WxH]] [--animate SECONDS]
 
 The mesh is a sphere-like grid of about T triangles (a UV sphere squashed a
 little, so rotations show), with normals. By default one node carries
@@ -16,7 +16,11 @@ runs write the same file. --rays also writes the primary rays of a
 camera looking down at the field (one per pixel, row by row; the .rays
 format of rtbench, rt/accel/rayset.h), so `bench/rtbench OUT.glb OUT.rays`
 and `bench/rtbench OUT.glb OUT.rays --flatten` compare the instanced and
-the flattened scene on the same rays. No dependencies beyond Python 3.
+the flattened scene on the same rays. --animate adds an animation that
+turns the whole field a quarter turn about y over SECONDS (the instancing
+node's rotation, or a parent of the --nodes nodes): node animation that
+moves instances and leaves the mesh as it is, for `rt --frames`. No
+dependencies beyond Python 3.
 """
 import argparse
 import json
@@ -60,6 +64,7 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--rays")
     ap.add_argument("--rays-size", default="640x480")
+    ap.add_argument("--animate", type=float, default=0.0)
     a = ap.parse_args()
 
     pos, nrm, idx = sphere(a.triangles)
@@ -128,6 +133,16 @@ def main():
         doc["scenes"] = [{"nodes": [0]}]
         doc["extensionsUsed"] = ["EXT_mesh_gpu_instancing"]
         doc["extensionsRequired"] = ["EXT_mesh_gpu_instancing"]
+    if a.animate > 0.0:
+        if a.nodes:  # one parent turns them all
+            doc["nodes"].append({"children": doc["scenes"][0]["nodes"]})
+            doc["scenes"] = [{"nodes": [len(doc["nodes"]) - 1]}]
+        target = len(doc["nodes"]) - 1 if a.nodes else 0
+        a_in = add(struct.pack("<2f", 0.0, a.animate), 5126, 2, "SCALAR", None, None, ([0.0], [a.animate]))
+        h = math.sqrt(0.5)
+        a_out = add(struct.pack("<8f", 0, 0, 0, 1, 0, h, 0, h), 5126, 2, "VEC4", None)
+        doc["animations"] = [{"samplers": [{"input": a_in, "output": a_out, "interpolation": "LINEAR"}],
+                              "channels": [{"sampler": 0, "target": {"node": target, "path": "rotation"}}]}]
     while len(blob) % 4:
         blob.append(0)
     doc["buffers"] = [{"byteLength": len(blob)}]

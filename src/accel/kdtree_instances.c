@@ -21,6 +21,14 @@
  * one object a thread, each on one thread; larger ones one after another,
  * each on all threads (the build forks inside). A tree is the same for any
  * thread count, so the result does not depend on the split.
+ *
+ * Kept trees (rt_kdtree_kept, for animation frames and motion slices): a
+ * tree depends only on its triangles' corner positions, in order, and the
+ * build parameters, so an object whose positions are the same bits as a
+ * kept tree's (its key: 9 floats a triangle, copied when the tree was
+ * built) takes that tree instead of building one; a moved instance
+ * changes only the top level. Every tree of a build with a set is the
+ * set's (the top-level tree borrows them).
  */
 #include "kdtree_internal.h"
 
@@ -44,6 +52,7 @@ typedef struct kd_object_jobs {
     const rt_kdtree_params *params; /* threads = 1 */
     size_t count;
     atomic_size_t next;
+    const bool *taken; /* per object: its tree came from a kept set */
     rt_result *results; /* per object */
     rt_error *errors;   /* per object */
 } kd_object_jobs;
@@ -55,9 +64,126 @@ static void *build_small_objects(void *arg)
         size_t o = atomic_fetch_add(&j->next, 1);
         if (o >= j->count)
             return NULL;
-        if (j->views[o].triangles.count < KD_OBJECT_ALONE)
+        if (!j->taken[o] && j->views[o].triangles.count < KD_OBJECT_ALONE)
             j->results[o] = rt_kdtree_build(&j->trees[o], &j->views[o], j->params, &j->errors[o]);
     }
+}
+
+/* One tree in a kept set: the tree, what it was built over (key: the
+ * corners' positions, 9 floats a triangle, all bits set for a corner
+ * whose index is out of range) and with, and whether a build has taken
+ * or made it since the last trim. */
+typedef struct rt_kd_kept_tree {
+    rt_kdtree tree;
+    float *key;
+    size_t triangle_count;
+    rt_kdtree_params params; /* threads and kept zeroed: they do not shape the tree */
+    bool used;
+} rt_kd_kept_tree;
+
+/* The parameters that shape a tree. */
+static rt_kdtree_params shaping(const rt_kdtree_params *p)
+{
+    rt_kdtree_params s = p ? *p : (rt_kdtree_params){0};
+    s.threads = 0;
+    s.kept = NULL;
+    return s;
+}
+
+static bool same_shaping(const rt_kdtree_params *a, const rt_kdtree_params *b)
+{
+    return a->traversal_cost == b->traversal_cost && a->intersect_cost == b->intersect_cost &&
+           a->empty_bonus == b->empty_bonus && a->max_depth == b->max_depth && a->portable == b->portable;
+}
+
+/* Corner k of triangle t of a view, as the key stores it. */
+static void key_corner(const rt_scene *v, size_t t, int k, float out[3])
+{
+    uint32_t ix = v->triangles.index[3 * t + (size_t)k];
+    if (ix < v->vertices.count) {
+        rt_vec3 p = v->vertices.position[ix];
+        out[0] = p.x, out[1] = p.y, out[2] = p.z;
+    } else {
+        memset(out, 0xff, 3 * sizeof *out);
+    }
+}
+
+/* Whether view v's triangles are key's, bit for bit. */
+static bool same_key(const rt_scene *v, const float *key)
+{
+    for (size_t t = 0; t < v->triangles.count; t++)
+        for (int k = 0; k < 3; k++) {
+            float c[3];
+            key_corner(v, t, k, c);
+            if (memcmp(c, key + 9 * t + 3 * (size_t)k, sizeof c) != 0)
+                return false;
+        }
+    return true;
+}
+
+/* The kept tree object view v can take (first trying item `hint`, where
+ * the same object sat last time), or NULL. */
+static rt_kd_kept_tree *find_kept(rt_kdtree_kept *kept, const rt_scene *v, const rt_kdtree_params *shape,
+                                  size_t hint)
+{
+    for (size_t i = 0; i < kept->count; i++) {
+        rt_kd_kept_tree *k = &kept->items[(hint + i) % kept->count];
+        if (k->triangle_count == v->triangles.count && same_shaping(&k->params, shape) && same_key(v, k->key))
+            return k;
+    }
+    return NULL;
+}
+
+/* Moves a freshly built tree of view v into the set; false when out of
+ * memory (the tree is then still the caller's). */
+static bool keep_tree(rt_kdtree_kept *kept, rt_kdtree *tree, const rt_scene *v, const rt_kdtree_params *shape)
+{
+    size_t n = v->triangles.count;
+    float *key = rt_alloc(n ? 9 * n : 1, sizeof *key);
+    if (!key || !rt_grow((void **)&kept->items, &kept->cap, kept->count + 1, sizeof *kept->items)) {
+        free(key);
+        return false;
+    }
+    for (size_t t = 0; t < n; t++)
+        for (int k = 0; k < 3; k++)
+            key_corner(v, t, k, key + 9 * t + 3 * (size_t)k);
+    rt_kd_kept_tree *k = &kept->items[kept->count++];
+    k->tree = *tree;
+    k->tree.scene = NULL; /* the view it was built over dies with its top-level tree */
+    k->key = key;
+    k->triangle_count = n;
+    k->params = *shape;
+    k->used = true;
+    kept->built++;
+    return true;
+}
+
+void rt_kdtree_kept_init(rt_kdtree_kept *kept) { memset(kept, 0, sizeof *kept); }
+
+void rt_kdtree_kept_trim(rt_kdtree_kept *kept)
+{
+    size_t w = 0;
+    for (size_t i = 0; i < kept->count; i++) {
+        rt_kd_kept_tree *k = &kept->items[i];
+        if (!k->used) {
+            rt_kdtree_free(&k->tree);
+            free(k->key);
+            continue;
+        }
+        k->used = false;
+        kept->items[w++] = *k;
+    }
+    kept->count = w;
+}
+
+void rt_kdtree_kept_free(rt_kdtree_kept *kept)
+{
+    for (size_t i = 0; i < kept->count; i++) {
+        rt_kdtree_free(&kept->items[i].tree);
+        free(kept->items[i].key);
+    }
+    free(kept->items);
+    memset(kept, 0, sizeof *kept);
 }
 
 /* The view of object o: the scene with only its triangles. */
@@ -76,25 +202,28 @@ static void object_view(rt_scene *v, const rt_scene *scene, const rt_object *ob)
     v->instance_count = v->instance_cap = 0;
 }
 
-rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
+/* The objects whose trees the kept set has: taken into the tree
+ * (taken[o]), the set's counts updated. */
+static void take_kept(rt_kdtree *tree, rt_kdtree_kept *kept, const rt_kdtree_params *shape, bool *taken)
 {
-    size_t n = scene->object_count;
-    tree->objects = rt_alloc(n, sizeof *tree->objects);
-    tree->object_views = rt_alloc(n, sizeof *tree->object_views);
-    rt_result *results = rt_alloc(n, sizeof *results);
-    rt_error *errors = rt_alloc(n, sizeof *errors);
-    if (!tree->objects || !tree->object_views || !results || !errors) {
-        free(results);
-        free(errors);
-        rt_kd_free_objects(tree);
-        return rt_fail(err, RT_ERR_NOMEM, "kdtree: out of memory for the trees of %zu instanced objects", n);
+    for (size_t o = 0; o < tree->object_count; o++) {
+        rt_kd_kept_tree *k = kept ? find_kept(kept, &tree->object_views[o], shape, o) : NULL;
+        taken[o] = k != NULL;
+        if (k) {
+            tree->objects[o] = k->tree;
+            tree->objects[o].scene = &tree->object_views[o];
+            k->used = true;
+            kept->taken++;
+        }
     }
-    memset(tree->objects, 0, n * sizeof *tree->objects);
-    for (size_t o = 0; o < n; o++) {
-        object_view(&tree->object_views[o], scene, &scene->objects[o]);
-        results[o] = RT_OK;
-    }
-    tree->object_count = n; /* every tree zeroed or built: rt_kd_free_objects frees either */
+}
+
+/* The trees not taken: the small ones side by side, one a thread, then
+ * the large ones one after another on all threads; per object results. */
+static void build_missing(rt_kdtree *tree, const rt_kdtree_params *params, const bool *taken, rt_result *results,
+                          rt_error *errors)
+{
+    size_t n = tree->object_count;
     int threads = params && params->threads > 0 ? params->threads : rt_cpu_count();
     if (threads < 1)
         threads = 1;
@@ -102,7 +231,10 @@ rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_k
         threads = 64;
     rt_kdtree_params one = params ? *params : (rt_kdtree_params){0};
     one.threads = 1;
-    kd_object_jobs jobs = {tree->objects, tree->object_views, &one, n, 0, results, errors};
+    one.kept = NULL;
+    rt_kdtree_params all = params ? *params : (rt_kdtree_params){0};
+    all.kept = NULL;
+    kd_object_jobs jobs = {tree->objects, tree->object_views, &one, n, 0, taken, results, errors};
     pthread_t th[64];
     int started = 0;
     for (int t = 1; t < threads && (size_t)t < n; t++) /* this thread is the first worker */
@@ -112,8 +244,35 @@ rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_k
     for (int t = 0; t < started; t++)
         pthread_join(th[t], NULL);
     for (size_t o = 0; o < n; o++) /* the large ones, each forking on all threads */
-        if (tree->object_views[o].triangles.count >= KD_OBJECT_ALONE)
-            results[o] = rt_kdtree_build(&tree->objects[o], &tree->object_views[o], params, &errors[o]);
+        if (!taken[o] && tree->object_views[o].triangles.count >= KD_OBJECT_ALONE)
+            results[o] = rt_kdtree_build(&tree->objects[o], &tree->object_views[o], &all, &errors[o]);
+}
+
+rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err)
+{
+    size_t n = scene->object_count;
+    tree->objects = rt_alloc(n, sizeof *tree->objects);
+    tree->object_views = rt_alloc(n, sizeof *tree->object_views);
+    rt_result *results = rt_alloc(n, sizeof *results);
+    rt_error *errors = rt_alloc(n, sizeof *errors);
+    bool *taken = rt_alloc(n, sizeof *taken);
+    if (!tree->objects || !tree->object_views || !results || !errors || !taken) {
+        free(results);
+        free(errors);
+        free(taken);
+        rt_kd_free_objects(tree);
+        return rt_fail(err, RT_ERR_NOMEM, "kdtree: out of memory for the trees of %zu instanced objects", n);
+    }
+    memset(tree->objects, 0, n * sizeof *tree->objects);
+    for (size_t o = 0; o < n; o++) {
+        object_view(&tree->object_views[o], scene, &scene->objects[o]);
+        results[o] = RT_OK;
+    }
+    tree->object_count = n; /* every tree zeroed or built: rt_kd_free_objects frees either */
+    rt_kdtree_kept *kept = params ? params->kept : NULL;
+    rt_kdtree_params shape = shaping(params);
+    take_kept(tree, kept, &shape, taken);
+    build_missing(tree, params, taken, results, errors);
     rt_result r = RT_OK;
     for (size_t o = 0; o < n && r == RT_OK; o++)
         if (results[o] != RT_OK) {
@@ -121,8 +280,23 @@ rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_k
             if (err)
                 *err = errors[o];
         }
+    for (size_t o = 0; o < n && r == RT_OK && kept; o++) /* what was built goes into the set */
+        if (!taken[o]) {
+            if (!keep_tree(kept, &tree->objects[o], &tree->object_views[o], &shape)) {
+                r = rt_fail(err, RT_ERR_NOMEM, "kdtree: out of memory keeping the trees of %zu instanced objects", n);
+                break;
+            }
+            taken[o] = true; /* the set's now */
+        }
     free(results);
     free(errors);
+    if (r != RT_OK) { /* the trees the set does not hold are this build's to free */
+        for (size_t o = 0; o < n; o++)
+            if (!taken[o])
+                rt_kdtree_free(&tree->objects[o]);
+    }
+    tree->objects_kept = r != RT_OK || kept != NULL;
+    free(taken);
     if (r != RT_OK)
         rt_kd_free_objects(tree);
     return r;
@@ -130,13 +304,14 @@ rt_result rt_kd_build_objects(rt_kdtree *tree, const rt_scene *scene, const rt_k
 
 void rt_kd_free_objects(rt_kdtree *tree)
 {
-    for (size_t o = 0; o < tree->object_count; o++)
+    for (size_t o = 0; o < tree->object_count && !tree->objects_kept; o++)
         rt_kdtree_free(&tree->objects[o]);
     free(tree->objects);
     free(tree->object_views);
     tree->objects = NULL;
     tree->object_views = NULL;
     tree->object_count = 0;
+    tree->objects_kept = false;
 }
 
 bool rt_kd_instance_hit(const rt_kdtree *tree, uint32_t i, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit,

@@ -139,8 +139,8 @@ static const flag flags[] = {
      "use camera N of the loaded glTF models, or 'auto': frame the whole scene automatically, ignoring the file's "
      "camera", OWN},
     {NULL, "--flatten", NULL, FLAG_FLATTEN, NULL,
-     "a glTF input keeps no instances: every use of a mesh becomes world triangles, as before instancing "
-     "(to compare; docs/gltf.md, Instancing)", SETS_TRUE(flatten)},
+     "no instances from glTF: every use of a mesh becomes world triangles, and a scene's model lines load "
+     "their file at every line, as before instancing (to compare; docs/gltf.md, Instancing)", SETS_TRUE(flatten)},
     {NULL, "--variant", "NAME", FLAG_VARIANT, NULL,
      "show a glTF model's material variant NAME (KHR_materials_variants); default: the file's default materials", OWN},
     {NULL, "--look-from", "X,Y,Z", FLAG_LOOK_FROM, NULL, "camera position (replaces the file's or the automatic one)", OWN},

@@ -161,6 +161,8 @@ static int render_frames(args *a, const run_signals *sig)
     int first = a->has_only_frames ? a->only_begin : a->frame_begin;
     int end = a->has_only_frames ? a->only_end : a->frame_end;
     int status = 0;
+    rt_kdtree_kept kept; /* the objects' trees, built once while node animation only moves their instances */
+    rt_kdtree_kept_init(&kept);
     for (int f = first; f < end && status == 0; f++) {
         if (!frames_name(pattern, f, name, sizeof name) ||
             (part_pattern && !frames_name(part_pattern, f, part_name, sizeof part_name))) {
@@ -178,9 +180,10 @@ static int render_frames(args *a, const run_signals *sig)
         a->posed = true;
         rt_scene scene;
         rt_scene_init(&scene);
-        status = run_one(&scene, a, rt_now_seconds(), sig);
+        status = run_one(&scene, a, rt_now_seconds(), sig, &kept);
         rt_scene_free(&scene);
     }
+    rt_kdtree_kept_free(&kept);
     return status;
 }
 
@@ -209,7 +212,7 @@ int main(int argc, char **argv)
         return render_frames(&a, &sig);
     rt_scene scene;
     rt_scene_init(&scene);
-    status = run_one(&scene, &a, t_start, &sig);
+    status = run_one(&scene, &a, t_start, &sig, NULL);
     rt_scene_free(&scene);
     return status;
 }

@@ -52,6 +52,7 @@ typedef struct run {
     viewer session;
     rt_render_options ro;
     rt_render_stats rs;
+    rt_kdtree_kept *kept; /* objects' trees shared with earlier frames and the motion slices; NULL: none */
     bool have_tree, have_pj, have_fb, have_aov;
 } run;
 
@@ -271,7 +272,10 @@ static int run_setup(run *rn)
     char prims[64];
     snprintf(prims, sizeof prims, "(%zu primitives)", rt_scene_prim_count(rn->scene));
     progress_phase(rn->view, "kd-tree", prims);
-    if (rt_kdtree_build(&rn->tree, rn->scene, NULL, &err) != RT_OK)
+    rt_kdtree_params par = {0};
+    par.kept = rn->kept;
+    size_t built0 = rn->kept ? rn->kept->built : 0, taken0 = rn->kept ? rn->kept->taken : 0;
+    if (rt_kdtree_build(&rn->tree, rn->scene, &par, &err) != RT_OK)
         return run_failed(rn, &err);
     rn->have_tree = true;
     const rt_kdtree_stats *ts = &rn->tree.stats;
@@ -279,6 +283,9 @@ static int run_setup(run *rn)
             "%zu 64-byte nodes of 3 levels, %.1f MiB",
             ts->build_ms, ts->nodes, ts->leaves, ts->empty_leaves, ts->prim_refs, ts->depth, ts->wide_nodes,
             (double)ts->bytes / (1024.0 * 1024.0));
+    if (rn->tree.object_count)
+        rt_info("kd-tree: objects' trees: %zu built, %zu kept from earlier builds",
+                rn->kept ? rn->kept->built - built0 : rn->tree.object_count, rn->kept ? rn->kept->taken - taken0 : 0);
     rn->have_pj = true;
     if (rt_part_job_init(&rn->pj, &rn->jo, rn->scene, rn->settings, &rn->tree, &err) != RT_OK)
         return run_failed(rn, &err);
@@ -440,7 +447,7 @@ static int run_slices(run *rn, int slices)
     rt_job_slices plan = {.slices = slices, .frame_time = a->posed ? a->frame_time : 0.0f,
                           .s_begin = pj->s_begin, .s_end = pj->s_end, .pass_samples = rn->ro.pass_samples,
                           .time_limit = a->time_limit, .load = load_slice, .loading = slice_loading,
-                          .rendering = slice_rendering, .user = rn};
+                          .rendering = slice_rendering, .user = rn, .kept = rn->kept};
     rt_result r = rt_job_render_slices(rn->scene, rn->settings, &rn->tree, &plan, &rn->ro, &rn->fb, &rn->rs, &err);
     return r == RT_ERR_NOMEM ? 2 : write_result(rn, r, &err);
 }
@@ -487,11 +494,13 @@ static int run_renders(run *rn)
  * image; the exit status. t_start: when the run began, for the wall time in
  * the "wrote" line. */
 static int render_and_write(rt_scene *scene, const rt_settings *settings, const args *a, int slices,
-                            const char *output, progress_view *view, double t_start, const run_signals *sig)
+                            const char *output, progress_view *view, double t_start, const run_signals *sig,
+                            rt_kdtree_kept *kept)
 {
     run rn;
     memset(&rn, 0, sizeof rn);
     rn.a = a;
+    rn.kept = kept;
     args_job_options(a, &rn.jo);
     rn.jo.stop_part = a->stop_part;
     rn.scene = scene;
@@ -518,7 +527,7 @@ static int render_and_write(rt_scene *scene, const rt_settings *settings, const 
 
 /* Loads, prepares (posed at a->frame_time when a->posed), renders and
  * writes one image (or part); the exit status. */
-int run_one(rt_scene *scene, const args *a, double t_start, const run_signals *sig)
+int run_one(rt_scene *scene, const args *a, double t_start, const run_signals *sig, rt_kdtree_kept *kept)
 {
     rt_error err = {0};
     char output[1024];
@@ -575,7 +584,15 @@ int run_one(rt_scene *scene, const args *a, double t_start, const run_signals *s
             return 2;
         }
     }
-    int status = render_and_write(scene, &settings, a, animated ? slices : 1, output, &view, t_start, sig);
+    /* motion slices share the objects' trees: each later slice builds only its top level */
+    rt_kdtree_kept own;
+    rt_kdtree_kept_init(&own);
+    rt_kdtree_kept *share = kept ? kept : animated && slices > 1 ? &own : NULL;
+    int status =
+        render_and_write(scene, &settings, a, animated ? slices : 1, output, &view, t_start, sig, share);
+    if (kept)
+        rt_kdtree_kept_trim(kept); /* this frame's trees, for the next */
+    rt_kdtree_kept_free(&own);
     progress_view_free(&view);
     return status;
 }

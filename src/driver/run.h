@@ -7,7 +7,7 @@
  *   static atomic_int interrupted, stop;   // the signal handler's
  *   static rt_write_temp temp;
  *   run_signals sig = {&interrupted, &stop, &temp, on_signal};
- *   int status = run_one(&scene, &a, rt_now_seconds(), &sig);   // 0, 2, or 128 + a signal
+ *   int status = run_one(&scene, &a, rt_now_seconds(), &sig, NULL);   // 0, 2, or 128 + a signal
  */
 #ifndef RT_DRIVER_RUN_H
 #define RT_DRIVER_RUN_H
@@ -15,6 +15,7 @@
 #include <stdatomic.h>
 
 #include "args.h"
+#include "rt/accel/kdtree.h"
 #include "rt/io/image_write.h"
 #include "rt/scene/scene.h"
 
@@ -30,7 +31,10 @@ typedef struct run_signals {
 } run_signals;
 
 /* Loads, prepares (posed at a->frame_time when a->posed), renders and
- * writes one image (or part) into the initialised scene; the exit status. */
-int run_one(rt_scene *scene, const args *a, double t_start, const run_signals *sig);
+ * writes one image (or part) into the initialised scene; the exit status.
+ * kept: the objects' trees of earlier frames (rt_kdtree_kept), taken where
+ * the objects are the same and trimmed to this frame's after it; NULL: the
+ * trees are this render's (its motion slices still share them). */
+int run_one(rt_scene *scene, const args *a, double t_start, const run_signals *sig, rt_kdtree_kept *kept);
 
 #endif

@@ -348,8 +348,8 @@ static rt_result count_geometry(gl_doc *d, rt_gltf_stats *st, gl_totals *t, gl_p
             const gl_accessor *pa = &d->accessors[p->attr[ATTR_POSITION]];
             if (copies > 0 && pa->count > (GL_MAX_VERTICES + 1) / copies)
                 return rt_fail(d->err, RT_ERR_LIMIT,
-                               "%s: the scene has over %zu vertices or triangles (instancing included); over the "
-                               "loader's limit",
+                               "%s: the scene has over %zu vertices or triangles (flattened copies included; an "
+                               "instanced mesh counts once); over the loader's limit",
                                d->path, GL_MAX_VERTICES);
             t->verts += pa->count * copies;
             if (pa->view == RT_NONE && (zeros += pa->count * copies) > GL_MAX_ZEROS)
@@ -360,8 +360,8 @@ static rt_result count_geometry(gl_doc *d, rt_gltf_stats *st, gl_totals *t, gl_p
             t->tris += prim_triangles(d, p) * copies;
             if (t->verts > GL_MAX_VERTICES || t->tris > GL_MAX_TRIANGLES)
                 return rt_fail(d->err, RT_ERR_LIMIT,
-                               "%s: the scene has over %zu vertices or triangles (instancing included); over the "
-                               "loader's limit",
+                               "%s: the scene has over %zu vertices or triangles (flattened copies included; an "
+                               "instanced mesh counts once); over the loader's limit",
                                d->path, GL_MAX_VERTICES);
             if (p->material == RT_NONE)
                 t->need_default = true;

@@ -187,7 +187,8 @@ static rt_result load_kind(rt_scene *s, rt_settings *settings, const void *bytes
     }
     rt_scene_parse_options po = {
         .use_time = opt->use_time, .time = opt->time, .animation = opt->animation,
-        .animation_name = opt->animation_name, .animated = &info->animated, .catalog = opt->catalog};
+        .animation_name = opt->animation_name, .animated = &info->animated, .catalog = opt->catalog,
+        .flatten_instances = opt->flatten_instances};
     return rt_scene_parse_string_with(s, settings, bytes, size, name, NULL, &po, err);
 }
 

@@ -84,6 +84,20 @@ typedef struct name_table {
     size_t nslots;
 } name_table;
 
+/* A model line's load (outside objects), by what shapes its geometry:
+ * the file and the glTF options but the transform. A later line of the
+ * same load places it again as an instance (st_model). */
+typedef struct model_load {
+    char *path; /* resolved, owned */
+    rt_gltf_options opt; /* scene, pose and animation; animation_name owned; no transform, catalog or flatten */
+    size_t t0, nt, v0, nv;  /* its triangles and vertices in the scene, in world space by `placed` */
+    rt_mat4 placed;         /* the first line's transform */
+    bool instanceable;      /* only triangles (no lights, cameras, emitters, objects of its own) */
+    bool animated;          /* its pose follows the frame time */
+    uint32_t object;        /* the object it became, RT_NONE until a second line */
+    int line;
+} model_load;
+
 typedef struct parser {
     rt_scene *s;
     rt_settings *settings; /* the setting statements' values; NULL: checked, not kept */
@@ -105,6 +119,8 @@ typedef struct parser {
     tok object_name;
     size_t object_t0, object_v0;
     uint32_t default_material; /* made on first use by a mesh without a material */
+    model_load *models; /* the model lines' loads */
+    size_t model_count, model_cap;
     /* textures standing in for a missing image (rt_texture_missing): a data
      * slot given one is left empty instead */
     uint32_t *missing_tex;
@@ -204,6 +220,16 @@ static rt_result loader_err(parser *p, const tok *t, rt_result code, const rt_er
 static rt_result nomem(parser *p, const tok *t)
 {
     return perr(p, RT_ERR_NOMEM, t, "out of memory");
+}
+
+/* Out of memory placing one more instance (the table grows by doubling):
+ * the count placed and the bytes they take (rt/scene/instance.h), for
+ * --max-memory's user. */
+static rt_result instance_nomem(parser *p, const tok *t)
+{
+    size_t n = p->s->instance_count;
+    return perr(p, RT_ERR_NOMEM, t, "out of memory for more than %zu instances (%zu bytes each, %zu bytes)", n,
+                (size_t)RT_INSTANCE_BYTES, n * (size_t)RT_INSTANCE_BYTES);
 }
 
 /* ------------------------------------------------------------ cursor */
@@ -1563,7 +1589,7 @@ static rt_result st_instance(parser *p, const tok *kw)
     if (c != RT_INSTANCE_OK)
         return perr(p, RT_ERR_INVALID, kw, "the instance's transform is %s", rt_instance_check_name(c));
     if (rt_scene_add_instance(p->s, e->index, &m) == RT_NONE)
-        return nomem(p, kw);
+        return instance_nomem(p, kw);
     return RT_OK;
 }
 
@@ -1634,6 +1660,114 @@ static rt_result apply_pose(parser *p, const model_pose *m, rt_gltf_options *opt
     return RT_OK;
 }
 
+/* Whether two loads of a file give the same geometry: the glTF options
+ * that shape it (the transform aside). */
+static bool same_model_options(const rt_gltf_options *a, const rt_gltf_options *b)
+{
+    if (a->use_scene_index != b->use_scene_index || (a->use_scene_index && a->scene_index != b->scene_index) ||
+        a->use_time != b->use_time)
+        return false;
+    if (!a->use_time)
+        return true;
+    return memcmp(&a->time, &b->time, sizeof a->time) == 0 && a->animation == b->animation &&
+           a->animation_optional == b->animation_optional &&
+           (a->animation_name && b->animation_name ? strcmp(a->animation_name, b->animation_name) == 0
+                                                   : a->animation_name == b->animation_name);
+}
+
+static model_load *find_model(parser *p, const char *path, const rt_gltf_options *opt)
+{
+    for (size_t i = 0; i < p->model_count; i++)
+        if (strcmp(p->models[i].path, path) == 0 && same_model_options(&p->models[i].opt, opt))
+            return &p->models[i];
+    return NULL;
+}
+
+/* True when triangles [t0, t0 + nt) use an emissive material (a lamp
+ * stays world geometry, for the light table). */
+static bool range_emits(const rt_scene *s, size_t t0, size_t nt)
+{
+    for (size_t t = t0; t < t0 + nt; t++) {
+        uint32_t mi = s->triangles.material[t];
+        if (mi >= s->material_count)
+            continue;
+        const rt_material *m = &s->materials[mi];
+        if ((m->emission.x > 0.0f || m->emission.y > 0.0f || m->emission.z > 0.0f) && m->emission_strength > 0.0f)
+            return true;
+    }
+    return false;
+}
+
+/* Notes a model line's load (its scene counts before it in `before`) for
+ * the lines after it; false when out of memory. */
+static bool record_model(parser *p, const char *path, const rt_gltf_options *opt, const rt_scene_mark *before,
+                         bool animated, int line)
+{
+    rt_scene *s = p->s;
+    if (!rt_grow((void **)&p->models, &p->model_cap, p->model_count + 1, sizeof *p->models))
+        return false;
+    model_load m;
+    memset(&m, 0, sizeof m);
+    m.path = strdup(path);
+    m.opt.use_scene_index = opt->use_scene_index;
+    m.opt.scene_index = opt->scene_index;
+    m.opt.use_time = opt->use_time;
+    m.opt.time = opt->time;
+    m.opt.animation = opt->animation;
+    m.opt.animation_optional = opt->animation_optional;
+    m.opt.animation_name = opt->animation_name ? strdup(opt->animation_name) : NULL;
+    if (!m.path || (opt->animation_name && !m.opt.animation_name)) {
+        free(m.path);
+        free((char *)m.opt.animation_name);
+        return false;
+    }
+    m.t0 = before->triangles;
+    m.nt = s->triangles.count - before->triangles;
+    m.v0 = before->vertices;
+    m.nv = s->vertices.count - before->vertices;
+    m.placed = opt->use_transform ? opt->transform : rt_mat4_identity();
+    m.instanceable = m.nt > 0 && s->object_count == before->objects && s->instance_count == before->instances &&
+                     s->light_count == before->lights && s->camera_count == before->cameras &&
+                     !range_emits(s, m.t0, m.nt) && rt_instance_check_transform(&m.placed) == RT_INSTANCE_OK;
+    m.animated = animated;
+    m.object = RT_NONE;
+    m.line = line;
+    p->models[p->model_count++] = m;
+    return true;
+}
+
+/* A second (or later) line of a load: the first load's triangles become
+ * an object, in the space of the first line's transform, placed where
+ * they are (identity) and by this line's transform times the first's
+ * inverse. */
+static rt_result place_model_again(parser *p, const tok *kw, model_load *m, const rt_mat4 *to_world)
+{
+    rt_scene *s = p->s;
+    if (m->object == RT_NONE) {
+        uint32_t id = rt_scene_add_object(s, m->t0, m->nt, m->v0, m->nv);
+        if (id == RT_NONE)
+            return nomem(p, kw);
+        for (size_t i = 0; i < p->objects.count; i++) /* objects after it moved up one */
+            if (p->objects.items[i].index >= id)
+                p->objects.items[i].index++;
+        for (size_t i = 0; i < p->model_count; i++)
+            if (p->models[i].object != RT_NONE && p->models[i].object >= id)
+                p->models[i].object++;
+        m->object = id;
+        rt_mat4 same = rt_mat4_identity();
+        if (rt_scene_add_instance(s, id, &same) == RT_NONE)
+            return instance_nomem(p, kw);
+    }
+    rt_mat4 rel = rt_mat4_mul(*to_world, rt_instance_inverse(&m->placed));
+    rt_instance_check c = rt_instance_check_transform(&rel);
+    if (c != RT_INSTANCE_OK)
+        return perr(p, RT_ERR_INVALID, kw, "the model's transform relative to line %d's is %s", m->line,
+                    rt_instance_check_name(c));
+    if (rt_scene_add_instance(s, m->object, &rel) == RT_NONE)
+        return instance_nomem(p, kw);
+    return RT_OK;
+}
+
 static rt_result st_model(parser *p, const tok *kw)
 {
     const tok *file = NULL;
@@ -1644,7 +1778,8 @@ static rt_result st_model(parser *p, const tok *kw)
     xform x = {0};
     model_pose pose = {0};
     rt_gltf_options opt = {0};
-    opt.flatten_instances = p->in_object; /* an object holds triangles; instances do not nest */
+    opt.flatten_instances = p->in_object || p->pose.flatten_instances; /* an object holds triangles; instances
+                                                                          * do not nest */
     const tok *scene_tok = NULL;
     while (peek(p)) {
         bool taken = false;
@@ -1680,12 +1815,26 @@ static rt_result st_model(parser *p, const tok *kw)
     opt.catalog = p->pose.catalog;
     opt.use_transform = x.translate_tok || x.rotate_tok || x.scale_tok;
     opt.transform = opt.use_transform ? xform_matrix(&x) : rt_mat4_identity();
+    bool share = !p->in_object && !p->pose.flatten_instances; /* the same file and pose again: an instance */
+    model_load *again = share ? find_model(p, path, &opt) : NULL;
+    if (again && again->instanceable) {
+        if ((r = place_model_again(p, kw, again, &opt.transform)) != RT_OK)
+            return r;
+        if (again->animated && !pose.time_tok && p->pose.animated)
+            *p->pose.animated = true;
+        rt_info("%s:%d: model %s: placed again as an instance of line %d's load (%zu triangles)", p->name, kw->line,
+                path, again->line, again->nt);
+        return RT_OK;
+    }
+    rt_scene_mark before = rt_scene_mark_of(p->s);
     rt_error inner = {0};
     rt_gltf_stats stats;
     memset(&stats, 0, sizeof stats);
     r = rt_gltf_load(p->s, path, &opt, &stats, &inner);
     if (r != RT_OK)
         return loader_err(p, file, r, &inner);
+    if (share && !again && !record_model(p, path, &opt, &before, stats.animated, kw->line))
+        return nomem(p, kw);
     if (stats.animated && !pose.time_tok && p->pose.animated) /* its pose follows the frame time */
         *p->pose.animated = true;
     rt_info("%s:%d: model %s: %zu triangles, %zu materials, %zu cameras%s", p->name, kw->line, path, stats.triangles,
@@ -2239,6 +2388,11 @@ rt_result rt_scene_parse_string_with(rt_scene *s, rt_settings *settings, const c
     name_table_free(&p.textures);
     name_table_free(&p.objects);
     name_table_free(&p.media);
+    for (size_t i = 0; i < p.model_count; i++) {
+        free(p.models[i].path);
+        free((char *)p.models[i].opt.animation_name);
+    }
+    free(p.models);
     free(buf);
     return r;
 }

@@ -3,7 +3,9 @@
  * times and samples are rt/job/motion.h's). Slice 0 renders the scene and
  * kd-tree it is given; slice k > 0 is loaded by the caller at its time into
  * a scene that shares slice 0's decoded images, gets its own kd-tree, and
- * is freed after its samples. Every slice renders in passes (one pass of
+ * is freed after its samples; with plan->kept (rt_kdtree_kept) it takes
+ * the objects' trees slice 0 built (instances moved by node animation
+ * keep their objects), so a slice rebuilds only the top level. Every slice renders in passes (one pass of
  * all its samples where tiles were asked for): a stopped slice then has
  * every pixel at the same sample, which sums kept as a part can say. The
  * renderer and the kd-tree know nothing of time. */
@@ -37,8 +39,16 @@ static rt_result load_slice(rt_scene *scene, const rt_job_slices *plan, int k, r
     rt_result r = RT_OK;
     if (!rt_scene_share_images(sk, scene))
         r = rt_fail(err, RT_ERR_NOMEM, "out of memory for the images of motion slice %d", k + 1);
-    else if ((r = plan->load(plan->user, sk, time, err)) == RT_OK)
-        r = rt_kdtree_build(tk, sk, NULL, err);
+    else if ((r = plan->load(plan->user, sk, time, err)) == RT_OK) {
+        rt_kdtree_params par = {0};
+        par.kept = plan->kept; /* the objects' trees of slice 0: only the top level is built again */
+        size_t built0 = plan->kept ? plan->kept->built : 0;
+        if ((r = rt_kdtree_build(tk, sk, &par, err)) == RT_OK && tk->object_count)
+            rt_info("motion: slice %d's tree built in %.1f ms; objects' trees: %zu built, %zu kept from earlier builds",
+                    k + 1,
+                    tk->stats.build_ms, plan->kept ? plan->kept->built - built0 : tk->object_count,
+                    plan->kept ? tk->object_count - (plan->kept->built - built0) : 0);
+    }
     if (r != RT_OK)
         rt_scene_free(sk);
     return r;

@@ -32,8 +32,19 @@ uint32_t rt_scene_add_object(rt_scene *s, size_t first_triangle, size_t triangle
                 o.bounds = rt_box_point(o.bounds, s->vertices.position[v]);
         }
     }
-    s->objects[s->object_count] = o;
-    return (uint32_t)s->object_count++;
+    /* in vertex order (the framing walk, rt_scene.c, relies on it): an
+     * object over earlier vertices than the last ones goes before them,
+     * and the instances of those after it are renumbered */
+    size_t at = s->object_count;
+    while (at > 0 && s->objects[at - 1].first_vertex > first_vertex)
+        at--;
+    memmove(s->objects + at + 1, s->objects + at, (s->object_count - at) * sizeof *s->objects);
+    s->objects[at] = o;
+    s->object_count++;
+    for (size_t i = 0; i < s->instance_count && at + 1 < s->object_count; i++)
+        if (s->instances[i].object >= at)
+            s->instances[i].object++;
+    return (uint32_t)at;
 }
 
 rt_instance_check rt_instance_check_transform(const rt_mat4 *to_world)
@@ -71,8 +82,7 @@ const char *rt_instance_check_name(rt_instance_check c)
     }
 }
 
-/* to_world's inverse (rt_instance_check_transform said it has one). */
-static rt_mat4 affine_inverse(const rt_mat4 *to_world)
+rt_mat4 rt_instance_inverse(const rt_mat4 *to_world)
 {
     const float(*m)[4] = to_world->m;
     double a[3][3], c[3][3];
@@ -114,7 +124,7 @@ uint32_t rt_scene_add_instance(rt_scene *s, uint32_t object, const rt_mat4 *to_w
     memset(&in, 0, sizeof in);
     in.object = object;
     in.to_world = *to_world;
-    in.to_object = affine_inverse(to_world);
+    in.to_object = rt_instance_inverse(to_world);
     rt_mat4_normal_matrix(to_world, &in.normal);
     in.mirror = rt_mat4_det3(to_world) < 0.0f;
     rt_box ob = s->objects[object].bounds;

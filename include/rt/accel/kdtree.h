@@ -71,6 +71,7 @@ typedef struct rt_kdtree_params {
     int max_depth;        /* 0 = 8 + 1.3 log2(N) (pbrt's rule) */
     int threads;          /* build threads; 0 = one per online CPU (same tree for any count) */
     int portable;         /* 1: the portable traversal even when the CPU has AVX2 (tests; same answers) */
+    struct rt_kdtree_kept *kept; /* objects' trees kept between builds (below); NULL: build every one */
 } rt_kdtree_params;
 
 /* The traversal kernels a tree uses, chosen once by the build from the CPU
@@ -136,7 +137,39 @@ typedef struct rt_kdtree {
     struct rt_kdtree *objects;
     struct rt_scene *object_views;
     size_t object_count, instance_count;
+    bool objects_kept;    /* the objects' trees belong to params->kept, not to this tree */
 } rt_kdtree;
+
+/* Objects' trees kept from one build for the next (animation frames,
+ * motion slices): node animation moves instances, not the objects, so a
+ * build given the same set (rt_kdtree_params.kept) takes every object's
+ * tree from it whose triangles are the same, bit for bit (the positions
+ * of their corners, in order, and the build parameters), and builds
+ * only the others and the top level; what it builds goes into the set.
+ * The trees of a tree built so belong to the set: the set must outlive
+ * it. A taken tree is the one a fresh build makes (a tree depends only on
+ * those positions and parameters), so hits do not change.
+ *
+ *   rt_kdtree_kept kept;
+ *   rt_kdtree_kept_init(&kept);
+ *   rt_kdtree_params par = {0};
+ *   par.kept = &kept;
+ *   for each frame: load the scene posed; rt_kdtree_build(&tree, &scene, &par, &err);
+ *                   render; rt_kdtree_free(&tree); rt_kdtree_kept_trim(&kept);
+ *   rt_kdtree_kept_free(&kept);
+ *
+ * built and taken count the objects' trees built into the set and taken
+ * from it, over its life (what rt -v says, and what tests check). */
+typedef struct rt_kdtree_kept {
+    struct rt_kd_kept_tree *items; /* kdtree_instances.c */
+    size_t count, cap;
+    size_t built, taken;
+} rt_kdtree_kept;
+void rt_kdtree_kept_init(rt_kdtree_kept *kept);
+/* Frees the trees no build took or made since the last trim: call it only
+ * when no tree built with the set is alive. */
+void rt_kdtree_kept_trim(rt_kdtree_kept *kept);
+void rt_kdtree_kept_free(rt_kdtree_kept *kept);
 
 rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtree_params *params, rt_error *err);
 void rt_kdtree_free(rt_kdtree *tree);

@@ -44,6 +44,8 @@ typedef struct rt_scene_parse_options {
     bool *animated;  /* out, may be NULL: set true when a model line's pose follows the frame time (an animation
                       * with channels, no fixed `time`), so that another time may give another pose */
     struct rt_gltf_catalog *catalog; /* not NULL: the model lines' animations and variants (rt/io/gltf.h) */
+    bool flatten_instances; /* model lines flatten every mesh use, and a file loaded twice is loaded twice
+                             * (rt_gltf_options.flatten_instances; rt --flatten) */
 } rt_scene_parse_options;
 
 /* rt_scene_parse_string with model lines posed at options' time (NULL =

@@ -33,6 +33,10 @@ typedef struct rt_job_slices {
     void (*loading)(void *user, int k, int slices, float time);
     void (*rendering)(void *user, int tiles_total);
     void *user;
+    /* The objects' trees slice 0's tree was built with (rt_kdtree_kept):
+     * later slices take them and rebuild only the top level; NULL: every
+     * slice builds its whole tree. */
+    rt_kdtree_kept *kept;
 } rt_job_slices;
 
 /* Samples a pass for rt_render_options.pass_samples (0: the integrator's

@@ -56,7 +56,11 @@ typedef struct rt_instance {
 
 /* Declares the triangles and vertices an object (flags them
  * RT_TRI_OBJECT, computes its bounds); its index, or RT_NONE when out of
- * memory or the ranges are not in the tables. */
+ * memory or the ranges are not in the tables. Objects stay in the order
+ * of their vertices: one over vertices before the last object's goes
+ * before it (its index is then not the last, and the instances of the
+ * objects after it are renumbered; an index kept by the caller shifts by
+ * one from the returned index on). */
 uint32_t rt_scene_add_object(rt_scene *s, size_t first_triangle, size_t triangle_count, size_t first_vertex,
                              size_t vertex_count);
 /* Whether to_world can place an object: RT_INSTANCE_NOT_FINITE (an
@@ -69,6 +73,9 @@ typedef enum rt_instance_check {
 } rt_instance_check;
 rt_instance_check rt_instance_check_transform(const rt_mat4 *to_world);
 const char *rt_instance_check_name(rt_instance_check c);
+/* to_world's inverse (to_world must check RT_INSTANCE_OK): the adjugate
+ * over the determinant in double, rounded once to float. */
+rt_mat4 rt_instance_inverse(const rt_mat4 *to_world);
 /* Places object `object` by to_world (which must check RT_INSTANCE_OK);
  * the instance's index, or RT_NONE when out of memory or it does not. */
 uint32_t rt_scene_add_instance(rt_scene *s, uint32_t object, const rt_mat4 *to_world);
