@@ -40,8 +40,19 @@
  * CPU) the top levels fork: a below child's subtree is built by a new
  * thread into its own arrays while the above child is built here, down to
  * about 4 concurrent subtrees per thread, and the pieces are spliced into
- * depth-first order afterwards: the tree is bit-identical for any thread
- * count.
+ * depth-first order afterwards. Above that, where fewer subtrees than
+ * threads are being built (the root on 2 threads; the root and its
+ * children on 4), a node of 16k or more primitives shares its own work:
+ * the primitives' bounds and events and the root's radix sort in parts of
+ * the arrays, the sweeps in parts of each event list (cut where the key
+ * changes) started from the counts of the parts before, the sides in two
+ * passes (STARTs and PLANARs, then ENDs) and the children's lists by
+ * counts, then offsets. Each step gives what the one-thread step gives and
+ * the best plane is the first cheapest in the same order, so the tree is
+ * bit-identical for any thread count. What stays on one thread is the
+ * splice and the packing (kdtree_pack.c): 5-6% of the 1M-triangle model's
+ * CPU time (rt_kdtree_stats.serial_cpu_ms; docs/performance.md, "Build
+ * time").
  *
  * Output (kdtree_internal.h): 8-byte nodes in depth-first order (below
  * child = next node, above child index in the node) and leaf id lists in a
@@ -147,19 +158,56 @@ static inline uint32_t ev_key(uint64_t e) { return (uint32_t)(e >> 32); }
 static inline unsigned ev_type(uint64_t e) { return (unsigned)(e >> PRIM_BITS) & 3u; }
 static inline uint32_t ev_prim(uint64_t e) { return (uint32_t)e & PRIM_MASK; }
 
-/* Sorts events by (position, type); tmp has room for n. */
+/* Insertion sort by (position, type), stable. */
+static void ev_insertion_sort(uint64_t *a, size_t n)
+{
+    for (size_t i = 1; i < n; i++) {
+        uint64_t x = a[i];
+        size_t j = i;
+        while (j > 0 && (a[j - 1] >> PRIM_BITS) > (x >> PRIM_BITS)) {
+            a[j] = a[j - 1];
+            j--;
+        }
+        a[j] = x;
+    }
+}
+
+/* Bottom-up merge sort by (position, type), stable (runs of 16 by
+ * insertion); tmp has room for n. For the short lists of a split's
+ * straddlers, where the radix sort's 8,192 counters (zeroed and summed each
+ * pass) cost more than the events: the same order, as both are stable. */
+static void ev_merge_sort(uint64_t *a, size_t n, uint64_t *tmp)
+{
+    for (size_t i = 0; i < n; i += 16)
+        ev_insertion_sort(a + i, n - i < 16 ? n - i : 16);
+    uint64_t *src = a, *dst = tmp;
+    for (size_t w = 16; w < n; w *= 2) {
+        for (size_t i = 0; i < n; i += 2 * w) {
+            size_t m = i + w < n ? i + w : n, e = i + 2 * w < n ? i + 2 * w : n, p = i, q = m, k = i;
+            while (p < m && q < e)
+                dst[k++] = (src[q] >> PRIM_BITS) < (src[p] >> PRIM_BITS) ? src[q++] : src[p++];
+            while (p < m)
+                dst[k++] = src[p++];
+            while (q < e)
+                dst[k++] = src[q++];
+        }
+        uint64_t *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != a)
+        memcpy(a, src, n * sizeof *a);
+}
+
+/* Sorts events by (position, type), stable; tmp has room for n. */
 static void ev_sort(uint64_t *a, size_t n, uint64_t *tmp)
 {
     if (n < 64) {
-        for (size_t i = 1; i < n; i++) {
-            uint64_t x = a[i];
-            size_t j = i;
-            while (j > 0 && (a[j - 1] >> PRIM_BITS) > (x >> PRIM_BITS)) {
-                a[j] = a[j - 1];
-                j--;
-            }
-            a[j] = x;
-        }
+        ev_insertion_sort(a, n);
+        return;
+    }
+    if (n < 512) {
+        ev_merge_sort(a, n, tmp);
         return;
     }
     static const int shift[3] = {30, 41, 52}, bits[3] = {11, 11, 12};
@@ -242,6 +290,17 @@ static int clip_plane(double (*in)[3], int n, double (*out)[3], int k, double c,
         }
     }
     return m;
+}
+
+/* Whether the whole polygon keeps sign * (x_k - c) >= 0: then clip_plane
+ * would return it unchanged, and is skipped (most planes of a box cut a
+ * straddling triangle nowhere). */
+static bool all_inside(double (*in)[3], int n, int k, double c, double sign)
+{
+    for (int i = 0; i < n; i++)
+        if (!(sign * (in[i][k] - c) >= 0.0))
+            return false;
+    return true;
 }
 
 /* ------------------------------------------------------------- build */
@@ -433,9 +492,11 @@ static bool prim_clip_bounds(const kd_build *c, uint32_t prim, rt_box box, rt_bo
     if (n > 0) {
         int cur = 0;
         for (int k = 0; k < 3 && n > 0; k++) {
-            n = clip_plane(poly[cur], n, poly[cur ^ 1], k, bl[k], 1.0);
-            cur ^= 1;
-            if (n > 0) {
+            if (!all_inside(poly[cur], n, k, bl[k], 1.0)) {
+                n = clip_plane(poly[cur], n, poly[cur ^ 1], k, bl[k], 1.0);
+                cur ^= 1;
+            }
+            if (n > 0 && !all_inside(poly[cur], n, k, bh[k], -1.0)) {
                 n = clip_plane(poly[cur], n, poly[cur ^ 1], k, bh[k], -1.0);
                 cur ^= 1;
             }
@@ -604,6 +665,7 @@ static void sweep(const kd_axis *ax, int k, const uint64_t *E, size_t from, size
     double kt = ax->kt, scale = ax->scale, lambda = ax->lambda, ab = ax->ab, apb = ax->apb, lo = ax->lo,
            hi = ax->hi;
     uint32_t lo_key = ax->lo_key, hi_key = ax->hi_key;
+    kd_plane b = *best;
     for (size_t i = from; i < to;) {
         uint64_t e = E[i];
         uint32_t key = ev_key(e);
@@ -626,16 +688,17 @@ static void sweep(const kd_axis *ax, int k, const uint64_t *E, size_t from, size
             double p = (double)o2f(key);
             double wl = ab + (p - lo) * apb, wr = ab + (hi - p) * apb;
             double c1 = plane_cost(kt, scale, lambda, wl, wr, nl + pp, nr); /* planar ones left */
-            if (c1 < best->cost)
-                *best = (kd_plane){c1, k, SIDE_LEFT, key};
+            if (c1 < b.cost)
+                b = (kd_plane){c1, k, SIDE_LEFT, key};
             if (pp > 0) { /* planar ones right */
                 double c2 = plane_cost(kt, scale, lambda, wl, wr, nl, nr + pp);
-                if (c2 < best->cost)
-                    *best = (kd_plane){c2, k, SIDE_RIGHT, key};
+                if (c2 < b.cost)
+                    b = (kd_plane){c2, k, SIDE_RIGHT, key};
             }
         }
         nl += ps + pp;
     }
+    *best = b;
 }
 
 /* Best SAH plane of a node (section 4.2 of Wald and Havran): one sweep per
