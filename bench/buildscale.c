@@ -11,7 +11,7 @@
  * them). For each: K (default 3) builds with 1 thread and with 2 threads,
  * interleaved, and their medians: wall time, the process's CPU time, the
  * 2-thread build's serial CPU time (the part with one build thread only,
- * rt_kdtree_stats.serial_cpu_ms) and the speed-up that predicts on two free
+ * rt_kdtree_stats.serial_cpu_ms) and the speed-up they predict on two free
  * cores; and the 1-thread CPU time divided by N log2 N (in ns), which stays
  * flat when the build is O(N log N). On a shared machine the wall-clock
  * speed-up is what the other load leaves; the predicted one is not.
@@ -110,8 +110,9 @@ static bool build_times_of(const rt_scene *s, int threads, int reps, build_times
 }
 
 /* One row; with 1 and 2 threads interleaved, A B A B. The predicted
- * speed-up: the 1-thread CPU time over the 2-thread serial CPU time plus
- * half the rest (what two free cores would give, with even halves). */
+ * speed-up: the 1-thread CPU time over the 2-thread build's serial CPU time
+ * plus half the rest of its CPU time (its extra work included): what two
+ * free cores would give if the subtrees shared them evenly. */
 static void row(const char *name, const rt_scene *s, int reps)
 {
     rt_kdtree_stats st;
@@ -127,7 +128,7 @@ static void row(const char *name, const rt_scene *s, int reps)
            ser2 = median(s2, reps);
     printf("| %s | %zu | %.1f | %.1f | %.2f | %.1f | %.1f | %.1f (%.1f%%) | %.2f | %.0f | %.2f | %.1f |\n", name,
            s->triangles.count, t1, t2, t2 > 0 ? t1 / t2 : 0.0, cpu1, cpu2, ser2, 100.0 * ser2 / cpu1,
-           cpu1 / (ser2 + 0.5 * (cpu1 - ser2)), 1e6 * cpu1 / (n * log2(n)), (double)st.prim_refs / n,
+           cpu1 / (ser2 + 0.5 * (cpu2 - ser2)), 1e6 * cpu1 / (n * log2(n)), (double)st.prim_refs / n,
            (double)st.bytes / n);
     fflush(stdout);
 }
