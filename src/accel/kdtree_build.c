@@ -50,7 +50,7 @@
  * counts, then offsets. Each step gives what the one-thread step gives and
  * the best plane is the first cheapest in the same order, so the tree is
  * bit-identical for any thread count. What stays on one thread is the
- * splice and the packing (kdtree_pack.c): 5-6% of the 1M-triangle model's
+ * splice and the packing (kdtree_pack.c): 5-8% of the 1M-triangle model's
  * CPU time (rt_kdtree_stats.serial_cpu_ms; docs/performance.md, "Build
  * time").
  *
