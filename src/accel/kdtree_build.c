@@ -40,8 +40,19 @@
  * CPU) the top levels fork: a below child's subtree is built by a new
  * thread into its own arrays while the above child is built here, down to
  * about 4 concurrent subtrees per thread, and the pieces are spliced into
- * depth-first order afterwards: the tree is bit-identical for any thread
- * count.
+ * depth-first order afterwards. Above that, where fewer subtrees than
+ * threads are being built (the root on 2 threads; the root and its
+ * children on 4), a node of 16k or more primitives shares its own work:
+ * the primitives' bounds and events and the root's radix sort in parts of
+ * the arrays, the sweeps in parts of each event list (cut where the key
+ * changes) started from the counts of the parts before, the sides in two
+ * passes (STARTs and PLANARs, then ENDs) and the children's lists by
+ * counts, then offsets. Each step gives what the one-thread step gives and
+ * the best plane is the first cheapest in the same order, so the tree is
+ * bit-identical for any thread count. What stays on one thread is the
+ * splice and the packing (kdtree_pack.c): 5-8% of the 1M-triangle model's
+ * CPU time (rt_kdtree_stats.serial_cpu_ms; docs/performance.md, "Build
+ * time").
  *
  * Output (kdtree_internal.h): 8-byte nodes in depth-first order (below
  * child = next node, above child index in the node) and leaf id lists in a
@@ -83,6 +94,45 @@ enum { SIDE_BOTH = 0, SIDE_LEFT = 1, SIDE_RIGHT = 2 };
  * second core free, DamagedHelmet (15k triangles) builds in 21-24 ms with 2
  * threads against 30-36 ms with 1 (20000 before, measured under load). */
 #define KD_FORK_MIN_PRIMS 4096
+/* A node of at least this many primitives near the root, where fewer
+ * subtrees than threads are being built, shares its own work (the plane
+ * sweeps, the sides, the children's lists) among the threads left over;
+ * so do the root's bounds and event sort. */
+#define KD_PART_MIN_PRIMS 16384
+#define KD_MAX_THREADS 64
+
+/* ----------------------------------------------------- fork-join parts */
+
+/* CPU time of the calling thread, ms. */
+static double thread_cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+}
+
+/* Runs fn on the n records at args (`size` bytes each), n - 1 of them on
+ * new threads and the first on this one, and waits for all; a record whose
+ * thread cannot start runs here afterwards. The records never depend on
+ * which thread ran them, so neither does the tree. */
+static void run_parts(void *(*fn)(void *), void *args, size_t size, int n)
+{
+    pthread_t th[KD_MAX_THREADS];
+    bool started[KD_MAX_THREADS];
+    char *a = args;
+    for (int i = 1; i < n; i++)
+        started[i] = pthread_create(&th[i], NULL, fn, a + (size_t)i * size) == 0;
+    fn(a);
+    for (int i = 1; i < n; i++) {
+        if (started[i])
+            pthread_join(th[i], NULL);
+        else
+            fn(a + (size_t)i * size);
+    }
+}
+
+/* Start of part i of n of a range of m items. */
+static inline size_t part_start(size_t m, int i, int n) { return m * (size_t)i / (size_t)n; }
 
 /* Event = ordered position bits << 32 | type << 30 | primitive: sorting the
  * integers sorts by (position, type). */
@@ -108,19 +158,56 @@ static inline uint32_t ev_key(uint64_t e) { return (uint32_t)(e >> 32); }
 static inline unsigned ev_type(uint64_t e) { return (unsigned)(e >> PRIM_BITS) & 3u; }
 static inline uint32_t ev_prim(uint64_t e) { return (uint32_t)e & PRIM_MASK; }
 
-/* Sorts events by (position, type); tmp has room for n. */
+/* Insertion sort by (position, type), stable. */
+static void ev_insertion_sort(uint64_t *a, size_t n)
+{
+    for (size_t i = 1; i < n; i++) {
+        uint64_t x = a[i];
+        size_t j = i;
+        while (j > 0 && (a[j - 1] >> PRIM_BITS) > (x >> PRIM_BITS)) {
+            a[j] = a[j - 1];
+            j--;
+        }
+        a[j] = x;
+    }
+}
+
+/* Bottom-up merge sort by (position, type), stable (runs of 16 by
+ * insertion); tmp has room for n. For the short lists of a split's
+ * straddlers, where the radix sort's 8,192 counters (zeroed and summed each
+ * pass) cost more than the events: the same order, as both are stable. */
+static void ev_merge_sort(uint64_t *a, size_t n, uint64_t *tmp)
+{
+    for (size_t i = 0; i < n; i += 16)
+        ev_insertion_sort(a + i, n - i < 16 ? n - i : 16);
+    uint64_t *src = a, *dst = tmp;
+    for (size_t w = 16; w < n; w *= 2) {
+        for (size_t i = 0; i < n; i += 2 * w) {
+            size_t m = i + w < n ? i + w : n, e = i + 2 * w < n ? i + 2 * w : n, p = i, q = m, k = i;
+            while (p < m && q < e)
+                dst[k++] = (src[q] >> PRIM_BITS) < (src[p] >> PRIM_BITS) ? src[q++] : src[p++];
+            while (p < m)
+                dst[k++] = src[p++];
+            while (q < e)
+                dst[k++] = src[q++];
+        }
+        uint64_t *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != a)
+        memcpy(a, src, n * sizeof *a);
+}
+
+/* Sorts events by (position, type), stable; tmp has room for n. */
 static void ev_sort(uint64_t *a, size_t n, uint64_t *tmp)
 {
     if (n < 64) {
-        for (size_t i = 1; i < n; i++) {
-            uint64_t x = a[i];
-            size_t j = i;
-            while (j > 0 && (a[j - 1] >> PRIM_BITS) > (x >> PRIM_BITS)) {
-                a[j] = a[j - 1];
-                j--;
-            }
-            a[j] = x;
-        }
+        ev_insertion_sort(a, n);
+        return;
+    }
+    if (n < 512) {
+        ev_merge_sort(a, n, tmp);
         return;
     }
     static const int shift[3] = {30, 41, 52}, bits[3] = {11, 11, 12};
@@ -205,6 +292,17 @@ static int clip_plane(double (*in)[3], int n, double (*out)[3], int k, double c,
     return m;
 }
 
+/* Whether the whole polygon keeps sign * (x_k - c) >= 0: then clip_plane
+ * would return it unchanged, and is skipped (most planes of a box cut a
+ * straddling triangle nowhere). */
+static bool all_inside(double (*in)[3], int n, int k, double c, double sign)
+{
+    for (int i = 0; i < n; i++)
+        if (!(sign * (in[i][k] - c) >= 0.0))
+            return false;
+    return true;
+}
+
 /* ------------------------------------------------------------- build */
 
 /* Parallel build: near the root (depth < fork_depth) the below child's
@@ -234,7 +332,107 @@ typedef struct kd_build {
     size_t nprims_total;  /* length of a side array */
     kd_fork **forks;      /* subtrees built by other threads (stable addresses) */
     size_t fork_count, fork_cap;
+    int threads;          /* of the whole build: a node at depth d shares its work among threads >> d */
+    bool track;           /* the caller's builder: times its parallel sections */
+    int par_nest;
+    double par_t0, par_cpu_ms; /* CPU time this thread spent while other build threads ran */
 } kd_build;
+
+/* Brackets a stretch during which other build threads run (nested ones
+ * count once): what the calling thread spends outside them is the build's
+ * serial part, which a second thread cannot shorten. */
+static void par_begin(kd_build *c)
+{
+    if (c->track && c->par_nest++ == 0)
+        c->par_t0 = thread_cpu_ms();
+}
+static void par_end(kd_build *c)
+{
+    if (c->track && --c->par_nest == 0)
+        c->par_cpu_ms += thread_cpu_ms() - c->par_t0;
+}
+
+/* run_parts, inside par_begin / par_end when on more than one thread. */
+static void run_parts_of(kd_build *c, void *(*fn)(void *), void *args, size_t size, int n)
+{
+    if (n < 2) {
+        fn(args);
+        return;
+    }
+    par_begin(c);
+    run_parts(fn, args, size, n);
+    par_end(c);
+}
+
+/* One part of a pass of ev_sort_parts: counts its events' digits, or
+ * scatters them to the offsets in count. */
+typedef struct kd_sort_part {
+    const uint64_t *src;
+    uint64_t *dst;
+    size_t from, to, mask;
+    size_t *count; /* mask + 1 entries */
+    int shift;
+    bool scatter;
+} kd_sort_part;
+
+static void *sort_part(void *arg)
+{
+    kd_sort_part *w = arg;
+    const uint64_t *src = w->src;
+    size_t *count = w->count, mask = w->mask;
+    int shift = w->shift;
+    if (!w->scatter) {
+        memset(count, 0, (mask + 1) * sizeof *count);
+        for (size_t i = w->from; i < w->to; i++)
+            count[(src[i] >> shift) & mask]++;
+    } else {
+        for (size_t i = w->from; i < w->to; i++)
+            w->dst[count[(src[i] >> shift) & mask]++] = src[i];
+    }
+    return NULL;
+}
+
+/* ev_sort on nt threads: the same three stable passes, each part of the
+ * list counting its digits, then scattering them after those of the parts
+ * before it; so the same order as ev_sort. tmp has room for n. */
+static void ev_sort_parts(kd_build *c, uint64_t *a, size_t n, uint64_t *tmp, int nt)
+{
+    size_t *counts = nt > 1 && n >= 2 * KD_PART_MIN_PRIMS ? malloc((size_t)nt * 4096 * sizeof *counts) : NULL;
+    if (!counts) {
+        ev_sort(a, n, tmp);
+        return;
+    }
+    static const int shift[3] = {30, 41, 52}, bits[3] = {11, 11, 12};
+    kd_sort_part part[KD_MAX_THREADS];
+    uint64_t *src = a, *dst = tmp;
+    for (int pass = 0; pass < 3; pass++) {
+        size_t radix = (size_t)1 << bits[pass], first = (src[0] >> shift[pass]) & (radix - 1), same = 0;
+        for (int i = 0; i < nt; i++)
+            part[i] = (kd_sort_part){src, dst, part_start(n, i, nt), part_start(n, i + 1, nt), radix - 1,
+                                     counts + (size_t)i * 4096, shift[pass], false};
+        run_parts_of(c, sort_part, part, sizeof *part, nt);
+        for (int i = 0; i < nt; i++)
+            same += part[i].count[first];
+        if (same == n)
+            continue; /* every key shares this digit */
+        size_t sum = 0;
+        for (size_t r = 0; r < radix; r++)
+            for (int i = 0; i < nt; i++) {
+                size_t m = part[i].count[r];
+                part[i].count[r] = sum;
+                sum += m;
+            }
+        for (int i = 0; i < nt; i++)
+            part[i].scatter = true;
+        run_parts_of(c, sort_part, part, sizeof *part, nt);
+        uint64_t *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != a)
+        memcpy(a, src, n * sizeof *a);
+    free(counts);
+}
 
 struct kd_fork {
     kd_build out; /* the subtree's nodes, ids, stats and its own forks */
@@ -294,9 +492,11 @@ static bool prim_clip_bounds(const kd_build *c, uint32_t prim, rt_box box, rt_bo
     if (n > 0) {
         int cur = 0;
         for (int k = 0; k < 3 && n > 0; k++) {
-            n = clip_plane(poly[cur], n, poly[cur ^ 1], k, bl[k], 1.0);
-            cur ^= 1;
-            if (n > 0) {
+            if (!all_inside(poly[cur], n, k, bl[k], 1.0)) {
+                n = clip_plane(poly[cur], n, poly[cur ^ 1], k, bl[k], 1.0);
+                cur ^= 1;
+            }
+            if (n > 0 && !all_inside(poly[cur], n, k, bh[k], -1.0)) {
                 n = clip_plane(poly[cur], n, poly[cur ^ 1], k, bh[k], -1.0);
                 cur ^= 1;
             }
@@ -423,63 +623,95 @@ static inline double plane_cost(double kt, double scale, double lambda, double w
     return nl == 0 || nr == 0 ? c * lambda : c;
 }
 
-/* Best SAH plane of a node (section 4.2 of Wald and Havran): one sweep per
- * axis over its sorted events. Returns the cost, INFINITY when no plane. */
-static double find_plane(const kd_build *c, rt_box V, uint64_t *const list[3], const size_t cnt[3], size_t nprims,
-                         int *best_k, uint32_t *best_key, int *best_side)
+/* A node's best plane so far: its cost, axis, position key and the side
+ * its planar primitives go to. */
+typedef struct kd_plane {
+    double cost;
+    int k, side;
+    uint32_t key;
+} kd_plane;
+
+/* What the plane cost needs of a node on one axis (find_plane). */
+typedef struct kd_axis {
+    double kt, scale, lambda, ab, apb, lo, hi;
+    uint32_t lo_key, hi_key;
+    bool ok; /* the node has extent on this axis */
+} kd_axis;
+
+/* The sweep's constants on each axis of V; false when V has no area (no
+ * plane then). cost = kt + ki * (PL * nl + PR * nr)
+ *                   = kt + (2 ki / area) * ((ab + dl (a+b)) nl + (ab + dr (a+b)) nr) */
+static bool node_axes(const kd_build *c, rt_box V, kd_axis ax[3])
 {
     const float *vlo = &V.lo.x, *vhi = &V.hi.x;
     double ext[3] = {(double)vhi[0] - vlo[0], (double)vhi[1] - vlo[1], (double)vhi[2] - vlo[2]};
     double area = 2.0 * (ext[0] * ext[1] + ext[1] * ext[2] + ext[2] * ext[0]);
-    double best = INFINITY;
     if (!(area > 0.0) || !isfinite(area))
-        return best;
-    /* cost = kt + ki * (PL * nl + PR * nr) = kt + (2 ki / area) * ((ab + dl (a+b)) nl + (ab + dr (a+b)) nr) */
-    double scale = 2.0 * c->ki / area, kt = c->kt, lambda = c->lambda;
+        return false;
     for (int k = 0; k < 3; k++) {
-        if (!(vlo[k] < vhi[k]))
-            continue;
-        double a = ext[(k + 1) % 3], b = ext[(k + 2) % 3], ab = a * b, apb = a + b;
-        uint32_t lo_key = f2o(vlo[k] + 0.0f), hi_key = f2o(vhi[k] + 0.0f);
-        const uint64_t *E = list[k];
-        size_t n = cnt[k], nl = 0, nr = nprims;
-        double lo = vlo[k], hi = vhi[k];
-        for (size_t i = 0; i < n;) {
-            uint64_t e = E[i];
-            uint32_t key = ev_key(e);
-            size_t pe, pp, ps;
-            if (i + 1 == n || ev_key(E[i + 1]) != key) { /* the usual lone event */
-                unsigned t = ev_type(e);
-                pe = t == EV_END, pp = t == EV_PLANAR, ps = t == EV_START;
-                i++;
-            } else {
-                pe = pp = ps = 0;
-                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_END)
-                    pe++, i++;
-                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_PLANAR)
-                    pp++, i++;
-                while (i < n && ev_key(E[i]) == key && ev_type(E[i]) == EV_START)
-                    ps++, i++;
-            }
-            nr -= pp + pe;
-            if (key > lo_key && key < hi_key) {
-                double p = (double)o2f(key);
-                double wl = ab + (p - lo) * apb, wr = ab + (hi - p) * apb;
-                double c1 = plane_cost(kt, scale, lambda, wl, wr, nl + pp, nr); /* planar ones left */
-                if (c1 < best) {
-                    best = c1, *best_k = k, *best_key = key, *best_side = SIDE_LEFT;
-                }
-                if (pp > 0) { /* planar ones right */
-                    double c2 = plane_cost(kt, scale, lambda, wl, wr, nl, nr + pp);
-                    if (c2 < best) {
-                        best = c2, *best_k = k, *best_key = key, *best_side = SIDE_RIGHT;
-                    }
-                }
-            }
-            nl += ps + pp;
-        }
+        double a = ext[(k + 1) % 3], b = ext[(k + 2) % 3];
+        ax[k] = (kd_axis){c->kt, 2.0 * c->ki / area, c->lambda, a * b, a + b, vlo[k], vhi[k],
+                          f2o(vlo[k] + 0.0f), f2o(vhi[k] + 0.0f), vlo[k] < vhi[k]};
     }
-    return best;
+    return true;
+}
+
+/* Sweeps events E[from..to) of axis k (a range that starts and ends where
+ * the key changes), with nl primitives left of the first event and nr not
+ * ended before it, and keeps in *best the first plane cheaper than it. */
+static void sweep(const kd_axis *ax, int k, const uint64_t *E, size_t from, size_t to, size_t nl, size_t nr,
+                  kd_plane *best)
+{
+    double kt = ax->kt, scale = ax->scale, lambda = ax->lambda, ab = ax->ab, apb = ax->apb, lo = ax->lo,
+           hi = ax->hi;
+    uint32_t lo_key = ax->lo_key, hi_key = ax->hi_key;
+    kd_plane b = *best;
+    for (size_t i = from; i < to;) {
+        uint64_t e = E[i];
+        uint32_t key = ev_key(e);
+        size_t pe, pp, ps;
+        if (i + 1 == to || ev_key(E[i + 1]) != key) { /* the usual lone event */
+            unsigned t = ev_type(e);
+            pe = t == EV_END, pp = t == EV_PLANAR, ps = t == EV_START;
+            i++;
+        } else {
+            pe = pp = ps = 0;
+            while (i < to && ev_key(E[i]) == key && ev_type(E[i]) == EV_END)
+                pe++, i++;
+            while (i < to && ev_key(E[i]) == key && ev_type(E[i]) == EV_PLANAR)
+                pp++, i++;
+            while (i < to && ev_key(E[i]) == key && ev_type(E[i]) == EV_START)
+                ps++, i++;
+        }
+        nr -= pp + pe;
+        if (key > lo_key && key < hi_key) {
+            double p = (double)o2f(key);
+            double wl = ab + (p - lo) * apb, wr = ab + (hi - p) * apb;
+            double c1 = plane_cost(kt, scale, lambda, wl, wr, nl + pp, nr); /* planar ones left */
+            if (c1 < b.cost)
+                b = (kd_plane){c1, k, SIDE_LEFT, key};
+            if (pp > 0) { /* planar ones right */
+                double c2 = plane_cost(kt, scale, lambda, wl, wr, nl, nr + pp);
+                if (c2 < b.cost)
+                    b = (kd_plane){c2, k, SIDE_RIGHT, key};
+            }
+        }
+        nl += ps + pp;
+    }
+    *best = b;
+}
+
+/* Best SAH plane of a node (section 4.2 of Wald and Havran): one sweep per
+ * axis over its sorted events, into *best (cost INFINITY when no plane). */
+static void find_plane(const kd_build *c, rt_box V, uint64_t *const list[3], const size_t cnt[3], size_t nprims,
+                       kd_plane *best)
+{
+    kd_axis ax[3];
+    if (!node_axes(c, V, ax))
+        return;
+    for (int k = 0; k < 3; k++)
+        if (ax[k].ok)
+            sweep(&ax[k], k, list[k], 0, cnt[k], 0, nprims, best);
 }
 
 /* Fills in interior node `node` once both children are built: split
@@ -574,6 +806,20 @@ typedef struct kd_children {
     size_t left_prims, right_prims;
 } kd_children;
 
+/* Gives back what the worst case of the children's lists did not need
+ * (shrinking cannot fail for good) and hands them to ch. */
+static void children_shrink(kd_children *ch, uint64_t *lev, size_t lo, size_t lcap, uint64_t *rev, size_t ro,
+                            size_t rcap)
+{
+    uint64_t *t;
+    if (lo < lcap && (t = realloc(lev, (lo ? lo : 1) * sizeof *lev)) != NULL)
+        lev = t;
+    if (ro < rcap && (t = realloc(rev, (ro ? ro : 1) * sizeof *rev)) != NULL)
+        rev = t;
+    ch->lev = lev;
+    ch->rev = rev;
+}
+
 /* Filters the parent's lists into the children's blocks by c->side, merging
  * the straddlers' new events in; sized for the worst case, shrunk
  * afterwards. k: the split axis, whose events count the primitives. False
@@ -621,14 +867,7 @@ static bool split_events(const kd_build *c, uint64_t *const list[3], const size_
         lo += ch->lc[d];
         ro += ch->rc[d];
     }
-    /* give back what the worst case did not need (shrinking cannot fail for good) */
-    uint64_t *t;
-    if (lo < lcap && (t = realloc(lev, (lo ? lo : 1) * sizeof *lev)) != NULL)
-        lev = t;
-    if (ro < rcap && (t = realloc(rev, (ro ? ro : 1) * sizeof *rev)) != NULL)
-        rev = t;
-    ch->lev = lev;
-    ch->rev = rev;
+    children_shrink(ch, lev, lo, lcap, rev, ro, rcap);
     return true;
 }
 
@@ -654,12 +893,14 @@ static void build_forked(kd_build *c, kd_fork *f, uint32_t node, int k, float sp
     o->kt = c->kt, o->ki = c->ki, o->lambda = c->lambda;
     o->max_depth = c->max_depth;
     o->fork_depth = c->fork_depth, o->fork_min = c->fork_min, o->nprims_total = c->nprims_total;
+    o->threads = c->threads;
     f->V = VL;
     f->ev = ch->lev;
     memcpy(f->cnt, ch->lc, sizeof f->cnt);
     f->nprims = ch->left_prims;
     f->depth = depth + 1;
     pthread_t th;
+    par_begin(c);
     bool started = pthread_create(&th, NULL, fork_worker, f) == 0;
     if (!started)
         fork_worker(f);
@@ -667,6 +908,7 @@ static void build_forked(kd_build *c, kd_fork *f, uint32_t node, int k, float sp
     build_rec(c, VR, ch->rev, ch->rc, ch->right_prims, depth + 1);
     if (started)
         pthread_join(th, NULL);
+    par_end(c);
     if (f->out.oom) {
         c->oom = true;
         c->limit |= f->out.limit;
@@ -675,6 +917,297 @@ static void build_forked(kd_build *c, kd_fork *f, uint32_t node, int k, float sp
         return;
     bool below_empty = f->out.node_count == 1 && f->out.nodes[0].b == KD_LEAF_TAG;
     set_interior(c, node, k, split, below_empty, above);
+}
+
+/* ------------------------------------------- a large node on many threads */
+
+/* Near the root, where fewer subtrees than threads are being built, a
+ * large node cuts each axis' event list into parts (at key changes, so a
+ * sweep's group of equal keys stays in one part) and runs each step on
+ * them side by side: counts, then the sweeps from the counts of the parts
+ * before; the primitives' sides (STARTs and PLANARs, then ENDs); the
+ * children's lists (counts, then copies to the offsets they give, then the
+ * straddlers merged in). Every step gives what the one-thread step gives,
+ * and the best plane is the first cheapest in the same order: the same
+ * tree. */
+enum { STEP_COUNT, STEP_SWEEP, STEP_STARTS, STEP_ENDS, STEP_SPLIT_COUNT, STEP_SPLIT, STEP_MERGE };
+
+typedef struct kd_node_work {
+    kd_build *c;
+    uint64_t *const *list;
+    kd_axis ax[3];
+    kd_plane plane;
+    const kd_straddlers *x;
+    uint64_t *lbase[3], *rbase[3]; /* the children's lists per axis */
+    size_t la[3], rb[3];           /* ... before the straddlers' events */
+    int parts;
+} kd_node_work;
+
+typedef struct kd_node_part {
+    kd_node_work *w;
+    int index, step;
+    size_t from[3], to[3];
+    size_t nl[3], nr[3]; /* STEP_COUNT: non-END, non-START events; then the sweep's counts before the part */
+    kd_plane best[3];
+    size_t ns; /* straddlers, at c->strad + from[k] */
+    size_t nleft[3], nright[3], lprims, rprims;
+    uint64_t *lout[3], *rout[3];
+} kd_node_part;
+
+static void part_count(kd_node_part *p)
+{
+    for (int k = 0; k < 3; k++) {
+        const uint64_t *E = p->w->list[k];
+        size_t nl = 0, nr = 0;
+        if (p->w->ax[k].ok)
+            for (size_t i = p->from[k]; i < p->to[k]; i++) {
+                unsigned t = ev_type(E[i]);
+                nl += t != EV_END;
+                nr += t != EV_START;
+            }
+        p->nl[k] = nl;
+        p->nr[k] = nr;
+    }
+}
+
+static void part_sweep(kd_node_part *p)
+{
+    for (int k = 0; k < 3; k++) {
+        p->best[k] = (kd_plane){INFINITY, -1, SIDE_LEFT, 0};
+        if (p->w->ax[k].ok)
+            sweep(&p->w->ax[k], k, p->w->list[k], p->from[k], p->to[k], p->nl[k], p->nr[k], &p->best[k]);
+    }
+}
+
+/* classify's START and PLANAR events (ends: its END events, after all
+ * parts' starts). */
+static void part_sides(kd_node_part *p, bool ends)
+{
+    kd_plane pl = p->w->plane;
+    uint8_t *side = p->w->c->side;
+    const uint64_t *E = p->w->list[pl.k];
+    uint32_t *strad = p->w->c->strad + p->from[pl.k];
+    size_t ns = 0;
+    for (size_t i = p->from[pl.k]; i < p->to[pl.k]; i++) {
+        uint64_t e = E[i];
+        uint32_t key = ev_key(e), q = ev_prim(e);
+        unsigned t = ev_type(e);
+        if (ends && t == EV_END) {
+            if (key <= pl.key)
+                side[q] = SIDE_LEFT;
+            else if (side[q] == SIDE_BOTH)
+                strad[ns++] = q;
+        } else if (!ends && t == EV_START) {
+            side[q] = key >= pl.key ? SIDE_RIGHT : SIDE_BOTH;
+        } else if (!ends && t == EV_PLANAR) {
+            side[q] = key < pl.key || (key == pl.key && pl.side == SIDE_LEFT) ? SIDE_LEFT : SIDE_RIGHT;
+        }
+    }
+    p->ns = ns;
+}
+
+static void part_split_count(kd_node_part *p)
+{
+    const uint8_t *side = p->w->c->side;
+    int k = p->w->plane.k;
+    for (int d = 0; d < 3; d++) {
+        const uint64_t *E = p->w->list[d];
+        size_t a = 0, b = 0;
+        for (size_t i = p->from[d]; i < p->to[d]; i++) {
+            uint8_t sd = side[ev_prim(E[i])];
+            a += sd == SIDE_LEFT;
+            b += sd == SIDE_RIGHT;
+        }
+        p->nleft[d] = a;
+        p->nright[d] = b;
+    }
+    const uint64_t *E = p->w->list[k];
+    p->lprims = p->rprims = 0;
+    for (size_t i = p->from[k]; i < p->to[k]; i++) {
+        uint8_t sd = side[ev_prim(E[i])];
+        bool counts = ev_type(E[i]) != EV_END;
+        p->lprims += counts && sd == SIDE_LEFT;
+        p->rprims += counts && sd == SIDE_RIGHT;
+    }
+}
+
+/* split_events' copy, each event to its side's list or to a sink (a
+ * write past the part's end would land in the next part's). */
+static void part_split(kd_node_part *p)
+{
+    const uint8_t *side = p->w->c->side;
+    for (int d = 0; d < 3; d++) {
+        const uint64_t *E = p->w->list[d];
+        uint64_t *lp = p->lout[d], *rp = p->rout[d], sink;
+        size_t a = 0, b = 0;
+        for (size_t i = p->from[d]; i < p->to[d]; i++) {
+            uint64_t e = E[i];
+            uint8_t sd = side[ev_prim(e)];
+            *(sd == SIDE_LEFT ? lp + a : &sink) = e;
+            *(sd == SIDE_RIGHT ? rp + b : &sink) = e;
+            a += sd == SIDE_LEFT;
+            b += sd == SIDE_RIGHT;
+        }
+    }
+}
+
+/* The straddlers' events merged into the six lists, list j of 6 in part j
+ * mod parts. */
+static void part_merge(kd_node_part *p)
+{
+    kd_node_work *w = p->w;
+    for (int j = p->index; j < 6; j += w->parts) {
+        int d = j / 2;
+        if (j & 1)
+            merge_back(w->rbase[d], w->rb[d], w->x->r[d], w->x->rcnt[d]);
+        else
+            merge_back(w->lbase[d], w->la[d], w->x->l[d], w->x->lcnt[d]);
+    }
+}
+
+static void *node_part(void *arg)
+{
+    kd_node_part *p = arg;
+    switch (p->step) {
+    case STEP_COUNT: part_count(p); break;
+    case STEP_SWEEP: part_sweep(p); break;
+    case STEP_STARTS: part_sides(p, false); break;
+    case STEP_ENDS: part_sides(p, true); break;
+    case STEP_SPLIT_COUNT: part_split_count(p); break;
+    case STEP_SPLIT: part_split(p); break;
+    default: part_merge(p); break;
+    }
+    return NULL;
+}
+
+static void run_step(kd_node_part *part, int step)
+{
+    int n = part[0].w->parts;
+    for (int i = 0; i < n; i++)
+        part[i].step = step;
+    run_parts_of(part[0].w->c, node_part, part, sizeof *part, n);
+}
+
+/* The parts of a node's lists: each axis' cut at key changes. */
+static void node_parts_cut(kd_node_part *part, int n, uint64_t *const list[3], const size_t cnt[3])
+{
+    for (int k = 0; k < 3; k++) {
+        size_t prev = 0;
+        for (int i = 0; i < n; i++) {
+            size_t b = i + 1 == n ? cnt[k] : part_start(cnt[k], i + 1, n);
+            if (b < prev)
+                b = prev;
+            while (b > 0 && b < cnt[k] && ev_key(list[k][b]) == ev_key(list[k][b - 1]))
+                b++;
+            part[i].from[k] = prev;
+            part[i].to[k] = b;
+            prev = b;
+        }
+    }
+}
+
+/* find_plane on the parts. */
+static void find_plane_parts(kd_node_work *w, kd_node_part *part, rt_box V, size_t nprims, kd_plane *best)
+{
+    if (!node_axes(w->c, V, w->ax))
+        return;
+    run_step(part, STEP_COUNT);
+    for (int k = 0; k < 3; k++) {
+        size_t nl = 0, nr = nprims;
+        for (int i = 0; i < w->parts; i++) {
+            size_t dl = part[i].nl[k], dr = part[i].nr[k];
+            part[i].nl[k] = nl;
+            part[i].nr[k] = nr;
+            nl += dl;
+            nr -= dr;
+        }
+    }
+    run_step(part, STEP_SWEEP);
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < w->parts; i++)
+            if (part[i].best[k].cost < best->cost)
+                *best = part[i].best[k];
+}
+
+/* classify on the parts (c->strad has room for the axis' events). */
+static size_t classify_parts(kd_node_work *w, kd_node_part *part)
+{
+    run_step(part, STEP_STARTS);
+    run_step(part, STEP_ENDS);
+    size_t ns = 0;
+    uint32_t *strad = w->c->strad;
+    for (int i = 0; i < w->parts; i++) {
+        memmove(strad + ns, strad + part[i].from[w->plane.k], part[i].ns * sizeof *strad);
+        ns += part[i].ns;
+    }
+    return ns;
+}
+
+/* split_events on the parts. */
+static bool split_events_parts(kd_node_work *w, kd_node_part *part, const size_t cnt[3], size_t ns,
+                               const kd_straddlers *x, kd_children *ch)
+{
+    run_step(part, STEP_SPLIT_COUNT);
+    size_t total = cnt[0] + cnt[1] + cnt[2];
+    size_t lcap = total + x->lcnt[0] + x->lcnt[1] + x->lcnt[2], rcap = total + x->rcnt[0] + x->rcnt[1] + x->rcnt[2];
+    uint64_t *lev = malloc((lcap ? lcap : 1) * sizeof *lev);
+    uint64_t *rev = malloc((rcap ? rcap : 1) * sizeof *rev);
+    if (!lev || !rev) {
+        free(lev);
+        free(rev);
+        return false;
+    }
+    size_t lo = 0, ro = 0;
+    ch->left_prims = x->npl;
+    ch->right_prims = x->npr;
+    for (int d = 0; d < 3; d++) {
+        size_t a = 0, b = 0;
+        w->lbase[d] = lev + lo;
+        w->rbase[d] = rev + ro;
+        for (int i = 0; i < w->parts; i++) {
+            part[i].lout[d] = lev + lo + a;
+            part[i].rout[d] = rev + ro + b;
+            a += part[i].nleft[d];
+            b += part[i].nright[d];
+        }
+        w->la[d] = a;
+        w->rb[d] = b;
+        ch->lc[d] = a + x->lcnt[d];
+        ch->rc[d] = b + x->rcnt[d];
+        lo += ch->lc[d];
+        ro += ch->rc[d];
+    }
+    for (int i = 0; i < w->parts; i++) {
+        ch->left_prims += part[i].lprims;
+        ch->right_prims += part[i].rprims;
+    }
+    run_step(part, STEP_SPLIT);
+    if (ns > 0) {
+        w->x = x;
+        run_step(part, STEP_MERGE);
+    }
+    children_shrink(ch, lev, lo, lcap, rev, ro, rcap);
+    return true;
+}
+
+/* The parts of a node of nprims primitives at `depth`, when it is large
+ * and threads are left over (NULL: the node runs on this thread). */
+static kd_node_part *node_parts(kd_build *c, kd_node_work *w, uint64_t *const list[3], const size_t cnt[3],
+                                size_t nprims, int depth)
+{
+    int n = depth < 8 ? c->threads >> depth : 1;
+    if (n < 2 || nprims < KD_PART_MIN_PRIMS || depth >= c->max_depth)
+        return NULL;
+    kd_node_part *part = calloc((size_t)n, sizeof *part);
+    if (!part)
+        return NULL;
+    *w = (kd_node_work){.c = c, .list = list, .parts = n};
+    for (int i = 0; i < n; i++) {
+        part[i].w = w;
+        part[i].index = i;
+    }
+    node_parts_cut(part, n, list, cnt);
+    return part;
 }
 
 /* Builds the subtree of box V from its event lists (one block `ev`, lists of
@@ -690,24 +1223,32 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
         return;
     }
     uint64_t *list[3] = {ev, ev + cnt[0], ev + cnt[0] + cnt[1]};
-    int k = -1, best_side = SIDE_LEFT;
-    uint32_t best_key = 0;
-    double best = INFINITY;
-    if (nprims > 1 && depth < c->max_depth)
-        best = find_plane(c, V, list, cnt, nprims, &k, &best_key, &best_side);
-    if (k < 0 || !(best < c->ki * (double)nprims)) {
+    kd_node_work work;
+    kd_node_part *parts = node_parts(c, &work, list, cnt, nprims, depth);
+    kd_plane pl = {INFINITY, -1, SIDE_LEFT, 0};
+    if (nprims > 1 && depth < c->max_depth) {
+        if (parts)
+            find_plane_parts(&work, parts, V, nprims, &pl);
+        else
+            find_plane(c, V, list, cnt, nprims, &pl);
+    }
+    int k = pl.k;
+    if (k < 0 || !(pl.cost < c->ki * (double)nprims)) {
         make_leaf(c, node, list[0], cnt[0], nprims, depth);
+        free(parts);
         free(ev);
         return;
     }
-    if (!rt_grow((void **)&c->strad, &c->strad_cap, nprims, sizeof *c->strad)) {
+    if (!rt_grow((void **)&c->strad, &c->strad_cap, parts ? cnt[k] : nprims, sizeof *c->strad)) {
         c->oom = true;
+        free(parts);
         free(ev);
         return;
     }
-    size_t ns = classify(c, list[k], cnt[k], best_key, best_side);
+    work.plane = pl;
+    size_t ns = parts ? classify_parts(&work, parts) : classify(c, list[k], cnt[k], pl.key, pl.side);
 
-    float split = o2f(best_key);
+    float split = o2f(pl.key);
     rt_box VL = V, VR = V;
     box_hi(&VL)[k] = split;
     box_lo(&VR)[k] = split;
@@ -715,11 +1256,13 @@ static void build_rec(kd_build *c, rt_box V, uint64_t *ev, size_t cnt[3], size_t
     kd_straddlers x;
     if (!clip_straddlers(c, ns, VL, VR, &x)) {
         c->oom = true;
+        free(parts);
         free(ev);
         return;
     }
     kd_children ch;
-    bool ok = split_events(c, list, cnt, k, ns, &x, &ch);
+    bool ok = parts ? split_events_parts(&work, parts, cnt, ns, &x, &ch) : split_events(c, list, cnt, k, ns, &x, &ch);
+    free(parts);
     free(x.buf);
     free(ev);
     if (!ok) {
@@ -831,20 +1374,6 @@ static size_t stitch(const kd_build *b, size_t i, rt_kdtree_node *nodes, size_t 
 
 static bool finite_box(rt_box b) { return rt_finite3(b.lo) && rt_finite3(b.hi); }
 
-typedef struct kd_sort_job {
-    uint64_t *list[2];
-    size_t cnt[2];
-    uint64_t *tmp;
-} kd_sort_job;
-
-static void *sort_worker(void *arg)
-{
-    kd_sort_job *j = arg;
-    ev_sort(j->list[0], j->cnt[0], j->tmp);
-    ev_sort(j->list[1], j->cnt[1], j->tmp);
-    return NULL;
-}
-
 /* ------------------------------------------------------- the whole build */
 
 /* Bounds of every primitive (and the triangles' records), the root's three
@@ -931,53 +1460,96 @@ static bool prim_bounds(const kd_build *c, rt_kdtree *tree, size_t i, rt_box *ou
     return ok;
 }
 
-/* Every primitive's box into pb (empty for one that can never be hit) and
- * the tree's bounds; returns how many can be hit. */
-static size_t bound_prims(const kd_build *c, rt_kdtree *tree, rt_box *pb, size_t N)
+/* One part of the primitives: their boxes (pass 1), then their events
+ * (pass 2, into list at the offsets the parts before it leave). */
+typedef struct kd_bound_part {
+    const kd_build *c;
+    rt_kdtree *tree;
+    rt_box *pb;
+    size_t from, to;
+    size_t nvalid, placed, cnt[3]; /* pass 1: hittable primitives, objects' triangles, events per axis */
+    rt_box bounds;
+    uint64_t *list[3]; /* pass 2 */
+    bool emit;
+} kd_bound_part;
+
+static void *bound_part(void *arg)
 {
-    size_t nvalid = 0, placed = 0; /* placed: objects' triangles, left out on purpose */
-    for (size_t i = 0; i < N; i++) {
+    kd_bound_part *w = arg;
+    if (w->emit) {
+        size_t n[3] = {0, 0, 0};
+        for (size_t i = w->from; i < w->to; i++)
+            if (!rt_box_is_empty(w->pb[i]))
+                emit_events(w->pb[i], (uint32_t)i, w->list, n);
+        return NULL;
+    }
+    const kd_build *c = w->c;
+    w->bounds = rt_box_empty();
+    for (size_t i = w->from; i < w->to; i++) {
         if (c->skip_objects && i < c->T && (c->s->triangles.flags[i] & RT_TRI_OBJECT))
-            placed++;
+            w->placed++;
         rt_box b;
-        bool ok = prim_bounds(c, tree, i, &b);
-        pb[i] = b;
-        if (ok) {
-            nvalid++;
-            tree->bounds = rt_box_union(tree->bounds, b);
-        } else {
-            pb[i] = rt_box_empty();
+        if (!prim_bounds(c, w->tree, i, &b)) {
+            w->pb[i] = rt_box_empty();
+            continue;
         }
+        w->pb[i] = b;
+        w->nvalid++;
+        w->bounds = rt_box_union(w->bounds, b);
+        for (int k = 0; k < 3; k++)
+            w->cnt[k] += (&b.lo.x)[k] == (&b.hi.x)[k] ? 1 : 2;
+    }
+    return NULL;
+}
+
+/* Every primitive's box (pb: empty for one that can never be hit), the
+ * tree's bounds and the root's unsorted event lists, in primitive order, in
+ * ev (room for 6 N): list k at ev + 2 k nvalid, cnt[k] long; on nt threads.
+ * Returns how many primitives can be hit. */
+static size_t bound_prims(kd_build *c, rt_kdtree *tree, rt_box *pb, size_t N, int nt, uint64_t *ev,
+                          uint64_t *list[3], size_t cnt[3])
+{
+    kd_bound_part part[KD_MAX_THREADS];
+    if (nt < 1 || N < KD_PART_MIN_PRIMS)
+        nt = 1;
+    for (int i = 0; i < nt; i++)
+        part[i] = (kd_bound_part){.c = c, .tree = tree, .pb = pb, .from = part_start(N, i, nt),
+                                  .to = part_start(N, i + 1, nt)};
+    run_parts_of(c, bound_part, part, sizeof *part, nt);
+    size_t nvalid = 0, placed = 0;
+    for (int i = 0; i < nt; i++) {
+        nvalid += part[i].nvalid;
+        placed += part[i].placed;
+        if (part[i].nvalid > 0)
+            tree->bounds = rt_box_union(tree->bounds, part[i].bounds);
     }
     if (nvalid + placed < N)
         rt_info("kdtree: %zu of %zu primitives can never be hit (non-finite or degenerate) and are left out",
                 N - nvalid - placed, N - placed);
+    for (int k = 0; k < 3; k++) {
+        list[k] = ev + 2 * (size_t)k * nvalid;
+        cnt[k] = 0;
+    }
+    for (int i = 0; i < nt; i++)
+        for (int k = 0; k < 3; k++) {
+            part[i].list[k] = list[k] + cnt[k];
+            cnt[k] += part[i].cnt[k];
+            part[i].emit = true;
+        }
+    run_parts_of(c, bound_part, part, sizeof *part, nt);
     return nvalid;
 }
 
-/* Sorts the three event lists (y and z on a helper thread when threads > 1
- * and there are enough) and compacts them into one block at list[0];
- * false when out of memory. */
-static bool sort_events(uint64_t *list[3], const size_t cnt[3], size_t nvalid, int threads)
+/* Sorts the three event lists (each on nt threads when long) and compacts
+ * them into one block at list[0]; false when out of memory. */
+static bool sort_events(kd_build *c, uint64_t *list[3], const size_t cnt[3], size_t nvalid, int nt)
 {
     uint64_t *ev = list[0];
     uint64_t *tmp = malloc((nvalid ? 2 * nvalid : 1) * sizeof *tmp);
     if (!tmp)
         return false;
-    /* the three axes sort independently: y and z on a helper thread */
-    kd_sort_job job = {{list[1], list[2]}, {cnt[1], cnt[2]}, NULL};
-    pthread_t th;
-    bool started = false;
-    if (threads > 1 && nvalid >= KD_FORK_MIN_PRIMS && (job.tmp = malloc(2 * nvalid * sizeof *job.tmp)) != NULL)
-        started = pthread_create(&th, NULL, sort_worker, &job) == 0;
-    ev_sort(list[0], cnt[0], tmp);
-    if (started) {
-        pthread_join(th, NULL);
-    } else {
-        ev_sort(list[1], cnt[1], tmp);
-        ev_sort(list[2], cnt[2], tmp);
-    }
-    free(job.tmp);
+    for (int k = 0; k < 3; k++)
+        ev_sort_parts(c, list[k], cnt[k], tmp, nt);
     free(tmp);
     /* compact the three lists into one block */
     memmove(ev + cnt[0], list[1], cnt[1] * sizeof *ev);
@@ -1059,6 +1631,9 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
 
     kd_build c;
     int threads = init_build(&c, scene, params);
+    c.threads = threads;
+    c.track = true;
+    double cpu0 = thread_cpu_ms();
     uint64_t *ev = NULL;
     if (T > 0) {
         tree->tri = malloc(T * 9 * sizeof *tree->tri);
@@ -1074,15 +1649,11 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     rt_box *pb = malloc((N ? N : 1) * sizeof *pb);
     if (!pb)
         goto oom;
-    size_t nvalid = bound_prims(&c, tree, pb, N);
-
-    size_t cnt[3] = {0, 0, 0};
-    uint64_t *list[3] = {ev, ev + 2 * nvalid, ev + 4 * nvalid};
-    for (size_t i = 0; i < N; i++)
-        if (!rt_box_is_empty(pb[i]))
-            emit_events(pb[i], (uint32_t)i, list, cnt);
+    size_t cnt[3];
+    uint64_t *list[3];
+    size_t nvalid = bound_prims(&c, tree, pb, N, threads, ev, list, cnt);
     free(pb);
-    if (!sort_events(list, cnt, nvalid, threads))
+    if (!sort_events(&c, list, cnt, nvalid, threads))
         goto oom;
 
     if (nvalid > 0) {
@@ -1130,6 +1701,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     free(c.nodes);
     free(c.ids);
     c.st.build_ms = 1e3 * rt_now_seconds() - t0;
+    c.st.serial_cpu_ms = thread_cpu_ms() - cpu0 - c.par_cpu_ms;
     tree->stats = c.st;
     return RT_OK;
 

@@ -86,6 +86,7 @@ typedef struct rt_kdtree_stats {
     size_t max_leaf_prims;
     int depth;
     double build_ms;
+    double serial_cpu_ms; /* CPU time the building thread spent with no other build thread running (the top-level tree) */
     size_t bytes;         /* wide nodes + leaf blocks (ids and triangles) + prepared quads (+ the objects' trees) */
 } rt_kdtree_stats;
 
