@@ -198,16 +198,20 @@ rt_vec3 rt_path_shadow(const rt_trace_ctx *ctx, const rt_path_state *ps, const r
     return rt_shadow_path_transmittance(ctx, sf, rec->wi, rec->dist, thin);
 }
 
-bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
-                     rt_nee_record *rec)
+bool rt_path_env_sample(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, rt_vec3 *d, float *pdf_l)
 {
     if (!rt_path_samples_env(ctx))
         return false;
-    const rt_light_table *t = ctx->state->light_table;
     rt_vec2 u = path_2d(ctx, ps, rng, DIM_ENV);
+    return rt_light_table_sample_env(ctx->state->light_table, u, d, pdf_l);
+}
+
+bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
+                     rt_nee_record *rec)
+{
     rt_vec3 d;
     float pdf_l;
-    if (rt_light_table_sample_env(t, u, &d, &pdf_l) && rt_dot(d, b->ng) > 0.0f)
+    if (rt_path_env_sample(ctx, ps, rng, &d, &pdf_l) && rt_dot(d, b->ng) > 0.0f)
         return light_table_record(ctx, b, wo, d, NULL, pdf_l, INFINITY, rec);
     return false;
 }

@@ -1,7 +1,8 @@
-/* shade_lanes.c - BSDF sampling and weighting in SIMD lanes over
- * structure-of-arrays paths (rt/render/shade_lanes.h): the wavefront's
- * shading of a material kind, RT_SHADE_LANES paths a step, written once
- * with GCC / clang vector types.
+/* shade_lanes.c - BSDF sampling and weighting, and light sampling with
+ * the BSDF evaluated at the light and the power heuristic, in SIMD lanes
+ * over structure-of-arrays paths (rt/render/shade_lanes.h): the
+ * wavefront's shading of a material kind, RT_SHADE_LANES paths a step,
+ * written once with GCC / clang vector types.
  *
  * The approach is Afra, Benthin, Wald and Munkberg, "Local shading
  * coherence extraction for SIMD-efficient path tracing on CPUs" (HPG
@@ -10,7 +11,11 @@
  * one path at a time. Each lane repeats the scalar code's operations in
  * its order (rt/render/sampling.h's concentric cosine sampling and
  * rt/base/vec.h's rt_sincosf, bsdf.c's lambert_sample and finish_sample,
- * pathtrace.c's rt_path_vertex_end), branches as selects: the same bits.
+ * pathtrace.c's rt_path_vertex_end; light.c's rt_light_sample_at,
+ * bsdf.c's evaluations, pathtrace.c's rt_path_nee_light_at), branches as
+ * selects: the same bits. The solid-angle sampling of a rectangle seen
+ * large (light.c, spherical.c: double precision, atan2) is called per
+ * lane from the vector step, so it keeps its bits too.
  */
 #include "rt/render/shade_lanes.h"
 
@@ -665,7 +670,7 @@ static void nee_step(rt_shade_lanes *l, size_t k, int kind, bool mis)
 
 void rt_nee_eval_lanes(rt_shade_lanes *l, int kind, bool mis, size_t n)
 {
-    size_t end = (n + W - 1) / W * W; /* (rt_light_sample_lanes padded the inputs) */
+    size_t end = (n + W - 1) / W * W; /* (lanes past n compute on what they hold; nobody reads them) */
     for (size_t k = 0; k < end; k += W)
         nee_step(l, k, kind, mis);
 }

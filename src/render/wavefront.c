@@ -40,6 +40,7 @@
 
 #include "rt/accel/kdtree_batch.h"
 #include "rt/base/alloc.h"
+#include "rt/render/environment.h"
 #include "rt/render/pathtrace.h"
 #include "rt/render/shade_lanes.h"
 
@@ -99,6 +100,12 @@ struct rt_wavefront {
          * at [slot * lights + j] */
         rt_vec2 *lu;
         uint32_t *lrec;
+        /* the environment's sample likewise (direction, pdf, whether
+         * there is one, its record) */
+        rt_vec3 *ed;
+        float *epdf;
+        uint8_t *eok;
+        uint32_t *erec;
     } kl[4];
 };
 
@@ -154,6 +161,10 @@ rt_wavefront *rt_wavefront_new(size_t batch, const rt_render_state *state)
         size_t L = state->scene->light_count ? state->scene->light_count : 1;
         wf->kl[c].lu = grab(B * L, sizeof(rt_vec2), &ok);
         wf->kl[c].lrec = grab(B * L, sizeof(uint32_t), &ok);
+        wf->kl[c].ed = grab(B, sizeof(rt_vec3), &ok);
+        wf->kl[c].epdf = grab(B, sizeof(float), &ok);
+        wf->kl[c].eok = grab(B, 1, &ok);
+        wf->kl[c].erec = grab(B, sizeof(uint32_t), &ok);
         wf->kl[c].soa = rt_shade_lanes_new(B);
         if (!wf->kl[c].soa)
             ok = false;
@@ -181,6 +192,10 @@ void rt_wavefront_free(rt_wavefront *wf)
         free(wf->kl[c].draw);
         free(wf->kl[c].lu);
         free(wf->kl[c].lrec);
+        free(wf->kl[c].ed);
+        free(wf->kl[c].epdf);
+        free(wf->kl[c].eok);
+        free(wf->kl[c].erec);
         rt_shade_lanes_free(wf->kl[c].soa);
     }
     free(wf);
@@ -362,21 +377,26 @@ static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, si
     const size_t lights = ctx->state->scene->light_count;
     int lanes = rt_shade_lanes_kind(&b);
     if (lanes >= 0 && lanes != RT_BSDF_KIND_DIELECTRIC) {
-        /* light samples in lanes (nee_lanes): their values drawn now, in
-         * order, a record kept for each */
+        /* light and environment samples in lanes (nee_lanes): their
+         * values drawn now, in order, a record kept for each */
         struct kind_lanes *kl = kind_lanes_of(wf, lanes);
+        size_t k = kl->n;
         for (size_t l = 0; l < lights; l++) {
-            kl->lu[kl->n * lights + l] = rt_path_light_u(ctx, ps, rng, l);
-            kl->lrec[kl->n * lights + l] = (uint32_t)n++;
+            kl->lu[k * lights + l] = rt_path_light_u(ctx, ps, rng, l);
+            kl->lrec[k * lights + l] = (uint32_t)n++;
+        }
+        if (env) {
+            kl->eok[k] = rt_path_env_sample(ctx, ps, rng, &kl->ed[k], &kl->epdf[k]);
+            kl->erec[k] = (uint32_t)n++;
         }
     } else {
         for (size_t l = 0; l < lights; l++)
             if (rt_path_nee_light(ctx, ps, sf, &b, wo, rng, l, &wf->rec[n]))
                 add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
+        /* (skipped when they could make nothing: they would draw nothing) */
+        if (env && rt_path_nee_env(ctx, ps, &b, wo, rng, &wf->rec[n]))
+            add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
     }
-    /* (skipped when they could make nothing: they would draw nothing) */
-    if (env && rt_path_nee_env(ctx, ps, &b, wo, rng, &wf->rec[n]))
-        add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
     if (emitters && rt_path_nee_emitter(ctx, ps, sf, &b, wo, rng, &wf->rec[n]))
         add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
     *n_rec = n;
@@ -396,12 +416,31 @@ static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, si
  * kept for them: a record that can contribute gets its shadow ray (or
  * its visibility), one that cannot gets visibility 0, which
  * rt_path_nee_add skips as the scalar tracer skips a record it never made. */
-static void nee_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, int c, size_t *n_pending)
+static void nee_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, int c, bool env, size_t *n_pending)
 {
     static const int kinds[] = {RT_BSDF_KIND_LAMBERT, RT_BSDF_KIND_CONDUCTOR, RT_BSDF_KIND_GLTF};
     struct kind_lanes *kl = &wf->kl[c];
     rt_shade_lanes *l = kl->soa;
     const size_t lights = ctx->state->scene->light_count;
+    if (env) { /* the environment: its radiance 1 here, times the image's after (f 1 Le = f Le) */
+        for (size_t k = 0; k < kl->n; k++) {
+            l->lwx[k] = kl->ed[k].x, l->lwy[k] = kl->ed[k].y, l->lwz[k] = kl->ed[k].z;
+            l->ldist[k] = INFINITY, l->lr[k] = l->lg[k] = l->lb[k] = 1.0f;
+            l->lpdf[k] = kl->epdf[k], l->lok[k] = kl->eok[k];
+        }
+        rt_nee_eval_lanes(l, kinds[c], true, kl->n);
+        for (size_t k = 0; k < kl->n; k++) {
+            uint32_t i = kl->lane[k], r = kl->erec[k];
+            if (!l->rok[k]) {
+                wf->vis[r] = rt_v3s(0.0f);
+                continue;
+            }
+            rt_vec3 Le = rt_environment(ctx->state->scene, kl->ed[k]);
+            wf->rec[r] = (rt_nee_record){.fl = rt_mul(rt_v3(l->fr[k], l->fg[k], l->fb[k]), Le), .cos = l->fcos[k],
+                                         .w = l->fw[k], .pdf = kl->epdf[k], .wi = kl->ed[k], .dist = INFINITY};
+            add_record(wf, ctx, &wf->ps[i], &wf->sf[i], r, n_pending);
+        }
+    }
     for (size_t j = 0; j < lights; j++) {
         const rt_light *lt = &ctx->state->scene->lights[j];
         for (size_t k = 0; k < kl->n; k++)
@@ -425,7 +464,7 @@ static void nee_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, int c, size_t *
 /* Each kind's vertices' light samples and BSDF samples in SIMD lanes,
  * then each path's roulette and next ray: rt_path_vertex_end's steps, the
  * same bits. */
-static void shade_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t *n_pending)
+static void shade_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, bool env, size_t *n_pending)
 {
     for (int c = 0; c < LANE_KINDS; c++) {
         struct kind_lanes *kl = &wf->kl[c];
@@ -433,7 +472,7 @@ static void shade_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t *n_pen
         if (kl->n == 0)
             continue;
         if (c != LANES_DIELECTRIC)
-            nee_lanes(wf, ctx, c, n_pending);
+            nee_lanes(wf, ctx, c, env, n_pending);
         if (c == LANES_LAMBERT)
             rt_lambert_sample_lanes(l, kl->n);
         else if (c == LANES_CONDUCTOR)
@@ -512,7 +551,7 @@ void rt_wavefront_radiance(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_w
         size_t n_rec = 0, n_pending = 0;
         for (size_t k = 0; k < n_active; k++)
             shade_lane(wf, ctx, wf->order[k], &n_rec, &n_pending, env, emitters);
-        shade_lanes(wf, ctx, &n_pending);
+        shade_lanes(wf, ctx, env, &n_pending);
         /* shadow rays, one batch */
         if (n_pending > 0) {
             if (ctx->ray_count)

@@ -119,6 +119,9 @@ bool rt_path_nee_light_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p,
                           rt_vec2 u, rt_nee_record *rec);
 bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
                      rt_nee_record *rec);
+/* rt_path_nee_env's first half: the environment's sample (direction d,
+ * pdf_l), drawn as it draws it; false when there is none. */
+bool rt_path_env_sample(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, rt_vec3 *d, float *pdf_l);
 bool rt_path_nee_emitter(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                          rt_vec3 wo, rt_rng *rng, rt_nee_record *rec);
 /* What the shadow ray of record rec, made at the path's current vertex

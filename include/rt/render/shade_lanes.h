@@ -1,5 +1,6 @@
-/* rt/render/shade_lanes.h - BSDF sampling and weighting over arrays of
- * paths, RT_SHADE_LANES paths a SIMD step: the wavefront's shading of one
+/* rt/render/shade_lanes.h - BSDF sampling and weighting, and light
+ * sampling with its BSDF evaluation, over arrays of paths,
+ * RT_SHADE_LANES paths a SIMD step: the wavefront's shading of one
  * material kind at a time (rt/render/wavefront.h; docs/path-tracer.md,
  * section 8).
  *
@@ -11,6 +12,8 @@
  *   // light sampling at the same vertices (p = px..pz, lu = the light's 2D value, wo too for Lambert):
  *   rt_light_sample_lanes(l, ctx, &scene.lights[j], n);  // lwx..lok: rt_light_sample_at's sample
  *   rt_nee_eval_lanes(l, kind, mis, n);                  // fr..rok: rt_path_nee_light_at's record
+ *   // (a sample made elsewhere, e.g. the environment's: set lwx..lok yourself, li 1, then
+ *   //  rt_nee_eval_lanes(l, kind, true, n) and multiply fr..fb by its radiance)
  *   for each k: l->ok[k] ? (world direction wx..wz, pdf, throughput br..bb updated) : the path ends
  *   rt_shade_lanes_free(l);
  *
