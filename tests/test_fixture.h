@@ -12,7 +12,7 @@
  * Or in two steps, to change the scene between parsing and building:
  *
  *   test_fixture_parse(&f, text);
- *   ... add an environment map to f.s ...
+ *   ... add an environment map to f.s (test_fixture_add_env) ...
  *   test_fixture_build(&f, RT_PREPARE_LIGHT_TABLE);
  *
  * A scene text that does not parse fails the test with the parser's
@@ -30,6 +30,7 @@
 #include "rt/render/render_state.h"
 #include "rt/render/surface.h"
 #include "rt/scene/scene.h"
+#include "rt/scene/texture.h"
 #include "rt/scene/validate.h"
 
 typedef struct test_fixture {
@@ -115,6 +116,34 @@ static inline void test_render_scene(rt_scene *s, const rt_settings *settings, i
     assert_int_equal(rt_render(s, settings, &tree, &opt, fb, &st, &err), RT_OK);
     assert_int_equal(st.bad_samples, 0);
     rt_kdtree_free(&tree);
+}
+
+/* Adds a w x h float environment image: sky radiance everywhere, `sun`
+ * in a 2 x 2 texel patch around texel (si, sj). */
+static inline void test_fixture_add_env(rt_scene *s, int w, int h, float sky, float sun, int si, int sj)
+{
+    rt_image img;
+    memset(&img, 0, sizeof img);
+    img.width = w;
+    img.height = h;
+    img.rgbaf = malloc((size_t)w * (size_t)h * 4 * sizeof(float));
+    assert_non_null(img.rgbaf);
+    for (int j = 0; j < h; j++)
+        for (int i = 0; i < w; i++) {
+            bool in = (i == si || i == si + 1) && (j == sj || j == sj + 1);
+            float *px = img.rgbaf + 4 * ((size_t)j * (size_t)w + (size_t)i);
+            px[0] = px[1] = px[2] = in ? sun : sky;
+            px[3] = 1.0f;
+        }
+    snprintf(img.name, sizeof img.name, "test-env");
+    uint32_t im = rt_scene_add_image(s, &img);
+    assert_true(im != RT_NONE);
+    rt_texture tex = rt_texture_image(im);
+    tex.wrap_t = RT_WRAP_CLAMP;
+    uint32_t t = rt_scene_add_texture(s, &tex);
+    assert_true(t != RT_NONE);
+    s->environment.environment_texture = t;
+    s->environment.environment_strength = 1.0f;
 }
 
 #endif

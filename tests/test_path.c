@@ -505,38 +505,10 @@ static void test_emissive_triangles_vs_area_light(void **state)
 
 /* --------------------------------------------------------- environment */
 
-/* Adds a w x h float environment image: sky radiance everywhere, `sun`
- * in a 2 x 2 texel patch around texel (si, sj). */
-static void add_env(rt_scene *s, int w, int h, float sky, float sun, int si, int sj)
-{
-    rt_image img;
-    memset(&img, 0, sizeof img);
-    img.width = w;
-    img.height = h;
-    img.rgbaf = malloc((size_t)w * (size_t)h * 4 * sizeof(float));
-    assert_non_null(img.rgbaf);
-    for (int j = 0; j < h; j++)
-        for (int i = 0; i < w; i++) {
-            bool in = (i == si || i == si + 1) && (j == sj || j == sj + 1);
-            float *px = img.rgbaf + 4 * ((size_t)j * (size_t)w + (size_t)i);
-            px[0] = px[1] = px[2] = in ? sun : sky;
-            px[3] = 1.0f;
-        }
-    snprintf(img.name, sizeof img.name, "test-env");
-    uint32_t im = rt_scene_add_image(s, &img);
-    assert_true(im != RT_NONE);
-    rt_texture tex = rt_texture_image(im);
-    tex.wrap_t = RT_WRAP_CLAMP;
-    uint32_t t = rt_scene_add_texture(s, &tex);
-    assert_true(t != RT_NONE);
-    s->environment.environment_texture = t;
-    s->environment.environment_strength = 1.0f;
-}
-
 static void load_env(fixture *f, const char *text, float sky, float sun, bool table)
 {
     test_fixture_parse(f, text);
-    add_env(&f->s, 64, 32, sky, sun, 40, 8);
+    test_fixture_add_env(&f->s, 64, 32, sky, sun, 40, 8);
     test_fixture_build(f, table ? RT_PREPARE_LIGHT_TABLE : 0);
 }
 

@@ -153,13 +153,23 @@ static bool light_table_record(const rt_trace_ctx *ctx, const rt_bsdf *b, rt_vec
     return true;
 }
 
+rt_vec2 rt_path_light_u(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, size_t i)
+{
+    return path_2d(ctx, ps, rng, DIM_LIGHT0 + (uint32_t)i);
+}
+
 bool rt_path_nee_light(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                        rt_vec3 wo, rt_rng *rng, size_t i, rt_nee_record *rec)
 {
-    const rt_light *l = &ctx->state->scene->lights[i];
-    rt_vec2 u = path_2d(ctx, ps, rng, DIM_LIGHT0 + (uint32_t)i);
+    rt_vec2 u = rt_path_light_u(ctx, ps, rng, i);
+    return rt_path_nee_light_at(ctx, &ctx->state->scene->lights[i], sf->p, b, wo, u, rec);
+}
+
+bool rt_path_nee_light_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, const rt_bsdf *b, rt_vec3 wo,
+                          rt_vec2 u, rt_nee_record *rec)
+{
     rt_light_sample ls;
-    if (!rt_light_sample_at(ctx, l, sf->p, u, &ls))
+    if (!rt_light_sample_at(ctx, l, p, u, &ls))
         return false;
     if (!(rt_dot(ls.wi, b->ng) > 0.0f))
         return false; /* below the geometric surface */
@@ -189,16 +199,20 @@ rt_vec3 rt_path_shadow(const rt_trace_ctx *ctx, const rt_path_state *ps, const r
     return rt_shadow_path_transmittance(ctx, sf, rec->wi, rec->dist, thin);
 }
 
-bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
-                     rt_nee_record *rec)
+bool rt_path_env_sample(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, rt_vec3 *d, float *pdf_l)
 {
     if (!rt_path_samples_env(ctx))
         return false;
-    const rt_light_table *t = ctx->state->light_table;
     rt_vec2 u = path_2d(ctx, ps, rng, DIM_ENV);
+    return rt_light_table_sample_env(ctx->state->light_table, u, d, pdf_l);
+}
+
+bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
+                     rt_nee_record *rec)
+{
     rt_vec3 d;
     float pdf_l;
-    if (rt_light_table_sample_env(t, u, &d, &pdf_l) && rt_dot(d, b->ng) > 0.0f)
+    if (rt_path_env_sample(ctx, ps, rng, &d, &pdf_l) && rt_dot(d, b->ng) > 0.0f)
         return light_table_record(ctx, b, wo, d, NULL, pdf_l, INFINITY, rec);
     return false;
 }

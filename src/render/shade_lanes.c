@@ -1,7 +1,8 @@
-/* shade_lanes.c - BSDF sampling and weighting in SIMD lanes over
- * structure-of-arrays paths (rt/render/shade_lanes.h): the wavefront's
- * shading of a material kind, RT_SHADE_LANES paths a step, written once
- * with GCC / clang vector types.
+/* shade_lanes.c - BSDF sampling and weighting, and light sampling with
+ * the BSDF evaluated at the light and the power heuristic, in SIMD lanes
+ * over structure-of-arrays paths (rt/render/shade_lanes.h): the
+ * wavefront's shading of a material kind, RT_SHADE_LANES paths a step,
+ * written once with GCC / clang vector types.
  *
  * The approach is Afra, Benthin, Wald and Munkberg, "Local shading
  * coherence extraction for SIMD-efficient path tracing on CPUs" (HPG
@@ -10,7 +11,11 @@
  * one path at a time. Each lane repeats the scalar code's operations in
  * its order (rt/render/sampling.h's concentric cosine sampling and
  * rt/base/vec.h's rt_sincosf, bsdf.c's lambert_sample and finish_sample,
- * pathtrace.c's rt_path_vertex_end), branches as selects: the same bits.
+ * pathtrace.c's rt_path_vertex_end; light.c's rt_light_sample_at,
+ * bsdf.c's evaluations, pathtrace.c's rt_path_nee_light_at), branches as
+ * selects: the same bits. The solid-angle sampling of a rectangle seen
+ * large (light.c, spherical.c: double precision, atan2) is called per
+ * lane from the vector step, so it keeps its bits too.
  */
 #include "rt/render/shade_lanes.h"
 
@@ -21,6 +26,8 @@
 #if defined(__SSE__)
 #include <immintrin.h>
 #endif
+
+#include <math.h>
 
 #include "rt/base/alloc.h"
 #include "rt/base/vec.h"
@@ -160,7 +167,7 @@ static size_t pad(rt_shade_lanes *l, size_t n)
     float *in[] = {l->tx, l->ty, l->tz, l->bx, l->by, l->bz, l->nx, l->ny, l->nz, l->gx, l->gy, l->gz,
                    l->br, l->bg, l->bb, l->ux, l->uy, l->dr, l->dg, l->db, l->ox, l->oy, l->oz, l->ax,
                    l->ay, l->sep, l->er, l->eg, l->eb, l->kr, l->kg, l->kb, l->cr, l->cg, l->cb, l->metal,
-                   l->f0, l->pd, l->ps, l->ulobe, l->pt, l->eta};
+                   l->f0, l->pd, l->ps, l->ulobe, l->pt, l->eta, l->px, l->py, l->pz, l->lux, l->luy};
     for (size_t a = 0; a < sizeof in / sizeof in[0]; a++)
         for (size_t k = n; k < end; k++)
             in[a][k] = 0.0f;
@@ -246,20 +253,15 @@ static inline void vvndf(vf wx, vf wy, vf wz, vf ax, vf ay, vf ux, vf uy, vf *hx
     vnormalize(hx, hy, hz);
 }
 
-/* One SIMD step of the rough conductor: bsdf.c's conductor_sample with
- * its one lobe (p_specular 1), conductor_eval and finish_sample. */
-static void conductor_step(rt_shade_lanes *l, size_t k)
+/* bsdf.c's conductor_eval with its one lobe (p_specular 1): f (zero
+ * where it is not valid) and the VNDF pdf at wi = (x, y, z) from wo
+ * (local, wi unit), and which lanes are valid (both above, not opposite,
+ * finite). */
+static inline vi vconductor_eval(const rt_shade_lanes *l, size_t k, vf wox, vf woy, vf woz, vf x, vf y, vf z,
+                                 vf *fr, vf *fg, vf *fb, vf *pdf)
 {
-    vf wox = load(l->ox + k), woy = load(l->oy + k), woz = load(l->oz + k);
     vf ax = load(l->ax + k), ay = load(l->ay + k);
-    vf hx, hy, hz;
-    vvndf(wox, woy, woz, ax, ay, load(l->ux + k), load(l->uy + k), &hx, &hy, &hz);
-    vf c = 2.0f * (wox * hx + woy * hy + woz * hz);
-    vf x = hx * c - wox, y = hy * c - woy, z = hz * c - woz;
-    vi ok = (z > 0.0f) & finite(x) & finite(y) & finite(z);
-    vnormalize(&x, &y, &z);
-    /* conductor_eval: both above, the half vector, F D G2 / (4 cos cos), VNDF pdf */
-    ok &= (woz > 0.0f) & (z > 0.0f);
+    vi ok = (woz > 0.0f) & (z > 0.0f);
     vf mx = wox + x, my = woy + y, mz = woz + z;
     vf l2 = mx * mx + my * my + mz * mz;
     ok &= l2 > 1e-20f;
@@ -273,14 +275,32 @@ static void conductor_step(rt_shade_lanes *l, size_t k)
     g2 = sel(finite(lo) & finite(li), g2, splat(0.0f));
     vf spec = D * g2 / (4.0f * woz * z);
     vf g1 = sel(finite(lo), 1.0f / (1.0f + lo), splat(0.0f));
-    vf pdf = g1 * D / (4.0f * woz);
-    ok &= finite(spec) & finite(pdf);
+    vf pv = g1 * D / (4.0f * woz);
+    ok &= finite(spec) & finite(pv);
+    *pdf = sel(ok, 1.0f * pv, splat(0.0f));
+    *fr = sel(ok, vfresnel_conductor(voh, load(l->er + k), load(l->kr + k)) * spec, splat(0.0f));
+    *fg = sel(ok, vfresnel_conductor(voh, load(l->eg + k), load(l->kg + k)) * spec, splat(0.0f));
+    *fb = sel(ok, vfresnel_conductor(voh, load(l->eb + k), load(l->kb + k)) * spec, splat(0.0f));
+    return ok;
+}
+
+/* One SIMD step of the rough conductor: bsdf.c's conductor_sample with
+ * its one lobe (p_specular 1), conductor_eval and finish_sample. */
+static void conductor_step(rt_shade_lanes *l, size_t k)
+{
+    vf wox = load(l->ox + k), woy = load(l->oy + k), woz = load(l->oz + k);
+    vf hx, hy, hz;
+    vvndf(wox, woy, woz, load(l->ax + k), load(l->ay + k), load(l->ux + k), load(l->uy + k), &hx, &hy, &hz);
+    vf c = 2.0f * (wox * hx + woy * hy + woz * hz);
+    vf x = hx * c - wox, y = hy * c - woy, z = hz * c - woz;
+    vi ok = (z > 0.0f) & finite(x) & finite(y) & finite(z);
+    vnormalize(&x, &y, &z);
+    vf fr, fg, fb, pdf;
+    ok &= vconductor_eval(l, k, wox, woy, woz, x, y, z, &fr, &fg, &fb, &pdf);
     /* finish_sample */
     ok &= pdf > 0.0f;
     vf cw = z / pdf;
-    vf wr = vfresnel_conductor(voh, load(l->er + k), load(l->kr + k)) * spec * cw;
-    vf wg = vfresnel_conductor(voh, load(l->eg + k), load(l->kg + k)) * spec * cw;
-    vf wb = vfresnel_conductor(voh, load(l->eb + k), load(l->kb + k)) * spec * cw;
+    vf wr = fr * cw, wg = fg * cw, wb = fb * cw;
     ok &= finite(wr) & finite(wg) & finite(wb);
     world_and_weigh(l, k, x, y, z, pdf, wr, wg, wb, ok, (vi){0});
 }
@@ -311,26 +331,14 @@ static inline vf vfresnel_specular(vf base, vf m, vf w, vf fd)
     return fd * (1.0f - m) + fm * m;
 }
 
-/* One SIMD step of the rough, opaque glTF BRDF: bsdf.c's
- * dielectric_sample with no transmission (the diffuse lobe by the cosine
- * or the specular one by its visible normals), dielectric_eval and
- * finish_sample. */
-static void gltf_step(rt_shade_lanes *l, size_t k)
+/* bsdf.c's dielectric_eval for the rough, opaque glTF BRDF (no
+ * transmission): f (zero where not valid) and pdf at wi = (x, y, z) from
+ * wo, and which lanes are valid (both above, not opposite). */
+static inline vi vgltf_eval(const rt_shade_lanes *l, size_t k, vf wox, vf woy, vf woz, vf x, vf y, vf z, vf *fr,
+                            vf *fg, vf *fb, vf *pdf)
 {
-    vf wox = load(l->ox + k), woy = load(l->oy + k), woz = load(l->oz + k);
-    vf a = load(l->ax + k), ay = load(l->ay + k), pd = load(l->pd + k), ps = load(l->ps + k);
-    vf ux = load(l->ux + k), uy = load(l->uy + k);
-    vi ok = pd + ps > 0.0f;
-    vi diffuse = (load(l->ulobe + k) < pd) | ~(ps > 0.0f);
-    vf cx, cy, cz, hx, hy, hz;
-    vcosine_hemisphere(ux, uy, &cx, &cy, &cz);
-    vvndf(wox, woy, woz, a, ay, ux, uy, &hx, &hy, &hz); /* (the glTF BRDF's ay is a: its eval is isotropic) */
-    vf c = 2.0f * (wox * hx + woy * hy + woz * hz);
-    vf x = sel(diffuse, cx, hx * c - wox), y = sel(diffuse, cy, hy * c - woy), z = sel(diffuse, cz, hz * c - woz);
-    ok &= (z > 0.0f) & finite(x) & finite(y) & finite(z);
-    vnormalize(&x, &y, &z);
-    /* dielectric_eval: both above, the half vector */
-    ok &= (woz > 0.0f) & (z > 0.0f);
+    vf a = load(l->ax + k), pd = load(l->pd + k), ps = load(l->ps + k);
+    vi ok = (woz > 0.0f) & (z > 0.0f);
     vf mx = wox + x, my = woy + y, mz = woz + z;
     vf l2 = mx * mx + my * my + mz * mz;
     ok &= l2 > 1e-20f;
@@ -351,12 +359,40 @@ static void gltf_step(rt_shade_lanes *l, size_t k)
     vf g1 = sel(finite(lo), 1.0f / (1.0f + lo), splat(0.0f));
     vf pv = g1 * D / (4.0f * woz);
     p = sel((ps > 0.0f) & finite(pv), p + ps * pv, p);
+    vf m = load(l->metal + k);
+    *fr = sel(ok, load(l->dr + k) * (tdiff * RT_INV_PI) + vfresnel_specular(load(l->cr + k), m, w, fd) * spec,
+              splat(0.0f));
+    *fg = sel(ok, load(l->dg + k) * (tdiff * RT_INV_PI) + vfresnel_specular(load(l->cg + k), m, w, fd) * spec,
+              splat(0.0f));
+    *fb = sel(ok, load(l->db + k) * (tdiff * RT_INV_PI) + vfresnel_specular(load(l->cb + k), m, w, fd) * spec,
+              splat(0.0f));
+    *pdf = sel(ok, p, splat(0.0f));
+    return ok;
+}
+
+/* One SIMD step of the rough, opaque glTF BRDF: bsdf.c's
+ * dielectric_sample with no transmission (the diffuse lobe by the cosine
+ * or the specular one by its visible normals), dielectric_eval and
+ * finish_sample. */
+static void gltf_step(rt_shade_lanes *l, size_t k)
+{
+    vf wox = load(l->ox + k), woy = load(l->oy + k), woz = load(l->oz + k);
+    vf a = load(l->ax + k), ay = load(l->ay + k), pd = load(l->pd + k), ps = load(l->ps + k);
+    vf ux = load(l->ux + k), uy = load(l->uy + k);
+    vi ok = pd + ps > 0.0f;
+    vi diffuse = (load(l->ulobe + k) < pd) | ~(ps > 0.0f);
+    vf cx, cy, cz, hx, hy, hz;
+    vcosine_hemisphere(ux, uy, &cx, &cy, &cz);
+    vvndf(wox, woy, woz, a, ay, ux, uy, &hx, &hy, &hz); /* (the glTF BRDF's ay is a: its eval is isotropic) */
+    vf c = 2.0f * (wox * hx + woy * hy + woz * hz);
+    vf x = sel(diffuse, cx, hx * c - wox), y = sel(diffuse, cy, hy * c - woy), z = sel(diffuse, cz, hz * c - woz);
+    ok &= (z > 0.0f) & finite(x) & finite(y) & finite(z);
+    vnormalize(&x, &y, &z);
+    vf fr, fg, fb, p;
+    ok &= vgltf_eval(l, k, wox, woy, woz, x, y, z, &fr, &fg, &fb, &p);
     /* finish_sample */
     ok &= (p > 0.0f) & finite(p);
-    vf m = load(l->metal + k), cw = z / p;
-    vf fr = load(l->dr + k) * (tdiff * RT_INV_PI) + vfresnel_specular(load(l->cr + k), m, w, fd) * spec;
-    vf fg = load(l->dg + k) * (tdiff * RT_INV_PI) + vfresnel_specular(load(l->cg + k), m, w, fd) * spec;
-    vf fb = load(l->db + k) * (tdiff * RT_INV_PI) + vfresnel_specular(load(l->cb + k), m, w, fd) * spec;
+    vf cw = z / p;
     vf wr = fr * cw, wg = fg * cw, wb = fb * cw;
     ok &= finite(wr) & finite(wg) & finite(wb);
     world_and_weigh(l, k, x, y, z, p, wr, wg, wb, ok, (vi){0});
@@ -424,6 +460,221 @@ void rt_dielectric_sample_lanes(rt_shade_lanes *l, size_t n)
         dielectric_step(l, k);
 }
 
+/* ------------------------------------------------------------ light sampling */
+
+static inline vi mask_of(const uint8_t *p)
+{
+    vi m;
+    for (int j = 0; j < W; j++)
+        m[j] = p[j] ? -1 : 0;
+    return m;
+}
+
+static inline void store_mask(uint8_t *p, vi m)
+{
+    for (int j = 0; j < W; j++)
+        p[j] = m[j] != 0;
+}
+
+/* rt_light_sample's fields, stored (pdf 0 for the deltas, whose scalar
+ * pdf is unset and never read) */
+static inline void store_light(rt_shade_lanes *l, size_t k, vf wx, vf wy, vf wz, vf dist, vf r, vf g, vf b, vf pdf,
+                               vi ok)
+{
+    store(l->lwx + k, wx);
+    store(l->lwy + k, wy);
+    store(l->lwz + k, wz);
+    store(l->ldist + k, dist);
+    store(l->lr + k, r);
+    store(l->lg + k, g);
+    store(l->lb + k, b);
+    store(l->lpdf + k, pdf);
+    store_mask(l->lok + k, ok);
+}
+
+/* light.c's toward(p, q): the unit direction and the distance from p to
+ * q, their squared distance; false where they coincide */
+static inline vi vtoward(vf px, vf py, vf pz, vf qx, vf qy, vf qz, vf *wx, vf *wy, vf *wz, vf *dist, vf *d2)
+{
+    vf dx = qx - px, dy = qy - py, dz = qz - pz;
+    *d2 = dx * dx + dy * dy + dz * dz;
+    *dist = vsqrt(*d2);
+    vf inv = 1.0f / *dist;
+    *wx = dx * inv, *wy = dy * inv, *wz = dz * inv;
+    return *d2 > 0.0f;
+}
+
+/* One SIMD step of a point or spot light: rt_light_sample_at's intensity
+ * over d^2, the spot's smooth cone (its cosines and unit direction from
+ * the caller, computed as the scalar code computes them) and the range
+ * window. */
+static void point_step(rt_shade_lanes *l, size_t k, const rt_light *lt, rt_vec3 power, rt_vec3 axis, float co,
+                       float ci)
+{
+    vf wx, wy, wz, dist, d2;
+    vi ok = vtoward(load(l->px + k), load(l->py + k), load(l->pz + k), splat(lt->position.x), splat(lt->position.y),
+                    splat(lt->position.z), &wx, &wy, &wz, &dist, &d2);
+    vf atten = 1.0f / d2;
+    if (lt->kind == RT_LIGHT_SPOT) {
+        vf cd = axis.x * -wx + axis.y * -wy + axis.z * -wz;
+        vf x = ci > co ? vclamp01((cd - co) / (ci - co)) : sel(cd >= co, splat(1.0f), splat(0.0f));
+        atten = atten * (x * x);
+    }
+    if (lt->range > 0.0f) {
+        vf r = dist / lt->range, r4 = r * r * r * r;
+        vf win = vclamp01(1.0f - r4);
+        atten = atten * (win * win);
+    }
+    ok &= atten > 0.0f;
+    store_light(l, k, wx, wy, wz, dist, power.x * atten, power.y * atten, power.z * atten, splat(0.0f), ok);
+}
+
+/* What an area light's step takes from the light, computed once as the
+ * scalar code computes it per sample. */
+typedef struct area_consts {
+    rt_vec3 n, unit, centre; /* edge_u x edge_v, it normalised, the centre */
+    float area, size2;
+    bool rect;               /* edges perpendicular: solid-angle sampling may apply */
+    rt_vec3 power;
+} area_consts;
+
+/* One SIMD step of an area light sampled by area (rt_light_sample_at's
+ * second branch); the lanes that see a rectangle large (looks_large) are
+ * flagged in *solid, for the scalar function. */
+static vi area_step(rt_shade_lanes *l, size_t k, const rt_light *lt, const area_consts *a)
+{
+    vf px = load(l->px + k), py = load(l->py + k), pz = load(l->pz + k);
+    /* looks_large(n, centre - p, size2) */
+    vf dx = a->centre.x - px, dy = a->centre.y - py, dz = a->centre.z - pz;
+    vf nd = -(a->n.x * dx + a->n.y * dy + a->n.z * dz), dd2 = dx * dx + dy * dy + dz * dz;
+    vi solid = (nd > 0.0f) & ((dd2 <= a->size2) | (nd >= 0.1f * dd2 * vsqrt(dd2)));
+    if (!a->rect)
+        solid = (vi){0};
+    /* the point position + u.x edge_u + u.y edge_v */
+    vf ux = load(l->lux + k), uy = load(l->luy + k);
+    vf qx = lt->position.x + (lt->edge_u.x * ux + lt->edge_v.x * uy);
+    vf qy = lt->position.y + (lt->edge_u.y * ux + lt->edge_v.y * uy);
+    vf qz = lt->position.z + (lt->edge_u.z * ux + lt->edge_v.z * uy);
+    vf wx, wy, wz, dist, d2;
+    vi ok = vtoward(px, py, pz, qx, qy, qz, &wx, &wy, &wz, &dist, &d2);
+    vf cos_l = -(a->unit.x * wx + a->unit.y * wy + a->unit.z * wz);
+    ok &= cos_l > 0.0f;
+    vf s = a->area * cos_l / d2;
+    /* area_light_area_pdf */
+    vf c2 = -(a->n.x * wx + a->n.y * wy + a->n.z * wz) / a->area;
+    vf pdf = dist * dist / (a->area * c2);
+    pdf = sel((c2 > 0.0f) & finite(pdf), pdf, splat(0.0f));
+    store_light(l, k, wx, wy, wz, dist, a->power.x * s, a->power.y * s, a->power.z * s, pdf, ok);
+    return solid;
+}
+
+void rt_light_sample_lanes(rt_shade_lanes *l, const rt_trace_ctx *ctx, const rt_light *lt, size_t n)
+{
+    size_t end = pad(l, n);
+    rt_vec3 power = rt_scale(lt->color, lt->intensity);
+    if (lt->kind == RT_LIGHT_POINT || lt->kind == RT_LIGHT_SPOT) {
+        rt_vec3 axis = rt_normalize(lt->direction);
+        float co = cosf(lt->outer_cone), ci = cosf(lt->inner_cone);
+        for (size_t k = 0; k < end; k += W)
+            point_step(l, k, lt, power, axis, co, ci);
+        return;
+    }
+    if (lt->kind == RT_LIGHT_DIRECTIONAL) {
+        rt_vec3 wi = rt_neg(rt_normalize(lt->direction));
+        vi ok = (vi){0} + (rt_length2(wi) > 0.0f ? -1 : 0);
+        for (size_t k = 0; k < end; k += W)
+            store_light(l, k, splat(wi.x), splat(wi.y), splat(wi.z), splat(INFINITY), splat(power.x),
+                        splat(power.y), splat(power.z), splat(0.0f), ok);
+        return;
+    }
+    area_consts a;
+    a.n = rt_cross(lt->edge_u, lt->edge_v);
+    a.area = rt_length(a.n);
+    if (!(a.area > 0.0f)) {
+        memset(l->lok, 0, end);
+        return;
+    }
+    a.centre = rt_madd(rt_madd(lt->position, lt->edge_u, 0.5f), lt->edge_v, 0.5f);
+    float lu = rt_length2(lt->edge_u), lv = rt_length2(lt->edge_v), uv = rt_dot(lt->edge_u, lt->edge_v);
+    a.size2 = lu + lv;
+    a.rect = uv * uv <= 1e-10f * lu * lv;
+    a.unit = rt_scale(a.n, 1.0f / a.area);
+    a.power = power;
+    for (size_t k = 0; k < end; k += W) {
+        vi solid = area_step(l, k, lt, &a);
+        for (int j = 0; j < W && k + (size_t)j < n; j++) {
+            if (!solid[j])
+                continue;
+            /* seen large: maybe its solid angle, set up in double precision */
+            size_t i = k + (size_t)j;
+            rt_light_sample ls = {.pdf = 0.0f};
+            l->lok[i] = rt_light_sample_at(ctx, lt, rt_v3(l->px[i], l->py[i], l->pz[i]), rt_v2(l->lux[i], l->luy[i]),
+                                           &ls);
+            l->lwx[i] = ls.wi.x, l->lwy[i] = ls.wi.y, l->lwz[i] = ls.wi.z, l->ldist[i] = ls.dist;
+            l->lr[i] = ls.li.x, l->lg[i] = ls.li.y, l->lb[i] = ls.li.z, l->lpdf[i] = ls.pdf;
+        }
+    }
+}
+
+/* rt_bsdf_eval of Lambert: albedo / pi, pdf cos / pi (0 for a black one) */
+static inline vi vlambert_eval(const rt_shade_lanes *l, size_t k, vf woz, vf z, vf *fr, vf *fg, vf *fb, vf *pdf)
+{
+    vf dr = load(l->dr + k), dg = load(l->dg + k), db = load(l->db + k);
+    vi ok = (woz > 0.0f) & (z > 0.0f);
+    vf prob = sel((dr + dg + db) * (1.0f / 3.0f) > 0.0f, splat(1.0f), splat(0.0f));
+    *pdf = sel(ok, prob * z * RT_INV_PI, splat(0.0f));
+    *fr = sel(ok, dr * RT_INV_PI, splat(0.0f));
+    *fg = sel(ok, dg * RT_INV_PI, splat(0.0f));
+    *fb = sel(ok, db * RT_INV_PI, splat(0.0f));
+    return ok;
+}
+
+/* pathtrace.h's rt_mis_power(a, b) */
+static inline vf vmis_power(vf a, vf b)
+{
+    vf a2 = a * a, b2 = b * b;
+    vf w = a2 / (a2 + b2);
+    w = sel(finite(w), w, sel(a > b, splat(1.0f), splat(0.0f)));
+    w = sel(((vi)vabs(a)) == 0x7f800000, splat(1.0f), w);
+    return sel(a > 0.0f, w, splat(0.0f));
+}
+
+/* One SIMD step of a light sample's record (rt_path_nee_light_at after
+ * rt_light_sample_at). */
+static void nee_step(rt_shade_lanes *l, size_t k, int kind, bool mis)
+{
+    vf wx = load(l->lwx + k), wy = load(l->lwy + k), wz = load(l->lwz + k);
+    vi ok = mask_of(l->lok + k);
+    ok &= wx * load(l->gx + k) + wy * load(l->gy + k) + wz * load(l->gz + k) > 0.0f;
+    vf x = wx * load(l->tx + k) + wy * load(l->ty + k) + wz * load(l->tz + k);
+    vf y = wx * load(l->bx + k) + wy * load(l->by + k) + wz * load(l->bz + k);
+    vf z = wx * load(l->nx + k) + wy * load(l->ny + k) + wz * load(l->nz + k);
+    vf wox = load(l->ox + k), woy = load(l->oy + k), woz = load(l->oz + k);
+    vf fr, fg, fb, pdf_b;
+    if (kind == RT_BSDF_KIND_LAMBERT)
+        vlambert_eval(l, k, woz, z, &fr, &fg, &fb, &pdf_b);
+    else if (kind == RT_BSDF_KIND_CONDUCTOR)
+        vconductor_eval(l, k, wox, woy, woz, x, y, z, &fr, &fg, &fb, &pdf_b);
+    else
+        vgltf_eval(l, k, wox, woy, woz, x, y, z, &fr, &fg, &fb, &pdf_b);
+    ok &= vmax(fr, vmax(fg, fb)) > 0.0f;
+    vf w = mis ? vmis_power(load(l->lpdf + k), pdf_b) : splat(1.0f);
+    ok &= w > 0.0f;
+    store(l->fr + k, fr * load(l->lr + k));
+    store(l->fg + k, fg * load(l->lg + k));
+    store(l->fb + k, fb * load(l->lb + k));
+    store(l->fcos + k, z);
+    store(l->fw + k, w);
+    store_mask(l->rok + k, ok);
+}
+
+void rt_nee_eval_lanes(rt_shade_lanes *l, int kind, bool mis, size_t n)
+{
+    size_t end = (n + W - 1) / W * W; /* (lanes past n compute on what they hold; nobody reads them) */
+    for (size_t k = 0; k < end; k += W)
+        nee_step(l, k, kind, mis);
+}
+
 rt_shade_lanes *rt_shade_lanes_new(size_t batch)
 {
     rt_shade_lanes *l = rt_alloc(1, sizeof *l);
@@ -435,12 +686,15 @@ rt_shade_lanes *rt_shade_lanes_new(size_t batch)
                      &l->gz, &l->br, &l->bg, &l->bb, &l->ux, &l->uy, &l->dr, &l->dg, &l->db, &l->ox, &l->oy,
                      &l->oz, &l->ax, &l->ay, &l->sep, &l->er, &l->eg, &l->eb, &l->kr, &l->kg, &l->kb, &l->cr,
                      &l->cg, &l->cb, &l->metal, &l->f0, &l->pd, &l->ps, &l->ulobe, &l->pt, &l->eta, &l->wx, &l->wy,
-                     &l->wz, &l->pdf};
+                     &l->wz, &l->pdf, &l->px, &l->py, &l->pz, &l->lux, &l->luy, &l->lwx, &l->lwy, &l->lwz,
+                     &l->ldist, &l->lr, &l->lg, &l->lb, &l->lpdf, &l->fr, &l->fg, &l->fb, &l->fcos, &l->fw};
     bool ok = true;
     for (size_t a = 0; a < sizeof all / sizeof all[0]; a++)
         ok = (*all[a] = rt_alloc(room, sizeof(float))) != NULL && ok;
     ok = (l->ok = rt_alloc(room, 1)) != NULL && ok;
     ok = (l->down = rt_alloc(room, 1)) != NULL && ok;
+    ok = (l->lok = rt_alloc(room, 1)) != NULL && ok;
+    ok = (l->rok = rt_alloc(room, 1)) != NULL && ok;
     if (!ok) {
         rt_shade_lanes_free(l);
         return NULL;
@@ -455,10 +709,14 @@ void rt_shade_lanes_free(rt_shade_lanes *l)
     float *all[] = {l->tx, l->ty, l->tz, l->bx, l->by, l->bz, l->nx, l->ny, l->nz, l->gx, l->gy, l->gz,
                     l->br, l->bg, l->bb, l->ux, l->uy, l->dr, l->dg, l->db, l->ox, l->oy, l->oz, l->ax,
                     l->ay, l->sep, l->er, l->eg, l->eb, l->kr, l->kg, l->kb, l->cr, l->cg, l->cb, l->metal,
-                    l->f0, l->pd, l->ps, l->ulobe, l->pt, l->eta, l->wx, l->wy, l->wz, l->pdf};
+                    l->f0, l->pd, l->ps, l->ulobe, l->pt, l->eta, l->wx, l->wy, l->wz, l->pdf,
+                    l->px, l->py, l->pz, l->lux, l->luy, l->lwx, l->lwy, l->lwz, l->ldist, l->lr, l->lg,
+                    l->lb, l->lpdf, l->fr, l->fg, l->fb, l->fcos, l->fw};
     for (size_t a = 0; a < sizeof all / sizeof all[0]; a++)
         free(all[a]);
     free(l->ok);
     free(l->down);
+    free(l->lok);
+    free(l->rok);
     free(l);
 }

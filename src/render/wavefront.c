@@ -40,6 +40,7 @@
 
 #include "rt/accel/kdtree_batch.h"
 #include "rt/base/alloc.h"
+#include "rt/render/environment.h"
 #include "rt/render/pathtrace.h"
 #include "rt/render/shade_lanes.h"
 
@@ -94,6 +95,17 @@ struct rt_wavefront {
         uint32_t *lane;
         rt_path_bsdf_draw *draw;
         rt_shade_lanes *soa;
+        /* light sampling deferred to the lanes (not for glass): the 2D
+         * value each vertex drew for light j and the record kept for it,
+         * at [slot * lights + j] */
+        rt_vec2 *lu;
+        uint32_t *lrec;
+        /* the environment's sample likewise (direction, pdf, whether
+         * there is one, its record) */
+        rt_vec3 *ed;
+        float *epdf;
+        uint8_t *eok;
+        uint32_t *erec;
     } kl[4];
 };
 
@@ -146,6 +158,13 @@ rt_wavefront *rt_wavefront_new(size_t batch, const rt_render_state *state)
     for (int c = 0; c < LANE_KINDS; c++) {
         wf->kl[c].lane = grab(B, sizeof(uint32_t), &ok);
         wf->kl[c].draw = grab(B, sizeof(rt_path_bsdf_draw), &ok);
+        size_t L = state->scene->light_count ? state->scene->light_count : 1;
+        wf->kl[c].lu = grab(B * L, sizeof(rt_vec2), &ok);
+        wf->kl[c].lrec = grab(B * L, sizeof(uint32_t), &ok);
+        wf->kl[c].ed = grab(B, sizeof(rt_vec3), &ok);
+        wf->kl[c].epdf = grab(B, sizeof(float), &ok);
+        wf->kl[c].eok = grab(B, 1, &ok);
+        wf->kl[c].erec = grab(B, sizeof(uint32_t), &ok);
         wf->kl[c].soa = rt_shade_lanes_new(B);
         if (!wf->kl[c].soa)
             ok = false;
@@ -171,6 +190,12 @@ void rt_wavefront_free(rt_wavefront *wf)
     for (int c = 0; c < LANE_KINDS; c++) {
         free(wf->kl[c].lane);
         free(wf->kl[c].draw);
+        free(wf->kl[c].lu);
+        free(wf->kl[c].lrec);
+        free(wf->kl[c].ed);
+        free(wf->kl[c].epdf);
+        free(wf->kl[c].eok);
+        free(wf->kl[c].erec);
         rt_shade_lanes_free(wf->kl[c].soa);
     }
     free(wf);
@@ -280,13 +305,18 @@ static void add_record(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_path_
 /* Lane i's vertex into the next slot of its kind's lanes: its frame,
  * geometric normal, throughput and the kind's parameters, and the random
  * numbers of its sample, drawn now as rt_path_vertex_end draws them. */
+static struct kind_lanes *kind_lanes_of(rt_wavefront *wf, int kind)
+{
+    return &wf->kl[kind == RT_BSDF_KIND_LAMBERT     ? LANES_LAMBERT
+                   : kind == RT_BSDF_KIND_CONDUCTOR ? LANES_CONDUCTOR
+                   : kind == RT_BSDF_KIND_GLTF      ? LANES_GLTF
+                                                    : LANES_DIELECTRIC];
+}
+
 static void lanes_gather(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, const rt_bsdf *b, rt_vec3 wo,
                          int kind)
 {
-    struct kind_lanes *kl = &wf->kl[kind == RT_BSDF_KIND_LAMBERT     ? LANES_LAMBERT
-                                    : kind == RT_BSDF_KIND_CONDUCTOR ? LANES_CONDUCTOR
-                                    : kind == RT_BSDF_KIND_GLTF      ? LANES_GLTF
-                                                                     : LANES_DIELECTRIC];
+    struct kind_lanes *kl = kind_lanes_of(wf, kind);
     rt_shade_lanes *l = kl->soa;
     size_t k = kl->n++;
     rt_path_state *ps = &wf->ps[i];
@@ -299,11 +329,12 @@ static void lanes_gather(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, 
     l->gx[k] = wf->sf[i].ng.x, l->gy[k] = wf->sf[i].ng.y, l->gz[k] = wf->sf[i].ng.z;
     l->br[k] = ps->beta.x, l->bg[k] = ps->beta.y, l->bb[k] = ps->beta.z;
     l->ux[k] = d->u.x, l->uy[k] = d->u.y;
+    l->px[k] = wf->sf[i].p.x, l->py[k] = wf->sf[i].p.y, l->pz[k] = wf->sf[i].p.z;
+    l->ox[k] = wo.x, l->oy[k] = wo.y, l->oz[k] = wo.z;
     if (kind != RT_BSDF_KIND_CONDUCTOR)
         l->dr[k] = b->diffuse.x, l->dg[k] = b->diffuse.y, l->db[k] = b->diffuse.z;
     if (kind == RT_BSDF_KIND_LAMBERT)
         return;
-    l->ox[k] = wo.x, l->oy[k] = wo.y, l->oz[k] = wo.z;
     l->ax[k] = b->alpha, l->ay[k] = b->alpha_y;
     if (kind == RT_BSDF_KIND_CONDUCTOR) {
         l->sep[k] = b->separable ? 1.0f : 0.0f;
@@ -344,12 +375,28 @@ static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, si
     }
     size_t first = *n_rec, n = first;
     const size_t lights = ctx->state->scene->light_count;
-    for (size_t l = 0; l < lights; l++)
-        if (rt_path_nee_light(ctx, ps, sf, &b, wo, rng, l, &wf->rec[n]))
+    int lanes = rt_shade_lanes_kind(&b);
+    if (lanes >= 0 && lanes != RT_BSDF_KIND_DIELECTRIC) {
+        /* light and environment samples in lanes (nee_lanes): their
+         * values drawn now, in order, a record kept for each */
+        struct kind_lanes *kl = kind_lanes_of(wf, lanes);
+        size_t k = kl->n;
+        for (size_t l = 0; l < lights; l++) {
+            kl->lu[k * lights + l] = rt_path_light_u(ctx, ps, rng, l);
+            kl->lrec[k * lights + l] = (uint32_t)n++;
+        }
+        if (env) {
+            kl->eok[k] = rt_path_env_sample(ctx, ps, rng, &kl->ed[k], &kl->epdf[k]);
+            kl->erec[k] = (uint32_t)n++;
+        }
+    } else {
+        for (size_t l = 0; l < lights; l++)
+            if (rt_path_nee_light(ctx, ps, sf, &b, wo, rng, l, &wf->rec[n]))
+                add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
+        /* (skipped when they could make nothing: they would draw nothing) */
+        if (env && rt_path_nee_env(ctx, ps, &b, wo, rng, &wf->rec[n]))
             add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
-    /* (skipped when they could make nothing: they would draw nothing) */
-    if (env && rt_path_nee_env(ctx, ps, &b, wo, rng, &wf->rec[n]))
-        add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
+    }
     if (emitters && rt_path_nee_emitter(ctx, ps, sf, &b, wo, rng, &wf->rec[n]))
         add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
     *n_rec = n;
@@ -357,7 +404,6 @@ static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, si
     wf->rec_first[i] = (uint32_t)first;
     wf->rec_count[i] = (uint32_t)(n - first);
     wf->nbr[i] = ps->beta.x, wf->nbg[i] = ps->beta.y, wf->nbb[i] = ps->beta.z;
-    int lanes = rt_shade_lanes_kind(&b);
     if (lanes >= 0) { /* sampled with the others of its kind, in lanes */
         lanes_gather(wf, ctx, i, &b, wo, lanes);
         return;
@@ -365,15 +411,68 @@ static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, si
     wf->status[i] = rt_path_vertex_end(ctx, ps, sf, &b, wo, rng) ? LANE_LIVE : LANE_DONE;
 }
 
-/* Each kind's vertices' BSDF samples in SIMD lanes, then each path's
- * roulette and next ray: rt_path_vertex_end's steps, the same bits. */
-static void shade_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx)
+/* Kind c's vertices' light samples, light by light in SIMD lanes
+ * (rt_path_nee_light's steps, the same bits), into the records shade_lane
+ * kept for them: a record that can contribute gets its shadow ray (or
+ * its visibility), one that cannot gets visibility 0, which
+ * rt_path_nee_add skips as the scalar tracer skips a record it never made. */
+static void nee_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, int c, bool env, size_t *n_pending)
+{
+    static const int kinds[] = {RT_BSDF_KIND_LAMBERT, RT_BSDF_KIND_CONDUCTOR, RT_BSDF_KIND_GLTF};
+    struct kind_lanes *kl = &wf->kl[c];
+    rt_shade_lanes *l = kl->soa;
+    const size_t lights = ctx->state->scene->light_count;
+    if (env) { /* the environment: its radiance 1 here, times the image's after (f 1 Le = f Le) */
+        for (size_t k = 0; k < kl->n; k++) {
+            l->lwx[k] = kl->ed[k].x, l->lwy[k] = kl->ed[k].y, l->lwz[k] = kl->ed[k].z;
+            l->ldist[k] = INFINITY, l->lr[k] = l->lg[k] = l->lb[k] = 1.0f;
+            l->lpdf[k] = kl->epdf[k], l->lok[k] = kl->eok[k];
+        }
+        rt_nee_eval_lanes(l, kinds[c], true, kl->n);
+        for (size_t k = 0; k < kl->n; k++) {
+            uint32_t i = kl->lane[k], r = kl->erec[k];
+            if (!l->rok[k]) {
+                wf->vis[r] = rt_v3s(0.0f);
+                continue;
+            }
+            rt_vec3 Le = rt_environment(ctx->state->scene, kl->ed[k]);
+            wf->rec[r] = (rt_nee_record){.fl = rt_mul(rt_v3(l->fr[k], l->fg[k], l->fb[k]), Le), .cos = l->fcos[k],
+                                         .w = l->fw[k], .pdf = kl->epdf[k], .wi = kl->ed[k], .dist = INFINITY};
+            add_record(wf, ctx, &wf->ps[i], &wf->sf[i], r, n_pending);
+        }
+    }
+    for (size_t j = 0; j < lights; j++) {
+        const rt_light *lt = &ctx->state->scene->lights[j];
+        for (size_t k = 0; k < kl->n; k++)
+            l->lux[k] = kl->lu[k * lights + j].x, l->luy[k] = kl->lu[k * lights + j].y;
+        rt_light_sample_lanes(l, ctx, lt, kl->n);
+        rt_nee_eval_lanes(l, kinds[c], lt->kind == RT_LIGHT_AREA && lt->quad != RT_NONE, kl->n);
+        for (size_t k = 0; k < kl->n; k++) {
+            uint32_t i = kl->lane[k], r = kl->lrec[k * lights + j];
+            if (!l->rok[k]) {
+                wf->vis[r] = rt_v3s(0.0f);
+                continue;
+            }
+            wf->rec[r] = (rt_nee_record){.fl = rt_v3(l->fr[k], l->fg[k], l->fb[k]), .cos = l->fcos[k],
+                                         .w = l->fw[k], .pdf = 1.0f, .wi = rt_v3(l->lwx[k], l->lwy[k], l->lwz[k]),
+                                         .dist = l->ldist[k]};
+            add_record(wf, ctx, &wf->ps[i], &wf->sf[i], r, n_pending);
+        }
+    }
+}
+
+/* Each kind's vertices' light samples and BSDF samples in SIMD lanes,
+ * then each path's roulette and next ray: rt_path_vertex_end's steps, the
+ * same bits. */
+static void shade_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, bool env, size_t *n_pending)
 {
     for (int c = 0; c < LANE_KINDS; c++) {
         struct kind_lanes *kl = &wf->kl[c];
         rt_shade_lanes *l = kl->soa;
         if (kl->n == 0)
             continue;
+        if (c != LANES_DIELECTRIC)
+            nee_lanes(wf, ctx, c, env, n_pending);
         if (c == LANES_LAMBERT)
             rt_lambert_sample_lanes(l, kl->n);
         else if (c == LANES_CONDUCTOR)
@@ -452,7 +551,7 @@ void rt_wavefront_radiance(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_w
         size_t n_rec = 0, n_pending = 0;
         for (size_t k = 0; k < n_active; k++)
             shade_lane(wf, ctx, wf->order[k], &n_rec, &n_pending, env, emitters);
-        shade_lanes(wf, ctx);
+        shade_lanes(wf, ctx, env, &n_pending);
         /* shadow rays, one batch */
         if (n_pending > 0) {
             if (ctx->ray_count)

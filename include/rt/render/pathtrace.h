@@ -111,8 +111,17 @@ rt_path_vertex rt_path_vertex_begin(const rt_trace_ctx *ctx, rt_path_state *ps, 
  * its random numbers and fills *rec when it can contribute. */
 bool rt_path_nee_light(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                        rt_vec3 wo, rt_rng *rng, size_t i, rt_nee_record *rec);
+/* rt_path_nee_light in its two halves: the 2D value light i's sample
+ * draws, and the record of light l's sample from point p with that value
+ * (the wavefront draws first and computes the records later, in lanes). */
+rt_vec2 rt_path_light_u(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, size_t i);
+bool rt_path_nee_light_at(const rt_trace_ctx *ctx, const rt_light *l, rt_vec3 p, const rt_bsdf *b, rt_vec3 wo,
+                          rt_vec2 u, rt_nee_record *rec);
 bool rt_path_nee_env(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_bsdf *b, rt_vec3 wo, rt_rng *rng,
                      rt_nee_record *rec);
+/* rt_path_nee_env's first half: the environment's sample (direction d,
+ * pdf_l), drawn as it draws it; false when there is none. */
+bool rt_path_env_sample(const rt_trace_ctx *ctx, rt_path_state *ps, rt_rng *rng, rt_vec3 *d, float *pdf_l);
 bool rt_path_nee_emitter(const rt_trace_ctx *ctx, rt_path_state *ps, const rt_surface *sf, const rt_bsdf *b,
                          rt_vec3 wo, rt_rng *rng, rt_nee_record *rec);
 /* What the shadow ray of record rec, made at the path's current vertex

@@ -1,5 +1,6 @@
-/* rt/render/shade_lanes.h - BSDF sampling and weighting over arrays of
- * paths, RT_SHADE_LANES paths a SIMD step: the wavefront's shading of one
+/* rt/render/shade_lanes.h - BSDF sampling and weighting, and light
+ * sampling with its BSDF evaluation, over arrays of paths,
+ * RT_SHADE_LANES paths a SIMD step: the wavefront's shading of one
  * material kind at a time (rt/render/wavefront.h; docs/path-tracer.md,
  * section 8).
  *
@@ -8,6 +9,11 @@
  *                        throughput br..bb; u = the direction's 2D value;
  *                        the kind's parameters: Lambert's albedo d = b.diffuse, ...)
  *   rt_lambert_sample_lanes(l, n);                    // or rt_conductor_ / rt_gltf_sample_lanes
+ *   // light sampling at the same vertices (p = px..pz, lu = the light's 2D value, wo too for Lambert):
+ *   rt_light_sample_lanes(l, ctx, &scene.lights[j], n);  // lwx..lok: rt_light_sample_at's sample
+ *   rt_nee_eval_lanes(l, kind, mis, n);                  // fr..rok: rt_path_nee_light_at's record
+ *   // (a sample made elsewhere, e.g. the environment's: set lwx..lok yourself, li 1, then
+ *   //  rt_nee_eval_lanes(l, kind, true, n) and multiply fr..fb by its radiance)
  *   for each k: l->ok[k] ? (world direction wx..wz, pdf, throughput br..bb updated) : the path ends
  *   rt_shade_lanes_free(l);
  *
@@ -28,6 +34,7 @@
 #include <stdint.h>
 
 #include "rt/render/bsdf.h"
+#include "rt/render/light.h"
 
 #if defined(__AVX512F__)
 #define RT_SHADE_LANES 16
@@ -66,6 +73,16 @@ typedef struct rt_shade_lanes {
     float *wx, *wy, *wz, *pdf;                        /* world direction (unit), its pdf */
     uint8_t *ok;                                      /* 1 when the path goes on */
     uint8_t *down;                                    /* 1 when it went below the surface (refracted) */
+    /* light sampling (next-event estimation) at the vertex: in */
+    float *px, *py, *pz;                              /* the vertex (sf.p) */
+    float *lux, *luy;                                 /* the light's 2D sample value */
+    /* rt_light_sample_lanes' out (rt_light_sample's fields), read by rt_nee_eval_lanes */
+    float *lwx, *lwy, *lwz, *ldist, *lr, *lg, *lb, *lpdf;
+    uint8_t *lok;                                     /* 1 when rt_light_sample_at is true */
+    /* rt_nee_eval_lanes' out: the record (rt_nee_record: fl, cos, w; wi and
+     * dist are the sample's, pdf 1) when rok */
+    float *fr, *fg, *fb, *fcos, *fw;
+    uint8_t *rok;
 } rt_shade_lanes;
 
 /* Which lanes sample b: RT_BSDF_KIND_LAMBERT, RT_BSDF_KIND_CONDUCTOR,
@@ -103,5 +120,18 @@ void rt_gltf_sample_lanes(rt_shade_lanes *l, size_t n);
  * the mirror or the refraction by ulobe, delta samples (pdf 0); `down`
  * says which. */
 void rt_dielectric_sample_lanes(rt_shade_lanes *l, size_t n);
+
+/* Light sampling in lanes: rt_light_sample_at(ctx, light, p, lu) for
+ * paths 0 .. n - 1 into lwx .. lok, the same bits. Point, spot,
+ * directional lights and area lights sampled by area run in lanes; the
+ * paths that see a rectangular area light large (its solid-angle
+ * sampling, set up in double precision) take the scalar function. */
+void rt_light_sample_lanes(rt_shade_lanes *l, const rt_trace_ctx *ctx, const rt_light *light, size_t n);
+/* The rest of rt_path_nee_light_at for those samples: the geometric side
+ * test, the BSDF of kind (RT_BSDF_KIND_LAMBERT, _CONDUCTOR or _GLTF, as
+ * rt_shade_lanes_kind says; their inputs above, wo included) evaluated at
+ * the light's direction, the power heuristic against its pdf when mis
+ * (an area light with a visible quad), into fr .. rok. */
+void rt_nee_eval_lanes(rt_shade_lanes *l, int kind, bool mis, size_t n);
 
 #endif
