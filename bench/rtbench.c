@@ -4,7 +4,7 @@
  *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
  *           [--build-threads N] [--occluded] [--portable] [--instances] [--limit N]
  *           [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H [--image-width N]]
- *           [--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]]
+ *           [--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]] [--simd 8|16]
  *
  * Loads the model with rt_load, as `rt` does (a glTF: every triangle of
  * the default scene in world space, as ../shared/bench/FORMAT.md defines;
@@ -45,7 +45,10 @@
  * rays; --lanes chooses the SIMD width (default the widest the CPU runs;
  * stream_lanes: says which ran), --min-rays and --chunk the stream's
  * parameters (kd_stream_params). The rays are copied into the stream's
- * arrays before the clock starts. Exit 2 on bad arguments or files.
+ * arrays before the clock starts. --simd 8|16: the SIMD width of the
+ * packets and frustum tiles (rt_kdtree_params.lanes; default the widest
+ * the CPU runs; packet_simd: says which ran, 0 for single rays). Exit 2
+ * on bad arguments or files.
  */
 #include <pthread.h>
 #include <stdatomic.h>
@@ -221,7 +224,7 @@ static int usage(void)
 {
     fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K] [--build-threads N] "
                     "[--occluded] [--portable] [--instances] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H] "
-                    "[--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]]\n");
+                    "[--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]] [--simd 8|16]\n");
     return 2;
 }
 
@@ -231,7 +234,7 @@ int main(int argc, char **argv)
     int threads = 1, runs = 5, build_threads = 0;
     bool flatten = true; /* FORMAT.md's scene: every triangle in world space */
     long limit = 0;
-    int pw = 0, ph = 0, image_width = 640, lanes = 0;
+    int pw = 0, ph = 0, image_width = 640, lanes = 0, simd = 0;
     bool occluded = false, portable = false, stream = false, frustum = false;
     long stream_size = 4096, min_rays = 0, chunk = 0;
     for (int i = 1; i < argc; i++) {
@@ -258,6 +261,10 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--lanes") == 0 && i + 1 < argc) {
             lanes = atoi(argv[++i]);
             if (lanes != 4 && lanes != 8 && lanes != 16)
+                return usage();
+        } else if (strcmp(argv[i], "--simd") == 0 && i + 1 < argc) {
+            simd = atoi(argv[++i]);
+            if (simd != 8 && simd != 16)
                 return usage();
         } else if (strcmp(argv[i], "--stream") == 0)
             stream = true;
@@ -320,6 +327,7 @@ int main(int argc, char **argv)
     memset(&params, 0, sizeof params);
     params.threads = build_threads;
     params.portable = portable;
+    params.lanes = simd;
     if (rt_kdtree_build(&tree, &scene, &params, &err) != RT_OK) {
         fprintf(stderr, "rtbench: %s\n", err.message);
         return 2;
@@ -414,6 +422,7 @@ int main(int argc, char **argv)
     printf("bytes_per_triangle: %.1f\n",
            scene.triangles.count ? (double)tree.stats.bytes / (double)scene.triangles.count : 0.0);
     printf("traversal: %s\n", tree.isa == RT_KD_ISA_AVX2 ? "avx2" : "portable");
+    printf("packet_simd: %d\n", tree.lanes);
     printf("threads: %d\n", threads);
     printf("rays: %zu\n", rs.count);
     printf("query: %s\n", occluded ? "occluded" : "closest");
