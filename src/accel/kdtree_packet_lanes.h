@@ -52,7 +52,8 @@ KD_PINLINE kd_pf psplat(float x)
 
 /* m ? a : b per lane (m: 0 or -1), and SSE's min and max: a < b ? a : b
  * and a > b ? a : b, b on ties and NaN (the instructions: GCC does not
- * find them in the vector-type forms, which cost 5-10% here) */
+ * find them in the vector-type and/or forms, which made the 8-lane packets
+ * 13-22% slower than with these, docs/performance.md) */
 #if KD_PW == 16
 KD_PINLINE kd_pf psel(kd_pi m, kd_pf a, kd_pf b)
 {
