@@ -13,7 +13,11 @@ $SHARED/bench/MANIFEST.md, Embree 3 installed when missing, bench/rtbench's
 and `rt compare`'s `key: value` lines read into dicts, the machine's load
 and the CPU time of finished child processes.
 Environment: SHARED (default ../shared), RUNS (default 5), BUILD_EMBREE
-(default /tmp/rt-embree, where the anchor and the triangle files go).
+(default /tmp/rt-embree, where the anchor and the triangle files go),
+RTBENCH (the rtbench commands to time, '|'-separated, each a binary with
+any flags, e.g. "old/bench/rtbench|./bench/rtbench --simd 8|./bench/rtbench":
+bench-packets runs each configuration with each in turn, interleaved;
+bench-compare takes the first; default ./bench/rtbench).
 """
 import os, re, resource, subprocess, sys
 
@@ -21,6 +25,7 @@ shared = os.environ.get("SHARED", "../shared")
 runs = os.environ.get("RUNS", "5")
 embree_dir = os.path.join(shared, "bench", "embree")
 build = os.environ.get("BUILD_EMBREE", "/tmp/rt-embree")
+rtbench_cmds = [c.split() for c in os.environ.get("RTBENCH", "./bench/rtbench").split("|") if c.strip()]
 
 
 def bench_models(tool):
@@ -47,10 +52,11 @@ def key_values(text):
     return dict(line.split(": ", 1) for line in text.splitlines() if ": " in line)
 
 
-def rtbench(args):
-    """Runs bench/rtbench with args: its `key: value` lines, with its exit
-    status under "status" and its standard error under "stderr"."""
-    out = subprocess.run(["./bench/rtbench"] + list(args), capture_output=True, text=True)
+def rtbench(args, cmd=None):
+    """Runs bench/rtbench (or cmd, one of rtbench_cmds; default the first)
+    with args: its `key: value` lines, with its exit status under "status"
+    and its standard error under "stderr"."""
+    out = subprocess.run((cmd or rtbench_cmds[0]) + list(args), capture_output=True, text=True)
     d = key_values(out.stdout)
     d["status"] = out.returncode
     d["stderr"] = out.stderr

@@ -17,7 +17,10 @@ compared with rtcIntersect16 when the anchor ran it, else with
 rtcIntersect8 on 4x2 tiles (marked). Each tracer's answers are checked
 against the reference hits (mismatches column: rt's, then Embree's).
 Environment: SHARED (default ../shared), RUNS (default 5), BUILD_EMBREE
-(default /tmp/rt-embree, where the anchor and the triangle files go).
+(default /tmp/rt-embree, where the anchor and the triangle files go),
+RTBENCH (several rtbench builds or flags, '|'-separated: each row runs
+with each in turn, interleaved, labelled by its index and the SIMD width
+it ran at, `simd`; common.py).
 """
 import json, os, re, subprocess, sys
 
@@ -36,11 +39,11 @@ def image_size(model):
     return (int(m.group(1)), int(m.group(2))) if m else (640, 480)
 
 
-def rtbench(glb, model, threads, tw, th, how="--packets"):
+def rtbench(glb, model, threads, tw, th, how="--packets", cmd=None):
     w, _ = image_size(model)
     rays = os.path.join(shared, "bench", model, model + ".primary")
     d = common.rtbench([os.path.join(shared, glb), rays + ".rays", "--ref", rays + ".hits", "-t", str(threads),
-                        "--runs", runs, how, str(tw), str(th), "--image-width", str(w)])
+                        "--runs", runs, how, str(tw), str(th), "--image-width", str(w)], cmd)
     if d["status"] != 0:
         print(d["stderr"], file=sys.stderr, end="")
     return d
@@ -62,29 +65,35 @@ def embree(model, glb):
 
 
 print("load average at start: " + loadavg())
-print("%-28s %5s %3s %9s %9s %-16s %9s %9s %6s %6s %8s" % (
-    "model (primary)", "tiles", "thr", "rt Mray/s", "rt CPU", "Embree query", "Mray/s", "CPU", "ratio", "CPU r.",
-    "mism."))
+print("%-28s %5s %3s %-6s %9s %9s %-16s %9s %9s %6s %6s %8s" % (
+    "model (primary)", "tiles", "thr", "rt", "rt Mray/s", "rt CPU", "Embree query", "Mray/s", "CPU", "ratio",
+    "CPU r.", "mism."))
 no16 = False
 for model, glb in models:
     e = embree(model, glb)
     for tw, th, how in ((4, 2, "--packets"), (4, 4, "--packets"), (4, 4, "--frustum"), (8, 8, "--frustum")):
         for t in (1, 2):
-            r = rtbench(glb, model, t, tw, th, how)
-            n16 = min(tw * th, 16)  # frustum tiles are compared with Embree's 16-ray packets
-            key, query = ("packet%d_%dT" % (n16, t), "rtcIntersect%d" % n16)
-            if key not in e:  # no native ray16: the 4x2 tiles' rtcIntersect8
-                key, query = "packet8_%dT" % t, "rtcIntersect8 (*)"
-                no16 = True
-            ef = e.get(key, {})
-            # rtbench's CPU figure is rays per CPU-second summed over threads, the anchor's the sum of each
-            # thread's rate: the same footing is rtbench's times the threads
-            mr, mc = float(r.get("mrays_per_s", 0)), float(r.get("cpu_mrays_per_s", 0)) * t
-            er, ec = ef.get("mrays_s", 0.0), ef.get("cpu_mrays_s", 0.0)
-            print("%-28s %5s %3d %9.2f %9.2f %-16s %9.2f %9.2f %6.2f %6.2f %8s" % (
-                model, "%dx%d%s" % (tw, th, "f" if how == "--frustum" else ""), t, mr, mc, query, er, ec, mr / er if er else 0, mc / ec if ec else 0,
-                "%s/%s" % (r.get("mismatches", "?"), ef.get("mismatch_vs_ref", "?"))))
-print("(4x4f, 8x8f: rt's frustum walk on those tiles)")
+            for ci, cmd in enumerate(common.rtbench_cmds):  # several builds: interleaved, row by row
+                r = rtbench(glb, model, t, tw, th, how, cmd)
+                # which rt ran: its index in RTBENCH and the packets' SIMD width (builds before it: "-")
+                label = "%d/%s" % (ci, r.get("packet_simd", "-")) if len(common.rtbench_cmds) > 1 \
+                    else r.get("packet_simd", "-")
+                n16 = min(tw * th, 16)  # frustum tiles are compared with Embree's 16-ray packets
+                key, query = ("packet%d_%dT" % (n16, t), "rtcIntersect%d" % n16)
+                if key not in e:  # no native ray16: the 4x2 tiles' rtcIntersect8
+                    key, query = "packet8_%dT" % t, "rtcIntersect8 (*)"
+                    no16 = True
+                ef = e.get(key, {})
+                # rtbench's CPU figure is rays per CPU-second summed over threads, the anchor's the sum of each
+                # thread's rate: the same footing is rtbench's times the threads
+                mr, mc = float(r.get("mrays_per_s", 0)), float(r.get("cpu_mrays_per_s", 0)) * t
+                er, ec = ef.get("mrays_s", 0.0), ef.get("cpu_mrays_s", 0.0)
+                print("%-28s %5s %3d %-6s %9.2f %9.2f %-16s %9.2f %9.2f %6.2f %6.2f %8s" % (
+                    model, "%dx%d%s" % (tw, th, "f" if how == "--frustum" else ""), t, label, mr, mc, query, er, ec,
+                    mr / er if er else 0, mc / ec if ec else 0,
+                    "%s/%s" % (r.get("mismatches", "?"), ef.get("mismatch_vs_ref", "?"))), flush=True)
+print("(4x4f, 8x8f: rt's frustum walk on those tiles; rt: the packets' SIMD width, 16 AVX-512 or 8 AVX2, with"
+      " the build's index in RTBENCH when there are several)")
 if no16:
     print("(*) no native 16-wide rays for Embree on this CPU (they need AVX-512), so the anchor runs no"
           " rtcIntersect16: those 4x4 rows compare with rtcIntersect8 on 4x2 tiles")

@@ -4,7 +4,7 @@
  *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
  *           [--build-threads N] [--occluded] [--portable] [--instances] [--limit N]
  *           [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H [--image-width N]]
- *           [--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]]
+ *           [--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]] [--simd 8|16]
  *
  * Loads the model with rt_load, as `rt` does (a glTF: every triangle of
  * the default scene in world space, as ../shared/bench/FORMAT.md defines;
@@ -45,7 +45,10 @@
  * rays; --lanes chooses the SIMD width (default the widest the CPU runs;
  * stream_lanes: says which ran), --min-rays and --chunk the stream's
  * parameters (kd_stream_params). The rays are copied into the stream's
- * arrays before the clock starts. Exit 2 on bad arguments or files.
+ * arrays before the clock starts. --simd 8|16: the SIMD width of the
+ * packets and frustum tiles (rt_kdtree_params.lanes; default the widest
+ * the CPU runs; packet_simd: says which ran, 0 for single rays). Exit 2
+ * on bad arguments or files.
  */
 #include <pthread.h>
 #include <stdatomic.h>
@@ -90,17 +93,24 @@ typedef struct job {
     rt_hit_batch stream_hits;
     uint8_t *blocked;
     rt_kd_stream_params stream_params;
-    size_t step; /* rays a thread takes at a time */
+    size_t step; /* the most rays a thread takes at a time */
+    size_t step_min; /* the fewest (at the end of a pass), a multiple of every tile size */
     int threads;
-    atomic_size_t next;
-    double *thread_cpu; /* per thread: CPU seconds, over all runs */
-    size_t *thread_rays; /* per thread: rays traced, over all runs */
+    bool quit; /* the pool's threads return at the next start */
+    pthread_barrier_t start, end; /* a pass starts when every thread is running, ends when all are done */
+    /* the next ray to hand out, alone on its cache line (the fields above
+     * are read all through the pass) */
+    _Alignas(64) atomic_size_t next;
+    char pad[64 - sizeof(atomic_size_t)];
 } job;
 
-/* One thread's part of a pass: the job and the thread's number. */
+/* One thread of the pass: the job, the thread's number, and its CPU
+ * seconds and rays over the timed passes, on a cache line of its own. */
 typedef struct worker {
-    job *j;
+    _Alignas(64) job *j;
     int index;
+    double cpu;
+    size_t rays;
 } worker;
 
 /* The rays of one tile, j->lanes (8 or 16) at a time. */
@@ -135,7 +145,7 @@ static void trace_tile(const job *j, const size_t *idx, size_t n)
     }
 }
 
-enum { CHUNK = 1024 };
+enum { CHUNK = 1024, CHUNK_MIN = 64 };
 
 static double thread_cpu_s(void)
 {
@@ -144,17 +154,38 @@ static double thread_cpu_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void *trace_worker(void *arg)
+/* The next rays for a thread, [start, *end): guided, half of what is left
+ * shared among the threads, at most j->step and at least j->step_min (a
+ * multiple of it), so the threads finish together instead of one running
+ * a whole last chunk alone. start == *end: the pass is done. */
+static size_t grab(job *j, size_t *end)
 {
-    worker *wk = arg;
+    size_t n = j->rays->count, s = atomic_load_explicit(&j->next, memory_order_relaxed);
+    for (;;) {
+        if (s >= n) {
+            *end = s;
+            return s;
+        }
+        size_t take = (n - s) / (2 * (size_t)j->threads);
+        take = take >= j->step ? j->step : take < j->step_min ? j->step_min : take / j->step_min * j->step_min;
+        if (atomic_compare_exchange_weak_explicit(&j->next, &s, s + take, memory_order_relaxed,
+                                                  memory_order_relaxed)) {
+            *end = s + take < n ? s + take : n;
+            return s;
+        }
+    }
+}
+
+/* One thread's part of a pass. */
+static void trace_part(worker *wk)
+{
     job *j = wk->j;
     double c0 = thread_cpu_s();
     for (;;) {
-        size_t start = atomic_fetch_add(&j->next, j->step);
-        if (start >= j->rays->count)
+        size_t end, start = grab(j, &end);
+        if (start >= end)
             break;
-        size_t end = start + j->step < j->rays->count ? start + j->step : j->rays->count;
-        j->thread_rays[wk->index] += end - start;
+        wk->rays += end - start;
         if (j->stream) { /* one stream call: the arrays from `start` on */
             const rt_ray_batch *b = j->stream;
             rt_ray_batch rb = {b->ox + start, b->oy + start, b->oz + start, b->dx + start, b->dy + start,
@@ -170,7 +201,7 @@ static void *trace_worker(void *arg)
                 for (size_t i = start; i < end; i++)
                     j->t_out[i] = h->prim[i] != RT_NONE ? h->t[i] : INFINITY;
             }
-        } else if (j->order) { /* CHUNK is a multiple of every tile size */
+        } else if (j->order) { /* grabs are multiples of every tile size */
             for (size_t i = start; i < end; i += j->pack)
                 trace_tile(j, j->order + i, end - i < j->pack ? end - i : j->pack);
         } else if (j->occluded) {
@@ -183,29 +214,32 @@ static void *trace_worker(void *arg)
             }
         }
     }
-    j->thread_cpu[wk->index] += thread_cpu_s() - c0;
-    return NULL;
+    wk->cpu += thread_cpu_s() - c0;
 }
 
-/* Wall seconds of one pass; *cpu gets the CPU seconds of all threads. */
-static double trace_all(job *jp, double *cpu)
+/* A thread of the pool: a part of every pass, until quit. */
+static void *pool_worker(void *arg)
 {
-    job j = *jp;
-    int threads = jp->threads;
-    atomic_init(&j.next, 0);
-    pthread_t th[256];
-    worker wk[256];
-    double c0 = cpu_s(), t0 = now_s();
-    int started = 0;
-    for (int i = 1; i < threads; i++) {
-        wk[started + 1] = (worker){&j, started + 1};
-        if (pthread_create(&th[started], NULL, trace_worker, &wk[started + 1]) == 0)
-            started++;
+    worker *wk = arg;
+    for (;;) {
+        pthread_barrier_wait(&wk->j->start);
+        if (wk->j->quit)
+            return NULL;
+        trace_part(wk);
+        pthread_barrier_wait(&wk->j->end);
     }
-    wk[0] = (worker){&j, 0};
-    trace_worker(&wk[0]);
-    for (int i = 0; i < started; i++)
-        pthread_join(th[i], NULL);
+}
+
+/* Wall seconds of one pass, from when every thread runs until all are
+ * done; *cpu gets the CPU seconds of the process over it. */
+static double trace_all(job *j, worker *wk, double *cpu)
+{
+    atomic_store(&j->next, 0);
+    double c0 = cpu_s();
+    pthread_barrier_wait(&j->start);
+    double t0 = now_s();
+    trace_part(&wk[0]);
+    pthread_barrier_wait(&j->end);
     double wall = now_s() - t0;
     *cpu = cpu_s() - c0;
     return wall;
@@ -221,7 +255,7 @@ static int usage(void)
 {
     fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K] [--build-threads N] "
                     "[--occluded] [--portable] [--instances] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H] "
-                    "[--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]]\n");
+                    "[--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]] [--simd 8|16]\n");
     return 2;
 }
 
@@ -231,7 +265,7 @@ int main(int argc, char **argv)
     int threads = 1, runs = 5, build_threads = 0;
     bool flatten = true; /* FORMAT.md's scene: every triangle in world space */
     long limit = 0;
-    int pw = 0, ph = 0, image_width = 640, lanes = 0;
+    int pw = 0, ph = 0, image_width = 640, lanes = 0, simd = 0;
     bool occluded = false, portable = false, stream = false, frustum = false;
     long stream_size = 4096, min_rays = 0, chunk = 0;
     for (int i = 1; i < argc; i++) {
@@ -258,6 +292,10 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--lanes") == 0 && i + 1 < argc) {
             lanes = atoi(argv[++i]);
             if (lanes != 4 && lanes != 8 && lanes != 16)
+                return usage();
+        } else if (strcmp(argv[i], "--simd") == 0 && i + 1 < argc) {
+            simd = atoi(argv[++i]);
+            if (simd != 8 && simd != 16)
                 return usage();
         } else if (strcmp(argv[i], "--stream") == 0)
             stream = true;
@@ -320,6 +358,7 @@ int main(int argc, char **argv)
     memset(&params, 0, sizeof params);
     params.threads = build_threads;
     params.portable = portable;
+    params.lanes = simd;
     if (rt_kdtree_build(&tree, &scene, &params, &err) != RT_OK) {
         fprintf(stderr, "rtbench: %s\n", err.message);
         return 2;
@@ -350,8 +389,6 @@ int main(int argc, char **argv)
     }
     float *t_out = malloc((rs.count ? rs.count : 1) * sizeof(float));
     double *times = malloc((size_t)runs * sizeof(double)), *cpus = malloc((size_t)runs * sizeof(double));
-    double thread_cpu[256] = {0};
-    size_t thread_rays[256] = {0};
     if (!t_out || !times || !cpus) {
         fprintf(stderr, "rtbench: out of memory\n");
         return 2;
@@ -360,8 +397,8 @@ int main(int argc, char **argv)
     memset(&jb, 0, sizeof jb);
     jb.tree = &tree, jb.rays = &rs, jb.t_out = t_out, jb.occluded = occluded, jb.order = order;
     jb.frustum = frustum;
-    jb.thread_cpu = thread_cpu, jb.thread_rays = thread_rays;
-    jb.pack = (size_t)pw * (size_t)ph, jb.lanes = lanes, jb.threads = threads, jb.step = CHUNK;
+    jb.pack = (size_t)pw * (size_t)ph, jb.lanes = lanes, jb.threads = threads;
+    jb.step = CHUNK, jb.step_min = CHUNK_MIN; /* multiples of every tile size (at most 64 rays, dividing 1024) */
     float *soa = NULL;
     rt_ray_batch rb;
     if (stream) { /* the rays as arrays, and the hits' (before the clock) */
@@ -385,9 +422,38 @@ int main(int argc, char **argv)
         jb.blocked = (uint8_t *)(void *)(soa + 12 * n);
         jb.stream_params = (rt_kd_stream_params){lanes, (int)min_rays, (int)chunk};
         jb.step = (size_t)stream_size;
+        jb.step_min = jb.step / 4 ? jb.step / 4 : 1; /* the last calls of a pass: smaller streams */
     }
+    /* the threads, started once: every pass is timed from when all of them
+     * run (no thread start-up or join in the window), after one warm-up
+     * pass that is not (page faults of the outputs, cold caches), as
+     * Embree's anchor warms up */
+    static worker wk[256];
+    pthread_t th[256];
+    if (pthread_barrier_init(&jb.start, NULL, (unsigned)threads) != 0 ||
+        pthread_barrier_init(&jb.end, NULL, (unsigned)threads) != 0) {
+        fprintf(stderr, "rtbench: cannot set up %d threads\n", threads);
+        return 2;
+    }
+    for (int i = 0; i < threads; i++)
+        wk[i] = (worker){.j = &jb, .index = i};
+    for (int i = 1; i < threads; i++)
+        if (pthread_create(&th[i], NULL, pool_worker, &wk[i]) != 0) {
+            fprintf(stderr, "rtbench: cannot start %d threads\n", threads);
+            return 2;
+        }
+    double warm;
+    trace_all(&jb, wk, &warm);
+    for (int i = 0; i < threads; i++)
+        wk[i].cpu = 0.0, wk[i].rays = 0;
     for (int r = 0; r < runs; r++)
-        times[r] = trace_all(&jb, &cpus[r]);
+        times[r] = trace_all(&jb, wk, &cpus[r]);
+    jb.quit = true;
+    pthread_barrier_wait(&jb.start);
+    for (int i = 1; i < threads; i++)
+        pthread_join(th[i], NULL);
+    pthread_barrier_destroy(&jb.start);
+    pthread_barrier_destroy(&jb.end);
     qsort(times, (size_t)runs, sizeof(double), cmp_double);
     qsort(cpus, (size_t)runs, sizeof(double), cmp_double);
     double median = runs % 2 ? times[runs / 2] : 0.5 * (times[runs / 2 - 1] + times[runs / 2]);
@@ -414,6 +480,7 @@ int main(int argc, char **argv)
     printf("bytes_per_triangle: %.1f\n",
            scene.triangles.count ? (double)tree.stats.bytes / (double)scene.triangles.count : 0.0);
     printf("traversal: %s\n", tree.isa == RT_KD_ISA_AVX2 ? "avx2" : "portable");
+    printf("packet_simd: %d\n", tree.lanes);
     printf("threads: %d\n", threads);
     printf("rays: %zu\n", rs.count);
     printf("query: %s\n", occluded ? "occluded" : "closest");
@@ -434,10 +501,10 @@ int main(int argc, char **argv)
     printf("hits: %zu\n", hits);
     printf("thread_cpu_s:"); /* each thread's CPU seconds and rays, over all runs: how evenly the work split */
     for (int i = 0; i < threads; i++)
-        printf(" %.4f", thread_cpu[i]);
+        printf(" %.4f", wk[i].cpu);
     printf("\nthread_rays:");
     for (int i = 0; i < threads; i++)
-        printf(" %zu", thread_rays[i]);
+        printf(" %zu", wk[i].rays);
     printf("\n");
     if (rs.ref_t)
         printf("mismatches: %zu\n", mismatches);

@@ -20,7 +20,10 @@
  * the single ray's bit for bit, and through its any-hit query: each ray cut
  * exactly at its hit (tmax = t: not occluded, one ulp more: occluded), and
  * shadow rays from the hit points to a light, as the single query answers.
- * 8x8 tiles go the same ways through the frustum walk (kdtree_frustum.h).
+ * 8x8 tiles go the same ways through the frustum walk (kdtree_frustum.h),
+ * and their 4x4 quadrants as 16-ray packets, at every SIMD width the CPU
+ * runs (16 lanes with AVX-512, 8 with AVX2): t, primitive and
+ * barycentrics the single ray's, bit for bit.
  *
  * Cost: all three models, including the 1M-triangle one (its build is about
  * 1-2 s on two cores). It stays in because it is the model that tests the
@@ -40,12 +43,24 @@
 
 #define RAYS_PER_SET 2500
 
+/* A ray's hit from a packet or a frustum tile is its single walk's: t,
+ * primitive and barycentrics, bit for bit. */
+static void assert_same_hit(const rt_kdtree *tree, const rt_ray *ray, bool hit, const rt_hit *got)
+{
+    rt_hit h;
+    assert_int_equal(rt_kdtree_intersect(tree, ray, &h), hit);
+    if (hit && (h.t != got->t || h.prim != got->prim || h.u != got->u || h.v != got->v))
+        fail_msg("tile ray: t %a prim %u u %a v %a, single ray t %a prim %u u %a v %a", (double)got->t, got->prim,
+                 (double)got->u, (double)got->v, (double)h.t, h.prim, (double)h.u, (double)h.v);
+}
+
 /* Frustum packets: 8x8 pixel tiles spread over a 640x480 primary set
  * through rt_kdtree_intersect_frustum, each ray's t the single ray's bit
  * for bit, and rt_kdtree_occluded_frustum on the same rays cut at their
  * hit (open at tmax: not occluded; one ulp later: occluded) and on shadow
  * rays from the hit points to a light above the model, as the single
- * any-hit query answers. */
+ * any-hit query answers; the tiles' 4x4 quadrants through
+ * rt_kdtree_intersect16 the same way. */
 static void check_frustum_tiles(const rt_kdtree *tree, const rt_rayset *rs, float diag)
 {
     size_t tiles = 0;
@@ -58,12 +73,16 @@ static void check_frustum_tiles(const rt_kdtree *tree, const rt_rayset *rs, floa
             for (int k = 0; k < 64; k++)
                 pr[k] = rs->rays[(ty + (size_t)k / 8) * 640 + tx + (size_t)k % 8];
             uint64_t m = rt_kdtree_intersect_frustum(tree, pr, 64, ph);
-            for (int k = 0; k < 64; k++) {
-                rt_hit h;
-                bool hit = rt_kdtree_intersect(tree, &pr[k], &h);
-                assert_int_equal(hit, (int)(m >> k & 1));
-                if (hit)
-                    assert_true(h.t == ph[k].t);
+            for (int k = 0; k < 64; k++)
+                assert_same_hit(tree, &pr[k], (m >> k & 1) != 0, &ph[k]);
+            for (int q = 0; q < 4; q++) { /* its four 4x4 quadrants as 16-ray packets */
+                rt_ray qr[16];
+                rt_hit qh[16];
+                for (int k = 0; k < 16; k++)
+                    qr[k] = pr[(q / 2 * 4 + k / 4) * 8 + q % 2 * 4 + k % 4];
+                unsigned qm = rt_kdtree_intersect16(tree, qr, 16, qh);
+                for (int k = 0; k < 16; k++)
+                    assert_same_hit(tree, &qr[k], (qm >> k & 1) != 0, &qh[k]);
             }
             for (int k = 0; k < 64; k++) {
                 sr[k] = pr[k];
@@ -131,13 +150,8 @@ static void check_set(const rt_kdtree *tree, const char *model, const char *kind
                 for (int k = 0; k < 8; k++)
                     pr[k] = rs.rays[(ty + (size_t)k / 4) * 640 + tx + (size_t)k % 4];
                 unsigned m = rt_kdtree_intersect8(tree, pr, 8, ph);
-                for (int k = 0; k < 8; k++) {
-                    rt_hit h;
-                    bool hit = rt_kdtree_intersect(tree, &pr[k], &h);
-                    assert_int_equal(hit, (m >> k) & 1);
-                    if (hit)
-                        assert_true(h.t == ph[k].t);
-                }
+                for (int k = 0; k < 8; k++)
+                    assert_same_hit(tree, &pr[k], (m >> k & 1) != 0, &ph[k]);
                 /* rt_kdtree_occluded8: the same rays cut at their hit (open
                  * at tmax: not occluded; one ulp later: occluded), then
                  * shadow rays from the hit points to a light above the
@@ -163,7 +177,14 @@ static void check_set(const rt_kdtree *tree, const char *model, const char *kind
                 tiles++;
             }
         assert_true(tiles > 2000);
+        /* the frustum tiles and 16-ray packets at every width this CPU
+         * runs: the tree's (the widest), and 8 lanes where that is 16 */
         check_frustum_tiles(tree, &rs, diag);
+        if (tree->lanes == 16) {
+            rt_kdtree at8 = *tree; /* the same tree, its packets at 8 lanes (not freed: shares the arrays) */
+            at8.lanes = 8;
+            check_frustum_tiles(&at8, &rs, diag);
+        }
     }
     size_t allowed = tested / 10000;
     if (getenv("RT_TEST_VERBOSE"))

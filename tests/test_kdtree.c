@@ -347,6 +347,34 @@ static void build_ok(rt_kdtree *tree, const rt_scene *s)
     check_tree(s, tree);
 }
 
+/* A tree whose packets and frustum tiles run at `lanes` SIMD lanes (16:
+ * AVX-512, 8: AVX2 or, in the portable build of this file, single rays):
+ * false, with nothing left built, where this CPU does not run that width,
+ * so each width is tested on every machine that can run it. */
+static bool build_at(rt_kdtree *tree, const rt_scene *s, int lanes)
+{
+    rt_error err = {0};
+    rt_kdtree_params p = {0};
+    p.portable = TEST_PORTABLE;
+    p.lanes = lanes;
+    rt_result res = rt_kdtree_build(tree, s, &p, &err);
+    if (res != RT_OK)
+        fprintf(stderr, "build failed: %s\n", err.message);
+    assert_int_equal(res, RT_OK);
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(RT_KD_SCALAR)
+    if (lanes == 16 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+        __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl"))
+        assert_int_equal(tree->lanes, 16);
+    if (lanes == 8 && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+        assert_int_equal(tree->lanes, 8);
+#endif
+    if (tree->lanes == lanes || (lanes == 8 && tree->lanes == 0))
+        return true;
+    fprintf(stderr, "[          ] %d-lane packets: not on this CPU\n", lanes);
+    rt_kdtree_free(tree);
+    return false;
+}
+
 /* -------------------------------------------------------------- tests */
 
 static void test_empty_scene(void **state)
@@ -907,6 +935,23 @@ static void check_tile_hits(const rt_scene *s, const rt_ray *rays, int n, uint64
     }
 }
 
+/* The packets' and the frustum's hits are the single walk's to the bit,
+ * ties included, at every width: each ray meets the same leaves in the
+ * same order with the same closest hit so far (kdtree_packet.c,
+ * kdtree_frustum.c), so the renderer can take either. */
+static void check_as_single(const rt_kdtree *tree, const rt_ray *rays, int n, uint64_t mask, const rt_hit *h)
+{
+    for (int i = 0; i < n; i++) {
+        rt_hit b;
+        bool hb = rt_kdtree_intersect(tree, &rays[i], &b);
+        assert_int_equal(hb, (int)(mask >> i & 1));
+        if (hb && (b.prim != h[i].prim || b.t != h[i].t || b.u != h[i].u || b.v != h[i].v))
+            fprintf(stderr, "tile ray %d of %d: prim %u t %a, single prim %u t %a\n", i, n, h[i].prim,
+                    (double)h[i].t, b.prim, (double)b.t);
+        assert_true(!hb || (b.prim == h[i].prim && b.t == h[i].t && b.u == h[i].u && b.v == h[i].v));
+    }
+}
+
 /* One packet of n rays through rt_kdtree_intersect8 (n <= 8) or
  * rt_kdtree_intersect16 against brute force. */
 static void check_packet(const rt_scene *s, const rt_kdtree *tree, const rt_ray *rays, int n, check_stats *cs)
@@ -915,22 +960,7 @@ static void check_packet(const rt_scene *s, const rt_kdtree *tree, const rt_ray 
     memset(h, 0x55, sizeof h);
     unsigned mask = n > 8 ? rt_kdtree_intersect16(tree, rays, n, h) : rt_kdtree_intersect8(tree, rays, n, h);
     check_tile_hits(s, rays, n, mask, h, "packet", cs);
-}
-
-/* The frustum's hits are the single walk's to the bit, ties included: each
- * ray meets the same leaves in the same order with the same closest hit so
- * far (kdtree_frustum.c), so the renderer can take either. */
-static void check_as_single(const rt_kdtree *tree, const rt_ray *rays, int n, uint64_t mask, const rt_hit *h)
-{
-    for (int i = 0; i < n; i++) {
-        rt_hit b;
-        bool hb = rt_kdtree_intersect(tree, &rays[i], &b);
-        assert_int_equal(hb, (int)(mask >> i & 1));
-        if (hb && (b.prim != h[i].prim || b.t != h[i].t || b.u != h[i].u || b.v != h[i].v))
-            fprintf(stderr, "frustum ray %d of %d: prim %u t %a, single prim %u t %a\n", i, n, h[i].prim,
-                    (double)h[i].t, b.prim, (double)b.t);
-        assert_true(!hb || (b.prim == h[i].prim && b.t == h[i].t && b.u == h[i].u && b.v == h[i].v));
-    }
+    check_as_single(tree, rays, n, mask, h);
 }
 
 /* A tile of n rays (up to 64) through rt_kdtree_intersect_frustum against
@@ -983,9 +1013,8 @@ static rt_vec3 tile_dir(const tile_camera *c, float x0, float y0, float pix, int
     return rt_add(c->fw, rt_add(rt_scale(c->rx, x0 + pix * (float)(i % 4)), rt_scale(c->uy, y0 + pix * (float)(i / 4))));
 }
 
-static void test_packets(void **state)
+static void packets_at(int lanes)
 {
-    (void)state;
     /* rt_kdtree_intersect8 gives each ray its single-ray (so brute-force)
      * hit: coherent 4x2 tiles of pinhole cameras (the packet path),
      * packets of random rays (mixed direction signs: single rays), rays
@@ -997,7 +1026,10 @@ static void test_packets(void **state)
         test_rng r = {700 + (uint64_t)sc};
         packet_scene(&s, &r, sc);
         rt_kdtree tree;
-        build_ok(&tree, &s);
+        if (!build_at(&tree, &s, lanes)) {
+            rt_scene_free(&s);
+            return;
+        }
         check_stats cs = {0, 0, 0};
         float span = sc == 0 ? 1.0f : 9.0f;
         for (int cam = 0; cam < 40; cam++) {
@@ -1032,6 +1064,13 @@ static void test_packets(void **state)
     }
 }
 
+static void test_packets(void **state)
+{
+    (void)state;
+    packets_at(16); /* AVX-512 */
+    packets_at(8);  /* AVX2 */
+}
+
 /* One packet of n shadow rays through rt_kdtree_occluded8 (n <= 8) or
  * rt_kdtree_occluded16: each ray's bit is the single-ray
  * rt_kdtree_occluded and brute force's any-hit. */
@@ -1053,9 +1092,8 @@ static void check_packet_occluded(const rt_scene *s, const rt_kdtree *tree, cons
     }
 }
 
-static void test_packets_occluded(void **state)
+static void packets_occluded_at(int lanes)
 {
-    (void)state;
     /* rt_kdtree_occluded8 against single rays and brute force: shadow rays
      * from the hit points of coherent 4x2 tiles to one point light (the
      * packet path when the points lie on one side of the light), from
@@ -1069,7 +1107,10 @@ static void test_packets_occluded(void **state)
         test_rng r = {900 + (uint64_t)sc};
         packet_scene(&s, &r, sc);
         rt_kdtree tree;
-        build_ok(&tree, &s);
+        if (!build_at(&tree, &s, lanes)) {
+            rt_scene_free(&s);
+            return;
+        }
         check_stats cs = {0, 0, 0};
         size_t ends = 0;
         float span = sc == 0 ? 1.0f : 9.0f;
@@ -1149,9 +1190,15 @@ static void test_packets_occluded(void **state)
     }
 }
 
-static void test_frustum(void **state)
+static void test_packets_occluded(void **state)
 {
     (void)state;
+    packets_occluded_at(16); /* AVX-512 */
+    packets_occluded_at(8);  /* AVX2 */
+}
+
+static void frustum_at(int lanes)
+{
     /* rt_kdtree_intersect_frustum and rt_kdtree_occluded_frustum on 8x8
      * tiles (64 rays, four groups of 16) against brute force: pinhole
      * cameras outside the scene and inside it, tight tiles and wide ones,
@@ -1165,7 +1212,10 @@ static void test_frustum(void **state)
         test_rng r = {1300 + (uint64_t)sc};
         packet_scene(&s, &r, sc);
         rt_kdtree tree;
-        build_ok(&tree, &s);
+        if (!build_at(&tree, &s, lanes)) {
+            rt_scene_free(&s);
+            return;
+        }
         check_stats cs = {0, 0, 0}, cso = {0, 0, 0};
         float span = sc == 0 ? 1.0f : 9.0f;
         for (int cam = 0; cam < 24; cam++) {
@@ -1233,6 +1283,13 @@ static void test_frustum(void **state)
         rt_kdtree_free(&tree);
         rt_scene_free(&s);
     }
+}
+
+static void test_frustum(void **state)
+{
+    (void)state;
+    frustum_at(16); /* AVX-512 */
+    frustum_at(8);  /* AVX2 */
 }
 
 static void test_threads_safe_reads(void **state)

@@ -26,6 +26,19 @@ rt_kd_isa rt_kd_isa_best(void)
     return RT_KD_ISA_PORTABLE;
 }
 
+int rt_kd_lanes_best(rt_kd_isa isa, int want)
+{
+    if (isa != RT_KD_ISA_AVX2)
+        return 0;
+#ifdef KD_HAVE_AVX2
+    if (want != 8 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+        __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl"))
+        return 16;
+#endif
+    (void)want;
+    return 8;
+}
+
 bool rt_kdtree_intersect(const rt_kdtree *tree, const rt_ray *ray, rt_hit *hit)
 {
 #ifdef KD_HAVE_AVX2

@@ -1614,6 +1614,7 @@ rt_result rt_kdtree_build(rt_kdtree *tree, const rt_scene *scene, const rt_kdtre
     memset(tree, 0, sizeof *tree);
     tree->scene = scene;
     tree->isa = params && params->portable ? RT_KD_ISA_PORTABLE : rt_kd_isa_best(); /* once a tree */
+    tree->lanes = rt_kd_lanes_best(tree->isa, params ? params->lanes : 0);
     tree->bounds = rt_box_empty();
     size_t T = scene->triangles.count, S = scene->spheres.count, Q = scene->quads.count;
     size_t I = scene->object_count > 0 ? scene->instance_count : 0, N = T + S + Q + I;

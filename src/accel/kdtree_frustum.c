@@ -9,8 +9,8 @@
  * the deepest node it enters as one (the entry point); Wald's thesis
  * (2004), ch. 7, for the packet walk it replaces (kdtree_packet.c).
  *
- * The bound. The rays (set up in AVX2 lanes by kdtree_packet_lanes.h, the
- * single-ray set-up's operations, 16 a group) must share the sign of each
+ * The bound. The rays (set up in SIMD lanes by kdtree_packet_lanes.h, the
+ * single-ray set-up's operations) must share the sign of each
  * direction component and have none parallel to an axis (else the tile
  * goes as 16-ray packets, which split such rays off as single rays). Per
  * axis the tile keeps [omin, omax] of the origins, [imin, imax] of 1/d
@@ -43,9 +43,9 @@
  * the ray's widening: exactly the interval its single walk has there (the
  * tightest plane on each side of each axis is the box's, and t is monotone
  * in the plane's position). A ray is tested when that interval starts
- * before its closest hit so far, in 8-lane halves against each triangle
+ * before its closest hit so far, a vector of rays against each triangle
  * (tri_rays, the watertight test lane by lane with each ray's own shear)
- * when two or more rays of a half share the shear's axis, else with the
+ * when two or more rays of a vector share the shear's axis, else with the
  * single-ray leaf test. Each ray so meets the same leaves as its single
  * walk, in the same order, with the same closest hit so far, and gets its
  * single walk's answer to the bit, ties included (test_kdtree checks that
@@ -56,10 +56,16 @@
  * 4x4 tiles, 2.2x on 8x8).
  * For occlusion a ray drops out at its first hit.
  *
- * The walk is an AVX2 kernel (kdtree_internal.h's dispatch); a tree whose
- * rays take the portable traversal, or a tile that cannot share the
- * bound, goes through rt_kdtree_intersect16 / rt_kdtree_occluded16 sixteen
- * rays at a time.
+ * Widths. The node step is one 8-lane step whatever the width (its lanes
+ * are the node's cells); the rays' work (set-up, per-ray intervals, leaf
+ * tests, the closest hits) is in vectors of KD_PW rays, written once
+ * (kdtree_packet_lanes.h) and compiled twice: as this file, 16 lanes for
+ * AVX-512 (rt_kd_frustum_walk16, four vectors for an 8x8 tile), and by
+ * kdtree_frustum8.c, 8 lanes for AVX2 (rt_kd_frustum_walk8), chosen by
+ * the tree's width (rt_kdtree.lanes, as the packets). Every width gives
+ * each ray its single walk's bits. A tree whose rays take the portable
+ * traversal, or a tile that cannot share the bound, goes through
+ * rt_kdtree_intersect16 / rt_kdtree_occluded16 sixteen rays at a time.
  */
 #include "rt/accel/kdtree_frustum.h"
 
@@ -73,24 +79,18 @@
 #include <immintrin.h>
 #endif
 
-#define KD_FGROUPS (RT_KD_FRUSTUM_MAX / 16) /* groups of 16 rays (two 8-lane halves) */
+#if !defined(KD_PW) && defined(KD_HAVE_AVX2) /* compiled as itself: the 16-lane walk, then the entry points */
+#define KD_PW 16
+#define KD_FRUSTUM_WALK rt_kd_frustum_walk16
+#define KD_PBEGIN KD_AVX512_BEGIN
+#define KD_PEND KD_AVX512_END
+#endif
 
-/* The tile as 16-ray packets. */
-static uint64_t as_packets(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, bool any)
-{
-    uint64_t mask = 0;
-    for (int g = 0; 16 * g < n; g++) {
-        int m = n - 16 * g < 16 ? n - 16 * g : 16;
-        unsigned b = any ? rt_kdtree_occluded16(tree, rays + 16 * g, m)
-                         : rt_kdtree_intersect16(tree, rays + 16 * g, m, hits + 16 * g);
-        mask |= (uint64_t)b << (16 * g);
-    }
-    return mask;
-}
-
-#ifdef KD_HAVE_AVX2
-KD_AVX2_BEGIN
+#ifdef KD_PW
+KD_PBEGIN
 #include "kdtree_packet_lanes.h"
+
+#define KD_FVEC (RT_KD_FRUSTUM_MAX / KD_PW) /* vectors of KD_PW rays */
 
 #define KD_FSTACK 192 /* as kdtree_trace.c's stack: 7 pushes a wide level */
 _Static_assert(7 * ((KD_MAX_DEPTH + 2) / 3) + 1 <= KD_FSTACK, "frustum traversal stack");
@@ -133,26 +133,21 @@ KD_PINLINE float kd_max(float a, float b)
     return b > a ? b : a;
 }
 
-KD_PINLINE float hmin8(__m256 v)
+/* The smallest and largest lane (SSE's min and max order). */
+KD_PINLINE float hminv(kd_pf v)
 {
-    __m128 m = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-    m = _mm_min_ps(m, _mm_movehl_ps(m, m));
-    return _mm_cvtss_f32(_mm_min_ss(m, _mm_shuffle_ps(m, m, 1)));
+    float m = v[0];
+    for (int i = 1; i < KD_PW; i++)
+        m = v[i] < m ? v[i] : m;
+    return m;
 }
 
-KD_PINLINE float hmax8(__m256 v)
+KD_PINLINE float hmaxv(kd_pf v)
 {
-    __m128 m = _mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
-    m = _mm_max_ps(m, _mm_movehl_ps(m, m));
-    return _mm_cvtss_f32(_mm_max_ss(m, _mm_shuffle_ps(m, m, 1)));
-}
-
-/* Lanes of half k (bits of an 8-bit mask) as a vector mask. */
-KD_PINLINE __m256 lane_mask(unsigned bits)
-{
-    return _mm256_castsi256_ps(_mm256_cmpeq_epi32(
-        _mm256_and_si256(_mm256_set1_epi32((int)bits), _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)),
-        _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128)));
+    float m = v[0];
+    for (int i = 1; i < KD_PW; i++)
+        m = v[i] > m ? v[i] : m;
+    return m;
 }
 
 /* Wide node w (number node, its box at depth d) for the tile in [L, H]
@@ -233,13 +228,13 @@ KD_PINLINE void cell_box(const rt_kdtree_wide *w, unsigned c, const float pb[6],
     }
 }
 
-/* The rays' state, in groups of 16 (halves h = 2 g + k of 8 lanes). */
+/* The rays' state, in vectors of KD_PW rays (vector g: rays KD_PW g ..). */
 typedef struct kd_ftile {
-    __m256 O[2 * KD_FGROUPS][3], INV[2 * KD_FGROUPS][3], MA[2 * KD_FGROUPS][3];
-    __m256 TN[2 * KD_FGROUPS], TF[2 * KD_FGROUPS], TMAX[2 * KD_FGROUPS], BEST[2 * KD_FGROUPS];
-    kd_pray P[2 * KD_FGROUPS];
-    bool across[2 * KD_FGROUPS];
-    _Alignas(32) float best[RT_KD_FRUSTUM_MAX];
+    kd_pf O[KD_FVEC][3], INV[KD_FVEC][3], MA[KD_FVEC][3];
+    kd_pf TN[KD_FVEC], TF[KD_FVEC], TMAX[KD_FVEC], BEST[KD_FVEC];
+    kd_pray P[KD_FVEC];
+    bool across[KD_FVEC];
+    _Alignas(64) float best[RT_KD_FRUSTUM_MAX];
     rt_tri_ray tr[RT_KD_FRUSTUM_MAX];
     rt_hit h[RT_KD_FRUSTUM_MAX];
 } kd_ftile;
@@ -253,26 +248,18 @@ KD_PINLINE bool frustum_setup(const rt_kdtree *tree, const rt_ray *rays, int n, 
 {
     uint64_t act = 0;
     unsigned negany[3] = {0, 0, 0}, posany[3] = {0, 0, 0};
-    int groups = (n + 15) / 16;
-    for (int g = 0; g < groups; g++) {
-        int gn = n - 16 * g < 16 ? n - 16 * g : 16;
-        unsigned parm = 0, negbits[3] = {0, 0, 0}, ag = 0;
-        for (int k = 0; k < 2; k++) {
-            int hx = 2 * g + k;
-            for (int a = 0; a < 3; a++)
-                T->O[hx][a] = T->INV[hx][a] = T->MA[hx][a] = _mm256_setzero_ps();
-            T->TN[hx] = T->TF[hx] = T->TMAX[hx] = _mm256_setzero_ps();
-            if (8 * k < gn)
-                ag |= setup_half(tree, rays + 16 * g, gn, k, T->O[hx], T->INV[hx], T->MA[hx], &T->TN[hx], &T->TF[hx],
-                                 &T->TMAX[hx], &parm, negbits);
-        }
+    int vecs = (n + KD_PW - 1) / KD_PW;
+    for (int g = 0; g < vecs; g++) {
+        unsigned parm = 0, negbits[3] = {0, 0, 0};
+        unsigned ag = setup_half(tree, rays + KD_PW * g, n - KD_PW * g, 0, T->O[g], T->INV[g], T->MA[g], &T->TN[g],
+                                 &T->TF[g], &T->TMAX[g], &parm, negbits);
         if (parm & ag)
             return false;
         for (int a = 0; a < 3; a++) {
             negany[a] |= negbits[a] & ag;
             posany[a] |= ~negbits[a] & ag;
         }
-        act |= (uint64_t)ag << (16 * g);
+        act |= (uint64_t)ag << (KD_PW * g);
     }
     *active = act;
     if (!act)
@@ -286,71 +273,63 @@ KD_PINLINE bool frustum_setup(const rt_kdtree *tree, const rt_ray *rays, int n, 
     for (int i = 0; i < n; i++)
         if (act >> i & 1)
             T->tr[i] = rt_tri_ray_make(rays[i].org, rays[i].dir);
-    const __m256 inf = _mm256_set1_ps(INFINITY), ninf = _mm256_set1_ps(-INFINITY);
-    __m256 omin[3], omax[3], imin[3], imax[3], ma[3], tn = inf, tf = ninf;
+    const kd_pf inf = psplat(INFINITY), ninf = psplat(-INFINITY);
+    kd_pf omin[3], omax[3], imin[3], imax[3], ma[3], tn = inf, tf = ninf;
     for (int a = 0; a < 3; a++)
         omin[a] = imin[a] = inf, omax[a] = imax[a] = ma[a] = ninf;
-    for (int g = 0; g < groups; g++) {
-        unsigned ag = (unsigned)(act >> (16 * g)) & 0xffffu;
-        for (int k = 0; k < 2; k++) {
-            int hx = 2 * g + k;
-            /* the lanes' values before prepare_half zeroes the idle ones */
-            __m256 m = lane_mask(ag >> (8 * k) & 0xffu);
-            for (int a = 0; a < 3; a++) {
-                omin[a] = _mm256_min_ps(omin[a], _mm256_blendv_ps(inf, T->O[hx][a], m));
-                omax[a] = _mm256_max_ps(omax[a], _mm256_blendv_ps(ninf, T->O[hx][a], m));
-                imin[a] = _mm256_min_ps(imin[a], _mm256_blendv_ps(inf, T->INV[hx][a], m));
-                imax[a] = _mm256_max_ps(imax[a], _mm256_blendv_ps(ninf, T->INV[hx][a], m));
-                ma[a] = _mm256_max_ps(ma[a], _mm256_blendv_ps(ninf, T->MA[hx][a], m));
-            }
-            tn = _mm256_min_ps(tn, _mm256_blendv_ps(inf, T->TN[hx], m));
-            tf = _mm256_max_ps(tf, _mm256_blendv_ps(ninf, T->TF[hx], m));
-            T->across[hx] = prepare_half(rays + 16 * g, T->tr + 16 * g, ag, k, T->O[hx], T->INV[hx], T->MA[hx],
-                                         &T->TN[hx], &T->TF[hx], T->TMAX[hx], &T->BEST[hx], T->best + 16 * g,
-                                         &T->P[hx]);
+    const unsigned lanes = (1u << (KD_PW - 1)) * 2u - 1u;
+    for (int g = 0; g < vecs; g++) {
+        unsigned ag = (unsigned)(act >> (KD_PW * g)) & lanes;
+        /* the lanes' values before prepare_half zeroes the idle ones */
+        kd_pi m = planes(ag);
+        for (int a = 0; a < 3; a++) {
+            omin[a] = pmin(omin[a], psel(m, T->O[g][a], inf));
+            omax[a] = pmax(omax[a], psel(m, T->O[g][a], ninf));
+            imin[a] = pmin(imin[a], psel(m, T->INV[g][a], inf));
+            imax[a] = pmax(imax[a], psel(m, T->INV[g][a], ninf));
+            ma[a] = pmax(ma[a], psel(m, T->MA[g][a], ninf));
         }
+        tn = pmin(tn, psel(m, T->TN[g], inf));
+        tf = pmax(tf, psel(m, T->TF[g], ninf));
+        T->across[g] = prepare_half(rays + KD_PW * g, T->tr + KD_PW * g, ag, 0, T->O[g], T->INV[g], T->MA[g],
+                                    &T->TN[g], &T->TF[g], T->TMAX[g], &T->BEST[g], T->best + KD_PW * g, &T->P[g]);
     }
     for (int a = 0; a < 3; a++) {
-        F->omin[a] = hmin8(omin[a]), F->omax[a] = hmax8(omax[a]);
-        F->imin[a] = hmin8(imin[a]), F->imax[a] = hmax8(imax[a]);
-        F->ma[a] = hmax8(ma[a]);
+        F->omin[a] = hminv(omin[a]), F->omax[a] = hmaxv(omax[a]);
+        F->imin[a] = hminv(imin[a]), F->imax[a] = hmaxv(imax[a]);
+        F->ma[a] = hmaxv(ma[a]);
     }
-    *L0 = hmin8(tn);
-    *H0 = hmax8(tf);
+    *L0 = hminv(tn);
+    *H0 = hmaxv(tf);
     return true;
 }
 
 /* The largest closest-hit-so-far of the tile's rays (-inf for rays that
  * are done or idle). */
-KD_PINLINE float best_max(const kd_ftile *T, int groups)
+KD_PINLINE float best_max(const kd_ftile *T, int vecs)
 {
-    __m256 m = T->BEST[0];
-    for (int hx = 1; hx < 2 * groups; hx++)
-        m = _mm256_max_ps(m, T->BEST[hx]);
-    return hmax8(m);
+    kd_pf m = T->BEST[0];
+    for (int g = 1; g < vecs; g++)
+        m = pmax(m, T->BEST[g]);
+    return hmaxv(m);
 }
 
-/* Each ray's own interval in the cell of box b (lo xyz, hi xyz) into L[k]
- * and H[k] for the halves of group g: the slab test with the cell's
- * widening, so exactly the interval the single walk gives the ray in that
- * cell (the tightest plane on each side of each axis is the box's, and t
- * is monotone in the plane's position), cut by the ray's [tn, tf]; idle
- * lanes get an empty one. */
-KD_PINLINE void ray_intervals(const kd_ftile *T, const kd_frustum *F, int g, const float b[6], __m256 L[2],
-                              __m256 H[2])
+/* Each ray's own interval in the cell of box b (lo xyz, hi xyz) into *L
+ * and *H for vector g: the slab test with the cell's widening, so exactly
+ * the interval the single walk gives the ray in that cell (the tightest
+ * plane on each side of each axis is the box's, and t is monotone in the
+ * plane's position), cut by the ray's [tn, tf]; idle lanes get an empty
+ * one. */
+KD_PINLINE void ray_intervals(const kd_ftile *T, const kd_frustum *F, int g, const float b[6], kd_pf *L, kd_pf *H)
 {
-    for (int k = 0; k < 2; k++) {
-        int hx = 2 * g + k;
-        __m256 l = T->TN[hx], h = T->TF[hx];
-        for (int a = 0; a < 3; a++) {
-            __m256 in = _mm256_set1_ps(b[F->neg[a] ? 3 + a : a]), out = _mm256_set1_ps(b[F->neg[a] ? a : 3 + a]);
-            l = _mm256_max_ps(l, _mm256_sub_ps(_mm256_mul_ps(_mm256_sub_ps(in, T->O[hx][a]), T->INV[hx][a]),
-                                               T->MA[hx][a]));
-            h = _mm256_min_ps(h, _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(out, T->O[hx][a]), T->INV[hx][a]),
-                                               T->MA[hx][a]));
-        }
-        L[k] = l, H[k] = h;
+    RT_NO_FP_CONTRACT
+    kd_pf l = T->TN[g], h = T->TF[g];
+    for (int a = 0; a < 3; a++) {
+        kd_pf in = psplat(b[F->neg[a] ? 3 + a : a]), out = psplat(b[F->neg[a] ? a : 3 + a]);
+        l = pmax(l, (in - T->O[g][a]) * T->INV[g][a] - T->MA[g][a]);
+        h = pmin(h, (out - T->O[g][a]) * T->INV[g][a] + T->MA[g][a]);
     }
+    *L = l, *H = h;
 }
 
 /* The one walk of both entry points (any: occlusion, hits not written).
@@ -372,8 +351,9 @@ KD_PINLINE bool frustum_walk(const rt_kdtree *tree, const rt_ray *rays, int n, r
         return false;
     if (!active)
         return true;
-    int groups = (n + 15) / 16;
-    float bmax = best_max(&T, groups);
+    const unsigned lanes = (1u << (KD_PW - 1)) * 2u - 1u;
+    int vecs = (n + KD_PW - 1) / KD_PW;
+    float bmax = best_max(&T, vecs);
     uint64_t found = 0;
     kd_fstack S;
     S.sp = 0;
@@ -391,18 +371,16 @@ KD_PINLINE bool frustum_walk(const rt_kdtree *tree, const rt_ray *rays, int n, r
             d = (int)S.depth[S.sp] + 1;
             cell_box(&tree->wide[S.parent[S.sp]], S.cell[S.sp], boxes[d - 1], boxes[d]);
         }
-        {
-            __m256 Lv[2], Hv[2];
-            for (int g = 0; g < groups; g++) {
-                unsigned ag = (unsigned)(active >> (16 * g)) & 0xffffu;
-                if (!ag)
-                    continue;
-                ray_intervals(&T, &F, g, boxes[d], Lv, Hv);
-                unsigned fg = (unsigned)(found >> (16 * g)) & 0xffffu;
-                fg = leaf_rays(tree, ref, 2, any, ag, &T.across[2 * g], &T.P[2 * g], Lv, Hv, &T.BEST[2 * g],
-                               rays + 16 * g, T.tr + 16 * g, T.best + 16 * g, T.h + 16 * g, fg);
-                found |= (uint64_t)fg << (16 * g);
-            }
+        for (int g = 0; g < vecs; g++) {
+            unsigned ag = (unsigned)(active >> (KD_PW * g)) & lanes;
+            if (!ag)
+                continue;
+            kd_pf Lv, Hv;
+            ray_intervals(&T, &F, g, boxes[d], &Lv, &Hv);
+            unsigned fg = (unsigned)(found >> (KD_PW * g)) & lanes;
+            fg = leaf_rays(tree, ref, 1, any, ag, &T.across[g], &T.P[g], &Lv, &Hv, &T.BEST[g], rays + KD_PW * g,
+                           T.tr + KD_PW * g, T.best + KD_PW * g, T.h + KD_PW * g, fg);
+            found |= (uint64_t)fg << (KD_PW * g);
         }
         if (any) {
             uint64_t done = found & active;
@@ -414,9 +392,9 @@ KD_PINLINE bool frustum_walk(const rt_kdtree *tree, const rt_ray *rays, int n, r
                     T.best[__builtin_ctzll(done)] = -INFINITY;
             }
         }
-        for (int hx = 0; hx < 2 * groups; hx++)
-            T.BEST[hx] = _mm256_load_ps(T.best + 8 * hx);
-        bmax = best_max(&T, groups);
+        for (int g = 0; g < vecs; g++)
+            T.BEST[g] = pload(T.best + KD_PW * g);
+        bmax = best_max(&T, vecs);
     pop:
         for (;;) { /* the next cell that starts before some ray's closest hit */
             if (S.sp == 0)
@@ -440,21 +418,40 @@ done:
     return true;
 }
 
-static bool intersect_avx2(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, uint64_t *mask)
+/* The width's kernel (kdtree_internal.h). */
+bool KD_FRUSTUM_WALK(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, bool any, uint64_t *mask)
 {
-    return frustum_walk(tree, rays, n, hits, false, mask);
+    return any ? frustum_walk(tree, rays, n, NULL, true, mask) : frustum_walk(tree, rays, n, hits, false, mask);
+}
+KD_PEND
+#endif /* KD_PW */
+
+#ifndef KD_FRUSTUM_WALK_ONLY
+/* The tile as 16-ray packets. */
+static uint64_t as_packets(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, bool any)
+{
+    uint64_t mask = 0;
+    for (int g = 0; 16 * g < n; g++) {
+        int m = n - 16 * g < 16 ? n - 16 * g : 16;
+        unsigned b = any ? rt_kdtree_occluded16(tree, rays + 16 * g, m)
+                         : rt_kdtree_intersect16(tree, rays + 16 * g, m, hits + 16 * g);
+        mask |= (uint64_t)b << (16 * g);
+    }
+    return mask;
 }
 
-static bool occluded_avx2(const rt_kdtree *tree, const rt_ray *rays, int n, uint64_t *mask)
-{
-    return frustum_walk(tree, rays, n, NULL, true, mask);
-}
-KD_AVX2_END
+#ifdef KD_HAVE_AVX2
 #define KD_FRUSTUM(tree) ((tree)->isa == RT_KD_ISA_AVX2 && (tree)->instance_count == 0) /* nor does the frustum */
+/* The frustum kernel of the tree's width. */
+static bool frustum_kernel(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, bool any, uint64_t *mask)
+{
+    if (tree->lanes == 16)
+        return rt_kd_frustum_walk16(tree, rays, n, hits, any, mask);
+    return rt_kd_frustum_walk8(tree, rays, n, hits, any, mask);
+}
 #else
 #define KD_FRUSTUM(tree) false
-#define intersect_avx2(tree, rays, n, hits, mask) ((void)(mask), false)
-#define occluded_avx2(tree, rays, n, mask) ((void)(mask), false)
+#define frustum_kernel(tree, rays, n, hits, any, mask) ((void)(mask), false)
 #endif
 
 uint64_t rt_kdtree_intersect_frustum(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits)
@@ -463,7 +460,7 @@ uint64_t rt_kdtree_intersect_frustum(const rt_kdtree *tree, const rt_ray *rays, 
     if (n < 1)
         return 0;
     n = n > RT_KD_FRUSTUM_MAX ? RT_KD_FRUSTUM_MAX : n;
-    if (KD_FRUSTUM(tree) && intersect_avx2(tree, rays, n, hits, &mask))
+    if (KD_FRUSTUM(tree) && frustum_kernel(tree, rays, n, hits, false, &mask))
         return mask;
     return as_packets(tree, rays, n, hits, false);
 }
@@ -474,7 +471,8 @@ uint64_t rt_kdtree_occluded_frustum(const rt_kdtree *tree, const rt_ray *rays, i
     if (n < 1)
         return 0;
     n = n > RT_KD_FRUSTUM_MAX ? RT_KD_FRUSTUM_MAX : n;
-    if (KD_FRUSTUM(tree) && occluded_avx2(tree, rays, n, &mask))
+    if (KD_FRUSTUM(tree) && frustum_kernel(tree, rays, n, NULL, true, &mask))
         return mask;
     return as_packets(tree, rays, n, NULL, true);
 }
+#endif /* KD_FRUSTUM_WALK_ONLY */

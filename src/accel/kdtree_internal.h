@@ -126,6 +126,16 @@ typedef struct kd_ray {
 #define KD_AVX2_BEGIN _Pragma("GCC push_options") _Pragma("GCC target(\"avx2,fma\")")
 #define KD_AVX2_END _Pragma("GCC pop_options")
 #endif
+/* The 16-lane kernels of the packets and frustum tiles (kdtree_packet.c,
+ * kdtree_frustum.c): AVX-512 F, BW, DQ and VL, with AVX2 and FMA, by a
+ * target pragma in the same way. */
+#if defined(__clang__)
+#define KD_AVX512_BEGIN _Pragma("clang attribute push (__attribute__((target(\"avx2,fma,avx512f,avx512bw,avx512dq,avx512vl\"))), apply_to = function)")
+#define KD_AVX512_END _Pragma("clang attribute pop")
+#else
+#define KD_AVX512_BEGIN _Pragma("GCC push_options") _Pragma("GCC target(\"avx2,fma,avx512f,avx512bw,avx512dq,avx512vl\")")
+#define KD_AVX512_END _Pragma("GCC pop_options")
+#endif
 #endif
 
 #ifdef KD_HAVE_AVX2
@@ -143,6 +153,24 @@ extern const uint64_t rt_kd_key_of_cell[128];
 /* The traversal a tree can use on this CPU: RT_KD_ISA_AVX2 when the
  * kernels are compiled in and the CPU has AVX2 and FMA. */
 rt_kd_isa rt_kd_isa_best(void);
+/* The SIMD width of a tree's packets and frustum tiles (rt_kdtree.lanes):
+ * want (16, 8, or 0 for the widest) where the CPU runs it, else the
+ * widest it runs: 16 with AVX-512 F/BW/DQ/VL, 8 with AVX2 and FMA; 0 when
+ * the tree takes the portable traversal (packets then go as single rays). */
+int rt_kd_lanes_best(rt_kd_isa isa, int want);
+
+#ifdef KD_HAVE_AVX2
+/* The packet walk (kdtree_packet.c) per width: n rays (1..16) sharing one
+ * walk, closest hits into hits or (any) occlusion, the rays that hit into
+ * *mask; false, with nothing done, when they cannot share it. 16 lanes
+ * (AVX-512) only where rt_kd_lanes_best gives 16. */
+bool rt_kd_packet_walk16(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, bool any, unsigned *mask);
+bool rt_kd_packet_walk8(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, bool any, unsigned *mask);
+/* The frustum walk (kdtree_frustum.c) per width: n rays (1..64), the same
+ * way. */
+bool rt_kd_frustum_walk16(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, bool any, uint64_t *mask);
+bool rt_kd_frustum_walk8(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, bool any, uint64_t *mask);
+#endif
 
 /* kdtree_trace.c's entry points, once per variant (_avx2: the AVX2 pass,
  * _portable: kdtree.c's); kdtree.h's functions call one. */

@@ -71,6 +71,8 @@ typedef struct rt_kdtree_params {
     int max_depth;        /* 0 = 8 + 1.3 log2(N) (pbrt's rule) */
     int threads;          /* build threads; 0 = one per online CPU (same tree for any count) */
     int portable;         /* 1: the portable traversal even when the CPU has AVX2 (tests; same answers) */
+    int lanes;            /* SIMD width of packets and frustum tiles: 16 (AVX-512), 8 (AVX2); 0 = the widest
+                           * the CPU runs, as is a width it lacks (tests, benchmarks; same answers) */
     struct rt_kdtree_kept *kept; /* objects' trees kept between builds (below); NULL: build every one */
 } rt_kdtree_params;
 
@@ -129,6 +131,7 @@ typedef struct rt_kdtree {
     float scale; /* largest absolute coordinate of bounds (traversal epsilon) */
     const rt_scene *scene;
     rt_kd_isa isa;        /* the traversal kernels this tree uses */
+    int lanes;            /* its packets' and frustum tiles' SIMD width: 16, 8, 0 (single rays) */
     rt_box bounds;
     int max_depth;
     rt_kdtree_stats stats;

@@ -15,9 +15,10 @@
  *
  * The tile's rays are bounded per axis by the ranges of their origins and
  * reciprocal directions; each node of the walk is decided for the whole
- * tile at once from those ranges (interval arithmetic: one scalar step a
- * node, whatever the tile's size), and only at the leaves are the rays
- * tested one by one (in AVX2 lanes). A tile whose rays run in different
+ * tile at once from those ranges (interval arithmetic: one step a node,
+ * whatever the tile's size), and only at the leaves are the rays tested
+ * one by one (in SIMD lanes: 16 with AVX-512, 8 with AVX2, the tree's
+ * rt_kdtree.lanes; the same bits at every width). A tile whose rays run in different
  * directions along some axis, or with a ray parallel to an axis, goes as
  * 16-ray packets (kdtree_packet.h), which trace such rays singly. Trees
  * whose rays take the portable traversal trace tiles as packets too.

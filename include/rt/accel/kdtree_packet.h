@@ -20,9 +20,10 @@
  * out of the packet at its first hit. Packets whose rays run in different
  * directions along some axis (the cells' order would differ), or with a
  * ray parallel to an axis, are traced as single rays. A 4x4 tile is one
- * call of rt_kdtree_intersect16 (two 8-lane halves sharing the walk).
- * Packets go through the AVX2 kernels when the tree's rays do
- * (rt_kdtree.isa), else as single rays.
+ * call of rt_kdtree_intersect16 (one 16-lane vector with AVX-512, two
+ * 8-lane halves sharing the walk with AVX2: rt_kdtree.lanes, chosen by the
+ * build). Packets go through the SIMD kernels when the tree's rays do
+ * (rt_kdtree.isa), else as single rays; every width gives the same bits.
  */
 #ifndef RT_KDTREE_PACKET_H
 #define RT_KDTREE_PACKET_H
@@ -33,9 +34,9 @@
 unsigned rt_kdtree_intersect8(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits);
 /* n rays (1..8); returns the mask of rays with any hit in (tmin, tmax). */
 unsigned rt_kdtree_occluded8(const rt_kdtree *tree, const rt_ray *rays, int n);
-/* The same for n = 1..16 rays (a 4x4 tile) in one walk: two 8-lane halves
- * share each node step and leaf; rays that cannot share it go as two
- * packets of 8. */
+/* The same for n = 1..16 rays (a 4x4 tile) in one walk (16 lanes, or two
+ * 8-lane halves sharing each node step and leaf); rays that cannot share
+ * it go as two packets of 8. */
 unsigned rt_kdtree_intersect16(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits);
 unsigned rt_kdtree_occluded16(const rt_kdtree *tree, const rt_ray *rays, int n);
 
