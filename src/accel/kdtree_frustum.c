@@ -435,7 +435,7 @@ done:
         for (int i = 0; i < n; i++)
             if (found >> i & 1) {
                 hits[i] = T.h[i];
-                hits[i].prim = rt_kdtree_scene_prim(tree, T.h[i].prim);
+                rt_kd_finish_hit(tree, &hits[i]);
             }
     return true;
 }
@@ -450,7 +450,7 @@ static bool occluded_avx2(const rt_kdtree *tree, const rt_ray *rays, int n, uint
     return frustum_walk(tree, rays, n, NULL, true, mask);
 }
 KD_AVX2_END
-#define KD_FRUSTUM(tree) ((tree)->isa == RT_KD_ISA_AVX2 && (tree)->instance_count == 0) /* nor does the frustum */
+#define KD_FRUSTUM(tree) ((tree)->isa == RT_KD_ISA_AVX2)
 #else
 #define KD_FRUSTUM(tree) false
 #define intersect_avx2(tree, rays, n, hits, mask) ((void)(mask), false)
