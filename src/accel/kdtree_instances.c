@@ -181,7 +181,7 @@ unsigned rt_kd_instance_packet(const rt_kdtree *tree, uint32_t id, unsigned m, c
         rt_hit sh[16];
         int lane[16], n = 0;
         for (int r = r0; r < 32 && n < 16; r = ++r0) {
-            if (!(m >> r & 1u) || !rt_kd_ray_may_enter(&in->bounds, &rays[r], best[r]))
+            if (!(m >> r & 1u))
                 continue;
             lane[n] = r;
             sub[n++] = rt_ray_make(rt_mat4_point(x, rays[r].org), rt_mat4_vector(x, rays[r].dir), rays[r].tmin,
