@@ -9,6 +9,7 @@
 #   make denoiser     Intel Open Image Denoise for --denoise: the pyoidn wheel in build/oidn-venv
 #   make reference    the path tracer against the shared Mitsuba reference, through rt compare (SPP=64)
 #   make bench-packets rt's packets and Embree's on the same pixel tiles (also run by bench-compare)
+#   make bench-instances rt instanced vs flattened vs Embree 3 instances on the same rays
 #   make bench-render rt's path tracer against Mitsuba 3 (sets it up in build/mitsuba-venv)
 #   make bench-denoise --denoise at 4/16/64 spp against raw 256 and 1024 spp
 #   make bench-helmet  path tracer rays/s on DamagedHelmet under a sky and a sun (RT_BINS: several builds)
@@ -66,7 +67,7 @@ DEPS_OK  := $(BUILD)/.deps-ok
 
 
 .PHONY: test-slurm test-kubernetes test-parallel test-launchers
-.PHONY: all test asan tsan profile scenes clean deps reference bench bench-load bench-compare bench-packets bench-build bench-render bench-helmet bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
+.PHONY: all test asan tsan profile scenes clean deps reference bench bench-load bench-compare bench-packets bench-instances bench-build bench-render bench-helmet bench-denoise fuzz install uninstall test-install denoiser ggx-albedo-table
 all: $(RT)
 
 deps: $(DEPS_OK)
@@ -193,6 +194,12 @@ bench-compare: bench/rtbench
 # rt's 8- and 16-ray packets and Embree's rtcIntersect8/16 on the same 4x2 and 4x4 tiles of the primary sets.
 bench-packets: bench/rtbench
 	@SHARED=$(SHARED) python3 bench/packets.py
+
+# rt's instanced kd-tree against the same scene flattened and against Embree 3's instances
+# (RTC_GEOMETRY_TYPE_INSTANCE, same transforms, same rays; bench/instances.py and bench/embree_instances.c):
+# single rays, packets, frustum tiles and streams, 1 and 2 threads, interleaved.
+bench-instances: bench/rtbench
+	@SHARED=$(SHARED) python3 bench/instances.py
 
 # rt's path tracer against Mitsuba 3 on the shared Cornell box (sets up Mitsuba in build/mitsuba-venv
 # and Debian's libllvm19 on first use); RT_BINS="./rt other/rt" compares rt builds too.

@@ -2,7 +2,7 @@
  * checked against Embree's reference hits.
  *
  *   rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K]
- *           [--build-threads N] [--occluded] [--portable] [--instances] [--limit N]
+ *           [--build-threads N] [--occluded] [--portable] [--instances] [--write-scene FILE] [--limit N]
  *           [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H [--image-width N]]
  *           [--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]] [--simd 8|16]
  *
@@ -26,8 +26,10 @@
  * as ../shared/bench/FORMAT.md defines the rays' scene, every triangle in
  * world space, as Embree's single-level BVH sees it; --instances keeps a
  * glTF's meshes used more than once as objects placed by instances instead
- * (rt/scene/instance.h; --packets is then refused: the packets do not
- * enter them, and the streams trace ray by ray). --limit N keeps N rays spread evenly over the set
+ * (rt/scene/instance.h; packets, frustum tiles and streams enter them as
+ * sub-packets and sub-streams); --write-scene FILE writes the loaded
+ * scene's triangles, objects and instances' transforms for the Embree
+ * side of make bench-instances (bench/embree_instances.c). --limit N keeps N rays spread evenly over the set
  * (every count/N-th, with its reference hit): a fixed small subset for
  * instruction counts under callgrind. --packets W H traces the set (a
  * primary set: one ray per pixel, row by row, N pixels wide, default 640)
@@ -59,6 +61,7 @@
 
 #include "rt/base/log.h"
 #include "rt/io/load.h"
+#include "rt/scene/instance.h"
 #include "rt/accel/kdtree.h"
 #include "rt/accel/kdtree_frustum.h"
 #include "rt/accel/kdtree_packet.h"
@@ -251,17 +254,74 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* --write-scene FILE: the loaded scene as bench/embree_instances.c reads
+ * it (little endian): "RTINST01"; u64 n and n x 9 float32 (the world
+ * triangles: those of no object); u64 objects, each u64 n and n x 9
+ * float32 (object space); u64 instances, each u32 object, u32 0 and 12
+ * float32 (rows 0-2 of to_world, row major). Returns false on a write
+ * error. */
+static bool write_triangles(FILE *f, const rt_scene *s, size_t first, size_t n)
+{
+    uint64_t c = n;
+    bool ok = fwrite(&c, 8, 1, f) == 1;
+    for (size_t t = first; t < first + n && ok; t++)
+        for (int k = 0; k < 3 && ok; k++) {
+            rt_vec3 v = rt_tri_vertex(s, t, k);
+            float xyz[3] = {v.x, v.y, v.z};
+            ok = fwrite(xyz, sizeof xyz, 1, f) == 1;
+        }
+    return ok;
+}
+
+static bool write_scene(const char *path, const rt_scene *s)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return false;
+    bool ok = fwrite("RTINST01", 1, 8, f) == 8;
+    /* the world triangles: objects' triangles are contiguous ranges */
+    size_t in_objects = 0;
+    for (size_t o = 0; o < s->object_count; o++)
+        in_objects += s->objects[o].triangle_count;
+    uint64_t world = s->triangles.count - in_objects;
+    ok = ok && fwrite(&world, 8, 1, f) == 1;
+    for (size_t t = 0; t < s->triangles.count && ok; t++) {
+        bool obj = false;
+        for (size_t o = 0; o < s->object_count; o++)
+            obj |= t >= s->objects[o].first_triangle && t < s->objects[o].first_triangle + s->objects[o].triangle_count;
+        for (int k = 0; k < 3 && ok && !obj; k++) {
+            rt_vec3 v = rt_tri_vertex(s, t, k);
+            float xyz[3] = {v.x, v.y, v.z};
+            ok = fwrite(xyz, sizeof xyz, 1, f) == 1;
+        }
+    }
+    uint64_t objects = s->object_count, instances = s->instance_count;
+    ok = ok && fwrite(&objects, 8, 1, f) == 1;
+    for (size_t o = 0; o < s->object_count && ok; o++)
+        ok = write_triangles(f, s, s->objects[o].first_triangle, s->objects[o].triangle_count);
+    ok = ok && fwrite(&instances, 8, 1, f) == 1;
+    for (size_t i = 0; i < s->instance_count && ok; i++) {
+        uint32_t head[2] = {s->instances[i].object, 0};
+        float m[12];
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 4; c++)
+                m[4 * r + c] = s->instances[i].to_world.m[r][c];
+        ok = fwrite(head, sizeof head, 1, f) == 1 && fwrite(m, sizeof m, 1, f) == 1;
+    }
+    return fclose(f) == 0 && ok;
+}
+
 static int usage(void)
 {
     fprintf(stderr, "usage: rtbench MODEL.glb RAYS.rays [--ref HITS.hits] [-t THREADS] [--runs K] [--build-threads N] "
-                    "[--occluded] [--portable] [--instances] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]] [--frustum W H] "
-                    "[--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]] [--simd 8|16]\n");
+                    "[--occluded] [--portable] [--instances] [--write-scene FILE] [--limit N] [--packets W H [--image-width N] [--lanes 8|16]] "
+                    "[--frustum W H] [--stream [--lanes 4|8|16] [--stream-size N] [--min-rays N] [--chunk N]] [--simd 8|16]\n");
     return 2;
 }
 
 int main(int argc, char **argv)
 {
-    const char *model = NULL, *rays_path = NULL, *hits_path = NULL;
+    const char *model = NULL, *rays_path = NULL, *hits_path = NULL, *scene_out = NULL;
     int threads = 1, runs = 5, build_threads = 0;
     bool flatten = true; /* FORMAT.md's scene: every triangle in world space */
     long limit = 0;
@@ -311,6 +371,8 @@ int main(int argc, char **argv)
             portable = true;
         else if (strcmp(argv[i], "--instances") == 0)
             flatten = false;
+        else if (strcmp(argv[i], "--write-scene") == 0 && i + 1 < argc)
+            scene_out = argv[++i];
         else if (argv[i][0] == '-')
             return usage();
         else if (!model)
@@ -339,6 +401,10 @@ int main(int argc, char **argv)
         return 2;
     }
     double load_ms = 1e3 * (now_s() - t0);
+    if (scene_out && !write_scene(scene_out, &scene)) {
+        fprintf(stderr, "rtbench: cannot write %s\n", scene_out);
+        return 2;
+    }
     rt_rayset rs;
     if (rt_rayset_load(&rs, rays_path, hits_path, &err) != RT_OK) {
         fprintf(stderr, "rtbench: %s\n", err.message);
@@ -361,11 +427,6 @@ int main(int argc, char **argv)
     params.lanes = simd;
     if (rt_kdtree_build(&tree, &scene, &params, &err) != RT_OK) {
         fprintf(stderr, "rtbench: %s\n", err.message);
-        return 2;
-    }
-    if (pw && tree.instance_count) {
-        fprintf(stderr, "rtbench: %s has instances, which the packets do not enter: trace it without --packets, or "
-                        "without --instances\n", model);
         return 2;
     }
     size_t *order = NULL;

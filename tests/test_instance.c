@@ -20,6 +20,7 @@
 #include "rt/accel/kdtree_frustum.h"
 #include "rt/accel/kdtree_packet.h"
 #include "rt/accel/kdtree_batch.h"
+#include "rt/accel/kdtree_stream.h"
 #include "rt/image/framebuffer.h"
 #include "rt/io/gltf.h"
 #include "rt/io/load.h"
@@ -367,8 +368,8 @@ static void test_instanced_hits(void **state)
                 assert_int_equal(hp[k], RT_NONE);
             }
         }
-        /* packets and frustum tiles do not enter instances: on an instanced
-         * tree they go ray by ray, with the single walk's answers */
+        /* packets and frustum tiles enter instances as sub-packets, with the
+         * single walk's answers (test_instanced_packets_streams: more) */
         for (int k = 0; k < 40; k++) {
             /* a tile of 8x8 coherent rays from one point, towards a small patch of the field */
             rt_ray rays[64];
@@ -752,6 +753,261 @@ static void test_parallel_object_builds(void **state)
     rt_scene_free(&s);
 }
 
+/* ------------------------------------- packets and streams in instances */
+
+/* A scene whose top level mixes world triangles, spheres and instances
+ * of three objects (some mirrored, rotated, scaled), from the scene
+ * format: leaves with instances beside other primitives. */
+static void mixed_scene(rt_scene *s)
+{
+    size_t cap = 1 << 17, n = 0;
+    char *text = malloc(cap);
+    assert_non_null(text);
+    test_rng g = {77};
+    n += (size_t)snprintf(text + n, cap - n, "material g color 0.5 0.5 0.5\n");
+    for (int o = 0; o < 3; o++) { /* a cluster of triangles */
+        n += (size_t)snprintf(text + n, cap - n, "object o%d\n", o);
+        for (int k = 0; k < 40 + 30 * o; k++) {
+            float x = test_rng_float(&g), y = test_rng_float(&g), z = test_rng_float(&g);
+            n += (size_t)snprintf(text + n, cap - n, " triangle %g %g %g  %g %g %g  %g %g %g g\n", x, y, z,
+                                  x + 0.2 + 0.1 * test_rng_float(&g), y, z + 0.1, x, y + 0.3, z + 0.2);
+        }
+        n += (size_t)snprintf(text + n, cap - n, "end\n");
+    }
+    for (int k = 0; k < 150; k++)
+        n += (size_t)snprintf(text + n, cap - n, "instance o%d translate %g %g %g rotate %d %d %d scale %s%g 1 1\n",
+                              k % 3, (double)(k % 12) * 1.1, (double)(k % 5) * 0.3, (double)(k / 12) * 1.1,
+                              (k * 37) % 360, (k * 53) % 360, (k * 11) % 90, k % 5 == 2 ? "-" : "",
+                              0.6 + 0.1 * (k % 7));
+    for (int k = 0; k < 30; k++) { /* world geometry among them */
+        float x = 13.0f * test_rng_float(&g), y = 1.5f * test_rng_float(&g), z = 14.0f * test_rng_float(&g);
+        n += (size_t)snprintf(text + n, cap - n, "triangle %g %g %g  %g %g %g  %g %g %g g\n", x, y, z, x + 0.7, y,
+                              z, x, y + 0.6, z + 0.3);
+        if (k % 3 == 0)
+            n += (size_t)snprintf(text + n, cap - n, "sphere %g %g %g %g g\n", x + 0.3, y, z - 0.4, 0.25);
+    }
+    assert_true(n < cap);
+    rt_scene_init(s);
+    rt_error err = {0};
+    assert_int_equal(rt_scene_parse_string(s, NULL, text, n, "mixed.txt", "", &err), RT_OK);
+    free(text);
+    assert_int_equal(s->object_count, 3);
+    assert_int_equal(s->instance_count, 150);
+}
+
+/* Brute force over everything: the world triangles (those of no object)
+ * and spheres, and every instance's triangles on the transformed ray. */
+static bool brute_force_all(const rt_scene *s, const rt_ray *ray, rt_hit *best)
+{
+    rt_ray r = *ray;
+    rt_hit b;
+    bool any = brute_force(s, &r, &b);
+    if (any)
+        r.tmax = b.t;
+    for (size_t t = 0; t < s->triangles.count; t++) {
+        bool in_object = false;
+        for (size_t o = 0; o < s->object_count; o++)
+            if (t >= s->objects[o].first_triangle && t < s->objects[o].first_triangle + s->objects[o].triangle_count)
+                in_object = true;
+        float th, u, v;
+        if (!in_object && rt_intersect_triangle(r.org, r.dir, rt_tri_vertex(s, t, 0), rt_tri_vertex(s, t, 1),
+                                                rt_tri_vertex(s, t, 2), r.tmin, r.tmax, &th, &u, &v)) {
+            r.tmax = th, b.t = th, b.u = u, b.v = v, b.prim = (uint32_t)t, b.inst = 0, any = true;
+        }
+    }
+    const rt_spheres *sp = &s->spheres;
+    for (size_t i = 0; i < sp->count; i++) {
+        float th;
+        if (rt_intersect_sphere(r.org, r.dir, rt_v3(sp->cx[i], sp->cy[i], sp->cz[i]), sp->radius[i], r.tmin, r.tmax,
+                                &th)) {
+            r.tmax = th, b.t = th, b.u = b.v = 0.0f, b.prim = (uint32_t)(s->triangles.count + i), b.inst = 0;
+            any = true;
+        }
+    }
+    *best = b;
+    return any;
+}
+
+/* A hit against the single walk's: the same bits (t, prim, inst, u, v),
+ * or, where two primitives tie at exactly the same t, the other one. */
+static void assert_same_hit(const rt_scene *s, const rt_ray *ray, const rt_hit *got, const rt_hit *want)
+{
+    assert_true(got->t == want->t);
+    if (got->prim == want->prim && got->inst == want->inst) {
+        assert_true(got->u == want->u && got->v == want->v);
+        return;
+    }
+    /* a tie: the other primitive must be hit at the same t */
+    assert_true(got->prim < s->triangles.count);
+    rt_vec3 org = ray->org, dir = ray->dir;
+    if (got->inst) {
+        const rt_mat4 *x = &s->instances[got->inst - 1].to_object;
+        org = rt_mat4_point(x, org), dir = rt_mat4_vector(x, dir);
+    }
+    float th, u, v;
+    assert_true(rt_intersect_triangle(org, dir, rt_tri_vertex(s, got->prim, 0), rt_tri_vertex(s, got->prim, 1),
+                                      rt_tri_vertex(s, got->prim, 2), ray->tmin, INFINITY, &th, &u, &v));
+    assert_true(th == got->t && u == got->u && v == got->v);
+}
+
+enum { TILES = 48, TILE = 64, PS_N = TILES * TILE };
+
+/* The rays: TILES tiles of 8x8 coherent rays (one origin, towards a patch
+ * of the scene; every third tile's rays end at the patch, tmax 1), then
+ * as many incoherent ones (random origins around the box, random targets,
+ * every third ending at its target). */
+static void packet_rays(rt_box b, rt_ray *coh, rt_ray *inc)
+{
+    test_rng g = {4242};
+    rt_vec3 e = rt_sub(b.hi, b.lo);
+    for (int k = 0; k < TILES; k++) {
+        rt_ray c = field_ray(&g, b);
+        float step = 0.004f + 0.02f * test_rng_float(&g);
+        for (int j = 0; j < TILE; j++) {
+            rt_vec3 off = rt_v3(e.x * step * (float)(j % 8 - 4), e.y * step * (float)(j / 8 - 4), e.z * step * 0.5f);
+            coh[k * TILE + j] = rt_ray_make(c.org, rt_add(c.dir, off), 0.0f, k % 3 == 1 ? 1.0f : INFINITY);
+        }
+    }
+    for (int k = 0; k < PS_N; k++) {
+        inc[k] = field_ray(&g, b);
+        if (k % 3 == 1)
+            inc[k].tmax = 1.0f;
+    }
+}
+
+/* Every traversal of rays through the instanced tree t against the single
+ * walk (and that against brute force): packets of 8 and 16, frustum tiles,
+ * the wavefront batch, streams at every width the CPU has, two chunk
+ * sizes; closest and any hit. */
+static void check_packets_streams(const rt_scene *s, const rt_kdtree *t, const rt_ray *rays, int n, bool tiles,
+                                  bool brute)
+{
+    rt_hit *want = malloc((size_t)n * sizeof *want), *got = malloc((size_t)n * sizeof *got);
+    bool *hit = malloc((size_t)n * sizeof *hit);
+    float *f = malloc((size_t)n * 11 * sizeof *f);
+    uint32_t *hp = malloc((size_t)n * 2 * sizeof *hp);
+    uint8_t *blocked = malloc((size_t)n);
+    assert_true(want && got && hit && f && hp && blocked);
+    int hits = 0, through = 0;
+    for (int k = 0; k < n; k++) {
+        hit[k] = rt_kdtree_intersect(t, &rays[k], &want[k]);
+        rt_hit b;
+        if (brute) /* (once a scene: the other traversal is held to this one) */
+            assert_int_equal(brute_force_all(s, &rays[k], &b), hit[k]);
+        if (hit[k]) {
+            assert_true(!brute || b.t == want[k].t);
+            hits++;
+            through += want[k].inst != 0;
+        }
+    }
+    assert_true(hits > n / 5);
+    assert_true(through > hits / 2);
+    /* packets of 8 and 16, closest and any */
+    for (int w = 8; w <= 16; w += 8)
+        for (int k0 = 0; k0 < n; k0 += w) {
+            int m = n - k0 < w ? n - k0 : w;
+            unsigned pm = w == 8 ? rt_kdtree_intersect8(t, rays + k0, m, got + k0)
+                                 : rt_kdtree_intersect16(t, rays + k0, m, got + k0);
+            unsigned om = w == 8 ? rt_kdtree_occluded8(t, rays + k0, m) : rt_kdtree_occluded16(t, rays + k0, m);
+            for (int j = 0; j < m; j++) {
+                assert_int_equal(pm >> j & 1u, hit[k0 + j]);
+                assert_int_equal(om >> j & 1u, hit[k0 + j]);
+                if (hit[k0 + j])
+                    assert_same_hit(s, &rays[k0 + j], &got[k0 + j], &want[k0 + j]);
+            }
+        }
+    /* frustum tiles */
+    for (int k0 = 0; k0 < n; k0 += RT_KD_FRUSTUM_MAX) {
+        int m = n - k0 < RT_KD_FRUSTUM_MAX ? n - k0 : RT_KD_FRUSTUM_MAX;
+        uint64_t fm = rt_kdtree_intersect_frustum(t, rays + k0, m, got + k0);
+        uint64_t fo = rt_kdtree_occluded_frustum(t, rays + k0, m);
+        for (int j = 0; j < m; j++) {
+            assert_int_equal(fm >> j & 1u, hit[k0 + j]);
+            assert_int_equal(fo >> j & 1u, hit[k0 + j]);
+            if (hit[k0 + j])
+                assert_same_hit(s, &rays[k0 + j], &got[k0 + j], &want[k0 + j]);
+        }
+    }
+    /* the batch and the streams, from structure-of-arrays */
+    float *ox = f, *oy = f + n, *oz = f + 2 * n, *dx = f + 3 * n, *dy = f + 4 * n, *dz = f + 5 * n, *tmin = f + 6 * n,
+          *tmax = f + 7 * n, *ht = f + 8 * n, *hu = f + 9 * n, *hv = f + 10 * n;
+    for (int k = 0; k < n; k++) {
+        ox[k] = rays[k].org.x, oy[k] = rays[k].org.y, oz[k] = rays[k].org.z;
+        dx[k] = rays[k].dir.x, dy[k] = rays[k].dir.y, dz[k] = rays[k].dir.z;
+        tmin[k] = rays[k].tmin, tmax[k] = rays[k].tmax;
+    }
+    rt_ray_batch rb = {ox, oy, oz, dx, dy, dz, tmin, tmax};
+    rt_hit_batch hb = {ht, hu, hv, hp, hp + n};
+    for (int pass = -1; pass < 6; pass++) {
+        rt_kd_stream_params sp = {0};
+        sp.lanes = pass < 0 ? 0 : 4 << (pass % 3);
+        sp.chunk = pass >= 3 ? 200 : 0;
+        if (pass >= 0 && !rt_kd_stream_lanes_supported(sp.lanes))
+            continue;
+        memset(hp, 0xab, (size_t)n * 2 * sizeof *hp);
+        size_t c = pass < 0 ? rt_kdtree_intersect_batch(t, &rb, NULL, (size_t)n, &hb)
+                            : rt_kdtree_intersect_stream(t, &rb, (size_t)n, &hb, &sp);
+        assert_int_equal(c, (size_t)hits);
+        size_t o = pass < 0 ? rt_kdtree_occluded_batch(t, &rb, NULL, (size_t)n, blocked)
+                            : rt_kdtree_occluded_stream(t, &rb, (size_t)n, blocked, &sp);
+        assert_int_equal(o, (size_t)hits);
+        for (int k = 0; k < n; k++) {
+            assert_int_equal(blocked[k], hit[k]);
+            if (!hit[k]) {
+                assert_int_equal(hb.prim[k], RT_NONE);
+                continue;
+            }
+            rt_hit h = {ht[k], hu[k], hv[k], hb.prim[k], hb.inst[k]};
+            assert_same_hit(s, &rays[k], &h, &want[k]);
+        }
+    }
+    print_message("%s rays: %d of %d hit, %d through instances\n", tiles ? "coherent" : "incoherent", hits, n,
+                  through);
+    free(want);
+    free(got);
+    free(hit);
+    free(f);
+    free(hp);
+    free(blocked);
+}
+
+/* Packets, frustum tiles and streams walk the top level together and enter
+ * instances as sub-packets and sub-streams: every answer is the single
+ * walk's (same t bits, instance, triangle, barycentrics) and brute
+ * force's t, on coherent tiles and incoherent rays, on the glTF field
+ * (instances only) and a scene-format scene mixing instances of three
+ * objects with world triangles and spheres, both traversals. */
+static void test_instanced_packets_streams(void **state)
+{
+    (void)state;
+    field f = field_of(100);
+    write_field("field100.glb", &f);
+    rt_scene scenes[2];
+    rt_gltf_stats st;
+    rt_error err;
+    assert_int_equal(load("field100.glb", false, &scenes[0], &st, &err, NULL, 0), RT_OK);
+    assert_int_equal(scenes[0].instance_count, 100);
+    mixed_scene(&scenes[1]);
+    rt_ray *coh = malloc(PS_N * sizeof *coh), *inc = malloc(PS_N * sizeof *inc);
+    assert_true(coh && inc);
+    for (int sc = 0; sc < 2; sc++) {
+        packet_rays(rt_scene_bounds(&scenes[sc]), coh, inc);
+        for (int portable = 0; portable < 2; portable++) {
+            rt_kdtree_params par = {0};
+            par.portable = portable;
+            rt_kdtree t;
+            assert_int_equal(rt_kdtree_build(&t, &scenes[sc], &par, &err), RT_OK);
+            assert_true(t.instance_count > 0);
+            check_packets_streams(&scenes[sc], &t, coh, PS_N, true, !portable);
+            check_packets_streams(&scenes[sc], &t, inc, PS_N, false, !portable);
+            rt_kdtree_free(&t);
+        }
+        rt_scene_free(&scenes[sc]);
+    }
+    free(coh);
+    free(inc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -759,6 +1015,7 @@ int main(void)
         cmocka_unit_test(test_instanced_image), cmocka_unit_test(test_ten_thousand),
         cmocka_unit_test(test_malformed),       cmocka_unit_test(test_rollback),
         cmocka_unit_test(test_scene_objects),   cmocka_unit_test(test_parallel_object_builds),
+        cmocka_unit_test(test_instanced_packets_streams),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -3,7 +3,7 @@
 
     python3 tools/gen-instanced-gltf.py OUT.glb [--instances N] [--triangles T]
         [--nodes] [--rotation float|short|byte] [--grid SPACING] [--seed S]
-        [--rays OUT.rays [--rays-size WxH]] [--animate SECONDS]
+        [--rays OUT.rays [--rays-size WxH]] [--animate SECONDS] [--mesh-from MODEL.glb]
 
 The mesh is a sphere-like grid of about T triangles (a UV sphere squashed a
 little, so rotations show), with normals. By default one node carries
@@ -53,6 +53,38 @@ def sphere(triangles):
     return pos, nrm, idx
 
 
+def mesh_from(path):
+    """The first primitive of a GLB's first mesh: positions (scaled and moved
+    into the sphere's box, about 0.8 x 1 x 0.6), no normals, indices."""
+    with open(path, "rb") as f:
+        data = f.read()
+    magic, _, _ = struct.unpack_from("<III", data, 0)
+    if magic != 0x46546C67:
+        raise SystemExit("%s: not a GLB" % path)
+    jl, _ = struct.unpack_from("<II", data, 12)
+    doc = json.loads(data[20:20 + jl])
+    bl, _ = struct.unpack_from("<II", data, 20 + jl)
+    blob = data[28 + jl:28 + jl + bl]
+
+    def read(ai):
+        acc = doc["accessors"][ai]
+        view = doc["bufferViews"][acc["bufferView"]]
+        fmt, size = {5126: ("f", 4), 5125: ("I", 4), 5123: ("H", 2), 5121: ("B", 1)}[acc["componentType"]]
+        comps = {"SCALAR": 1, "VEC3": 3}[acc["type"]]
+        stride = view.get("byteStride", size * comps)
+        off = view.get("byteOffset", 0) + acc.get("byteOffset", 0)
+        return [struct.unpack_from("<%d%s" % (comps, fmt), blob, off + k * stride) for k in range(acc["count"])]
+
+    prim = doc["meshes"][0]["primitives"][0]
+    pos = read(prim["attributes"]["POSITION"])
+    idx = [i[0] for i in read(prim["indices"])]
+    lo = [min(p[i] for p in pos) for i in range(3)]
+    hi = [max(p[i] for p in pos) for i in range(3)]
+    sc = 1.0 / max(hi[i] - lo[i] for i in range(3))
+    pos = [((p[0] - 0.5 * (lo[0] + hi[0])) * sc, (p[1] - lo[1]) * sc, (p[2] - 0.5 * (lo[2] + hi[2])) * sc) for p in pos]
+    return pos, None, idx
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("out")
@@ -65,9 +97,10 @@ def main():
     ap.add_argument("--rays")
     ap.add_argument("--rays-size", default="640x480")
     ap.add_argument("--animate", type=float, default=0.0)
+    ap.add_argument("--mesh-from")
     a = ap.parse_args()
 
-    pos, nrm, idx = sphere(a.triangles)
+    pos, nrm, idx = mesh_from(a.mesh_from) if a.mesh_from else sphere(a.triangles)
     rng = random.Random(a.seed)
     side = max(1, int(math.ceil(math.sqrt(a.instances))))
     placements = []
@@ -103,9 +136,12 @@ def main():
     lo = [min(p[i] for p in pos) for i in range(3)]
     hi = [max(p[i] for p in pos) for i in range(3)]
     a_pos = add(struct.pack("<%df" % (3 * len(pos)), *flat(pos)), 5126, len(pos), "VEC3", None, 34962, (lo, hi))
-    a_nrm = add(struct.pack("<%df" % (3 * len(nrm)), *flat(nrm)), 5126, len(nrm), "VEC3", None, 34962)
+    attributes = {"POSITION": a_pos}
+    if nrm:
+        attributes["NORMAL"] = add(struct.pack("<%df" % (3 * len(nrm)), *flat(nrm)), 5126, len(nrm), "VEC3", None,
+                                   34962)
     a_idx = add(struct.pack("<%dI" % len(idx), *idx), 5125, len(idx), "SCALAR", None, 34963)
-    mesh = {"primitives": [{"attributes": {"POSITION": a_pos, "NORMAL": a_nrm}, "indices": a_idx, "material": 0}]}
+    mesh = {"primitives": [{"attributes": attributes, "indices": a_idx, "material": 0}]}
     doc = {
         "asset": {"version": "2.0", "generator": "rt tools/gen-instanced-gltf.py"},
         "scene": 0,

@@ -9,9 +9,9 @@
  * "Interactive Rendering with Coherent Ray Tracing"), the rest through the
  * single-ray traversal of kdtree_trace.c (rt_kdtree_intersect). Both give
  * the same answers, so results do not depend on how the rays are grouped.
- * Any hits: single rays (rt_kdtree_occluded). A tree with instances
- * (rt/scene/instance.h) takes every ray alone: the packets do not enter
- * instances.
+ * Any hits: single rays (rt_kdtree_occluded). On a tree with instances
+ * (rt/scene/instance.h) the packets enter them as sub-packets
+ * (kdtree_instances.c).
  */
 #include "rt/accel/kdtree_batch.h"
 
@@ -78,7 +78,7 @@ size_t rt_kdtree_intersect_batch(const rt_kdtree *tree, const rt_ray_batch *rays
 {
     size_t count = 0;
     for (size_t k = 0; k < n;) {
-        int m = tree->instance_count ? 1 : coherent_run(rays, lanes, k, n);
+        int m = coherent_run(rays, lanes, k, n);
         if (m >= KD_BATCH_MIN_PACKET) {
             rt_ray r8[8];
             rt_hit h8[8];

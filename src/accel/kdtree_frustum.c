@@ -413,7 +413,7 @@ done:
         for (int i = 0; i < n; i++)
             if (found >> i & 1) {
                 hits[i] = T.h[i];
-                hits[i].prim = rt_kdtree_scene_prim(tree, T.h[i].prim);
+                rt_kd_finish_hit(tree, &hits[i]);
             }
     return true;
 }
@@ -441,7 +441,7 @@ static uint64_t as_packets(const rt_kdtree *tree, const rt_ray *rays, int n, rt_
 }
 
 #ifdef KD_HAVE_AVX2
-#define KD_FRUSTUM(tree) ((tree)->isa == RT_KD_ISA_AVX2 && (tree)->instance_count == 0) /* nor does the frustum */
+#define KD_FRUSTUM(tree) ((tree)->isa == RT_KD_ISA_AVX2)
 /* The frustum kernel of the tree's width. */
 static bool frustum_kernel(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, bool any, uint64_t *mask)
 {

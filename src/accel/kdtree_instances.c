@@ -29,6 +29,13 @@
  * built) takes that tree instead of building one; a moved instance
  * changes only the top level. Every tree of a build with a set is the
  * set's (the top-level tree borrows them).
+ *
+ * Packets (kdtree_packet.c, kdtree_frustum.c) walk the top level together
+ * and, at an instance in a leaf, send the rays that reached it on as a
+ * sub-packet (rt_kd_instance_packet): each ray moved into object space by
+ * the same operations as a single ray's visit, the sub-packet through the
+ * object's tree, each hit merged back as the single visit merges it; the
+ * streams do the same with sub-streams (kdtree_stream_instances.c).
  */
 #include "kdtree_internal.h"
 
@@ -37,6 +44,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "rt/accel/kdtree_packet.h"
 #include "rt/base/alloc.h"
 #include "rt/base/cpu.h"
 #include "rt/scene/instance.h"
@@ -332,4 +340,49 @@ bool rt_kd_instance_hit(const rt_kdtree *tree, uint32_t i, uint32_t id, const rt
     hit->prim = id;
     hit->inst = h.prim + (uint32_t)tree->scene->objects[in->object].first_triangle;
     return true;
+}
+
+unsigned rt_kd_instance_packet(const rt_kdtree *tree, uint32_t id, unsigned m, const rt_ray *rays, float *best,
+                               rt_hit *h, bool any)
+{
+    uint32_t first_instance = (uint32_t)(tree->other_base + tree->sphere_count + tree->quad_count);
+    const rt_instance *in = &tree->scene->instances[id - first_instance];
+    const rt_kdtree *ob = &tree->objects[in->object];
+    uint32_t first_triangle = (uint32_t)tree->scene->objects[in->object].first_triangle;
+    const rt_mat4 *x = &in->to_object;
+    unsigned found = 0;
+    for (int r0 = 0; r0 < 32 && m >> r0; ) {
+        rt_ray sub[16];
+        rt_hit sh[16];
+        int lane[16], n = 0;
+        for (int r = r0; r < 32 && n < 16; r = ++r0) {
+            if (!(m >> r & 1u))
+                continue;
+            lane[n] = r;
+            sub[n++] = rt_ray_make(rt_mat4_point(x, rays[r].org), rt_mat4_vector(x, rays[r].dir), rays[r].tmin,
+                                   best[r]);
+        }
+        if (n == 0)
+            break;
+        unsigned got = any ? rt_kdtree_occluded16(ob, sub, n) : rt_kdtree_intersect16(ob, sub, n, sh);
+        for (int j = 0; j < n; j++) {
+            int r = lane[j];
+            if (!(got >> j & 1u))
+                continue;
+            if (any) {
+                found |= 1u << r;
+                continue;
+            }
+            if (!(sh[j].t < best[r]))
+                continue;
+            best[r] = sh[j].t;
+            h[r].t = sh[j].t;
+            h[r].u = sh[j].u;
+            h[r].v = sh[j].v;
+            h[r].prim = id;
+            h[r].inst = sh[j].prim + first_triangle;
+            found |= 1u << r;
+        }
+    }
+    return found;
 }

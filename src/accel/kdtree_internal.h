@@ -21,7 +21,10 @@
  *                   its lane kernels are in kdtree_packet_lanes.h;
  *   kdtree_frustum.c rt_kdtree_intersect_frustum: a tile of up to 64
  *                   rays walked as one frustum (kdtree_packet_lanes.h's
- *                   set-up and leaf test, kdtree_trace.c's step tables).
+ *                   set-up and leaf test, kdtree_trace.c's step tables);
+ *   kdtree_instances.c the objects' trees of an instanced tree, and a ray's
+ *                   or a sub-packet's visit to an instance (the streams'
+ *                   sub-streams: kdtree_stream_instances.c).
  *
  * Only the build and packing use rt_kdtree_node; the traversal reads
  * nothing but rt_kdtree and this file's KD_MAX_DEPTH and KD_IDS_PAD.
@@ -217,6 +220,75 @@ void rt_kd_free_objects(rt_kdtree *tree);
  * through rt_kdtree_intersect / rt_kdtree_occluded. */
 bool rt_kd_instance_hit(const rt_kdtree *tree, uint32_t i, uint32_t id, const rt_ray *ray, float *best, rt_hit *hit,
                         bool any);
+
+/* Whether tree id `id` (as in a leaf list, below RT_KD_PAYLOAD) is an
+ * instance: ids past the spheres and quads. */
+static inline bool rt_kd_is_instance(const rt_kdtree *tree, uint32_t id)
+{
+    return tree->instance_count > 0 && id >= tree->other_base &&
+           id - tree->other_base >= tree->sphere_count + tree->quad_count;
+}
+
+/* Whether leaf reference ref (RT_KD_ONE or RT_KD_LEAF) holds an instance:
+ * its single primitive, or its list's last id (lists are ascending, and
+ * instances have the highest ids). */
+static inline bool rt_kd_leaf_has_instance(const rt_kdtree *tree, uint32_t ref)
+{
+    if (tree->instance_count == 0)
+        return false;
+    if (ref >= RT_KD_ONE)
+        return rt_kd_is_instance(tree, ref & RT_KD_PAYLOAD);
+    const uint32_t *p = tree->prim_ids + (ref & RT_KD_PAYLOAD);
+    while (!(*p & RT_KD_LAST))
+        p++;
+    return rt_kd_is_instance(tree, *p & RT_KD_PAYLOAD);
+}
+
+/* Whether the ray can meet anything inside world box b on (ray->tmin,
+ * tmax): the slab test on b grown by 2^-10 of its size and of its
+ * coordinates' magnitude, far more than the rounding of the transform that
+ * made an instance's box from its object's or of the slab test itself, so
+ * a false answer means the ray cannot reach the object's box in its space
+ * and its single visit would find nothing there. The streams leave such
+ * rays out of an instance's sub-stream (their set-up is most of what a
+ * miss costs; the packets measured no gain from it: 3 divides a ray). */
+static inline bool rt_kd_ray_may_enter(const rt_box *b, const rt_ray *ray, float tmax)
+{
+    const float *o = &ray->org.x, *d = &ray->dir.x, *lo = &b->lo.x, *hi = &b->hi.x;
+    float t0 = ray->tmin, t1 = tmax;
+    for (int k = 0; k < 3; k++) {
+        float pad = 0x1p-10f * ((hi[k] - lo[k]) + (lo[k] < 0.0f ? -lo[k] : lo[k]) + (hi[k] < 0.0f ? -hi[k] : hi[k]));
+        float l = lo[k] - pad, h = hi[k] + pad;
+        if (d[k] == 0.0f) {
+            if (o[k] < l || o[k] > h)
+                return false;
+            continue;
+        }
+        float inv = 1.0f / d[k], a = (l - o[k]) * inv, c = (h - o[k]) * inv;
+        if (a > c) {
+            float x = a;
+            a = c;
+            c = x;
+        }
+        if (a > t0)
+            t0 = a;
+        if (c < t1)
+            t1 = c;
+    }
+    return !(t0 > t1); /* (NaN: kept) */
+}
+
+/* A packet's rays of mask m (bits of rays, best and h; at most 32 rays)
+ * against the instance of tree id `id` on (rays[r].tmin, best[r]): the
+ * rays moved into the object's space by the stored inverse, exactly as
+ * rt_kd_instance_hit moves one (t unchanged), and traced together through
+ * the object's tree as sub-packets of up to 16 (rt_kdtree_intersect16 /
+ * rt_kdtree_occluded16, which give each ray its single walk's answer);
+ * a closer hit is merged back as rt_kd_instance_hit writes it (best[r],
+ * h[r].t, u, v, prim = id, inst = the object's triangle). Returns the
+ * rays that hit (any: that are blocked; best and h untouched). */
+unsigned rt_kd_instance_packet(const rt_kdtree *tree, uint32_t id, unsigned m, const rt_ray *rays, float *best,
+                               rt_hit *h, bool any);
 
 /* A closest hit's tree id to the scene's (hit->prim) and hit->inst:
  * 0 for world geometry, instance + 1 (prim then the object's triangle,

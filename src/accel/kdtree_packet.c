@@ -24,7 +24,10 @@
  * vertices broadcast), when the rays share the shear's axis kz; else ray by
  * ray with the single-ray leaf test (kdtree_trace.c's rt_kd_leaf_hit).
  * Either way each ray gets the reference's bits, so its single-ray hit and
- * brute force's (test_packets checks it). The 8 rays are set up together
+ * brute force's (test_packets checks it). An instance in a leaf takes the
+ * rays in lanes that reached it as one sub-packet through its object's
+ * tree (rt_kd_instance_packet, kdtree_instances.c; test_instance checks it
+ * against the single walk and brute force). The 8 rays are set up together
  * too (kdtree_trace.c's ray set-up, the same operations with the rays in
  * lanes after an 8x8 transpose of the rt_ray records). callgrind,
  * DamagedHelmet's primary set in 4x2 tiles, against single rays: -11%
@@ -228,7 +231,7 @@ done:
         for (int i = 0; i < n; i++)
             if (found >> i & 1) {
                 hits[i] = h[i];
-                hits[i].prim = rt_kdtree_scene_prim(tree, h[i].prim);
+                rt_kd_finish_hit(tree, &hits[i]);
             }
     return true;
 }
@@ -257,7 +260,7 @@ static unsigned single_rays(const rt_kdtree *tree, const rt_ray *rays, int n, rt
 }
 
 #ifdef KD_HAVE_AVX2
-#define KD_PACKETS(tree) ((tree)->isa == RT_KD_ISA_AVX2 && (tree)->instance_count == 0) /* packets do not enter instances */
+#define KD_PACKETS(tree) ((tree)->isa == RT_KD_ISA_AVX2)
 /* The packet kernel of the tree's width: 16 lanes for packets of more
  * than 8 rays when the tree has them, else 8. */
 static bool packet_kernel(const rt_kdtree *tree, const rt_ray *rays, int n, rt_hit *hits, bool any, unsigned *mask)

@@ -296,8 +296,9 @@ KD_PINLINE bool prepare_half(const rt_ray *rays, const rt_tri_ray *tr, unsigned 
 
 /* Leaf ref for each active ray whose interval [L, min(H, BEST)] crosses
  * its cell: the vectors with two or more such rays sharing kz (across)
- * primitive by primitive with the rays in lanes (vec), the other rays one
- * by one; with any, a ray that hits is done. Returns found with the rays
+ * primitive by primitive with the rays in lanes (vec), an instance as one
+ * sub-packet of those rays (rt_kd_instance_packet), the other rays one by
+ * one; with any, a ray that hits is done. Returns found with the rays
  * that hit added. */
 KD_PINLINE unsigned leaf_rays(const rt_kdtree *tree, uint32_t ref, int K, bool any, unsigned active,
                               const bool *across, const kd_pray *P, const kd_pf *L, const kd_pf *H, const kd_pf *BEST,
@@ -331,6 +332,8 @@ KD_PINLINE unsigned leaf_rays(const rt_kdtree *tree, uint32_t ref, int K, bool a
                     found |= fk << (KD_PW * k);
                 }
             }
+        } else if (rt_kd_is_instance(tree, id)) { /* a sub-packet through the object's tree */
+            found |= rt_kd_instance_packet(tree, id, vec, rays, best, h, any);
         } else {
             for (unsigned s = vec; s; s &= s - 1) {
                 int i = __builtin_ctz(s);

@@ -13,8 +13,11 @@
  * params.portable takes 4). Its leaves and thin lists come back here: a
  * leaf is tested for one ray with kdtree_trace.c's leaf test, a thin
  * list's rays walk on alone with kdtree_trace.c's walk from that node
- * (both of the pass the tree uses: AVX2 or portable). When the chunk's
- * memory cannot be had, its rays are traced one by one instead.
+ * (both of the pass the tree uses: AVX2 or portable). A leaf holding
+ * instances sends its rays on as sub-streams (kdtree_stream_instances.c,
+ * which sets up and walks them with rt_kd_stream_chunk, as here). When
+ * the chunk's memory cannot be had, its rays are traced one by one
+ * instead.
  */
 #include "rt/accel/kdtree_stream.h"
 
@@ -117,17 +120,13 @@ void rt_kd_stream_single(kd_stream *s, uint32_t ref, uint32_t i, float tn, float
 }
 
 /* The per-ray arrays of a chunk of up to `chunk` rays, in one block. */
-typedef struct stream_mem {
-    void *block;
-} stream_mem;
-
-static bool stream_alloc(kd_stream *s, stream_mem *mem, size_t chunk)
+static bool stream_alloc(kd_stream *s, size_t chunk)
 {
     size_t floats = 10 * chunk, ints = 3 * chunk;
     size_t bytes = floats * sizeof(float) + ints * sizeof(int32_t) + chunk * (sizeof(rt_ray) + sizeof(rt_tri_ray) +
                                                                             sizeof(rt_hit)) + 64;
     char *p = malloc(bytes);
-    mem->block = p;
+    s->block = p;
     if (!p)
         return false;
     /* the structs first (their alignment), then the floats and ints */
@@ -151,40 +150,40 @@ static bool stream_alloc(kd_stream *s, stream_mem *mem, size_t chunk)
     return s->best != NULL;
 }
 
-static void stream_free(kd_stream *s, stream_mem *mem)
+bool rt_kd_stream_open(kd_stream *s, const rt_kdtree *tree, bool any, int lanes, int min_rays, size_t chunk)
 {
-    free(mem->block);
+    memset(s, 0, sizeof *s);
+    s->tree = tree;
+    s->any = any;
+    s->lanes = lanes;
+    s->min_rays = min_rays;
+    s->chunk = chunk;
+    return stream_alloc(s, chunk) && rt_kd_stream_reserve(s, chunk);
+}
+
+void rt_kd_stream_close(kd_stream *s)
+{
+    rt_kd_stream_sub_free(s->sub);
+    free(s->block);
     free(s->best);
     free(s->lid);
     free(s->llo);
     free(s->lhi);
+    memset(s, 0, sizeof *s);
 }
 
-static bool walk(kd_stream *s, size_t count, int lanes)
+bool rt_kd_stream_chunk(kd_stream *s, const rt_ray_batch *rb, size_t g0, size_t m)
 {
-    switch (lanes) {
+    s->any_par = false;
+    switch (s->lanes) {
 #ifdef KD_HAVE_AVX2
     case 16:
-        return rt_kd_stream_walk16(s, count);
+        return rt_kd_stream_walk16(s, rt_kd_stream_setup16(s, rb, g0, m));
     case 8:
-        return rt_kd_stream_walk8(s, count);
+        return rt_kd_stream_walk8(s, rt_kd_stream_setup8(s, rb, g0, m));
 #endif
     default:
-        return rt_kd_stream_walk4(s, count);
-    }
-}
-
-static size_t setup(kd_stream *s, const rt_ray_batch *rb, size_t g0, size_t m, int lanes)
-{
-    switch (lanes) {
-#ifdef KD_HAVE_AVX2
-    case 16:
-        return rt_kd_stream_setup16(s, rb, g0, m);
-    case 8:
-        return rt_kd_stream_setup8(s, rb, g0, m);
-#endif
-    default:
-        return rt_kd_stream_setup4(s, rb, g0, m);
+        return rt_kd_stream_walk4(s, rt_kd_stream_setup4(s, rb, g0, m));
     }
 }
 
@@ -206,23 +205,12 @@ static size_t trace_stream(const rt_kdtree *tree, const rt_ray_batch *rays, size
     if (chunk > n)
         chunk = n ? n : 1;
     kd_stream s;
-    memset(&s, 0, sizeof s);
-    s.tree = tree;
-    s.any = any;
-    s.min_rays = params && params->min_rays > 0 ? params->min_rays : RT_KD_STREAM_MIN_RAYS;
-    stream_mem mem;
-    memset(&mem, 0, sizeof mem);
-    /* (a tree with instances: ray by ray, below; the walk does not enter them) */
-    bool ok = tree->instance_count == 0 && stream_alloc(&s, &mem, chunk) && rt_kd_stream_reserve(&s, chunk);
+    int min_rays = params && params->min_rays > 0 ? params->min_rays : RT_KD_STREAM_MIN_RAYS;
+    bool ok = rt_kd_stream_open(&s, tree, any, lanes, min_rays, chunk);
     size_t found = 0;
     for (size_t c0 = 0; c0 < n; c0 += chunk) {
         size_t m = n - c0 < chunk ? n - c0 : chunk;
-        bool done = false;
-        if (ok) {
-            s.any_par = false;
-            size_t count = setup(&s, rays, c0, m, lanes);
-            done = walk(&s, count, lanes);
-        }
+        bool done = ok && rt_kd_stream_chunk(&s, rays, c0, m);
         for (size_t i = 0; i < m; i++) {
             size_t g = c0 + i;
             rt_hit h = {0.0f, 0.0f, 0.0f, RT_NONE, 0};
@@ -235,7 +223,7 @@ static size_t trace_stream(const rt_kdtree *tree, const rt_ray_batch *rays, size
             } else {
                 h = s.hit[i];
                 if (!any && h.prim != RT_NONE)
-                    h.prim = rt_kdtree_scene_prim(tree, h.prim);
+                    rt_kd_finish_hit(tree, &h);
             }
             bool hit = h.prim != RT_NONE;
             found += hit;
@@ -253,7 +241,7 @@ static size_t trace_stream(const rt_kdtree *tree, const rt_ray_batch *rays, size
             }
         }
     }
-    stream_free(&s, &mem);
+    rt_kd_stream_close(&s);
     return found;
 }
 

@@ -35,7 +35,9 @@
  * A leaf of triangles reached by KD_STREAM_LEAF_LANES rays or more (8-64
  * on average on the benchmark sets) is tested ray-major instead: each of
  * its triangles against the rays in lanes (leaf_lanes, tri_lanes), with
- * the watertight test's own operations per lane.
+ * the watertight test's own operations per lane. A leaf holding instances
+ * reached by two or more rays sends them into each instance's object as a
+ * sub-stream (kdtree_stream_instances.c).
  *
  * The answers: every primitive a ray tests is tested with the single-ray
  * test's operations on (tmin, closest so far), in the leaf's order, and the cells are culled only where the
@@ -466,6 +468,7 @@ KD_SINLINE bool tri_leaf(const rt_kdtree *tree, const uint32_t *p)
     return (*p & RT_KD_PAYLOAD) < tree->other_base;
 }
 #define KD_STREAM_LEAF_LANES 4 /* rays a leaf list needs for the ray-major test */
+#define KD_STREAM_INSTANCE_RAYS 2 /* rays a leaf list needs to enter its instances as a sub-stream */
 
 bool KD_STREAM_WALK(kd_stream *s, size_t count)
 {
@@ -480,6 +483,9 @@ bool KD_STREAM_WALK(kd_stream *s, size_t count)
         if (e.ref >= RT_KD_LEAF && e.ref < RT_KD_ONE && e.count >= KD_STREAM_LEAF_LANES &&
             tri_leaf(tree, tree->prim_ids + (e.ref & RT_KD_PAYLOAD))) {
             leaf_lanes(s, tree->prim_ids + (e.ref & RT_KD_PAYLOAD), e.begin, e.count);
+        } else if (e.ref >= RT_KD_LEAF && e.count >= KD_STREAM_INSTANCE_RAYS && rt_kd_leaf_has_instance(tree, e.ref)) {
+            if (!rt_kd_stream_instance_leaf(s, e.ref, e.begin, e.count))
+                return false;
         } else if (e.ref >= RT_KD_LEAF) {
             for (size_t k = e.begin; k < e.begin + e.count; k++) {
                 uint32_t i = s->lid[k];

@@ -42,10 +42,11 @@
  * instance in a leaf goes into object space by the instance's inverse (t
  * is unchanged: the direction is not renormalised) and is traced in the
  * object's tree; the hit reports the object's triangle (its scene id) and
- * hit.inst = instance + 1. The packet and stream traversals
- * (kdtree_packet.h, kdtree_stream.h) do not enter instances: on a tree
- * with instances, rt_kdtree_intersect_batch and the streams trace ray by
- * ray, and rt_kdtree_intersect8/16 must not be called.
+ * hit.inst = instance + 1. The packet, frustum and stream traversals
+ * (kdtree_packet.h, kdtree_frustum.h, kdtree_stream.h) walk the top level
+ * together and enter an instance with the rays that reached it as a
+ * sub-packet or sub-stream through the object's tree, each ray with the
+ * single walk's answer.
  *
  * The tree keeps a pointer to the scene (for spheres) and each quad's
  * prepared test (rt_quad_prep): the scene must outlive it and must not

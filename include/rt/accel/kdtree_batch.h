@@ -15,8 +15,9 @@
  * consecutive rays in the list that share one origin (a pinhole camera's
  * rays, listed pixel by pixel) are traced 8 at a time as packets
  * (rt/accel/kdtree_packet.h): list coherent rays next to each other.
- * On a tree with instances every ray goes alone (rt_kdtree_intersect), and
- * hits->inst should be given (rt_hit.inst: which instance, + 1).
+ * On a tree with instances the packets enter them as sub-packets (the same
+ * answers), and hits->inst should be given (rt_hit.inst: which instance,
+ * + 1).
  */
 #ifndef RT_KDTREE_BATCH_H
 #define RT_KDTREE_BATCH_H
