@@ -9,6 +9,10 @@
  *     cut-outs, glass, emitters, every light kind, the emitter table; its
  *     shadow rays walk through surfaces) and on the Cornell box (batched
  *     shadow rays);
+ *   - the camera stage: camera rays traced by screen tile as frustums and
+ *     their first hits' shadow rays as bundles, sample by sample against
+ *     rt_radiance_path on a field of triangles, tiles cut by the work's
+ *     rectangle and units; a tree of one leaf keeps the batch;
  *   - rt_render with `path` (wavefront) and `path_scalar`: the same bytes for
  *     1 and 3 threads, tiles and passes, any batch and tile size;
  *   - rt_sincosf (rt/base/vec.h) within its stated error of double sin, cos;

@@ -17,7 +17,9 @@
  *             rt/render/pathtrace.h (emission and MIS, the BSDF, one
  *             light-sampling record per light / environment / emitter, BSDF
  *             sampling, Russian roulette), lanes grouped by material kind
- *   shadow    the records' shadow rays as one batch (rt_kdtree_occluded_batch)
+ *   shadow    the shadow rays of the new tiles' first hits, light by light,
+ *             as frustums (rt_kdtree_occluded_frustum, the single answers),
+ *             the other records' as one batch (rt_kdtree_occluded_batch)
  *   resolve   each path adds its light samples, in their order
  *   retire    finished paths write their radiance; survivors stay, in order
  *
