@@ -6,7 +6,8 @@
  * gathered into structure-of-arrays form for the batch traversal:
  *
  *   refill    free lanes take the next camera samples of the work, in
- *             screen-tile order (cam_cursor: a few pixels' runs of samples)
+ *             screen-tile order where tiles pay (cam_cursor: a few pixels'
+ *             runs of samples)
  *   trace     closest hits for every live path: the new camera rays tile
  *             by tile as frustums (rt_kdtree_intersect_frustum, Reshetov,
  *             Soupikov, Hurley 2005), the other rays as one batch
@@ -217,7 +218,10 @@ enum { TILE_MIN_RAYS = 4, TILE_SAMPLES = 16 };
  * row by row and each pixel's samples of the run in order (the work's
  * only). Every sample of the work comes once; `group` counts (tile, run)
  * pairs, at most tw x th x sg <= RT_KD_FRUSTUM_MAX rays each: one
- * frustum. */
+ * frustum. Where tiles do not pay (tiles_pay) the samples come in the
+ * work's own order (a pixel's samples, then the next pixel's), which the
+ * batch traces as packets and which measured faster there than the tile
+ * order. */
 typedef struct cam_cursor {
     uint64_t first, end;  /* the work's pixels [first, end) of the rectangle */
     uint32_t w, n;        /* rectangle width, samples per pixel in the work */
@@ -226,6 +230,8 @@ typedef struct cam_cursor {
     uint32_t s, j;        /* the run's first sample (from 0), the next ray in the group */
     uint32_t group;
     bool done;
+    bool linear;          /* no tiles: the work's order, sample k after k - 1 */
+    uint64_t next, total; /* (linear) */
 } cam_cursor;
 
 static bool tile_has_pixels(const cam_cursor *c)
@@ -255,8 +261,11 @@ static void next_tile(cam_cursor *c)
     } while (!tile_has_pixels(c));
 }
 
-static void cam_cursor_init(cam_cursor *c, const rt_wavefront_work *wk)
+static void cam_cursor_init(cam_cursor *c, const rt_wavefront_work *wk, bool tiles)
 {
+    c->linear = !tiles;
+    c->next = 0;
+    c->total = (uint64_t)wk->count * (wk->s1 - wk->s0);
     c->w = (uint32_t)(wk->x1 - wk->x0);
     c->n = wk->s1 - wk->s0;
     /* up to TILE_SAMPLES samples a run, and as many pixels as fill a frustum */
@@ -277,6 +286,12 @@ static void cam_cursor_init(cam_cursor *c, const rt_wavefront_work *wk)
  * camera sample in tile order; false when every sample has come. */
 static bool cam_cursor_next(cam_cursor *c, uint32_t *k)
 {
+    if (c->linear) {
+        if (c->next >= c->total)
+            return false;
+        *k = (uint32_t)c->next++;
+        return true;
+    }
     while (!c->done) {
         if (c->j == c->tw * c->th * c->sg) {
             c->j = 0;
@@ -667,9 +682,9 @@ static void shading_order(rt_wavefront *wf, const rt_scene *s, size_t n)
 void rt_wavefront_radiance(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_wavefront_work *wk, float *out)
 {
     const rt_scene *s = ctx->state->scene;
-    cam_cursor cam;
-    cam_cursor_init(&cam, wk);
     const bool tiles = tiles_pay(ctx->state->tree);
+    cam_cursor cam;
+    cam_cursor_init(&cam, wk, tiles);
     size_t n_active = 0, n_free = wf->batch;
     for (size_t k = 0; k < wf->batch; k++)
         wf->free_lanes[k] = (uint32_t)(wf->batch - 1 - k);
