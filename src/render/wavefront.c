@@ -201,8 +201,6 @@ static inline void put_out(float *out, uint32_t k, rt_vec3 L)
     out[3 * (size_t)k + 2] = L.z;
 }
 
-/* ------------------------------------------------------------ stages */
-
 /* ------------------------------------------------------------ camera tiles */
 
 /* Groups smaller than this go ray by ray (the frustum's set-up does not
@@ -368,6 +366,8 @@ static void trace_camera_tiles(rt_wavefront *wf, const rt_kdtree *tree, size_t f
         a = b;
     }
 }
+
+/* ------------------------------------------------------------ stages */
 
 /* Camera sample k of the work into lane i; false (radiance 0 written) for
  * a degenerate camera ray. */
