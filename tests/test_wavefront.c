@@ -9,6 +9,10 @@
  *     cut-outs, glass, emitters, every light kind, the emitter table; its
  *     shadow rays walk through surfaces) and on the Cornell box (batched
  *     shadow rays);
+ *   - the camera stage: camera rays traced by screen tile as frustums and
+ *     their first hits' shadow rays as bundles, sample by sample against
+ *     rt_radiance_path on a field of triangles, tiles cut by the work's
+ *     rectangle and units; a tree of one leaf keeps the batch;
  *   - rt_render with `path` (wavefront) and `path_scalar`: the same bytes for
  *     1 and 3 threads, tiles and passes, any batch and tile size;
  *   - rt_sincosf (rt/base/vec.h) within its stated error of double sin, cos;
@@ -213,16 +217,19 @@ static void load_cornell(fixture *f, int res)
 
 static void unload(fixture *f) { test_fixture_free(f); }
 
-/* Every sample of rows [y0, y1) of the image through the wavefront with
- * the given batch size and pixels per work unit, against rt_radiance_path. */
-static void check_against_scalar(fixture *f, size_t batch, uint32_t per_unit, int y0, int y1, uint32_t spp)
+/* Every sample of the rectangle of columns [x0, x1), rows [y0, y1) of the
+ * image through the wavefront with the given batch size and pixels per
+ * work unit, against rt_radiance_path; what the wavefront traced as tiles
+ * and bundles. */
+static rt_wavefront_stats check_rect(fixture *f, size_t batch, uint32_t per_unit, int x0, int x1, int y0, int y1,
+                                     uint32_t spp)
 {
-    int W = f->settings.width, H = f->settings.height;
+    int W = f->settings.width, H = f->settings.height, RW = x1 - x0;
     rt_camera_frame cf;
     rt_camera_frame_init(&cf, &f->s.camera, W, H);
     rt_wavefront *wf = rt_wavefront_new(batch, &f->rs);
     assert_non_null(wf);
-    uint32_t npx = (uint32_t)(W * (y1 - y0));
+    uint32_t npx = (uint32_t)(RW * (y1 - y0));
     float *out = malloc(3 * sizeof(float) * npx * spp);
     assert_non_null(out);
     uint64_t rays_wave = 0, rays_scalar = 0;
@@ -232,8 +239,8 @@ static void check_against_scalar(fixture *f, size_t batch, uint32_t per_unit, in
         /* samples split in two halves of the range, the second first */
         uint32_t half = spp / 2;
         uint32_t count = npx - p < per_unit ? npx - p : per_unit;
-        rt_wavefront_work hi = {&cf, W, f->settings.seed, spp, 0, W, y0, p, count, half, spp};
-        rt_wavefront_work lo = {&cf, W, f->settings.seed, spp, 0, W, y0, p, count, 0, half};
+        rt_wavefront_work hi = {&cf, W, f->settings.seed, spp, x0, x1, y0, p, count, half, spp};
+        rt_wavefront_work lo = {&cf, W, f->settings.seed, spp, x0, x1, y0, p, count, 0, half};
         static float tmp[3 * 4096];
         assert_true(count * spp <= 4096);
         rt_wavefront_radiance(wf, &ctx, &hi, tmp);
@@ -250,7 +257,7 @@ static void check_against_scalar(fixture *f, size_t batch, uint32_t per_unit, in
     sctx.ray_count = &rays_scalar;
     double sum = 0.0;
     for (uint32_t p = 0; p < npx; p++) {
-        int x = (int)(p % (uint32_t)W), y = y0 + (int)(p / (uint32_t)W);
+        int x = x0 + (int)(p % (uint32_t)RW), y = y0 + (int)(p / (uint32_t)RW);
         for (uint32_t s = 0; s < spp; s++) {
             rt_rng rng;
             rt_ray r = rt_camera_pixel_sample(&cf, W, f->settings.seed, spp, x, y, s, &rng);
@@ -266,7 +273,15 @@ static void check_against_scalar(fixture *f, size_t batch, uint32_t per_unit, in
     assert_true(sum > 0.0);
     assert_true(rays_wave == rays_scalar); /* the same rays, counted the same */
     free(out);
+    rt_wavefront_stats st = rt_wavefront_stats_of(wf);
     rt_wavefront_free(wf);
+    return st;
+}
+
+/* Every sample of rows [y0, y1) of the image, as check_rect. */
+static void check_against_scalar(fixture *f, size_t batch, uint32_t per_unit, int y0, int y1, uint32_t spp)
+{
+    check_rect(f, batch, per_unit, 0, f->settings.width, y0, y1, spp);
 }
 
 static void test_wavefront_equals_scalar(void **state)
@@ -315,6 +330,76 @@ static void test_wavefront_equals_scalar(void **state)
     assert_true(rt_path_samples_env(&f.ctx));
     assert_false(f.rs.shadows_need_shading);
     check_against_scalar(&f, 256, 48, 0, 16, 4);
+    unload(&f);
+}
+
+/* A bumpy field of 1152 triangles under a point, a spot, an area and a
+ * directional light: a tree with inner nodes, so the wavefront traces its
+ * camera rays as tiles and its first hits' shadow rays as bundles. */
+static void load_field(fixture *f)
+{
+    static char text[1152 * 96 + 1024];
+    int n = snprintf(text, sizeof text,
+                     "integrator path\nresolution 37 29\nsamples 4\nbackground 0.1 0.1 0.2\n"
+                     "camera position 0 6 9 look_at 0 0 0 fov 50\n"
+                     "material m color 0.7 0.6 0.5\n"
+                     "light point 2 4 1  1 0.9 0.8  30\n"
+                     "light spot -3 5 2  0.5 -1 -0.3  1 1 1  60  15 25\n"
+                     "light area -0.5 3 -0.5  1 0 0  0 0 1  1 0.9 0.8  10\n"
+                     "light directional -0.5 -1 -0.3  0.6 0.7 1  0.5\n"
+                     "sphere 1 1 0 0.8 m\n");
+    const int G = 24;
+    for (int i = 0; i < G; i++)
+        for (int j = 0; j < G; j++) {
+            float x0 = -6.0f + 12.0f * (float)i / G, x1 = -6.0f + 12.0f * (float)(i + 1) / G;
+            float z0 = -6.0f + 12.0f * (float)j / G, z1 = -6.0f + 12.0f * (float)(j + 1) / G;
+            float h00 = 0.3f * sinf(x0) * cosf(z0), h10 = 0.3f * sinf(x1) * cosf(z0);
+            float h01 = 0.3f * sinf(x0) * cosf(z1), h11 = 0.3f * sinf(x1) * cosf(z1);
+            n += snprintf(text + n, sizeof text - (size_t)n,
+                          "triangle %g %g %g  %g %g %g  %g %g %g m\ntriangle %g %g %g  %g %g %g  %g %g %g m\n", x0,
+                          h00, z0, x1, h10, z0, x1, h11, z1, x0, h00, z0, x1, h11, z1, x0, h01, z1);
+        }
+    assert_true(n < (int)sizeof text);
+    load_text(f, text);
+}
+
+/* The camera stage traces the camera rays a refill starts by screen tile
+ * (rt_kdtree_intersect_frustum), and the shadow rays of their first hits
+ * light by light as bundles (rt_kdtree_occluded_frustum): on rectangles
+ * whose sides are no multiple of a tile, work units that start mid-row and
+ * mid-tile and sample ranges split in two, every sample is still
+ * rt_radiance_path's (single rays), and most camera rays went as tiles. A
+ * tree of one leaf keeps the batch. */
+static void test_camera_tiles_equal_single_rays(void **state)
+{
+    (void)state;
+    fixture f;
+    load_field(&f);
+    assert_false(f.rs.shadows_need_shading);
+    struct { size_t batch; uint32_t per_unit; int x0, x1, y0, y1; uint32_t spp; } runs[] = {
+        {1024, 200, 0, 37, 0, 29, 16}, /* whole rows; tiles of 2x2 pixels, the last column 1 wide */
+        {1024, 77, 5, 30, 3, 26, 8},   /* a rectangle inside, units starting mid-row; 4x2 pixels */
+        {100, 45, 9, 28, 1, 20, 1},    /* one sample: 8x8 pixels of one sample index */
+        {4096, 500, 0, 37, 2, 29, 3},  /* 4x4 pixels of 3 samples */
+    };
+    for (size_t k = 0; k < sizeof runs / sizeof runs[0]; k++) {
+        rt_wavefront_stats st = check_rect(&f, runs[k].batch, runs[k].per_unit, runs[k].x0, runs[k].x1, runs[k].y0,
+                                           runs[k].y1, runs[k].spp);
+        uint64_t camera = (uint64_t)(runs[k].x1 - runs[k].x0) * (uint64_t)(runs[k].y1 - runs[k].y0) * runs[k].spp;
+        if (f.tree.isa != RT_KD_ISA_AVX2) { /* (the frustum would trace them as packets) */
+            assert_true(st.tiles == 0 && st.bundles == 0);
+            continue;
+        }
+        assert_true(st.tile_rays * 2 > camera && st.tile_rays <= camera);
+        assert_true(st.bundle_rays > camera); /* most first hits see several lights */
+    }
+    unload(&f);
+    load_text(&f, "integrator path\nresolution 16 16\nsamples 4\ncamera position 0 1 5 look_at 0 0 0 fov 50\n"
+                  "material m color 0.7 0.7 0.7\nquad -5 0 5  10 0 0  0 0 -10  m\nsphere 0 0.5 0 0.5 m\n"
+                  "light point 1 3 1  1 1 1  20\n");
+    assert_int_equal(f.tree.wide_count, 0); /* one leaf */
+    rt_wavefront_stats st = check_rect(&f, 256, 64, 0, 16, 0, 16, 4);
+    assert_true(st.tiles == 0 && st.bundles == 0);
     unload(&f);
 }
 
@@ -419,6 +504,7 @@ int main(void)
         cmocka_unit_test(test_batch_traversal_matches_single_rays),
         cmocka_unit_test(test_batch_packets_match_single_rays),
         cmocka_unit_test(test_wavefront_equals_scalar),
+        cmocka_unit_test(test_camera_tiles_equal_single_rays),
         cmocka_unit_test(test_render_bytes_any_split),
         cmocka_unit_test(test_cornell_wavefront_equals_scalar),
         cmocka_unit_test(test_sincos_error),

@@ -5,14 +5,22 @@
  * in and out); the rays to trace, their hits and the shadow rays are
  * gathered into structure-of-arrays form for the batch traversal:
  *
- *   refill    free lanes take the next camera samples of the work
- *   trace     closest hits for every live path (rt_kdtree_intersect_batch),
- *             repeated for the lanes whose hit an alpha cut-out removes
+ *   refill    free lanes take the next camera samples of the work, in
+ *             screen-tile order where tiles pay (cam_cursor: a few pixels'
+ *             runs of samples)
+ *   trace     closest hits for every live path: the new camera rays tile
+ *             by tile as frustums (rt_kdtree_intersect_frustum, Reshetov,
+ *             Soupikov, Hurley 2005), the other rays as one batch
+ *             (rt_kdtree_intersect_batch); both give the single walk's
+ *             hits to the bit; repeated (batch) for the lanes whose hit an
+ *             alpha cut-out removes
  *   shade     surface records, then per path the steps of
  *             rt/render/pathtrace.h (emission and MIS, the BSDF, one
  *             light-sampling record per light / environment / emitter, BSDF
  *             sampling, Russian roulette), lanes grouped by material kind
- *   shadow    the records' shadow rays as one batch (rt_kdtree_occluded_batch)
+ *   shadow    the shadow rays of the new tiles' first hits, light by light,
+ *             as frustums (rt_kdtree_occluded_frustum, the single answers),
+ *             the other records' as one batch (rt_kdtree_occluded_batch)
  *   resolve   each path adds its light samples, in their order
  *   retire    finished paths write their radiance; survivors stay, in order
  *
@@ -39,6 +47,7 @@
 #include <stdlib.h>
 
 #include "rt/accel/kdtree_batch.h"
+#include "rt/accel/kdtree_frustum.h"
 #include "rt/base/alloc.h"
 #include "rt/render/environment.h"
 #include "rt/render/pathtrace.h"
@@ -69,6 +78,11 @@ struct rt_wavefront {
     uint8_t *status, *nee;
     int32_t *layers;
     uint32_t *out;       /* index of the sample in the work */
+    /* the camera stage: for the lanes a refill started (active[n_old ..]),
+     * the screen tile and sample each camera ray belongs to; rays of one
+     * group are traced as one frustum */
+    uint32_t *cam_group;
+    rt_wavefront_stats stats;
     /* the rays to trace, gathered from the paths, and their hits */
     float *ox, *oy, *oz, *dx, *dy, *dz, *tmin, *tmax;
     float *ht, *hu, *hv;
@@ -83,6 +97,7 @@ struct rt_wavefront {
     rt_vec3 *vis;        /* what each record's shadow ray lets through */
     float *sox, *soy, *soz, *sdx, *sdy, *sdz, *stmin, *stmax;
     uint8_t *blocked;
+    uint8_t *rec_src;    /* each record's bundle source (shadow_bundles), SRC_NONE: traced in the batch */
     uint32_t *pending;   /* records whose shadow ray is to trace */
     /* lane lists */
     uint32_t *active, *queue, *queue2, *order, *free_lanes;
@@ -139,7 +154,7 @@ rt_wavefront *rt_wavefront_new(size_t batch, const rt_render_state *state)
     for (size_t i = 0; i < sizeof fl / sizeof fl[0]; i++)
         *fl[i] = grab(B, sizeof(float), &ok);
     uint32_t **u32[] = {&wf->hprim, &wf->hinst, &wf->out, &wf->rec_first, &wf->rec_count, &wf->active,
-                        &wf->queue, &wf->queue2, &wf->order, &wf->free_lanes};
+                        &wf->queue, &wf->queue2, &wf->order, &wf->free_lanes, &wf->cam_group};
     for (size_t i = 0; i < sizeof u32 / sizeof u32[0]; i++)
         *u32[i] = grab(B, sizeof(uint32_t), &ok);
     wf->ps = grab(B, sizeof(rt_path_state), &ok);
@@ -154,6 +169,7 @@ rt_wavefront *rt_wavefront_new(size_t batch, const rt_render_state *state)
     for (size_t i = 0; i < sizeof sfl / sizeof sfl[0]; i++)
         *sfl[i] = grab(R, sizeof(float), &ok);
     wf->blocked = grab(R, 1, &ok);
+    wf->rec_src = grab(R, 1, &ok);
     wf->pending = grab(R, sizeof(uint32_t), &ok);
     for (int c = 0; c < LANE_KINDS; c++) {
         wf->kl[c].lane = grab(B, sizeof(uint32_t), &ok);
@@ -183,8 +199,8 @@ void rt_wavefront_free(rt_wavefront *wf)
     void *all[] = {wf->ps, wf->rng, wf->ox, wf->oy, wf->oz, wf->dx, wf->dy, wf->dz, wf->tmin, wf->tmax, wf->ht,
                    wf->hu, wf->hv, wf->hprim, wf->hinst, wf->status, wf->nee, wf->layers, wf->out, wf->rec_first,
                    wf->rec_count, wf->nbr, wf->nbg, wf->nbb, wf->sf, wf->rec, wf->vis, wf->sox, wf->soy,
-                   wf->soz, wf->sdx, wf->sdy, wf->sdz, wf->stmin, wf->stmax, wf->blocked, wf->pending,
-                   wf->active, wf->queue, wf->queue2, wf->order, wf->free_lanes};
+                   wf->soz, wf->sdx, wf->sdy, wf->sdz, wf->stmin, wf->stmax, wf->blocked, wf->rec_src, wf->pending,
+                   wf->active, wf->queue, wf->queue2, wf->order, wf->free_lanes, wf->cam_group};
     for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
         free(all[i]);
     for (int c = 0; c < LANE_KINDS; c++) {
@@ -201,11 +217,179 @@ void rt_wavefront_free(rt_wavefront *wf)
     free(wf);
 }
 
+rt_wavefront_stats rt_wavefront_stats_of(const rt_wavefront *wf) { return wf->stats; }
+
 static inline void put_out(float *out, uint32_t k, rt_vec3 L)
 {
     out[3 * (size_t)k] = L.x;
     out[3 * (size_t)k + 1] = L.y;
     out[3 * (size_t)k + 2] = L.z;
+}
+
+/* ------------------------------------------------------------ camera tiles */
+
+/* Groups smaller than this go ray by ray (the frustum's set-up does not
+ * pay); a group takes up to TILE_SAMPLES samples of each of its pixels
+ * (docs/performance.md, "Frustum tiles in the renderer": 2x2 pixels of 16
+ * samples cost a third fewer instructions a camera ray than 8x8 pixels of
+ * one, whose frustum is wider). */
+enum { TILE_MIN_RAYS = 4, TILE_SAMPLES = 16 };
+
+/* The work's camera samples in tile order: the rectangle's rows in bands
+ * of th from the work's first row, each band in tiles of tw columns from
+ * column 0, each tile in runs of sg sample indices, each run its pixels
+ * row by row and each pixel's samples of the run in order (the work's
+ * only). Every sample of the work comes once; `group` counts (tile, run)
+ * pairs, at most tw x th x sg <= RT_KD_FRUSTUM_MAX rays each: one
+ * frustum. Where tiles do not pay (tiles_pay) the samples come in the
+ * work's own order (a pixel's samples, then the next pixel's), which the
+ * batch traces as packets and which measured faster there than the tile
+ * order. */
+typedef struct cam_cursor {
+    uint64_t first, end;  /* the work's pixels [first, end) of the rectangle */
+    uint32_t w, n;        /* rectangle width, samples per pixel in the work */
+    uint32_t tw, th, sg;  /* tile width and height in pixels, samples a run */
+    uint32_t band, tx;    /* the tile: its first row and column */
+    uint32_t s, j;        /* the run's first sample (from 0), the next ray in the group */
+    uint32_t group;
+    bool done;
+    bool linear;          /* no tiles: the work's order, sample k after k - 1 */
+    uint64_t next, total; /* (linear) */
+} cam_cursor;
+
+static bool tile_has_pixels(const cam_cursor *c)
+{
+    uint32_t cols = c->w - c->tx < c->tw ? c->w - c->tx : c->tw;
+    for (uint64_t r = c->band; r < (uint64_t)c->band + c->th; r++) {
+        uint64_t a = r * c->w + c->tx;
+        if (a < c->end && a + cols > c->first)
+            return true;
+    }
+    return false;
+}
+
+/* The next tile of the work with a pixel in it, or done. */
+static void next_tile(cam_cursor *c)
+{
+    do {
+        c->tx += c->tw;
+        if (c->tx >= c->w) {
+            c->tx = 0;
+            c->band += c->th;
+            if ((uint64_t)c->band * c->w >= c->end) {
+                c->done = true;
+                return;
+            }
+        }
+    } while (!tile_has_pixels(c));
+}
+
+static void cam_cursor_init(cam_cursor *c, const rt_wavefront_work *wk, bool tiles)
+{
+    c->linear = !tiles;
+    c->next = 0;
+    c->total = (uint64_t)wk->count * (wk->s1 - wk->s0);
+    c->w = (uint32_t)(wk->x1 - wk->x0);
+    c->n = wk->s1 - wk->s0;
+    /* up to TILE_SAMPLES samples a run, and as many pixels as fill a frustum */
+    c->sg = c->n < TILE_SAMPLES ? c->n : TILE_SAMPLES;
+    uint32_t px = c->sg > 0 ? RT_KD_FRUSTUM_MAX / c->sg : 64;
+    c->tw = px >= 32 ? 8 : px >= 8 ? 4 : 2; /* 8x8, 8x4, 4x4, 4x2, 2x2 */
+    c->th = px >= 64 ? 8 : px >= 16 ? 4 : 2;
+    c->first = wk->first;
+    c->end = (uint64_t)wk->first + wk->count;
+    c->band = c->w > 0 ? wk->first / c->w : 0;
+    c->tx = c->s = c->j = c->group = 0;
+    c->done = wk->count == 0 || c->n == 0 || c->w == 0;
+    if (!c->done && !tile_has_pixels(c))
+        next_tile(c);
+}
+
+/* The index in the work (pixel-major, as out is laid out) of the next
+ * camera sample in tile order; false when every sample has come. */
+static bool cam_cursor_next(cam_cursor *c, uint32_t *k)
+{
+    if (c->linear) {
+        if (c->next >= c->total)
+            return false;
+        *k = (uint32_t)c->next++;
+        return true;
+    }
+    while (!c->done) {
+        if (c->j == c->tw * c->th * c->sg) {
+            c->j = 0;
+            c->group++;
+            c->s += c->sg;
+            if (c->s >= c->n) {
+                c->s = 0;
+                next_tile(c);
+            }
+            continue;
+        }
+        uint32_t px = c->j / c->sg, s = c->s + c->j % c->sg;
+        uint32_t col = c->tx + px % c->tw;
+        uint64_t p = ((uint64_t)c->band + px / c->tw) * c->w + col;
+        c->j++;
+        if (s < c->n && col < c->w && p >= c->first && p < c->end) {
+            *k = (uint32_t)((p - c->first) * c->n + s);
+            return true;
+        }
+    }
+    return false;
+}
+
+/* Whether camera tiles and shadow bundles go as frustums: on a tree with
+ * inner nodes, whose rays take the AVX2 walks, without instances. A tree
+ * of one leaf has nothing to cull (every ray tests every primitive: the
+ * tiles measured 0.3% more instructions on the Cornell boxes), and the
+ * frustum walk traces the other trees' tiles as packets or single rays,
+ * as the batch does (docs/performance.md, "Frustum tiles in the
+ * renderer"). */
+static bool tiles_pay(const rt_kdtree *tree)
+{
+    return tree->wide_count > 0 && tree->isa == RT_KD_ISA_AVX2 && tree->instance_count == 0;
+}
+
+/* The end of the camera group starting at active position a (at most a
+ * frustum's rays). */
+static size_t group_end(const rt_wavefront *wf, size_t a, size_t to)
+{
+    size_t b = a + 1;
+    while (b < to && b - a < RT_KD_FRUSTUM_MAX && wf->cam_group[b] == wf->cam_group[a])
+        b++;
+    return b;
+}
+
+/* The camera rays of the lanes at active[from .. to), each group of one
+ * tile and sample through rt_kdtree_intersect_frustum (the single walk's
+ * hits to the bit), their hits into the lanes' hit arrays as the batch
+ * traversal writes them. */
+static void trace_camera_tiles(rt_wavefront *wf, const rt_kdtree *tree, size_t from, size_t to)
+{
+    rt_ray rays[RT_KD_FRUSTUM_MAX];
+    rt_hit hits[RT_KD_FRUSTUM_MAX];
+    for (size_t a = from; a < to;) {
+        size_t b = group_end(wf, a, to);
+        int n = (int)(b - a);
+        for (int j = 0; j < n; j++)
+            rays[j] = wf->ps[wf->active[a + (size_t)j]].r;
+        if (n >= TILE_MIN_RAYS) {
+            rt_kdtree_intersect_frustum(tree, rays, n, hits);
+            wf->stats.tiles++;
+            wf->stats.tile_rays += (uint64_t)n;
+        } else {
+            for (int j = 0; j < n; j++)
+                if (!rt_kdtree_intersect(tree, &rays[j], &hits[j]))
+                    hits[j].prim = RT_NONE;
+        }
+        for (int j = 0; j < n; j++) {
+            uint32_t i = wf->active[a + (size_t)j];
+            wf->hprim[i] = hits[j].prim;
+            if (hits[j].prim != RT_NONE)
+                wf->ht[i] = hits[j].t, wf->hu[i] = hits[j].u, wf->hv[i] = hits[j].v, wf->hinst[i] = hits[j].inst;
+        }
+        a = b;
+    }
 }
 
 /* ------------------------------------------------------------ stages */
@@ -230,8 +414,9 @@ static bool start_path(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_wavef
 }
 
 /* Closest kept surface for every lane of the active list: the alpha walk
- * of rt_trace_surface, one batch of rays per layer. */
-static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_active)
+ * of rt_trace_surface, one batch of rays per layer; the first layer of the
+ * camera rays a refill started (active[n_old ..]) as screen tiles. */
+static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_active, size_t n_old)
 {
     const rt_kdtree *tree = ctx->state->tree;
     const rt_material *materials = ctx->state->scene->materials;
@@ -248,10 +433,17 @@ static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_acti
         wf->dx[i] = r->dir.x, wf->dy[i] = r->dir.y, wf->dz[i] = r->dir.z;
         wf->tmin[i] = r->tmin, wf->tmax[i] = r->tmax;
     }
+    bool first_layer = true;
     while (n > 0) {
         if (ctx->ray_count)
             *ctx->ray_count += n;
-        rt_kdtree_intersect_batch(tree, &rb, q, n, &hb);
+        if (first_layer) { /* q[k] == active[k] */
+            rt_kdtree_intersect_batch(tree, &rb, q, n_old, &hb);
+            trace_camera_tiles(wf, tree, n_old, n);
+            first_layer = false;
+        } else {
+            rt_kdtree_intersect_batch(tree, &rb, q, n, &hb);
+        }
         size_t n2 = 0;
         for (size_t k = 0; k < n; k++) {
             uint32_t i = q[k];
@@ -285,12 +477,24 @@ static void trace_stage(rt_wavefront *wf, const rt_trace_ctx *ctx, size_t n_acti
     }
 }
 
-/* One light-sampling record made at lane i's vertex: its visibility now
- * (shadows that need shading) or its shadow ray queued for the batch. */
+/* Shadow-ray bundles: the shadow rays of one camera tile's first hits to
+ * one light (lights 0 .. BUNDLE_SOURCES - 2) or to the sampled emitter
+ * (BUNDLE_SOURCES - 1) share an end point or a small end region: one
+ * frustum (shadow_bundles). Environment samples scatter and are not
+ * bundled. */
+enum { BUNDLE_SOURCES = 8, SRC_NONE = 0xff, SRC_DONE = 0xfe };
+
+/* One light-sampling record made at lane i's vertex (from light `src`, or
+ * lights: the environment, lights + 1: the emitter table): its visibility
+ * now (shadows that need shading) or its shadow ray queued for the batch. */
 static void add_record(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_path_state *ps, const rt_surface *sf,
-                       uint32_t r, size_t *n_pending)
+                       uint32_t r, size_t src, size_t *n_pending)
 {
     const rt_nee_record *rec = &wf->rec[r];
+    const size_t lights = ctx->state->scene->light_count;
+    wf->rec_src[r] = src < lights && src < BUNDLE_SOURCES - 1 ? (uint8_t)src
+                     : src == lights + 1                      ? BUNDLE_SOURCES - 1
+                                                              : SRC_NONE;
     if (ctx->state->shadows_need_shading) {
         wf->vis[r] = rt_path_shadow(ctx, ps, sf, rec);
         return;
@@ -300,6 +504,56 @@ static void add_record(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_path_
     wf->sdx[r] = sr.dir.x, wf->sdy[r] = sr.dir.y, wf->sdz[r] = sr.dir.z;
     wf->stmin[r] = sr.tmin, wf->stmax[r] = sr.tmax;
     wf->pending[(*n_pending)++] = r;
+}
+
+/* The shadow rays of the first hits of the camera tiles at active[from ..
+ * to), source by source, as frustum bundles (rt_kdtree_occluded_frustum:
+ * rt_kdtree_occluded's answers); their visibility is set and they leave
+ * the pending list, whose new length is returned. */
+static size_t shadow_bundles(rt_wavefront *wf, const rt_kdtree *tree, size_t from, size_t to, size_t n_pending)
+{
+    uint32_t bucket[BUNDLE_SOURCES][RT_KD_FRUSTUM_MAX];
+    rt_ray rays[RT_KD_FRUSTUM_MAX];
+    bool any = false;
+    for (size_t a = from; a < to;) {
+        size_t b = group_end(wf, a, to);
+        int cnt[BUNDLE_SOURCES] = {0};
+        for (size_t p = a; p < b; p++) {
+            uint32_t i = wf->active[p];
+            if (!wf->nee[i])
+                continue;
+            for (uint32_t r = wf->rec_first[i], e = r + wf->rec_count[i]; r < e; r++)
+                if (wf->rec_src[r] < BUNDLE_SOURCES)
+                    bucket[wf->rec_src[r]][cnt[wf->rec_src[r]]++] = r;
+        }
+        for (int src = 0; src < BUNDLE_SOURCES; src++) {
+            int n = cnt[src];
+            if (n < TILE_MIN_RAYS)
+                continue;
+            for (int j = 0; j < n; j++) {
+                uint32_t r = bucket[src][j];
+                rays[j] = rt_ray_make(rt_v3(wf->sox[r], wf->soy[r], wf->soz[r]),
+                                      rt_v3(wf->sdx[r], wf->sdy[r], wf->sdz[r]), wf->stmin[r], wf->stmax[r]);
+            }
+            uint64_t blocked = rt_kdtree_occluded_frustum(tree, rays, n);
+            for (int j = 0; j < n; j++) {
+                uint32_t r = bucket[src][j];
+                wf->vis[r] = rt_v3s((blocked >> j) & 1 ? 0.0f : 1.0f);
+                wf->rec_src[r] = SRC_DONE;
+            }
+            wf->stats.bundles++;
+            wf->stats.bundle_rays += (uint64_t)n;
+            any = true;
+        }
+        a = b;
+    }
+    if (!any)
+        return n_pending;
+    size_t kept = 0;
+    for (size_t k = 0; k < n_pending; k++)
+        if (wf->rec_src[wf->pending[k]] != SRC_DONE)
+            wf->pending[kept++] = wf->pending[k];
+    return kept;
 }
 
 /* Lane i's vertex into the next slot of its kind's lanes: its frame,
@@ -392,13 +646,13 @@ static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, si
     } else {
         for (size_t l = 0; l < lights; l++)
             if (rt_path_nee_light(ctx, ps, sf, &b, wo, rng, l, &wf->rec[n]))
-                add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
+                add_record(wf, ctx, ps, sf, (uint32_t)n++, l, n_pending);
         /* (skipped when they could make nothing: they would draw nothing) */
         if (env && rt_path_nee_env(ctx, ps, &b, wo, rng, &wf->rec[n]))
-            add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
+            add_record(wf, ctx, ps, sf, (uint32_t)n++, lights, n_pending);
     }
     if (emitters && rt_path_nee_emitter(ctx, ps, sf, &b, wo, rng, &wf->rec[n]))
-        add_record(wf, ctx, ps, sf, (uint32_t)n++, n_pending);
+        add_record(wf, ctx, ps, sf, (uint32_t)n++, lights + 1, n_pending);
     *n_rec = n;
     wf->nee[i] = 1;
     wf->rec_first[i] = (uint32_t)first;
@@ -433,12 +687,13 @@ static void nee_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, int c, bool env
             uint32_t i = kl->lane[k], r = kl->erec[k];
             if (!l->rok[k]) {
                 wf->vis[r] = rt_v3s(0.0f);
+                wf->rec_src[r] = SRC_NONE; /* no shadow ray: not in a bundle */
                 continue;
             }
             rt_vec3 Le = rt_environment(ctx->state->scene, kl->ed[k]);
             wf->rec[r] = (rt_nee_record){.fl = rt_mul(rt_v3(l->fr[k], l->fg[k], l->fb[k]), Le), .cos = l->fcos[k],
                                          .w = l->fw[k], .pdf = kl->epdf[k], .wi = kl->ed[k], .dist = INFINITY};
-            add_record(wf, ctx, &wf->ps[i], &wf->sf[i], r, n_pending);
+            add_record(wf, ctx, &wf->ps[i], &wf->sf[i], r, lights, n_pending);
         }
     }
     for (size_t j = 0; j < lights; j++) {
@@ -451,12 +706,13 @@ static void nee_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, int c, bool env
             uint32_t i = kl->lane[k], r = kl->lrec[k * lights + j];
             if (!l->rok[k]) {
                 wf->vis[r] = rt_v3s(0.0f);
+                wf->rec_src[r] = SRC_NONE;
                 continue;
             }
             wf->rec[r] = (rt_nee_record){.fl = rt_v3(l->fr[k], l->fg[k], l->fb[k]), .cos = l->fcos[k],
                                          .w = l->fw[k], .pdf = 1.0f, .wi = rt_v3(l->lwx[k], l->lwy[k], l->lwz[k]),
                                          .dist = l->ldist[k]};
-            add_record(wf, ctx, &wf->ps[i], &wf->sf[i], r, n_pending);
+            add_record(wf, ctx, &wf->ps[i], &wf->sf[i], r, j, n_pending);
         }
     }
 }
@@ -527,25 +783,29 @@ static void shading_order(rt_wavefront *wf, const rt_scene *s, size_t n)
 void rt_wavefront_radiance(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_wavefront_work *wk, float *out)
 {
     const rt_scene *s = ctx->state->scene;
-    const uint64_t total = (uint64_t)wk->count * (uint64_t)(wk->s1 - wk->s0);
-    uint64_t next = 0;
+    const bool tiles = tiles_pay(ctx->state->tree);
+    cam_cursor cam;
+    cam_cursor_init(&cam, wk, tiles);
     size_t n_active = 0, n_free = wf->batch;
     for (size_t k = 0; k < wf->batch; k++)
         wf->free_lanes[k] = (uint32_t)(wf->batch - 1 - k);
     rt_ray_batch srb = {wf->sox, wf->soy, wf->soz, wf->sdx, wf->sdy, wf->sdz, wf->stmin, wf->stmax};
     const bool env = rt_path_samples_env(ctx), emitters = rt_path_samples_emitters(ctx);
     for (;;) {
-        /* refill: free lanes take the next samples, in order */
-        while (n_free > 0 && next < total) {
+        /* refill: free lanes take the next camera samples, tile by tile */
+        const size_t n_old = n_active;
+        uint32_t sample;
+        while (n_free > 0 && cam_cursor_next(&cam, &sample)) {
             uint32_t i = wf->free_lanes[n_free - 1];
-            if (start_path(wf, ctx, wk, i, (uint32_t)next++, out)) {
+            if (start_path(wf, ctx, wk, i, sample, out)) {
+                wf->cam_group[n_active] = cam.group;
                 wf->active[n_active++] = i;
                 n_free--;
             }
         }
         if (n_active == 0)
             break;
-        trace_stage(wf, ctx, n_active);
+        trace_stage(wf, ctx, n_active, tiles ? n_old : n_active);
         /* shade, grouped by material kind */
         shading_order(wf, s, n_active);
         size_t n_rec = 0, n_pending = 0;
@@ -553,9 +813,11 @@ void rt_wavefront_radiance(rt_wavefront *wf, const rt_trace_ctx *ctx, const rt_w
             shade_lane(wf, ctx, wf->order[k], &n_rec, &n_pending, env, emitters);
         shade_lanes(wf, ctx, env, &n_pending);
         /* shadow rays, one batch */
+        if (ctx->ray_count)
+            *ctx->ray_count += n_pending;
+        if (n_pending > 0 && tiles)
+            n_pending = shadow_bundles(wf, ctx->state->tree, n_old, n_active, n_pending);
         if (n_pending > 0) {
-            if (ctx->ray_count)
-                *ctx->ray_count += n_pending;
             rt_kdtree_occluded_batch(ctx->state->tree, &srb, wf->pending, n_pending, wf->blocked);
             for (size_t k = 0; k < n_pending; k++) {
                 uint32_t r = wf->pending[k];

@@ -43,6 +43,17 @@ typedef struct rt_wavefront_work {
     uint32_t s0, s1;
 } rt_wavefront_work;
 
+/* What went as coherent groups so far (counted over the wavefront's life):
+ * camera rays traced as screen tiles (kdtree_frustum.h), and shadow rays
+ * traced as bundles. The images do not depend on it; tests read it to see
+ * the tiles were used. */
+typedef struct rt_wavefront_stats {
+    uint64_t tiles, tile_rays;     /* frustum calls on camera rays, rays in them */
+    uint64_t bundles, bundle_rays; /* frustum calls on shadow rays, rays in them */
+} rt_wavefront_stats;
+
+rt_wavefront_stats rt_wavefront_stats_of(const rt_wavefront *wf);
+
 /* Room for batch paths (0: RT_WAVEFRONT_BATCH) and their light samples in
  * the scene of `state` (fewer paths when its lights would need more than
  * 2^18 light-sample records: about 20 MB); NULL when out of memory. */
