@@ -11,6 +11,7 @@
  * scaled, some mirrored.
  */
 #include "test_util.h"
+#include "test_tree_mesh.h"
 #include "test_fixture.h"
 #include <fcntl.h>
 #include <math.h>
@@ -66,7 +67,7 @@ typedef struct field {
     bool rotation_vec3; /* ROTATION declared VEC3 */
 } field;
 
-enum { RINGS = 4, SEGS = 6, NV = (RINGS + 1) * (SEGS + 1), NT = SEGS * (2 * RINGS - 2) };
+enum { NV = TEST_TREE_NV, NT = TEST_TREE_NT };
 
 typedef struct buf {
     unsigned char *p;
@@ -105,23 +106,7 @@ static void write_field(const char *name, const field *f)
 {
     float pos[NV][3], nrm[NV][3];
     uint32_t idx[3 * NT];
-    for (int r = 0, v = 0; r <= RINGS; r++)
-        for (int sg = 0; sg <= SEGS; sg++, v++) {
-            double th = RT_PI * r / RINGS, ph = 2.0 * RT_PI * sg / SEGS;
-            double x = sin(th) * cos(ph), y = cos(th), z = sin(th) * sin(ph);
-            pos[v][0] = (float)(0.4 * x), pos[v][1] = (float)(0.5 + 0.5 * y), pos[v][2] = (float)(0.3 * z);
-            nrm[v][0] = (float)x, nrm[v][1] = (float)y, nrm[v][2] = (float)z;
-        }
-    int ni = 0;
-    for (int r = 0; r < RINGS; r++)
-        for (int sg = 0; sg < SEGS; sg++) {
-            uint32_t a = (uint32_t)(r * (SEGS + 1) + sg), b = a + SEGS + 1;
-            if (r > 0)
-                idx[ni++] = a, idx[ni++] = b, idx[ni++] = a + 1;
-            if (r < RINGS - 1)
-                idx[ni++] = a + 1, idx[ni++] = b, idx[ni++] = b + 1;
-        }
-    assert_int_equal(ni, 3 * NT);
+    test_tree_mesh(pos, nrm, idx);
     buf b = {malloc(1024), 0, 1024};
     assert_non_null(b.p);
     size_t o_pos = put(&b, pos, sizeof pos), o_nrm = put(&b, nrm, sizeof nrm), o_idx = put(&b, idx, sizeof idx);

@@ -18,6 +18,7 @@
  * animation, each used once.
  */
 #include "test_util.h"
+#include "test_tree_mesh.h"
 #include "test_fixture.h"
 #include <math.h>
 #include <sys/wait.h>
@@ -57,7 +58,7 @@ static const char *tmp_path(const char *name)
 
 /* ------------------------------------------------- the animated file */
 
-enum { RINGS = 4, SEGS = 6, NV = (RINGS + 1) * (SEGS + 1), NT = SEGS * (2 * RINGS - 2) };
+enum { NV = TEST_TREE_NV, NT = TEST_TREE_NT };
 
 /* anim.gltf and anim.bin: the mesh, the ground, the animation (keys at
  * 0, 1 and 2 s, LINEAR). */
@@ -65,23 +66,7 @@ static void write_animated(void)
 {
     static float pos[NV][3], nrm[NV][3];
     static uint32_t idx[3 * NT];
-    for (int r = 0, v = 0; r <= RINGS; r++)
-        for (int sg = 0; sg <= SEGS; sg++, v++) {
-            double th = RT_PI * r / RINGS, ph = 2.0 * RT_PI * sg / SEGS;
-            double x = sin(th) * cos(ph), y = cos(th), z = sin(th) * sin(ph);
-            pos[v][0] = (float)(0.4 * x), pos[v][1] = (float)(0.5 + 0.5 * y), pos[v][2] = (float)(0.3 * z);
-            nrm[v][0] = (float)x, nrm[v][1] = (float)y, nrm[v][2] = (float)z;
-        }
-    int ni = 0;
-    for (int r = 0; r < RINGS; r++)
-        for (int sg = 0; sg < SEGS; sg++) {
-            uint32_t a = (uint32_t)(r * (SEGS + 1) + sg), b = a + SEGS + 1;
-            if (r > 0)
-                idx[ni++] = a, idx[ni++] = b, idx[ni++] = a + 1;
-            if (r < RINGS - 1)
-                idx[ni++] = a + 1, idx[ni++] = b, idx[ni++] = b + 1;
-        }
-    assert_int_equal(ni, 3 * NT);
+    test_tree_mesh(pos, nrm, idx);
     const float gpos[4][3] = {{-4, 0, -4}, {4, 0, -4}, {4, 0, 4}, {-4, 0, 4}};
     const float gnrm[4][3] = {{0, 1, 0}, {0, 1, 0}, {0, 1, 0}, {0, 1, 0}};
     const uint32_t gidx[6] = {0, 2, 1, 0, 3, 2};
