@@ -336,7 +336,7 @@ static void test_wavefront_equals_scalar(void **state)
 /* A bumpy field of 1152 triangles under a point, a spot, an area and a
  * directional light: a tree with inner nodes, so the wavefront traces its
  * camera rays as tiles and its first hits' shadow rays as bundles. */
-static void load_field(fixture *f)
+static void load_field(fixture *f, bool instanced)
 {
     static char text[1152 * 96 + 1024];
     int n = snprintf(text, sizeof text,
@@ -347,7 +347,7 @@ static void load_field(fixture *f)
                      "light spot -3 5 2  0.5 -1 -0.3  1 1 1  60  15 25\n"
                      "light area -0.5 3 -0.5  1 0 0  0 0 1  1 0.9 0.8  10\n"
                      "light directional -0.5 -1 -0.3  0.6 0.7 1  0.5\n"
-                     "sphere 1 1 0 0.8 m\n");
+                     "sphere 1 1 0 0.8 m\n%s", instanced ? "object terrain\n" : "");
     const int G = 24;
     for (int i = 0; i < G; i++)
         for (int j = 0; j < G; j++) {
@@ -359,23 +359,20 @@ static void load_field(fixture *f)
                           "triangle %g %g %g  %g %g %g  %g %g %g m\ntriangle %g %g %g  %g %g %g  %g %g %g m\n", x0,
                           h00, z0, x1, h10, z0, x1, h11, z1, x0, h00, z0, x1, h11, z1, x0, h01, z1);
         }
+    if (instanced) /* the terrain twice: a top level over two instances of one object */
+        n += snprintf(text + n, sizeof text - (size_t)n,
+                      "end\ninstance terrain\ninstance terrain translate 0.5 -0.4 -3 rotate 0 20 0 scale 0.9\n");
     assert_true(n < (int)sizeof text);
     load_text(f, text);
 }
 
-/* The camera stage traces the camera rays a refill starts by screen tile
- * (rt_kdtree_intersect_frustum), and the shadow rays of their first hits
- * light by light as bundles (rt_kdtree_occluded_frustum): on rectangles
- * whose sides are no multiple of a tile, work units that start mid-row and
- * mid-tile and sample ranges split in two, every sample is still
- * rt_radiance_path's (single rays), and most camera rays went as tiles. A
- * tree of one leaf keeps the batch. */
-static void test_camera_tiles_equal_single_rays(void **state)
+/* The tile checks on the field, flat or as two instances of one object. */
+static void check_tiles_on_field(bool instanced)
 {
-    (void)state;
     fixture f;
-    load_field(&f);
+    load_field(&f, instanced);
     assert_false(f.rs.shadows_need_shading);
+    assert_int_equal(f.tree.instance_count, instanced ? 2 : 0);
     struct { size_t batch; uint32_t per_unit; int x0, x1, y0, y1; uint32_t spp; } runs[] = {
         {1024, 200, 0, 37, 0, 29, 16}, /* whole rows; tiles of 2x2 pixels, the last column 1 wide */
         {1024, 77, 5, 30, 3, 26, 8},   /* a rectangle inside, units starting mid-row; 4x2 pixels */
@@ -394,6 +391,21 @@ static void test_camera_tiles_equal_single_rays(void **state)
         assert_true(st.bundle_rays > camera); /* most first hits see several lights */
     }
     unload(&f);
+}
+
+/* The camera stage traces the camera rays a refill starts by screen tile
+ * (rt_kdtree_intersect_frustum), and the shadow rays of their first hits
+ * light by light as bundles (rt_kdtree_occluded_frustum): on rectangles
+ * whose sides are no multiple of a tile, work units that start mid-row and
+ * mid-tile and sample ranges split in two, every sample is still
+ * rt_radiance_path's (single rays), and most camera rays went as tiles. A
+ * tree of one leaf keeps the batch. */
+static void test_camera_tiles_equal_single_rays(void **state)
+{
+    (void)state;
+    check_tiles_on_field(false);
+    check_tiles_on_field(true); /* frustums enter instances */
+    fixture f;
     load_text(&f, "integrator path\nresolution 16 16\nsamples 4\ncamera position 0 1 5 look_at 0 0 0 fov 50\n"
                   "material m color 0.7 0.7 0.7\nquad -5 0 5  10 0 0  0 0 -10  m\nsphere 0 0.5 0 0.5 m\n"
                   "light point 1 3 1  1 1 1  20\n");
