@@ -2,13 +2,15 @@
  * (rt/render/shade_lanes.h) against the scalar steps it replaces, bit
  * for bit: for Lambert, rough GGX conductors (isotropic, anisotropic,
  * separable or height-correlated Smith) and the rough opaque glTF BRDF
- * (metallic, dielectric and in between, both lobes), and smooth glass
+ * (metallic, dielectric and in between, both lobes), smooth glass
  * (either index ratio, tinted, mirror and refraction, total internal
- * reflection) over random frames, geometric
+ * reflection) and the plastic (smooth and rough coats mixed in one
+ * batch, either index ratio, black bases; the mirror, specular and
+ * diffuse lobes) over random frames, geometric
  * normals that disagree with the shading normal, random and edge sample
  * values (u = (0.5, 0.5), the concentric map's centre; 0 and just below
- * 1), black albedos and grazing views, the lanes' ok flag, direction, pdf
- * and throughput equal rt_bsdf_sample_dir's sample taken to the world and
+ * 1), black albedos and grazing views, the lanes' ok flag, direction, pdf,
+ * delta flag and throughput equal rt_bsdf_sample_dir's sample taken to the world and
  * normalised, the geometric side test and beta times the weight
  * (rt_path_vertex_end). Counts that are not a multiple of the lane width
  * check the padding. The whole-image equality with path_scalar is
@@ -41,7 +43,7 @@ static float edge_or_random(test_rng *r, int k)
 
 /* The scalar steps for one vertex: false when the path ends there. */
 static bool scalar_steps(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, rt_vec3 beta, rt_vec3 *wi,
-                         float *pdf, rt_vec3 *beta_out, bool *down)
+                         float *pdf, rt_vec3 *beta_out, bool *down, bool *delta)
 {
     rt_bsdf_sample bs;
     if (!rt_bsdf_sample_dir(b, wo, u, ulobe, &bs))
@@ -51,6 +53,7 @@ static bool scalar_steps(const rt_bsdf *b, rt_vec3 wo, rt_vec2 u, float ulobe, r
     if (bs.wi.z > 0.0f ? !(side > 0.0f) : !(side < 0.0f))
         return false;
     *down = bs.wi.z < 0.0f;
+    *delta = bs.delta;
     *beta_out = rt_mul(beta, bs.weight);
     *pdf = bs.pdf;
     return rt_finite3(*beta_out) && rt_max3(*beta_out) > 0.0f;
@@ -74,6 +77,10 @@ static void random_bsdf(rt_bsdf_kind kind, size_t k, test_rng *r, rt_bsdf *b, rt
         rt_bsdf_make_dielectric(b, nn, 0.4f + 2.0f * test_rng_float(r), 0.0f);
         if (k % 5 == 2)
             b->diffuse = rt_v3(test_rng_float(r), test_rng_float(r), test_rng_float(r)); /* a tint */
+    } else if (kind == RT_BSDF_KIND_PLASTIC) {
+        rt_vec3 albedo = k % 13 == 5 ? rt_v3s(0.0f) : rt_v3(test_rng_float(r), test_rng_float(r), test_rng_float(r));
+        float alpha = k % 3 == 0 ? 0.0f : 0.01f + 0.99f * test_rng_float(r); /* a third smooth */
+        rt_bsdf_make_plastic(b, nn, albedo, 0.3f + 1.5f * test_rng_float(r), alpha);
     } else {
         float ax = 0.01f + test_rng_float(r), ay = k % 2 ? ax : 0.01f + test_rng_float(r);
         rt_vec3 eta = rt_v3(0.1f + 2.0f * test_rng_float(r), 0.1f + 2.0f * test_rng_float(r), 1.3f);
@@ -107,6 +114,7 @@ static void put_bsdf(rt_shade_lanes *l, size_t k, const rt_bsdf *b, rt_vec3 wo)
     l->metal[k] = b->metallic, l->f0[k] = b->f0;
     l->pd[k] = b->p_d, l->ps[k] = b->p_s;
     l->pt[k] = b->p_t, l->eta[k] = b->eta;
+    l->smooth[k] = b->delta ? 1.0f : 0.0f;
 }
 
 static void check_kind(rt_bsdf_kind kind, size_t n, uint64_t seed)
@@ -119,7 +127,7 @@ static void check_kind(rt_bsdf_kind kind, size_t n, uint64_t seed)
     rt_vec2 *us = malloc(n * sizeof *us);
     float *ulobes = malloc(n * sizeof *ulobes);
     assert_true(bs && wos && betas && us && ulobes);
-    size_t live = 0;
+    size_t live = 0, deltas = 0;
     for (size_t k = 0; k < n; k++) {
         rt_vec3 wo;
         random_bsdf(kind, k, &r, &bs[k], &wo);
@@ -138,13 +146,15 @@ static void check_kind(rt_bsdf_kind kind, size_t n, uint64_t seed)
         rt_conductor_sample_lanes(l, n);
     else if (kind == RT_BSDF_KIND_GLTF)
         rt_gltf_sample_lanes(l, n);
+    else if (kind == RT_BSDF_KIND_PLASTIC)
+        rt_plastic_sample_lanes(l, n);
     else
         rt_dielectric_sample_lanes(l, n);
     for (size_t k = 0; k < n; k++) {
         rt_vec3 wi = rt_v3s(0.0f), beta = rt_v3s(0.0f);
         float pdf = 0.0f;
-        bool down = false;
-        bool ok = scalar_steps(&bs[k], wos[k], us[k], ulobes[k], betas[k], &wi, &pdf, &beta, &down);
+        bool down = false, delta = false;
+        bool ok = scalar_steps(&bs[k], wos[k], us[k], ulobes[k], betas[k], &wi, &pdf, &beta, &down, &delta);
         if (ok != (l->ok[k] != 0))
             fail_msg("kind %d, path %zu: lanes say %d, scalar %d", (int)kind, k, l->ok[k], ok);
         if (!ok)
@@ -153,6 +163,9 @@ static void check_kind(rt_bsdf_kind kind, size_t n, uint64_t seed)
         if (down != (l->down[k] != 0))
             fail_msg("kind %d, path %zu: lanes went %s, scalar %s", (int)kind, k, l->down[k] ? "down" : "up",
                      down ? "down" : "up");
+        if (delta != (l->delta[k] != 0))
+            fail_msg("kind %d, path %zu: lanes delta %d, scalar %d", (int)kind, k, l->delta[k], delta);
+        deltas += delta;
         float got[7] = {l->wx[k], l->wy[k], l->wz[k], l->pdf[k], l->br[k], l->bg[k], l->bb[k]};
         float want[7] = {wi.x, wi.y, wi.z, pdf, beta.x, beta.y, beta.z};
         if (memcmp(got, want, sizeof got) != 0)
@@ -163,6 +176,8 @@ static void check_kind(rt_bsdf_kind kind, size_t n, uint64_t seed)
     }
     /* most paths go on, not all (black albedos, the side test) */
     assert_true(live > n / 2 && live < n);
+    if (kind == RT_BSDF_KIND_PLASTIC) /* some smooth coats' mirror samples, not only */
+        assert_true(deltas > n / 100 && deltas < live / 2);
     free(bs);
     free(wos);
     free(betas);
@@ -201,6 +216,14 @@ static void test_dielectric_lanes_equal_scalar(void **state)
     const size_t counts[] = {RT_SHADE_LANES + 5, 4099, 20000};
     for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++)
         check_kind(RT_BSDF_KIND_DIELECTRIC, counts[c] < 16 ? 64 + counts[c] : counts[c], 301 + c);
+}
+
+static void test_plastic_lanes_equal_scalar(void **state)
+{
+    (void)state;
+    const size_t counts[] = {RT_SHADE_LANES + 7, 4099, 20000};
+    for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++)
+        check_kind(RT_BSDF_KIND_PLASTIC, counts[c] < 16 ? 64 + counts[c] : counts[c], 401 + c);
 }
 
 /* ------------------------------------------------------------ light sampling */
@@ -318,8 +341,8 @@ static void test_light_sample_lanes_equal_scalar(void **state)
 }
 
 /* rt_nee_eval_lanes after rt_light_sample_lanes against
- * rt_path_nee_light_at: the record's every bit, for Lambert, conductors
- * and the glTF BRDF under each test light (the power heuristic where the
+ * rt_path_nee_light_at: the record's every bit, for Lambert, conductors,
+ * the glTF BRDF and the plastic under each test light (the power heuristic where the
  * area light has a quad). */
 static void check_nee(rt_bsdf_kind kind, int c, size_t n, uint64_t seed)
 {
@@ -367,8 +390,9 @@ static void check_nee(rt_bsdf_kind kind, int c, size_t n, uint64_t seed)
 static void test_nee_lanes_equal_scalar(void **state)
 {
     (void)state;
-    const rt_bsdf_kind kinds[] = {RT_BSDF_KIND_LAMBERT, RT_BSDF_KIND_CONDUCTOR, RT_BSDF_KIND_GLTF};
-    for (size_t i = 0; i < 3; i++)
+    const rt_bsdf_kind kinds[] = {RT_BSDF_KIND_LAMBERT, RT_BSDF_KIND_CONDUCTOR, RT_BSDF_KIND_GLTF,
+                                  RT_BSDF_KIND_PLASTIC};
+    for (size_t i = 0; i < sizeof kinds / sizeof kinds[0]; i++)
         for (int c = 0; c < LIGHT_CASES; c++) {
             check_nee(kinds[i], c, RT_SHADE_LANES + 3, 5000 + 31 * i + (uint64_t)c);
             check_nee(kinds[i], c, 3001, 6000 + 31 * i + (uint64_t)c);
@@ -377,7 +401,8 @@ static void test_nee_lanes_equal_scalar(void **state)
 
 /* Which BSDFs the lanes take: Lambert, rough conductors without the
  * multiple-scattering lobe, the rough opaque glTF BRDF once its lobe
- * probabilities are cached, smooth glass likewise; not a delta conductor,
+ * probabilities are cached, smooth glass and the plastic (smooth or
+ * rough) likewise; not a delta conductor,
  * a compensated one, a smooth or transmissive glTF BSDF, rough glass. */
 static void test_lanes_kind(void **state)
 {
@@ -409,6 +434,12 @@ static void test_lanes_kind(void **state)
     rt_bsdf_make_dielectric(&b, n, 1.0f / 1.5f, 0.2f); /* rough glass */
     rt_bsdf_set_wo(&b, rt_v3(0.0f, 0.6f, 0.8f));
     assert_int_equal(rt_shade_lanes_kind(&b), -1);
+    for (int rough = 0; rough < 2; rough++) {
+        rt_bsdf_make_plastic(&b, n, rt_v3s(0.5f), 1.0f / 1.5f, rough ? 0.2f : 0.0f);
+        assert_int_equal(rt_shade_lanes_kind(&b), -1); /* no lobe probabilities cached yet */
+        rt_bsdf_set_wo(&b, rt_v3(0.0f, 0.6f, 0.8f));
+        assert_int_equal(rt_shade_lanes_kind(&b), RT_BSDF_KIND_PLASTIC);
+    }
 }
 
 int main(void)
@@ -418,6 +449,7 @@ int main(void)
         cmocka_unit_test(test_conductor_lanes_equal_scalar),
         cmocka_unit_test(test_gltf_lanes_equal_scalar),
         cmocka_unit_test(test_dielectric_lanes_equal_scalar),
+        cmocka_unit_test(test_plastic_lanes_equal_scalar),
         cmocka_unit_test(test_lanes_kind),
         cmocka_unit_test(test_light_sample_lanes_equal_scalar),
         cmocka_unit_test(test_nee_lanes_equal_scalar),

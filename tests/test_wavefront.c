@@ -317,13 +317,16 @@ static void test_wavefront_equals_scalar(void **state)
     check_against_scalar(&f, 1024, 512, 0, 32, 4);
     unload(&f);
     /* an environment image sampled beside a directional and an area
-     * light, over Lambert, rough metal and the rough glTF BRDF (their
-     * light samples taken in lanes) */
+     * light, over Lambert, rough metal, the rough glTF BRDF and smooth and
+     * rough plastic (their light samples taken in lanes) */
     test_fixture_parse(&f, "integrator path\nresolution 24 16\nsamples 4\n"
                            "camera position 0 1.5 5 look_at 0 0.5 0 fov 50\n"
                            "material m color 0.7 0.7 0.7\nmaterial g color 0.8 0.5 0.3 metallic 0.3 roughness 0.5\n"
                            "material cu bsdf conductor metal Cu ggx_alpha_uv 0.3 0.2\n"
+                           "material sp bsdf plastic color 0.7 0.1 0.05 ior 1.5\n"
+                           "material rp bsdf plastic color 0.1 0.2 0.6 ior 1.5 ggx_alpha 0.2\n"
                            "quad -5 0 5  10 0 0  0 0 -10  m\nsphere -1 0.5 0 0.5 g\nsphere 1 0.5 0 0.5 cu\n"
+                           "sphere -0.6 0.4 1.2 0.4 sp\nsphere 0.6 0.4 1.2 0.4 rp\n"
                            "light directional -1 -1 -0.5  1 1 1  1\nlight area -1 3 -1  2 0 0  0 0 2  2 2 2  1\n");
     test_fixture_add_env(&f.s, 32, 16, 0.5f, 20.0f, 20, 3);
     test_fixture_build(&f, RT_PREPARE_LIGHT_TABLE);

@@ -113,9 +113,9 @@ static inline void vnormalize(vf *x, vf *y, vf *z)
  * the world and normalised, on the geometric surface's side the sample
  * is on (below: refracted), the throughput
  * times the weight (w), finite and positive (rt_path_vertex_end's steps);
- * the results stored. */
+ * the results stored, with which samples were deltas. */
 static inline void world_and_weigh(rt_shade_lanes *l, size_t k, vf x, vf y, vf z, vf pdf, vf wr, vf wg, vf wb, vi ok,
-                                   vi below)
+                                   vi below, vi delta)
 {
     vf tx = load(l->tx + k), ty = load(l->ty + k), tz = load(l->tz + k);
     vf bx = load(l->bx + k), by = load(l->by + k), bz = load(l->bz + k);
@@ -136,6 +136,7 @@ static inline void world_and_weigh(rt_shade_lanes *l, size_t k, vf x, vf y, vf z
     for (int j = 0; j < W; j++) {
         l->ok[k + (size_t)j] = ok[j] != 0;
         l->down[k + (size_t)j] = below[j] != 0;
+        l->delta[k + (size_t)j] = delta[j] != 0;
     }
 }
 
@@ -156,7 +157,7 @@ static void lambert_step(rt_shade_lanes *l, size_t k)
     vf c = z / pdf;
     vf wr = dr * RT_INV_PI * c, wg = dg * RT_INV_PI * c, wb = db * RT_INV_PI * c;
     ok &= finite(wr) & finite(wg) & finite(wb);
-    world_and_weigh(l, k, x, y, z, pdf, wr, wg, wb, ok, (vi){0});
+    world_and_weigh(l, k, x, y, z, pdf, wr, wg, wb, ok, (vi){0}, (vi){0});
 }
 
 /* The last step's unused lanes (n .. the next multiple of W): zeros in
@@ -167,7 +168,8 @@ static size_t pad(rt_shade_lanes *l, size_t n)
     float *in[] = {l->tx, l->ty, l->tz, l->bx, l->by, l->bz, l->nx, l->ny, l->nz, l->gx, l->gy, l->gz,
                    l->br, l->bg, l->bb, l->ux, l->uy, l->dr, l->dg, l->db, l->ox, l->oy, l->oz, l->ax,
                    l->ay, l->sep, l->er, l->eg, l->eb, l->kr, l->kg, l->kb, l->cr, l->cg, l->cb, l->metal,
-                   l->f0, l->pd, l->ps, l->ulobe, l->pt, l->eta, l->px, l->py, l->pz, l->lux, l->luy};
+                   l->f0, l->pd, l->ps, l->ulobe, l->pt, l->eta, l->smooth, l->px, l->py, l->pz, l->lux,
+                   l->luy};
     for (size_t a = 0; a < sizeof in / sizeof in[0]; a++)
         for (size_t k = n; k < end; k++)
             in[a][k] = 0.0f;
@@ -302,7 +304,7 @@ static void conductor_step(rt_shade_lanes *l, size_t k)
     vf cw = z / pdf;
     vf wr = fr * cw, wg = fg * cw, wb = fb * cw;
     ok &= finite(wr) & finite(wg) & finite(wb);
-    world_and_weigh(l, k, x, y, z, pdf, wr, wg, wb, ok, (vi){0});
+    world_and_weigh(l, k, x, y, z, pdf, wr, wg, wb, ok, (vi){0}, (vi){0});
 }
 
 void rt_conductor_sample_lanes(rt_shade_lanes *l, size_t n)
@@ -395,7 +397,7 @@ static void gltf_step(rt_shade_lanes *l, size_t k)
     vf cw = z / p;
     vf wr = fr * cw, wg = fg * cw, wb = fb * cw;
     ok &= finite(wr) & finite(wg) & finite(wb);
-    world_and_weigh(l, k, x, y, z, p, wr, wg, wb, ok, (vi){0});
+    world_and_weigh(l, k, x, y, z, p, wr, wg, wb, ok, (vi){0}, (vi){0});
 }
 
 void rt_gltf_sample_lanes(rt_shade_lanes *l, size_t n)
@@ -450,7 +452,7 @@ static void dielectric_step(rt_shade_lanes *l, size_t k)
     /* delta_sample: finite, some weight */
     ok &= finite(x) & finite(y) & finite(z) & finite(wr) & finite(wg) & finite(wb);
     ok &= (wr > 0.0f) | (wg > 0.0f) | (wb > 0.0f);
-    world_and_weigh(l, k, x, y, z, splat(0.0f), wr, wg, wb, ok, refract);
+    world_and_weigh(l, k, x, y, z, splat(0.0f), wr, wg, wb, ok, refract, (vi){0} - 1);
 }
 
 void rt_dielectric_sample_lanes(rt_shade_lanes *l, size_t n)
@@ -458,6 +460,91 @@ void rt_dielectric_sample_lanes(rt_shade_lanes *l, size_t n)
     size_t end = pad(l, n);
     for (size_t k = 0; k < end; k += W)
         dielectric_step(l, k);
+}
+
+/* ------------------------------------------------------------ plastic */
+
+/* bsdf.c's dielectric_eval for the plastic: the diffuse base under the
+ * coat, (1 - F(wo.z)) (1 - F(wi.z)) diffuse / pi (exact Fresnel), and
+ * for a rough coat (smooth 0) the specular lobe F(wo.h) D G2 / (4 cos
+ * cos); f (zero where not valid) and pdf at wi = (x, y, z) from wo, and
+ * which lanes are valid (both above, not opposite). */
+static inline vi vplastic_eval(const rt_shade_lanes *l, size_t k, vf wox, vf woy, vf woz, vf x, vf y, vf z, vf *fr,
+                               vf *fg, vf *fb, vf *pdf)
+{
+    vf a = load(l->ax + k), pd = load(l->pd + k), ps = load(l->ps + k), eta = load(l->eta + k);
+    vi rough = load(l->smooth + k) == 0.0f;
+    vi ok = (woz > 0.0f) & (z > 0.0f);
+    vf mx = wox + x, my = woy + y, mz = woz + z;
+    vf l2 = mx * mx + my * my + mz * mz;
+    ok &= l2 > 1e-20f;
+    vf inv = 1.0f / vsqrt(l2);
+    mx = mx * inv, my = my * inv, mz = mz * inv;
+    vf voh = wox * mx + woy * my + woz * mz;
+    vf fd = vfresnel_exact(voh, eta);
+    vf tdiff = (1.0f - vfresnel_exact(woz, eta)) * (1.0f - vfresnel_exact(z, eta));
+    vf p = pd * z * RT_INV_PI;
+    /* the specular lobe (fresnel_specular with metallic 0: fd) */
+    vf F = vfresnel_specular(splat(0.0f), splat(0.0f), splat(0.0f), fd);
+    vf D = vggx_d(mx, my, mz, a, a);
+    vf lo = vlambda(wox, woy, woz, a, a), li = vlambda(x, y, z, a, a);
+    vf g2 = sel(finite(lo) & finite(li), 1.0f / (1.0f + lo + li), splat(0.0f));
+    vf spec = D * g2 / (4.0f * woz * z);
+    spec = sel(finite(spec), spec, splat(0.0f));
+    vf g1 = sel(finite(lo), 1.0f / (1.0f + lo), splat(0.0f));
+    vf pv = g1 * D / (4.0f * woz);
+    p = sel(rough & (ps > 0.0f) & finite(pv), p + ps * pv, p);
+    vf dr = load(l->dr + k) * (tdiff * RT_INV_PI), dg = load(l->dg + k) * (tdiff * RT_INV_PI);
+    vf db = load(l->db + k) * (tdiff * RT_INV_PI);
+    *fr = sel(ok, sel(rough, dr + F * spec, dr), splat(0.0f));
+    *fg = sel(ok, sel(rough, dg + F * spec, dg), splat(0.0f));
+    *fb = sel(ok, sel(rough, db + F * spec, db), splat(0.0f));
+    *pdf = sel(ok, p, splat(0.0f));
+    return ok;
+}
+
+/* One SIMD step of the plastic: bsdf.c's dielectric_sample for its kind
+ * (no transmission): a smooth coat's mirror (delta, weight F / ps) by
+ * ulobe, else the diffuse lobe by the cosine or a rough coat's specular
+ * one by its visible normals, dielectric_eval and finish_sample. */
+static void plastic_step(rt_shade_lanes *l, size_t k)
+{
+    vf wox = load(l->ox + k), woy = load(l->oy + k), woz = load(l->oz + k);
+    vf a = load(l->ax + k), ay = load(l->ay + k), pd = load(l->pd + k), ps = load(l->ps + k);
+    vf ux = load(l->ux + k), uy = load(l->uy + k), ul = load(l->ulobe + k);
+    vi smooth = load(l->smooth + k) != 0.0f;
+    vi any = pd + ps + 0.0f + 0.0f > 0.0f;
+    vi mirror = smooth & (ps > 0.0f) & (ul >= pd);
+    /* the mirror: delta_sample of (-wo.x, -wo.y, wo.z), weight F(wo.z) / ps */
+    vf mw = vfresnel_specular(splat(0.0f), splat(0.0f), splat(0.0f), vfresnel_exact(woz, load(l->eta + k))) *
+            (1.0f / ps);
+    vi mok = (woz > 0.0f) & finite(wox) & finite(woy) & finite(mw) & (mw > 0.0f);
+    /* the diffuse or the specular lobe */
+    vi diffuse = (ul < pd) | smooth | ~(ps > 0.0f);
+    vf cx, cy, cz, hx, hy, hz;
+    vcosine_hemisphere(ux, uy, &cx, &cy, &cz);
+    vvndf(wox, woy, woz, a, ay, ux, uy, &hx, &hy, &hz);
+    vf c = 2.0f * (wox * hx + woy * hy + woz * hz);
+    vf x = sel(diffuse, cx, hx * c - wox), y = sel(diffuse, cy, hy * c - woy), z = sel(diffuse, cz, hz * c - woz);
+    vi ok = (z > 0.0f) & finite(x) & finite(y) & finite(z);
+    vnormalize(&x, &y, &z);
+    vf fr, fg, fb, p;
+    ok &= vplastic_eval(l, k, wox, woy, woz, x, y, z, &fr, &fg, &fb, &p);
+    /* finish_sample */
+    ok &= (p > 0.0f) & finite(p);
+    vf cw = z / p;
+    vf wr = fr * cw, wg = fg * cw, wb = fb * cw;
+    ok &= finite(wr) & finite(wg) & finite(wb);
+    x = sel(mirror, -wox, x), y = sel(mirror, -woy, y), z = sel(mirror, woz, z);
+    world_and_weigh(l, k, x, y, z, sel(mirror, splat(0.0f), p), sel(mirror, mw, wr), sel(mirror, mw, wg),
+                    sel(mirror, mw, wb), any & ((mirror & mok) | (~mirror & ok)), (vi){0}, mirror);
+}
+
+void rt_plastic_sample_lanes(rt_shade_lanes *l, size_t n)
+{
+    size_t end = pad(l, n);
+    for (size_t k = 0; k < end; k += W)
+        plastic_step(l, k);
 }
 
 /* ------------------------------------------------------------ light sampling */
@@ -655,8 +742,10 @@ static void nee_step(rt_shade_lanes *l, size_t k, int kind, bool mis)
         vlambert_eval(l, k, woz, z, &fr, &fg, &fb, &pdf_b);
     else if (kind == RT_BSDF_KIND_CONDUCTOR)
         vconductor_eval(l, k, wox, woy, woz, x, y, z, &fr, &fg, &fb, &pdf_b);
-    else
+    else if (kind == RT_BSDF_KIND_GLTF)
         vgltf_eval(l, k, wox, woy, woz, x, y, z, &fr, &fg, &fb, &pdf_b);
+    else
+        vplastic_eval(l, k, wox, woy, woz, x, y, z, &fr, &fg, &fb, &pdf_b);
     ok &= vmax(fr, vmax(fg, fb)) > 0.0f;
     vf w = mis ? vmis_power(load(l->lpdf + k), pdf_b) : splat(1.0f);
     ok &= w > 0.0f;
@@ -685,7 +774,7 @@ rt_shade_lanes *rt_shade_lanes_new(size_t batch)
     float **all[] = {&l->tx, &l->ty, &l->tz, &l->bx, &l->by, &l->bz, &l->nx, &l->ny, &l->nz, &l->gx, &l->gy,
                      &l->gz, &l->br, &l->bg, &l->bb, &l->ux, &l->uy, &l->dr, &l->dg, &l->db, &l->ox, &l->oy,
                      &l->oz, &l->ax, &l->ay, &l->sep, &l->er, &l->eg, &l->eb, &l->kr, &l->kg, &l->kb, &l->cr,
-                     &l->cg, &l->cb, &l->metal, &l->f0, &l->pd, &l->ps, &l->ulobe, &l->pt, &l->eta, &l->wx, &l->wy,
+                     &l->cg, &l->cb, &l->metal, &l->f0, &l->pd, &l->ps, &l->ulobe, &l->pt, &l->eta, &l->smooth, &l->wx, &l->wy,
                      &l->wz, &l->pdf, &l->px, &l->py, &l->pz, &l->lux, &l->luy, &l->lwx, &l->lwy, &l->lwz,
                      &l->ldist, &l->lr, &l->lg, &l->lb, &l->lpdf, &l->fr, &l->fg, &l->fb, &l->fcos, &l->fw};
     bool ok = true;
@@ -693,6 +782,7 @@ rt_shade_lanes *rt_shade_lanes_new(size_t batch)
         ok = (*all[a] = rt_alloc(room, sizeof(float))) != NULL && ok;
     ok = (l->ok = rt_alloc(room, 1)) != NULL && ok;
     ok = (l->down = rt_alloc(room, 1)) != NULL && ok;
+    ok = (l->delta = rt_alloc(room, 1)) != NULL && ok;
     ok = (l->lok = rt_alloc(room, 1)) != NULL && ok;
     ok = (l->rok = rt_alloc(room, 1)) != NULL && ok;
     if (!ok) {
@@ -709,13 +799,14 @@ void rt_shade_lanes_free(rt_shade_lanes *l)
     float *all[] = {l->tx, l->ty, l->tz, l->bx, l->by, l->bz, l->nx, l->ny, l->nz, l->gx, l->gy, l->gz,
                     l->br, l->bg, l->bb, l->ux, l->uy, l->dr, l->dg, l->db, l->ox, l->oy, l->oz, l->ax,
                     l->ay, l->sep, l->er, l->eg, l->eb, l->kr, l->kg, l->kb, l->cr, l->cg, l->cb, l->metal,
-                    l->f0, l->pd, l->ps, l->ulobe, l->pt, l->eta, l->wx, l->wy, l->wz, l->pdf,
+                    l->f0, l->pd, l->ps, l->ulobe, l->pt, l->eta, l->smooth, l->wx, l->wy, l->wz, l->pdf,
                     l->px, l->py, l->pz, l->lux, l->luy, l->lwx, l->lwy, l->lwz, l->ldist, l->lr, l->lg,
                     l->lb, l->lpdf, l->fr, l->fg, l->fb, l->fcos, l->fw};
     for (size_t a = 0; a < sizeof all / sizeof all[0]; a++)
         free(all[a]);
     free(l->ok);
     free(l->down);
+    free(l->delta);
     free(l->lok);
     free(l->rok);
     free(l);

@@ -121,10 +121,10 @@ struct rt_wavefront {
         float *epdf;
         uint8_t *eok;
         uint32_t *erec;
-    } kl[4];
+    } kl[5];
 };
 
-enum lane_kind { LANES_LAMBERT, LANES_CONDUCTOR, LANES_GLTF, LANES_DIELECTRIC, LANE_KINDS };
+enum lane_kind { LANES_LAMBERT, LANES_CONDUCTOR, LANES_GLTF, LANES_PLASTIC, LANES_DIELECTRIC, LANE_KINDS };
 
 static void *grab(size_t n, size_t size, bool *ok)
 {
@@ -566,6 +566,7 @@ static struct kind_lanes *kind_lanes_of(rt_wavefront *wf, int kind)
     return &wf->kl[kind == RT_BSDF_KIND_LAMBERT     ? LANES_LAMBERT
                    : kind == RT_BSDF_KIND_CONDUCTOR ? LANES_CONDUCTOR
                    : kind == RT_BSDF_KIND_GLTF      ? LANES_GLTF
+                   : kind == RT_BSDF_KIND_PLASTIC   ? LANES_PLASTIC
                                                     : LANES_DIELECTRIC];
 }
 
@@ -600,6 +601,9 @@ static void lanes_gather(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, 
         l->cr[k] = b->base.x, l->cg[k] = b->base.y, l->cb[k] = b->base.z;
         l->metal[k] = b->metallic, l->f0[k] = b->f0;
         l->pd[k] = b->p_d, l->ps[k] = b->p_s, l->ulobe[k] = d->ulobe;
+    } else if (kind == RT_BSDF_KIND_PLASTIC) {
+        l->pd[k] = b->p_d, l->ps[k] = b->p_s, l->ulobe[k] = d->ulobe;
+        l->eta[k] = b->eta, l->smooth[k] = b->delta ? 1.0f : 0.0f;
     } else {
         l->pd[k] = b->p_d, l->ps[k] = b->p_s, l->pt[k] = b->p_t, l->ulobe[k] = d->ulobe;
         l->eta[k] = b->eta;
@@ -674,7 +678,7 @@ static void shade_lane(rt_wavefront *wf, const rt_trace_ctx *ctx, uint32_t i, si
  * rt_path_nee_add skips as the scalar tracer skips a record it never made. */
 static void nee_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, int c, bool env, size_t *n_pending)
 {
-    static const int kinds[] = {RT_BSDF_KIND_LAMBERT, RT_BSDF_KIND_CONDUCTOR, RT_BSDF_KIND_GLTF};
+    static const int kinds[] = {RT_BSDF_KIND_LAMBERT, RT_BSDF_KIND_CONDUCTOR, RT_BSDF_KIND_GLTF, RT_BSDF_KIND_PLASTIC};
     struct kind_lanes *kl = &wf->kl[c];
     rt_shade_lanes *l = kl->soa;
     const size_t lights = ctx->state->scene->light_count;
@@ -737,6 +741,8 @@ static void shade_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, bool env, siz
             rt_conductor_sample_lanes(l, kl->n);
         else if (c == LANES_GLTF)
             rt_gltf_sample_lanes(l, kl->n);
+        else if (c == LANES_PLASTIC)
+            rt_plastic_sample_lanes(l, kl->n);
         else
             rt_dielectric_sample_lanes(l, kl->n);
         const rt_material *materials = ctx->state->scene->materials;
@@ -752,8 +758,8 @@ static void shade_lanes(rt_wavefront *wf, const rt_trace_ctx *ctx, bool env, siz
                     ps->eta_scale /= l->eta[k] * l->eta[k];
                 }
                 live = rt_path_vertex_advance(ctx, ps, sf, &wf->rng[i], &kl->draw[k],
-                                              rt_v3(l->wx[k], l->wy[k], l->wz[k]), l->pdf[k],
-                                              c == LANES_DIELECTRIC, false);
+                                              rt_v3(l->wx[k], l->wy[k], l->wz[k]), l->pdf[k], l->delta[k],
+                                              false);
             }
             wf->status[i] = live ? LANE_LIVE : LANE_DONE;
         }

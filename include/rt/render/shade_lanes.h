@@ -8,13 +8,14 @@
  *   for each path k < n: l->tx[k] = b.t.x, ... (frame t, b, n; geometric normal g;
  *                        throughput br..bb; u = the direction's 2D value;
  *                        the kind's parameters: Lambert's albedo d = b.diffuse, ...)
- *   rt_lambert_sample_lanes(l, n);                    // or rt_conductor_ / rt_gltf_sample_lanes
+ *   rt_lambert_sample_lanes(l, n);                    // or rt_conductor_ / rt_gltf_ / rt_plastic_sample_lanes
  *   // light sampling at the same vertices (p = px..pz, lu = the light's 2D value, wo too for Lambert):
  *   rt_light_sample_lanes(l, ctx, &scene.lights[j], n);  // lwx..lok: rt_light_sample_at's sample
  *   rt_nee_eval_lanes(l, kind, mis, n);                  // fr..rok: rt_path_nee_light_at's record
  *   // (a sample made elsewhere, e.g. the environment's: set lwx..lok yourself, li 1, then
  *   //  rt_nee_eval_lanes(l, kind, true, n) and multiply fr..fb by its radiance)
- *   for each k: l->ok[k] ? (world direction wx..wz, pdf, throughput br..bb updated) : the path ends
+ *   for each k: l->ok[k] ? (world direction wx..wz, pdf, throughput br..bb updated,
+ *                           delta: a delta sample) : the path ends
  *   rt_shade_lanes_free(l);
  *
  * Each path gets bit for bit what the scalar steps give
@@ -69,10 +70,15 @@ typedef struct rt_shade_lanes {
     /* the smooth dielectric (glass): albedo above is its tint, pd and ps as above */
     float *pt;                                        /* the refraction's probability */
     float *eta;                                       /* index ratio n_wo / n_wi */
+    /* the plastic: albedo above is its diffuse (b.diffuse), ax = ay its
+     * alpha, pd, ps and eta as above */
+    float *smooth;                                    /* 1: a smooth (delta) coat, 0: rough */
     /* out */
     float *wx, *wy, *wz, *pdf;                        /* world direction (unit), its pdf */
     uint8_t *ok;                                      /* 1 when the path goes on */
     uint8_t *down;                                    /* 1 when it went below the surface (refracted) */
+    uint8_t *delta;                                   /* 1 for a delta sample (pdf 0: glass, a smooth
+                                                       * plastic's mirror) */
     /* light sampling (next-event estimation) at the vertex: in */
     float *px, *py, *pz;                              /* the vertex (sf.p) */
     float *lux, *luy;                                 /* the light's 2D sample value */
@@ -87,7 +93,8 @@ typedef struct rt_shade_lanes {
 
 /* Which lanes sample b: RT_BSDF_KIND_LAMBERT, RT_BSDF_KIND_CONDUCTOR,
  * RT_BSDF_KIND_GLTF (rough and opaque), RT_BSDF_KIND_DIELECTRIC (smooth
- * glass), the last two with their lobe probabilities cached by
+ * glass), RT_BSDF_KIND_PLASTIC (smooth or rough), the last three with
+ * their lobe probabilities cached by
  * rt_bsdf_set_wo, or -1 for a BSDF the lanes do not cover (the scalar
  * rt_path_vertex_end). */
 static inline int rt_shade_lanes_kind(const rt_bsdf *b)
@@ -101,6 +108,9 @@ static inline int rt_shade_lanes_kind(const rt_bsdf *b)
         return RT_BSDF_KIND_GLTF;
     if (b->kind == RT_BSDF_KIND_DIELECTRIC && b->delta && !b->ms && !b->thin && b->wo_z == b->wo_z)
         return RT_BSDF_KIND_DIELECTRIC;
+    if (b->kind == RT_BSDF_KIND_PLASTIC && !b->ms && !b->thin && b->transmission == 0.0f && b->metallic == 0.0f &&
+        b->alpha == b->alpha_y && b->wo_z == b->wo_z)
+        return RT_BSDF_KIND_PLASTIC;
     return -1;
 }
 
@@ -120,6 +130,11 @@ void rt_gltf_sample_lanes(rt_shade_lanes *l, size_t n);
  * the mirror or the refraction by ulobe, delta samples (pdf 0); `down`
  * says which. */
 void rt_dielectric_sample_lanes(rt_shade_lanes *l, size_t n);
+/* The plastic (RT_BSDF_KIND_PLASTIC): a smooth coat's delta mirror
+ * (`delta`, pdf 0) or a rough coat's specular lobe by its visible
+ * normals, or the diffuse base by the cosine, chosen by ulobe, then
+ * bsdf.c's dielectric_eval at the direction. */
+void rt_plastic_sample_lanes(rt_shade_lanes *l, size_t n);
 
 /* Light sampling in lanes: rt_light_sample_at(ctx, light, p, lu) for
  * paths 0 .. n - 1 into lwx .. lok, the same bits. Point, spot,
@@ -128,7 +143,7 @@ void rt_dielectric_sample_lanes(rt_shade_lanes *l, size_t n);
  * sampling, set up in double precision) take the scalar function. */
 void rt_light_sample_lanes(rt_shade_lanes *l, const rt_trace_ctx *ctx, const rt_light *light, size_t n);
 /* The rest of rt_path_nee_light_at for those samples: the geometric side
- * test, the BSDF of kind (RT_BSDF_KIND_LAMBERT, _CONDUCTOR or _GLTF, as
+ * test, the BSDF of kind (RT_BSDF_KIND_LAMBERT, _CONDUCTOR, _GLTF or _PLASTIC, as
  * rt_shade_lanes_kind says; their inputs above, wo included) evaluated at
  * the light's direction, the power heuristic against its pdf when mis
  * (an area light with a visible quad), into fr .. rok. */
