@@ -161,10 +161,13 @@ test: $(RT) $(TEST_BIN)
 # the denoiser's (denoise.c refuses --denoise there: OIDN's TBB dlopens with
 # RTLD_DEEPBIND, which ASan and TSan abort on) and the memory caps' (rt does
 # not enforce --max-memory there; RLIMIT_DATA is below what the runtime
-# reserves), and the peak-memory one of test_outputs (the runtime's shadow
-# memory is resident). Under RT_FAIL_ON_SKIP=1 any other skip fails make asan/tsan.
+# reserves: test_memory_budget, test_memory_budget_makes_clean_errors and
+# test_instance_reuse's instances over a budget), and the peak-memory one of
+# test_outputs (the runtime's shadow memory is resident). Under
+# RT_FAIL_ON_SKIP=1 any other skip fails make asan/tsan.
 SANITIZER_SKIPS := test_denoise_cornell test_denoise_quality_and_threads test_denoise_keeps_noisy \
-	test_memory_budget test_memory_budget_makes_clean_errors test_tiny_files_claiming_huge_images
+	test_memory_budget test_memory_budget_makes_clean_errors test_tiny_files_claiming_huge_images \
+	test_cli_instances_over_budget
 
 # Sanitizer builds live in their own directories so they never mix objects.
 asan:
